@@ -1,0 +1,47 @@
+"""The part as it was really built: the map's designed parts with the scenario's deviations, placed in the world.
+
+Deviations are given per part in the part's own box frame B (size and offset in mm, rotation in degrees about the
+part centre). After the deviations, every part is dropped (or lifted) so that its lowest corner rests on the table:
+a part lies on the table, it does not float or sink into it. The result is the ground truth of the simulation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cell.errors import ScenarioError
+from cell.geometry import make_pose, rpy_to_matrix
+from cell.scenario import Scenario
+from cell.types import Box, Part, WeldMap
+
+
+def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
+    """The as-built parts in the world frame W.
+
+    weldmap_M : the designed map, frame ``"M"``.
+    Returns one :class:`Part` per designed part, same names and order, boxes in W.
+    """
+    names = {p.name for p in weldmap_M.parts}
+    unknown = sorted(set(scenario.deviations) - names)
+    if unknown:
+        raise ScenarioError(
+            f"deviations name unknown part(s) {', '.join(unknown)}; parts of the map: {', '.join(sorted(names))}"
+        )
+    X_WM = scenario.X_WM @ scenario.map.placement_error.X  # true placement, not the nominal one
+    table_top = scenario.table.top_z
+    parts = []
+    for part in weldmap_M.parts:
+        dev = scenario.deviations.get(part.name)
+        box_W = part.box.transformed(X_WM)
+        if dev is not None:
+            size = box_W.size + np.asarray(dev.size_mm) / 1000.0
+            if np.any(size <= 0):
+                raise ScenarioError(f"deviations.{part.name}.size_mm makes the part's size non-positive")
+            # Offset and rotation are about the part's own centre, along its own axes.
+            X_B_Bdev = make_pose(rpy_to_matrix(np.radians(dev.rpy_deg)), np.asarray(dev.offset_mm) / 1000.0)
+            box_W = Box(box_W.X_AB @ X_B_Bdev, size)
+        lowest = float(box_W.corners()[:, 2].min())
+        X = box_W.X_AB.copy()
+        X[2, 3] += table_top - lowest  # rest on the table
+        parts.append(Part(part.name, Box(X, box_W.size)))
+    return tuple(parts)

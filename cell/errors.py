@@ -1,0 +1,91 @@
+"""One exception tree for the whole cell; the CLI maps each class to a documented exit code.
+
+Every error carries a one-line message that names what was wrong and what is valid. Classes also inherit the
+matching builtin (as ezdxf does with ``DXFValueError(DXFError, ValueError)``) so generic callers can catch them.
+
+Exit codes (also in the README):
+
+====  =========================================================================
+code  meaning
+====  =========================================================================
+0     everything asked for was done
+1     internal error (a bug: please report it with the traceback)
+2     command-line usage error (typer/click)
+3     partial result: the report is written, some seams were not found/welded
+10    scenario file invalid (unknown key, value out of range, missing file)
+11    welding map (DXF) unreadable or invalid
+12    welding map has no known units
+13    camera/sensor failure (no image, no points)
+14    map-to-cloud alignment failed
+15    motion: IK, timing or plan failed as a whole
+====  =========================================================================
+"""
+
+from __future__ import annotations
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_USAGE = 2
+EXIT_PARTIAL = 3
+
+
+class CellError(Exception):
+    """Base of every error the cell raises on purpose."""
+
+    exit_code: int = EXIT_INTERNAL
+
+    def __init__(self, message: str) -> None:
+        # One line: the CLI prints it as is.
+        super().__init__(" ".join(message.split()))
+
+    @property
+    def message(self) -> str:
+        return str(self.args[0])
+
+
+class ScenarioError(CellError, ValueError):
+    """The scenario file is missing, malformed, or has an unknown or out-of-range key."""
+
+    exit_code = 10
+
+
+class MapError(CellError, ValueError):
+    """The DXF welding map cannot be read or holds no usable seams/parts."""
+
+    exit_code = 11
+
+
+class MapUnitsError(MapError):
+    """The DXF declares no usable units and the scenario states none."""
+
+    exit_code = 12
+
+
+class SensorError(CellError, RuntimeError):
+    """A camera returned no image, or an image with no usable points."""
+
+    exit_code = 13
+
+
+class AlignmentError(CellError, RuntimeError):
+    """The welding map could not be aligned to the point cloud with enough fitness."""
+
+    exit_code = 14
+
+
+class MotionError(CellError, RuntimeError):
+    """Base of motion failures (IK, timing, planning)."""
+
+    exit_code = 15
+
+
+class IKError(MotionError):
+    """Inverse kinematics did not converge to a pose within tolerance and limits."""
+
+
+class TimingError(MotionError):
+    """The trajectory generator (Ruckig) returned an error result."""
+
+
+class PlanError(MotionError):
+    """A plan violates limits, collides, or cannot be built."""

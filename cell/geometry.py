@@ -8,6 +8,7 @@ Roll-pitch-yaw is the fixed-axis X-Y-Z convention: ``R = Rz(yaw) @ Ry(pitch) @ R
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -17,7 +18,7 @@ FloatArray = npt.NDArray[np.float64]
 
 def readonly(a: npt.ArrayLike, dtype: type = np.float64) -> npt.NDArray:
     """A read-only copy of ``a`` (values in frozen dataclasses must not be mutated in place)."""
-    out = np.array(a, dtype=dtype, copy=True)
+    out: npt.NDArray[Any] = np.array(a, dtype=dtype, copy=True)
     out.setflags(write=False)
     return out
 
@@ -37,9 +38,9 @@ def rot_z(a: float) -> FloatArray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def rpy_to_matrix(rpy: Sequence[float]) -> FloatArray:
+def rpy_to_matrix(rpy: npt.ArrayLike) -> FloatArray:
     """Rotation from fixed-axis roll, pitch, yaw [rad]."""
-    roll, pitch, yaw = (float(v) for v in rpy)
+    roll, pitch, yaw = (float(v) for v in np.asarray(rpy, dtype=float).reshape(3))
     return rot_z(yaw) @ rot_y(pitch) @ rot_x(roll)
 
 
@@ -65,7 +66,7 @@ def make_pose(R: npt.ArrayLike | None = None, p: npt.ArrayLike | None = None) ->
     return X
 
 
-def pose_from_xyz_rpy(xyz: Sequence[float], rpy: Sequence[float]) -> FloatArray:
+def pose_from_xyz_rpy(xyz: npt.ArrayLike, rpy: npt.ArrayLike) -> FloatArray:
     """4x4 pose from a translation [m] and fixed-axis roll, pitch, yaw [rad]."""
     return make_pose(rpy_to_matrix(rpy), xyz)
 
@@ -90,7 +91,9 @@ def rotate_vectors(X_AB: FloatArray, v_B: npt.ArrayLike) -> FloatArray:
     return np.asarray(v_B, dtype=float) @ X_AB[:3, :3].T
 
 
-def look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float] = (0.0, 0.0, 1.0)) -> FloatArray:
+def look_at(
+    eye: Sequence[float], target: Sequence[float], up: Sequence[float] = (0.0, 0.0, 1.0)
+) -> FloatArray:
     """Pose X_WC of a camera optical frame (z forward, x right, y down) at ``eye`` looking at ``target``."""
     e = np.asarray(eye, dtype=float)
     z = np.asarray(target, dtype=float) - e

@@ -108,7 +108,10 @@ class CameraSpec(_Model):
     eye_m: Vec3
     target_m: Vec3
     up: Vec3 = (0.0, 0.0, 1.0)
-    resolution: tuple[Annotated[int, Field(ge=16, le=4096)], Annotated[int, Field(ge=16, le=4096)]] = (1280, 720)
+    resolution: tuple[Annotated[int, Field(ge=16, le=4096)], Annotated[int, Field(ge=16, le=4096)]] = (
+        1280,
+        720,
+    )
     hfov_deg: Annotated[float, Field(gt=1.0, lt=170.0)] = 65.0
     near_m: Annotated[float, Field(ge=0.05)] = 0.1
     far_m: Pos = 4.0
@@ -296,7 +299,9 @@ def from_dict(data: Any, base_dir: Path, source: str = "<scenario>") -> Scenario
     except ValidationError as err:
         raise ScenarioError(_explain(err, source)) from None
     if not scenario.map_path.is_file():
-        raise ScenarioError(f"{source}: map.file {scenario.map.file!r} does not exist (looked at {scenario.map_path})")
+        raise ScenarioError(
+            f"{source}: map.file {scenario.map.file!r} does not exist (looked at {scenario.map_path})"
+        )
     return scenario
 
 

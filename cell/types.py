@@ -224,7 +224,7 @@ class Cloud:
         return Cloud(transform_points(X_AF, self.points), frame, self.camera, self.cameras)
 
 
-class SeamStatus(str, enum.Enum):
+class SeamStatus(enum.StrEnum):
     """What became of a seam."""
 
     FOUND = "found"

@@ -65,4 +65,3 @@ class SeamLocator(Protocol):
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
         """Find ``seam`` (given in R, from the aligned map) in ``scene``; time is filled in by the caller."""
         ...
-

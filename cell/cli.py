@@ -1,0 +1,216 @@
+"""The ``cell`` command: a thin typer layer over :mod:`cell.pipeline`.
+
+Heavy packages (pybullet, open3d, pinocchio) are imported inside the commands so ``cell --help`` is instant.
+Progress goes to stderr, results to stdout. Every :class:`~cell.errors.CellError` becomes a one-line message and its
+documented exit code (see :mod:`cell.errors`); nothing else is caught, so a bug still shows its traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated, Literal
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from cell.errors import EXIT_PARTIAL, CellError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="Robotic weld cell: find weld seams with depth cameras and a DXF welding map, in simulation.",
+)
+map_app = typer.Typer(no_args_is_help=True, help="Welding maps (DXF).")
+app.add_typer(map_app, name="map")
+
+err = Console(stderr=True, highlight=False)
+out = Console(highlight=False, width=140)
+
+NoiseOpt = Annotated[
+    str | None, typer.Option("--noise", help="Override the scenario's noise model: none | realistic.")
+]
+
+
+@contextmanager
+def _cell_errors() -> Iterator[None]:
+    """Turn a CellError into its one-line message and exit code."""
+    try:
+        yield
+    except CellError as e:
+        err.print(f"[bold red]error[/]: {e.message}", soft_wrap=True)
+        raise typer.Exit(e.exit_code) from None
+
+
+def _progress() -> Callable[[str], None]:
+    def say(msg: str) -> None:
+        err.print(f"[dim]· {msg}[/]")
+
+    return say
+
+
+def _noise(value: str | None) -> Literal["none", "realistic"] | None:
+    if value is None:
+        return None
+    if value not in ("none", "realistic"):
+        raise typer.BadParameter(f"{value!r}; valid: none, realistic", param_hint="--noise")
+    return "none" if value == "none" else "realistic"
+
+
+@app.command()
+def scenarios() -> None:
+    """List the scenarios shipped in scenarios/."""
+    from cell import scenario as sc
+
+    with _cell_errors():
+        for name in sc.available():
+            s = sc.load(name)
+            out.print(f"{name:28s} {s.description}")
+
+
+@map_app.command("info")
+def map_info(
+    path: Annotated[Path, typer.Argument(help="A DXF welding map.")],
+    units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
+) -> None:
+    """Print the units, parts and seams of a DXF welding map."""
+    from cell.weldmap import describe, read_map
+
+    with _cell_errors():
+        out.print(describe(read_map(path, units=units)), soft_wrap=True)
+
+
+@app.command()
+def detect(
+    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    method: Annotated[
+        str | None, typer.Option(help="Seam locator: paper, ransac or ours (default: the scenario's).")
+    ] = None,
+    noise: NoiseOpt = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
+    save_cloud: Annotated[
+        Path | None, typer.Option(help="Write the spliced cloud (robot frame) as PLY.")
+    ] = None,
+) -> None:
+    """Capture the cell, splice the clouds, align the map and locate every seam; report errors against truth."""
+    from cell import pipeline
+    from cell import scenario as sc
+    from cell.export.report import detection_report, write_json
+
+    with _cell_errors():
+        scn = sc.load(scenario)
+        if method is not None:
+            from cell.seams.registry import METHODS
+
+            if method not in METHODS:
+                raise typer.BadParameter(f"{method!r}; valid: {', '.join(METHODS)}", param_hint="--method")
+        det = pipeline.detect(scn, method, noise=_noise(noise), progress=_progress())
+        if json_path is not None:
+            write_json(json_path, detection_report(det))
+            err.print(f"[dim]· report written to {json_path}[/]")
+        if save_cloud is not None and det.scene is not None:
+            from cell.perception import save_ply
+
+            save_ply(det.scene.perceived.dense, save_cloud)
+            err.print(f"[dim]· spliced cloud written to {save_cloud}[/]")
+        _print_detection(det)
+    if not det.complete:
+        raise typer.Exit(EXIT_PARTIAL)
+
+
+@app.command()
+def bench(
+    scenarios: Annotated[
+        list[str] | None, typer.Argument(help="Scenarios to run (default: fence1-exact fence1 fence2).")
+    ] = None,
+    methods: Annotated[str, typer.Option(help="Comma-separated locators.")] = "paper,ransac,ours",
+    noise: NoiseOpt = None,
+    extrinsics: Annotated[
+        str, typer.Option(help="Comma-separated calibration errors of the fixed cameras: exact or MM/DEG.")
+    ] = "exact",
+    repeat: Annotated[int, typer.Option(min=1, help="Runs per locator (median time).")] = 1,
+    json_path: Annotated[Path, typer.Option("--json", help="Where to write the rows.")] = Path(
+        "benchmarks/results/latest.json"
+    ),
+) -> None:
+    """Table 1 of the paper, reproduced and extended: every locator on the same clouds in one run."""
+    from cell import bench as b
+    from cell import scenario as sc
+    from cell.export.report import write_json
+    from cell.seams.registry import METHODS
+
+    with _cell_errors():
+        names = scenarios or ["fence1-exact", "fence1", "fence2"]
+        wanted = [m.strip() for m in methods.split(",") if m.strip()]
+        bad = [m for m in wanted if m not in METHODS]
+        if bad:
+            raise typer.BadParameter(f"{', '.join(bad)}; valid: {', '.join(METHODS)}", param_hint="--methods")
+        try:
+            exts = [b.Extrinsics.parse(e.strip()) for e in extrinsics.split(",")]
+        except ValueError as e:
+            raise typer.BadParameter(str(e), param_hint="--extrinsics") from None
+        rows = b.run(
+            [sc.load(n) for n in names],
+            wanted,
+            noise=_noise(noise),
+            extrinsics=exts,
+            repeat=repeat,
+            progress=_progress(),
+        )
+        write_json(json_path, rows)
+        md = b.markdown_table(rows)
+        json_path.with_suffix(".md").write_text(md, encoding="utf-8")
+        out.print(md, soft_wrap=True)
+        err.print(f"[dim]· rows written to {json_path} and {json_path.with_suffix('.md')}[/]")
+
+
+def _fmt(v: float | None, nd: int = 2) -> str:
+    return "-" if v is None else f"{v:.{nd}f}"
+
+
+def _print_detection(det: object) -> None:
+    from cell.export.report import detection_report
+    from cell.pipeline import Detection
+
+    assert isinstance(det, Detection)
+    rep = detection_report(det)
+    t = Table(
+        title=f"{rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
+        title_justify="left",
+    )
+    for col in ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason"):
+        t.add_column(col, justify="right" if col not in ("seam", "status", "reason") else "left")
+    for s in rep["seams"]:
+        e = s.get("error_mm", {})
+        t.add_row(
+            s["id"],
+            s["status"],
+            _fmt(e.get("paper_me")),
+            _fmt(e.get("endpoint")),
+            _fmt(e.get("lateral")),
+            _fmt(s.get("confidence")),
+            _fmt(s["time_ms"], 1) if s["status"] == "found" else "-",
+            s["reason"],
+        )
+    out.print(t)
+    m = rep["summary"]
+    out.print(
+        f"found {m['found']}/{m['visible']} visible ({m['seams']} seams) · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm"
+        f" (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint {_fmt(m['endpoint_mean_mm'])} mm · lateral"
+        f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)"
+    )
+    tim = rep["timings_s"]
+    out.print(
+        "time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None)
+    )
+
+
+def main() -> None:
+    """Console-script entry point."""
+    try:
+        app()
+    except KeyboardInterrupt:
+        sys.exit(130)

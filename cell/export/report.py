@@ -1,0 +1,84 @@
+"""JSON reports: the contract other tools read (README "Report"). Metres inside, millimetres only where named _mm."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.pipeline import Detection
+from cell.types import SeamStatus
+
+REPORT_VERSION = 1
+
+
+def _r(v: float, nd: int = 6) -> float | None:
+    """Round for the report; NaN/inf become null (JSON has no NaN)."""
+    return None if not math.isfinite(v) else round(float(v), nd)
+
+
+def _pt(p: np.ndarray) -> list[float | None]:
+    return [_r(float(x), 7) for x in p]
+
+
+def detection_report(det: Detection) -> dict[str, Any]:
+    """The ``cell detect`` report as a JSON-ready dict (schema in the README)."""
+    seams = []
+    for est in det.estimates:
+        entry: dict[str, Any] = {"id": est.id, "status": est.status.value, "reason": est.reason}
+        if est.status is SeamStatus.FOUND:
+            entry["detected"] = {"start": _pt(est.p_start), "end": _pt(est.p_end)}
+            entry["confidence"] = _r(est.confidence, 4)
+        t0, t1 = det.truths[est.id]
+        entry["truth"] = {"start": _pt(t0), "end": _pt(t1)}
+        m = det.metrics.get(est.id)
+        if m is not None:
+            entry["error_mm"] = {
+                "paper_me": _r(m.paper_me_mm, 4),
+                "endpoint": _r(m.endpoint_mm, 4),
+                "lateral": _r(m.lateral_mm, 4),
+            }
+        entry["time_ms"] = _r(est.time_s * 1000.0, 3)
+        seams.append(entry)
+    s = det.summary
+    summary = {
+        "seams": len(det.estimates),
+        "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),
+        "found": s.found,
+        "paper_me_mean_mm": _r(s.paper_me_mean_mm, 4),
+        "paper_me_p95_mm": _r(s.paper_me_p95_mm, 4),
+        "endpoint_mean_mm": _r(s.endpoint_mean_mm, 4),
+        "lateral_mean_mm": _r(s.lateral_mean_mm, 4),
+        "time_ms_per_seam_median": _r(s.time_ms_per_seam_median, 3),
+    }
+    return {
+        "report_version": REPORT_VERSION,
+        "scenario": det.scenario.name,
+        "method": det.method,
+        "noise": det.scenario.noise,
+        "frame": "R",
+        "units": "m",
+        "X_WR": [[_r(v, 9) for v in row] for row in det.scenario.X_WR],
+        "lost_cameras": list(det.lost_cameras),
+        "seams": seams,
+        "summary": summary,
+        "timings_s": {k: _r(v, 4) for k, v in det.timings.items()},
+    }
+
+
+def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
+    """Write JSON atomically (a crash never leaves half a report), creating parent folders."""
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=p.name, dir=p.parent)
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        json.dump(data, f, indent=2)
+        f.write("\n")
+    os.replace(tmp, p)
+    return p

@@ -1,0 +1,238 @@
+"""Inverse kinematics: damped least squares on the 6D pose error (log6), joint limits kept by clamping.
+
+Frames: targets are ``X_RT``, poses of the target T in the robot base frame R [m]; the solved frame F
+(default ``torch_tcp``) is brought onto T. With ``free_axis=True`` only F's origin and z axis (the torch
+axis) must match T's: the rotation about the torch axis is left to the solver (a 5-DoF task, REFERENCE.md
+section 7).
+
+A solution is returned only when it reaches the tolerance (default 0.01 mm and 0.01 deg) within the joint
+limits; otherwise :class:`~cell.errors.IKError` says which target, the best error reached and why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.errors import IKError
+from cell.geometry import FloatArray, axis_angle_to_matrix, readonly
+from cell.motion.robot import RobotModel
+
+
+@dataclass(frozen=True)
+class IKOptions:
+    """Solver settings (defaults suit a 6-axis arm of about 1.5 m reach)."""
+
+    pos_tol: float = 1e-5  # [m] 0.01 mm
+    rot_tol: float = np.radians(0.01)  # [rad] 0.01 deg
+    max_iters: int = 60  # per attempt
+    restarts: int = 12  # extra attempts from random configurations, only when an rng is given
+    damping: float = 1e-6  # lambda^2 of the damped least squares [m^2]
+    max_step: float = 0.5  # [rad] largest joint change per iteration
+    restart_margin: float = np.radians(5.0)  # [rad] random restarts stay this far inside the limits
+
+
+@dataclass
+class _Attempt:
+    q: FloatArray
+    pos_err: float
+    rot_err: float
+    converged: bool
+
+
+def _align_z(R_RF: FloatArray, z_RT: FloatArray) -> FloatArray:
+    """R_RF turned by the smallest rotation that carries its z axis onto z_RT (unit, in R)."""
+    z_RF = R_RF[:, 2]
+    axis = np.cross(z_RF, z_RT)
+    s, c = float(np.linalg.norm(axis)), float(z_RF @ z_RT)
+    if s < 1e-12:
+        if c > 0.0:
+            return R_RF
+        axis = R_RF[:, 0]  # opposite axes: any axis normal to z_RF does
+    return axis_angle_to_matrix(axis, float(np.arctan2(s, c))) @ R_RF
+
+
+def _errors(X_RF: FloatArray, X_RT: FloatArray, free_axis: bool) -> tuple[float, float]:
+    """Position error [m] and orientation error [rad] (angle between z axes when free_axis)."""
+    pos = float(np.linalg.norm(X_RT[:3, 3] - X_RF[:3, 3]))
+    if free_axis:
+        zf, zt = X_RF[:3, 2], X_RT[:3, 2]
+        return pos, float(np.arctan2(np.linalg.norm(np.cross(zf, zt)), zf @ zt))
+    cos = (np.trace(X_RF[:3, :3].T @ X_RT[:3, :3]) - 1.0) / 2.0
+    sin = np.linalg.norm(_vee(X_RF[:3, :3].T @ X_RT[:3, :3]))
+    return pos, float(np.arctan2(sin, cos))
+
+
+def _vee(R: FloatArray) -> FloatArray:
+    """sin(angle) * axis of a rotation matrix (half the skew part)."""
+    return 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+
+
+def _descend(
+    model: RobotModel, fid: int, X_RT: FloatArray, q0: FloatArray, free_axis: bool, opt: IKOptions
+) -> _Attempt:
+    """One damped least-squares run from q0; returns the best iterate."""
+    lim = model.limits
+    q = lim.clip(q0)
+    best = _Attempt(q, np.inf, np.inf, False)
+    eye = np.eye(5 if free_axis else 6)
+    for _ in range(opt.max_iters + 1):
+        X_RF, J_F = model.pose_and_jacobian(q, fid)
+        X_goal = X_RT
+        if free_axis:  # the target turned about its z axis to the orientation nearest to F's
+            X_goal = X_RT.copy()
+            X_goal[:3, :3] = _align_z(X_RF[:3, :3], X_RT[:3, 2])
+        e, J = model.pose_residual(X_RF, X_goal, J_F)
+        pos_err, rot_err = _errors(X_RF, X_RT, free_axis)
+        if pos_err + rot_err * 0.1 < best.pos_err + best.rot_err * 0.1:
+            best = _Attempt(q, pos_err, rot_err, False)
+        if pos_err <= opt.pos_tol and rot_err <= opt.rot_tol:
+            return _Attempt(q, pos_err, rot_err, True)
+        if free_axis:  # e[5] (turn about F's z) is zero by construction of X_goal: drop that row
+            e, J = e[:5], J[:5]
+        dq = _dls_step(J, e, eye, opt.damping)
+        # Joints at a limit that the step pushes further out are frozen and the step is solved again
+        # (multi-turn joints are not: they wrap by a full turn below).
+        out = (((q <= lim.q_min) & (dq < 0)) | ((q >= lim.q_max) & (dq > 0))) & ~model.multi_turn
+        if np.any(out):
+            dq = _dls_step(J * ~out, e, eye, opt.damping)
+        big = float(np.max(np.abs(dq)))
+        if big > opt.max_step:
+            dq *= opt.max_step / big
+        q = model.integrate(q, dq)
+        q -= 2.0 * np.pi * (model.multi_turn & (q > lim.q_max))
+        q += 2.0 * np.pi * (model.multi_turn & (q < lim.q_min))
+        q = lim.clip(q)
+    return best
+
+
+def _dls_step(J: FloatArray, e: FloatArray, eye: FloatArray, damping: float) -> FloatArray:
+    """dq = J^T (J J^T + lambda^2 I)^-1 e."""
+    return np.asarray(J.T @ np.linalg.solve(J @ J.T + damping * eye, e))
+
+
+def solve_ik(
+    model: RobotModel,
+    X_RT_target: npt.ArrayLike,
+    q_seed: npt.ArrayLike,
+    *,
+    frame: str = "torch_tcp",
+    rng: np.random.Generator | None = None,
+    free_axis: bool = False,
+    options: IKOptions | None = None,
+) -> FloatArray:
+    """Joint values (dof,) [rad], read-only, that put ``frame`` on the target pose X_RT_target (4, 4) in R.
+
+    q_seed : (dof,) start (warm start: the previous pose's solution). When the seeded run fails and ``rng``
+        is given, ``options.restarts`` more runs start from random configurations drawn from it
+        (deterministic for a seeded generator); without ``rng`` there are no restarts.
+    free_axis : leave the rotation about the target's z axis free (position and z direction only).
+    Raises IKError (target, best error, reason) when no run reaches the tolerance within the joint limits.
+    """
+    opt = options or IKOptions()
+    X_RT = np.asarray(X_RT_target, dtype=float)
+    if X_RT.shape != (4, 4) or not np.all(np.isfinite(X_RT)):
+        raise ValueError(f"solve_ik: target must be a finite (4, 4) pose, got shape {X_RT.shape}")
+    q_start = np.asarray(q_seed, dtype=float)
+    if q_start.shape != (model.dof,) or not np.all(np.isfinite(q_start)):
+        raise ValueError(
+            f"solve_ik: q_seed must be {model.dof} finite joint values, got shape {q_start.shape}"
+        )
+    fid = model.frame_id(frame)
+    p_RJ, reach = model.reach_bound(frame)
+    dist = float(np.linalg.norm(X_RT[:3, 3] - p_RJ))
+    if dist > reach:
+        raise IKError(
+            f"IK for {frame}: the target at p_RT = {np.round(X_RT[:3, 3] * 1000.0, 2).tolist()} mm is "
+            f"{dist:.3f} m from {model.joint_names[0]}'s origin, beyond the arm's reach bound of "
+            f"{reach:.3f} m"
+        )
+    best: _Attempt | None = None
+    n_attempts = 1 + (opt.restarts if rng is not None else 0)
+    for k in range(n_attempts):
+        q0 = q_start if k == 0 or rng is None else model.limits.sample(rng, opt.restart_margin)
+        att = _descend(model, fid, X_RT, q0, free_axis, opt)
+        if att.converged:
+            if not model.limits.contains(att.q):  # _descend clamps: this would be a bug; never return it
+                raise IKError(f"IK for {frame} left the joint limits at q = {np.degrees(att.q).round(3)} deg")
+            return readonly(att.q)
+        if best is None or att.pos_err + 0.1 * att.rot_err < best.pos_err + 0.1 * best.rot_err:
+            best = att
+    assert best is not None
+    raise IKError(_failure_message(model, frame, X_RT, best, n_attempts, free_axis, opt))
+
+
+def _failure_message(
+    model: RobotModel,
+    frame: str,
+    X_RT: FloatArray,
+    best: _Attempt,
+    n_attempts: int,
+    free_axis: bool,
+    opt: IKOptions,
+) -> str:
+    lim = model.limits
+    at_limit = [
+        n
+        for n, q, lo, hi in zip(lim.names, best.q, lim.q_min, lim.q_max, strict=True)
+        if min(q - lo, hi - q) < np.radians(0.5)
+    ]
+    why = f"joints at their limits: {', '.join(at_limit)}" if at_limit else "no joint at a limit"
+    # A small manipulability means the best pose is singular: typically the arm stretched towards a target
+    # out of its workspace, or the wrist aligned.
+    why += f"; manipulability there {model.manipulability(best.q):.2g} (0 = singular)"
+    task = "position and torch axis" if free_axis else "pose"
+    p = np.round(X_RT[:3, 3] * 1000.0, 2)
+    return (
+        f"IK for {frame} did not reach the target {task} at p_RT = {p.tolist()} mm within "
+        f"{opt.pos_tol * 1000:g} mm / {np.degrees(opt.rot_tol):g} deg after {n_attempts} attempt(s); "
+        f"best error {best.pos_err * 1000:.3f} mm / {np.degrees(best.rot_err):.3f} deg ({why})"
+    )
+
+
+def solve_path(
+    model: RobotModel,
+    targets: Sequence[FloatArray] | FloatArray,
+    q_seed: npt.ArrayLike,
+    *,
+    frame: str = "torch_tcp",
+    rng: np.random.Generator | None = None,
+    free_axis: bool = False,
+    max_joint_step: float = np.radians(20.0),
+    options: IKOptions | None = None,
+) -> FloatArray:
+    """Joint values (n, dof) [rad], read-only, for a sequence of target poses (n, 4, 4) in R, warm-started.
+
+    The first pose starts from q_seed (with restarts when ``rng`` is given); each later pose starts from the
+    previous solution, without restarts. Raises IKError naming the index of the first pose that does not
+    converge, or at which some joint moves more than ``max_joint_step`` [rad] from the previous pose (a
+    configuration flip, e.g. through the wrist singularity).
+    """
+    X = np.asarray(targets, dtype=float)
+    if X.ndim != 3 or X.shape[1:] != (4, 4) or len(X) == 0:
+        raise ValueError(f"solve_path: targets must be (n, 4, 4) with n >= 1, got {X.shape}")
+    out = np.empty((len(X), model.dof))
+    q = np.asarray(q_seed, dtype=float)
+    for i, X_RT in enumerate(X):
+        try:
+            q_new = solve_ik(
+                model, X_RT, q, frame=frame, rng=rng if i == 0 else None, free_axis=free_axis, options=options
+            )
+        except IKError as exc:
+            raise IKError(f"path pose {i} of {len(X)}: {exc.message}") from exc
+        if i > 0:
+            jump = np.abs(q_new - out[i - 1])
+            j = int(np.argmax(jump))
+            if jump[j] > max_joint_step:
+                raise IKError(
+                    f"path pose {i} of {len(X)}: joint {model.joint_names[j]} jumps "
+                    f"{np.degrees(jump[j]):.1f} deg from the previous pose (limit "
+                    f"{np.degrees(max_joint_step):.1f} deg): a configuration flip or a singularity "
+                    "on the path"
+                )
+        out[i] = q_new
+        q = q_new
+    return readonly(out)

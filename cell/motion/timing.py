@@ -1,0 +1,310 @@
+"""Jerk-limited timing with Ruckig: the only module that imports ruckig.
+
+Only state-to-state motions are used (REFERENCE.md section 9): Ruckig's intermediate waypoints call a
+remote service. A point-to-point move is one Ruckig solve over all joints; a weld along a seam is timed by
+a one-axis profile of the path length s(t) (:func:`path_profile`) that the planner maps through IK. Every
+Ruckig result is checked: anything but Working/Finished raises :class:`~cell.errors.TimingError` with the
+result's name.
+
+Units: joints [rad], [rad/s], [rad/s^2], [rad/s^3]; path length [m], [m/s], [m/s^2], [m/s^3]; time [s].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+import ruckig
+
+from cell.errors import TimingError
+from cell.geometry import FloatArray, readonly
+from cell.motion.limits import JointLimits
+
+DEFAULT_DT = 0.004  # [s] sample period (250 Hz)
+_END_TOL = 1e-8  # how far Ruckig's end state may be from the target before it is an error [rad, rad/s]
+
+
+def _hermite5(
+    times: FloatArray, x: FloatArray, xd: FloatArray, xdd: FloatArray, t: npt.ArrayLike
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Quintic Hermite interpolation of samples (n, d) at times t (m,): values, rates, second rates (m, d).
+
+    It matches position, velocity and acceleration at every sample, so it is exact on any interval where the
+    motion is a polynomial of degree <= 5 (a jerk-limited profile between its switching times).
+    t is clamped to [times[0], times[-1]].
+    """
+    ts: FloatArray = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), times[0], times[-1])
+    if len(times) == 1:
+        m = len(ts)
+        return np.repeat(x[:1], m, 0), np.repeat(xd[:1], m, 0), np.repeat(xdd[:1], m, 0)
+    k = np.clip(np.searchsorted(times, ts, side="right") - 1, 0, len(times) - 2)
+    h = (times[k + 1] - times[k])[:, None]
+    tau = (ts - times[k])[:, None] / h
+    p0, p1, v0, v1, a0, a1 = x[k], x[k + 1], xd[k] * h, xd[k + 1] * h, xdd[k] * h * h, xdd[k + 1] * h * h
+    dp = p1 - p0
+    c3 = 10.0 * dp - 6.0 * v0 - 4.0 * v1 - (3.0 * a0 - a1) / 2.0
+    c4 = -15.0 * dp + 8.0 * v0 + 7.0 * v1 + (3.0 * a0 - 2.0 * a1) / 2.0
+    c5 = 6.0 * dp - 3.0 * (v0 + v1) - (a0 - a1) / 2.0
+    c2 = a0 / 2.0
+    pos = p0 + tau * (v0 + tau * (c2 + tau * (c3 + tau * (c4 + tau * c5))))
+    vel = (v0 + tau * (2.0 * c2 + tau * (3.0 * c3 + tau * (4.0 * c4 + tau * 5.0 * c5)))) / h
+    acc = (2.0 * c2 + tau * (6.0 * c3 + tau * (12.0 * c4 + tau * 20.0 * c5))) / (h * h)
+    return pos, vel, acc
+
+
+def _check_samples(times: FloatArray, *arrays: FloatArray) -> None:
+    if times.ndim != 1 or len(times) == 0 or times[0] != 0.0 or np.any(np.diff(times) <= 0.0):
+        raise ValueError("trajectory times must be (n,) with n >= 1, start at 0 and increase strictly")
+    shape = arrays[0].shape
+    if any(a.shape != shape or a.shape[0] != len(times) or not np.all(np.isfinite(a)) for a in arrays):
+        raise ValueError(
+            f"trajectory samples must be finite, one row per time ({len(times)}), all of one shape"
+        )
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A timed joint trajectory sampled at a fixed period (the last interval may be shorter).
+
+    times : (n,) [s], from 0 to ``duration``; q : (n, dof) [rad]; qd : (n, dof) [rad/s]; qdd : (n, dof)
+    [rad/s^2].
+    """
+
+    times: FloatArray
+    q: FloatArray
+    qd: FloatArray
+    qdd: FloatArray
+
+    def __post_init__(self) -> None:
+        for key in ("times", "q", "qd", "qdd"):
+            object.__setattr__(self, key, readonly(getattr(self, key)))
+        _check_samples(self.times, self.q, self.qd, self.qdd)
+        if self.q.ndim != 2:
+            raise ValueError(f"Trajectory q must be (n, dof), got {self.q.shape}")
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1])
+
+    @property
+    def dof(self) -> int:
+        return int(self.q.shape[1])
+
+    def sample(self, t: float | npt.ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """(q, qd, qdd) at t [s], clamped to [0, duration]: (dof,) each for a scalar t, (m, dof) for t (m,).
+
+        Between samples this is a quintic Hermite interpolation: exact where no profile switch falls inside
+        the sample interval, within O(j_max dt^3) elsewhere (tests/test_timing.py bounds it).
+        """
+        q, qd, qdd = _hermite5(self.times, self.q, self.qd, self.qdd, t)
+        if np.ndim(t) == 0:
+            return q[0], qd[0], qdd[0]
+        return q, qd, qdd
+
+
+@dataclass(frozen=True)
+class PathProfile:
+    """Timing of a path parameter s(t): the arc length travelled along a seam.
+
+    times : (n,) [s]; s : (n,) [m] from 0 to ``length``; sd : (n,) [m/s]; sdd : (n,) [m/s^2].
+    """
+
+    times: FloatArray
+    s: FloatArray
+    sd: FloatArray
+    sdd: FloatArray
+
+    def __post_init__(self) -> None:
+        for key in ("times", "s", "sd", "sdd"):
+            object.__setattr__(self, key, readonly(getattr(self, key)))
+        _check_samples(self.times, self.s, self.sd, self.sdd)
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1])
+
+    @property
+    def length(self) -> float:
+        return float(self.s[-1])
+
+    def at(self, t: float | npt.ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """(s, sd, sdd) at times t [s] (clamped to [0, duration]), each shaped like t."""
+        s, sd, sdd = _hermite5(self.times, self.s[:, None], self.sd[:, None], self.sdd[:, None], t)
+        shape = np.shape(t)
+        return s.reshape(shape), sd.reshape(shape), sdd.reshape(shape)
+
+    def __call__(self, t: float | npt.ArrayLike) -> FloatArray:
+        """s(t) [m]."""
+        return self.at(t)[0]
+
+
+def _vec(name: str, value: npt.ArrayLike | None, dof: int) -> FloatArray:
+    arr = np.zeros(dof) if value is None else np.asarray(value, dtype=float)
+    if arr.shape != (dof,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be {dof} finite values, got shape {arr.shape}")
+    return arr
+
+
+def _solve(inp: ruckig.InputParameter, what: str) -> ruckig.Trajectory:
+    """Run Ruckig offline; TimingError unless the result is Working or Finished."""
+    otg = ruckig.Ruckig(inp.degrees_of_freedom)
+    traj = ruckig.Trajectory(inp.degrees_of_freedom)
+    try:
+        result = otg.calculate(inp, traj)
+    except (ruckig.RuckigError, RuntimeError) as exc:  # invalid input raises instead of returning a result
+        raise TimingError(f"Ruckig rejected the {what}: {' '.join(str(exc).split())}") from exc
+    if result not in (ruckig.Result.Working, ruckig.Result.Finished):
+        raise TimingError(
+            f"Ruckig returned {result.name} for the {what}; only Working or Finished are success"
+        )
+    return traj
+
+
+def _sample_times(duration: float, dt: float) -> FloatArray:
+    """0, dt, 2 dt, ... and the exact end ``duration`` [s]."""
+    if not dt > 0.0:
+        raise ValueError(f"sample period dt must be positive, got {dt}")
+    n = max(math.ceil(duration / dt - 1e-9), 0)
+    return np.append(np.arange(n) * dt, duration) if duration > 0.0 else np.zeros(1)
+
+
+def _at_times_loop(traj: ruckig.Trajectory, times: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """pos, vel, acc (n, dof) from Ruckig's own evaluation, one call per time."""
+    rows = [traj.at_time(float(t)) for t in times]
+    return tuple(np.array([r[i] for r in rows]) for i in range(3))  # type: ignore[return-value]
+
+
+def _at_times(traj: ruckig.Trajectory, times: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """pos, vel, acc (n, dof) at times (n,), evaluated from the profiles' constant-jerk phases in one go.
+
+    Each joint's profile has 7 phases (durations t, jerks j, start states p, v, a). Profiles with a brake or
+    acceleration pre/post phase (start or goal outside the limits) fall back to Ruckig's at_time.
+    """
+    sections = traj.profiles
+    if len(sections) != 1 or any(p.brake.duration > 0.0 or p.accel.duration > 0.0 for p in sections[0]):
+        return _at_times_loop(traj, times)
+    profs = sections[0]
+    dof = len(profs)
+    ends = np.cumsum([x.t for x in profs], axis=1)  # (dof, 7) end time of each phase
+    # (n, dof) phase index: the number of phase ends at or before t (so zero-length phases are skipped)
+    # One sorted search for all joints: joint d's phase ends and the times are shifted by d * span.
+    span = float(ends[:, -1].max() + times[-1]) + 1.0
+    shift = np.arange(dof) * span
+    flat = (ends[:, :6] + shift[:, None]).ravel()
+    k = np.searchsorted(flat, times[:, None] + shift[None, :], side="right") - 6 * np.arange(dof)[None, :]
+    starts = np.concatenate((np.zeros((dof, 1)), ends[:, :6]), axis=1)  # (dof, 7)
+    # phase start states and jerks, (dof, 5, 7): p, v, a, j, start time
+    coef = np.array(
+        [[x.p[:7], x.v[:7], x.a[:7], x.j, s] for x, s in zip(profs, starts.tolist(), strict=True)]
+    )
+    g = coef[np.arange(dof)[None, :], :, k]  # (n, dof, 5)
+    p, v, a, j = g[..., 0], g[..., 1], g[..., 2], g[..., 3]
+    tau = times[:, None] - g[..., 4]
+    return p + tau * (v + tau * (a / 2.0 + tau * j / 6.0)), v + tau * (a + tau * j / 2.0), a + tau * j
+
+
+def _ptp_solve(
+    q0: npt.ArrayLike,
+    q1: npt.ArrayLike,
+    limits: JointLimits,
+    v0: npt.ArrayLike | None,
+    v1: npt.ArrayLike | None,
+) -> tuple[ruckig.Trajectory, FloatArray, FloatArray]:
+    """Checked inputs -> Ruckig trajectory within all limits, and the goal (q1, v1) as arrays."""
+    dof = limits.dof
+    q = np.array([_vec("q0", q0, dof), _vec("q1", q1, dof)])  # (2, dof): start, goal
+    v = np.array([_vec("v0", v0, dof), _vec("v1", v1, dof)])
+    outside = (q < limits.q_min - 1e-9) | (q > limits.q_max + 1e-9)
+    if outside.any():
+        row = int(np.argmax(outside.any(axis=1)))
+        bad = [n for n, o in zip(limits.names, outside[row], strict=True) if o]
+        raise TimingError(
+            f"ptp {('start', 'goal')[row]} configuration is outside the position limits at {', '.join(bad)}"
+        )
+    if (np.abs(v) > limits.v_max * (1 + 1e-9)).any():
+        raise TimingError("ptp start or goal velocity exceeds the joint velocity limits")
+    inp = ruckig.InputParameter(dof)
+    zeros = [0.0] * dof
+    inp.current_position, inp.current_velocity, inp.current_acceleration = q[0].tolist(), v[0].tolist(), zeros
+    inp.target_position, inp.target_velocity, inp.target_acceleration = q[1].tolist(), v[1].tolist(), zeros
+    inp.max_velocity = limits.v_max.tolist()
+    inp.max_acceleration = limits.a_max.tolist()
+    inp.max_jerk = limits.j_max.tolist()
+    inp.min_position, inp.max_position = limits.q_min.tolist(), limits.q_max.tolist()
+    traj = _solve(inp, "point-to-point move")
+    # Ruckig returns Working even when a joint overshoots its range (a start velocity towards a near limit
+    # that cannot be braked in time): check the exact extrema of each joint's profile.
+    over = [
+        n
+        for n, b, lo, hi in zip(limits.names, traj.position_extrema, limits.q_min, limits.q_max, strict=True)
+        if b.min < lo - 1e-9 or b.max > hi + 1e-9
+    ]
+    if over:
+        raise TimingError(
+            f"ptp move leaves the position limits at {', '.join(over)} "
+            "(the start velocity cannot be braked in time)"
+        )
+    return traj, q[1], v[1]
+
+
+def ptp(
+    q0: npt.ArrayLike,
+    q1: npt.ArrayLike,
+    limits: JointLimits,
+    *,
+    v0: npt.ArrayLike | None = None,
+    v1: npt.ArrayLike | None = None,
+    dt: float = DEFAULT_DT,
+) -> Trajectory:
+    """Time-optimal jerk-limited joint move from (q0, v0, 0) to (q1, v1, 0), all joints arriving together.
+
+    q0, q1 : (dof,) [rad] within the position limits; v0, v1 : (dof,) [rad/s], default rest.
+    Velocity, acceleration, jerk and position stay within ``limits``; sampled every ``dt`` [s] plus the exact
+    end. Raises TimingError when the states are outside the limits or Ruckig finds no trajectory.
+    """
+    traj, q1a, v1a = _ptp_solve(q0, q1, limits, v0, v1)
+    times = _sample_times(float(traj.duration), dt)
+    q, qd, qdd = _at_times(traj, times)
+    if np.max(np.abs(q[-1] - q1a)) > _END_TOL or np.max(np.abs(qd[-1] - v1a)) > _END_TOL:
+        raise TimingError("Ruckig's point-to-point move does not end at the goal state")
+    q[-1], qd[-1], qdd[-1] = q1a, v1a, 0.0  # the goal exactly, not up to rounding
+    return Trajectory(times, q, qd, qdd)
+
+
+def ptp_duration(
+    q0: npt.ArrayLike,
+    q1: npt.ArrayLike,
+    limits: JointLimits,
+    *,
+    v0: npt.ArrayLike | None = None,
+    v1: npt.ArrayLike | None = None,
+) -> float:
+    """Duration [s] of :func:`ptp` for the same move, without sampling it (cheap: for ordering and costs)."""
+    return float(_ptp_solve(q0, q1, limits, v0, v1)[0].duration)
+
+
+def path_profile(
+    length_m: float, speed_mps: float, a_max: float, j_max: float, *, dt: float = DEFAULT_DT
+) -> PathProfile:
+    """s(t) from rest at 0 to rest at ``length_m`` [m], at most ``speed_mps`` [m/s] (the travel speed).
+
+    a_max [m/s^2], j_max [m/s^3] bound the path acceleration and jerk; on a long enough seam the middle
+    part runs at exactly the travel speed. Raises TimingError for non-positive inputs or when Ruckig fails.
+    """
+    values = {"length_m": length_m, "speed_mps": speed_mps, "a_max": a_max, "j_max": j_max}
+    bad = [k for k, v in values.items() if not (math.isfinite(v) and v > 0.0)]
+    if bad:
+        raise TimingError(f"path_profile needs positive finite {', '.join(bad)}; got {values}")
+    inp = ruckig.InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [0.0], [0.0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [float(length_m)], [0.0], [0.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [float(speed_mps)], [float(a_max)], [float(j_max)]
+    traj = _solve(inp, f"path profile over {length_m:.4f} m")
+    times = _sample_times(float(traj.duration), dt)
+    s, sd, sdd = _at_times(traj, times)
+    if abs(s[-1, 0] - length_m) > _END_TOL or abs(sd[-1, 0]) > _END_TOL:
+        raise TimingError("Ruckig's path profile does not end at rest at the path length")
+    s[-1], sd[-1], sdd[-1] = length_m, 0.0, 0.0
+    return PathProfile(times, s[:, 0], sd[:, 0], sdd[:, 0])

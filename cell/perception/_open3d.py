@@ -1,0 +1,139 @@
+"""The only module of the cell that imports open3d: numpy in, numpy out.
+
+open3d takes about a second to import, so it is imported on first use (inside the functions), never at import
+time of this module: ``cell --help`` and the numpy-only stages stay instant. Every function takes and returns
+plain numpy arrays (points ``(n, 3)`` float64 [m], poses ``(4, 4)``); open3d objects never leave this module.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+
+
+@cache
+def _o3d() -> Any:
+    import open3d
+
+    # open3d prints warnings on stdout; the cell reports through returned values instead.
+    open3d.utility.set_verbosity_level(open3d.utility.VerbosityLevel.Error)
+    return open3d
+
+
+def _array(a: npt.ArrayLike, dtype: type = np.float64) -> npt.NDArray:
+    """C-contiguous and writeable (open3d refuses the read-only arrays of the cell's frozen values)."""
+    return np.require(a, dtype=dtype, requirements=["C", "W"])
+
+
+def _legacy_cloud(points: npt.ArrayLike, normals: npt.ArrayLike | None = None) -> Any:
+    o3d = _o3d()
+    pc = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(_array(points)))
+    if normals is not None:
+        pc.normals = o3d.utility.Vector3dVector(_array(normals))
+    return pc
+
+
+@dataclass(frozen=True)
+class IcpResult:
+    """One ICP run.
+
+    X_TS : (4, 4) transform that moves the source points onto the target (p_T = X_TS p_S).
+    fitness : fraction of source points with a target point within the final max correspondence distance.
+    rmse_m : RMS residual of those inlier correspondences [m] (point-to-point or point-to-plane as run).
+    """
+
+    X_TS: FloatArray
+    fitness: float
+    rmse_m: float
+
+
+def icp(
+    source: npt.ArrayLike,
+    target: npt.ArrayLike,
+    max_correspondence_m: float,
+    iterations: int,
+    init: FloatArray | None = None,
+    target_normals: npt.ArrayLike | None = None,
+) -> IcpResult:
+    """Rigid ICP of ``source`` (n, 3) onto ``target`` (m, 3).
+
+    Point-to-point when ``target_normals`` is None, point-to-plane (with those unit normals (m, 3)) otherwise.
+    ``init`` is the starting X_TS (identity by default). Stops after ``iterations`` or when fitness and RMSE
+    stop changing (relative change 1e-9).
+    """
+    o3d = _o3d()
+    reg = o3d.pipelines.registration
+    src = _legacy_cloud(source)
+    tgt = _legacy_cloud(target, target_normals)
+    method = (
+        reg.TransformationEstimationPointToPoint()
+        if target_normals is None
+        else reg.TransformationEstimationPointToPlane()
+    )
+    criteria = reg.ICPConvergenceCriteria(relative_fitness=1e-9, relative_rmse=1e-9, max_iteration=int(iterations))
+    X0 = np.eye(4) if init is None else _array(init)
+    result = reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, criteria)
+    return IcpResult(np.array(result.transformation), float(result.fitness), float(result.inlier_rmse))
+
+
+def evaluate(
+    source: npt.ArrayLike, target: npt.ArrayLike, max_correspondence_m: float, X_TS: FloatArray | None = None
+) -> tuple[float, float]:
+    """(fitness, inlier RMSE [m]) of ``source`` moved by X_TS against ``target``, point-to-point."""
+    o3d = _o3d()
+    X = np.eye(4) if X_TS is None else _array(X_TS)
+    r = o3d.pipelines.registration.evaluate_registration(
+        _legacy_cloud(source), _legacy_cloud(target), float(max_correspondence_m), X
+    )
+    return float(r.fitness), float(r.inlier_rmse)
+
+
+def radius_outlier_mask(points: npt.ArrayLike, radius_m: float, min_neighbours: int) -> npt.NDArray[np.bool_]:
+    """(n,) True for points with at least ``min_neighbours`` other points within ``radius_m``."""
+    pts = np.asarray(points, dtype=np.float64)
+    keep = np.zeros(len(pts), dtype=bool)
+    if len(pts) == 0:
+        return keep
+    # open3d keeps a point when its neighbour count *including itself* exceeds nb_points.
+    _, index = _legacy_cloud(pts).remove_radius_outlier(nb_points=int(min_neighbours), radius=float(radius_m))
+    keep[np.asarray(index, dtype=np.intp)] = True
+    return keep
+
+
+def neighbour_counts(points: npt.ArrayLike, queries: npt.ArrayLike, radius_m: float) -> npt.NDArray[np.int64]:
+    """(q,) number of ``points`` (n, 3) within ``radius_m`` of each of ``queries`` (q, 3), itself included."""
+    o3d = _o3d()
+    nns = o3d.core.nns.NearestNeighborSearch(o3d.core.Tensor(_array(points)))
+    nns.fixed_radius_index(float(radius_m))
+    _, _, splits = nns.fixed_radius_search(o3d.core.Tensor(_array(queries)), float(radius_m))
+    return np.diff(splits.numpy()).astype(np.int64)
+
+
+def write_ply(path: Path, points: FloatArray, camera: npt.NDArray[np.integer] | None) -> None:
+    """Binary PLY with double x, y, z and, when given, an int ``camera`` vertex property."""
+    o3d = _o3d()
+    pc = o3d.t.geometry.PointCloud()
+    pc.point.positions = o3d.core.Tensor(_array(points))
+    if camera is not None:
+        # open3d's PLY writer has no int16: the index is stored as int32.
+        pc.point.camera = o3d.core.Tensor(_array(np.reshape(camera, (-1, 1)), np.int32))
+    if not o3d.t.io.write_point_cloud(str(path), pc, write_ascii=False):
+        raise OSError(f"open3d could not write {str(path)!r}")
+
+
+def read_ply(path: Path) -> tuple[FloatArray, npt.NDArray[np.int32] | None]:
+    """Points (n, 3) float64 and the ``camera`` vertex property (n,) if the file has one."""
+    o3d = _o3d()
+    pc = o3d.t.io.read_point_cloud(str(path))
+    if "positions" not in pc.point:
+        return np.zeros((0, 3)), None
+    points = pc.point.positions.numpy().astype(np.float64).reshape(-1, 3)
+    camera = pc.point.camera.numpy().astype(np.int32).reshape(-1) if "camera" in pc.point else None
+    return points, camera

@@ -1,0 +1,166 @@
+"""Aligning the welding map to the point cloud (paper section 3.5).
+
+The map's part boxes are sampled into surface points with normals (faces pointing down into the table and face
+areas in contact with another part are left out: no camera can see them). ICP then runs with the *cloud as
+source and the map samples as target*, point-to-plane with the boxes' exact normals, coarse to fine, from the
+nominal placement (identity). The inverse of the ICP transform is the correction that moves the map onto the
+cloud.
+
+A part lies on the table, so the correction may turn it about the vertical only: a fit that tilts it by more
+than :data:`MAX_TILT_RAD` in roll or pitch is refused, as is a fit whose fitness stays below the scenario's
+minimum.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from cell.errors import AlignmentError
+from cell.geometry import FloatArray, invert, matrix_to_rpy, readonly, transform_points
+from cell.perception import _open3d
+from cell.perception.preprocess import downsample
+from cell.scenario import PerceptionSpec
+from cell.types import BOX_FACES, Box, Cloud, WeldMap
+
+MAX_TILT_RAD = math.radians(2.0)  # largest roll or pitch correction accepted for a part lying on the table
+STAGES = (1.0, 0.25, 0.1)  # max correspondence per ICP stage, as fractions of spec.align_max_correspondence_m
+# Fitness is judged within the middle stage's distance (5 mm by default): depth noise of 3-6 mm (D415 at
+# 1.5-2 m, REFERENCE.md section 2) leaves only about half of a well-aligned cloud within the finest 2 mm.
+_FITNESS_STAGE = 1
+_SPACING_PER_FINEST = 1.5  # map sample spacing, in units of the finest stage's max correspondence
+_DOWN_COS = 0.5  # faces whose outward normal is within 60 deg of -z (R) point down into the table
+_MAX_SOURCE = 60_000  # larger clouds are voxel-downsampled at the finest correspondence distance first
+
+
+@dataclass(frozen=True)
+class Alignment:
+    """The map-to-cloud fit.
+
+    X_RR_corr : (4, 4) correction in R: aligned map = ``weldmap_R.transformed(X_RR_corr, "R")``.
+    fitness : fraction of cloud points within the middle stage's max correspondence (5 mm by default) of the
+        map's surfaces (distance to the tangent plane of the nearest surface sample, at most one sample
+        spacing further away).
+    rmse_m : RMS of those inliers' distances to the map's surfaces [m].
+    """
+
+    X_RR_corr: FloatArray
+    fitness: float
+    rmse_m: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "X_RR_corr", readonly(self.X_RR_corr))
+
+
+def sample_box_faces(box: Box, spacing_m: float) -> tuple[FloatArray, FloatArray]:
+    """Grid samples (at most ``spacing_m`` apart, edges included) of the six faces of ``box``.
+
+    Returns points (n, 3) and outward unit normals (n, 3) in the frame A the box is given in.
+    """
+    points, normals = [], []
+    for face in BOX_FACES:
+        axis = "xyz".index(face[1])
+        sign = 1.0 if face[0] == "+" else -1.0
+        u_ax, v_ax = [a for a in range(3) if a != axis]
+        nu = max(2, math.ceil(box.size[u_ax] / spacing_m) + 1)
+        nv = max(2, math.ceil(box.size[v_ax] / spacing_m) + 1)
+        uu, vv = np.meshgrid(
+            np.linspace(-box.size[u_ax] / 2, box.size[u_ax] / 2, nu),
+            np.linspace(-box.size[v_ax] / 2, box.size[v_ax] / 2, nv),
+            indexing="ij",
+        )
+        p_B = np.zeros((nu * nv, 3))
+        p_B[:, axis] = sign * box.size[axis] / 2
+        p_B[:, u_ax] = uu.reshape(-1)
+        p_B[:, v_ax] = vv.reshape(-1)
+        n, _ = box.face_plane(face)
+        points.append(transform_points(box.X_AB, p_B))
+        normals.append(np.broadcast_to(n, (len(p_B), 3)))
+    return np.concatenate(points), np.concatenate(normals)
+
+
+def sample_map(weldmap: WeldMap, spacing_m: float, contact_margin_m: float) -> tuple[FloatArray, FloatArray]:
+    """Visible-surface samples of the map's parts: points (n, 3), outward unit normals (n, 3), map frame.
+
+    Leaves out faces pointing down (within 60 deg of -z) and samples within ``contact_margin_m`` of another
+    part (faces in contact across the assembly gap).
+    """
+    points, normals = [], []
+    for i, part in enumerate(weldmap.parts):
+        p, n = sample_box_faces(part.box, spacing_m)
+        keep = n[:, 2] > -_DOWN_COS
+        for j, other in enumerate(weldmap.parts):
+            if j != i:
+                keep &= ~other.box.contains(p, contact_margin_m)
+        points.append(p[keep])
+        normals.append(n[keep])
+    if not points:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    return np.concatenate(points), np.concatenate(normals)
+
+
+def surface_fit(
+    points: FloatArray, samples: FloatArray, normals: FloatArray, threshold_m: float, spacing_m: float
+) -> tuple[float, float]:
+    """(fitness, rmse [m]) of points (n, 3) against a surface given by samples (m, 3) with normals (m, 3).
+
+    A point is an inlier when its nearest sample is within ``spacing_m + threshold_m`` and its distance to
+    that sample's tangent plane is at most ``threshold_m``; fitness is the inlier fraction, rmse their RMS
+    distance.
+    """
+    if len(points) == 0:
+        return 0.0, 0.0
+    dist, idx = cKDTree(samples).query(points, distance_upper_bound=spacing_m + threshold_m)
+    near = np.isfinite(dist)
+    d = np.abs(np.einsum("ij,ij->i", points[near] - samples[idx[near]], normals[idx[near]]))
+    inlier = d <= threshold_m
+    if not inlier.any():
+        return 0.0, 0.0
+    return float(inlier.sum() / len(points)), float(np.sqrt(np.mean(d[inlier] ** 2)))
+
+
+def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignment:
+    """Fit the nominal map (already in R) to the cloud (in R); see the module docstring.
+
+    Pass the dense filtered cloud (``Perceived.dense``): 1 cm voxel centroids sit inside the parts at their
+    edges and bias the fit by millimetres. Clouds over 60 000 points are first put on a grid of the finest
+    correspondence distance (2 mm by default).
+
+    Raises :class:`AlignmentError` when the fit's fitness stays below ``spec.align_min_fitness`` or it tilts
+    the map by more than 2 degrees.
+    """
+    if weldmap_R.frame != "R" or cloud.frame != "R":
+        raise ValueError(f"align_map: map and cloud must be in R, not {weldmap_R.frame!r}, {cloud.frame!r}")
+    if not weldmap_R.parts:
+        raise AlignmentError(f"map {weldmap_R.source!r} has no parts to align to the cloud")
+    thresholds = [spec.align_max_correspondence_m * f for f in STAGES]
+    finest = thresholds[-1]
+    if len(cloud) > _MAX_SOURCE:
+        cloud = downsample(cloud, finest)
+    if len(cloud) < 3:
+        raise AlignmentError(f"map alignment needs a cloud of at least 3 points, got {len(cloud)}")
+    target, target_normals = sample_map(weldmap_R, _SPACING_PER_FINEST * finest, finest)
+    X_MC = np.eye(4)  # moves cloud points onto the map (p_map = X_MC p_cloud)
+    for threshold in thresholds:
+        X_MC = _open3d.icp(cloud.points, target, threshold, spec.align_iterations, X_MC, target_normals).X_TS
+    band = thresholds[_FITNESS_STAGE]
+    fitness, rmse = surface_fit(
+        transform_points(X_MC, cloud.points), target, target_normals, band, _SPACING_PER_FINEST * finest
+    )
+    if fitness < spec.align_min_fitness:
+        raise AlignmentError(
+            f"map-to-cloud ICP reached fitness {fitness:.2f} within {band * 1000:.1f} mm, "
+            f"needs at least {spec.align_min_fitness:.2f} (is the part on the table, inside the workspace?)"
+        )
+    X_RR_corr = invert(X_MC)
+    roll, pitch, _ = matrix_to_rpy(X_RR_corr[:3, :3])
+    if max(abs(roll), abs(pitch)) > MAX_TILT_RAD:
+        raise AlignmentError(
+            f"map-to-cloud ICP tilts the part by roll {math.degrees(roll):.2f} / pitch "
+            f"{math.degrees(pitch):.2f} deg; at most {math.degrees(MAX_TILT_RAD):.1f} deg is accepted "
+            "for a part lying on the table"
+        )
+    return Alignment(X_RR_corr, fitness, rmse)

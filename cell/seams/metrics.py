@@ -1,0 +1,126 @@
+"""Seam accuracy against ground truth: metres in (frame R), millimetres out.
+
+``paper_me_mm`` is the paper's measure (Table 1, "ME is the summation of ME values along the x and y-axes"):
+per seam, the mean over its two end points of |dx| + |dy| in the robot frame. ``endpoint_mm`` is the mean 3D
+distance of the end points, ``lateral_mm`` the largest distance of the detected segment from the true seam
+line (what the torch feels). Detected ends are matched to true ends first (swapped when the locator reports
+the seam reversed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from cell.geometry import FloatArray, point_line_distance
+from cell.types import SeamEstimate, SeamStatus
+
+_MM = 1000.0
+
+
+@dataclass(frozen=True)
+class SeamMetrics:
+    """One seam's errors [mm] (NaN when the seam was not found) and the locator's time [ms]."""
+
+    id: str
+    status: SeamStatus
+    paper_me_mm: float
+    endpoint_mm: float
+    lateral_mm: float
+    time_ms: float
+    swapped: bool = False
+
+    @property
+    def found(self) -> bool:
+        return self.status is SeamStatus.FOUND
+
+
+def segment_errors(
+    p_start: FloatArray, p_end: FloatArray, t_start: FloatArray, t_end: FloatArray
+) -> tuple[float, float, float, bool]:
+    """(paper_me_mm, endpoint_mm, lateral_mm, swapped) of a detected segment against the true one, all in R
+    [m]."""
+    det = np.stack([np.asarray(p_start, float), np.asarray(p_end, float)])
+    tru = np.stack([np.asarray(t_start, float), np.asarray(t_end, float)])
+    direct = np.linalg.norm(det - tru, axis=1).sum()
+    crossed = np.linalg.norm(det[::-1] - tru, axis=1).sum()
+    swapped = bool(crossed < direct)
+    if swapped:
+        det = det[::-1]
+    diff = det - tru
+    paper = float(np.mean(np.abs(diff[:, 0]) + np.abs(diff[:, 1])))
+    endpoint = float(np.mean(np.linalg.norm(diff, axis=1)))
+    lateral = float(np.max(point_line_distance(det, tru[0], tru[1])))
+    return paper * _MM, endpoint * _MM, lateral * _MM, swapped
+
+
+def seam_metrics(estimate: SeamEstimate, t_start: FloatArray, t_end: FloatArray) -> SeamMetrics:
+    """Errors of one locator answer against its true seam (t_start_R, t_end_R) (3,) [m]; NaN when not
+    found."""
+    time_ms = estimate.time_s * _MM
+    if estimate.status is not SeamStatus.FOUND:
+        nan = float("nan")
+        return SeamMetrics(estimate.id, estimate.status, nan, nan, nan, time_ms)
+    paper, endpoint, lateral, swapped = segment_errors(estimate.p_start, estimate.p_end, t_start, t_end)
+    return SeamMetrics(estimate.id, estimate.status, paper, endpoint, lateral, time_ms, swapped)
+
+
+def evaluate(
+    estimates: Sequence[SeamEstimate], truths: Mapping[str, tuple[FloatArray, FloatArray]]
+) -> dict[str, SeamMetrics]:
+    """:func:`seam_metrics` of every found estimate, keyed by seam id (each needs a true seam of the same
+    id)."""
+    missing = [e.id for e in estimates if e.id not in truths]
+    if missing:
+        raise KeyError(f"no true seam for {', '.join(missing)}; true seams: {', '.join(truths)}")
+    return {e.id: seam_metrics(e, *truths[e.id]) for e in estimates if e.status is SeamStatus.FOUND}
+
+
+@dataclass(frozen=True)
+class MetricsSummary:
+    """Summary over a set of seams.
+
+    seams : all seams; visible : those not NOT_VISIBLE (the locator ran on them); found : FOUND ones.
+    Errors [mm] are over the found seams (NaN when none); the median time [ms] is over the visible seams.
+    """
+
+    seams: int
+    visible: int
+    found: int
+    paper_me_mean_mm: float
+    paper_me_p95_mm: float
+    endpoint_mean_mm: float
+    lateral_mean_mm: float
+    time_ms_per_seam_median: float
+
+    def as_dict(self) -> dict[str, float | int]:
+        return asdict(self)
+
+
+def _mean(v: list[float]) -> float:
+    return float(np.mean(v)) if v else float("nan")
+
+
+def summarise(estimates: Sequence[SeamEstimate], per_seam: Mapping[str, SeamMetrics]) -> MetricsSummary:
+    """Counts, mean and 95th percentile of the paper ME, mean endpoint and lateral errors, median time per
+    seam.
+
+    per_seam : seam id -> :class:`SeamMetrics` of the found seams (as :func:`evaluate` returns); entries of
+    seams
+        that were not found are ignored.
+    """
+    found = [m for m in per_seam.values() if m.found]
+    paper = [m.paper_me_mm for m in found]
+    times = [e.time_s * _MM for e in estimates if e.status is not SeamStatus.NOT_VISIBLE]
+    return MetricsSummary(
+        seams=len(estimates),
+        visible=len(times),
+        found=sum(e.status is SeamStatus.FOUND for e in estimates),
+        paper_me_mean_mm=_mean(paper),
+        paper_me_p95_mm=float(np.percentile(paper, 95)) if paper else float("nan"),
+        endpoint_mean_mm=_mean([m.endpoint_mm for m in found]),
+        lateral_mean_mm=_mean([m.lateral_mm for m in found]),
+        time_ms_per_seam_median=float(np.median(times)) if times else float("nan"),
+    )

@@ -1,0 +1,376 @@
+"""The paper's seam locator (section 3.6): masks around the map seam, boundary points, extremes and
+frequencies.
+
+Everything is in the robot frame R, metres. The cloud features (KD-tree, point spacing, normals, boundary
+points) are computed with numpy/scipy once per scene and cached in :attr:`SeamScene.cache`; every threshold
+derives from the cloud's own point spacing (the voxel size of a voxel-downsampled cloud) or from
+:class:`PaperLocatorSpec`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.spatial import cKDTree
+
+from cell.geometry import FloatArray
+from cell.scenario import PaperLocatorSpec
+from cell.seams.base import SeamScene
+from cell.types import MapSeam, SeamEstimate, SeamStatus
+
+TREE_KEY = "kdtree:cloud"  # scipy cKDTree of scene.cloud.points (shared with other locators)
+FEATURES_KEY = "features:cloud"
+
+# Point spacing = median distance to the 4th nearest neighbour: on a voxel grid that is one voxel whether a
+# face keeps one point per grid cell or two (a face lying on a grid plane fills the voxels on both sides of
+# it, and the nearest neighbour is then its twin, a fraction of a millimetre away).
+SPACING_NEIGHBOUR = 4
+NORMAL_NEIGHBOURS = 12  # PCA normal from the k nearest points ...
+NORMAL_RADIUS_SPACINGS = 2.5  # ... within this many point spacings
+BOUNDARY_NEIGHBOURS = 30  # as open3d's compute_boundary_points default max_nn
+BOUNDARY_RADIUS_SPACINGS = 2.5
+BOUNDARY_ANGLE_RAD = np.pi / 2.0  # angle gap that makes a boundary point (open3d's default 90 deg)
+
+
+@dataclass(frozen=True)
+class CloudFeatures:
+    """spacing : point spacing [m] (the voxel size of a voxelised cloud, see :data:`SPACING_NEIGHBOUR`);
+    normals : (n, 3) unit (sign arbitrary);
+    boundary : (n,) bool, the point's neighbourhood is one-sided on its tangent plane."""
+
+    spacing: float
+    normals: FloatArray
+    boundary: npt.NDArray[np.bool_]
+
+
+def scene_tree(scene: SeamScene) -> cKDTree:
+    """The KD-tree of ``scene.cloud``, built once per scene."""
+    tree = scene.cache.get(TREE_KEY)
+    if tree is None:
+        tree = cKDTree(np.asarray(scene.cloud.points))
+        scene.cache[TREE_KEY] = tree
+    return tree
+
+
+def _neighbours(
+    tree: cKDTree, pts: FloatArray, k: int, radius: float
+) -> tuple[npt.NDArray[np.intp], npt.NDArray]:
+    """(n, k) neighbour indices and a validity mask (inside ``radius``, not the point itself)."""
+    k = min(k, len(pts))
+    dist, idx = tree.query(pts, k=k, distance_upper_bound=radius)
+    idx = np.asarray(idx).reshape(len(pts), k)
+    valid = np.isfinite(np.asarray(dist).reshape(len(pts), k)) & (idx != np.arange(len(pts))[:, None])
+    return np.where(valid, idx, 0), valid
+
+
+def estimate_normals(tree: cKDTree, pts: FloatArray, radius: float) -> FloatArray:
+    """(n, 3) unit normals by PCA of each point's neighbourhood (the point included); NaN rows when < 3
+    points."""
+    idx, valid = _neighbours(tree, pts, NORMAL_NEIGHBOURS + 1, radius)
+    w = valid.astype(float)
+    q = pts[idx]  # (n, k, 3)
+    cnt = w.sum(1) + 1.0
+    mean = (np.einsum("nk,nkd->nd", w, q) + pts) / cnt[:, None]
+    dq = (q - mean[:, None, :]) * w[:, :, None]
+    d0 = pts - mean
+    cov = np.einsum("nki,nkj->nij", dq, dq) + np.einsum("ni,nj->nij", d0, d0)
+    _, vecs = np.linalg.eigh(cov)
+    normals = vecs[:, :, 0]
+    normals[cnt < 3.5] = np.nan
+    return np.asarray(normals)
+
+
+def boundary_points(
+    tree: cKDTree, pts: FloatArray, normals: FloatArray, radius: float
+) -> npt.NDArray[np.bool_]:
+    """Angle-gap criterion: project the neighbours onto the point's tangent plane; a gap wider than 90 deg
+    between consecutive neighbour directions makes it a boundary point (so do fewer than 3 neighbours or no
+    normal)."""
+    idx, valid = _neighbours(tree, pts, BOUNDARY_NEIGHBOURS + 1, radius)
+    n = np.nan_to_num(normals)
+    # A tangent basis (e1, e2) per point.
+    helper = np.where(np.abs(n[:, [0]]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    e1 = np.cross(n, helper)
+    e1 /= np.maximum(np.linalg.norm(e1, axis=1, keepdims=True), 1e-12)
+    e2 = np.cross(n, e1)
+    v = pts[idx] - pts[:, None, :]
+    ang = np.arctan2(np.einsum("nkd,nd->nk", v, e2), np.einsum("nkd,nd->nk", v, e1))
+    # Invalid neighbours repeat the first valid angle: duplicates open no gap.
+    first = np.take_along_axis(ang, np.argmax(valid, axis=1)[:, None], axis=1)
+    ang = np.sort(np.where(valid, ang, first), axis=1)
+    gaps = np.diff(ang, axis=1)
+    wrap = 2.0 * np.pi - (ang[:, -1] - ang[:, 0])
+    max_gap = np.maximum(gaps.max(axis=1, initial=0.0), wrap)
+    few = valid.sum(1) < 3
+    return np.asarray((max_gap > BOUNDARY_ANGLE_RAD) | few | ~np.isfinite(normals).all(1))
+
+
+def cloud_features(scene: SeamScene) -> CloudFeatures:
+    """Spacing, normals and boundary flags of ``scene.cloud``, computed once per scene."""
+    feats = scene.cache.get(FEATURES_KEY)
+    if isinstance(feats, CloudFeatures):
+        return feats
+    pts = np.asarray(scene.cloud.points)
+    if len(pts) < 4:
+        feats = CloudFeatures(0.0, np.full((len(pts), 3), np.nan), np.ones(len(pts), bool))
+    else:
+        tree = scene_tree(scene)
+        d, _ = tree.query(pts, k=SPACING_NEIGHBOUR + 1)
+        spacing = float(np.median(d[:, SPACING_NEIGHBOUR]))
+        normals = estimate_normals(tree, pts, NORMAL_RADIUS_SPACINGS * spacing)
+        boundary = boundary_points(tree, pts, normals, BOUNDARY_RADIUS_SPACINGS * spacing)
+        feats = CloudFeatures(spacing, normals, boundary)
+    scene.cache[FEATURES_KEY] = feats
+    return feats
+
+
+# The locator ------------------------------------------------------------------------------------------------
+
+AXIS_TOLERANCE_DEG = 10.0  # a seam within this of x, y or z counts as "along" it
+MIN_MASK_POINTS = 8  # fewer cloud points than this in the outer mask: nothing to measure
+MIN_BOUNDARY_POINTS = 3  # fewer boundary points than this in the inner mask: nothing to measure
+MIN_FACE_POINTS = 3  # points sharing a coordinate needed to call them a face
+FACE_EXTENT_SPACINGS = 0.75  # ... how far they spread in both other axes (a face, not an edge or a column)
+FACE_NORMAL_COS = float(np.cos(np.radians(30.0)))  # ... and how close to the axis their normals are
+_NOT_AXIS = "the paper's method handles seams along x, y or z only"
+
+
+def _not_found(seam: MapSeam, reason: str) -> SeamEstimate:
+    return SeamEstimate(seam.id, SeamStatus.NOT_FOUND, reason)
+
+
+def second_most_frequent(values: FloatArray, bin_m: float) -> float:
+    """The paper's rule: centre of the second most frequent ``bin_m`` bin of ``values`` (the most frequent if
+    only one bin is filled)."""
+    k, counts = np.unique(np.floor(values / bin_m).astype(np.int64), return_counts=True)
+    order = np.argsort(-counts, kind="stable")
+    pick = order[1] if len(order) > 1 else order[0]
+    return float((k[pick] + 0.5) * bin_m)
+
+
+def axis_faces(
+    p: FloatArray, normals: FloatArray, axis: int, bin_m: float, min_extent: float, at: FloatArray
+) -> list[tuple[float, int]]:
+    """Faces perpendicular to ``axis`` among points p (n, 3) with normals (n, 3): (coordinate [m], number of
+    points), densest first; the coordinate is read at the point ``at`` (3,) (a plane fit, for faces a little
+    off the axis).
+
+    A face is a set of at least :data:`MIN_FACE_POINTS` points whose normals lie within 30 deg of ``axis``,
+    whose ``axis`` coordinates agree within ``bin_m`` (the densest window of that width, so no bin edge splits
+    a face), and that spread at least ``min_extent`` in both other axes. Normal and spread tell a face from
+    the other things that repeat a coordinate in a voxel-averaged cloud: the voxels of faces parallel to
+    ``axis`` (they share the voxel-centre value) and the mixed voxels along an edge.
+    """
+    p = p[np.abs(np.nan_to_num(normals[:, axis])) >= FACE_NORMAL_COS]
+    v = p[:, axis]
+    order = np.argsort(v, kind="stable")
+    vs = v[order]
+    lo = np.searchsorted(vs, vs - bin_m / 2.0, side="left")
+    hi = np.searchsorted(vs, vs + bin_m / 2.0, side="right")
+    density = hi - lo
+    others = [t for t in range(3) if t != axis]
+    seen: list[float] = []
+    faces: list[tuple[float, int]] = []
+    for i in np.argsort(-density, kind="stable"):
+        if density[i] < MIN_FACE_POINTS:
+            break
+        if any(abs(vs[i] - u) < bin_m for u in seen):
+            continue
+        seen.append(float(vs[i]))
+        members = p[order[lo[i] : hi[i]]]
+        if np.all(np.ptp(members[:, others], axis=0) >= min_extent):
+            faces.append((_plane_at(members, axis, at), int(density[i])))
+    return faces
+
+
+def _plane_at(members: FloatArray, axis: int, at: FloatArray) -> float:
+    """The ``axis`` coordinate of the plane through ``members`` (n, 3), as a function of the other two
+    coordinates, at the point ``at`` (3,); the median when the fit is ill-posed."""
+    others = [t for t in range(3) if t != axis]
+    A = np.column_stack([np.ones(len(members)), members[:, others] - at[others]])
+    if len(members) < 4 or np.linalg.cond(A) > 1e6:
+        return float(np.median(members[:, axis]))
+    coef, *_ = np.linalg.lstsq(A, members[:, axis], rcond=None)
+    return float(coef[0])
+
+
+def _nearest(faces: list[tuple[float, int]], target: float, centre: float, half_width: float) -> float | None:
+    """The face value nearest ``target`` among those within ``half_width`` of ``centre`` (the inner mask)."""
+    inside = [f[0] for f in faces if abs(f[0] - centre) <= half_width]
+    return min(inside, key=lambda v: abs(v - target)) if inside else None
+
+
+class PaperLocator:
+    """The paper's local search (section 3.6) on the voxel-downsampled cloud ``scene.cloud`` (frame R).
+
+    For a seam along the robot's y axis (along x: swap the roles of x and y):
+
+    1. outer mask around the map seam's start point, ``outer_mask_m`` = (across, along) half-widths, all z
+       (l_z);
+    2. boundary points (angle-gap criterion on the local tangent plane, computed once per scene);
+    3. inner mask ``inner_mask_m`` = (across, along) half-widths on the boundary points;
+    4. start X = the min or max X of those points, whichever is nearer the map start's X; start Y = the second
+       most frequent Y (``frequency_bin_m`` bins); start Z = the map start's Z;
+    5. end = start + the map's seam vector (the seam length is the map's).
+
+    A vertical seam is handled as the horizontal seam it is near (step 4c): its receiving face's normal (from
+    the joint) is across the junction's horizontal seams, so that axis is "across" and the other horizontal
+    axis is "along". Without a joint, the nearest horizontal seam of the map decides.
+
+    Which mask number is along which axis (eq. 5-6 say "3 cm x 5 cm x l_z" and do not say): the smaller across
+    the seam, the larger along it, both as half-widths around the start. Across, the mask must hold the
+    receiving face wherever the as-built part put it (several mm of deviation plus the map alignment error)
+    and little else; along, it must hold the abutting part's side face at the seam start (the along value is
+    read there) but, for parts 40-80 mm wide, not the side face at the seam's end. The other way round the
+    along window would be narrower than the errors it has to absorb.
+
+    Robustness choices (``strict=False``, the default; ``strict=True`` runs step 4 exactly as written):
+
+    - Boundary points are found once on the whole scene cloud, then masked (on a masked cloud the mask's own
+      cut would be "boundary", which is what the paper's second, smaller mask removes).
+    - Step 4 reads each value on the face it belongs to. In a voxel-averaged cloud a voxel that holds one flat
+      face keeps the face's coordinate exactly, while boundary (edge) voxels average two faces and are off by
+      up to half a voxel, and the voxels of a face parallel to an axis share their voxel-centre coordinate:
+      that is the paper's "most frequent value [that] usually comes from noise". So both values are taken from
+      faces (points that share the coordinate and spread over an area, see :func:`axis_faces`; found on the
+      outer mask's points, kept when they lie within the inner mask): across, the face nearest the paper's
+      min/max value; along, the face nearest the map start (instead of "the second most frequent").
+    - When the abutting part's face at the start is not seen (a side no camera looks at), the along value is
+      read on its opposite face (at the seam's other end) less the part's width from the map, in the spirit of
+      step 5. When no face is seen at all the paper's value is kept and the confidence is lowered.
+    """
+
+    name = "paper"
+
+    def __init__(self, spec: PaperLocatorSpec | None = None, *, strict: bool = False) -> None:
+        self.spec = spec if spec is not None else PaperLocatorSpec()
+        self.strict = strict
+
+    def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
+        """Find ``seam`` (the aligned map's seam, in R) in ``scene.cloud``; ``rng`` is unused
+        (deterministic)."""
+        del rng
+        axes = self.axes(scene, seam)
+        if isinstance(axes, str):
+            return _not_found(seam, axes)
+        c, a = axes
+        pts = np.asarray(scene.cloud.points)
+        s0 = np.asarray(seam.p_start)
+        (oc, oa), (ic, ia) = self.spec.outer_mask_m, self.spec.inner_mask_m
+        # Step 1: the larger mask (all z: l_z = Z_max - Z_min of the masked points).
+        outer = (np.abs(pts[:, c] - s0[c]) <= oc) & (np.abs(pts[:, a] - s0[a]) <= oa)
+        n_outer = int(outer.sum())
+        if n_outer < MIN_MASK_POINTS:
+            return _not_found(
+                seam,
+                f"only {n_outer} cloud points in the outer mask around the seam start "
+                f"(need {MIN_MASK_POINTS})",
+            )
+        feats = cloud_features(scene)
+        # Steps 2-3: the boundary points within the smaller mask.
+        inner = outer & (np.abs(pts[:, c] - s0[c]) <= ic) & (np.abs(pts[:, a] - s0[a]) <= ia)
+        pb = pts[inner & feats.boundary]
+        if len(pb) < MIN_BOUNDARY_POINTS:
+            return _not_found(
+                seam,
+                f"only {len(pb)} boundary points in the inner mask around the seam start "
+                f"(need {MIN_BOUNDARY_POINTS})",
+            )
+        # Step 4: the start point, as written ...
+        bin_m = self.spec.frequency_bin_m
+        lo, hi = float(pb[:, c].min()), float(pb[:, c].max())
+        across = lo if abs(lo - s0[c]) <= abs(hi - s0[c]) else hi
+        along = second_most_frequent(pb[:, a], bin_m)
+        confidence = 0.5
+        if not self.strict:  # ... then read on the faces (see the class docstring).
+            po, no = pts[outer], feats.normals[outer]
+            ext = FACE_EXTENT_SPACINGS * feats.spacing
+            face_c = _nearest(axis_faces(po, no, c, bin_m, ext, s0), across, float(s0[c]), ic)
+            face_a = _nearest(axis_faces(po, no, a, bin_m, ext, s0), float(s0[a]), float(s0[a]), ia)
+            confidence = 1.0
+            if face_a is None:  # the start face is not seen: read the abutting part's opposite face
+                face_a = self._along_from_far_face(scene, seam, pts, feats, (c, a), ext)
+                confidence -= 0.1
+            confidence -= 0.25 * ((face_c is None) + (face_a is None))
+            across = across if face_c is None else face_c
+            along = along if face_a is None else face_a
+        start = s0.copy()
+        start[c], start[a] = across, along
+        # Step 5: the end from the map's seam vector.
+        end = start + (np.asarray(seam.p_end) - s0)
+        return SeamEstimate(seam.id, SeamStatus.FOUND, "", start, end, confidence)
+
+    def _along_from_far_face(
+        self,
+        scene: SeamScene,
+        seam: MapSeam,
+        pts: FloatArray,
+        feats: CloudFeatures,
+        axes: tuple[int, int],
+        min_extent: float,
+    ) -> float | None:
+        """The along value of the start read on the abutting part's other face across ``a`` (the face at the
+        seam's far end for a horizontal seam), minus the part's width there from the map; None when that is
+        not seen."""
+        joint = scene.joints.get(seam.id)
+        if joint is None:
+            return None
+        c, a = axes
+        s0 = np.asarray(seam.p_start)
+        box = scene.weldmap.part(joint.abutting).box
+        # The a-values, at the start point, of the abutting part's two faces most nearly perpendicular to a.
+        k = int(np.argmax(np.abs(box.X_AB[a, :3])))
+        values = []
+        for sign in "+-":
+            n, d = box.face_plane(f"{sign}{'xyz'[k]}")
+            values.append((d - n @ s0 + n[a] * s0[a]) / n[a])
+        near, far = sorted(values, key=lambda v: abs(v - s0[a]))
+        (oc, oa), ia = self.spec.outer_mask_m, self.spec.inner_mask_m[1]
+        mask = (np.abs(pts[:, c] - s0[c]) <= oc) & (np.abs(pts[:, a] - far) <= oa)
+        at = s0.copy()
+        at[a] = far
+        faces = axis_faces(pts[mask], feats.normals[mask], a, self.spec.frequency_bin_m, min_extent, at)
+        found = _nearest(faces, far, far, ia)
+        return None if found is None else found + (near - far)
+
+    def axes(self, scene: SeamScene, seam: MapSeam) -> tuple[int, int] | str:
+        """(across, along) axis indices in R for ``seam``, or the reason the method cannot handle it."""
+        u = np.asarray(seam.direction)
+        k = int(np.argmax(np.abs(u)))
+        if abs(u[k]) < np.cos(np.radians(AXIS_TOLERANCE_DEG)):
+            return _NOT_AXIS
+        if k < 2:
+            return 1 - k, k
+        joint = scene.joints.get(seam.id)
+        if joint is not None:
+            n_b, _ = scene.weldmap.part(joint.receiving).box.face_plane(joint.face_receiving)
+            if np.hypot(n_b[0], n_b[1]) > 0.5:
+                c = int(np.argmax(np.abs(n_b[:2])))
+                return c, 1 - c
+        near = _nearest_horizontal_axis(scene, seam)
+        if near is None:
+            return "a vertical seam needs its joint or a horizontal seam nearby to choose its axes"
+        return 1 - near, near
+
+
+def _nearest_horizontal_axis(scene: SeamScene, seam: MapSeam) -> int | None:
+    """Axis (0: x, 1: y) of the map's horizontal seam nearest to ``seam``'s midpoint, if any."""
+    mid = 0.5 * (np.asarray(seam.p_start) + np.asarray(seam.p_end))
+    best, best_d = None, np.inf
+    for other in scene.weldmap.seams:
+        v = np.asarray(other.direction)
+        if other.id == seam.id or abs(v[2]) > np.sin(np.radians(AXIS_TOLERANCE_DEG)):
+            continue
+        d = point_segment_distance(mid, np.asarray(other.p_start), np.asarray(other.p_end))
+        if d < best_d:
+            best, best_d = int(np.argmax(np.abs(v[:2]))), d
+    return best
+
+
+def point_segment_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
+    """Distance [m] of the point p (3,) from the segment a-b."""
+    d = b - a
+    t = float(np.clip((p - a) @ d / max(float(d @ d), 1e-18), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * d)))

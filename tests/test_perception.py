@@ -1,0 +1,377 @@
+"""Perception: deprojection, crop, splice (ICP, prioritised merge), preprocessing, map alignment, PLY I/O.
+
+No simulator: depth images are ray-cast analytically (boxes, a table plane), clouds are sampled directly.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cell.errors import AlignmentError, SensorError
+from cell.geometry import (
+    axis_angle_to_matrix,
+    invert,
+    look_at,
+    make_pose,
+    matrix_to_rpy,
+    rot_z,
+    transform_points,
+)
+from cell.perception import (
+    _open3d,
+    align_map,
+    clouds_in_robot_frame,
+    crop,
+    deproject,
+    downsample,
+    load_ply,
+    perceive,
+    preprocess,
+    sample_map,
+    save_ply,
+    splice,
+)
+from cell.perception.merge import predicted_noise, prioritised_merge
+from cell.perception.preprocess import radius_outlier_mask, z_range_R
+from cell.perception.splice import register, splice_order
+from cell.scenario import PerceptionSpec, WorkspaceSpec
+from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
+
+TABLE_Z = 0.90  # table top in W [m]
+X_WR = make_pose(p=[0.15, -1.1, 1.9])  # the paper's robot base (eq. 3)
+WORKSPACE = WorkspaceSpec(min_m=(-0.7, -0.55, 0.905), max_m=(1.0, 0.55, 1.2))
+SPEC = PerceptionSpec(workspace=WORKSPACE)
+
+
+# ----------------------------------------------------------------------------------------------- helpers
+def intrinsics(width: int = 320, height: int = 240, hfov_deg: float = 65.0) -> CameraIntrinsics:
+    f = 0.5 * width / math.tan(math.radians(hfov_deg) / 2)
+    return CameraIntrinsics(width, height, f, f, (width - 1) / 2, (height - 1) / 2)
+
+
+def render(boxes_W: list[Box], X_WC: np.ndarray, k: CameraIntrinsics, table_z: float | None = TABLE_Z) -> np.ndarray:
+    """Analytic depth image (optical-axis depth, 0 = no hit) of boxes and the horizontal table plane."""
+    u, v = np.meshgrid(np.arange(k.width), np.arange(k.height))
+    d_C = np.stack([(u - k.cx) / k.fx, (v - k.cy) / k.fy, np.ones_like(u, dtype=float)], -1).reshape(-1, 3)
+    d_W = d_C @ X_WC[:3, :3].T  # ray parameter s along d_W equals the optical depth (d_C.z = 1)
+    o_W = X_WC[:3, 3]
+    depth = np.full(len(d_W), np.inf)
+    if table_z is not None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = (table_z - o_W[2]) / d_W[:, 2]
+        depth = np.where(s > 0, np.minimum(depth, s), depth)
+    for box in boxes_W:
+        X_BW = invert(box.X_AB)
+        o_B = transform_points(X_BW, o_W)
+        d_B = d_W @ X_BW[:3, :3].T
+        half = box.size / 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t1 = (-half - o_B) / d_B
+            t2 = (half - o_B) / d_B
+        t_near = np.nanmax(np.minimum(t1, t2), axis=1)
+        t_far = np.nanmin(np.maximum(t1, t2), axis=1)
+        hit = (t_far >= t_near) & (t_near > 0)
+        depth = np.where(hit, np.minimum(depth, t_near), depth)
+    depth[~np.isfinite(depth)] = 0.0
+    return depth.reshape(k.height, k.width).astype(np.float32)
+
+
+def fence_W() -> list[Box]:
+    """Four box tubes lying on the table, 1 mm gaps: two rails along x, two posts between them."""
+    z = TABLE_Z + 0.02
+    rail = np.array([1.2, 0.04, 0.04])
+    post = np.array([0.04, 0.5 - 0.04 - 0.002, 0.04])
+    return [
+        Box(make_pose(p=[0.15, -0.25, z]), rail),
+        Box(make_pose(p=[0.15, 0.25, z]), rail),
+        Box(make_pose(p=[-0.40, 0.0, z]), post),
+        Box(make_pose(p=[0.70, 0.0, z]), post),
+    ]
+
+
+def fence_map_R() -> WeldMap:
+    X_RW = invert(X_WR)
+    names = ("BOTTOM_RAIL", "TOP_RAIL", "POST_L", "POST_R")
+    parts = tuple(Part(n, b.transformed(X_RW)) for n, b in zip(names, fence_W(), strict=True))
+    return WeldMap(parts=parts, seams=(), units="mm", source="<test>", frame="R")
+
+
+def paper_images(size: tuple[int, int] = (320, 240)) -> dict[str, DepthImage]:
+    """The paper's three cameras (two fixed, one eye-in-hand) looking at the test fence."""
+    k = intrinsics(*size)
+    eyes = {"cam_right": (1.0, 0.0, 2.0), "cam_left": (-0.7, 0.0, 2.0), "eye_in_hand": (0.15, -1.0, 2.5)}
+    images = {}
+    for name, eye in eyes.items():
+        X_WC = look_at(eye, (0.15, 0.0, 0.95))
+        mount = "eye_in_hand" if name == "eye_in_hand" else "fixed"
+        images[name] = DepthImage(name, render(fence_W(), X_WC, k), k, X_WC, mount)
+    return images
+
+
+def rotation_angle(R: np.ndarray) -> float:
+    return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)))
+
+
+# ----------------------------------------------------------------------------------------------- 3.2
+def test_deproject_round_trip() -> None:
+    rng = np.random.default_rng(1)
+    k = intrinsics(64, 48)
+    X_WC = look_at((0.3, -0.8, 1.7), (0.1, 0.2, 0.9))
+    u = rng.integers(0, k.width, 200)
+    v = rng.integers(0, k.height, 200)
+    flat = np.unique(v * k.width + u)  # deproject returns pixels in row-major order
+    u, v = flat % k.width, flat // k.width
+    z = rng.uniform(0.4, 3.0, len(flat)).astype(np.float32).astype(np.float64)
+    p_C = np.stack([(u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z], 1)
+    p_W = transform_points(X_WC, p_C)
+    # The points project back onto their pixels (checks the test's own convention).
+    q = transform_points(invert(X_WC), p_W) @ k.K.T
+    np.testing.assert_allclose(q[:, :2] / q[:, 2:], np.stack([u, v], 1), atol=1e-9)
+    depth = np.zeros((k.height, k.width), np.float32)
+    depth[v, u] = z
+    depth[0, 0] = np.nan  # invalid pixels are skipped, never deprojected
+    image = DepthImage("c", depth, k, X_WC)
+    got = deproject(image)
+    assert got.shape == p_W.shape
+    assert np.abs(got - p_W).max() < 1e-6
+
+
+def test_crop_keeps_inside_and_bounds() -> None:
+    p = np.array([[0.0, 0.0, 1.0], [-0.7, -0.55, 0.905], [1.0, 0.55, 1.2], [1.01, 0.0, 1.0], [0.0, 0.0, 0.9]])
+    assert crop(p, WORKSPACE).tolist() == [True, True, True, False, False]
+    with pytest.raises(ValueError, match=r"\(n, 3\)"):
+        crop(np.zeros((3, 2)), WORKSPACE)
+
+
+def test_clouds_in_robot_frame_crop_transform_and_camera_indices() -> None:
+    images = paper_images((160, 120))
+    clouds = clouds_in_robot_frame(images, X_WR, WORKSPACE)
+    assert list(clouds) == list(images)
+    for i, (name, cloud) in enumerate(clouds.items()):
+        assert cloud.frame == "R" and cloud.cameras == tuple(images)
+        assert len(cloud) > 100 and np.all(cloud.camera == i), name
+        p_W = transform_points(X_WR, cloud.points)
+        assert crop(p_W, WORKSPACE).all()
+        assert p_W[:, 2].min() > TABLE_Z  # the table is cropped away; only the fence is left
+        # Every point lies on the surface of one of the boxes.
+        on_box = np.zeros(len(p_W), bool)
+        for box in fence_W():
+            on_box |= box.contains(p_W, 1e-6)
+        assert on_box.all()
+
+
+# ----------------------------------------------------------------------------------------------- 3.3
+def test_icp_recovers_small_transform() -> None:
+    rng = np.random.default_rng(7)
+    # Jittered (not gridded) samples: a regular grid would also match itself shifted by one grid step.
+    target = np.asarray(_surface_cloud(fence_map_R(), rng, noise_m=0.0).points)
+    axis = rng.normal(size=3)
+    angle = math.radians(rng.uniform(0.2, 0.4))
+    centre = target.mean(axis=0)
+    X_true = make_pose(axis_angle_to_matrix(axis, angle), rng.uniform(-3e-3, 3e-3, 3))
+    X_true = make_pose(p=centre) @ X_true @ make_pose(p=-centre)  # turn about the fence, not R's origin
+    source = transform_points(invert(X_true), target)
+    X, fitness, rmse, _ = register(source, target, 0.01, 50)  # 1 cm: the offset is larger than the paper's 1 mm
+    err = X @ invert(X_true)
+    assert np.linalg.norm(err[:3, 3] + err[:3, :3] @ centre - centre) < 1e-4  # at the fence [m]
+    assert math.degrees(rotation_angle(err[:3, :3])) < 0.01
+    assert fitness > 0.99 and rmse < 1e-5
+
+
+def test_predicted_noise_grows_with_range_and_obliqueness() -> None:
+    assert predicted_noise(2.0, 1.0, 900.0) > predicted_noise(1.0, 1.0, 900.0)
+    assert predicted_noise(1.0, math.cos(math.radians(60)), 900.0) > predicted_noise(1.0, 1.0, 900.0)
+    assert predicted_noise(1.0, 1.0, 450.0) > predicted_noise(1.0, 1.0, 900.0)
+
+
+def test_prioritised_merge_takes_each_region_from_the_camera_that_sees_it_best() -> None:
+    rng = np.random.default_rng(3)
+    X_RC = {0: look_at((-1.0, 0.0, 1.0), (0.0, 0.0, 0.0)), 1: look_at((1.0, 0.0, 1.0), (0.0, 0.0, 0.0))}
+    fx = {0: 900.0, 1: 900.0}
+
+    def floor(n: int) -> np.ndarray:  # about 2 mm point spacing, like a D415 at 1.5 m
+        return np.column_stack([rng.uniform(-0.5, 0.5, n), rng.uniform(-0.05, 0.05, n), np.zeros(n)])
+
+    # Both cameras see the floor; only the right camera (at +x) sees the wall facing +x at x = -0.3.
+    wall = np.column_stack([np.full(4000, -0.3), rng.uniform(-0.05, 0.05, 4000), rng.uniform(0.0, 0.1, 4000)])
+    points = np.concatenate([floor(25000), floor(25000), wall])
+    camera = np.repeat([0, 1, 1], [25000, 25000, 4000])
+    keep = prioritised_merge(points, camera, X_RC, fx, 0.05, 0.01)
+    on_floor = points[:, 2] == 0.0
+    x = points[:, 0]
+    left = on_floor & (x < -0.05) & (np.abs(x + 0.3) > 0.01)  # away from the middle and the wall's foot
+    right = on_floor & (x > 0.05)
+    assert np.all(keep[left] == (camera[left] == 0))  # left half from the left camera only
+    assert np.all(keep[right] == (camera[right] == 1))  # right half from the right camera only
+    assert keep[~on_floor].mean() > 0.97  # a surface only one camera sees is kept where the other one wins
+    assert 0.45 < keep[on_floor].mean() < 0.55  # the floor is not doubled
+
+
+def test_splice_order_and_diagnostics() -> None:
+    images = paper_images((160, 120))
+    assert splice_order(images, tuple(images)) == ("cam_left", "cam_right", "eye_in_hand")
+    clouds = clouds_in_robot_frame(images, X_WR, WORKSPACE)
+    spliced = splice(clouds, images, X_WR, SPEC)
+    assert [(r.source, r.target) for r in spliced.registrations] == [
+        ("cam_right", ("cam_left",)),
+        ("eye_in_hand", ("cam_left", "cam_right")),
+    ]
+    for r in spliced.registrations:  # exact extrinsics: nothing to correct
+        assert np.abs(r.X_corr - np.eye(4)).max() < 1e-3
+    assert spliced.dense.frame == "R" and set(spliced.dense.camera.tolist()) == {0, 1, 2}
+    assert sum(spliced.kept.values()) == len(spliced.dense) < sum(len(c) for c in clouds.values())
+    one = splice({"cam_left": clouds["cam_left"]}, images, X_WR, SPEC)  # a single camera works too
+    assert len(one.dense) == len(clouds["cam_left"]) and one.registrations == ()
+
+
+def test_splice_icp_never_makes_a_miscalibrated_camera_worse() -> None:
+    """The first fixed camera's calibrated pose is 0.6 mm off along x; the paper's ICP (1 mm, 50 iterations)
+    may or may not take it out, but an accepted correction brings the clouds closer, never apart."""
+    images = paper_images((480, 360))
+    clouds = clouds_in_robot_frame(images, X_WR, WORKSPACE)
+    offset = np.array([0.0006, 0.0, 0.0])
+    shifted = clouds["cam_left"].transformed(make_pose(p=offset), "R")
+    spliced = splice({"cam_left": shifted, "cam_right": clouds["cam_right"]}, images, X_WR, SPEC)
+    (reg,) = spliced.registrations
+    assert reg.source == "cam_left" and reg.target == ("cam_right",)
+    assert reg.misfit_before_m > 1e-4  # the shift is seen
+    if reg.accepted:
+        assert reg.misfit_m < reg.misfit_before_m
+        assert np.linalg.norm(reg.X_corr[:3, 3] + offset) < np.linalg.norm(offset)
+    else:
+        np.testing.assert_array_equal(reg.X_corr, np.eye(4))
+
+
+# ----------------------------------------------------------------------------------------------- 3.4
+def test_downsample_count_extent_and_camera() -> None:
+    rng = np.random.default_rng(5)
+    p = rng.uniform([0.0, 0.0, 0.0], [0.1, 0.05, 0.02], (20000, 3))
+    cloud = Cloud(p, "R", (p[:, 0] > 0.05).astype(np.int16), ("a", "b"))
+    down = downsample(cloud, 0.01)
+    occupied = {tuple(ijk) for ijk in np.floor(p / 0.01).astype(int)}
+    assert len(down) == len(occupied) == 10 * 5 * 2
+    assert np.all(down.points >= p.min(0)) and np.all(down.points <= p.max(0))
+    cells = {tuple(ijk) for ijk in np.floor(down.points / 0.01).astype(int)}
+    assert cells == occupied  # each centroid lies in its own voxel
+    assert set(down.camera.tolist()) == {0, 1}  # x = 0.05 is a voxel boundary: no voxel is mixed
+    mixed = downsample(Cloud(p, "R", rng.integers(0, 2, len(p)).astype(np.int16), ("a", "b")), 0.01)
+    assert np.all(mixed.camera == -1)
+
+
+def test_radius_outlier_mask_matches_open3d_on_the_whole_cloud() -> None:
+    rng = np.random.default_rng(11)
+    surface = np.column_stack([rng.uniform(0, 0.3, 30000), rng.uniform(0, 0.3, 30000), np.zeros(30000)])
+    grid = np.stack(np.meshgrid(np.arange(10), np.arange(10), np.arange(1, 4), indexing="ij"), -1).reshape(-1, 3)
+    strays = grid * 0.03 + rng.uniform(-0.003, 0.003, grid.shape)  # 3 cm apart, 3 cm and more above the surface
+    pairs = strays[:50] + 0.002  # two strays close together: still isolated (fewer than 3 neighbours)
+    p = np.concatenate([surface, strays, pairs])
+    fast = radius_outlier_mask(p, 0.01, 3)
+    assert np.array_equal(fast, _open3d.radius_outlier_mask(p, 0.01, 3))
+    assert fast[:30000].all() and not fast[30000:].any()
+
+
+def test_preprocess_z_passthrough_and_outliers() -> None:
+    z_lo, z_hi = z_range_R(WORKSPACE, X_WR)
+    assert (z_lo, z_hi) == pytest.approx((0.905 - 1.9, 1.2 - 1.9))
+    rng = np.random.default_rng(2)
+    top = np.column_stack([rng.uniform(0, 0.2, 5000), rng.uniform(0, 0.2, 5000), np.full(5000, -0.9)])
+    below = top[:100] - [0, 0, 0.2]  # under the workspace
+    stray = np.array([[0.5, 0.5, -0.85]])  # inside the z range but alone
+    cloud = Cloud(np.concatenate([top, below, stray]), "R")
+    out = preprocess(cloud, WORKSPACE, X_WR, SPEC)
+    assert len(out) == 5000 and np.allclose(out.points[:, 2], -0.9)
+
+
+# ----------------------------------------------------------------------------------------------- 3.5
+def _surface_cloud(weldmap: WeldMap, rng: np.random.Generator, noise_m: float = 0.0005) -> Cloud:
+    p, n = sample_map(weldmap, 0.004, 0.002)
+    p = p + rng.uniform(-0.002, 0.002, p.shape) * (1 - np.abs(n))  # off the sampling grid, in the face
+    return Cloud(p + rng.normal(0.0, noise_m, p.shape) * np.abs(n), "R")
+
+
+def test_align_map_recovers_offset_and_yaw() -> None:
+    rng = np.random.default_rng(4)
+    nominal = fence_map_R()
+    centre = np.mean([part.box.center for part in nominal.parts], axis=0)
+    X_true = (
+        make_pose(p=centre + np.array([0.010, -0.004, 0.0]))
+        @ make_pose(rot_z(math.radians(0.5)))
+        @ make_pose(p=-centre)
+    )
+    cloud = _surface_cloud(nominal.transformed(X_true, "R"), rng)
+    a = align_map(nominal, cloud, SPEC)
+    corners = np.concatenate([part.box.corners() for part in nominal.parts])
+    err = transform_points(a.X_RR_corr, corners) - transform_points(X_true, corners)
+    assert np.linalg.norm(err, axis=1).max() < 3e-4  # [m] over every corner of the fence
+    assert abs(math.degrees(matrix_to_rpy(a.X_RR_corr[:3, :3])[2]) - 0.5) < 0.01
+    assert a.fitness > 0.9 and a.rmse_m < 1e-3
+
+
+def test_align_map_refuses_junk_and_tilt() -> None:
+    rng = np.random.default_rng(6)
+    nominal = fence_map_R()
+    lo = np.min([p.box.corners().min(0) for p in nominal.parts], axis=0)
+    hi = np.max([p.box.corners().max(0) for p in nominal.parts], axis=0)
+    junk = Cloud(rng.uniform(lo - 0.05, hi + 0.1, (20000, 3)), "R")
+    with pytest.raises(AlignmentError, match="fitness"):
+        align_map(nominal, junk, SPEC)
+    # The whole fence tilted by 3 degrees about x: fits well, but a part on the table cannot be tilted.
+    centre = np.mean([p.box.center for p in nominal.parts], axis=0)
+    tilt = make_pose(p=centre) @ make_pose(axis_angle_to_matrix([1, 0, 0], math.radians(3))) @ make_pose(p=-centre)
+    with pytest.raises(AlignmentError, match="tilt"):
+        align_map(nominal, _surface_cloud(nominal.transformed(tilt, "R"), rng), SPEC)
+
+
+def test_sample_map_skips_faces_down_and_contacts() -> None:
+    nominal = fence_map_R()
+    p, n = sample_map(nominal, 0.005, 0.002)
+    assert np.all(n[:, 2] > -0.5)
+    np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0)
+    post_l, bottom = nominal.part("POST_L").box, nominal.part("BOTTOM_RAIL").box
+    assert not np.any(bottom.contains(p, 1e-9) & post_l.contains(p, 0.0015))  # rail face under the post's end
+
+
+# ------------------------------------------------------------------------------------------ PLY, perceive
+def test_ply_round_trip(tmp_path: Path) -> None:
+    rng = np.random.default_rng(8)
+    cloud = Cloud(rng.normal(size=(500, 3)), "R", rng.integers(-1, 3, 500).astype(np.int16), ("a", "b", "c"))
+    path = tmp_path / "cloud.ply"
+    save_ply(cloud, path)
+    back = load_ply(path)
+    assert back.frame == "R" and back.cameras == cloud.cameras
+    np.testing.assert_array_equal(back.points, cloud.points)
+    np.testing.assert_array_equal(back.camera, cloud.camera)
+    plain = tmp_path / "plain.ply"  # a PLY from elsewhere: float32, no camera property
+    header = "ply\nformat ascii 1.0\nelement vertex 3\n" + "".join(f"property float {c}\n" for c in "xyz")
+    header += "end_header\n"
+    plain.write_text(header + "0 0 0\n1 2 3\n0.5 0.25 0.125\n")
+    got = load_ply(plain, frame="W")
+    assert got.frame == "W" and len(got) == 3 and np.all(got.camera == -1)
+    np.testing.assert_allclose(got.points[1], [1, 2, 3])
+    with pytest.raises(SensorError, match="does not exist"):
+        load_ply(tmp_path / "missing.ply")
+
+
+def test_perceive_end_to_end_and_lost_camera() -> None:
+    images = paper_images((240, 180))
+    # The left camera looks away from the table (at a wall 1 m off): it gives no point inside the workspace.
+    k = images["cam_left"].intrinsics
+    away = look_at((-0.7, 0.0, 2.0), (-3.0, 0.0, 3.0))
+    images["cam_left"] = DepthImage("cam_left", np.ones((k.height, k.width), np.float32), k, away)
+    result = perceive(images, X_WR, SPEC)
+    assert result.lost == ("cam_left",)
+    assert len(result.clouds["cam_left"]) == 0 and len(result.dense) > 1000
+    assert set(result.timings) == {"clouds", "splice", "preprocess", "downsample"}
+    assert len(result.downsampled) < len(result.dense)
+    assert set(result.dense.camera.tolist()) == {0, 2}  # cam_right and eye_in_hand
+    # The downsampled cloud is good enough to align the map to.
+    assert align_map(fence_map_R(), result.downsampled, SPEC).fitness > 0.5
+    dark = {
+        n: DepthImage(n, np.zeros((k.height, k.width), np.float32), k, im.X_WC, im.mount) for n, im in images.items()
+    }
+    with pytest.raises(SensorError, match="cam_right, cam_left, eye_in_hand"):
+        perceive(dark, X_WR, SPEC)

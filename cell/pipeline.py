@@ -102,7 +102,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     progress("aligning the welding map to the cloud")
     X_RM_nominal = invert(sc.X_WR) @ sc.X_WM
     weldmap_nominal_R = cap.weldmap.transformed(X_RM_nominal, "R")
-    alignment = align_map(weldmap_nominal_R, perceived.downsampled, sc.perception)
+    alignment = align_map(weldmap_nominal_R, perceived.dense, sc.perception)
     X_RM = alignment.X_RR_corr @ X_RM_nominal
     weldmap_R = cap.weldmap.transformed(X_RM, "R")
     joints = find_joints(weldmap_R)

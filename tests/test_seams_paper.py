@@ -134,9 +134,7 @@ def test_finds_seams_of_a_part_built_off_the_map() -> None:
     map seams are mm off, the locator comes back within 1 mm of the true seams (the axis values it
     measures)."""
     design = junction()
-    built = junction(
-        post=box((195.7, 300, 0), (276.3, 697.5, 80)), rail=box((277.8, 453, 0), (400, 513, 60.5))
-    )
+    built = junction(post=box((195.7, 300, 0), (276.3, 697.5, 80)), rail=box((277.8, 453, 0), (400, 513, 60.5)))
     scene = scene_of(built, design, GRIDS[1])
     truth = truth_R(design, built)
     locator = PaperLocator()
@@ -189,9 +187,7 @@ def test_diagonal_seam_is_not_found() -> None:
     est = PaperLocator().locate(scene, diagonal, np.random.default_rng(0))
     assert est.status is SeamStatus.NOT_FOUND
     assert est.reason == "the paper's method handles seams along x, y or z only"
-    nearly = MapSeam(
-        "NEAR", s.p_start, s.p_start + np.array([0.08, 0.008, 0.0])
-    )  # 5.7 deg off x: still "along x"
+    nearly = MapSeam("NEAR", s.p_start, s.p_start + np.array([0.08, 0.008, 0.0]))  # 5.7 deg off x: still "along x"
     assert PaperLocator().locate(scene, nearly, np.random.default_rng(0)).status is SeamStatus.FOUND
 
 
@@ -200,9 +196,7 @@ def test_vertical_seam_axes_from_the_joint_or_the_nearest_horizontal_seam() -> N
     scene = scene_of(design, design, GRIDS[0])
     loc = PaperLocator()
     lateral_top = scene.weldmap.seam("POST_L>TOP_RAIL:-x")  # on the rail's -y face: like the seam along x
-    lateral_bottom = scene.weldmap.seam(
-        "BOTTOM_RAIL>POST_L:-y"
-    )  # on the post's +x face: like the seam along y
+    lateral_bottom = scene.weldmap.seam("BOTTOM_RAIL>POST_L:-y")  # on the post's +x face: like the seam along y
     assert loc.axes(scene, lateral_top) == (1, 0)
     assert loc.axes(scene, lateral_bottom) == (0, 1)
     no_joints = SeamScene(scene.cloud, scene.dense, scene.weldmap, {}, scene.table_z)

@@ -178,9 +178,7 @@ def test_truth_follows_a_lengthened_and_thickened_part() -> None:
     t0, t1 = truth["BOTTOM_RAIL>POST_L:+z"]
     np.testing.assert_allclose(t0, transform_points(X_RM, np.array([0.280, 0.2485, 0.062])), atol=1e-9)
     np.testing.assert_allclose(t1, transform_points(X_RM, np.array([0.280, 0.3115, 0.062])), atol=1e-9)
-    longer = box(
-        (275, 250, 0), (1125, 310, 60)
-    )  # 6 mm longer at each end (into the posts): still on their faces
+    longer = box((275, 250, 0), (1125, 310, 60))  # 6 mm longer at each end (into the posts): still on their faces
     t0, _ = _truth(_built(BOTTOM_RAIL=longer))["BOTTOM_RAIL>POST_R:-y"]
     np.testing.assert_allclose(t0, transform_points(X_RM, np.array([1.120, 0.250, 0.0])), atol=1e-9)
 
@@ -259,9 +257,7 @@ def test_metrics_different_errors_at_each_end() -> None:
     m = seam_metrics(_est(T0 + np.array([0.002, 0, 0]), T1 + np.array([0, 0.004, 0])), T0, T1)
     assert m.paper_me_mm == pytest.approx(3.0)
     assert m.endpoint_mm == pytest.approx(3.0)
-    assert m.lateral_mm == pytest.approx(
-        2.0
-    )  # the end is off along the line: the start sets the lateral error
+    assert m.lateral_mm == pytest.approx(2.0)  # the end is off along the line: the start sets the lateral error
 
 
 def test_metrics_swapped_ends_are_matched() -> None:
@@ -271,9 +267,9 @@ def test_metrics_swapped_ends_are_matched() -> None:
 
 
 def test_metrics_lateral_offset_only() -> None:
-    assert segment_errors(
-        T0 + np.array([0, 0, -0.0015]), T1 + np.array([0, 0, -0.0015]), T0, T1
-    ) == pytest.approx((0.0, 1.5, 1.5, False))
+    assert segment_errors(T0 + np.array([0, 0, -0.0015]), T1 + np.array([0, 0, -0.0015]), T0, T1) == pytest.approx(
+        (0.0, 1.5, 1.5, False)
+    )
 
 
 def test_summary() -> None:

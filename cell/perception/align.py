@@ -33,7 +33,7 @@ STAGES = (1.0, 0.25, 0.1)  # max correspondence per ICP stage, as fractions of s
 _FITNESS_STAGE = 1
 _SPACING_PER_FINEST = 1.5  # map sample spacing, in units of the finest stage's max correspondence
 _DOWN_COS = 0.5  # faces whose outward normal is within 60 deg of -z (R) point down into the table
-_MAX_SOURCE = 60_000  # larger clouds are voxel-downsampled at the finest correspondence distance first
+_MAX_SOURCE = 30_000  # larger clouds are thinned to about this many points (finest-distance grid, then stride)
 
 
 @dataclass(frozen=True)
@@ -126,8 +126,8 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
     """Fit the nominal map (already in R) to the cloud (in R); see the module docstring.
 
     Pass the dense filtered cloud (``Perceived.dense``): 1 cm voxel centroids sit inside the parts at their
-    edges and bias the fit by millimetres. Clouds over 60 000 points are first put on a grid of the finest
-    correspondence distance (2 mm by default).
+    edges and bias the fit by millimetres. Clouds over 30 000 points are first put on a grid of the finest
+    correspondence distance (2 mm by default), then thinned to about 30 000 points.
 
     Raises :class:`AlignmentError` when the fit's fitness stays below ``spec.align_min_fitness`` or it tilts
     the map by more than 2 degrees.
@@ -138,8 +138,9 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
         raise AlignmentError(f"map {weldmap_R.source!r} has no parts to align to the cloud")
     thresholds = [spec.align_max_correspondence_m * f for f in STAGES]
     finest = thresholds[-1]
-    if len(cloud) > _MAX_SOURCE:
+    if len(cloud) > _MAX_SOURCE:  # thin a dense cloud: a grid of the finest distance, then every k-th point
         cloud = downsample(cloud, finest)
+        cloud = cloud.select(np.arange(0, len(cloud), math.ceil(len(cloud) / _MAX_SOURCE)))
     if len(cloud) < 3:
         raise AlignmentError(f"map alignment needs a cloud of at least 3 points, got {len(cloud)}")
     target, target_normals = sample_map(weldmap_R, _SPACING_PER_FINEST * finest, finest)

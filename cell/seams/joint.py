@@ -29,9 +29,7 @@ def _on_plane(part: Part, face: str, pts: FloatArray, tol: float) -> bool:
     return bool(np.all(np.abs(pts @ n - d) <= tol))
 
 
-def _candidates(
-    seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: float
-) -> list[tuple[float, Joint]]:
+def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: float) -> list[tuple[float, Joint]]:
     """Every (score, joint) that explains ``seam``; the score (smaller is better) is the gap plus plane
     residuals."""
     pts = np.stack([seam.p_start, seam.p_end])
@@ -80,9 +78,7 @@ def find_joints(weldmap: WeldMap, tol_m: float = 0.003, max_gap_m: float = 0.006
     joints: dict[str, Joint] = {}
     for seam in weldmap.seams:
         if seam.length <= tol_m:
-            raise MapError(
-                f"seam {seam.id!r} is {seam.length * 1000:.2f} mm long; a seam must be longer than tol_m"
-            )
+            raise MapError(f"seam {seam.id!r} is {seam.length * 1000:.2f} mm long; a seam must be longer than tol_m")
         found = _candidates(seam, weldmap.parts, tol_m, max_gap_m)
         if not found:
             raise MapError(

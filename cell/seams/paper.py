@@ -54,9 +54,7 @@ def scene_tree(scene: SeamScene) -> cKDTree:
     return tree
 
 
-def _neighbours(
-    tree: cKDTree, pts: FloatArray, k: int, radius: float
-) -> tuple[npt.NDArray[np.intp], npt.NDArray]:
+def _neighbours(tree: cKDTree, pts: FloatArray, k: int, radius: float) -> tuple[npt.NDArray[np.intp], npt.NDArray]:
     """(n, k) neighbour indices and a validity mask (inside ``radius``, not the point itself)."""
     k = min(k, len(pts))
     dist, idx = tree.query(pts, k=k, distance_upper_bound=radius)
@@ -82,9 +80,7 @@ def estimate_normals(tree: cKDTree, pts: FloatArray, radius: float) -> FloatArra
     return np.asarray(normals)
 
 
-def boundary_points(
-    tree: cKDTree, pts: FloatArray, normals: FloatArray, radius: float
-) -> npt.NDArray[np.bool_]:
+def boundary_points(tree: cKDTree, pts: FloatArray, normals: FloatArray, radius: float) -> npt.NDArray[np.bool_]:
     """Angle-gap criterion: project the neighbours onto the point's tangent plane; a gap wider than 90 deg
     between consecutive neighbour directions makes it a boundary point (so do fewer than 3 neighbours or no
     normal)."""
@@ -265,8 +261,7 @@ class PaperLocator:
         if n_outer < MIN_MASK_POINTS:
             return _not_found(
                 seam,
-                f"only {n_outer} cloud points in the outer mask around the seam start "
-                f"(need {MIN_MASK_POINTS})",
+                f"only {n_outer} cloud points in the outer mask around the seam start (need {MIN_MASK_POINTS})",
             )
         feats = cloud_features(scene)
         # Steps 2-3: the boundary points within the smaller mask.
@@ -275,8 +270,7 @@ class PaperLocator:
         if len(pb) < MIN_BOUNDARY_POINTS:
             return _not_found(
                 seam,
-                f"only {len(pb)} boundary points in the inner mask around the seam start "
-                f"(need {MIN_BOUNDARY_POINTS})",
+                f"only {len(pb)} boundary points in the inner mask around the seam start (need {MIN_BOUNDARY_POINTS})",
             )
         # Step 4: the start point, as written ...
         bin_m = self.spec.frequency_bin_m

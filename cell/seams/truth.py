@@ -49,9 +49,7 @@ def _as_built(parts: Sequence[Part], name: str) -> Part:
     raise MapError(f"the as-built parts have no part {name!r}; they have: {', '.join(p.name for p in parts)}")
 
 
-def true_seam_W(
-    design: WeldMap, joint: Joint, parts_as_built_W: Sequence[Part]
-) -> tuple[FloatArray, FloatArray]:
+def true_seam_W(design: WeldMap, joint: Joint, parts_as_built_W: Sequence[Part]) -> tuple[FloatArray, FloatArray]:
     """One true seam, (p_start_W, p_end_W) (3,) each [m], in the same order as the map seam."""
     seam = design.seam(joint.seam_id)
     a_design = design.part(joint.abutting).box
@@ -65,9 +63,7 @@ def true_seam_W(
     n_b, d_b = b.face_plane(joint.face_receiving)
     denom = float(n_b @ n_e)
     if abs(denom) < 1e-6:
-        raise MapError(
-            f"seam {joint.seam_id!r}: the abutting part's end face is perpendicular to the receiving face"
-        )
+        raise MapError(f"seam {joint.seam_id!r}: the abutting part's end face is perpendicular to the receiving face")
 
     def onto_b(p: FloatArray) -> FloatArray:
         return np.asarray(p + ((d_b - n_b @ p) / denom) * n_e)

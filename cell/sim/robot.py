@@ -1,0 +1,391 @@
+"""The arm inside the simulated cell: load a URDF, pose it by joint name, play back timed joint trajectories.
+
+A :class:`SimRobot` lives in the PyBullet client of a :class:`~cell.sim.cell.SimCell` (which creates it through
+``SimCell.load_robot``). Joints and links are found by name, never by index. Poses come from PyBullet's own
+forward kinematics (``getLinkState``), so a recorded tool path is an independent check of the Pinocchio model
+in :mod:`cell.motion.robot`.
+
+Playback is kinematic (``resetJointStatesMultiDof`` at each record time, no dynamics): deterministic and about
+10 us per sample, so minutes of robot time replay in well under a second. While the arc is on, the torch's
+path is drawn as a weld bead: visual-only capsules (no collision shape) that show up in rendered images.
+
+Frames: ``W`` world, ``R`` robot base (URDF root link, KUKA $ROBROOT). Units: metres, radians, seconds.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+from scipy.spatial.transform import Rotation
+
+from cell.errors import PlanError, ScenarioError
+from cell.geometry import FloatArray, make_pose, readonly
+
+_MOVABLE = (pybullet.JOINT_REVOLUTE, pybullet.JOINT_PRISMATIC)
+_LIMIT_TOL = 1e-6  # [rad] how far a played configuration may lie outside the URDF limits (rounding)
+
+
+# PyBullet orders quaternions (x, y, z, w), as scipy's Rotation.as_quat/from_quat do; Pinocchio and Eigen
+# print (w, x, y, z). Every PyBullet quaternion of the robot and the bead passes through these two functions.
+def _quat_from_matrix(R: FloatArray) -> list[float]:
+    """PyBullet quaternion (x, y, z, w) of a rotation matrix (3, 3)."""
+    return [float(v) for v in Rotation.from_matrix(R).as_quat()]
+
+
+def _matrices_from_quats(quats: npt.ArrayLike) -> FloatArray:
+    """Rotation matrices (n, 3, 3) from PyBullet quaternions (n, 4) ordered (x, y, z, w)."""
+    return np.asarray(Rotation.from_quat(np.asarray(quats, dtype=float).reshape(-1, 4)).as_matrix())
+
+
+def _pose(position: Sequence[float], quat_xyzw: Sequence[float]) -> FloatArray:
+    return make_pose(_matrices_from_quats(quat_xyzw)[0], position)
+
+
+class Event(NamedTuple):
+    """One entry of an execution log: time [s], kind ``"move"`` | ``"arc_on"`` | ``"arc_off"``, free text."""
+
+    t: float
+    kind: str
+    detail: str
+
+
+@dataclass(frozen=True)
+class BeadStyle:
+    """How the weld bead is drawn: capsules of ``radius_m`` [m] along chords of about ``step_m`` [m]."""
+
+    radius_m: float = 0.003
+    step_m: float = 0.005
+    rgba: tuple[float, float, float, float] = (0.9, 0.1, 0.1, 1.0)
+
+
+@dataclass(frozen=True)
+class Execution:
+    """What the simulated arm did while playing back a joint trajectory.
+
+    times : (n,) record times [s] (the trajectory's time axis: a grid of ``record_dt`` from its first time, every
+        arc switch time, and its last time).
+    q : (n, dof) joint values played at those times [rad], in the robot's joint order.
+    tcp_W : (n, 3) position of the tool frame in W [m], from PyBullet's forward kinematics.
+    arc_on : (n,) bool, the arc state holding from each record time to the next.
+    events : time-ordered log of :class:`Event` (move marks, arc_on, arc_off).
+    X_W_tcp : (n, 4, 4) full tool poses in W, or None when not recorded.
+    """
+
+    times: FloatArray
+    q: FloatArray
+    tcp_W: FloatArray
+    arc_on: npt.NDArray[np.bool_]
+    events: tuple[Event, ...]
+    X_W_tcp: FloatArray | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "times", readonly(self.times))
+        object.__setattr__(self, "q", readonly(self.q))
+        object.__setattr__(self, "tcp_W", readonly(self.tcp_W))
+        object.__setattr__(self, "arc_on", readonly(self.arc_on, np.bool_))
+        if self.X_W_tcp is not None:
+            object.__setattr__(self, "X_W_tcp", readonly(self.X_W_tcp))
+        n = len(self.times)
+        if self.tcp_W.shape != (n, 3) or self.arc_on.shape != (n,) or self.q.shape[0] != n:
+            raise ValueError(f"Execution arrays must have one row per record time ({n})")
+
+    @property
+    def duration(self) -> float:
+        """Robot time from the first to the last record [s]."""
+        return float(self.times[-1] - self.times[0])
+
+    @property
+    def arc_time(self) -> float:
+        """Time with the arc on [s]."""
+        return float(np.sum(np.diff(self.times)[self.arc_on[:-1]]))
+
+    @property
+    def weld_length(self) -> float:
+        """Length of the tool path travelled with the arc on [m]."""
+        steps = np.linalg.norm(np.diff(self.tcp_W, axis=0), axis=1)
+        return float(np.sum(steps[self.arc_on[:-1]]))
+
+
+def _check_trajectory(
+    times: npt.ArrayLike, q: npt.ArrayLike, arc_on: npt.ArrayLike, dof: int
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    t = np.asarray(times, dtype=float)
+    qa = np.asarray(q, dtype=float)
+    arc = np.asarray(arc_on)
+    if t.ndim != 1 or len(t) == 0 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0.0):
+        raise ValueError("execute: times must be (n,) finite, n >= 1, strictly increasing [s]")
+    if qa.shape != (len(t), dof) or not np.all(np.isfinite(qa)):
+        raise ValueError(f"execute: q must be ({len(t)}, {dof}) finite joint values [rad], got {qa.shape}")
+    if arc.shape != (len(t),) or arc.dtype != np.bool_:
+        raise ValueError(f"execute: arc_on must be ({len(t)},) bool, got {arc.shape} {arc.dtype}")
+    return t, qa, arc
+
+
+def _record_times(times: FloatArray, arc_on: npt.NDArray[np.bool_], record_dt: float) -> FloatArray:
+    """A grid of ``record_dt`` over [times[0], times[-1]], plus the arc switch times and the end, sorted."""
+    if not record_dt > 0.0:
+        raise ValueError(f"execute: record_dt must be positive [s], got {record_dt}")
+    t0, t1 = float(times[0]), float(times[-1])
+    grid = t0 + np.arange(int(np.floor((t1 - t0) / record_dt + 1e-9)) + 1) * record_dt
+    switches = times[1:][arc_on[1:] != arc_on[:-1]]
+    out = np.unique(np.concatenate([grid[grid < t1], switches, [t1]]))
+    # drop grid points closer than a microsecond to a switch time (keep the exact switch)
+    keep = np.ones(len(out), bool)
+    keep[1:] = np.diff(out) > 1e-6
+    keep[np.isin(out, switches)] = True
+    return out[keep]
+
+
+def _interp_rows(t: FloatArray, times: FloatArray, values: FloatArray) -> FloatArray:
+    """Piecewise-linear interpolation of samples (n, d) at times t (m,): (m, d)."""
+    return np.column_stack([np.interp(t, times, values[:, j]) for j in range(values.shape[1])])
+
+
+def _chord_points(path: FloatArray, step: float) -> FloatArray:
+    """Points (k, 3) along a polyline at arc lengths 0, step, 2 step, ..., and its end."""
+    seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    if s[-1] < 1e-9:
+        return path[:1]
+    n = max(int(np.ceil(s[-1] / step - 1e-9)), 1)
+    targets = np.linspace(0.0, s[-1], n + 1)
+    return _interp_rows(targets, s, path)
+
+
+class SimRobot:
+    """A fixed-base arm in a PyBullet client, posed and read by joint and link name.
+
+    client : the owning cell's client. urdf_path : the arm's URDF. X_WR : (4, 4) pose of the URDF root link
+    (``base_link``) in W. q : (dof,) initial joint values [rad] in ``joint_names`` order.
+    joint_names : order of q; default the movable joints in URDF tree order (give ``RobotModel.joint_names`` to
+    be sure both models agree).
+    """
+
+    def __init__(
+        self,
+        client: BulletClient,
+        urdf_path: str | Path,
+        X_WR: npt.ArrayLike,
+        q: npt.ArrayLike,
+        joint_names: Sequence[str] | None = None,
+    ) -> None:
+        path = Path(urdf_path)
+        if not path.is_file():
+            raise ScenarioError(f"robot URDF {path} not found")
+        X = np.asarray(X_WR, dtype=float)
+        if X.shape != (4, 4):
+            raise ValueError(f"X_WR must be (4, 4), got {X.shape}")
+        self._c = client
+        try:
+            # loadURDF places the root link's own frame (not its inertial frame) at basePosition/Orientation.
+            self.body = int(
+                client.loadURDF(
+                    str(path),
+                    basePosition=[float(v) for v in X[:3, 3]],
+                    baseOrientation=_quat_from_matrix(X[:3, :3]),
+                    useFixedBase=True,
+                )
+            )
+        except pybullet.error as exc:
+            raise ScenarioError(f"robot URDF {path} cannot be loaded by PyBullet: {exc}") from exc
+        self.name = client.getBodyInfo(self.body)[1].decode()
+        self.base_link = client.getBodyInfo(self.body)[0].decode()
+        self._links: dict[str, int] = {self.base_link: -1}
+        movable: dict[str, int] = {}
+        lower: dict[str, float] = {}
+        upper: dict[str, float] = {}
+        for j in range(client.getNumJoints(self.body)):
+            info = client.getJointInfo(self.body, j)
+            self._links[info[12].decode()] = j  # a link's index is the index of its parent joint
+            if info[2] in _MOVABLE:
+                jname = info[1].decode()
+                movable[jname] = j
+                lower[jname], upper[jname] = float(info[8]), float(info[9])
+        names = tuple(movable) if joint_names is None else tuple(joint_names)
+        unknown = [n for n in names if n not in movable]
+        if unknown or len(set(names)) != len(movable):
+            raise ScenarioError(
+                f"robot {self.name}: joint_names {', '.join(names)} must name each movable joint once; "
+                f"movable joints: {', '.join(movable)}"
+            )
+        self.joint_names: tuple[str, ...] = names
+        self._joint_ids = [movable[n] for n in names]
+        self.q_min = readonly([lower[n] for n in names])
+        self.q_max = readonly([upper[n] for n in names])
+        # pose of the root link frame in its inertial frame (getBasePositionAndOrientation gives the latter)
+        dyn = client.getDynamicsInfo(self.body, -1)
+        self._X_inertial_base = np.linalg.inv(_pose(dyn[3], dyn[4]))
+        self.set_q(q)
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        return tuple(self._links)
+
+    def link_index(self, link: str) -> int:
+        """PyBullet link index of ``link`` (-1 for the root); KeyError naming the links if there is none."""
+        try:
+            return self._links[link]
+        except KeyError:
+            raise KeyError(f"robot {self.name} has no link {link!r}; links: {', '.join(self._links)}") from None
+
+    def _q(self, q: npt.ArrayLike) -> FloatArray:
+        qa = np.asarray(q, dtype=float)
+        if qa.shape != (self.dof,) or not np.all(np.isfinite(qa)):
+            raise ValueError(f"robot {self.name}: q must be {self.dof} finite values [rad], got {qa.shape}")
+        return qa
+
+    def set_q(self, q: npt.ArrayLike) -> None:
+        """Put the arm at joint values q (dof,) [rad] (kinematic: no dynamics, zero velocity)."""
+        qa = self._q(q)
+        self._c.resetJointStatesMultiDof(self.body, self._joint_ids, [[float(v)] for v in qa])
+
+    @property
+    def q(self) -> FloatArray:
+        """Current joint values (dof,) [rad], read back from PyBullet."""
+        return np.array([s[0] for s in self._c.getJointStates(self.body, self._joint_ids)])
+
+    def link_pose(self, link: str) -> FloatArray:
+        """X_W_link (4, 4): pose of the URDF frame of ``link`` in W at the current joint values."""
+        i = self.link_index(link)
+        if i < 0:
+            pos, orn = self._c.getBasePositionAndOrientation(self.body)
+            return _pose(pos, orn) @ self._X_inertial_base
+        state = self._c.getLinkState(self.body, i, computeForwardKinematics=True)
+        return _pose(state[4], state[5])  # worldLinkFramePosition/Orientation: the URDF link frame
+
+    def limit_violation(self, q: FloatArray) -> str:
+        """'' when every row of q (n, dof) is within the URDF limits, else which joint leaves them first."""
+        out = (q < self.q_min - _LIMIT_TOL) | (q > self.q_max + _LIMIT_TOL)
+        if not out.any():
+            return ""
+        row, col = np.argwhere(out)[0]
+        return (
+            f"{self.joint_names[col]} = {np.degrees(q[row, col]):.2f} deg at sample {row}, "
+            f"limits [{np.degrees(self.q_min[col]):.2f}, {np.degrees(self.q_max[col]):.2f}] deg"
+        )
+
+    def play(
+        self,
+        times: npt.ArrayLike,
+        q: npt.ArrayLike,
+        arc_on: npt.ArrayLike,
+        *,
+        tcp_link: str,
+        record_dt: float,
+        record_poses: bool = True,
+        marks: Sequence[tuple[float, str]] = (),
+    ) -> Execution:
+        """Play a timed joint trajectory kinematically and record the tool path (see ``SimCell.execute``)."""
+        t_in, q_in, arc_in = _check_trajectory(times, q, arc_on, self.dof)
+        tcp = self.link_index(tcp_link)
+        bad = self.limit_violation(q_in)
+        if bad:
+            raise PlanError(f"trajectory leaves the joint limits of robot {self.name}: {bad}")
+        t_rec = _record_times(t_in, arc_in, record_dt)
+        q_rec = _interp_rows(t_rec, t_in, q_in)
+        arc_rec = arc_in[np.searchsorted(t_in, t_rec, side="right") - 1]
+        pos = np.empty((len(t_rec), 3))
+        quat = np.empty((len(t_rec), 4))
+        for k, qk in enumerate(q_rec):
+            self._c.resetJointStatesMultiDof(self.body, self._joint_ids, [[float(v)] for v in qk])
+            if tcp < 0:
+                p, o = self._c.getBasePositionAndOrientation(self.body)
+                X = _pose(p, o) @ self._X_inertial_base
+                pos[k], quat[k] = X[:3, 3], _quat_from_matrix(X[:3, :3])
+            else:
+                state = self._c.getLinkState(self.body, tcp, computeForwardKinematics=True)
+                pos[k], quat[k] = state[4], state[5]
+        X_W_tcp = None
+        if record_poses:
+            X_W_tcp = np.tile(np.eye(4), (len(t_rec), 1, 1))
+            X_W_tcp[:, :3, :3] = _matrices_from_quats(quat)
+            X_W_tcp[:, :3, 3] = pos
+        events = _events(t_rec, q_rec, pos, arc_rec, marks)
+        return Execution(times=t_rec, q=q_rec, tcp_W=pos, arc_on=arc_rec, events=events, X_W_tcp=X_W_tcp)
+
+
+def _events(
+    t: FloatArray,
+    q: FloatArray,
+    tcp_W: FloatArray,
+    arc_on: npt.NDArray[np.bool_],
+    marks: Sequence[tuple[float, str]],
+) -> tuple[Event, ...]:
+    """The log: a move mark at the start (and the caller's marks), arc_on/arc_off at every switch."""
+    q_deg = np.round(np.degrees(q[0]), 2).tolist()
+    log = [Event(float(t[0]), "move", f"start at q = {q_deg} deg, {t[-1] - t[0]:.3f} s of motion")]
+    log += [Event(float(tm), "move", str(text)) for tm, text in marks]
+    for k in range(len(t)):
+        was = bool(arc_on[k - 1]) if k > 0 else False
+        if bool(arc_on[k]) != was:
+            kind = "arc_on" if arc_on[k] else "arc_off"
+            log.append(Event(float(t[k]), kind, f"tcp at {np.round(tcp_W[k] * 1000.0, 1).tolist()} mm in W"))
+    if arc_on[-1]:  # the arc is never left burning past the end of a trajectory
+        log.append(Event(float(t[-1]), "arc_off", "end of trajectory"))
+    log.sort(key=lambda e: e.t)  # stable: the start mark stays first
+    return tuple(log)
+
+
+def bead_chords(tcp_W: FloatArray, arc_on: npt.NDArray[np.bool_], step_m: float) -> list[tuple[FloatArray, FloatArray]]:
+    """Straight pieces (a, b) [m] of about ``step_m`` along the tool path where the arc is on.
+
+    The arc state ``arc_on[k]`` holds from record k to record k + 1, so a run of on-samples k0..k1 welds the
+    path from point k0 to point k1 + 1 (or to the last point).
+    """
+    out: list[tuple[FloatArray, FloatArray]] = []
+    on = np.asarray(arc_on, bool)
+    k = 0
+    n = len(on)
+    while k < n:
+        if not on[k]:
+            k += 1
+            continue
+        k1 = k
+        while k1 + 1 < n and on[k1 + 1]:
+            k1 += 1
+        pts = _chord_points(tcp_W[k : min(k1 + 2, n)], step_m)
+        out.extend((pts[i], pts[i + 1]) for i in range(len(pts) - 1))
+        k = k1 + 1
+    return out
+
+
+def add_bead(client: BulletClient, a_W: FloatArray, b_W: FloatArray, style: BeadStyle) -> int:
+    """A visual-only capsule (no collision shape) from a to b [m] in W; returns its body id."""
+    d = np.asarray(b_W, float) - np.asarray(a_W, float)
+    length = float(np.linalg.norm(d))
+    z = d / length
+    x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
+    x /= np.linalg.norm(x)
+    R = np.column_stack([x, np.cross(z, x), z])  # PyBullet capsules lie along their local z axis
+    visual = client.createVisualShape(
+        pybullet.GEOM_CAPSULE, radius=style.radius_m, length=length, rgbaColor=list(style.rgba)
+    )
+    body = client.createMultiBody(
+        baseMass=0.0,
+        baseCollisionShapeIndex=-1,
+        baseVisualShapeIndex=visual,
+        basePosition=[float(v) for v in (np.asarray(a_W, float) + d / 2.0)],
+        baseOrientation=_quat_from_matrix(R),
+    )
+    return int(body)
+
+
+def bead_segment(client: BulletClient, body: int) -> tuple[FloatArray, FloatArray]:
+    """End points (a, b) in W [m] of a bead capsule's axis, read back from PyBullet."""
+    pos, orn = client.getBasePositionAndOrientation(body)
+    shape = client.getVisualShapeData(body)[0]
+    half = float(shape[3][1]) / 2.0  # visual dimensions of a capsule: (radius, length, ...)
+    axis = _matrices_from_quats(orn)[0][:, 2]
+    p = np.asarray(pos, dtype=float)
+    return p - half * axis, p + half * axis

@@ -4,6 +4,11 @@ The world frame W has z up; the ground is the plane z = 0. Bodies are static box
 (``"ground"``, ``"table"`` and each part's name), never by index. Cameras render with PyBullet's TinyRenderer
 (headless, CPU), also when a GUI is shown, because its sampling is the one :mod:`cell.sim.camera` models
 exactly.
+
+An arm can be added with :meth:`SimCell.load_robot` (see :mod:`cell.sim.robot`): it is then posed by joint
+values, plays back timed joint trajectories (:meth:`SimCell.execute`), draws the weld bead where the arc is on,
+and carries the eye-in-hand camera. Its links render in every camera, as a real arm would: put it in a scan
+pose out of the fixed cameras' way before capturing.
 """
 
 from __future__ import annotations
@@ -12,9 +17,11 @@ import contextlib
 import os
 import sys
 from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
 from types import MappingProxyType, TracebackType
 
 import numpy as np
+import numpy.typing as npt
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 from scipy.spatial.transform import Rotation
@@ -24,6 +31,7 @@ from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.noise import apply_noise, perturb_pose
+from cell.sim.robot import BeadStyle, Execution, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
 
 GROUND = "ground"
@@ -31,6 +39,8 @@ TABLE = "table"
 _GROUND_SIZE = (20.0, 20.0, 0.02)  # [m] a thin box whose top face is the plane z = 0
 _RGBA = {GROUND: (0.35, 0.35, 0.35, 1.0), TABLE: (0.55, 0.45, 0.35, 1.0)}
 _PART_RGBA = (0.7, 0.72, 0.75, 1.0)
+DEFAULT_BEAD = BeadStyle()
+EYE_IN_HAND_LINK = "camera_optical"  # the arm's optical frame of the eye-in-hand camera (z forward, y down)
 
 
 @contextlib.contextmanager
@@ -77,6 +87,8 @@ class SimCell:
             )
         self._bodies: dict[str, int] = {}
         self._noise_rngs: dict[str, np.random.Generator] = {}
+        self._robot: SimRobot | None = None
+        self._beads: list[int] = []
         ground = Box(make_pose(p=(0.0, 0.0, -_GROUND_SIZE[2] / 2.0)), np.array(_GROUND_SIZE))
         self._add_box(GROUND, ground, _RGBA[GROUND])
         table = scenario.table
@@ -157,14 +169,16 @@ class SimCell:
     def capture(self, camera: str, X_WC: FloatArray | None = None) -> DepthImage:
         """One depth image from ``camera``.
 
-        X_WC : true pose (4, 4) of the optical frame in W to render from (an eye-in-hand camera's pose from
-            the arm); the scenario's fixed pose when None.
+        X_WC : true pose (4, 4) of the optical frame in W to render from; when None, the scenario's pose, or
+            for an eye-in-hand camera with a robot loaded, the pose of the arm's ``camera_optical`` link.
         The image carries the *believed* pose (true pose with the camera's calibration error) and exact
         intrinsics. With ``scenario.noise == "realistic"`` the camera's sensor model is applied; its random
         stream starts from ``scenario.rng(camera)`` and continues across captures (a second capture has new
         noise).
         """
         spec = self.camera_spec(camera)
+        if X_WC is None and spec.mount == "eye_in_hand" and self._robot is not None:
+            X_WC = self._robot.link_pose(EYE_IN_HAND_LINK)  # the camera rides on the arm
         X_true = spec.X_WC if X_WC is None else np.asarray(X_WC, dtype=float)
         if X_true.shape != (4, 4):
             raise ValueError(f"X_WC must be (4, 4), got {X_true.shape}")
@@ -179,8 +193,93 @@ class SimCell:
         return DepthImage(camera=camera, depth=noisy, intrinsics=intr, X_WC=X_believed, mount=spec.mount)
 
     def capture_all(self) -> dict[str, DepthImage]:
-        """One capture from every camera of the scenario at its scenario pose, by camera name."""
+        """One capture from every camera of the scenario, by camera name: fixed cameras at their scenario pose,
+        an eye-in-hand camera where the arm holds it (its scenario pose when no robot is loaded)."""
         return {name: self.capture(name) for name in self.scenario.cameras}
+
+    # -- robot -----------------------------------------------------------------------------------------------
+
+    def load_robot(
+        self,
+        urdf_path: str | Path,
+        X_WR: npt.ArrayLike,
+        q: npt.ArrayLike,
+        *,
+        joint_names: Sequence[str] | None = None,
+    ) -> SimRobot:
+        """Add the arm: its URDF with a fixed base, root link (``base_link``) at X_WR (4, 4) in W, joints at q.
+
+        q : (dof,) [rad] in the order of ``joint_names`` (default: the URDF's movable joints in tree order;
+        pass ``RobotModel.joint_names`` to tie both models to one order). One robot per cell.
+        """
+        if self._robot is not None:
+            raise ScenarioError(f"a robot ({self._robot.name}) is already loaded; one robot per SimCell")
+        self._robot = SimRobot(self.client, urdf_path, X_WR, q, joint_names)
+        return self._robot
+
+    @property
+    def robot(self) -> SimRobot:
+        """The loaded arm; ScenarioError when there is none (SensorError once the cell is closed)."""
+        self.client  # noqa: B018 - raises once closed, before a stale robot is used
+        if self._robot is None:
+            raise ScenarioError("this cell has no robot; call SimCell.load_robot(urdf_path, X_WR, q) first")
+        return self._robot
+
+    def set_q(self, q: npt.ArrayLike) -> None:
+        """Put the arm at joint values q (dof,) [rad]."""
+        self.robot.set_q(q)
+
+    def link_pose(self, link: str) -> FloatArray:
+        """X_W_link (4, 4): pose of the arm's link frame ``link`` (by URDF name) in W, from PyBullet."""
+        return self.robot.link_pose(link)
+
+    def execute(
+        self,
+        times: npt.ArrayLike,
+        q: npt.ArrayLike,
+        arc_on: npt.ArrayLike,
+        *,
+        tcp_link: str = "torch_tcp",
+        record_dt: float = 0.01,
+        record_poses: bool = True,
+        marks: Sequence[tuple[float, str]] = (),
+        bead: BeadStyle | None = DEFAULT_BEAD,
+    ) -> Execution:
+        """Drive the arm along a timed joint trajectory and record what the tool did.
+
+        times : (n,) strictly increasing [s]; q : (n, dof) [rad]; arc_on : (n,) bool, holding from each sample
+            to the next (the arc switches exactly at the sample where the flag changes).
+        Playback is kinematic and deterministic (joint values interpolated linearly between samples), far
+        faster than real time. Records every ``record_dt`` [s], at every arc switch and at the end: the pose of
+        ``tcp_link`` in W from PyBullet's own kinematics, and the arc state. ``marks`` (time [s], text) are
+        logged as ``"move"`` events (e.g. segment starts). Where the arc is on, a weld bead is drawn (visual
+        only, see :class:`BeadStyle`; None draws none). PlanError when q leaves the URDF's joint limits.
+        The arm stays at the last configuration.
+        """
+        robot = self.robot
+        ex = robot.play(
+            times, q, arc_on, tcp_link=tcp_link, record_dt=record_dt, record_poses=record_poses, marks=marks
+        )
+        if bead is not None:
+            for a, b in bead_chords(ex.tcp_W, ex.arc_on, bead.step_m):
+                self._beads.append(add_bead(self.client, a, b, bead))
+        return ex
+
+    def bead_segments(self) -> FloatArray:
+        """(m, 2, 3) end points [m] in W of every bead capsule drawn so far, read back from PyBullet."""
+        segs = [bead_segment(self.client, b) for b in self._beads]
+        return np.array(segs, dtype=float).reshape(len(segs), 2, 3)
+
+    def clear_beads(self) -> None:
+        """Remove every weld bead drawn so far."""
+        for b in self._beads:
+            self.client.removeBody(b)
+        self._beads.clear()
+
+    def capture_from_link(self, camera: str, link: str = EYE_IN_HAND_LINK) -> DepthImage:
+        """One depth image from ``camera`` rendered from the arm's link frame ``link`` (optical convention:
+        z forward, x right, y down), with the camera's noise and calibration error as in :meth:`capture`."""
+        return self.capture(camera, X_WC=self.robot.link_pose(link))
 
     # -- lifetime --------------------------------------------------------------------------------------------
 
@@ -189,6 +288,8 @@ class SimCell:
         if self._client is not None:
             self._client.disconnect()
             self._client = None
+        self._robot = None
+        self._beads.clear()
 
     def __enter__(self) -> SimCell:
         return self

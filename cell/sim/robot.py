@@ -385,7 +385,7 @@ def bead_segment(client: BulletClient, body: int) -> tuple[FloatArray, FloatArra
     """End points (a, b) in W [m] of a bead capsule's axis, read back from PyBullet."""
     pos, orn = client.getBasePositionAndOrientation(body)
     shape = client.getVisualShapeData(body)[0]
-    half = float(shape[3][1]) / 2.0  # visual dimensions of a capsule: (radius, length, ...)
+    half = float(shape[3][0]) / 2.0  # visual dimensions of a capsule: (length, radius, 0)
     axis = _matrices_from_quats(orn)[0][:, 2]
     p = np.asarray(pos, dtype=float)
     return p - half * axis, p + half * axis

@@ -4,6 +4,10 @@
 
 Goals (issue "Motion"): warm-started IK median <= 0.5 ms per pose; ptp computation <= 100 us.
 Times are wall-clock per call on this machine (single thread); the table gives median, 90th percentile, max.
+
+Second section, welding plans: every visible seam of each paper scenario's welding map (the designed seams in
+the robot frame, no perception: the planner's cost alone) planned by ``plan_welds``, then the safety gate with
+and without collision checks: planning time, cycle and arc time, gate times.
 """
 
 from __future__ import annotations
@@ -138,6 +142,59 @@ def run(seed: int) -> list[dict[str, object]]:
     return rows
 
 
+def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, object]]:
+    """Plan every visible designed seam of each scenario; times [s]."""
+    from cell import scenario as sc
+    from cell.geometry import invert
+    from cell.motion.checks import find_violations
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.plan import SeamTask, cell_obstacles, plan_welds
+    from cell.motion.torch import WeldProcess
+    from cell.seams.joint import find_joints, weld_faces
+    from cell.seams.visibility import visibility
+    from cell.weldmap import read_map
+
+    rows: list[dict[str, object]] = []
+    for name in names:
+        s = sc.load(name)
+        assert s.robot.urdf is not None and s.robot.home_deg is not None
+        robot = RobotModel.from_urdf(sc.REPO_ROOT / "robots" / s.robot.urdf)
+        X_RM = invert(s.X_WR) @ s.X_WM
+        wm = read_map(s.map_path, units=s.map.units).transformed(X_RM, "R")
+        joints = find_joints(wm)
+        table_z = float((invert(s.X_WR) @ [0.0, 0.0, s.table.top_z, 1.0])[2])
+        tasks = []
+        for seam in wm.seams:
+            if visibility(wm, joints[seam.id], table_z)[0]:
+                n_a, _, n_b, _ = weld_faces(wm, joints[seam.id])
+                tasks.append(SeamTask(seam.id, seam.p_start, seam.p_end, n_a, n_b))
+        obstacles = cell_obstacles(wm, s.X_WR, s.table.center_m, s.table.size_m)
+        home = np.radians(s.robot.home_deg)
+        process = WeldProcess.from_spec(s.process, s.robot.stickout_mm)
+        plan = plan_welds(robot, tasks, home, process, obstacles, rng=s.rng("plan"))
+        checker = CollisionChecker(robot, obstacles)
+        t0 = time.perf_counter()
+        find_violations(robot, plan, home)
+        t_gate = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        found = find_violations(robot, plan, home, checker=checker)
+        t_all = time.perf_counter() - t0
+        rows.append(
+            {
+                "scenario": name,
+                "seams": len(tasks),
+                "planned": sum(o.feasible for o in plan.seams),
+                "planning_s": plan.planning_s,
+                "cycle_s": plan.cycle_time,
+                "arc_s": plan.arc_time,
+                "gate_s": t_gate,
+                "collision_check_s": t_all - t_gate,
+                "violations": len(found),
+            }
+        )
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path, help="also write the rows to this JSON file")
@@ -152,8 +209,17 @@ def main() -> None:
             f"{r['case']:<36} {r['n']:>5} {r['median_us']:>10.1f} {r['p90_us']:>9.1f} {r['max_us']:>9.1f} "
             f"{goal:>8}  {ok}"
         )
+    plans = run_plans()
+    print()
+    print(f"{'welding plan':<14} {'seams':>5} {'planned':>7} {'plan s':>7} {'cycle s':>8} {'arc s':>7} "
+          f"{'gate s':>7} {'collide s':>9} {'viol':>5}")
+    for p in plans:
+        print(
+            f"{p['scenario']:<14} {p['seams']:>5} {p['planned']:>7} {p['planning_s']:>7.2f} {p['cycle_s']:>8.1f} "
+            f"{p['arc_s']:>7.1f} {p['gate_s']:>7.2f} {p['collision_check_s']:>9.2f} {p['violations']:>5}"
+        )
     if args.json:
-        args.json.write_text(json.dumps(rows, indent=2))
+        args.json.write_text(json.dumps({"primitives": rows, "plans": plans}, indent=2))
 
 
 if __name__ == "__main__":

@@ -30,9 +30,7 @@ app.add_typer(map_app, name="map")
 err = Console(stderr=True, highlight=False)
 out = Console(highlight=False, width=140)
 
-NoiseOpt = Annotated[
-    str | None, typer.Option("--noise", help="Override the scenario's noise model: none | realistic.")
-]
+NoiseOpt = Annotated[str | None, typer.Option("--noise", help="Override the scenario's noise model: none | realistic.")]
 
 
 @contextmanager
@@ -91,9 +89,7 @@ def detect(
     ] = None,
     noise: NoiseOpt = None,
     json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
-    save_cloud: Annotated[
-        Path | None, typer.Option(help="Write the spliced cloud (robot frame) as PLY.")
-    ] = None,
+    save_cloud: Annotated[Path | None, typer.Option(help="Write the spliced cloud (robot frame) as PLY.")] = None,
 ) -> None:
     """Capture the cell, splice the clouds, align the map and locate every seam; report errors against truth."""
     from cell import pipeline
@@ -102,11 +98,7 @@ def detect(
 
     with _cell_errors():
         scn = sc.load(scenario)
-        if method is not None:
-            from cell.seams.registry import METHODS
-
-            if method not in METHODS:
-                raise typer.BadParameter(f"{method!r}; valid: {', '.join(METHODS)}", param_hint="--method")
+        _check_method(method)
         det = pipeline.detect(scn, method, noise=_noise(noise), progress=_progress())
         if json_path is not None:
             write_json(json_path, detection_report(det))
@@ -167,6 +159,134 @@ def bench(
         err.print(f"[dim]· rows written to {json_path} and {json_path.with_suffix('.md')}[/]")
 
 
+@app.command()
+def weld(
+    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
+    noise: NoiseOpt = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
+    krl: Annotated[
+        Path | None, typer.Option(help="Write the KUKA KRL program (.src/.dat) and the trajectory (JSON, CSV) here.")
+    ] = None,
+    gui: Annotated[bool, typer.Option(help="Open the PyBullet window (needs a display).")] = False,
+) -> None:
+    """The whole cell: capture, locate every seam, plan the torch paths, check them, weld in simulation."""
+    from cell import pipeline
+    from cell import scenario as sc
+
+    with _cell_errors():
+        scn = sc.load(scenario)
+        _check_method(method)
+        run = pipeline.weld(scn, method, noise=_noise(noise), progress=_progress(), gui=gui)
+        _finish_run(run, json_path, krl, title="weld")
+
+
+@app.command()
+def preview(
+    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures and the report.")] = Path("preview"),
+    method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
+    noise: NoiseOpt = None,
+) -> None:
+    """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots."""
+    from cell import pipeline
+    from cell import scenario as sc
+    from cell.preview import write_run
+
+    with _cell_errors():
+        scn = sc.load(scenario)
+        _check_method(method)
+        run = pipeline.weld(scn, method, noise=_noise(noise), execute_plan=False, progress=_progress())
+        from cell.station import load_arm
+
+        _progress()(f"drawing pictures into {out_dir}/")
+        paths = write_run(run, out_dir, load_arm(scn).model.limits)
+        _finish_run(run, out_dir / "report.json", None, title="preview")
+        for p in paths:
+            err.print(f"[dim]· {p}[/]")
+
+
+def _check_method(method: str | None) -> None:
+    from cell.seams.registry import METHODS
+
+    if method is not None and method not in METHODS:
+        raise typer.BadParameter(f"{method!r}; valid: {', '.join(METHODS)}", param_hint="--method")
+
+
+def _finish_run(run: object, json_path: Path | None, krl: Path | None, *, title: str) -> None:
+    """Write what was asked (report first: it survives any later failure), print the table, exit with the code."""
+    from cell.export.report import weld_report, write_json
+    from cell.pipeline import WeldRun
+
+    assert isinstance(run, WeldRun)
+    rep = weld_report(run)
+    if json_path is not None:
+        write_json(json_path, rep)
+        err.print(f"[dim]· report written to {json_path}[/]")
+    if krl is not None and run.plan is not None and run.plan.segments:
+        from cell.export.krl import write_krl
+        from cell.export.trajectory import write_csv
+        from cell.export.trajectory import write_json as write_traj
+        from cell.station import load_arm
+
+        name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in run.detection.scenario.name).upper()
+        src, dat = write_krl(
+            run.plan, load_arm(run.detection.scenario).model, krl, name[:24], X_WR=run.detection.scenario.X_WR
+        )
+        traj_json = write_traj(run.plan, krl / "trajectory.json")
+        traj_csv = write_csv(run.plan, krl / "trajectory.csv")
+        err.print(f"[dim]· robot program: {src}, {dat}; trajectory: {traj_json}, {traj_csv}[/]")
+    _print_weld(rep, title)
+    if run.error is not None:
+        err.print(f"[bold red]error[/]: {run.error.message}", soft_wrap=True)
+        raise typer.Exit(run.error.exit_code)
+    if not run.complete:
+        raise typer.Exit(EXIT_PARTIAL)
+
+
+def _print_weld(rep: dict, title: str) -> None:
+    t = Table(
+        title=f"{title} {rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
+        title_justify="left",
+    )
+    for col in (
+        "seam",
+        "detected",
+        "paper ME mm",
+        "lateral mm",
+        "welded",
+        "TCP rms mm",
+        "TCP max mm",
+        "weld s",
+        "why not",
+    ):
+        t.add_column(col, justify="left" if col in ("seam", "detected", "welded", "why not") else "right")
+    for s in rep["seams"]:
+        e = s.get("error_mm", {})
+        tcp = s.get("tcp_error_mm", {})
+        t.add_row(
+            s["id"],
+            s["status"],
+            _fmt(e.get("paper_me")),
+            _fmt(e.get("lateral")),
+            "yes" if s["welded"] else "no",
+            _fmt(tcp.get("rms")),
+            _fmt(tcp.get("max")),
+            _fmt(s.get("weld_time_s"), 1),
+            s.get("weld_reason", ""),
+        )
+    out.print(t)
+    m = rep["summary"]
+    cyc = rep["cycle_time_s"] if rep["cycle_time_s"] else rep["planned_cycle_time_s"]
+    out.print(
+        f"welded {rep['welded']}/{m['visible']} visible seams ({m['seams']} in the map) · located {m['found']} · "
+        f"paper ME mean {_fmt(m['paper_me_mean_mm'])} mm · cycle time {_fmt(cyc, 1)} s"
+        + ("" if rep["cycle_time_s"] else " (planned)")
+    )
+    tim = rep["timings_s"]
+    out.print("time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None))
+
+
 def _fmt(v: float | None, nd: int = 2) -> str:
     return "-" if v is None else f"{v:.{nd}f}"
 
@@ -198,14 +318,13 @@ def _print_detection(det: object) -> None:
     out.print(t)
     m = rep["summary"]
     out.print(
-        f"found {m['found']}/{m['visible']} visible ({m['seams']} seams) · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm"
-        f" (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint {_fmt(m['endpoint_mean_mm'])} mm · lateral"
+        f"found {m['found']}/{m['visible']} visible ({m['seams']} seams) · paper ME mean"
+        f" {_fmt(m['paper_me_mean_mm'])} mm (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint"
+        f" {_fmt(m['endpoint_mean_mm'])} mm · lateral"
         f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)"
     )
     tim = rep["timings_s"]
-    out.print(
-        "time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None)
-    )
+    out.print("time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None))
 
 
 def main() -> None:

@@ -1,4 +1,4 @@
-"""The only place that knows the order of the stages: capture -> perceive -> align map -> locate -> evaluate.
+"""The only place that knows the order of the stages: capture -> perceive -> align map -> locate -> plan -> execute.
 
 Each stage is a function taking values and returning values; this module wires them and times them. The CLI is a thin
 layer over :func:`detect` (and, for the bench, over :func:`capture`, :func:`build_scene` and :func:`locate`).
@@ -11,14 +11,20 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
+from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray, invert
+from cell.motion.quality import WeldQuality
 from cell.scenario import Scenario
 from cell.seams.base import SeamScene
 from cell.seams.metrics import MetricsSummary, SeamMetrics
+from cell.station import Station
 from cell.types import DepthImage, Part, SeamEstimate, SeamStatus, WeldMap
 
 if TYPE_CHECKING:  # heavy imports stay inside the stages that need them
+    from cell.motion.plan import WeldPlan
+    from cell.motion.timing import Trajectory
     from cell.perception import Alignment, Perceived
+    from cell.sim.robot import Execution
 
 Progress = Callable[[str], None]
 
@@ -70,20 +76,22 @@ class Detection:
         return all(e.status is not SeamStatus.NOT_FOUND for e in self.estimates)
 
 
-def capture(scenario: Scenario, *, gui: bool = False, progress: Progress = _quiet) -> Capture:
-    """Build the simulated cell from the scenario and take one image with every camera."""
-    from cell.asbuilt import as_built_parts
-    from cell.sim.cell import SimCell
-    from cell.weldmap import read_map
+def capture(
+    scenario: Scenario, *, gui: bool = False, progress: Progress = _quiet, station: Station | None = None
+) -> Capture:
+    """Take one image with every camera of the scenario's cell (built here unless a running ``station`` is given).
 
+    With a robot in the scenario, the arm first moves to its scan configuration: the eye-in-hand camera rides on
+    it. The capture keeps the as-built parts (ground truth) for measuring, never for perception.
+    """
     t0 = time.perf_counter()
-    progress(f"reading welding map {scenario.map_path.name}")
-    weldmap = read_map(scenario.map_path, units=scenario.map.units)
-    parts_W = as_built_parts(weldmap, scenario)
+    if station is None:
+        progress(f"building the cell of {scenario.name}")
+        with Station(scenario, gui=gui) as st:
+            return capture(scenario, progress=progress, station=st)
     progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
-    with SimCell(scenario, parts_W, gui=gui) as sim:
-        images = sim.capture_all()
-    return Capture(scenario, weldmap, parts_W, images, time.perf_counter() - t0)
+    images = station.capture()
+    return Capture(scenario, station.weldmap, station.parts_W, images, time.perf_counter() - t0)
 
 
 def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
@@ -119,9 +127,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     return Scene(seam_scene, perceived, alignment, X_RM, timings)
 
 
-def locate(
-    scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet
-) -> tuple[SeamEstimate, ...]:
+def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet) -> tuple[SeamEstimate, ...]:
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
     from cell.seams.registry import make_locator
     from cell.seams.visibility import visibility
@@ -139,9 +145,7 @@ def locate(
         t = time.perf_counter()
         est = locator.locate(ss, seam, rng)
         dt = time.perf_counter() - t
-        out.append(
-            SeamEstimate(est.id, est.status, est.reason, est.p_start, est.p_end, est.confidence, time_s=dt)
-        )
+        out.append(SeamEstimate(est.id, est.status, est.reason, est.p_start, est.p_end, est.confidence, time_s=dt))
     return tuple(out)
 
 
@@ -173,13 +177,14 @@ def detect(
     noise: Literal["none", "realistic"] | None = None,
     progress: Progress = _quiet,
     gui: bool = False,
+    station: Station | None = None,
 ) -> Detection:
     """Capture, perceive, align and locate every seam of the scenario's welding map; measure against truth."""
     if noise is not None:
         scenario = scenario.with_noise(noise)
     method = method or scenario.locator.method
     t_all = time.perf_counter()
-    cap = capture(scenario, gui=gui, progress=progress)
+    cap = capture(scenario, gui=gui, progress=progress, station=station)
     scene = build_scene(cap, progress=progress)
     estimates = locate(scene, scenario, method, progress=progress)
     weldmap_R = scene.seam_scene.weldmap
@@ -200,3 +205,191 @@ def detect(
         lost_cameras=scene.perceived.lost,
         scene=scene,
     )
+
+
+# -- plan and execute ------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SeamWeld:
+    """What became of one seam in ``cell weld``: welded, or why not; how well (executed TCP vs the true seam)."""
+
+    id: str
+    welded: bool
+    reason: str = ""
+    quality: WeldQuality | None = None
+
+
+@dataclass(frozen=True)
+class WeldRun:
+    """The outcome of ``cell weld`` / ``cell preview``.
+
+    plan : the checked welding plan (None when planning failed as a whole: see ``error``).
+    execution : what the simulated arm did (None for a preview or when the gate refused the plan).
+    error : the failure that stopped the run after detection, or None; the rest of the run is still reported.
+    """
+
+    detection: Detection
+    seams: tuple[SeamWeld, ...]
+    plan: WeldPlan | None = None
+    pre_move: Trajectory | None = None
+    execution: Execution | None = None
+    violations: tuple[str, ...] = ()
+    error: CellError | None = None
+    timings: dict[str, float] = field(default_factory=dict)
+    torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT
+
+    @property
+    def cycle_time_s(self) -> float:
+        """Robot time of the executed program, from the scan pose to home [s] (0 when nothing moved)."""
+        return self.execution.duration if self.execution is not None else 0.0
+
+    @property
+    def complete(self) -> bool:
+        """Every seam that can be seen was welded (or, for a preview, planned) and nothing failed."""
+        vis = [
+            w
+            for w, e in zip(self.seams, self.detection.estimates, strict=True)
+            if e.status is not SeamStatus.NOT_VISIBLE
+        ]
+        return self.error is None and all(w.welded for w in vis)
+
+
+def plan_for(
+    station: Station, det: Detection, *, progress: Progress = _quiet
+) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
+    """Plan the found seams of a detection and run the safety gate (REFERENCE section 7).
+
+    Returns the plan, the move from the scan pose to home that precedes it, and the gate's violations (empty when
+    the plan may run). PlanError when nothing can be planned at all.
+    """
+    from cell.motion.checks import find_violations
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.plan import cell_obstacles, plan_welds, seam_tasks
+    from cell.motion.timing import ptp
+    from cell.motion.torch import WeldProcess
+
+    sc = det.scenario
+    arm = station.arm
+    if arm is None:
+        raise ScenarioError(f"scenario {sc.name!r} has no robot to weld with: set robot.urdf and robot.X_WR")
+    assert det.scene is not None
+    ss = det.scene.seam_scene
+    tasks = seam_tasks(det.estimates, ss.weldmap, ss.joints, ss.table_z)
+    obstacles = cell_obstacles(ss.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
+    checker = CollisionChecker(arm.model, obstacles)
+    progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
+    process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
+    plan = plan_welds(arm.model, tasks, arm.q_home, process, obstacles, rng=sc.rng("plan"), checker=checker)
+    pre = ptp(arm.q_scan, arm.q_home, arm.model.limits, dt=0.001)
+    problems = []
+    hit = checker.check_path(pre.q, pre.times)
+    if hit is not None:
+        problems.append(f"move from the scan pose to home collides: {hit.describe()}")
+    progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
+    problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker)]
+    return plan, pre, tuple(problems)
+
+
+def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = _quiet) -> Execution:
+    """Drive the simulated arm: the move from the scan pose to home, then the welding program; arc where planned."""
+    import numpy as np
+
+    traj, arc = plan.joint_trajectory()
+    times = np.concatenate([pre.times, traj.times[1:] + pre.duration])
+    q = np.concatenate([pre.q, traj.q[1:]])
+    arc_on = np.concatenate([np.zeros(len(pre.times), bool), arc[1:]])
+    marks = [(0.0, "move scan -> home")] + [
+        (pre.duration + seg.t0, f"{seg.kind} {seg.seam_id}".strip()) for seg in plan.segments
+    ]
+    progress(f"executing {plan.cycle_time + pre.duration:.1f} s of robot motion in the simulator")
+    return station.sim.execute(times, q, arc_on, marks=marks, record_dt=0.01)
+
+
+def _seam_welds(
+    det: Detection, plan: WeldPlan | None, ex: Execution | None, pre_s: float, refused: str
+) -> tuple[SeamWeld, ...]:
+    """Per seam: welded (with its quality against the true seam) or the reason it was not."""
+    import numpy as np
+
+    from cell.geometry import transform_points
+    from cell.motion.quality import weld_quality
+
+    X_RW = invert(det.scenario.X_WR)
+    out = []
+    for est in det.estimates:
+        if est.status is SeamStatus.NOT_VISIBLE:
+            out.append(SeamWeld(est.id, False, est.reason))  # e.g. against the table: needs a flip
+            continue
+        if est.status is not SeamStatus.FOUND:
+            out.append(SeamWeld(est.id, False, f"not located: {est.reason}"))
+            continue
+        outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
+        if outcome is None or not outcome.feasible:
+            out.append(SeamWeld(est.id, False, outcome.reason if outcome is not None else refused or "not planned"))
+            continue
+        if ex is None or plan is None:
+            out.append(SeamWeld(est.id, False, refused or "planned, not executed (preview)"))
+            continue
+        seg = next(g for g in plan.segments if g.arc_on and g.seam_id == est.id)
+        t0, t1 = pre_s + seg.t0, pre_s + seg.t1
+        k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
+        tcp_R = transform_points(X_RW, ex.tcp_W[k])
+        out.append(SeamWeld(est.id, True, "", weld_quality(ex.times[k], tcp_R, *det.truths[est.id])))
+    return tuple(out)
+
+
+def weld(
+    scenario: Scenario,
+    method: str | None = None,
+    *,
+    noise: Literal["none", "realistic"] | None = None,
+    execute_plan: bool = True,
+    progress: Progress = _quiet,
+    gui: bool = False,
+) -> WeldRun:
+    """The whole cell: capture, detect, plan, gate and (unless ``execute_plan`` is False: a preview) weld.
+
+    A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
+    every seam's reason, so the report can still be written.
+    """
+    t_all = time.perf_counter()
+    with Station(scenario.with_noise(noise) if noise else scenario, gui=gui) as station:
+        det = detect(station.scenario, method, progress=progress, station=station)
+        timings = dict(det.timings)
+        plan = pre = ex = None
+        violations: tuple[str, ...] = ()
+        error: CellError | None = None
+        try:
+            t = time.perf_counter()
+            plan, pre, violations = plan_for(station, det, progress=progress)
+            timings["plan_s"] = time.perf_counter() - t
+            if violations:
+                raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
+            if execute_plan:
+                t = time.perf_counter()
+                ex = execute(station, plan, pre, progress=progress)
+                timings["execute_s"] = time.perf_counter() - t
+        except CellError as e:
+            error = e
+        refused = f"not executed: {error.message}" if error is not None else ""
+        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused)
+        paths = torch_paths(station, plan) if plan is not None else {}
+        timings["total_s"] = time.perf_counter() - t_all
+        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths)
+
+
+def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:
+    """Planned torch poses X_RT (n, 4, 4) along each weld, every ``step_s`` of arc time (for pictures and reports)."""
+    import numpy as np
+
+    if station.arm is None:
+        return {}
+    model = station.arm.model
+    out = {}
+    for seg in plan.segments:
+        if seg.arc_on:
+            tr = seg.trajectory
+            k = np.unique(np.r_[np.searchsorted(tr.times, np.arange(0.0, tr.duration, step_s)), len(tr.times) - 1])
+            out[seg.seam_id] = np.stack([model.fk(tr.q[i]) for i in k])
+    return out

@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from cell.pipeline import WeldRun
+
 MM = 1000.0  # [mm/m]
 STATUS_COLOURS = {"found": "#2ca02c", "not_found": "#d62728", "not_visible": "#ff7f0e"}
 TRUTH_COLOUR = "#000000"
@@ -514,3 +516,33 @@ def render_html(
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.write_html(str(path), include_plotlyjs=True, full_html=True)
     return path
+
+
+def write_run(run: WeldRun, out_dir: str | Path, limits: JointLimits) -> list[Path]:
+    """Every picture of a ``cell weld`` / ``cell preview`` run: overview PNGs, joint plots and the HTML 3D view.
+
+    Tool paths are the executed ones when the arm moved, else the planned torch positions.
+    """
+    from cell.geometry import invert, transform_points
+
+    det = run.detection
+    assert det.scene is not None
+    cloud = det.scene.perceived.dense.points
+    views = seam_views(det.estimates, det.truths)
+    poses = dict(run.torch_paths)
+    if run.execution is not None:
+        ex = run.execution
+        X_RW = invert(det.scenario.X_WR)
+        tcp = {"executed": transform_points(X_RW, ex.tcp_W[ex.arc_on])}
+    else:
+        tcp = {sid: np.asarray(X)[:, :3, 3] for sid, X in poses.items()}
+    title = f"{det.scenario.name} · {det.method} · {det.scenario.noise} noise"
+    out = Path(out_dir)
+    paths = render_overview(cloud, det.weldmap_R, views, poses, tcp, out, title=title)
+    if run.plan is not None and run.plan.segments:
+        traj, arc = run.plan.joint_trajectory()
+        paths.append(
+            render_joint_plots(traj.times, traj.q, traj.qd, limits, out / "joints.png", arc_on=arc, title=title)
+        )
+    paths.append(render_html(cloud, det.weldmap_R, views, poses, tcp, out / "cell.html", title=title))
+    return paths

@@ -78,6 +78,32 @@ class RobotSpec(_Model):
     urdf: str | None = None  # relative to the repository's robots/ folder; None: no arm in the cell
     X_WR: PoseSpec = PoseSpec()
     home_deg: tuple[float, ...] | None = None
+    # Wire stick-out [mm] beyond the contact tip in the URDF's torch_tcp (robots/build_kr5_arc.py STICKOUT): the
+    # torch planner stands the TCP off the seam by contact_tip_distance_mm minus this (0 by default).
+    stickout_mm: Pos = 15.0
+
+
+class ProcessSpec(_Model):
+    """The arc welding process: speeds, torch angles and offsets (REFERENCE.md sections 4 and 7).
+
+    Angles follow the welding convention: the work angle is measured from face B (the receiving part's face) in
+    the plane perpendicular to the seam; the travel angle tilts the torch along the seam, positive = push (the
+    wire points ahead, in the weld direction), negative = drag.
+    """
+
+    travel_speed_mm_s: Annotated[float, Field(gt=0.0, le=100.0)] = 8.0  # MAG fillet 8-10 mm/s (section 4)
+    work_angle_deg: Annotated[float, Field(gt=0.0, lt=90.0)] = 45.0  # 45 bisects a square fillet (section 4)
+    work_angle_tol_deg: Annotated[float, Field(ge=0.0, le=30.0)] = 10.0  # how far the planner may move it
+    travel_angle_deg: Annotated[float, Field(ge=-45.0, le=45.0)] = 10.0  # push 5-15 deg (section 4)
+    # The planner tries the nominal angle first and widens in 5 deg steps up to this tolerance before it calls a
+    # seam unreachable (section 7); past 5 deg it leaves section 4's 5-15 range (needed where a vertical seam
+    # meets the table: the nozzle needs 20-25 deg there) and the plan reports the angle it used.
+    travel_angle_tol_deg: Annotated[float, Field(ge=0.0, le=40.0)] = 20.0
+    contact_tip_distance_mm: Annotated[float, Field(gt=0.0, le=50.0)] = 15.0  # CTWD 12-20 mm (section 4)
+    spin_tol_deg: Annotated[float, Field(ge=0.0, le=180.0)] = 180.0  # rotation about the torch axis: free
+    approach_mm: Annotated[float, Field(gt=0.0, le=500.0)] = 50.0  # back along the torch axis before the seam
+    depart_mm: Annotated[float, Field(gt=0.0, le=500.0)] = 50.0  # back along the torch axis after the seam
+    approach_speed_mm_s: Annotated[float, Field(gt=0.0, le=250.0)] = 250.0  # reduced speed, ISO 10218 (s. 7)
 
 
 class NoiseSpec(_Model):
@@ -189,6 +215,7 @@ class Scenario(_Model):
     deviations: dict[str, Deviation] = Field(default_factory=dict)
     table: TableSpec
     robot: RobotSpec = RobotSpec()
+    process: ProcessSpec = ProcessSpec()
     cameras: dict[str, CameraSpec]
     perception: PerceptionSpec
     locator: LocatorSpec = LocatorSpec()

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from cell.cli import app
 from cell.scenario import SCENARIO_DIR
-from tests.dxf_factory import design, make_maps
+from dxf_factory import design, make_maps
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parent.parent

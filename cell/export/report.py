@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from cell.pipeline import Detection
+from cell.pipeline import Detection, WeldRun
 from cell.types import SeamStatus
 
 REPORT_VERSION = 1
@@ -82,3 +82,45 @@ def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
         f.write("\n")
     os.replace(tmp, p)
     return p
+
+
+def weld_report(run: WeldRun) -> dict[str, Any]:
+    """The ``cell weld`` / ``cell preview`` report: the detection report plus, per seam, ``welded``, ``reason``,
+    ``tcp_error_mm`` {rms, max} of the executed tool path against the true seam and ``weld_time_s``; at the top,
+    ``cycle_time_s``, ``events``, the gate's ``violations`` and the ``error`` that stopped the run (or null)."""
+    rep = detection_report(run.detection)
+    plan = run.plan
+    for entry, w in zip(rep["seams"], run.seams, strict=True):
+        entry["welded"] = w.welded
+        if not w.welded:
+            # The detection's reason says why a seam was not found; the weld's why it was not welded.
+            entry["weld_reason"] = w.reason
+        if plan is not None:
+            o = next((o for o in plan.seams if o.seam_id == w.id), None)
+            if o is not None and o.feasible:
+                entry["torch"] = {
+                    "work_angle_deg": _r(math.degrees(o.work_angle), 2),
+                    "travel_angle_deg": _r(math.degrees(o.travel_angle), 2),
+                    "spin_deg": _r(math.degrees(o.spin), 2),
+                    "reversed": o.reversed,
+                }
+            elif o is not None and o.p_fail.size == 3:
+                entry["failing_point"] = _pt(o.p_fail)
+        if w.quality is not None:
+            q = w.quality
+            entry["tcp_error_mm"] = {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)}
+            entry["weld_time_s"] = _r(q.weld_time_s, 3)
+            entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
+    ex = run.execution
+    rep["welded"] = sum(w.welded for w in run.seams)
+    rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
+    rep["planned_cycle_time_s"] = (
+        _r(plan.cycle_time + (run.pre_move.duration if run.pre_move is not None else 0.0), 3) if plan else None
+    )
+    rep["arc_time_s"] = _r(ex.arc_time, 3) if ex is not None else None
+    rep["weld_order"] = list(plan.order) if plan is not None else []
+    rep["events"] = [{"t_s": _r(e.t, 4), "kind": e.kind, "detail": e.detail} for e in ex.events] if ex else []
+    rep["violations"] = list(run.violations)
+    rep["error"] = None if run.error is None else {"type": type(run.error).__name__, "message": run.error.message}
+    rep["timings_s"] = {k: _r(v, 4) for k, v in run.timings.items()}
+    return rep

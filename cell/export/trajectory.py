@@ -1,0 +1,94 @@
+"""Joint trajectory export: JSON shaped like ROS ``trajectory_msgs/JointTrajectory`` and CSV.
+
+JSON: ``{"header": {"stamp": {"sec", "nanosec"}, "frame_id"}, "joint_names": [...], "points": [{"positions",
+"velocities", "accelerations", "effort": [], "time_from_start": {"sec", "nanosec"}}]}`` in rad, rad/s, rad/s^2
+(the message's fields and units; the arc state has no field there: it is in the CSV and the KRL program).
+CSV: a header line ``t_s,q1_rad,...,qN_rad,arc_on`` then one row per sample (arc_on 1 while the arc burns from
+that sample to the next, else 0).
+
+Both are re-sampled from the plan every ``dt`` [s] (default 4 ms) plus every segment boundary (so the arc
+switches exactly at a row) and the end; ``dt=None`` writes the plan's own samples.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.motion.plan import WeldPlan
+from cell.motion.timing import Trajectory
+
+
+def export_samples(plan: WeldPlan, dt: float | None = 0.004) -> tuple[Trajectory, np.ndarray]:
+    """(trajectory, arc flags (n,) bool) re-sampled every dt [s] plus segment boundaries and the end."""
+    traj, arc = plan.joint_trajectory()
+    if dt is None:
+        return traj, arc
+    if not dt > 0.0:
+        raise ValueError(f"export period dt must be positive or None, got {dt}")
+    bounds = [s.t0 for s in plan.segments] + [plan.cycle_time]
+    t = np.unique(np.concatenate([np.arange(0.0, traj.duration, dt), bounds]))
+    t = t[(t >= 0.0) & (t <= traj.duration)]
+    t = t[np.concatenate([[True], np.diff(t) > 1e-9])]
+    q, qd, qdd = traj.sample(t)
+    t[0] = 0.0
+    return Trajectory(t, q, qd, qdd), plan.arc_at(t)
+
+
+def _duration(t: float) -> dict[str, int]:
+    sec = math.floor(t)
+    nanosec = round((t - sec) * 1e9)
+    if nanosec >= 1_000_000_000:
+        sec, nanosec = sec + 1, nanosec - 1_000_000_000
+    return {"sec": int(sec), "nanosec": nanosec}
+
+
+def joint_trajectory_msg(
+    traj: Trajectory, joint_names: tuple[str, ...] | list[str], frame_id: str = "base_link"
+) -> dict[str, Any]:
+    """A JSON-ready dict shaped like trajectory_msgs/JointTrajectory (times from the start of the plan)."""
+    if len(joint_names) != traj.dof:
+        raise ValueError(f"{len(joint_names)} joint names for a trajectory of {traj.dof} joints")
+
+    def row(a: FloatArray) -> list[float]:
+        return [round(float(v), 9) for v in a]
+
+    return {
+        "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": frame_id},
+        "joint_names": list(joint_names),
+        "points": [
+            {
+                "positions": row(traj.q[i]),
+                "velocities": row(traj.qd[i]),
+                "accelerations": row(traj.qdd[i]),
+                "effort": [],
+                "time_from_start": _duration(float(traj.times[i])),
+            }
+            for i in range(len(traj.times))
+        ],
+    }
+
+
+def write_json(plan: WeldPlan, path: str | Path, dt: float | None = 0.004) -> Path:
+    """Write the plan's joint trajectory as JointTrajectory-shaped JSON; the path written."""
+    import json
+
+    traj, _ = export_samples(plan, dt)
+    p = Path(path)
+    p.write_text(json.dumps(joint_trajectory_msg(traj, plan.joint_names), separators=(",", ":")))
+    return p
+
+
+def write_csv(plan: WeldPlan, path: str | Path, dt: float | None = 0.004) -> Path:
+    """Write ``t_s,q1_rad..qN_rad,arc_on`` rows; the path written."""
+    traj, arc = export_samples(plan, dt)
+    header = ",".join(["t_s", *[f"q{i + 1}_rad" for i in range(traj.dof)], "arc_on"])
+    table = np.column_stack([traj.times, traj.q, arc.astype(float)])
+    fmt = ["%.6f"] + ["%.9f"] * traj.dof + ["%d"]
+    p = Path(path)
+    np.savetxt(p, table, fmt=fmt, delimiter=",", header=header, comments="")
+    return p

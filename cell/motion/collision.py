@@ -1,0 +1,290 @@
+"""Collision checking with coal (through Pinocchio's GeometryModel): the only module that imports coal.
+
+What is checked, all in the robot base frame R [m]:
+
+* the arm's URDF collision shapes against obstacles: the as-perceived parts (boxes of the aligned welding map,
+  grown by ``part_inflation``) and the table (a fixture, known exactly: grown by ``table_inflation``);
+* the arm against itself, except pairs on the same or on adjacent links (``parentJoint`` equal, or one the
+  parent of the other: their shapes touch at the joint by construction).
+
+The torch tip must reach into the fillet, a few mm from both faces. The wire is not modelled, and every torch
+shape within ``tcp_clearance`` (25 mm) of the wire tip is cut away: the gas nozzle cylinder, which ends 15 mm
+behind the tip, is shortened to start 25 mm behind it. In a square fillet at 45 deg the nozzle's rim then stays
+about 9 mm off both faces (2.5 mm with the full nozzle), which leaves room for the seam's position error;
+everything else of the torch (the rest of the nozzle, the neck, the body) and the whole arm must stay clear.
+
+Along a motion, checks use conservative advancement: at a configuration with clearance c (the smallest signed
+distance over the checked pairs), no point of the arm can touch anything before it has moved c; a joint-space
+step dq moves no arm point more than sum_j |dq_j| r_j (r_j: the farthest any collision shape can be from joint
+j's axis), so the next check is where that bound reaches c, and never more than ``max_step`` [m] of motion
+later (subdividing between trajectory samples when needed). A collision found this way is certain; a path
+declared free is free up to the clearance threshold (``min_clearance``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import coal
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from cell.geometry import FloatArray, invert, readonly
+from cell.motion.robot import RobotModel
+from cell.types import Part
+
+
+@dataclass(frozen=True)
+class CollisionOptions:
+    """part_inflation, table_inflation [m]: growth of obstacle boxes on every side; tcp_clearance [m]: torch
+    shapes within this distance of the wire tip are cut away; max_step [m]: most an arm point may move between
+    two checks; min_clearance [m]: a distance below this counts as contact; table_name: which obstacle is the
+    table."""
+
+    part_inflation: float = 0.002
+    table_inflation: float = 0.0
+    tcp_clearance: float = 0.035
+    max_step: float = 0.05
+    min_clearance: float = 0.0
+    table_name: str = "TABLE"
+    tcp_frame: str = "torch_tcp"
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A collision: link ``a`` against ``b`` (a link or an obstacle name), distance ``depth`` [m] (<= the
+    threshold; negative = penetration), witness point p_R (3,) on ``a`` [m], at sample ``index`` of the path
+    checked and, when the path was timed, time ``t`` [s]; q (dof,) the configuration."""
+
+    a: str
+    b: str
+    depth: float
+    p_R: FloatArray
+    q: FloatArray
+    index: int = 0
+    t: float = float("nan")
+
+    def describe(self) -> str:
+        p = np.round(self.p_R * 1000.0, 1).tolist()
+        when = f" at t = {self.t:.3f} s" if np.isfinite(self.t) else ""
+        return f"{self.a} vs {self.b} at p_R = {p} mm (distance {self.depth * 1000:.1f} mm){when}"
+
+
+@dataclass
+class _Pairs:
+    obstacle: list[int] = field(default_factory=list)
+    self_: list[int] = field(default_factory=list)
+
+
+class CollisionChecker:
+    """Robot against obstacles and itself, for one arm and one set of obstacles (build one per plan).
+
+    Holds Pinocchio/coal scratch data: not thread-safe.
+    """
+
+    def __init__(self, robot: RobotModel, obstacles: Sequence[Part], options: CollisionOptions | None = None) -> None:
+        self.robot = robot
+        self.options = opt = options or CollisionOptions()
+        self._model = pin.buildModelFromUrdf(str(robot.source))
+        if tuple(self._model.names[1:]) != robot.joint_names:
+            raise ValueError("CollisionChecker: the URDF's joints differ from the RobotModel's")
+        geom = pin.buildGeomFromUrdf(self._model, str(robot.source), pin.COLLISION)
+        tcp = self._model.getFrameId(opt.tcp_frame)
+        self._tcp_frame = tcp
+        self._trim_near_tcp(geom, tcp)
+        self._n_robot = len(geom.geometryObjects)
+        self.link_of: list[str] = [self._model.frames[o.parentFrame].name for o in geom.geometryObjects]
+        for part in obstacles:
+            grow = opt.table_inflation if part.name == opt.table_name else opt.part_inflation
+            shape = coal.Box(np.asarray(part.box.size, dtype=float) + 2.0 * grow)
+            obj = pin.GeometryObject(part.name, 0, 0, pin.SE3(np.asarray(part.box.X_AB, dtype=float)), shape)
+            geom.addGeometryObject(obj)
+            self.link_of.append(part.name)
+        self.obstacle_names = tuple(p.name for p in obstacles)
+        self._pairs = _Pairs()
+        parents = self._model.parents
+        objs = geom.geometryObjects
+        for i in range(self._n_robot):
+            ji = objs[i].parentJoint
+            for k in range(i + 1, len(objs)):
+                jk = objs[k].parentJoint
+                if k >= self._n_robot:  # robot shape vs obstacle (the fixed base never moves: skip it)
+                    if ji != 0:
+                        self._pairs.obstacle.append(len(geom.collisionPairs))
+                        geom.addCollisionPair(pin.CollisionPair(i, k))
+                    continue
+                if ji == jk or parents[max(ji, jk)] == min(ji, jk):
+                    continue
+                self._pairs.self_.append(len(geom.collisionPairs))
+                geom.addCollisionPair(pin.CollisionPair(i, k))
+        self._geom = geom
+        self._gdata = pin.GeometryData(geom)
+        self._data = self._model.createData()
+        self._radius = self._joint_radii()
+        self._tool_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == self._model.njoints - 1]
+        self._obstacle_ids = list(range(self._n_robot, len(objs)))
+
+    # -- set-up ------------------------------------------------------------------------------------------------
+
+    def _trim_near_tcp(self, geom: pin.GeometryModel, tcp: int) -> None:
+        """Cut torch cylinders coaxial with the wire back to ``tcp_clearance`` behind the wire tip."""
+        r_ex = self.options.tcp_clearance
+        frame = self._model.frames[tcp]
+        X_JT = np.array(frame.placement.homogeneous)  # TCP in its parent joint's frame
+        drop = []
+        for i, obj in enumerate(geom.geometryObjects):
+            if obj.parentJoint != frame.parentJoint or not isinstance(obj.geometry, coal.Cylinder):
+                continue
+            X_JG = np.array(obj.placement.homogeneous)
+            X_TG = invert(X_JT) @ X_JG  # the shape in the TCP frame: coaxial shapes lie on -z
+            axis, c = X_TG[:3, 2], X_TG[:3, 3]
+            if np.linalg.norm(c[:2]) > 1e-6 or abs(abs(axis[2]) - 1.0) > 1e-6:
+                continue
+            half = float(obj.geometry.halfLength)
+            front, back = -c[2] - half, -c[2] + half  # distances behind the tip [m]
+            if front >= r_ex:
+                continue
+            if back <= r_ex:
+                drop.append(i)
+                continue
+            new_half = (back - r_ex) / 2.0
+            X_TG_new = X_TG.copy()
+            X_TG_new[:3, 3] = [0.0, 0.0, -(r_ex + new_half)]
+            obj.geometry = coal.Cylinder(float(obj.geometry.radius), 2.0 * new_half)
+            obj.placement = pin.SE3(X_JT @ X_TG_new)
+        for i in reversed(drop):
+            geom.removeGeometryObject(geom.geometryObjects[i].name)
+
+    def _joint_radii(self) -> FloatArray:
+        """r_j (dof,): bound on the distance of any collision shape point from joint j's axis [m]."""
+        m = self._model
+        r = np.zeros(m.njoints - 1)
+        for obj in self._geom.geometryObjects[: self._n_robot]:
+            # radius of a ball around the shape's origin that holds the shape
+            g = obj.geometry
+            if isinstance(g, coal.Box):
+                rad = float(np.linalg.norm(g.halfSide))
+            elif isinstance(g, coal.Cylinder):
+                rad = float(np.hypot(g.radius, g.halfLength))
+            else:
+                g.computeLocalAABB()
+                rad = float(np.linalg.norm(g.aabb_local.max_ - g.aabb_local.min_) / 2.0)
+            j = obj.parentJoint
+            reach = float(np.linalg.norm(obj.placement.translation)) + rad
+            while j > 0:  # the shape's distance from each joint up the chain, by the triangle inequality
+                r[j - 1] = max(r[j - 1], reach)
+                reach += float(np.linalg.norm(m.jointPlacements[j].translation))
+                j = m.parents[j]
+        return readonly(r)
+
+    # -- queries ---------------------------------------------------------------------------------------------
+
+    def _distances(self, q: FloatArray) -> FloatArray:
+        """Signed distance [m] of every checked pair at configuration q (negative: penetration)."""
+        pin.computeDistances(self._model, self._data, self._geom, self._gdata, np.asarray(q, dtype=float))
+        return np.array([r.min_distance for r in self._gdata.distanceResults])
+
+    def _contact(self, k: int, d: float, q: FloatArray, index: int, t: float) -> Contact:
+        pair = self._geom.collisionPairs[k]
+        res = self._gdata.distanceResults[k]
+        a, b = self.link_of[pair.first], self.link_of[pair.second]
+        return Contact(a, b, float(d), readonly(np.array(res.getNearestPoint1())), readonly(q), index, t)
+
+    def clearance(self, q: npt.ArrayLike) -> tuple[float, float]:
+        """(clearance to obstacles, clearance between non-adjacent links) [m] at configuration q (dof,)."""
+        d = self._distances(np.asarray(q, dtype=float))
+        obs = d[self._pairs.obstacle] if self._pairs.obstacle else np.array([np.inf])
+        slf = d[self._pairs.self_] if self._pairs.self_ else np.array([np.inf])
+        return float(obs.min()), float(slf.min())
+
+    def check(self, q: npt.ArrayLike, index: int = 0, t: float = float("nan")) -> Contact | None:
+        """The deepest contact at configuration q (dof,), or None when the arm is clear."""
+        q = np.asarray(q, dtype=float)
+        d = self._distances(q)
+        k = int(np.argmin(d))
+        if d[k] <= self.options.min_clearance:
+            return self._contact(k, float(d[k]), q, index, t)
+        return None
+
+    def _step_bound(self, q: npt.ArrayLike) -> tuple[float, Contact | None]:
+        """Allowed motion [m] from q before the next check, or the contact at q."""
+        q = np.asarray(q, dtype=float)
+        d = self._distances(q)
+        k = int(np.argmin(d))
+        if d[k] <= self.options.min_clearance:
+            return 0.0, self._contact(k, float(d[k]), q, 0, float("nan"))
+        obs = min((d[i] for i in self._pairs.obstacle), default=np.inf)
+        slf = min((d[i] for i in self._pairs.self_), default=np.inf)
+        # two links of the arm can approach each other at twice the single-link bound
+        free = min(obs, slf / 2.0) - self.options.min_clearance
+        return float(min(free, self.options.max_step)), None
+
+    def motion_bound(self, dq: npt.ArrayLike) -> float:
+        """Upper bound [m] on how far any arm point moves for a joint step dq (dof,) [rad]."""
+        return float(np.abs(np.asarray(dq, dtype=float)) @ self._radius)
+
+    def check_path(
+        self, q_path: npt.ArrayLike, times: npt.ArrayLike | None = None, min_step: float = 0.001
+    ) -> Contact | None:
+        """First contact along a path of configurations (n, dof), linear in joint space between samples.
+
+        times : (n,) [s] to report when the contact happens (optional). ``min_step`` [m]: smallest motion
+        between two checks (near contact the check spacing shrinks to this, so a touch thinner than it can be
+        missed). Returns None when the whole path is clear.
+        """
+        Q = np.asarray(q_path, dtype=float)
+        T = None if times is None else np.asarray(times, dtype=float)
+        i, frac = 0, 0.0  # current position: Q[i] + frac (Q[i+1] - Q[i])
+        n = len(Q)
+        while True:
+            q = Q[i] if frac == 0.0 or i + 1 >= n else Q[i] + frac * (Q[i + 1] - Q[i])
+            step, hit = self._step_bound(q)
+            if hit is not None:
+                t = float("nan") if T is None else float(T[i] + frac * (T[min(i + 1, n - 1)] - T[i]))
+                return Contact(hit.a, hit.b, hit.depth, hit.p_R, hit.q, i, t)
+            budget = max(step, min_step)
+            # advance along the path until the motion bound uses the budget
+            while i + 1 < n:
+                seg = self.motion_bound(Q[i + 1] - Q[i])
+                left = (1.0 - frac) * seg
+                if left <= budget:
+                    budget -= left
+                    i, frac = i + 1, 0.0
+                    continue
+                frac += budget / seg
+                break
+            else:
+                if frac == 0.0 and budget >= 0.0:
+                    # reached the last sample: check it once more exactly (it may be within the budget)
+                    _, hit = self._step_bound(Q[-1])
+                    if hit is not None:
+                        t = float("nan") if T is None else float(T[-1])
+                        return Contact(hit.a, hit.b, hit.depth, hit.p_R, hit.q, n - 1, t)
+                    return None
+
+    def torch_clear(self, X_RT: npt.ArrayLike, q_ref: npt.ArrayLike) -> Contact | None:
+        """Contact of the tool-side shapes (everything rigid with the flange) against the obstacles when the TCP
+        is at X_RT (4, 4), without IK: the tool's shapes are placed from a reference configuration q_ref."""
+        X_RT = np.asarray(X_RT, dtype=float)
+        q_ref = np.asarray(q_ref, dtype=float)
+        pin.forwardKinematics(self._model, self._data, q_ref)
+        pin.updateFramePlacements(self._model, self._data)
+        pin.updateGeometryPlacements(self._model, self._data, self._geom, self._gdata)
+        X_ref_T = np.array(self._data.oMf[self._tcp_frame].homogeneous)
+        move = X_RT @ invert(X_ref_T)  # carries the tool from its reference pose to the target
+        req = coal.DistanceRequest()
+        best: Contact | None = None
+        for i in self._tool_shapes:
+            X_RG = move @ np.array(self._gdata.oMg[i].homogeneous)
+            Tg = coal.Transform3s(X_RG[:3, :3], X_RG[:3, 3])
+            for k in self._obstacle_ids:
+                obj = self._geom.geometryObjects[k]
+                To = coal.Transform3s(np.array(obj.placement.rotation), np.array(obj.placement.translation))
+                res = coal.DistanceResult()
+                dist = coal.distance(self._geom.geometryObjects[i].geometry, Tg, obj.geometry, To, req, res)
+                if dist <= self.options.min_clearance and (best is None or dist < best.depth):
+                    p = readonly(np.array(res.getNearestPoint1()))
+                    best = Contact(self.link_of[i], self.link_of[k], float(dist), p, readonly(q_ref))
+        return best

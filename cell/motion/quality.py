@@ -1,0 +1,65 @@
+"""How well a seam was welded: the executed tool path against the true seam, and the travel speed along it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+
+_MM = 1000.0
+
+
+@dataclass(frozen=True)
+class WeldQuality:
+    """One seam's weld as executed.
+
+    tcp_rms_mm, tcp_max_mm : distance of the tool centre point from the true seam segment while the arc burned.
+    weld_time_s : arc time [s]; length_mm : length of the executed arc-on path.
+    speed_mm_s : median TCP speed while the arc burned, ramps excluded (the constant-speed part).
+    samples : number of recorded tool positions behind the figures.
+    """
+
+    tcp_rms_mm: float
+    tcp_max_mm: float
+    weld_time_s: float
+    length_mm: float
+    speed_mm_s: float
+    samples: int
+
+
+def distance_to_segment(p: npt.ArrayLike, a: npt.ArrayLike, b: npt.ArrayLike) -> FloatArray:
+    """Distance [m] of points p (n, 3) from the segment a-b (3,)."""
+    p = np.asarray(p, dtype=float)
+    a = np.asarray(a, dtype=float)
+    ab = np.asarray(b, dtype=float) - a
+    t = np.clip(((p - a) @ ab) / float(ab @ ab), 0.0, 1.0)
+    return np.asarray(np.linalg.norm(p - (a + t[:, None] * ab), axis=1))
+
+
+def weld_quality(
+    times: npt.ArrayLike, tcp_R: npt.ArrayLike, truth_start: npt.ArrayLike, truth_end: npt.ArrayLike
+) -> WeldQuality:
+    """Quality of one weld from the records taken while its arc burned.
+
+    times : (n,) record times [s]; tcp_R : (n, 3) tool positions in R [m] (n >= 2); truth : the true seam in R [m].
+    """
+    t = np.asarray(times, dtype=float)
+    p = np.asarray(tcp_R, dtype=float)
+    if len(t) < 2:
+        raise ValueError("a weld needs at least two tool records")
+    d = distance_to_segment(p, truth_start, truth_end) * _MM
+    step = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    dt = np.diff(t)
+    speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0) * _MM
+    cruise = speed[speed > 0.5 * speed.max()] if speed.size and speed.max() > 0 else speed
+    return WeldQuality(
+        tcp_rms_mm=float(np.sqrt(np.mean(d**2))),
+        tcp_max_mm=float(d.max()),
+        weld_time_s=float(t[-1] - t[0]),
+        length_mm=float(step.sum() * _MM),
+        speed_mm_s=float(np.median(cruise)) if cruise.size else 0.0,
+        samples=len(t),
+    )

@@ -1,0 +1,194 @@
+"""Torch poses along a fillet seam, from the joint geometry alone (values in, poses out).
+
+Frames: ``R`` robot base; ``T`` the torch tool frame ``torch_tcp`` of the URDF: origin at the wire tip, z along
+the wire, out of the torch (so z points INTO the joint). Units: metres and radians.
+
+Geometry of a fillet between face A (the abutting part's face, outward normal n_a) and face B (the receiving
+part's face, outward normal n_b), seam direction d (unit, from the weld start to its end):
+
+* work angle w: in the plane perpendicular to the seam, the torch axis leaves the joint at angle w from face B,
+  turned towards face A: u = cos(w) t_b + sin(w) n_b, where t_b is the direction in face B pointing away from
+  the corner (n_a with its n_b component removed). In a square fillet w = 45 deg gives u = (n_a + n_b) / sqrt 2,
+  the bisector.
+* travel angle a: the torch axis tilts along the seam, z = -cos(a) u + sin(a) d; a > 0 is a push angle (the wire
+  points ahead, z . d > 0), a < 0 a drag angle.
+* spin psi: the free rotation about the torch axis. psi = 0 puts T's x axis along the part of d perpendicular to
+  z (ahead); psi turns x and y about z.
+
+Contact-tip-to-work distance (CTWD): ``torch_tcp`` sits at the wire tip, ``stickout`` beyond the contact tip
+(15 mm in robots/build_kr5_arc.py). The wire tip is put on the seam line when CTWD equals that stick-out (the
+default); a longer CTWD stands the whole torch back along its axis by ``ctwd - stickout`` (the wire tip then
+ends that far short of the seam: the arc length grows, as when a welder holds the torch higher), a shorter one
+pushes it in. The seam line is the fillet's root: the torch aims at the corner.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.errors import PlanError
+from cell.geometry import FloatArray, make_pose, readonly, rot_z
+from cell.scenario import ProcessSpec
+
+_DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class WeldProcess:
+    """The welding process in SI units, built from a :class:`~cell.scenario.ProcessSpec` (the one conversion).
+
+    travel_speed [m/s]; work_angle, travel_angle [rad]; *_tol [rad] how far the planner may move them;
+    ctwd, stickout, approach, depart [m]; approach_speed [m/s]; spin_tol [rad] (pi: fully free).
+    """
+
+    travel_speed: float
+    work_angle: float
+    work_angle_tol: float
+    travel_angle: float
+    travel_angle_tol: float
+    ctwd: float
+    stickout: float
+    spin_tol: float
+    approach: float
+    depart: float
+    approach_speed: float
+
+    @classmethod
+    def from_spec(cls, spec: ProcessSpec, stickout_mm: float = 15.0) -> WeldProcess:
+        """SI values from the scenario's process spec; ``stickout_mm`` is the scenario's robot.stickout_mm."""
+        return cls(
+            travel_speed=spec.travel_speed_mm_s / 1000.0,
+            work_angle=spec.work_angle_deg * _DEG,
+            work_angle_tol=spec.work_angle_tol_deg * _DEG,
+            travel_angle=spec.travel_angle_deg * _DEG,
+            travel_angle_tol=spec.travel_angle_tol_deg * _DEG,
+            ctwd=spec.contact_tip_distance_mm / 1000.0,
+            stickout=stickout_mm / 1000.0,
+            spin_tol=spec.spin_tol_deg * _DEG,
+            approach=spec.approach_mm / 1000.0,
+            depart=spec.depart_mm / 1000.0,
+            approach_speed=spec.approach_speed_mm_s / 1000.0,
+        )
+
+    @property
+    def standoff(self) -> float:
+        """How far [m] the wire tip stays back from the seam along the torch axis (ctwd - stickout)."""
+        return self.ctwd - self.stickout
+
+
+def _unit(v: npt.ArrayLike, what: str) -> FloatArray:
+    a = np.asarray(v, dtype=float).reshape(-1)
+    n = float(np.linalg.norm(a))
+    if a.shape != (3,) or not np.isfinite(n) or n < 1e-9:
+        raise PlanError(f"{what} must be a finite non-zero 3-vector, got {np.round(a, 6).tolist()}")
+    return np.asarray(a / n)
+
+
+def fillet_axes(d_R: npt.ArrayLike, n_a_R: npt.ArrayLike, n_b_R: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """(t_b, n_b) (3,) each: the unit direction in face B away from the corner, and face B's unit normal, both
+    perpendicular to the seam direction d. PlanError when the faces do not form a fillet along d."""
+    d = _unit(d_R, "seam direction")
+    n_a = _unit(n_a_R, "normal of face A")
+    n_b = _unit(n_b_R, "normal of face B")
+    n_b = n_b - (n_b @ d) * d  # the faces contain the seam: drop any rounding component along it
+    n_a = n_a - (n_a @ d) * d
+    if np.linalg.norm(n_b) < 0.5 or np.linalg.norm(n_a) < 0.5:
+        raise PlanError("a weld face normal is nearly parallel to the seam: the seam does not lie on that face")
+    n_b = n_b / np.linalg.norm(n_b)
+    t_b = n_a - (n_a @ n_b) * n_b
+    if np.linalg.norm(t_b) < 1e-3:
+        raise PlanError("the two weld faces are parallel: there is no fillet between them")
+    return np.asarray(t_b / np.linalg.norm(t_b)), n_b
+
+
+def torch_rotation(
+    d_R: npt.ArrayLike,
+    n_a_R: npt.ArrayLike,
+    n_b_R: npt.ArrayLike,
+    work_angle: float,
+    travel_angle: float,
+    spin: float = 0.0,
+) -> FloatArray:
+    """R_RT (3, 3): the torch orientation for a seam of direction d with faces A, B (outward normals in R).
+
+    work_angle, travel_angle, spin [rad]: see the module docstring.
+    """
+    d = _unit(d_R, "seam direction")
+    t_b, n_b = fillet_axes(d, n_a_R, n_b_R)
+    u = math.cos(work_angle) * t_b + math.sin(work_angle) * n_b  # out of the joint, perpendicular to d
+    z = -math.cos(travel_angle) * u + math.sin(travel_angle) * d
+    x = d - (d @ z) * z
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return np.column_stack([x, y, z]) @ rot_z(spin)
+
+
+def torch_poses(
+    p_start_R: npt.ArrayLike,
+    p_end_R: npt.ArrayLike,
+    n_a_R: npt.ArrayLike,
+    n_b_R: npt.ArrayLike,
+    process: WeldProcess,
+    *,
+    spin: float = 0.0,
+    work_offset: float = 0.0,
+    travel_offset: float = 0.0,
+    spacing: float = 0.0025,
+) -> FloatArray:
+    """X_RT (n, 4, 4), read-only: torch poses along the seam from p_start to p_end (3,) [m] in R.
+
+    n_a_R, n_b_R : outward normals (3,) of face A and face B in R.
+    spin [rad] : rotation about the torch axis; work_offset, travel_offset [rad] : added to the process's
+        nominal angles (the planner's tolerance search).
+    spacing [m] : largest distance between consecutive poses; the poses are evenly spaced, ends included.
+    The wire tip lies on the seam line, backed off along the torch axis by ``process.standoff``.
+    """
+    p0 = np.asarray(p_start_R, dtype=float).reshape(3)
+    p1 = np.asarray(p_end_R, dtype=float).reshape(3)
+    length = float(np.linalg.norm(p1 - p0))
+    if length < 1e-4:
+        raise PlanError(f"seam of length {length * 1000:.3f} mm: needs at least 0.1 mm between its ends")
+    if not spacing > 0.0:
+        raise ValueError(f"torch_poses: spacing must be positive, got {spacing}")
+    d = (p1 - p0) / length
+    R = torch_rotation(d, n_a_R, n_b_R, process.work_angle + work_offset, process.travel_angle + travel_offset, spin)
+    n = max(2, math.ceil(length / spacing - 1e-9) + 1)
+    p = p0 + np.outer(np.linspace(0.0, length, n), d) - process.standoff * R[:, 2]
+    out = np.repeat(make_pose(R)[None], n, axis=0)
+    out[:, :3, 3] = p
+    return readonly(out)
+
+
+def back_off(X_RT: npt.ArrayLike, distance: float) -> FloatArray:
+    """X_RT (4, 4) moved back along its own torch axis (-z) by ``distance`` [m] (approach and depart poses)."""
+    X = np.array(X_RT, dtype=float)
+    X[:3, 3] -= distance * X[:3, 2]
+    return X
+
+
+def line_poses(X_from: npt.ArrayLike, X_to: npt.ArrayLike, spacing: float = 0.005) -> FloatArray:
+    """(n, 4, 4) poses evenly spaced on the straight line between two poses of the same orientation, ends
+    included, at most ``spacing`` [m] apart (the approach and depart moves along the torch axis)."""
+    a, b = np.asarray(X_from, dtype=float), np.asarray(X_to, dtype=float)
+    length = float(np.linalg.norm(b[:3, 3] - a[:3, 3]))
+    n = max(2, math.ceil(length / spacing - 1e-9) + 1)
+    out = np.repeat(a[None], n, axis=0)
+    out[:, :3, 3] = a[:3, 3] + np.outer(np.linspace(0.0, 1.0, n), b[:3, 3] - a[:3, 3])
+    return out
+
+
+def measured_angles(
+    X_RT: npt.ArrayLike, d_R: npt.ArrayLike, n_a_R: npt.ArrayLike, n_b_R: npt.ArrayLike
+) -> tuple[float, float]:
+    """(work angle, travel angle) [rad] of a torch pose on a seam (the inverse of :func:`torch_rotation`)."""
+    z = np.asarray(X_RT, dtype=float)[:3, 2]
+    d = _unit(d_R, "seam direction")
+    t_b, n_b = fillet_axes(d, n_a_R, n_b_R)
+    travel = math.asin(float(np.clip(z @ d, -1.0, 1.0)))
+    u = -(z - (z @ d) * d)
+    work = math.atan2(float(u @ n_b), float(u @ t_b))
+    return work, travel

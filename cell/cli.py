@@ -197,10 +197,8 @@ def preview(
         scn = sc.load(scenario)
         _check_method(method)
         run = pipeline.weld(scn, method, noise=_noise(noise), execute_plan=False, progress=_progress())
-        from cell.station import load_arm
-
         _progress()(f"drawing pictures into {out_dir}/")
-        paths = write_run(run, out_dir, load_arm(scn).model.limits)
+        paths = write_run(run, out_dir)
         _finish_run(run, out_dir / "report.json", None, title="preview")
         for p in paths:
             err.print(f"[dim]· {p}[/]")
@@ -223,16 +221,13 @@ def _finish_run(run: object, json_path: Path | None, krl: Path | None, *, title:
     if json_path is not None:
         write_json(json_path, rep)
         err.print(f"[dim]· report written to {json_path}[/]")
-    if krl is not None and run.plan is not None and run.plan.segments:
+    if krl is not None and run.plan is not None and run.plan.segments and run.arm is not None:
         from cell.export.krl import write_krl
         from cell.export.trajectory import write_csv
         from cell.export.trajectory import write_json as write_traj
-        from cell.station import load_arm
 
         name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in run.detection.scenario.name).upper()
-        src, dat = write_krl(
-            run.plan, load_arm(run.detection.scenario).model, krl, name[:24], X_WR=run.detection.scenario.X_WR
-        )
+        src, dat = write_krl(run.plan, run.arm.model, krl, name[:24], X_WR=run.detection.scenario.X_WR)
         traj_json = write_traj(run.plan, krl / "trajectory.json")
         traj_csv = write_csv(run.plan, krl / "trajectory.csv")
         err.print(f"[dim]· robot program: {src}, {dat}; trajectory: {traj_json}, {traj_csv}[/]")
@@ -269,7 +264,7 @@ def _print_weld(rep: dict, title: str) -> None:
             s["status"],
             _fmt(e.get("paper_me")),
             _fmt(e.get("lateral")),
-            "yes" if s["welded"] else "no",
+            "yes" if s["welded"] else ("planned" if s.get("planned") else "no"),
             _fmt(tcp.get("rms")),
             _fmt(tcp.get("max")),
             _fmt(s.get("weld_time_s"), 1),

@@ -17,7 +17,7 @@ from cell.motion.quality import WeldQuality
 from cell.scenario import Scenario
 from cell.seams.base import SeamScene
 from cell.seams.metrics import MetricsSummary, SeamMetrics
-from cell.station import Station
+from cell.station import Arm, Station
 from cell.types import DepthImage, Part, SeamEstimate, SeamStatus, WeldMap
 
 if TYPE_CHECKING:  # heavy imports stay inside the stages that need them
@@ -212,9 +212,11 @@ def detect(
 
 @dataclass(frozen=True)
 class SeamWeld:
-    """What became of one seam in ``cell weld``: welded, or why not; how well (executed TCP vs the true seam)."""
+    """What became of one seam in ``cell weld``: planned and welded, or why not; how well (executed TCP vs the true
+    seam)."""
 
     id: str
+    planned: bool
     welded: bool
     reason: str = ""
     quality: WeldQuality | None = None
@@ -238,6 +240,7 @@ class WeldRun:
     error: CellError | None = None
     timings: dict[str, float] = field(default_factory=dict)
     torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT
+    arm: Arm | None = None
 
     @property
     def cycle_time_s(self) -> float:
@@ -246,13 +249,14 @@ class WeldRun:
 
     @property
     def complete(self) -> bool:
-        """Every seam that can be seen was welded (or, for a preview, planned) and nothing failed."""
+        """Every seam that can be seen was welded (for a preview: planned) and nothing failed."""
         vis = [
             w
             for w, e in zip(self.seams, self.detection.estimates, strict=True)
             if e.status is not SeamStatus.NOT_VISIBLE
         ]
-        return self.error is None and all(w.welded for w in vis)
+        executed = self.execution is not None
+        return self.error is None and all(w.welded if executed else w.planned for w in vis)
 
 
 def plan_for(
@@ -319,23 +323,24 @@ def _seam_welds(
     out = []
     for est in det.estimates:
         if est.status is SeamStatus.NOT_VISIBLE:
-            out.append(SeamWeld(est.id, False, est.reason))  # e.g. against the table: needs a flip
+            out.append(SeamWeld(est.id, False, False, est.reason))  # e.g. against the table: needs a flip
             continue
         if est.status is not SeamStatus.FOUND:
-            out.append(SeamWeld(est.id, False, f"not located: {est.reason}"))
+            out.append(SeamWeld(est.id, False, False, f"not located: {est.reason}"))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
         if outcome is None or not outcome.feasible:
-            out.append(SeamWeld(est.id, False, outcome.reason if outcome is not None else refused or "not planned"))
+            reason = outcome.reason if outcome is not None else refused or "not planned"
+            out.append(SeamWeld(est.id, False, False, reason))
             continue
         if ex is None or plan is None:
-            out.append(SeamWeld(est.id, False, refused or "planned, not executed (preview)"))
+            out.append(SeamWeld(est.id, True, False, refused or "planned, not executed (preview)"))
             continue
         seg = next(g for g in plan.segments if g.arc_on and g.seam_id == est.id)
         t0, t1 = pre_s + seg.t0, pre_s + seg.t1
         k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
         tcp_R = transform_points(X_RW, ex.tcp_W[k])
-        out.append(SeamWeld(est.id, True, "", weld_quality(ex.times[k], tcp_R, *det.truths[est.id])))
+        out.append(SeamWeld(est.id, True, True, "", weld_quality(ex.times[k], tcp_R, *det.truths[est.id])))
     return tuple(out)
 
 
@@ -376,7 +381,7 @@ def weld(
         seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
-        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths)
+        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm)
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

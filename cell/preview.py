@@ -142,8 +142,7 @@ def _legend_handles(has_truth: bool, has_torch: bool, has_path: bool) -> list[An
         h.append(Line2D([], [], color=TRUTH_COLOUR, marker="x", ls="", label="true seam ends"))
     if has_torch:
         h += [
-            Line2D([], [], color=c, lw=1.5, label=f"torch {a} axis")
-            for c, a in zip(AXIS_COLOURS, "xyz", strict=True)
+            Line2D([], [], color=c, lw=1.5, label=f"torch {a} axis") for c, a in zip(AXIS_COLOURS, "xyz", strict=True)
         ]
     if has_path:
         h.append(Line2D([], [], color=PATH_COLOUR, lw=1.0, ls=":", label="tool path"))
@@ -173,8 +172,9 @@ def _draw_2d(
     seams and true ends on top (in that order)."""
     i, j = ij
     k = 3 - i - j
-    sc = ax.scatter(cloud[:, i], cloud[:, j], c=cloud[:, k], s=point_size, cmap="viridis", linewidths=0,
-                    rasterized=True, zorder=1)
+    sc = ax.scatter(
+        cloud[:, i], cloud[:, j], c=cloud[:, k], s=point_size, cmap="viridis", linewidths=0, rasterized=True, zorder=1
+    )
     for part in weldmap.parts:
         for e in _box_edges(part.box) * MM:
             ax.plot(e[:, i], e[:, j], color=BOX_COLOUR, lw=0.6, zorder=2)
@@ -186,8 +186,15 @@ def _draw_2d(
             for seg, colour in zip(glyph, AXIS_COLOURS, strict=True):
                 ax.plot(seg[:, i], seg[:, j], color=colour, lw=1.0, zorder=4)
     for ln in lines:
-        ax.plot(ln.pts[:, i], ln.pts[:, j], color=STATUS_COLOURS[ln.status], lw=2.5,
-                ls="-" if ln.estimated else "--", solid_capstyle="round", zorder=5)
+        ax.plot(
+            ln.pts[:, i],
+            ln.pts[:, j],
+            color=STATUS_COLOURS[ln.status],
+            lw=2.5,
+            ls="-" if ln.estimated else "--",
+            solid_capstyle="round",
+            zorder=5,
+        )
         if ln.truth is not None:
             ax.plot(ln.truth[:, i], ln.truth[:, j], "x", color=TRUTH_COLOUR, ms=6, mew=1.2, zorder=6)
     ax.set_aspect("equal")
@@ -204,14 +211,28 @@ def _draw_3d(
     torch_poses: Mapping[str, npt.ArrayLike],
     tcp_paths: Mapping[str, npt.ArrayLike],
 ) -> Any:
-    sc = ax.scatter(cloud[:, 0], cloud[:, 1], cloud[:, 2], c=cloud[:, 2], s=0.6, cmap="viridis", linewidths=0,
-                    alpha=0.5, depthshade=False, rasterized=True)
+    sc = ax.scatter(
+        cloud[:, 0],
+        cloud[:, 1],
+        cloud[:, 2],
+        c=cloud[:, 2],
+        s=0.6,
+        cmap="viridis",
+        linewidths=0,
+        alpha=0.5,
+        depthshade=False,
+        rasterized=True,
+    )
     for part in weldmap.parts:
         for e in _box_edges(part.box) * MM:
             ax.plot(e[:, 0], e[:, 1], e[:, 2], color=BOX_COLOUR, lw=0.6)
     for ln in lines:
-        ax.plot(*ln.pts.T, color=STATUS_COLOURS[ln.status], lw=3.0 if ln.estimated else 2.0,
-                ls="-" if ln.estimated else "--")
+        ax.plot(
+            *ln.pts.T,
+            color=STATUS_COLOURS[ln.status],
+            lw=3.0 if ln.estimated else 2.0,
+            ls="-" if ln.estimated else "--",
+        )
         if ln.truth is not None:
             ax.plot(*ln.truth.T, "x", color=TRUTH_COLOUR, ms=4)
     for path in tcp_paths.values():
@@ -251,8 +272,16 @@ def _draw_seam_panel(
     mid = ln.pts.mean(axis=0)
     half = max(0.6 * float(np.linalg.norm(ln.pts[1] - ln.pts[0])), 30.0) + 20.0  # [mm]
     near = _thin(cloud[np.all(np.abs(cloud - mid) < half, axis=1)], _PANEL_POINTS)
-    _draw_2d(ax, ij, near, weldmap, [ln], {} if torch_poses is None else {ln.id: torch_poses},
-             {} if tcp_path is None else {ln.id: tcp_path}, point_size=3.0)
+    _draw_2d(
+        ax,
+        ij,
+        near,
+        weldmap,
+        [ln],
+        {} if torch_poses is None else {ln.id: torch_poses},
+        {} if tcp_path is None else {ln.id: tcp_path},
+        point_size=3.0,
+    )
     detail = ln.status.replace("_", " ")
     if ln.truth is not None and ln.estimated:
         err = np.linalg.norm(ln.pts - ln.truth, axis=1)
@@ -311,8 +340,15 @@ def render_overview(
     ax = fig.add_subplot()
     sc = _draw_2d(ax, (0, 1), cloud, weldmap_R, lines, torch_poses, tcp_paths, point_size=1.0)
     for text, (x, y) in _label_groups(lines):
-        ax.annotate(text, (x, y), xytext=(5, 5), textcoords="offset points", fontsize=7, zorder=7,
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.7})
+        ax.annotate(
+            text,
+            (x, y),
+            xytext=(5, 5),
+            textcoords="offset points",
+            fontsize=7,
+            zorder=7,
+            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.7},
+        )
     fig.colorbar(sc, ax=ax, label="height z_R [mm]", shrink=0.7, pad=0.02)
     fig.suptitle(f"{head}top view in the robot frame R")
     ax.set_title(caption(len(cloud)), fontsize=9)
@@ -338,9 +374,10 @@ def render_overview(
         fig = _new_figure(3.2 * ncols + 1.8, 3.1 * nrows + 0.6)
         grid = fig.subplots(nrows, ncols, squeeze=False)
         for i, ln in enumerate(lines):
-            _draw_seam_panel(grid.flat[i], i + 1, ln, all_points, weldmap_R, torch_poses.get(ln.id),
-                             tcp_paths.get(ln.id))
-        for ax_unused in list(grid.flat)[len(lines):]:
+            _draw_seam_panel(
+                grid.flat[i], i + 1, ln, all_points, weldmap_R, torch_poses.get(ln.id), tcp_paths.get(ln.id)
+            )
+        for ax_unused in list(grid.flat)[len(lines) :]:
             ax_unused.set_axis_off()
         fig.suptitle(f"{head}every seam close up (R frame; colour = depth along the unseen axis)")
         fig.legend(handles=handles, loc="outside right upper", fontsize=8, frameon=False)
@@ -371,8 +408,9 @@ def render_joint_plots(
     qa, qda = np.degrees(np.asarray(q, dtype=float)), np.degrees(np.asarray(qd, dtype=float))
     dof = limits.dof
     if t.ndim != 1 or qa.shape != (len(t), dof) or qda.shape != (len(t), dof):
-        raise ValueError(f"render_joint_plots: need times (n,), q and qd (n, {dof}); got {t.shape}, "
-                         f"{qa.shape}, {qda.shape}")
+        raise ValueError(
+            f"render_joint_plots: need times (n,), q and qd (n, {dof}); got {t.shape}, {qa.shape}, {qda.shape}"
+        )
     lo, hi = np.degrees(limits.q_min), np.degrees(limits.q_max)
     vmax = np.degrees(limits.v_max)
     arc = None if arc_on is None else np.asarray(arc_on, bool)
@@ -465,17 +503,29 @@ def render_html(
     lines = _seam_lines(seams, weldmap_R)
     traces: list[Any] = [
         go.Scatter3d(
-            x=cloud[:, 0], y=cloud[:, 1], z=cloud[:, 2], mode="markers", name="cloud",
-            marker={"size": 1.5, "color": cloud[:, 2], "colorscale": "Viridis", "opacity": 0.6,
-                    "colorbar": {"title": "z_R [mm]", "x": 1.0}},
+            x=cloud[:, 0],
+            y=cloud[:, 1],
+            z=cloud[:, 2],
+            mode="markers",
+            name="cloud",
+            marker={
+                "size": 1.5,
+                "color": cloud[:, 2],
+                "colorscale": "Viridis",
+                "opacity": 0.6,
+                "colorbar": {"title": "z_R [mm]", "x": 1.0},
+            },
             hoverinfo="skip",
         )
     ]
     edges = np.concatenate([_box_edges(p.box) for p in weldmap_R.parts]) * MM if weldmap_R.parts else None
     if edges is not None:
         x, y, z = _segments_trace(edges)
-        traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", name="map parts",
-                                   line={"color": BOX_COLOUR, "width": 2}, hoverinfo="skip"))
+        traces.append(
+            go.Scatter3d(
+                x=x, y=y, z=z, mode="lines", name="map parts", line={"color": BOX_COLOUR, "width": 2}, hoverinfo="skip"
+            )
+        )
     for status, colour in STATUS_COLOURS.items():
         mine = [ln for ln in lines if ln.status == status]
         if not mine:
@@ -484,31 +534,64 @@ def render_html(
         text: list[str | None] = []
         for ln in mine:
             text += [ln.id, ln.id, None]
-        traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", name=f"seams {status.replace('_', ' ')}",
-                                   text=text, hoverinfo="text+name",
-                                   line={"color": colour, "width": 8 if status == "found" else 5}))
+        traces.append(
+            go.Scatter3d(
+                x=x,
+                y=y,
+                z=z,
+                mode="lines",
+                name=f"seams {status.replace('_', ' ')}",
+                text=text,
+                hoverinfo="text+name",
+                line={"color": colour, "width": 8 if status == "found" else 5},
+            )
+        )
     truth = [ln.truth for ln in lines if ln.truth is not None]
     if truth:
         t = np.concatenate(truth)
-        traces.append(go.Scatter3d(x=t[:, 0], y=t[:, 1], z=t[:, 2], mode="markers", name="true seam ends",
-                                   marker={"size": 3, "color": TRUTH_COLOUR, "symbol": "x"}))
+        traces.append(
+            go.Scatter3d(
+                x=t[:, 0],
+                y=t[:, 1],
+                z=t[:, 2],
+                mode="markers",
+                name="true seam ends",
+                marker={"size": 3, "color": TRUTH_COLOUR, "symbol": "x"},
+            )
+        )
     glyphs = [g for poses in torch_poses.values() for g in _glyphs(poses)]
     if glyphs:
         g = np.array(glyphs)  # (k, 3 axes, 2, 3)
         for i, axis in enumerate("xyz"):
             x, y, z = _segments_trace(g[:, i])
-            traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", name=f"torch {axis} axis",
-                                       line={"color": AXIS_COLOURS[i], "width": 4}, hoverinfo="skip"))
+            traces.append(
+                go.Scatter3d(
+                    x=x,
+                    y=y,
+                    z=z,
+                    mode="lines",
+                    name=f"torch {axis} axis",
+                    line={"color": AXIS_COLOURS[i], "width": 4},
+                    hoverinfo="skip",
+                )
+            )
     for key, tcp in tcp_paths.items():
         p = np.asarray(tcp, dtype=float).reshape(-1, 3) * MM
         if len(p):
-            traces.append(go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], mode="lines", name=f"tool path {key}",
-                                       line={"color": PATH_COLOUR, "width": 3}))
+            traces.append(
+                go.Scatter3d(
+                    x=p[:, 0],
+                    y=p[:, 1],
+                    z=p[:, 2],
+                    mode="lines",
+                    name=f"tool path {key}",
+                    line={"color": PATH_COLOUR, "width": 3},
+                )
+            )
     fig = go.Figure(traces)
     fig.update_layout(
         title=title or "weld cell preview (robot frame R, mm)",
-        scene={"aspectmode": "data", "xaxis_title": "x_R [mm]", "yaxis_title": "y_R [mm]",
-               "zaxis_title": "z_R [mm]"},
+        scene={"aspectmode": "data", "xaxis_title": "x_R [mm]", "yaxis_title": "y_R [mm]", "zaxis_title": "z_R [mm]"},
         legend={"itemsizing": "constant"},
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
     )
@@ -518,7 +601,7 @@ def render_html(
     return path
 
 
-def write_run(run: WeldRun, out_dir: str | Path, limits: JointLimits) -> list[Path]:
+def write_run(run: WeldRun, out_dir: str | Path) -> list[Path]:
     """Every picture of a ``cell weld`` / ``cell preview`` run: overview PNGs, joint plots and the HTML 3D view.
 
     Tool paths are the executed ones when the arm moved, else the planned torch positions.
@@ -539,7 +622,8 @@ def write_run(run: WeldRun, out_dir: str | Path, limits: JointLimits) -> list[Pa
     title = f"{det.scenario.name} · {det.method} · {det.scenario.noise} noise"
     out = Path(out_dir)
     paths = render_overview(cloud, det.weldmap_R, views, poses, tcp, out, title=title)
-    if run.plan is not None and run.plan.segments:
+    if run.plan is not None and run.plan.segments and run.arm is not None:
+        limits = run.arm.model.limits
         traj, arc = run.plan.joint_trajectory()
         paths.append(
             render_joint_plots(traj.times, traj.q, traj.qd, limits, out / "joints.png", arc_on=arc, title=title)

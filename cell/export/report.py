@@ -91,6 +91,7 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
     rep = detection_report(run.detection)
     plan = run.plan
     for entry, w in zip(rep["seams"], run.seams, strict=True):
+        entry["planned"] = w.planned
         entry["welded"] = w.welded
         if not w.welded:
             # The detection's reason says why a seam was not found; the weld's why it was not welded.

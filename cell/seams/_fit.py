@@ -6,7 +6,6 @@ Everything is in the robot frame R, metres. Planes are ``n . p = d`` with a unit
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,6 +17,7 @@ from cell.seams.base import SeamScene
 
 _TREE_KEY = "cell.seams._fit.dense_tree"
 _SPACING_KEY = "cell.seams._fit.dense_spacing"
+_GRID_KEY = "cell.seams._fit.dense_grid"
 _TUKEY_C = 4.685  # biweight tuning constant: 95 % efficiency under Gaussian noise
 _MAD_TO_SIGMA = 1.4826
 
@@ -49,11 +49,39 @@ def dense_spacing(scene: SeamScene, sample: int = 2000) -> float:
     return float(spacing)
 
 
-def tube_indices(
-    scene: SeamScene, p_start: FloatArray, p_end: FloatArray, radius: float, extend: float
-) -> IntArray:
+@dataclass(frozen=True)
+class _Grid:
+    """The dense cloud's points bucketed in cubic cells of ``cell`` [m], sorted by cell key (built once)."""
+
+    cell: float
+    origin: FloatArray  # (3,) corner of cell (0, 0, 0) [m]
+    dims: npt.NDArray[np.int64]  # (3,) cells along x, y, z
+    keys: npt.NDArray[np.int64]  # (n,) sorted cell keys
+    order: IntArray  # (n,) point index of each sorted key
+
+
+def dense_grid(scene: SeamScene, cell: float = 0.02) -> _Grid:
+    """The dense cloud bucketed on a grid of ``cell`` [m], built once per scene and kept in ``scene.cache``."""
+    grid = scene.cache.get(_GRID_KEY)
+    if grid is None or grid.cell != cell:
+        pts = scene.dense.points
+        origin = pts.min(axis=0) if len(pts) else np.zeros(3)
+        ijk = np.floor((pts - origin) / cell).astype(np.int64)
+        dims = ijk.max(axis=0) + 1 if len(pts) else np.ones(3, np.int64)
+        keys = (ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]
+        order = np.argsort(keys, kind="stable")
+        grid = _Grid(cell, origin, dims, keys[order], order.astype(np.intp))
+        scene.cache[_GRID_KEY] = grid
+    return grid
+
+
+def tube_indices(scene: SeamScene, p_start: FloatArray, p_end: FloatArray, radius: float, extend: float) -> IntArray:
     """Indices into ``scene.dense`` of the points within ``radius`` [m] of the segment p_start-p_end (3,) [m]
-    extended by ``extend`` [m] at both ends (a capsule-free cylinder), sorted."""
+    extended by ``extend`` [m] at both ends (a capsule-free cylinder), in a fixed order.
+
+    The candidates come from the cells of :func:`dense_grid` inside the tube's bounding box: one range of the
+    sorted keys per (x, y) column of cells, so the cost does not grow with the size of the cloud.
+    """
     pts = scene.dense.points
     if len(pts) == 0:
         return np.zeros(0, np.intp)
@@ -62,17 +90,35 @@ def tube_indices(
     t = axis / length
     a = p_start - extend * t
     span = length + 2.0 * extend
-    k = max(1, int(np.ceil(span / radius)))
-    step = span / k
-    centres = a + np.outer((np.arange(k) + 0.5) * step, t)
-    hits = dense_tree(scene).query_ball_point(centres, np.hypot(radius, 0.5 * step), return_sorted=False)
-    idx = np.sort(np.fromiter(itertools.chain.from_iterable(hits), np.intp))
-    if len(idx) > 1:  # drop the duplicates of overlapping balls (np.unique's hashing is slower here)
-        idx = idx[np.concatenate(([True], idx[1:] != idx[:-1]))]
+    b = a + span * t
+    # Bounding box of the cylinder: per axis, the ends' range grown by radius * sqrt(1 - t_i^2).
+    grow = radius * np.sqrt(np.clip(1.0 - t * t, 0.0, 1.0))
+    g = dense_grid(scene)
+    lo = np.floor((np.minimum(a, b) - grow - g.origin) / g.cell).astype(np.int64)
+    hi = np.floor((np.maximum(a, b) + grow - g.origin) / g.cell).astype(np.int64)
+    lo = np.maximum(lo, 0)
+    hi = np.minimum(hi, g.dims - 1)
+    if np.any(hi < lo):
+        return np.zeros(0, np.intp)
+    ix, iy = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
+    col = (ix.ravel() * g.dims[1] + iy.ravel()) * g.dims[2]
+    first = np.searchsorted(g.keys, col + lo[2], side="left")
+    last = np.searchsorted(g.keys, col + hi[2], side="right")
+    counts = last - first
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, np.intp)
+    # Concatenate the ranges [first, last) without a Python loop.
+    steps = np.ones(total, np.int64)
+    nz = counts > 0
+    starts = np.cumsum(np.concatenate(([0], counts[nz][:-1])))
+    steps[starts] = first[nz] - np.concatenate(([0], last[nz][:-1])) + 1
+    steps[0] = first[nz][0]
+    idx = g.order[np.cumsum(steps)]
     q = pts[idx] - a
     s = q @ t
-    perp = q - np.outer(s, t)
-    keep = (s >= 0.0) & (s <= span) & (np.einsum("ij,ij->i", perp, perp) <= radius * radius)
+    d2 = np.einsum("ij,ij->i", q, q) - s * s
+    keep = (s >= 0.0) & (s <= span) & (d2 <= radius * radius)
     return np.asarray(idx[keep], np.intp)
 
 
@@ -84,13 +130,19 @@ def plane_intersection(
 
     Raises ValueError when the planes are (nearly) parallel.
     """
-    t = np.cross(n_a, n_b)
-    norm = float(np.linalg.norm(t))
-    if norm < 1e-6:
+    ax, ay, az = (float(v) for v in n_a)
+    bx, by, bz = (float(v) for v in n_b)
+    t = np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
+    norm2 = float(t @ t)  # = 1 - c^2 for unit normals
+    if norm2 < 1e-12:
         raise ValueError("planes are parallel: they do not meet in a line")
-    t = t / norm
-    A = np.vstack([n_a, n_b, t])
-    p0 = np.linalg.solve(A, np.array([d_a, d_b, float(t @ p_near)]))
+    t = t / np.sqrt(norm2)
+    c = ax * bx + ay * by + az * bz
+    # The point of the line nearest the origin is a n_a + b n_b; then slide along t to the one nearest p_near.
+    a = (d_a - d_b * c) / norm2
+    b = (d_b - d_a * c) / norm2
+    p0 = a * np.asarray(n_a, float) + b * np.asarray(n_b, float)
+    p0 = p0 + float(t @ (np.asarray(p_near, float) - p0)) * t
     return p0, t
 
 
@@ -124,12 +176,14 @@ class PlaneFit:
     cov : (k, k) sandwich covariance of coef.
     scale : robust residual scale pooled over groups [m].
     weights : (n,) final biweight weights in [0, 1] (0: rejected).
+    sigmas : (n,) the per-group noise scale each point was weighted by [m].
     """
 
     coef: FloatArray
     cov: FloatArray
     scale: float
     weights: FloatArray
+    sigmas: FloatArray  # (n,) the noise scale each point was weighted by [m]
 
     @property
     def offset(self) -> float:
@@ -145,14 +199,26 @@ class PlaneFit:
         return int(np.count_nonzero(self.weights > 0.0))
 
 
-def _scales(res: FloatArray, members: list[IntArray], min_scale: float) -> FloatArray | float:
-    """Robust scale (MAD) of the residuals: one per group (camera) when there are several, else pooled."""
-    pooled = max(_MAD_TO_SIGMA * float(np.median(np.abs(res))), min_scale)
-    if not members:
-        return pooled
+def _mad(a: FloatArray, cap: int = 1500) -> float:
+    """Median of |residuals| a (n,) >= 0, from an evenly strided subsample of at most about ``cap`` values
+    (the scale only sets weights: a subsample's median is plenty)."""
+    if len(a) > 2 * cap:
+        a = a[:: len(a) // cap]
+    if len(a) == 0:
+        return float("nan")
+    k = len(a) // 2
+    return float(np.partition(a, k)[k])  # the upper median: np.median's overhead is most of its cost here
+
+
+def _group_scales(res: FloatArray, labels: IntArray, n_groups: int, min_scale: float) -> FloatArray:
+    """Robust scale (MAD) [m] per point (n,): each group's own, the pooled one for points of small groups
+    (``labels`` -1) or when there are fewer than two groups."""
+    a = np.abs(res)
+    pooled = max(_MAD_TO_SIGMA * _mad(a), min_scale)
     out = np.full(len(res), pooled)
-    for m in members:
-        out[m] = max(_MAD_TO_SIGMA * float(np.median(np.abs(res[m]))), min_scale)
+    for g in range(n_groups if n_groups > 1 else 0):
+        m = labels == g
+        out[m] = max(_MAD_TO_SIGMA * _mad(a[m]), min_scale)
     return out
 
 
@@ -164,6 +230,9 @@ def robust_plane_fit(
     min_scale: float = 1e-4,
     iterations: int = 10,
     min_group: int = 40,
+    prior_precision: FloatArray | None = None,
+    sigmas: FloatArray | None = None,
+    rescale_at: tuple[int, ...] = (0, 3),
 ) -> PlaneFit:
     """Iteratively reweighted least squares with Tukey's biweight and per-group noise weighting.
 
@@ -173,46 +242,77 @@ def robust_plane_fit(
         their own robust scale (the others the pooled one) and points weigh 1/scale^2.
     start : initial offset [m] (e.g. a histogram mode).
     min_scale : floor on the robust scale [m] (noise-free data).
+    prior_precision : (k,) precision of a zero-mean Gaussian prior on each coefficient (0: none), in the units
+        of the weighted normal equations (1 / coefficient^2): a ridge that keeps tilts small unless the data
+        demand them. None: no prior.
+    sigmas : (n,) noise scale of each point [m] when already known (e.g. from an earlier fit of the same
+        points): used as is. Otherwise the scales are measured (a robust MAD per group) at the iterations
+        ``rescale_at`` (about the start, and again once the offset has settled), then held fixed so that the
+        iteration converges.
     """
-    k = X.shape[1]
+    n, k = X.shape
     coef = np.zeros(k)
     coef[0] = start
-    labels = groups - groups.min() if len(groups) else groups
-    big = np.flatnonzero(np.bincount(labels) >= min_group) if len(groups) else np.zeros(0, np.intp)
-    members = [np.flatnonzero(labels == g) for g in big] if len(big) > 1 else []
-    w = np.ones(len(r))
-    sig: FloatArray | float = min_scale
+    labels = np.full(n, -1, np.intp)
+    n_groups = 0
+    if n:
+        counts = np.bincount(groups)
+        big = np.flatnonzero(counts >= min_group)
+        if len(big) > 1:
+            lut = np.full(len(counts), -1, np.intp)
+            lut[big] = np.arange(len(big))
+            labels = lut[groups]
+            n_groups = len(big)
+    lam = np.zeros(k) if prior_precision is None else np.asarray(prior_precision, float)
+    w = np.ones(n)
+    sig = np.full(n, min_scale) if sigmas is None else np.maximum(np.asarray(sigmas, float), min_scale)
+    inv_sig2 = 1.0 / (sig * sig)
+    inv_cut2 = inv_sig2 / (_TUKEY_C * _TUKEY_C)
     for it in range(iterations):
-        res = r - X @ coef
-        if it < 3:  # settle the scales first, then keep them fixed so the iteration converges
-            sig = _scales(res, members, min_scale)
-        u = res / (_TUKEY_C * sig)
-        w = np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0)
-        if np.count_nonzero(w) < k + 1:
+        res = r - coef[0] if k == 1 else r - X @ coef
+        if sigmas is None and it in rescale_at:
+            sig = _group_scales(res, labels, n_groups, min_scale)
+            inv_sig2 = 1.0 / (sig * sig)
+            inv_cut2 = inv_sig2 / (_TUKEY_C * _TUKEY_C)
+        w = 1.0 - res * res * inv_cut2
+        np.maximum(w, 0.0, out=w)
+        w *= w
+        ww = w * inv_sig2
+        if k == 1:
+            sw = float(ww.sum())
+            if sw <= 0.0:
+                break
+            new = np.array([float(ww @ r) / (sw + lam[0])])
+        else:
+            if np.count_nonzero(w) < k + 1:
+                break
+            XtW = X.T * ww
+            try:
+                new = np.asarray(np.linalg.solve(XtW @ X + np.diag(lam), XtW @ r), dtype=np.float64)
+            except np.linalg.LinAlgError:
+                break
+        done = float(np.max(np.abs(new - coef))) < 1e-6
+        coef = new
+        if done and it >= max(rescale_at if sigmas is None else (0,)):
             break
-        ww = w / (sig * sig)
+    res = r - coef[0] if k == 1 else r - X @ coef
+    ww = w * inv_sig2
+    inl = w > 0
+    n_eff = max(int(np.count_nonzero(inl)), k + 1)
+    if k == 1:  # the sandwich in scalars
+        h = float(ww.sum()) + lam[0]
+        wr = ww * res
+        cov = np.array([[float(wr @ wr) / (h * h) * n_eff / (n_eff - 1)]]) if h > 0.0 else np.full((1, 1), np.inf)
+    else:
         XtW = X.T * ww
         try:
-            new: FloatArray = np.asarray(np.linalg.solve(XtW @ X, XtW @ r), dtype=np.float64)
+            Hinv = np.linalg.inv(XtW @ X + np.diag(lam))
+            meat = (X.T * (ww * res) ** 2) @ X
+            cov = Hinv @ meat @ Hinv * n_eff / (n_eff - k)
         except np.linalg.LinAlgError:
-            break
-        done = float(np.max(np.abs(new - coef))) < 1e-7
-        coef = new
-        if done and it >= 3:
-            break
-    res = r - X @ coef
-    ww = w / (sig * sig)
-    XtW = X.T * ww
-    try:
-        Hinv = np.linalg.inv(XtW @ X)
-        meat = (X.T * (ww * res) ** 2) @ X
-        n_eff = max(np.count_nonzero(w), k + 1)
-        cov = Hinv @ meat @ Hinv * n_eff / (n_eff - k)
-    except np.linalg.LinAlgError:
-        cov = np.full((k, k), np.inf)
-    inl = w > 0
-    scale = _MAD_TO_SIGMA * float(np.median(np.abs(res[inl]))) if np.any(inl) else float("inf")
-    return PlaneFit(coef=coef, cov=cov, scale=scale, weights=w)
+            cov = np.full((k, k), np.inf)
+    scale = _MAD_TO_SIGMA * _mad(np.abs(res[inl])) if np.any(inl) else float("inf")
+    return PlaneFit(coef=coef, cov=cov, scale=scale, weights=w, sigmas=sig)
 
 
 def cdf_extent(s: FloatArray, q_lo: float = 0.15, q_hi: float = 0.85) -> tuple[float, float, float]:
@@ -259,6 +359,7 @@ def edge_ml(
     step: float = 1e-4,
     blurs: tuple[float, ...] = (2e-4, 5e-4, 1e-3, 1.5e-3, 2.5e-3),
     stray: float = 0.01,
+    max_points: int = 400,
 ) -> tuple[float, float]:
     """Maximum-likelihood upper edge b [m] of a locally uniform density sampled at s (n,) blurred by Gaussian
     noise, and its standard error [m]; for a lower edge pass -s and -guess, and negate the result.
@@ -267,22 +368,31 @@ def edge_ml(
     sigma) (plus a small ``stray`` floor for points far beyond the edge), normalised over the window, so
     neither the density nor the count needs to be known. b is searched on a grid of ``step`` within ``guess +-
     search``, the blur sigma over ``blurs``; the standard error comes from the curvature of the profile
-    log-likelihood.
+    log-likelihood. Above ``2 max_points`` points in the window, an even stride of the sorted sample is used.
     """
-    from scipy.special import log_ndtr
+    from scipy.special import ndtr
 
     lo, hi = guess - inner, guess + inner
     x = s[(s > lo) & (s < hi)]
     if len(x) < 5:
         return guess, float("inf")
-    b = np.arange(guess - search, guess + search + 0.5 * step, step)  # (m,)
-    best = np.full(len(b), -np.inf)
-    for sig in blurs:
-        z = (b[:, None] - x[None, :]) / sig
-        ll = np.logaddexp(log_ndtr(z), np.log(stray)).sum(axis=1) - len(x) * np.log(
-            (b - lo) + stray * (hi - lo)
-        )
-        best = np.maximum(best, ll)
+    if len(x) > 2 * max_points:  # an even stride keeps the shape of the sample
+        x = np.sort(x)[:: len(x) // max_points]
+
+    def profile(b: FloatArray) -> FloatArray:
+        """Profile log-likelihood (m,) of the edges b (m,), maximised over the blurs."""
+        out = np.full(len(b), -np.inf)
+        norm = len(x) * np.log((b - lo) + stray * (hi - lo))
+        for sig in blurs:
+            ll = np.log(ndtr((b[:, None] - x[None, :]) / sig) + stray).sum(axis=1) - norm
+            out = np.maximum(out, ll)
+        return out
+
+    # Coarse to fine: a grid of 5 steps over +-search, then of one step around the coarse best.
+    coarse = np.arange(guess - search, guess + search + 2.5 * step, 5.0 * step)
+    centre = float(coarse[int(np.argmax(profile(np.asarray(coarse, np.float64))))])
+    b = np.asarray(centre + step * np.arange(-6, 7), np.float64)  # (13,)
+    best = profile(b)
     i = int(np.argmax(best))
     if 0 < i < len(b) - 1:
         c2 = best[i - 1] - 2.0 * best[i] + best[i + 1]

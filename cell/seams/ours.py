@@ -5,25 +5,31 @@ Method (general: no assumption that a seam runs along x, y or z):
 1. From the aligned map: the weld faces, A's ``face_abutting`` (n_a, d_a) and B's ``face_receiving`` (n_b,
    d_b), the seam line where they meet with its direction t, and A's side faces across t (where the seam
    ends).
-2. Points of ``scene.dense`` in a tube around the map seam (a KD-tree built once per scene).
+2. Points of ``scene.dense`` in a tube around the map seam (a KD-tree built once per scene); points within a
+   band of any other part of the map are left out, so neighbouring parts never lend a face their points.
 3. Face A's support: points near A's plane, away from B's face by a corner band (gap, shadow and corner noise
    live there), inside A's extent along t less an edge band (flying pixels on convex edges), above the table.
    Face B's support: points near B's plane inside B's face less an edge band, outside the footprint of A grown
-   by the band. Each face's offset is fitted along the map's normal by iteratively reweighted least squares
-   (Tukey biweight), each camera weighted by its own measured noise; the normal is refined by a small tilt
-   only when the data demand it (a Wald test on the tilt). ``passes`` passes: the first from the map with wide
-   gates, the others with gates and bands from the measured noise and the ends found.
-4. The seam line is the intersection of the fitted planes. Each end is where the line meets A's side face
+   by the band. Each face is fitted along the map's normal by iteratively reweighted least squares (Tukey
+   biweight), each camera weighted by its own measured noise; in the last pass with a small tilt held near
+   the map's normal by a Gaussian prior (as-built parts are rotated by hundredths of a degree, not degrees).
+   ``passes`` passes: the first from the map with wide gates, the others with gates and bands from the
+   measured noise and the ends found.
+4. A weld face no camera sees (too oblique, occluded) is placed from the edge where an adjacent face of the
+   same part ends: the extent of that face's points across the edge (a blurred-step likelihood). With neither
+   the face nor such an edge seen, the seam is NOT_FOUND naming the face.
+5. The seam line is the intersection of the fitted planes. Each end is where the line meets A's side face
    across it, fitted from that face's points when it is seen, the table when A rests on it there, or else the
-   extent of face A's support along t (its empirical CDF extrapolated, then refined by a blurred-edge
-   likelihood: robust to blur and strays).
-5. Confidence from the support of each face against the expected count, the standard errors of the fitted
-   offsets and ends, and the residual scale. A face without enough support gives NOT_FOUND naming that face.
+   extent of face A's support along t (its empirical CDF extrapolated, then refined by the same edge
+   likelihood).
+6. Confidence from the standard errors of the fitted offsets and ends, each face's support and the residual
+   scale; lower when a face was placed from an edge.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -32,33 +38,40 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _fit
 from cell.seams.base import Joint, SeamScene
-from cell.types import Box, MapSeam, SeamEstimate, SeamStatus
+from cell.types import BOX_FACES, Box, MapSeam, SeamEstimate, SeamStatus
 
 BoolArray = npt.NDArray[np.bool_]
+IntArray = npt.NDArray[np.intp]
 _Z = np.array([0.0, 0.0, 1.0])
+_EDGE_CONFIDENCE = 0.5  # confidence factor of a seam one of whose faces was placed from an edge
 
 
 @dataclass(frozen=True)
 class OursOptions:
     """Options of :class:`OursLocator` (defaults suit RealSense D4xx-class clouds at 1-2 m); lengths [m]."""
 
-    tube_radius_m: float = 0.035  # points within this distance of the map seam are looked at
+    tube_radius_m: float = 0.06  # points within this distance of the map seam are looked at
     extend_m: float = 0.02  # ... and this far past the map's ends
-    corner_band_m: float = (
-        0.005  # least band excluded next to the other weld face (gap, shadow, corner noise)
-    )
+    corner_band_m: float = 0.005  # least band excluded next to the other weld face (gap, shadow, corner noise)
     edge_band_m: float = 0.004  # band excluded along convex edges (flying pixels, side faces)
     map_tolerance_m: float = 0.006  # how far the as-built faces and ends may lie from the aligned map
     sensor_sigma_m: float = 0.003  # depth noise assumed before it is measured
     gate_sigmas: float = 3.5  # half-width of the gate around a plane, in measured noise scales
     passes: int = 2  # fits: the first from the map with wide gates, the others with measured noise and ends
-    min_face_points: int = 30  # fewer supporting points on a weld face: NOT_FOUND
+    min_face_points: int = 30  # fewer supporting points on a weld face: place it from an edge, or NOT_FOUND
     min_end_points: int = 40  # fewer points on a side face of A: take the end from the extent instead
-    refine_normals: bool = True  # tilt a face's normal when the data demand it
-    tilt_sigmas: float = 4.0  # ... significance of the tilt (Wald statistic, in standard errors)
-    max_tilt_deg: float = 3.0  # ... and at most this much
-    max_points: int = 30000  # random subsample of the tube above this
+    min_end_fill: float = 0.05  # ... or fewer than this fraction of the points its area would hold head on
+    refine_normals: bool = True  # let a face tilt off the map's normal in the last pass
+    tilt_prior_deg: float = 0.05  # ... standard deviation of the tilt's Gaussian prior [deg]
+    max_points: int = 40000  # random subsample of the tube above this
+    max_fit_points: int = 1000  # a plane is fitted to an even stride of its support above this
     target_se_m: float = 0.0002  # standard error of the seam's position that still earns full confidence
+
+    def __post_init__(self) -> None:
+        if self.passes < 1 or self.min_face_points < 3 or self.min_end_points < 3:
+            raise ValueError("ours options need passes >= 1, min_face_points >= 3 and min_end_points >= 3")
+        if self.tube_radius_m <= self.corner_band_m or self.tilt_prior_deg <= 0.0:
+            raise ValueError("ours options need tube_radius_m > corner_band_m and tilt_prior_deg > 0")
 
 
 @dataclass
@@ -68,9 +81,11 @@ class _Face:
     n: FloatArray
     d: float
     scale: float
+    name: str
     se: float = float("inf")
     count: int = 0
-    tilted: bool = False
+    source: str = "points"  # or "edge of <face>" (an adjacent face of the same part)
+    area: float = 0.0  # area of its support region [m^2] (what a head-on view would fill with points)
 
 
 @dataclass
@@ -84,6 +99,26 @@ class _End:
     se: float = float("inf")
     scale: float = 0.003  # noise of the side face's points [m]
     source: str = "map"
+
+
+@dataclass
+class _Points:
+    """The points looked at for one seam: positions P (n, 3) [m], camera index (n,), usable mask (n,)."""
+
+    P: FloatArray
+    cam: IntArray
+    ok: BoolArray  # above the table and away from every other part
+    scene: SeamScene
+    kept: float = 1.0  # fraction of the tube's points kept (a random subsample above ``max_points``)
+    _along: dict[bytes, FloatArray] = field(default_factory=dict)
+
+    def along(self, n: FloatArray) -> FloatArray:
+        """P @ n (n,) [m], computed once per direction (most planes keep the map's normal)."""
+        key = np.asarray(n, np.float64).tobytes()
+        out = self._along.get(key)
+        if out is None:
+            out = self._along[key] = self.P @ n
+        return out
 
 
 class OursLocator:
@@ -104,92 +139,91 @@ class OursLocator:
         n_b, d_b = box_b.face_plane(joint.face_receiving)
         mid = 0.5 * (seam.p_start + seam.p_end)
         try:
-            p0, t = _fit.plane_intersection(n_a, d_a, n_b, d_b, mid)
+            p0, t = _line(n_a, d_a, n_b, d_b, mid, seam.direction)
         except ValueError:
             raise MapError(
                 f"seam {seam.id}: faces {joint.abutting} {joint.face_abutting} and {joint.receiving} "
                 f"{joint.face_receiving} are parallel; a joint needs two faces that meet in a line"
             ) from None
-        if t @ seam.direction < 0.0:
-            t = -t
         if _against_table(n_a, n_b, seam, scene.table_z, o.map_tolerance_m):
             return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason="the seam lies against the table")
 
-        idx = _fit.tube_indices(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m)
-        if len(idx) > o.max_points:
-            idx = np.sort(rng.choice(idx, o.max_points, replace=False))
-        P = scene.dense.points[idx]
-        cam = scene.dense.camera[idx].astype(np.intp)
-        above = P[:, 2] >= scene.table_z + o.corner_band_m
+        pts = self._points(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng)
+        P, cam = pts.P, pts.cam
         geo = _Geometry.of(box_a, box_b, joint, t, o.edge_band_m)
         s_map = sorted((float(t @ (seam.p_start - p0)), float(t @ (seam.p_end - p0))))
-        face_a = _Face(n_a, d_a, o.sensor_sigma_m)
-        face_b = _Face(n_b, d_b, o.sensor_sigma_m)
+        face_a = _Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
+        face_b = _Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
         ends = geo.end_planes(t, scene.table_z, o.map_tolerance_m)
         ends[0].s, ends[1].s = s_map
-        names = (f"{joint.abutting} {joint.face_abutting}", f"{joint.receiving} {joint.face_receiving}")
 
         for it in range(o.passes):
-            first = it == 0
-            p0, t = _fit.plane_intersection(face_a.n, face_a.d, face_b.n, face_b.d, mid)
-            if t @ seam.direction < 0.0:
-                t = -t
-            r_a = P @ face_a.n - face_a.d
-            r_b = P @ face_b.n - face_b.d
-            s = (P - p0) @ t
+            first, last = it == 0, it == o.passes - 1
+            p0, t = _line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
+            r_a = pts.along(face_a.n) - face_a.d
+            r_b = pts.along(face_b.n) - face_b.d
+            s = pts.along(t) - float(p0 @ t)
             slack = o.map_tolerance_m if first else 0.0
             band_a = max(o.corner_band_m, 3.0 * face_a.scale) + slack
             band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
             e0, e1 = ends[0].s, ends[1].s
             eb = o.edge_band_m + (slack if first else min(max(ends[0].se, ends[1].se), o.map_tolerance_m))
-            in_a = (r_b >= band_b) & (s >= e0 + eb) & (s <= e1 - eb) & above
+            in_a = (r_b >= band_b) & (r_b <= geo.length_a - eb) & (s >= e0 + eb) & (s <= e1 - eb) & pts.ok
             in_b = (
-                geo.in_face_b(P)
+                geo.in_face_b(pts, slack)
                 & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
-                & above
+                & pts.ok
             )
-            for face, r, region, name, other in (
-                (face_a, r_a, in_a, names[0], face_b),
-                (face_b, r_b, in_b, names[1], face_a),
+            for face, r, region, other, box, face_name, skip in (
+                (face_a, r_a, in_a, face_b, box_a, joint.face_abutting, joint.end_face),
+                (face_b, r_b, in_b, face_a, box_b, joint.face_receiving, ""),
             ):
+                # Where an adjacent face of the same part may show this face's edge: away from the other part.
+                away = _away_from(face_b, band_b) if face is face_a else _outside(box_a, band_a)
+                if face.source != "points":
+                    continue  # placed from an edge in the first pass
                 gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
-                sel = region & (np.abs(r) < gate)
-                face.count = int(np.count_nonzero(sel))
-                if face.count < o.min_face_points:
-                    return _not_found(
-                        seam.id,
-                        f"face {name} has {face.count} points near the seam "
-                        f"(needs {o.min_face_points}): not seen or not there",
-                    )
-                self._fit_face(face, other, r[sel], P[sel], cam[sel], p0, t, first, refine=it == o.passes - 1)
-            p0, t = _fit.plane_intersection(face_a.n, face_a.d, face_b.n, face_b.d, mid)
-            if t @ seam.direction < 0.0:
-                t = -t
+                sel = np.flatnonzero(region & (np.abs(r) < gate))
+                count = len(sel)
+                if count >= o.min_face_points:
+                    fit_sel = _thin(sel, o.max_fit_points)
+                    self._fit_face(face, other, r[fit_sel], P[fit_sel], cam[fit_sel], p0, t, first, last)
+                    face.se *= np.sqrt(len(fit_sel) / count)  # the stride stands for all the support
+                    face.count = count
+                    continue
+                if first and self._face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng):
+                    continue
+                return _not_found(
+                    seam.id,
+                    f"face {face.name} has {count} points near the seam (needs {o.min_face_points}) and no "
+                    "edge of it is seen either: not seen or not there",
+                )
+            # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
+            face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
+            face_b.area = (e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0)
+            p0, t = _line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
             # p0 lies on both fitted planes: its distance from a map plane is how far that face moved.
-            for drift, name in (
-                (abs(float(n_a @ p0) - d_a), names[0]),
-                (abs(float(n_b @ p0) - d_b), names[1]),
-            ):
+            for drift, name in ((abs(float(n_a @ p0) - d_a), face_a.name), (abs(float(n_b @ p0) - d_b), face_b.name)):
                 if drift > 2.0 * o.map_tolerance_m:
                     return _not_found(
                         seam.id,
                         f"face {name} fitted {drift * 1000:.1f} mm from the map "
                         f"(allowed {2000 * o.map_tolerance_m:.1f} mm): wrong surface or part moved",
                     )
-            self._find_ends(ends, P, cam, face_a, face_b, p0, t, geo, above, first, s_map)
+            self._find_ends(ends, pts, face_a, face_b, p0, t, geo, first, s_map)
 
         length = ends[1].s - ends[0].s
         if not 0.3 * (s_map[1] - s_map[0]) < length < 2.0 * (s_map[1] - s_map[0]) + 2.0 * o.extend_m:
             return _not_found(
                 seam.id,
-                f"seam length {length * 1000:.1f} mm found, the map says "
-                f"{(s_map[1] - s_map[0]) * 1000:.1f} mm",
+                f"seam length {length * 1000:.1f} mm found, the map says {(s_map[1] - s_map[0]) * 1000:.1f} mm",
             )
-        conf = self._confidence(scene, face_a, face_b, ends, p0, t, geo, s_map)
+        conf = self._confidence(face_a, face_b, ends, _fit.dense_spacing(scene) / np.sqrt(pts.kept))
+        via = [f"face {f.name} from the {f.source}" for f in (face_a, face_b) if f.source != "points"]
         return SeamEstimate(
             id=seam.id,
             status=SeamStatus.FOUND,
-            reason=f"ends from {ends[0].source} / {ends[1].source}",
+            reason="; ".join([f"ends from {ends[0].source} / {ends[1].source}", *via]),
             p_start=p0 + ends[0].s * t,
             p_end=p0 + ends[1].s * t,
             confidence=conf,
@@ -197,80 +231,188 @@ class OursLocator:
 
     # -- steps ------------------------------------------------------------------------------------------
 
+    def _points(
+        self,
+        scene: SeamScene,
+        a: FloatArray,
+        b: FloatArray,
+        radius: float,
+        extend: float,
+        joint: Joint,
+        rng: np.random.Generator,
+    ) -> _Points:
+        """The dense cloud's points in the tube of ``radius`` around the segment a-b (3,) extended by
+        ``extend`` [m], and which of them may support a plane (above the table, away from other parts)."""
+        o = self.options
+        idx = _fit.tube_indices(scene, a, b, radius, extend)
+        kept = 1.0
+        if len(idx) > o.max_points:
+            kept = o.max_points / len(idx)
+            idx = np.sort(rng.choice(idx, o.max_points, replace=False))
+        P = scene.dense.points[idx]
+        cam = scene.dense.camera[idx].astype(np.intp)
+        cam = np.where(cam < 0, int(cam.max(initial=0)) + 1, cam)  # mixed / unknown captures: their own group
+        ok = P[:, 2] >= scene.table_z + o.corner_band_m
+        reach = radius + extend + 0.5 * float(np.linalg.norm(b - a)) + o.map_tolerance_m
+        mid = 0.5 * (a + b)
+        for part in scene.weldmap.parts:
+            if part.name in (joint.abutting, joint.receiving):
+                continue
+            if np.linalg.norm(part.box.center - mid) > reach + 0.5 * float(np.linalg.norm(part.box.size)):
+                continue
+            ok &= ~part.box.contains(P, margin=o.map_tolerance_m)
+        return _Points(P, cam, ok, scene, kept)
+
     def _fit_face(
         self,
         face: _Face,
         other: _Face,
         r: FloatArray,
         P: FloatArray,
-        cam: npt.NDArray[np.intp],
+        cam: IntArray,
         p0: FloatArray,
         t: FloatArray,
         first: bool,
-        refine: bool,
+        last: bool,
     ) -> None:
-        """Fit the offset (and, when asked and significant, a small tilt) of ``face``; update it in place."""
+        """Fit the offset of ``face`` (and in the last pass a small tilt, held by its prior); update it."""
         o = self.options
         start = _fit.histogram_mode(r, max(0.002, o.sensor_sigma_m)) if first else 0.0
-        ones = np.ones((len(r), 1))
-        fit = _fit.robust_plane_fit(r, ones, cam, start)
-        face.d += fit.offset
-        face.scale, face.se = max(fit.scale, 1e-4), fit.se
-        face.count = fit.n_inliers
-        if not (refine and o.refine_normals and fit.n_inliers >= 3 * o.min_face_points):
+        # The first pass's wide gates let other surfaces in: its scales are not reused; the later passes
+        # measure them once, about the previous fit.
+        rescale = (0, 3) if first else (0,)
+        if not (last and o.refine_normals):
+            fit = _fit.robust_plane_fit(r, np.ones((len(r), 1)), cam, start, rescale_at=rescale)
+            face.d += fit.offset
+            face.scale, face.se, face.count = max(fit.scale, 1e-4), fit.se, fit.n_inliers
             return
+        # Offset and tilt about the points' centroid (decorrelated), then carried to the seam line.
         e_u = other.n - (other.n @ face.n) * face.n
         e_u /= np.linalg.norm(e_u)
         q = P - p0
-        X = np.column_stack([ones[:, 0], q @ e_u, q @ t])
-        tilt = _fit.robust_plane_fit(r - fit.offset, X, cam, 0.0)
-        ab = tilt.coef[1:]
-        try:
-            wald = float(ab @ np.linalg.solve(tilt.cov[1:, 1:], ab))
-        except np.linalg.LinAlgError:
-            return
-        if wald < o.tilt_sigmas**2 or np.degrees(np.arctan(np.hypot(*ab))) > o.max_tilt_deg:
-            return
-        m = face.n - ab[0] * e_u - ab[1] * t
+        u, v = q @ e_u, q @ t
+        uc, vc = float(np.mean(u)), float(np.mean(v))
+        X = np.column_stack([np.ones(len(r)), u - uc, v - vc])
+        tau = np.tan(np.radians(o.tilt_prior_deg))
+        prior = np.array([0.0, tau**-2, tau**-2])
+        fit = _fit.robust_plane_fit(r, X, cam, start, prior_precision=prior, rescale_at=rescale)
+        c0, a, b = fit.coef
+        # The plane r = c0 + a (u - uc) + b (v - vc): its value and standard error on the seam line (u = 0).
+        J = np.array([1.0, -uc, 0.0])
+        se0 = float(np.sqrt(max(J @ fit.cov @ J, 0.0)))
+        m = face.n - a * e_u - b * t
         norm = float(np.linalg.norm(m))
-        face.d = (face.d + tilt.coef[0] - ab[0] * float(e_u @ p0) - ab[1] * float(t @ p0)) / norm
+        face.d = (face.d + c0 - a * (uc + float(e_u @ p0)) - b * (vc + float(t @ p0))) / norm
         face.n = m / norm
-        face.se, face.tilted = tilt.se, True
+        face.scale, face.se, face.count = max(fit.scale, 1e-4), se0, fit.n_inliers
+
+    def _face_from_edge(
+        self,
+        scene: SeamScene,
+        face: _Face,
+        box: Box,
+        face_name: str,
+        skip: str,
+        seam: MapSeam,
+        joint: Joint,
+        away: Callable[[FloatArray], BoolArray],
+        rng: np.random.Generator,
+    ) -> bool:
+        """Place an unseen ``face`` of ``box`` from the edge where an adjacent face of the same part, seen,
+        ends across it (the stretch of that edge alongside ``seam``); False when no adjacent face shows its
+        edge. ``away`` masks the points (n, 3) far enough from the joint's other part."""
+        o = self.options
+        k_f = "xyz".index(face_name[1])
+        inner = 2.0 * o.map_tolerance_m  # the edge likelihood's window [m]
+        best: tuple[float, float, float, int, str] | None = None
+        for g in BOX_FACES:
+            k_g = "xyz".index(g[1])
+            if k_g == k_f or g == skip:
+                continue
+            n_g, d_g = box.face_plane(g)
+            # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
+            q0, e = _fit.plane_intersection(face.n, face.d, n_g, d_g, 0.5 * (seam.p_start + seam.p_end))
+            s_ends = sorted(float(e @ (p - q0)) for p in (seam.p_start, seam.p_end))
+            lo, hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
+            pts = self._points(scene, q0 + lo * e, q0 + hi * e, 2.0 * inner, 0.0, joint, rng)
+            P, cam = pts.P, pts.cam
+            u = P @ face.n - face.d  # along the face's outward normal: the adjacent face's points end at u = 0
+            r_g = P @ n_g - d_g
+            region = pts.ok & away(P) & (u > -float(box.size[k_f]) + o.edge_band_m) & (u < o.map_tolerance_m)
+            region &= _in_face(box, P, (k_f, k_g), o.edge_band_m)
+            sel = region & (np.abs(r_g) < o.map_tolerance_m + 3.0 * o.sensor_sigma_m)
+            if np.count_nonzero(sel) < o.min_face_points:
+                continue
+            start = _fit.histogram_mode(r_g[sel], max(0.002, o.sensor_sigma_m))
+            fit = _fit.robust_plane_fit(r_g[sel], np.ones((int(np.count_nonzero(sel)), 1)), cam[sel], start)
+            on = region & (np.abs(r_g - fit.offset) < 2.5 * max(fit.scale, 1e-4))
+            uu = u[on]
+            if np.count_nonzero(uu > -0.01) < o.min_face_points:
+                continue
+            # The map puts the edge at u = 0, within the tolerance.
+            edge, se = _fit.edge_ml(uu, 0.0, inner=inner, search=o.map_tolerance_m)
+            if not np.isfinite(se):
+                continue
+            density = len(uu) / max(float(np.ptp(uu)), 1e-3)  # [1/m]
+            se = max(se, 2.0 / density)
+            if abs(edge) <= o.map_tolerance_m and (best is None or se < best[1]):
+                best = (edge, se, max(fit.scale, 1e-4), len(uu), g)
+        if best is None:
+            return False
+        edge, se, scale, count, g = best
+        face.d += edge
+        face.se, face.scale, face.count = se, scale, count
+        face.source = f"edge of {g}"
+        return True
 
     def _find_ends(
         self,
         ends: list[_End],
-        P: FloatArray,
-        cam: npt.NDArray[np.intp],
+        pts: _Points,
         face_a: _Face,
         face_b: _Face,
         p0: FloatArray,
         t: FloatArray,
         geo: _Geometry,
-        above: BoolArray,
         first: bool,
         s_map: list[float],
     ) -> None:
         """Update both ends: the table where A rests on it, A's side face where it is seen, else the extent
         of face A's support along the seam."""
         o = self.options
-        r_a = P @ face_a.n - face_a.d
-        r_b = P @ face_b.n - face_b.d
-        s = (P - p0) @ t
+        r_a = pts.along(face_a.n) - face_a.d
+        r_b = pts.along(face_b.n) - face_b.d
+        s = pts.along(t) - float(p0 @ t)
         band_b = max(o.corner_band_m, 3.0 * face_b.scale)
-        side = (r_a < -o.edge_band_m) & (r_a > -(geo.depth_a - o.edge_band_m)) & (r_b >= band_b) & above
+        side = (
+            (r_a < -o.edge_band_m)
+            & (r_a > -(geo.depth_a - o.edge_band_m))
+            & (r_b >= band_b)
+            & (r_b <= geo.length_a - o.edge_band_m)
+            & pts.ok
+        )
+        # A side face seen at all shows a good part of the points its patch would hold seen head on; a few
+        # dozen flying pixels off an edge (a face seen at grazing incidence drops out) must not pass for it.
+        spacing = _fit.dense_spacing(pts.scene) / np.sqrt(pts.kept)  # of the points looked at
+        patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * o.edge_band_m) * (
+            min(geo.length_a, o.tube_radius_m) - band_b - o.edge_band_m
+        )
+        need = max(o.min_end_points, int(o.min_end_fill * max(patch, 0.0) / spacing**2))
         known = [False, False]
         for k, end in enumerate(ends):
             if end.on_table:
                 end.s, end.se, end.source = _fit.line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table"
                 known[k] = True
             elif geo.has_sides:
-                known[k] = self._fit_side(end, P, cam, side, p0, t, first)
-        if all(known):
+                known[k] = self._fit_side(end, pts, side, p0, t, first, need)
+        if all(known) or face_a.source != "points":
+            for k, end in enumerate(ends):
+                if not known[k]:
+                    end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
             return
         # Face A's support along t; a known end's neighbourhood is cut away (A's side face shows up there),
         # which only shifts the CDF by a constant and leaves the other end's extrapolation unbiased.
-        near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & above
+        near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         cut = o.edge_band_m + 3.0 * face_a.scale
         if known[0]:
             near_a &= s > ends[0].s + cut
@@ -294,67 +436,54 @@ class OursLocator:
                 end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
 
     def _fit_side(
-        self,
-        end: _End,
-        P: FloatArray,
-        cam: npt.NDArray[np.intp],
-        side: BoolArray,
-        p0: FloatArray,
-        t: FloatArray,
-        first: bool,
+        self, end: _End, pts: _Points, side: BoolArray, p0: FloatArray, t: FloatArray, first: bool, need: int
     ) -> bool:
         """Fit the offset of A's side face at ``end`` from the points on it; False when too few are seen."""
         o = self.options
-        r_l = P @ end.n - end.d
+        r_l = pts.along(end.n) - end.d
         gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
-        sel = side & (np.abs(r_l) < gate)
-        count = int(np.count_nonzero(sel))
-        if count < o.min_end_points:
+        sel = np.flatnonzero(side & (np.abs(r_l) < gate))
+        count = len(sel)
+        if count < need:
             return False
+        fit_sel = _thin(sel, o.max_fit_points)
+        thin = np.sqrt(len(fit_sel) / count)
+        sel = fit_sel
         start = _fit.histogram_mode(r_l[sel], max(0.002, o.sensor_sigma_m)) if first else 0.0
-        fit = _fit.robust_plane_fit(r_l[sel], np.ones((count, 1)), cam[sel], start)
-        if fit.n_inliers < o.min_end_points:
+        rescale = (0, 3) if first else (0,)
+        fit = _fit.robust_plane_fit(r_l[sel], np.ones((len(sel), 1)), pts.cam[sel], start, rescale_at=rescale)
+        if fit.n_inliers < min(need, len(sel)):
             return False
         end.d += fit.offset
         end.scale = max(fit.scale, 1e-4)
         end.s = _fit.line_plane_parameter(p0, t, end.n, end.d)
-        end.se = fit.se / max(abs(float(end.n @ t)), 1e-3)
+        end.se = thin * fit.se / max(abs(float(end.n @ t)), 1e-3)
         end.source = "side face"
         return True
 
-    def _confidence(
-        self,
-        scene: SeamScene,
-        face_a: _Face,
-        face_b: _Face,
-        ends: list[_End],
-        p0: FloatArray,
-        t: FloatArray,
-        geo: _Geometry,
-        s_map: list[float],
-    ) -> float:
-        """Confidence in [0, 1]: support vs the expected count, offset and end standard errors, noise."""
+    def _confidence(self, face_a: _Face, face_b: _Face, ends: list[_End], spacing: float) -> float:
+        """Confidence in [0, 1] from the standard errors of the line (lateral) and of the ends, the support of
+        each face (its points against what a head-on view of its region at the cloud's point ``spacing`` [m]
+        would give; half of that earns full marks) and the residual noise; halved when a face was placed from
+        an edge."""
         o = self.options
-        spacing = _fit.dense_spacing(scene)
-        band_a = max(o.corner_band_m, 3.0 * face_a.scale)
-        band_b = max(o.corner_band_m, 3.0 * face_b.scale)
-        length = max(ends[1].s - ends[0].s - 2.0 * o.edge_band_m, 1e-3)
-        area_a = length * max(o.tube_radius_m - band_b, 1e-3)
-        area_b = geo.face_b_area(p0, t, face_a, face_b, ends, band_a, o.tube_radius_m, s_map, o.extend_m)
-        support = 1.0
-        if np.isfinite(spacing) and spacing > 0.0:
-            expect_a, expect_b = area_a / spacing**2, max(area_b, 1e-6) / spacing**2
-            support = min(1.0, face_a.count / expect_a, face_b.count / expect_b)
         sin_ab = float(np.linalg.norm(np.cross(face_a.n, face_b.n)))
         se_lat = float(np.hypot(face_a.se, face_b.se)) / max(sin_ab, 0.1)
         se_end = max(ends[0].se, ends[1].se)
+        support = 1.0
+        if np.isfinite(spacing) and spacing > 0.0:
+            for f in (face_a, face_b):
+                if f.source == "points":
+                    expect = max(f.area, 1e-6) / spacing**2
+                    support = min(support, f.count / (0.5 * expect))
         noise = min(1.0, 2.0 * o.sensor_sigma_m / max(face_a.scale, face_b.scale))
         conf = (
-            np.sqrt(support)
+            np.sqrt(support * noise)
             / (1.0 + (se_lat / o.target_se_m) ** 2)
             / (1.0 + (se_end / (4.0 * o.target_se_m)) ** 2)
-            * np.sqrt(noise)
         )
+        if face_a.source != "points" or face_b.source != "points":
+            conf *= _EDGE_CONFIDENCE
         return float(np.clip(conf, 0.0, 1.0))
 
 
@@ -365,20 +494,21 @@ class _Geometry:
     box_a: Box
     box_b: Box
     depth_a: float  # A's thickness below its weld face [m]
+    length_a: float  # A's length away from B (along its end face's normal) [m]
     side_axis: int  # A's box axis across the seam's ends (-1: none: the seam is not across A's faces)
-    b_axes: tuple[int, int]  # B's in-plane box axes of the receiving face
+    k_b: int  # B's box axis normal to the receiving face
     edge_band: float
 
     @staticmethod
     def of(box_a: Box, box_b: Box, joint: Joint, t: FloatArray, edge_band: float) -> _Geometry:
         k_a = "xyz".index(joint.face_abutting[1])
+        k_e = "xyz".index(joint.end_face[1])
         R_A = box_a.X_AB[:3, :3]
         cand = [k for k in range(3) if k != k_a]
         k_t = max(cand, key=lambda k: abs(float(R_A[:, k] @ t)))
         side_axis = k_t if abs(float(R_A[:, k_t] @ t)) > np.cos(np.radians(30.0)) else -1
         k_b = "xyz".index(joint.face_receiving[1])
-        b_axes = tuple(k for k in range(3) if k != k_b)
-        return _Geometry(box_a, box_b, float(box_a.size[k_a]), side_axis, (b_axes[0], b_axes[1]), edge_band)
+        return _Geometry(box_a, box_b, float(box_a.size[k_a]), float(box_a.size[k_e]), side_axis, k_b, edge_band)
 
     @property
     def has_sides(self) -> bool:
@@ -400,41 +530,51 @@ class _Geometry:
             out.append(_End(-_Z, -table_z, True) if on_table else _End(n, d, False))
         return out
 
-    def in_face_b(self, P: FloatArray) -> BoolArray:
-        """Points whose projection lies inside B's receiving face shrunk by the edge band."""
-        q = (P - self.box_b.center) @ self.box_b.X_AB[:3, :3]
-        ok = np.ones(len(P), bool)
-        for j in self.b_axes:
-            ok &= np.abs(q[:, j]) <= 0.5 * float(self.box_b.size[j]) - self.edge_band
+    def in_face_b(self, pts: _Points, slack: float) -> BoolArray:
+        """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""
+        ok = np.ones(len(pts.P), bool)
+        R_B, c_B = self.box_b.X_AB[:3, :3], self.box_b.center
+        for j in range(3):
+            if j != self.k_b:
+                axis = R_B[:, j]
+                half = 0.5 * float(self.box_b.size[j]) - self.edge_band - slack
+                ok &= np.abs(pts.along(axis) - float(axis @ c_B)) <= half
         return ok
 
-    def face_b_area(
-        self,
-        p0: FloatArray,
-        t: FloatArray,
-        face_a: _Face,
-        face_b: _Face,
-        ends: list[_End],
-        band_a: float,
-        radius: float,
-        s_map: list[float],
-        extend: float,
-    ) -> float:
-        """Area [m^2] of face B's support region inside the tube (counted on a 2 mm grid on B's plane)."""
-        e_v = face_a.n - (face_a.n @ face_b.n) * face_b.n
-        e_v /= np.linalg.norm(e_v)
-        step = 0.002
-        sv = np.arange(s_map[0] - extend, s_map[1] + extend, step)
-        vv = np.arange(-radius, radius, step)
-        S, V = np.meshgrid(sv, vv)
-        G = p0 + np.outer(S.ravel(), t) + np.outer(V.ravel(), e_v)
-        r_a = G @ face_a.n - face_a.d
-        s = S.ravel()
-        e0, e1 = ends[0].s, ends[1].s
-        keep = self.in_face_b(G) & ~(
-            (r_a < band_a) & (r_a > -self.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a)
-        )
-        return float(np.count_nonzero(keep)) * step * step
+
+def _away_from(face: _Face, band: float) -> Callable[[FloatArray], BoolArray]:
+    """A mask of points (n, 3) at least ``band`` [m] in front of ``face``."""
+    return lambda P: np.asarray(P @ face.n - face.d >= band)
+
+
+def _outside(box: Box, band: float) -> Callable[[FloatArray], BoolArray]:
+    """A mask of points (n, 3) outside ``box`` grown by ``band`` [m]."""
+    return lambda P: ~box.contains(P, margin=band)
+
+
+def _in_face(box: Box, P: FloatArray, free: tuple[int, ...], band: float) -> BoolArray:
+    """Points (n, 3) whose coordinates along every box axis but the ``free`` ones lie inside the box shrunk by
+    ``band`` [m]."""
+    q = (P - box.center) @ box.X_AB[:3, :3]
+    ok = np.ones(len(P), bool)
+    for j in range(3):
+        if j not in free:
+            ok &= np.abs(q[:, j]) <= 0.5 * float(box.size[j]) - band
+    return ok
+
+
+def _thin(idx: IntArray, cap: int) -> IntArray:
+    """An even stride of the indices ``idx`` leaving at most about ``cap`` of them (deterministic)."""
+    return idx[:: len(idx) // cap] if len(idx) > 2 * cap else idx
+
+
+def _line(
+    n_a: FloatArray, d_a: float, n_b: FloatArray, d_b: float, near: FloatArray, direction: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The line where two planes meet, nearest ``near``, directed along ``direction``; ValueError if
+    parallel."""
+    p0, t = _fit.plane_intersection(n_a, d_a, n_b, d_b, near)
+    return p0, (t if float(t @ direction) >= 0.0 else -t)
 
 
 def _joint_of(scene: SeamScene, seam: MapSeam) -> Joint:

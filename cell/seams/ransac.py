@@ -1,13 +1,18 @@
 """The baseline: Takubo et al. as the paper ran it (RANSAC planes, weld line = their intersection).
 
-In a region around the map's seam (the paper's "slight enhancement": search only near the seam), planes are
-segmented one after the other with RANSAC (vectorised numpy, hypotheses drawn from the given ``rng``) and
-refitted to their inliers by least squares. The two dominant non-parallel planes of the joint are kept (the
-largest planes whose normals match the joint's two faces in the map; the two largest non-parallel planes when
-the map's faces are not among them), the weld line is their intersection, clipped to the extent along it of
-both planes' inliers near the line (less a band along the corner, where both planes' points mix, and a small
-quantile at each end). RANSAC is random, so the paper ran it three times per seam; the median of
-the ``runs`` results is reported.
+As in the paper (section 4, Table 1), by default on the 1 cm voxel-downsampled cloud (``scene.cloud``), three
+independent runs per seam. In a region around the map's seam (the paper's "slight enhancement": search only
+near the seam), planes are segmented one after the other with RANSAC (vectorised numpy, hypotheses drawn from
+the given ``rng``, so a run is deterministic for a given seed) and refitted to their inliers by least squares.
+The joint's two planes are the largest ones whose normals match the map's two weld faces and that pass near
+the map's seam; a run that finds no such pair finds nothing (the method has no other way to tell which planes
+make the joint). The weld line is their intersection, clipped to the extent along it of both planes' inliers
+near the line (less a band along the corner, where both planes' points mix, and a small quantile at each
+end). The median of the runs that found the pair is reported, its confidence from their agreement.
+
+Thresholds that depend on the point spacing (inlier distance, the least plane, the clipping radius and band)
+are derived in one place, :meth:`RansacOptions.thresholds`, from the spacing measured in the region, so the
+same options serve the voxel cloud and the dense one (``cloud="dense"``).
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from cell.errors import MapError, ScenarioError
 from cell.geometry import FloatArray
@@ -27,28 +33,45 @@ from cell.types import MapSeam, SeamEstimate, SeamStatus
 class RansacOptions:
     """Options of :class:`RansacLocator`; lengths [m]."""
 
+    cloud: str = "voxel"  # "voxel": the paper's 1 cm cloud (scene.cloud); "dense": full resolution
+    runs: int = 3  # independent runs per seam; the median is reported (paper: three)
     region_m: float = 0.05  # points within this distance of the map's seam segment (extended as far) are used
-    distance_m: float = 0.003  # RANSAC inlier distance
+    distance_m: float = 0.003  # least RANSAC inlier distance ...
+    distance_spacings: float = 0.3  # ... or this many point spacings, whichever is larger
+    min_plane_area_m2: float = 0.0008  # a plane needs the points of this much area (8 cm^2) ...
+    min_inliers: int = 6  # ... and at least this many points; a smaller plane ends the segmentation
     iterations: int = 300  # hypotheses per plane
     max_planes: int = 5  # planes segmented per region
-    min_inliers: int = 50  # a smaller plane ends the segmentation
     sample_points: int = 4000  # points used to score hypotheses (all region points are used for the refits)
     parallel_deg: float = 30.0  # planes closer than this in angle count as parallel
     match_deg: float = 20.0  # a plane matches a map face when their normals are this close
     match_offset_m: float = 0.01  # ... and it passes this close to the map's seam
-    clip_radius_m: float = 0.015  # inliers this near the line give its extent...
-    clip_band_m: float = (
-        0.006  # ... unless this near the other plane (the corner, where the planes' points mix)
-    )
+    clip_radius_m: float = 0.015  # inliers this near the line (or 2 spacings) give its extent ...
+    clip_band_m: float = 0.006  # ... unless this near the other plane (or 0.6 spacings): the corner
     clip_quantile: float = 0.01  # ... from this quantile to 1 - this (0: the extreme inliers)
-    runs: int = 3  # independent runs per seam; the median is reported (paper: three)
-    cloud: str = "dense"  # "dense" (full resolution) or "voxel" (the paper's 1 cm cloud)
 
     def __post_init__(self) -> None:
         if self.cloud not in ("dense", "voxel"):
             raise ScenarioError(f"ransac option cloud is {self.cloud!r}; valid: 'dense', 'voxel'")
-        if self.runs < 1 or self.iterations < 1 or self.max_planes < 2:
-            raise ScenarioError("ransac options need runs >= 1, iterations >= 1 and max_planes >= 2")
+        if self.runs < 1 or self.iterations < 1 or self.max_planes < 2 or self.min_inliers < 3:
+            raise ScenarioError("ransac options need runs >= 1, iterations >= 1, max_planes >= 2 and min_inliers >= 3")
+
+    def thresholds(self, spacing: float) -> _Thresholds:
+        """The spacing-dependent thresholds for a cloud of point spacing ``spacing`` [m]."""
+        return _Thresholds(
+            distance=max(self.distance_m, self.distance_spacings * spacing),
+            min_inliers=max(self.min_inliers, int(self.min_plane_area_m2 / spacing**2)),
+            clip_radius=max(self.clip_radius_m, 2.0 * spacing),
+            clip_band=max(self.clip_band_m, 0.6 * spacing),
+        )
+
+
+@dataclass(frozen=True)
+class _Thresholds:
+    distance: float  # RANSAC inlier distance [m]
+    min_inliers: int  # least plane [points]
+    clip_radius: float  # [m]
+    clip_band: float  # [m]
 
 
 @dataclass(frozen=True)
@@ -67,7 +90,7 @@ class RansacLocator:
         self.options = options if options is not None else RansacOptions()
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
-        """Median of ``runs`` RANSAC runs on the points near ``seam`` (frame R)."""
+        """Median of ``runs`` RANSAC runs on the points near ``seam`` (frame R); deterministic for ``rng``."""
         o = self.options
         normals = self._map_normals(scene, seam)
         P = self._region(scene, seam)
@@ -77,16 +100,18 @@ class RansacLocator:
                 SeamStatus.NOT_FOUND,
                 reason=f"{len(P)} points near the seam, RANSAC needs {2 * o.min_inliers}",
             )
+        th = o.thresholds(_spacing(P))
         results = []
         for _ in range(o.runs):
-            res = self._one_run(P, seam, normals, rng)
+            res = self._one_run(P, seam, normals, th, rng)
             if res is not None:
                 results.append(res)
         if not results:
             return SeamEstimate(
                 seam.id,
                 SeamStatus.NOT_FOUND,
-                reason=f"no two non-parallel planes meeting near the seam in {o.runs} RANSAC runs",
+                reason=f"no two planes along the map's weld faces near the seam in {o.runs} RANSAC runs "
+                f"({len(P)} points, planes of at least {th.min_inliers})",
             )
         ends = np.array(results)  # (runs, 2, 3)
         med = np.median(ends, axis=0)
@@ -115,23 +140,21 @@ class RansacLocator:
         """Points (n, 3) within region_m of the map seam segment extended by region_m."""
         o = self.options
         if o.cloud == "dense":
-            return scene.dense.points[
-                _fit.tube_indices(scene, seam.p_start, seam.p_end, o.region_m, o.region_m)
-            ]
+            return scene.dense.points[_fit.tube_indices(scene, seam.p_start, seam.p_end, o.region_m, o.region_m)]
         pts = scene.cloud.points
         t = seam.direction
-        q = pts - seam.p_start
+        q = pts - (seam.p_start - o.region_m * t)
         s = q @ t
-        perp = np.linalg.norm(q - np.outer(s, t), axis=1)
-        keep = (s >= -o.region_m) & (s <= seam.length + o.region_m) & (perp <= o.region_m)
+        d2 = np.einsum("ij,ij->i", q, q) - s * s
+        keep = (s >= 0.0) & (s <= seam.length + 2.0 * o.region_m) & (d2 <= o.region_m**2)
         return np.asarray(pts[keep])
 
-    def _segment(self, P: FloatArray, rng: np.random.Generator) -> list[_Plane]:
+    def _segment(self, P: FloatArray, th: _Thresholds, rng: np.random.Generator) -> list[_Plane]:
         """Sequential RANSAC: planes in decreasing order of support, each refitted by least squares."""
         o = self.options
         remaining = np.arange(len(P))
         planes: list[_Plane] = []
-        while len(planes) < o.max_planes and len(remaining) >= o.min_inliers:
+        while len(planes) < o.max_planes and len(remaining) >= th.min_inliers:
             score = (
                 remaining
                 if len(remaining) <= o.sample_points
@@ -145,18 +168,18 @@ class RansacLocator:
                 break
             n = n[good] / norm[good, None]
             d = np.einsum("ij,ij->i", n, tri[good, 0])
-            counts = (np.abs(P[score] @ n.T - d) < o.distance_m).sum(axis=0)
+            counts = (np.abs(P[score] @ n.T - d) < th.distance).sum(axis=0)
             best = int(np.argmax(counts))
             nb, db = n[best], float(d[best])
             for _ in range(2):  # least-squares refit on all remaining inliers
-                inl = remaining[np.abs(P[remaining] @ nb - db) < o.distance_m]
+                inl = remaining[np.abs(P[remaining] @ nb - db) < th.distance]
                 if len(inl) < 3:
                     break
                 c = P[inl].mean(axis=0)
                 nb = np.linalg.svd(P[inl] - c, full_matrices=False)[2][2]
                 db = float(nb @ c)
-            inl = remaining[np.abs(P[remaining] @ nb - db) < o.distance_m]
-            if len(inl) < o.min_inliers:
+            inl = remaining[np.abs(P[remaining] @ nb - db) < th.distance]
+            if len(inl) < th.min_inliers:
                 break
             planes.append(_Plane(nb, db, inl))
             remaining = np.setdiff1d(remaining, inl, assume_unique=True)
@@ -165,8 +188,8 @@ class RansacLocator:
     def _pick(
         self, planes: list[_Plane], normals: tuple[FloatArray, FloatArray], mid: FloatArray
     ) -> tuple[_Plane, _Plane] | None:
-        """The joint's two planes: the largest planes along the map's faces passing near the seam's middle
-        ``mid`` (3,) when both are found, else the two largest non-parallel planes."""
+        """The joint's two planes: for each of the map's weld faces, the largest plane along it passing near
+        the seam's middle ``mid`` (3,); None unless both are found, distinct and not parallel."""
         o = self.options
         cos_par, cos_match = np.cos(np.radians(o.parallel_deg)), np.cos(np.radians(o.match_deg))
         matched = []
@@ -180,18 +203,20 @@ class RansacLocator:
         a, b = matched
         if a is not None and b is not None and a is not b and abs(float(a.n @ b.n)) < cos_par:
             return a, b
-        for i, p in enumerate(planes):
-            for q in planes[i + 1 :]:
-                if abs(float(p.n @ q.n)) < cos_par:
-                    return p, q
         return None
 
     def _one_run(
-        self, P: FloatArray, seam: MapSeam, normals: tuple[FloatArray, FloatArray], rng: np.random.Generator
+        self,
+        P: FloatArray,
+        seam: MapSeam,
+        normals: tuple[FloatArray, FloatArray],
+        th: _Thresholds,
+        rng: np.random.Generator,
     ) -> tuple[FloatArray, FloatArray] | None:
+        """One RANSAC run: (start, end) (3,) each [m], or None when it finds no pair of joint planes."""
         o = self.options
         mid = 0.5 * (seam.p_start + seam.p_end)
-        pair = self._pick(self._segment(P, rng), normals, mid)
+        pair = self._pick(self._segment(P, th, rng), normals, mid)
         if pair is None:
             return None
         a, b = pair
@@ -203,8 +228,8 @@ class RansacLocator:
             q = P[plane.inliers] - p0
             s = q @ t
             # Inliers near the line, but not on the other plane too (there the planes cannot tell who is who).
-            near = (np.linalg.norm(q - np.outer(s, t), axis=1) < o.clip_radius_m) & (
-                np.abs(P[plane.inliers] @ other.n - other.d) > o.clip_band_m
+            near = (np.linalg.norm(q - np.outer(s, t), axis=1) < th.clip_radius) & (
+                np.abs(P[plane.inliers] @ other.n - other.d) > th.clip_band
             )
             if np.count_nonzero(near) < 3:
                 return None
@@ -214,3 +239,11 @@ class RansacLocator:
         if hi <= lo:
             return None
         return p0 + lo * t, p0 + hi * t
+
+
+def _spacing(P: FloatArray) -> float:
+    """Point spacing [m] of the region's points (n, 3): the median distance to the 4th nearest neighbour (on a
+    voxel grid one voxel, even where a face lying on a grid plane fills the voxels on both sides of it)."""
+    k = min(5, len(P))
+    dist, _ = cKDTree(P).query(P[:: max(1, len(P) // 500)], k=k)
+    return float(np.median(dist[:, k - 1]))

@@ -37,9 +37,7 @@ def _options(cls: type[T], given: Mapping[str, object], method: str) -> T:
     valid = list(getattr(cls, "__dataclass_fields__", {}))
     unknown = sorted(set(given) - set(valid))
     if unknown:
-        raise ScenarioError(
-            f"unknown key(s) locator.options.{method}.{', '.join(unknown)}; valid: {', '.join(valid)}"
-        )
+        raise ScenarioError(f"unknown key(s) locator.options.{method}.{', '.join(unknown)}; valid: {', '.join(valid)}")
     try:
         return cls(**given)
     except (TypeError, ValueError) as e:

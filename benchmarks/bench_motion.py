@@ -43,9 +43,7 @@ def _seams(rng: np.random.Generator, n_seams: int, step: float) -> list[FloatArr
         start = np.array([rng.uniform(0.8, 1.2), rng.uniform(-0.4, 0.4), rng.uniform(-0.3, 0.3)])
         direction = rot_z(rng.uniform(0, 2 * np.pi)) @ np.array([1.0, 0.0, 0.0])
         length = rng.uniform(0.1, 0.3)
-        R = rot_z(rng.uniform(-np.pi, np.pi)) @ rot_y(
-            np.pi - rng.uniform(0.3, 0.8)
-        )  # wire 17-46 deg off down
+        R = rot_z(rng.uniform(-np.pi, np.pi)) @ rot_y(np.pi - rng.uniform(0.3, 0.8))  # wire 17-46 deg off down
         n = int(length / step) + 1
         seams.append(np.array([make_pose(R, start + direction * s) for s in np.linspace(0.0, length, n)]))
     return seams
@@ -94,8 +92,7 @@ def run(seed: int) -> list[dict[str, object]]:
             q_free = solve_ik(robot, X, q_free, free_axis=True)
             warm_free.append(time.perf_counter() - t0)
         per_pose_path.append(
-            _timed(lambda t=targets: solve_path(robot, t, HOME, rng=np.random.default_rng(seed)))
-            / len(targets)
+            _timed(lambda t=targets: solve_path(robot, t, HOME, rng=np.random.default_rng(seed))) / len(targets)
         )
     rows.append(_stats(f"IK warm, full pose ({seams} seams, 2 mm)", warm, 0.5e-3))
     rows.append(_stats("IK warm, free torch axis", warm_free, 0.5e-3))
@@ -120,9 +117,7 @@ def run(seed: int) -> list[dict[str, object]]:
     # Ruckig: point-to-point moves between random configurations (rest to rest), sampled at 4 ms.
     lim = robot.limits
     pairs = [(lim.sample(rng), lim.sample(rng)) for _ in range(300)]
-    rows.append(
-        _stats("ptp incl. 4 ms sampling", [_timed(lambda a=a, b=b: ptp(a, b, lim)) for a, b in pairs], 100e-6)
-    )
+    rows.append(_stats("ptp incl. 4 ms sampling", [_timed(lambda a=a, b=b: ptp(a, b, lim)) for a, b in pairs], 100e-6))
     durations = [ptp(a, b, lim).duration for a, b in pairs[:50]]
     rows[-1]["mean_motion_s"] = float(np.mean(durations))
     rows.append(
@@ -211,8 +206,10 @@ def main() -> None:
         )
     plans = run_plans()
     print()
-    print(f"{'welding plan':<14} {'seams':>5} {'planned':>7} {'plan s':>7} {'cycle s':>8} {'arc s':>7} "
-          f"{'gate s':>7} {'collide s':>9} {'viol':>5}")
+    print(
+        f"{'welding plan':<14} {'seams':>5} {'planned':>7} {'plan s':>7} {'cycle s':>8} {'arc s':>7} "
+        f"{'gate s':>7} {'collide s':>9} {'viol':>5}"
+    )
     for p in plans:
         print(
             f"{p['scenario']:<14} {p['seams']:>5} {p['planned']:>7} {p['planning_s']:>7.2f} {p['cycle_s']:>8.1f} "

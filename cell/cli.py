@@ -109,6 +109,9 @@ def detect(
             save_ply(det.scene.perceived.dense, save_cloud)
             err.print(f"[dim]· spliced cloud written to {save_cloud}[/]")
         _print_detection(det)
+    if det.error is not None:
+        err.print(f"[bold red]error[/]: {det.error.message}", soft_wrap=True)
+        raise typer.Exit(det.error.exit_code)
     if not det.complete:
         raise typer.Exit(EXIT_PARTIAL)
 

@@ -11,7 +11,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
-from cell.errors import CellError, PlanError, ScenarioError
+from cell.errors import AlignmentError, CellError, PlanError, ScenarioError, SensorError
 from cell.geometry import FloatArray, invert
 from cell.motion.quality import WeldQuality
 from cell.scenario import Scenario
@@ -69,6 +69,7 @@ class Detection:
     timings: dict[str, float] = field(default_factory=dict)
     lost_cameras: tuple[str, ...] = ()
     scene: Scene | None = None
+    error: CellError | None = None  # perception or alignment failed: no seam was searched (report still written)
 
     @property
     def complete(self) -> bool:
@@ -185,7 +186,12 @@ def detect(
     method = method or scenario.locator.method
     t_all = time.perf_counter()
     cap = capture(scenario, gui=gui, progress=progress, station=station)
-    scene = build_scene(cap, progress=progress)
+    try:
+        scene = build_scene(cap, progress=progress)
+    except (SensorError, AlignmentError) as e:
+        # No seam can be searched, but every seam is still reported, with the reason; nothing is invented.
+        progress(f"no seam search: {e.message}")
+        return _failed_detection(cap, method, e, time.perf_counter() - t_all)
     estimates = locate(scene, scenario, method, progress=progress)
     weldmap_R = scene.seam_scene.weldmap
     truth = truths(cap, weldmap_R)
@@ -204,6 +210,37 @@ def detect(
         timings=timings,
         lost_cameras=scene.perceived.lost,
         scene=scene,
+    )
+
+
+def _failed_detection(cap: Capture, method: str, error: CellError, seconds: float) -> Detection:
+    """A detection whose perception or alignment failed: every seam NOT_FOUND (underside ones NOT_VISIBLE, which
+    the drawing alone tells) with the reason, against the nominal map."""
+    from cell.seams.joint import find_joints
+    from cell.seams.visibility import visibility
+
+    sc = cap.scenario
+    X_RW = invert(sc.X_WR)
+    weldmap_R = cap.weldmap.transformed(X_RW @ sc.X_WM, "R")
+    joints = find_joints(weldmap_R)
+    table_z = float((X_RW @ [0.0, 0.0, sc.table.top_z, 1.0])[2])
+    estimates = []
+    for seam in weldmap_R.seams:
+        visible, why = visibility(weldmap_R, joints[seam.id], table_z)
+        status = SeamStatus.NOT_FOUND if visible else SeamStatus.NOT_VISIBLE
+        estimates.append(SeamEstimate(seam.id, status, f"no seam search: {error.message}" if visible else why))
+    truth = truths(cap, weldmap_R)
+    metrics, summary = evaluate(estimates, truth)
+    return Detection(
+        scenario=sc,
+        method=method,
+        weldmap_R=weldmap_R,
+        estimates=tuple(estimates),
+        truths=truth,
+        metrics=metrics,
+        summary=summary,
+        timings={"capture_s": cap.seconds, "total_s": seconds},
+        error=error,
     )
 
 
@@ -366,6 +403,8 @@ def weld(
         violations: tuple[str, ...] = ()
         error: CellError | None = None
         try:
+            if det.error is not None:
+                raise det.error
             t = time.perf_counter()
             plan, pre, violations = plan_for(station, det, progress=progress)
             timings["plan_s"] = time.perf_counter() - t

@@ -6,11 +6,11 @@ import json
 from pathlib import Path
 
 import pytest
+from dxf_factory import design, make_maps
 from typer.testing import CliRunner
 
 from cell.cli import app
 from cell.scenario import SCENARIO_DIR
-from dxf_factory import design, make_maps
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parent.parent

@@ -73,9 +73,7 @@ def test_fk_matches_opw_closed_form(robot: RobotModel) -> None:
         np.testing.assert_allclose(X[:3, 3], p, atol=1e-9)
         np.testing.assert_allclose(X[:3, :3], R @ rot_y(-np.pi / 2.0), atol=1e-9)
     # Zero joints: arm stretched forward; KUKA home: the OPW zero pose with the forearm lowered by 90 deg.
-    np.testing.assert_allclose(
-        robot.fk(np.zeros(6), "tool0")[:3, 3], [A1 + C2 + C3 + C4, 0.0, C1 - A2], atol=1e-12
-    )
+    np.testing.assert_allclose(robot.fk(np.zeros(6), "tool0")[:3, 3], [A1 + C2 + C3 + C4, 0.0, C1 - A2], atol=1e-12)
     np.testing.assert_allclose(robot.fk(HOME, "tool0")[:3, 3], [A1 + C3 + C4, 0.0, C1 + C2 - A2], atol=1e-12)
 
 
@@ -232,9 +230,7 @@ def test_solve_path_warm_starts_along_a_seam(robot: RobotModel) -> None:
 
 def test_solve_path_reports_a_configuration_flip(robot: RobotModel) -> None:
     targets = _seam_targets(robot, 11)
-    targets[6:, :3, :3] = targets[6:, :3, :3] @ rot_z(
-        np.pi
-    )  # the torch turns half a turn between poses 5 and 6
+    targets[6:, :3, :3] = targets[6:, :3, :3] @ rot_z(np.pi)  # the torch turns half a turn between poses 5 and 6
     with pytest.raises(IKError, match="pose 6 of 11: joint joint_a"):
         solve_path(robot, targets, HOME, rng=np.random.default_rng(0))
 

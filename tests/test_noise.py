@@ -94,9 +94,7 @@ def test_none_is_identity_and_invalid_pixels_stay_invalid() -> None:
         assert np.all(noisy[depth == 0] == 0)
 
 
-def _tilted_plane(
-    normal: FloatArray, point: FloatArray, intr: CameraIntrinsics
-) -> tuple[FloatArray, FloatArray]:
+def _tilted_plane(normal: FloatArray, point: FloatArray, intr: CameraIntrinsics) -> tuple[FloatArray, FloatArray]:
     """Depth image (H, W) [m] of the plane through ``point`` with unit ``normal`` (optical frame), and the
     true incidence angle per pixel [rad]; rays missing the plane (or beyond 20 m): 0 / NaN."""
     u, v = np.meshgrid(np.arange(intr.width), np.arange(intr.height))

@@ -101,8 +101,14 @@ def test_overview_without_torch_or_paths_and_bad_input(tmp_path: Path) -> None:
 
 def limits() -> JointLimits:
     names = tuple(f"joint_a{i}" for i in range(1, 4))
-    return JointLimits(names, np.radians([-155.0, -180.0, -15.0]), np.radians([155.0, 65.0, 158.0]),
-                       np.radians([154.0, 154.0, 228.0]), np.full(3, 6.0), np.full(3, 60.0))
+    return JointLimits(
+        names,
+        np.radians([-155.0, -180.0, -15.0]),
+        np.radians([155.0, 65.0, 158.0]),
+        np.radians([154.0, 154.0, 228.0]),
+        np.full(3, 6.0),
+        np.full(3, 60.0),
+    )
 
 
 def test_joint_plots(tmp_path: Path) -> None:
@@ -119,8 +125,15 @@ def test_joint_plots(tmp_path: Path) -> None:
 def test_html_is_self_contained_plotly(tmp_path: Path) -> None:
     cloud = surface_cloud(np.random.default_rng(7), 1000)
     front = torch_along(SEAMS[0])
-    out = render_html(cloud, WELDMAP, views(), {"S_front": front}, {"S_front": front[:, :3, 3]},
-                      tmp_path / "view.html", title="tiny T joint")
+    out = render_html(
+        cloud,
+        WELDMAP,
+        views(),
+        {"S_front": front},
+        {"S_front": front[:, :3, 3]},
+        tmp_path / "view.html",
+        title="tiny T joint",
+    )
     text = out.read_text(encoding="utf-8")
     assert out.stat().st_size > 1_000_000  # plotly.js is inline
     assert "plotly" in text.lower() and "Plotly.newPlot" in text

@@ -14,7 +14,8 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.types import SeamStatus
+from cell.seams.metrics import MetricsSummary, SeamMetrics
+from cell.types import SeamEstimate, SeamStatus
 
 pytestmark = pytest.mark.scenario
 
@@ -34,7 +35,7 @@ def scene_for(name: str, noise: str) -> tuple[pipeline.Capture, pipeline.Scene]:
     return _cache[key]
 
 
-def run(name: str, noise: str, method: str) -> tuple[tuple, dict, object]:
+def run(name: str, noise: str, method: str) -> tuple[tuple[SeamEstimate, ...], dict[str, SeamMetrics], MetricsSummary]:
     cap, scene = scene_for(name, noise)
     estimates = pipeline.locate(scene, cap.scenario, method)
     truth = pipeline.truths(cap, scene.seam_scene.weldmap)
@@ -44,14 +45,14 @@ def run(name: str, noise: str, method: str) -> tuple[tuple, dict, object]:
 
 @pytest.mark.parametrize("name", ["fence1-exact", "fence1", "fence2"])
 def test_paper_method_noise_free_reproduces_table1(name: str) -> None:
-    estimates, per_seam, summary = run(name, "none", "paper")
+    estimates, _, summary = run(name, "none", "paper")
     assert len(estimates) == 16
     statuses = [e.status for e in estimates]
     # The four seams under the abutting parts lie against the table: reported, never invented.
     assert statuses.count(SeamStatus.NOT_VISIBLE) == 4
     assert all(e.reason.startswith("underside") for e in estimates if e.status is SeamStatus.NOT_VISIBLE)
-    assert summary.found == 12  # type: ignore[attr-defined]
-    assert summary.paper_me_mean_mm <= PAPER_BOUND_MM[name]  # type: ignore[attr-defined]
+    assert summary.found == 12
+    assert summary.paper_me_mean_mm <= PAPER_BOUND_MM[name]
 
 
 @pytest.mark.parametrize("name", ["fence1-exact", "fence1", "fence2"])
@@ -65,7 +66,7 @@ def test_realistic_noise_runs_and_reports_honest_figures(name: str) -> None:
         else:
             assert e.reason, f"{e.id} is {e.status.value} without a reason"
     # Noise makes the paper's method worse than in its noise-free conditions, but it stays in the right place.
-    assert summary.paper_me_mean_mm < 20.0  # type: ignore[attr-defined]
+    assert summary.paper_me_mean_mm < 20.0
 
 
 def test_alignment_recovers_the_placement_error() -> None:

@@ -38,9 +38,7 @@ def check_design(m: WeldMap, parts: dict[str, make_maps.BoxSpec], seams: list[ma
 # --- The shipped maps --------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(
-    ("name", "n_parts", "n_seams"), [("fence1", 4, 16), ("fence2", 4, 16), ("ladder", 28, 208)]
-)
+@pytest.mark.parametrize(("name", "n_parts", "n_seams"), [("fence1", 4, 16), ("fence2", 4, 16), ("ladder", 28, 208)])
 def test_shipped_map_reads_as_designed(name: str, n_parts: int, n_seams: int) -> None:
     m = read_map(MAPS / f"{name}.dxf")
     assert (len(m.parts), len(m.seams), m.units, m.frame) == (n_parts, n_seams, "mm", "M")
@@ -242,9 +240,7 @@ def test_fit_box_orders_axes_like_m_and_right_handed() -> None:
 def test_fit_box_refuses_an_l_shape() -> None:
     L = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
     v = np.array([(x, y, z) for z in (0.0, 0.5) for x, y in L], dtype=float)
-    faces = [(5, 4, 3, 2, 1, 0), (6, 7, 8, 9, 10, 11)] + [
-        (i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6) for i in range(6)
-    ]
+    faces = [(5, 4, 3, 2, 1, 0), (6, 7, 8, 9, 10, 11)] + [(i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6) for i in range(6)]
     with pytest.raises(MapError, match="part ELL is not a box"):
         fit_box(v, faces, "ELL")
 
@@ -315,9 +311,7 @@ def test_empty_drawing(tmp_path: Path) -> None:
 def test_flat_drawing(tmp_path: Path) -> None:
     doc = ezdxf.new("R2018", units=4)
     msp = doc.modelspace()
-    msp.add_lwpolyline(
-        [(200, 0), (280, 0), (280, 699), (200, 699)], close=True, dxfattribs={"layer": "POST_L"}
-    )
+    msp.add_lwpolyline([(200, 0), (280, 0), (280, 699), (200, 699)], close=True, dxfattribs={"layer": "POST_L"})
     msp.add_line((200, 700), (280, 700), dxfattribs={"color": 1})
     msp.add_line((200, 700), (200, 800), dxfattribs={"color": 1})
     doc.saveas(tmp_path / "flat.dxf")

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from cell.errors import CellError
 from cell.pipeline import Detection, WeldRun
 from cell.types import SeamStatus
 
@@ -69,7 +70,13 @@ def detection_report(det: Detection) -> dict[str, Any]:
         "seams": seams,
         "summary": summary,
         "timings_s": {k: _r(v, 4) for k, v in det.timings.items()},
+        "error": _error(det.error),
     }
+
+
+def _error(e: CellError | None) -> dict[str, Any] | None:
+    """The failure that stopped a run early (the seams still say why each was not done), or None."""
+    return None if e is None else {"type": type(e).__name__, "message": e.message, "exit_code": e.exit_code}
 
 
 def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
@@ -122,6 +129,6 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
     rep["weld_order"] = list(plan.order) if plan is not None else []
     rep["events"] = [{"t_s": _r(e.t, 4), "kind": e.kind, "detail": e.detail} for e in ex.events] if ex else []
     rep["violations"] = list(run.violations)
-    rep["error"] = None if run.error is None else {"type": type(run.error).__name__, "message": run.error.message}
+    rep["error"] = _error(run.error)
     rep["timings_s"] = {k: _r(v, 4) for k, v in run.timings.items()}
     return rep

@@ -63,9 +63,7 @@ NECK_BEND = math.radians(22.0)  # [rad]
 NECK, NOZZLE, STICKOUT = 0.085, 0.030, 0.015  # bend to nozzle, nozzle length, contact tip to wire tip [m]
 # Eye-in-hand depth camera (RealSense D415 outline) above the torch body, pitched down to the wire tip.
 CAMERA_XYZ = (0.100, 0.0, 0.080)  # [m] in tool0
-CAMERA_PITCH = math.radians(
-    25.0
-)  # [rad] about tool0 y: x (the viewing direction) tilted towards the torch tip
+CAMERA_PITCH = math.radians(25.0)  # [rad] about tool0 y: x (the viewing direction) tilted towards the torch tip
 
 
 @dataclass(frozen=True)
@@ -216,9 +214,7 @@ def _link(robot: ET.Element, name: str, mass: float, colour: str | None, shapes:
                 ET.SubElement(el, "material", name=colour)
 
 
-def _fixed(
-    robot: ET.Element, parent: str, child: str, xyz: tuple[float, ...], rpy: tuple[float, ...]
-) -> None:
+def _fixed(robot: ET.Element, parent: str, child: str, xyz: tuple[float, ...], rpy: tuple[float, ...]) -> None:
     j = ET.SubElement(robot, "joint", name=f"{parent}-{child}", type="fixed")
     _origin(j, xyz, rpy)
     ET.SubElement(j, "parent", link=parent)
@@ -269,8 +265,7 @@ def build_limits_yaml() -> str:
         "#   (REFERENCE.md section 3); the URDF <limit velocity> holds the same values.",
         f"# acceleration [rad/s^2]: not published by KUKA; assumed {ACCEL_PER_SPEED:g} x velocity"
         " (full speed reached in 0.4 s).",
-        f"# jerk [rad/s^3]: not published; assumed {JERK_PER_ACCEL:g} x acceleration"
-        " (full acceleration in 0.1 s).",
+        f"# jerk [rad/s^3]: not published; assumed {JERK_PER_ACCEL:g} x acceleration (full acceleration in 0.1 s).",
         "# Values may be lowered here (a slower cell); raising velocity above the URDF's is an error.",
         "joints:",
     ]
@@ -278,9 +273,7 @@ def build_limits_yaml() -> str:
         v = math.radians(vel)
         a = ACCEL_PER_SPEED * v
         j = JERK_PER_ACCEL * a
-        lines.append(
-            f"  {name}: {{velocity: {_num(v)}, acceleration: {_num(a)}, jerk: {_num(j)}}}  # {vel:g} deg/s"
-        )
+        lines.append(f"  {name}: {{velocity: {_num(v)}, acceleration: {_num(a)}, jerk: {_num(j)}}}  # {vel:g} deg/s")
     return "\n".join(lines) + "\n"
 
 

@@ -1,0 +1,97 @@
+"""Scenario tests of the main job: `cell weld fence1` and `cell preview fence1`, headless, on real simulated data."""
+
+from __future__ import annotations
+
+import functools
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cell import pipeline
+from cell import scenario as sc
+from cell.cli import app
+from cell.types import SeamStatus
+
+pytestmark = pytest.mark.scenario
+
+
+@functools.cache
+def fence1_run() -> pipeline.WeldRun:
+    return pipeline.weld(sc.load("fence1"))
+
+
+def test_every_visible_seam_is_welded_within_a_millimetre() -> None:
+    run = fence1_run()
+    assert run.error is None and not run.violations
+    assert run.complete
+    visible = [e.id for e in run.detection.estimates if e.status is not SeamStatus.NOT_VISIBLE]
+    assert len(visible) == 12
+    speed = run.detection.scenario.process.travel_speed_mm_s
+    for w in run.seams:
+        if w.id not in visible:
+            assert not w.welded and "flip" in w.reason
+            continue
+        assert w.welded, f"{w.id}: {w.reason}"
+        assert w.quality is not None
+        # Executed tool path against the TRUE seam (perception, alignment, IK and playback errors all included).
+        assert w.quality.tcp_rms_mm <= 1.0, w.id
+        assert abs(w.quality.speed_mm_s - speed) <= 0.02 * speed, w.id
+
+
+def test_events_and_cycle_time() -> None:
+    run = fence1_run()
+    ex = run.execution
+    assert ex is not None and run.plan is not None
+    kinds = [e.kind for e in ex.events]
+    assert kinds.count("arc_on") == kinds.count("arc_off") == 12
+    # The arc burns only during the welds: arc time is the welded length at the travel speed (ramps aside).
+    lengths = sum(w.quality.length_mm for w in run.seams if w.quality is not None)
+    assert ex.arc_time == pytest.approx(lengths / run.detection.scenario.process.travel_speed_mm_s, rel=0.02)
+    assert run.cycle_time_s == pytest.approx(run.plan.cycle_time + run.pre_move.duration, abs=0.02)  # type: ignore[union-attr]
+    # Every arc_on is followed by its arc_off before the next arc_on.
+    on = [e.t for e in ex.events if e.kind == "arc_on"]
+    off = [e.t for e in ex.events if e.kind == "arc_off"]
+    assert all(a < b for a, b in zip(on, off, strict=True))
+    assert all(b <= a for b, a in zip(off[:-1], on[1:], strict=True))
+
+
+def test_executed_joints_stay_within_limits_at_1khz() -> None:
+    run = fence1_run()
+    assert run.plan is not None and run.arm is not None
+    traj, _ = run.plan.joint_trajectory()
+    lim = run.arm.model.limits
+    t = np.arange(0.0, traj.duration, 0.001)
+    q = np.array([traj.sample(ti)[0] for ti in t[:: max(1, len(t) // 20000)]])
+    assert np.all(q >= lim.q_min - 1e-9) and np.all(q <= lim.q_max + 1e-9)
+    assert np.all(np.abs(traj.qd) <= lim.v_max * (1 + 1e-6))
+
+
+def test_weld_cli_writes_report_and_robot_program(tmp_path: Path) -> None:
+    runner = CliRunner()
+    report, krl = tmp_path / "r.json", tmp_path / "krl"
+    result = runner.invoke(app, ["weld", "fence1", "--json", str(report), "--krl", str(krl)])
+    assert result.exit_code == 0, result.stderr
+    data = json.loads(report.read_text())
+    assert data["welded"] == 12 and data["error"] is None
+    assert data["cycle_time_s"] > 0 and data["events"]
+    for s in data["seams"]:
+        if s["welded"]:
+            assert s["tcp_error_mm"]["rms"] <= 1.0 and s["weld_time_s"] > 0
+    assert (krl / "WELD_FENCE1.src").is_file() and (krl / "WELD_FENCE1.dat").is_file()
+    assert json.loads((krl / "trajectory.json").read_text())["joint_names"][0] == "joint_a1"
+
+
+def test_preview_draws_and_moves_nothing(tmp_path: Path) -> None:
+    runner = CliRunner()
+    result = runner.invoke(app, ["preview", "fence1", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.stderr
+    for name in ("overview_top.png", "overview_3d.png", "overview_seams.png", "joints.png"):
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "plotly" in (tmp_path / "cell.html").read_text()[:200000]
+    data = json.loads((tmp_path / "report.json").read_text())
+    assert data["cycle_time_s"] == 0 and data["events"] == []
+    assert all(not s["welded"] for s in data["seams"])
+    assert sum(s["planned"] for s in data["seams"]) == 12

@@ -91,9 +91,7 @@ def rotate_vectors(X_AB: FloatArray, v_B: npt.ArrayLike) -> FloatArray:
     return np.asarray(v_B, dtype=float) @ X_AB[:3, :3].T
 
 
-def look_at(
-    eye: Sequence[float], target: Sequence[float], up: Sequence[float] = (0.0, 0.0, 1.0)
-) -> FloatArray:
+def look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float] = (0.0, 0.0, 1.0)) -> FloatArray:
     """Pose X_WC of a camera optical frame (z forward, x right, y down) at ``eye`` looking at ``target``."""
     e = np.asarray(eye, dtype=float)
     z = np.asarray(target, dtype=float) - e

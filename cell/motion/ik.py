@@ -138,9 +138,7 @@ def solve_ik(
         raise ValueError(f"solve_ik: target must be a finite (4, 4) pose, got shape {X_RT.shape}")
     q_start = np.asarray(q_seed, dtype=float)
     if q_start.shape != (model.dof,) or not np.all(np.isfinite(q_start)):
-        raise ValueError(
-            f"solve_ik: q_seed must be {model.dof} finite joint values, got shape {q_start.shape}"
-        )
+        raise ValueError(f"solve_ik: q_seed must be {model.dof} finite joint values, got shape {q_start.shape}")
     fid = model.frame_id(frame)
     p_RJ, reach = model.reach_bound(frame)
     dist = float(np.linalg.norm(X_RT[:3, 3] - p_RJ))

@@ -40,9 +40,7 @@ class JointLimits:
         for key in ("q_min", "q_max", "v_max", "a_max", "j_max"):
             arr = readonly(getattr(self, key))
             if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-                raise ValueError(
-                    f"JointLimits.{key} must be {n} finite values (one per joint), got {arr.shape}"
-                )
+                raise ValueError(f"JointLimits.{key} must be {n} finite values (one per joint), got {arr.shape}")
             object.__setattr__(self, key, arr)
         if np.any(self.q_min >= self.q_max):
             raise ValueError("JointLimits: q_min must be below q_max for every joint")
@@ -66,9 +64,7 @@ class JointLimits:
         """A configuration (dof,) drawn uniformly within the limits shrunk by ``margin`` [rad] at each end."""
         lo, hi = self.q_min + margin, self.q_max - margin
         if np.any(lo >= hi):
-            raise ValueError(
-                f"JointLimits.sample: margin {margin} rad leaves no room within the position limits"
-            )
+            raise ValueError(f"JointLimits.sample: margin {margin} rad leaves no room within the position limits")
         return rng.uniform(lo, hi)
 
     def scaled(self, velocity: float = 1.0, acceleration: float = 1.0, jerk: float = 1.0) -> JointLimits:
@@ -96,17 +92,13 @@ def load_limits(
     allows a joint faster than the URDF does.
     """
     if not path.is_file():
-        raise ScenarioError(
-            f"robot limits file {path} not found; it must sit beside the URDF as <name>.limits.yaml"
-        )
+        raise ScenarioError(f"robot limits file {path} not found; it must sit beside the URDF as <name>.limits.yaml")
     try:
         data = yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:
         raise ScenarioError(f"robot limits file {path} is not valid YAML: {exc}") from exc
     if not isinstance(data, Mapping) or set(data) != {"joints"} or not isinstance(data["joints"], Mapping):
-        raise ScenarioError(
-            f"robot limits file {path} must hold exactly one key 'joints' mapping joint names"
-        )
+        raise ScenarioError(f"robot limits file {path} must hold exactly one key 'joints' mapping joint names")
     joints: Mapping[str, object] = data["joints"]
     unknown = sorted(set(joints) - set(names))
     missing = [n for n in names if n not in joints]
@@ -119,9 +111,7 @@ def load_limits(
     for i, name in enumerate(names):
         entry = joints[name]
         if not isinstance(entry, Mapping) or set(entry) != set(_KEYS):
-            raise ScenarioError(
-                f"robot limits file {path}: joint {name} must give exactly {', '.join(_KEYS)}"
-            )
+            raise ScenarioError(f"robot limits file {path}: joint {name} must give exactly {', '.join(_KEYS)}")
         try:
             table[i] = [float(entry[k]) for k in _KEYS]
         except (TypeError, ValueError) as exc:

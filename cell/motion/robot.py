@@ -56,9 +56,7 @@ class RobotModel:
         except (RuntimeError, ValueError) as exc:
             raise ScenarioError(f"robot URDF {path} cannot be loaded: {exc}") from exc
         if model.nq != model.nv or model.nq != model.njoints - 1:
-            raise ScenarioError(
-                f"robot URDF {path}: only single-axis joints are supported (no continuous/floating)"
-            )
+            raise ScenarioError(f"robot URDF {path}: only single-axis joints are supported (no continuous/floating)")
         names = tuple(model.names[1:])
         q_min = np.array(model.lowerPositionLimit, dtype=float)
         q_max = np.array(model.upperPositionLimit, dtype=float)
@@ -82,9 +80,7 @@ class RobotModel:
         try:
             return self._frames[frame]
         except KeyError:
-            raise MotionError(
-                f"robot {self.name} has no frame {frame!r}; frames: {', '.join(self._frames)}"
-            ) from None
+            raise MotionError(f"robot {self.name} has no frame {frame!r}; frames: {', '.join(self._frames)}") from None
 
     def _q(self, q: npt.ArrayLike) -> FloatArray:
         q = np.asarray(q, dtype=float)

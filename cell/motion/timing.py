@@ -59,9 +59,7 @@ def _check_samples(times: FloatArray, *arrays: FloatArray) -> None:
         raise ValueError("trajectory times must be (n,) with n >= 1, start at 0 and increase strictly")
     shape = arrays[0].shape
     if any(a.shape != shape or a.shape[0] != len(times) or not np.all(np.isfinite(a)) for a in arrays):
-        raise ValueError(
-            f"trajectory samples must be finite, one row per time ({len(times)}), all of one shape"
-        )
+        raise ValueError(f"trajectory samples must be finite, one row per time ({len(times)}), all of one shape")
 
 
 @dataclass(frozen=True)
@@ -156,9 +154,7 @@ def _solve(inp: ruckig.InputParameter, what: str) -> ruckig.Trajectory:
     except (ruckig.RuckigError, RuntimeError) as exc:  # invalid input raises instead of returning a result
         raise TimingError(f"Ruckig rejected the {what}: {' '.join(str(exc).split())}") from exc
     if result not in (ruckig.Result.Working, ruckig.Result.Finished):
-        raise TimingError(
-            f"Ruckig returned {result.name} for the {what}; only Working or Finished are success"
-        )
+        raise TimingError(f"Ruckig returned {result.name} for the {what}; only Working or Finished are success")
     return traj
 
 
@@ -196,9 +192,7 @@ def _at_times(traj: ruckig.Trajectory, times: FloatArray) -> tuple[FloatArray, F
     k = np.searchsorted(flat, times[:, None] + shift[None, :], side="right") - 6 * np.arange(dof)[None, :]
     starts = np.concatenate((np.zeros((dof, 1)), ends[:, :6]), axis=1)  # (dof, 7)
     # phase start states and jerks, (dof, 5, 7): p, v, a, j, start time
-    coef = np.array(
-        [[x.p[:7], x.v[:7], x.a[:7], x.j, s] for x, s in zip(profs, starts.tolist(), strict=True)]
-    )
+    coef = np.array([[x.p[:7], x.v[:7], x.a[:7], x.j, s] for x, s in zip(profs, starts.tolist(), strict=True)])
     g = coef[np.arange(dof)[None, :], :, k]  # (n, dof, 5)
     p, v, a, j = g[..., 0], g[..., 1], g[..., 2], g[..., 3]
     tau = times[:, None] - g[..., 4]
@@ -243,8 +237,7 @@ def _ptp_solve(
     ]
     if over:
         raise TimingError(
-            f"ptp move leaves the position limits at {', '.join(over)} "
-            "(the start velocity cannot be braked in time)"
+            f"ptp move leaves the position limits at {', '.join(over)} (the start velocity cannot be braked in time)"
         )
     return traj, q[1], v[1]
 

@@ -40,9 +40,7 @@ _KINECT_C = 0.0001  # [m^1.5]
 _MAX_INCIDENCE = np.radians(89.0)  # keeps the incidence term finite [rad]
 
 
-def sigma_z(
-    z_m: npt.ArrayLike, spec: NoiseSpec, fx_px: float, incidence_rad: npt.ArrayLike = 0.0
-) -> FloatArray:
+def sigma_z(z_m: npt.ArrayLike, spec: NoiseSpec, fx_px: float, incidence_rad: npt.ArrayLike = 0.0) -> FloatArray:
     """Axial (depth) noise standard deviation [m] of the model at depths ``z_m`` [m] (any shape).
 
     fx_px : focal length [px]; used by ``active_stereo``.

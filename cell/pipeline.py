@@ -111,7 +111,9 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     progress("aligning the welding map to the cloud")
     X_RM_nominal = invert(sc.X_WR) @ sc.X_WM
     weldmap_nominal_R = cap.weldmap.transformed(X_RM_nominal, "R")
-    alignment = align_map(weldmap_nominal_R, perceived.dense, sc.perception)
+    # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
+    # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud.
+    alignment = align_map(weldmap_nominal_R, perceived.registered, sc.perception)
     X_RM = alignment.X_RR_corr @ X_RM_nominal
     weldmap_R = cap.weldmap.transformed(X_RM, "R")
     joints = find_joints(weldmap_R)
@@ -120,7 +122,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     table_z_R = float((invert(sc.X_WR) @ [0.0, 0.0, sc.table.top_z, 1.0])[2])
     seam_scene = SeamScene(
         cloud=perceived.downsampled,
-        dense=perceived.dense,
+        dense=perceived.registered,
         weldmap=weldmap_R,
         joints=joints,
         table_z=table_z_R,

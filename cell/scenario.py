@@ -30,7 +30,8 @@ Pos = Annotated[float, Field(gt=0.0)]
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # Non-finite numbers (.nan, .inf in YAML) are rejected: they would turn poses into NaN (fuzzing found it).
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class PoseSpec(_Model):
@@ -204,6 +205,45 @@ class LocatorSpec(_Model):
     options: dict[str, dict[str, float | int | str | bool]] = Field(default_factory=dict)
 
 
+class CameraFaultSpec(_Model):
+    """A simulated camera failure: what the camera delivers instead of a good image (for fault scenarios).
+
+    ``dead``: no valid pixel (unplugged, blinded, laser off); ``random``: every pixel a random depth between
+    near_m and far_m (corrupted stream); ``constant``: every pixel reads ``depth_m`` (a stuck sensor);
+    ``salt``: ``fraction`` of the pixels replaced by random depths (a failing projector / interference).
+    """
+
+    mode: Literal["dead", "random", "constant", "salt"]
+    fraction: Annotated[float, Field(gt=0.0, le=1.0)] = 0.3  # salt: share of pixels replaced
+    depth_m: Pos = 1.0  # constant: the value every pixel reads [m]
+
+
+class OccluderSpec(_Model):
+    """An object in the cell that the welding map does not know (a clamp, a cable): a box in the world [m]."""
+
+    center_m: Vec3
+    size_m: tuple[Pos, Pos, Pos]
+    rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+
+    @property
+    def X_WO(self) -> FloatArray:
+        return pose_from_xyz_rpy(self.center_m, np.radians(self.rpy_deg))
+
+
+class FaultsSpec(_Model):
+    """Faults to simulate (all empty by default: a healthy cell).
+
+    cameras : camera name -> its failure. occluders : name -> a box the map does not know, rendered in every
+    camera. missing_parts : parts of the map that were not built (not put on the table).
+    The part placed off its nominal place is ``map.placement_error``; a camera knocked out of calibration is
+    ``cameras.<name>.extrinsic_error``.
+    """
+
+    cameras: dict[str, CameraFaultSpec] = Field(default_factory=dict)
+    occluders: dict[str, OccluderSpec] = Field(default_factory=dict)
+    missing_parts: tuple[str, ...] = ()
+
+
 class Scenario(_Model):
     """A whole cell: map, as-built part, table, robot, cameras, seed and algorithm options."""
 
@@ -219,6 +259,7 @@ class Scenario(_Model):
     cameras: dict[str, CameraSpec]
     perception: PerceptionSpec
     locator: LocatorSpec = LocatorSpec()
+    faults: FaultsSpec = FaultsSpec()
     # Set by the loader: the folder the file lives in (paths inside are relative to it).
     base_dir: str = Field(default=".", exclude=True)
 
@@ -228,6 +269,15 @@ class Scenario(_Model):
         if not v:
             raise ValueError("at least one camera is needed")
         return v
+
+    @model_validator(mode="after")
+    def _fault_cameras(self) -> Scenario:
+        unknown = sorted(set(self.faults.cameras) - set(self.cameras))
+        if unknown:
+            raise ValueError(
+                f"faults.cameras names unknown camera(s) {', '.join(unknown)}; cameras: {', '.join(self.cameras)}"
+            )
+        return self
 
     @property
     def map_path(self) -> Path:

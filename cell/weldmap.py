@@ -83,9 +83,7 @@ class _Reader:
 
     def _insert(self, insert: Insert, ctx: _Ctx) -> None:
         if ctx.depth >= _MAX_NESTING:
-            raise MapError(
-                f"{self.source}: blocks nested over {_MAX_NESTING} deep (a block inserting itself?)"
-            )
+            raise MapError(f"{self.source}: blocks nested over {_MAX_NESTING} deep (a block inserting itself?)")
         name = insert.dxf.name
         block = self.doc.blocks.get(name)
         if block is None:
@@ -282,9 +280,7 @@ def read_map(path: str | Path, units: str | None = None) -> WeldMap:
         raise MapError(f"{src}: malformed DXF content ({type(exc).__name__}: {exc})") from None
     what = "expected red 3D LINEs (colour 1, or on a red layer) and solid box parts (3DSOLID, MESH, POLYFACE)"
     if not reader.seams and not reader.bodies:
-        empty = (
-            "the drawing is empty (truncated or blank?)" if len(doc.modelspace()) == 0 else "nothing found"
-        )
+        empty = "the drawing is empty (truncated or blank?)" if len(doc.modelspace()) == 0 else "nothing found"
         raise MapError(f"{src}: {empty}; {what}")
     pts = [p for _, a, b in reader.seams for p in (a, b)] + [v for _, vs, _ in reader.bodies for v in vs]
     P = np.array(pts) * scale

@@ -35,9 +35,9 @@ from cell.perception import (
     save_ply,
     splice,
 )
-from cell.perception.merge import predicted_noise, prioritised_merge
+from cell.perception.merge import direction_classes, predicted_noise, prioritised_merge
 from cell.perception.preprocess import radius_outlier_mask, z_range_R
-from cell.perception.splice import register, splice_order
+from cell.perception.splice import MIN_SHIFT_M, Surfaces, register, splice_order
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
 
@@ -165,27 +165,51 @@ def test_clouds_in_robot_frame_crop_transform_and_camera_indices() -> None:
 
 
 # ----------------------------------------------------------------------------------------------- 3.3
-def test_icp_recovers_small_transform() -> None:
+def test_register_recovers_small_transform() -> None:
     rng = np.random.default_rng(7)
-    # Jittered (not gridded) samples: a regular grid would also match itself shifted by one grid step.
-    target = np.asarray(_surface_cloud(fence_map_R(), rng, noise_m=0.0).points)
+    # Jittered (not gridded) samples of the fence's visible faces, with their faces' normals.
+    p, n = sample_map(fence_map_R(), 0.004, 0.002)
+    target = p + rng.uniform(-0.002, 0.002, p.shape) * (1 - np.abs(n))
+    cls, dirs = direction_classes(n)
     axis = rng.normal(size=3)
     angle = math.radians(rng.uniform(0.2, 0.4))
     centre = target.mean(axis=0)
     X_true = make_pose(axis_angle_to_matrix(axis, angle), rng.uniform(-3e-3, 3e-3, 3))
     X_true = make_pose(p=centre) @ X_true @ make_pose(p=-centre)  # turn about the fence, not R's origin
     source = transform_points(invert(X_true), target)
-    X, fitness, rmse, _ = register(source, target, 0.01, 50)  # 1 cm: the offset is larger than the paper's 1 mm
+    X, info = register(source, cls, Surfaces(target, cls, dirs), SPEC)
     err = X @ invert(X_true)
+    assert info["constrained"] == 6 and info["overlap"] > 1000
     assert np.linalg.norm(err[:3, 3] + err[:3, :3] @ centre - centre) < 1e-4  # at the fence [m]
     assert math.degrees(rotation_angle(err[:3, :3])) < 0.01
-    assert fitness > 0.99 and rmse < 1e-5
+    assert info["misfit_m"] < 0.1 * info["misfit_before_m"]
 
 
-def test_predicted_noise_grows_with_range_and_obliqueness() -> None:
+def test_predicted_noise_active_stereo() -> None:
+    """Range and a short focal length rank worse; an oblique view ranks slightly *better* (depth noise runs along
+    the ray, so it spreads less across a face seen obliquely), but only up to the grazing cut-off."""
     assert predicted_noise(2.0, 1.0, 900.0) > predicted_noise(1.0, 1.0, 900.0)
-    assert predicted_noise(1.0, math.cos(math.radians(60)), 900.0) > predicted_noise(1.0, 1.0, 900.0)
     assert predicted_noise(1.0, 1.0, 450.0) > predicted_noise(1.0, 1.0, 900.0)
+    oblique = predicted_noise(1.0, math.cos(math.radians(60)), 900.0)
+    assert oblique < predicted_noise(1.0, 1.0, 900.0)
+    assert oblique == pytest.approx(predicted_noise(1.0, 1.0, 900.0) * math.sqrt(0.5))
+    # Past the cut-off (80 deg) a view earns nothing more.
+    assert predicted_noise(1.0, 0.01, 900.0) == predicted_noise(1.0, math.cos(math.radians(80)), 900.0)
+    # The same surface seen off the optical axis: the ray is longer than the optical depth.
+    assert predicted_noise(1.0, 1.0, 900.0, 0.8) > predicted_noise(1.0, 1.0, 900.0, 1.0)
+
+
+def test_direction_classes_find_rotated_faces() -> None:
+    rng = np.random.default_rng(0)
+    R = rot_z(math.radians(20.0))[:3, :3]
+    true = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]]) @ R.T  # faces of a box turned 20 deg about z
+    n = np.repeat(true, 3000, axis=0) + rng.normal(0, 0.08, (9000, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    label, dirs = direction_classes(n)
+    assert len(dirs) == 3
+    for d in true:  # each dominant direction found to a fraction of a degree
+        assert math.degrees(math.acos(min(1.0, float(np.max(dirs @ d))))) < 0.5
+    assert np.mean(label >= 0) > 0.95
 
 
 def test_prioritised_merge_takes_each_region_from_the_camera_that_sees_it_best() -> None:
@@ -213,37 +237,60 @@ def test_prioritised_merge_takes_each_region_from_the_camera_that_sees_it_best()
 
 def test_splice_order_and_diagnostics() -> None:
     images = paper_images((160, 120))
-    assert splice_order(images, tuple(images)) == ("cam_left", "cam_right", "eye_in_hand")
+    # The eye-in-hand camera (calibrated to the robot) is the reference, then the paper's fixed order.
+    assert splice_order(images, tuple(images)) == ("eye_in_hand", "cam_left", "cam_right")
     clouds = clouds_in_robot_frame(images, X_WR, WORKSPACE)
     spliced = splice(clouds, images, X_WR, SPEC)
     assert [(r.source, r.target) for r in spliced.registrations] == [
-        ("cam_right", ("cam_left",)),
-        ("eye_in_hand", ("cam_left", "cam_right")),
+        ("cam_left", ("eye_in_hand",)),
+        ("cam_right", ("eye_in_hand", "cam_left")),
     ]
-    for r in spliced.registrations:  # exact extrinsics: nothing to correct
-        assert np.abs(r.X_corr - np.eye(4)).max() < 1e-3
+    for r in spliced.registrations:  # exact extrinsics: nothing to correct, nothing applied
+        assert not r.accepted and np.array_equal(r.X_corr, np.eye(4))
+        assert r.shift_m < MIN_SHIFT_M
     assert spliced.dense.frame == "R" and set(spliced.dense.camera.tolist()) == {0, 1, 2}
     assert sum(spliced.kept.values()) == len(spliced.dense) < sum(len(c) for c in clouds.values())
+    # The registered cloud keeps every point of every camera, each with its camera index.
+    assert len(spliced.registered) == sum(len(c) for c in clouds.values())
+    for name, cloud in clouds.items():
+        assert np.count_nonzero(spliced.registered.camera == cloud.cameras.index(name)) == len(cloud)
     one = splice({"cam_left": clouds["cam_left"]}, images, X_WR, SPEC)  # a single camera works too
     assert len(one.dense) == len(clouds["cam_left"]) and one.registrations == ()
 
 
-def test_splice_icp_never_makes_a_miscalibrated_camera_worse() -> None:
-    """The first fixed camera's calibrated pose is 0.6 mm off along x; the paper's ICP (1 mm, 50 iterations)
-    may or may not take it out, but an accepted correction brings the clouds closer, never apart."""
-    images = paper_images((480, 360))
+def _noisy_images(size: tuple[int, int], seed: int) -> dict[str, DepthImage]:
+    """The paper's cameras with 1.5 mm of depth noise (about a D415 at 1.2 m)."""
+    rng = np.random.default_rng(seed)
+    out = {}
+    for name, im in paper_images(size).items():
+        depth = np.where(im.depth > 0, im.depth + rng.normal(0.0, 0.0015, im.depth.shape), 0.0)
+        out[name] = DepthImage(name, depth.astype(np.float32), im.intrinsics, im.X_WC, im.mount)
+    return out
+
+
+def test_splice_takes_out_a_real_miscalibration_and_applies_no_noise() -> None:
+    """cam_left's calibration is off by 1.5 mm and 0.1 deg (1.6 mm on average at the fence): the registration
+    removes most of it. With exact calibrations and the same noise, what it estimates stays small (regression:
+    the paper's ICP moved exact cameras by up to 0.6 mm). Known limit: on this coarse synthetic scene (4 cm
+    tubes, 640 x 480) points at edges still bias the estimate by up to about 0.4 mm, and the significance rule
+    does not always reject it; on the simulated scenarios it does (tests/test_scenarios_detect.py, cell bench)."""
+    images = _noisy_images((640, 480), 5)
+    exact = splice(clouds_in_robot_frame(images, X_WR, WORKSPACE), images, X_WR, SPEC)
+    assert all(r.shift_m < 0.0005 for r in exact.registrations)
+    X_err = make_pose(axis_angle_to_matrix([0.3, -1.0, 0.5], math.radians(0.1)), [0.0012, -0.0006, 0.0006])
+    left = images["cam_left"]
+    images["cam_left"] = DepthImage("cam_left", left.depth, left.intrinsics, left.X_WC @ X_err, left.mount)
     clouds = clouds_in_robot_frame(images, X_WR, WORKSPACE)
-    offset = np.array([0.0006, 0.0, 0.0])
-    shifted = clouds["cam_left"].transformed(make_pose(p=offset), "R")
-    spliced = splice({"cam_left": shifted, "cam_right": clouds["cam_right"]}, images, X_WR, SPEC)
-    (reg,) = spliced.registrations
-    assert reg.source == "cam_left" and reg.target == ("cam_right",)
-    assert reg.misfit_before_m > 1e-4  # the shift is seen
-    if reg.accepted:
-        assert reg.misfit_m < reg.misfit_before_m
-        assert np.linalg.norm(reg.X_corr[:3, 3] + offset) < np.linalg.norm(offset)
-    else:
-        np.testing.assert_array_equal(reg.X_corr, np.eye(4))
+    spliced = splice(clouds, images, X_WR, SPEC)
+    reg = next(r for r in spliced.registrations if r.source == "cam_left")
+    assert reg.accepted and reg.misfit_m < 0.95 * reg.misfit_before_m
+    # The ideal correction in R undoes the error; compare the two at the fence's points.
+    X_RW = invert(X_WR)
+    ideal = X_RW @ left.X_WC @ invert(left.X_WC @ X_err) @ X_WR
+    p = clouds["cam_left"].points[::50]
+    before = np.linalg.norm(transform_points(ideal, p) - p, axis=1).mean()
+    after = np.linalg.norm(transform_points(ideal, p) - transform_points(reg.X_corr, p), axis=1).mean()
+    assert before > 0.0012 and after < 0.25 * before
 
 
 # ----------------------------------------------------------------------------------------------- 3.4
@@ -373,5 +420,5 @@ def test_perceive_end_to_end_and_lost_camera() -> None:
     dark = {
         n: DepthImage(n, np.zeros((k.height, k.width), np.float32), k, im.X_WC, im.mount) for n, im in images.items()
     }
-    with pytest.raises(SensorError, match="cam_right, cam_left, eye_in_hand"):
+    with pytest.raises(SensorError, match=r"cam_right.*cam_left.*eye_in_hand"):
         perceive(dark, X_WR, SPEC)

@@ -2,8 +2,8 @@
 
 The paper takes "the left side of the fence from the left camera and the right side from the right camera",
 because a camera far from a region measures it with several millimetres of noise. Here space is cut into cubic
-cells of ``cell_m`` and every cell takes its points only from the camera with the lowest *predicted* depth
-noise there.
+cells of ``cell_m`` and every cell takes its points only from the camera with the lowest *predicted* noise
+there.
 
 A cell may hold two surfaces that different cameras see (the top of a tube and its side, which only one camera
 sees). So the unit of the merge is a cell *and* a surface direction: each camera's points get a normal from a
@@ -11,15 +11,23 @@ local plane fit (per camera, per sub-cell of ``normal_cell_m``), the normal is s
 directions of R, and cameras compete only for the same (cell, direction). A surface seen by one camera alone
 is always kept.
 
-Predicted noise (a ranking score, not metres): the active-stereo law sigma_z ~ z^2 / (f B) (REFERENCE.md
-section 2; the baseline B is unknown here and taken equal for all cameras) times the incidence growth of
-Nguyen et al. 2012, 1 + theta^2 / (pi/2 - theta)^2, with z the depth along the camera's optical axis and theta
-the angle between the surface normal and the ray to the camera. Larger range and a more oblique view both rank
-worse.
+Predicted noise (:func:`predicted_noise`, a ranking score, not metres) follows the active-stereo sensor of the
+cell (RealSense D4xx, REFERENCE.md section 2): the error is in depth along the optical axis, sigma_z ~ z^2 /
+(f B) (the baseline B is unknown here and taken equal for all cameras), so a point moves along its *ray*. What
+a surface's position suffers from is the spread across the surface, sigma_z cos(theta) / cos(alpha) (theta the
+incidence, alpha the ray's angle off the optical axis), averaged over the points the camera puts on a unit of
+area, f^2 cos(theta) / (z^2 cos(alpha)). Their ratio, the standard error of the surface per unit area, is
+z^3 sqrt(cos(theta) / cos(alpha)) / f^2: range ranks a camera worse, an oblique view slightly *better* (its
+points are fewer but spread less across the face). Incidence is capped at :data:`MAX_INCIDENCE_DEG`, past which
+stereo matching drops pixels.
+
+:func:`direction_classes` groups oriented normals into the scene's dominant surface directions (found from the
+data, seeded with R's axes), which the splice's registration uses.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -28,15 +36,61 @@ import numpy.typing as npt
 from cell.geometry import FloatArray
 
 _MIN_PLANE_POINTS = 6  # points a plane fit needs to give a normal worth snapping to an axis
+MAX_INCIDENCE_DEG = 80.0  # stereo matching drops pixels seen more obliquely (the sensor model's grazing dropout)
+_COS_MAX_INCIDENCE = math.cos(math.radians(MAX_INCIDENCE_DEG))
+_DIRECTION_SAMPLE = 40_000  # normals the dominant directions are found from (an even stride)
 
 
-def predicted_noise(depth_m: npt.ArrayLike, cos_incidence: npt.ArrayLike, fx_px: npt.ArrayLike) -> FloatArray:
-    """Relative depth noise score (lower is better) of a camera with focal length ``fx_px`` [px] at optical
-    depth ``depth_m`` [m], seeing a surface at an incidence of cosine ``cos_incidence`` (1: head on)."""
+def predicted_noise(
+    depth_m: npt.ArrayLike, cos_incidence: npt.ArrayLike, fx_px: npt.ArrayLike, cos_off_axis: npt.ArrayLike = 1.0
+) -> FloatArray:
+    """Relative standard error (lower is better) of a surface's position per unit area, seen by an active-stereo
+    camera of focal length ``fx_px`` [px] at optical depth ``depth_m`` [m], at an incidence of cosine
+    ``cos_incidence`` (1: head on), along a ray at an angle of cosine ``cos_off_axis`` off the optical axis.
+
+    z^3 sqrt(cos(theta) / cos(alpha)) / f^2 (see the module docstring); incidence capped at
+    :data:`MAX_INCIDENCE_DEG`.
+    """
     z = np.asarray(depth_m, dtype=np.float64)
-    theta = np.arccos(np.clip(np.asarray(cos_incidence, dtype=np.float64), 0.0, 1.0))
-    grazing = np.maximum(np.pi / 2.0 - theta, 1e-6)
-    return np.asarray(z**2 / np.asarray(fx_px, dtype=np.float64) * (1.0 + theta**2 / grazing**2))
+    cos_t = np.clip(np.asarray(cos_incidence, dtype=np.float64), _COS_MAX_INCIDENCE, 1.0)
+    cos_a = np.clip(np.asarray(cos_off_axis, dtype=np.float64), 1e-3, 1.0)
+    f = np.asarray(fx_px, dtype=np.float64)
+    return np.asarray(z**3 * np.sqrt(cos_t / cos_a) / (f * f))
+
+
+def direction_classes(
+    normals: FloatArray, max_angle_rad: float = math.radians(25.0), iterations: int = 5, min_share: float = 0.005
+) -> tuple[npt.NDArray[np.intp], FloatArray]:
+    """Group oriented unit normals (n, 3) into the dominant surface directions of the scene.
+
+    A spherical k-means seeded with the six axis directions of the frame (parts of a cell are boxes: their
+    faces take a few directions, which need not be the frame's axes): each direction becomes the mean of the
+    normals within ``max_angle_rad`` of it. Returns (class (n,): index of the nearest direction within
+    ``max_angle_rad``, -1 for none; directions (k, 3) unit), dropping directions that hold fewer than
+    ``min_share`` of the normals.
+    """
+    n_all = np.asarray(normals, dtype=np.float64)
+    n = n_all[:: max(1, len(n_all) // _DIRECTION_SAMPLE)]  # the directions from an even stride: plenty
+    dirs = np.vstack([np.eye(3), -np.eye(3)])
+    cos_max = math.cos(max_angle_rad)
+
+    def nearest(m: FloatArray) -> npt.NDArray[np.intp]:
+        dots = m @ dirs.T
+        label = np.argmax(dots, axis=1)
+        label[np.max(dots, axis=1) < cos_max] = -1
+        return np.asarray(label, np.intp)
+
+    for _ in range(max(1, iterations)):
+        if len(dirs) == 0 or len(n) == 0:
+            break
+        label = nearest(n)
+        sums = np.stack([np.bincount(label + 1, n[:, i], len(dirs) + 1)[1:] for i in range(3)], axis=1)
+        counts = np.bincount(label + 1, minlength=len(dirs) + 1)[1:]
+        keep = counts >= max(1, min_share * len(n))
+        dirs = sums[keep] / np.linalg.norm(sums[keep], axis=1, keepdims=True)
+    if len(dirs) == 0:
+        return np.full(len(n_all), -1, np.intp), np.zeros((0, 3))
+    return nearest(n_all), np.asarray(dirs)
 
 
 def _group(keys: npt.NDArray[np.int64]) -> tuple[npt.NDArray[np.intp], int]:
@@ -113,11 +167,13 @@ def prioritised_merge(
     fx_px: Mapping[int, float],
     cell_m: float,
     normal_cell_m: float,
+    normals: FloatArray | None = None,
 ) -> npt.NDArray[np.bool_]:
     """(n,) True for the points to keep: in each (cell, surface direction) only the best camera's points.
 
     points : (n, 3) in R [m], from several captures; camera : (n,) capture index of each point (>= 0);
     X_RC : capture index -> (4, 4) pose of its optical frame in R; fx_px : capture index -> focal length [px].
+    normals : (n, 3) the points' :func:`surface_normals` when already computed (else computed here).
     """
     n_points = len(points)
     if n_points == 0:
@@ -126,7 +182,8 @@ def prioritised_merge(
     missing = sorted(set(np.unique(cams).tolist()) - set(X_RC))
     if missing:
         raise ValueError(f"prioritised_merge: no camera pose for capture index(es) {missing}")
-    normals = surface_normals(points, cams, {i: X[:3, 3] for i, X in X_RC.items()}, normal_cell_m, cell_m)
+    if normals is None:
+        normals = surface_normals(points, cams, {i: X[:3, 3] for i, X in X_RC.items()}, normal_cell_m, cell_m)
     axis = np.argmax(np.abs(normals), axis=1)
     sign = normals[np.arange(n_points), axis] < 0.0
     direction = axis * 2 + sign  # one of six classes: +x, -x, +y, -y, +z, -z
@@ -154,7 +211,7 @@ def prioritised_merge(
     dist = np.maximum(np.linalg.norm(ray, axis=1), 1e-12)
     depth = np.einsum("ij,ij->i", centroid - eye, axis_z)
     cos_inc = np.einsum("ij,ij->i", normal, ray) / dist
-    score = predicted_noise(depth, cos_inc, fxs[group_cam])
+    score = predicted_noise(depth, cos_inc, fxs[group_cam], depth / dist)
     # Best group per unit: sort by (unit, score) and take the first of each unit.
     order = np.lexsort((score, group_unit))
     best = np.zeros(n_units, dtype=np.intp)

@@ -1,8 +1,11 @@
 """Depth images to the clouds the seam locators read, in one call: the perception stage of the pipeline.
 
 deproject + crop + robot frame (section 3.2) -> splice (3.3) -> Z passthrough and outlier removal (3.4) ->
-voxel grid (3.4). A camera whose image gives no point inside the workspace is *lost*: the others go on without
-it, and only when every camera is lost is it a :class:`SensorError`.
+voxel grid (3.4). A camera whose data cannot be trusted is *lost*, with the reason, before it can poison the
+splice (:mod:`cell.perception.health`): no valid pixel (dead, blinded), an implausible image (one value
+everywhere, random depths, heavy interference), no point inside the workspace, or a cloud that agrees with no
+other camera while the others agree (knocked out of calibration). The others go on without it; only when no
+usable camera remains is it a :class:`SensorError`.
 """
 
 from __future__ import annotations
@@ -11,9 +14,12 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from cell.errors import SensorError
 from cell.geometry import FloatArray
 from cell.perception.deproject import clouds_in_robot_frame
+from cell.perception.health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.preprocess import downsample, preprocess
 from cell.perception.splice import Spliced, splice
 from cell.scenario import PerceptionSpec
@@ -28,8 +34,11 @@ class Perceived:
     downsampled : ``dense`` on the voxel grid of ``spec.voxel_m`` (what the paper's locator reads).
     clouds : camera name -> its own cropped cloud before splicing (empty for a lost camera).
     spliced : the splice result (unfiltered dense cloud and the ICP diagnostics).
-    lost : cameras whose image gave no point inside the workspace.
+    lost : cameras left out (their data cannot be trusted), in capture order; ``lost_reasons`` says why.
+    lost_reasons : camera name -> one-line reason it was left out.
     timings : step name -> wall time [s] (``clouds``, ``splice``, ``preprocess``, ``downsample``).
+    registered : every camera registered, Z-passthrough and outlier filtered, *not* merged (per-point camera
+        index): what a locator that weighs each camera by its own noise reads.
     """
 
     dense: Cloud
@@ -38,35 +47,57 @@ class Perceived:
     spliced: Spliced
     lost: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
+    lost_reasons: dict[str, str] = field(default_factory=dict)
+
+    def lost_described(self) -> tuple[str, ...]:
+        """``"name: reason"`` of every lost camera (for reports)."""
+        return tuple(f"{n}: {self.lost_reasons.get(n, 'lost')}" for n in self.lost)
+
+    registered: Cloud = field(default_factory=lambda: Cloud(np.zeros((0, 3)), "R"))
 
 
-def perceive(images: Mapping[str, DepthImage], X_WR: FloatArray, spec: PerceptionSpec) -> Perceived:
+def perceive(
+    images: Mapping[str, DepthImage], X_WR: FloatArray, spec: PerceptionSpec, health: HealthOptions | None = None
+) -> Perceived:
     """Run the perception stage on one depth image per camera (see the module docstring).
 
-    X_WR : (4, 4) pose of the robot base R in the world. Raises :class:`SensorError` when there is no image or
-    no camera sees anything inside ``spec.workspace``, or when filtering leaves no point.
+    X_WR : (4, 4) pose of the robot base R in the world. health : thresholds of the camera checks (defaults
+    when None). Raises :class:`SensorError` when there is no image, when no usable camera remains (naming
+    each camera and why it was left out), or when filtering leaves no point.
     """
     if not images:
         raise SensorError("no depth images to perceive from (no camera delivered one)")
     timings: dict[str, float] = {}
     t = time.perf_counter()
+    why: dict[str, str] = {}
+    for name, image in images.items():
+        verdict = image_health(image, health)
+        if not verdict.ok:
+            why[name] = verdict.reason
     clouds = clouds_in_robot_frame(images, X_WR, spec.workspace)
+    for name, cloud in clouds.items():
+        if name in why:
+            clouds[name] = cloud.select(np.zeros(len(cloud), dtype=bool))
+        elif len(cloud) == 0:
+            ws = spec.workspace
+            why[name] = f"no point inside the workspace {ws.min_m}..{ws.max_m} m (looking elsewhere, or covered)"
+    why.update(disagreeing_cameras({n: c for n, c in clouds.items() if n not in why}, health))
+    for name in why:
+        clouds[name] = clouds[name].select(np.zeros(len(clouds[name]), dtype=bool))
+    lost = tuple(name for name in clouds if name in why)
     timings["clouds"] = time.perf_counter() - t
-    lost = tuple(name for name, cloud in clouds.items() if len(cloud) == 0)
     if len(lost) == len(clouds):
-        ws = spec.workspace
-        raise SensorError(
-            f"no camera sees a point inside the workspace {ws.min_m}..{ws.max_m} m (lost: {', '.join(lost)})"
-        )
+        raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in lost))
     t = time.perf_counter()
     spliced = splice({n: c for n, c in clouds.items() if n not in lost}, images, X_WR, spec)
     timings["splice"] = time.perf_counter() - t
     t = time.perf_counter()
     dense = preprocess(spliced.dense, spec.workspace, X_WR, spec)
+    registered = preprocess(spliced.registered, spec.workspace, X_WR, spec)
     timings["preprocess"] = time.perf_counter() - t
     if len(dense) == 0:
         raise SensorError(f"Z passthrough and outlier removal left no point of the {len(spliced.dense)} spliced ones")
     t = time.perf_counter()
     downsampled = downsample(dense, spec.voxel_m)
     timings["downsample"] = time.perf_counter() - t
-    return Perceived(dense, downsampled, clouds, spliced, lost, timings)
+    return Perceived(dense, downsampled, clouds, spliced, lost, timings, {n: why[n] for n in lost}, registered)

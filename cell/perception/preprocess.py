@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 import numpy.typing as npt
+from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray, invert, transform_points
-from cell.perception import _open3d
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Cloud
 
@@ -38,10 +38,10 @@ def z_range_R(workspace: WorkspaceSpec, X_WR: FloatArray) -> tuple[float, float]
 def radius_outlier_mask(points: FloatArray, radius_m: float, min_neighbours: int) -> npt.NDArray[np.bool_]:
     """(n,) True for points (n, 3) with at least ``min_neighbours`` other points within ``radius_m``.
 
-    Same answer as open3d's radius outlier removal, but open3d only searches around the points that are not
-    plainly inliers. Cut space into cubes of edge radius / (2 sqrt 3): every point of the 3 x 3 x 3 cubes
-    around a point's own cube lies within the radius of it, so a point with enough points in that block is
-    kept without a search.
+    Same answer as open3d's radius outlier removal, but only the points that are not plainly inliers are
+    searched. Cut space into cubes of edge radius / (2 sqrt 3): every point of the 3 x 3 x 3 cubes around a
+    point's own cube lies within the radius of it, so a point with enough points in that block is kept without
+    a search; the others are counted with a KD-tree of the points near them only.
     """
     n = len(points)
     if n == 0:
@@ -59,11 +59,21 @@ def radius_outlier_mask(points: FloatArray, radius_m: float, min_neighbours: int
         at = np.searchsorted(cells, cells + shift)
         at = np.minimum(at, len(cells) - 1)
         block += np.where(cells[at] == cells + shift, counts[at], 0)
-    keep = block[inverse.reshape(-1)] - 1 >= min_neighbours
+    inverse = inverse.reshape(-1)
+    keep = block[inverse] - 1 >= min_neighbours
     doubtful = np.flatnonzero(~keep)
     if len(doubtful):
-        found = _open3d.neighbour_counts(points, points[doubtful], radius_m)
-        keep[doubtful] = found - 1 >= min_neighbours  # each query point finds itself
+        # Only points within one radius-sized cube of a doubtful point's cube can be its neighbours.
+        coarse = np.floor(points / radius_m).astype(np.int64)
+        coarse -= coarse.min(axis=0) - 1
+        cdims = coarse.max(axis=0) + 2
+        ckeys = (coarse[:, 0] * cdims[1] + coarse[:, 1]) * cdims[2] + coarse[:, 2]
+        near = np.unique(ckeys[doubtful])
+        shifts = ((di * cdims[1] + dj) * cdims[2] + dk).reshape(-1)
+        wanted = np.unique((near[:, None] + shifts[None, :]).reshape(-1))
+        candidates = points[np.isin(ckeys, wanted)]
+        found = cKDTree(candidates).query_ball_point(points[doubtful], radius_m, return_length=True)
+        keep[doubtful] = np.asarray(found) - 1 >= min_neighbours  # each query point finds itself
     return keep
 
 

@@ -41,7 +41,8 @@ class SeamScene:
     """Everything a locator may look at, all in the robot frame R.
 
     cloud : the spliced, filtered, voxel-downsampled cloud (what the paper's method uses).
-    dense : the spliced, filtered cloud before downsampling (full resolution, per-point camera index).
+    dense : every camera's registered, filtered points, not merged and not downsampled (full resolution, per-point
+        camera index): what our locator and the map alignment read.
     weldmap : the welding map aligned to the cloud (frame ``"R"``).
     joints : seam id -> :class:`Joint`.
     table_z : height of the table top in R [m] (seams against it cannot be seen).

@@ -30,6 +30,7 @@ from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
+from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.noise import apply_noise, perturb_pose
 from cell.sim.robot import BeadStyle, Execution, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
@@ -39,6 +40,7 @@ TABLE = "table"
 _GROUND_SIZE = (20.0, 20.0, 0.02)  # [m] a thin box whose top face is the plane z = 0
 _RGBA = {GROUND: (0.35, 0.35, 0.35, 1.0), TABLE: (0.55, 0.45, 0.35, 1.0)}
 _PART_RGBA = (0.7, 0.72, 0.75, 1.0)
+_OCCLUDER_RGBA = (0.2, 0.3, 0.8, 1.0)
 DEFAULT_BEAD = BeadStyle()
 EYE_IN_HAND_LINK = "camera_optical"  # the arm's optical frame of the eye-in-hand camera (z forward, y down)
 
@@ -67,6 +69,9 @@ class SimCell:
     scenario : the cell (table, cameras, noise, seed).
     parts_W : the as-built parts, boxes in W (``cell.asbuilt.as_built_parts``); names must be unique.
     gui : show PyBullet's GUI (needs a display); headless ``DIRECT`` by default.
+    The scenario's ``faults:`` (:mod:`cell.sim.faults`) are applied here: parts in ``missing_parts`` are not
+    built (``parts_W`` still lists them: it is the design as built), occluders are added as bodies
+    ``occluder:<name>``, and a faulty camera's images are corrupted after the noise model.
 
     Use as a context manager (``with SimCell(scenario, parts) as sim:``) or call :meth:`close`.
     """
@@ -82,9 +87,7 @@ class SimCell:
         self.scenario = scenario
         self.parts_W: tuple[Part, ...] = tuple(parts_W)
         with _stdout_to_stderr():  # pybullet's C code prints "argv[0]=" on stdout, which carries our results
-            self._client: BulletClient | None = BulletClient(
-                connection_mode=pybullet.GUI if gui else pybullet.DIRECT
-            )
+            self._client: BulletClient | None = BulletClient(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
         self._bodies: dict[str, int] = {}
         self._noise_rngs: dict[str, np.random.Generator] = {}
         self._robot: SimRobot | None = None
@@ -93,8 +96,11 @@ class SimCell:
         self._add_box(GROUND, ground, _RGBA[GROUND])
         table = scenario.table
         self._add_box(TABLE, Box(make_pose(p=table.center_m), np.array(table.size_m)), _RGBA[TABLE])
-        for part in self.parts_W:
+        # Faults (scenario ``faults:``): parts not built are left out, objects the map does not know are added.
+        for part in built_parts(self.parts_W, scenario.faults):
             self._add_box(part.name, part.box, _PART_RGBA)
+        for name, box in occluder_boxes(scenario.faults):
+            self._add_box(name, box, _OCCLUDER_RGBA)
 
     # -- scene -----------------------------------------------------------------------------------------------
 
@@ -140,8 +146,7 @@ class SimCell:
         spec = self.scenario.cameras.get(camera)
         if spec is None:
             raise SensorError(
-                f"no camera {camera!r} in scenario {self.scenario.name!r}; "
-                f"cameras: {', '.join(self.scenario.cameras)}"
+                f"no camera {camera!r} in scenario {self.scenario.name!r}; cameras: {', '.join(self.scenario.cameras)}"
             )
         return spec
 
@@ -150,9 +155,7 @@ class SimCell:
         spec = self.camera_spec(camera)
         return intrinsics_for(spec.resolution[0], spec.resolution[1], np.radians(spec.hfov_deg))
 
-    def render_depth(
-        self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float
-    ) -> FloatArray:
+    def render_depth(self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float) -> FloatArray:
         """Noise-free depth (H, W) [m] along the optical axis seen from the optical frame at X_WC (4, 4) in W;
         0 where nothing lies between the near and far planes."""
         _, _, _, buffer, _ = self.client.getCameraImage(
@@ -189,6 +192,10 @@ class SimCell:
             noisy = apply_noise(depth, intr, spec.noise, rng)
         else:
             noisy = depth.astype(np.float32)
+        fault = self.scenario.faults.cameras.get(camera)
+        if fault is not None:  # a broken camera (fault scenarios); its own stream, so noise draws are unchanged
+            rng = self._noise_rngs.setdefault(camera + "/fault", self.scenario.rng(camera + "/fault"))
+            noisy = corrupt_depth(noisy, fault, spec.near_m, spec.far_m, rng)
         X_believed = perturb_pose(X_true, spec.extrinsic_error, self.scenario.rng(camera + "/extrinsics"))
         return DepthImage(camera=camera, depth=noisy, intrinsics=intr, X_WC=X_believed, mount=spec.mount)
 

@@ -1,0 +1,435 @@
+"""Close-up re-scan of seams with the eye-in-hand camera, and fusion with the first estimate.
+
+The fixed cameras see the fence from 1.5-2 m (D415: sigma_z ~3-6 mm, pixel footprint 1.5-2 mm) and their
+extrinsic calibration bounds what they can do. The eye-in-hand camera, brought to ~0.35 m of a seam, sees it
+with ~0.2 mm depth noise and a ~0.35 mm footprint, and its pose comes from the robot's kinematics, not from the
+fixed cameras' calibration. Per seam (:func:`rescan_seams`):
+
+1. plan a view (:func:`cell.motion.viewpoint.plan_view`) from where the arm is;
+2. move the simulated arm there (arc off) and take one image from the camera on the arm;
+3. deproject it with the image's believed pose, keep the points in a box around the seam (``crop_margin_m``),
+   and run the same locator on a local :class:`SeamScene` (this close cloud, the same aligned map and joints);
+4. fuse the close-up estimate with the first by inverse variance (:func:`fuse`): each estimate's standard
+   deviation comes from its confidence (:func:`sigma_from_confidence`) and a floor for what the confidence
+   cannot see (the fixed cameras' calibration, the arm's accuracy). A failed close-up keeps the first estimate;
+   a low-confidence one gets a small weight.
+
+Finally the arm goes back to its scan configuration (when that move is free). Frames: R (robot base) for every
+estimate and pose, W for the simulator; metres, radians, seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from cell.errors import CellError, ScenarioError
+from cell.geometry import FloatArray, invert, readonly
+from cell.motion.viewpoint import ViewOptions, Viewpoint, ViewTarget, plan_view
+from cell.seams.base import SeamLocator, SeamScene
+from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamStatus
+
+if TYPE_CHECKING:
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.timing import Trajectory
+    from cell.pipeline import Detection
+    from cell.scenario import Scenario
+    from cell.sim.robot import Execution
+    from cell.station import Station
+
+Progress = Callable[[str], None]
+
+# Below this confidence a seam is worth a close look (measured on fence1-exact, fence1 and fence2 with realistic
+# noise, see the report of the re-scan issue: seams under it carry most of the large errors). A scenario can
+# override it (proposed key ``rescan.confidence_threshold``).
+CONFIDENCE_THRESHOLD = 0.55
+
+# Options of the "ours" locator for a close-up cloud (~0.2 mm noise and ~0.35 mm pixels at 0.35 m instead of
+# ~4 mm and ~1.6 mm at 1.6 m): the standard error that earns full confidence and the bands cut along edges and
+# corners shrink with the sensor. The noise assumed before it is measured (sensor_sigma_m) stays: it also sets
+# the first pass's gate, which must span the aligned map's local error (up to ~8 mm on fence1's posts).
+CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
+    "target_se_m": 0.00002,
+    "edge_band_m": 0.002,
+    "corner_band_m": 0.003,
+}
+_FIRST_TARGET_SE_M = 0.0002  # OursOptions.target_se_m: the first estimate's confidence scale [m]
+
+
+def _quiet(_: str) -> None:
+    return None
+
+
+@dataclass(frozen=True)
+class RescanOptions:
+    """Options of the close-up re-scan (lengths [m]).
+
+    first_floor_m : standard deviation the first estimate has whatever its confidence says: the fixed cameras'
+        calibration, which no confidence sees (0.3-1 mm / 0.03-0.1 deg on real cells, REFERENCE section 2; the
+        default 0.2 mm is about what the exact simulated cameras give at high confidence).
+    closeup_floor_m : the same for the close-up (the arm's pose accuracy and hand-eye calibration on a real cell;
+        exact kinematics in the simulator).
+    first_scale_m, closeup_scale_m : the locator's standard error at confidence 1/2 for each kind of cloud.
+    """
+
+    confidence_threshold: float = CONFIDENCE_THRESHOLD  # for callers: seams_to_rescan(det, this)
+    camera: str | None = None  # the eye-in-hand camera; None: the scenario's only one
+    crop_margin_m: float = 0.08  # the box around the seam grown by this (the locator's tube and end search)
+    min_points: int = 2000  # fewer points in that box: nothing seen
+    first_floor_m: float = 0.0002
+    closeup_floor_m: float = 0.00002
+    first_scale_m: float = _FIRST_TARGET_SE_M
+    closeup_scale_m: float = 0.00002
+    closeup_locator_options: Mapping[str, Mapping[str, float | int | str | bool]] = field(
+        default_factory=lambda: {"ours": CLOSEUP_OURS_OPTIONS}
+    )
+    return_to_scan: bool = True
+    view: ViewOptions = field(default_factory=ViewOptions)
+
+
+@dataclass(frozen=True)
+class SeamRescan:
+    """What the re-scan did for one seam (all estimates in R).
+
+    before : the first estimate; closeup : the close-up estimate (None when no image was taken); fused : what
+    the cell should use now; weight : the close-up's share of the fused position (0: the first kept);
+    viewpoint : the view (None when none was reachable); motion_s : robot time of the move to it [s];
+    wall_s : wall time of planning, moving, capturing and locating [s]; reason : why the re-scan failed or was
+    not used ('' when it was).
+    """
+
+    id: str
+    before: SeamEstimate
+    closeup: SeamEstimate | None
+    fused: SeamEstimate
+    weight: float
+    viewpoint: Viewpoint | None
+    motion_s: float
+    wall_s: float
+    reason: str = ""
+    points: int = 0
+
+    @property
+    def used(self) -> bool:
+        return self.weight > 0.0
+
+
+@dataclass(frozen=True)
+class Rescan:
+    """The outcome of :func:`rescan_seams`.
+
+    seams : one :class:`SeamRescan` per re-scanned seam, in the order visited.
+    estimates : every seam of the detection, the re-scanned ones replaced by their fused estimate.
+    moves : the moves played (to each view, then back), executions : what the simulated arm did.
+    q_end : (dof,) [rad] where the arm was left; returned : whether that is the scan configuration; note : why
+    not.
+    """
+
+    seams: tuple[SeamRescan, ...]
+    estimates: tuple[SeamEstimate, ...]
+    moves: tuple[Trajectory, ...]
+    executions: tuple[Execution, ...]
+    q_end: FloatArray
+    returned: bool
+    note: str = ""
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def motion_s(self) -> float:
+        """Robot time of every move of the re-scan [s]."""
+        return float(sum(m.duration for m in self.moves))
+
+
+# -- uncertainty and fusion --------------------------------------------------------------------------------
+
+
+def sigma_from_confidence(confidence: float, scale_m: float, floor_m: float) -> float:
+    """Standard deviation [m] of a seam estimate from its confidence in (0, 1].
+
+    The "ours" locator's confidence falls as 1 / (1 + (se / target_se)^2) with the standard error se of the
+    seam line (other factors: support, noise, ends, multiply in); inverting that gives
+    se = scale * sqrt(1 / c - 1), added in quadrature to ``floor_m``. Confidence 0 gives infinity.
+    """
+    if not 0.0 <= confidence <= 1.0 or not math.isfinite(confidence):
+        raise ValueError(f"confidence must be in [0, 1], got {confidence}")
+    if confidence <= 0.0:
+        return math.inf
+    return math.hypot(scale_m * math.sqrt(1.0 / confidence - 1.0), floor_m)
+
+
+def fuse(
+    first: SeamEstimate, closeup: SeamEstimate | None, sigma_first: float, sigma_closeup: float, scale_m: float
+) -> tuple[SeamEstimate, float]:
+    """Inverse-variance fusion of two estimates of one seam: (fused estimate, weight of the close-up).
+
+    An estimate that is not FOUND, or has an infinite sigma, has no weight. The fused ends are matched (a
+    reversed close-up is turned round) and weighted w = s1^2 / (s1^2 + s2^2); the fused confidence is
+    1 / (1 + (sigma / scale_m)^2) of the fused sigma, on the first estimate's confidence scale.
+    """
+    ok1 = first.status is SeamStatus.FOUND and math.isfinite(sigma_first)
+    ok2 = closeup is not None and closeup.status is SeamStatus.FOUND and math.isfinite(sigma_closeup)
+    if not ok2:
+        return first, 0.0
+    assert closeup is not None
+    if not ok1:
+        conf = 1.0 / (1.0 + (sigma_closeup / scale_m) ** 2)
+        return replace(closeup, confidence=conf, reason=f"close-up only; {closeup.reason}"), 1.0
+    a, b = closeup.p_start, closeup.p_end
+    if np.linalg.norm(a - first.p_end) + np.linalg.norm(b - first.p_start) < np.linalg.norm(
+        a - first.p_start
+    ) + np.linalg.norm(b - first.p_end):
+        a, b = b, a
+    v1, v2 = sigma_first**2, sigma_closeup**2
+    w = v1 / (v1 + v2) if v1 + v2 > 0.0 else 0.5
+    sigma = math.sqrt(v1 * v2 / (v1 + v2)) if v1 + v2 > 0.0 else 0.0
+    fused = SeamEstimate(
+        id=first.id,
+        status=SeamStatus.FOUND,
+        reason=f"fused, close-up weight {w:.2f}; close-up {closeup.reason}",
+        p_start=(1.0 - w) * first.p_start + w * a,
+        p_end=(1.0 - w) * first.p_end + w * b,
+        confidence=1.0 / (1.0 + (sigma / scale_m) ** 2),
+        time_s=first.time_s + closeup.time_s,
+    )
+    return fused, float(w)
+
+
+# -- which seams ---------------------------------------------------------------------------------------------
+
+
+def seams_to_rescan(detection: Detection, threshold: float = CONFIDENCE_THRESHOLD) -> list[str]:
+    """Ids of the seams worth a close look: found with confidence below ``threshold``, or visible but not found.
+
+    ``threshold=math.inf`` selects every visible seam. Seams no camera can see (against the table) are left out.
+    """
+    out = []
+    for e in detection.estimates:
+        if e.status is SeamStatus.NOT_FOUND or (e.status is SeamStatus.FOUND and e.confidence < threshold):
+            out.append(e.id)
+    return out
+
+
+# -- the re-scan ----------------------------------------------------------------------------------------------
+
+
+def eye_in_hand_camera(scenario: Scenario, name: str | None = None) -> str:
+    """The name of the scenario's eye-in-hand camera (``name`` checked when given); ScenarioError if none."""
+    eye = [n for n, c in scenario.cameras.items() if c.mount == "eye_in_hand"]
+    if name is not None:
+        if name not in eye:
+            raise ScenarioError(f"camera {name!r} is not an eye-in-hand camera of {scenario.name!r}; those: {eye}")
+        return name
+    if not eye:
+        raise ScenarioError(
+            f"scenario {scenario.name!r} has no eye-in-hand camera (mount: eye_in_hand) to re-scan with"
+        )
+    return eye[0]
+
+
+def closeup_scenario(scenario: Scenario, method: str, options: RescanOptions) -> Scenario:
+    """The scenario with the locator options for close-up clouds merged in (only for the locator ``method``)."""
+    extra = options.closeup_locator_options.get(method)
+    if not extra:
+        return scenario
+    opts: dict[str, dict[str, Any]] = {k: dict(v) for k, v in scenario.locator.options.items()}
+    opts[method] = {**opts.get(method, {}), **extra}
+    return scenario.model_copy(update={"locator": scenario.locator.model_copy(update={"options": opts})})
+
+
+def crop_around(points_R: FloatArray, seam: MapSeam, margin: float) -> np.ndarray:
+    """(n,) mask of the points (n, 3) inside the seam's axis-aligned bounding box grown by ``margin`` [m]."""
+    lo = np.minimum(seam.p_start, seam.p_end) - margin
+    hi = np.maximum(seam.p_start, seam.p_end) + margin
+    return np.asarray(np.all((points_R >= lo) & (points_R <= hi), axis=1))
+
+
+def closeup_scene(
+    image: DepthImage, X_WR: FloatArray, seam: MapSeam, base: SeamScene, options: RescanOptions, voxel_m: float
+) -> SeamScene:
+    """A local SeamScene from one close-up image: its points in R (deprojected with the image's believed pose)
+    inside the box around ``seam``; the aligned map, joints and table of ``base``."""
+    from cell.perception import deproject, downsample
+
+    # Deproject straight into R (one transform of the ~1e6 points instead of two): the image's X_WC becomes X_RC.
+    in_R = replace(image, X_WC=invert(np.asarray(X_WR, dtype=float)) @ image.X_WC)
+    p_R = deproject(in_R)
+    p_R = p_R[crop_around(p_R, seam, options.crop_margin_m)]
+    dense = Cloud(p_R, "R", np.zeros(len(p_R), np.int16), (image.camera,))
+    return SeamScene(
+        cloud=downsample(dense, voxel_m), dense=dense, weldmap=base.weldmap, joints=base.joints, table_z=base.table_z
+    )
+
+
+def _view_target(scene: SeamScene, seam: MapSeam, first: SeamEstimate) -> ViewTarget:
+    from cell.seams.joint import weld_faces
+
+    joint = scene.joints[seam.id]
+    n_a, _, n_b, _ = weld_faces(scene.weldmap, joint)
+    a, b = (first.p_start, first.p_end) if first.status is SeamStatus.FOUND else (seam.p_start, seam.p_end)
+    return ViewTarget(seam.id, a, b, n_a, n_b)
+
+
+def _occluders(scene: SeamScene, seam_id: str) -> tuple[Part, ...]:
+    """The map's parts that may stand between the camera and the seam: all but the joint's own two."""
+    joint = scene.joints[seam_id]
+    return tuple(p for p in scene.weldmap.parts if p.name not in (joint.abutting, joint.receiving))
+
+
+@dataclass
+class _Run:
+    """What every seam of one re-scan shares: the station, the checker, the locator, where the arm is."""
+
+    station: Station
+    detection: Detection
+    options: RescanOptions
+    camera: str
+    checker: CollisionChecker
+    locator: SeamLocator
+    q: FloatArray
+    moves: list[Trajectory] = field(default_factory=list)
+    executions: list[Execution] = field(default_factory=list)
+
+    def play(self, move: Trajectory) -> None:
+        """Drive the simulated arm along ``move`` with the arc off, and record it."""
+        arc = np.zeros(len(move.times), bool)
+        self.executions.append(self.station.sim.execute(move.times, move.q, arc, record_dt=0.02, bead=None))
+        self.moves.append(move)
+        self.q = np.asarray(move.q[-1], dtype=float)
+
+
+def _sigma(est: SeamEstimate | None, scale_m: float, floor_m: float) -> float:
+    if est is None or est.status is not SeamStatus.FOUND:
+        return math.inf
+    return sigma_from_confidence(est.confidence, scale_m, floor_m)
+
+
+def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan:
+    """Plan the view, move, capture, locate and fuse one seam (see the module docstring)."""
+    t0 = time.perf_counter()
+    o, det = run.options, run.detection
+    assert det.scene is not None and run.station.arm is not None
+    base, arm = det.scene.seam_scene, run.station.arm
+    first = next(e for e in det.estimates if e.id == seam_id)
+    seam = base.weldmap.seam(seam_id)
+    try:
+        target = _view_target(base, seam, first)
+        vp = plan_view(
+            arm.model,
+            run.checker,
+            target,
+            run.q,
+            run.station.sim.intrinsics(run.camera),
+            _occluders(base, seam_id),
+            base.table_z,
+            rng=rng,
+            q_via=arm.q_scan,
+            options=o.view,
+        )
+    except CellError as exc:
+        reason = f"unreachable view: {exc.message}"
+        return SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)
+    run.play(vp.move)
+    image = run.station.sim.capture_from_link(run.camera)
+    scene = closeup_scene(image, det.scenario.X_WR, seam, base, o, det.scenario.perception.voxel_m)
+    n = len(scene.dense)
+    if n < o.min_points:
+        reason = f"nothing seen: {n} points near the seam in the close-up (needs {o.min_points})"
+        return SeamRescan(seam_id, first, None, first, 0.0, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
+    t = time.perf_counter()
+    est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
+    est = replace(est, time_s=time.perf_counter() - t)
+    s1 = _sigma(first, o.first_scale_m, o.first_floor_m)
+    s2 = _sigma(est, o.closeup_scale_m, o.closeup_floor_m)
+    fused, w = fuse(first, est, s1, s2, o.first_scale_m)
+    reason = "" if w > 0.0 else f"close-up not used: {est.reason or est.status.value}"
+    return SeamRescan(seam_id, first, est, fused, w, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
+
+
+def rescan_seams(
+    station: Station,
+    detection: Detection,
+    seam_ids: Sequence[str],
+    *,
+    options: RescanOptions | None = None,
+    progress: Progress = _quiet,
+) -> Rescan:
+    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (module docstring).
+
+    station : the running cell the detection came from. Its arm moves from where it is to each view (arc off)
+    and, with ``options.return_to_scan``, back to the scan configuration when that move is free; the result says
+    where it was left. A seam whose view is unreachable, or whose close-up sees nothing or finds no seam, keeps
+    its first estimate and says why. Raises ScenarioError without an arm or an eye-in-hand camera, KeyError for
+    a seam id the detection does not have, ValueError for a detection without its scene.
+    """
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.plan import cell_obstacles
+    from cell.motion.timing import ptp
+    from cell.seams.registry import make_locator
+
+    o = options or RescanOptions()
+    sc = detection.scenario
+    arm = station.arm
+    if arm is None:
+        raise ScenarioError(f"scenario {sc.name!r} has no robot to carry the camera: set robot.urdf")
+    camera = eye_in_hand_camera(sc, o.camera)
+    if detection.scene is None:
+        raise ValueError("rescan_seams needs a detection that kept its scene (pipeline.detect does)")
+    base = detection.scene.seam_scene
+    known = {e.id for e in detection.estimates}
+    unknown = [s for s in seam_ids if s not in known]
+    if unknown:
+        raise KeyError(f"no seam {', '.join(unknown)} in the detection; seams: {', '.join(sorted(known))}")
+    t_all = time.perf_counter()
+    obstacles = cell_obstacles(base.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
+    checker = CollisionChecker(arm.model, obstacles)
+    locator = make_locator(detection.method, closeup_scenario(sc, detection.method, o))
+    run = _Run(station, detection, o, camera, checker, locator, np.asarray(station.sim.robot.q, dtype=float))
+    rng = sc.rng("rescan/view")
+    results = []
+    for k, sid in enumerate(seam_ids):
+        progress(f"re-scan {k + 1}/{len(seam_ids)}: {sid}")
+        results.append(_rescan_one(run, sid, rng))
+    returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
+    if o.return_to_scan and not returned:
+        back = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
+        hit = checker.check_path(back.q, back.times)
+        if hit is None:
+            run.play(back)
+            returned = True
+        else:
+            note = f"left at the last view: the move back to the scan pose collides ({hit.describe()})"
+    elif not returned:
+        note = "left at the last view (return_to_scan is off)"
+    fused_by_id = {r.id: r.fused for r in results}
+    estimates = tuple(fused_by_id.get(e.id, e) for e in detection.estimates)
+    timings = {"rescan_s": time.perf_counter() - t_all}
+    return Rescan(
+        tuple(results), estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings
+    )
+
+
+def rescanned(detection: Detection, rescan: Rescan) -> Detection:
+    """The detection with the fused estimates in place and its metrics measured again against the truths."""
+    from cell.pipeline import evaluate
+
+    metrics, summary = evaluate(rescan.estimates, detection.truths)
+    timings = {**detection.timings, **rescan.timings}
+    return replace(detection, estimates=rescan.estimates, metrics=metrics, summary=summary, timings=timings)
+
+
+__all__ = [
+    "CONFIDENCE_THRESHOLD",
+    "Rescan",
+    "RescanOptions",
+    "SeamRescan",
+    "fuse",
+    "rescan_seams",
+    "rescanned",
+    "seams_to_rescan",
+    "sigma_from_confidence",
+]

@@ -1,0 +1,224 @@
+"""Close-up re-scan: view planning on a tiny inline cell (distance, looking into the joint, reachable, clear of the
+torch and of collisions), fusion weights, and on a real scenario: the close-up improves a seam; a failed close-up
+keeps the first estimate."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+
+from cell import scenario as sc
+from cell.errors import PlanError
+from cell.geometry import invert, make_pose, transform_points
+from cell.motion.collision import CollisionChecker
+from cell.motion.robot import RobotModel
+from cell.motion.viewpoint import (
+    ViewOptions,
+    ViewTarget,
+    _segments_hit_box,
+    plan_view,
+    torch_axis_in_camera,
+)
+from cell.rescan import (
+    RescanOptions,
+    fuse,
+    rescan_seams,
+    rescanned,
+    seams_to_rescan,
+    sigma_from_confidence,
+)
+from cell.seams.metrics import segment_errors
+from cell.sim.camera import intrinsics_for
+from cell.types import Box, Part, SeamEstimate, SeamStatus
+
+URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
+HOME = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
+K = intrinsics_for(1280, 720, math.radians(65.0))  # the D415 of the scenarios
+# Robot base at table-top height; a rail 0.92 m ahead, a post abutting its near face (y = 0.87) across 1 mm.
+TABLE = Part("TABLE", Box(make_pose(p=[0.0, 1.05, -0.05]), np.array([2.0, 1.2, 0.1])))
+RAIL = Part("RAIL", Box(make_pose(p=[0.0, 0.92, 0.03]), np.array([0.4, 0.1, 0.06])))
+POST = Part("POST", Box(make_pose(p=[0.0, 0.769, 0.03]), np.array([0.06, 0.2, 0.06])))
+OBSTACLES = (TABLE, RAIL, POST)
+Y = 0.87
+TOP = ViewTarget(
+    "top", np.array([-0.03, Y, 0.06]), np.array([0.03, Y, 0.06]), np.array([0, 0, 1.0]), np.array([0, -1.0, 0])
+)
+SIDE = ViewTarget(
+    "side", np.array([0.03, Y, 0.0]), np.array([0.03, Y, 0.06]), np.array([1.0, 0, 0]), np.array([0, -1.0, 0])
+)
+
+
+@pytest.fixture(scope="module")
+def robot() -> RobotModel:
+    return RobotModel.from_urdf(URDF)
+
+
+@pytest.fixture(scope="module")
+def checker(robot: RobotModel) -> CollisionChecker:
+    return CollisionChecker(robot, OBSTACLES)
+
+
+# -- view planning ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("target", [TOP, SIDE], ids=["top", "side"])
+def test_view_looks_into_the_joint_from_its_distance_and_is_reached_without_collision(
+    robot: RobotModel, checker: CollisionChecker, target: ViewTarget
+) -> None:
+    opt = ViewOptions()
+    vp = plan_view(robot, checker, target, HOME, K, (), 0.0, rng=np.random.default_rng(0), options=opt)
+    eye = vp.X_RC[:3, 3]
+    # Distance: one of the candidate distances (IK reaches the pose to 0.01 mm).
+    assert min(abs(vp.distance_m - d) for d in opt.distances_m) < 1e-4
+    # Looking into the joint: the camera is out along the fillet's bisector, within the tilt/slant grid.
+    to_eye = (eye - target.mid) / np.linalg.norm(eye - target.mid)
+    assert to_eye @ target.bisector > math.cos(math.radians(60.0))
+    # Both weld faces seen at an acceptable incidence; the seam's midpoint ahead of the camera, near the axis.
+    assert max(vp.incidence_deg) <= opt.max_incidence_deg
+    p_C = transform_points(invert(vp.X_RC), target.mid)
+    off_axis = math.degrees(math.atan2(math.hypot(p_C[0], p_C[1]), p_C[2]))
+    assert p_C[2] > 0.0 and off_axis == pytest.approx(opt.image_offset_deg, abs=0.1)
+    # The whole seam in the image, above the torch (which rides on the optical axis, lower half of the image).
+    for p in (target.p_start, target.p_end):
+        q_C = transform_points(invert(vp.X_RC), p)
+        u, v = K.fx * q_C[0] / q_C[2] + K.cx, K.fy * q_C[1] / q_C[2] + K.cy
+        assert 0.0 < u < K.width and 0.0 < v < K.cy
+    # Reachable: the joint values put the camera there; the move starts here, ends there and is collision-free.
+    np.testing.assert_allclose(robot.fk(vp.q, opt.camera_frame), vp.X_RC, atol=1e-6)
+    np.testing.assert_allclose(vp.move.q[0], HOME, atol=1e-12)
+    np.testing.assert_allclose(vp.move.q[-1], vp.q, atol=1e-12)
+    assert robot.limits.contains(vp.q)
+    assert checker.check_path(vp.move.q, vp.move.times) is None
+
+
+def test_torch_lies_ahead_of_the_camera_on_its_axis(robot: RobotModel) -> None:
+    axis = torch_axis_in_camera(robot)
+    tip = axis[-1]
+    assert 0.25 < tip[2] < 0.35  # the TCP about 0.3 m ahead of the camera
+    assert math.hypot(tip[0], tip[1]) < 0.01  # on the optical axis: why views put the seam off-centre
+
+
+def test_unreachable_seam_raises_a_plan_error_naming_it(robot: RobotModel, checker: CollisionChecker) -> None:
+    far = ViewTarget("far", np.array([-0.03, 2.6, 0.06]), np.array([0.03, 2.6, 0.06]), TOP.n_a, TOP.n_b)
+    with pytest.raises(PlanError, match=r"seam far: none of \d+ close-up views works \(.*unreachable"):
+        plan_view(robot, checker, far, HOME, K, (), 0.0, rng=np.random.default_rng(0), restart_candidates=2)
+
+
+def test_a_part_in_the_line_of_sight_rules_views_out(robot: RobotModel, checker: CollisionChecker) -> None:
+    wall = Part("WALL", Box(make_pose(p=[0.0, 0.6, 0.3]), np.array([1.0, 0.6, 0.6])))  # over the whole joint
+    with pytest.raises(PlanError, match="no close-up view sees the seam"):
+        plan_view(robot, checker, TOP, HOME, K, (wall,), 0.0, rng=np.random.default_rng(0))
+
+
+def test_segment_box_test() -> None:
+    box = Part("B", Box(make_pose(p=[0.0, 0.0, 0.0]), np.array([0.2, 0.2, 0.2])))
+    p0 = np.array([-1.0, 0.0, 0.0])
+    ends = np.array([[1.0, 0.0, 0.0], [-0.5, 0.0, 0.0], [1.0, 0.5, 0.0], [-0.11, 0.0, 0.0], [1.0, 0.0, 0.099]])
+    np.testing.assert_array_equal(_segments_hit_box(p0, ends, box, 0.0), [True, False, False, False, True])
+
+
+# -- uncertainty and fusion ------------------------------------------------------------------------------
+
+
+def _est(p0: Any, p1: Any, conf: float, status: SeamStatus = SeamStatus.FOUND) -> SeamEstimate:
+    if status is not SeamStatus.FOUND:
+        return SeamEstimate("s", status, "not seen")
+    return SeamEstimate("s", status, "", np.asarray(p0, float), np.asarray(p1, float), conf)
+
+
+def test_sigma_falls_with_confidence_to_its_floor() -> None:
+    s = [sigma_from_confidence(c, 2e-4, 1e-4) for c in (0.1, 0.3, 0.55, 0.8, 1.0)]
+    assert all(a > b for a, b in itertools.pairwise(s))
+    assert s[-1] == pytest.approx(1e-4)
+    assert sigma_from_confidence(0.5, 2e-4, 0.0) == pytest.approx(2e-4)  # the scale is the sigma at c = 1/2
+    assert math.isinf(sigma_from_confidence(0.0, 2e-4, 1e-4))
+    with pytest.raises(ValueError):
+        sigma_from_confidence(1.5, 2e-4, 1e-4)
+
+
+def test_fusion_weights_by_inverse_variance_and_turns_a_reversed_closeup_round() -> None:
+    first = _est([0, 0, 0], [0.1, 0, 0], 0.5)
+    close = _est([0.1, 0.003, 0], [0, 0.003, 0], 0.9)  # reported the other way round, 3 mm off
+    fused, w = fuse(first, close, 3e-4, 1e-4, 2e-4)
+    assert w == pytest.approx(0.9)  # 9e-8 / (9e-8 + 1e-8)
+    np.testing.assert_allclose(fused.p_start, [0, 0.0027, 0], atol=1e-12)
+    np.testing.assert_allclose(fused.p_end, [0.1, 0.0027, 0], atol=1e-12)
+    sigma = math.sqrt(9e-8 * 1e-8 / 1e-7)
+    assert fused.confidence == pytest.approx(1.0 / (1.0 + (sigma / 2e-4) ** 2))
+    even, w_even = fuse(first, _est([0, 0.002, 0], [0.1, 0.002, 0], 0.5), 1e-4, 1e-4, 2e-4)
+    assert w_even == pytest.approx(0.5) and even.p_start[1] == pytest.approx(0.001)
+
+
+def test_failed_or_weak_closeup_keeps_the_first_estimate() -> None:
+    first = _est([0, 0, 0], [0.1, 0, 0], 0.8)
+    s1 = sigma_from_confidence(0.8, 2e-4, 2e-4)
+    for failed in (None, _est(None, None, 0.0, SeamStatus.NOT_FOUND)):
+        fused, w = fuse(first, failed, s1, 1e-5, 2e-4)
+        assert fused is first and w == 0.0
+    weak = _est([0, 0.01, 0], [0.1, 0.01, 0], 0.001)  # a 10 mm wrong close-up the locator barely believes
+    fused, w = fuse(first, weak, s1, sigma_from_confidence(0.001, 2e-5, 2e-5), 2e-4)
+    assert w < 0.2 and fused.p_start[1] < 0.002
+    # A visible seam the fixed cameras missed: the close-up alone.
+    only, w_only = fuse(_est(None, None, 0.0, SeamStatus.NOT_FOUND), first, math.inf, 1e-4, 2e-4)
+    assert w_only == 1.0 and only.status is SeamStatus.FOUND
+
+
+def test_seams_to_rescan_takes_low_confidence_and_missed_visible_seams() -> None:
+    det: Any = SimpleNamespace(
+        estimates=(
+            SeamEstimate("a", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 0.9),
+            SeamEstimate("b", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 0.3),
+            SeamEstimate("c", SeamStatus.NOT_FOUND, "too few points"),
+            SeamEstimate("d", SeamStatus.NOT_VISIBLE, "underside"),
+        )
+    )
+    assert seams_to_rescan(det, 0.55) == ["b", "c"]
+    assert seams_to_rescan(det, math.inf) == ["a", "b", "c"]
+
+
+# -- the real pipeline ---------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def fence1() -> Any:
+    from cell.pipeline import detect
+    from cell.station import Station
+
+    scenario = sc.load("fence1")
+    with Station(scenario) as station:
+        det = detect(scenario, station=station)
+        yield station, det
+
+
+@pytest.mark.scenario
+def test_rescan_improves_the_least_confident_seam_and_returns_the_arm(fence1: Any) -> None:
+    station, det = fence1
+    worst = min((e for e in det.estimates if e.status is SeamStatus.FOUND), key=lambda e: e.confidence)
+    rs = rescan_seams(station, det, [worst.id])
+    (r,) = rs.seams
+    assert r.reason == "" and r.viewpoint is not None and r.closeup is not None and r.weight > 0.5
+    truth = det.truths[worst.id]
+    lat0 = segment_errors(r.before.p_start, r.before.p_end, *truth)[2]
+    _, end1, lat1, _ = segment_errors(r.fused.p_start, r.fused.p_end, *truth)
+    assert lat1 < lat0 and lat1 < 0.1 and end1 < 0.3  # [mm]
+    assert r.motion_s > 0.0 and len(rs.executions) == 2  # to the view, and back
+    assert rs.returned and np.allclose(station.sim.robot.q, station.arm.q_scan, atol=1e-9)
+    after = rescanned(det, rs)
+    assert after.metrics[worst.id].lateral_mm == pytest.approx(lat1)
+    assert [e.id for e in after.estimates] == [e.id for e in det.estimates]
+
+
+@pytest.mark.scenario
+def test_a_closeup_that_sees_nothing_keeps_the_first_estimate(fence1: Any) -> None:
+    station, det = fence1
+    seam = next(e for e in det.estimates if e.status is SeamStatus.FOUND)
+    rs = rescan_seams(station, det, [seam.id], options=RescanOptions(min_points=10**8))
+    (r,) = rs.seams
+    assert r.reason.startswith("nothing seen") and r.fused is r.before and r.weight == 0.0
+    assert next(e for e in rs.estimates if e.id == seam.id) is seam

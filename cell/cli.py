@@ -109,9 +109,9 @@ def detect(
             save_ply(det.scene.perceived.dense, save_cloud)
             err.print(f"[dim]· spliced cloud written to {save_cloud}[/]")
         _print_detection(det)
-    if det.error is not None:
+    if det.error is not None:  # the report says which seams and why: partial, with the cause in report.error
         err.print(f"[bold red]error[/]: {det.error.message}", soft_wrap=True)
-        raise typer.Exit(det.error.exit_code)
+        raise typer.Exit(EXIT_PARTIAL)
     if not det.complete:
         raise typer.Exit(EXIT_PARTIAL)
 
@@ -171,17 +171,99 @@ def weld(
     krl: Annotated[
         Path | None, typer.Option(help="Write the KUKA KRL program (.src/.dat) and the trajectory (JSON, CSV) here.")
     ] = None,
+    rescan: Annotated[
+        str | None, typer.Option(help="Re-scan before welding: none | low (below the confidence threshold) | all.")
+    ] = None,
     gui: Annotated[bool, typer.Option(help="Open the PyBullet window (needs a display).")] = False,
 ) -> None:
-    """The whole cell: capture, locate every seam, plan the torch paths, check them, weld in simulation."""
+    """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation."""
     from cell import pipeline
     from cell import scenario as sc
 
     with _cell_errors():
         scn = sc.load(scenario)
         _check_method(method)
-        run = pipeline.weld(scn, method, noise=_noise(noise), progress=_progress(), gui=gui)
+        run = pipeline.weld(
+            scn, method, noise=_noise(noise), rescan=_rescan_mode(rescan), progress=_progress(), gui=gui
+        )
         _finish_run(run, json_path, krl, title="weld")
+
+
+@app.command("rescan")
+def rescan_cmd(
+    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    seams: Annotated[
+        str | None, typer.Option(help="Comma-separated seam ids (default: the scenario's rescan.mode choice).")
+    ] = None,
+    all_seams: Annotated[bool, typer.Option("--all", help="Re-scan every visible seam.")] = False,
+    method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
+    noise: NoiseOpt = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
+) -> None:
+    """Only the close-up re-scan: detect, look again at seams with the eye-in-hand camera, compare before/after."""
+    import math
+
+    from cell import pipeline
+    from cell import scenario as sc
+    from cell.export.report import rescan_report, write_json
+    from cell.rescan import rescan_seams, rescanned, seams_to_rescan
+    from cell.station import Station
+
+    with _cell_errors():
+        scn = sc.load(scenario)
+        _check_method(method)
+        scn = scn.with_noise(n) if (n := _noise(noise)) else scn
+        with Station(scn) as station:
+            det = pipeline.detect(scn, method, progress=_progress(), station=station)
+            if det.error is not None:
+                raise det.error
+            if seams:
+                ids = [s.strip() for s in seams.split(",") if s.strip()]
+            else:
+                ids = seams_to_rescan(det, math.inf if all_seams else scn.rescan.confidence_threshold)
+            try:
+                rs = rescan_seams(station, det, ids, progress=_progress())
+            except KeyError as e:
+                raise typer.BadParameter(str(e.args[0]), param_hint="--seams") from None
+            after = rescanned(det, rs)
+        rep = rescan_report(det, after, rs)
+        if json_path is not None:
+            write_json(json_path, rep)
+            err.print(f"[dim]· report written to {json_path}[/]")
+        _print_rescan(rep)
+
+
+def _print_rescan(rep: dict) -> None:
+    t = Table(title=f"re-scan {rep['scenario']} · method {rep['method']} · frame R", title_justify="left")
+    for col in ("seam", "lateral before", "lateral after", "endpoint before", "endpoint after", "weight", "why not"):
+        t.add_column(col, justify="left" if col in ("seam", "why not") else "right")
+    for s in rep["seams"]:
+        b, a = s.get("error_mm_before", {}), s.get("error_mm", {})
+        t.add_row(
+            s["id"],
+            _fmt(b.get("lateral")),
+            _fmt(a.get("lateral")),
+            _fmt(b.get("endpoint")),
+            _fmt(a.get("endpoint")),
+            _fmt(s["rescan"]["weight"]),
+            s["rescan"]["reason"],
+        )
+    out.print(t)
+    b, a = rep["summary_before_rescan"], rep["summary"]
+    out.print(
+        f"{rep['rescan']['seams']} seams re-scanned ({rep['rescan']['used']} used) · mean lateral"
+        f" {_fmt(b['lateral_mean_mm'], 3)} -> {_fmt(a['lateral_mean_mm'], 3)} mm · mean endpoint"
+        f" {_fmt(b['endpoint_mean_mm'], 3)} -> {_fmt(a['endpoint_mean_mm'], 3)} mm · robot time"
+        f" {_fmt(rep['rescan']['motion_s'], 1)} s"
+    )
+
+
+def _rescan_mode(value: str | None) -> Literal["none", "low", "all"] | None:
+    if value is None:
+        return None
+    if value not in ("none", "low", "all"):
+        raise typer.BadParameter(f"{value!r}; valid: none, low, all", param_hint="--rescan")
+    return "none" if value == "none" else ("low" if value == "low" else "all")
 
 
 @app.command()
@@ -235,9 +317,9 @@ def _finish_run(run: object, json_path: Path | None, krl: Path | None, *, title:
         traj_csv = write_csv(run.plan, krl / "trajectory.csv")
         err.print(f"[dim]· robot program: {src}, {dat}; trajectory: {traj_json}, {traj_csv}[/]")
     _print_weld(rep, title)
-    if run.error is not None:
+    if run.error is not None:  # the report says which seams and why: partial, with the cause in report.error
         err.print(f"[bold red]error[/]: {run.error.message}", soft_wrap=True)
-        raise typer.Exit(run.error.exit_code)
+        raise typer.Exit(EXIT_PARTIAL)
     if not run.complete:
         raise typer.Exit(EXIT_PARTIAL)
 

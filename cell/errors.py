@@ -11,7 +11,7 @@ code  meaning
 0     everything asked for was done
 1     internal error (a bug: please report it with the traceback)
 2     command-line usage error (typer/click)
-3     partial result: the report is written, some seams were not found/welded
+3     partial result: the report is written; some seams were not found/welded, or a stage failed after capture
 10    scenario file invalid (unknown key, value out of range, missing file)
 11    welding map (DXF) unreadable or invalid
 12    welding map has no known units

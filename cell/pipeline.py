@@ -7,7 +7,7 @@ layer over :func:`detect` (and, for the bench, over :func:`capture`, :func:`buil
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
@@ -24,6 +24,7 @@ if TYPE_CHECKING:  # heavy imports stay inside the stages that need them
     from cell.motion.plan import WeldPlan
     from cell.motion.timing import Trajectory
     from cell.perception import Alignment, Perceived
+    from cell.rescan import Rescan
     from cell.sim.robot import Execution
 
 Progress = Callable[[str], None]
@@ -53,6 +54,7 @@ class Scene:
     alignment: Alignment
     X_RM: FloatArray  # pose of the aligned map in the robot frame
     timings: dict[str, float]
+    missing: Mapping[str, str] = field(default_factory=dict)  # parts of the map not in the cloud -> why
 
 
 @dataclass(frozen=True)
@@ -98,6 +100,7 @@ def capture(
 def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints."""
     from cell.perception import align_map, perceive
+    from cell.perception.health import check_alignment_unique, check_parts_seen
     from cell.seams.joint import find_joints
 
     sc = cap.scenario
@@ -116,6 +119,10 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     alignment = align_map(weldmap_nominal_R, perceived.registered, sc.perception)
     X_RM = alignment.X_RR_corr @ X_RM_nominal
     weldmap_R = cap.weldmap.transformed(X_RM, "R")
+    # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
+    # parts that are simply not there are named, and their seams are never searched.
+    check_alignment_unique(weldmap_R, perceived.registered, alignment)
+    missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception)
     joints = find_joints(weldmap_R)
     timings["align_s"] = time.perf_counter() - t
 
@@ -127,11 +134,12 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
         joints=joints,
         table_z=table_z_R,
     )
-    return Scene(seam_scene, perceived, alignment, X_RM, timings)
+    return Scene(seam_scene, perceived, alignment, X_RM, timings, missing)
 
 
 def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet) -> tuple[SeamEstimate, ...]:
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
+    from cell.perception.health import screen
     from cell.seams.registry import make_locator
     from cell.seams.visibility import visibility
 
@@ -149,7 +157,8 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
         est = locator.locate(ss, seam, rng)
         dt = time.perf_counter() - t
         out.append(SeamEstimate(est.id, est.status, est.reason, est.p_start, est.p_end, est.confidence, time_s=dt))
-    return tuple(out)
+    # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
+    return screen(ss, tuple(out), scene.missing)
 
 
 def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:
@@ -210,7 +219,7 @@ def detect(
         metrics=metrics,
         summary=summary,
         timings=timings,
-        lost_cameras=scene.perceived.lost,
+        lost_cameras=tuple(scene.perceived.lost_described()),
         scene=scene,
     )
 
@@ -280,11 +289,15 @@ class WeldRun:
     timings: dict[str, float] = field(default_factory=dict)
     torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT
     arm: Arm | None = None
+    first_detection: Detection | None = None  # before the re-scan (the same as detection when none ran)
+    rescan: Rescan | None = None
 
     @property
     def cycle_time_s(self) -> float:
-        """Robot time of the executed program, from the scan pose to home [s] (0 when nothing moved)."""
-        return self.execution.duration if self.execution is not None else 0.0
+        """Robot time of everything the arm did: re-scan moves and the welding program [s] (0 when nothing moved)."""
+        if self.execution is None:
+            return 0.0
+        return self.execution.duration + (self.rescan.motion_s if self.rescan is not None else 0.0)
 
     @property
     def complete(self) -> bool:
@@ -299,12 +312,18 @@ class WeldRun:
 
 
 def plan_for(
-    station: Station, det: Detection, *, progress: Progress = _quiet
+    station: Station,
+    det: Detection,
+    *,
+    skip: Collection[str] = (),
+    q_start: FloatArray | None = None,
+    progress: Progress = _quiet,
 ) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
-    """Plan the found seams of a detection and run the safety gate (REFERENCE section 7).
+    """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (REFERENCE section 7).
 
-    Returns the plan, the move from the scan pose to home that precedes it, and the gate's violations (empty when
-    the plan may run). PlanError when nothing can be planned at all.
+    q_start : where the arm is now (default: its scan configuration). Returns the plan, the move from q_start to
+    home that precedes it, and the gate's violations (empty when the plan may run). PlanError when nothing can be
+    planned at all.
     """
     from cell.motion.checks import find_violations
     from cell.motion.collision import CollisionChecker
@@ -318,17 +337,17 @@ def plan_for(
         raise ScenarioError(f"scenario {sc.name!r} has no robot to weld with: set robot.urdf and robot.X_WR")
     assert det.scene is not None
     ss = det.scene.seam_scene
-    tasks = seam_tasks(det.estimates, ss.weldmap, ss.joints, ss.table_z)
+    tasks = seam_tasks([e for e in det.estimates if e.id not in skip], ss.weldmap, ss.joints, ss.table_z)
     obstacles = cell_obstacles(ss.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
     checker = CollisionChecker(arm.model, obstacles)
     progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     plan = plan_welds(arm.model, tasks, arm.q_home, process, obstacles, rng=sc.rng("plan"), checker=checker)
-    pre = ptp(arm.q_scan, arm.q_home, arm.model.limits, dt=0.001)
+    pre = ptp(arm.q_scan if q_start is None else q_start, arm.q_home, arm.model.limits, dt=0.001)
     problems = []
     hit = checker.check_path(pre.q, pre.times)
     if hit is not None:
-        problems.append(f"move from the scan pose to home collides: {hit.describe()}")
+        problems.append(f"move from the arm's position to home collides: {hit.describe()}")
     progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
     problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker)]
     return plan, pre, tuple(problems)
@@ -350,7 +369,7 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
 
 
 def _seam_welds(
-    det: Detection, plan: WeldPlan | None, ex: Execution | None, pre_s: float, refused: str
+    det: Detection, plan: WeldPlan | None, ex: Execution | None, pre_s: float, refused: str, sc: Scenario
 ) -> tuple[SeamWeld, ...]:
     """Per seam: welded (with its quality against the true seam) or the reason it was not."""
     import numpy as np
@@ -366,6 +385,10 @@ def _seam_welds(
             continue
         if est.status is not SeamStatus.FOUND:
             out.append(SeamWeld(est.id, False, False, f"not located: {est.reason}"))
+            continue
+        if est.confidence < sc.rescan.weld_min_confidence:
+            why = f"low_confidence: {est.confidence:.2f} < {sc.rescan.weld_min_confidence:.2f} after the re-scan"
+            out.append(SeamWeld(est.id, False, False, why))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
         if outcome is None or not outcome.feasible:
@@ -388,18 +411,23 @@ def weld(
     method: str | None = None,
     *,
     noise: Literal["none", "realistic"] | None = None,
+    rescan: Literal["none", "low", "all"] | None = None,
     execute_plan: bool = True,
     progress: Progress = _quiet,
     gui: bool = False,
 ) -> WeldRun:
-    """The whole cell: capture, detect, plan, gate and (unless ``execute_plan`` is False: a preview) weld.
+    """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a
+    preview) weld. ``rescan`` overrides the scenario's ``rescan.mode``.
 
     A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
-    every seam's reason, so the report can still be written.
+    every seam's reason, so the report can still be written. A seam whose confidence stays below
+    ``rescan.weld_min_confidence`` after the re-scan is not welded (``low_confidence``).
     """
     t_all = time.perf_counter()
     with Station(scenario.with_noise(noise) if noise else scenario, gui=gui) as station:
-        det = detect(station.scenario, method, progress=progress, station=station)
+        sc = station.scenario
+        det = detect(sc, method, progress=progress, station=station)
+        first, rs = det, None
         timings = dict(det.timings)
         plan = pre = ex = None
         violations: tuple[str, ...] = ()
@@ -407,8 +435,18 @@ def weld(
         try:
             if det.error is not None:
                 raise det.error
+            mode = rescan or sc.rescan.mode
+            if mode != "none" and station.arm is not None and execute_plan:
+                rs, det = rescan_detection(station, det, mode, progress=progress)
+                timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
+            low = {
+                e.id
+                for e in det.estimates
+                if e.status is SeamStatus.FOUND and e.confidence < sc.rescan.weld_min_confidence
+            }
             t = time.perf_counter()
-            plan, pre, violations = plan_for(station, det, progress=progress)
+            q_start = rs.q_end if rs is not None else None
+            plan, pre, violations = plan_for(station, det, skip=low, q_start=q_start, progress=progress)
             timings["plan_s"] = time.perf_counter() - t
             if violations:
                 raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
@@ -419,10 +457,26 @@ def weld(
         except CellError as e:
             error = e
         refused = f"not executed: {error.message}" if error is not None else ""
-        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused)
+        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused, sc)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
-        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm)
+        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs)
+
+
+def rescan_detection(
+    station: Station, det: Detection, mode: Literal["low", "all"], *, progress: Progress = _quiet
+) -> tuple[Rescan, Detection]:
+    """Re-scan the seams worth a closer look (``low``: below the confidence threshold or not found; ``all``: every
+    visible seam) with the eye-in-hand camera and return the detection with the fused estimates."""
+    import math
+
+    from cell.rescan import rescan_seams, rescanned, seams_to_rescan
+
+    sc = det.scenario
+    ids = seams_to_rescan(det, math.inf if mode == "all" else sc.rescan.confidence_threshold)
+    progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
+    rs = rescan_seams(station, det, ids, progress=progress)
+    return rs, rescanned(det, rs)
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

@@ -205,6 +205,19 @@ class LocatorSpec(_Model):
     options: dict[str, dict[str, float | int | str | bool]] = Field(default_factory=dict)
 
 
+class RescanSpec(_Model):
+    """Close-up re-scan before welding and the confidence gate (cell.rescan; calibration in its docstring).
+
+    mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` (and visible seams not
+        found), ``all`` every visible seam, ``none`` nothing.
+    weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
+    """
+
+    mode: Literal["none", "low", "all"] = "low"
+    confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = 0.55  # catches every seam > 0.15 mm lateral
+    weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
+
+
 class CameraFaultSpec(_Model):
     """A simulated camera failure: what the camera delivers instead of a good image (for fault scenarios).
 
@@ -259,6 +272,7 @@ class Scenario(_Model):
     cameras: dict[str, CameraSpec]
     perception: PerceptionSpec
     locator: LocatorSpec = LocatorSpec()
+    rescan: RescanSpec = RescanSpec()
     faults: FaultsSpec = FaultsSpec()
     # Set by the loader: the folder the file lives in (paths inside are relative to it).
     base_dir: str = Field(default=".", exclude=True)

@@ -119,3 +119,17 @@ def test_detect_writes_the_report_contract(tmp_path: Path) -> None:
     for key in ("found", "paper_me_mean_mm", "endpoint_mean_mm", "lateral_mean_mm", "time_ms_per_seam_median"):
         assert key in summary
     assert cloud.stat().st_size > 10_000
+
+
+@pytest.mark.scenario
+def test_alignment_failure_still_writes_every_seam_with_its_reason(tmp_path: Path) -> None:
+    report = tmp_path / "out.json"
+    code, _, err = invoke("detect", "faults/displaced-far", "--json", str(report))
+    assert code == 3, err  # partial: the report is written, the cause is in it
+    assert "error:" in err and "Traceback" not in err
+    data = json.loads(report.read_text())
+    assert data["error"]["type"] == "AlignmentError" and data["error"]["exit_code"] == 14
+    assert len(data["seams"]) == 16
+    assert all(s["status"] in ("not_found", "not_visible") for s in data["seams"])
+    assert all(s["reason"] for s in data["seams"])
+    assert not any("detected" in s for s in data["seams"])

@@ -8,12 +8,15 @@ import os
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from cell.errors import CellError
 from cell.pipeline import Detection, WeldRun
+
+if TYPE_CHECKING:
+    from cell.rescan import Rescan
 from cell.types import SeamStatus
 
 REPORT_VERSION = 1
@@ -74,6 +77,48 @@ def detection_report(det: Detection) -> dict[str, Any]:
     }
 
 
+def _add_rescan(rep: dict[str, Any], first: Detection | None, rs: Rescan | None) -> None:
+    """Before/after figures of the close-up re-scan: per seam ``rescan`` and ``error_mm_before``, and at the top
+    ``rescan`` (counts, robot time) and ``summary_before_rescan``."""
+    if rs is None or first is None:
+        rep["rescan"] = None
+        return
+    by_id = {r.id: r for r in rs.seams}
+    for entry in rep["seams"]:
+        r = by_id.get(entry["id"])
+        if r is None:
+            continue
+        before = first.metrics.get(entry["id"])
+        if before is not None:
+            entry["error_mm_before"] = {
+                "paper_me": _r(before.paper_me_mm, 4),
+                "endpoint": _r(before.endpoint_mm, 4),
+                "lateral": _r(before.lateral_mm, 4),
+            }
+        entry["rescan"] = {
+            "used": r.used,
+            "weight": _r(r.weight, 3),
+            "reason": r.reason,
+            "confidence_before": _r(r.before.confidence, 4),
+            "view_distance_m": _r(r.viewpoint.distance_m, 4) if r.viewpoint is not None else None,
+            "points": r.points,
+        }
+    s = first.summary
+    rep["summary_before_rescan"] = {
+        "found": s.found,
+        "paper_me_mean_mm": _r(s.paper_me_mean_mm, 4),
+        "endpoint_mean_mm": _r(s.endpoint_mean_mm, 4),
+        "lateral_mean_mm": _r(s.lateral_mean_mm, 4),
+    }
+    rep["rescan"] = {
+        "seams": len(rs.seams),
+        "used": sum(r.used for r in rs.seams),
+        "motion_s": _r(rs.motion_s, 3),
+        "returned_to_scan_pose": rs.returned,
+        "note": rs.note,
+    }
+
+
 def _error(e: CellError | None) -> dict[str, Any] | None:
     """The failure that stopped a run early (the seams still say why each was not done), or None."""
     return None if e is None else {"type": type(e).__name__, "message": e.message, "exit_code": e.exit_code}
@@ -119,6 +164,7 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
             entry["tcp_error_mm"] = {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)}
             entry["weld_time_s"] = _r(q.weld_time_s, 3)
             entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
+    _add_rescan(rep, run.first_detection, run.rescan)
     ex = run.execution
     rep["welded"] = sum(w.welded for w in run.seams)
     rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
@@ -131,4 +177,13 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
     rep["violations"] = list(run.violations)
     rep["error"] = _error(run.error)
     rep["timings_s"] = {k: _r(v, 4) for k, v in run.timings.items()}
+    return rep
+
+
+def rescan_report(before: Detection, after: Detection, rs: Rescan) -> dict[str, Any]:
+    """The ``cell rescan`` report: the detection report of the fused estimates, with the figures before."""
+    rep = detection_report(after)
+    only_rescanned = {r.id for r in rs.seams}
+    rep["seams"] = [s for s in rep["seams"] if s["id"] in only_rescanned]
+    _add_rescan(rep, before, rs)
     return rep

@@ -36,6 +36,7 @@ from cell.errors import IKError, PlanError, TimingError
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, readonly, transform_points
 from cell.motion.collision import CollisionChecker
 from cell.motion.ik import solve_ik
+from cell.motion.plan import SeamTask
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.types import CameraIntrinsics, Part
@@ -74,22 +75,15 @@ class ViewOptions:
 
 
 @dataclass(frozen=True)
-class ViewTarget:
-    """What a close-up looks at, in R: the seam's ends (3,) [m] and the weld faces' outward unit normals (3,)."""
-
-    seam_id: str
-    p_start: FloatArray
-    p_end: FloatArray
-    n_a: FloatArray
-    n_b: FloatArray
+class ViewTarget(SeamTask):
+    """What a close-up looks at: a seam task (ends and weld-face normals in R) that has a fillet to look into."""
 
     def __post_init__(self) -> None:
-        for key in ("p_start", "p_end", "n_a", "n_b"):
-            object.__setattr__(self, key, readonly(getattr(self, key)))
-        if float(np.linalg.norm(self.p_end - self.p_start)) < 1e-6:
-            raise ValueError(f"seam {self.seam_id}: a view target needs two distinct end points")
+        super().__post_init__()
+        if self.length < 1e-6:
+            raise ValueError(f"seam {self.id}: a view target needs two distinct end points")
         if float(np.linalg.norm(self.n_a + self.n_b)) < 1e-6:
-            raise ValueError(f"seam {self.seam_id}: the weld faces are parallel, there is no fillet to look into")
+            raise ValueError(f"seam {self.id}: the weld faces are parallel, there is no fillet to look into")
 
     @property
     def mid(self) -> FloatArray:
@@ -333,7 +327,7 @@ def plan_view(
     cands = view_candidates(target, intrinsics, torch_C, parts, table_z, o)
     if not cands:
         raise PlanError(
-            f"seam {target.seam_id}: no close-up view sees the seam and both faces (in the image, clear of the "
+            f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "
             f"torch, incidence <= {o.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m"
         )
     why: dict[str, int] = {}
@@ -356,9 +350,9 @@ def plan_view(
                 continue
             X_RC = model.fk(q, o.camera_frame)
             dist = float(np.linalg.norm(X_RC[:3, 3] - target.mid))
-            return Viewpoint(target.seam_id, X_RC, q, move, dist, c.incidence, c.tilt, c.slant, c.roll, tried, via)
+            return Viewpoint(target.id, X_RC, q, move, dist, c.incidence, c.tilt, c.slant, c.roll, tried, via)
     summary = ", ".join(f"{n} {r}" for r, n in why.items())
-    raise PlanError(f"seam {target.seam_id}: none of {tried} close-up views works ({summary})")
+    raise PlanError(f"seam {target.id}: none of {tried} close-up views works ({summary})")
 
 
 def _ik(

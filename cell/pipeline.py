@@ -75,8 +75,9 @@ class Detection:
 
     @property
     def complete(self) -> bool:
-        """Every seam that can be seen was found."""
-        return all(e.status is not SeamStatus.NOT_FOUND for e in self.estimates)
+        """Every seam that can be seen was found, with every camera working (a lost camera is a degraded run)."""
+        undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
+        return not self.lost_cameras and all(e.status not in undone for e in self.estimates)
 
 
 def capture(
@@ -308,7 +309,8 @@ class WeldRun:
             if e.status is not SeamStatus.NOT_VISIBLE
         ]
         executed = self.execution is not None
-        return self.error is None and all(w.welded if executed else w.planned for w in vis)
+        done = all(w.welded if executed else w.planned for w in vis)
+        return self.error is None and self.detection.complete and done
 
 
 def plan_for(
@@ -384,7 +386,7 @@ def _seam_welds(
             out.append(SeamWeld(est.id, False, False, est.reason))  # e.g. against the table: needs a flip
             continue
         if est.status is not SeamStatus.FOUND:
-            out.append(SeamWeld(est.id, False, False, f"not located: {est.reason}"))
+            out.append(SeamWeld(est.id, False, False, f"not located ({est.status.value}): {est.reason}"))
             continue
         if est.confidence < sc.rescan.weld_min_confidence:
             why = f"low_confidence: {est.confidence:.2f} < {sc.rescan.weld_min_confidence:.2f} after the re-scan"

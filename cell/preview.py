@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from cell.pipeline import WeldRun
 
 MM = 1000.0  # [mm/m]
-STATUS_COLOURS = {"found": "#2ca02c", "not_found": "#d62728", "not_visible": "#ff7f0e"}
+STATUS_COLOURS = {"found": "#2ca02c", "not_found": "#d62728", "not_visible": "#ff7f0e", "occluded": "#9467bd"}
 TRUTH_COLOUR = "#000000"
 PATH_COLOUR = "#17becf"
 BOX_COLOUR = "#555555"

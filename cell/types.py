@@ -228,8 +228,9 @@ class SeamStatus(enum.StrEnum):
     """What became of a seam."""
 
     FOUND = "found"
-    NOT_VISIBLE = "not_visible"  # no camera can see it (underside, occluded): flip or re-scan
+    NOT_VISIBLE = "not_visible"  # no camera can see it by design (against the table): flip the part
     NOT_FOUND = "not_found"  # visible, but the data does not support a seam there
+    OCCLUDED = "occluded"  # visible by design, but something the map does not know is in the way: clear it
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ Map (for the pipeline, after :func:`cell.perception.align.align_map`):
   cloud covers; a part with almost none while the others are well covered is not on the table (its seams are
   NOT_FOUND, never invented); parts half covered mean the map lies in the wrong place (AlignmentError).
 
-Seams (for the pipeline, after the locator): :func:`screen` turns a found seam into NOT_FOUND / NOT_VISIBLE,
+Seams (for the pipeline, after the locator): :func:`screen` turns a found seam into NOT_FOUND / OCCLUDED,
 with the reason, when its part is missing, when an object the map does not know lies over it
 (:func:`foreign_points`), or when the locator itself had almost no confidence in it.
 """
@@ -381,7 +381,7 @@ def screen(
 
     missing : part name -> reason (from :func:`check_parts_seen`): every seam of such a part is NOT_FOUND,
     whatever the locator or the visibility check said. A seam (found or not) with at least ``min_foreign``
-    foreign points near it (map seam when not found) is NOT_VISIBLE: occluded. A found seam with confidence
+    foreign points near it (map seam when not found) is OCCLUDED. A found seam with confidence
     below ``min_confidence`` is NOT_FOUND.
     """
     o = options if options is not None else ScreenOptions()
@@ -402,7 +402,7 @@ def screen(
             out.append(
                 SeamEstimate(
                     est.id,
-                    SeamStatus.NOT_VISIBLE,
+                    SeamStatus.OCCLUDED,
                     f"occluded: {n} points of an object the map does not know lie within "
                     f"{o.radius_m * 1000:.0f} mm of the seam (a clamp, a cable?): clear it and re-scan",
                 )

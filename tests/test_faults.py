@@ -73,21 +73,15 @@ def assert_no_wrong_seam(o: Outcome) -> None:
 
 UNDERSIDE = {"POST_L>TOP_RAIL:-z", "POST_R>TOP_RAIL:-z", "BOTTOM_RAIL>POST_L:-z", "BOTTOM_RAIL>POST_R:-z"}
 
-# With a fixed camera gone, the weld face that only it saw is placed by ours from the edge of the top face and
-# lands ~3 mm off (cell/seams/ours.py, _face_from_edge): strict xfail until the locator refuses such a face.
-EDGE_FACE_BUG = pytest.mark.xfail(
-    strict=True, reason="ours.py places a face only the lost camera saw from an edge, ~3 mm off (see report)"
-)
-
 
 @pytest.mark.parametrize(
     ("name", "camera", "why"),
     [
-        pytest.param("faults/camera-dead", "cam_left", "no usable image", marks=EDGE_FACE_BUG),
-        pytest.param("faults/camera-random", "cam_right", "implausible image", marks=EDGE_FACE_BUG),
-        pytest.param("faults/camera-frozen", "cam_left", "stuck or frozen", marks=EDGE_FACE_BUG),
+        ("faults/camera-dead", "cam_left", "no usable image"),
+        ("faults/camera-random", "cam_right", "implausible image"),
+        ("faults/camera-frozen", "cam_left", "stuck or frozen"),
         ("faults/camera-salt", "eye_in_hand", "implausible image"),
-        pytest.param("faults/camera-bumped", "cam_right", "disagrees with the other cameras", marks=EDGE_FACE_BUG),
+        ("faults/camera-bumped", "cam_right", "disagrees with the other cameras"),
     ],
 )
 def test_a_broken_camera_is_dropped_with_its_reason_and_the_rest_find_the_seams(

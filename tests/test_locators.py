@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from cell.geometry import FloatArray, invert, look_at, make_pose, rot_x, rot_z, transform_points
+from cell.seams import _fit
 from cell.seams.base import Joint, SeamScene
 from cell.seams.ours import OursLocator, OursOptions
 from cell.seams.ransac import RansacLocator, RansacOptions
@@ -262,6 +263,114 @@ def test_ours_places_an_unseen_face_from_its_edge(scenes: dict) -> None:
     gone = OursLocator().locate(_thinned(hidden, ~rim), seam, np.random.default_rng(0))
     assert gone.status is SeamStatus.NOT_FOUND
     assert "face A +z" in gone.reason and "edge" in gone.reason
+
+
+def _scene_with(boxes: dict[str, Box], opts: Render, seed: int = 0) -> tuple[SeamScene, dict]:
+    """Like :func:`make_scene` (axis-aligned case) with other as-built boxes; the map stays NOMINAL."""
+    X = CASES["axis-aligned"][0]
+    dense = render(boxes, X, opts, np.random.default_rng(seed))
+    parts = tuple(Part(k, b.transformed(X)) for k, b in NOMINAL.items())
+    nominal = {k: b.transformed(X) for k, b in NOMINAL.items()}
+    seams = tuple(MapSeam(j, *seam_of(nominal, JOINTS[j])) for j in JOINTS)
+    truth = {j: seam_of({k: b.transformed(X) for k, b in boxes.items()}, JOINTS[j]) for j in JOINTS}
+    weldmap = WeldMap(parts, seams, "mm", "synthetic", frame="R")
+    return SeamScene(dense, dense, weldmap, JOINTS, float(X[2, 3])), truth
+
+
+def _a_taller(dz: float) -> dict[str, Box]:
+    a = AS_BUILT["A"]
+    lo, hi = a.center - a.size / 2.0, a.center + a.size / 2.0 + np.array([0.0, 0.0, dz])
+    return {"A": _box(lo.tolist(), hi.tolist()), "B": AS_BUILT["B"]}
+
+
+def test_ours_places_an_unseen_face_whose_edge_lies_beyond_the_map_tolerance() -> None:
+    """Regression: A 8.7 mm taller than the map (tolerance 6 mm), its top unseen. The edge was searched only
+    within the tolerance, where the selected points stopped, and the face landed ~3 mm off at the usual
+    confidence (faults/camera-dead, POST_L's -x face)."""
+    scene, truth = _scene_with(_a_taller(0.008), Render(hide_top_of="A"))
+    seam = scene.weldmap.seam(TOP)
+    est, err = OursLocator().locate_with_errors(scene, seam, np.random.default_rng(0))
+    assert est.status is SeamStatus.FOUND, est.reason
+    assert "face A +z from the edge of" in est.reason
+    lat, _ = errors(est.p_start, est.p_end, truth[TOP])
+    assert lat < 0.5e-3 and lat < 3.0 * err.lateral_m, (lat, err)
+
+
+@pytest.mark.parametrize(
+    ("boxes", "render_opts", "why"),
+    [
+        (_a_taller(0.014), Render(hide_top_of="A"), "lies at the limit of the 12 mm searched"),
+        (AS_BUILT, Render(hide_top_of="A", sigma_m=0.006), "is blurred over 2.5 mm"),
+    ],
+    ids=["edge beyond the search", "edge seen blurred"],
+)
+def test_ours_refuses_an_unseen_face_whose_edge_is_not_defined(
+    boxes: dict[str, Box], render_opts: Render, why: str
+) -> None:
+    scene, _ = _scene_with(boxes, render_opts)
+    est = OursLocator().locate(scene, scene.weldmap.seam(TOP), np.random.default_rng(0))
+    assert est.status is SeamStatus.NOT_FOUND
+    assert "face A +z is seen by no usable camera" in est.reason
+    assert "its edge is not defined well enough" in est.reason and why in est.reason, est.reason
+
+
+def test_ours_edge_placed_face_carries_its_edge_standard_error(scenes: dict) -> None:
+    scene, truth = scenes["axis-aligned"]
+    seam = scene.weldmap.seam(TOP)
+    full, e_full = OursLocator().locate_with_errors(scene, seam, np.random.default_rng(0))
+    hidden, _ = make_scene(CASES["axis-aligned"][0], Render(hide_top_of="A"), seed=0)
+    est, e_edge = OursLocator().locate_with_errors(hidden, seam, np.random.default_rng(0))
+    assert est.status is SeamStatus.FOUND and full.status is SeamStatus.FOUND
+    # The edge defines the face far less well than its own points do: a larger error, a lower confidence.
+    assert e_edge.face_a_m > 3.0 * e_full.face_a_m and e_edge.lateral_m > 3.0 * e_full.lateral_m
+    assert np.isclose(e_edge.face_b_m, e_full.face_b_m, rtol=0.5)
+    assert est.confidence < 0.5 * full.confidence
+    lat, _ = errors(est.p_start, est.p_end, truth[TOP])
+    assert lat < 3.0 * e_edge.lateral_m, (lat, e_edge.lateral_m)
+    assert f"+-{1000 * e_edge.face_a_m:.2f} mm" in est.reason
+    gone = OursLocator().locate_with_errors(hidden, hidden.weldmap.seam(TOP), np.random.default_rng(0))
+    assert gone[1] == e_edge  # deterministic
+
+
+def test_ours_takes_no_end_where_the_cloud_stops(scenes: dict) -> None:
+    """A's +x end beyond the workspace's crop: its top's points run to the crop, which is not the part's end
+    (was: a short seam ending at the crop)."""
+    scene, _ = scenes["axis-aligned"]
+    seam = scene.weldmap.seam(TOP)
+    x_cut = float(CASES["axis-aligned"][0][0, 3]) + 0.02  # through A (x 0.262..0.342 m)
+    cut = _thinned(scene, scene.dense.points[:, 0] < x_cut)
+    est = OursLocator().locate(cut, seam, np.random.default_rng(0))
+    assert est.status is SeamStatus.NOT_FOUND
+    assert "the seam's end is not seen" in est.reason and "workspace" in est.reason, est.reason
+    # Given the workspace, the same; a workspace that the cloud does not reach is not a cut.
+    lo, hi = np.array([-1.0, -1.0, -1.0]), np.array([x_cut, 1.0, 2.0])
+    ws = Box(make_pose(p=(lo + hi) / 2.0), hi - lo)
+    est = OursLocator(OursOptions(workspace_R=ws)).locate(cut, seam, np.random.default_rng(0))
+    assert est.status is SeamStatus.NOT_FOUND and "workspace" in est.reason
+    hi_wide = np.array([x_cut + 0.2, 1.0, 2.0])
+    wide = Box(make_pose(p=(lo + hi_wide) / 2.0), hi_wide - lo)
+    thin = OursLocator(OursOptions(workspace_R=wide)).locate(cut, seam, np.random.default_rng(0))
+    assert thin.status is not SeamStatus.NOT_FOUND or "workspace" not in thin.reason
+
+
+def test_edge_fit_finds_a_blurred_edge_and_flags_a_cut_off() -> None:
+    rng = np.random.default_rng(4)
+    s = rng.uniform(-0.03, 0.0021, 3000) + 0.0005 * rng.standard_normal(3000)
+    f = _fit.edge_fit(s, -0.024, 0.0235, -0.012, 0.012)
+    assert f.ok and abs(f.b - 0.0021) < 3.0 * f.se + 1e-4 and f.blur <= 1e-3 and f.n_edge > 50
+    # The same points cut off at 1 mm (a crop or a selection) inside a search that reaches 2 mm: an edge at the
+    # cut would be wrong; it is flagged when the window ends there.
+    cut = s[s < 0.001]
+    assert _fit.edge_fit(cut, -0.024, 0.001, -0.012, 0.012).at_limit
+    # Searched only up to 0.5 mm: the density does not end inside the search.
+    assert _fit.edge_fit(s, -0.024, 0.0235, -0.012, 0.0005).at_limit
+
+
+def test_line_box_span() -> None:
+    box = Box(make_pose(rot_z(np.radians(90.0)), (1.0, 0.0, 0.0)), np.array([2.0, 4.0, 6.0]))
+    s_in, s_out = _fit.line_box_span(np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)
+    assert np.isclose(s_in, -2.0) and np.isclose(s_out, 2.0)  # the box's y (4 m) lies along R's x
+    assert _fit.line_box_span(np.array([1.0, 5.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)[0] == np.inf
 
 
 def _voxel_cloud(cloud: Cloud, voxel: float) -> Cloud:

@@ -12,12 +12,14 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import cKDTree
 
-from cell.geometry import FloatArray
+from cell.geometry import FloatArray, make_pose
 from cell.seams.base import SeamScene
+from cell.types import Box
 
 _TREE_KEY = "cell.seams._fit.dense_tree"
 _SPACING_KEY = "cell.seams._fit.dense_spacing"
 _GRID_KEY = "cell.seams._fit.dense_grid"
+_BOX_KEY = "cell.seams._fit.cloud_box"
 _TUKEY_C = 4.685  # biweight tuning constant: 95 % efficiency under Gaussian noise
 _MAD_TO_SIGMA = 1.4826
 
@@ -351,52 +353,149 @@ def cdf_extent(s: FloatArray, q_lo: float = 0.15, q_hi: float = 0.85) -> tuple[f
     return float(a), float(b), se
 
 
+@dataclass(frozen=True)
+class EdgeFit:
+    """Result of :func:`edge_fit`: where a locally uniform density sampled along s ends, and how well the sample
+    defines it.
+
+    b : the edge [m] (NaN when the window holds fewer than 5 points).
+    se : its standard error from the curvature of the profile likelihood [m] (statistical only; inf when the
+        likelihood has no interior maximum).
+    blur : the Gaussian blur of the best fit [m] (the noise across the edge: depth noise seen along the
+        surface, which grows with the incidence).
+    n_edge : points within ``max(3 blur, 2 mm)`` inside the edge (how many points define it).
+    strays : density of the points beyond ``b + 3 blur`` relative to the density inside the edge (flying
+        pixels, a second surface); 0 when no room is left beyond.
+    pitch : mean spacing of the points along s inside the edge, ``1 / density`` [m] (with the edge's length,
+        the caller turns it into a point pitch on the surface).
+    at_limit : the edge lies within a coarse step (``5 step``) of the searched range's ends, or within ``2 blur``
+        of the window's upper end: the sample's own cut-off (a crop, a selection), not an edge.
+    """
+
+    b: float
+    se: float
+    blur: float
+    n_edge: int
+    strays: float
+    pitch: float
+    at_limit: bool
+
+    @property
+    def ok(self) -> bool:
+        """A maximum inside the searched range with a finite standard error."""
+        return bool(np.isfinite(self.b) and np.isfinite(self.se) and not self.at_limit)
+
+
+EDGE_BLURS = (2e-4, 5e-4, 1e-3, 1.5e-3, 2.5e-3)  # [m]
+
+
+def edge_fit(
+    s: FloatArray,
+    lo: float,
+    hi: float,
+    b_lo: float,
+    b_hi: float,
+    step: float = 1e-4,
+    blurs: tuple[float, ...] = EDGE_BLURS,
+    stray: float = 0.01,
+    max_points: int = 400,
+) -> EdgeFit:
+    """Maximum-likelihood upper edge b [m] of a locally uniform density sampled at s (n,) blurred by Gaussian
+    noise, searched in [b_lo, b_hi] from the points inside the window (lo, hi) [m]; for a lower edge pass -s
+    (and the negated, swapped bounds) and negate the result.
+
+    The caller must pass every point of the window: a selection that stops inside it is a cut-off that looks
+    like an edge (:attr:`EdgeFit.at_limit` flags an edge found there). Within the window the density is
+    proportional to Phi((b - s) / sigma) (plus a small ``stray`` floor for points far beyond the edge),
+    normalised over the window, so neither the density nor the count needs to be known. b is searched on a grid
+    of ``step`` (coarse to fine), the blur sigma over ``blurs``; the standard error comes from the curvature of
+    the profile log-likelihood. Above ``2 max_points`` points in the window, an even stride of the sorted
+    sample is used for the likelihood (the counts of :class:`EdgeFit` use them all).
+    """
+    from scipy.special import ndtr
+
+    nan = float("nan")
+    x_all = np.sort(s[(s > lo) & (s < hi)])
+    if len(x_all) < 5:
+        return EdgeFit(nan, float("inf"), nan, len(x_all), 0.0, nan, True)
+    x = x_all[:: len(x_all) // max_points] if len(x_all) > 2 * max_points else x_all
+    sig = np.asarray(blurs, np.float64)
+
+    def profile(b: FloatArray) -> FloatArray:
+        """Log-likelihood (len(blurs), m) of the edges b (m,) for each blur."""
+        norm = len(x) * np.log((b - lo) + stray * (hi - lo))
+        z = (b[None, :, None] - x[None, None, :]) / sig[:, None, None]
+        return np.asarray(np.log(ndtr(z) + stray).sum(axis=2) - norm[None, :], np.float64)
+
+    # Coarse to fine: a grid of 5 steps over [b_lo, b_hi], then of one step around the coarse best.
+    coarse = np.arange(b_lo, b_hi + 2.5 * step, 5.0 * step)
+    centre = float(coarse[int(np.argmax(profile(np.asarray(coarse, np.float64)).max(axis=0)))])
+    b = np.asarray(centre + step * np.arange(-6, 7), np.float64)  # (13,)
+    ll = profile(b)
+    best = ll.max(axis=0)
+    i = int(np.argmax(best))
+    pos, se = float(b[i]), float("inf")
+    if 0 < i < len(b) - 1:
+        c2 = best[i - 1] - 2.0 * best[i] + best[i + 1]
+        if c2 < 0.0:
+            pos += float(0.5 * (best[i - 1] - best[i + 1]) / c2) * step
+            se = float(step / np.sqrt(-c2))
+    blur = float(sig[int(np.argmax(ll[:, i]))])
+    inside = max(3.0 * blur, 0.002)
+    n_edge = int(np.count_nonzero((x_all > pos - inside) & (x_all <= pos)))
+    core = x_all[x_all < pos - 3.0 * blur]
+    density = len(core) / max(pos - 3.0 * blur - lo, step)  # [1/m]
+    room = hi - (pos + 3.0 * blur)
+    beyond = int(np.count_nonzero(x_all > pos + 3.0 * blur))
+    strays = beyond / (density * room) if room > step and density > 0.0 else 0.0
+    pitch = 1.0 / density if density > 0.0 else float("inf")
+    at_limit = pos - b_lo < 5.0 * step or b_hi - pos < 5.0 * step or hi - pos < 2.0 * blur
+    return EdgeFit(pos, se, blur, n_edge, float(strays), float(pitch), bool(at_limit))
+
+
 def edge_ml(
     s: FloatArray,
     guess: float,
     inner: float = 0.01,
     search: float = 0.003,
     step: float = 1e-4,
-    blurs: tuple[float, ...] = (2e-4, 5e-4, 1e-3, 1.5e-3, 2.5e-3),
+    blurs: tuple[float, ...] = EDGE_BLURS,
     stray: float = 0.01,
     max_points: int = 400,
 ) -> tuple[float, float]:
-    """Maximum-likelihood upper edge b [m] of a locally uniform density sampled at s (n,) blurred by Gaussian
-    noise, and its standard error [m]; for a lower edge pass -s and -guess, and negate the result.
-
-    Only the points beyond ``guess - inner`` are used. There the density is proportional to Phi((b - s) /
-    sigma) (plus a small ``stray`` floor for points far beyond the edge), normalised over the window, so
-    neither the density nor the count needs to be known. b is searched on a grid of ``step`` within ``guess +-
-    search``, the blur sigma over ``blurs``; the standard error comes from the curvature of the profile
-    log-likelihood. Above ``2 max_points`` points in the window, an even stride of the sorted sample is used.
-    """
-    from scipy.special import ndtr
-
-    lo, hi = guess - inner, guess + inner
-    x = s[(s > lo) & (s < hi)]
-    if len(x) < 5:
+    """:func:`edge_fit` of the points within ``guess +- inner`` [m], the edge searched within ``guess +-
+    search`` [m]: (edge [m], its standard error [m]); inf when the likelihood has no interior maximum."""
+    f = edge_fit(s, guess - inner, guess + inner, guess - search, guess + search, step, blurs, stray, max_points)
+    if not np.isfinite(f.b):
         return guess, float("inf")
-    if len(x) > 2 * max_points:  # an even stride keeps the shape of the sample
-        x = np.sort(x)[:: len(x) // max_points]
+    return f.b, f.se
 
-    def profile(b: FloatArray) -> FloatArray:
-        """Profile log-likelihood (m,) of the edges b (m,), maximised over the blurs."""
-        out = np.full(len(b), -np.inf)
-        norm = len(x) * np.log((b - lo) + stray * (hi - lo))
-        for sig in blurs:
-            ll = np.log(ndtr((b[:, None] - x[None, :]) / sig) + stray).sum(axis=1) - norm
-            out = np.maximum(out, ll)
-        return out
 
-    # Coarse to fine: a grid of 5 steps over +-search, then of one step around the coarse best.
-    coarse = np.arange(guess - search, guess + search + 2.5 * step, 5.0 * step)
-    centre = float(coarse[int(np.argmax(profile(np.asarray(coarse, np.float64))))])
-    b = np.asarray(centre + step * np.arange(-6, 7), np.float64)  # (13,)
-    best = profile(b)
-    i = int(np.argmax(best))
-    if 0 < i < len(b) - 1:
-        c2 = best[i - 1] - 2.0 * best[i] + best[i + 1]
-        off = 0.5 * (best[i - 1] - best[i + 1]) / c2 if c2 < 0.0 else 0.0
-        se = float(step / np.sqrt(-c2)) if c2 < 0.0 else float("inf")
-        return float(b[i] + off * step), se
-    return float(b[i]), float("inf")
+def line_box_span(p0: FloatArray, t: FloatArray, box: Box) -> tuple[float, float]:
+    """Parameters (s_in, s_out) [m] where the line p0 + s t (3,) (frame of ``box``) enters and leaves ``box``;
+    (inf, -inf) when it misses it."""
+    R, c = box.X_AB[:3, :3], box.center
+    o, d = R.T @ (np.asarray(p0, float) - c), R.T @ np.asarray(t, float)
+    h = 0.5 * np.asarray(box.size, float)
+    s_in, s_out = -np.inf, np.inf
+    for k in range(3):
+        if abs(d[k]) < 1e-12:
+            if abs(o[k]) > h[k]:
+                return float("inf"), float("-inf")
+            continue
+        a, b = (-h[k] - o[k]) / d[k], (h[k] - o[k]) / d[k]
+        s_in, s_out = max(s_in, min(a, b)), min(s_out, max(a, b))
+    return (float(s_in), float(s_out)) if s_in <= s_out else (float("inf"), float("-inf"))
+
+
+def cloud_box(scene: SeamScene) -> Box:
+    """The bounds of ``scene.dense`` along the axes of R (a box in R), cached per scene: where a passthrough
+    crop of the workspace cut the cloud, when the workspace is axis-aligned in R."""
+    box = scene.cache.get(_BOX_KEY)
+    if box is None:
+        P = scene.dense.points
+        lo = P.min(axis=0) if len(P) else np.zeros(3)
+        hi = P.max(axis=0) if len(P) else np.ones(3)
+        box = Box(make_pose(p=0.5 * (lo + hi)), np.maximum(hi - lo, 1e-9))
+        scene.cache[_BOX_KEY] = box
+    return box

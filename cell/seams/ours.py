@@ -16,14 +16,21 @@ Method (general: no assumption that a seam runs along x, y or z):
    ``passes`` passes: the first from the map with wide gates, the others with gates and bands from the
    measured noise and the ends found.
 4. A weld face no camera sees (too oblique, occluded) is placed from the edge where an adjacent face of the
-   same part ends: the extent of that face's points across the edge (a blurred-step likelihood). With neither
-   the face nor such an edge seen, the seam is NOT_FOUND naming the face.
+   same part ends: the extent of that face's points across the edge (a blurred-step likelihood), searched as
+   far from the map as a fitted face may drift, each camera's edge on its own. A camera's edge counts only
+   when enough points define it, it is not blurred beyond the likelihood's widest blur (grazing incidence),
+   few points lie beyond it (flying pixels), and it is neither at the searched range's limit nor where the
+   cloud stops (the sample's own cut-off, not an edge). Its standard error: the likelihood's and the sampling
+   pitch of the face (``edge_pitch_factor``); the cameras' edges are combined by inverse variance, the error
+   inflated when they disagree beyond it (Birge ratio). With no such edge, the seam is NOT_FOUND naming the
+   face and why.
 5. The seam line is the intersection of the fitted planes. Each end is where the line meets A's side face
    across it, fitted from that face's points when it is seen, the table when A rests on it there, or else the
    extent of face A's support along t (its empirical CDF extrapolated, then refined by the same edge
-   likelihood).
-6. Confidence from the standard errors of the fitted offsets and ends, each face's support and the residual
-   scale; lower when a face was placed from an edge.
+   likelihood). An extent end where the cloud stops (the workspace crop: ``workspace_R``, or the cloud's bounds
+   along R's axes) is not an end: the seam is NOT_FOUND.
+6. Confidence from the standard errors of the fitted offsets (an edge-placed face: its edge's) and ends
+   (:class:`SeamErrors`, :meth:`OursLocator.locate_with_errors`), each face's support and the residual scale.
 """
 
 from __future__ import annotations
@@ -43,7 +50,6 @@ from cell.types import BOX_FACES, Box, MapSeam, SeamEstimate, SeamStatus
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
 _Z = np.array([0.0, 0.0, 1.0])
-_EDGE_CONFIDENCE = 0.5  # confidence factor of a seam one of whose faces was placed from an edge
 
 
 @dataclass(frozen=True)
@@ -66,12 +72,37 @@ class OursOptions:
     max_points: int = 40000  # random subsample of the tube above this
     max_fit_points: int = 1000  # a plane is fitted to an even stride of its support above this
     target_se_m: float = 0.0002  # standard error of the seam's position that still earns full confidence
+    min_edge_points: int = 20  # fewer points just inside an edge: it does not place an unseen face
+    max_edge_strays: float = 0.3  # more density beyond an edge (share of that inside): it places nothing
+    edge_pitch_factor: float = 0.15  # an edge's sampling error, in point pitches on its face [-] (0.29: aligned grid)
+    workspace_R: Box | None = None  # where the cloud was cropped (frame R); None: the cloud's bounds along R's axes
 
     def __post_init__(self) -> None:
-        if self.passes < 1 or self.min_face_points < 3 or self.min_end_points < 3:
-            raise ValueError("ours options need passes >= 1, min_face_points >= 3 and min_end_points >= 3")
+        if self.passes < 1 or self.min_face_points < 3 or self.min_end_points < 3 or self.min_edge_points < 3:
+            raise ValueError(
+                "ours options need passes >= 1, min_face_points >= 3, min_end_points >= 3 and min_edge_points >= 3"
+            )
         if self.tube_radius_m <= self.corner_band_m or self.tilt_prior_deg <= 0.0:
             raise ValueError("ours options need tube_radius_m > corner_band_m and tilt_prior_deg > 0")
+
+
+@dataclass(frozen=True)
+class SeamErrors:
+    """Standard errors [m] of a seam found by :class:`OursLocator` (what its confidence is computed from).
+
+    lateral_m : of the seam line across itself (from the two faces' offsets).
+    start_m, end_m : of the ends along the line.
+    face_a_m, face_b_m : of the offsets of A's and B's weld faces (an edge-placed face: its edge's).
+    """
+
+    lateral_m: float
+    start_m: float
+    end_m: float
+    face_a_m: float
+    face_b_m: float
+
+
+NO_ERRORS = SeamErrors(*(5 * (float("inf"),)))  # a seam not found
 
 
 @dataclass
@@ -86,6 +117,7 @@ class _Face:
     count: int = 0
     source: str = "points"  # or "edge of <face>" (an adjacent face of the same part)
     area: float = 0.0  # area of its support region [m^2] (what a head-on view would fill with points)
+    note: str = ""  # how well an edge placed it (for the reason)
 
 
 @dataclass
@@ -131,6 +163,12 @@ class OursLocator:
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
         """Find ``seam`` (frame R) in ``scene.dense`` (see the module docstring); MapError for a bad joint."""
+        return self.locate_with_errors(scene, seam, rng)[0]
+
+    def locate_with_errors(
+        self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator
+    ) -> tuple[SeamEstimate, SeamErrors]:
+        """:meth:`locate`, and the standard errors behind the estimate's confidence (all inf unless FOUND)."""
         o = self.options
         joint = _joint_of(scene, seam)
         box_a = scene.weldmap.part(joint.abutting).box
@@ -146,7 +184,7 @@ class OursLocator:
                 f"{joint.face_receiving} are parallel; a joint needs two faces that meet in a line"
             ) from None
         if _against_table(n_a, n_b, seam, scene.table_z, o.map_tolerance_m):
-            return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason="the seam lies against the table")
+            return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, "the seam lies against the table"), NO_ERRORS
 
         pts = self._points(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng)
         P, cam = pts.P, pts.cam
@@ -191,12 +229,15 @@ class OursLocator:
                     face.se *= np.sqrt(len(fit_sel) / count)  # the stride stands for all the support
                     face.count = count
                     continue
-                if first and self._face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng):
-                    continue
+                why = "no edge of it is seen either: not seen or not there"
+                if first:
+                    why = self._face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng)
+                    if not why:
+                        continue
                 return _not_found(
                     seam.id,
-                    f"face {face.name} has {count} points near the seam (needs {o.min_face_points}) and no "
-                    "edge of it is seen either: not seen or not there",
+                    f"face {face.name} is seen by no usable camera ({count} points near the seam, needs "
+                    f"{o.min_face_points}) and {why}",
                 )
             # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
             face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
@@ -218,9 +259,18 @@ class OursLocator:
                 seam.id,
                 f"seam length {length * 1000:.1f} mm found, the map says {(s_map[1] - s_map[0]) * 1000:.1f} mm",
             )
-        conf = self._confidence(face_a, face_b, ends, _fit.dense_spacing(scene) / np.sqrt(pts.kept))
-        via = [f"face {f.name} from the {f.source}" for f in (face_a, face_b) if f.source != "points"]
-        return SeamEstimate(
+        crop = self._crop_box(scene)
+        for k, end in enumerate(ends):
+            if end.source == "extent" and self._at_cut(crop, p0 + end.s * t, t if k == 1 else -t, 0.0):
+                return _not_found(
+                    seam.id,
+                    f"the seam's {('start', 'end')[k]} is not seen: face {face_a.name}'s points run to where the "
+                    "cloud stops (the workspace's boundary): the part reaches out of the workspace",
+                )
+        errors = _errors_of(face_a, face_b, ends)
+        conf = self._confidence(face_a, face_b, errors, _fit.dense_spacing(scene) / np.sqrt(pts.kept))
+        via = [f"face {f.name} from the {f.source} ({f.note})" for f in (face_a, face_b) if f.source != "points"]
+        estimate = SeamEstimate(
             id=seam.id,
             status=SeamStatus.FOUND,
             reason="; ".join([f"ends from {ends[0].source} / {ends[1].source}", *via]),
@@ -228,6 +278,7 @@ class OursLocator:
             p_end=p0 + ends[1].s * t,
             confidence=conf,
         )
+        return estimate, errors
 
     # -- steps ------------------------------------------------------------------------------------------
 
@@ -317,14 +368,20 @@ class OursLocator:
         joint: Joint,
         away: Callable[[FloatArray], BoolArray],
         rng: np.random.Generator,
-    ) -> bool:
+    ) -> str:
         """Place an unseen ``face`` of ``box`` from the edge where an adjacent face of the same part, seen,
-        ends across it (the stretch of that edge alongside ``seam``); False when no adjacent face shows its
-        edge. ``away`` masks the points (n, 3) far enough from the joint's other part."""
+        ends across it (the stretch of that edge alongside ``seam``); ``away`` masks the points (n, 3) far
+        enough from the joint's other part. Returns "" when placed (``face`` updated, its standard error from
+        the edge's own data), else why not (no adjacent face seen, or its edge not defined well enough)."""
         o = self.options
         k_f = "xyz".index(face_name[1])
-        inner = 2.0 * o.map_tolerance_m  # the edge likelihood's window [m]
-        best: tuple[float, float, float, int, str] | None = None
+        search = 2.0 * o.map_tolerance_m  # the edge may lie as far from the map as a fitted face may drift [m]
+        lo = max(-2.0 * search, -float(box.size[k_f]) + o.edge_band_m)  # the window along u, inside ...
+        hi = search + 3.0 * max(_fit.EDGE_BLURS) + o.edge_band_m  # ... and beyond the edge [m]
+        gate = o.map_tolerance_m + 3.0 * o.sensor_sigma_m
+        crop = self._crop_box(scene)
+        best: _EdgePlacement | None = None
+        why: list[str] = []
         for g in BOX_FACES:
             k_g = "xyz".index(g[1])
             if k_g == k_f or g == skip:
@@ -333,37 +390,94 @@ class OursLocator:
             # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
             q0, e = _fit.plane_intersection(face.n, face.d, n_g, d_g, 0.5 * (seam.p_start + seam.p_end))
             s_ends = sorted(float(e @ (p - q0)) for p in (seam.p_start, seam.p_end))
-            lo, hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
-            pts = self._points(scene, q0 + lo * e, q0 + hi * e, 2.0 * inner, 0.0, joint, rng)
+            e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
+            radius = float(np.hypot(max(-lo, hi), gate))
+            pts = self._points(scene, q0 + e_lo * e, q0 + e_hi * e, radius, 0.0, joint, rng)
             P, cam = pts.P, pts.cam
             u = P @ face.n - face.d  # along the face's outward normal: the adjacent face's points end at u = 0
             r_g = P @ n_g - d_g
-            region = pts.ok & away(P) & (u > -float(box.size[k_f]) + o.edge_band_m) & (u < o.map_tolerance_m)
-            region &= _in_face(box, P, (k_f, k_g), o.edge_band_m)
-            sel = region & (np.abs(r_g) < o.map_tolerance_m + 3.0 * o.sensor_sigma_m)
+            region = pts.ok & away(P) & (u > lo) & (u < hi) & _in_face(box, P, (k_f, k_g), o.edge_band_m)
+            sel = region & (np.abs(r_g) < gate)
             if np.count_nonzero(sel) < o.min_face_points:
                 continue
             start = _fit.histogram_mode(r_g[sel], max(0.002, o.sensor_sigma_m))
             fit = _fit.robust_plane_fit(r_g[sel], np.ones((int(np.count_nonzero(sel)), 1)), cam[sel], start)
             on = region & (np.abs(r_g - fit.offset) < 2.5 * max(fit.scale, 1e-4))
-            uu = u[on]
-            if np.count_nonzero(uu > -0.01) < o.min_face_points:
+            if np.count_nonzero(on) < o.min_face_points:
                 continue
-            # The map puts the edge at u = 0, within the tolerance.
-            edge, se = _fit.edge_ml(uu, 0.0, inner=inner, search=o.map_tolerance_m)
-            if not np.isfinite(se):
+            # Each camera's edge on its own (incidence, sampling and calibration differ between cameras), with
+            # its standard error: the likelihood's and the sampling of the surface (points land on a pixel grid:
+            # with the grid nearly parallel to the edge, every row ends at the same phase).
+            uu, cc = u[on], cam[on]
+            along = P[on] @ e
+            cams, counts = np.unique(cc, return_counts=True)
+            per_cam: list[tuple[float, float]] = []
+            faults: list[tuple[int, str]] = []
+            for c, n_c in zip(cams, counts, strict=True):
+                if n_c < o.min_face_points:
+                    continue
+                mine = cc == c
+                edge = _fit.edge_fit(uu[mine], lo, hi, -search, search)
+                b = edge.b if np.isfinite(edge.b) else 0.0
+                fault = self._edge_fault(edge, g, search, self._at_cut(crop, q0 + b * face.n, face.n, edge.blur))
+                if fault:
+                    faults.append((int(n_c), fault))
+                    continue
+                pitch = float(np.sqrt(edge.pitch * max(float(np.ptp(along[mine])), 1e-3)))  # on face g [m]
+                per_cam.append((edge.b, float(np.hypot(edge.se, o.edge_pitch_factor * pitch))))
+            if not per_cam:
+                if faults:
+                    why.append(max(faults)[1])
                 continue
-            density = len(uu) / max(float(np.ptp(uu)), 1e-3)  # [1/m]
-            se = max(se, 2.0 / density)
-            if abs(edge) <= o.map_tolerance_m and (best is None or se < best[1]):
-                best = (edge, se, max(fit.scale, 1e-4), len(uu), g)
+            b_g, se_g = _combine(per_cam)
+            # The face is carried from its edge to the seam: a tilt within the prior moves it by tilt x distance.
+            mid = 0.5 * (seam.p_start + seam.p_end)
+            reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
+            se_g = float(np.hypot(se_g, np.tan(np.radians(o.tilt_prior_deg)) * reach))
+            if best is None or se_g < best.se:
+                best = _EdgePlacement(g, b_g, se_g, max(fit.scale, 1e-4), len(uu), len(per_cam))
         if best is None:
-            return False
-        edge, se, scale, count, g = best
-        face.d += edge
-        face.se, face.scale, face.count = se, scale, count
-        face.source = f"edge of {g}"
-        return True
+            if why:
+                return "its edge is not defined well enough: " + "; ".join(why)
+            return "no edge of it is seen either: not seen or not there"
+        face.d += best.b
+        face.se, face.scale, face.count = best.se, best.scale, best.count
+        face.source = f"edge of {best.g}"
+        face.note = f"+-{1000 * best.se:.2f} mm, {best.cameras} camera{'s' if best.cameras != 1 else ''}"
+        return ""
+
+    def _edge_fault(self, edge: _fit.EdgeFit, g: str, search: float, cut: bool) -> str:
+        """Why the edge of the adjacent face ``g`` does not define the unseen face, or "" when it does."""
+        o = self.options
+        if not np.isfinite(edge.b) or edge.n_edge < o.min_edge_points:
+            return f"the edge of {g} is defined by {edge.n_edge} points (needs {o.min_edge_points})"
+        if cut:
+            return f"the edge of {g} lies where the cloud stops (the workspace's boundary?)"
+        if edge.at_limit or not np.isfinite(edge.se):
+            return (
+                f"the edge of {g} lies at the limit of the {1000 * search:.0f} mm searched about the map "
+                "(no end of the points there: part moved, or the points stop there)"
+            )
+        if edge.blur >= max(_fit.EDGE_BLURS):
+            return f"the edge of {g} is blurred over {1000 * edge.blur:.1f} mm (seen at grazing incidence only)"
+        if edge.strays > o.max_edge_strays:
+            return (
+                f"the edge of {g} has {edge.strays:.0%} of its density beyond it (allowed "
+                f"{o.max_edge_strays:.0%}): flying pixels or another surface"
+            )
+        return ""
+
+    def _crop_box(self, scene: SeamScene) -> Box:
+        """Where the cloud was cropped: the workspace (in R) when the options give it, else the cloud's bounds."""
+        ws = self.options.workspace_R
+        return ws if ws is not None else _fit.cloud_box(scene)
+
+    def _at_cut(self, crop: Box, p: FloatArray, n: FloatArray, blur: float) -> bool:
+        """Whether the boundary of ``crop`` lies within the edge band (and 3 ``blur``) of ``p`` (3,) ahead along
+        ``n`` (3,): where the points stop because the cloud does, not the part."""
+        _, s_out = _fit.line_box_span(p, n, crop)
+        tol = self.options.edge_band_m + 3.0 * (blur if np.isfinite(blur) else 0.0)
+        return bool(np.isfinite(s_out) and abs(s_out) < tol)
 
     def _find_ends(
         self,
@@ -461,15 +575,13 @@ class OursLocator:
         end.source = "side face"
         return True
 
-    def _confidence(self, face_a: _Face, face_b: _Face, ends: list[_End], spacing: float) -> float:
+    def _confidence(self, face_a: _Face, face_b: _Face, errors: SeamErrors, spacing: float) -> float:
         """Confidence in [0, 1] from the standard errors of the line (lateral) and of the ends, the support of
         each face (its points against what a head-on view of its region at the cloud's point ``spacing`` [m]
-        would give; half of that earns full marks) and the residual noise; halved when a face was placed from
-        an edge."""
+        would give; half of that earns full marks) and the residual noise. A face placed from an edge enters by
+        its edge's standard error (see :meth:`_face_from_edge`)."""
         o = self.options
-        sin_ab = float(np.linalg.norm(np.cross(face_a.n, face_b.n)))
-        se_lat = float(np.hypot(face_a.se, face_b.se)) / max(sin_ab, 0.1)
-        se_end = max(ends[0].se, ends[1].se)
+        se_lat, se_end = errors.lateral_m, max(errors.start_m, errors.end_m)
         support = 1.0
         if np.isfinite(spacing) and spacing > 0.0:
             for f in (face_a, face_b):
@@ -482,9 +594,21 @@ class OursLocator:
             / (1.0 + (se_lat / o.target_se_m) ** 2)
             / (1.0 + (se_end / (4.0 * o.target_se_m)) ** 2)
         )
-        if face_a.source != "points" or face_b.source != "points":
-            conf *= _EDGE_CONFIDENCE
         return float(np.clip(conf, 0.0, 1.0))
+
+
+@dataclass(frozen=True)
+class _EdgePlacement:
+    """The best edge found for an unseen face: the adjacent face ``g`` whose edge it is, the edge's offset b
+    along the face's normal from the map [m] and its standard error [m], g's noise scale [m], the points near
+    the edge and how many cameras' edges were combined."""
+
+    g: str
+    b: float
+    se: float
+    scale: float
+    count: int
+    cameras: int
 
 
 @dataclass(frozen=True)
@@ -593,5 +717,25 @@ def _against_table(n_a: FloatArray, n_b: FloatArray, seam: MapSeam, table_z: flo
     return low and min(float(n_a @ _Z), float(n_b @ _Z)) < -0.7
 
 
-def _not_found(seam_id: str, reason: str) -> SeamEstimate:
-    return SeamEstimate(seam_id, SeamStatus.NOT_FOUND, reason=reason)
+def _combine(estimates: list[tuple[float, float]]) -> tuple[float, float]:
+    """Inverse-variance mean of (value, standard error) pairs and its standard error, inflated by the Birge
+    ratio sqrt(chi^2 / (k - 1)) when the values scatter more than their errors say."""
+    v = np.array([e[0] for e in estimates])
+    w = 1.0 / np.square(np.maximum([e[1] for e in estimates], 1e-9))
+    mean = float(w @ v / w.sum())
+    se = float(1.0 / np.sqrt(w.sum()))
+    if len(v) > 1:
+        se *= max(1.0, float(np.sqrt(w @ (v - mean) ** 2 / (len(v) - 1))))
+    return mean, se
+
+
+def _errors_of(face_a: _Face, face_b: _Face, ends: list[_End]) -> SeamErrors:
+    """The seam's standard errors from its faces' offsets and its ends (the line moves by the faces' offsets
+    over the sine of the angle between them)."""
+    sin_ab = float(np.linalg.norm(np.cross(face_a.n, face_b.n)))
+    lateral = float(np.hypot(face_a.se, face_b.se)) / max(sin_ab, 0.1)
+    return SeamErrors(lateral, ends[0].se, ends[1].se, face_a.se, face_b.se)
+
+
+def _not_found(seam_id: str, reason: str) -> tuple[SeamEstimate, SeamErrors]:
+    return SeamEstimate(seam_id, SeamStatus.NOT_FOUND, reason=reason), NO_ERRORS

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from typing import Any, TypeVar
 
+import numpy as np
+
 from cell.errors import ScenarioError
+from cell.geometry import invert, make_pose
 from cell.scenario import Scenario
 from cell.seams.base import SeamLocator
+from cell.types import Box
 
 T = TypeVar("T")
 
@@ -28,7 +33,12 @@ def make_locator(method: str, scenario: Scenario) -> SeamLocator:
     if method == "ours":
         from cell.seams.ours import OursLocator, OursOptions
 
-        return OursLocator(_options(OursOptions, options, method))
+        opts = _options(OursOptions, options, method)
+        # The exact crop, so an end where the cloud is cut off is refused, not reported.
+        ws = scenario.perception.workspace
+        lo, hi = np.array(ws.min_m), np.array(ws.max_m)
+        workspace_R = Box(invert(scenario.X_WR) @ make_pose(p=(lo + hi) / 2.0), hi - lo)
+        return OursLocator(dataclasses.replace(opts, workspace_R=workspace_R))
     raise ScenarioError(f"unknown locator method {method!r}; valid: {', '.join(METHODS)}")
 
 

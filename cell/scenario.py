@@ -182,6 +182,7 @@ class PerceptionSpec(_Model):
     workspace: WorkspaceSpec
     icp_max_correspondence_m: Pos = 0.001  # paper: 1 mm
     icp_iterations: Annotated[int, Field(ge=1, le=1000)] = 50  # paper: 50
+    splice_icp: Literal["paper", "robust"] = "robust"  # paper: point-to-point ICP; robust: point-to-plane, Tukey
     merge_cell_m: Pos = 0.05  # region size for "each region from the camera that sees it best"
     voxel_m: Pos = 0.01  # paper: 1 cm
     align_max_correspondence_m: Pos = 0.02  # map-to-cloud ICP

@@ -54,6 +54,16 @@ class IcpResult:
     rmse_m: float
 
 
+def _criteria(iterations: int) -> Any:
+    """Stop after ``iterations`` or when fitness and RMSE stop changing (relative change 1e-9)."""
+    reg = _o3d().pipelines.registration
+    return reg.ICPConvergenceCriteria(relative_fitness=1e-9, relative_rmse=1e-9, max_iteration=int(iterations))
+
+
+def _result(result: Any) -> IcpResult:
+    return IcpResult(np.array(result.transformation), float(result.fitness), float(result.inlier_rmse))
+
+
 def icp(
     source: npt.ArrayLike,
     target: npt.ArrayLike,
@@ -61,26 +71,49 @@ def icp(
     iterations: int,
     init: FloatArray | None = None,
     target_normals: npt.ArrayLike | None = None,
+    tukey_k_m: float | None = None,
 ) -> IcpResult:
-    """Rigid ICP of ``source`` (n, 3) onto ``target`` (m, 3).
+    """Rigid ICP of ``source`` (n, 3) onto ``target`` (m, 3) (``registration_icp``).
 
-    Point-to-point when ``target_normals`` is None, point-to-plane (with those unit normals (m, 3)) otherwise.
-    ``init`` is the starting X_TS (identity by default). Stops after ``iterations`` or when fitness and RMSE
-    stop changing (relative change 1e-9).
+    Point-to-point when ``target_normals`` is None, point-to-plane (with those unit normals (m, 3)) otherwise;
+    ``tukey_k_m`` [m] (point-to-plane only) weights the residuals with open3d's ``TukeyLoss(k)`` (a residual
+    beyond k weighs nothing). ``init`` is the starting X_TS (identity by default). Stops after ``iterations``
+    or when fitness and RMSE stop changing (relative change 1e-9).
     """
-    o3d = _o3d()
-    reg = o3d.pipelines.registration
-    src = _legacy_cloud(source)
-    tgt = _legacy_cloud(target, target_normals)
-    method = (
-        reg.TransformationEstimationPointToPoint()
-        if target_normals is None
-        else reg.TransformationEstimationPointToPlane()
-    )
-    criteria = reg.ICPConvergenceCriteria(relative_fitness=1e-9, relative_rmse=1e-9, max_iteration=int(iterations))
+    reg = _o3d().pipelines.registration
+    if target_normals is None:
+        if tukey_k_m is not None:
+            raise ValueError("icp: a robust kernel (tukey_k_m) needs target normals (point-to-plane)")
+        method = reg.TransformationEstimationPointToPoint()
+    elif tukey_k_m is None:
+        method = reg.TransformationEstimationPointToPlane()
+    else:
+        method = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=float(tukey_k_m)))
     X0 = np.eye(4) if init is None else _array(init)
-    result = reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, criteria)
-    return IcpResult(np.array(result.transformation), float(result.fitness), float(result.inlier_rmse))
+    src, tgt = _legacy_cloud(source), _legacy_cloud(target, target_normals)
+    return _result(reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations)))
+
+
+def estimate_normals(points: npt.ArrayLike, radius_m: float, max_neighbours: int) -> FloatArray:
+    """Unit normals (n, 3), unoriented, of a plane fit to each point's neighbours within ``radius_m`` [m] (at
+    most the ``max_neighbours`` nearest): open3d's ``estimate_normals`` with a hybrid KD-tree search."""
+    o3d = _o3d()
+    pc = _legacy_cloud(points)
+    pc.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=float(radius_m), max_nn=int(max_neighbours)))
+    return np.asarray(pc.normals, dtype=np.float64).reshape(-1, 3)
+
+
+def correspondences(
+    source: npt.ArrayLike, target: npt.ArrayLike, max_correspondence_m: float, X_TS: FloatArray | None = None
+) -> npt.NDArray[np.intp]:
+    """(k, 2) index pairs (source, target): each source point moved by X_TS with its nearest target point, for
+    the source points that have one within ``max_correspondence_m`` [m] (open3d's ``evaluate_registration``)."""
+    o3d = _o3d()
+    X = np.eye(4) if X_TS is None else _array(X_TS)
+    r = o3d.pipelines.registration.evaluate_registration(
+        _legacy_cloud(source), _legacy_cloud(target), float(max_correspondence_m), X
+    )
+    return np.asarray(r.correspondence_set, dtype=np.intp).reshape(-1, 2)
 
 
 def evaluate(

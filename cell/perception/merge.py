@@ -21,8 +21,6 @@ z^3 sqrt(cos(theta) / cos(alpha)) / f^2: range ranks a camera worse, an oblique 
 points are fewer but spread less across the face). Incidence is capped at :data:`MAX_INCIDENCE_DEG`, past which
 stereo matching drops pixels.
 
-:func:`direction_classes` groups oriented normals into the scene's dominant surface directions (found from the
-data, seeded with R's axes), which the splice's registration uses.
 """
 
 from __future__ import annotations
@@ -56,41 +54,6 @@ def predicted_noise(
     cos_a = np.clip(np.asarray(cos_off_axis, dtype=np.float64), 1e-3, 1.0)
     f = np.asarray(fx_px, dtype=np.float64)
     return np.asarray(z**3 * np.sqrt(cos_t / cos_a) / (f * f))
-
-
-def direction_classes(
-    normals: FloatArray, max_angle_rad: float = math.radians(25.0), iterations: int = 5, min_share: float = 0.005
-) -> tuple[npt.NDArray[np.intp], FloatArray]:
-    """Group oriented unit normals (n, 3) into the dominant surface directions of the scene.
-
-    A spherical k-means seeded with the six axis directions of the frame (parts of a cell are boxes: their
-    faces take a few directions, which need not be the frame's axes): each direction becomes the mean of the
-    normals within ``max_angle_rad`` of it. Returns (class (n,): index of the nearest direction within
-    ``max_angle_rad``, -1 for none; directions (k, 3) unit), dropping directions that hold fewer than
-    ``min_share`` of the normals.
-    """
-    n_all = np.asarray(normals, dtype=np.float64)
-    n = n_all[:: max(1, len(n_all) // _DIRECTION_SAMPLE)]  # the directions from an even stride: plenty
-    dirs = np.vstack([np.eye(3), -np.eye(3)])
-    cos_max = math.cos(max_angle_rad)
-
-    def nearest(m: FloatArray) -> npt.NDArray[np.intp]:
-        dots = m @ dirs.T
-        label = np.argmax(dots, axis=1)
-        label[np.max(dots, axis=1) < cos_max] = -1
-        return np.asarray(label, np.intp)
-
-    for _ in range(max(1, iterations)):
-        if len(dirs) == 0 or len(n) == 0:
-            break
-        label = nearest(n)
-        sums = np.stack([np.bincount(label + 1, n[:, i], len(dirs) + 1)[1:] for i in range(3)], axis=1)
-        counts = np.bincount(label + 1, minlength=len(dirs) + 1)[1:]
-        keep = counts >= max(1, min_share * len(n))
-        dirs = sums[keep] / np.linalg.norm(sums[keep], axis=1, keepdims=True)
-    if len(dirs) == 0:
-        return np.full(len(n_all), -1, np.intp), np.zeros((0, 3))
-    return nearest(n_all), np.asarray(dirs)
 
 
 def _group(keys: npt.NDArray[np.int64]) -> tuple[npt.NDArray[np.intp], int]:

@@ -1,31 +1,33 @@
 """Splicing the camera clouds into one (paper section 3.3), generalised to 1, 2 or more cameras.
 
 The paper: (1) ICP of camera 1's cloud onto camera 2's, (2) merge the two with priority (each side from the
-camera nearer to it), (3) ICP of the eye-in-hand cloud onto that, (4) merge again. Here: the second fixed
-camera is the reference, the first fixed camera is registered onto it, then every further fixed camera and then
-every eye-in-hand camera onto all the cameras registered before it; the prioritised merge
-(:func:`cell.perception.merge.prioritised_merge`) then makes the paper's cloud, ``Spliced.dense``. The cloud of
-all cameras registered but *not* merged is kept as well (``Spliced.registered``): a locator that weighs each
-camera by its own noise loses nothing to the merge.
+camera nearer to it), (3) ICP of the eye-in-hand cloud onto that, (4) merge again. Here: the eye-in-hand camera
+(calibrated to the robot) is the reference when there is one, else the second fixed camera; then the fixed
+cameras in the paper's order are each registered onto all the cameras registered before them; the prioritised
+merge (:func:`cell.perception.merge.prioritised_merge`) then makes the paper's cloud, ``Spliced.dense``. The
+cloud of all cameras registered but *not* merged is kept as well (``Spliced.registered``): a locator that
+weighs each camera by its own noise loses nothing to the merge.
 
-Registration (:func:`register`). The paper's point-to-point ICP with a 1 mm correspondence distance, on clouds
-with 1-3 mm of depth noise and 1.5-4 mm point spacing, latches onto chance near-coincidences: it "corrects"
-exact extrinsics by tenths of a millimetre and removes only a fraction of a real calibration error. Instead:
+Registration (:func:`register`) is open3d's, through :mod:`cell.perception._open3d`, chosen by
+``PerceptionSpec.splice_icp``:
 
-- each point's normal comes from a plane fit of its own camera's points (:func:`surface_normals`), snapped to
-  one of the scene's dominant surface directions (:func:`direction_classes`): accurate normals from noisy
-  points, and points only ever pair with points of a surface facing the same way;
-- a source point's residual is its distance along that direction from the median of the nearest target points
-  of its class, the neighbours chosen mostly *across* the direction (the normal coordinate is shrunk), so the
-  depth noise does not choose them;
-- Gauss-Newton point-to-plane steps, Tukey-weighted, solved only in the directions the overlap constrains (a
-  view of top faces alone says nothing about a shift along them: such a direction is left as calibrated);
-- the correction is *applied* only when it is significant: its displacement of the overlap exceeds
-  :data:`MIN_SHIFT_M` and its chi-square against a covariance that treats every patch of ``merge_cell_m`` as
-  one independent measurement (edges, flying pixels and shadows bias whole patches, not single points)
-  exceeds :data:`SIGNIFICANCE_CHI2`, and the patch misfit drops by at least :data:`MIN_MISFIT_DROP`. With
-  exact extrinsics nothing is applied; a miscalibration of 0.3-1 mm / 0.03-0.1 deg is taken out in the
-  directions the overlap sees.
+- ``"paper"``: the paper's point-to-point ICP on every point, max correspondence ``icp_max_correspondence_m``
+  (1 mm), ``icp_iterations`` (50). On clouds with 1-3 mm of depth noise and 1.5-4 mm point spacing it latches onto
+  chance near-coincidences: it "corrects" exact extrinsics by tenths of a millimetre and removes only part of
+  a real calibration error.
+- ``"robust"`` (default): point-to-plane ICP with a Tukey kernel, target normals estimated by open3d; the
+  kernel width, correspondence distance and normal radius are derived in one place
+  (:func:`registration_settings`) from the voxel size and the noise measured in the overlap; source and
+  target are thinned to an even stride of at most :data:`_PROBE_POINTS` / :data:`_TARGET_POINTS` points.
+
+A correction's motion along a direction the overlap does not constrain (a view of top faces alone says nothing
+about a shift along them) is dropped: that direction stays as calibrated.
+Either way the correction is *applied* only when it is significant (a test, not a solver): its displacement
+of the overlap exceeds :data:`MIN_SHIFT_M`, its chi-square against a covariance that treats every patch of
+``merge_cell_m`` as one independent measurement (edges, flying pixels and shadows bias whole patches, not
+single points) exceeds :data:`SIGNIFICANCE_CHI2`, and the patch misfit (point-to-plane) drops by at least
+:data:`MIN_MISFIT_DROP`. With exact extrinsics nothing is applied; a miscalibration of 0.3-1 mm / 0.03-0.1 deg
+is taken out.
 """
 
 from __future__ import annotations
@@ -36,11 +38,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
 
 from cell.errors import SensorError
-from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, readonly, transform_points
-from cell.perception.merge import direction_classes, prioritised_merge, surface_normals
+from cell.geometry import FloatArray, invert, make_pose, readonly, transform_points
+from cell.perception import _open3d
+from cell.perception.merge import prioritised_merge, surface_normals
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage
 
@@ -49,15 +52,14 @@ MIN_SHIFT_M = 0.0001  # [m] a correction moving the overlap by less than this (R
 SIGNIFICANCE_CHI2 = 50.0  # a correction is applied only above this chi-square (patch-robust covariance)
 MIN_MISFIT_DROP = 0.05  # ... and only if it lowers the patch misfit by at least this fraction
 _PROBE_POINTS = 20_000  # source points a registration uses (an even stride)
-_TARGET_POINTS = 150_000  # target points a registration searches (an even stride)
-_NEIGHBOURS = 12  # target points whose median is a source point's local surface
-_ACROSS_SHRINK = 0.2  # the normal coordinate's weight in the neighbour search (neighbours chosen in-plane)
-_MIN_NEIGHBOURS = 4  # fewer target points within reach: the source point is not in the overlap
+_TARGET_POINTS = 60_000  # target points a registration searches (an even stride)
 _MIN_OVERLAP = 200  # fewer source points in the overlap: no registration, the calibrated extrinsics stand
-_WEAK_DIRECTION = 0.02  # a direction whose share of the constraint is below this is left as calibrated
-_TUKEY_C = 4.685  # biweight cut-off [robust scales]
-_CONVERGED_M = 2e-6  # [m] a step moving nothing by more than this ends the iteration
-_CLASS_STRIDE_M = 1000.0  # classes are moved this far apart so one KD-tree only pairs points of one class
+_WEAK_DIRECTION = 0.005  # a direction holding less than this share of the constraint is left as calibrated
+_TUKEY_C = 4.685  # biweight cut-off [robust scales] (95 % efficiency on Gaussian residuals)
+_MAD_TO_SIGMA = 1.4826  # median absolute deviation -> standard deviation (Gaussian)
+_NORMAL_RADIUS_VOXELS = 2.0  # target normals from neighbours within this many voxels
+_NORMAL_NEIGHBOURS = 50  # ... at most this many (the nearest)
+_MIN_NOISE_M = 1e-4  # [m] floor of the measured noise (noise-free synthetic clouds)
 
 
 @dataclass(frozen=True)
@@ -65,14 +67,16 @@ class Registration:
     """One splice registration: the cloud of ``source`` onto the registered cloud of the ``target`` cameras.
 
     X_corr : (4, 4) correction applied to the source cloud in R (p_R' = X_corr p_R); identity if not accepted.
-    X_estimated : (4, 4) the correction the registration found, applied or not.
-    overlap : source probe points with target points of the same surface direction within reach.
-    constrained : number of the six rigid degrees of freedom the overlap constrains (the others stay 0).
+    X_estimated : (4, 4) the correction the registration found, applied or not: open3d's ICP result without
+        its motion along directions the overlap does not constrain.
+    overlap : source probe points with a target point within reach (``voxel_m``) at the calibrated extrinsics.
+    constrained : number of the six rigid degrees of freedom the overlap constrains (the chi-square's).
     shift_m : RMS displacement of the overlap by ``X_estimated`` [m].
     chi2 : its chi-square against the patch-robust covariance.
-    misfit_before_m, misfit_m : RMS over patches of the mean point-to-surface residual [m], at the calibrated
+    misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibrated
         extrinsics and after ``X_estimated``.
     accepted : whether the correction was applied (see the module docstring).
+    noise_m : robust standard deviation of the point-to-plane residuals in the overlap [m] (calibrated).
     """
 
     source: str
@@ -86,6 +90,7 @@ class Registration:
     misfit_before_m: float
     misfit_m: float
     accepted: bool
+    noise_m: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "X_corr", readonly(self.X_corr))
@@ -109,61 +114,66 @@ class Spliced:
 
 
 @dataclass(frozen=True)
-class Surfaces:
-    """Points with their surface-direction class: points (n, 3) [m] in R, cls (n,) (-1: none), dirs (k, 3)."""
+class RegistrationSettings:
+    """The distances of one registration [m], all derived in :func:`registration_settings`.
 
-    points: FloatArray
-    cls: npt.NDArray[np.intp]
-    dirs: FloatArray
+    reach_m : correspondence search of the overlap and of the significance test.
+    normal_radius_m : neighbourhood of the target normals (open3d ``estimate_normals``).
+    max_correspondence_m : ICP's max correspondence distance.
+    tukey_k_m : width of the Tukey kernel (robust ICP and the significance test's weights).
+    """
 
-    def search_coords(self, points: FloatArray, cls: npt.NDArray[np.intp]) -> FloatArray:
-        """Coordinates for the same-class neighbour search: per class, two in-plane ones and the normal one
-        shrunk by ``_ACROSS_SHRINK``, classes ``_CLASS_STRIDE_M`` apart."""
-        d = self.dirs[cls]
-        helper = np.where(np.abs(d[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-        e1 = np.cross(d, helper)
-        e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-        e2 = np.cross(d, e1)
-        out = np.empty((len(points), 3))
-        out[:, 0] = np.einsum("ij,ij->i", points, e1) + cls * _CLASS_STRIDE_M
-        out[:, 1] = np.einsum("ij,ij->i", points, e2)
-        out[:, 2] = _ACROSS_SHRINK * np.einsum("ij,ij->i", points, d)
-        return out
+    reach_m: float
+    normal_radius_m: float
+    max_correspondence_m: float
+    tukey_k_m: float
 
 
-def _rigid(delta: FloatArray, centre: FloatArray) -> FloatArray:
-    """(4, 4) small rigid motion: rotation by delta[:3] [rad] about ``centre`` (3,), then shift delta[3:] [m]."""
-    angle = float(np.linalg.norm(delta[:3]))
-    R = axis_angle_to_matrix(delta[:3], angle) if angle > 0.0 else np.eye(3)
-    return make_pose(R, centre - R @ centre + delta[3:])
+def registration_settings(spec: PerceptionSpec, noise_m: float) -> RegistrationSettings:
+    """The one place the registration's distances come from: the voxel size and the measured noise [m].
+
+    noise_m : robust standard deviation of the point-to-plane residuals in the overlap at the calibrated
+    extrinsics (both clouds' noise, and the miscalibration's spread). Points pair within a voxel (an ICP
+    correspondence is a point-to-point distance: it must cover the point spacing and the miscalibration; the
+    kernel, not the distance, rejects the outliers); the Tukey width is :data:`_TUKEY_C` noise deviations. The
+    paper's mode pairs within ``spec.icp_max_correspondence_m`` instead.
+    """
+    return RegistrationSettings(
+        reach_m=spec.voxel_m,
+        normal_radius_m=_NORMAL_RADIUS_VOXELS * spec.voxel_m,
+        max_correspondence_m=spec.icp_max_correspondence_m if spec.splice_icp == "paper" else spec.voxel_m,
+        tukey_k_m=_TUKEY_C * max(noise_m, _MIN_NOISE_M),
+    )
 
 
-def _residuals(
-    probe: FloatArray, cls: npt.NDArray[np.intp], target: Surfaces, tree: cKDTree, reach_m: float
-) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
-    """Signed distance (n,) [m] of each probe point along its class direction from the median of its nearest
-    same-class target points, and whether it has enough of them within reach (the overlap)."""
-    q = target.search_coords(probe, cls)
-    dist, idx = tree.query(q, k=_NEIGHBOURS, distance_upper_bound=reach_m)
-    found = np.isfinite(dist)
-    ok = found.sum(axis=1) >= _MIN_NEIGHBOURS
-    idx = np.where(found, idx, 0)
-    d = target.dirs[cls]
-    w = np.einsum("ikj,ij->ik", target.points[idx], d)  # target points along the source point's direction
-    w = np.where(found, w, np.nan)
-    with np.errstate(all="ignore"):
-        surface = np.nanmedian(np.where(ok[:, None], w, 0.0), axis=1)
-    return np.einsum("ij,ij->i", probe, d) - surface, ok
+def _plane_residuals(
+    probe: FloatArray, target: FloatArray, normals: FloatArray, reach_m: float, X: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Point-to-plane residuals of the probe points moved by X against their nearest target points within reach.
+
+    Returns (moved probe points (k, 3), their target normals (k, 3), signed residuals (k,) [m]).
+    """
+    pairs = _open3d.correspondences(probe, target, reach_m, X)
+    moved = transform_points(X, probe[pairs[:, 0]])
+    n = normals[pairs[:, 1]]
+    return moved, n, np.einsum("ij,ij->i", moved - target[pairs[:, 1]], n)
 
 
-def _patch_keys(points: FloatArray, cls: npt.NDArray[np.intp], patch_m: float) -> npt.NDArray[np.intp]:
-    """(n,) patch index: points of one class in one cube of edge ``patch_m``."""
+def _patch_keys(points: FloatArray, normals: FloatArray, patch_m: float) -> npt.NDArray[np.intp]:
+    """(n,) patch index: points in one cube of edge ``patch_m`` whose normals share an axis direction."""
+    axis = np.argmax(np.abs(normals), axis=1)
+    direction = axis * 2 + (normals[np.arange(len(normals)), axis] < 0.0)
     ijk = np.floor(points / patch_m).astype(np.int64)
     ijk -= ijk.min(axis=0)
     dims = ijk.max(axis=0) + 1
-    key = ((ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]) * 64 + cls
+    key = ((ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]) * 6 + direction
     _, inverse = np.unique(key, return_inverse=True)
     return np.asarray(inverse.reshape(-1), np.intp)
+
+
+def _tukey(r: FloatArray, k_m: float) -> FloatArray:
+    u = r / k_m
+    return np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0)
 
 
 def _patch_misfit(r: FloatArray, w: FloatArray, patch: npt.NDArray[np.intp]) -> float:
@@ -174,90 +184,112 @@ def _patch_misfit(r: FloatArray, w: FloatArray, patch: npt.NDArray[np.intp]) -> 
     return float(np.sqrt(np.sum(sw[used] * mean**2) / np.sum(sw[used]))) if used.any() else math.inf
 
 
-def register(
-    source: FloatArray,
-    source_cls: npt.NDArray[np.intp],
-    target: Surfaces,
-    spec: PerceptionSpec,
-) -> tuple[FloatArray, dict[str, float]]:
-    """Point-to-surface registration of ``source`` (n, 3) [m] in R (classes (n,)) onto ``target``.
+def _constrained(p: FloatArray, n: FloatArray, w: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, float]:
+    """The point-to-plane least-squares problem of points p (k, 3) on planes of normals n (k, 3), weights w (k,).
 
-    Returns the estimated correction X (4, 4) in R (p' = X p) and diagnostics: overlap, constrained, shift_m,
-    chi2, misfit_before_m, misfit_m (see :class:`Registration`). X is the identity when the overlap is too
-    small. Iterates at most ``spec.icp_iterations`` times; neighbours are searched within ``spec.voxel_m``.
+    Coordinates: rotation vector scaled to metres at the points' RMS radius ``lever`` about their centroid,
+    then shift. Returns (J (k, 6), the constrained directions D (6, d) (eigenvectors of the weighted normal
+    matrix holding at least :data:`_WEAK_DIRECTION` of its trace), centroid (3,), lever [m]).
     """
-    use = source_cls >= 0
-    probe, cls = source[use], source_cls[use]
-    stride = max(1, math.ceil(len(probe) / _PROBE_POINTS))
-    probe, cls = probe[::stride], cls[::stride]
-    t_use = np.flatnonzero(target.cls >= 0)
-    t_use = t_use[:: max(1, math.ceil(len(t_use) / _TARGET_POINTS))]
-    sub = Surfaces(target.points[t_use], target.cls[t_use], target.dirs)
-    info = {"overlap": 0.0, "constrained": 0.0, "shift_m": 0.0, "chi2": 0.0}
-    info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
-    if len(probe) < _MIN_OVERLAP or len(sub.points) < _MIN_OVERLAP:
+    centre = p.mean(axis=0)
+    lever = max(float(np.sqrt(np.mean(np.sum((p - centre) ** 2, axis=1)))), 1e-9)
+    J = np.hstack([np.cross(p - centre, n) / lever, n])
+    vals, vecs = np.linalg.eigh((J.T * w) @ J)
+    return J, vecs[:, vals >= _WEAK_DIRECTION * max(float(vals.sum()), 1e-300)], centre, lever
+
+
+def _restricted(X: FloatArray, D: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
+    """X (4, 4), a motion that puts points at ``centre`` (3,), keeping only its part along the directions D (6, d)
+    (coordinates of :func:`_constrained`): a motion along a direction the overlap does not see is arbitrary."""
+    c0 = transform_points(invert(X), centre[None])[0]  # X moves c0 to the centre: X p = R (p - c0) + centre
+    est = np.concatenate([Rotation.from_matrix(X[:3, :3]).as_rotvec() * lever, centre - c0])
+    kept = D @ (D.T @ est)
+    R = Rotation.from_rotvec(kept[:3] / lever).as_matrix()
+    return make_pose(R, c0 + kept[3:] - R @ c0)
+
+
+def significance(
+    probe: FloatArray,
+    target: FloatArray,
+    normals: FloatArray,
+    X_icp: FloatArray,
+    settings: RegistrationSettings,
+    patch_m: float,
+) -> tuple[FloatArray, dict[str, float]]:
+    """The part of the correction X_icp (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3))
+    that the overlap constrains, and how much the data support it (all in R).
+
+    Returns (X (4, 4): X_icp without its motion along directions the overlap does not constrain; diagnostics
+    constrained, shift_m, chi2, misfit_before_m, misfit_m of X, see :class:`Registration`). The chi-square is a
+    sandwich (patch-robust) covariance of a point-to-plane least-squares estimate at X: Tukey-weighted
+    residuals, one score per patch of ``patch_m`` and surface direction, in the constrained directions.
+    """
+    reach, k = settings.reach_m, settings.tukey_k_m
+    info = {"constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "misfit_before_m": math.inf, "misfit_m": math.inf}
+    p0, n0, r0 = _plane_residuals(probe, target, normals, reach, np.eye(4))
+    p, n, r = _plane_residuals(probe, target, normals, reach, X_icp)
+    if len(r0) < _MIN_OVERLAP or len(r) < _MIN_OVERLAP:
         return np.eye(4), info
-    tree = cKDTree(sub.search_coords(sub.points, sub.cls), balanced_tree=False, compact_nodes=False)
-    reach = spec.voxel_m
-    r0, ok0 = _residuals(probe, cls, sub, tree, reach)
-    probe, cls, r0 = probe[ok0], cls[ok0], r0[ok0]
-    info["overlap"] = float(len(probe))
-    if len(probe) < _MIN_OVERLAP:
+    info["misfit_before_m"] = _patch_misfit(r0, _tukey(r0, k), _patch_keys(p0, n0, patch_m))
+    _, D, centre, lever = _constrained(p, n, _tukey(r, k))
+    X = _restricted(X_icp, D, centre, lever)
+    p, n, r = _plane_residuals(probe, target, normals, reach, X)
+    if len(r) < _MIN_OVERLAP:
         return np.eye(4), info
-    centre = probe.mean(axis=0)
-    lever = float(np.sqrt(np.mean(np.sum((probe - centre) ** 2, axis=1))))  # rotation [rad] -> [m]
-    normal = sub.dirs[cls]
-    patch = _patch_keys(probe, cls, spec.merge_cell_m)
-    X = np.eye(4)
-    w = np.ones(len(probe))
-    r = r0
-    ok = np.ones(len(probe), bool)
-    keep_dirs = np.zeros((6, 0))
-    for it in range(spec.icp_iterations):
-        if it:
-            r, ok = _residuals(transform_points(X, probe), cls, sub, tree, reach)
-            r = np.where(ok, r, 0.0)
-        scale = max(1.4826 * float(np.median(np.abs(r[ok]))), 1e-5)
-        u = r / (_TUKEY_C * scale)
-        w = np.where(ok & (np.abs(u) < 1.0), (1.0 - u * u) ** 2, 0.0)
-        p = transform_points(X, probe) - centre
-        J = np.hstack([np.cross(p, normal) / lever, normal])  # rotation columns scaled to metres at the lever
-        H = (J.T * w) @ J
-        g = (J.T * w) @ r
-        vals, vecs = np.linalg.eigh(H)
-        keep_dirs = vecs[:, vals >= _WEAK_DIRECTION * max(float(vals.sum()), 1e-300)]
-        step = -keep_dirs @ ((keep_dirs.T @ g) / vals[vals >= _WEAK_DIRECTION * max(float(vals.sum()), 1e-300)])
-        delta = np.concatenate([step[:3] / lever, step[3:]])
-        X = _rigid(delta, transform_points(X, centre[None])[0]) @ X
-        if np.max(np.abs(step)) < _CONVERGED_M:
-            break
-    moved = transform_points(X, probe)
-    shift = float(np.sqrt(np.mean(np.sum((moved - probe) ** 2, axis=1))))
-    # Patch-robust covariance of the estimate in the constrained directions: each patch one measurement.
-    p = moved - transform_points(X, centre[None])[0]
-    J = np.hstack([np.cross(p, normal) / lever, normal]) @ keep_dirs
-    n_patch = int(patch.max()) + 1
-    score = np.stack([np.bincount(patch, w * r * J[:, j], n_patch) for j in range(J.shape[1])], axis=1)
-    H = (J.T * w) @ J
+    w = _tukey(r, k)
+    patch = _patch_keys(p, n, patch_m)
+    info["misfit_m"] = _patch_misfit(r, w, patch)
+    info["shift_m"] = float(np.sqrt(np.mean(np.sum((transform_points(X, probe) - probe) ** 2, axis=1))))
+    J, D, centre, lever = _constrained(p, n, w)
+    Jd = J @ D
+    score = np.stack([np.bincount(patch, w * r * Jd[:, j], int(patch.max()) + 1) for j in range(D.shape[1])], 1)
+    c0 = transform_points(invert(X), centre[None])[0]
+    est = D.T @ np.concatenate([Rotation.from_matrix(X[:3, :3]).as_rotvec() * lever, centre - c0])
     try:
-        H_inv = np.linalg.inv(H)
-        cov = H_inv @ (score.T @ score) @ H_inv
-        # The estimate, in the same coordinates: the rigid motion's rotation vector (scaled) and shift.
-        R = X[:3, :3]
-        rotvec = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-        c = transform_points(X, centre[None])[0]
-        est = keep_dirs.T @ np.concatenate([rotvec * lever, c - centre])
-        chi2 = float(est @ np.linalg.solve(cov, est))
+        H_inv = np.linalg.inv((Jd.T * w) @ Jd)
+        chi2 = float(est @ np.linalg.solve(H_inv @ (score.T @ score) @ H_inv, est))
     except np.linalg.LinAlgError:
         chi2 = 0.0
-    info |= {"constrained": float(keep_dirs.shape[1]), "shift_m": shift, "chi2": chi2}
-    info["misfit_before_m"] = _patch_misfit(r0, w, patch)
-    info["misfit_m"] = _patch_misfit(r, w, patch)
+    info |= {"constrained": float(D.shape[1]), "chi2": chi2}
     return X, info
 
 
+def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tuple[FloatArray, dict[str, float]]:
+    """Open3D ICP of ``source`` (n, 3) [m] in R onto ``target`` (m, 3) in R, as ``spec.splice_icp`` says.
+
+    Returns the estimated correction X (4, 4) in R (p' = X p) and diagnostics: overlap, noise_m and those of
+    :func:`significance` (X is restricted to the constrained directions there). X is the identity when the
+    overlap is too small. Runs ``spec.icp_iterations`` iterations at most; distances from
+    :func:`registration_settings`. The paper's ICP runs on every point, the robust one and the test on an
+    even stride of the points.
+    """
+    probe = np.asarray(source, dtype=np.float64)[:: max(1, math.ceil(len(source) / _PROBE_POINTS))]
+    sub = np.asarray(target, dtype=np.float64)[:: max(1, math.ceil(len(target) / _TARGET_POINTS))]
+    info = {"overlap": 0.0, "noise_m": 0.0, "constrained": 0.0, "shift_m": 0.0, "chi2": 0.0}
+    info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
+    if len(probe) < _MIN_OVERLAP or len(sub) < _MIN_OVERLAP:
+        return np.eye(4), info
+    settings = registration_settings(spec, 0.0)
+    normals = _open3d.estimate_normals(sub, settings.normal_radius_m, _NORMAL_NEIGHBOURS)
+    _, _, r0 = _plane_residuals(probe, sub, normals, settings.reach_m, np.eye(4))
+    info["overlap"] = float(len(r0))
+    if len(r0) < _MIN_OVERLAP:
+        return np.eye(4), info
+    noise = _MAD_TO_SIGMA * float(np.median(np.abs(r0)))  # about 0, not the median: an offset widens it
+    settings = registration_settings(spec, noise)
+    info["noise_m"] = noise
+    corr = settings.max_correspondence_m
+    if spec.splice_icp == "paper":  # as the paper ran it: every point, no subsampling
+        X = _open3d.icp(source, target, corr, spec.icp_iterations).X_TS
+    else:
+        X = _open3d.icp(probe, sub, corr, spec.icp_iterations, None, normals, settings.tukey_k_m).X_TS
+    X, stats = significance(probe, sub, normals, X, settings, spec.merge_cell_m)
+    return X, info | stats
+
+
 def splice_order(images: Mapping[str, DepthImage], names: tuple[str, ...]) -> tuple[str, ...]:
-    """Splicing order: 2nd fixed camera (the reference), 1st fixed, other fixed, then the eye-in-hand ones."""
+    """Splicing order: the eye-in-hand cameras (the first is the reference), then the 2nd fixed camera, the 1st
+    fixed and the other fixed ones (the paper registers camera 1 onto camera 2)."""
     for name in names:
         if name not in images:
             raise ValueError(f"splice: no depth image for camera {name!r}; images: {', '.join(images)}")
@@ -301,36 +333,34 @@ def splice(
     registrations = []
     # Normals from plane fits twice the voxel wide (a voxel-wide fit of 2-3 mm noise is as noisy as the depth).
     normals = surface_normals(points, camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
-    if len(order) > 1:
-        cls, dirs = direction_classes(normals)
-        for k, name in enumerate(order[1:], start=1):
-            part = slice(bounds[k], bounds[k + 1])
-            target = Surfaces(points[: bounds[k]], cls[: bounds[k]], dirs)
-            X, info = register(points[part], cls[part], target, spec)
-            accepted = (
-                info["shift_m"] >= MIN_SHIFT_M
-                and info["chi2"] >= SIGNIFICANCE_CHI2
-                and info["misfit_m"] <= (1.0 - MIN_MISFIT_DROP) * info["misfit_before_m"]
+    for k, name in enumerate(order[1:], start=1):
+        part = slice(bounds[k], bounds[k + 1])
+        X, info = register(points[part], points[: bounds[k]], spec)
+        accepted = (
+            info["shift_m"] >= MIN_SHIFT_M
+            and info["chi2"] >= SIGNIFICANCE_CHI2
+            and info["misfit_m"] <= (1.0 - MIN_MISFIT_DROP) * info["misfit_before_m"]
+        )
+        X_corr = X if accepted else np.eye(4)
+        registrations.append(
+            Registration(
+                name,
+                order[:k],
+                X_corr,
+                X,
+                int(info["overlap"]),
+                int(info["constrained"]),
+                info["shift_m"],
+                info["chi2"],
+                info["misfit_before_m"],
+                info["misfit_m"],
+                accepted,
+                info["noise_m"],
             )
-            X_corr = X if accepted else np.eye(4)
-            registrations.append(
-                Registration(
-                    name,
-                    order[:k],
-                    X_corr,
-                    X,
-                    int(info["overlap"]),
-                    int(info["constrained"]),
-                    info["shift_m"],
-                    info["chi2"],
-                    info["misfit_before_m"],
-                    info["misfit_m"],
-                    accepted,
-                )
-            )
-            if accepted:
-                points[part] = transform_points(X_corr, points[part])
-                X_RC[index[name]] = X_corr @ X_RC[index[name]]
+        )
+        if accepted:
+            points[part] = transform_points(X_corr, points[part])
+            X_RC[index[name]] = X_corr @ X_RC[index[name]]
     registered = Cloud(points, "R", camera, cameras)
     keep = prioritised_merge(points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
     kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}

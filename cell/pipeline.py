@@ -388,7 +388,8 @@ def _seam_welds(
         if est.status is not SeamStatus.FOUND:
             out.append(SeamWeld(est.id, False, False, f"not located ({est.status.value}): {est.reason}"))
             continue
-        if est.confidence < sc.rescan.weld_min_confidence:
+        doubtful = est.confidence < sc.rescan.weld_min_confidence
+        if doubtful and ex is not None:
             why = f"low_confidence: {est.confidence:.2f} < {sc.rescan.weld_min_confidence:.2f} after the re-scan"
             out.append(SeamWeld(est.id, False, False, why))
             continue
@@ -398,7 +399,8 @@ def _seam_welds(
             out.append(SeamWeld(est.id, False, False, reason))
             continue
         if ex is None or plan is None:
-            out.append(SeamWeld(est.id, True, False, refused or "planned, not executed (preview)"))
+            note = f"; confidence {est.confidence:.2f}: would be re-scanned before welding" if doubtful else ""
+            out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note))
             continue
         seg = next(g for g in plan.segments if g.arc_on and g.seam_id == est.id)
         t0, t1 = pre_s + seg.t0, pre_s + seg.t1
@@ -441,10 +443,11 @@ def weld(
             if mode != "none" and station.arm is not None and execute_plan:
                 rs, det = rescan_detection(station, det, mode, progress=progress)
                 timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
+            # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so.
             low = {
                 e.id
                 for e in det.estimates
-                if e.status is SeamStatus.FOUND and e.confidence < sc.rescan.weld_min_confidence
+                if e.status is SeamStatus.FOUND and e.confidence < sc.rescan.weld_min_confidence and execute_plan
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None

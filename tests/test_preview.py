@@ -84,8 +84,8 @@ def test_overview_pngs_show_seams_by_status(tmp_path: Path) -> None:
     assert [f.name for f in files] == ["overview_top.png", "overview_3d.png", "overview_seams.png"]
     for f in files:
         assert_png(f)
-    for status, colour in STATUS_COLOURS.items():  # every status is drawn in its own colour
-        assert colour_fraction(files[2], colour) > 1e-4, status
+    for status in {v[1] for v in views()}:  # every status present is drawn in its own colour
+        assert colour_fraction(files[2], STATUS_COLOURS[status]) > 1e-4, status
     assert colour_fraction(files[0], STATUS_COLOURS["found"]) > 1e-4
 
 

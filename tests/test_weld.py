@@ -50,7 +50,9 @@ def test_events_and_cycle_time() -> None:
     # The arc burns only during the welds: arc time is the welded length at the travel speed (ramps aside).
     lengths = sum(w.quality.length_mm for w in run.seams if w.quality is not None)
     assert ex.arc_time == pytest.approx(lengths / run.detection.scenario.process.travel_speed_mm_s, rel=0.02)
-    assert run.cycle_time_s == pytest.approx(run.plan.cycle_time + run.pre_move.duration, abs=0.02)  # type: ignore[union-attr]
+    rescan_s = run.rescan.motion_s if run.rescan is not None else 0.0
+    assert run.pre_move is not None
+    assert run.cycle_time_s == pytest.approx(run.plan.cycle_time + run.pre_move.duration + rescan_s, abs=0.02)
     # Every arc_on is followed by its arc_off before the next arc_on.
     on = [e.t for e in ex.events if e.kind == "arc_on"]
     off = [e.t for e in ex.events if e.kind == "arc_off"]

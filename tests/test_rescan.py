@@ -222,3 +222,21 @@ def test_a_closeup_that_sees_nothing_keeps_the_first_estimate(fence1: Any) -> No
     (r,) = rs.seams
     assert r.reason.startswith("nothing seen") and r.fused is r.before and r.weight == 0.0
     assert next(e for e in rs.estimates if e.id == seam.id) is seam
+
+
+@pytest.mark.scenario
+def test_rescan_undoes_the_fixed_cameras_calibration_error() -> None:
+    """Fixed cameras off by 1 mm / 0.1 deg: the arm's camera (posed by the robot's kinematics) brings every seam
+    back under 0.5 mm lateral (issue acceptance), and improves the mean."""
+    from cell import pipeline
+    from cell.rescan import rescan_seams, rescanned
+    from cell.station import Station
+
+    scn = sc.load("faults/extrinsics-fixed-off")
+    with Station(scn) as station:
+        det = pipeline.detect(scn, station=station)
+        ids = [e.id for e in det.estimates if e.status is SeamStatus.FOUND]
+        after = rescanned(det, rescan_seams(station, det, ids))
+    assert after.summary.found == 12
+    assert after.summary.lateral_mean_mm < 0.5
+    assert after.summary.lateral_mean_mm < det.summary.lateral_mean_mm

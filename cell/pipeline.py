@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Collection, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
 from cell.errors import AlignmentError, CellError, PlanError, ScenarioError, SensorError
@@ -472,7 +472,11 @@ def rescan_detection(
     station: Station, det: Detection, mode: Literal["low", "all"], *, progress: Progress = _quiet
 ) -> tuple[Rescan, Detection]:
     """Re-scan the seams worth a closer look (``low``: below the confidence threshold or not found; ``all``: every
-    visible seam) with the eye-in-hand camera and return the detection with the fused estimates."""
+    visible seam) with the eye-in-hand camera and return the detection with the fused estimates.
+
+    In ``low`` mode, a close-up that moves its seam by more than ``rescan.escalate_mm`` shows the fixed cameras
+    cannot be trusted here (calibration off, a bumped camera): every other visible seam is re-scanned as well.
+    """
     import math
 
     from cell.rescan import rescan_seams, rescanned, seams_to_rescan
@@ -481,7 +485,36 @@ def rescan_detection(
     ids = seams_to_rescan(det, math.inf if mode == "all" else sc.rescan.confidence_threshold)
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
     rs = rescan_seams(station, det, ids, progress=progress)
-    return rs, rescanned(det, rs)
+    after = rescanned(det, rs)
+    shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
+    rest = [i for i in seams_to_rescan(after, math.inf) if i not in ids]
+    if mode == "low" and shift_mm > sc.rescan.escalate_mm and rest:
+        progress(
+            f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
+            f" {len(rest)} seams too"
+        )
+        more = rescan_seams(station, after, rest, progress=progress)
+        after = rescanned(after, more)
+        rs = replace(
+            more,
+            seams=rs.seams + more.seams,
+            moves=rs.moves + more.moves,
+            executions=rs.executions + more.executions,
+            note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
+            timings={k: rs.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*rs.timings, *more.timings}},
+        )
+    return rs, after
+
+
+def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
+    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing)."""
+    import numpy as np
+
+    if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
+        return 0.0
+    a = np.stack([before.p_start, before.p_end])
+    b = np.stack([closeup.p_start, closeup.p_end])
+    return float(min(np.linalg.norm(a - b, axis=1).max(), np.linalg.norm(a - b[::-1], axis=1).max()))
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

@@ -212,11 +212,16 @@ class RescanSpec(_Model):
     mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` (and visible seams not
         found), ``all`` every visible seam, ``none`` nothing.
     weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
+    escalate_mm : in ``low`` mode, a close-up that disagrees with the first estimate by more than this [mm]
+        triggers a re-scan of every visible seam.
     """
 
     mode: Literal["none", "low", "all"] = "low"
     confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = 0.55  # catches every seam > 0.15 mm lateral
     weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
+    # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
+    # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.
+    escalate_mm: Annotated[float, Field(gt=0.0)] = 0.5
 
 
 class CameraFaultSpec(_Model):

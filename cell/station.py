@@ -7,7 +7,6 @@ The robot model (Pinocchio) is loaded from the same URDF as the simulated arm, s
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -108,8 +107,3 @@ class Station:
         self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
     ) -> None:
         self.close()
-
-
-def degrees(q: FloatArray) -> list[float]:
-    """Joint values [rad] as rounded degrees for messages and reports."""
-    return [round(math.degrees(float(v)), 3) for v in q]

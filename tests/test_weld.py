@@ -97,3 +97,15 @@ def test_preview_draws_and_moves_nothing(tmp_path: Path) -> None:
     assert data["cycle_time_s"] == 0 and data["events"] == []
     assert all(not s["welded"] for s in data["seams"])
     assert sum(s["planned"] for s in data["seams"]) == 12
+
+
+def test_both_fixed_cameras_dead_still_welds_nothing_wrong() -> None:
+    """Only the arm's camera is left: the close-up re-scan carries the cell; the run is partial (cameras lost)."""
+    run = pipeline.weld(sc.load("faults/two-cameras-dead"))
+    assert {c.split(":")[0] for c in run.detection.lost_cameras} == {"cam_left", "cam_right"}
+    assert not run.complete  # a degraded run never exits 0
+    for w in run.seams:
+        if w.welded:
+            assert w.quality is not None and w.quality.tcp_max_mm <= 1.0, w.id
+        else:
+            assert w.reason, w.id

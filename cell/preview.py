@@ -625,8 +625,11 @@ def write_run(run: WeldRun, out_dir: str | Path) -> list[Path]:
     if run.plan is not None and run.plan.segments and run.arm is not None:
         limits = run.arm.model.limits
         traj, arc = run.plan.joint_trajectory()
+        k = max(1, len(traj.times) // 4000)  # 1 kHz samples: a few thousand are plenty for a plot
         paths.append(
-            render_joint_plots(traj.times, traj.q, traj.qd, limits, out / "joints.png", arc_on=arc, title=title)
+            render_joint_plots(
+                traj.times[::k], traj.q[::k], traj.qd[::k], limits, out / "joints.png", arc_on=arc[::k], title=title
+            )
         )
     paths.append(render_html(cloud, det.weldmap_R, views, poses, tcp, out / "cell.html", title=title))
     return paths

@@ -30,7 +30,6 @@ import math
 import time
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -40,70 +39,11 @@ from cell.errors import IKError, PlanError, TimingError
 from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker, CollisionOptions
 from cell.motion.ik import solve_ik
+from cell.motion.program import SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan, seam_tasks
 from cell.motion.robot import RobotModel
 from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile, ptp, ptp_duration
 from cell.motion.torch import WeldProcess, back_off, line_poses, torch_poses
-from cell.seams.base import Joint
-from cell.types import Part, SeamEstimate, SeamStatus, WeldMap
-
-SegmentKind = Literal["move", "approach", "weld", "depart"]
-
-
-@dataclass(frozen=True)
-class SeamTask:
-    """One seam to weld, in R: end points p_start, p_end (3,) [m] and the outward unit normals (3,) of the weld
-    faces (n_a on the abutting part, n_b on the receiving part)."""
-
-    id: str
-    p_start: FloatArray
-    p_end: FloatArray
-    n_a: FloatArray
-    n_b: FloatArray
-
-    def __post_init__(self) -> None:
-        for key in ("p_start", "p_end", "n_a", "n_b"):
-            arr = readonly(getattr(self, key))
-            if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-                raise ValueError(f"SeamTask {self.id}: {key} must be 3 finite values, got {arr.shape}")
-            object.__setattr__(self, key, arr)
-
-    @property
-    def length(self) -> float:
-        return float(np.linalg.norm(self.p_end - self.p_start))
-
-
-def seam_tasks(
-    estimates: Sequence[SeamEstimate],
-    weldmap_R: WeldMap,
-    joints: Mapping[str, Joint],
-    table_z: float | None = None,
-) -> tuple[SeamTask, ...]:
-    """Tasks for the found seams: the located end points with the weld faces' normals from the aligned map.
-
-    table_z : height of the table top in R [m]. A located end point below it (the locator's error on a seam that
-    ends at the table) is moved along the seam up to the table top: a seam cannot run inside the table.
-    """
-    from cell.seams.joint import weld_faces  # the seams package stays out of the motion import chain
-
-    out = []
-    for est in estimates:
-        if est.status is not SeamStatus.FOUND:
-            continue
-        n_a, _, n_b, _ = weld_faces(weldmap_R, joints[est.id])
-        p0, p1 = np.array(est.p_start), np.array(est.p_end)
-        if table_z is not None:
-            p0, p1 = _clip_above(p0, p1, table_z), _clip_above(p1, p0, table_z)
-        out.append(SeamTask(est.id, p0, p1, n_a, n_b))
-    return tuple(out)
-
-
-def _clip_above(p: FloatArray, other: FloatArray, z: float) -> FloatArray:
-    """p moved along the line towards ``other`` until its height is at least z (unchanged if it already is or
-    the line does not climb)."""
-    if p[2] >= z or other[2] <= p[2]:
-        return p
-    f = min(1.0, (z - p[2]) / (other[2] - p[2]))
-    return np.asarray(p + f * (other - p))
+from cell.types import Part, WeldMap
 
 
 @dataclass(frozen=True)
@@ -124,114 +64,6 @@ class PlanOptions:
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
     dt: float = 0.001  # [s] sample period: 1 kHz, the rate the safety gate re-samples at
     collision: CollisionOptions = field(default_factory=CollisionOptions)
-
-
-@dataclass(frozen=True)
-class Segment:
-    """One motion of the plan. kind: move (PTP) | approach | weld | depart (LIN); t0 [s] its start in the plan;
-    speed [m/s] the TCP speed of a LIN (0 for PTP); X_end (4, 4) the TCP pose at its end in R; arc_on: the arc
-    burns during this segment (welds only: on at its start, off at its end, both at rest)."""
-
-    kind: SegmentKind
-    seam_id: str
-    trajectory: Trajectory
-    t0: float
-    X_end: FloatArray
-    speed: float = 0.0
-    arc_on: bool = False
-
-    @property
-    def t1(self) -> float:
-        return self.t0 + self.trajectory.duration
-
-
-@dataclass(frozen=True)
-class SeamOutcome:
-    """What became of one seam: feasible, or the reason and the failing point p_fail (3,) in R (empty if none).
-
-    For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]."""
-
-    seam_id: str
-    feasible: bool
-    reason: str = ""
-    p_fail: FloatArray = field(default_factory=lambda: np.zeros(0))
-    reversed: bool = False
-    spin: float = float("nan")
-    work_angle: float = float("nan")
-    travel_angle: float = float("nan")
-
-
-@dataclass(frozen=True)
-class WeldPlan:
-    """An ordered, timed welding program. segments: back to back (each starts where the previous ends, at rest);
-    seams: one outcome per seam asked for, in input order; order: ids of the welded seams in welding order;
-    planning_s: wall time spent planning [s]."""
-
-    joint_names: tuple[str, ...]
-    q_home: FloatArray
-    segments: tuple[Segment, ...]
-    seams: tuple[SeamOutcome, ...]
-    order: tuple[str, ...]
-    planning_s: float = 0.0
-
-    @property
-    def cycle_time(self) -> float:
-        """Total duration [s] from home back to home."""
-        return self.segments[-1].t1 if self.segments else 0.0
-
-    @property
-    def arc_time(self) -> float:
-        return sum(s.trajectory.duration for s in self.segments if s.arc_on)
-
-    def outcome(self, seam_id: str) -> SeamOutcome:
-        for o in self.seams:
-            if o.seam_id == seam_id:
-                return o
-        raise KeyError(f"no seam {seam_id!r} in the plan; seams: {', '.join(o.seam_id for o in self.seams)}")
-
-    def sample(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """(q, qd, qdd) (dof,) each at plan time t [s], clamped to [0, cycle_time]."""
-        if not self.segments:
-            z = np.zeros(len(self.joint_names))
-            return np.array(self.q_home), z, z
-        starts = np.array([s.t0 for s in self.segments])
-        k = int(np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1))
-        seg = self.segments[k]
-        q, qd, qdd = seg.trajectory.sample(float(t) - seg.t0)
-        return np.asarray(q), np.asarray(qd), np.asarray(qdd)
-
-    def arc_at(self, times: npt.ArrayLike) -> npt.NDArray[np.bool_]:
-        """(n,) whether the arc burns from each time to the next: on over [t0, t1) of every weld segment."""
-        t = np.asarray(times, dtype=float)
-        on = np.zeros(t.shape, dtype=bool)
-        for s in self.segments:
-            if s.arc_on:
-                on |= (t >= s.t0 - 1e-9) & (t < s.t1 - 1e-9)
-        return on
-
-    def joint_trajectory(self) -> tuple[Trajectory, npt.NDArray[np.bool_]]:
-        """The whole plan as one Trajectory (segments joined, shared boundary samples once) and the arc flag
-        (n,) of each sample (holding until the next sample)."""
-        if not self.segments:
-            raise PlanError("the plan has no motion: no seam could be planned")
-        parts_t, parts_q, parts_qd, parts_qdd = [], [], [], []
-        for k, s in enumerate(self.segments):
-            tr = s.trajectory
-            sl = slice(0 if k == 0 else 1, None)
-            parts_t.append(tr.times[sl] + s.t0)
-            parts_q.append(tr.q[sl])
-            parts_qd.append(tr.qd[sl])
-            parts_qdd.append(tr.qdd[sl])
-        times = np.concatenate(parts_t)
-        times[0] = 0.0
-        keep = np.concatenate([[True], np.diff(times) > 1e-12])  # zero-length segments add no sample
-        traj = Trajectory(
-            times[keep],
-            np.concatenate(parts_q)[keep],
-            np.concatenate(parts_qd)[keep],
-            np.concatenate(parts_qdd)[keep],
-        )
-        return traj, self.arc_at(traj.times)
 
 
 # -- per-seam search -------------------------------------------------------------------------------------------
@@ -851,3 +683,18 @@ def cell_obstacles(
     X_RW = invert(np.asarray(X_WR, dtype=float))
     table = Part(table_name, Box(X_RW @ make_pose(p=table_center_W), np.asarray(table_size, dtype=float)))
     return (*weldmap_R.parts, table)
+
+
+__all__ = [
+    "PlanOptions",
+    "SeamOutcome",
+    "SeamTask",
+    "Segment",
+    "SegmentKind",
+    "WeldPlan",
+    "cell_obstacles",
+    "line_trajectory",
+    "plan_welds",
+    "scan_configuration",
+    "seam_tasks",
+]

@@ -11,13 +11,16 @@ import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import typer
 from rich.console import Console
 from rich.table import Table
 
 from cell.errors import EXIT_PARTIAL, CellError
+
+if TYPE_CHECKING:  # the pipeline (and what it imports) loads inside the commands, so `cell --help` stays instant
+    from cell.pipeline import Detection, WeldRun
 
 app = typer.Typer(
     add_completion=False,
@@ -296,12 +299,10 @@ def _check_method(method: str | None) -> None:
         raise typer.BadParameter(f"{method!r}; valid: {', '.join(METHODS)}", param_hint="--method")
 
 
-def _finish_run(run: object, json_path: Path | None, krl: Path | None, *, title: str) -> None:
+def _finish_run(run: WeldRun, json_path: Path | None, krl: Path | None, *, title: str) -> None:
     """Write what was asked (report first: it survives any later failure), print the table, exit with the code."""
     from cell.export.report import weld_report, write_json
-    from cell.pipeline import WeldRun
 
-    assert isinstance(run, WeldRun)
     rep = weld_report(run)
     if json_path is not None:
         write_json(json_path, rep)
@@ -363,6 +364,11 @@ def _print_weld(rep: dict, title: str) -> None:
         f"paper ME mean {_fmt(m['paper_me_mean_mm'])} mm · cycle time {_fmt(cyc, 1)} s"
         + ("" if rep["cycle_time_s"] else " (planned)")
     )
+    _print_timings(rep)
+
+
+def _print_timings(rep: dict) -> None:
+    """The stage times of a report, one line."""
     tim = rep["timings_s"]
     out.print("time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None))
 
@@ -371,11 +377,9 @@ def _fmt(v: float | None, nd: int = 2) -> str:
     return "-" if v is None else f"{v:.{nd}f}"
 
 
-def _print_detection(det: object) -> None:
+def _print_detection(det: Detection) -> None:
     from cell.export.report import detection_report
-    from cell.pipeline import Detection
 
-    assert isinstance(det, Detection)
     rep = detection_report(det)
     t = Table(
         title=f"{rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
@@ -403,8 +407,7 @@ def _print_detection(det: object) -> None:
         f" {_fmt(m['endpoint_mean_mm'])} mm · lateral"
         f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)"
     )
-    tim = rep["timings_s"]
-    out.print("time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None))
+    _print_timings(rep)
 
 
 def main() -> None:

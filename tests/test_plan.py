@@ -6,10 +6,10 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
+from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TABLE, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.errors import PlanError
@@ -22,21 +22,8 @@ from cell.motion.timing import Trajectory
 from cell.motion.torch import WeldProcess, torch_poses
 from cell.types import Box, Part
 
-URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
-HOME = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
-# The robot base R sits at table-top height (z = 0 is the table top); a rail lies 0.92 m in front of it and a
-# post abuts the rail's near face (y = 0.87) across a 1 mm gap.
-TABLE = Part("TABLE", Box(make_pose(p=[0.0, 1.05, -0.05]), np.array([2.0, 1.2, 0.1])))
-RAIL = Part("RAIL", Box(make_pose(p=[0.0, 0.92, 0.03]), np.array([0.4, 0.1, 0.06])))
-POST = Part("POST", Box(make_pose(p=[0.0, 0.769, 0.03]), np.array([0.06, 0.2, 0.06])))
-OBSTACLES = (TABLE, RAIL, POST)
-Y = 0.87
-TOP = SeamTask(
-    "top", np.array([-0.03, Y, 0.06]), np.array([0.03, Y, 0.06]), np.array([0, 0, 1.0]), np.array([0, -1.0, 0])
-)
-SIDE = SeamTask(
-    "side", np.array([0.03, Y, 0.0]), np.array([0.03, Y, 0.06]), np.array([1.0, 0, 0]), np.array([0, -1.0, 0])
-)
+TOP = SeamTask(*TOP_SEAM)
+SIDE = SeamTask(*SIDE_SEAM)
 FAR = SeamTask(
     "far", np.array([0.0, 2.2, 0.06]), np.array([0.06, 2.2, 0.06]), np.array([0, 0, 1.0]), np.array([0, -1.0, 0])
 )

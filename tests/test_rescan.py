@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import itertools
 import math
-from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
+from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.errors import PlanError
@@ -37,21 +37,9 @@ from cell.seams.metrics import segment_errors
 from cell.sim.camera import intrinsics_for
 from cell.types import Box, Part, SeamEstimate, SeamStatus
 
-URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
-HOME = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
 K = intrinsics_for(1280, 720, math.radians(65.0))  # the D415 of the scenarios
-# Robot base at table-top height; a rail 0.92 m ahead, a post abutting its near face (y = 0.87) across 1 mm.
-TABLE = Part("TABLE", Box(make_pose(p=[0.0, 1.05, -0.05]), np.array([2.0, 1.2, 0.1])))
-RAIL = Part("RAIL", Box(make_pose(p=[0.0, 0.92, 0.03]), np.array([0.4, 0.1, 0.06])))
-POST = Part("POST", Box(make_pose(p=[0.0, 0.769, 0.03]), np.array([0.06, 0.2, 0.06])))
-OBSTACLES = (TABLE, RAIL, POST)
-Y = 0.87
-TOP = ViewTarget(
-    "top", np.array([-0.03, Y, 0.06]), np.array([0.03, Y, 0.06]), np.array([0, 0, 1.0]), np.array([0, -1.0, 0])
-)
-SIDE = ViewTarget(
-    "side", np.array([0.03, Y, 0.0]), np.array([0.03, Y, 0.06]), np.array([1.0, 0, 0]), np.array([0, -1.0, 0])
-)
+TOP = ViewTarget(*TOP_SEAM)
+SIDE = ViewTarget(*SIDE_SEAM)
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,6 @@ map's seam fails.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -400,16 +399,3 @@ def test_ransac_default_is_the_papers_voxel_cloud_three_runs_and_deterministic(s
     assert dense.status is SeamStatus.FOUND, dense.reason
     lat_d, _ = errors(dense.p_start, dense.p_end, truth[TOP])
     assert lat_d < 0.004, lat_d
-
-
-def test_time_per_seam(scenes: dict) -> None:
-    """Measured, not asserted: milliseconds per seam of both locators (KD-tree already built)."""
-    scene, _ = scenes["axis-aligned"]
-    for loc in (OursLocator(), RansacLocator()):
-        times = []
-        for i in range(5):
-            for seam in scene.weldmap.seams:
-                t0 = time.perf_counter()
-                loc.locate(scene, seam, np.random.default_rng(i))
-                times.append(time.perf_counter() - t0)
-        print(f"\n{loc.name}: median {1000 * np.median(times):.2f} ms per seam over {len(times)} calls")

@@ -5,19 +5,24 @@ Method (general: no assumption that a seam runs along x, y or z):
 1. From the aligned map: the weld faces, A's ``face_abutting`` (n_a, d_a) and B's ``face_receiving`` (n_b,
    d_b), the seam line where they meet with its direction t, and A's side faces across t (where the seam
    ends).
-2. Points of ``scene.dense`` in a tube around the map seam (a KD-tree built once per scene); points within a
-   band of any other part of the map are left out, so neighbouring parts never lend a face their points.
+2. Points in a tube around the map seam, from a fixed random share (``sample_share``) of ``scene.dense``
+   (:class:`~cell.seams._fit.CloudIndex`, built once per scene: thousands of points per face are plenty for a
+   sub-0.1 mm offset, and every numpy call costs the same whatever the share); points within a band of any
+   other part of the map are left out, so neighbouring parts never lend a face their points.
 3. Face A's support: points near A's plane, away from B's face by a corner band (gap, shadow and corner noise
    live there), inside A's extent along t less an edge band (flying pixels on convex edges), above the table.
    Face B's support: points near B's plane inside B's face less an edge band, outside the footprint of A grown
-   by the band. Each face is fitted along the map's normal by iteratively reweighted least squares (Tukey
-   biweight), each camera weighted by its own measured noise; in the last pass with a small tilt held near
-   the map's normal by a Gaussian prior (as-built parts are rotated by hundredths of a degree, not degrees).
-   ``passes`` passes: the first from the map with wide gates, the others with gates and bands from the
-   measured noise and the ends found.
+   by the band. A's side faces across the seam (where it ends) likewise. All of them are fitted at once
+   (:func:`~cell.seams._batch.fit_offsets`): each plane's offset along the map's normal by iteratively
+   reweighted least squares (Tukey biweight), each camera weighted by its own measured noise on that face.
+   ``passes`` passes: the first from the map with wide gates (from each face's densest layer), the others with
+   gates and bands from the measured noise and the ends found. Optionally (``refine_normals``) the weld faces
+   may tilt a little in the last pass, held near the map's normal by a Gaussian prior (as-built parts are
+   rotated by hundredths of a degree, not degrees; on the fence scenarios this gained nothing measurable).
 4. A weld face no camera sees (too oblique, occluded) is placed from the edge where an adjacent face of the
    same part ends: the extent of that face's points across the edge (a blurred-step likelihood), searched as
-   far from the map as a fitted face may drift, each camera's edge on its own. A camera's edge counts only
+   far from the map as a fitted face may drift, each camera's edge on its own (from ``edge_sample_share`` of
+   the dense cloud: an edge needs density). A camera's edge counts only
    when enough points define it, it is not blurred beyond the likelihood's widest blur (grazing incidence),
    few points lie beyond it (flying pixels), and it is neither at the searched range's limit nor where the
    cloud stops (the sample's own cut-off, not an edge). Its standard error: the likelihood's and the sampling
@@ -43,7 +48,7 @@ import numpy.typing as npt
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.seams import _fit
+from cell.seams import _batch, _fit
 from cell.seams.base import Joint, SeamScene
 from cell.types import BOX_FACES, Box, MapSeam, SeamEstimate, SeamStatus
 
@@ -67,8 +72,10 @@ class OursOptions:
     min_face_points: int = 30  # fewer supporting points on a weld face: place it from an edge, or NOT_FOUND
     min_end_points: int = 40  # fewer points on a side face of A: take the end from the extent instead
     min_end_fill: float = 0.05  # ... or fewer than this fraction of the points its area would hold head on
-    refine_normals: bool = True  # let a face tilt off the map's normal in the last pass
+    refine_normals: bool = False  # let a face tilt off the map's normal in the last pass (no gain measured)
     tilt_prior_deg: float = 0.05  # ... standard deviation of the tilt's Gaussian prior [deg]
+    sample_share: float = 0.25  # share of the dense cloud looked at (layers of _fit.INDEX_SHARES: 0.25, 0.5 or 1)
+    edge_sample_share: float = 1.0  # ... where an unseen face is placed from an edge (an edge needs every point)
     max_points: int = 40000  # random subsample of the tube above this
     max_fit_points: int = 1000  # a plane is fitted to an even stride of its support above this
     target_se_m: float = 0.0002  # standard error of the seam's position that still earns full confidence
@@ -82,6 +89,8 @@ class OursOptions:
             raise ValueError(
                 "ours options need passes >= 1, min_face_points >= 3, min_end_points >= 3 and min_edge_points >= 3"
             )
+        if self.sample_share not in _fit.INDEX_SHARES or self.edge_sample_share not in _fit.INDEX_SHARES:
+            raise ValueError(f"ours options need sample_share and edge_sample_share among {_fit.INDEX_SHARES}")
         if self.tube_radius_m <= self.corner_band_m or self.tilt_prior_deg <= 0.0:
             raise ValueError("ours options need tube_radius_m > corner_band_m and tilt_prior_deg > 0")
 
@@ -131,17 +140,37 @@ class _End:
     se: float = float("inf")
     scale: float = 0.003  # noise of the side face's points [m]
     source: str = "map"
+    count: int = 0  # points on the side face
+
+
+@dataclass
+class _Selection:
+    """A plane's support for one fit: the plane (a weld face or a side face at an end), the residuals r (n,) of
+    all the seam's points from it [m], the indices of its support and of the points fitted (an even stride of
+    the support above ``max_fit_points``), the points it needs; after the fit: whether it was fitted, the
+    offset it moved by [m], the offset's standard error [m] and the fitted points' weights."""
+
+    plane: _Face | _End
+    r: FloatArray
+    sel: IntArray
+    fit: IntArray
+    need: int = 0
+    ok: bool = False
+    offset: float = 0.0
+    se: float = float("inf")
+    weights: FloatArray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass
 class _Points:
-    """The points looked at for one seam: positions P (n, 3) [m], camera index (n,), usable mask (n,)."""
+    """The points looked at for one seam: coordinates xyz (3, n) [m], camera index (n,), usable mask (n,)."""
 
-    P: FloatArray
+    xyz: FloatArray
     cam: IntArray
     ok: BoolArray  # above the table and away from every other part
     scene: SeamScene
-    kept: float = 1.0  # fraction of the tube's points kept (a random subsample above ``max_points``)
+    pitch: float  # point pitch of these points on a surface seen head on [m] (the sample's, thinned)
+    n_cams: int  # camera indices run 0 .. n_cams - 1
     _along: dict[bytes, FloatArray] = field(default_factory=dict)
 
     def along(self, n: FloatArray) -> FloatArray:
@@ -149,8 +178,13 @@ class _Points:
         key = np.asarray(n, np.float64).tobytes()
         out = self._along.get(key)
         if out is None:
-            out = self._along[key] = self.P @ n
+            out = self._along[key] = n @ self.xyz
         return out
+
+    @property
+    def P(self) -> FloatArray:
+        """The points (n, 3) [m]."""
+        return self.xyz.T
 
 
 class OursLocator:
@@ -187,7 +221,6 @@ class OursLocator:
             return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, "the seam lies against the table"), NO_ERRORS
 
         pts = self._points(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng)
-        P, cam = pts.P, pts.cam
         geo = _Geometry.of(box_a, box_b, joint, t, o.edge_band_m)
         s_map = sorted((float(t @ (seam.p_start - p0)), float(t @ (seam.p_end - p0))))
         face_a = _Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
@@ -212,33 +245,36 @@ class OursLocator:
                 & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
                 & pts.ok
             )
-            for face, r, region, other, box, face_name, skip in (
-                (face_a, r_a, in_a, face_b, box_a, joint.face_abutting, joint.end_face),
-                (face_b, r_b, in_b, face_a, box_b, joint.face_receiving, ""),
+            planes: list[_Selection] = []
+            for face, r, region, box, face_name, skip in (
+                (face_a, r_a, in_a, box_a, joint.face_abutting, joint.end_face),
+                (face_b, r_b, in_b, box_b, joint.face_receiving, ""),
             ):
-                # Where an adjacent face of the same part may show this face's edge: away from the other part.
-                away = _away_from(face_b, band_b) if face is face_a else _outside(box_a, band_a)
                 if face.source != "points":
                     continue  # placed from an edge in the first pass
                 gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
                 sel = np.flatnonzero(region & (np.abs(r) < gate))
-                count = len(sel)
-                if count >= o.min_face_points:
-                    fit_sel = _thin(sel, o.max_fit_points)
-                    self._fit_face(face, other, r[fit_sel], P[fit_sel], cam[fit_sel], p0, t, first, last)
-                    face.se *= np.sqrt(len(fit_sel) / count)  # the stride stands for all the support
-                    face.count = count
+                if len(sel) >= o.min_face_points:
+                    planes.append(_Selection(face, r, sel, _thin(sel, o.max_fit_points)))
                     continue
                 why = "no edge of it is seen either: not seen or not there"
                 if first:
+                    # Where an adjacent face of the same part may show this face's edge: away from the other part.
+                    away = _away_from(face_b, band_b) if face is face_a else _outside(box_a, band_a)
                     why = self._face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng)
                     if not why:
                         continue
                 return _not_found(
                     seam.id,
-                    f"face {face.name} is seen by no usable camera ({count} points near the seam, needs "
+                    f"face {face.name} is seen by no usable camera ({len(sel)} points near the seam, needs "
                     f"{o.min_face_points}) and {why}",
                 )
+            sides = self._side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack)
+            self._fit_planes(planes + sides, pts, first)
+            if last and o.refine_normals:
+                for sel_ in planes:
+                    other = face_b if sel_.plane is face_a else face_a
+                    self._tilt(sel_, other, pts, p0, t)
             # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
             face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
             face_b.area = (e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0)
@@ -251,7 +287,7 @@ class OursLocator:
                         f"face {name} fitted {drift * 1000:.1f} mm from the map "
                         f"(allowed {2000 * o.map_tolerance_m:.1f} mm): wrong surface or part moved",
                     )
-            self._find_ends(ends, pts, face_a, face_b, p0, t, geo, first, s_map)
+            self._find_ends(ends, sides, pts, face_a, face_b, p0, t, s_map)
 
         length = ends[1].s - ends[0].s
         if not 0.3 * (s_map[1] - s_map[0]) < length < 2.0 * (s_map[1] - s_map[0]) + 2.0 * o.extend_m:
@@ -268,7 +304,7 @@ class OursLocator:
                     "cloud stops (the workspace's boundary): the part reaches out of the workspace",
                 )
         errors = _errors_of(face_a, face_b, ends)
-        conf = self._confidence(face_a, face_b, errors, _fit.dense_spacing(scene) / np.sqrt(pts.kept))
+        conf = self._confidence(face_a, face_b, errors, pts.pitch)
         via = [f"face {f.name} from the {f.source} ({f.note})" for f in (face_a, face_b) if f.source != "points"]
         estimate = SeamEstimate(
             id=seam.id,
@@ -291,19 +327,22 @@ class OursLocator:
         extend: float,
         joint: Joint,
         rng: np.random.Generator,
+        share: float | None = None,
     ) -> _Points:
         """The dense cloud's points in the tube of ``radius`` around the segment a-b (3,) extended by
-        ``extend`` [m], and which of them may support a plane (above the table, away from other parts)."""
+        ``extend`` [m], and which of them may support a plane (above the table, away from other parts); from
+        the sample of ``share`` of the dense cloud (None: ``sample_share``)."""
         o = self.options
-        idx = _fit.tube_indices(scene, a, b, radius, extend)
+        index = _fit.dense_index(scene)
+        share = o.sample_share if share is None else share
+        xyz, cam = index.tube(a, b, radius, extend, share)
         kept = 1.0
-        if len(idx) > o.max_points:
-            kept = o.max_points / len(idx)
-            idx = np.sort(rng.choice(idx, o.max_points, replace=False))
-        P = scene.dense.points[idx]
-        cam = scene.dense.camera[idx].astype(np.intp)
+        if len(cam) > o.max_points:
+            kept = o.max_points / len(cam)
+            pick = np.sort(rng.choice(len(cam), o.max_points, replace=False))
+            xyz, cam = xyz[:, pick], cam[pick]
         cam = np.where(cam < 0, int(cam.max(initial=0)) + 1, cam)  # mixed / unknown captures: their own group
-        ok = P[:, 2] >= scene.table_z + o.corner_band_m
+        ok = xyz[2] >= scene.table_z + o.corner_band_m
         reach = radius + extend + 0.5 * float(np.linalg.norm(b - a)) + o.map_tolerance_m
         mid = 0.5 * (a + b)
         for part in scene.weldmap.parts:
@@ -311,51 +350,11 @@ class OursLocator:
                 continue
             if np.linalg.norm(part.box.center - mid) > reach + 0.5 * float(np.linalg.norm(part.box.size)):
                 continue
-            ok &= ~part.box.contains(P, margin=o.map_tolerance_m)
-        return _Points(P, cam, ok, scene, kept)
-
-    def _fit_face(
-        self,
-        face: _Face,
-        other: _Face,
-        r: FloatArray,
-        P: FloatArray,
-        cam: IntArray,
-        p0: FloatArray,
-        t: FloatArray,
-        first: bool,
-        last: bool,
-    ) -> None:
-        """Fit the offset of ``face`` (and in the last pass a small tilt, held by its prior); update it."""
-        o = self.options
-        start = _fit.histogram_mode(r, max(0.002, o.sensor_sigma_m)) if first else 0.0
-        # The first pass's wide gates let other surfaces in: its scales are not reused; the later passes
-        # measure them once, about the previous fit.
-        rescale = (0, 3) if first else (0,)
-        if not (last and o.refine_normals):
-            fit = _fit.robust_plane_fit(r, np.ones((len(r), 1)), cam, start, rescale_at=rescale)
-            face.d += fit.offset
-            face.scale, face.se, face.count = max(fit.scale, 1e-4), fit.se, fit.n_inliers
-            return
-        # Offset and tilt about the points' centroid (decorrelated), then carried to the seam line.
-        e_u = other.n - (other.n @ face.n) * face.n
-        e_u /= np.linalg.norm(e_u)
-        q = P - p0
-        u, v = q @ e_u, q @ t
-        uc, vc = float(np.mean(u)), float(np.mean(v))
-        X = np.column_stack([np.ones(len(r)), u - uc, v - vc])
-        tau = np.tan(np.radians(o.tilt_prior_deg))
-        prior = np.array([0.0, tau**-2, tau**-2])
-        fit = _fit.robust_plane_fit(r, X, cam, start, prior_precision=prior, rescale_at=rescale)
-        c0, a, b = fit.coef
-        # The plane r = c0 + a (u - uc) + b (v - vc): its value and standard error on the seam line (u = 0).
-        J = np.array([1.0, -uc, 0.0])
-        se0 = float(np.sqrt(max(J @ fit.cov @ J, 0.0)))
-        m = face.n - a * e_u - b * t
-        norm = float(np.linalg.norm(m))
-        face.d = (face.d + c0 - a * (uc + float(e_u @ p0)) - b * (vc + float(t @ p0))) / norm
-        face.n = m / norm
-        face.scale, face.se, face.count = max(fit.scale, 1e-4), se0, fit.n_inliers
+            R, c = part.box.X_AB[:3, :3], part.box.center
+            q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
+            h = 0.5 * part.box.size + o.map_tolerance_m
+            ok &= (np.abs(q[0]) > h[0]) | (np.abs(q[1]) > h[1]) | (np.abs(q[2]) > h[2])
+        return _Points(xyz, cam, ok, scene, index.pitch(share * kept), int(cam.max(initial=0)) + 1)
 
     def _face_from_edge(
         self,
@@ -392,7 +391,7 @@ class OursLocator:
             s_ends = sorted(float(e @ (p - q0)) for p in (seam.p_start, seam.p_end))
             e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
             radius = float(np.hypot(max(-lo, hi), gate))
-            pts = self._points(scene, q0 + e_lo * e, q0 + e_hi * e, radius, 0.0, joint, rng)
+            pts = self._points(scene, q0 + e_lo * e, q0 + e_hi * e, radius, 0.0, joint, rng, o.edge_sample_share)
             P, cam = pts.P, pts.cam
             u = P @ face.n - face.d  # along the face's outward normal: the adjacent face's points end at u = 0
             r_g = P @ n_g - d_g
@@ -482,43 +481,29 @@ class OursLocator:
     def _find_ends(
         self,
         ends: list[_End],
+        sides: list[_Selection],
         pts: _Points,
         face_a: _Face,
         face_b: _Face,
         p0: FloatArray,
         t: FloatArray,
-        geo: _Geometry,
-        first: bool,
         s_map: list[float],
     ) -> None:
-        """Update both ends: the table where A rests on it, A's side face where it is seen, else the extent
-        of face A's support along the seam."""
+        """Update both ends on the fitted line p0 + s t: the table where A rests on it, A's side face where it
+        was fitted, else the extent of face A's support along the seam."""
         o = self.options
-        r_a = pts.along(face_a.n) - face_a.d
-        r_b = pts.along(face_b.n) - face_b.d
-        s = pts.along(t) - float(p0 @ t)
-        band_b = max(o.corner_band_m, 3.0 * face_b.scale)
-        side = (
-            (r_a < -o.edge_band_m)
-            & (r_a > -(geo.depth_a - o.edge_band_m))
-            & (r_b >= band_b)
-            & (r_b <= geo.length_a - o.edge_band_m)
-            & pts.ok
-        )
-        # A side face seen at all shows a good part of the points its patch would hold seen head on; a few
-        # dozen flying pixels off an edge (a face seen at grazing incidence drops out) must not pass for it.
-        spacing = _fit.dense_spacing(pts.scene) / np.sqrt(pts.kept)  # of the points looked at
-        patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * o.edge_band_m) * (
-            min(geo.length_a, o.tube_radius_m) - band_b - o.edge_band_m
-        )
-        need = max(o.min_end_points, int(o.min_end_fill * max(patch, 0.0) / spacing**2))
+        fitted = {id(x.plane): x for x in sides if x.ok}
         known = [False, False]
         for k, end in enumerate(ends):
+            side = fitted.get(id(end))
             if end.on_table:
                 end.s, end.se, end.source = _fit.line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table"
                 known[k] = True
-            elif geo.has_sides:
-                known[k] = self._fit_side(end, pts, side, p0, t, first, need)
+            elif side is not None:
+                end.s = _fit.line_plane_parameter(p0, t, end.n, end.d)
+                end.se = side.se / max(abs(float(end.n @ t)), 1e-3)
+                end.source = "side face"
+                known[k] = True
         if all(known) or face_a.source != "points":
             for k, end in enumerate(ends):
                 if not known[k]:
@@ -526,6 +511,10 @@ class OursLocator:
             return
         # Face A's support along t; a known end's neighbourhood is cut away (A's side face shows up there),
         # which only shifts the CDF by a constant and leaves the other end's extrapolation unbiased.
+        r_a = pts.along(face_a.n) - face_a.d
+        r_b = pts.along(face_b.n) - face_b.d
+        s = pts.along(t) - float(p0 @ t)
+        band_b = max(o.corner_band_m, 3.0 * face_b.scale)
         near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         cut = o.edge_band_m + 3.0 * face_a.scale
         if known[0]:
@@ -549,31 +538,110 @@ class OursLocator:
             else:
                 end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
 
-    def _fit_side(
-        self, end: _End, pts: _Points, side: BoolArray, p0: FloatArray, t: FloatArray, first: bool, need: int
-    ) -> bool:
-        """Fit the offset of A's side face at ``end`` from the points on it; False when too few are seen."""
+    def _side_selections(
+        self,
+        ends: list[_End],
+        pts: _Points,
+        r_a: FloatArray,
+        r_b: FloatArray,
+        face_b: _Face,
+        geo: _Geometry,
+        first: bool,
+        slack: float,
+    ) -> list[_Selection]:
+        """The points on A's side faces at the seam's ends (where they are seen well enough to place an end),
+        to be fitted with the weld faces."""
         o = self.options
-        r_l = pts.along(end.n) - end.d
-        gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
-        sel = np.flatnonzero(side & (np.abs(r_l) < gate))
-        count = len(sel)
-        if count < need:
-            return False
-        fit_sel = _thin(sel, o.max_fit_points)
-        thin = np.sqrt(len(fit_sel) / count)
-        sel = fit_sel
-        start = _fit.histogram_mode(r_l[sel], max(0.002, o.sensor_sigma_m)) if first else 0.0
-        rescale = (0, 3) if first else (0,)
-        fit = _fit.robust_plane_fit(r_l[sel], np.ones((len(sel), 1)), pts.cam[sel], start, rescale_at=rescale)
-        if fit.n_inliers < min(need, len(sel)):
-            return False
-        end.d += fit.offset
-        end.scale = max(fit.scale, 1e-4)
-        end.s = _fit.line_plane_parameter(p0, t, end.n, end.d)
-        end.se = thin * fit.se / max(abs(float(end.n @ t)), 1e-3)
-        end.source = "side face"
-        return True
+        if not geo.has_sides:
+            return []
+        band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
+        eb = o.edge_band_m + slack
+        side = (r_a < -eb) & (r_a > -(geo.depth_a - eb)) & (r_b >= band_b) & (r_b <= geo.length_a - eb) & pts.ok
+        # A side face seen at all shows a good part of the points its patch would hold seen head on; a few
+        # dozen flying pixels off an edge (a face seen at grazing incidence drops out) must not pass for it.
+        patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * o.edge_band_m) * (
+            min(geo.length_a, o.tube_radius_m) - band_b - o.edge_band_m
+        )
+        need = max(o.min_end_points, int(o.min_end_fill * max(patch, 0.0) / pts.pitch**2))
+        out = []
+        for end in ends:
+            if end.on_table:
+                continue
+            r_l = pts.along(end.n) - end.d
+            gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
+            sel = np.flatnonzero(side & (np.abs(r_l) < gate))
+            if len(sel) >= need:
+                out.append(_Selection(end, r_l, sel, _thin(sel, o.max_fit_points), need))
+        return out
+
+    def _fit_planes(self, selections: list[_Selection], pts: _Points, first: bool) -> None:
+        """Fit the offsets of every selected plane at once (:func:`_batch.fit_offsets`; the first pass from a
+        histogram mode with its scales measured again once settled, the later ones from the previous fit) and
+        update them. A side face whose fit keeps fewer points than it needs stays unfitted."""
+        o = self.options
+        if not selections:
+            return
+        fit_idx = [x.fit for x in selections]
+        fit = _batch.fit_offsets(
+            np.concatenate([x.r[i] for x, i in zip(selections, fit_idx, strict=True)]),
+            [len(i) for i in fit_idx],
+            pts.cam[np.concatenate(fit_idx)],
+            pts.n_cams,
+            start=None if first else np.zeros(len(selections)),
+            mode_half_width=o.map_tolerance_m + 3.0 * o.sensor_sigma_m,
+            mode_bin=max(0.002, o.sensor_sigma_m),
+            rescale_after=3 if first else 0,
+        )
+        at = 0
+        for j, x in enumerate(selections):
+            weights = fit.weights[at : at + len(x.fit)]
+            at += len(x.fit)
+            if int(fit.count[j]) < min(x.need, len(x.fit)):
+                continue
+            x.ok, x.offset, x.weights = True, float(fit.offset[j]), weights
+            x.se = float(fit.se[j]) * np.sqrt(len(x.fit) / len(x.sel))  # the stride stands for all the support
+            x.plane.d += x.offset
+            x.plane.scale = max(float(fit.scale[j]), 1e-4)
+            x.plane.count = len(x.sel)
+            if isinstance(x.plane, _Face):
+                x.plane.se = x.se
+
+    def _tilt(self, x: _Selection, other: _Face, pts: _Points, p0: FloatArray, t: FloatArray) -> None:
+        """Let a fitted weld face tilt a little off its normal (a Gaussian prior of ``tilt_prior_deg``): one
+        weighted least-squares step of offset and tilt about the points' centroid (decorrelated), with the
+        biweight weights of its offset fit, carried to the seam line."""
+        o = self.options
+        face = x.plane
+        assert isinstance(face, _Face)
+        keep = x.weights > 0.0
+        if not x.ok or np.count_nonzero(keep) < 4:
+            return
+        idx, ww = x.fit[keep], x.weights[keep]
+        r = x.r[idx] - x.offset  # from the plane as fitted
+        e_u = other.n - (other.n @ face.n) * face.n
+        e_u /= np.linalg.norm(e_u)
+        q = np.take(pts.xyz, idx, axis=1) - p0[:, None]
+        u, v = e_u @ q, t @ q
+        uc, vc = float(ww @ u / ww.sum()), float(ww @ v / ww.sum())
+        X = np.column_stack([np.ones(len(r)), u - uc, v - vc])
+        tau = np.tan(np.radians(o.tilt_prior_deg))
+        XtW = X.T * ww
+        try:
+            H_inv = np.linalg.inv(XtW @ X + np.diag([0.0, tau**-2, tau**-2]))
+        except np.linalg.LinAlgError:
+            return
+        c0, a, b = H_inv @ (XtW @ r)
+        res = r - X @ np.array([c0, a, b])
+        meat = (X.T * (ww * res) ** 2) @ X
+        cov = H_inv @ meat @ H_inv * len(r) / max(len(r) - 3, 1)
+        # The plane r = c0 + a (u - uc) + b (v - vc): its value and standard error on the seam line (u = 0).
+        J = np.array([1.0, -uc, 0.0])
+        se0 = float(np.sqrt(max(J @ cov @ J, 0.0)))
+        m = face.n - a * e_u - b * t
+        norm = float(np.linalg.norm(m))
+        face.d = (face.d + c0 - a * (uc + float(e_u @ p0)) - b * (vc + float(t @ p0))) / norm
+        face.n = m / norm
+        face.se = se0 * np.sqrt(len(x.fit) / len(x.sel))
 
     def _confidence(self, face_a: _Face, face_b: _Face, errors: SeamErrors, spacing: float) -> float:
         """Confidence in [0, 1] from the standard errors of the line (lateral) and of the ends, the support of
@@ -656,7 +724,7 @@ class _Geometry:
 
     def in_face_b(self, pts: _Points, slack: float) -> BoolArray:
         """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""
-        ok = np.ones(len(pts.P), bool)
+        ok = np.ones(len(pts.cam), bool)
         R_B, c_B = self.box_b.X_AB[:3, :3], self.box_b.center
         for j in range(3):
             if j != self.k_b:

@@ -140,7 +140,8 @@ class RansacLocator:
         """Points (n, 3) within region_m of the map seam segment extended by region_m."""
         o = self.options
         if o.cloud == "dense":
-            return scene.dense.points[_fit.tube_indices(scene, seam.p_start, seam.p_end, o.region_m, o.region_m)]
+            dense = _fit.dense_index(scene)
+            return dense.tube(seam.p_start, seam.p_end, o.region_m, o.region_m, 1.0)[0].T
         pts = scene.cloud.points
         t = seam.direction
         q = pts - (seam.p_start - o.region_m * t)

@@ -1,0 +1,65 @@
+"""The vectorised plane-offset fit and the layered cloud index that make our locator fast."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cell.seams import _batch, _fit
+
+
+def test_fit_offsets_recovers_each_plane_despite_outliers_and_weighs_cameras_by_their_noise() -> None:
+    rng = np.random.default_rng(0)
+    truth = np.array([0.0021, -0.0013, 0.0004])
+    r, cam, lengths = [], [], []
+    for j, off in enumerate(truth):
+        n = 1500 + 500 * j
+        c = rng.integers(0, 2, n)  # camera 1 is five times noisier than camera 0
+        x = off + np.where(c == 0, 0.0005, 0.0025) * rng.standard_normal(n)
+        out = rng.random(n) < 0.1  # 10 % of another surface 6 mm behind
+        x[out] = off - 0.006 + 0.0005 * rng.standard_normal(int(out.sum()))
+        r.append(x)
+        cam.append(c)
+        lengths.append(n)
+    fit = _batch.fit_offsets(np.concatenate(r), lengths, np.concatenate(cam), 2, mode_half_width=0.015, rescale_after=3)
+    assert np.all(np.abs(fit.offset - truth) < 4.0 * fit.se), (fit.offset - truth, fit.se)
+    assert np.all(fit.se < 3e-5)
+    # Weighted by camera: far better than the plain mean of the inliers would be (sigma ~1.8 mm / sqrt(n)).
+    assert np.all(fit.se < 0.6 * 0.0018 / np.sqrt(np.array(lengths)))
+    # The quiet camera's outliers get no weight (beyond its biweight cut-off, not the noisy camera's); the noisy
+    # camera's inliers a twenty-fifth of the quiet one's.
+    w = np.split(fit.weights, np.cumsum(lengths)[:-1])
+    for j in range(3):
+        inl = np.abs(r[j] - truth[j]) < 0.0005
+        quiet, noisy = np.median(w[j][inl & (cam[j] == 0)]), np.median(w[j][inl & (cam[j] == 1)])
+        assert 10.0 < quiet / noisy < 60.0
+        assert np.all(w[j][(np.abs(r[j] - (truth[j] - 0.006)) < 0.001) & (cam[j] == 0)] == 0.0)
+
+
+def test_group_medians() -> None:
+    a = np.array([3.0, 1.0, 2.0, 10.0, 20.0, 0.5])
+    g = np.array([0, 0, 0, 2, 2, 2])
+    med, counts = _batch.group_medians(a, g, 4)
+    assert list(counts) == [3, 0, 3, 0]
+    assert np.allclose(med, [2.0, 0.0, 10.0, 0.0], rtol=1e-12)
+
+
+def test_cloud_index_tube_is_the_cylinder_and_its_layers_are_nested_shares() -> None:
+    rng = np.random.default_rng(1)
+    P = rng.uniform(-0.3, 0.3, (200_000, 3))
+    cam = rng.integers(0, 3, len(P))
+    index = _fit.index_of(P, cam)
+    a, b, radius, extend = np.array([-0.1, 0.02, 0.0]), np.array([0.12, -0.05, 0.07]), 0.04, 0.01
+    t = (b - a) / np.linalg.norm(b - a)
+    s = (P - (a - extend * t)) @ t
+    d = np.linalg.norm(P - (a - extend * t) - np.outer(s, t), axis=1)
+    inside = (s >= 0.0) & (s <= np.linalg.norm(b - a) + 2 * extend) & (d <= radius)
+    xyz, c = index.tube(a, b, radius, extend, 1.0)
+    assert xyz.shape[1] == int(inside.sum())
+    got = {tuple(p) for p in xyz.T}
+    assert got == {tuple(p) for p in P[inside]}
+    quarter, _ = index.tube(a, b, radius, extend, 0.25)
+    half, _ = index.tube(a, b, radius, extend, 0.5)
+    assert {tuple(p) for p in quarter.T} <= {tuple(p) for p in half.T} <= got
+    assert abs(quarter.shape[1] / inside.sum() - 0.25) < 0.03 and abs(half.shape[1] / inside.sum() - 0.5) < 0.03
+    # The density of a uniform volume is not a surface's, but the pitch must follow the share.
+    assert np.isclose(index.pitch(0.25), 2.0 * index.pitch(1.0))

@@ -16,9 +16,9 @@ Method (general: no assumption that a seam runs along x, y or z):
    (:func:`~cell.seams._batch.fit_offsets`): each plane's offset along the map's normal by iteratively
    reweighted least squares (Tukey biweight), each camera weighted by its own measured noise on that face.
    ``passes`` passes: the first from the map with wide gates (from each face's densest layer), the others with
-   gates and bands from the measured noise and the ends found. Optionally (``refine_normals``) the weld faces
-   may tilt a little in the last pass, held near the map's normal by a Gaussian prior (as-built parts are
-   rotated by hundredths of a degree, not degrees; on the fence scenarios this gained nothing measurable).
+   gates and bands from the measured noise and the ends found. In the last pass (``refine_normals``) the weld
+   faces may tilt a little, held near the map's normal by a Gaussian prior (as-built parts are rotated by
+   hundredths of a degree, not degrees): one weighted least-squares step with the fit's weights.
 4. A weld face no camera sees (too oblique, occluded) is placed from the edge where an adjacent face of the
    same part ends: the extent of that face's points across the edge (a blurred-step likelihood), searched as
    far from the map as a fitted face may drift, each camera's edge on its own (from ``edge_sample_share`` of
@@ -72,7 +72,7 @@ class OursOptions:
     min_face_points: int = 30  # fewer supporting points on a weld face: place it from an edge, or NOT_FOUND
     min_end_points: int = 40  # fewer points on a side face of A: take the end from the extent instead
     min_end_fill: float = 0.05  # ... or fewer than this fraction of the points its area would hold head on
-    refine_normals: bool = False  # let a face tilt off the map's normal in the last pass (no gain measured)
+    refine_normals: bool = True  # let a face tilt off the map's normal in the last pass (as-built parts tilt)
     tilt_prior_deg: float = 0.05  # ... standard deviation of the tilt's Gaussian prior [deg]
     sample_share: float = 0.25  # share of the dense cloud looked at (layers of _fit.INDEX_SHARES: 0.25, 0.5 or 1)
     edge_sample_share: float = 1.0  # ... where an unseen face is placed from an edge (an edge needs every point)

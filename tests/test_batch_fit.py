@@ -57,6 +57,8 @@ def test_cloud_index_tube_is_the_cylinder_and_its_layers_are_nested_shares() -> 
     assert xyz.shape[1] == int(inside.sum())
     got = {tuple(p) for p in xyz.T}
     assert got == {tuple(p) for p in P[inside]}
+    camera_of = {tuple(p): k for p, k in zip(P[inside], cam[inside], strict=True)}
+    assert all(camera_of[tuple(p)] == k for p, k in zip(xyz.T, c, strict=True))  # each point keeps its camera
     quarter, _ = index.tube(a, b, radius, extend, 0.25)
     half, _ = index.tube(a, b, radius, extend, 0.5)
     assert {tuple(p) for p in quarter.T} <= {tuple(p) for p in half.T} <= got

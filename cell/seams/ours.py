@@ -273,8 +273,8 @@ class OursLocator:
             self._fit_planes(planes + sides, pts, first)
             if last and o.refine_normals:
                 for sel_ in planes:
-                    other = face_b if sel_.plane is face_a else face_a
-                    self._tilt(sel_, other, pts, p0, t)
+                    face, other = (face_a, face_b) if sel_.plane is face_a else (face_b, face_a)
+                    self._tilt(sel_, face, other, pts, p0, t)
             # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
             face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
             face_b.area = (e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0)
@@ -606,13 +606,11 @@ class OursLocator:
             if isinstance(x.plane, _Face):
                 x.plane.se = x.se
 
-    def _tilt(self, x: _Selection, other: _Face, pts: _Points, p0: FloatArray, t: FloatArray) -> None:
+    def _tilt(self, x: _Selection, face: _Face, other: _Face, pts: _Points, p0: FloatArray, t: FloatArray) -> None:
         """Let a fitted weld face tilt a little off its normal (a Gaussian prior of ``tilt_prior_deg``): one
         weighted least-squares step of offset and tilt about the points' centroid (decorrelated), with the
         biweight weights of its offset fit, carried to the seam line."""
         o = self.options
-        face = x.plane
-        assert isinstance(face, _Face)
         keep = x.weights > 0.0
         if not x.ok or np.count_nonzero(keep) < 4:
             return

@@ -34,7 +34,6 @@ class BatchFit:
     scale : (L,) robust noise scale of each plane's points, all cameras pooled [m].
     count : (L,) points with a non-zero weight.
     weights : (n,) final combined weight of each point (biweight / sigma^2 of its camera) [1/m^2].
-    iterations : IRLS iterations run.
     """
 
     offset: FloatArray
@@ -42,7 +41,6 @@ class BatchFit:
     scale: FloatArray
     count: IntArray
     weights: FloatArray
-    iterations: int
 
 
 def group_medians(a: FloatArray, group: IntArray, n_groups: int) -> tuple[FloatArray, IntArray]:
@@ -130,7 +128,6 @@ def fit_offsets(
     inv_s2 = 1.0 / (sig * sig)
     inv_c2 = inv_s2 * (1.0 / (TUKEY_C * TUKEY_C))
     sums = np.empty((2, len(r)))
-    it = 0
     for it in range(1, iterations + 1):
         res = r - coef[label]
         if it == rescale_after + 1 and rescale_after:
@@ -155,4 +152,4 @@ def fit_offsets(
     n_eff = np.maximum(count, 2.0)
     se = np.sqrt(num / np.maximum(h * h, 1e-300) * n_eff / (n_eff - 1.0))
     se[h <= 0.0] = np.inf
-    return BatchFit(coef, se, pooled, count.astype(np.intp), ww.copy(), it)
+    return BatchFit(coef, se, pooled, count.astype(np.intp), ww.copy())

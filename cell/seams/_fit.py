@@ -16,6 +16,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray, make_pose
+from cell.seams._batch import MAD_TO_SIGMA, TUKEY_C
 from cell.seams.base import SeamScene
 from cell.types import Box
 
@@ -23,8 +24,6 @@ _BOX_KEY = "cell.seams._fit.cloud_box"
 _INDEX_KEY = "cell.seams._fit.dense_index"
 _INDEX_SEED = 20_240_601  # any fixed seed: the ranks are a property of the cloud, not of a run
 INDEX_SHARES = (0.25, 0.5, 1.0)  # cumulative shares of the dense cloud a query may ask for
-_TUKEY_C = 4.685  # biweight tuning constant: 95 % efficiency under Gaussian noise
-_MAD_TO_SIGMA = 1.4826
 
 IntArray = npt.NDArray[np.intp]
 
@@ -279,11 +278,11 @@ def _group_scales(res: FloatArray, labels: IntArray, n_groups: int, min_scale: f
     """Robust scale (MAD) [m] per point (n,): each group's own, the pooled one for points of small groups
     (``labels`` -1) or when there are fewer than two groups."""
     a = np.abs(res)
-    pooled = max(_MAD_TO_SIGMA * _mad(a), min_scale)
+    pooled = max(MAD_TO_SIGMA * _mad(a), min_scale)
     out = np.full(len(res), pooled)
     for g in range(n_groups if n_groups > 1 else 0):
         m = labels == g
-        out[m] = max(_MAD_TO_SIGMA * _mad(a[m]), min_scale)
+        out[m] = max(MAD_TO_SIGMA * _mad(a[m]), min_scale)
     return out
 
 
@@ -332,13 +331,13 @@ def robust_plane_fit(
     w = np.ones(n)
     sig = np.full(n, min_scale) if sigmas is None else np.maximum(np.asarray(sigmas, float), min_scale)
     inv_sig2 = 1.0 / (sig * sig)
-    inv_cut2 = inv_sig2 / (_TUKEY_C * _TUKEY_C)
+    inv_cut2 = inv_sig2 / (TUKEY_C * TUKEY_C)
     for it in range(iterations):
         res = r - coef[0] if k == 1 else r - X @ coef
         if sigmas is None and it in rescale_at:
             sig = _group_scales(res, labels, n_groups, min_scale)
             inv_sig2 = 1.0 / (sig * sig)
-            inv_cut2 = inv_sig2 / (_TUKEY_C * _TUKEY_C)
+            inv_cut2 = inv_sig2 / (TUKEY_C * TUKEY_C)
         w = 1.0 - res * res * inv_cut2
         np.maximum(w, 0.0, out=w)
         w *= w
@@ -376,7 +375,7 @@ def robust_plane_fit(
             cov = Hinv @ meat @ Hinv * n_eff / (n_eff - k)
         except np.linalg.LinAlgError:
             cov = np.full((k, k), np.inf)
-    scale = _MAD_TO_SIGMA * _mad(np.abs(res[inl])) if np.any(inl) else float("inf")
+    scale = MAD_TO_SIGMA * _mad(np.abs(res[inl])) if np.any(inl) else float("inf")
     return PlaneFit(coef=coef, cov=cov, scale=scale, weights=w, sigmas=sig)
 
 

@@ -140,7 +140,6 @@ class _End:
     se: float = float("inf")
     scale: float = 0.003  # noise of the side face's points [m]
     source: str = "map"
-    count: int = 0  # points on the side face
 
 
 @dataclass
@@ -168,7 +167,6 @@ class _Points:
     xyz: FloatArray
     cam: IntArray
     ok: BoolArray  # above the table and away from every other part
-    scene: SeamScene
     pitch: float  # point pitch of these points on a surface seen head on [m] (the sample's, thinned)
     n_cams: int  # camera indices run 0 .. n_cams - 1
     _along: dict[bytes, FloatArray] = field(default_factory=dict)
@@ -354,7 +352,7 @@ class OursLocator:
             q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
             h = 0.5 * part.box.size + o.map_tolerance_m
             ok &= (np.abs(q[0]) > h[0]) | (np.abs(q[1]) > h[1]) | (np.abs(q[2]) > h[2])
-        return _Points(xyz, cam, ok, scene, index.pitch(share * kept), int(cam.max(initial=0)) + 1)
+        return _Points(xyz, cam, ok, index.pitch(share * kept), int(cam.max(initial=0)) + 1)
 
     def _face_from_edge(
         self,
@@ -602,9 +600,8 @@ class OursLocator:
             x.se = float(fit.se[j]) * np.sqrt(len(x.fit) / len(x.sel))  # the stride stands for all the support
             x.plane.d += x.offset
             x.plane.scale = max(float(fit.scale[j]), 1e-4)
-            x.plane.count = len(x.sel)
             if isinstance(x.plane, _Face):
-                x.plane.se = x.se
+                x.plane.se, x.plane.count = x.se, len(x.sel)
 
     def _tilt(self, x: _Selection, face: _Face, other: _Face, pts: _Points, p0: FloatArray, t: FloatArray) -> None:
         """Let a fitted weld face tilt a little off its normal (a Gaussian prior of ``tilt_prior_deg``): one

@@ -11,7 +11,7 @@ from cell.scenario import PaperLocatorSpec
 from cell.seams.base import SeamScene
 from cell.seams.joint import find_joints
 from cell.seams.metrics import segment_errors
-from cell.seams.paper import TREE_KEY, PaperLocator, axis_faces, second_most_frequent
+from cell.seams.paper import PaperLocator, axis_faces, second_most_frequent
 from cell.seams.truth import true_seams
 from cell.seams.visibility import visibility
 from cell.types import Box, Cloud, MapSeam, Part, SeamStatus, WeldMap
@@ -126,7 +126,6 @@ def test_finds_seams_along_x_y_and_z_on_the_exact_part(grid: tuple[float, float,
         paper_me, endpoint, lateral, swapped = segment_errors(est.p_start, est.p_end, *truth[s.id])
         assert not swapped
         assert paper_me < 1.0 and endpoint < 1.0 and lateral < 1.0, s.id
-    assert TREE_KEY in scene.cache  # built once, kept for the other seams
 
 
 def test_finds_seams_of_a_part_built_off_the_map() -> None:

@@ -1,10 +1,10 @@
 """The paper's seam locator (section 3.6): masks around the map seam, boundary points, extremes and
 frequencies.
 
-Everything is in the robot frame R, metres. The cloud features (KD-tree, point spacing, normals, boundary
-points) are computed with numpy/scipy once per scene and cached in :attr:`SeamScene.cache`; every threshold
-derives from the cloud's own point spacing (the voxel size of a voxel-downsampled cloud) or from
-:class:`PaperLocatorSpec`.
+Everything is in the robot frame R, metres. The features of a mask's points (KD-tree, point spacing, normals,
+boundary points) are computed with numpy/scipy for each mask, as the paper's step 2 does ("from the masked point
+cloud, extract boundary points"); every threshold derives from the cloud's own point spacing (the voxel size of
+a voxel-downsampled cloud) or from :class:`PaperLocatorSpec`.
 """
 
 from __future__ import annotations
@@ -20,9 +20,6 @@ from cell.scenario import PaperLocatorSpec
 from cell.seams.base import SeamScene
 from cell.types import MapSeam, SeamEstimate, SeamStatus
 
-TREE_KEY = "kdtree:cloud"  # scipy cKDTree of scene.cloud.points (shared with other locators)
-FEATURES_KEY = "features:cloud"
-
 # Point spacing = median distance to the 4th nearest neighbour: on a voxel grid that is one voxel whether a
 # face keeps one point per grid cell or two (a face lying on a grid plane fills the voxels on both sides of
 # it, and the nearest neighbour is then its twin, a fraction of a millimetre away).
@@ -36,22 +33,15 @@ BOUNDARY_ANGLE_RAD = np.pi / 2.0  # angle gap that makes a boundary point (open3
 
 @dataclass(frozen=True)
 class CloudFeatures:
-    """spacing : point spacing [m] (the voxel size of a voxelised cloud, see :data:`SPACING_NEIGHBOUR`);
+    """Features of a set of points (n, 3).
+
+    spacing : point spacing [m] (the voxel size of a voxelised cloud, see :data:`SPACING_NEIGHBOUR`);
     normals : (n, 3) unit (sign arbitrary);
     boundary : (n,) bool, the point's neighbourhood is one-sided on its tangent plane."""
 
     spacing: float
     normals: FloatArray
     boundary: npt.NDArray[np.bool_]
-
-
-def scene_tree(scene: SeamScene) -> cKDTree:
-    """The KD-tree of ``scene.cloud``, built once per scene."""
-    tree = scene.cache.get(TREE_KEY)
-    if tree is None:
-        tree = cKDTree(np.asarray(scene.cloud.points))
-        scene.cache[TREE_KEY] = tree
-    return tree
 
 
 def _neighbours(tree: cKDTree, pts: FloatArray, k: int, radius: float) -> tuple[npt.NDArray[np.intp], npt.NDArray]:
@@ -103,23 +93,16 @@ def boundary_points(tree: cKDTree, pts: FloatArray, normals: FloatArray, radius:
     return np.asarray((max_gap > BOUNDARY_ANGLE_RAD) | few | ~np.isfinite(normals).all(1))
 
 
-def cloud_features(scene: SeamScene) -> CloudFeatures:
-    """Spacing, normals and boundary flags of ``scene.cloud``, computed once per scene."""
-    feats = scene.cache.get(FEATURES_KEY)
-    if isinstance(feats, CloudFeatures):
-        return feats
-    pts = np.asarray(scene.cloud.points)
-    if len(pts) < 4:
-        feats = CloudFeatures(0.0, np.full((len(pts), 3), np.nan), np.ones(len(pts), bool))
-    else:
-        tree = scene_tree(scene)
-        d, _ = tree.query(pts, k=SPACING_NEIGHBOUR + 1)
-        spacing = float(np.median(d[:, SPACING_NEIGHBOUR]))
-        normals = estimate_normals(tree, pts, NORMAL_RADIUS_SPACINGS * spacing)
-        boundary = boundary_points(tree, pts, normals, BOUNDARY_RADIUS_SPACINGS * spacing)
-        feats = CloudFeatures(spacing, normals, boundary)
-    scene.cache[FEATURES_KEY] = feats
-    return feats
+def cloud_features(pts: FloatArray) -> CloudFeatures:
+    """Spacing, normals and boundary flags of the points ``pts`` (n, 3) (one mask's), from their own KD-tree."""
+    if len(pts) < SPACING_NEIGHBOUR + 1:
+        return CloudFeatures(0.0, np.full((len(pts), 3), np.nan), np.ones(len(pts), bool))
+    tree = cKDTree(pts)
+    d, _ = tree.query(pts, k=SPACING_NEIGHBOUR + 1)
+    spacing = float(np.median(d[:, SPACING_NEIGHBOUR]))
+    normals = estimate_normals(tree, pts, NORMAL_RADIUS_SPACINGS * spacing)
+    boundary = boundary_points(tree, pts, normals, BOUNDARY_RADIUS_SPACINGS * spacing)
+    return CloudFeatures(spacing, normals, boundary)
 
 
 # The locator ------------------------------------------------------------------------------------------------
@@ -205,7 +188,7 @@ class PaperLocator:
 
     1. outer mask around the map seam's start point, ``outer_mask_m`` = (across, along) half-widths, all z
        (l_z);
-    2. boundary points (angle-gap criterion on the local tangent plane, computed once per scene);
+    2. boundary points of the masked cloud (angle-gap criterion on the local tangent plane);
     3. inner mask ``inner_mask_m`` = (across, along) half-widths on the boundary points;
     4. start X = the min or max X of those points, whichever is nearer the map start's X; start Y = the second
        most frequent Y (``frequency_bin_m`` bins); start Z = the map start's Z;
@@ -224,8 +207,9 @@ class PaperLocator:
 
     Robustness choices (``strict=False``, the default; ``strict=True`` runs step 4 exactly as written):
 
-    - Boundary points are found once on the whole scene cloud, then masked (on a masked cloud the mask's own
-      cut would be "boundary", which is what the paper's second, smaller mask removes).
+    - Boundary points are extracted from the outer mask's points, as step 2 says; the mask's own cut is
+      "boundary" too, and the paper's second, smaller mask removes it (on fence1, fence1-exact and fence2, 10
+      of 4000 boundary flags inside the inner masks differ from those found on the whole cloud).
     - Step 4 reads each value on the face it belongs to. In a voxel-averaged cloud a voxel that holds one flat
       face keeps the face's coordinate exactly, while boundary (edge) voxels average two faces and are off by
       up to half a voxel, and the voxels of a face parallel to an axis share their voxel-centre coordinate:
@@ -263,10 +247,11 @@ class PaperLocator:
                 seam,
                 f"only {n_outer} cloud points in the outer mask around the seam start (need {MIN_MASK_POINTS})",
             )
-        feats = cloud_features(scene)
-        # Steps 2-3: the boundary points within the smaller mask.
-        inner = outer & (np.abs(pts[:, c] - s0[c]) <= ic) & (np.abs(pts[:, a] - s0[a]) <= ia)
-        pb = pts[inner & feats.boundary]
+        # Step 2: the masked cloud's features (boundary points); step 3: those within the smaller mask.
+        po = pts[outer]
+        feats = cloud_features(po)
+        inner = (np.abs(po[:, c] - s0[c]) <= ic) & (np.abs(po[:, a] - s0[a]) <= ia)
+        pb = po[inner & feats.boundary]
         if len(pb) < MIN_BOUNDARY_POINTS:
             return _not_found(
                 seam,
@@ -279,13 +264,12 @@ class PaperLocator:
         along = second_most_frequent(pb[:, a], bin_m)
         confidence = 0.5
         if not self.strict:  # ... then read on the faces (see the class docstring).
-            po, no = pts[outer], feats.normals[outer]
             ext = FACE_EXTENT_SPACINGS * feats.spacing
-            face_c = _nearest(axis_faces(po, no, c, bin_m, ext, s0), across, float(s0[c]), ic)
-            face_a = _nearest(axis_faces(po, no, a, bin_m, ext, s0), float(s0[a]), float(s0[a]), ia)
+            face_c = _nearest(axis_faces(po, feats.normals, c, bin_m, ext, s0), across, float(s0[c]), ic)
+            face_a = _nearest(axis_faces(po, feats.normals, a, bin_m, ext, s0), float(s0[a]), float(s0[a]), ia)
             confidence = 1.0
             if face_a is None:  # the start face is not seen: read the abutting part's opposite face
-                face_a = self._along_from_far_face(scene, seam, pts, feats, (c, a), ext)
+                face_a = self._along_from_far_face(scene, seam, pts, (c, a), ext)
                 confidence -= 0.1
             confidence -= 0.25 * ((face_c is None) + (face_a is None))
             across = across if face_c is None else face_c
@@ -301,7 +285,6 @@ class PaperLocator:
         scene: SeamScene,
         seam: MapSeam,
         pts: FloatArray,
-        feats: CloudFeatures,
         axes: tuple[int, int],
         min_extent: float,
     ) -> float | None:
@@ -325,7 +308,8 @@ class PaperLocator:
         mask = (np.abs(pts[:, c] - s0[c]) <= oc) & (np.abs(pts[:, a] - far) <= oa)
         at = s0.copy()
         at[a] = far
-        faces = axis_faces(pts[mask], feats.normals[mask], a, self.spec.frequency_bin_m, min_extent, at)
+        pm = pts[mask]
+        faces = axis_faces(pm, cloud_features(pm).normals, a, self.spec.frequency_bin_m, min_extent, at)
         found = _nearest(faces, far, far, ia)
         return None if found is None else found + (near - far)
 

@@ -134,6 +134,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
         weldmap=weldmap_R,
         joints=joints,
         table_z=table_z_R,
+        dense_voxels=perceived.registered_voxels,
     )
     return Scene(seam_scene, perceived, alignment, X_RM, timings, missing)
 

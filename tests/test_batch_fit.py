@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from cell.seams import _batch, _fit
+from cell.types import Cloud
 
 
 def test_fit_offsets_recovers_each_plane_despite_outliers_and_weighs_cameras_by_their_noise() -> None:
@@ -46,8 +47,8 @@ def test_group_medians() -> None:
 def test_cloud_index_tube_is_the_cylinder_and_its_layers_are_nested_shares() -> None:
     rng = np.random.default_rng(1)
     P = rng.uniform(-0.3, 0.3, (200_000, 3))
-    cam = rng.integers(0, 3, len(P))
-    index = _fit.index_of(P, cam)
+    cam = rng.integers(0, 3, len(P)).astype(np.int16)
+    index = _fit.index_of(Cloud(P, "R", cam))
     a, b, radius, extend = np.array([-0.1, 0.02, 0.0]), np.array([0.12, -0.05, 0.07]), 0.04, 0.01
     t = (b - a) / np.linalg.norm(b - a)
     s = (P - (a - extend * t)) @ t

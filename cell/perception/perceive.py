@@ -24,6 +24,7 @@ from cell.perception.preprocess import downsample, preprocess
 from cell.perception.splice import Spliced, splice
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage
+from cell.voxels import VoxelTable, voxel_order
 
 
 @dataclass(frozen=True)
@@ -36,9 +37,12 @@ class Perceived:
     spliced : the splice result (unfiltered dense cloud and the ICP diagnostics).
     lost : cameras left out (their data cannot be trusted), in capture order; ``lost_reasons`` says why.
     lost_reasons : camera name -> one-line reason it was left out.
-    timings : step name -> wall time [s] (``clouds``, ``splice``, ``preprocess``, ``downsample``).
+    timings : step name -> wall time [s] (``clouds``, ``splice``, ``preprocess``, ``downsample``: both voxel
+        grids).
     registered : every camera registered, Z-passthrough and outlier filtered, *not* merged (per-point camera
-        index): what a locator that weighs each camera by its own noise reads.
+        index), in voxel order: what a locator that weighs each camera by its own noise reads.
+    registered_voxels : where ``registered``'s voxels (``spec.voxel_m``) lie in it (what such a locator's tube
+        queries read).
     """
 
     dense: Cloud
@@ -54,6 +58,7 @@ class Perceived:
         return tuple(f"{n}: {self.lost_reasons.get(n, 'lost')}" for n in self.lost)
 
     registered: Cloud = field(default_factory=lambda: Cloud(np.zeros((0, 3)), "R"))
+    registered_voxels: VoxelTable | None = None
 
 
 def perceive(
@@ -99,5 +104,8 @@ def perceive(
         raise SensorError(f"Z passthrough and outlier removal left no point of the {len(spliced.dense)} spliced ones")
     t = time.perf_counter()
     downsampled = downsample(dense, spec.voxel_m)
+    registered, registered_voxels = voxel_order(registered, spec.voxel_m)
     timings["downsample"] = time.perf_counter() - t
-    return Perceived(dense, downsampled, clouds, spliced, lost, timings, {n: why[n] for n in lost}, registered)
+    return Perceived(
+        dense, downsampled, clouds, spliced, lost, timings, {n: why[n] for n in lost}, registered, registered_voxels
+    )

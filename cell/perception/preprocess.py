@@ -14,6 +14,7 @@ from scipy.spatial import cKDTree
 from cell.geometry import FloatArray, invert, transform_points
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Cloud
+from cell.voxels import voxel_corners, voxel_order
 
 _OUTLIER_MIN_NEIGHBOURS = 3  # other points within the radius a point needs to be kept
 
@@ -94,31 +95,20 @@ def downsample(cloud: Cloud, voxel_m: float) -> Cloud:
 
     The grid is anchored at the origin of the cloud's frame (so it does not move with outliers). A voxel's
     camera index is that of its points when they all came from one capture, else -1. Points come out in voxel
-    order.
+    order (:func:`cell.voxels.voxel_order`).
     """
     if voxel_m <= 0:
         raise ValueError(f"downsample: voxel_m must be positive, got {voxel_m}")
     if len(cloud) == 0:
         return cloud
-    p = np.asarray(cloud.points)
-    ijk = np.floor(p / voxel_m).astype(np.int64)
-    ijk -= ijk.min(axis=0)
-    dims = ijk.max(axis=0) + 1
-    keys = (ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2]
-    _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
-    m = len(counts)
+    ordered, table = voxel_order(cloud, voxel_m)
+    at = table.starts[:-1]
+    counts = table.counts
     # Centroids relative to each voxel's corner keep the sums small (precision far from the origin).
-    corner = np.floor(p / voxel_m) * voxel_m
-    q = p - corner
-    centroid = np.stack([np.bincount(inverse, q[:, i], m) for i in range(3)], axis=1) / counts[:, None]
-    first = np.zeros(m, dtype=np.intp)
-    first[inverse[::-1]] = np.arange(len(p))[::-1]
-    centroid += corner[first]
-    cam = cloud.camera.astype(np.int64)
-    lo = np.full(m, np.iinfo(np.int64).max)
-    hi = np.full(m, np.iinfo(np.int64).min)
-    np.minimum.at(lo, inverse, cam)
-    np.maximum.at(hi, inverse, cam)
+    corner = voxel_corners(table)
+    q = ordered.points - np.repeat(corner, counts, axis=0)
+    centroid = np.add.reduceat(q, at, axis=0) / counts[:, None] + corner
+    cam = ordered.camera
+    lo, hi = np.minimum.reduceat(cam, at), np.maximum.reduceat(cam, at)
     camera = np.where(lo == hi, lo, -1).astype(np.int16)
     return Cloud(centroid, cloud.frame, camera, cloud.cameras)

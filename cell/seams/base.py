@@ -14,6 +14,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from cell.types import Cloud, MapSeam, SeamEstimate, WeldMap
+from cell.voxels import VoxelTable
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,8 @@ class SeamScene:
     weldmap : the welding map aligned to the cloud (frame ``"R"``).
     joints : seam id -> :class:`Joint`.
     table_z : height of the table top in R [m] (seams against it cannot be seen).
+    dense_voxels : where the voxels of ``dense`` lie in it, when perception handed it on in voxel order (None:
+        a locator that needs it orders ``dense`` itself).
     cache : per-scene scratch space a locator may fill once and reuse for every seam (e.g. a KD-tree);
         it is the one mutable member, and only ever holds values derived from the fields above.
     """
@@ -55,6 +58,7 @@ class SeamScene:
     weldmap: WeldMap
     joints: Mapping[str, Joint]
     table_z: float
+    dense_voxels: VoxelTable | None = None
     cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
 

@@ -40,6 +40,7 @@ Method (general: no assumption that a seam runs along x, y or z):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -53,6 +54,7 @@ from cell.seams.base import Joint, SeamScene
 from cell.types import BOX_FACES, Box, MapSeam, SeamEstimate, SeamStatus
 
 BoolArray = npt.NDArray[np.bool_]
+SUPPORT_FULL_MARKS = 0.4  # share of a well-seen surface's points on a face that earns full confidence
 IntArray = npt.NDArray[np.intp]
 _Z = np.array([0.0, 0.0, 1.0])
 
@@ -69,9 +71,9 @@ class OursOptions:
     sensor_sigma_m: float = 0.003  # depth noise assumed before it is measured
     gate_sigmas: float = 3.5  # half-width of the gate around a plane, in measured noise scales
     passes: int = 2  # fits: the first from the map with wide gates, the others with measured noise and ends
-    min_face_points: int = 30  # fewer supporting points on a weld face: place it from an edge, or NOT_FOUND
+    min_face_points: int = 30  # fewer supporting points (dense cloud's) on a weld face: place it from an edge
     min_end_points: int = 40  # fewer points on a side face of A: take the end from the extent instead
-    min_end_fill: float = 0.05  # ... or fewer than this fraction of the points its area would hold head on
+    min_end_fill: float = 0.04  # ... or fewer than this fraction of the points its area would hold seen well
     refine_normals: bool = True  # let a face tilt off the map's normal in the last pass (as-built parts tilt)
     tilt_prior_deg: float = 0.05  # ... standard deviation of the tilt's Gaussian prior [deg]
     sample_share: float = 0.25  # share of the dense cloud looked at (layers of _fit.INDEX_SHARES: 0.25, 0.5 or 1)
@@ -167,9 +169,14 @@ class _Points:
     xyz: FloatArray
     cam: IntArray
     ok: BoolArray  # above the table and away from every other part
-    pitch: float  # point pitch of these points on a surface seen head on [m] (the sample's, thinned)
+    pitch: float  # point pitch of these points on a well-seen surface [m] (the sample's, thinned)
+    share: float  # the share of the dense cloud's points these are
     n_cams: int  # camera indices run 0 .. n_cams - 1
     _along: dict[bytes, FloatArray] = field(default_factory=dict)
+
+    def least(self, dense_points: int) -> int:
+        """How many of these points stand for ``dense_points`` of the dense cloud (at least 3)."""
+        return max(3, math.ceil(dense_points * self.share))
 
     def along(self, n: FloatArray) -> FloatArray:
         """P @ n (n,) [m], computed once per direction (most planes keep the map's normal)."""
@@ -219,6 +226,12 @@ class OursLocator:
             return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, "the seam lies against the table"), NO_ERRORS
 
         pts = self._points(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng)
+
+        def dense(a: FloatArray, b: FloatArray) -> _Points:
+            """The tube about a-b (3,) from ``edge_sample_share`` of the cloud (an end found as an edge needs
+            density)."""
+            return self._points(scene, a, b, o.tube_radius_m, 0.0, joint, rng, o.edge_sample_share)
+
         geo = _Geometry.of(box_a, box_b, joint, t, o.edge_band_m)
         s_map = sorted((float(t @ (seam.p_start - p0)), float(t @ (seam.p_end - p0))))
         face_a = _Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
@@ -252,7 +265,7 @@ class OursLocator:
                     continue  # placed from an edge in the first pass
                 gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
                 sel = np.flatnonzero(region & (np.abs(r) < gate))
-                if len(sel) >= o.min_face_points:
+                if len(sel) >= pts.least(o.min_face_points):
                     planes.append(_Selection(face, r, sel, _thin(sel, o.max_fit_points)))
                     continue
                 why = "no edge of it is seen either: not seen or not there"
@@ -264,8 +277,8 @@ class OursLocator:
                         continue
                 return _not_found(
                     seam.id,
-                    f"face {face.name} is seen by no usable camera ({len(sel)} points near the seam, needs "
-                    f"{o.min_face_points}) and {why}",
+                    f"face {face.name} is seen by no usable camera ({len(sel)} points near the seam in a "
+                    f"{pts.share:.0%} sample, needs {pts.least(o.min_face_points)}) and {why}",
                 )
             sides = self._side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack)
             self._fit_planes(planes + sides, pts, first)
@@ -285,7 +298,7 @@ class OursLocator:
                         f"face {name} fitted {drift * 1000:.1f} mm from the map "
                         f"(allowed {2000 * o.map_tolerance_m:.1f} mm): wrong surface or part moved",
                     )
-            self._find_ends(ends, sides, pts, face_a, face_b, p0, t, s_map)
+            self._find_ends(ends, sides, pts, dense if last else None, face_a, face_b, p0, t, s_map)
 
         length = ends[1].s - ends[0].s
         if not 0.3 * (s_map[1] - s_map[0]) < length < 2.0 * (s_map[1] - s_map[0]) + 2.0 * o.extend_m:
@@ -352,7 +365,7 @@ class OursLocator:
             q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
             h = 0.5 * part.box.size + o.map_tolerance_m
             ok &= (np.abs(q[0]) > h[0]) | (np.abs(q[1]) > h[1]) | (np.abs(q[2]) > h[2])
-        return _Points(xyz, cam, ok, index.pitch(share * kept), int(cam.max(initial=0)) + 1)
+        return _Points(xyz, cam, ok, index.pitch(share * kept), share * kept, int(cam.max(initial=0)) + 1)
 
     def _face_from_edge(
         self,
@@ -379,13 +392,23 @@ class OursLocator:
         crop = self._crop_box(scene)
         best: _EdgePlacement | None = None
         why: list[str] = []
+        mid = 0.5 * (seam.p_start + seam.p_end)
+        tilt = np.tan(np.radians(o.tilt_prior_deg))
+        edges = []
         for g in BOX_FACES:
-            k_g = "xyz".index(g[1])
-            if k_g == k_f or g == skip:
-                continue
             n_g, d_g = box.face_plane(g)
+            if "xyz".index(g[1]) == k_f or g == skip or _on_table(n_g, d_g, scene.table_z, o.map_tolerance_m):
+                continue  # not adjacent, the joint's end face, or never seen
+            q0, e = _fit.plane_intersection(face.n, face.d, n_g, d_g, mid)
+            reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
+            edges.append((reach, g, n_g, d_g, q0, e))
+        for reach, g, n_g, d_g, q0, e in sorted(edges, key=lambda x: x[0]):
+            # The face is carried from its edge to the seam: a tilt within the prior moves it by tilt x reach, so
+            # an edge that far cannot place it better than the best one found.
+            if best is not None and tilt * reach >= best.se:
+                continue
+            k_g = "xyz".index(g[1])
             # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
-            q0, e = _fit.plane_intersection(face.n, face.d, n_g, d_g, 0.5 * (seam.p_start + seam.p_end))
             s_ends = sorted(float(e @ (p - q0)) for p in (seam.p_start, seam.p_end))
             e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
             radius = float(np.hypot(max(-lo, hi), gate))
@@ -427,10 +450,7 @@ class OursLocator:
                     why.append(max(faults)[1])
                 continue
             b_g, se_g = _combine(per_cam)
-            # The face is carried from its edge to the seam: a tilt within the prior moves it by tilt x distance.
-            mid = 0.5 * (seam.p_start + seam.p_end)
-            reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
-            se_g = float(np.hypot(se_g, np.tan(np.radians(o.tilt_prior_deg)) * reach))
+            se_g = float(np.hypot(se_g, tilt * reach))
             if best is None or se_g < best.se:
                 best = _EdgePlacement(g, b_g, se_g, max(fit.scale, 1e-4), len(uu), len(per_cam))
         if best is None:
@@ -481,6 +501,7 @@ class OursLocator:
         ends: list[_End],
         sides: list[_Selection],
         pts: _Points,
+        dense: Callable[[FloatArray, FloatArray], _Points] | None,
         face_a: _Face,
         face_b: _Face,
         p0: FloatArray,
@@ -488,7 +509,9 @@ class OursLocator:
         s_map: list[float],
     ) -> None:
         """Update both ends on the fitted line p0 + s t: the table where A rests on it, A's side face where it
-        was fitted, else the extent of face A's support along the seam."""
+        was fitted, else the extent of face A's support along the seam: the quantiles of its points in ``pts``
+        extrapolated, then refined as an edge in the ``dense`` points of a short tube about it (None: not
+        refined, as in a pass before the last)."""
         o = self.options
         fitted = {id(x.plane): x for x in sides if x.ok}
         known = [False, False]
@@ -509,28 +532,38 @@ class OursLocator:
             return
         # Face A's support along t; a known end's neighbourhood is cut away (A's side face shows up there),
         # which only shifts the CDF by a constant and leaves the other end's extrapolation unbiased.
-        r_a = pts.along(face_a.n) - face_a.d
-        r_b = pts.along(face_b.n) - face_b.d
-        s = pts.along(t) - float(p0 @ t)
         band_b = max(o.corner_band_m, 3.0 * face_b.scale)
-        near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         cut = o.edge_band_m + 3.0 * face_a.scale
-        if known[0]:
-            near_a &= s > ends[0].s + cut
-        if known[1]:
-            near_a &= s < ends[1].s - cut
-        extent = _fit.cdf_extent(s[near_a]) if np.count_nonzero(near_a) >= o.min_face_points else None
+
+        def along_a(pts: _Points) -> FloatArray:
+            """The parameters along the line of the points of face A's support among ``pts``."""
+            r_a = pts.along(face_a.n) - face_a.d
+            r_b = pts.along(face_b.n) - face_b.d
+            s = pts.along(t) - float(p0 @ t)
+            near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
+            if known[0]:
+                near_a &= s > ends[0].s + cut
+            if known[1]:
+                near_a &= s < ends[1].s - cut
+            return s[near_a]
+
+        s_a = along_a(pts)
+        extent = _fit.cdf_extent(s_a) if len(s_a) >= pts.least(o.min_face_points) else None
         for k, end in enumerate(ends):
             if known[k]:
                 continue
-            if extent is not None:
-                # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood).
+            if extent is not None and dense is not None:
+                # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
+                # point of the dense cloud within the likelihood's window about it.
                 sign = 1.0 if k == 1 else -1.0
-                edge, se = _fit.edge_ml(sign * s[near_a], sign * extent[k])
+                reach = _fit.EDGE_WINDOW_M + o.edge_band_m
+                s_d = along_a(dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t))
+                edge, se = _fit.edge_ml(sign * s_d, sign * extent[k])
                 if np.isfinite(se):
                     # The curvature understates the scatter of a blurred edge: no better than 3 spacings.
-                    density = np.count_nonzero(near_a) / max(extent[1] - extent[0], 1e-3)  # [1/m]
-                    end.s, end.se, end.source = sign * edge, max(se, 3.0 / density), "extent"
+                    inside = np.count_nonzero(np.abs(s_d - extent[k]) < _fit.EDGE_WINDOW_M)
+                    density = inside / (2.0 * _fit.EDGE_WINDOW_M)  # [1/m]
+                    end.s, end.se, end.source = sign * edge, max(se, 3.0 / max(density, 1.0)), "extent"
                 else:
                     end.s, end.se, end.source = extent[k], extent[2], "extent"
             else:
@@ -555,7 +588,7 @@ class OursLocator:
         band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
         eb = o.edge_band_m + slack
         side = (r_a < -eb) & (r_a > -(geo.depth_a - eb)) & (r_b >= band_b) & (r_b <= geo.length_a - eb) & pts.ok
-        # A side face seen at all shows a good part of the points its patch would hold seen head on; a few
+        # A side face seen at all shows a good part of the points its patch would hold seen well; a few
         # dozen flying pixels off an edge (a face seen at grazing incidence drops out) must not pass for it.
         patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * o.edge_band_m) * (
             min(geo.length_a, o.tube_radius_m) - band_b - o.edge_band_m
@@ -640,8 +673,8 @@ class OursLocator:
 
     def _confidence(self, face_a: _Face, face_b: _Face, errors: SeamErrors, spacing: float) -> float:
         """Confidence in [0, 1] from the standard errors of the line (lateral) and of the ends, the support of
-        each face (its points against what a head-on view of its region at the cloud's point ``spacing`` [m]
-        would give; half of that earns full marks) and the residual noise. A face placed from an edge enters by
+        each face (its points against what a well-seen surface of its region at the cloud's point ``spacing``
+        [m] would give; 40 % of that earns full marks) and the residual noise. A face placed from an edge enters by
         its edge's standard error (see :meth:`_face_from_edge`)."""
         o = self.options
         se_lat, se_end = errors.lateral_m, max(errors.start_m, errors.end_m)
@@ -650,7 +683,7 @@ class OursLocator:
             for f in (face_a, face_b):
                 if f.source == "points":
                     expect = max(f.area, 1e-6) / spacing**2
-                    support = min(support, f.count / (0.5 * expect))
+                    support = min(support, f.count / (SUPPORT_FULL_MARKS * expect))
         noise = min(1.0, 2.0 * o.sensor_sigma_m / max(face_a.scale, face_b.scale))
         conf = (
             np.sqrt(support * noise)
@@ -713,7 +746,7 @@ class _Geometry:
         for sign in (-1.0, 1.0):
             n = sign * axis
             d = float(n @ c) + h
-            on_table = self.has_sides and float(n @ _Z) < -0.9 and abs(d + table_z) < tol
+            on_table = self.has_sides and _on_table(n, d, table_z, tol)
             out.append(_End(-_Z, -table_z, True) if on_table else _End(n, d, False))
         return out
 
@@ -778,6 +811,11 @@ def _against_table(n_a: FloatArray, n_b: FloatArray, seam: MapSeam, table_z: flo
     """A seam on a downward face, at the table's height: no camera can see it."""
     low = max(float(seam.p_start[2]), float(seam.p_end[2])) < table_z + tol
     return low and min(float(n_a @ _Z), float(n_b @ _Z)) < -0.7
+
+
+def _on_table(n: FloatArray, d: float, table_z: float, tol: float) -> bool:
+    """Whether the plane n . p = d is a downward face resting on the table (within ``tol`` [m])."""
+    return float(n @ _Z) < -0.9 and abs(d + table_z) < tol
 
 
 def _combine(estimates: list[tuple[float, float]]) -> tuple[float, float]:

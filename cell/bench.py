@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 from cell import pipeline
 from cell.scenario import ExtrinsicErrorSpec, Scenario
+from cell.types import SeamEstimate
 
 # The paper's Table 1 (ms and mm per seam, 8 seams each): scenario -> method -> (ME mm, ms).
 PAPER_TABLE1: dict[str, dict[str, tuple[float, float]]] = {
@@ -95,14 +96,17 @@ def run(
             cap = pipeline.capture(s)
             scene = pipeline.build_scene(cap)
             truth = pipeline.truths(cap, scene.seam_scene.weldmap)
-            for method in methods:
-                progress(f"{s.name}: {method}")
-                runs = []
-                for _ in range(max(1, repeat)):
-                    # Every run from a cold cache: each method's once-per-scene work (indexes, KD-trees,
-                    # features) lands on its first seam, in every run, so the amortised time includes it.
+            progress(f"{s.name}: {', '.join(methods)} x {max(1, repeat)}")
+            all_runs: dict[str, list[tuple[SeamEstimate, ...]]] = {method: [] for method in methods}
+            for _ in range(max(1, repeat)):
+                # The methods take turns (a slower spell of the machine hits them alike), every run from a cold
+                # cache: each method's once-per-scene work (indexes, KD-trees, features) lands in every run,
+                # so the amortised time includes it.
+                for method in methods:
                     scene.seam_scene.cache.clear()
-                    runs.append(pipeline.locate(scene, s, method))
+                    all_runs[method].append(pipeline.locate(scene, s, method))
+            for method in methods:
+                runs = all_runs[method]
                 estimates = runs[0]
                 per_seam, _ = pipeline.evaluate(estimates, truth)
                 times = [

@@ -142,6 +142,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
 def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet) -> tuple[SeamEstimate, ...]:
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
     from cell.perception.health import screen
+    from cell.seams.base import BatchSeamLocator
     from cell.seams.registry import make_locator
     from cell.seams.visibility import visibility
 
@@ -150,14 +151,29 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     rng = scenario.rng(f"locator/{method}")
     progress(f"locating {len(ss.weldmap.seams)} seams ({method})")
     out = []
+    hidden = {}
     for seam in ss.weldmap.seams:
         visible, reason = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
         if not visible:
-            out.append(SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason))
-            continue
+            hidden[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason)
+    seams = [seam for seam in ss.weldmap.seams if seam.id not in hidden]
+    timed: dict[str, tuple[SeamEstimate, float]] = {}
+    if isinstance(locator, BatchSeamLocator) and seams:
+        # Found together: each seam is charged an equal share of the whole batch's time.
         t = time.perf_counter()
-        est = locator.locate(ss, seam, rng)
-        dt = time.perf_counter() - t
+        found = locator.locate_many(ss, seams, rng)
+        dt = (time.perf_counter() - t) / len(seams)
+        timed = {est.id: (est, dt) for est in found}
+    else:
+        for seam in seams:
+            t = time.perf_counter()
+            est = locator.locate(ss, seam, rng)
+            timed[seam.id] = (est, time.perf_counter() - t)
+    for seam in ss.weldmap.seams:
+        if seam.id in hidden:
+            out.append(hidden[seam.id])
+            continue
+        est, dt = timed[seam.id]
         out.append(SeamEstimate(est.id, est.status, est.reason, est.p_start, est.p_end, est.confidence, time_s=dt))
     # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
     return screen(ss, tuple(out), scene.missing)

@@ -242,6 +242,20 @@ def test_ours_is_deterministic(scenes: dict) -> None:
     assert e1.confidence == e2.confidence
 
 
+@pytest.mark.parametrize("case", list(CASES))
+def test_ours_finds_seams_together_as_it_does_one_by_one(scenes: dict, case: str) -> None:
+    """locate_many batches the plane fits of all seams of a pass; each seam's answer must not change (the
+    batched IRLS iterates until every plane has settled: within a micrometre)."""
+    scene, _ = scenes[case]
+    seams = [scene.weldmap.seam(TOP), scene.weldmap.seam(SIDE)]
+    together = OursLocator().locate_many(scene, seams, np.random.default_rng(0))
+    for seam, est in zip(seams, together, strict=True):
+        alone = OursLocator().locate(scene, seam, np.random.default_rng(0))
+        assert est.id == seam.id and est.status is alone.status is SeamStatus.FOUND
+        assert np.allclose(est.p_start, alone.p_start, atol=1e-6) and np.allclose(est.p_end, alone.p_end, atol=1e-6)
+        assert abs(est.confidence - alone.confidence) < 0.01
+
+
 def test_ours_places_an_unseen_face_from_its_edge(scenes: dict) -> None:
     """A's top face unseen (as a face at grazing incidence drops out): its plane comes from where A's side
     faces end; with those edges gone too, the seam is NOT_FOUND naming the face."""

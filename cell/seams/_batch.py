@@ -153,3 +153,54 @@ def fit_offsets(
     se = np.sqrt(num / np.maximum(h * h, 1e-300) * n_eff / (n_eff - 1.0))
     se[h <= 0.0] = np.inf
     return BatchFit(coef, se, pooled, count.astype(np.intp), ww.copy())
+
+
+@dataclass(frozen=True)
+class TiltFit:
+    """Result of :func:`tilt_fits` for J planes: each fitted as r = c0 + a (u - uc) + b (v - vc).
+
+    c0, a, b : (J,) offset [m] and slopes [-]; uc, vc : (J,) weighted centroids [m].
+    se0 : (J,) standard error of the plane's value at u = 0, v = vc [m] (sandwich).
+    """
+
+    c0: FloatArray
+    a: FloatArray
+    b: FloatArray
+    uc: FloatArray
+    vc: FloatArray
+    se0: FloatArray
+
+
+def tilt_fits(
+    r: FloatArray, u: FloatArray, v: FloatArray, w: FloatArray, lengths: list[int], prior_sd: float
+) -> TiltFit:
+    """Weighted least squares of the residuals r (n,) [m] of J planes (one segment of ``lengths[j] >= 4``
+    points per plane, in order) as r = c0 + a (u - uc) + b (v - vc) in each plane's coordinates u, v (n,) [m]
+    with weights w (n,), the slopes held near 0 by a Gaussian prior of ``prior_sd``; about each plane's
+    weighted centroid (uc, vc), so that the offset and the slopes are uncorrelated. The covariance is the
+    sandwich (robust to weights that are not inverse variances), scaled by n / (n - 3)."""
+    n_planes = len(lengths)
+    starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
+    label = np.repeat(np.arange(n_planes), lengths)
+    sw, swu, swv = np.add.reduceat(np.stack([w, w * u, w * v]), starts, axis=1)
+    uc, vc = swu / sw, swv / sw
+    X = np.stack([np.ones(len(r)), u - uc[label], v - vc[label]])  # (3, n)
+
+    def outer_sums(m: FloatArray, k: FloatArray) -> FloatArray:
+        """Per plane, the sum over its points of m k^T: (J, 3, 3) from m, k (3, n)."""
+        prods = (m[:, None, :] * k[None, :, :]).reshape(9, len(r))
+        return np.add.reduceat(prods, starts, axis=1).reshape(3, 3, n_planes).transpose(2, 0, 1)
+
+    wX = X * w
+    H = outer_sums(wX, X)
+    H[:, 1, 1] += prior_sd**-2
+    H[:, 2, 2] += prior_sd**-2
+    H_inv = np.linalg.inv(H)
+    coef = np.einsum("jik,kj->ji", H_inv, np.add.reduceat(wX * r, starts, axis=1))  # (J, 3)
+    res = r - np.einsum("in,ni->n", X, coef[label])
+    m = X * (w * res)
+    n = np.asarray(lengths, np.float64)
+    cov = H_inv @ outer_sums(m, m) @ H_inv * (n / np.maximum(n - 3.0, 1.0))[:, None, None]
+    J = np.stack([np.ones(n_planes), -uc, np.zeros(n_planes)], axis=1)
+    se0 = np.sqrt(np.maximum(np.einsum("ji,jik,jk->j", J, cov, J), 0.0))
+    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0)

@@ -28,22 +28,13 @@ IntArray = npt.NDArray[np.intp]
 
 
 @dataclass(frozen=True)
-class _Layer:
-    """One layer of a :class:`CloudIndex`: every ``stride``-th point of the cloud in voxel order."""
-
-    xyz: FloatArray  # (3, m) [m]
-    camera: IntArray  # (m,)
-    starts: npt.NDArray[np.int64]  # (voxels + 1,) where each voxel's points start in the layer
-
-
-@dataclass(frozen=True)
 class CloudIndex:
     """The dense cloud in voxel order (:func:`cell.voxels.voxel_order`) for tube queries, in layers: a query
     asks for a share of the points, so that a locator needing thousands, not tens of thousands, of points per
     seam gathers only those. The layer of share 1/k is every k-th point of the ordered cloud: each voxel keeps
     its share of its points (a stratified thinning, spread like the dense cloud: a fit on it only sees fewer
-    points), the layers are nested, and a layer is stored by coordinate the first time a query needs it, so
-    that a query gathers a few runs of contiguous arrays: no search, no sort.
+    points) and the layers are nested. A query gathers a few runs of the ordered cloud: no search, no sort,
+    no copy of the cloud.
 
     points : (n, 3) the cloud's coordinates in voxel order [m]; camera : (n,) camera index (-1: unknown);
     voxels : where each voxel's points lie.
@@ -53,7 +44,6 @@ class CloudIndex:
     camera: npt.NDArray[np.integer[Any]]
     voxels: VoxelTable
     shares: tuple[float, ...] = INDEX_SHARES
-    _layers: dict[float, _Layer] = field(default_factory=dict, compare=False, repr=False)
     _density: dict[int, float] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -76,15 +66,6 @@ class CloudIndex:
         """Point pitch [m] of ``share`` of the points on a well-seen surface (``1 / sqrt(density)``)."""
         density = self.density
         return float(1.0 / np.sqrt(density * share)) if density > 0.0 else float("nan")
-
-    def _layer(self, share: float) -> _Layer:
-        out = self._layers.get(share)
-        if out is None:
-            k = round(1.0 / share)
-            xyz = np.ascontiguousarray(self.points[::k].T)  # (3, m): column reductions are ~10x faster
-            starts = (self.voxels.starts + (k - 1)) // k  # the first multiple of k at or after each start
-            out = self._layers[share] = _Layer(xyz, np.asarray(self.camera[::k], np.intp), starts)
-        return out
 
     def tube(
         self, p_start: FloatArray, p_end: FloatArray, radius: float, extend: float, share: float
@@ -117,9 +98,10 @@ class CloudIndex:
             return empty
         cols = np.add.outer(np.arange(lo[0], hi[0] + 1) * vox.dims[1], np.arange(lo[1], hi[1] + 1)).ravel()
         cols *= vox.dims[2]
-        layer = self._layer(share)
-        first = layer.starts[np.searchsorted(vox.keys, cols + lo[2], side="left")]
-        last = layer.starts[np.searchsorted(vox.keys, cols + hi[2], side="right")]
+        k = round(1.0 / share)  # the layer: every k-th point of the ordered cloud
+        starts = (vox.starts + (k - 1)) // k if k > 1 else vox.starts  # the first multiple of k from each start
+        first = starts[np.searchsorted(vox.keys, cols + lo[2], side="left")]
+        last = starts[np.searchsorted(vox.keys, cols + hi[2], side="right")]
         counts = last - first
         nz = counts > 0
         first, last, counts = first[nz], last[nz], counts[nz]
@@ -130,13 +112,13 @@ class CloudIndex:
         steps = np.ones(total, np.intp)
         steps[0] = first[0]
         steps[np.cumsum(counts[:-1])] = first[1:] - last[:-1] + 1
-        idx = np.cumsum(steps)
-        xyz = np.take(layer.xyz, idx, axis=1)
+        idx = np.cumsum(steps) * k
+        xyz = np.ascontiguousarray(np.take(self.points, idx, axis=0).T)  # (3, m): column reductions are faster
         x, y, z = xyz[0] - a[0], xyz[1] - a[1], xyz[2] - a[2]
         s = x * t[0] + y * t[1] + z * t[2]
         d2 = x * x + y * y + z * z - s * s
         keep = np.flatnonzero((s >= 0.0) & (s <= span) & (d2 <= radius * radius))
-        return np.take(xyz, keep, axis=1), layer.camera[idx[keep]]
+        return np.take(xyz, keep, axis=1), np.asarray(self.camera[idx[keep]], np.intp)
 
 
 def index_of(cloud: Cloud, voxels: VoxelTable | None = None, voxel_m: float = INDEX_VOXEL_M) -> CloudIndex:
@@ -454,27 +436,26 @@ def edge_fit(
     x = x_all[:: len(x_all) // max_points] if len(x_all) > 2 * max_points else x_all
     sig = np.asarray(blurs, np.float64)
 
-    def profile(b: FloatArray, at: FloatArray, count: FloatArray) -> FloatArray:
-        """Log-likelihood (len(blurs), m) of the edges b (m,) for each blur, of ``count`` points at ``at``."""
-        norm = float(count.sum()) * np.log((b - lo) + stray * (hi - lo))
-        z = (b[None, :, None] - at[None, None, :]) / sig[:, None, None]
-        return np.asarray((np.log(ndtr(z) + stray) * count).sum(axis=2) - norm[None, :], np.float64)
-
-    # Coarse to fine: a grid of 5 steps over [b_lo, b_hi] on the points binned by 2.5 steps (the best edge
-    # only has to fall within the fine grid), then of one step around the coarse best on the points themselves.
+    # Coarse to fine: a grid of 5 steps over [b_lo, b_hi], on the points binned by 5 steps and for every other
+    # blur (the best edge only has to fall within the fine grid), then of one step around the coarse best, on
+    # the points themselves and for every blur.
     coarse = np.asarray(np.arange(b_lo, b_hi + 2.5 * step, 5.0 * step), np.float64)
-    width = 2.5 * step
+    width = 5.0 * step
     bins = np.bincount(((x - lo) / width).astype(np.intp))
     filled = np.flatnonzero(bins)
     at = np.asarray(lo + (filled + 0.5) * width, np.float64)
-    centre = float(coarse[int(np.argmax(profile(coarse, at, bins[filled].astype(np.float64)).max(axis=0)))])
+    sig_c = sig[::2]
+    z = (coarse[None, :, None] - at[None, None, :]) / sig_c[:, None, None]
+    ll_c = (np.log(ndtr(z) + stray) * bins[filled]).sum(axis=2)  # the normalisation is the same for every blur
+    ll_c -= len(x) * np.log((coarse - lo) + stray * (hi - lo))
+    centre = float(coarse[int(np.argmax(ll_c.max(axis=0)))])
     b = np.asarray(centre + step * np.arange(-6, 7), np.float64)  # (13,)
-    # Points more than 8 blurs inside (outside) every b add log(1 + stray) (log(stray)) whatever b: only those
-    # nearer are evaluated, for each blur (x is sorted).
+    # Points more than 6 blurs inside (outside) every b add log(1 + stray) (log(stray)) whatever b, to within
+    # 1e-7: only those nearer are evaluated, for each blur (x is sorted).
     ll = np.empty((len(sig), len(b)))
     norm = len(x) * np.log((b - lo) + stray * (hi - lo))
     for j, sj in enumerate(blurs):
-        i0, i1 = np.searchsorted(x, (b[0] - 8.0 * sj, b[-1] + 8.0 * sj))
+        i0, i1 = np.searchsorted(x, (b[0] - 6.0 * sj, b[-1] + 6.0 * sj))
         z = (b[:, None] - x[None, i0:i1]) / sj
         far = i0 * np.log1p(stray) + (len(x) - i1) * np.log(stray)
         ll[j] = np.log(ndtr(z) + stray).sum(axis=1) + far - norm

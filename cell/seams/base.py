@@ -7,9 +7,9 @@ calls the simulator and never reads globals; anything stochastic takes the ``rng
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -69,4 +69,13 @@ class SeamLocator(Protocol):
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
         """Find ``seam`` (given in R, from the aligned map) in ``scene``; time is filled in by the caller."""
+        ...
+
+
+@runtime_checkable
+class BatchSeamLocator(SeamLocator, Protocol):
+    """A seam finder that finds several seams of a scene together (faster than one by one, same answers)."""
+
+    def locate_many(self, scene: SeamScene, seams: Sequence[MapSeam], rng: np.random.Generator) -> list[SeamEstimate]:
+        """:meth:`SeamLocator.locate` for each of ``seams``, in order."""
         ...

@@ -41,7 +41,7 @@ Method (general: no assumption that a seam runs along x, y or z):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,6 +54,7 @@ from cell.seams.base import Joint, SeamScene
 from cell.types import BOX_FACES, Box, MapSeam, SeamEstimate, SeamStatus
 
 BoolArray = npt.NDArray[np.bool_]
+_SPHERES_KEY = "cell.seams.ours.part_spheres"
 SUPPORT_FULL_MARKS = 0.4  # share of a well-seen surface's points on a face that earns full confidence
 IntArray = npt.NDArray[np.intp]
 _Z = np.array([0.0, 0.0, 1.0])
@@ -202,12 +203,52 @@ class OursLocator:
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
         """Find ``seam`` (frame R) in ``scene.dense`` (see the module docstring); MapError for a bad joint."""
-        return self.locate_with_errors(scene, seam, rng)[0]
+        return self.locate_many_with_errors(scene, [seam], rng)[0][0]
 
     def locate_with_errors(
         self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator
     ) -> tuple[SeamEstimate, SeamErrors]:
         """:meth:`locate`, and the standard errors behind the estimate's confidence (all inf unless FOUND)."""
+        return self.locate_many_with_errors(scene, [seam], rng)[0]
+
+    def locate_many(self, scene: SeamScene, seams: Sequence[MapSeam], rng: np.random.Generator) -> list[SeamEstimate]:
+        """:meth:`locate` every seam of ``seams``, together (see :meth:`locate_many_with_errors`)."""
+        return [est for est, _ in self.locate_many_with_errors(scene, seams, rng)]
+
+    def locate_many_with_errors(
+        self, scene: SeamScene, seams: Sequence[MapSeam], rng: np.random.Generator
+    ) -> list[tuple[SeamEstimate, SeamErrors]]:
+        """:meth:`locate_with_errors` for every seam of ``seams``, in lock-step: each seam's steps run as they
+        would alone, but the plane fits of a pass (and the tilt steps) are one batched fit for all the seams,
+        so that numpy's cost per call is paid once per pass, not once per seam. Each seam draws from its own
+        generator spawned from ``rng``, in the order given."""
+        runs = [self._run(scene, seam, r) for seam, r in zip(seams, rng.spawn(len(seams)), strict=True)]
+        out: list[tuple[SeamEstimate, SeamErrors] | None] = [None] * len(runs)
+        pending: dict[int, _FitRequest] = {}
+
+        def advance(i: int) -> None:
+            try:
+                pending[i] = next(runs[i])
+            except StopIteration as stop:
+                out[i] = stop.value
+
+        for i in range(len(runs)):
+            advance(i)
+        while pending:
+            batch = list(pending.items())
+            pending.clear()
+            for first in (True, False):
+                self._fit_planes([req for _, req in batch if req.first is first], first)
+            self._tilt([(x, face, other, req.pts, p0, t) for _, req in batch for x, face, other, p0, t in req.tilts])
+            for i, _ in batch:
+                advance(i)
+        return [x for x in out if x is not None]
+
+    def _run(
+        self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator
+    ) -> Generator[_FitRequest, None, tuple[SeamEstimate, SeamErrors]]:
+        """The steps of :meth:`locate_with_errors` for one seam: yields each pass's plane fits (and tilt steps)
+        for :meth:`locate_many_with_errors` to do, returns the estimate and its standard errors."""
         o = self.options
         joint = _joint_of(scene, seam)
         box_a = scene.weldmap.part(joint.abutting).box
@@ -281,11 +322,12 @@ class OursLocator:
                     f"{pts.share:.0%} sample, needs {pts.least(o.min_face_points)}) and {why}",
                 )
             sides = self._side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack)
-            self._fit_planes(planes + sides, pts, first)
+            tilts = []
             if last and o.refine_normals:
                 for sel_ in planes:
                     face, other = (face_a, face_b) if sel_.plane is face_a else (face_b, face_a)
-                    self._tilt(sel_, face, other, pts, p0, t)
+                    tilts.append((sel_, face, other, p0, t))
+            yield _FitRequest(planes + sides, pts, first, tilts)
             # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
             face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
             face_b.area = (e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0)
@@ -355,11 +397,11 @@ class OursLocator:
         cam = np.where(cam < 0, int(cam.max(initial=0)) + 1, cam)  # mixed / unknown captures: their own group
         ok = xyz[2] >= scene.table_z + o.corner_band_m
         reach = radius + extend + 0.5 * float(np.linalg.norm(b - a)) + o.map_tolerance_m
-        mid = 0.5 * (a + b)
-        for part in scene.weldmap.parts:
+        centres, radii = _part_spheres(scene)
+        near = np.linalg.norm(centres - 0.5 * (a + b), axis=1) <= reach + radii
+        for k in np.flatnonzero(near):
+            part = scene.weldmap.parts[k]
             if part.name in (joint.abutting, joint.receiving):
-                continue
-            if np.linalg.norm(part.box.center - mid) > reach + 0.5 * float(np.linalg.norm(part.box.size)):
                 continue
             R, c = part.box.X_AB[:3, :3], part.box.center
             q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
@@ -605,19 +647,20 @@ class OursLocator:
                 out.append(_Selection(end, r_l, sel, _thin(sel, o.max_fit_points), need))
         return out
 
-    def _fit_planes(self, selections: list[_Selection], pts: _Points, first: bool) -> None:
-        """Fit the offsets of every selected plane at once (:func:`_batch.fit_offsets`; the first pass from a
-        histogram mode with its scales measured again once settled, the later ones from the previous fit) and
-        update them. A side face whose fit keeps fewer points than it needs stays unfitted."""
+    def _fit_planes(self, requests: list[_FitRequest], first: bool) -> None:
+        """Fit the offsets of every plane selected by ``requests`` (of one or several seams) at once
+        (:func:`_batch.fit_offsets`; the first pass from a histogram mode with its scales measured again once
+        settled, the later ones from the previous fit) and update them. A side face whose fit keeps fewer
+        points than it needs stays unfitted."""
         o = self.options
+        selections = [x for req in requests for x in req.selections]
         if not selections:
             return
-        fit_idx = [x.fit for x in selections]
         fit = _batch.fit_offsets(
-            np.concatenate([x.r[i] for x, i in zip(selections, fit_idx, strict=True)]),
-            [len(i) for i in fit_idx],
-            pts.cam[np.concatenate(fit_idx)],
-            pts.n_cams,
+            np.concatenate([x.r[x.fit] for x in selections]),
+            [len(x.fit) for x in selections],
+            np.concatenate([req.pts.cam[x.fit] for req in requests for x in req.selections]),
+            max(req.pts.n_cams for req in requests),
             start=None if first else np.zeros(len(selections)),
             mode_half_width=o.map_tolerance_m + 3.0 * o.sensor_sigma_m,
             mode_bin=max(0.002, o.sensor_sigma_m),
@@ -636,40 +679,47 @@ class OursLocator:
             if isinstance(x.plane, _Face):
                 x.plane.se, x.plane.count = x.se, len(x.sel)
 
-    def _tilt(self, x: _Selection, face: _Face, other: _Face, pts: _Points, p0: FloatArray, t: FloatArray) -> None:
-        """Let a fitted weld face tilt a little off its normal (a Gaussian prior of ``tilt_prior_deg``): one
-        weighted least-squares step of offset and tilt about the points' centroid (decorrelated), with the
-        biweight weights of its offset fit, carried to the seam line."""
+    def _tilt(self, jobs: list[tuple[_Selection, _Face, _Face, _Points, FloatArray, FloatArray]]) -> None:
+        """Let fitted weld faces tilt a little off their normals (a Gaussian prior of ``tilt_prior_deg``): one
+        weighted least-squares step of offset and tilt about each face's points' centroid (decorrelated), with
+        the biweight weights of its offset fit, carried to the seam line (:func:`_batch.tilt_fits`, all faces
+        at once). A job: the face's selection, the face, the other weld face, its points, p0 (3,) and t (3,)
+        of the line."""
         o = self.options
-        keep = x.weights > 0.0
-        if not x.ok or np.count_nonzero(keep) < 4:
+        todo, r, u, v, w = [], [], [], [], []
+        for x, face, other, pts, p0, t in jobs:
+            keep = x.weights > 0.0
+            if not x.ok or np.count_nonzero(keep) < 4:
+                continue
+            idx = x.fit[keep]
+            e_u = other.n - (other.n @ face.n) * face.n
+            e_u /= np.linalg.norm(e_u)
+            q = np.take(pts.xyz, idx, axis=1) - p0[:, None]
+            todo.append((x, face, e_u, p0, t))
+            r.append(x.r[idx] - x.offset)  # from the plane as fitted
+            u.append(e_u @ q)
+            v.append(t @ q)
+            w.append(x.weights[keep])
+        if not todo:
             return
-        idx, ww = x.fit[keep], x.weights[keep]
-        r = x.r[idx] - x.offset  # from the plane as fitted
-        e_u = other.n - (other.n @ face.n) * face.n
-        e_u /= np.linalg.norm(e_u)
-        q = np.take(pts.xyz, idx, axis=1) - p0[:, None]
-        u, v = e_u @ q, t @ q
-        uc, vc = float(ww @ u / ww.sum()), float(ww @ v / ww.sum())
-        X = np.column_stack([np.ones(len(r)), u - uc, v - vc])
-        tau = np.tan(np.radians(o.tilt_prior_deg))
-        XtW = X.T * ww
-        try:
-            H_inv = np.linalg.inv(XtW @ X + np.diag([0.0, tau**-2, tau**-2]))
-        except np.linalg.LinAlgError:
-            return
-        c0, a, b = H_inv @ (XtW @ r)
-        res = r - X @ np.array([c0, a, b])
-        meat = (X.T * (ww * res) ** 2) @ X
-        cov = H_inv @ meat @ H_inv * len(r) / max(len(r) - 3, 1)
-        # The plane r = c0 + a (u - uc) + b (v - vc): its value and standard error on the seam line (u = 0).
-        J = np.array([1.0, -uc, 0.0])
-        se0 = float(np.sqrt(max(J @ cov @ J, 0.0)))
-        m = face.n - a * e_u - b * t
-        norm = float(np.linalg.norm(m))
-        face.d = (face.d + c0 - a * (uc + float(e_u @ p0)) - b * (vc + float(t @ p0))) / norm
-        face.n = m / norm
-        face.se = se0 * np.sqrt(len(x.fit) / len(x.sel))
+        fit = _batch.tilt_fits(
+            np.concatenate(r),
+            np.concatenate(u),
+            np.concatenate(v),
+            np.concatenate(w),
+            [len(ri) for ri in r],
+            float(np.tan(np.radians(o.tilt_prior_deg))),
+        )
+        for j, (x, face, e_u, p0, t) in enumerate(todo):
+            # The plane r = c0 + a (u - uc) + b (v - vc) in the face's normal and offset.
+            c0, a, b = float(fit.c0[j]), float(fit.a[j]), float(fit.b[j])
+            m = face.n - a * e_u - b * t
+            norm = float(np.linalg.norm(m))
+            face.d = (
+                face.d + c0 - a * (float(fit.uc[j]) + float(e_u @ p0)) - b * (float(fit.vc[j]) + float(t @ p0))
+            ) / norm
+            face.n = m / norm
+            face.se = float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel))
 
     def _confidence(self, face_a: _Face, face_b: _Face, errors: SeamErrors, spacing: float) -> float:
         """Confidence in [0, 1] from the standard errors of the line (lateral) and of the ends, the support of
@@ -691,6 +741,18 @@ class OursLocator:
             / (1.0 + (se_end / (4.0 * o.target_se_m)) ** 2)
         )
         return float(np.clip(conf, 0.0, 1.0))
+
+
+@dataclass(frozen=True)
+class _FitRequest:
+    """What one seam's pass needs fitted: its planes' selections of ``pts``, whether it is the first pass, and
+    the tilt steps to take after the fit (selection, face, the other weld face, p0 (3,) and t (3,) of the
+    line)."""
+
+    selections: list[_Selection]
+    pts: _Points
+    first: bool
+    tilts: list[tuple[_Selection, _Face, _Face, FloatArray, FloatArray]]
 
 
 @dataclass(frozen=True)
@@ -811,6 +873,17 @@ def _against_table(n_a: FloatArray, n_b: FloatArray, seam: MapSeam, table_z: flo
     """A seam on a downward face, at the table's height: no camera can see it."""
     low = max(float(seam.p_start[2]), float(seam.p_end[2])) < table_z + tol
     return low and min(float(n_a @ _Z), float(n_b @ _Z)) < -0.7
+
+
+def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
+    """Centres (P, 3) and radii (P,) of the spheres around the map's parts [m], cached per scene."""
+    out = scene.cache.get(_SPHERES_KEY)
+    if out is None:
+        parts = scene.weldmap.parts
+        centres = np.array([p.box.center for p in parts]).reshape(-1, 3)
+        radii = np.array([0.5 * float(np.linalg.norm(p.box.size)) for p in parts])
+        out = scene.cache[_SPHERES_KEY] = (centres, radii)
+    return out
 
 
 def _on_table(n: FloatArray, d: float, table_z: float, tol: float) -> bool:

@@ -15,7 +15,6 @@ A locator that finds a scene's seams together (ours) charges each seam an equal 
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import time
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import Any
 
 from cell import pipeline
 from cell import scenario as sc
+from cell.export.report import write_json
 from cell.types import SeamEstimate, SeamStatus
 
 
@@ -109,9 +109,7 @@ def main() -> None:
             f"({(b / a - 1.0) * 100.0:+.0f} %)"
         )
     if args.json is not None:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(rows, indent=2))
-        print(f"wrote {args.json}")
+        print(f"wrote {write_json(args.json, rows)}")
 
 
 if __name__ == "__main__":

@@ -217,7 +217,7 @@ class RescanSpec(_Model):
     """
 
     mode: Literal["none", "low", "all"] = "low"
-    confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = 0.55  # catches every seam > 0.15 mm lateral
+    confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = 0.55  # benchmarks/bench_confidence.py
     weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
     # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
     # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.

@@ -153,8 +153,8 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
     )
     if fitness < spec.align_min_fitness:
         raise AlignmentError(
-            f"map-to-cloud ICP reached fitness {fitness:.2f} within {band * 1000:.1f} mm, "
-            f"needs at least {spec.align_min_fitness:.2f} (is the part on the table, inside the workspace?)"
+            f"map-to-cloud ICP reached fitness {fitness:.3f} within {band * 1000:.1f} mm, "
+            f"needs at least {spec.align_min_fitness:.3f} (is the part on the table, inside the workspace?)"
         )
     X_RR_corr = invert(X_MC)
     roll, pitch, _ = matrix_to_rpy(X_RR_corr[:3, :3])

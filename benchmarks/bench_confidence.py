@@ -1,0 +1,95 @@
+"""Confidence calibration: how well our locator's confidence flags its own large errors.
+
+    .venv/bin/python benchmarks/bench_confidence.py [--scenarios fence1-exact,fence1,fence2] [--seeds 4]
+        [--big-mm 0.15] [--json PATH]
+
+Each scenario is captured with seeds 0 .. N-1 (realistic noise; a new seed draws new sensor noise and, where the
+scenario has them, new as-built deviations), perceived, and located with ``ours``. Per threshold: how many seams
+fall below it (re-scanned by ``cell weld``) and how many of the seams with a lateral error over ``--big-mm`` it
+catches; and the Spearman rank correlation of confidence with the lateral error. The re-scan threshold lives in
+``cell.rescan.CONFIDENCE_THRESHOLD``.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.stats import spearmanr
+
+from cell import pipeline
+from cell import scenario as sc
+from cell.export.report import write_json
+from cell.rescan import CONFIDENCE_THRESHOLD
+
+THRESHOLDS = (0.45, 0.5, CONFIDENCE_THRESHOLD, 0.6, 0.65)
+
+
+def seams(names: list[str], seeds: int) -> list[dict[str, Any]]:
+    """One row per visible seam: scenario, seed, seam id, confidence, lateral and endpoint error [mm]."""
+    rows = []
+    for name in names:
+        for seed in range(seeds):
+            s = sc.load(name).with_noise("realistic").model_copy(update={"seed": seed})
+            cap = pipeline.capture(s)
+            scene = pipeline.build_scene(cap)
+            truth = pipeline.truths(cap, scene.seam_scene.weldmap)
+            estimates = pipeline.locate(scene, s, "ours")
+            per_seam, _ = pipeline.evaluate(estimates, truth)
+            for e in estimates:
+                if e.status.value == "not_visible":
+                    continue
+                m = per_seam.get(e.id)
+                rows.append(
+                    {
+                        "scenario": name,
+                        "seed": seed,
+                        "seam": e.id,
+                        "confidence": e.confidence if m else 0.0,
+                        "lateral_mm": m.lateral_mm if m else float("nan"),
+                        "endpoint_mm": m.endpoint_mm if m else float("nan"),
+                    }
+                )
+    return rows
+
+
+def summary(rows: list[dict[str, Any]], big_mm: float) -> str:
+    """The thresholds' catch table and the rank correlation, as Markdown."""
+    conf = np.array([r["confidence"] for r in rows])
+    lat = np.array([r["lateral_mm"] for r in rows])
+    found = np.isfinite(lat)
+    big = found & (lat > big_mm)
+    rho = spearmanr(conf[found], lat[found])[0]
+    lines = [
+        f"{len(rows)} seams, {int(found.sum())} found, {int(big.sum())} with a lateral error over {big_mm} mm "
+        f"(max {np.nanmax(lat):.3f} mm); Spearman(confidence, lateral) = {rho:.2f}",
+        "",
+        f"| threshold | seams below (re-scanned) | of the {int(big.sum())} over {big_mm} mm caught | "
+        "max lateral above it [mm] |",
+        "|---|---|---|---|",
+    ]
+    for thr in THRESHOLDS:
+        below = conf < thr
+        above = found & ~below
+        worst = float(lat[above].max()) if above.any() else float("nan")
+        lines.append(f"| {thr:.2f} | {int(below.sum())} | {int((big & below).sum())} | {worst:.3f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenarios", default="fence1-exact,fence1,fence2", help="comma-separated scenario names")
+    ap.add_argument("--seeds", type=int, default=4, help="seeds 0 .. N-1 per scenario")
+    ap.add_argument("--big-mm", type=float, default=0.15, help="a lateral error over this is one to catch [mm]")
+    ap.add_argument("--json", type=Path, default=None, help="write the per-seam rows as JSON here")
+    args = ap.parse_args()
+    rows = seams([n.strip() for n in args.scenarios.split(",") if n.strip()], args.seeds)
+    print(summary(rows, args.big_mm))
+    if args.json is not None:
+        print(f"wrote {write_json(args.json, rows)}")
+
+
+if __name__ == "__main__":
+    main()

@@ -21,15 +21,14 @@ Method (general: no assumption that a seam runs along x, y or z):
    faces may tilt a little, held near the map's normal by a Gaussian prior (as-built parts are rotated by
    hundredths of a degree, not degrees): one weighted least-squares step with the fit's weights.
 4. A weld face no camera sees (too oblique, occluded) is placed from the edge where an adjacent face of the
-   same part ends: the extent of that face's points across the edge (a blurred-step likelihood), searched as
-   far from the map as a fitted face may drift, each camera's edge on its own (from ``edge_sample_share`` of
-   the dense cloud: an edge needs density). A camera's edge counts only
-   when enough points define it, it is not blurred beyond the likelihood's widest blur (grazing incidence),
-   few points lie beyond it (flying pixels), and it is neither at the searched range's limit nor where the
-   cloud stops (the sample's own cut-off, not an edge). Its standard error: the likelihood's and the sampling
-   pitch of the face (``edge_pitch_factor``); the cameras' edges are combined by inverse variance, the error
-   inflated when they disagree beyond it (Birge ratio). With no such edge, the seam is NOT_FOUND naming the
-   face and why.
+   same part ends (:mod:`cell.seams._edge`): the extent of that face's points across the edge (a blurred-step
+   likelihood), searched as far from the map as a fitted face may drift, each camera's edge on its own (from
+   ``edge_sample_share`` of the dense cloud: an edge needs density). A camera's edge counts only when enough
+   points define it, it is not blurred beyond the likelihood's widest blur (grazing incidence), few points lie
+   beyond it (flying pixels), and it is neither at the searched range's limit nor where the cloud stops (the
+   sample's own cut-off, not an edge). Its standard error: the likelihood's and the sampling pitch of the face
+   (``edge_pitch_factor``); the cameras' edges are combined by inverse variance, the error inflated when they
+   disagree beyond it (Birge ratio). With no such edge, the seam is NOT_FOUND naming the face and why.
 5. The seam line is the intersection of the fitted planes. Each end is where the line meets A's side face
    across it, fitted from that face's points when it is seen, the table when A rests on it there, or else the
    extent of face A's support along t (its empirical CDF extrapolated, then refined by the same edge
@@ -54,9 +53,9 @@ import numpy.typing as npt
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.seams import _batch, _fit
+from cell.seams import _batch, _edge, _fit
 from cell.seams.base import Joint, SeamScene
-from cell.types import BOX_FACES, Box, MapSeam, SeamEstimate, SeamStatus
+from cell.types import Box, MapSeam, SeamEstimate, SeamStatus
 
 BoolArray = npt.NDArray[np.bool_]
 _SPHERES_KEY = "cell.seams.ours.part_spheres"
@@ -355,7 +354,7 @@ class OursLocator:
             )
         crop = self._crop_box(scene)
         for k, end in enumerate(ends):
-            if end.source == "extent" and self._at_cut(crop, p0 + end.s * t, t if k == 1 else -t, 0.0):
+            if end.source == "extent" and _edge.at_cut(crop, p0 + end.s * t, t if k == 1 else -t, 0.0, o.edge_band_m):
                 return _not_found(
                     seam.id,
                     f"the seam's {('start', 'end')[k]} is not seen: face {face_a.name}'s points run to where the "
@@ -426,122 +425,41 @@ class OursLocator:
         away: Callable[[FloatArray], BoolArray],
         rng: np.random.Generator,
     ) -> str:
-        """Place an unseen ``face`` of ``box`` from the edge where an adjacent face of the same part, seen,
-        ends across it (the stretch of that edge alongside ``seam``); ``away`` masks the points (n, 3) far
-        enough from the joint's other part. Returns "" when placed (``face`` updated, its standard error from
-        the edge's own data), else why not (no adjacent face seen, or its edge not defined well enough)."""
+        """Place an unseen ``face`` of ``box`` from an edge (:func:`_edge.place_from_edge`, on
+        ``edge_sample_share`` of the cloud); ``away`` masks the points (n, 3) far enough from the joint's other
+        part. Returns "" when placed (``face`` updated, its standard error from the edge's own data), else why
+        not."""
         o = self.options
-        k_f = "xyz".index(face_name[1])
-        search = 2.0 * o.map_tolerance_m  # the edge may lie as far from the map as a fitted face may drift [m]
-        lo = max(-2.0 * search, -float(box.size[k_f]) + o.edge_band_m)  # the window along u, inside ...
-        hi = search + 3.0 * max(_fit.EDGE_BLURS) + o.edge_band_m  # ... and beyond the edge [m]
-        gate = o.map_tolerance_m + 3.0 * o.sensor_sigma_m
-        crop = self._crop_box(scene)
-        best: _EdgePlacement | None = None
-        why: list[str] = []
-        mid = 0.5 * (seam.p_start + seam.p_end)
-        tilt = np.tan(np.radians(o.tilt_prior_deg))
-        edges = []
-        for g in BOX_FACES:
-            n_g, d_g = box.face_plane(g)
-            if "xyz".index(g[1]) == k_f or g == skip or _on_table(n_g, d_g, scene.table_z, o.map_tolerance_m):
-                continue  # not adjacent, the joint's end face, or never seen
-            q0, e = _fit.plane_intersection(face.n, face.d, n_g, d_g, mid)
-            reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
-            edges.append((reach, g, n_g, d_g, q0, e))
-        for reach, g, n_g, d_g, q0, e in sorted(edges, key=lambda x: x[0]):
-            # The face is carried from its edge to the seam: a tilt within the prior moves it by tilt x reach, so
-            # an edge that far cannot place it better than the best one found.
-            if best is not None and tilt * reach >= best.se:
-                continue
-            k_g = "xyz".index(g[1])
-            # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
-            s_ends = sorted(float(e @ (p - q0)) for p in (seam.p_start, seam.p_end))
-            e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
-            radius = float(np.hypot(max(-lo, hi), gate))
-            pts = self._points(scene, q0 + e_lo * e, q0 + e_hi * e, radius, 0.0, joint, rng, o.edge_sample_share)
-            P, cam = pts.P, pts.cam
-            u = P @ face.n - face.d  # along the face's outward normal: the adjacent face's points end at u = 0
-            r_g = P @ n_g - d_g
-            region = pts.ok & away(P) & (u > lo) & (u < hi) & _in_face(box, P, (k_f, k_g), o.edge_band_m)
-            sel = region & (np.abs(r_g) < gate)
-            if np.count_nonzero(sel) < o.min_face_points:
-                continue
-            start = _fit.histogram_mode(r_g[sel], max(0.002, o.sensor_sigma_m))
-            fit = _fit.robust_plane_fit(r_g[sel], np.ones((int(np.count_nonzero(sel)), 1)), cam[sel], start)
-            on = region & (np.abs(r_g - fit.offset) < 2.5 * max(fit.scale, 1e-4))
-            if np.count_nonzero(on) < o.min_face_points:
-                continue
-            # Each camera's edge on its own (incidence, sampling and calibration differ between cameras), with
-            # its standard error: the likelihood's and the sampling of the surface (points land on a pixel grid:
-            # with the grid nearly parallel to the edge, every row ends at the same phase).
-            uu, cc = u[on], cam[on]
-            along = P[on] @ e
-            cams, counts = np.unique(cc, return_counts=True)
-            per_cam: list[tuple[float, float]] = []
-            faults: list[tuple[int, str]] = []
-            for c, n_c in zip(cams, counts, strict=True):
-                if n_c < o.min_face_points:
-                    continue
-                mine = cc == c
-                edge = _fit.edge_fit(uu[mine], lo, hi, -search, search)
-                b = edge.b if np.isfinite(edge.b) else 0.0
-                fault = self._edge_fault(edge, g, search, self._at_cut(crop, q0 + b * face.n, face.n, edge.blur))
-                if fault:
-                    faults.append((int(n_c), fault))
-                    continue
-                pitch = float(np.sqrt(edge.pitch * max(float(np.ptp(along[mine])), 1e-3)))  # on face g [m]
-                per_cam.append((edge.b, float(np.hypot(edge.se, o.edge_pitch_factor * pitch))))
-            if not per_cam:
-                if faults:
-                    why.append(max(faults)[1])
-                continue
-            b_g, se_g = _combine(per_cam)
-            se_g = float(np.hypot(se_g, tilt * reach))
-            if best is None or se_g < best.se:
-                best = _EdgePlacement(g, b_g, se_g, max(fit.scale, 1e-4), len(uu), len(per_cam))
-        if best is None:
-            if why:
-                return "its edge is not defined well enough: " + "; ".join(why)
-            return "no edge of it is seen either: not seen or not there"
-        face.d += best.b
-        face.se, face.scale, face.count = best.se, best.scale, best.count
-        face.source = f"edge of {best.g}"
-        face.note = f"+-{1000 * best.se:.2f} mm, {best.cameras} camera{'s' if best.cameras != 1 else ''}"
-        return ""
 
-    def _edge_fault(self, edge: _fit.EdgeFit, g: str, search: float, cut: bool) -> str:
-        """Why the edge of the adjacent face ``g`` does not define the unseen face, or "" when it does."""
-        o = self.options
-        if not np.isfinite(edge.b) or edge.n_edge < o.min_edge_points:
-            return f"the edge of {g} is defined by {edge.n_edge} points (needs {o.min_edge_points})"
-        if cut:
-            return f"the edge of {g} lies where the cloud stops (the workspace's boundary?)"
-        if edge.at_limit or not np.isfinite(edge.se):
-            return (
-                f"the edge of {g} lies at the limit of the {1000 * search:.0f} mm searched about the map "
-                "(no end of the points there: part moved, or the points stop there)"
-            )
-        if edge.blur >= max(_fit.EDGE_BLURS):
-            return f"the edge of {g} is blurred over {1000 * edge.blur:.1f} mm (seen at grazing incidence only)"
-        if edge.strays > o.max_edge_strays:
-            return (
-                f"the edge of {g} has {edge.strays:.0%} of its density beyond it (allowed "
-                f"{o.max_edge_strays:.0%}): flying pixels or another surface"
-            )
+        def points(a: FloatArray, b: FloatArray, radius: float) -> tuple[FloatArray, IntArray, BoolArray]:
+            pts = self._points(scene, a, b, radius, 0.0, joint, rng, o.edge_sample_share)
+            return pts.P, pts.cam, pts.ok
+
+        placed = _edge.place_from_edge(
+            face.n,
+            face.d,
+            box,
+            face_name,
+            skip,
+            (seam.p_start, seam.p_end),
+            scene.table_z,
+            away,
+            points,
+            self._crop_box(scene),
+            o,
+        )
+        if isinstance(placed, str):
+            return placed
+        face.d += placed.b
+        face.se, face.scale, face.count = placed.se, placed.scale, placed.count
+        face.source = f"edge of {placed.g}"
+        face.note = f"+-{1000 * placed.se:.2f} mm, {placed.cameras} camera{'s' if placed.cameras != 1 else ''}"
         return ""
 
     def _crop_box(self, scene: SeamScene) -> Box:
         """Where the cloud was cropped: the workspace (in R) when the options give it, else the cloud's bounds."""
         ws = self.options.workspace_R
         return ws if ws is not None else _fit.cloud_box(scene)
-
-    def _at_cut(self, crop: Box, p: FloatArray, n: FloatArray, blur: float) -> bool:
-        """Whether the boundary of ``crop`` lies within the edge band (and 3 ``blur``) of ``p`` (3,) ahead along
-        ``n`` (3,): where the points stop because the cloud does, not the part."""
-        _, s_out = _fit.line_box_span(p, n, crop)
-        tol = self.options.edge_band_m + 3.0 * (blur if np.isfinite(blur) else 0.0)
-        return bool(np.isfinite(s_out) and abs(s_out) < tol)
 
     def _find_ends(
         self,
@@ -761,20 +679,6 @@ class _FitRequest:
 
 
 @dataclass(frozen=True)
-class _EdgePlacement:
-    """The best edge found for an unseen face: the adjacent face ``g`` whose edge it is, the edge's offset b
-    along the face's normal from the map [m] and its standard error [m], g's noise scale [m], the points near
-    the edge and how many cameras' edges were combined."""
-
-    g: str
-    b: float
-    se: float
-    scale: float
-    count: int
-    cameras: int
-
-
-@dataclass(frozen=True)
 class _Geometry:
     """What the map says about the joint's boxes, for region tests (frame R)."""
 
@@ -813,7 +717,7 @@ class _Geometry:
         for sign in (-1.0, 1.0):
             n = sign * axis
             d = float(n @ c) + h
-            on_table = self.has_sides and _on_table(n, d, table_z, tol)
+            on_table = self.has_sides and _edge.on_table(n, d, table_z, tol)
             out.append(_End(-_Z, -table_z, True) if on_table else _End(n, d, False))
         return out
 
@@ -837,17 +741,6 @@ def _away_from(face: _Face, band: float) -> Callable[[FloatArray], BoolArray]:
 def _outside(box: Box, band: float) -> Callable[[FloatArray], BoolArray]:
     """A mask of points (n, 3) outside ``box`` grown by ``band`` [m]."""
     return lambda P: ~box.contains(P, margin=band)
-
-
-def _in_face(box: Box, P: FloatArray, free: tuple[int, ...], band: float) -> BoolArray:
-    """Points (n, 3) whose coordinates along every box axis but the ``free`` ones lie inside the box shrunk by
-    ``band`` [m]."""
-    q = (P - box.center) @ box.X_AB[:3, :3]
-    ok = np.ones(len(P), bool)
-    for j in range(3):
-        if j not in free:
-            ok &= np.abs(q[:, j]) <= 0.5 * float(box.size[j]) - band
-    return ok
 
 
 def _thin(idx: IntArray, cap: int) -> IntArray:
@@ -889,23 +782,6 @@ def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
         radii = np.array([0.5 * float(np.linalg.norm(p.box.size)) for p in parts])
         out = scene.cache[_SPHERES_KEY] = (centres, radii)
     return out
-
-
-def _on_table(n: FloatArray, d: float, table_z: float, tol: float) -> bool:
-    """Whether the plane n . p = d is a downward face resting on the table (within ``tol`` [m])."""
-    return float(n @ _Z) < -0.9 and abs(d + table_z) < tol
-
-
-def _combine(estimates: list[tuple[float, float]]) -> tuple[float, float]:
-    """Inverse-variance mean of (value, standard error) pairs and its standard error, inflated by the Birge
-    ratio sqrt(chi^2 / (k - 1)) when the values scatter more than their errors say."""
-    v = np.array([e[0] for e in estimates])
-    w = 1.0 / np.square(np.maximum([e[1] for e in estimates], 1e-9))
-    mean = float(w @ v / w.sum())
-    se = float(1.0 / np.sqrt(w.sum()))
-    if len(v) > 1:
-        se *= max(1.0, float(np.sqrt(w @ (v - mean) ** 2 / (len(v) - 1))))
-    return mean, se
 
 
 def _errors_of(face_a: _Face, face_b: _Face, ends: list[_End]) -> SeamErrors:

@@ -1,0 +1,216 @@
+"""Placing a face no camera sees from the edge where an adjacent face of the same part ends (our locator's step
+4, :mod:`cell.seams.ours`).
+
+A weld face can be hidden from every camera (too oblique, occluded) while an adjacent face of the same part is
+seen: that face's points end where the hidden face begins. The extent of those points across the edge, measured
+per camera with a blurred-step likelihood (:func:`cell.seams._fit.edge_fit`), places the hidden face, with a
+standard error from the edge's own data. Everything is in the robot frame R, metres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+from cell.seams import _fit
+from cell.types import BOX_FACES, Box
+
+BoolArray = npt.NDArray[np.bool_]
+IntArray = npt.NDArray[np.intp]
+_Z = np.array([0.0, 0.0, 1.0])
+
+# The points of the cloud within ``radius`` [m] of the segment a-b (3,): (n, 3) [m], camera (n,), and whether each
+# may support a plane (above the table, away from the map's other parts).
+Points = Callable[[FloatArray, FloatArray, float], tuple[FloatArray, IntArray, BoolArray]]
+
+
+class EdgeOptions(Protocol):
+    """What edge placement reads of the locator's options (:class:`cell.seams.ours.OursOptions`); lengths [m]."""
+
+    @property
+    def map_tolerance_m(self) -> float: ...  # how far the as-built faces may lie from the aligned map
+    @property
+    def sensor_sigma_m(self) -> float: ...  # depth noise assumed before it is measured
+    @property
+    def edge_band_m(self) -> float: ...  # band excluded along convex edges
+    @property
+    def tube_radius_m(self) -> float: ...  # how far along the edge, past the seam's ends, points are read
+    @property
+    def min_face_points(self) -> int: ...  # fewer points on the adjacent face: it places nothing
+    @property
+    def min_edge_points(self) -> int: ...  # fewer points just inside an edge: it places nothing
+    @property
+    def max_edge_strays(self) -> float: ...  # more density beyond an edge (share of that inside): nothing
+    @property
+    def edge_pitch_factor(self) -> float: ...  # an edge's sampling error, in point pitches on its face
+    @property
+    def tilt_prior_deg(self) -> float: ...  # standard deviation of a face's tilt off the map [deg]
+
+
+@dataclass(frozen=True)
+class EdgePlacement:
+    """The best edge found for an unseen face: the adjacent face ``g`` whose edge it is, the edge's offset b
+    along the face's normal from the map [m] and its standard error [m], g's noise scale [m], the points near
+    the edge and how many cameras' edges were combined."""
+
+    g: str
+    b: float
+    se: float
+    scale: float
+    count: int
+    cameras: int
+
+
+def place_from_edge(
+    n: FloatArray,
+    d: float,
+    box: Box,
+    face_name: str,
+    skip: str,
+    seam: tuple[FloatArray, FloatArray],
+    table_z: float,
+    away: Callable[[FloatArray], BoolArray],
+    points: Points,
+    crop: Box,
+    o: EdgeOptions,
+) -> EdgePlacement | str:
+    """Place the unseen face ``face_name`` of ``box`` (plane n . p = d from the map, outward unit normal n (3,))
+    from the edge where an adjacent face of the same part, seen, ends across it: the stretch of that edge
+    alongside ``seam`` (its start and end (3,)). ``skip``: a face not to read (the joint's end face); ``away``
+    masks the points (n, 3) far enough from the joint's other part; ``points`` reads the cloud; ``crop``: where
+    the cloud was cropped (an edge there is the crop's, not the part's). The adjacent faces are tried nearest
+    first; each camera's edge on its own, combined by inverse variance. Returns the placement, or why none."""
+    k_f = "xyz".index(face_name[1])
+    search = 2.0 * o.map_tolerance_m  # the edge may lie as far from the map as a fitted face may drift [m]
+    lo = max(-2.0 * search, -float(box.size[k_f]) + o.edge_band_m)  # the window along u, inside ...
+    hi = search + 3.0 * max(_fit.EDGE_BLURS) + o.edge_band_m  # ... and beyond the edge [m]
+    gate = o.map_tolerance_m + 3.0 * o.sensor_sigma_m
+    best: EdgePlacement | None = None
+    why: list[str] = []
+    mid = 0.5 * (seam[0] + seam[1])
+    tilt = np.tan(np.radians(o.tilt_prior_deg))
+    edges = []
+    for g in BOX_FACES:
+        n_g, d_g = box.face_plane(g)
+        if "xyz".index(g[1]) == k_f or g == skip or on_table(n_g, d_g, table_z, o.map_tolerance_m):
+            continue  # not adjacent, the joint's end face, or never seen
+        q0, e = _fit.plane_intersection(n, d, n_g, d_g, mid)
+        reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
+        edges.append((reach, g, n_g, d_g, q0, e))
+    for reach, g, n_g, d_g, q0, e in sorted(edges, key=lambda x: x[0]):
+        # The face is carried from its edge to the seam: a tilt within the prior moves it by tilt x reach, so an
+        # edge that far cannot place it better than the best one found.
+        if best is not None and tilt * reach >= best.se:
+            continue
+        k_g = "xyz".index(g[1])
+        # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
+        s_ends = sorted(float(e @ (p - q0)) for p in seam)
+        e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
+        P, cam, ok = points(q0 + e_lo * e, q0 + e_hi * e, float(np.hypot(max(-lo, hi), gate)))
+        u = P @ n - d  # along the face's outward normal: the adjacent face's points end at u = 0
+        r_g = P @ n_g - d_g
+        region = ok & away(P) & (u > lo) & (u < hi) & in_face(box, P, (k_f, k_g), o.edge_band_m)
+        sel = region & (np.abs(r_g) < gate)
+        if np.count_nonzero(sel) < o.min_face_points:
+            continue
+        start = _fit.histogram_mode(r_g[sel], max(0.002, o.sensor_sigma_m))
+        fit = _fit.robust_plane_fit(r_g[sel], np.ones((int(np.count_nonzero(sel)), 1)), cam[sel], start)
+        on = region & (np.abs(r_g - fit.offset) < 2.5 * max(fit.scale, 1e-4))
+        if np.count_nonzero(on) < o.min_face_points:
+            continue
+        # Each camera's edge on its own (incidence, sampling and calibration differ between cameras), with its
+        # standard error: the likelihood's and the sampling of the surface (points land on a pixel grid: with
+        # the grid nearly parallel to the edge, every row ends at the same phase).
+        uu, cc = u[on], cam[on]
+        along = P[on] @ e
+        cams, counts = np.unique(cc, return_counts=True)
+        per_cam: list[tuple[float, float]] = []
+        faults: list[tuple[int, str]] = []
+        for c, n_c in zip(cams, counts, strict=True):
+            if n_c < o.min_face_points:
+                continue
+            mine = cc == c
+            edge = _fit.edge_fit(uu[mine], lo, hi, -search, search)
+            b = edge.b if np.isfinite(edge.b) else 0.0
+            fault = edge_fault(edge, g, search, at_cut(crop, q0 + b * n, n, edge.blur, o.edge_band_m), o)
+            if fault:
+                faults.append((int(n_c), fault))
+                continue
+            pitch = float(np.sqrt(edge.pitch * max(float(np.ptp(along[mine])), 1e-3)))  # on face g [m]
+            per_cam.append((edge.b, float(np.hypot(edge.se, o.edge_pitch_factor * pitch))))
+        if not per_cam:
+            if faults:
+                why.append(max(faults)[1])
+            continue
+        b_g, se_g = combine(per_cam)
+        se_g = float(np.hypot(se_g, tilt * reach))
+        if best is None or se_g < best.se:
+            best = EdgePlacement(g, b_g, se_g, max(fit.scale, 1e-4), len(uu), len(per_cam))
+    if best is not None:
+        return best
+    if why:
+        return "its edge is not defined well enough: " + "; ".join(why)
+    return "no edge of it is seen either: not seen or not there"
+
+
+def edge_fault(edge: _fit.EdgeFit, g: str, search: float, cut: bool, o: EdgeOptions) -> str:
+    """Why the edge of the adjacent face ``g``, searched ``search`` [m] about the map, does not define the
+    unseen face (``cut``: it lies where the cloud stops), or "" when it does."""
+    if not np.isfinite(edge.b) or edge.n_edge < o.min_edge_points:
+        return f"the edge of {g} is defined by {edge.n_edge} points (needs {o.min_edge_points})"
+    if cut:
+        return f"the edge of {g} lies where the cloud stops (the workspace's boundary?)"
+    if edge.at_limit or not np.isfinite(edge.se):
+        return (
+            f"the edge of {g} lies at the limit of the {1000 * search:.0f} mm searched about the map "
+            "(no end of the points there: part moved, or the points stop there)"
+        )
+    if edge.blur >= max(_fit.EDGE_BLURS):
+        return f"the edge of {g} is blurred over {1000 * edge.blur:.1f} mm (seen at grazing incidence only)"
+    if edge.strays > o.max_edge_strays:
+        return (
+            f"the edge of {g} has {edge.strays:.0%} of its density beyond it (allowed "
+            f"{o.max_edge_strays:.0%}): flying pixels or another surface"
+        )
+    return ""
+
+
+def at_cut(crop: Box, p: FloatArray, n: FloatArray, blur: float, band: float) -> bool:
+    """Whether the boundary of ``crop`` lies within ``band`` (and 3 ``blur``) [m] of ``p`` (3,) ahead along ``n``
+    (3,): where the points stop because the cloud does, not the part."""
+    _, s_out = _fit.line_box_span(p, n, crop)
+    tol = band + 3.0 * (blur if np.isfinite(blur) else 0.0)
+    return bool(np.isfinite(s_out) and abs(s_out) < tol)
+
+
+def on_table(n: FloatArray, d: float, table_z: float, tol: float) -> bool:
+    """Whether the plane n . p = d is a downward face resting on the table (within ``tol`` [m])."""
+    return float(n @ _Z) < -0.9 and abs(d + table_z) < tol
+
+
+def in_face(box: Box, P: FloatArray, free: tuple[int, ...], band: float) -> BoolArray:
+    """Points (n, 3) whose coordinates along every box axis but the ``free`` ones lie inside the box shrunk by
+    ``band`` [m]."""
+    q = (P - box.center) @ box.X_AB[:3, :3]
+    ok = np.ones(len(P), bool)
+    for j in range(3):
+        if j not in free:
+            ok &= np.abs(q[:, j]) <= 0.5 * float(box.size[j]) - band
+    return ok
+
+
+def combine(estimates: list[tuple[float, float]]) -> tuple[float, float]:
+    """Inverse-variance mean of (value, standard error) pairs and its standard error, inflated by the Birge
+    ratio sqrt(chi^2 / (k - 1)) when the values scatter more than their errors say."""
+    v = np.array([e[0] for e in estimates])
+    w = 1.0 / np.square(np.maximum([e[1] for e in estimates], 1e-9))
+    mean = float(w @ v / w.sum())
+    se = float(1.0 / np.sqrt(w.sum()))
+    if len(v) > 1:
+        se *= max(1.0, float(np.sqrt(w @ (v - mean) ** 2 / (len(v) - 1))))
+    return mean, se

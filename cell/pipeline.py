@@ -150,33 +150,27 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     locator = make_locator(method, scenario)
     rng = scenario.rng(f"locator/{method}")
     progress(f"locating {len(ss.weldmap.seams)} seams ({method})")
-    out = []
-    hidden = {}
+    hidden: dict[str, SeamEstimate] = {}
     for seam in ss.weldmap.seams:
         visible, reason = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
         if not visible:
             hidden[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason)
     seams = [seam for seam in ss.weldmap.seams if seam.id not in hidden]
-    timed: dict[str, tuple[SeamEstimate, float]] = {}
+    timed: dict[str, SeamEstimate] = {}
     if isinstance(locator, BatchSeamLocator) and seams:
         # Found together: each seam is charged an equal share of the whole batch's time.
         t = time.perf_counter()
         found = locator.locate_many(ss, seams, rng)
         dt = (time.perf_counter() - t) / len(seams)
-        timed = {est.id: (est, dt) for est in found}
+        timed = {est.id: replace(est, time_s=dt) for est in found}
     else:
         for seam in seams:
             t = time.perf_counter()
             est = locator.locate(ss, seam, rng)
-            timed[seam.id] = (est, time.perf_counter() - t)
-    for seam in ss.weldmap.seams:
-        if seam.id in hidden:
-            out.append(hidden[seam.id])
-            continue
-        est, dt = timed[seam.id]
-        out.append(SeamEstimate(est.id, est.status, est.reason, est.p_start, est.p_end, est.confidence, time_s=dt))
+            timed[seam.id] = replace(est, time_s=time.perf_counter() - t)
+    out = tuple(hidden[seam.id] if seam.id in hidden else timed[seam.id] for seam in ss.weldmap.seams)
     # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
-    return screen(ss, tuple(out), scene.missing)
+    return screen(ss, out, scene.missing)
 
 
 def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:

@@ -517,7 +517,11 @@ class OursLocator:
         for k, end in enumerate(ends):
             if known[k]:
                 continue
-            if extent is not None and dense is not None:
+            if extent is None:
+                end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
+            elif dense is None:
+                end.s, end.se, end.source = extent[k], extent[2], "extent"
+            else:
                 # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
                 # point of the dense cloud within the likelihood's window about it.
                 sign = 1.0 if k == 1 else -1.0
@@ -531,8 +535,6 @@ class OursLocator:
                     end.s, end.se, end.source = sign * edge, max(se, 3.0 / max(density, 1.0)), "extent"
                 else:
                     end.s, end.se, end.source = extent[k], extent[2], "extent"
-            else:
-                end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
 
     def _side_selections(
         self,

@@ -129,7 +129,7 @@ def bench(
     extrinsics: Annotated[
         str, typer.Option(help="Comma-separated calibration errors of the fixed cameras: exact or MM/DEG.")
     ] = "exact",
-    repeat: Annotated[int, typer.Option(min=1, help="Runs per locator (median time).")] = 1,
+    repeat: Annotated[int, typer.Option(min=1, help="Runs per locator (each seam's fastest).")] = 1,
     json_path: Annotated[Path, typer.Option("--json", help="Where to write the rows.")] = Path(
         "benchmarks/results/latest.json"
     ),

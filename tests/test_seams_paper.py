@@ -11,7 +11,7 @@ from cell.scenario import PaperLocatorSpec
 from cell.seams.base import SeamScene
 from cell.seams.joint import find_joints
 from cell.seams.metrics import segment_errors
-from cell.seams.paper import PaperLocator, axis_faces, second_most_frequent
+from cell.seams.paper import PaperLocator, axis_faces, cloud_features, second_most_frequent
 from cell.seams.truth import true_seams
 from cell.seams.visibility import visibility
 from cell.types import Box, Cloud, MapSeam, Part, SeamStatus, WeldMap
@@ -231,3 +231,28 @@ def test_axis_faces_tells_a_face_from_a_column() -> None:
     assert len(faces) == 1 and faces[0][0] == pytest.approx(0.0123) and faces[0][1] == 30
     # The same points with normals along y are not a face perpendicular to x.
     assert axis_faces(pts, np.tile([0.0, 1.0, 0.0], (len(pts), 1)), 0, 0.001, 0.0075, np.zeros(3)) == []
+
+
+def test_boundary_points_of_a_masked_cloud_match_the_whole_clouds_inside_the_inner_mask() -> None:
+    """Step 2 on the outer mask's points (as the paper does) marks the mask's own cut as boundary; the inner
+    mask must remove that, leaving the flags the whole cloud would give."""
+    design = junction()
+    scene = scene_of(design, design, GRIDS[1])
+    pts = np.asarray(scene.cloud.points)
+    whole = cloud_features(pts)
+    locator = PaperLocator()
+    (oc, oa), (ic, ia) = locator.spec.outer_mask_m, locator.spec.inner_mask_m
+    agree, total = 0, 0
+    for s in visible_seams(scene):
+        axes = locator.axes(scene, s)
+        assert not isinstance(axes, str)
+        c, a = axes
+        outer = (np.abs(pts[:, c] - s.p_start[c]) <= oc) & (np.abs(pts[:, a] - s.p_start[a]) <= oa)
+        masked = cloud_features(pts[outer])
+        q = pts[outer]
+        inner = (np.abs(q[:, c] - s.p_start[c]) <= ic) & (np.abs(q[:, a] - s.p_start[a]) <= ia)
+        cut = ~inner & (masked.boundary != whole.boundary[outer])
+        assert cut.any()  # the outer mask's cut is boundary on its own points: the test can fail
+        agree += int(np.count_nonzero(masked.boundary[inner] == whole.boundary[outer][inner]))
+        total += int(np.count_nonzero(inner))
+    assert total > 200 and agree >= 0.98 * total, (agree, total)

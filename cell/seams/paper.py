@@ -208,8 +208,8 @@ class PaperLocator:
     Robustness choices (``strict=False``, the default; ``strict=True`` runs step 4 exactly as written):
 
     - Boundary points are extracted from the outer mask's points, as step 2 says; the mask's own cut is
-      "boundary" too, and the paper's second, smaller mask removes it (on fence1, fence1-exact and fence2, 10
-      of 4000 boundary flags inside the inner masks differ from those found on the whole cloud).
+      "boundary" too, and the paper's second, smaller mask removes it (inside it the flags are the whole
+      cloud's: tests/test_seams_paper.py).
     - Step 4 reads each value on the face it belongs to. In a voxel-averaged cloud a voxel that holds one flat
       face keeps the face's coordinate exactly, while boundary (edge) voxels average two faces and are off by
       up to half a voxel, and the voxels of a face parallel to an axis share their voxel-centre coordinate:

@@ -39,7 +39,7 @@ Method (general: no assumption that a seam runs along x, y or z):
 
 The seams of a scene are found together (:meth:`OursLocator.locate_many`): each seam's steps are as above, but
 every plane fit of a pass, and every tilt step, is one vectorised fit for all the seams (numpy costs about the
-same per call whatever the size: on the 156-seam ladder, 1.38 ms for the median seam alone, 0.93 ms per seam
+same per call whatever the size: on the 156-seam ladder, 1.38 ms for the median seam alone, 0.94 ms per seam
 together; benchmarks/bench_scaling.py).
 """
 

@@ -151,10 +151,18 @@ def test_jacobian_matches_finite_differences(robot: RobotModel) -> None:
 
 
 def test_manipulability_vanishes_at_the_wrist_singularity(robot: RobotModel) -> None:
+    # Relative to the problem's own scale: the Jacobian's smallest singular value over its largest (its inverse
+    # condition number), never an absolute bar on a product of floats (sqrt(det) near 1e-17 is rounding noise).
+    def inverse_condition(q: np.ndarray) -> float:
+        s = np.linalg.svd(robot.jacobian(q, "tool0", "aligned"), compute_uv=False)
+        return float(s[-1] / s[0])
+
     q = np.radians([10.0, -60.0, 100.0, 20.0, 50.0, -30.0])
-    assert robot.manipulability(q) > 1e-2
+    w_regular, k_regular = robot.manipulability(q), inverse_condition(q)  # measured 0.30 m^3, 0.17
+    assert w_regular > 1e-2 and k_regular > 0.05
     q[4] = 0.0  # A5 = 0: A4 and A6 aligned
-    assert robot.manipulability(q) < 1e-9
+    assert inverse_condition(q) < 1e-6 * k_regular  # measured 2.5e-18
+    assert robot.manipulability(q) < 1e-6 * w_regular  # 0 here; 6.4e-9 seen where det(J J^T) rounds to 4e-17
 
 
 def test_ik_round_trip_from_perturbed_seeds(robot: RobotModel) -> None:

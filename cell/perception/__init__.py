@@ -4,26 +4,52 @@ The only part of the cell that uses open3d, and only through :mod:`cell.percepti
 """
 
 from cell.perception.align import Alignment, align_map, sample_map
+from cell.perception.alignment_checks import (
+    Alternative,
+    SymmetryOptions,
+    alignment_alternatives,
+    check_alignment_unique,
+    check_parts_seen,
+    missing_parts,
+    part_coverage,
+)
+from cell.perception.camera_health import HealthOptions, ImageHealth, agreement, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame, crop, deproject
 from cell.perception.perceive import Perceived, perceive
 from cell.perception.ply import load_ply, save_ply
 from cell.perception.preprocess import downsample, preprocess
+from cell.perception.seam_screen import ScreenOptions, foreign_points, screen
 from cell.perception.splice import Registration, Spliced, splice
 
 __all__ = [
     "Alignment",
+    "Alternative",
+    "HealthOptions",
+    "ImageHealth",
     "Perceived",
     "Registration",
+    "ScreenOptions",
     "Spliced",
+    "SymmetryOptions",
+    "agreement",
     "align_map",
+    "alignment_alternatives",
+    "check_alignment_unique",
+    "check_parts_seen",
     "clouds_in_robot_frame",
     "crop",
     "deproject",
+    "disagreeing_cameras",
     "downsample",
+    "foreign_points",
+    "image_health",
     "load_ply",
+    "missing_parts",
+    "part_coverage",
     "perceive",
     "preprocess",
     "sample_map",
     "save_ply",
+    "screen",
     "splice",
 ]

@@ -2,7 +2,7 @@
 
 deproject + crop + robot frame (section 3.2) -> splice (3.3) -> Z passthrough and outlier removal (3.4) ->
 voxel grid (3.4). A camera whose data cannot be trusted is *lost*, with the reason, before it can poison the
-splice (:mod:`cell.perception.health`): no valid pixel (dead, blinded), an implausible image (one value
+splice (:mod:`cell.perception.camera_health`): no valid pixel (dead, blinded), an implausible image (one value
 everywhere, random depths, heavy interference), no point inside the workspace, or a cloud that agrees with no
 other camera while the others agree (knocked out of calibration). The others go on without it; only when no
 usable camera remains is it a :class:`SensorError`.
@@ -18,8 +18,8 @@ import numpy as np
 
 from cell.errors import SensorError
 from cell.geometry import FloatArray
+from cell.perception.camera_health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame
-from cell.perception.health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.preprocess import downsample, preprocess
 from cell.perception.splice import Spliced, splice
 from cell.scenario import PerceptionSpec

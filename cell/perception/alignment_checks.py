@@ -1,0 +1,202 @@
+"""Is the map fitted to the cloud where the part is? Checks that turn a wrong map fit into a reason.
+
+For the pipeline, after :func:`cell.perception.align.align_map`:
+
+- :func:`check_alignment_unique`: the map's near-symmetries (a ladder shifted by one rung pitch, a part turned
+  by 180 degrees) fit the cloud almost as well as the true placement. Compare the chosen fit with each
+  alternative on the only surfaces that tell them apart; refuse (AlignmentError) when the cloud does not
+  clearly prefer the chosen one.
+- :func:`check_parts_seen` (:func:`part_coverage`, :func:`missing_parts`): how much of each part's top the
+  cloud covers; a part with almost none while the others are well covered is not on the table (its seams are
+  NOT_FOUND, never invented); parts half covered mean the map lies in the wrong place (AlignmentError).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from cell.errors import AlignmentError
+from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
+from cell.perception.align import Alignment, sample_map
+from cell.scenario import PerceptionSpec
+from cell.types import Cloud, WeldMap
+
+
+@dataclass(frozen=True)
+class Alternative:
+    """A near-symmetry of the map and how the cloud judges it against the chosen fit.
+
+    X : (4, 4) the alternative's pose change in R (aligned map -> alternative map), about the map's centre.
+    label : what it is, in words (``"shifted 76.0 mm along x"``).
+    self_overlap : share of the map's visible samples that the alternative puts on the map's own surfaces.
+    support_chosen, support_alt : share of the samples only the chosen / only the alternative map has (the
+        surfaces that tell them apart) with a cloud point within the band.
+    n_distinct : how many such telling samples each side has (the smaller of the two).
+    """
+
+    X: FloatArray
+    label: str
+    self_overlap: float
+    support_chosen: float
+    support_alt: float
+    n_distinct: int
+
+
+@dataclass(frozen=True)
+class SymmetryOptions:
+    """Thresholds of :func:`check_alignment_unique`; lengths [m]."""
+
+    band_m: float = 0.01  # a map sample is supported if a cloud point lies this near
+    spacing_m: float = 0.005  # map sample spacing
+    min_self_overlap: float = 0.6  # alternatives that keep less of the map on itself are not near-symmetries
+    min_margin: float = 0.3  # the chosen fit must be supported this much more than any alternative
+    min_distinct: int = 50  # fewer telling samples: the map is exactly symmetric there (see the docstring)
+
+
+def _candidates(weldmap_R: WeldMap, centre: FloatArray) -> list[tuple[FloatArray, str]]:
+    """Rigid motions on the table that could map the drawing onto itself: 180 degrees about the vertical
+    through ``centre``, and shifts by the offset between two parts of the same size (a rung pitch)."""
+    out: list[tuple[FloatArray, str]] = []
+    T = make_pose(p=centre) @ make_pose(rpy_to_matrix((0.0, 0.0, math.pi))) @ make_pose(p=-centre)
+    out.append((T, "turned 180 deg about the vertical"))
+    parts = weldmap_R.parts
+    shifts: list[FloatArray] = []
+    for i, a in enumerate(parts):
+        for b in parts[i + 1 :]:
+            if np.allclose(np.sort(a.box.size), np.sort(b.box.size), atol=1e-4):
+                d = b.box.center - a.box.center
+                d[2] = 0.0
+                if np.linalg.norm(d) > 1e-3:
+                    shifts.append(d)
+    # The smallest shift in each direction (a pitch), both ways.
+    shifts.sort(key=lambda v: float(np.linalg.norm(v)))
+    kept: list[FloatArray] = []
+    for d in shifts:
+        if all(abs(float(d @ k)) / (np.linalg.norm(d) * np.linalg.norm(k)) < 0.99 for k in kept):
+            kept.append(d)
+    for d in kept:
+        for sign in (1.0, -1.0):
+            axis = "xyz"[int(np.argmax(np.abs(d)))]
+            out.append((make_pose(p=sign * d), f"shifted {sign * float(np.linalg.norm(d)) * 1000:.1f} mm along {axis}"))
+    return out
+
+
+def alignment_alternatives(
+    weldmap_R: WeldMap, cloud: Cloud, options: SymmetryOptions | None = None
+) -> list[Alternative]:
+    """The aligned map's near-symmetries (self-overlap at least ``min_self_overlap``), each judged by the
+    cloud on the samples that distinguish it from the chosen fit. ``weldmap_R`` is the map as aligned."""
+    o = options if options is not None else SymmetryOptions()
+    samples, _ = sample_map(weldmap_R, o.spacing_m, o.spacing_m)
+    if len(samples) == 0 or len(cloud) == 0:
+        return []
+    map_tree = cKDTree(samples)
+    cloud_tree = cKDTree(np.asarray(cloud.points))
+    near_cloud = np.isfinite(cloud_tree.query(samples, distance_upper_bound=o.band_m)[0])
+    out = []
+    for T, label in _candidates(weldmap_R, samples.mean(axis=0)):
+        moved = transform_points(T, samples)
+        on_map = np.isfinite(map_tree.query(moved, distance_upper_bound=o.band_m)[0])
+        self_overlap = float(on_map.mean())
+        if self_overlap < o.min_self_overlap:
+            continue
+        # Samples only the chosen map has (the alternative puts nothing there) and only the alternative has.
+        only_chosen = ~np.isfinite(cKDTree(moved).query(samples, distance_upper_bound=o.band_m)[0])
+        only_alt = ~on_map
+        alt_near = np.isfinite(cloud_tree.query(moved[only_alt], distance_upper_bound=o.band_m)[0])
+        n = int(min(only_chosen.sum(), only_alt.sum()))
+        s_chosen = float(near_cloud[only_chosen].mean()) if only_chosen.any() else 0.0
+        s_alt = float(alt_near.mean()) if only_alt.any() else 0.0
+        out.append(Alternative(T, label, self_overlap, s_chosen, s_alt, n))
+    return out
+
+
+def check_alignment_unique(
+    weldmap_R: WeldMap, cloud: Cloud, alignment: Alignment, options: SymmetryOptions | None = None
+) -> list[Alternative]:
+    """Refuse a map fit that a near-symmetry of the map explains about as well (AlignmentError naming it).
+
+    weldmap_R : the map *as aligned* (frame R); cloud : the dense cloud it was aligned to (frame R).
+    An alternative whose telling surfaces the cloud supports at least as well as the chosen fit's, less
+    ``min_margin``, makes the seams' identities ambiguous (a ladder one rung off puts every seam on its
+    neighbour's joint). An exact symmetry (fewer than ``min_distinct`` telling samples: the drawing is the same
+    either way) is not refused: every seam lands on an identical joint. Returns the alternatives examined.
+    """
+    o = options if options is not None else SymmetryOptions()
+    alts = alignment_alternatives(weldmap_R, cloud, o)
+    for alt in alts:
+        if alt.n_distinct < o.min_distinct:
+            continue
+        if alt.support_chosen - alt.support_alt < o.min_margin:
+            better = "fits better" if alt.support_alt > alt.support_chosen else "fits almost as well"
+            raise AlignmentError(
+                f"ambiguous map alignment: the map {alt.label} {better} (cloud covers {alt.support_alt:.0%} of the "
+                f"surfaces that tell the fits apart, against {alt.support_chosen:.0%} for the chosen fit, "
+                f"fitness {alignment.fitness:.2f}); every seam could be on its neighbour's joint: place the part "
+                "against its fixture stops and re-scan"
+            )
+    return alts
+
+
+def part_coverage(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, band_m: float = 0.01) -> dict[str, float]:
+    """Part name -> share of its upward faces' samples (top, in R) with a cloud point within ``band_m`` [m].
+
+    Upward faces are seen by every camera above the table; a part that is on the table covers most of its top.
+    """
+    spacing = max(spec.voxel_m / 2.0, 0.002)
+    tree = cKDTree(np.asarray(cloud.points)) if len(cloud) else None
+    out = {}
+    for part in weldmap_R.parts:
+        one = WeldMap((part,), (), weldmap_R.units, weldmap_R.source, weldmap_R.frame)
+        p, n = sample_map(one, spacing, spacing)
+        top = p[n[:, 2] > 0.9]
+        # Leave out where another part covers it (in contact) or stands over it.
+        for other in weldmap_R.parts:
+            if other is not part and len(top):
+                top = top[~other.box.contains(top, band_m)]
+        if tree is None or len(top) == 0:
+            out[part.name] = 0.0
+            continue
+        out[part.name] = float(np.mean(np.isfinite(tree.query(top, distance_upper_bound=band_m)[0])))
+    return out
+
+
+def missing_parts(coverage: Mapping[str, float], min_coverage: float = 0.1, min_others: float = 0.4) -> dict[str, str]:
+    """Parts whose top the cloud hardly covers while the best-covered part is well covered: name -> reason."""
+    if not coverage or max(coverage.values()) < min_others:
+        return {}
+    return {
+        name: f"part {name} is not in the cloud ({c:.0%} of its top seen, others up to "
+        f"{max(coverage.values()):.0%}): missing or not placed"
+        for name, c in coverage.items()
+        if c < min_coverage
+    }
+
+
+def check_parts_seen(
+    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, min_coverage: float = 0.1, min_seen: float = 0.6
+) -> dict[str, str]:
+    """After alignment: refuse a map that does not lie where the cloud is; name the parts that are missing.
+
+    weldmap_R : the map as aligned (frame R); cloud : the dense cloud (frame R).
+    A part whose top is covered less than ``min_seen`` but more than ``min_coverage`` lies half on, half off
+    the cloud: the map settled in a wrong place (part displaced beyond what alignment corrects), or the part
+    runs out of the workspace: AlignmentError. So it is when more than half of the parts are missing. Returns
+    the missing parts (covered less than ``min_coverage``): name -> reason; their seams must be NOT_FOUND.
+    """
+    coverage = part_coverage(weldmap_R, cloud, spec)
+    partial = {n: c for n, c in coverage.items() if min_coverage <= c < min_seen}
+    missing = missing_parts(coverage, min_coverage)
+    if partial or len(missing) > len(coverage) / 2 or not coverage:
+        worst = ", ".join(f"{n} {c:.0%}" for n, c in sorted(coverage.items(), key=lambda x: x[1])[:3])
+        raise AlignmentError(
+            f"the aligned map does not lie on the cloud: share of each part's top with points: {worst} (needs "
+            f"{min_seen:.0%}, or under {min_coverage:.0%} for a missing part): part displaced beyond what the "
+            "alignment corrects, running out of the workspace, or covered"
+        )
+    return missing

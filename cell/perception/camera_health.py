@@ -1,0 +1,134 @@
+"""Is a camera's data fit to splice? Checks that turn a broken camera into a reason before it poisons the splice.
+
+Run by :func:`cell.perception.perceive.perceive` before splicing:
+
+- :func:`image_health`: one depth image on its own. A dead camera has (almost) no valid pixel; a stuck one reads
+  one value everywhere; a garbage stream (random depths, heavy interference) is rough everywhere, while a real
+  scene is piecewise smooth: only the pixels along depth edges jump between neighbours (a few per cent).
+- :func:`disagreeing_cameras`: the cameras' clouds against each other in R (calibrated extrinsics). A camera
+  knocked out of calibration sees the same part elsewhere: few of its points lie on the others' surfaces while
+  the others agree with each other. With only two cameras nobody can tell which one is wrong: none is dropped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from cell.perception.preprocess import downsample
+from cell.types import Cloud, DepthImage
+
+
+@dataclass(frozen=True)
+class HealthOptions:
+    """Thresholds of the camera checks (defaults suit D4xx-class depth cameras at 1-2.5 m)."""
+
+    min_valid_fraction: float = 0.01  # fewer valid pixels: the camera is dead or blinded
+    max_constant_fraction: float = 0.5  # more valid pixels reading one identical value: stuck sensor
+    rough_jump_m: float = 0.05  # a depth step to a neighbour pixel larger than this (and 5 % of the depth) ...
+    max_rough_fraction: float = 0.2  # ... on more than this share of neighbour pairs: not a scene, garbage
+    agree_voxel_m: float = 0.005  # clouds are compared on a grid of this [m] (averages the depth noise)
+    agree_tol_m: float = 0.01  # a point agrees with another camera if that camera has a point this near [m]
+    min_agreement: float = 0.5  # share of a camera's points that must agree with some other camera
+
+
+@dataclass(frozen=True)
+class ImageHealth:
+    """Statistics of one depth image and the verdict: ``reason`` is empty for a usable image."""
+
+    camera: str
+    valid_fraction: float
+    constant_fraction: float  # share of valid pixels reading the most frequent value
+    rough_fraction: float  # share of valid neighbour pairs with an implausible depth step
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return not self.reason
+
+
+def image_health(image: DepthImage, options: HealthOptions | None = None) -> ImageHealth:
+    """Judge one depth image from its own pixels (see the module docstring)."""
+    o = options if options is not None else HealthOptions()
+    z = np.asarray(image.depth, dtype=np.float64)
+    valid = np.isfinite(z) & (z > 0)
+    n_valid = int(valid.sum())
+    valid_fraction = n_valid / max(z.size, 1)
+    if valid_fraction < o.min_valid_fraction:
+        return ImageHealth(
+            image.camera,
+            valid_fraction,
+            0.0,
+            0.0,
+            f"no usable image: {n_valid} valid pixels of {z.size} (needs {o.min_valid_fraction:.0%}): "
+            "dead, unplugged or blinded",
+        )
+    values, counts = np.unique(z[valid].astype(np.float32), return_counts=True)
+    k = int(np.argmax(counts))
+    constant_fraction = float(counts[k]) / n_valid
+    rough = 0
+    pairs = 0
+    for a, b in ((z[:, :-1], z[:, 1:]), (z[:-1, :], z[1:, :])):
+        ok = (a > 0) & (b > 0) & np.isfinite(a) & np.isfinite(b)
+        step = np.abs(a - b)
+        limit = np.maximum(o.rough_jump_m, 0.05 * np.minimum(a, b))
+        rough += int(np.count_nonzero(ok & (step > limit)))
+        pairs += int(np.count_nonzero(ok))
+    rough_fraction = rough / max(pairs, 1)
+    reason = ""
+    if constant_fraction > o.max_constant_fraction:
+        reason = (
+            f"implausible image: {constant_fraction:.0%} of the valid pixels read exactly {float(values[k]):.4f} m "
+            "(a stuck or frozen sensor)"
+        )
+    elif rough_fraction > o.max_rough_fraction:
+        reason = (
+            f"implausible image: {rough_fraction:.0%} of neighbouring pixels differ by more than "
+            f"{o.rough_jump_m * 1000:.0f} mm (a real scene: a few per cent at edges): random depths or interference"
+        )
+    return ImageHealth(image.camera, valid_fraction, constant_fraction, rough_fraction, reason)
+
+
+def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None) -> dict[tuple[str, str], float]:
+    """(a, b) -> share of camera a's points (on a grid of ``agree_voxel_m``) with a point of camera b within
+    ``agree_tol_m``; for every ordered pair of non-empty clouds (frame R, calibrated extrinsics)."""
+    o = options if options is not None else HealthOptions()
+    grids = {n: np.asarray(downsample(c, o.agree_voxel_m).points) for n, c in clouds.items() if len(c) > 0}
+    trees = {n: cKDTree(p) for n, p in grids.items()}
+    out: dict[tuple[str, str], float] = {}
+    for a, pa in grids.items():
+        for b, tree in trees.items():
+            if a != b:
+                dist, _ = tree.query(pa, distance_upper_bound=o.agree_tol_m)
+                out[(a, b)] = float(np.mean(np.isfinite(dist)))
+    return out
+
+
+def disagreeing_cameras(clouds: Mapping[str, Cloud], options: HealthOptions | None = None) -> dict[str, str]:
+    """Cameras whose cloud agrees with no other camera while at least two others agree with each other:
+    name -> reason. Empty when all agree, or when there is no agreeing majority to judge by."""
+    o = options if options is not None else HealthOptions()
+    share = agreement(clouds, o)
+    names = sorted({a for a, _ in share})
+
+    def agree(a: str, b: str) -> bool:  # both ways: a shifted cloud can still cover the other's tops
+        return min(share[(a, b)], share[(b, a)]) >= o.min_agreement
+
+    out = {}
+    for c in names:
+        others = [n for n in names if n != c]
+        if any(agree(c, n) for n in others):
+            continue
+        if not any(agree(a, b) for i, a in enumerate(others) for b in others[i + 1 :]):
+            continue  # no pair of the others agrees either: no majority to tell who is wrong
+        best = max(others, key=lambda n: min(share[(c, n)], share[(n, c)]))
+        worst = min(share[(c, best)], share[(best, c)])
+        out[c] = (
+            f"disagrees with the other cameras: at best {worst:.0%} of its points and {best}'s lie within "
+            f"{o.agree_tol_m * 1000:.0f} mm of each other (needs {o.min_agreement:.0%}), while the others agree: "
+            "knocked out of calibration?"
+        )
+    return out

@@ -1,0 +1,102 @@
+"""Which found seams must not be welded? The screen after the locator, turning seams into reasons.
+
+For the pipeline, after the locator: :func:`screen` turns a found seam into NOT_FOUND / OCCLUDED, with the
+reason, when its part is missing (:func:`cell.perception.alignment_checks.check_parts_seen`), when an object the
+map does not know lies over it (:func:`foreign_points`), or when the locator itself had almost no confidence in it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.seams.base import SeamScene
+from cell.types import Cloud, SeamEstimate, SeamStatus, WeldMap
+
+
+@dataclass(frozen=True)
+class ScreenOptions:
+    """Thresholds of :func:`screen`; lengths [m]."""
+
+    radius_m: float = 0.06  # look this far around the seam for points of unknown objects (the locator's tube)
+    margin_m: float = 0.02  # a point further than this from every part of the map is foreign (3 sigma at 2 m)
+    min_foreign: int = 40  # this many foreign points (a few cm^2 of surface) near a seam: it is occluded
+    min_confidence: float = 0.1  # found seams below this confidence are not trusted
+
+
+def foreign_points(
+    weldmap_R: WeldMap,
+    dense: Cloud,
+    p_start: FloatArray,
+    p_end: FloatArray,
+    table_z: float,
+    options: ScreenOptions | None = None,
+) -> int:
+    """How many points of ``dense`` (R) within ``radius_m`` of the segment p_start-p_end (3,) [m] lie further
+    than ``margin_m`` from every part of the map and above the table: an object the map does not know."""
+    o = options if options is not None else ScreenOptions()
+    P = np.asarray(dense.points)
+    a, b = np.asarray(p_start, float), np.asarray(p_end, float)
+    ab = b - a
+    lo, hi = np.minimum(a, b) - o.radius_m, np.maximum(a, b) + o.radius_m
+    box = np.all((lo <= P) & (hi >= P), axis=1)
+    Q = P[box]
+    t = np.clip((Q - a) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0)
+    near = np.linalg.norm(Q - (a + t[:, None] * ab), axis=1) <= o.radius_m
+    Q = Q[near & (Q[:, 2] > table_z + o.margin_m)]
+    for part in weldmap_R.parts:
+        Q = Q[~part.box.contains(Q, o.margin_m)]
+    return len(Q)
+
+
+def screen(
+    scene: SeamScene,
+    estimates: tuple[SeamEstimate, ...],
+    missing: Mapping[str, str],
+    options: ScreenOptions | None = None,
+) -> tuple[SeamEstimate, ...]:
+    """The locator's estimates with the seams that must not be welded taken out, each with its reason.
+
+    missing : part name -> reason (from :func:`~cell.perception.alignment_checks.check_parts_seen`): every seam
+    of such a part is NOT_FOUND, whatever the locator or the visibility check said. A seam (found or not) with at
+    least ``min_foreign`` foreign points near it (map seam when not found) is OCCLUDED. A found seam with
+    confidence below ``min_confidence`` is NOT_FOUND.
+    """
+    o = options if options is not None else ScreenOptions()
+    out = []
+    for est in estimates:
+        seam = scene.weldmap.seam(est.id)
+        joint = scene.joints.get(est.id)
+        parts = (joint.abutting, joint.receiving) if joint is not None else ()
+        part = next((n for n in parts if n in missing), None)
+        if part is not None:
+            out.append(SeamEstimate(est.id, SeamStatus.NOT_FOUND, missing[part]))
+            continue
+        if est.status is SeamStatus.NOT_VISIBLE:
+            out.append(est)
+            continue
+        n = foreign_points(scene.weldmap, scene.dense, seam.p_start, seam.p_end, scene.table_z, o)
+        if n >= o.min_foreign:
+            out.append(
+                SeamEstimate(
+                    est.id,
+                    SeamStatus.OCCLUDED,
+                    f"occluded: {n} points of an object the map does not know lie within "
+                    f"{o.radius_m * 1000:.0f} mm of the seam (a clamp, a cable?): clear it and re-scan",
+                )
+            )
+            continue
+        if est.status is SeamStatus.FOUND and est.confidence < o.min_confidence:
+            out.append(
+                SeamEstimate(
+                    est.id,
+                    SeamStatus.NOT_FOUND,
+                    f"too uncertain to weld: confidence {est.confidence:.2f} < {o.min_confidence:.2f} ({est.reason})",
+                )
+            )
+            continue
+        out.append(est)
+    return tuple(out)

@@ -37,7 +37,8 @@ from cell.perception import (
 )
 from cell.perception.merge import predicted_noise, prioritised_merge
 from cell.perception.preprocess import radius_outlier_mask, z_range_R
-from cell.perception.splice import MIN_SHIFT_M, register, registration_settings, splice_order
+from cell.perception.registration import register, registration_settings
+from cell.perception.splice import MIN_SHIFT_M, splice_order
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
 

@@ -1,0 +1,80 @@
+"""The generated docs are what their sources give now: docs/scenarios.md from the scenario models, the README's
+result tables from benchmarks/results/. A model or a result changed without regenerating fails here."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import shutil
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _tool(name: str) -> ModuleType:
+    """A script of tools/ as a module (tools/ is not a package)."""
+    spec = importlib.util.spec_from_file_location(f"tools_{name}", REPO / "tools" / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def scenario_docs() -> ModuleType:
+    return _tool("scenario_docs")
+
+
+@pytest.fixture(scope="module")
+def readme_results() -> ModuleType:
+    return _tool("readme_results")
+
+
+def test_scenarios_md_is_generated_from_the_models(scenario_docs: ModuleType) -> None:
+    committed = (REPO / "docs" / "scenarios.md").read_text(encoding="utf-8")
+    assert committed == scenario_docs.render(), (
+        f"docs/scenarios.md is out of date with cell/scenario.py: regenerate it with {scenario_docs.COMMAND}"
+    )
+
+
+def test_scenarios_md_lists_every_key(scenario_docs: ModuleType) -> None:
+    from cell.scenario import Scenario
+
+    keys = {row.key for row in scenario_docs.rows(Scenario)}
+    assert {"seed", "cameras.<name>.noise.subpixel_px", "process.travel_speed_mm_s", "rescan.escalate_mm"} <= keys
+    assert "base_dir" not in keys  # set by the loader, never in a file
+    by_key = {row.key: row for row in scenario_docs.rows(Scenario)}
+    assert by_key["process.travel_speed_mm_s"].unit == "mm/s"
+    assert by_key["cameras.<name>.eye_m"].default == "required"
+
+
+def test_scenario_docs_check_mode(scenario_docs: ModuleType, tmp_path: Path) -> None:
+    stale = tmp_path / "scenarios.md"
+    stale.write_text("old\n", encoding="utf-8")
+    assert scenario_docs.main(["--check", "--out", str(stale)]) == 1
+    assert scenario_docs.main(["--out", str(stale)]) == 0
+    assert scenario_docs.main(["--check", "--out", str(stale)]) == 0
+
+
+def test_readme_tables_are_generated_from_the_results(readme_results: ModuleType) -> None:
+    assert readme_results.main(["--check"]) == 0, (
+        f"README.md's result tables differ from benchmarks/results/: regenerate them with {readme_results.COMMAND}"
+    )
+
+
+def test_readme_check_fails_on_a_changed_result(readme_results: ModuleType, tmp_path: Path) -> None:
+    results = tmp_path / "results"
+    shutil.copytree(REPO / "benchmarks" / "results", results)
+    rows = json.loads((results / "scaling.json").read_text(encoding="utf-8"))
+    rows[0]["align_s"] += 1.0
+    (results / "scaling.json").write_text(json.dumps(rows), encoding="utf-8")
+    readme = tmp_path / "README.md"
+    shutil.copy(REPO / "README.md", readme)
+    assert readme_results.main(["--check", "--readme", str(readme), "--results", str(results)]) == 1
+    assert readme_results.main(["--readme", str(readme), "--results", str(results)]) == 0
+    assert readme_results.main(["--check", "--readme", str(readme), "--results", str(results)]) == 0

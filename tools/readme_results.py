@@ -1,0 +1,161 @@
+"""Render the README's result tables from ``benchmarks/results/`` and put them between the README's markers.
+
+Run from the repository root::
+
+    .venv/bin/python tools/readme_results.py           # rewrite the marked blocks of README.md
+    .venv/bin/python tools/readme_results.py --check   # exit 1 when README.md differs from the results
+
+Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->`` in README.md:
+
+- ``table1``: Table 1 with realistic noise and exact calibration (``latest.json``, the ``exact`` rows);
+- ``table1-noise-none``: the same with noise-free depth (``noise-none.json``);
+- ``calibration``: our locator under calibration error (``latest.json``, ``ours``, every other extrinsics row);
+- ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``).
+
+The Table 1 blocks are :func:`cell.bench.markdown_table` of the rows, the renderer that also writes
+``benchmarks/results/*.md``; the scaling block is the README's one-line-per-scenario summary of
+``scaling.json``. The JSON is the truth: re-run a benchmark with ``--json`` and then this script.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:  # run as a script from anywhere: the package is the repository's
+    sys.path.insert(0, str(REPO))
+
+from cell.bench import markdown_table  # noqa: E402  (after the path set-up above)
+
+README = REPO / "README.md"
+RESULTS = REPO / "benchmarks" / "results"
+COMMAND = ".venv/bin/python tools/readme_results.py"
+
+Rows = list[dict[str, Any]]
+
+# How the README names a scenario in the scaling table (the JSON holds the name only).
+SCALING_LABELS: Mapping[str, str] = {"ladder": "ladder (26 rungs)"}
+# The methods of the scaling table, in its column order, and what each column shows.
+SCALING_METHODS = ("ours", "paper", "ransac")
+
+
+def _load(results: Path, name: str) -> Rows:
+    data = json.loads((results / name).read_text(encoding="utf-8"))
+    if not isinstance(data, list):
+        raise ValueError(f"{results / name}: expected a JSON list of rows, got {type(data).__name__}")
+    return data
+
+
+def table1(results: Path) -> str:
+    """Table 1, realistic noise, exact calibration: every method on every scenario."""
+    return markdown_table([r for r in _load(results, "latest.json") if r["extrinsics"] == "exact"])
+
+
+def table1_noise_none(results: Path) -> str:
+    """Table 1 with noise-free depth (the paper's own conditions)."""
+    return markdown_table(_load(results, "noise-none.json"))
+
+
+def calibration(results: Path) -> str:
+    """Ours under calibration error: the non-exact extrinsics rows of the same run as Table 1."""
+    return markdown_table(
+        [r for r in _load(results, "latest.json") if r["extrinsics"] != "exact" and r["method"] == "ours"]
+    )
+
+
+def scaling_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """One line per scenario: size, perception and alignment [s], and per method found and ms per seam."""
+    head = (
+        "| scenario | seams / visible | points dense / 1 cm | perceive s | align s | "
+        "ours: found, ms/seam median, lateral mm | paper: found, ms/seam | ransac: found, ms/seam |\n"
+        "|---|---|---|---|---|---|---|---|\n"
+    )
+    lines = []
+    for r in rows:
+        m = r["methods"]
+        ours, paper, ransac = (m[k] for k in SCALING_METHODS)
+        lines.append(
+            f"| {SCALING_LABELS.get(r['scenario'], r['scenario'])} | {r['seams']} / {r['visible']} | "
+            f"{r['points_dense']:,} / {r['points_voxel']:,} | {r['perceive_s']:.2f} | {r['align_s']:.2f} | "
+            f"{ours['found']}, {ours['ms_per_seam_median']:.2f}, {ours['lateral_mean_mm']:.3f} | "
+            f"{paper['found']}, {paper['ms_per_seam_median']:.2f} | "
+            f"{ransac['found']}, {ransac['ms_per_seam_median']:.2f} |"
+        )
+    return head + "\n".join(lines) + "\n"
+
+
+def scaling(results: Path) -> str:
+    """The scaling table of ``scaling.json``."""
+    return scaling_table(_load(results, "scaling.json"))
+
+
+BLOCKS: Mapping[str, Callable[[Path], str]] = {
+    "table1": table1,
+    "table1-noise-none": table1_noise_none,
+    "calibration": calibration,
+    "scaling": scaling,
+}
+
+
+def _pattern(name: str) -> re.Pattern[str]:
+    return re.compile(rf"(<!-- results:{re.escape(name)} -->\n)(.*?)(<!-- /results:{re.escape(name)} -->)", re.DOTALL)
+
+
+def _block(readme: str, name: str) -> str:
+    found = _pattern(name).search(readme)
+    return found.group(2) if found else ""
+
+
+def _replacement(table: str) -> Callable[[re.Match[str]], str]:
+    """A ``re.sub`` replacement keeping the markers around ``table`` (taken as is, no escapes)."""
+    return lambda m: m.group(1) + table + m.group(3)
+
+
+def render(readme: str, results: Path = RESULTS) -> str:
+    """``readme`` with every marked block replaced by the table the results give (ValueError: a marker missing)."""
+    out = readme
+    for name, make in BLOCKS.items():
+        pattern = _pattern(name)
+        if len(pattern.findall(out)) != 1:
+            raise ValueError(f"README needs exactly one <!-- results:{name} --> ... <!-- /results:{name} --> block")
+        table = make(results)
+        out = pattern.sub(_replacement(table), out)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--check", action="store_true", help="exit 1 when README.md differs from the results")
+    ap.add_argument("--readme", type=Path, default=README)
+    ap.add_argument("--results", type=Path, default=RESULTS)
+    args = ap.parse_args(argv)
+    current = args.readme.read_text(encoding="utf-8")
+    try:
+        text = render(current, args.results)
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    if args.check:
+        if text != current:
+            stale = [n for n in BLOCKS if _block(text, n) != _block(current, n)]
+            print(
+                f"{args.readme}: blocks {', '.join(stale)} differ from {args.results}; run {COMMAND}", file=sys.stderr
+            )
+            return 1
+        return 0
+    if text != current:
+        args.readme.write_text(text, encoding="utf-8")
+        print(f"rewrote the result blocks of {args.readme}")
+    else:
+        print(f"{args.readme} already matches {args.results}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -7,7 +7,8 @@ in :mod:`cell.motion.robot`.
 
 Playback is kinematic (``resetJointStatesMultiDof`` at each record time, no dynamics): deterministic and about
 10 us per sample, so minutes of robot time replay in well under a second. While the arc is on, the torch's
-path is drawn as a weld bead: visual-only capsules (no collision shape) that show up in rendered images.
+path is drawn as a weld bead: visual-only capsules (no collision shape) that show up in rendered images. What
+a playback records (:class:`~cell.sim.execution.Execution`) is numpy only, in :mod:`cell.sim.execution`.
 
 Frames: ``W`` world, ``R`` robot base (URDF root link, KUKA $ROBROOT). Units: metres, radians, seconds.
 """
@@ -17,7 +18,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,9 @@ from scipy.spatial.transform import Rotation
 
 from cell.errors import PlanError, ScenarioError
 from cell.geometry import FloatArray, make_pose, readonly
+from cell.sim.execution import Event, Execution, _check_trajectory, _events, _interp_rows, _record_times
+
+__all__ = ["BeadStyle", "Event", "Execution", "SimRobot", "add_bead", "bead_chords", "bead_segment"]
 
 _MOVABLE = (pybullet.JOINT_REVOLUTE, pybullet.JOINT_PRISMATIC)
 _LIMIT_TOL = 1e-6  # [rad] how far a played configuration may lie outside the URDF limits (rounding)
@@ -48,14 +51,6 @@ def _pose(position: Sequence[float], quat_xyzw: Sequence[float]) -> FloatArray:
     return make_pose(_matrices_from_quats(quat_xyzw)[0], position)
 
 
-class Event(NamedTuple):
-    """One entry of an execution log: time [s], kind ``"move"`` | ``"arc_on"`` | ``"arc_off"``, free text."""
-
-    t: float
-    kind: str
-    detail: str
-
-
 @dataclass(frozen=True)
 class BeadStyle:
     """How the weld bead is drawn: capsules of ``radius_m`` [m] along chords of about ``step_m`` [m]."""
@@ -63,89 +58,6 @@ class BeadStyle:
     radius_m: float = 0.003
     step_m: float = 0.005
     rgba: tuple[float, float, float, float] = (0.9, 0.1, 0.1, 1.0)
-
-
-@dataclass(frozen=True)
-class Execution:
-    """What the simulated arm did while playing back a joint trajectory.
-
-    times : (n,) record times [s] (the trajectory's time axis: a grid of ``record_dt`` from its first time, every
-        arc switch time, and its last time).
-    q : (n, dof) joint values played at those times [rad], in the robot's joint order.
-    tcp_W : (n, 3) position of the tool frame in W [m], from PyBullet's forward kinematics.
-    arc_on : (n,) bool, the arc state holding from each record time to the next.
-    events : time-ordered log of :class:`Event` (move marks, arc_on, arc_off).
-    X_W_tcp : (n, 4, 4) full tool poses in W, or None when not recorded.
-    """
-
-    times: FloatArray
-    q: FloatArray
-    tcp_W: FloatArray
-    arc_on: npt.NDArray[np.bool_]
-    events: tuple[Event, ...]
-    X_W_tcp: FloatArray | None = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "times", readonly(self.times))
-        object.__setattr__(self, "q", readonly(self.q))
-        object.__setattr__(self, "tcp_W", readonly(self.tcp_W))
-        object.__setattr__(self, "arc_on", readonly(self.arc_on, np.bool_))
-        if self.X_W_tcp is not None:
-            object.__setattr__(self, "X_W_tcp", readonly(self.X_W_tcp))
-        n = len(self.times)
-        if self.tcp_W.shape != (n, 3) or self.arc_on.shape != (n,) or self.q.shape[0] != n:
-            raise ValueError(f"Execution arrays must have one row per record time ({n})")
-
-    @property
-    def duration(self) -> float:
-        """Robot time from the first to the last record [s]."""
-        return float(self.times[-1] - self.times[0])
-
-    @property
-    def arc_time(self) -> float:
-        """Time with the arc on [s]."""
-        return float(np.sum(np.diff(self.times)[self.arc_on[:-1]]))
-
-    @property
-    def weld_length(self) -> float:
-        """Length of the tool path travelled with the arc on [m]."""
-        steps = np.linalg.norm(np.diff(self.tcp_W, axis=0), axis=1)
-        return float(np.sum(steps[self.arc_on[:-1]]))
-
-
-def _check_trajectory(
-    times: npt.ArrayLike, q: npt.ArrayLike, arc_on: npt.ArrayLike, dof: int
-) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
-    t = np.asarray(times, dtype=float)
-    qa = np.asarray(q, dtype=float)
-    arc = np.asarray(arc_on)
-    if t.ndim != 1 or len(t) == 0 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0.0):
-        raise ValueError("execute: times must be (n,) finite, n >= 1, strictly increasing [s]")
-    if qa.shape != (len(t), dof) or not np.all(np.isfinite(qa)):
-        raise ValueError(f"execute: q must be ({len(t)}, {dof}) finite joint values [rad], got {qa.shape}")
-    if arc.shape != (len(t),) or arc.dtype != np.bool_:
-        raise ValueError(f"execute: arc_on must be ({len(t)},) bool, got {arc.shape} {arc.dtype}")
-    return t, qa, arc
-
-
-def _record_times(times: FloatArray, arc_on: npt.NDArray[np.bool_], record_dt: float) -> FloatArray:
-    """A grid of ``record_dt`` over [times[0], times[-1]], plus the arc switch times and the end, sorted."""
-    if not record_dt > 0.0:
-        raise ValueError(f"execute: record_dt must be positive [s], got {record_dt}")
-    t0, t1 = float(times[0]), float(times[-1])
-    grid = t0 + np.arange(int(np.floor((t1 - t0) / record_dt + 1e-9)) + 1) * record_dt
-    switches = times[1:][arc_on[1:] != arc_on[:-1]]
-    out = np.unique(np.concatenate([grid[grid < t1], switches, [t1]]))
-    # drop grid points closer than a microsecond to a switch time (keep the exact switch)
-    keep = np.ones(len(out), bool)
-    keep[1:] = np.diff(out) > 1e-6
-    keep[np.isin(out, switches)] = True
-    return out[keep]
-
-
-def _interp_rows(t: FloatArray, times: FloatArray, values: FloatArray) -> FloatArray:
-    """Piecewise-linear interpolation of samples (n, d) at times t (m,): (m, d)."""
-    return np.column_stack([np.interp(t, times, values[:, j]) for j in range(values.shape[1])])
 
 
 def _chord_points(path: FloatArray, step: float) -> FloatArray:
@@ -313,28 +225,6 @@ class SimRobot:
             X_W_tcp[:, :3, 3] = pos
         events = _events(t_rec, q_rec, pos, arc_rec, marks)
         return Execution(times=t_rec, q=q_rec, tcp_W=pos, arc_on=arc_rec, events=events, X_W_tcp=X_W_tcp)
-
-
-def _events(
-    t: FloatArray,
-    q: FloatArray,
-    tcp_W: FloatArray,
-    arc_on: npt.NDArray[np.bool_],
-    marks: Sequence[tuple[float, str]],
-) -> tuple[Event, ...]:
-    """The log: a move mark at the start (and the caller's marks), arc_on/arc_off at every switch."""
-    q_deg = np.round(np.degrees(q[0]), 2).tolist()
-    log = [Event(float(t[0]), "move", f"start at q = {q_deg} deg, {t[-1] - t[0]:.3f} s of motion")]
-    log += [Event(float(tm), "move", str(text)) for tm, text in marks]
-    for k in range(len(t)):
-        was = bool(arc_on[k - 1]) if k > 0 else False
-        if bool(arc_on[k]) != was:
-            kind = "arc_on" if arc_on[k] else "arc_off"
-            log.append(Event(float(t[k]), kind, f"tcp at {np.round(tcp_W[k] * 1000.0, 1).tolist()} mm in W"))
-    if arc_on[-1]:  # the arc is never left burning past the end of a trajectory
-        log.append(Event(float(t[-1]), "arc_off", "end of trajectory"))
-    log.sort(key=lambda e: e.t)  # stable: the start mark stays first
-    return tuple(log)
 
 
 def bead_chords(tcp_W: FloatArray, arc_on: npt.NDArray[np.bool_], step_m: float) -> list[tuple[FloatArray, FloatArray]]:

@@ -1,0 +1,160 @@
+"""The interactive 3D view of a run (plotly): one self-contained HTML file, plotly.js inline.
+
+plotly is imported inside :func:`render_html`, so importing this module costs nothing. Input in the robot frame
+R [m], drawn in millimetres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+from cell.preview.views import (
+    AXIS_COLOURS,
+    BOX_COLOUR,
+    MM,
+    PATH_COLOUR,
+    STATUS_COLOURS,
+    TRUTH_COLOUR,
+    SeamView,
+    box_edges,
+    seam_lines,
+    thin,
+    torch_glyphs,
+)
+from cell.types import WeldMap
+
+
+def _segments_trace(segs: FloatArray) -> tuple[list[float | None], list[float | None], list[float | None]]:
+    """Line segments (m, 2, 3) as one polyline with None breaks (what plotly draws as separate lines)."""
+    xs: list[float | None] = []
+    ys: list[float | None] = []
+    zs: list[float | None] = []
+    for a, b in segs:
+        xs += [float(a[0]), float(b[0]), None]
+        ys += [float(a[1]), float(b[1]), None]
+        zs += [float(a[2]), float(b[2]), None]
+    return xs, ys, zs
+
+
+def render_html(
+    cloud_R: npt.ArrayLike,
+    weldmap_R: WeldMap,
+    seams: Sequence[SeamView | tuple[Any, ...]],
+    torch_poses: Mapping[str, npt.ArrayLike],
+    tcp_paths: Mapping[str, npt.ArrayLike],
+    out_path: str | Path,
+    *,
+    title: str = "",
+    max_points: int = 30_000,
+) -> Path:
+    """One interactive 3D view (cloud, part boxes, seams by status, true ends, torch axes, tool paths) in R [mm],
+    as a self-contained HTML file (plotly.js inline: it opens without a network). Arguments as
+    :func:`render_overview`. Returns ``out_path``."""
+    import plotly.graph_objects as go
+
+    cloud = thin(cloud_R, max_points) * MM
+    lines = seam_lines(seams, weldmap_R)
+    traces: list[Any] = [
+        go.Scatter3d(
+            x=cloud[:, 0],
+            y=cloud[:, 1],
+            z=cloud[:, 2],
+            mode="markers",
+            name="cloud",
+            marker={
+                "size": 1.5,
+                "color": cloud[:, 2],
+                "colorscale": "Viridis",
+                "opacity": 0.6,
+                "colorbar": {"title": "z_R [mm]", "x": 1.0},
+            },
+            hoverinfo="skip",
+        )
+    ]
+    edges = np.concatenate([box_edges(p.box) for p in weldmap_R.parts]) * MM if weldmap_R.parts else None
+    if edges is not None:
+        x, y, z = _segments_trace(edges)
+        traces.append(
+            go.Scatter3d(
+                x=x, y=y, z=z, mode="lines", name="map parts", line={"color": BOX_COLOUR, "width": 2}, hoverinfo="skip"
+            )
+        )
+    for status, colour in STATUS_COLOURS.items():
+        mine = [ln for ln in lines if ln.status == status]
+        if not mine:
+            continue
+        x, y, z = _segments_trace(np.array([ln.pts for ln in mine]))
+        text: list[str | None] = []
+        for ln in mine:
+            text += [ln.id, ln.id, None]
+        traces.append(
+            go.Scatter3d(
+                x=x,
+                y=y,
+                z=z,
+                mode="lines",
+                name=f"seams {status.replace('_', ' ')}",
+                text=text,
+                hoverinfo="text+name",
+                line={"color": colour, "width": 8 if status == "found" else 5},
+            )
+        )
+    truth = [ln.truth for ln in lines if ln.truth is not None]
+    if truth:
+        t = np.concatenate(truth)
+        traces.append(
+            go.Scatter3d(
+                x=t[:, 0],
+                y=t[:, 1],
+                z=t[:, 2],
+                mode="markers",
+                name="true seam ends",
+                marker={"size": 3, "color": TRUTH_COLOUR, "symbol": "x"},
+            )
+        )
+    glyphs = [g for poses in torch_poses.values() for g in torch_glyphs(poses)]
+    if glyphs:
+        g = np.array(glyphs)  # (k, 3 axes, 2, 3)
+        for i, axis in enumerate("xyz"):
+            x, y, z = _segments_trace(g[:, i])
+            traces.append(
+                go.Scatter3d(
+                    x=x,
+                    y=y,
+                    z=z,
+                    mode="lines",
+                    name=f"torch {axis} axis",
+                    line={"color": AXIS_COLOURS[i], "width": 4},
+                    hoverinfo="skip",
+                )
+            )
+    for key, tcp in tcp_paths.items():
+        p = np.asarray(tcp, dtype=float).reshape(-1, 3) * MM
+        if len(p):
+            traces.append(
+                go.Scatter3d(
+                    x=p[:, 0],
+                    y=p[:, 1],
+                    z=p[:, 2],
+                    mode="lines",
+                    name=f"tool path {key}",
+                    line={"color": PATH_COLOUR, "width": 3},
+                )
+            )
+    fig = go.Figure(traces)
+    fig.update_layout(
+        title=title or "weld cell preview (robot frame R, mm)",
+        scene={"aspectmode": "data", "xaxis_title": "x_R [mm]", "yaxis_title": "y_R [mm]", "zaxis_title": "z_R [mm]"},
+        legend={"itemsizing": "constant"},
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+    )
+    path = Path(out_path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.write_html(str(path), include_plotlyjs=True, full_html=True)
+    return path

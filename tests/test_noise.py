@@ -1,4 +1,4 @@
-"""The depth-sensor model (cell.sim.noise) against its own formulas (REFERENCE.md section 2)."""
+"""The depth-sensor model (cell.sim.noise) against its own formulas (docs/reference.md section 2)."""
 
 from __future__ import annotations
 

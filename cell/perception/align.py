@@ -29,7 +29,7 @@ from cell.types import BOX_FACES, Box, Cloud, WeldMap
 MAX_TILT_RAD = math.radians(2.0)  # largest roll or pitch correction accepted for a part lying on the table
 STAGES = (1.0, 0.25, 0.1)  # max correspondence per ICP stage, as fractions of spec.align_max_correspondence_m
 # Fitness is judged within the middle stage's distance (5 mm by default): depth noise of 3-6 mm (D415 at
-# 1.5-2 m, REFERENCE.md section 2) leaves only about half of a well-aligned cloud within the finest 2 mm.
+# 1.5-2 m, docs/reference.md section 2) leaves only about half of a well-aligned cloud within the finest 2 mm.
 _FITNESS_STAGE = 1
 _SPACING_PER_FINEST = 1.5  # map sample spacing, in units of the finest stage's max correspondence
 _DOWN_COS = 0.5  # faces whose outward normal is within 60 deg of -z (R) point down into the table

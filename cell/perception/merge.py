@@ -12,7 +12,7 @@ directions of R, and cameras compete only for the same (cell, direction). A surf
 is always kept.
 
 Predicted noise (:func:`predicted_noise`, a ranking score, not metres) follows the active-stereo sensor of the
-cell (RealSense D4xx, REFERENCE.md section 2): the error is in depth along the optical axis, sigma_z ~ z^2 /
+cell (RealSense D4xx, docs/reference.md section 2): the error is in depth along the optical axis, sigma_z ~ z^2 /
 (f B) (the baseline B is unknown here and taken equal for all cameras), so a point moves along its *ray*. What
 a surface's position suffers from is the spread across the surface, sigma_z cos(theta) / cos(alpha) (theta the
 incidence, alpha the ray's angle off the optical axis), averaged over the points the camera puts on a unit of

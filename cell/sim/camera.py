@@ -55,7 +55,7 @@ def gl_projection_matrix(intrinsics: CameraIntrinsics, near_m: float, far_m: flo
 
 
 def linearise_depth(buffer: npt.ArrayLike, near_m: float, far_m: float) -> FloatArray:
-    """Metric depth along the optical axis [m] from a depth buffer in [0, 1] (REFERENCE.md section 2):
+    """Metric depth along the optical axis [m] from a depth buffer in [0, 1] (docs/reference.md section 2):
     ``z = far * near / (far - (far - near) * d)``. Pixels where nothing was drawn (d = 1, at or beyond the far
     plane) become 0 (invalid)."""
     d = np.asarray(buffer, dtype=float)

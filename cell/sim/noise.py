@@ -1,4 +1,4 @@
-"""A depth-sensor error model, numpy only (REFERENCE.md section 2).
+"""A depth-sensor error model, numpy only (docs/reference.md section 2).
 
 What a real depth camera does to a perfect depth image, driven by a :class:`~cell.scenario.NoiseSpec` and an
 ``np.random.Generator`` (never a global RNG):

@@ -14,7 +14,7 @@ import pytest
 
 from cell.errors import IKError, MotionError, ScenarioError
 from cell.geometry import FloatArray, invert, make_pose, rot_y, rot_z
-from cell.motion.ik import solve_ik, solve_path
+from cell.motion.ik import IKOptions, IKSolveError, solve_ik, solve_path
 from cell.motion.robot import RobotModel
 
 ROBOTS = Path(__file__).resolve().parent.parent / "robots"
@@ -190,13 +190,19 @@ def test_ik_cold_start_with_restarts(robot: RobotModel) -> None:
 
 def test_ik_unreachable_target_raises(robot: RobotModel) -> None:
     X = make_pose(p=[3.0, 0.0, 0.4])
-    with pytest.raises(IKError, match="reach"):
+    with pytest.raises(IKSolveError) as far:
         solve_ik(robot, X, HOME, rng=np.random.default_rng(0))
+    assert far.value.beyond_reach and far.value.frame == "torch_tcp"
+    np.testing.assert_array_equal(far.value.target, X)
+    p_RJ, reach = robot.reach_bound()
+    assert far.value.residual_m == pytest.approx(np.linalg.norm(X[:3, 3] - p_RJ) - reach)
     # Within the reach bound but beyond the real workspace: the solver itself must give up, saying how close
     # it got.
     X = make_pose(rot_y(np.pi / 2.0), p=[1.85, 0.0, 0.9])
-    with pytest.raises(IKError, match="best error"):
+    with pytest.raises(IKSolveError, match="best error") as near:
         solve_ik(robot, X, HOME, rng=np.random.default_rng(0))
+    assert isinstance(near.value, IKError) and not near.value.beyond_reach
+    assert near.value.residual_m > IKOptions().pos_tol and np.isfinite(near.value.residual_rad)
 
 
 def _wrist_centre_distance(X_RT: FloatArray, X_0T: FloatArray) -> float:
@@ -241,6 +247,15 @@ def test_solve_path_reports_a_configuration_flip(robot: RobotModel) -> None:
     targets[6:, :3, :3] = targets[6:, :3, :3] @ rot_z(np.pi)  # the torch turns half a turn between poses 5 and 6
     with pytest.raises(IKError, match="pose 6 of 11: joint joint_a"):
         solve_path(robot, targets, HOME, rng=np.random.default_rng(0))
+
+
+def test_solve_path_keeps_the_failure_fields(robot: RobotModel) -> None:
+    targets = _seam_targets(robot, 3)
+    targets[2, :3, 3] = [3.0, 0.0, 0.4]  # beyond the reach bound
+    with pytest.raises(IKSolveError, match="pose 2 of 3: ") as err:
+        solve_path(robot, targets, HOME, rng=np.random.default_rng(0))
+    assert err.value.beyond_reach
+    np.testing.assert_array_equal(err.value.target, targets[2])
 
 
 def test_limits_file_errors(tmp_path: Path) -> None:

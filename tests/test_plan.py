@@ -16,7 +16,7 @@ from cell.errors import PlanError
 from cell.geometry import make_pose, point_line_distance
 from cell.motion.checks import GateOptions, check_plan, find_violations
 from cell.motion.collision import CollisionChecker
-from cell.motion.plan import SeamTask, WeldPlan, plan_welds, scan_configuration
+from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
 from cell.motion.torch import WeldProcess, torch_poses
@@ -48,10 +48,11 @@ def checker(robot: RobotModel) -> CollisionChecker:
 def test_unreachable_seam_is_reported_and_the_others_planned(plan: WeldPlan) -> None:
     far = plan.outcome("far")
     assert not far.feasible
-    assert far.reason.startswith("unreachable: IK did not converge at 0.0 mm along the seam")
-    assert "reach" in far.reason
+    assert far.code is PlanReason.BEYOND_REACH
+    assert far.reason.startswith("unreachable: IK did not converge at 0.0 mm along the seam")  # the report's text
     assert np.linalg.norm(far.p_fail - FAR.p_start) < 0.03  # the failing point, in R
     assert plan.outcome("top").feasible and plan.outcome("side").feasible
+    assert plan.outcome("top").code is None and plan.outcome("side").code is None
     assert set(plan.order) == {"top", "side"}
     assert [s.kind for s in plan.segments if s.seam_id == "top" and s.kind != "move"][-3:] == [
         "approach",
@@ -77,7 +78,7 @@ def test_seam_reachable_only_with_a_rotated_torch(robot: RobotModel) -> None:
     no_spin = WeldProcess.from_spec(sc.ProcessSpec(spin_tol_deg=0.0, **fixed))
     free = WeldProcess.from_spec(sc.ProcessSpec(spin_tol_deg=180.0, **fixed))
     out = plan_welds(robot, [TOP], HOME, no_spin, OBSTACLES).outcome("top")
-    assert not out.feasible and out.reason.startswith("unreachable")
+    assert not out.feasible and out.code is PlanReason.IK_FAILED
     p = plan_welds(robot, [TOP], HOME, free, OBSTACLES)
     got = p.outcome("top")
     assert got.feasible and abs(got.spin) > math.radians(30.0)

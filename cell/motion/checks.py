@@ -29,7 +29,7 @@ import numpy as np
 from cell.errors import PlanError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
-from cell.motion.plan import WeldPlan
+from cell.motion.program import WeldPlan
 from cell.motion.robot import RobotModel
 
 

@@ -6,7 +6,8 @@ axis) must match T's: the rotation about the torch axis is left to the solver (a
 section 7).
 
 A solution is returned only when it reaches the tolerance (default 0.01 mm and 0.01 deg) within the joint
-limits; otherwise :class:`~cell.errors.IKError` says which target, the best error reached and why.
+limits; otherwise :class:`IKSolveError` (an :class:`~cell.errors.IKError`) says which target, the best error reached
+and why, in words and in its fields (``target``, ``residual_m``, ``residual_rad``, ``beyond_reach``).
 """
 
 from __future__ import annotations
@@ -33,6 +34,41 @@ class IKOptions:
     damping: float = 1e-6  # lambda^2 of the damped least squares [m^2]
     max_step: float = 0.5  # [rad] largest joint change per iteration
     restart_margin: float = np.radians(5.0)  # [rad] random restarts stay this far inside the limits
+
+
+class IKSolveError(IKError):
+    """An :class:`~cell.errors.IKError` with its data: ``frame`` solved for, ``target`` X_RT (4, 4) in R,
+    ``residual_m`` [m] and ``residual_rad`` [rad] of the best attempt, ``beyond_reach``: the target lies beyond
+    the arm's reach bound, so no attempt was made (``residual_m`` is then how far beyond the bound it lies, a lower
+    bound on any attempt's error, and ``residual_rad`` is nan)."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        frame: str,
+        target: FloatArray,
+        residual_m: float,
+        residual_rad: float,
+        beyond_reach: bool = False,
+    ) -> None:
+        super().__init__(message)
+        self.frame = frame
+        self.target = readonly(target)
+        self.residual_m = residual_m
+        self.residual_rad = residual_rad
+        self.beyond_reach = beyond_reach
+
+    def reworded(self, message: str) -> IKSolveError:
+        """The same failure with another message (e.g. prefixed with where on a path it happened)."""
+        return IKSolveError(
+            message,
+            frame=self.frame,
+            target=self.target,
+            residual_m=self.residual_m,
+            residual_rad=self.residual_rad,
+            beyond_reach=self.beyond_reach,
+        )
 
 
 @dataclass
@@ -130,7 +166,8 @@ def solve_ik(
         is given, ``options.restarts`` more runs start from random configurations drawn from it
         (deterministic for a seeded generator); without ``rng`` there are no restarts.
     free_axis : leave the rotation about the target's z axis free (position and z direction only).
-    Raises IKError (target, best error, reason) when no run reaches the tolerance within the joint limits.
+    Raises IKSolveError (an IKError: target, best error, reason, and those as fields) when no run reaches the
+    tolerance within the joint limits.
     """
     opt = options or IKOptions()
     X_RT = np.asarray(X_RT_target, dtype=float)
@@ -143,24 +180,41 @@ def solve_ik(
     p_RJ, reach = model.reach_bound(frame)
     dist = float(np.linalg.norm(X_RT[:3, 3] - p_RJ))
     if dist > reach:
-        raise IKError(
+        raise IKSolveError(
             f"IK for {frame}: the target at p_RT = {np.round(X_RT[:3, 3] * 1000.0, 2).tolist()} mm is "
             f"{dist:.3f} m from {model.joint_names[0]}'s origin, beyond the arm's reach bound of "
-            f"{reach:.3f} m"
+            f"{reach:.3f} m",
+            frame=frame,
+            target=X_RT,
+            residual_m=dist - reach,
+            residual_rad=float("nan"),
+            beyond_reach=True,
         )
-    best: _Attempt | None = None
     n_attempts = 1 + (opt.restarts if rng is not None else 0)
-    for k in range(n_attempts):
-        q0 = q_start if k == 0 or rng is None else model.limits.sample(rng, opt.restart_margin)
-        att = _descend(model, fid, X_RT, q0, free_axis, opt)
-        if att.converged:
-            if not model.limits.contains(att.q):  # _descend clamps: this would be a bug; never return it
-                raise IKError(f"IK for {frame} left the joint limits at q = {np.degrees(att.q).round(3)} deg")
-            return readonly(att.q)
-        if best is None or att.pos_err + 0.1 * att.rot_err < best.pos_err + 0.1 * best.rot_err:
+    att = _descend(model, fid, X_RT, q_start, free_axis, opt)
+    best, k = att, 1
+    while not att.converged:
+        if rng is None or k >= n_attempts:
+            raise IKSolveError(
+                _failure_message(model, frame, X_RT, best, n_attempts, free_axis, opt),
+                frame=frame,
+                target=X_RT,
+                residual_m=best.pos_err,
+                residual_rad=best.rot_err,
+            )
+        att = _descend(model, fid, X_RT, model.limits.sample(rng, opt.restart_margin), free_axis, opt)
+        if att.pos_err + 0.1 * att.rot_err < best.pos_err + 0.1 * best.rot_err:
             best = att
-    assert best is not None
-    raise IKError(_failure_message(model, frame, X_RT, best, n_attempts, free_axis, opt))
+        k += 1
+    if not model.limits.contains(att.q):  # _descend clamps: this would be a bug; never return it
+        raise IKSolveError(
+            f"IK for {frame} left the joint limits at q = {np.degrees(att.q).round(3)} deg",
+            frame=frame,
+            target=X_RT,
+            residual_m=att.pos_err,
+            residual_rad=att.rot_err,
+        )
+    return readonly(att.q)
 
 
 def _failure_message(
@@ -219,6 +273,8 @@ def solve_path(
             q_new = solve_ik(
                 model, X_RT, q, frame=frame, rng=rng if i == 0 else None, free_axis=free_axis, options=options
             )
+        except IKSolveError as exc:
+            raise exc.reworded(f"path pose {i} of {len(X)}: {exc.message}") from exc
         except IKError as exc:
             raise IKError(f"path pose {i} of {len(X)}: {exc.message}") from exc
         if i > 0:

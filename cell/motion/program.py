@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Literal
 
 import numpy as np
@@ -98,11 +99,24 @@ class Segment:
         return self.t0 + self.trajectory.duration
 
 
+class PlanReason(StrEnum):
+    """Why a seam could not be planned: the code of a :class:`SeamOutcome` (its ``reason`` gives the detail)."""
+
+    BEYOND_REACH = "beyond_reach"  # a torch pose lies beyond the arm's reach bound (IK not even tried)
+    IK_FAILED = "ik_failed"  # IK did not converge within tolerance and joint limits
+    FLIP = "flip"  # a joint jumps between neighbouring IK knots (a configuration flip)
+    SINGULAR = "singular"  # manipulability below the bound along a LIN
+    COLLISION = "collision"  # the torch or the arm collides at the seam, on the approach or the depart
+    TRANSFER_COLLISION = "transfer_collision"  # no collision-free transfer move to or from the seam
+    TIMING = "timing"  # a line cannot be timed within the joint limits (e.g. the weld at the travel speed)
+
+
 @dataclass(frozen=True)
 class SeamOutcome:
     """What became of one seam: feasible, or the reason and the failing point p_fail (3,) in R (empty if none).
 
-    For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]."""
+    For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]. code: why it
+    could not be planned (None when feasible); reason: the same in words, with where and by how much."""
 
     seam_id: str
     feasible: bool
@@ -112,6 +126,7 @@ class SeamOutcome:
     spin: float = float("nan")
     work_angle: float = float("nan")
     travel_angle: float = float("nan")
+    code: PlanReason | None = None
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ from cell.errors import IKError, PlanError, TimingError
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, readonly, transform_points
 from cell.motion.collision import CollisionChecker
 from cell.motion.ik import solve_ik
-from cell.motion.plan import SeamTask
+from cell.motion.program import SeamTask
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.types import CameraIntrinsics, Part

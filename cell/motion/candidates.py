@@ -1,0 +1,206 @@
+"""The torch search for one seam (step 1 and 2 of :func:`cell.motion.plan.plan_welds`).
+
+1. Candidates (:func:`candidate_groups`): both weld directions x spins about the torch axis (``spin_step``
+   apart, within the process's spin tolerance) x work/travel angles (nominal first, then widened in
+   ``angle_step`` steps within their tolerances, docs/reference.md section 7). A candidate whose torch (placed by
+   pose alone) hits a part or the table at a seam end is dropped without IK; the rest get IK at the weld start,
+   ranked by manipulability.
+2. The best candidates are solved along the seam (warm-started IK every ``spacing``, no joint jump beyond
+   ``max_joint_step``), along the approach line (back along the torch axis to ``process.approach``) and the
+   depart line, checked against singularities and for collisions (conservative advancement between knots).
+   The first candidate that passes is kept (:class:`SeamSolution`); otherwise the failure that got furthest
+   (:class:`~cell.motion.failures.SeamFailure`), e.g. ``unreachable: IK did not converge at 35.0 mm along the
+   seam``.
+
+Frames: everything in the robot base frame R [m]; joints [rad].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cell.errors import IKError, PlanError
+from cell.geometry import FloatArray
+from cell.motion.collision import CollisionChecker
+from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
+from cell.motion.ik import solve_ik
+from cell.motion.lines import solve_line
+from cell.motion.plan_options import PlanOptions
+from cell.motion.program import PlanReason, SeamTask
+from cell.motion.robot import RobotModel
+from cell.motion.torch import WeldProcess, back_off, line_poses, torch_poses
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One way to hold the torch on a seam: weld direction, spin [rad] about the torch axis, work and travel
+    angle offsets [rad] from the process's nominal angles."""
+
+    reversed: bool
+    spin: float
+    work_offset: float
+    travel_offset: float
+
+
+def _offsets(tol: float, step: float) -> list[float]:
+    """0, +-step, +-2 step, ... within +-tol, and +-tol itself."""
+    k = math.floor(tol / step + 1e-9)
+    out = [0.0] + [s * i * step for i in range(1, k + 1) for s in (1.0, -1.0)]
+    if tol > k * step + 1e-9:
+        out += [tol, -tol]
+    return out
+
+
+def candidate_groups(process: WeldProcess, options: PlanOptions) -> list[list[Candidate]]:
+    """Candidate groups, one per (work, travel) angle setting, nominal first then widening."""
+    pr, opt = process, options
+    angles = sorted(
+        (
+            (w, a)
+            for w in _offsets(pr.work_angle_tol, opt.angle_step)
+            for a in _offsets(pr.travel_angle_tol, opt.angle_step)
+        ),
+        key=lambda wa: (abs(wa[0]) + abs(wa[1]), abs(wa[0])),
+    )
+    spins = sorted(  # ordered so that neighbours warm-start each other's IK; pi and -pi coincide
+        {round(s, 12) for s in _offsets(pr.spin_tol, opt.spin_step) if -math.pi + 1e-9 < s <= math.pi + 1e-9}
+    )
+    return [[Candidate(rev, sp, w, a) for rev in (False, True) for sp in spins] for w, a in angles]
+
+
+@dataclass(frozen=True)
+class SeamSolution:
+    """A candidate solved along approach, seam and depart: the weld poses X_weld (n, 4, 4), joint knots
+    q_approach (m, dof) from the approach pose to the weld start, q_weld (n, dof), q_depart (k, dof) from the weld
+    end to the depart pose, and the approach and depart poses X_approach, X_depart (4, 4)."""
+
+    task: SeamTask
+    cand: Candidate
+    X_weld: FloatArray
+    q_approach: FloatArray
+    q_weld: FloatArray
+    q_depart: FloatArray
+    X_approach: FloatArray
+    X_depart: FloatArray
+
+
+class SeamSearch:
+    """The per-seam torch search for one arm, process, scene and options (see the module docstring)."""
+
+    def __init__(
+        self,
+        robot: RobotModel,
+        process: WeldProcess,
+        checker: CollisionChecker,
+        options: PlanOptions,
+        rng: np.random.Generator,
+    ) -> None:
+        self.robot, self.process, self.checker, self.opt, self.rng = robot, process, checker, options, rng
+
+    def plan_seam(self, task: SeamTask, q_seed: FloatArray) -> SeamSolution | SeamFailure:
+        """The first candidate that passes, or the failure that got furthest; q_seed (dof,) [rad] seeds IK."""
+        best_fail: SeamFailure | None = None
+        pr, opt = self.process, self.opt
+        for group in candidate_groups(pr, opt):
+            ranked: list[tuple[float, Candidate, FloatArray, FloatArray]] = []
+            q_prev: FloatArray | None = None
+            for cand in group:
+                a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
+                X = torch_poses(
+                    a,
+                    b,
+                    task.n_a,
+                    task.n_b,
+                    pr,
+                    spin=cand.spin,
+                    work_offset=cand.work_offset,
+                    travel_offset=cand.travel_offset,
+                    spacing=opt.spacing,
+                )
+                hit_start = self.checker.torch_clear(X[0], q_seed)
+                hit = hit_start or self.checker.torch_clear(X[-1], q_seed)
+                if hit is not None:
+                    end = "start" if hit_start is not None else "end"
+                    where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
+                    # ranks below an IK failure at the start: the pose was not even tried
+                    best_fail = better(best_fail, SeamFailure(PlanReason.COLLISION, where, hit.p_R, -1e-3))
+                    continue
+                q0: FloatArray | None = None
+                if q_prev is not None:  # warm start from the neighbouring candidate
+                    try:
+                        q0 = self._ik(X[0], q_prev)
+                    except IKError:
+                        q0 = None
+                if q0 is None:
+                    try:
+                        q0 = self._ik(X[0], q_seed, restarts=True)
+                    except IKError as exc:
+                        best_fail = better(best_fail, unreachable(exc, X[0], 0.0, 0.0))
+                        continue
+                q_prev = q0
+                ranked.append((self.robot.manipulability(q0), cand, X, q0))
+            ranked.sort(key=lambda r: -r[0])
+            for _, cand, X, q0 in ranked[: opt.max_full]:
+                res = self.solve_candidate(task, cand, X, q0)
+                if isinstance(res, SeamSolution):
+                    return res
+                best_fail = better(best_fail, res)
+        if best_fail is None:  # cannot happen: there is always the nominal candidate, and it passes or fails
+            raise PlanError(f"seam {task.id}: the torch search tried no candidate")
+        return best_fail
+
+    def _ik(self, X: FloatArray, seed: FloatArray, restarts: bool = False) -> FloatArray:
+        return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None)
+
+    def solve_line(self, X: FloatArray, q0: FloatArray, what: str, offset: float, step: float) -> FloatArray:
+        """:func:`~cell.motion.lines.solve_line` with this search's arm and joint step bound."""
+        return solve_line(self.robot, X, q0, what, offset, step, self.opt.max_joint_step)
+
+    def solve_candidate(
+        self, task: SeamTask, cand: Candidate, X: FloatArray, q0: FloatArray
+    ) -> SeamSolution | SeamFailure:
+        """Solve one candidate (weld poses X (n, 4, 4), q0 (dof,) its IK at X[0]) along approach, seam, depart."""
+        pr, opt = self.process, self.opt
+        step = task.length / (len(X) - 1)
+        try:
+            q_weld = self.solve_line(X, q0, "seam", 0.0, step)
+            X_app = back_off(X[0], pr.approach)
+            app = line_poses(X[0], X_app, opt.line_spacing)  # from the weld start outwards
+            # progress (for picking the most telling failure): seam first, then approach, then depart
+            q_app = self.solve_line(app, q_weld[0], "approach", task.length, pr.approach / (len(app) - 1))[::-1]
+            X_dep = back_off(X[-1], pr.depart)
+            dep = line_poses(X[-1], X_dep, opt.line_spacing)
+            q_dep = self.solve_line(dep, q_weld[-1], "depart", task.length + pr.approach, pr.depart / (len(dep) - 1))
+        except LineError as exc:
+            return exc.failure
+        path = np.concatenate([q_app, q_weld[1:], q_dep[1:]])
+        poses = np.concatenate([app[::-1], X[1:], dep[1:]])
+        s_path = np.concatenate(
+            [
+                -np.linspace(pr.approach, 0.0, len(app)),
+                np.linspace(0.0, task.length, len(X))[1:],
+                task.length + np.linspace(0.0, pr.depart, len(dep))[1:],
+            ]
+        )
+        manip = np.array([self.robot.manipulability(q) for q in path])
+        k = int(np.argmin(manip))
+        if manip[k] < opt.min_manipulability:
+            return SeamFailure(
+                PlanReason.SINGULAR,
+                f"manipulability {manip[k]:.3g} < {opt.min_manipulability:g} "
+                f"at {where_on_path(s_path[k], task.length)}",
+                poses[k][:3, 3].copy(),
+                float(s_path[k]),
+            )
+        hit = self.checker.check_path(path)
+        if hit is not None:
+            return SeamFailure(
+                PlanReason.COLLISION,
+                f"{hit.a} vs {hit.b} at {where_on_path(s_path[hit.index], task.length)} (p_R = {mm(hit.p_R)} mm)",
+                hit.p_R,
+                float(s_path[hit.index]),
+            )
+        return SeamSolution(task, cand, X, q_app, q_weld, q_dep, X_app, X_dep)

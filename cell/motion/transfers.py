@@ -1,0 +1,192 @@
+"""Transfers between seams and from/to home (step 3 of :func:`cell.motion.plan.plan_welds`).
+
+A transfer is a Ruckig point-to-point move (KRL PTP) where the direct move is free. Where it collides, the next
+strategy is tried, in order (:data:`DEFAULT_STRATEGIES`): straight up (a LIN, as a depart) to ``transfer_lift``
+above the highest obstacle, across (PTP) and straight down (a LIN, as an approach); the same one
+``transfer_lift`` higher; PTP via home. When every strategy collides or fails, the last one's contact (or error)
+is the :class:`TransferFail`; the planner then re-orders the seams, or drops the seam.
+
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+from cell.errors import IKError, TimingError
+from cell.geometry import FloatArray
+from cell.motion.collision import CollisionChecker
+from cell.motion.failures import LineError
+from cell.motion.lines import line_trajectory, solve_line
+from cell.motion.plan_options import PlanOptions
+from cell.motion.program import SegmentKind
+from cell.motion.robot import RobotModel
+from cell.motion.timing import Trajectory, ptp
+from cell.motion.torch import WeldProcess, line_poses
+from cell.types import Part
+
+
+class Piece(NamedTuple):
+    """One timed motion before it gets its place in the plan: kind, trajectory, TCP speed [m/s] (0: PTP) and
+    the TCP pose X_end (4, 4) in R at its end."""
+
+    kind: SegmentKind
+    trajectory: Trajectory
+    speed: float
+    X_end: FloatArray
+
+
+@dataclass(frozen=True)
+class TransferFail:
+    """No free way: why (the last strategy's contact or error) and the contact point p_R (3,) [m] in R."""
+
+    reason: str
+    p_R: FloatArray
+
+
+class TransferStrategy(Protocol):
+    """One way to move between two configurations; ``name`` is how failure messages call it."""
+
+    @property
+    def name(self) -> str: ...
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        """The motions q_a -> q_b (dof,) [rad]; raises IKError, TimingError or LineError when it cannot time
+        them. Collisions are not checked here."""
+        ...
+
+
+@dataclass(frozen=True)
+class Direct:
+    """One PTP move."""
+
+    name: str = "direct"
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot = mover.robot
+        return [Piece("move", ptp(q_a, q_b, robot.limits, dt=mover.opt.dt), 0.0, robot.fk(q_b))]
+
+
+@dataclass(frozen=True)
+class Lift:
+    """Straight up to the lift height (plus ``extra`` times ``transfer_lift``), PTP across, straight down."""
+
+    name: str = "lift"
+    extra: int = 0
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot, opt = mover.robot, mover.opt
+        h = mover.lift_z + opt.transfer_lift * self.extra
+        up = mover.vertical(q_a, h, up=True)
+        down = mover.vertical(q_b, h, up=False)
+        top_a = up.trajectory.q[-1] if up is not None else q_a
+        top_b = down.trajectory.q[0] if down is not None else q_b
+        pieces = [up] if up is not None else []
+        pieces.append(Piece("move", ptp(top_a, top_b, robot.limits, dt=opt.dt), 0.0, robot.fk(top_b)))
+        if down is not None:
+            pieces.append(down)
+        return pieces
+
+
+@dataclass(frozen=True)
+class ViaHome:
+    """PTP to home, PTP on."""
+
+    name: str = "home"
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot, lim, dt, home = mover.robot, mover.robot.limits, mover.opt.dt, mover.q_home
+        return [
+            Piece("move", ptp(q_a, home, lim, dt=dt), 0.0, robot.fk(home)),
+            Piece("move", ptp(home, q_b, lim, dt=dt), 0.0, robot.fk(q_b)),
+        ]
+
+
+DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (Direct(), Lift(), Lift("lift_high", extra=1), ViaHome())
+
+
+class Transfers:
+    """Collision-free transfers for one arm, process and scene (see the module docstring).
+
+    obstacles : the parts and the table in R (the lift height is ``transfer_lift`` above the highest of them);
+    q_home (dof,) [rad].
+    """
+
+    def __init__(
+        self,
+        robot: RobotModel,
+        process: WeldProcess,
+        checker: CollisionChecker,
+        options: PlanOptions,
+        obstacles: Sequence[Part],
+        q_home: FloatArray,
+        strategies: Sequence[TransferStrategy] = DEFAULT_STRATEGIES,
+    ) -> None:
+        self.robot, self.process, self.checker, self.opt = robot, process, checker, options
+        self.q_home = q_home
+        self.strategies = tuple(strategies)
+        tops = [float(np.max(o.box.corners()[:, 2])) for o in obstacles]
+        self.lift_z = (max(tops) if tops else 0.0) + options.transfer_lift
+
+    def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
+        """The first strategy's motions q_a -> q_b that collide with nothing (zero-length ones left out); the
+        last contact, or error, when every way collides."""
+        fail = TransferFail("no collision-free way found", np.zeros(3))
+        for strategy in self.strategies:
+            try:
+                pieces = strategy.pieces(self, q_a, q_b)
+            except (IKError, TimingError, LineError) as exc:
+                fail = TransferFail(f"{strategy.name}: {exc}", fail.p_R)
+                continue
+            hit = next(
+                (
+                    h
+                    for pc in pieces
+                    if (h := self.checker.check_path(pc.trajectory.q, pc.trajectory.times)) is not None
+                ),
+                None,
+            )
+            if hit is None:
+                return [pc for pc in pieces if pc.trajectory.duration > 0.0]
+            fail = TransferFail(hit.describe(), hit.p_R)
+        return fail
+
+    def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
+        """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is
+        already that high): up from q (a depart) or down to q (an approach)."""
+        robot, pr, opt = self.robot, self.process, self.opt
+        X = robot.fk(q)
+        rise = height - float(X[2, 3])
+        if rise < 1e-3:
+            return None
+        X_top = X.copy()
+        X_top[2, 3] = height
+        poses = line_poses(X, X_top, opt.line_spacing)
+        knots = solve_line(robot, poses, q, "lift", 0.0, rise / (len(poses) - 1), opt.max_joint_step)
+        if up:
+            tr, v = line_trajectory(
+                robot,
+                knots,
+                rise,
+                np.array([0.0, 0.0, 1.0]),
+                pr.approach_speed,
+                opt.line_accel,
+                opt.line_jerk,
+                dt=opt.dt,
+            )
+            return Piece("depart", tr, v, X_top)
+        tr, v = line_trajectory(
+            robot,
+            knots[::-1],
+            rise,
+            np.array([0.0, 0.0, -1.0]),
+            pr.approach_speed,
+            opt.line_accel,
+            opt.line_jerk,
+            dt=opt.dt,
+        )
+        return Piece("approach", tr, v, X)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cell.seams import _batch, _fit
+from cell.seams import _batch, _index
 from cell.types import Cloud
 from cell.voxels import voxel_order
 
@@ -49,7 +49,7 @@ def test_cloud_index_tube_is_the_cylinder_and_its_layers_are_nested_shares() -> 
     rng = np.random.default_rng(1)
     P = rng.uniform(-0.3, 0.3, (200_000, 3))
     cam = rng.integers(0, 3, len(P)).astype(np.int16)
-    index = _fit.index_of(Cloud(P, "R", cam), voxel_m=0.02)
+    index = _index.index_of(Cloud(P, "R", cam), voxel_m=0.02)
     a, b, radius, extend = np.array([-0.1, 0.02, 0.0]), np.array([0.12, -0.05, 0.07]), 0.04, 0.01
     t = (b - a) / np.linalg.norm(b - a)
     s = (P - (a - extend * t)) @ t

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from cell.geometry import FloatArray, invert, look_at, make_pose, rot_x, rot_z, transform_points
-from cell.seams import _fit
+from cell.seams import _extent, _lines
 from cell.seams.base import Joint, SeamScene
 from cell.seams.ours import OursLocator, OursOptions
 from cell.seams.ransac import RansacLocator, RansacOptions
@@ -369,21 +369,21 @@ def test_ours_takes_no_end_where_the_cloud_stops(scenes: dict) -> None:
 def test_edge_fit_finds_a_blurred_edge_and_flags_a_cut_off() -> None:
     rng = np.random.default_rng(4)
     s = rng.uniform(-0.03, 0.0021, 3000) + 0.0005 * rng.standard_normal(3000)
-    f = _fit.edge_fit(s, -0.024, 0.0235, -0.012, 0.012)
+    f = _extent.edge_fit(s, -0.024, 0.0235, -0.012, 0.012)
     assert f.ok and abs(f.b - 0.0021) < 3.0 * f.se + 1e-4 and f.blur <= 1e-3 and f.n_edge > 50
     # The same points cut off at 1 mm (a crop or a selection) inside a search that reaches 2 mm: an edge at the
     # cut would be wrong; it is flagged when the window ends there.
     cut = s[s < 0.001]
-    assert _fit.edge_fit(cut, -0.024, 0.001, -0.012, 0.012).at_limit
+    assert _extent.edge_fit(cut, -0.024, 0.001, -0.012, 0.012).at_limit
     # Searched only up to 0.5 mm: the density does not end inside the search.
-    assert _fit.edge_fit(s, -0.024, 0.0235, -0.012, 0.0005).at_limit
+    assert _extent.edge_fit(s, -0.024, 0.0235, -0.012, 0.0005).at_limit
 
 
 def test_line_box_span() -> None:
     box = Box(make_pose(rot_z(np.radians(90.0)), (1.0, 0.0, 0.0)), np.array([2.0, 4.0, 6.0]))
-    s_in, s_out = _fit.line_box_span(np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)
+    s_in, s_out = _lines.line_box_span(np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)
     assert np.isclose(s_in, -2.0) and np.isclose(s_out, 2.0)  # the box's y (4 m) lies along R's x
-    assert _fit.line_box_span(np.array([1.0, 5.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)[0] == np.inf
+    assert _lines.line_box_span(np.array([1.0, 5.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)[0] == np.inf
 
 
 def _voxel_cloud(cloud: Cloud, voxel: float) -> Cloud:

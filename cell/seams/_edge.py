@@ -3,7 +3,7 @@
 
 A weld face can be hidden from every camera (too oblique, occluded) while an adjacent face of the same part is
 seen: that face's points end where the hidden face begins. The extent of those points across the edge, measured
-per camera with a blurred-step likelihood (:func:`cell.seams._fit.edge_fit`), places the hidden face, with a
+per camera with a blurred-step likelihood (:func:`cell.seams._extent.edge_fit`), places the hidden face, with a
 standard error from the edge's own data. Everything is in the robot frame R, metres.
 """
 
@@ -17,7 +17,9 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.seams import _fit
+from cell.seams._extent import EDGE_BLURS, EdgeFit, edge_fit
+from cell.seams._lines import line_box_span, plane_intersection
+from cell.seams._robust import histogram_mode, robust_offset
 from cell.types import BOX_FACES, Box
 
 BoolArray = npt.NDArray[np.bool_]
@@ -88,7 +90,7 @@ def place_from_edge(
     k_f = "xyz".index(face_name[1])
     search = 2.0 * o.map_tolerance_m  # the edge may lie as far from the map as a fitted face may drift [m]
     lo = max(-2.0 * search, -float(box.size[k_f]) + o.edge_band_m)  # the window along u, inside ...
-    hi = search + 3.0 * max(_fit.EDGE_BLURS) + o.edge_band_m  # ... and beyond the edge [m]
+    hi = search + 3.0 * max(EDGE_BLURS) + o.edge_band_m  # ... and beyond the edge [m]
     gate = o.map_tolerance_m + 3.0 * o.sensor_sigma_m
     best: EdgePlacement | None = None
     why: list[str] = []
@@ -99,7 +101,7 @@ def place_from_edge(
         n_g, d_g = box.face_plane(g)
         if "xyz".index(g[1]) == k_f or g == skip or on_table(n_g, d_g, table_z, o.map_tolerance_m):
             continue  # not adjacent, the joint's end face, or never seen
-        q0, e = _fit.plane_intersection(n, d, n_g, d_g, mid)
+        q0, e = plane_intersection(n, d, n_g, d_g, mid)
         reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
         edges.append((reach, g, n_g, d_g, q0, e))
     for reach, g, n_g, d_g, q0, e in sorted(edges, key=lambda x: x[0]):
@@ -118,8 +120,8 @@ def place_from_edge(
         sel = region & (np.abs(r_g) < gate)
         if np.count_nonzero(sel) < o.min_face_points:
             continue
-        start = _fit.histogram_mode(r_g[sel], max(0.002, o.sensor_sigma_m))
-        fit = _fit.robust_plane_fit(r_g[sel], np.ones((int(np.count_nonzero(sel)), 1)), cam[sel], start)
+        start = histogram_mode(r_g[sel], max(0.002, o.sensor_sigma_m))
+        fit = robust_offset(r_g[sel], cam[sel], start)
         on = region & (np.abs(r_g - fit.offset) < 2.5 * max(fit.scale, 1e-4))
         if np.count_nonzero(on) < o.min_face_points:
             continue
@@ -135,7 +137,7 @@ def place_from_edge(
             if n_c < o.min_face_points:
                 continue
             mine = cc == c
-            edge = _fit.edge_fit(uu[mine], lo, hi, -search, search)
+            edge = edge_fit(uu[mine], lo, hi, -search, search)
             b = edge.b if np.isfinite(edge.b) else 0.0
             fault = edge_fault(edge, g, search, at_cut(crop, q0 + b * n, n, edge.blur, o.edge_band_m), o)
             if fault:
@@ -158,7 +160,7 @@ def place_from_edge(
     return "no edge of it is seen either: not seen or not there"
 
 
-def edge_fault(edge: _fit.EdgeFit, g: str, search: float, cut: bool, o: EdgeOptions) -> str:
+def edge_fault(edge: EdgeFit, g: str, search: float, cut: bool, o: EdgeOptions) -> str:
     """Why the edge of the adjacent face ``g``, searched ``search`` [m] about the map, does not define the
     unseen face (``cut``: it lies where the cloud stops), or "" when it does."""
     if not np.isfinite(edge.b) or edge.n_edge < o.min_edge_points:
@@ -170,7 +172,7 @@ def edge_fault(edge: _fit.EdgeFit, g: str, search: float, cut: bool, o: EdgeOpti
             f"the edge of {g} lies at the limit of the {1000 * search:.0f} mm searched about the map "
             "(no end of the points there: part moved, or the points stop there)"
         )
-    if edge.blur >= max(_fit.EDGE_BLURS):
+    if edge.blur >= max(EDGE_BLURS):
         return f"the edge of {g} is blurred over {1000 * edge.blur:.1f} mm (seen at grazing incidence only)"
     if edge.strays > o.max_edge_strays:
         return (
@@ -183,7 +185,7 @@ def edge_fault(edge: _fit.EdgeFit, g: str, search: float, cut: bool, o: EdgeOpti
 def at_cut(crop: Box, p: FloatArray, n: FloatArray, blur: float, band: float) -> bool:
     """Whether the boundary of ``crop`` lies within ``band`` (and 3 ``blur``) [m] of ``p`` (3,) ahead along ``n``
     (3,): where the points stop because the cloud does, not the part."""
-    _, s_out = _fit.line_box_span(p, n, crop)
+    _, s_out = line_box_span(p, n, crop)
     tol = band + 3.0 * (blur if np.isfinite(blur) else 0.0)
     return bool(np.isfinite(s_out) and abs(s_out) < tol)
 

@@ -24,7 +24,8 @@ from scipy.spatial import cKDTree
 
 from cell.errors import MapError, ScenarioError
 from cell.geometry import FloatArray
-from cell.seams import _fit
+from cell.seams._index import dense_index
+from cell.seams._lines import plane_intersection
 from cell.seams.base import SeamScene
 from cell.types import MapSeam, SeamEstimate, SeamStatus
 
@@ -140,7 +141,7 @@ class RansacLocator:
         """Points (n, 3) within region_m of the map seam segment extended by region_m."""
         o = self.options
         if o.cloud == "dense":
-            dense = _fit.dense_index(scene)
+            dense = dense_index(scene)
             return dense.tube(seam.p_start, seam.p_end, o.region_m, o.region_m, 1.0)[0].T
         pts = scene.cloud.points
         t = seam.direction
@@ -221,7 +222,7 @@ class RansacLocator:
         if pair is None:
             return None
         a, b = pair
-        p0, t = _fit.plane_intersection(a.n, a.d, b.n, b.d, mid)
+        p0, t = plane_intersection(a.n, a.d, b.n, b.d, mid)
         if t @ seam.direction < 0.0:
             t = -t
         extents = []

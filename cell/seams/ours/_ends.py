@@ -1,0 +1,128 @@
+"""The ends of a seam our locator finds (frame R, metres): where the fitted line meets A's side face across it
+(fitted with the weld faces), the table, or the extent of face A's points along it (an empirical CDF extrapolated,
+refined as a blurred edge, :mod:`cell.seams._extent`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_ml
+from cell.seams._lines import line_plane_parameter
+from cell.seams.ours._geometry import JointGeometry
+from cell.seams.ours._planes import End, Face, Selection, thin
+from cell.seams.ours._points import Points
+from cell.seams.ours.options import OursOptions
+
+
+def side_selections(
+    ends: list[End],
+    pts: Points,
+    r_a: FloatArray,
+    r_b: FloatArray,
+    face_b: Face,
+    geo: JointGeometry,
+    first: bool,
+    slack: float,
+    o: OursOptions,
+) -> list[Selection]:
+    """The points on A's side faces at the seam's ends (where they are seen well enough to place an end),
+    to be fitted with the weld faces."""
+    if not geo.has_sides:
+        return []
+    band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
+    eb = o.edge_band_m + slack
+    side = (r_a < -eb) & (r_a > -(geo.depth_a - eb)) & (r_b >= band_b) & (r_b <= geo.length_a - eb) & pts.ok
+    # A side face seen at all shows a good part of the points its patch would hold seen well; a few
+    # dozen flying pixels off an edge (a face seen at grazing incidence drops out) must not pass for it.
+    patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * o.edge_band_m) * (
+        min(geo.length_a, o.tube_radius_m) - band_b - o.edge_band_m
+    )
+    need = max(o.min_end_points, int(o.min_end_fill * max(patch, 0.0) / pts.pitch**2))
+    out = []
+    for end in ends:
+        if end.on_table:
+            continue
+        r_l = pts.along(end.n) - end.d
+        gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
+        sel = np.flatnonzero(side & (np.abs(r_l) < gate))
+        if len(sel) >= need:
+            out.append(Selection(end, r_l, sel, thin(sel, o.max_fit_points), need))
+    return out
+
+
+def find_ends(
+    ends: list[End],
+    sides: list[Selection],
+    pts: Points,
+    dense: Callable[[FloatArray, FloatArray], Points] | None,
+    face_a: Face,
+    face_b: Face,
+    p0: FloatArray,
+    t: FloatArray,
+    s_map: list[float],
+    o: OursOptions,
+) -> None:
+    """Update both ends on the fitted line p0 + s t: the table where A rests on it, A's side face where it
+    was fitted, else the extent of face A's support along the seam: the quantiles of its points in ``pts``
+    extrapolated, then refined as an edge in the ``dense`` points of a short tube about it (None: not
+    refined, as in a pass before the last)."""
+    fitted = {id(x.plane): x for x in sides if x.ok}
+    known = [False, False]
+    for k, end in enumerate(ends):
+        side = fitted.get(id(end))
+        if end.on_table:
+            end.s, end.se, end.source = line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table"
+            known[k] = True
+        elif side is not None:
+            end.s = line_plane_parameter(p0, t, end.n, end.d)
+            end.se = side.se / max(abs(float(end.n @ t)), 1e-3)
+            end.source = "side face"
+            known[k] = True
+    if all(known) or face_a.source != "points":
+        for k, end in enumerate(ends):
+            if not known[k]:
+                end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
+        return
+    # Face A's support along t; a known end's neighbourhood is cut away (A's side face shows up there),
+    # which only shifts the CDF by a constant and leaves the other end's extrapolation unbiased.
+    band_b = max(o.corner_band_m, 3.0 * face_b.scale)
+    cut = o.edge_band_m + 3.0 * face_a.scale
+
+    def along_a(pts: Points) -> FloatArray:
+        """The parameters along the line of the points of face A's support among ``pts``."""
+        r_a = pts.along(face_a.n) - face_a.d
+        r_b = pts.along(face_b.n) - face_b.d
+        s = pts.along(t) - float(p0 @ t)
+        near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
+        if known[0]:
+            near_a &= s > ends[0].s + cut
+        if known[1]:
+            near_a &= s < ends[1].s - cut
+        return s[near_a]
+
+    s_a = along_a(pts)
+    extent = cdf_extent(s_a) if len(s_a) >= pts.least(o.min_face_points) else None
+    for k, end in enumerate(ends):
+        if known[k]:
+            continue
+        if extent is None:
+            end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
+        elif dense is None:
+            end.s, end.se, end.source = extent[k], extent[2], "extent"
+        else:
+            # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
+            # point of the dense cloud within the likelihood's window about it.
+            sign = 1.0 if k == 1 else -1.0
+            reach = EDGE_WINDOW_M + o.edge_band_m
+            s_d = along_a(dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t))
+            edge, se = edge_ml(sign * s_d, sign * extent[k])
+            if np.isfinite(se):
+                # The curvature understates the scatter of a blurred edge: no better than 3 spacings.
+                inside = np.count_nonzero(np.abs(s_d - extent[k]) < EDGE_WINDOW_M)
+                density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
+                end.s, end.se, end.source = sign * edge, max(se, 3.0 / max(density, 1.0)), "extent"
+            else:
+                end.s, end.se, end.source = extent[k], extent[2], "extent"

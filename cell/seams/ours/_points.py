@@ -1,0 +1,107 @@
+"""The points our locator looks at for one seam (frame R, metres): a tube of the dense cloud about it, from a share
+of its points (:class:`~cell.seams._index.CloudIndex`), and which of them may support a plane (above the table,
+away from every other part of the map)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+from cell.seams._index import cloud_box, dense_index
+from cell.seams.base import Joint, SeamScene
+from cell.seams.ours.options import OursOptions
+from cell.types import Box
+
+BoolArray = npt.NDArray[np.bool_]
+IntArray = npt.NDArray[np.intp]
+_SPHERES_KEY = "cell.seams.ours.part_spheres"
+
+
+@dataclass(frozen=True)
+class Points:
+    """The points looked at for one seam: coordinates xyz (3, n) [m], camera index (n,), usable mask (n,)."""
+
+    xyz: FloatArray
+    cam: IntArray
+    ok: BoolArray  # above the table and away from every other part
+    pitch: float  # point pitch of these points on a well-seen surface [m] (the sample's, thinned)
+    share: float  # the share of the dense cloud's points these are
+    n_cams: int  # camera indices run 0 .. n_cams - 1
+    _along: dict[bytes, FloatArray] = field(default_factory=dict, compare=False, repr=False)  # memo of along()
+
+    def least(self, dense_points: int) -> int:
+        """How many of these points stand for ``dense_points`` of the dense cloud (at least 3)."""
+        return max(3, math.ceil(dense_points * self.share))
+
+    def along(self, n: FloatArray) -> FloatArray:
+        """P @ n (n,) [m], computed once per direction (most planes keep the map's normal)."""
+        key = np.asarray(n, np.float64).tobytes()
+        out = self._along.get(key)
+        if out is None:
+            out = self._along[key] = n @ self.xyz
+        return out
+
+    @property
+    def P(self) -> FloatArray:
+        """The points (n, 3) [m]."""
+        return self.xyz.T
+
+
+def gather(
+    scene: SeamScene,
+    a: FloatArray,
+    b: FloatArray,
+    radius: float,
+    extend: float,
+    joint: Joint,
+    rng: np.random.Generator,
+    o: OursOptions,
+    share: float | None = None,
+) -> Points:
+    """The dense cloud's points in the tube of ``radius`` around the segment a-b (3,) extended by
+    ``extend`` [m], and which of them may support a plane (above the table, away from other parts); from
+    the sample of ``share`` of the dense cloud (None: ``o.sample_share``); more than ``o.max_points`` are
+    subsampled with ``rng``."""
+    index = dense_index(scene)
+    share = o.sample_share if share is None else share
+    xyz, cam = index.tube(a, b, radius, extend, share)
+    kept = 1.0
+    if len(cam) > o.max_points:
+        kept = o.max_points / len(cam)
+        pick = np.sort(rng.choice(len(cam), o.max_points, replace=False))
+        xyz, cam = xyz[:, pick], cam[pick]
+    cam = np.where(cam < 0, int(cam.max(initial=0)) + 1, cam)  # mixed / unknown captures: their own group
+    ok = xyz[2] >= scene.table_z + o.corner_band_m
+    reach = radius + extend + 0.5 * float(np.linalg.norm(b - a)) + o.map_tolerance_m
+    centres, radii = _part_spheres(scene)
+    near = np.linalg.norm(centres - 0.5 * (a + b), axis=1) <= reach + radii
+    for k in np.flatnonzero(near):
+        part = scene.weldmap.parts[k]
+        if part.name in (joint.abutting, joint.receiving):
+            continue
+        R, c = part.box.X_AB[:3, :3], part.box.center
+        q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
+        h = 0.5 * part.box.size + o.map_tolerance_m
+        ok &= (np.abs(q[0]) > h[0]) | (np.abs(q[1]) > h[1]) | (np.abs(q[2]) > h[2])
+    return Points(xyz, cam, ok, index.pitch(share * kept), share * kept, int(cam.max(initial=0)) + 1)
+
+
+def crop_box(scene: SeamScene, o: OursOptions) -> Box:
+    """Where the cloud was cropped: the workspace (in R) when the options give it, else the cloud's bounds."""
+    ws = o.workspace_R
+    return ws if ws is not None else cloud_box(scene)
+
+
+def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
+    """Centres (P, 3) and radii (P,) of the spheres around the map's parts [m], cached per scene."""
+    out = scene.cache.get(_SPHERES_KEY)
+    if out is None:
+        parts = scene.weldmap.parts
+        centres = np.array([p.box.center for p in parts]).reshape(-1, 3)
+        radii = np.array([0.5 * float(np.linalg.norm(p.box.size)) for p in parts])
+        out = scene.cache[_SPHERES_KEY] = (centres, radii)
+    return out

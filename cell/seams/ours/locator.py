@@ -1,0 +1,206 @@
+"""Our map-guided seam locator's driver (the method: :mod:`cell.seams.ours`): each seam's steps as a coroutine
+that yields its pass's plane fits, and the loop that runs the seams of a scene in lock-step, so that every fit of a
+pass (and every tilt step) is one batched fit for all of them."""
+
+from __future__ import annotations
+
+from collections.abc import Generator, Sequence
+
+import numpy as np
+
+from cell.errors import MapError
+from cell.geometry import FloatArray
+from cell.seams._edge import at_cut
+from cell.seams.base import SeamScene
+from cell.seams.ours._ends import find_ends, side_selections
+from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
+from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line
+from cell.seams.ours._planes import Face, FitRequest, Selection, thin
+from cell.seams.ours._points import Points, crop_box, gather
+from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
+from cell.seams.ours.options import OursOptions
+from cell.types import MapSeam, SeamEstimate, SeamStatus
+
+
+class OursLocator:
+    """Map-guided plane-fit seam locator (see the module docstring). Deterministic for a given ``rng``."""
+
+    name: str = "ours"
+
+    def __init__(self, options: OursOptions | None = None) -> None:
+        self.options = options if options is not None else OursOptions()
+
+    def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
+        """Find ``seam`` (frame R) in ``scene.dense`` (see the module docstring); MapError for a bad joint."""
+        return self.locate_many_with_errors(scene, [seam], rng)[0][0]
+
+    def locate_with_errors(
+        self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator
+    ) -> tuple[SeamEstimate, SeamErrors]:
+        """:meth:`locate`, and the standard errors behind the estimate's confidence (all inf unless FOUND)."""
+        return self.locate_many_with_errors(scene, [seam], rng)[0]
+
+    def locate_many(self, scene: SeamScene, seams: Sequence[MapSeam], rng: np.random.Generator) -> list[SeamEstimate]:
+        """:meth:`locate` every seam of ``seams``, together (see :meth:`locate_many_with_errors`)."""
+        return [est for est, _ in self.locate_many_with_errors(scene, seams, rng)]
+
+    def locate_many_with_errors(
+        self, scene: SeamScene, seams: Sequence[MapSeam], rng: np.random.Generator
+    ) -> list[tuple[SeamEstimate, SeamErrors]]:
+        """:meth:`locate_with_errors` for every seam of ``seams``, in lock-step: each seam's steps run as they
+        would alone, but the plane fits of a pass (and the tilt steps) are one batched fit for all the seams,
+        so that numpy's cost per call is paid once per pass, not once per seam. Each seam draws from its own
+        generator spawned from ``rng``, in the order given."""
+        runs = [self._run(scene, seam, r) for seam, r in zip(seams, rng.spawn(len(seams)), strict=True)]
+        out: list[tuple[SeamEstimate, SeamErrors] | None] = [None] * len(runs)
+        pending: dict[int, FitRequest] = {}
+
+        def advance(i: int) -> None:
+            try:
+                pending[i] = next(runs[i])
+            except StopIteration as stop:
+                out[i] = stop.value
+
+        for i in range(len(runs)):
+            advance(i)
+        while pending:
+            batch = list(pending.items())
+            pending.clear()
+            for first in (True, False):
+                fit_planes([req for _, req in batch if req.first is first], first, self.options)
+            tilt(
+                [(x, face, other, req.pts, p0, t) for _, req in batch for x, face, other, p0, t in req.tilts],
+                self.options,
+            )
+            for i, _ in batch:
+                advance(i)
+        return [x for x in out if x is not None]
+
+    def _run(
+        self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator
+    ) -> Generator[FitRequest, None, tuple[SeamEstimate, SeamErrors]]:
+        """The steps of :meth:`locate_with_errors` for one seam: yields each pass's plane fits (and tilt steps)
+        for :meth:`locate_many_with_errors` to do, returns the estimate and its standard errors."""
+        o = self.options
+        joint = joint_of(scene, seam)
+        box_a = scene.weldmap.part(joint.abutting).box
+        box_b = scene.weldmap.part(joint.receiving).box
+        n_a, d_a = box_a.face_plane(joint.face_abutting)
+        n_b, d_b = box_b.face_plane(joint.face_receiving)
+        mid = 0.5 * (seam.p_start + seam.p_end)
+        try:
+            p0, t = line(n_a, d_a, n_b, d_b, mid, seam.direction)
+        except ValueError:
+            raise MapError(
+                f"seam {seam.id}: faces {joint.abutting} {joint.face_abutting} and {joint.receiving} "
+                f"{joint.face_receiving} are parallel; a joint needs two faces that meet in a line"
+            ) from None
+        if against_table(n_a, n_b, seam, scene.table_z, o.map_tolerance_m):
+            return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, "the seam lies against the table"), NO_ERRORS
+
+        pts = gather(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng, o)
+
+        def dense(a: FloatArray, b: FloatArray) -> Points:
+            """The tube about a-b (3,) from ``edge_sample_share`` of the cloud (an end found as an edge needs
+            density)."""
+            return gather(scene, a, b, o.tube_radius_m, 0.0, joint, rng, o, o.edge_sample_share)
+
+        geo = JointGeometry.of(box_a, box_b, joint, t, o.edge_band_m)
+        s_map = sorted((float(t @ (seam.p_start - p0)), float(t @ (seam.p_end - p0))))
+        face_a = Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
+        face_b = Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
+        ends = geo.end_planes(t, scene.table_z, o.map_tolerance_m)
+        ends[0].s, ends[1].s = s_map
+
+        for it in range(o.passes):
+            first, last = it == 0, it == o.passes - 1
+            p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
+            r_a = pts.along(face_a.n) - face_a.d
+            r_b = pts.along(face_b.n) - face_b.d
+            s = pts.along(t) - float(p0 @ t)
+            slack = o.map_tolerance_m if first else 0.0
+            band_a = max(o.corner_band_m, 3.0 * face_a.scale) + slack
+            band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
+            e0, e1 = ends[0].s, ends[1].s
+            eb = o.edge_band_m + (slack if first else min(max(ends[0].se, ends[1].se), o.map_tolerance_m))
+            in_a = (r_b >= band_b) & (r_b <= geo.length_a - eb) & (s >= e0 + eb) & (s <= e1 - eb) & pts.ok
+            in_b = (
+                geo.in_face_b(pts, slack)
+                & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
+                & pts.ok
+            )
+            planes: list[Selection] = []
+            for face, r, region, box, face_name, skip in (
+                (face_a, r_a, in_a, box_a, joint.face_abutting, joint.end_face),
+                (face_b, r_b, in_b, box_b, joint.face_receiving, ""),
+            ):
+                if face.source != "points":
+                    continue  # placed from an edge in the first pass
+                gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
+                sel = np.flatnonzero(region & (np.abs(r) < gate))
+                if len(sel) >= pts.least(o.min_face_points):
+                    planes.append(Selection(face, r, sel, thin(sel, o.max_fit_points)))
+                    continue
+                why = "no edge of it is seen either: not seen or not there"
+                if first:
+                    # Where an adjacent face of the same part may show this face's edge: away from the other part.
+                    away = away_from(face_b, band_b) if face is face_a else outside(box_a, band_a)
+                    why = face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng, o)
+                    if not why:
+                        continue
+                return _not_found(
+                    seam.id,
+                    f"face {face.name} is seen by no usable camera ({len(sel)} points near the seam in a "
+                    f"{pts.share:.0%} sample, needs {pts.least(o.min_face_points)}) and {why}",
+                )
+            sides = side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack, o)
+            tilts = []
+            if last and o.refine_normals:
+                for sel_ in planes:
+                    face, other = (face_a, face_b) if sel_.plane is face_a else (face_b, face_a)
+                    tilts.append((sel_, face, other, p0, t))
+            yield FitRequest(planes + sides, pts, first, tilts)
+            # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
+            face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
+            face_b.area = (e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0)
+            p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
+            # p0 lies on both fitted planes: its distance from a map plane is how far that face moved.
+            for drift, name in ((abs(float(n_a @ p0) - d_a), face_a.name), (abs(float(n_b @ p0) - d_b), face_b.name)):
+                if drift > 2.0 * o.map_tolerance_m:
+                    return _not_found(
+                        seam.id,
+                        f"face {name} fitted {drift * 1000:.1f} mm from the map "
+                        f"(allowed {2000 * o.map_tolerance_m:.1f} mm): wrong surface or part moved",
+                    )
+            find_ends(ends, sides, pts, dense if last else None, face_a, face_b, p0, t, s_map, o)
+
+        length = ends[1].s - ends[0].s
+        if not 0.3 * (s_map[1] - s_map[0]) < length < 2.0 * (s_map[1] - s_map[0]) + 2.0 * o.extend_m:
+            return _not_found(
+                seam.id,
+                f"seam length {length * 1000:.1f} mm found, the map says {(s_map[1] - s_map[0]) * 1000:.1f} mm",
+            )
+        crop = crop_box(scene, o)
+        for k, end in enumerate(ends):
+            if end.source == "extent" and at_cut(crop, p0 + end.s * t, t if k == 1 else -t, 0.0, o.edge_band_m):
+                return _not_found(
+                    seam.id,
+                    f"the seam's {('start', 'end')[k]} is not seen: face {face_a.name}'s points run to where the "
+                    "cloud stops (the workspace's boundary): the part reaches out of the workspace",
+                )
+        errors = errors_of(face_a, face_b, ends)
+        conf = confidence(face_a, face_b, errors, pts.pitch, o)
+        via = [f"face {f.name} from the {f.source} ({f.note})" for f in (face_a, face_b) if f.source != "points"]
+        estimate = SeamEstimate(
+            id=seam.id,
+            status=SeamStatus.FOUND,
+            reason="; ".join([f"ends from {ends[0].source} / {ends[1].source}", *via]),
+            p_start=p0 + ends[0].s * t,
+            p_end=p0 + ends[1].s * t,
+            confidence=conf,
+        )
+        return estimate, errors
+
+
+def _not_found(seam_id: str, reason: str) -> tuple[SeamEstimate, SeamErrors]:
+    return SeamEstimate(seam_id, SeamStatus.NOT_FOUND, reason=reason), NO_ERRORS

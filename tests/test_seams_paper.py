@@ -8,10 +8,11 @@ import pytest
 
 from cell.geometry import invert, make_pose, transform_points
 from cell.scenario import PaperLocatorSpec
+from cell.seams._features import cloud_features
 from cell.seams.base import SeamScene
 from cell.seams.joint import find_joints
 from cell.seams.metrics import segment_errors
-from cell.seams.paper import PaperLocator, axis_faces, cloud_features, second_most_frequent
+from cell.seams.paper import PaperLocator, axis_faces, second_most_frequent
 from cell.seams.truth import true_seams
 from cell.seams.visibility import visibility
 from cell.types import Box, Cloud, MapSeam, Part, SeamStatus, WeldMap

@@ -1,0 +1,90 @@
+"""Seams: pair each map seam with its joint, tell whether a camera can see it, locate it, and score it.
+
+The public names are listed in ``__all__`` and load on first use (``from cell.seams import OursLocator`` imports
+only the ours locator's modules, as :func:`make_locator` does): the locators and their options, the scene they read
+(:class:`SeamScene`), the registry (:data:`METHODS`, :func:`make_locator`), joints, truth and metrics. Visibility is
+the module :mod:`cell.seams.visibility` (its function ``visibility`` shares the module's name, so the package does
+not re-export it). The modules with a leading underscore are this package's own; nothing outside it imports them.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from cell.seams.base import BatchSeamLocator, Joint, SeamLocator, SeamScene
+    from cell.seams.joint import fillet_bisector, find_joints, weld_faces
+    from cell.seams.metrics import MetricsSummary, SeamMetrics, evaluate, seam_metrics, segment_errors, summarise
+    from cell.seams.ours import OursLocator, OursOptions, SeamErrors
+    from cell.seams.paper import PaperLocator
+    from cell.seams.ransac import RansacLocator, RansacOptions
+    from cell.seams.registry import METHODS, make_locator
+    from cell.seams.truth import true_seams
+    from cell.seams.visibility import UNDERSIDE_REASON
+
+_HOME = {
+    "BatchSeamLocator": "base",
+    "Joint": "base",
+    "SeamLocator": "base",
+    "SeamScene": "base",
+    "fillet_bisector": "joint",
+    "find_joints": "joint",
+    "weld_faces": "joint",
+    "MetricsSummary": "metrics",
+    "SeamMetrics": "metrics",
+    "evaluate": "metrics",
+    "seam_metrics": "metrics",
+    "segment_errors": "metrics",
+    "summarise": "metrics",
+    "OursLocator": "ours",
+    "OursOptions": "ours",
+    "SeamErrors": "ours",
+    "PaperLocator": "paper",
+    "RansacLocator": "ransac",
+    "RansacOptions": "ransac",
+    "METHODS": "registry",
+    "make_locator": "registry",
+    "true_seams": "truth",
+    "UNDERSIDE_REASON": "visibility",
+}
+
+__all__ = [
+    "METHODS",
+    "UNDERSIDE_REASON",
+    "BatchSeamLocator",
+    "Joint",
+    "MetricsSummary",
+    "OursLocator",
+    "OursOptions",
+    "PaperLocator",
+    "RansacLocator",
+    "RansacOptions",
+    "SeamErrors",
+    "SeamLocator",
+    "SeamMetrics",
+    "SeamScene",
+    "evaluate",
+    "fillet_bisector",
+    "find_joints",
+    "make_locator",
+    "seam_metrics",
+    "segment_errors",
+    "summarise",
+    "true_seams",
+    "weld_faces",
+]
+
+
+def __getattr__(name: str) -> Any:
+    """A public name of the package, imported from its module on first use (PEP 562)."""
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{home}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -203,32 +203,31 @@ def rescan_cmd(
     noise: NoiseOpt = None,
     json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
 ) -> None:
-    """Only the close-up re-scan: detect, look again at seams with the eye-in-hand camera, compare before/after."""
-    import math
+    """Only the close-up re-scan: detect, look again at seams with the eye-in-hand camera, compare before/after.
 
+    The same re-scan as ``cell weld`` (its selection and its escalation when a close-up disagrees).
+    """
     from cell import pipeline
     from cell import scenario as sc
     from cell.export.report import rescan_report, write_json
-    from cell.rescan import rescan_seams, rescanned, seams_to_rescan
-    from cell.station import Station
+    from cell.station import open_station
 
     with _cell_errors():
         scn = sc.load(scenario)
         _check_method(method)
         scn = scn.with_noise(n) if (n := _noise(noise)) else scn
-        with Station(scn) as station:
-            det = pipeline.detect(scn, method, progress=_progress(), station=station)
+        ids = [s.strip() for s in seams.split(",") if s.strip()] if seams else None
+        weldmap = pipeline.read_weldmap(scn)
+        unknown = sorted(set(ids or ()) - {s.id for s in weldmap.seams})
+        if unknown:
+            valid = ", ".join(s.id for s in weldmap.seams)
+            raise typer.BadParameter(f"no seam {', '.join(unknown)} in the map; seams: {valid}", param_hint="--seams")
+        with open_station(scn, weldmap) as station:
+            det = pipeline.detect(scn, method, progress=_progress(), station=station, weldmap=weldmap)
             if det.error is not None:
                 raise det.error
-            if seams:
-                ids = [s.strip() for s in seams.split(",") if s.strip()]
-            else:
-                ids = seams_to_rescan(det, math.inf if all_seams else scn.rescan.confidence_threshold)
-            try:
-                rs = rescan_seams(station, det, ids, progress=_progress())
-            except KeyError as e:
-                raise typer.BadParameter(str(e.args[0]), param_hint="--seams") from None
-            after = rescanned(det, rs)
+            mode: pipeline.RescanMode = "all" if all_seams else "low"
+            rs, after = pipeline.rescan_detection(station, det, mode, seam_ids=ids, progress=_progress())
         rep = rescan_report(det, after, rs)
         if json_path is not None:
             write_json(json_path, rep)

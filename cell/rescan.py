@@ -3,7 +3,8 @@
 The fixed cameras see the fence from 1.5-2 m (D415: sigma_z ~3-6 mm, pixel footprint 1.5-2 mm) and their
 extrinsic calibration bounds what they can do. The eye-in-hand camera, brought to ~0.35 m of a seam, sees it
 with ~0.2 mm depth noise and a ~0.35 mm footprint, and its pose comes from the robot's kinematics, not from the
-fixed cameras' calibration. Per seam (:func:`rescan_seams`):
+fixed cameras' calibration. Per seam (the loop is :func:`cell.pipeline.rescan.rescan_seams`, the only code that
+moves the arm for it; this module holds the values it computes):
 
 1. plan a view (:func:`cell.motion.viewpoint.plan_view`) from where the arm is;
 2. move the simulated arm there (arc off) and take one image from the camera on the arm;
@@ -21,28 +22,22 @@ estimate and pose, W for the simulator; metres, radians, seconds.
 from __future__ import annotations
 
 import math
-import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from cell.errors import CellError, ScenarioError
-from cell.geometry import FloatArray, invert, readonly
-from cell.motion.viewpoint import ViewOptions, Viewpoint, ViewTarget, plan_view
-from cell.seams.base import SeamLocator, SeamScene
+from cell.errors import ScenarioError
+from cell.geometry import FloatArray, invert
+from cell.motion.viewpoint import ViewOptions, Viewpoint, ViewTarget
+from cell.seams.base import SeamScene
 from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamStatus
 
 if TYPE_CHECKING:
-    from cell.motion.collision import CollisionChecker
     from cell.motion.timing import Trajectory
-    from cell.pipeline import Detection
     from cell.scenario import Scenario
     from cell.sim.robot import Execution
-    from cell.station import Station
-
-Progress = Callable[[str], None]
 
 # Below this confidence a seam is worth a close look (benchmarks/bench_confidence.py: 144 seams of fence1-exact,
 # fence1 and fence2, realistic noise; 20 fall below it, with 2 of the 3 seams more than 0.15 mm off). A scenario
@@ -59,10 +54,6 @@ CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
     "corner_band_m": 0.003,
 }
 _FIRST_TARGET_SE_M = 0.0002  # OursOptions.target_se_m: the first estimate's confidence scale [m]
-
-
-def _quiet(_: str) -> None:
-    return None
 
 
 @dataclass(frozen=True)
@@ -127,7 +118,7 @@ class Rescan:
     estimates : every seam of the detection, the re-scanned ones replaced by their fused estimate.
     moves : the moves played (to each view, then back), executions : what the simulated arm did.
     q_end : (dof,) [rad] where the arm was left; returned : whether that is the scan configuration; note : why
-    not.
+    not. escalated_mm : the close-up disagreement [mm] that made the re-scan take every seam (0: no escalation).
     """
 
     seams: tuple[SeamRescan, ...]
@@ -138,6 +129,7 @@ class Rescan:
     returned: bool
     note: str = ""
     timings: dict[str, float] = field(default_factory=dict)
+    escalated_mm: float = 0.0
 
     @property
     def motion_s(self) -> float:
@@ -202,13 +194,13 @@ def fuse(
 # -- which seams ---------------------------------------------------------------------------------------------
 
 
-def seams_to_rescan(detection: Detection, threshold: float = CONFIDENCE_THRESHOLD) -> list[str]:
+def seams_to_rescan(estimates: Sequence[SeamEstimate], threshold: float = CONFIDENCE_THRESHOLD) -> list[str]:
     """Ids of the seams worth a close look: found with confidence below ``threshold``, or visible but not found.
 
     ``threshold=math.inf`` selects every visible seam. Seams no camera can see (against the table) are left out.
     """
     out = []
-    for e in detection.estimates:
+    for e in estimates:
         if e.status is SeamStatus.NOT_FOUND or (e.status is SeamStatus.FOUND and e.confidence < threshold):
             out.append(e.id)
     return out
@@ -265,7 +257,8 @@ def closeup_scene(
     )
 
 
-def _view_target(scene: SeamScene, seam: MapSeam, first: SeamEstimate) -> ViewTarget:
+def view_target(scene: SeamScene, seam: MapSeam, first: SeamEstimate) -> ViewTarget:
+    """What a close-up view must see of ``seam``: its first estimate (the map's line when not found), its faces."""
     from cell.seams.joint import weld_faces
 
     joint = scene.joints[seam.id]
@@ -274,152 +267,17 @@ def _view_target(scene: SeamScene, seam: MapSeam, first: SeamEstimate) -> ViewTa
     return ViewTarget(seam.id, a, b, n_a, n_b)
 
 
-def _occluders(scene: SeamScene, seam_id: str) -> tuple[Part, ...]:
+def occluders(scene: SeamScene, seam_id: str) -> tuple[Part, ...]:
     """The map's parts that may stand between the camera and the seam: all but the joint's own two."""
     joint = scene.joints[seam_id]
     return tuple(p for p in scene.weldmap.parts if p.name not in (joint.abutting, joint.receiving))
 
 
-@dataclass
-class _Run:
-    """What every seam of one re-scan shares: the station, the checker, the locator, where the arm is."""
-
-    station: Station
-    detection: Detection
-    options: RescanOptions
-    camera: str
-    checker: CollisionChecker
-    locator: SeamLocator
-    q: FloatArray
-    moves: list[Trajectory] = field(default_factory=list)
-    executions: list[Execution] = field(default_factory=list)
-
-    def play(self, move: Trajectory) -> None:
-        """Drive the simulated arm along ``move`` with the arc off, and record it."""
-        arc = np.zeros(len(move.times), bool)
-        self.executions.append(self.station.sim.execute(move.times, move.q, arc, record_dt=0.02, bead=None))
-        self.moves.append(move)
-        self.q = np.asarray(move.q[-1], dtype=float)
-
-
-def _sigma(est: SeamEstimate | None, scale_m: float, floor_m: float) -> float:
+def estimate_sigma(est: SeamEstimate | None, scale_m: float, floor_m: float) -> float:
+    """Standard deviation [m] of an estimate for fusion: infinite when there is none or it was not found."""
     if est is None or est.status is not SeamStatus.FOUND:
         return math.inf
     return sigma_from_confidence(est.confidence, scale_m, floor_m)
-
-
-def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan:
-    """Plan the view, move, capture, locate and fuse one seam (see the module docstring)."""
-    t0 = time.perf_counter()
-    o, det = run.options, run.detection
-    assert det.scene is not None and run.station.arm is not None
-    base, arm = det.scene.seam_scene, run.station.arm
-    first = next(e for e in det.estimates if e.id == seam_id)
-    seam = base.weldmap.seam(seam_id)
-    try:
-        target = _view_target(base, seam, first)
-        vp = plan_view(
-            arm.model,
-            run.checker,
-            target,
-            run.q,
-            run.station.sim.intrinsics(run.camera),
-            _occluders(base, seam_id),
-            base.table_z,
-            rng=rng,
-            q_via=arm.q_scan,
-            options=o.view,
-        )
-    except CellError as exc:
-        reason = f"unreachable view: {exc.message}"
-        return SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)
-    run.play(vp.move)
-    image = run.station.sim.capture_from_link(run.camera)
-    scene = closeup_scene(image, det.scenario.X_WR, seam, base, o, det.scenario.perception.voxel_m)
-    n = len(scene.dense)
-    if n < o.min_points:
-        reason = f"nothing seen: {n} points near the seam in the close-up (needs {o.min_points})"
-        return SeamRescan(seam_id, first, None, first, 0.0, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
-    t = time.perf_counter()
-    est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
-    est = replace(est, time_s=time.perf_counter() - t)
-    s1 = _sigma(first, o.first_scale_m, o.first_floor_m)
-    s2 = _sigma(est, o.closeup_scale_m, o.closeup_floor_m)
-    fused, w = fuse(first, est, s1, s2, o.first_scale_m)
-    reason = "" if w > 0.0 else f"close-up not used: {est.reason or est.status.value}"
-    return SeamRescan(seam_id, first, est, fused, w, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
-
-
-def rescan_seams(
-    station: Station,
-    detection: Detection,
-    seam_ids: Sequence[str],
-    *,
-    options: RescanOptions | None = None,
-    progress: Progress = _quiet,
-) -> Rescan:
-    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (module docstring).
-
-    station : the running cell the detection came from. Its arm moves from where it is to each view (arc off)
-    and, with ``options.return_to_scan``, back to the scan configuration when that move is free; the result says
-    where it was left. A seam whose view is unreachable, or whose close-up sees nothing or finds no seam, keeps
-    its first estimate and says why. Raises ScenarioError without an arm or an eye-in-hand camera, KeyError for
-    a seam id the detection does not have, ValueError for a detection without its scene.
-    """
-    from cell.motion.collision import CollisionChecker
-    from cell.motion.plan import cell_obstacles
-    from cell.motion.timing import ptp
-    from cell.seams.registry import make_locator
-
-    o = options or RescanOptions()
-    sc = detection.scenario
-    arm = station.arm
-    if arm is None:
-        raise ScenarioError(f"scenario {sc.name!r} has no robot to carry the camera: set robot.urdf")
-    camera = eye_in_hand_camera(sc, o.camera)
-    if detection.scene is None:
-        raise ValueError("rescan_seams needs a detection that kept its scene (pipeline.detect does)")
-    base = detection.scene.seam_scene
-    known = {e.id for e in detection.estimates}
-    unknown = [s for s in seam_ids if s not in known]
-    if unknown:
-        raise KeyError(f"no seam {', '.join(unknown)} in the detection; seams: {', '.join(sorted(known))}")
-    t_all = time.perf_counter()
-    obstacles = cell_obstacles(base.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
-    checker = CollisionChecker(arm.model, obstacles)
-    locator = make_locator(detection.method, closeup_scenario(sc, detection.method, o))
-    run = _Run(station, detection, o, camera, checker, locator, np.asarray(station.sim.robot.q, dtype=float))
-    rng = sc.rng("rescan/view")
-    results = []
-    for k, sid in enumerate(seam_ids):
-        progress(f"re-scan {k + 1}/{len(seam_ids)}: {sid}")
-        results.append(_rescan_one(run, sid, rng))
-    returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
-    if o.return_to_scan and not returned:
-        back = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
-        hit = checker.check_path(back.q, back.times)
-        if hit is None:
-            run.play(back)
-            returned = True
-        else:
-            note = f"left at the last view: the move back to the scan pose collides ({hit.describe()})"
-    elif not returned:
-        note = "left at the last view (return_to_scan is off)"
-    fused_by_id = {r.id: r.fused for r in results}
-    estimates = tuple(fused_by_id.get(e.id, e) for e in detection.estimates)
-    timings = {"rescan_s": time.perf_counter() - t_all}
-    return Rescan(
-        tuple(results), estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings
-    )
-
-
-def rescanned(detection: Detection, rescan: Rescan) -> Detection:
-    """The detection with the fused estimates in place and its metrics measured again against the truths."""
-    from cell.pipeline import evaluate
-
-    metrics, summary = evaluate(rescan.estimates, detection.truths)
-    timings = {**detection.timings, **rescan.timings}
-    return replace(detection, estimates=rescan.estimates, metrics=metrics, summary=summary, timings=timings)
 
 
 __all__ = [
@@ -427,9 +285,14 @@ __all__ = [
     "Rescan",
     "RescanOptions",
     "SeamRescan",
+    "closeup_scenario",
+    "closeup_scene",
+    "crop_around",
+    "estimate_sigma",
+    "eye_in_hand_camera",
     "fuse",
-    "rescan_seams",
-    "rescanned",
+    "occluders",
     "seams_to_rescan",
     "sigma_from_confidence",
+    "view_target",
 ]

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -25,11 +24,10 @@ from cell.motion.viewpoint import (
     plan_view,
     torch_axis_in_camera,
 )
+from cell.pipeline import rescan_seams, rescanned
 from cell.rescan import (
     RescanOptions,
     fuse,
-    rescan_seams,
-    rescanned,
     seams_to_rescan,
     sigma_from_confidence,
 )
@@ -158,16 +156,14 @@ def test_failed_or_weak_closeup_keeps_the_first_estimate() -> None:
 
 
 def test_seams_to_rescan_takes_low_confidence_and_missed_visible_seams() -> None:
-    det: Any = SimpleNamespace(
-        estimates=(
-            SeamEstimate("a", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 0.9),
-            SeamEstimate("b", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 0.3),
-            SeamEstimate("c", SeamStatus.NOT_FOUND, "too few points"),
-            SeamEstimate("d", SeamStatus.NOT_VISIBLE, "underside"),
-        )
+    estimates = (
+        SeamEstimate("a", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 0.9),
+        SeamEstimate("b", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 0.3),
+        SeamEstimate("c", SeamStatus.NOT_FOUND, "too few points"),
+        SeamEstimate("d", SeamStatus.NOT_VISIBLE, "underside"),
     )
-    assert seams_to_rescan(det, 0.55) == ["b", "c"]
-    assert seams_to_rescan(det, math.inf) == ["a", "b", "c"]
+    assert seams_to_rescan(estimates, 0.55) == ["b", "c"]
+    assert seams_to_rescan(estimates, math.inf) == ["a", "b", "c"]
 
 
 # -- the real pipeline ---------------------------------------------------------------------------------------
@@ -175,12 +171,13 @@ def test_seams_to_rescan_takes_low_confidence_and_missed_visible_seams() -> None
 
 @pytest.fixture(scope="module")
 def fence1() -> Any:
-    from cell.pipeline import detect
-    from cell.station import Station
+    from cell.pipeline import detect, read_weldmap
+    from cell.station import open_station
 
     scenario = sc.load("fence1")
-    with Station(scenario) as station:
-        det = detect(scenario, station=station)
+    weldmap = read_weldmap(scenario)
+    with open_station(scenario, weldmap) as station:
+        det = detect(scenario, station=station, weldmap=weldmap)
         yield station, det
 
 
@@ -196,7 +193,7 @@ def test_rescan_improves_the_least_confident_seam_and_returns_the_arm(fence1: An
     _, end1, lat1, _ = segment_errors(r.fused.p_start, r.fused.p_end, *truth)
     assert lat1 < lat0 and lat1 < 0.1 and end1 < 0.3  # [mm]
     assert r.motion_s > 0.0 and len(rs.executions) == 2  # to the view, and back
-    assert rs.returned and np.allclose(station.sim.robot.q, station.arm.q_scan, atol=1e-9)
+    assert rs.returned and np.allclose(station.joint_state(), station.arm.q_scan, atol=1e-9)
     after = rescanned(det, rs)
     assert after.metrics[worst.id].lateral_mm == pytest.approx(lat1)
     assert [e.id for e in after.estimates] == [e.id for e in det.estimates]
@@ -217,12 +214,12 @@ def test_rescan_undoes_the_fixed_cameras_calibration_error() -> None:
     """Fixed cameras off by 1 mm / 0.1 deg: the arm's camera (posed by the robot's kinematics) brings every seam
     back under 0.5 mm lateral (issue acceptance), and improves the mean."""
     from cell import pipeline
-    from cell.rescan import rescan_seams, rescanned
-    from cell.station import Station
+    from cell.station import open_station
 
     scn = sc.load("faults/extrinsics-fixed-off")
-    with Station(scn) as station:
-        det = pipeline.detect(scn, station=station)
+    weldmap = pipeline.read_weldmap(scn)
+    with open_station(scn, weldmap) as station:
+        det = pipeline.detect(scn, station=station, weldmap=weldmap)
         ids = [e.id for e in det.estimates if e.status is SeamStatus.FOUND]
         after = rescanned(det, rescan_seams(station, det, ids))
     assert after.summary.found == 12

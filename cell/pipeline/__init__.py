@@ -1,0 +1,37 @@
+"""The only place that knows the order of the stages: capture -> perceive -> align map -> locate -> re-scan ->
+plan -> gate -> execute.
+
+Each stage is a function taking values and returning values; this package wires them, times them, and is the only
+code that talks to the station's ports (:mod:`cell.station`). The CLI is a thin layer over :func:`detect`,
+:func:`weld` and :func:`rescan_detection` (and, for the bench, over :func:`capture`, :func:`build_scene` and
+:func:`locate`).
+"""
+
+from cell.pipeline.detect import build_scene, capture, detect, evaluate, locate, read_weldmap, table_z_R, truths
+from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun
+from cell.pipeline.rescan import RescanMode, rescan_detection, rescan_seams, rescanned
+from cell.pipeline.weld import execute, plan_for, torch_paths, weld
+
+__all__ = [
+    "Capture",
+    "Detection",
+    "RescanMode",
+    "Scene",
+    "SeamWeld",
+    "WeldRun",
+    "build_scene",
+    "capture",
+    "detect",
+    "evaluate",
+    "execute",
+    "locate",
+    "plan_for",
+    "read_weldmap",
+    "rescan_detection",
+    "rescan_seams",
+    "rescanned",
+    "table_z_R",
+    "torch_paths",
+    "truths",
+    "weld",
+]

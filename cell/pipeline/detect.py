@@ -1,0 +1,233 @@
+"""Detection: capture -> perceive -> align the map -> locate every seam -> measure against the truth, if known."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
+from typing import Literal
+
+from cell.errors import AlignmentError, CellError, SensorError
+from cell.geometry import FloatArray, invert
+from cell.pipeline.records import Capture, Detection, Scene
+from cell.scenario import Scenario
+from cell.seams.base import SeamScene
+from cell.seams.metrics import MetricsSummary, SeamMetrics
+from cell.station import Station, open_station
+from cell.types import SeamEstimate, SeamStatus, WeldMap
+
+Progress = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    return None
+
+
+def read_weldmap(scenario: Scenario) -> WeldMap:
+    """The scenario's welding map as drawn (frame M): the pipeline reads it, the station is built around it."""
+    from cell.weldmap import read_map
+
+    return read_map(scenario.map_path, units=scenario.map.units)
+
+
+def capture(
+    scenario: Scenario,
+    *,
+    gui: bool = False,
+    progress: Progress = _quiet,
+    station: Station | None = None,
+    weldmap: WeldMap | None = None,
+) -> Capture:
+    """Take one image with every camera of the scenario's cell (built here unless a running ``station`` is given).
+
+    With a robot in the scenario, the arm first moves to its scan configuration: the eye-in-hand camera rides on
+    it. The capture keeps the as-built parts (ground truth) for measuring, never for perception.
+    """
+    t0 = time.perf_counter()
+    weldmap = weldmap if weldmap is not None else read_weldmap(scenario)
+    if station is None:
+        progress(f"building the cell of {scenario.name}")
+        with open_station(scenario, weldmap, gui=gui) as st:
+            return capture(scenario, progress=progress, station=st, weldmap=weldmap)
+    progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
+    images = station.capture()
+    return Capture(scenario, weldmap, station.truth(), images, time.perf_counter() - t0)
+
+
+def table_z_R(scenario: Scenario) -> float:
+    """Height [m] of the table top in the robot frame R."""
+    return float((invert(scenario.X_WR) @ [0.0, 0.0, scenario.table.top_z, 1.0])[2])
+
+
+def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
+    """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints."""
+    from cell.perception import align_map, perceive
+    from cell.perception.health import check_alignment_unique, check_parts_seen
+    from cell.seams.joint import find_joints
+
+    sc = cap.scenario
+    timings: dict[str, float] = {}
+    t = time.perf_counter()
+    progress("splicing point clouds")
+    perceived = perceive(cap.images, sc.X_WR, sc.perception)
+    timings["perceive_s"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    progress("aligning the welding map to the cloud")
+    X_RM_nominal = invert(sc.X_WR) @ sc.X_WM
+    weldmap_nominal_R = cap.weldmap.transformed(X_RM_nominal, "R")
+    # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
+    # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud.
+    alignment = align_map(weldmap_nominal_R, perceived.registered, sc.perception)
+    X_RM = alignment.X_RR_corr @ X_RM_nominal
+    weldmap_R = cap.weldmap.transformed(X_RM, "R")
+    # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
+    # parts that are simply not there are named, and their seams are never searched.
+    check_alignment_unique(weldmap_R, perceived.registered, alignment)
+    missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception)
+    joints = find_joints(weldmap_R)
+    timings["align_s"] = time.perf_counter() - t
+
+    seam_scene = SeamScene(
+        cloud=perceived.downsampled,
+        dense=perceived.registered,
+        weldmap=weldmap_R,
+        joints=joints,
+        table_z=table_z_R(sc),
+        dense_voxels=perceived.registered_voxels,
+    )
+    return Scene(seam_scene, perceived, alignment, X_RM, timings, missing)
+
+
+def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet) -> tuple[SeamEstimate, ...]:
+    """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
+    from cell.perception.health import screen
+    from cell.seams.base import BatchSeamLocator
+    from cell.seams.registry import make_locator
+    from cell.seams.visibility import visibility
+
+    ss = scene.seam_scene
+    locator = make_locator(method, scenario)
+    rng = scenario.rng(f"locator/{method}")
+    progress(f"locating {len(ss.weldmap.seams)} seams ({method})")
+    hidden: dict[str, SeamEstimate] = {}
+    for seam in ss.weldmap.seams:
+        visible, reason = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
+        if not visible:
+            hidden[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason)
+    seams = [seam for seam in ss.weldmap.seams if seam.id not in hidden]
+    timed: dict[str, SeamEstimate] = {}
+    if isinstance(locator, BatchSeamLocator) and seams:
+        # Found together: each seam is charged an equal share of the whole batch's time.
+        t = time.perf_counter()
+        found = locator.locate_many(ss, seams, rng)
+        dt = (time.perf_counter() - t) / len(seams)
+        timed = {est.id: replace(est, time_s=dt) for est in found}
+    else:
+        for seam in seams:
+            t = time.perf_counter()
+            est = locator.locate(ss, seam, rng)
+            timed[seam.id] = replace(est, time_s=time.perf_counter() - t)
+    out = tuple(hidden[seam.id] if seam.id in hidden else timed[seam.id] for seam in ss.weldmap.seams)
+    # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
+    return screen(ss, out, scene.missing)
+
+
+def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:
+    """True seams from the as-built geometry, in R, keyed by seam id (empty when the station knows no truth)."""
+    from cell.seams.joint import find_joints
+    from cell.seams.truth import true_seams
+
+    if cap.parts_W is None:
+        return {}
+    design_W = cap.weldmap.transformed(cap.scenario.X_WM, "W")
+    joints = find_joints(design_W)
+    return true_seams(design_W, joints, cap.parts_W, cap.scenario.X_WR)
+
+
+def evaluate(
+    estimates: Sequence[SeamEstimate], truth: Mapping[str, tuple[FloatArray, FloatArray]]
+) -> tuple[dict[str, SeamMetrics], MetricsSummary]:
+    """Per-seam metrics of the found seams and the summary (paper ME, endpoint, lateral, time); no metrics when the
+    station knows no truth (``truth`` empty)."""
+    from cell.seams.metrics import evaluate as metrics_of
+    from cell.seams.metrics import summarise
+
+    per_seam = metrics_of(estimates, truth) if truth else {}
+    return per_seam, summarise(estimates, per_seam)
+
+
+def detect(
+    scenario: Scenario,
+    method: str | None = None,
+    *,
+    noise: Literal["none", "realistic"] | None = None,
+    progress: Progress = _quiet,
+    gui: bool = False,
+    station: Station | None = None,
+    weldmap: WeldMap | None = None,
+) -> Detection:
+    """Capture, perceive, align and locate every seam of the scenario's welding map; measure against truth.
+
+    station, weldmap : a running cell and the map it was built around (both built here when not given).
+    """
+    if noise is not None:
+        scenario = scenario.with_noise(noise)
+    method = method or scenario.locator.method
+    t_all = time.perf_counter()
+    cap = capture(scenario, gui=gui, progress=progress, station=station, weldmap=weldmap)
+    try:
+        scene = build_scene(cap, progress=progress)
+    except (SensorError, AlignmentError) as e:
+        # No seam can be searched, but every seam is still reported, with the reason; nothing is invented.
+        progress(f"no seam search: {e.message}")
+        return _failed_detection(cap, method, e, time.perf_counter() - t_all)
+    estimates = locate(scene, scenario, method, progress=progress)
+    weldmap_R = scene.seam_scene.weldmap
+    truth = truths(cap, weldmap_R)
+    metrics, summary = evaluate(estimates, truth)
+    timings = {"capture_s": cap.seconds, **scene.timings}
+    timings["locate_s"] = sum(e.time_s for e in estimates)
+    timings["total_s"] = time.perf_counter() - t_all
+    return Detection(
+        scenario=scenario,
+        method=method,
+        weldmap_R=weldmap_R,
+        estimates=estimates,
+        truths=truth,
+        metrics=metrics,
+        summary=summary,
+        timings=timings,
+        lost_cameras=tuple(scene.perceived.lost_described()),
+        scene=scene,
+    )
+
+
+def _failed_detection(cap: Capture, method: str, error: CellError, seconds: float) -> Detection:
+    """A detection whose perception or alignment failed: every seam NOT_FOUND (underside ones NOT_VISIBLE, which
+    the drawing alone tells) with the reason, against the nominal map."""
+    from cell.seams.joint import find_joints
+    from cell.seams.visibility import visibility
+
+    sc = cap.scenario
+    weldmap_R = cap.weldmap.transformed(invert(sc.X_WR) @ sc.X_WM, "R")
+    joints = find_joints(weldmap_R)
+    table_z = table_z_R(sc)
+    estimates = []
+    for seam in weldmap_R.seams:
+        visible, why = visibility(weldmap_R, joints[seam.id], table_z)
+        status = SeamStatus.NOT_FOUND if visible else SeamStatus.NOT_VISIBLE
+        estimates.append(SeamEstimate(seam.id, status, f"no seam search: {error.message}" if visible else why))
+    truth = truths(cap, weldmap_R)
+    metrics, summary = evaluate(estimates, truth)
+    return Detection(
+        scenario=sc,
+        method=method,
+        weldmap_R=weldmap_R,
+        estimates=tuple(estimates),
+        truths=truth,
+        metrics=metrics,
+        summary=summary,
+        timings={"capture_s": cap.seconds, "total_s": seconds},
+        error=error,
+    )

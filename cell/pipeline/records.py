@@ -1,0 +1,127 @@
+"""What a run of the pipeline produces: the capture, the perceived scene, the detection and the weld run.
+
+Values only (frozen dataclasses); the stages that fill them live beside this module.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from cell.errors import CellError
+from cell.geometry import FloatArray
+from cell.scenario import Scenario
+from cell.seams.base import SeamScene
+from cell.seams.metrics import MetricsSummary, SeamMetrics
+from cell.station.ports import Arm
+from cell.types import DepthImage, Part, SeamEstimate, SeamStatus, WeldMap
+
+if TYPE_CHECKING:
+    from cell.motion.plan import WeldPlan
+    from cell.motion.quality import WeldQuality
+    from cell.motion.timing import Trajectory
+    from cell.perception import Alignment, Perceived
+    from cell.rescan import Rescan
+    from cell.sim.robot import Execution
+
+
+@dataclass(frozen=True)
+class Capture:
+    """What the cameras saw, the map the pipeline read, and the ground truth when the station knows it (the
+    simulator does; it is never handed to perception)."""
+
+    scenario: Scenario
+    weldmap: WeldMap  # as drawn, frame M
+    parts_W: tuple[Part, ...] | None  # as built, world frame (ground truth), None when unknown
+    images: Mapping[str, DepthImage]
+    seconds: float
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The perceived cell: spliced clouds, the aligned map and the seam scene the locators read."""
+
+    seam_scene: SeamScene
+    perceived: Perceived
+    alignment: Alignment
+    X_RM: FloatArray  # pose of the aligned map in the robot frame
+    timings: dict[str, float]
+    missing: Mapping[str, str] = field(default_factory=dict)  # parts of the map not in the cloud -> why
+
+
+@dataclass(frozen=True)
+class Detection:
+    """The outcome of ``cell detect``: estimates, truths and metrics per seam, in the robot frame R."""
+
+    scenario: Scenario
+    method: str
+    weldmap_R: WeldMap
+    estimates: tuple[SeamEstimate, ...]
+    truths: Mapping[str, tuple[FloatArray, FloatArray]]
+    metrics: Mapping[str, SeamMetrics]  # found seams only
+    summary: MetricsSummary
+    timings: dict[str, float] = field(default_factory=dict)
+    lost_cameras: tuple[str, ...] = ()
+    scene: Scene | None = None
+    error: CellError | None = None  # perception or alignment failed: no seam was searched (report still written)
+
+    @property
+    def complete(self) -> bool:
+        """Every seam that can be seen was found, with every camera working (a lost camera is a degraded run)."""
+        undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
+        return not self.lost_cameras and all(e.status not in undone for e in self.estimates)
+
+
+@dataclass(frozen=True)
+class SeamWeld:
+    """What became of one seam in ``cell weld``: planned and welded, or why not; how well (executed TCP vs the true
+    seam)."""
+
+    id: str
+    planned: bool
+    welded: bool
+    reason: str = ""
+    quality: WeldQuality | None = None
+
+
+@dataclass(frozen=True)
+class WeldRun:
+    """The outcome of ``cell weld`` / ``cell preview``.
+
+    plan : the checked welding plan (None when planning failed as a whole: see ``error``).
+    execution : what the simulated arm did (None for a preview or when the gate refused the plan).
+    error : the failure that stopped the run after detection, or None; the rest of the run is still reported.
+    """
+
+    detection: Detection
+    seams: tuple[SeamWeld, ...]
+    plan: WeldPlan | None = None
+    pre_move: Trajectory | None = None
+    execution: Execution | None = None
+    violations: tuple[str, ...] = ()
+    error: CellError | None = None
+    timings: dict[str, float] = field(default_factory=dict)
+    torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT
+    arm: Arm | None = None
+    first_detection: Detection | None = None  # before the re-scan (the same as detection when none ran)
+    rescan: Rescan | None = None
+
+    @property
+    def cycle_time_s(self) -> float:
+        """Robot time of everything the arm did: re-scan moves and the welding program [s] (0 when nothing moved)."""
+        if self.execution is None:
+            return 0.0
+        return self.execution.duration + (self.rescan.motion_s if self.rescan is not None else 0.0)
+
+    @property
+    def complete(self) -> bool:
+        """Every seam that can be seen was welded (for a preview: planned) and nothing failed."""
+        vis = [
+            w
+            for w, e in zip(self.seams, self.detection.estimates, strict=True)
+            if e.status is not SeamStatus.NOT_VISIBLE
+        ]
+        executed = self.execution is not None
+        done = all(w.welded if executed else w.planned for w in vis)
+        return self.error is None and self.detection.complete and done

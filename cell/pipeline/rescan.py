@@ -1,0 +1,243 @@
+"""The close-up re-scan loop, once for ``cell weld`` and ``cell rescan``: plan a view, move, capture, locate, fuse,
+escalate.
+
+The values it needs (views, close-up scenes, fusion) come from :mod:`cell.rescan` and
+:mod:`cell.motion.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
+for it. Frames: R (robot base) for every estimate and pose; metres, radians, seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from cell.errors import CellError, ScenarioError
+from cell.geometry import FloatArray, readonly
+from cell.pipeline.detect import evaluate
+from cell.pipeline.records import Detection, Scene
+from cell.rescan import (
+    Rescan,
+    RescanOptions,
+    SeamRescan,
+    closeup_scenario,
+    closeup_scene,
+    estimate_sigma,
+    eye_in_hand_camera,
+    fuse,
+    occluders,
+    seams_to_rescan,
+    view_target,
+)
+from cell.seams.base import SeamLocator
+from cell.station import Arm, Station
+from cell.types import SeamEstimate, SeamStatus
+
+if TYPE_CHECKING:
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.timing import Trajectory
+    from cell.sim.robot import Execution
+
+Progress = Callable[[str], None]
+RescanMode = Literal["low", "all"]
+
+
+def _quiet(_: str) -> None:
+    return None
+
+
+@dataclass
+class _Run:
+    """What every seam of one re-scan shares: the station, its arm, the checker, the locator, where the arm is."""
+
+    station: Station
+    arm: Arm
+    detection: Detection
+    options: RescanOptions
+    camera: str
+    checker: CollisionChecker
+    locator: SeamLocator
+    q: FloatArray
+    moves: list[Trajectory] = field(default_factory=list)
+    executions: list[Execution] = field(default_factory=list)
+
+    def play(self, move: Trajectory) -> None:
+        """Drive the arm along ``move`` with the arc off, and record it."""
+        arc = np.zeros(len(move.times), bool)
+        self.executions.append(self.station.execute(move.times, move.q, arc, record_dt=0.02, bead=False))
+        self.moves.append(move)
+        self.q = np.asarray(move.q[-1], dtype=float)
+
+
+def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan:
+    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan`)."""
+    from cell.motion.viewpoint import plan_view
+
+    t0 = time.perf_counter()
+    o, det = run.options, run.detection
+    base = _scene_of(det).seam_scene
+    first = next(e for e in det.estimates if e.id == seam_id)
+    seam = base.weldmap.seam(seam_id)
+    try:
+        vp = plan_view(
+            run.arm.model,
+            run.checker,
+            view_target(base, seam, first),
+            run.q,
+            run.station.intrinsics(run.camera),
+            occluders(base, seam_id),
+            base.table_z,
+            rng=rng,
+            q_via=run.arm.q_scan,
+            options=o.view,
+        )
+    except CellError as exc:
+        reason = f"unreachable view: {exc.message}"
+        return SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)
+    run.play(vp.move)
+    image = run.station.capture_eye_in_hand(run.camera)
+    scene = closeup_scene(image, det.scenario.X_WR, seam, base, o, det.scenario.perception.voxel_m)
+    n = len(scene.dense)
+    if n < o.min_points:
+        reason = f"nothing seen: {n} points near the seam in the close-up (needs {o.min_points})"
+        return SeamRescan(seam_id, first, None, first, 0.0, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
+    t = time.perf_counter()
+    est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
+    est = replace(est, time_s=time.perf_counter() - t)
+    s1 = estimate_sigma(first, o.first_scale_m, o.first_floor_m)
+    s2 = estimate_sigma(est, o.closeup_scale_m, o.closeup_floor_m)
+    fused, w = fuse(first, est, s1, s2, o.first_scale_m)
+    reason = "" if w > 0.0 else f"close-up not used: {est.reason or est.status.value}"
+    return SeamRescan(seam_id, first, est, fused, w, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
+
+
+def _scene_of(det: Detection) -> Scene:
+    if det.scene is None:
+        raise ValueError("a re-scan needs a detection that kept its scene (pipeline.detect does)")
+    return det.scene
+
+
+def rescan_seams(
+    station: Station,
+    detection: Detection,
+    seam_ids: Sequence[str],
+    *,
+    options: RescanOptions | None = None,
+    progress: Progress = _quiet,
+) -> Rescan:
+    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`).
+
+    station : the running cell the detection came from. Its arm moves from where it is to each view (arc off)
+    and, with ``options.return_to_scan``, back to the scan configuration when that move is free; the result says
+    where it was left. A seam whose view is unreachable, or whose close-up sees nothing or finds no seam, keeps
+    its first estimate and says why. Raises ScenarioError without an arm or an eye-in-hand camera, KeyError for
+    a seam id the detection does not have, ValueError for a detection without its scene.
+    """
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.plan import cell_obstacles
+    from cell.motion.timing import ptp
+    from cell.seams.registry import make_locator
+
+    o = options or RescanOptions()
+    sc = detection.scenario
+    arm = station.arm
+    if arm is None:
+        raise ScenarioError(f"scenario {sc.name!r} has no robot to carry the camera: set robot.urdf")
+    camera = eye_in_hand_camera(sc, o.camera)
+    base = _scene_of(detection).seam_scene
+    known = {e.id for e in detection.estimates}
+    unknown = [s for s in seam_ids if s not in known]
+    if unknown:
+        raise KeyError(f"no seam {', '.join(unknown)} in the detection; seams: {', '.join(sorted(known))}")
+    t_all = time.perf_counter()
+    obstacles = cell_obstacles(base.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
+    checker = CollisionChecker(arm.model, obstacles)
+    locator = make_locator(detection.method, closeup_scenario(sc, detection.method, o))
+    run = _Run(station, arm, detection, o, camera, checker, locator, station.joint_state())
+    rng = sc.rng("rescan/view")
+    results = []
+    for k, sid in enumerate(seam_ids):
+        progress(f"re-scan {k + 1}/{len(seam_ids)}: {sid}")
+        results.append(_rescan_one(run, sid, rng))
+    returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
+    if o.return_to_scan and not returned:
+        back = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
+        hit = checker.check_path(back.q, back.times)
+        if hit is None:
+            run.play(back)
+            returned = True
+        else:
+            note = f"left at the last view: the move back to the scan pose collides ({hit.describe()})"
+    elif not returned:
+        note = "left at the last view (return_to_scan is off)"
+    fused_by_id = {r.id: r.fused for r in results}
+    estimates = tuple(fused_by_id.get(e.id, e) for e in detection.estimates)
+    timings = {"rescan_s": time.perf_counter() - t_all}
+    return Rescan(
+        tuple(results), estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings
+    )
+
+
+def rescanned(detection: Detection, rescan: Rescan) -> Detection:
+    """The detection with the fused estimates in place and its metrics measured again against the truths."""
+    metrics, summary = evaluate(rescan.estimates, detection.truths)
+    timings = {**detection.timings, **rescan.timings}
+    return replace(detection, estimates=rescan.estimates, metrics=metrics, summary=summary, timings=timings)
+
+
+def rescan_detection(
+    station: Station,
+    det: Detection,
+    mode: RescanMode,
+    *,
+    seam_ids: Sequence[str] | None = None,
+    progress: Progress = _quiet,
+) -> tuple[Rescan, Detection]:
+    """Re-scan the seams worth a closer look with the eye-in-hand camera and return the detection with the fused
+    estimates: the one re-scan path of ``cell weld`` and ``cell rescan``.
+
+    mode : ``low``: the seams below ``rescan.confidence_threshold`` or not found; ``all``: every visible seam.
+    seam_ids : these seams instead of the mode's choice (``cell rescan --seams``).
+    Escalation (unless ``all``): a close-up that moves its seam by more than ``rescan.escalate_mm`` shows the fixed
+    cameras cannot be trusted here (calibration off, a bumped camera): every other visible seam is re-scanned too.
+    """
+    sc = det.scenario
+    if seam_ids is not None:
+        ids = list(seam_ids)
+    else:
+        ids = seams_to_rescan(det.estimates, math.inf if mode == "all" else sc.rescan.confidence_threshold)
+    progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
+    rs = rescan_seams(station, det, ids, progress=progress)
+    after = rescanned(det, rs)
+    shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
+    rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids]
+    if mode == "low" and shift_mm > sc.rescan.escalate_mm and rest:
+        progress(
+            f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
+            f" {len(rest)} seams too"
+        )
+        more = rescan_seams(station, after, rest, progress=progress)
+        after = rescanned(after, more)
+        rs = replace(
+            more,
+            seams=rs.seams + more.seams,
+            moves=rs.moves + more.moves,
+            executions=rs.executions + more.executions,
+            note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
+            timings={k: rs.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*rs.timings, *more.timings}},
+            escalated_mm=shift_mm,
+        )
+    return rs, after
+
+
+def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
+    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing)."""
+    if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
+        return 0.0
+    a = np.stack([before.p_start, before.p_end])
+    b = np.stack([closeup.p_start, closeup.p_end])
+    return float(min(np.linalg.norm(a - b, axis=1).max(), np.linalg.norm(a - b[::-1], axis=1).max()))

@@ -1,0 +1,197 @@
+"""Welding: plan the found seams, run the safety gate, drive the arm, and say what became of every seam."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Collection
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from cell.errors import CellError, PlanError, ScenarioError
+from cell.geometry import FloatArray, invert, transform_points
+from cell.pipeline.detect import detect, read_weldmap
+from cell.pipeline.records import Detection, SeamWeld, WeldRun
+from cell.pipeline.rescan import rescan_detection
+from cell.scenario import Scenario
+from cell.station import Station, open_station
+from cell.types import SeamStatus
+
+if TYPE_CHECKING:
+    from cell.motion.plan import WeldPlan
+    from cell.motion.timing import Trajectory
+    from cell.sim.robot import Execution
+
+Progress = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    return None
+
+
+def plan_for(
+    station: Station,
+    det: Detection,
+    *,
+    skip: Collection[str] = (),
+    q_start: FloatArray | None = None,
+    progress: Progress = _quiet,
+) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
+    """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (REFERENCE section 7).
+
+    q_start : where the arm is now (default: its scan configuration). Returns the plan, the move from q_start to
+    home that precedes it, and the gate's violations (empty when the plan may run). PlanError when nothing can be
+    planned at all.
+    """
+    from cell.motion.checks import find_violations
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.plan import cell_obstacles, plan_welds, seam_tasks
+    from cell.motion.timing import ptp
+    from cell.motion.torch import WeldProcess
+
+    sc = det.scenario
+    arm = station.arm
+    if arm is None:
+        raise ScenarioError(f"scenario {sc.name!r} has no robot to weld with: set robot.urdf and robot.X_WR")
+    if det.scene is None:
+        raise PlanError(f"nothing to plan: the detection of {sc.name!r} kept no scene ({det.error})")
+    ss = det.scene.seam_scene
+    tasks = seam_tasks([e for e in det.estimates if e.id not in skip], ss.weldmap, ss.joints, ss.table_z)
+    obstacles = cell_obstacles(ss.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
+    checker = CollisionChecker(arm.model, obstacles)
+    progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
+    process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
+    plan = plan_welds(arm.model, tasks, arm.q_home, process, obstacles, rng=sc.rng("plan"), checker=checker)
+    pre = ptp(arm.q_scan if q_start is None else q_start, arm.q_home, arm.model.limits, dt=0.001)
+    problems = []
+    hit = checker.check_path(pre.q, pre.times)
+    if hit is not None:
+        problems.append(f"move from the arm's position to home collides: {hit.describe()}")
+    progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
+    problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker)]
+    return plan, pre, tuple(problems)
+
+
+def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = _quiet) -> Execution:
+    """Drive the simulated arm: the move from the scan pose to home, then the welding program; arc where planned."""
+    traj, arc = plan.joint_trajectory()
+    times = np.concatenate([pre.times, traj.times[1:] + pre.duration])
+    q = np.concatenate([pre.q, traj.q[1:]])
+    arc_on = np.concatenate([np.zeros(len(pre.times), bool), arc[1:]])
+    marks = [(0.0, "move scan -> home")] + [
+        (pre.duration + seg.t0, f"{seg.kind} {seg.seam_id}".strip()) for seg in plan.segments
+    ]
+    progress(f"executing {plan.cycle_time + pre.duration:.1f} s of robot motion in the simulator")
+    return station.execute(times, q, arc_on, marks=marks, record_dt=0.01)
+
+
+def _seam_welds(
+    det: Detection, plan: WeldPlan | None, ex: Execution | None, pre_s: float, refused: str, sc: Scenario
+) -> tuple[SeamWeld, ...]:
+    """Per seam: welded (with its quality against the true seam) or the reason it was not."""
+    from cell.motion.quality import weld_quality
+
+    X_RW = invert(det.scenario.X_WR)
+    out = []
+    for est in det.estimates:
+        if est.status is SeamStatus.NOT_VISIBLE:
+            out.append(SeamWeld(est.id, False, False, est.reason))  # e.g. against the table: needs a flip
+            continue
+        if est.status is not SeamStatus.FOUND:
+            out.append(SeamWeld(est.id, False, False, f"not located ({est.status.value}): {est.reason}"))
+            continue
+        doubtful = est.confidence < sc.rescan.weld_min_confidence
+        if doubtful and ex is not None:
+            why = f"low_confidence: {est.confidence:.2f} < {sc.rescan.weld_min_confidence:.2f} after the re-scan"
+            out.append(SeamWeld(est.id, False, False, why))
+            continue
+        outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
+        if outcome is None or not outcome.feasible:
+            reason = outcome.reason if outcome is not None else refused or "not planned"
+            out.append(SeamWeld(est.id, False, False, reason))
+            continue
+        if ex is None or plan is None:
+            note = f"; confidence {est.confidence:.2f}: would be re-scanned before welding" if doubtful else ""
+            out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note))
+            continue
+        seg = next(g for g in plan.segments if g.arc_on and g.seam_id == est.id)
+        t0, t1 = pre_s + seg.t0, pre_s + seg.t1
+        k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
+        tcp_R = transform_points(X_RW, ex.tcp_W[k])
+        truth = det.truths.get(est.id)  # none on a station that knows no truth: welded, quality unmeasured
+        quality = weld_quality(ex.times[k], tcp_R, *truth) if truth is not None else None
+        out.append(SeamWeld(est.id, True, True, "", quality))
+    return tuple(out)
+
+
+def weld(
+    scenario: Scenario,
+    method: str | None = None,
+    *,
+    noise: Literal["none", "realistic"] | None = None,
+    rescan: Literal["none", "low", "all"] | None = None,
+    execute_plan: bool = True,
+    progress: Progress = _quiet,
+    gui: bool = False,
+) -> WeldRun:
+    """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a
+    preview) weld. ``rescan`` overrides the scenario's ``rescan.mode``.
+
+    A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
+    every seam's reason, so the report can still be written. A seam whose confidence stays below
+    ``rescan.weld_min_confidence`` after the re-scan is not welded (``low_confidence``).
+    """
+    t_all = time.perf_counter()
+    sc = scenario.with_noise(noise) if noise else scenario
+    weldmap = read_weldmap(sc)
+    with open_station(sc, weldmap, gui=gui) as station:
+        det = detect(sc, method, progress=progress, station=station, weldmap=weldmap)
+        first, rs = det, None
+        timings = dict(det.timings)
+        plan = pre = ex = None
+        violations: tuple[str, ...] = ()
+        error: CellError | None = None
+        try:
+            if det.error is not None:
+                raise det.error
+            mode = rescan or sc.rescan.mode
+            if mode != "none" and station.arm is not None and execute_plan:
+                rs, det = rescan_detection(station, det, mode, progress=progress)
+                timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
+            # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so.
+            low = {
+                e.id
+                for e in det.estimates
+                if e.status is SeamStatus.FOUND and e.confidence < sc.rescan.weld_min_confidence and execute_plan
+            }
+            t = time.perf_counter()
+            q_start = rs.q_end if rs is not None else None
+            plan, pre, violations = plan_for(station, det, skip=low, q_start=q_start, progress=progress)
+            timings["plan_s"] = time.perf_counter() - t
+            if violations:
+                raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
+            if execute_plan:
+                t = time.perf_counter()
+                ex = execute(station, plan, pre, progress=progress)
+                timings["execute_s"] = time.perf_counter() - t
+        except CellError as e:
+            error = e
+        refused = f"not executed: {error.message}" if error is not None else ""
+        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused, sc)
+        paths = torch_paths(station, plan) if plan is not None else {}
+        timings["total_s"] = time.perf_counter() - t_all
+        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs)
+
+
+def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:
+    """Planned torch poses X_RT (n, 4, 4) along each weld, every ``step_s`` of arc time (for pictures and reports)."""
+    if station.arm is None:
+        return {}
+    model = station.arm.model
+    out = {}
+    for seg in plan.segments:
+        if seg.arc_on:
+            tr = seg.trajectory
+            k = np.unique(np.r_[np.searchsorted(tr.times, np.arange(0.0, tr.duration, step_s)), len(tr.times) - 1])
+            out[seg.seam_id] = np.stack([model.fk(tr.q[i]) for i in k])
+    return out

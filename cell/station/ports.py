@@ -1,0 +1,93 @@
+"""The station's ports: what the pipeline may ask of a running cell, whatever drives it.
+
+A station is the boundary between the stages (values in, values out) and the world: the simulator today
+(:class:`cell.station.sim.SimStation`), a recorded capture or the real cell later. Only the pipeline talks to a
+station; no stage receives one. The ports are those a real cell offers (cf. Drake's ``MakeHardwareStation``: the
+same ports for simulation and hardware):
+
+- :meth:`Station.capture`: one image from every camera, the arm holding the eye-in-hand camera at its scan pose;
+- :meth:`Station.capture_eye_in_hand`: one image from a camera on the arm, wherever the arm is now;
+- :meth:`Station.execute`: drive the arm along a timed joint trajectory (arc on where asked) and record it;
+- :meth:`Station.joint_state`: where the arm is;
+- :meth:`Station.truth`: the as-built parts, when the station knows them (a simulation does; a real cell does not).
+
+Frames: W world, R robot base; metres, radians, seconds.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+from cell.types import CameraIntrinsics, DepthImage, Part
+
+if TYPE_CHECKING:
+    from cell.motion.robot import RobotModel
+    from cell.sim.robot import Execution
+
+
+@dataclass(frozen=True)
+class Arm:
+    """The robot of the station: its model, home and scan configurations (dof,) [rad]."""
+
+    model: RobotModel
+    q_home: FloatArray
+    q_scan: FloatArray
+
+
+class Station(Protocol):
+    """The ports of a running cell (module docstring). Use as a context manager; :meth:`close` releases it."""
+
+    @property
+    def arm(self) -> Arm | None:
+        """The robot, or None for a cell without one (cameras only)."""
+        ...
+
+    def capture(self) -> Mapping[str, DepthImage]:
+        """One depth image from every camera, by name; the arm (if any) first goes to its scan configuration."""
+        ...
+
+    def capture_eye_in_hand(self, camera: str) -> DepthImage:
+        """One depth image from the arm's camera ``camera`` where the arm is now (its pose from the kinematics)."""
+        ...
+
+    def intrinsics(self, camera: str) -> CameraIntrinsics:
+        """The pinhole intrinsics of ``camera``."""
+        ...
+
+    def execute(
+        self,
+        times: npt.ArrayLike,
+        q: npt.ArrayLike,
+        arc_on: npt.ArrayLike,
+        *,
+        marks: Sequence[tuple[float, str]] = (),
+        record_dt: float = 0.01,
+        bead: bool = True,
+    ) -> Execution:
+        """Drive the arm along times (n,) [s], q (n, dof) [rad], arc on (n,) bool; record the tool.
+
+        marks (time [s], text) are logged as events; ``bead`` lays the weld where the arc is on (a move with the
+        arc off lays none either way). The arm stays at the last configuration.
+        """
+        ...
+
+    def joint_state(self) -> FloatArray:
+        """(dof,) [rad]: where the arm is now."""
+        ...
+
+    def truth(self) -> tuple[Part, ...] | None:
+        """The parts as built, in W, when the station knows them (for measuring, never for perception)."""
+        ...
+
+    def close(self) -> None:
+        """Release the station (idempotent)."""
+        ...
+
+    def __enter__(self) -> Station: ...
+
+    def __exit__(self, *exc: object) -> None: ...

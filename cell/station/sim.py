@@ -1,0 +1,95 @@
+"""The simulated station: the station's ports (:mod:`cell.station.ports`) served by PyBullet.
+
+The only station module that touches the simulator. It builds the as-built part from the welding map the pipeline
+read and the scenario's deviations (ground truth: :meth:`SimStation.truth`), the cameras with their noise and
+faults, and the arm at its scan configuration.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+from cell.scenario import Scenario
+from cell.station.arm import load_arm, robot_urdf
+from cell.station.ports import Arm
+from cell.types import CameraIntrinsics, DepthImage, Part, WeldMap
+
+if TYPE_CHECKING:
+    from cell.sim.cell import SimCell
+    from cell.sim.robot import Execution
+
+
+class SimStation:
+    """A running simulated cell built from a scenario and its welding map (as drawn, frame M).
+
+    The as-built parts are the map's parts with the scenario's deviations (:func:`cell.asbuilt.as_built_parts`).
+    Use as a context manager; the simulator's client is released on exit.
+    """
+
+    def __init__(self, scenario: Scenario, weldmap: WeldMap, *, gui: bool = False, with_robot: bool = True) -> None:
+        from cell.asbuilt import as_built_parts
+        from cell.sim import SimCell
+
+        self.scenario = scenario
+        self.parts_W: tuple[Part, ...] = as_built_parts(weldmap, scenario)
+        self.sim: SimCell = SimCell(scenario, self.parts_W, gui=gui)
+        self._arm: Arm | None = None
+        try:
+            if with_robot and scenario.robot.urdf is not None:
+                self._arm = load_arm(scenario)
+                self.sim.load_robot(
+                    robot_urdf(scenario), scenario.X_WR, self._arm.q_scan, joint_names=self._arm.model.joint_names
+                )
+        except BaseException:
+            self.sim.close()
+            raise
+
+    @property
+    def arm(self) -> Arm | None:
+        return self._arm
+
+    def capture(self) -> dict[str, DepthImage]:
+        """One image from every camera; the arm (if any) holds the eye-in-hand camera at its scan pose."""
+        if self._arm is not None:
+            self.sim.set_q(self._arm.q_scan)
+        return self.sim.capture_all()
+
+    def capture_eye_in_hand(self, camera: str) -> DepthImage:
+        return self.sim.capture_from_link(camera)
+
+    def intrinsics(self, camera: str) -> CameraIntrinsics:
+        return self.sim.intrinsics(camera)
+
+    def execute(
+        self,
+        times: npt.ArrayLike,
+        q: npt.ArrayLike,
+        arc_on: npt.ArrayLike,
+        *,
+        marks: Sequence[tuple[float, str]] = (),
+        record_dt: float = 0.01,
+        bead: bool = True,
+    ) -> Execution:
+        if not bead:
+            return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=None)
+        return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt)
+
+    def joint_state(self) -> FloatArray:
+        return np.asarray(self.sim.robot.q, dtype=float)
+
+    def truth(self) -> tuple[Part, ...]:
+        return self.parts_W
+
+    def close(self) -> None:
+        self.sim.close()
+
+    def __enter__(self) -> SimStation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

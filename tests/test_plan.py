@@ -14,8 +14,17 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TABLE, TOP_SEAM, URDF
 from cell import scenario as sc
 from cell.errors import PlanError
 from cell.geometry import make_pose, point_line_distance
-from cell.motion.checks import GateOptions, check_plan, find_violations
 from cell.motion.collision import CollisionChecker
+from cell.motion.gate import (
+    DEFAULT_CHECKS,
+    Check,
+    GateInput,
+    GateOptions,
+    GateRefusedError,
+    ViolationKind,
+    check_plan,
+    find_violations,
+)
 from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
@@ -124,6 +133,19 @@ def test_clean_plan_passes_the_gate(robot: RobotModel, plan: WeldPlan, checker: 
     check_plan(robot, plan, HOME, checker=checker)
 
 
+@pytest.mark.parametrize("check", DEFAULT_CHECKS, ids=lambda c: type(c).__name__)
+def test_every_gate_check_passes_the_clean_plan(
+    robot: RobotModel, plan: WeldPlan, checker: CollisionChecker, check: Check
+) -> None:
+    assert check.violations(GateInput(robot, plan, HOME, checker, GateOptions())) == []
+
+
+def test_the_gate_runs_only_the_checks_it_is_given(robot: RobotModel, plan: WeldPlan) -> None:
+    q_now = HOME + np.array([0.0, 0.01, 0.0, 0.0, 0.0, 0.0])
+    others = tuple(c for c in DEFAULT_CHECKS if type(c).__name__ != "StartState")
+    assert find_violations(robot, plan, q_now, checks=others) == []
+
+
 def _with_segment(plan: WeldPlan, k: int, tr: Trajectory) -> WeldPlan:
     """The plan with segment k's trajectory replaced and the start times after it shifted to match."""
     segs, t = [], 0.0
@@ -141,10 +163,11 @@ def _first_move(plan: WeldPlan) -> int:
 def test_gate_refuses_a_start_state_off_the_current_state(robot: RobotModel, plan: WeldPlan) -> None:
     q_now = HOME + np.array([0.0, 0.01, 0.0, 0.0, 0.0, 0.0])
     found = find_violations(robot, plan, q_now)
-    assert [(v.kind, v.joint) for v in found] == [("start_state", "joint_a2")]
+    assert [(v.kind, v.joint) for v in found] == [(ViolationKind.START_STATE, "joint_a2")]
     assert found[0].excess == pytest.approx(0.01)
-    with pytest.raises(PlanError, match=re.escape("start_state joint_a2 at t = 0.000 s")):
+    with pytest.raises(PlanError, match=re.escape("start_state joint_a2 at t = 0.000 s")) as refused:
         check_plan(robot, plan, q_now)
+    assert isinstance(refused.value, GateRefusedError) and list(refused.value.violations) == found
 
 
 def test_gate_refuses_a_move_over_the_velocity_limit(robot: RobotModel, plan: WeldPlan) -> None:
@@ -152,7 +175,7 @@ def test_gate_refuses_a_move_over_the_velocity_limit(robot: RobotModel, plan: We
     tr = plan.segments[k].trajectory
     fast = _with_segment(plan, k, Trajectory(tr.times / 1.5, tr.q, tr.qd * 1.5, tr.qdd * 2.25))
     found = find_violations(robot, fast, HOME)
-    vel = [v for v in found if v.kind == "velocity"]
+    vel = [v for v in found if v.kind is ViolationKind.VELOCITY]
     assert vel and all(fast.segments[k].t0 <= v.t <= fast.segments[k].t1 for v in vel)
     worst = max(vel, key=lambda v: v.excess / robot.limits.v_max[robot.joint_names.index(v.joint)])
     j = robot.joint_names.index(worst.joint)
@@ -167,9 +190,9 @@ def test_gate_refuses_a_collision(robot: RobotModel, plan: WeldPlan) -> None:
     q_mid = seg.trajectory.q[len(seg.trajectory.q) // 2]
     box = Part("INTRUDER", Box(make_pose(p=robot.fk(q_mid, "tool0")[:3, 3]), np.array([0.1, 0.1, 0.1])))
     found = find_violations(robot, plan, HOME, checker=CollisionChecker(robot, (*OBSTACLES, box)))
-    hits = [v for v in found if v.kind == "collision"]
+    hits = [v for v in found if v.kind is ViolationKind.COLLISION]
     assert hits and "INTRUDER" in hits[0].what and seg.t0 <= hits[0].t <= seg.t1
-    assert all(v.kind == "collision" for v in found)
+    assert all(v.kind is ViolationKind.COLLISION for v in found)
 
 
 def test_gate_refuses_a_joint_jump(robot: RobotModel, plan: WeldPlan) -> None:
@@ -179,7 +202,7 @@ def test_gate_refuses_a_joint_jump(robot: RobotModel, plan: WeldPlan) -> None:
     q[len(q) // 2, 3] += 0.2  # A4 jumps 11.5 deg within one 1 ms sample
     jumped = _with_segment(plan, k, Trajectory(tr.times, q, tr.qd, tr.qdd))
     found = find_violations(robot, jumped, HOME, options=GateOptions())
-    jumps = [v for v in found if v.kind == "jump"]
+    jumps = [v for v in found if v.kind is ViolationKind.JUMP]
     assert [v.joint for v in jumps] == ["joint_a4"] and jumps[0].what.startswith("moves 11.")
     assert jumps[0].t == pytest.approx(jumped.segments[k].t0 + tr.times[len(q) // 2])
 
@@ -187,13 +210,13 @@ def test_gate_refuses_a_joint_jump(robot: RobotModel, plan: WeldPlan) -> None:
 def test_gate_refuses_arc_on_while_moving(robot: RobotModel, plan: WeldPlan) -> None:
     k = _first_move(plan)
     bad = replace(plan, segments=tuple(replace(s, arc_on=True) if i == k else s for i, s in enumerate(plan.segments)))
-    found = [v for v in find_violations(robot, bad, HOME) if v.kind == "arc"]
+    found = [v for v in find_violations(robot, bad, HOME) if v.kind is ViolationKind.ARC]
     assert [v.what for v in found] == ["arc on during a move segment"]
     # a weld that does not start at rest: arc on while moving
     w = next(i for i, s in enumerate(plan.segments) if s.kind == "weld")
     tr = plan.segments[w].trajectory
     moving = _with_segment(plan, w, Trajectory(tr.times[5:] - tr.times[5], tr.q[5:], tr.qd[5:], tr.qdd[5:]))
-    whats = [v.what for v in find_violations(robot, moving, HOME) if v.kind == "arc"]
+    whats = [v.what for v in find_violations(robot, moving, HOME) if v.kind is ViolationKind.ARC]
     assert any(w.startswith("arc on while moving") for w in whats)
 
 

@@ -1,0 +1,139 @@
+"""The gate's vocabulary: what a violation is (:class:`Violation`, :class:`ViolationKind`), its options, what a
+check sees (:class:`GateInput`) and the two shapes of a check (:class:`Check`, :class:`SegmentCheck`).
+
+Units: SI (rad, rad/s, rad/s^2, rad/s^3, m, s) in the fields; degrees and mm in the messages.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from functools import cached_property
+from typing import Protocol
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.motion.collision import CollisionChecker
+from cell.motion.program import Segment, WeldPlan
+from cell.motion.robot import RobotModel
+from cell.motion.timing import Trajectory
+
+DEG = 180.0 / math.pi  # [deg/rad] for messages
+
+
+class ViolationKind(StrEnum):
+    """What a violation is about (the first word of its text)."""
+
+    START_STATE = "start_state"
+    POSITION = "position"
+    VELOCITY = "velocity"
+    ACCELERATION = "acceleration"
+    JERK = "jerk"
+    JUMP = "jump"
+    SINGULARITY = "singularity"
+    ARC = "arc"
+    COLLISION = "collision"
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One problem: kind (start_state | position | velocity | acceleration | jerk | jump | singularity | arc |
+    collision), a one-line description, where (time t [s], joint name or ""), and by how much (``excess`` in
+    the kind's SI unit: rad, rad/s, rad/s^2, rad/s^3, m^3 for manipulability, m for collision depth)."""
+
+    kind: ViolationKind
+    what: str
+    t: float
+    joint: str = ""
+    excess: float = 0.0
+
+    def __str__(self) -> str:
+        j = f" {self.joint}" if self.joint else ""
+        return f"{self.kind}{j} at t = {self.t:.3f} s: {self.what}"
+
+
+@dataclass(frozen=True)
+class GateOptions:
+    """rate_hz: re-sampling rate; rel_tol: relative slack on the velocity/acceleration/jerk limits; start_tol
+    [rad]; rest_tol [rad/s] (and [rad/s^2] for the acceleration) for an exact stop; min_manipulability [m^3];
+    lin_step [m]: TCP travel between singularity checks on LIN segments."""
+
+    rate_hz: float = 1000.0
+    rel_tol: float = 0.01
+    start_tol: float = 1e-4
+    rest_tol: float = 1e-6
+    min_manipulability: float = 0.01
+    lin_step: float = 0.002
+
+
+def resample_times(times: FloatArray, rate_hz: float) -> FloatArray:
+    """Times at least ``rate_hz`` apart-or-closer, keeping every stored sample (each interval of the stored
+    trajectory is cut into equal parts no longer than 1 / rate_hz)."""
+    h = np.diff(times)
+    n_sub = np.maximum(np.ceil(h * rate_hz - 1e-6).astype(int), 1)
+    start = np.repeat(times[:-1], n_sub)
+    first = np.repeat(np.cumsum(n_sub) - n_sub, n_sub)  # index of each interval's first new time
+    frac = (np.arange(int(n_sub.sum())) - first) / np.repeat(n_sub, n_sub)
+    return np.append(start + np.repeat(h, n_sub) * frac, times[-1])
+
+
+@dataclass(frozen=True)
+class Resampled:
+    """The whole plan re-sampled at the gate's rate: times t (m,) [s], q, qd, qdd (m, dof) and the jerk qddd
+    (m - 1, dof), the finite difference of qdd, at t[1:]."""
+
+    t: FloatArray
+    q: FloatArray
+    qd: FloatArray
+    qdd: FloatArray
+    qddd: FloatArray
+
+
+@dataclass(frozen=True)
+class GateInput:
+    """What every check sees: the arm, the plan (with at least one segment), the arm's current state q_current
+    (dof,) [rad], the collision checker (None: collisions are not checked) and the options. The joined trajectory
+    and its re-sampling are computed once, on first use."""
+
+    robot: RobotModel
+    plan: WeldPlan
+    q_current: FloatArray
+    checker: CollisionChecker | None
+    options: GateOptions
+
+    @cached_property
+    def trajectory(self) -> Trajectory:
+        """The plan as one trajectory (:meth:`WeldPlan.joint_trajectory`)."""
+        return self.plan.joint_trajectory()[0]
+
+    @cached_property
+    def resampled(self) -> Resampled:
+        t = resample_times(self.trajectory.times, self.options.rate_hz)
+        q, qd, qdd = self.trajectory.sample(t)
+        qddd = np.diff(qdd, axis=0) / np.diff(t)[:, None]
+        return Resampled(t, q, qd, qdd, qddd)
+
+
+class Check(Protocol):
+    """One gate check: every violation of its kind in the plan, in a fixed order."""
+
+    def violations(self, gate: GateInput) -> list[Violation]: ...
+
+
+class SegmentCheck(Protocol):
+    """A check that looks at one segment at a time (run by :class:`PerSegment`)."""
+
+    def segment_violations(self, gate: GateInput, seg: Segment) -> list[Violation]: ...
+
+
+@dataclass(frozen=True)
+class PerSegment:
+    """A :class:`Check` that runs its segment checks on every segment in turn (segment by segment, the checks in
+    their order within each)."""
+
+    checks: tuple[SegmentCheck, ...]
+
+    def violations(self, gate: GateInput) -> list[Violation]:
+        return [v for seg in gate.plan.segments for c in self.checks for v in c.segment_violations(gate, seg)]

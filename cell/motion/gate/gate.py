@@ -1,0 +1,80 @@
+"""Running the gate: every check in turn (:func:`find_violations`), and the refusal (:func:`check_plan`)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.errors import PlanError
+from cell.motion.collision import CollisionChecker
+from cell.motion.gate.arc import ArcSwitching
+from cell.motion.gate.base import Check, GateInput, GateOptions, PerSegment, Violation
+from cell.motion.gate.collisions import Collisions
+from cell.motion.gate.continuity import SampleJumps, SegmentJoins
+from cell.motion.gate.position import PositionLimits
+from cell.motion.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
+from cell.motion.gate.singularity import Singularity
+from cell.motion.gate.start import StartState
+from cell.motion.program import WeldPlan
+from cell.motion.robot import RobotModel
+
+# The gate's checks, in the order their violations are listed.
+DEFAULT_CHECKS: tuple[Check, ...] = (
+    StartState(),
+    SegmentJoins(),
+    SampleJumps(),
+    PositionLimits(),
+    VelocityLimit(),
+    AccelerationLimit(),
+    JerkLimit(),
+    PerSegment((Singularity(), ArcSwitching())),
+    Collisions(),
+)
+
+
+class GateRefusedError(PlanError):
+    """The safety gate refused a plan; ``violations`` lists every problem found, in the gate's order."""
+
+    def __init__(self, message: str, *, violations: Sequence[Violation]) -> None:
+        super().__init__(message)
+        self.violations = tuple(violations)
+
+
+def find_violations(
+    robot: RobotModel,
+    plan: WeldPlan,
+    q_current: npt.ArrayLike,
+    *,
+    checker: CollisionChecker | None = None,
+    options: GateOptions | None = None,
+    checks: Sequence[Check] = DEFAULT_CHECKS,
+) -> list[Violation]:
+    """Every violation of the gate's checks (see :mod:`cell.motion.gate`); an empty list means go.
+
+    q_current : (dof,) [rad] where the arm is now. checker : collisions are checked only when one is given.
+    """
+    if not plan.segments:
+        return []
+    gate = GateInput(robot, plan, np.asarray(q_current, dtype=float), checker, options or GateOptions())
+    return [v for check in checks for v in check.violations(gate)]
+
+
+def check_plan(
+    robot: RobotModel,
+    plan: WeldPlan,
+    q_current: npt.ArrayLike,
+    *,
+    checker: CollisionChecker | None = None,
+    options: GateOptions | None = None,
+) -> None:
+    """Raise GateRefusedError (a PlanError) naming the violations (the first five and a count) unless the plan
+    passes the gate."""
+    found = find_violations(robot, plan, q_current, checker=checker, options=options)
+    if found:
+        shown = "; ".join(str(v) for v in found[:5])
+        more = f" (+{len(found) - 5} more)" if len(found) > 5 else ""
+        raise GateRefusedError(
+            f"plan refused by the safety gate, {len(found)} violation(s): {shown}{more}", violations=found
+        )

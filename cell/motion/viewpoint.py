@@ -33,89 +33,22 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.errors import IKError, PlanError, TimingError
-from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, readonly, transform_points
+from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.ik import solve_ik
-from cell.motion.program import SeamTask
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
+from cell.motion.view_candidates import (
+    ViewCandidate,
+    ViewOptions,
+    ViewTarget,
+    segments_hit_box,
+    torch_axis_in_camera,
+    view_candidates,
+)
 from cell.types import CameraIntrinsics, Part
 
-
-@dataclass(frozen=True)
-class ViewOptions:
-    """Candidate grid and acceptance thresholds of a close-up view (lengths [m], angles [deg])."""
-
-    distances_m: tuple[float, ...] = (0.36, 0.40, 0.44, 0.33)  # D415 minimum range ~0.3 m; TCP 0.3 m ahead
-    preferred_distance_m: float = 0.36
-    tilts_deg: tuple[float, ...] = (0.0, 15.0, -15.0, 30.0, -30.0)  # about the seam, towards face A (+) or B
-    slants_deg: tuple[float, ...] = (0.0, 20.0, -20.0, 40.0, -40.0)  # along the seam
-    # The seam's angle in the image (a turn about the line of sight to its midpoint, which stays put): the
-    # wrist reaches some of these and not others.
-    rolls_deg: tuple[float, ...] = (0.0, 180.0, 20.0, -20.0, 160.0, -160.0, 40.0, -40.0, 140.0, -140.0)
-    image_offset_deg: float = 11.0  # the seam's midpoint this far above the image centre (torch below)
-    max_incidence_deg: float = 72.0  # largest angle between a line of sight and a weld face's normal
-    face_strip_m: float = 0.03  # width of each weld face next to the seam that must be in view
-    end_margin_m: float = 0.01  # the seam's line beyond its ends that must be in view
-    image_margin_px: float = 24.0  # kept free along the image border
-    torch_radius_m: float = 0.03  # the torch's radius about its axis, with margin (URDF body: 22 mm)
-    torch_margin_px: float = 12.0
-    occlusion_margin_m: float = 0.001  # parts grown by this for the line-of-sight test
-    distance_weight_deg_per_m: float = 200.0  # score: 10 deg of incidence for 5 cm off the preferred distance
-    camera_frame: str = "camera_optical"
-    tcp_frame: str = "torch_tcp"
-    flange_frame: str = "tool0"
-    dt: float = 0.004  # [s] sample period of the move
-
-    def __post_init__(self) -> None:
-        if not self.distances_m or min(self.distances_m) <= 0.0:
-            raise ValueError(f"view distances_m must be positive, got {self.distances_m}")
-        if not 0.0 < self.max_incidence_deg < 90.0:
-            raise ValueError(f"max_incidence_deg must be in (0, 90), got {self.max_incidence_deg}")
-
-
-@dataclass(frozen=True)
-class ViewTarget(SeamTask):
-    """What a close-up looks at: a seam task (ends and weld-face normals in R) that has a fillet to look into."""
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if self.length < 1e-6:
-            raise ValueError(f"seam {self.id}: a view target needs two distinct end points")
-        if float(np.linalg.norm(self.n_a + self.n_b)) < 1e-6:
-            raise ValueError(f"seam {self.id}: the weld faces are parallel, there is no fillet to look into")
-
-    @property
-    def mid(self) -> FloatArray:
-        return np.asarray(0.5 * (self.p_start + self.p_end))
-
-    @property
-    def direction(self) -> FloatArray:
-        d = self.p_end - self.p_start
-        return np.asarray(d / np.linalg.norm(d))
-
-    @property
-    def bisector(self) -> FloatArray:
-        s = self.n_a + self.n_b
-        return np.asarray(s / np.linalg.norm(s))
-
-    def samples(self, strip: float, end_margin: float, n: int = 5) -> tuple[FloatArray, FloatArray]:
-        """Points that must be seen (m, 3) [m] and the outward normal of the surface each lies on (m, 3).
-
-        The seam line (end margins included, normal the bisector) and, on each face, lines at 1/3, 2/3 and
-        3/3 of ``strip`` from the seam (moving on face A away from B is along B's normal, and conversely).
-        """
-        t = self.direction
-        s = np.linspace(-end_margin, float(np.linalg.norm(self.p_end - self.p_start)) + end_margin, n)
-        line = self.p_start + np.outer(s, t)
-        pts, normals = [line], [np.tile(self.bisector, (n, 1))]
-        for n_on, n_other in ((self.n_a, self.n_b), (self.n_b, self.n_a)):
-            e = n_other - float(n_other @ n_on) * n_on  # in the face, away from the other face
-            e /= np.linalg.norm(e)
-            for k in (1, 2, 3):
-                pts.append(line + (strip * k / 3.0) * e)
-                normals.append(np.tile(n_on, (n, 1)))
-        return np.concatenate(pts), np.concatenate(normals)
+_segments_hit_box = segments_hit_box  # the old private name (tests/test_rescan.py imports it from here)
 
 
 @dataclass(frozen=True)
@@ -144,160 +77,6 @@ class Viewpoint:
     def __post_init__(self) -> None:
         object.__setattr__(self, "X_RC", readonly(self.X_RC))
         object.__setattr__(self, "q", readonly(self.q))
-
-
-@dataclass(frozen=True)
-class _Candidate:
-    X_RC: FloatArray
-    distance: float
-    tilt: float
-    slant: float
-    roll: float
-    incidence: tuple[float, float]
-    score: float
-
-
-def torch_axis_in_camera(model: RobotModel, options: ViewOptions | None = None, n: int = 24) -> FloatArray:
-    """Points (n, 3) [m] on the torch's axis (flange origin to TCP) in the camera's optical frame C.
-
-    Both frames ride on the last link, so the result does not depend on the configuration.
-    """
-    o = options or ViewOptions()
-    q = 0.5 * (model.limits.q_min + model.limits.q_max)
-    X = model.fk_frames(q, (o.camera_frame, o.tcp_frame, o.flange_frame))
-    X_CR = invert(X[o.camera_frame])
-    a = transform_points(X_CR, X[o.flange_frame][:3, 3])
-    b = transform_points(X_CR, X[o.tcp_frame][:3, 3])
-    return np.asarray(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a))
-
-
-def _camera_pose(target: ViewTarget, u: FloatArray, distance: float, roll: float, offset: float) -> FloatArray:
-    """X_RC (4, 4): camera at mid + distance u, the seam's midpoint ``offset`` [rad] above the image centre and
-    the seam at angle ``roll`` [rad] to the image x axis (about the line of sight to the midpoint)."""
-    z0 = -u
-    x = target.direction - float(target.direction @ z0) * z0
-    x /= np.linalg.norm(x)
-    y0 = np.cross(z0, x)
-    # Midpoint direction = cos(offset) z - sin(offset) y: above the centre (image y points down).
-    z = np.cos(offset) * z0 + np.sin(offset) * y0
-    y = np.cos(offset) * y0 - np.sin(offset) * z0
-    R = axis_angle_to_matrix(z0, roll) @ np.column_stack([x, y, z])
-    return make_pose(R, target.mid + distance * u)
-
-
-def _face_labels(m: int) -> npt.NDArray[np.int_]:
-    """Which surface each of the m points of :meth:`ViewTarget.samples` lies on: 0 the seam line, 1 face A, 2 B."""
-    n = m // 7
-    return np.repeat(np.array([0, 1, 2]), [n, 3 * n, 3 * n])
-
-
-def _segments_hit_box(p0: FloatArray, p1: FloatArray, part: Part, margin: float) -> npt.NDArray[np.bool_]:
-    """(m,) whether each segment p0 (3,) -> p1 (m, 3) crosses the part's box grown by ``margin`` (slab test)."""
-    X_BA = invert(part.box.X_AB)
-    a = transform_points(X_BA, p0)
-    b = transform_points(X_BA, p1)
-    half = part.box.size / 2.0 + margin
-    d = b - a
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / d
-        t0 = (-half - a) * inv
-        t1 = (half - a) * inv
-    lo = np.where(np.isnan(t0), -np.inf, np.minimum(t0, t1))
-    hi = np.where(np.isnan(t1), np.inf, np.maximum(t0, t1))
-    # A zero component: inside the slab (always) or outside (never): inv is +-inf, t0/t1 are +-inf or nan.
-    flat = d == 0.0
-    inside = np.abs(a) <= half
-    lo = np.where(flat, np.where(inside, -np.inf, np.inf), lo)
-    hi = np.where(flat, np.where(inside, np.inf, -np.inf), hi)
-    enter = np.max(lo, axis=1)
-    leave = np.min(hi, axis=1)
-    return np.asarray((enter <= leave) & (leave >= 0.0) & (enter <= 1.0))
-
-
-def _geometry_ok(
-    X_RC: FloatArray,
-    pts: FloatArray,
-    normals: FloatArray,
-    face: npt.NDArray[np.int_],
-    K: CameraIntrinsics,
-    torch_C: FloatArray,
-    parts: Sequence[Part],
-    o: ViewOptions,
-) -> tuple[bool, tuple[float, float]]:
-    """Whether every sample point is in the image, clear of the torch, seen at a good incidence and not occluded;
-    and the worst incidence on face A's and B's samples [deg]."""
-    eye = X_RC[:3, 3]
-    p_C = transform_points(invert(X_RC), pts)
-    z = p_C[:, 2]
-    if np.any(z <= 0.05):
-        return False, (90.0, 90.0)
-    u = K.fx * p_C[:, 0] / z + K.cx
-    v = K.fy * p_C[:, 1] / z + K.cy
-    m = o.image_margin_px
-    if np.any((u < m) | (u > K.width - 1 - m) | (v < m) | (v > K.height - 1 - m)):
-        return False, (90.0, 90.0)
-    ahead = torch_C[torch_C[:, 2] > 0.02]
-    if len(ahead):
-        tu = K.fx * ahead[:, 0] / ahead[:, 2] + K.cx
-        tv = K.fy * ahead[:, 1] / ahead[:, 2] + K.cy
-        radius = K.fx * o.torch_radius_m / ahead[:, 2] + o.torch_margin_px
-        near = np.hypot(u[:, None] - tu[None, :], v[:, None] - tv[None, :]) < radius[None, :]
-        if np.any(near & (ahead[None, :, 2] < z[:, None])):
-            return False, (90.0, 90.0)
-    sight = eye - pts
-    sight /= np.linalg.norm(sight, axis=1, keepdims=True)
-    cos = np.einsum("ij,ij->i", sight, normals)
-    inc = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-    inc_a = float(inc[face == 1].max(initial=0.0))
-    inc_b = float(inc[face == 2].max(initial=0.0))
-    if float(inc.max()) > o.max_incidence_deg:
-        return False, (inc_a, inc_b)
-    ends = pts + 0.002 * normals  # just off the surfaces, so that their own part does not count
-    for part in parts:
-        if np.any(_segments_hit_box(eye, ends, part, o.occlusion_margin_m)):
-            return False, (inc_a, inc_b)
-    return True, (inc_a, inc_b)
-
-
-def view_candidates(
-    target: ViewTarget,
-    intrinsics: CameraIntrinsics,
-    torch_C: FloatArray,
-    parts: Sequence[Part],
-    table_z: float,
-    options: ViewOptions | None = None,
-) -> list[_Candidate]:
-    """The geometrically acceptable camera poses for ``target``, best score first (deterministic order).
-
-    torch_C : (n, 3) points on the torch axis in the camera frame (:func:`torch_axis_in_camera`).
-    parts : the map's parts in R that may stand in the line of sight (not the joint's own two: the incidence
-    test keeps their faces turned to the camera, and the seam estimate may lie inside their drawn boxes);
-    table_z : the table top in R [m] (the camera stays above it; samples below it are dropped).
-    """
-    o = options or ViewOptions()
-    b, t = target.bisector, target.direction
-    w = np.cross(t, b)
-    w /= np.linalg.norm(w)
-    pts, normals = target.samples(o.face_strip_m, o.end_margin_m)
-    above = pts[:, 2] >= table_z + 0.001
-    pts, normals, face = pts[above], normals[above], _face_labels(len(above))[above]
-    offset = np.radians(o.image_offset_deg)
-    out: list[_Candidate] = []
-    for distance in o.distances_m:
-        for tilt in o.tilts_deg:
-            for slant in o.slants_deg:
-                ta, sl = np.radians(tilt), np.radians(slant)
-                u = np.cos(sl) * (np.cos(ta) * b + np.sin(ta) * w) + np.sin(sl) * t
-                if float((target.mid + distance * u)[2]) < table_z + 0.05:
-                    continue
-                for roll in o.rolls_deg:
-                    X_RC = _camera_pose(target, u, distance, np.radians(roll), offset)
-                    ok, inc = _geometry_ok(X_RC, pts, normals, face, intrinsics, torch_C, parts, o)
-                    if ok:
-                        score = max(inc) + o.distance_weight_deg_per_m * abs(distance - o.preferred_distance_m)
-                        out.append(_Candidate(X_RC, distance, tilt, slant, roll, inc, score))
-    out.sort(key=lambda c: c.score)  # stable: ties keep the grid order
-    return out
 
 
 def plan_view(
@@ -407,3 +186,16 @@ def concatenate(moves: Sequence[Trajectory]) -> Trajectory:
         qdd.append(m.qdd[1:])
         t0 += m.duration
     return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))
+
+
+__all__ = [
+    "ViewCandidate",
+    "ViewOptions",
+    "ViewTarget",
+    "Viewpoint",
+    "concatenate",
+    "plan_view",
+    "segments_hit_box",
+    "torch_axis_in_camera",
+    "view_candidates",
+]

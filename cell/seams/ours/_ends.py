@@ -12,13 +12,13 @@ from cell.geometry import FloatArray
 from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_ml
 from cell.seams._lines import line_plane_parameter
 from cell.seams.ours._geometry import JointGeometry
-from cell.seams.ours._planes import End, Face, Selection, thin
+from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
 from cell.seams.ours._points import Points
 from cell.seams.ours.options import OursOptions
 
 
 def side_selections(
-    ends: list[End],
+    ends: tuple[End, End],
     pts: Points,
     r_a: FloatArray,
     r_b: FloatArray,
@@ -42,20 +42,20 @@ def side_selections(
     )
     need = max(o.min_end_points, int(o.min_end_fill * max(patch, 0.0) / pts.pitch**2))
     out = []
-    for end in ends:
+    for key, end in zip(END_KEYS, ends, strict=True):
         if end.on_table:
             continue
         r_l = pts.along(end.n) - end.d
         gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
         sel = np.flatnonzero(side & (np.abs(r_l) < gate))
         if len(sel) >= need:
-            out.append(Selection(end, r_l, sel, thin(sel, o.max_fit_points), need))
+            out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
     return out
 
 
 def find_ends(
-    ends: list[End],
-    sides: list[Selection],
+    ends: tuple[End, End],
+    sides_se: dict[int, float],
     pts: Points,
     dense: Callable[[FloatArray, FloatArray], Points] | None,
     face_a: Face,
@@ -64,32 +64,31 @@ def find_ends(
     t: FloatArray,
     s_map: list[float],
     o: OursOptions,
-) -> None:
-    """Update both ends on the fitted line p0 + s t: the table where A rests on it, A's side face where it
-    was fitted, else the extent of face A's support along the seam: the quantiles of its points in ``pts``
-    extrapolated, then refined as an edge in the ``dense`` points of a short tube about it (None: not
-    refined, as in a pass before the last)."""
-    fitted = {id(x.plane): x for x in sides if x.ok}
+) -> tuple[End, End]:
+    """Both ends placed on the fitted line p0 + s t: the table where A rests on it, A's side face where it was
+    fitted (``sides_se``: the standard error of each fitted side face's offset, by end index), else the extent of
+    face A's support along the seam: the quantiles of its points in ``pts`` extrapolated, then refined as an edge
+    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last)."""
+    placed = list(ends)
     known = [False, False]
     for k, end in enumerate(ends):
-        side = fitted.get(id(end))
         if end.on_table:
-            end.s, end.se, end.source = line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table"
+            placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table")
             known[k] = True
-        elif side is not None:
-            end.s = line_plane_parameter(p0, t, end.n, end.d)
-            end.se = side.se / max(abs(float(end.n @ t)), 1e-3)
-            end.source = "side face"
+        elif k in sides_se:
+            s = line_plane_parameter(p0, t, end.n, end.d)
+            placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
             known[k] = True
     if all(known) or face_a.source != "points":
         for k, end in enumerate(ends):
             if not known[k]:
-                end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
-        return
+                placed[k] = end.at(s_map[k], o.map_tolerance_m, "map")
+        return placed[0], placed[1]
     # Face A's support along t; a known end's neighbourhood is cut away (A's side face shows up there),
     # which only shifts the CDF by a constant and leaves the other end's extrapolation unbiased.
     band_b = max(o.corner_band_m, 3.0 * face_b.scale)
     cut = o.edge_band_m + 3.0 * face_a.scale
+    s_known = [end.s for end in placed]
 
     def along_a(pts: Points) -> FloatArray:
         """The parameters along the line of the points of face A's support among ``pts``."""
@@ -98,9 +97,9 @@ def find_ends(
         s = pts.along(t) - float(p0 @ t)
         near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         if known[0]:
-            near_a &= s > ends[0].s + cut
+            near_a &= s > s_known[0] + cut
         if known[1]:
-            near_a &= s < ends[1].s - cut
+            near_a &= s < s_known[1] - cut
         return s[near_a]
 
     s_a = along_a(pts)
@@ -109,9 +108,9 @@ def find_ends(
         if known[k]:
             continue
         if extent is None:
-            end.s, end.se, end.source = s_map[k], o.map_tolerance_m, "map"
+            placed[k] = end.at(s_map[k], o.map_tolerance_m, "map")
         elif dense is None:
-            end.s, end.se, end.source = extent[k], extent[2], "extent"
+            placed[k] = end.at(extent[k], extent[2], "extent")
         else:
             # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
             # point of the dense cloud within the likelihood's window about it.
@@ -123,6 +122,7 @@ def find_ends(
                 # The curvature understates the scatter of a blurred edge: no better than 3 spacings.
                 inside = np.count_nonzero(np.abs(s_d - extent[k]) < EDGE_WINDOW_M)
                 density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
-                end.s, end.se, end.source = sign * edge, max(se, 3.0 / max(density, 1.0)), "extent"
+                placed[k] = end.at(sign * edge, max(se, 3.0 / max(density, 1.0)), "extent")
             else:
-                end.s, end.se, end.source = extent[k], extent[2], "extent"
+                placed[k] = end.at(extent[k], extent[2], "extent")
+    return placed[0], placed[1]

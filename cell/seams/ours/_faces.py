@@ -5,6 +5,7 @@ biweight IRLS, :mod:`cell.seams._batch`), the weld faces' tilt step, and a face 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
@@ -13,7 +14,7 @@ from cell.geometry import FloatArray
 from cell.seams._batch import fit_offsets, tilt_fits
 from cell.seams._edge import place_from_edge
 from cell.seams.base import Joint, SeamScene
-from cell.seams.ours._planes import Face, FitRequest, Selection
+from cell.seams.ours._planes import Face, FitRequest, Fitted, Selection, Tilt, Tilted
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.options import OursOptions
 from cell.types import Box, MapSeam
@@ -22,14 +23,14 @@ BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
 
 
-def fit_planes(requests: list[FitRequest], first: bool, o: OursOptions) -> None:
+def fit_planes(requests: list[FitRequest], first: bool, o: OursOptions) -> list[list[Fitted | None]]:
     """Fit the offsets of every plane selected by ``requests`` (of one or several seams) at once
-    (:func:`~cell.seams._batch.fit_offsets`; the first pass from a histogram mode with its scales measured again once
-    settled, the later ones from the previous fit) and update them. A side face whose fit keeps fewer
-    points than it needs stays unfitted."""
+    (:func:`~cell.seams._batch.fit_offsets`; the first pass from a histogram mode with its scales measured again
+    once settled, the later ones from the previous fit): for each request, each selection's fit. A side face
+    whose fit keeps fewer points than it needs is not fitted (None)."""
     selections = [x for req in requests for x in req.selections]
     if not selections:
-        return
+        return [[] for _ in requests]
     fit = fit_offsets(
         np.concatenate([x.r[x.fit] for x in selections]),
         [len(x.fit) for x in selections],
@@ -40,42 +41,49 @@ def fit_planes(requests: list[FitRequest], first: bool, o: OursOptions) -> None:
         mode_bin=max(0.002, o.sensor_sigma_m),
         rescale_after=3 if first else 0,
     )
+    fitted: list[Fitted | None] = []
     at = 0
     for j, x in enumerate(selections):
         weights = fit.weights[at : at + len(x.fit)]
         at += len(x.fit)
         if int(fit.count[j]) < min(x.need, len(x.fit)):
+            fitted.append(None)
             continue
-        x.ok, x.offset, x.weights = True, float(fit.offset[j]), weights
-        x.se = float(fit.se[j]) * np.sqrt(len(x.fit) / len(x.sel))  # the stride stands for all the support
-        x.plane.d += x.offset
-        x.plane.scale = max(float(fit.scale[j]), 1e-4)
-        if isinstance(x.plane, Face):
-            x.plane.se, x.plane.count = x.se, len(x.sel)
+        se = float(fit.se[j]) * np.sqrt(len(x.fit) / len(x.sel))  # the stride stands for all the support
+        fitted.append(Fitted(float(fit.offset[j]), se, max(float(fit.scale[j]), 1e-4), weights))
+    out, at = [], 0
+    for req in requests:
+        out.append(fitted[at : at + len(req.selections)])
+        at += len(req.selections)
+    return out
 
 
-def tilt(jobs: list[tuple[Selection, Face, Face, Points, FloatArray, FloatArray]], o: OursOptions) -> None:
+def tilt(jobs: list[tuple[Selection, Fitted | None, Tilt, Points]], o: OursOptions) -> list[Tilted | None]:
     """Let fitted weld faces tilt a little off their normals (a Gaussian prior of ``tilt_prior_deg``): one
     weighted least-squares step of offset and tilt about each face's points' centroid (decorrelated), with
     the biweight weights of its offset fit, carried to the seam line (:func:`~cell.seams._batch.tilt_fits`, all
-    faces at once). A job: the face's selection, the face, the other weld face, its points, p0 (3,) and t (3,)
-    of the line."""
+    faces at once). A job: the face's selection, its offset fit, the tilt step asked for and the seam's points;
+    for each, the face tilted (None: not fitted, or too few weighted points)."""
     todo, r, u, v, w = [], [], [], [], []
-    for x, face, other, pts, p0, t in jobs:
-        keep = x.weights > 0.0
-        if not x.ok or np.count_nonzero(keep) < 4:
+    out: list[Tilted | None] = [None] * len(jobs)
+    for i, (x, fitted, step, pts) in enumerate(jobs):
+        if fitted is None or not isinstance(x.plane, Face):
             continue
+        keep = fitted.weights > 0.0
+        if np.count_nonzero(keep) < 4:
+            continue
+        face = x.plane
         idx = x.fit[keep]
-        e_u = other.n - (other.n @ face.n) * face.n
+        e_u = step.other_n - (step.other_n @ face.n) * face.n
         e_u /= np.linalg.norm(e_u)
-        q = np.take(pts.xyz, idx, axis=1) - p0[:, None]
-        todo.append((x, face, e_u, p0, t))
-        r.append(x.r[idx] - x.offset)  # from the plane as fitted
+        q = np.take(pts.xyz, idx, axis=1) - step.p0[:, None]
+        todo.append((i, x, face, fitted, e_u, step.p0, step.t))
+        r.append(x.r[idx] - fitted.offset)  # from the plane as fitted
         u.append(e_u @ q)
-        v.append(t @ q)
-        w.append(x.weights[keep])
+        v.append(step.t @ q)
+        w.append(fitted.weights[keep])
     if not todo:
-        return
+        return out
     fit = tilt_fits(
         np.concatenate(r),
         np.concatenate(u),
@@ -84,16 +92,15 @@ def tilt(jobs: list[tuple[Selection, Face, Face, Points, FloatArray, FloatArray]
         [len(ri) for ri in r],
         float(np.tan(np.radians(o.tilt_prior_deg))),
     )
-    for j, (x, face, e_u, p0, t) in enumerate(todo):
-        # The plane r = c0 + a (u - uc) + b (v - vc) in the face's normal and offset.
+    for j, (i, x, face, fitted, e_u, p0, t) in enumerate(todo):
+        # The plane r = c0 + a (u - uc) + b (v - vc) in the face's normal and offset (as its offset fit moved it).
         c0, a, b = float(fit.c0[j]), float(fit.a[j]), float(fit.b[j])
         m = face.n - a * e_u - b * t
         norm = float(np.linalg.norm(m))
-        face.d = (
-            face.d + c0 - a * (float(fit.uc[j]) + float(e_u @ p0)) - b * (float(fit.vc[j]) + float(t @ p0))
-        ) / norm
-        face.n = m / norm
-        face.se = float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel))
+        d_fitted = face.d + fitted.offset
+        d = (d_fitted + c0 - a * (float(fit.uc[j]) + float(e_u @ p0)) - b * (float(fit.vc[j]) + float(t @ p0))) / norm
+        out[i] = Tilted(m / norm, d, float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel)))
+    return out
 
 
 def face_from_edge(
@@ -107,11 +114,10 @@ def face_from_edge(
     away: Callable[[FloatArray], BoolArray],
     rng: np.random.Generator,
     o: OursOptions,
-) -> str:
+) -> Face | str:
     """Place an unseen ``face`` of ``box`` from an edge (:func:`~cell.seams._edge.place_from_edge`, on
     ``edge_sample_share`` of the cloud); ``away`` masks the points (n, 3) far enough from the joint's other
-    part. Returns "" when placed (``face`` updated, its standard error from the edge's own data), else why
-    not."""
+    part. Returns the face placed (its standard error from the edge's own data), else why not."""
 
     def points(a: FloatArray, b: FloatArray, radius: float) -> tuple[FloatArray, IntArray, BoolArray]:
         pts = gather(scene, a, b, radius, 0.0, joint, rng, o, o.edge_sample_share)
@@ -132,11 +138,15 @@ def face_from_edge(
     )
     if isinstance(placed, str):
         return placed
-    face.d += placed.b
-    face.se, face.scale, face.count = placed.se, placed.scale, placed.count
-    face.source = f"edge of {placed.g}"
-    face.note = f"+-{1000 * placed.se:.2f} mm, {placed.cameras} camera{'s' if placed.cameras != 1 else ''}"
-    return ""
+    return replace(
+        face,
+        d=face.d + placed.b,
+        se=placed.se,
+        scale=placed.scale,
+        count=placed.count,
+        source=f"edge of {placed.g}",
+        note=f"+-{1000 * placed.se:.2f} mm, {placed.cameras} camera{'s' if placed.cameras != 1 else ''}",
+    )
 
 
 def away_from(face: Face, band: float) -> Callable[[FloatArray], BoolArray]:

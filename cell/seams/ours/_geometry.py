@@ -50,21 +50,21 @@ class JointGeometry:
         """Whether the seam runs across A's side faces (so that they end it)."""
         return self.side_axis >= 0
 
-    def end_planes(self, t: FloatArray, table_z: float, tol: float) -> list[End]:
-        """Planes of A's side faces at the start and the end of the seam (direction t; outward normals); the
-        table instead of a side face that rests on it."""
+    def end_planes(self, t: FloatArray, s_map: list[float], table_z: float, tol: float) -> tuple[End, End]:
+        """Planes of A's side faces at the start and the end of the seam (direction t; outward normals), the
+        table instead of a side face that rests on it; the ends where the map puts them (``s_map`` along t [m])."""
         R_A = self.box_a.X_AB[:3, :3]
         k = max(self.side_axis, 0)
         h = 0.5 * float(self.box_a.size[k])
         c = self.box_a.center
         axis = R_A[:, k] if float(R_A[:, k] @ t) >= 0.0 else -R_A[:, k]
         out = []
-        for sign in (-1.0, 1.0):
+        for sign, s in zip((-1.0, 1.0), s_map, strict=True):
             n = sign * axis
             d = float(n @ c) + h
             on_table = self.has_sides and _edge.on_table(n, d, table_z, tol)
-            out.append(End(-_Z, -table_z, True) if on_table else End(n, d, False))
-        return out
+            out.append(End(-_Z, -table_z, True, s) if on_table else End(n, d, False, s))
+        return out[0], out[1]
 
     def in_face_b(self, pts: Points, slack: float) -> BoolArray:
         """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""

@@ -1,9 +1,10 @@
 """The planes our locator fits for one seam (frame R, metres): the weld faces, the ends, a plane's support for one
-fit, and what a seam's pass asks the batched fit for (:mod:`cell.seams.ours.locator`)."""
+fit, what a seam's pass asks the batched fit for and what it gets back (:mod:`cell.seams.ours.locator`). All are
+values: a fit makes new faces and ends, it does not change them."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -14,22 +15,26 @@ from cell.seams.ours._points import Points
 IntArray = npt.NDArray[np.intp]
 
 
-@dataclass
+@dataclass(frozen=True)
 class Face:
-    """A plane being fitted: unit normal n (3,), offset d [m], noise scale [m], offset standard error [m]."""
+    """A weld face being fitted: unit normal n (3,), offset d [m], noise scale [m], offset standard error [m]."""
 
     n: FloatArray
     d: float
     scale: float
     name: str
     se: float = float("inf")
-    count: int = 0
+    count: int = 0  # points of its support
     source: str = "points"  # or "edge of <face>" (an adjacent face of the same part)
     area: float = 0.0  # area of its support region [m^2] (what a head-on view would fill with points)
     note: str = ""  # how well an edge placed it (for the reason)
 
+    def moved(self, fit: Fitted, count: int) -> Face:
+        """The face moved by its offset fit, supported by ``count`` points."""
+        return replace(self, d=self.d + fit.offset, scale=fit.scale, se=fit.se, count=count)
 
-@dataclass
+
+@dataclass(frozen=True)
 class End:
     """One end of the seam: a plane across the line (A's side face or the table), or the extent of face A."""
 
@@ -41,35 +46,116 @@ class End:
     scale: float = 0.003  # noise of the side face's points [m]
     source: str = "map"
 
+    def moved(self, fit: Fitted) -> End:
+        """The side face at this end moved by its offset fit."""
+        return replace(self, d=self.d + fit.offset, scale=fit.scale)
 
-@dataclass
+    def at(self, s: float, se: float, source: str) -> End:
+        """This end placed at ``s`` along the line [m], with its standard error [m] and where it came from."""
+        return replace(self, s=s, se=se, source=source)
+
+
+END_KEYS = ("start", "end")  # the keys of the selections of A's side faces at the seam's ends
+
+
+@dataclass(frozen=True, eq=False)
 class Selection:
-    """A plane's support for one fit: the plane (a weld face or a side face at an end), the residuals r (n,) of
-    all the seam's points from it [m], the indices of its support and of the points fitted (an even stride of
-    the support above ``max_fit_points``), the points it needs; after the fit: whether it was fitted, the
-    offset it moved by [m], the offset's standard error [m] and the fitted points' weights."""
+    """A plane's support for one fit: which plane (``key``: ``"a"``, ``"b"`` the weld faces, or one of
+    :data:`END_KEYS`), the plane, the residuals r (n,) of all the seam's points from it [m], the indices of its
+    support and of the points fitted (an even stride of the support above ``max_fit_points``), and the points its
+    fit must keep (a side face keeping fewer is not fitted)."""
 
+    key: str
     plane: Face | End
     r: FloatArray
     sel: IntArray
     fit: IntArray
     need: int = 0
-    ok: bool = False
-    offset: float = 0.0
-    se: float = float("inf")
-    weights: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
+@dataclass(frozen=True)
+class Fitted:
+    """A selection's plane as fitted: the offset it moved by [m], the offset's standard error [m] (the fitted
+    stride standing for all the support), its points' noise scale [m] and the fitted points' weights (len(fit),)."""
+
+    offset: float
+    se: float
+    scale: float
+    weights: FloatArray
+
+
+@dataclass(frozen=True)
+class Tilt:
+    """A tilt step a seam's pass asks for after the fit: the weld face of selection ``j`` of the request, the
+    other weld face's normal (3,), and p0 (3,) and t (3,) of the line."""
+
+    j: int
+    other_n: FloatArray
+    p0: FloatArray
+    t: FloatArray
+
+
+@dataclass(frozen=True)
+class Tilted:
+    """A weld face tilted off the map's normal: its unit normal n (3,), offset d [m] and standard error [m]."""
+
+    n: FloatArray
+    d: float
+    se: float
 
 
 @dataclass(frozen=True)
 class FitRequest:
     """What one seam's pass needs fitted: its planes' selections of ``pts``, whether it is the first pass, and
-    the tilt steps to take after the fit (selection, face, the other weld face, p0 (3,) and t (3,) of the
-    line)."""
+    the tilt steps to take after the fit."""
 
     selections: list[Selection]
     pts: Points
     first: bool
-    tilts: list[tuple[Selection, Face, Face, FloatArray, FloatArray]]
+    tilts: list[Tilt]
+
+
+@dataclass(frozen=True)
+class PassFit:
+    """What the batched fit sends back to a seam's pass: each selection's fit (None: not fitted) and each tilt
+    step's face (by selection index; None: too few weighted points to tilt)."""
+
+    fits: list[Fitted | None]
+    tilted: dict[int, Tilted | None]
+
+    def applied(self, request: FitRequest, face_a: Face, face_b: Face, ends: tuple[End, End]) -> Fitting:
+        """The weld faces and the ends after this fit of ``request`` (and its tilt steps)."""
+        faces = {"a": face_a, "b": face_b}
+        moved = list(ends)
+        for x, fit in zip(request.selections, self.fits, strict=True):
+            if fit is None:
+                continue
+            if x.key in faces:
+                faces[x.key] = faces[x.key].moved(fit, len(x.sel))
+            else:
+                k = END_KEYS.index(x.key)
+                moved[k] = moved[k].moved(fit)
+        for j, tilted in self.tilted.items():
+            key = request.selections[j].key
+            if tilted is not None:
+                faces[key] = replace(faces[key], n=tilted.n, d=tilted.d, se=tilted.se)
+        sides_se = {
+            END_KEYS.index(x.key): fit.se
+            for x, fit in zip(request.selections, self.fits, strict=True)
+            if fit is not None and x.key in END_KEYS
+        }
+        return Fitting(faces["a"], faces["b"], (moved[0], moved[1]), sides_se)
+
+
+@dataclass(frozen=True)
+class Fitting:
+    """A seam's planes after a pass's fit: the weld faces, the ends (their side faces moved, not yet placed along
+    the line) and the standard errors of the side faces fitted, by end index (0: start, 1: end)."""
+
+    face_a: Face
+    face_b: Face
+    ends: tuple[End, End]
+    sides_se: dict[int, float]
 
 
 def thin(idx: IntArray, cap: int) -> IntArray:

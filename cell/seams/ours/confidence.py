@@ -33,7 +33,7 @@ class SeamErrors:
 NO_ERRORS = SeamErrors(*(5 * (float("inf"),)))  # a seam not found
 
 
-def errors_of(face_a: Face, face_b: Face, ends: list[End]) -> SeamErrors:
+def errors_of(face_a: Face, face_b: Face, ends: tuple[End, End]) -> SeamErrors:
     """The seam's standard errors from its faces' offsets and its ends (the line moves by the faces' offsets
     over the sine of the angle between them)."""
     sin_ab = float(np.linalg.norm(np.cross(face_a.n, face_b.n)))

@@ -5,6 +5,7 @@ pass (and every tilt step) is one batched fit for all of them."""
 from __future__ import annotations
 
 from collections.abc import Generator, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -15,7 +16,7 @@ from cell.seams.base import SeamScene
 from cell.seams.ours._ends import find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line
-from cell.seams.ours._planes import Face, FitRequest, Selection, thin
+from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
@@ -51,36 +52,39 @@ class OursLocator:
         would alone, but the plane fits of a pass (and the tilt steps) are one batched fit for all the seams,
         so that numpy's cost per call is paid once per pass, not once per seam. Each seam draws from its own
         generator spawned from ``rng``, in the order given."""
+        o = self.options
         runs = [self._run(scene, seam, r) for seam, r in zip(seams, rng.spawn(len(seams)), strict=True)]
         out: list[tuple[SeamEstimate, SeamErrors] | None] = [None] * len(runs)
         pending: dict[int, FitRequest] = {}
 
-        def advance(i: int) -> None:
+        def advance(i: int, result: PassFit | None) -> None:
             try:
-                pending[i] = next(runs[i])
+                pending[i] = next(runs[i]) if result is None else runs[i].send(result)
             except StopIteration as stop:
                 out[i] = stop.value
 
         for i in range(len(runs)):
-            advance(i)
+            advance(i, None)
         while pending:
             batch = list(pending.items())
             pending.clear()
+            fits: dict[int, list[Fitted | None]] = {}
             for first in (True, False):
-                fit_planes([req for _, req in batch if req.first is first], first, self.options)
-            tilt(
-                [(x, face, other, req.pts, p0, t) for _, req in batch for x, face, other, p0, t in req.tilts],
-                self.options,
-            )
+                group = [(i, req) for i, req in batch if req.first is first]
+                fits.update(zip([i for i, _ in group], fit_planes([req for _, req in group], first, o), strict=True))
+            jobs = [(req.selections[s.j], fits[i][s.j], s, req.pts) for i, req in batch for s in req.tilts]
+            tilted = iter(tilt(jobs, o))
+            results = {i: PassFit(fits[i], {s.j: next(tilted) for s in req.tilts}) for i, req in batch}
             for i, _ in batch:
-                advance(i)
+                advance(i, results[i])
         return [x for x in out if x is not None]
 
     def _run(
         self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator
-    ) -> Generator[FitRequest, None, tuple[SeamEstimate, SeamErrors]]:
+    ) -> Generator[FitRequest, PassFit, tuple[SeamEstimate, SeamErrors]]:
         """The steps of :meth:`locate_with_errors` for one seam: yields each pass's plane fits (and tilt steps)
-        for :meth:`locate_many_with_errors` to do, returns the estimate and its standard errors."""
+        for :meth:`locate_many_with_errors` to do and is sent their results; returns the estimate and its standard
+        errors."""
         o = self.options
         joint = joint_of(scene, seam)
         box_a = scene.weldmap.part(joint.abutting).box
@@ -109,8 +113,7 @@ class OursLocator:
         s_map = sorted((float(t @ (seam.p_start - p0)), float(t @ (seam.p_end - p0))))
         face_a = Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
         face_b = Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
-        ends = geo.end_planes(t, scene.table_z, o.map_tolerance_m)
-        ends[0].s, ends[1].s = s_map
+        ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m)
 
         for it in range(o.passes):
             first, last = it == 0, it == o.passes - 1
@@ -130,24 +133,26 @@ class OursLocator:
                 & pts.ok
             )
             planes: list[Selection] = []
-            for face, r, region, box, face_name, skip in (
-                (face_a, r_a, in_a, box_a, joint.face_abutting, joint.end_face),
-                (face_b, r_b, in_b, box_b, joint.face_receiving, ""),
+            for key, face, r, region, box, face_name, skip in (
+                ("a", face_a, r_a, in_a, box_a, joint.face_abutting, joint.end_face),
+                ("b", face_b, r_b, in_b, box_b, joint.face_receiving, ""),
             ):
                 if face.source != "points":
                     continue  # placed from an edge in the first pass
                 gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
                 sel = np.flatnonzero(region & (np.abs(r) < gate))
                 if len(sel) >= pts.least(o.min_face_points):
-                    planes.append(Selection(face, r, sel, thin(sel, o.max_fit_points)))
+                    planes.append(Selection(key, face, r, sel, thin(sel, o.max_fit_points)))
                     continue
                 why = "no edge of it is seen either: not seen or not there"
                 if first:
                     # Where an adjacent face of the same part may show this face's edge: away from the other part.
-                    away = away_from(face_b, band_b) if face is face_a else outside(box_a, band_a)
-                    why = face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng, o)
-                    if not why:
+                    away = away_from(face_b, band_b) if key == "a" else outside(box_a, band_a)
+                    placed = face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng, o)
+                    if isinstance(placed, Face):
+                        face_a, face_b = (placed, face_b) if key == "a" else (face_a, placed)
                         continue
+                    why = placed
                 return _not_found(
                     seam.id,
                     f"face {face.name} is seen by no usable camera ({len(sel)} points near the seam in a "
@@ -156,13 +161,14 @@ class OursLocator:
             sides = side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack, o)
             tilts = []
             if last and o.refine_normals:
-                for sel_ in planes:
-                    face, other = (face_a, face_b) if sel_.plane is face_a else (face_b, face_a)
-                    tilts.append((sel_, face, other, p0, t))
-            yield FitRequest(planes + sides, pts, first, tilts)
+                for j, x in enumerate(planes):
+                    tilts.append(Tilt(j, (face_b if x.key == "a" else face_a).n, p0, t))
+            request = FitRequest(planes + sides, pts, first, tilts)
+            fitting = (yield request).applied(request, face_a, face_b, ends)
             # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
-            face_a.area = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
-            face_b.area = (e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0)
+            area_a = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
+            face_a = replace(fitting.face_a, area=area_a)
+            face_b = replace(fitting.face_b, area=(e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0))
             p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
             # p0 lies on both fitted planes: its distance from a map plane is how far that face moved.
             for drift, name in ((abs(float(n_a @ p0) - d_a), face_a.name), (abs(float(n_b @ p0) - d_b), face_b.name)):
@@ -172,7 +178,9 @@ class OursLocator:
                         f"face {name} fitted {drift * 1000:.1f} mm from the map "
                         f"(allowed {2000 * o.map_tolerance_m:.1f} mm): wrong surface or part moved",
                     )
-            find_ends(ends, sides, pts, dense if last else None, face_a, face_b, p0, t, s_map, o)
+            ends = find_ends(
+                fitting.ends, fitting.sides_se, pts, dense if last else None, face_a, face_b, p0, t, s_map, o
+            )
 
         length = ends[1].s - ends[0].s
         if not 0.3 * (s_map[1] - s_map[0]) < length < 2.0 * (s_map[1] - s_map[0]) + 2.0 * o.extend_m:

@@ -12,14 +12,17 @@ Rewrites, in ``cell/ tests/ benchmarks/ tools/ robots/`` (text files: .py, .yaml
   section N`` (the sections of docs/reference.md keep the numbers of the notes the code was written against);
 - ``STYLE.md`` -> ``docs/architecture.md`` (frames and units, stages as values: both are described there).
 
-A rewritten line that grows past the line length (120, as ruff's) is re-wrapped within its comment or docstring
-paragraph: the words that do not fit move to the start of the next line when that line continues the same
-paragraph (same indentation, same comment prefix); otherwise the line is listed for a hand fix.
+A rewritten line of a Python file that grows past the line length (120, as ruff's) is re-wrapped within its
+comment or docstring paragraph: the words that do not fit move to the start of the next line when that line
+continues the same paragraph (same indentation, same comment prefix), else onto a new line of their own; a
+trailing comment after code moves above the code. Code itself is never split: such a line is listed for a hand
+fix. Other files (YAML, Markdown) have no line limit and are only rewritten.
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
 import io
 import re
 import sys
@@ -84,54 +87,92 @@ def _wrap_words(text: str, prefix: str, limit: int) -> list[str]:
     return [*lines, current]
 
 
-def rewrap(lines: list[str], changed: set[int], limit: int = MAX_LINE) -> tuple[list[str], list[int]]:
-    """Move the words of over-long ``changed`` lines onto the next line of their paragraph; return the lines and
-    the (0-based) indexes still too long."""
-    out = list(lines)
-    todo = sorted(changed)
-    left: list[int] = []
-    while todo:
-        i = todo.pop(0)
-        if len(out[i]) <= limit:
+def _kinds(text: str, suffix: str) -> list[str]:
+    """Per line: ``comment`` (a comment-only line), ``doc`` (inside a Python docstring) or ``code``."""
+    lines = text.splitlines()
+    kinds = ["comment" if line.lstrip().startswith("#") else "code" for line in lines]
+    if suffix != ".py":
+        return kinds
+    try:
+        tree = ast.parse(text)
+    except SyntaxError:
+        return kinds
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if not (isinstance(body, list) and body and isinstance(body[0], ast.Expr)):
             continue
-        prefix = _prefix(out[i])
-        nxt = i + 1
-        code, comment = _split_comment(out[i])
-        if code.strip() and comment:
-            # A trailing comment after code: the comment goes on lines of its own above the code.
-            indent = code[: len(code) - len(code.lstrip())]
-            out[i : i + 1] = [*_wrap_words(comment, indent + "# ", limit), code.rstrip()]
-            continue
-        if nxt >= len(out) or not _continues(out[nxt], prefix):
-            left.append(i)
-            continue
-        words = out[i].split(" ")
-        moved: list[str] = []
-        while len(words) > 1 and len(" ".join(words[:-1])) >= len(prefix):
-            kept = " ".join(words)
-            if len(kept) <= limit and kept.count("``") % 2 == 0:  # never split a ``literal``
-                break
-            moved.insert(0, words.pop())
-        if not moved:
-            left.append(i)
-            continue
-        out[i] = " ".join(words).rstrip()
-        out[nxt] = prefix + " ".join(moved) + " " + out[nxt][len(prefix) :]
-        todo.insert(0, nxt)
-    return out, sorted(set(left))
+        value = body[0].value
+        if isinstance(value, ast.Constant) and isinstance(value.value, str):
+            for k in range(value.lineno - 1, (value.end_lineno or value.lineno)):
+                kinds[k] = "doc"
+    return kinds
+
+
+def _split_words(line: str, prefix: str, limit: int) -> tuple[str, list[str]]:
+    """(what stays on the line, the words that move on) so that the line fits, never splitting a ``literal``."""
+    words = line.split(" ")
+    moved: list[str] = []
+    while len(words) > 1 and len(" ".join(words[:-1])) >= len(prefix):
+        kept = " ".join(words)
+        if len(kept) <= limit and kept.count("``") % 2 == 0:
+            break
+        moved.insert(0, words.pop())
+    while moved and len(words) > 1 and words[-1] in ("section", "sections"):  # "section N" stays together
+        moved.insert(0, words.pop())
+    return " ".join(words).rstrip(), moved
+
+
+def rewrap(lines: list[str], changed: set[int], kinds: list[str], limit: int = MAX_LINE) -> list[str]:
+    """Re-wrap the over-long ``changed`` lines within their comment or docstring paragraph.
+
+    The words that do not fit move to the start of the next line when it continues the paragraph, else onto a
+    new line of their own (comments and docstrings only); a trailing comment after code moves above the code.
+    Code is never split. Lines are handled from the bottom up, so insertions never shift a line still to do.
+    """
+    out, kind = list(lines), list(kinds)
+    for start in sorted(changed, reverse=True):
+        todo = [start]
+        while todo:
+            i = todo.pop()
+            if len(out[i]) <= limit:
+                continue
+            prefix = _prefix(out[i])
+            code, comment = _split_comment(out[i]) if kind[i] == "code" else ("", "")
+            if code.strip() and comment:
+                indent = code[: len(code) - len(code.lstrip())]
+                above = _wrap_words(comment, indent + "# ", limit)
+                out[i : i + 1] = [*above, code.rstrip()]
+                kind[i : i + 1] = ["comment"] * len(above) + ["code"]
+                continue
+            if kind[i] == "code":
+                continue
+            kept, moved = _split_words(out[i], prefix, limit)
+            if not moved:
+                continue
+            out[i] = kept
+            nxt = i + 1
+            if nxt < len(out) and kind[nxt] == kind[i] and _continues(out[nxt], prefix):
+                out[nxt] = prefix + " ".join(moved) + " " + out[nxt][len(prefix) :]
+            else:
+                out.insert(nxt, prefix + " ".join(moved))
+                kind.insert(nxt, kind[i])
+            todo.append(nxt)
+    return out
 
 
 def fix_file(path: Path) -> tuple[str, str, list[int]]:
-    """(old text, new text, 1-based numbers of lines still over the limit) of one file."""
+    """(old text, new text, 1-based numbers of the lines the rewrite left over the limit) of one file."""
     old = path.read_text(encoding="utf-8")
     new = rewrite_text(old)
-    if new == old:
+    if new == old or path.suffix != ".py":  # the line length is ruff's, for Python files only
         return old, new, []
     old_lines, new_lines = old.splitlines(), new.splitlines()
     changed = {i for i, (a, b) in enumerate(zip(old_lines, new_lines, strict=True)) if a != b}
-    lines, left = rewrap(new_lines, changed)
+    lines = rewrap(new_lines, changed, _kinds(new, path.suffix))
+    was_long = {line for line in old_lines if len(line) > MAX_LINE}
+    left = [k + 1 for k, line in enumerate(lines) if len(line) > MAX_LINE and line not in was_long]
     text = "\n".join(lines) + ("\n" if new.endswith("\n") else "")
-    return old, text, [i + 1 for i in left]
+    return old, text, left
 
 
 def files(paths: Sequence[str]) -> Iterator[Path]:

@@ -1,0 +1,162 @@
+"""Motion: the arm's model and IK (Pinocchio), torch poses, timing (Ruckig), collisions (coal), the welding plan,
+the safety gate and the eye-in-hand camera's close-up views.
+
+Modules of one concept each: the plan is made by :mod:`~cell.motion.plan` from the torch search
+(:mod:`~cell.motion.candidates`), straight lines (:mod:`~cell.motion.lines`), the order
+(:mod:`~cell.motion.order`), transfers (:mod:`~cell.motion.transfers`) and the assembly
+(:mod:`~cell.motion.assembly`); its values live in :mod:`~cell.motion.program`; the gate is the package
+:mod:`cell.motion.gate`, one check per module.
+
+``from cell.motion import X`` imports X's module when X is first asked for, so that a light name (say
+``JointLimits``) does not pull in Pinocchio, coal and Ruckig.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from cell.motion.collision import CollisionChecker, CollisionOptions, Contact
+    from cell.motion.gate import GateOptions, GateRefusedError, Violation, ViolationKind, check_plan, find_violations
+    from cell.motion.ik import IKOptions, IKSolveError, solve_ik, solve_path
+    from cell.motion.limits import JointLimits, load_limits
+    from cell.motion.lines import line_trajectory
+    from cell.motion.plan import plan_welds
+    from cell.motion.plan_options import PlanOptions
+    from cell.motion.program import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
+    from cell.motion.quality import WeldQuality, weld_quality
+    from cell.motion.robot import RobotModel
+    from cell.motion.scan import scan_configuration
+    from cell.motion.scene import cell_obstacles
+    from cell.motion.tasks import seam_tasks
+    from cell.motion.timing import DEFAULT_DT, path_profile, ptp, ptp_duration
+    from cell.motion.torch import (
+        WeldProcess,
+        back_off,
+        fillet_axes,
+        line_poses,
+        measured_angles,
+        torch_poses,
+        torch_rotation,
+    )
+    from cell.motion.trajectory import PathProfile, Trajectory
+    from cell.motion.viewpoint import (
+        ViewOptions,
+        Viewpoint,
+        ViewTarget,
+        plan_view,
+        torch_axis_in_camera,
+        view_candidates,
+    )
+
+_WHERE = {
+    "CollisionChecker": "cell.motion.collision",
+    "CollisionOptions": "cell.motion.collision",
+    "Contact": "cell.motion.collision",
+    "GateOptions": "cell.motion.gate",
+    "GateRefusedError": "cell.motion.gate",
+    "Violation": "cell.motion.gate",
+    "ViolationKind": "cell.motion.gate",
+    "check_plan": "cell.motion.gate",
+    "find_violations": "cell.motion.gate",
+    "IKOptions": "cell.motion.ik",
+    "IKSolveError": "cell.motion.ik",
+    "solve_ik": "cell.motion.ik",
+    "solve_path": "cell.motion.ik",
+    "JointLimits": "cell.motion.limits",
+    "load_limits": "cell.motion.limits",
+    "line_trajectory": "cell.motion.lines",
+    "plan_welds": "cell.motion.plan",
+    "PlanOptions": "cell.motion.plan_options",
+    "PlanReason": "cell.motion.program",
+    "SeamOutcome": "cell.motion.program",
+    "SeamTask": "cell.motion.program",
+    "Segment": "cell.motion.program",
+    "SegmentKind": "cell.motion.program",
+    "WeldPlan": "cell.motion.program",
+    "seam_tasks": "cell.motion.tasks",
+    "WeldQuality": "cell.motion.quality",
+    "weld_quality": "cell.motion.quality",
+    "RobotModel": "cell.motion.robot",
+    "scan_configuration": "cell.motion.scan",
+    "cell_obstacles": "cell.motion.scene",
+    "DEFAULT_DT": "cell.motion.timing",
+    "PathProfile": "cell.motion.trajectory",
+    "Trajectory": "cell.motion.trajectory",
+    "path_profile": "cell.motion.timing",
+    "ptp": "cell.motion.timing",
+    "ptp_duration": "cell.motion.timing",
+    "WeldProcess": "cell.motion.torch",
+    "back_off": "cell.motion.torch",
+    "fillet_axes": "cell.motion.torch",
+    "line_poses": "cell.motion.torch",
+    "measured_angles": "cell.motion.torch",
+    "torch_poses": "cell.motion.torch",
+    "torch_rotation": "cell.motion.torch",
+    "ViewOptions": "cell.motion.viewpoint",
+    "ViewTarget": "cell.motion.viewpoint",
+    "Viewpoint": "cell.motion.viewpoint",
+    "plan_view": "cell.motion.viewpoint",
+    "torch_axis_in_camera": "cell.motion.viewpoint",
+    "view_candidates": "cell.motion.viewpoint",
+}
+
+__all__ = [
+    "DEFAULT_DT",
+    "CollisionChecker",
+    "CollisionOptions",
+    "Contact",
+    "GateOptions",
+    "GateRefusedError",
+    "IKOptions",
+    "IKSolveError",
+    "JointLimits",
+    "PathProfile",
+    "PlanOptions",
+    "PlanReason",
+    "RobotModel",
+    "SeamOutcome",
+    "SeamTask",
+    "Segment",
+    "SegmentKind",
+    "Trajectory",
+    "ViewOptions",
+    "ViewTarget",
+    "Viewpoint",
+    "Violation",
+    "ViolationKind",
+    "WeldPlan",
+    "WeldProcess",
+    "WeldQuality",
+    "back_off",
+    "cell_obstacles",
+    "check_plan",
+    "fillet_axes",
+    "find_violations",
+    "line_poses",
+    "line_trajectory",
+    "load_limits",
+    "measured_angles",
+    "path_profile",
+    "plan_view",
+    "plan_welds",
+    "ptp",
+    "ptp_duration",
+    "scan_configuration",
+    "seam_tasks",
+    "solve_ik",
+    "solve_path",
+    "torch_axis_in_camera",
+    "torch_poses",
+    "torch_rotation",
+    "view_candidates",
+    "weld_quality",
+]
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'cell.motion' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)

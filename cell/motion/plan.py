@@ -36,10 +36,11 @@ from cell.motion.failures import SeamFailure, reason_text
 from cell.motion.lines import line_trajectory
 from cell.motion.order import seam_order
 from cell.motion.plan_options import PlanOptions
-from cell.motion.program import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan, seam_tasks
+from cell.motion.program import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.motion.robot import RobotModel
 from cell.motion.scan import scan_configuration
 from cell.motion.scene import cell_obstacles
+from cell.motion.tasks import seam_tasks
 from cell.motion.torch import WeldProcess
 from cell.motion.transfers import Piece, Transfers
 from cell.types import Part

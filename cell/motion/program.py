@@ -1,12 +1,13 @@
-"""The welding program as values: seams to weld (:class:`SeamTask`) and the timed, checked plan (:class:`WeldPlan`).
+"""The welding program as values: seams to weld (:class:`SeamTask`) and the timed, checked plan (:class:`WeldPlan`)
+with its segments and per-seam outcomes (:class:`SeamOutcome`, :class:`PlanReason`). Values only: no planning.
 
-Produced by :func:`cell.motion.plan.plan_welds`, read by the safety gate, the exporters, the simulator playback and
+Tasks are made from located seams by :func:`cell.motion.tasks.seam_tasks`; the plan by
+:func:`cell.motion.plan.plan_welds`, read by the safety gate, the exporters, the simulator playback and
 the pictures. Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Literal
@@ -16,9 +17,7 @@ import numpy.typing as npt
 
 from cell.errors import PlanError
 from cell.geometry import FloatArray, readonly
-from cell.motion.timing import Trajectory
-from cell.seams.base import Joint
-from cell.types import SeamEstimate, SeamStatus, WeldMap
+from cell.motion.trajectory import Trajectory
 
 SegmentKind = Literal["move", "approach", "weld", "depart"]
 
@@ -44,40 +43,6 @@ class SeamTask:
     @property
     def length(self) -> float:
         return float(np.linalg.norm(self.p_end - self.p_start))
-
-
-def seam_tasks(
-    estimates: Sequence[SeamEstimate],
-    weldmap_R: WeldMap,
-    joints: Mapping[str, Joint],
-    table_z: float | None = None,
-) -> tuple[SeamTask, ...]:
-    """Tasks for the found seams: the located end points with the weld faces' normals from the aligned map.
-
-    table_z : height of the table top in R [m]. A located end point below it (the locator's error on a seam that
-    ends at the table) is moved along the seam up to the table top: a seam cannot run inside the table.
-    """
-    from cell.seams.joint import weld_faces  # the seams package stays out of the motion import chain
-
-    out = []
-    for est in estimates:
-        if est.status is not SeamStatus.FOUND:
-            continue
-        n_a, _, n_b, _ = weld_faces(weldmap_R, joints[est.id])
-        p0, p1 = np.array(est.p_start), np.array(est.p_end)
-        if table_z is not None:
-            p0, p1 = _clip_above(p0, p1, table_z), _clip_above(p1, p0, table_z)
-        out.append(SeamTask(est.id, p0, p1, n_a, n_b))
-    return tuple(out)
-
-
-def _clip_above(p: FloatArray, other: FloatArray, z: float) -> FloatArray:
-    """p moved along the line towards ``other`` until its height is at least z (unchanged if it already is or
-    the line does not climb)."""
-    if p[2] >= z or other[2] <= p[2]:
-        return p
-    f = min(1.0, (z - p[2]) / (other[2] - p[2]))
-    return np.asarray(p + f * (other - p))
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.program import Segment, WeldPlan
 from cell.motion.robot import RobotModel
-from cell.motion.timing import Trajectory
+from cell.motion.trajectory import Trajectory
 
 DEG = 180.0 / math.pi  # [deg/rad] for messages
 

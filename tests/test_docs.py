@@ -123,3 +123,12 @@ def test_every_citation_of_the_reference_names_a_section_it_has() -> None:
 def test_no_citation_of_the_design_notes_is_left() -> None:
     fix_citations = _tool("fix_citations")
     assert fix_citations.main(["--check"]) == 0, "run .venv/bin/python tools/fix_citations.py"
+
+
+@pytest.mark.parametrize("doc", ["architecture.md", "reference.md"])
+def test_paths_the_docs_name_exist(doc: str) -> None:
+    # The layout moves; a doc that names a file or package the repository no longer has is out of date.
+    text = (REPO / "docs" / doc).read_text(encoding="utf-8")
+    named = set(re.findall(r"`((?:cell|tools|benchmarks|robots|scenarios|maps|tests|docs|scripts)/[^`\s]*)`", text))
+    missing = sorted(p for p in named if not (REPO / p.rstrip("/")).exists())
+    assert not missing, f"docs/{doc} names paths that do not exist (update the doc): {missing}"

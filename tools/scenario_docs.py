@@ -10,7 +10,8 @@ The walk starts at ``Scenario.model_fields`` and descends into every sub-model (
 name), its type, its unit (from a ``Field`` description or comment ``[unit]``, else from the name's suffix:
 ``_m``, ``_mm``, ``_deg``, ``_s``, ``_px``, ``_mm_s``), its default (``required`` when it has none), the
 allowed range, and its description: the ``Field``'s description, the ``name : text`` entry of the class
-docstring, and the comments on and just above the field's line in ``cell/scenario.py``, in that order.
+docstring (for a field of fixed choices, else the docstring paragraph that explains them), and the comments on
+and just above the field's line in ``cell/scenario.py``, in that order.
 """
 
 from __future__ import annotations
@@ -240,9 +241,22 @@ def _rst_to_md(text: str) -> str:
     return text.replace("``", "`")
 
 
+def _choices_paragraph(klass: type, annotation: Any) -> str:
+    """For a field of fixed choices: the class docstring's paragraph that explains two or more of them."""
+    tp, _ = _strip_annotated(annotation)
+    if get_origin(tp) is not Literal:
+        return ""
+    values = [str(v) for v in get_args(tp)]
+    for paragraph in inspect.cleandoc(klass.__doc__ or "").split("\n\n"):
+        if sum(f"``{v}``" in paragraph for v in values) >= 2:
+            return " ".join(paragraph.split())
+    return ""
+
+
 def _description(model: type[BaseModel], name: str, field: FieldInfo) -> str:
     klass = _defining_class(model, name)
-    parts = [field.description or "", _docstring_entries(klass).get(name, ""), _source_comments(klass).get(name, "")]
+    entry = _docstring_entries(klass).get(name, "") or _choices_paragraph(klass, field.annotation)
+    parts = [field.description or "", entry, _source_comments(klass).get(name, "")]
     seen: list[str] = []
     for p in parts:
         if p and p not in seen:

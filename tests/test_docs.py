@@ -39,7 +39,7 @@ def readme_results() -> ModuleType:
 def test_scenarios_md_is_generated_from_the_models(scenario_docs: ModuleType) -> None:
     committed = (REPO / "docs" / "scenarios.md").read_text(encoding="utf-8")
     assert committed == scenario_docs.render(), (
-        f"docs/scenarios.md is out of date with cell/scenario.py: regenerate it with {scenario_docs.COMMAND}"
+        f"docs/scenarios.md is out of date with the models of cell.scenario: regenerate it with {scenario_docs.COMMAND}"
     )
 
 

@@ -11,7 +11,7 @@ name), its type, its unit (from a ``Field`` description or comment ``[unit]``, e
 ``_m``, ``_mm``, ``_deg``, ``_s``, ``_px``, ``_mm_s``), its default (``required`` when it has none), the
 allowed range, and its description: the ``Field``'s description, the ``name : text`` entry of the class
 docstring (for a field of fixed choices, else the docstring paragraph that explains them), and the comments on
-and just above the field's line in ``cell/scenario.py``, in that order.
+and just above the field's line in the source of :mod:`cell.scenario`, in that order.
 """
 
 from __future__ import annotations
@@ -333,11 +333,12 @@ def _table(items: list[Row]) -> list[str]:
 def render() -> str:
     """The whole of ``docs/scenarios.md``."""
     top = scenario_module.Scenario
-    intro = inspect.cleandoc(scenario_module.__doc__ or "").split("\n\n", 1)[-1]
+    paragraphs = inspect.cleandoc(scenario_module.__doc__ or "").split("\n\n")
+    intro = paragraphs[1] if len(paragraphs) > 1 else ""  # the first is the summary line
     lines = [
         "# Scenario files: every key",
         "",
-        f"<!-- Generated from cell/scenario.py by `{COMMAND}`; do not edit by hand. -->",
+        f"<!-- Generated from the models of cell.scenario by `{COMMAND}`; do not edit by hand. -->",
         "",
         " ".join(_rst_to_md(intro).split()),
         "",
@@ -371,7 +372,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.check:
         current = args.out.read_text(encoding="utf-8") if args.out.is_file() else ""
         if current != text:
-            print(f"{args.out} is out of date with cell/scenario.py; regenerate it with {COMMAND}", file=sys.stderr)
+            print(f"{args.out} is out of date with cell.scenario; regenerate it with {COMMAND}", file=sys.stderr)
             return 1
         return 0
     args.out.parent.mkdir(parents=True, exist_ok=True)

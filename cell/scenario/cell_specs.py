@@ -1,0 +1,132 @@
+"""What a cell is: the map and its placement, the part as built, the table, the robot, the cameras and their
+sensor model, the workspace. Lengths in metres (``_m``) or millimetres (``_mm``), angles in degrees (``_deg``)."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from cell.geometry import FloatArray, look_at, pose_from_xyz_rpy
+from cell.scenario.base import Model, NonNeg, Pos, Vec3
+
+
+class PoseSpec(Model):
+    """A pose given as translation [m] and fixed-axis roll, pitch, yaw [deg]."""
+
+    xyz_m: Vec3 = (0.0, 0.0, 0.0)
+    rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+
+    @property
+    def X(self) -> FloatArray:
+        return pose_from_xyz_rpy(self.xyz_m, np.radians(self.rpy_deg))
+
+
+class MapSpec(Model):
+    """The welding map: a DXF file (relative to the scenario file) and where its origin sits in the world."""
+
+    file: str
+    units: Literal["mm", "cm", "m", "in"] | None = None  # only used when the DXF declares no $INSUNITS
+    X_WM: PoseSpec = PoseSpec()  # nominal placement of the drawing on the table (what the cell is told)
+    placement_error: PoseSpec = PoseSpec()  # where the part really lies, relative to X_WM (ground truth only)
+
+
+class Deviation(Model):
+    """How one part was built differently from the drawing (as-built minus designed), in the part's own frame."""
+
+    size_mm: Vec3 = (0.0, 0.0, 0.0)
+    offset_mm: Vec3 = (0.0, 0.0, 0.0)
+    rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+
+
+class TableSpec(Model):
+    """The welding table, a box: centre and size in the world [m]."""
+
+    center_m: Vec3
+    size_m: tuple[Pos, Pos, Pos]
+
+    @property
+    def top_z(self) -> float:
+        return self.center_m[2] + self.size_m[2] / 2.0
+
+
+class RobotSpec(Model):
+    """Which robot and where its base stands (X_WR = pose of the robot base frame R in the world)."""
+
+    urdf: str | None = None  # relative to the repository's robots/ folder; None: no arm in the cell
+    X_WR: PoseSpec = PoseSpec()
+    home_deg: tuple[float, ...] | None = None
+    # Wire stick-out [mm] beyond the contact tip in the URDF's torch_tcp (robots/build_kr5_arc.py STICKOUT): the
+    # torch planner stands the TCP off the seam by contact_tip_distance_mm minus this (0 by default).
+    stickout_mm: Pos = 15.0
+
+
+class NoiseSpec(Model):
+    """Depth sensor model (REFERENCE.md section 2). ``active_stereo`` follows the RealSense D4xx error model."""
+
+    model: Literal["none", "active_stereo", "structured_light"] = "active_stereo"
+    baseline_m: Pos = 0.055  # D415 [m]
+    subpixel_px: NonNeg = 0.08  # RMS subpixel disparity error [px]
+    disparity_step_px: NonNeg = 1.0 / 32.0  # disparity quantisation [px]
+    depth_unit_m: NonNeg = 0.0001  # depth output quantisation [m]
+    edge_invalid_fraction: Annotated[float, Field(ge=0.0, le=1.0)] = 0.09  # at depth discontinuities
+    edge_flying_fraction: Annotated[float, Field(ge=0.0, le=1.0)] = 0.5  # of those, how many come back mixed
+    edge_jump_m: Pos = 0.02  # depth step that counts as a discontinuity [m]
+    grazing_dropout_deg: Annotated[float, Field(gt=0.0, le=90.0)] = 80.0  # incidence beyond which pixels drop
+
+
+class ExtrinsicErrorSpec(Model):
+    """Calibration error of a camera pose: magnitudes, directions drawn from the scenario seed."""
+
+    translation_mm: NonNeg = 0.0
+    rotation_deg: NonNeg = 0.0
+
+
+class CameraSpec(Model):
+    """A depth camera looking from ``eye_m`` at ``target_m`` (world) with a pinhole of the given size and field."""
+
+    mount: Literal["fixed", "eye_in_hand"] = "fixed"
+    eye_m: Vec3
+    target_m: Vec3
+    up: Vec3 = (0.0, 0.0, 1.0)
+    resolution: tuple[Annotated[int, Field(ge=16, le=4096)], Annotated[int, Field(ge=16, le=4096)]] = (
+        1280,
+        720,
+    )
+    hfov_deg: Annotated[float, Field(gt=1.0, lt=170.0)] = 65.0
+    near_m: Annotated[float, Field(ge=0.05)] = 0.1
+    far_m: Pos = 4.0
+    noise: NoiseSpec = NoiseSpec()
+    extrinsic_error: ExtrinsicErrorSpec = ExtrinsicErrorSpec()
+
+    @model_validator(mode="after")
+    def _check(self) -> CameraSpec:
+        if self.far_m <= self.near_m:
+            raise ValueError(f"far_m ({self.far_m}) must be greater than near_m ({self.near_m})")
+        if math.dist(self.eye_m, self.target_m) < 1e-6:
+            raise ValueError("eye_m and target_m coincide")
+        return self
+
+    @property
+    def X_WC(self) -> FloatArray:
+        """True pose of the optical frame in the world."""
+        return look_at(self.eye_m, self.target_m, self.up)
+
+    @property
+    def fx_px(self) -> float:
+        return 0.5 * self.resolution[0] / math.tan(math.radians(self.hfov_deg) / 2.0)
+
+
+class WorkspaceSpec(Model):
+    """Passthrough crop in the world [m]: only points inside this box are kept (paper eq. 2)."""
+
+    min_m: Vec3
+    max_m: Vec3
+
+    @model_validator(mode="after")
+    def _check(self) -> WorkspaceSpec:
+        if any(lo >= hi for lo, hi in zip(self.min_m, self.max_m, strict=True)):
+            raise ValueError(f"workspace min_m {self.min_m} must be below max_m {self.max_m} on every axis")
+        return self

@@ -1,0 +1,123 @@
+"""How the cell works: the welding process, perception, the locator, the re-scan, and the faults a simulation
+plays. Lengths in metres (``_m``) or millimetres (``_mm``), angles in degrees (``_deg``)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field
+
+from cell.geometry import FloatArray, pose_from_xyz_rpy
+from cell.scenario.base import Model, Pos, Vec3
+from cell.scenario.cell_specs import WorkspaceSpec
+
+
+class ProcessSpec(Model):
+    """The arc welding process: speeds, torch angles and offsets (REFERENCE.md sections 4 and 7).
+
+    Angles follow the welding convention: the work angle is measured from face B (the receiving part's face) in
+    the plane perpendicular to the seam; the travel angle tilts the torch along the seam, positive = push (the
+    wire points ahead, in the weld direction), negative = drag.
+    """
+
+    travel_speed_mm_s: Annotated[float, Field(gt=0.0, le=100.0)] = 8.0  # MAG fillet 8-10 mm/s (section 4)
+    work_angle_deg: Annotated[float, Field(gt=0.0, lt=90.0)] = 45.0  # 45 bisects a square fillet (section 4)
+    work_angle_tol_deg: Annotated[float, Field(ge=0.0, le=30.0)] = 10.0  # how far the planner may move it
+    travel_angle_deg: Annotated[float, Field(ge=-45.0, le=45.0)] = 10.0  # push 5-15 deg (section 4)
+    # The planner tries the nominal angle first and widens in 5 deg steps up to this tolerance before it calls a
+    # seam unreachable (section 7); past 5 deg it leaves section 4's 5-15 range (needed where a vertical seam
+    # meets the table: the nozzle needs 20-25 deg there) and the plan reports the angle it used.
+    travel_angle_tol_deg: Annotated[float, Field(ge=0.0, le=40.0)] = 20.0
+    contact_tip_distance_mm: Annotated[float, Field(gt=0.0, le=50.0)] = 15.0  # CTWD 12-20 mm (section 4)
+    spin_tol_deg: Annotated[float, Field(ge=0.0, le=180.0)] = 180.0  # rotation about the torch axis: free
+    approach_mm: Annotated[float, Field(gt=0.0, le=500.0)] = 50.0  # back along the torch axis before the seam
+    depart_mm: Annotated[float, Field(gt=0.0, le=500.0)] = 50.0  # back along the torch axis after the seam
+    approach_speed_mm_s: Annotated[float, Field(gt=0.0, le=250.0)] = 250.0  # reduced speed, ISO 10218 (s. 7)
+
+
+class PerceptionSpec(Model):
+    """Splicing and preprocessing (paper sections 3.2-3.5)."""
+
+    workspace: WorkspaceSpec
+    icp_max_correspondence_m: Pos = 0.001  # paper: 1 mm
+    icp_iterations: Annotated[int, Field(ge=1, le=1000)] = 50  # paper: 50
+    splice_icp: Literal["paper", "robust"] = "robust"  # paper: point-to-point ICP; robust: point-to-plane, Tukey
+    merge_cell_m: Pos = 0.05  # region size for "each region from the camera that sees it best"
+    voxel_m: Pos = 0.01  # paper: 1 cm
+    align_max_correspondence_m: Pos = 0.02  # map-to-cloud ICP
+    align_iterations: Annotated[int, Field(ge=1, le=1000)] = 60
+    align_min_fitness: Annotated[float, Field(ge=0.0, le=1.0)] = 0.5
+
+
+class PaperLocatorSpec(Model):
+    """Options of the paper's locator (section 3.6); masks are (across, along) half-widths... as in eq. 5-6 [m]."""
+
+    outer_mask_m: tuple[Pos, Pos] = (0.03, 0.05)
+    inner_mask_m: tuple[Pos, Pos] = (0.015, 0.03)
+    frequency_bin_m: Pos = 0.001
+
+
+class LocatorSpec(Model):
+    """Which locator runs by default and its options."""
+
+    method: Literal["paper", "ransac", "ours"] = "ours"  # ours beats both (README, cell bench)
+    paper: PaperLocatorSpec = PaperLocatorSpec()
+    options: dict[str, dict[str, float | int | str | bool]] = Field(default_factory=dict)
+
+
+class RescanSpec(Model):
+    """Close-up re-scan before welding and the confidence gate (cell.rescan; calibration in its docstring).
+
+    mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` (and visible seams not
+        found), ``all`` every visible seam, ``none`` nothing.
+    weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
+    escalate_mm : in ``low`` mode, a close-up that disagrees with the first estimate by more than this [mm]
+        triggers a re-scan of every visible seam.
+    """
+
+    mode: Literal["none", "low", "all"] = "low"
+    confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = 0.55  # benchmarks/bench_confidence.py
+    weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
+    # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
+    # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.
+    escalate_mm: Annotated[float, Field(gt=0.0)] = 0.5
+
+
+class CameraFaultSpec(Model):
+    """A simulated camera failure: what the camera delivers instead of a good image (for fault scenarios).
+
+    ``dead``: no valid pixel (unplugged, blinded, laser off); ``random``: every pixel a random depth between
+    near_m and far_m (corrupted stream); ``constant``: every pixel reads ``depth_m`` (a stuck sensor);
+    ``salt``: ``fraction`` of the pixels replaced by random depths (a failing projector / interference).
+    """
+
+    mode: Literal["dead", "random", "constant", "salt"]
+    fraction: Annotated[float, Field(gt=0.0, le=1.0)] = 0.3  # salt: share of pixels replaced
+    depth_m: Pos = 1.0  # constant: the value every pixel reads [m]
+
+
+class OccluderSpec(Model):
+    """An object in the cell that the welding map does not know (a clamp, a cable): a box in the world [m]."""
+
+    center_m: Vec3
+    size_m: tuple[Pos, Pos, Pos]
+    rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+
+    @property
+    def X_WO(self) -> FloatArray:
+        return pose_from_xyz_rpy(self.center_m, np.radians(self.rpy_deg))
+
+
+class FaultsSpec(Model):
+    """Faults to simulate (all empty by default: a healthy cell).
+
+    cameras : camera name -> its failure. occluders : name -> a box the map does not know, rendered in every
+    camera. missing_parts : parts of the map that were not built (not put on the table).
+    The part placed off its nominal place is ``map.placement_error``; a camera knocked out of calibration is
+    ``cameras.<name>.extrinsic_error``.
+    """
+
+    cameras: dict[str, CameraFaultSpec] = Field(default_factory=dict)
+    occluders: dict[str, OccluderSpec] = Field(default_factory=dict)
+    missing_parts: tuple[str, ...] = ()

@@ -2,7 +2,7 @@
 
 Frames: targets are ``X_RT``, poses of the target T in the robot base frame R [m]; the solved frame F
 (default ``torch_tcp``) is brought onto T. With ``free_axis=True`` only F's origin and z axis (the torch
-axis) must match T's: the rotation about the torch axis is left to the solver (a 5-DoF task, REFERENCE.md
+axis) must match T's: the rotation about the torch axis is left to the solver (a 5-DoF task, docs/reference.md
 section 7).
 
 A solution is returned only when it reaches the tolerance (default 0.01 mm and 0.01 deg) within the joint

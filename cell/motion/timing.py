@@ -1,6 +1,6 @@
 """Jerk-limited timing with Ruckig: the only module that imports ruckig.
 
-Only state-to-state motions are used (REFERENCE.md section 9): Ruckig's intermediate waypoints call a
+Only state-to-state motions are used (docs/reference.md section 9): Ruckig's intermediate waypoints call a
 remote service. A point-to-point move is one Ruckig solve over all joints; a weld along a seam is timed by
 a one-axis profile of the path length s(t) (:func:`path_profile`) that the planner maps through IK. Every
 Ruckig result is checked: anything but Working/Finished raises :class:`~cell.errors.TimingError` with the

@@ -1,0 +1,87 @@
+"""Transfers between seams as typed strategies, tried in order; failure reasons as codes (tiny inline cell)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from tiny_cell import HOME, OBSTACLES, URDF
+
+from cell import scenario as sc
+from cell.errors import TimingError
+from cell.geometry import FloatArray, make_pose
+from cell.motion.collision import CollisionChecker
+from cell.motion.failures import SeamFailure, better, reason_text
+from cell.motion.plan_options import PlanOptions
+from cell.motion.program import PlanReason
+from cell.motion.robot import RobotModel
+from cell.motion.torch import WeldProcess
+from cell.motion.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
+from cell.types import Box, Part
+
+PROCESS = WeldProcess.from_spec(sc.ProcessSpec())
+Q_B = HOME + np.radians([30.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
+@pytest.fixture(scope="module")
+def robot() -> RobotModel:
+    return RobotModel.from_urdf(URDF)
+
+
+@dataclass(frozen=True)
+class _Untimeable:
+    name: str = "broken"
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        raise TimingError("no profile")
+
+
+def _mover(robot: RobotModel, obstacles: tuple[Part, ...], *strategies: TransferStrategy) -> Transfers:
+    checker = CollisionChecker(robot, obstacles)
+    return Transfers(robot, PROCESS, checker, PlanOptions(), obstacles, HOME, strategies or DEFAULT_STRATEGIES)
+
+
+def test_the_default_strategies_in_their_order() -> None:
+    assert [s.name for s in DEFAULT_STRATEGIES] == ["direct", "lift", "lift_high", "home"]
+    assert DEFAULT_STRATEGIES[1] == Lift() and DEFAULT_STRATEGIES[2] == Lift("lift_high", extra=1)
+
+
+def test_a_free_direct_move_is_one_ptp(robot: RobotModel) -> None:
+    moves = _mover(robot, OBSTACLES).move(HOME, Q_B)
+    assert not isinstance(moves, TransferFail)
+    assert [p.kind for p in moves] == ["move"] and moves[0].speed == 0.0
+    np.testing.assert_allclose(moves[0].trajectory.q[-1], Q_B, atol=1e-9)
+
+
+def test_a_strategy_that_fails_hands_on_to_the_next(robot: RobotModel) -> None:
+    moves = _mover(robot, OBSTACLES, _Untimeable(), Direct()).move(HOME, Q_B)
+    assert not isinstance(moves, TransferFail) and [p.kind for p in moves] == ["move"]
+    fail = _mover(robot, OBSTACLES, _Untimeable()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and fail.reason == "broken: no profile"
+
+
+def test_a_blocked_direct_move_is_lifted_over_the_obstacle(robot: RobotModel) -> None:
+    # A wall between the two configurations' torches, a little higher than the TCP: up, across, down.
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    blocked = _mover(robot, (*OBSTACLES, wall), Direct()).move(HOME, Q_B)
+    assert isinstance(blocked, TransferFail) and "WALL" in blocked.reason
+    mover = _mover(robot, (*OBSTACLES, wall))
+    assert mover.checker.check(HOME) is None and mover.checker.check(Q_B) is None
+    moves = mover.move(HOME, Q_B)
+    assert not isinstance(moves, TransferFail)
+    assert [p.kind for p in moves] == ["depart", "move", "approach"]
+    assert mover.lift_z == pytest.approx(0.8 + PlanOptions().transfer_lift)
+    assert robot.fk(moves[0].trajectory.q[-1])[2, 3] == pytest.approx(mover.lift_z, abs=1e-4)
+    np.testing.assert_allclose(moves[-1].trajectory.q[-1], Q_B, atol=1e-6)
+
+
+def test_reasons_are_codes_with_the_report_text() -> None:
+    assert reason_text(PlanReason.BEYOND_REACH, "x") == "unreachable: x"
+    assert reason_text(PlanReason.TRANSFER_COLLISION, "no free transfer move") == "collision: no free transfer move"
+    assert all(isinstance(reason_text(c, ""), str) for c in PlanReason)  # every code has its word
+    near = SeamFailure(PlanReason.IK_FAILED, "a", np.zeros(3), 0.01)
+    far = SeamFailure(PlanReason.COLLISION, "b", np.zeros(3), 0.02)
+    assert better(None, near) is near and better(near, far) is far and better(far, near) is far
+    assert better(near, SeamFailure(PlanReason.FLIP, "c", np.zeros(3), 0.01)) is near  # ties: the earlier

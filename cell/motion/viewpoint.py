@@ -21,13 +21,15 @@ and checked in that order, cheapest first:
 3. no collision at the view, and none along a jerk-limited point-to-point move from the current
    configuration (directly, else through ``q_via``, e.g. the scan configuration).
 
-The first candidate that passes is the view; PlanError (seam and why) when none does.
+The first candidate that passes is the view; :class:`NoViewError` (a PlanError: seam, how many were tried and why
+each was rejected) when none does.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from enum import StrEnum
 
 import numpy as np
 import numpy.typing as npt
@@ -49,6 +51,29 @@ from cell.motion.view_candidates import (
 from cell.types import CameraIntrinsics, Part
 
 _segments_hit_box = segments_hit_box  # the old private name (tests/test_rescan.py imports it from here)
+
+
+class ViewRejection(StrEnum):
+    """Why a geometrically acceptable candidate view was rejected (the value is the message's words)."""
+
+    UNREACHABLE = "unreachable"
+    COLLIDES_AT_VIEW = "collides at the view"
+    NO_TIMED_MOVE = "no timed move"
+    MOVE_COLLIDES = "move collides"
+    MOVE_COLLIDES_VIA = "move collides (also through the scan pose)"
+
+
+class NoViewError(PlanError):
+    """No close-up view of ``seam_id`` works: ``tried`` candidates got IK and collision checks, ``rejected``
+    counts why each failed (``tried == 0``: none passed the geometric tests, see :func:`view_candidates`)."""
+
+    def __init__(
+        self, message: str, *, seam_id: str, tried: int = 0, rejected: Mapping[ViewRejection, int] | None = None
+    ) -> None:
+        super().__init__(message)
+        self.seam_id = seam_id
+        self.tried = tried
+        self.rejected = dict(rejected or {})
 
 
 @dataclass(frozen=True)
@@ -105,11 +130,12 @@ def plan_view(
     torch_C = torch_axis_in_camera(model, o)
     cands = view_candidates(target, intrinsics, torch_C, parts, table_z, o)
     if not cands:
-        raise PlanError(
+        raise NoViewError(
             f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "
-            f"torch, incidence <= {o.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m"
+            f"torch, incidence <= {o.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m",
+            seam_id=target.id,
         )
-    why: dict[str, int] = {}
+    why: dict[ViewRejection, int] = {}
     seeds = [q0] if q_via is None else [q0, np.asarray(q_via, dtype=float)]
     tried = 0
     # Pass 1: warm-started IK only (cheap), on the best max_candidates; pass 2: random restarts on the best few.
@@ -118,20 +144,26 @@ def plan_view(
             tried += 1
             q = _ik(model, c.X_RC, seeds, o.camera_frame, rng if pass_ == 2 else None)
             if q is None:
-                why["unreachable"] = why.get("unreachable", 0) + 1
+                why[ViewRejection.UNREACHABLE] = why.get(ViewRejection.UNREACHABLE, 0) + 1
                 continue
             if checker.check(q) is not None:
-                why["collides at the view"] = why.get("collides at the view", 0) + 1
+                why[ViewRejection.COLLIDES_AT_VIEW] = why.get(ViewRejection.COLLIDES_AT_VIEW, 0) + 1
                 continue
-            move, via, reason = _move(model, checker, q0, q, q_via, o.dt)
-            if move is None:
-                why[reason] = why.get(reason, 0) + 1
+            moved = _move(model, checker, q0, q, q_via, o.dt)
+            if isinstance(moved, ViewRejection):
+                why[moved] = why.get(moved, 0) + 1
                 continue
+            move, via = moved
             X_RC = model.fk(q, o.camera_frame)
             dist = float(np.linalg.norm(X_RC[:3, 3] - target.mid))
             return Viewpoint(target.id, X_RC, q, move, dist, c.incidence, c.tilt, c.slant, c.roll, tried, via)
     summary = ", ".join(f"{n} {r}" for r, n in why.items())
-    raise PlanError(f"seam {target.id}: none of {tried} close-up views works ({summary})")
+    raise NoViewError(
+        f"seam {target.id}: none of {tried} close-up views works ({summary})",
+        seam_id=target.id,
+        tried=tried,
+        rejected=why,
+    )
 
 
 def _ik(
@@ -155,24 +187,25 @@ def _move(
     q1: FloatArray,
     q_via: npt.ArrayLike | None,
     dt: float,
-) -> tuple[Trajectory | None, bool, str]:
-    """A collision-free ptp move q0 -> q1, else q0 -> q_via -> q1; (None, False, reason) when neither is free."""
+) -> tuple[Trajectory, bool] | ViewRejection:
+    """A collision-free ptp move q0 -> q1, else q0 -> q_via -> q1, and whether it goes through q_via; why not when
+    neither is free."""
     try:
         direct = ptp(q0, q1, model.limits, dt=dt)
     except TimingError:
-        return None, False, "no timed move"
+        return ViewRejection.NO_TIMED_MOVE
     if checker.check_path(direct.q, direct.times) is None:
-        return direct, False, ""
+        return direct, False
     if q_via is None:
-        return None, False, "move collides"
+        return ViewRejection.MOVE_COLLIDES
     qv = np.asarray(q_via, dtype=float)
     try:
         legs = [ptp(q0, qv, model.limits, dt=dt), ptp(qv, q1, model.limits, dt=dt)]
     except TimingError:
-        return None, False, "no timed move"
+        return ViewRejection.NO_TIMED_MOVE
     if any(checker.check_path(leg.q, leg.times) is not None for leg in legs):
-        return None, False, "move collides (also through the scan pose)"
-    return concatenate(legs), True, ""
+        return ViewRejection.MOVE_COLLIDES_VIA
+    return concatenate(legs), True
 
 
 def concatenate(moves: Sequence[Trajectory]) -> Trajectory:
@@ -189,8 +222,10 @@ def concatenate(moves: Sequence[Trajectory]) -> Trajectory:
 
 
 __all__ = [
+    "NoViewError",
     "ViewCandidate",
     "ViewOptions",
+    "ViewRejection",
     "ViewTarget",
     "Viewpoint",
     "concatenate",

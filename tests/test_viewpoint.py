@@ -1,0 +1,42 @@
+"""Close-up view failures carry their data: the seam, how many candidates were tried and why each was rejected."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from tiny_cell import HOME, OBSTACLES, TOP_SEAM, URDF
+
+from cell.errors import PlanError
+from cell.geometry import make_pose
+from cell.motion.collision import CollisionChecker
+from cell.motion.robot import RobotModel
+from cell.motion.viewpoint import NoViewError, ViewRejection, ViewTarget, plan_view
+from cell.sim.camera import intrinsics_for
+from cell.types import Box, Part
+
+K = intrinsics_for(1280, 720, math.radians(65.0))  # the D415 of the scenarios
+TOP = ViewTarget(*TOP_SEAM)
+
+
+@pytest.fixture(scope="module")
+def robot() -> RobotModel:
+    return RobotModel.from_urdf(URDF)
+
+
+def test_an_unreachable_seam_counts_its_rejected_views(robot: RobotModel) -> None:
+    far = ViewTarget("far", np.array([-0.03, 2.6, 0.06]), np.array([0.03, 2.6, 0.06]), TOP.n_a, TOP.n_b)
+    with pytest.raises(NoViewError) as err:
+        checker = CollisionChecker(robot, OBSTACLES)
+        plan_view(robot, checker, far, HOME, K, (), 0.0, rng=np.random.default_rng(0), restart_candidates=2)
+    e = err.value
+    assert isinstance(e, PlanError) and e.seam_id == "far" and e.tried > 0
+    assert e.rejected[ViewRejection.UNREACHABLE] > 0 and sum(e.rejected.values()) == e.tried
+
+
+def test_no_geometric_candidate_is_a_view_error_with_nothing_tried(robot: RobotModel) -> None:
+    wall = Part("WALL", Box(make_pose(p=[0.0, 0.6, 0.3]), np.array([1.0, 0.6, 0.6])))  # over the whole joint
+    with pytest.raises(NoViewError) as err:
+        plan_view(robot, CollisionChecker(robot, OBSTACLES), TOP, HOME, K, (wall,), 0.0, rng=np.random.default_rng(0))
+    assert err.value.seam_id == "top" and err.value.tried == 0 and err.value.rejected == {}

@@ -1,186 +1,31 @@
-"""The RANSAC baseline and our map-guided locator on synthetic T joints rendered with numpy.
-
-A post A (80 x 300 x 80 mm, along y) abuts the -y face of a rail B (400 x 100 x 100 mm, along x) with a 1 mm
-gap, like fence1's POST_L > TOP_RAIL. Depth cameras are ray-cast (pixel footprint ~1.4 mm at ~1.3 m,
-occlusion, dropout at grazing incidence), with Gaussian noise along the ray, a few % of flying pixels and a
-missing band at the corner. The as-built parts differ from the map by a few mm, so a locator that returns the
-map's seam fails.
+"""The RANSAC baseline and our map-guided locator on the synthetic T joint of tests/synthetic_joint.py (ray-cast
+depth cameras, as-built parts a few mm off the map, so a locator that returns the map's seam fails).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
-
 import numpy as np
 import pytest
+from synthetic_joint import (
+    AS_BUILT,
+    CASES,
+    SIDE,
+    TOP,
+    Render,
+    a_taller,
+    errors,
+    make_scene,
+    scene_with,
+    thinned,
+    voxel_cloud,
+)
 
-from cell.geometry import FloatArray, invert, look_at, make_pose, rot_x, rot_z, transform_points
+from cell.geometry import make_pose, rot_z
 from cell.seams import _extent, _lines
-from cell.seams.base import Joint, SeamScene
+from cell.seams.base import SeamScene
 from cell.seams.ours import OursLocator, OursOptions
 from cell.seams.ransac import RansacLocator, RansacOptions
-from cell.types import Box, Cloud, MapSeam, Part, SeamStatus, WeldMap
-
-TOP = "A>B:+z"  # along x, on A's top
-SIDE = "A>B:+x"  # along z, on A's +x side
-JOINTS = {
-    TOP: Joint(TOP, "A", "B", "+z", "-y", "+y"),
-    SIDE: Joint(SIDE, "A", "B", "+x", "-y", "+y"),
-}
-CAMERAS = (
-    ((0.75, -0.65, 1.0), (0.0, -0.02, 0.05)),
-    ((-0.7, -0.7, 1.05), (0.0, -0.02, 0.05)),
-    ((0.1, -1.0, 1.1), (0.0, -0.02, 0.05)),
-)  # (eye, target) [m], in the joint's frame
-
-
-def _box(lo: Sequence[float], hi: Sequence[float]) -> Box:
-    lo_, hi_ = np.asarray(lo, float), np.asarray(hi, float)
-    return Box(make_pose(p=(lo_ + hi_) / 2.0), hi_ - lo_)
-
-
-NOMINAL = {
-    "A": _box((-0.04, -0.301, 0.0), (0.04, -0.001, 0.08)),
-    "B": _box((-0.2, 0.0, 0.0), (0.2, 0.1, 0.1)),
-}
-# As built [m]: A 2 mm to +x, 0.6 mm wider, 0.7 mm taller, 1.5 mm to -y; B's face 1.5 mm nearer A (gap still
-# 1 mm).
-AS_BUILT = {
-    "A": _box((-0.0383, -0.3025, 0.0), (0.0423, -0.0025, 0.0807)),
-    "B": _box((-0.2, -0.0015, 0.0), (0.2, 0.1, 0.1)),
-}
-
-
-def seam_of(boxes: dict[str, Box], joint: Joint) -> tuple[FloatArray, FloatArray]:
-    """The seam of ``joint``: where A's weld face plane meets B's, between A's two side faces across it."""
-    a, b = boxes[joint.abutting], boxes[joint.receiving]
-    n_a, d_a = a.face_plane(joint.face_abutting)
-    n_b, d_b = b.face_plane(joint.face_receiving)
-    t = np.cross(n_a, n_b)
-    t /= np.linalg.norm(t)
-    p0 = np.linalg.solve(np.vstack([n_a, n_b, t]), np.array([d_a, d_b, float(t @ a.center)]))
-    k = int(np.argmax(np.abs(a.X_AB[:3, :3].T @ t)))
-    ax = a.X_AB[:3, k] * np.sign(a.X_AB[:3, k] @ t)
-    half = a.size[k] / 2.0
-    s = sorted(((ax @ a.center + sg * half) - ax @ p0) / (ax @ t) for sg in (-1.0, 1.0))
-    return p0 + s[0] * t, p0 + s[1] * t
-
-
-def _ray_boxes(eye: FloatArray, D: FloatArray, boxes: Sequence[Box]) -> tuple[FloatArray, FloatArray, np.ndarray]:
-    """Nearest hit distance (m,) along unit rays D (m, 3) from ``eye``, the outward normal there (m, 3) and the
-    index of the box hit (m,) (-1: none)."""
-    best = np.full(len(D), np.inf)
-    normal = np.zeros((len(D), 3))
-    which = np.full(len(D), -1)
-    for i, box in enumerate(boxes):
-        R = box.X_AB[:3, :3]
-        o = R.T @ (eye - box.center)
-        d = D @ R
-        d = np.where(np.abs(d) < 1e-12, 1e-12, d)
-        h = box.size / 2.0
-        t1, t2 = (-h - o) / d, (h - o) / d
-        tn, tf = np.minimum(t1, t2), np.maximum(t1, t2)
-        near, axis = tn.max(axis=1), tn.argmax(axis=1)
-        hit = (near <= tf.min(axis=1)) & (near > 0.0) & (near < best)
-        best[hit] = near[hit]
-        which[hit] = i
-        sign = -np.sign(d[hit, axis[hit]])
-        normal[hit] = sign[:, None] * R[:, axis[hit]].T
-    return best, normal, which
-
-
-@dataclass(frozen=True)
-class Render:
-    sigma_m: float = 0.002  # depth noise along the ray
-    pixel_rad: float = 0.0011  # angular pixel pitch (about 1.4 mm at 1.3 m)
-    flying: float = 0.03  # fraction of pixels returned anywhere up to 40 mm behind the surface
-    corner_band_m: float = 0.0025  # no returns this close to the seams (gap, shadow)
-    table: bool = True
-    turn_cameras: bool = True  # the cameras turn with the parts (else they stay put, only shifted with them)
-    hide_top_of: str = ""  # no returns from this part's top face (as a face seen at grazing incidence drops out)
-
-
-def render(boxes: dict[str, Box], X: FloatArray, opts: Render, rng: np.random.Generator) -> Cloud:
-    """Ray-cast the boxes (and the table z = 0) from CAMERAS, all moved by the pose X (4, 4); frame R."""
-    pts, cams = [], []
-    moved = [b.transformed(X) for b in boxes.values()]
-    corners = np.vstack([b.corners() for b in moved])
-    lines = [seam_of({k: b.transformed(X) for k, b in boxes.items()}, j) for j in JOINTS.values()]
-    X_cam = X if opts.turn_cameras else make_pose(p=X[:3, 3])
-    for c, (eye, target) in enumerate(CAMERAS):
-        eye_R = transform_points(X_cam, eye)
-        target_R = transform_points(X_cam, target)
-        X_RC = look_at(tuple(eye_R), tuple(target_R), up=tuple(X_cam[:3, 2]))
-        q = transform_points(invert(X_RC), corners)
-        uv = q[:, :2] / q[:, 2:3]
-        u = np.arange(uv[:, 0].min(), uv[:, 0].max(), opts.pixel_rad)
-        v = np.arange(uv[:, 1].min(), uv[:, 1].max(), opts.pixel_rad)
-        U, V = np.meshgrid(u, v)
-        D = np.column_stack([U.ravel(), V.ravel(), np.ones(U.size)]) @ X_RC[:3, :3].T
-        D /= np.linalg.norm(D, axis=1, keepdims=True)
-        dist, normal, which = _ray_boxes(eye_R, D, moved)
-        hidden = np.zeros(len(D), bool)
-        if opts.hide_top_of:
-            hidden = (which == list(boxes).index(opts.hide_top_of)) & (normal @ X[:3, 2] > 0.9)
-        if opts.table:  # the table top z = 0 of the joint's frame, X being a turn about z
-            tz = (X[2, 3] - eye_R[2]) / np.where(D[:, 2] < -1e-9, D[:, 2], -1e-9)
-            on_table = tz < dist
-            hidden &= ~on_table
-            dist = np.where(on_table, tz, dist)
-            normal[on_table] = (0.0, 0.0, 1.0)
-        ok = np.isfinite(dist) & (np.abs(np.einsum("ij,ij->i", D, normal)) > np.cos(np.radians(80.0))) & ~hidden
-        dist, D = dist[ok], D[ok]
-        dist = dist + opts.sigma_m * rng.standard_normal(len(dist))
-        fly = rng.random(len(dist)) < opts.flying
-        dist[fly] += rng.uniform(-0.005, 0.04, int(fly.sum()))
-        p = eye_R + D * dist[:, None]
-        for a, b in lines:
-            t = (b - a) / np.linalg.norm(b - a)
-            q2 = p - a
-            perp = q2 - np.outer(q2 @ t, t)
-            p = p[np.linalg.norm(perp, axis=1) > opts.corner_band_m]
-        pts.append(p)
-        cams.append(np.full(len(p), c, np.int16))
-    return Cloud(np.vstack(pts), "R", np.concatenate(cams), tuple(f"cam{i}" for i in range(len(CAMERAS))))
-
-
-def make_scene(X: FloatArray | None = None, opts: Render = Render(), seed: int = 0) -> tuple[SeamScene, dict]:
-    """The T joint moved by X (4, 4): the scene (map = nominal boxes) and the true seams {id: (p0, p1)}."""
-    X = np.eye(4) if X is None else X
-    rng = np.random.default_rng(seed)
-    dense = render(AS_BUILT, X, opts, rng)
-    parts = tuple(Part(k, b.transformed(X)) for k, b in NOMINAL.items())
-    nominal = {k: b.transformed(X) for k, b in NOMINAL.items()}
-    built = {k: b.transformed(X) for k, b in AS_BUILT.items()}
-    seams = tuple(MapSeam(j, *seam_of(nominal, JOINTS[j])) for j in JOINTS)
-    truth = {j: seam_of(built, JOINTS[j]) for j in JOINTS}
-    weldmap = WeldMap(parts, seams, "mm", "synthetic", frame="R")
-    table_z = float(X[2, 3]) if opts.table else -1.0
-    return SeamScene(dense, dense, weldmap, JOINTS, table_z), truth
-
-
-def errors(est_start: FloatArray, est_end: FloatArray, truth: tuple[FloatArray, FloatArray]) -> tuple[float, float]:
-    """(largest lateral distance of the estimated ends from the true line, largest end error along it) [m]."""
-    a, b = truth
-    t = (b - a) / np.linalg.norm(b - a)
-    lat, along = 0.0, 0.0
-    for p, q in ((est_start, a), (est_end, b)):
-        v = p - a
-        lat = max(lat, float(np.linalg.norm(v - (v @ t) * t)))
-        along = max(along, abs(float((p - q) @ t)))
-    return lat, along
-
-
-def pose(R: FloatArray, p: Sequence[float] = (0.3, -0.2, 0.9)) -> FloatArray:
-    return make_pose(R, p)
-
-
-CASES = {
-    "axis-aligned": (pose(np.eye(3)), Render()),
-    "rotated 30 deg about z": (pose(rot_z(np.radians(30.0))), Render(turn_cameras=False)),
-    "tilted 20 deg about x": (pose(rot_x(np.radians(20.0))), Render(table=False)),
-}
+from cell.types import Box, SeamStatus
 
 
 @pytest.fixture(scope="module")
@@ -211,23 +56,18 @@ def test_ours_noise_free_is_exact() -> None:
         assert lat < 0.0001 and along < 0.001, (seam_id, lat, along)
 
 
-def _thinned(scene: SeamScene, keep: np.ndarray) -> SeamScene:
-    dense = scene.dense.select(keep)
-    return SeamScene(dense, dense, scene.weldmap, scene.joints, scene.table_z)
-
-
 def test_ours_confidence_falls_with_support_and_missing_face_is_not_found(scenes: dict) -> None:
     scene, _ = scenes["axis-aligned"]
     seam = scene.weldmap.seam(TOP)
     full = OursLocator().locate(scene, seam, np.random.default_rng(0))
     keep = np.random.default_rng(1).random(len(scene.dense)) > 0.7
-    thin = OursLocator().locate(_thinned(scene, keep), seam, np.random.default_rng(0))
+    thin = OursLocator().locate(thinned(scene, keep), seam, np.random.default_rng(0))
     assert thin.status is SeamStatus.FOUND
     assert thin.confidence < full.confidence - 0.05, (full.confidence, thin.confidence)
     # Remove face B (the rail's -y face) entirely.
     n_b, d_b = scene.weldmap.part("B").box.face_plane("-y")
     off_b = np.abs(scene.dense.points @ n_b - d_b) > 0.012
-    gone = OursLocator().locate(_thinned(scene, off_b), seam, np.random.default_rng(0))
+    gone = OursLocator().locate(thinned(scene, off_b), seam, np.random.default_rng(0))
     assert gone.status is SeamStatus.NOT_FOUND
     assert "B -y" in gone.reason
 
@@ -273,34 +113,16 @@ def test_ours_places_an_unseen_face_from_its_edge(scenes: dict) -> None:
     box_a = hidden.weldmap.part("A").box
     n_top, d_top = box_a.face_plane("+z")
     rim = ((hidden.dense.points @ n_top - d_top) > -0.015) & box_a.contains(hidden.dense.points, margin=0.01)
-    gone = OursLocator().locate(_thinned(hidden, ~rim), seam, np.random.default_rng(0))
+    gone = OursLocator().locate(thinned(hidden, ~rim), seam, np.random.default_rng(0))
     assert gone.status is SeamStatus.NOT_FOUND
     assert "face A +z" in gone.reason and "edge" in gone.reason
-
-
-def _scene_with(boxes: dict[str, Box], opts: Render, seed: int = 0) -> tuple[SeamScene, dict]:
-    """Like :func:`make_scene` (axis-aligned case) with other as-built boxes; the map stays NOMINAL."""
-    X = CASES["axis-aligned"][0]
-    dense = render(boxes, X, opts, np.random.default_rng(seed))
-    parts = tuple(Part(k, b.transformed(X)) for k, b in NOMINAL.items())
-    nominal = {k: b.transformed(X) for k, b in NOMINAL.items()}
-    seams = tuple(MapSeam(j, *seam_of(nominal, JOINTS[j])) for j in JOINTS)
-    truth = {j: seam_of({k: b.transformed(X) for k, b in boxes.items()}, JOINTS[j]) for j in JOINTS}
-    weldmap = WeldMap(parts, seams, "mm", "synthetic", frame="R")
-    return SeamScene(dense, dense, weldmap, JOINTS, float(X[2, 3])), truth
-
-
-def _a_taller(dz: float) -> dict[str, Box]:
-    a = AS_BUILT["A"]
-    lo, hi = a.center - a.size / 2.0, a.center + a.size / 2.0 + np.array([0.0, 0.0, dz])
-    return {"A": _box(lo.tolist(), hi.tolist()), "B": AS_BUILT["B"]}
 
 
 def test_ours_places_an_unseen_face_whose_edge_lies_beyond_the_map_tolerance() -> None:
     """Regression: A 8.7 mm taller than the map (tolerance 6 mm), its top unseen. The edge was searched only
     within the tolerance, where the selected points stopped, and the face landed ~3 mm off at the usual
     confidence (faults/camera-dead, POST_L's -x face)."""
-    scene, truth = _scene_with(_a_taller(0.008), Render(hide_top_of="A"))
+    scene, truth = scene_with(a_taller(0.008), Render(hide_top_of="A"))
     seam = scene.weldmap.seam(TOP)
     est, err = OursLocator().locate_with_errors(scene, seam, np.random.default_rng(0))
     assert est.status is SeamStatus.FOUND, est.reason
@@ -312,7 +134,7 @@ def test_ours_places_an_unseen_face_whose_edge_lies_beyond_the_map_tolerance() -
 @pytest.mark.parametrize(
     ("boxes", "render_opts", "why"),
     [
-        (_a_taller(0.014), Render(hide_top_of="A"), "lies at the limit of the 12 mm searched"),
+        (a_taller(0.014), Render(hide_top_of="A"), "lies at the limit of the 12 mm searched"),
         (AS_BUILT, Render(hide_top_of="A", sigma_m=0.006), "is blurred over 2.5 mm"),
     ],
     ids=["edge beyond the search", "edge seen blurred"],
@@ -320,7 +142,7 @@ def test_ours_places_an_unseen_face_whose_edge_lies_beyond_the_map_tolerance() -
 def test_ours_refuses_an_unseen_face_whose_edge_is_not_defined(
     boxes: dict[str, Box], render_opts: Render, why: str
 ) -> None:
-    scene, _ = _scene_with(boxes, render_opts)
+    scene, _ = scene_with(boxes, render_opts)
     est = OursLocator().locate(scene, scene.weldmap.seam(TOP), np.random.default_rng(0))
     assert est.status is SeamStatus.NOT_FOUND
     assert "face A +z is seen by no usable camera" in est.reason
@@ -351,7 +173,7 @@ def test_ours_takes_no_end_where_the_cloud_stops(scenes: dict) -> None:
     scene, _ = scenes["axis-aligned"]
     seam = scene.weldmap.seam(TOP)
     x_cut = float(CASES["axis-aligned"][0][0, 3]) + 0.02  # through A (x 0.262..0.342 m)
-    cut = _thinned(scene, scene.dense.points[:, 0] < x_cut)
+    cut = thinned(scene, scene.dense.points[:, 0] < x_cut)
     est = OursLocator().locate(cut, seam, np.random.default_rng(0))
     assert est.status is SeamStatus.NOT_FOUND
     assert "the seam's end is not seen" in est.reason and "workspace" in est.reason, est.reason
@@ -386,18 +208,9 @@ def test_line_box_span() -> None:
     assert _lines.line_box_span(np.array([1.0, 5.0, 0.0]), np.array([1.0, 0.0, 0.0]), box)[0] == np.inf
 
 
-def _voxel_cloud(cloud: Cloud, voxel: float) -> Cloud:
-    """The centroid of the points in each occupied voxel (the paper's 1 cm downsampling)."""
-    ijk = np.floor(cloud.points / voxel).astype(np.int64)
-    _, inverse, counts = np.unique(ijk, axis=0, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
-    sums = np.stack([np.bincount(inverse, cloud.points[:, i]) for i in range(3)], axis=1)
-    return Cloud(sums / counts[:, None], cloud.frame)
-
-
 def test_ransac_default_is_the_papers_voxel_cloud_three_runs_and_deterministic(scenes: dict) -> None:
     scene, truth = scenes["axis-aligned"]
-    voxel = SeamScene(_voxel_cloud(scene.dense, 0.01), scene.dense, scene.weldmap, scene.joints, scene.table_z)
+    voxel = SeamScene(voxel_cloud(scene.dense, 0.01), scene.dense, scene.weldmap, scene.joints, scene.table_z)
     seam = voxel.weldmap.seam(TOP)
     loc = RansacLocator()
     assert loc.options.cloud == "voxel" and loc.options.runs == 3

@@ -1,6 +1,6 @@
 """What every seam locator takes and returns: one signature for the paper's method, RANSAC and ours.
 
-A locator is a value-in, value-out stage (STYLE.md): it reads a :class:`SeamScene` (clouds and the aligned map, all in
+A locator is a value-in, value-out stage: it reads a :class:`SeamScene` (clouds and the aligned map, all in
 the robot frame R) and one seam with its :class:`Joint`, and returns a :class:`~cell.types.SeamEstimate`. It never
 calls the simulator and never reads globals; anything stochastic takes the ``rng`` it is given.
 """

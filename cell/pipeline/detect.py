@@ -43,6 +43,8 @@ def capture(
     With a robot in the scenario, the arm first moves to its scan configuration: the eye-in-hand camera rides on
     it. The capture keeps the as-built parts (ground truth) for measuring, never for perception.
     """
+    from cell.seams.joint import find_joints
+
     t0 = time.perf_counter()
     weldmap = weldmap if weldmap is not None else read_weldmap(scenario)
     if station is None:
@@ -51,7 +53,7 @@ def capture(
             return capture(scenario, progress=progress, station=st, weldmap=weldmap)
     progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
     images = station.capture()
-    return Capture(scenario, weldmap, station.truth(), images, time.perf_counter() - t0)
+    return Capture(scenario, weldmap, find_joints(weldmap), station.truth(), images, time.perf_counter() - t0)
 
 
 def table_z_R(scenario: Scenario) -> float:
@@ -61,9 +63,7 @@ def table_z_R(scenario: Scenario) -> float:
 
 def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints."""
-    from cell.perception import align_map, perceive
-    from cell.perception.health import check_alignment_unique, check_parts_seen
-    from cell.seams.joint import find_joints
+    from cell.perception import align_map, check_alignment_unique, check_parts_seen, perceive
 
     sc = cap.scenario
     timings: dict[str, float] = {}
@@ -85,14 +85,13 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     # parts that are simply not there are named, and their seams are never searched.
     check_alignment_unique(weldmap_R, perceived.registered, alignment)
     missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception)
-    joints = find_joints(weldmap_R)
     timings["align_s"] = time.perf_counter() - t
 
     seam_scene = SeamScene(
         cloud=perceived.downsampled,
         dense=perceived.registered,
         weldmap=weldmap_R,
-        joints=joints,
+        joints=cap.joints,
         table_z=table_z_R(sc),
         dense_voxels=perceived.registered_voxels,
     )
@@ -101,7 +100,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
 
 def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet) -> tuple[SeamEstimate, ...]:
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
-    from cell.perception.health import screen
+    from cell.perception import screen
     from cell.seams.base import BatchSeamLocator
     from cell.seams.registry import make_locator
     from cell.seams.visibility import visibility
@@ -135,14 +134,12 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
 
 def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:
     """True seams from the as-built geometry, in R, keyed by seam id (empty when the station knows no truth)."""
-    from cell.seams.joint import find_joints
     from cell.seams.truth import true_seams
 
     if cap.parts_W is None:
         return {}
     design_W = cap.weldmap.transformed(cap.scenario.X_WM, "W")
-    joints = find_joints(design_W)
-    return true_seams(design_W, joints, cap.parts_W, cap.scenario.X_WR)
+    return true_seams(design_W, cap.joints, cap.parts_W, cap.scenario.X_WR)
 
 
 def evaluate(
@@ -206,12 +203,11 @@ def detect(
 def _failed_detection(cap: Capture, method: str, error: CellError, seconds: float) -> Detection:
     """A detection whose perception or alignment failed: every seam NOT_FOUND (underside ones NOT_VISIBLE, which
     the drawing alone tells) with the reason, against the nominal map."""
-    from cell.seams.joint import find_joints
     from cell.seams.visibility import visibility
 
     sc = cap.scenario
     weldmap_R = cap.weldmap.transformed(invert(sc.X_WR) @ sc.X_WM, "R")
-    joints = find_joints(weldmap_R)
+    joints = cap.joints
     table_z = table_z_R(sc)
     estimates = []
     for seam in weldmap_R.seams:

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from cell.errors import CellError
 from cell.geometry import FloatArray
 from cell.scenario import Scenario
-from cell.seams.base import SeamScene
+from cell.seams.base import Joint, SeamScene
 from cell.seams.metrics import MetricsSummary, SeamMetrics
 from cell.station.ports import Arm
 from cell.types import DepthImage, Part, SeamEstimate, SeamStatus, WeldMap
@@ -33,6 +33,7 @@ class Capture:
 
     scenario: Scenario
     weldmap: WeldMap  # as drawn, frame M
+    joints: Mapping[str, Joint]  # seam id -> how it is made (topological: valid in every frame of the map)
     parts_W: tuple[Part, ...] | None  # as built, world frame (ground truth), None when unknown
     images: Mapping[str, DepthImage]
     seconds: float

@@ -19,6 +19,7 @@ import numpy as np
 from cell.errors import CellError, ScenarioError
 from cell.geometry import FloatArray, readonly
 from cell.pipeline.detect import evaluate
+from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, Scene
 from cell.rescan import (
     Rescan,
@@ -127,6 +128,7 @@ def rescan_seams(
     seam_ids: Sequence[str],
     *,
     options: RescanOptions | None = None,
+    motion: MotionScene | None = None,
     progress: Progress = _quiet,
 ) -> Rescan:
     """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`).
@@ -135,10 +137,9 @@ def rescan_seams(
     and, with ``options.return_to_scan``, back to the scan configuration when that move is free; the result says
     where it was left. A seam whose view is unreachable, or whose close-up sees nothing or finds no seam, keeps
     its first estimate and says why. Raises ScenarioError without an arm or an eye-in-hand camera, KeyError for
-    a seam id the detection does not have, ValueError for a detection without its scene.
+    a seam id the detection does not have, ValueError for a detection without its scene. motion : the run's
+    obstacles and checker (built here when not given).
     """
-    from cell.motion.collision import CollisionChecker
-    from cell.motion.plan import cell_obstacles
     from cell.motion.timing import ptp
     from cell.seams.registry import make_locator
 
@@ -148,14 +149,13 @@ def rescan_seams(
     if arm is None:
         raise ScenarioError(f"scenario {sc.name!r} has no robot to carry the camera: set robot.urdf")
     camera = eye_in_hand_camera(sc, o.camera)
-    base = _scene_of(detection).seam_scene
+    _scene_of(detection)  # ValueError now, not after the arm has moved
     known = {e.id for e in detection.estimates}
     unknown = [s for s in seam_ids if s not in known]
     if unknown:
         raise KeyError(f"no seam {', '.join(unknown)} in the detection; seams: {', '.join(sorted(known))}")
     t_all = time.perf_counter()
-    obstacles = cell_obstacles(base.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
-    checker = CollisionChecker(arm.model, obstacles)
+    checker = (motion or motion_scene(arm, detection)).checker
     locator = make_locator(detection.method, closeup_scenario(sc, detection.method, o))
     run = _Run(station, arm, detection, o, camera, checker, locator, station.joint_state())
     rng = sc.rng("rescan/view")
@@ -195,6 +195,7 @@ def rescan_detection(
     mode: RescanMode,
     *,
     seam_ids: Sequence[str] | None = None,
+    motion: MotionScene | None = None,
     progress: Progress = _quiet,
 ) -> tuple[Rescan, Detection]:
     """Re-scan the seams worth a closer look with the eye-in-hand camera and return the detection with the fused
@@ -211,7 +212,7 @@ def rescan_detection(
     else:
         ids = seams_to_rescan(det.estimates, math.inf if mode == "all" else sc.rescan.confidence_threshold)
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
-    rs = rescan_seams(station, det, ids, progress=progress)
+    rs = rescan_seams(station, det, ids, motion=motion, progress=progress)
     after = rescanned(det, rs)
     shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
     rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids]
@@ -220,7 +221,7 @@ def rescan_detection(
             f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
             f" {len(rest)} seams too"
         )
-        more = rescan_seams(station, after, rest, progress=progress)
+        more = rescan_seams(station, after, rest, motion=motion, progress=progress)
         after = rescanned(after, more)
         rs = replace(
             more,

@@ -11,6 +11,7 @@ import numpy as np
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import detect, read_weldmap
+from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, SeamWeld, WeldRun
 from cell.pipeline.rescan import rescan_detection
 from cell.scenario import Scenario
@@ -35,17 +36,18 @@ def plan_for(
     *,
     skip: Collection[str] = (),
     q_start: FloatArray | None = None,
+    motion: MotionScene | None = None,
     progress: Progress = _quiet,
 ) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (REFERENCE section 7).
 
-    q_start : where the arm is now (default: its scan configuration). Returns the plan, the move from q_start to
+    q_start : where the arm is now (default: its scan configuration). motion : the run's obstacles and checker
+    (built here when not given). Returns the plan, the move from q_start to
     home that precedes it, and the gate's violations (empty when the plan may run). PlanError when nothing can be
     planned at all.
     """
     from cell.motion.checks import find_violations
-    from cell.motion.collision import CollisionChecker
-    from cell.motion.plan import cell_obstacles, plan_welds, seam_tasks
+    from cell.motion.plan import plan_welds, seam_tasks
     from cell.motion.timing import ptp
     from cell.motion.torch import WeldProcess
 
@@ -57,8 +59,8 @@ def plan_for(
         raise PlanError(f"nothing to plan: the detection of {sc.name!r} kept no scene ({det.error})")
     ss = det.scene.seam_scene
     tasks = seam_tasks([e for e in det.estimates if e.id not in skip], ss.weldmap, ss.joints, ss.table_z)
-    obstacles = cell_obstacles(ss.weldmap, sc.X_WR, sc.table.center_m, sc.table.size_m)
-    checker = CollisionChecker(arm.model, obstacles)
+    motion = motion or motion_scene(arm, det)
+    obstacles, checker = motion.obstacles, motion.checker
     progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     plan = plan_welds(arm.model, tasks, arm.q_home, process, obstacles, rng=sc.rng("plan"), checker=checker)
@@ -154,9 +156,14 @@ def weld(
         try:
             if det.error is not None:
                 raise det.error
+            if station.arm is None:
+                raise ScenarioError(f"scenario {sc.name!r} has no robot to weld with: set robot.urdf and robot.X_WR")
+            t = time.perf_counter()
+            motion = motion_scene(station.arm, det)  # once: every re-scan view, the plan and the gate use it
+            setup_s = time.perf_counter() - t
             mode = rescan or sc.rescan.mode
-            if mode != "none" and station.arm is not None and execute_plan:
-                rs, det = rescan_detection(station, det, mode, progress=progress)
+            if mode != "none" and execute_plan:
+                rs, det = rescan_detection(station, det, mode, motion=motion, progress=progress)
                 timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so.
             low = {
@@ -166,8 +173,8 @@ def weld(
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
-            plan, pre, violations = plan_for(station, det, skip=low, q_start=q_start, progress=progress)
-            timings["plan_s"] = time.perf_counter() - t
+            plan, pre, violations = plan_for(station, det, skip=low, q_start=q_start, motion=motion, progress=progress)
+            timings["plan_s"] = setup_s + time.perf_counter() - t
             if violations:
                 raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
             if execute_plan:

@@ -35,12 +35,19 @@ def detection_report(det: Detection) -> dict[str, Any]:
     """The ``cell detect`` report as a JSON-ready dict (schema in the README)."""
     seams = []
     for est in det.estimates:
-        entry: dict[str, Any] = {"id": est.id, "status": est.status.value, "reason": est.reason}
+        entry: dict[str, Any] = {
+            "id": est.id,
+            "status": est.status.value,
+            "reason": est.reason,
+            "reason_code": est.code.value if est.code is not None else None,
+        }
         if est.status is SeamStatus.FOUND:
             entry["detected"] = {"start": _pt(est.p_start), "end": _pt(est.p_end)}
             entry["confidence"] = _r(est.confidence, 4)
-        t0, t1 = det.truths[est.id]
-        entry["truth"] = {"start": _pt(t0), "end": _pt(t1)}
+            entry["sigma_mm"] = _r(est.sigma_m * 1000.0, 4)
+        truth = det.truths.get(est.id)  # none when the station knows no truth (real data)
+        if truth is not None:
+            entry["truth"] = {"start": _pt(truth[0]), "end": _pt(truth[1])}
         m = det.metrics.get(est.id)
         if m is not None:
             entry["error_mm"] = {

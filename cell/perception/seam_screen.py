@@ -14,7 +14,7 @@ import numpy as np
 
 from cell.geometry import FloatArray
 from cell.seams.base import SeamScene
-from cell.types import Cloud, SeamEstimate, SeamStatus, WeldMap
+from cell.types import Cloud, Reason, SeamEstimate, SeamStatus, WeldMap
 
 
 @dataclass(frozen=True)
@@ -73,7 +73,7 @@ def screen(
         parts = (joint.abutting, joint.receiving) if joint is not None else ()
         part = next((n for n in parts if n in missing), None)
         if part is not None:
-            out.append(SeamEstimate(est.id, SeamStatus.NOT_FOUND, missing[part]))
+            out.append(SeamEstimate(est.id, SeamStatus.NOT_FOUND, missing[part], code=Reason.PART_MISSING))
             continue
         if est.status is SeamStatus.NOT_VISIBLE:
             out.append(est)
@@ -86,6 +86,7 @@ def screen(
                     SeamStatus.OCCLUDED,
                     f"occluded: {n} points of an object the map does not know lie within "
                     f"{o.radius_m * 1000:.0f} mm of the seam (a clamp, a cable?): clear it and re-scan",
+                    code=Reason.OCCLUDED,
                 )
             )
             continue
@@ -95,6 +96,7 @@ def screen(
                     est.id,
                     SeamStatus.NOT_FOUND,
                     f"too uncertain to weld: confidence {est.confidence:.2f} < {o.min_confidence:.2f} ({est.reason})",
+                    code=Reason.LOW_CONFIDENCE,
                 )
             )
             continue

@@ -14,7 +14,7 @@ from cell.scenario import Scenario
 from cell.seams.base import SeamScene
 from cell.seams.metrics import MetricsSummary, SeamMetrics
 from cell.station import Station, open_station
-from cell.types import SeamEstimate, SeamStatus, WeldMap
+from cell.types import Reason, SeamEstimate, SeamStatus, WeldMap
 
 Progress = Callable[[str], None]
 
@@ -113,7 +113,7 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     for seam in ss.weldmap.seams:
         visible, reason = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
         if not visible:
-            hidden[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason)
+            hidden[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason, code=Reason.UNDERSIDE)
     seams = [seam for seam in ss.weldmap.seams if seam.id not in hidden]
     timed: dict[str, SeamEstimate] = {}
     if isinstance(locator, BatchSeamLocator) and seams:
@@ -212,8 +212,12 @@ def _failed_detection(cap: Capture, method: str, error: CellError, seconds: floa
     estimates = []
     for seam in weldmap_R.seams:
         visible, why = visibility(weldmap_R, joints[seam.id], table_z)
-        status = SeamStatus.NOT_FOUND if visible else SeamStatus.NOT_VISIBLE
-        estimates.append(SeamEstimate(seam.id, status, f"no seam search: {error.message}" if visible else why))
+        if visible:
+            estimates.append(
+                SeamEstimate(seam.id, SeamStatus.NOT_FOUND, f"no seam search: {error.message}", code=Reason.NO_SEARCH)
+            )
+        else:
+            estimates.append(SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE))
     truth = truths(cap, weldmap_R)
     metrics, summary = evaluate(estimates, truth)
     return Detection(

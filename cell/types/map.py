@@ -1,14 +1,12 @@
-"""The vocabulary of the cell: frozen dataclasses with read-only arrays.
+"""The welding map's vocabulary: boxes, parts, seams and the map that holds them.
 
-Frames: ``W`` world, ``R`` robot base (KUKA $ROBROOT), ``M`` welding map (DXF drawing), ``C`` camera optical frame
-(z forward, x right, y down), ``B`` a box part's own frame (axes along its edges, origin at its centre).
-Units: metres and radians everywhere inside; millimetres and degrees only at the edges (DXF, reports, KRL).
+Frames: ``M`` welding map (DXF drawing), ``R`` robot base, ``W`` world, ``B`` a box part's own frame (axes along its
+edges, origin at its centre). Metres and radians.
 """
 
 from __future__ import annotations
 
-import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -144,114 +142,3 @@ class WeldMap:
             if s.id == seam_id:
                 return s
         raise KeyError(f"no seam {seam_id!r}; seams: {', '.join(s.id for s in self.seams)}")
-
-
-@dataclass(frozen=True)
-class CameraIntrinsics:
-    """Pinhole intrinsics [px] of a depth image, optical frame z forward, x right, y down."""
-
-    width: int
-    height: int
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-
-    @property
-    def K(self) -> FloatArray:
-        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
-
-
-@dataclass(frozen=True)
-class DepthImage:
-    """One depth capture.
-
-    depth : (height, width) float32 metric depth along the optical axis [m]; 0 marks an invalid pixel.
-    X_WC : (4, 4) pose of the optical frame in the world *as calibrated* (what perception may use; in simulation
-        it can differ from the true pose by the scenario's extrinsic error).
-    mount : ``"fixed"`` or ``"eye_in_hand"``.
-    """
-
-    camera: str
-    depth: npt.NDArray[np.float32]
-    intrinsics: CameraIntrinsics
-    X_WC: FloatArray
-    mount: str = "fixed"
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "depth", readonly(self.depth, np.float32))
-        object.__setattr__(self, "X_WC", readonly(self.X_WC))
-        if self.depth.shape != (self.intrinsics.height, self.intrinsics.width):
-            raise ValueError(
-                f"depth image of camera {self.camera!r} is {self.depth.shape}, intrinsics say "
-                f"{(self.intrinsics.height, self.intrinsics.width)}"
-            )
-
-
-@dataclass(frozen=True)
-class Cloud:
-    """A point cloud in ``frame``.
-
-    points : (n, 3) [m].
-    camera : (n,) int16 index of the capture each point came from (-1 when unknown or mixed).
-    cameras : names of the captures, indexed by ``camera``.
-    """
-
-    points: FloatArray
-    frame: str
-    camera: npt.NDArray[np.int16] = field(default_factory=lambda: np.zeros(0, np.int16))
-    cameras: tuple[str, ...] = ()
-
-    def __post_init__(self) -> None:
-        pts = readonly(self.points)
-        if pts.ndim != 2 or pts.shape[1] != 3:
-            raise ValueError(f"Cloud points must be (n, 3), got {pts.shape}")
-        cam = np.asarray(self.camera, dtype=np.int16)
-        if cam.size == 0:
-            cam = np.full(len(pts), -1, np.int16)
-        if cam.shape != (len(pts),):
-            raise ValueError(f"Cloud camera indices must be ({len(pts)},), got {cam.shape}")
-        object.__setattr__(self, "points", pts)
-        object.__setattr__(self, "camera", readonly(cam, np.int16))
-
-    def __len__(self) -> int:
-        return len(self.points)
-
-    def select(self, mask: npt.NDArray[np.bool_] | npt.NDArray[np.intp]) -> Cloud:
-        return Cloud(self.points[mask], self.frame, self.camera[mask], self.cameras)
-
-    def transformed(self, X_AF: FloatArray, frame: str) -> Cloud:
-        return Cloud(transform_points(X_AF, self.points), frame, self.camera, self.cameras)
-
-
-class SeamStatus(enum.StrEnum):
-    """What became of a seam."""
-
-    FOUND = "found"
-    NOT_VISIBLE = "not_visible"  # no camera can see it by design (against the table): flip the part
-    NOT_FOUND = "not_found"  # visible, but the data does not support a seam there
-    OCCLUDED = "occluded"  # visible by design, but something the map does not know is in the way: clear it
-
-
-@dataclass(frozen=True)
-class SeamEstimate:
-    """A locator's answer for one seam, in frame ``R``.
-
-    p_start, p_end : (3,) [m] when ``status`` is FOUND; empty arrays otherwise.
-    confidence : in [0, 1]; 0 when not found.
-    time_s : wall time the locator spent on this seam [s].
-    """
-
-    id: str
-    status: SeamStatus
-    reason: str = ""
-    p_start: FloatArray = field(default_factory=lambda: np.zeros(0))
-    p_end: FloatArray = field(default_factory=lambda: np.zeros(0))
-    confidence: float = 0.0
-    time_s: float = 0.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "p_start", readonly(self.p_start))
-        object.__setattr__(self, "p_end", readonly(self.p_end))
-        if self.status is SeamStatus.FOUND and (self.p_start.shape != (3,) or self.p_end.shape != (3,)):
-            raise ValueError(f"seam {self.id}: a found seam needs start and end points")

@@ -1,0 +1,26 @@
+"""The vocabulary of the cell: frozen dataclasses with read-only arrays, numpy only.
+
+Frames: ``W`` world, ``R`` robot base (KUKA $ROBROOT), ``M`` welding map (DXF drawing), ``C`` camera optical frame
+(z forward, x right, y down), ``B`` a box part's own frame (axes along its edges, origin at its centre).
+Units: metres and radians everywhere inside; millimetres and degrees only at the edges (DXF, reports, KRL).
+
+Every stage imports its values from here and nothing here imports a stage (an import-linter contract).
+"""
+
+from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
+from cell.types.seams import Reason, SeamEstimate, SeamStatus
+from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage
+
+__all__ = [
+    "BOX_FACES",
+    "Box",
+    "CameraIntrinsics",
+    "Cloud",
+    "DepthImage",
+    "MapSeam",
+    "Part",
+    "Reason",
+    "SeamEstimate",
+    "SeamStatus",
+    "WeldMap",
+]

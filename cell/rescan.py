@@ -35,9 +35,9 @@ from cell.seams.base import SeamScene
 from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamStatus
 
 if TYPE_CHECKING:
-    from cell.motion.timing import Trajectory
     from cell.scenario import Scenario
-    from cell.sim.robot import Execution
+    from cell.types.execution import Execution
+    from cell.types.trajectory import Trajectory
 
 # Below this confidence a seam is worth a close look (benchmarks/bench_confidence.py: 144 seams of fence1-exact,
 # fence1 and fence2, realistic noise; 20 fall below it, with 2 of the 3 seams more than 0.15 mm off). A scenario

@@ -27,9 +27,9 @@ from cell.motion.gate import (
 )
 from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
 from cell.motion.robot import RobotModel
-from cell.motion.timing import Trajectory
 from cell.motion.torch import WeldProcess, torch_poses
 from cell.types import Box, Part
+from cell.types.trajectory import Trajectory
 
 TOP = SeamTask(*TOP_SEAM)
 SIDE = SeamTask(*SIDE_SEAM)

@@ -33,8 +33,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
-from cell.motion.plan import WeldPlan
 from cell.motion.robot import RobotModel
+from cell.types.plan import WeldPlan
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,23}")
 _X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (x along the wire)

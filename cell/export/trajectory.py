@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.motion.plan import WeldPlan
-from cell.motion.timing import Trajectory
+from cell.types.plan import WeldPlan
+from cell.types.trajectory import Trajectory
 
 
 def export_samples(plan: WeldPlan, dt: float | None = 0.004) -> tuple[Trajectory, np.ndarray]:

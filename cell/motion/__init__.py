@@ -4,7 +4,7 @@ the safety gate and the eye-in-hand camera's close-up views.
 Modules of one concept each: the plan is made by :mod:`~cell.motion.plan` from the torch search
 (:mod:`~cell.motion.candidates`), straight lines (:mod:`~cell.motion.lines`), the order
 (:mod:`~cell.motion.order`), transfers (:mod:`~cell.motion.transfers`) and the assembly
-(:mod:`~cell.motion.assembly`); its values live in :mod:`~cell.motion.program`; the gate is the package
+(:mod:`~cell.motion.assembly`); its values live in :mod:`~cell.types.plan`; the gate is the package
 :mod:`cell.motion.gate`, one check per module.
 
 ``from cell.motion import X`` imports X's module when X is first asked for, so that a light name (say
@@ -24,7 +24,6 @@ if TYPE_CHECKING:
     from cell.motion.lines import line_trajectory
     from cell.motion.plan import plan_welds
     from cell.motion.plan_options import PlanOptions
-    from cell.motion.program import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
     from cell.motion.quality import WeldQuality, weld_quality
     from cell.motion.robot import RobotModel
     from cell.motion.scan import scan_configuration
@@ -40,7 +39,6 @@ if TYPE_CHECKING:
         torch_poses,
         torch_rotation,
     )
-    from cell.motion.trajectory import PathProfile, Trajectory
     from cell.motion.viewpoint import (
         ViewOptions,
         Viewpoint,
@@ -49,6 +47,8 @@ if TYPE_CHECKING:
         torch_axis_in_camera,
         view_candidates,
     )
+    from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
+    from cell.types.trajectory import PathProfile, Trajectory
 
 _WHERE = {
     "CollisionChecker": "cell.motion.collision",
@@ -69,21 +69,21 @@ _WHERE = {
     "line_trajectory": "cell.motion.lines",
     "plan_welds": "cell.motion.plan",
     "PlanOptions": "cell.motion.plan_options",
-    "PlanReason": "cell.motion.program",
-    "SeamOutcome": "cell.motion.program",
-    "SeamTask": "cell.motion.program",
-    "Segment": "cell.motion.program",
-    "SegmentKind": "cell.motion.program",
-    "WeldPlan": "cell.motion.program",
+    "PlanReason": "cell.types.plan",
+    "SeamOutcome": "cell.types.plan",
+    "SeamTask": "cell.types.plan",
+    "Segment": "cell.types.plan",
+    "SegmentKind": "cell.types.plan",
+    "WeldPlan": "cell.types.plan",
     "seam_tasks": "cell.motion.tasks",
-    "WeldQuality": "cell.motion.quality",
+    "WeldQuality": "cell.types.execution",
     "weld_quality": "cell.motion.quality",
     "RobotModel": "cell.motion.robot",
     "scan_configuration": "cell.motion.scan",
     "cell_obstacles": "cell.motion.scene",
     "DEFAULT_DT": "cell.motion.timing",
-    "PathProfile": "cell.motion.trajectory",
-    "Trajectory": "cell.motion.trajectory",
+    "PathProfile": "cell.types.trajectory",
+    "Trajectory": "cell.types.trajectory",
     "path_profile": "cell.motion.timing",
     "ptp": "cell.motion.timing",
     "ptp_duration": "cell.motion.timing",

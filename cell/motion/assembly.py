@@ -16,10 +16,10 @@ from cell.geometry import FloatArray, readonly
 from cell.motion.candidates import SeamSolution
 from cell.motion.lines import line_trajectory
 from cell.motion.plan_options import PlanOptions
-from cell.motion.program import Segment
 from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess
 from cell.motion.transfers import Piece, TransferFail, Transfers
+from cell.types.plan import Segment
 
 
 def seam_pieces(robot: RobotModel, process: WeldProcess, options: PlanOptions, sol: SeamSolution) -> list[Piece]:

@@ -29,9 +29,9 @@ from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable
 from cell.motion.ik import solve_ik
 from cell.motion.lines import solve_line
 from cell.motion.plan_options import PlanOptions
-from cell.motion.program import PlanReason, SeamTask
 from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess, back_off, line_poses, torch_poses
+from cell.types.plan import PlanReason, SeamTask
 
 
 @dataclass(frozen=True)

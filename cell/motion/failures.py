@@ -1,6 +1,6 @@
 """Why a seam's candidate failed while planning (:class:`SeamFailure`), and the words the report prints for it.
 
-A failure carries its code (:class:`~cell.motion.program.PlanReason`), where it happened in words, the failing
+A failure carries its code (:class:`~cell.types.plan.PlanReason`), where it happened in words, the failing
 point p_R (3,) in the robot base frame R [m] and its progress [m] along approach + seam + depart, by which the
 planner keeps the most telling failure of all the candidates it tried (:func:`better`).
 """
@@ -15,7 +15,7 @@ import numpy.typing as npt
 from cell.errors import IKError
 from cell.geometry import FloatArray
 from cell.motion.ik import IKSolveError
-from cell.motion.program import PlanReason
+from cell.types.plan import PlanReason
 
 # The word a reason's text starts with, per code (the report's text is "<word>: <where>").
 _WORD = {

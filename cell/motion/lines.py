@@ -16,9 +16,9 @@ from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.failures import LineError, SeamFailure, unreachable
 from cell.motion.ik import solve_ik
-from cell.motion.program import PlanReason
 from cell.motion.robot import RobotModel
 from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile
+from cell.types.plan import PlanReason
 
 
 def solve_line(

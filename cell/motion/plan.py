@@ -6,7 +6,7 @@ Per seam (:func:`plan_welds`):
    weld start, then along the seam, the approach and the depart; singularity and collision checks. The first
    candidate that passes is kept; otherwise the seam is reported with the reason that got furthest, e.g.
    ``unreachable: IK did not converge at 35.0 mm along the seam``, and its code
-   (:class:`~cell.motion.program.PlanReason`).
+   (:class:`~cell.types.plan.PlanReason`).
 3. Timing (:mod:`cell.motion.lines`, :mod:`cell.motion.assembly`): approach, weld and depart are straight TCP
    lines (KRL LIN): a one-axis Ruckig profile of the path length s(t) mapped through a C2 spline of the IK knots
    q(s); the weld runs at exactly the travel speed between its rest-to-rest ramps. Transfers between seams and
@@ -36,7 +36,6 @@ from cell.motion.failures import SeamFailure, reason_text
 from cell.motion.lines import line_trajectory
 from cell.motion.order import seam_order
 from cell.motion.plan_options import PlanOptions
-from cell.motion.program import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.motion.robot import RobotModel
 from cell.motion.scan import scan_configuration
 from cell.motion.scene import cell_obstacles
@@ -44,6 +43,7 @@ from cell.motion.tasks import seam_tasks
 from cell.motion.torch import WeldProcess
 from cell.motion.transfers import Piece, Transfers
 from cell.types import Part
+from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 
 
 def plan_welds(

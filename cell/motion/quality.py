@@ -2,32 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
+from cell.types.execution import WeldQuality
 
 _MM = 1000.0
-
-
-@dataclass(frozen=True)
-class WeldQuality:
-    """One seam's weld as executed.
-
-    tcp_rms_mm, tcp_max_mm : distance of the tool centre point from the true seam segment while the arc burned.
-    weld_time_s : arc time [s]; length_mm : length of the executed arc-on path.
-    speed_mm_s : median TCP speed while the arc burned, ramps excluded (the constant-speed part).
-    samples : number of recorded tool positions behind the figures.
-    """
-
-    tcp_rms_mm: float
-    tcp_max_mm: float
-    weld_time_s: float
-    length_mm: float
-    speed_mm_s: float
-    samples: int
 
 
 def distance_to_segment(p: npt.ArrayLike, a: npt.ArrayLike, b: npt.ArrayLike) -> FloatArray:

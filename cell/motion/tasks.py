@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.motion.program import SeamTask
 from cell.types import SeamEstimate, SeamStatus, WeldMap
+from cell.types.plan import SeamTask
 
 if TYPE_CHECKING:
     from cell.seams.base import Joint

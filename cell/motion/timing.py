@@ -20,7 +20,7 @@ import ruckig
 from cell.errors import TimingError
 from cell.geometry import FloatArray
 from cell.motion.limits import JointLimits
-from cell.motion.trajectory import PathProfile, Trajectory
+from cell.types.trajectory import PathProfile, Trajectory
 
 DEFAULT_DT = 0.004  # [s] sample period (250 Hz)
 _END_TOL = 1e-8  # how far Ruckig's end state may be from the target before it is an error [rad, rad/s]

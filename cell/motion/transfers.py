@@ -23,11 +23,11 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.failures import LineError
 from cell.motion.lines import line_trajectory, solve_line
 from cell.motion.plan_options import PlanOptions
-from cell.motion.program import SegmentKind
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.torch import WeldProcess, line_poses
 from cell.types import Part
+from cell.types.plan import SegmentKind
 
 
 class Piece(NamedTuple):

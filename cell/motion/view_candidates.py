@@ -16,9 +16,9 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, transform_points
-from cell.motion.program import SeamTask
 from cell.motion.robot import RobotModel
 from cell.types import CameraIntrinsics, Part
+from cell.types.plan import SeamTask
 
 
 @dataclass(frozen=True)

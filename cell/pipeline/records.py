@@ -18,12 +18,11 @@ from cell.station.ports import Arm
 from cell.types import DepthImage, Part, SeamEstimate, SeamStatus, WeldMap
 
 if TYPE_CHECKING:
-    from cell.motion.plan import WeldPlan
-    from cell.motion.quality import WeldQuality
-    from cell.motion.timing import Trajectory
     from cell.perception import Alignment, Perceived
     from cell.rescan import Rescan
-    from cell.sim.robot import Execution
+    from cell.types.execution import Execution, WeldQuality
+    from cell.types.plan import WeldPlan
+    from cell.types.trajectory import Trajectory
 
 
 @dataclass(frozen=True)

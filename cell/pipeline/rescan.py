@@ -40,8 +40,8 @@ from cell.types import SeamEstimate, SeamStatus
 
 if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker
-    from cell.motion.timing import Trajectory
-    from cell.sim.robot import Execution
+    from cell.types.execution import Execution
+    from cell.types.trajectory import Trajectory
 
 Progress = Callable[[str], None]
 RescanMode = Literal["low", "all"]

@@ -19,9 +19,9 @@ from cell.station import Station, open_station
 from cell.types import SeamStatus
 
 if TYPE_CHECKING:
-    from cell.motion.plan import WeldPlan
-    from cell.motion.timing import Trajectory
-    from cell.sim.robot import Execution
+    from cell.types.execution import Execution
+    from cell.types.plan import WeldPlan
+    from cell.types.trajectory import Trajectory
 
 Progress = Callable[[str], None]
 

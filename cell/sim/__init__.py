@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from cell.sim.execution import Event, Execution
+from cell.types.execution import Event, Execution
 
 if TYPE_CHECKING:
     from cell.sim.cell import SimCell

@@ -30,11 +30,11 @@ from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
-from cell.sim.execution import Execution
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.noise import apply_noise, perturb_pose
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
+from cell.types.execution import Execution
 
 GROUND = "ground"
 TABLE = "table"

@@ -10,69 +10,12 @@ Frames: ``W`` world. Units: metres, radians, seconds.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from cell.geometry import FloatArray, readonly
-
-
-class Event(NamedTuple):
-    """One entry of an execution log: time [s], kind ``"move"`` | ``"arc_on"`` | ``"arc_off"``, free text."""
-
-    t: float
-    kind: str
-    detail: str
-
-
-@dataclass(frozen=True)
-class Execution:
-    """What the simulated arm did while playing back a joint trajectory.
-
-    times : (n,) record times [s] (the trajectory's time axis: a grid of ``record_dt`` from its first time, every
-        arc switch time, and its last time).
-    q : (n, dof) joint values played at those times [rad], in the robot's joint order.
-    tcp_W : (n, 3) position of the tool frame in W [m], from PyBullet's forward kinematics.
-    arc_on : (n,) bool, the arc state holding from each record time to the next.
-    events : time-ordered log of :class:`Event` (move marks, arc_on, arc_off).
-    X_W_tcp : (n, 4, 4) full tool poses in W, or None when not recorded.
-    """
-
-    times: FloatArray
-    q: FloatArray
-    tcp_W: FloatArray
-    arc_on: npt.NDArray[np.bool_]
-    events: tuple[Event, ...]
-    X_W_tcp: FloatArray | None = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "times", readonly(self.times))
-        object.__setattr__(self, "q", readonly(self.q))
-        object.__setattr__(self, "tcp_W", readonly(self.tcp_W))
-        object.__setattr__(self, "arc_on", readonly(self.arc_on, np.bool_))
-        if self.X_W_tcp is not None:
-            object.__setattr__(self, "X_W_tcp", readonly(self.X_W_tcp))
-        n = len(self.times)
-        if self.tcp_W.shape != (n, 3) or self.arc_on.shape != (n,) or self.q.shape[0] != n:
-            raise ValueError(f"Execution arrays must have one row per record time ({n})")
-
-    @property
-    def duration(self) -> float:
-        """Robot time from the first to the last record [s]."""
-        return float(self.times[-1] - self.times[0])
-
-    @property
-    def arc_time(self) -> float:
-        """Time with the arc on [s]."""
-        return float(np.sum(np.diff(self.times)[self.arc_on[:-1]]))
-
-    @property
-    def weld_length(self) -> float:
-        """Length of the tool path travelled with the arc on [m]."""
-        steps = np.linalg.norm(np.diff(self.tcp_W, axis=0), axis=1)
-        return float(np.sum(steps[self.arc_on[:-1]]))
+from cell.geometry import FloatArray
+from cell.types.execution import Event
 
 
 def _check_trajectory(

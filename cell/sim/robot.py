@@ -27,7 +27,8 @@ from scipy.spatial.transform import Rotation
 
 from cell.errors import PlanError, ScenarioError
 from cell.geometry import FloatArray, make_pose, readonly
-from cell.sim.execution import Event, Execution, _check_trajectory, _events, _interp_rows, _record_times
+from cell.sim.execution import _check_trajectory, _events, _interp_rows, _record_times
+from cell.types.execution import Event, Execution
 
 __all__ = ["BeadStyle", "Event", "Execution", "SimRobot", "add_bead", "bead_chords", "bead_segment"]
 

@@ -27,7 +27,7 @@ from cell.types import CameraIntrinsics, DepthImage, Part
 
 if TYPE_CHECKING:
     from cell.motion.robot import RobotModel
-    from cell.sim.robot import Execution
+    from cell.types.execution import Execution
 
 
 @dataclass(frozen=True)

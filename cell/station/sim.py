@@ -21,7 +21,7 @@ from cell.types import CameraIntrinsics, DepthImage, Part, WeldMap
 
 if TYPE_CHECKING:
     from cell.sim.cell import SimCell
-    from cell.sim.robot import Execution
+    from cell.types.execution import Execution
 
 
 class SimStation:

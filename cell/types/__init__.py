@@ -7,9 +7,12 @@ Units: metres and radians everywhere inside; millimetres and degrees only at the
 Every stage imports its values from here and nothing here imports a stage (an import-linter contract).
 """
 
+from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
+from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.seams import Reason, SeamEstimate, SeamStatus
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage
+from cell.types.trajectory import PathProfile, Trajectory
 
 __all__ = [
     "BOX_FACES",
@@ -17,10 +20,21 @@ __all__ = [
     "CameraIntrinsics",
     "Cloud",
     "DepthImage",
+    "Event",
+    "Execution",
     "MapSeam",
     "Part",
+    "PathProfile",
+    "PlanReason",
     "Reason",
     "SeamEstimate",
+    "SeamOutcome",
     "SeamStatus",
+    "SeamTask",
+    "Segment",
+    "SegmentKind",
+    "Trajectory",
     "WeldMap",
+    "WeldPlan",
+    "WeldQuality",
 ]

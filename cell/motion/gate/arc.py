@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.motion.gate.base import DEG, GateInput, Violation, ViolationKind
-from cell.motion.program import Segment
+from cell.types.plan import Segment
 
 
 @dataclass(frozen=True)

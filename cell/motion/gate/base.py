@@ -16,9 +16,9 @@ import numpy as np
 
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
-from cell.motion.program import Segment, WeldPlan
 from cell.motion.robot import RobotModel
-from cell.motion.trajectory import Trajectory
+from cell.types.plan import Segment, WeldPlan
+from cell.types.trajectory import Trajectory
 
 DEG = 180.0 / math.pi  # [deg/rad] for messages
 

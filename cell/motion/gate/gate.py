@@ -17,8 +17,8 @@ from cell.motion.gate.position import PositionLimits
 from cell.motion.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
 from cell.motion.gate.singularity import Singularity
 from cell.motion.gate.start import StartState
-from cell.motion.program import WeldPlan
 from cell.motion.robot import RobotModel
+from cell.types.plan import WeldPlan
 
 # The gate's checks, in the order their violations are listed.
 DEFAULT_CHECKS: tuple[Check, ...] = (

@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from cell.errors import PlanError
 from cell.geometry import FloatArray, readonly
-from cell.motion.trajectory import Trajectory
+from cell.types.trajectory import Trajectory
 
 SegmentKind = Literal["move", "approach", "weld", "depart"]
 

@@ -5,7 +5,6 @@ pass (and every tilt step) is one batched fit for all of them."""
 from __future__ import annotations
 
 from collections.abc import Generator, Sequence
-from dataclasses import replace
 
 import numpy as np
 
@@ -167,8 +166,8 @@ class OursLocator:
             fitting = (yield request).applied(request, face_a, face_b, ends)
             # Support regions' areas, for the confidence: A's strip between its ends, B's strip beside A.
             area_a = max(e1 - e0 - 2.0 * eb, 0.0) * max(min(o.tube_radius_m, geo.length_a) - band_b - eb, 0.0)
-            face_a = replace(fitting.face_a, area=area_a)
-            face_b = replace(fitting.face_b, area=(e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0))
+            face_a = fitting.face_a.with_area(area_a)
+            face_b = fitting.face_b.with_area((e1 - e0 + 2.0 * o.extend_m) * max(o.tube_radius_m - band_a, 0.0))
             p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
             # p0 lies on both fitted planes: its distance from a map plane is how far that face moved.
             for drift, name in ((abs(float(n_a @ p0) - d_a), face_a.name), (abs(float(n_b @ p0) - d_b), face_b.name)):

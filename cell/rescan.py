@@ -30,14 +30,13 @@ import numpy as np
 
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, invert
-from cell.motion.viewpoint import ViewOptions, Viewpoint, ViewTarget
+from cell.motion.viewpoint import ViewOptions, ViewTarget
 from cell.seams.base import SeamScene
 from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamStatus
+from cell.types.rescan import Rescan, SeamRescan
 
 if TYPE_CHECKING:
     from cell.scenario import Scenario
-    from cell.types.execution import Execution
-    from cell.types.trajectory import Trajectory
 
 # Below this confidence a seam is worth a close look (benchmarks/bench_confidence.py: 144 seams of fence1-exact,
 # fence1 and fence2, realistic noise; 20 fall below it, with 2 of the 3 seams more than 0.15 mm off). A scenario
@@ -81,60 +80,6 @@ class RescanOptions:
     )
     return_to_scan: bool = True
     view: ViewOptions = field(default_factory=ViewOptions)
-
-
-@dataclass(frozen=True)
-class SeamRescan:
-    """What the re-scan did for one seam (all estimates in R).
-
-    before : the first estimate; closeup : the close-up estimate (None when no image was taken); fused : what
-    the cell should use now; weight : the close-up's share of the fused position (0: the first kept);
-    viewpoint : the view (None when none was reachable); motion_s : robot time of the move to it [s];
-    wall_s : wall time of planning, moving, capturing and locating [s]; reason : why the re-scan failed or was
-    not used ('' when it was).
-    """
-
-    id: str
-    before: SeamEstimate
-    closeup: SeamEstimate | None
-    fused: SeamEstimate
-    weight: float
-    viewpoint: Viewpoint | None
-    motion_s: float
-    wall_s: float
-    reason: str = ""
-    points: int = 0
-
-    @property
-    def used(self) -> bool:
-        return self.weight > 0.0
-
-
-@dataclass(frozen=True)
-class Rescan:
-    """The outcome of :func:`rescan_seams`.
-
-    seams : one :class:`SeamRescan` per re-scanned seam, in the order visited.
-    estimates : every seam of the detection, the re-scanned ones replaced by their fused estimate.
-    moves : the moves played (to each view, then back), executions : what the simulated arm did.
-    q_end : (dof,) [rad] where the arm was left; returned : whether that is the scan configuration; note : why
-    not. escalated_mm : the close-up disagreement [mm] that made the re-scan take every seam (0: no escalation).
-    """
-
-    seams: tuple[SeamRescan, ...]
-    estimates: tuple[SeamEstimate, ...]
-    moves: tuple[Trajectory, ...]
-    executions: tuple[Execution, ...]
-    q_end: FloatArray
-    returned: bool
-    note: str = ""
-    timings: dict[str, float] = field(default_factory=dict)
-    escalated_mm: float = 0.0
-
-    @property
-    def motion_s(self) -> float:
-        """Robot time of every move of the re-scan [s]."""
-        return float(sum(m.duration for m in self.moves))
 
 
 # -- uncertainty and fusion --------------------------------------------------------------------------------

@@ -28,14 +28,13 @@ each was rejected) when none does.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from enum import StrEnum
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.errors import IKError, PlanError, TimingError
-from cell.geometry import FloatArray, readonly
+from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
@@ -49,6 +48,7 @@ from cell.motion.view_candidates import (
     view_candidates,
 )
 from cell.types import CameraIntrinsics, Part
+from cell.types.rescan import Viewpoint
 
 _segments_hit_box = segments_hit_box  # the old private name (tests/test_rescan.py imports it from here)
 
@@ -74,34 +74,6 @@ class NoViewError(PlanError):
         self.seam_id = seam_id
         self.tried = tried
         self.rejected = dict(rejected or {})
-
-
-@dataclass(frozen=True)
-class Viewpoint:
-    """A checked close-up view of one seam.
-
-    X_RC : (4, 4) pose of the camera's optical frame in R at the view (what IK reached).
-    q : (dof,) [rad] the arm's configuration there; move : the checked jerk-limited move from the start.
-    distance_m : from the camera to the seam's midpoint; incidence_deg : worst angle between a line of sight
-    and face A's / face B's normal; tilt_deg, slant_deg, roll_deg : the candidate's angles; tried : candidates
-    given IK and collision checks before this one passed, this one included.
-    """
-
-    seam_id: str
-    X_RC: FloatArray
-    q: FloatArray
-    move: Trajectory
-    distance_m: float
-    incidence_deg: tuple[float, float]
-    tilt_deg: float
-    slant_deg: float
-    roll_deg: float
-    tried: int
-    via: bool = False  # the move passes through q_via
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "X_RC", readonly(self.X_RC))
-        object.__setattr__(self, "q", readonly(self.q))
 
 
 def plan_view(

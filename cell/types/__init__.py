@@ -10,6 +10,7 @@ Every stage imports its values from here and nothing here imports a stage (an im
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
+from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 from cell.types.seams import Reason, SeamEstimate, SeamStatus
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage
 from cell.types.trajectory import PathProfile, Trajectory
@@ -27,13 +28,16 @@ __all__ = [
     "PathProfile",
     "PlanReason",
     "Reason",
+    "Rescan",
     "SeamEstimate",
     "SeamOutcome",
+    "SeamRescan",
     "SeamStatus",
     "SeamTask",
     "Segment",
     "SegmentKind",
     "Trajectory",
+    "Viewpoint",
     "WeldMap",
     "WeldPlan",
     "WeldQuality",

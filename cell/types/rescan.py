@@ -1,0 +1,95 @@
+"""What a close-up re-scan did: the view it took of a seam, the estimates before and after, the moves it played.
+
+Frame ``R`` (robot base) for every estimate and pose; metres, radians, seconds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from cell.geometry import FloatArray, readonly
+from cell.types.execution import Execution
+from cell.types.seams import SeamEstimate
+from cell.types.trajectory import Trajectory
+
+
+@dataclass(frozen=True)
+class Viewpoint:
+    """A checked close-up view of one seam.
+
+    X_RC : (4, 4) pose of the camera's optical frame in R at the view (what IK reached).
+    q : (dof,) [rad] the arm's configuration there; move : the checked jerk-limited move from the start.
+    distance_m : from the camera to the seam's midpoint; incidence_deg : worst angle between a line of sight
+    and face A's / face B's normal; tilt_deg, slant_deg, roll_deg : the candidate's angles; tried : candidates
+    given IK and collision checks before this one passed, this one included.
+    """
+
+    seam_id: str
+    X_RC: FloatArray
+    q: FloatArray
+    move: Trajectory
+    distance_m: float
+    incidence_deg: tuple[float, float]
+    tilt_deg: float
+    slant_deg: float
+    roll_deg: float
+    tried: int
+    via: bool = False  # the move passes through q_via
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "X_RC", readonly(self.X_RC))
+        object.__setattr__(self, "q", readonly(self.q))
+
+
+@dataclass(frozen=True)
+class SeamRescan:
+    """What the re-scan did for one seam (all estimates in R).
+
+    before : the first estimate; closeup : the close-up estimate (None when no image was taken); fused : what
+    the cell should use now; weight : the close-up's share of the fused position (0: the first kept);
+    viewpoint : the view (None when none was reachable); motion_s : robot time of the move to it [s];
+    wall_s : wall time of planning, moving, capturing and locating [s]; reason : why the re-scan failed or was
+    not used ('' when it was).
+    """
+
+    id: str
+    before: SeamEstimate
+    closeup: SeamEstimate | None
+    fused: SeamEstimate
+    weight: float
+    viewpoint: Viewpoint | None
+    motion_s: float
+    wall_s: float
+    reason: str = ""
+    points: int = 0
+
+    @property
+    def used(self) -> bool:
+        return self.weight > 0.0
+
+
+@dataclass(frozen=True)
+class Rescan:
+    """The outcome of :func:`rescan_seams`.
+
+    seams : one :class:`SeamRescan` per re-scanned seam, in the order visited.
+    estimates : every seam of the detection, the re-scanned ones replaced by their fused estimate.
+    moves : the moves played (to each view, then back), executions : what the simulated arm did.
+    q_end : (dof,) [rad] where the arm was left; returned : whether that is the scan configuration; note : why
+    not. escalated_mm : the close-up disagreement [mm] that made the re-scan take every seam (0: no escalation).
+    """
+
+    seams: tuple[SeamRescan, ...]
+    estimates: tuple[SeamEstimate, ...]
+    moves: tuple[Trajectory, ...]
+    executions: tuple[Execution, ...]
+    q_end: FloatArray
+    returned: bool
+    note: str = ""
+    timings: dict[str, float] = field(default_factory=dict)
+    escalated_mm: float = 0.0
+
+    @property
+    def motion_s(self) -> float:
+        """Robot time of every move of the re-scan [s]."""
+        return float(sum(m.duration for m in self.moves))

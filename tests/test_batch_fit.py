@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cell.seams import _batch, _index
+from cell.seams import _batch, _index, _robust
 from cell.types import Cloud
 from cell.voxels import voxel_order
 
@@ -111,3 +111,20 @@ def test_voxel_order_groups_each_voxel_and_its_table_says_where() -> None:
     assert np.allclose(table.lo, P.min(axis=0)) and np.allclose(table.hi, P.max(axis=0))
     camera_of = {tuple(p): c for p, c in zip(P, cam, strict=True)}
     assert all(camera_of[tuple(p)] == c for p, c in zip(ordered.points[:500], ordered.camera[:500], strict=True))
+
+
+def test_robust_offset_recovers_a_plane_despite_outliers_and_weighs_cameras_by_their_noise() -> None:
+    """The scalar fit that places a face from an adjacent face's edge (cell.seams._edge)."""
+    rng = np.random.default_rng(5)
+    n = 2000
+    cam = rng.integers(0, 2, n)  # camera 1 is five times noisier than camera 0
+    r = 0.0012 + np.where(cam == 0, 0.0004, 0.002) * rng.standard_normal(n)
+    out = rng.random(n) < 0.1  # 10 % of another surface 6 mm behind
+    r[out] = 0.0012 - 0.006 + 0.0004 * rng.standard_normal(int(out.sum()))
+    fit = _robust.robust_offset(r, cam, _robust.histogram_mode(r, 0.002))
+    # Weighted by camera: within 3 standard errors of the quiet camera's mean (0.4 mm / sqrt(900); measured 1.6 um).
+    assert abs(fit.offset - 0.0012) < 3.0 * 0.0004 / np.sqrt(900)
+    assert 0.0006 < fit.scale < 0.0012  # the inliers' scale, both cameras pooled (measured 0.80 mm)
+    # Noise-free: exact, no scatter.
+    exact = _robust.robust_offset(np.full(100, 0.003), np.zeros(100, np.intp), 0.0)
+    assert exact.offset == 0.003 and exact.scale == 0.0

@@ -23,7 +23,7 @@ from cell.types import MapSeam, SeamEstimate, SeamStatus
 
 
 class OursLocator:
-    """Map-guided plane-fit seam locator (see the module docstring). Deterministic for a given ``rng``."""
+    """Map-guided plane-fit seam locator (the method: :mod:`cell.seams.ours`). Deterministic for a given ``rng``."""
 
     name: str = "ours"
 
@@ -31,7 +31,7 @@ class OursLocator:
         self.options = options if options is not None else OursOptions()
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
-        """Find ``seam`` (frame R) in ``scene.dense`` (see the module docstring); MapError for a bad joint."""
+        """Find ``seam`` (frame R) in ``scene.dense`` (the method: :mod:`cell.seams.ours`); MapError for a bad joint."""
         return self.locate_many_with_errors(scene, [seam], rng)[0][0]
 
     def locate_with_errors(

@@ -33,8 +33,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
-from cell.motion.robot import RobotModel
 from cell.types.plan import WeldPlan
+from cell.types.robot import Kinematics
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,23}")
 _X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (x along the wire)
@@ -76,7 +76,7 @@ def _e6axis(q: FloatArray) -> str:
 
 def krl_program(
     plan: WeldPlan,
-    robot: RobotModel,
+    robot: Kinematics,
     name: str,
     *,
     X_WR: npt.ArrayLike | None = None,
@@ -168,7 +168,7 @@ def _marker(which: str, seam_id: str, opt: KrlOptions) -> str:
 
 def write_krl(
     plan: WeldPlan,
-    robot: RobotModel,
+    robot: Kinematics,
     directory: str | Path,
     name: str,
     *,

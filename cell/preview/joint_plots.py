@@ -8,9 +8,9 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.motion.limits import JointLimits
 from cell.preview.figures import new_figure
 from cell.preview.views import ARC_COLOUR
+from cell.types.robot import JointLimits
 
 
 def render_joint_plots(

@@ -11,6 +11,7 @@ from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
+from cell.types.robot import JointLimits, Kinematics
 from cell.types.seams import Reason, SeamEstimate, SeamStatus
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage
 from cell.types.trajectory import PathProfile, Trajectory
@@ -23,6 +24,8 @@ __all__ = [
     "DepthImage",
     "Event",
     "Execution",
+    "JointLimits",
+    "Kinematics",
     "MapSeam",
     "Part",
     "PathProfile",

@@ -15,7 +15,7 @@ from cell.geometry import FloatArray
 from cell.scenario import PaperLocatorSpec
 from cell.seams._features import cloud_features
 from cell.seams.base import SeamScene
-from cell.types import MapSeam, SeamEstimate, SeamStatus
+from cell.types import MapSeam, Reason, SeamEstimate, SeamStatus
 
 AXIS_TOLERANCE_DEG = 10.0  # a seam within this of x, y or z counts as "along" it
 MIN_MASK_POINTS = 8  # fewer cloud points than this in the outer mask: nothing to measure
@@ -26,8 +26,8 @@ FACE_NORMAL_COS = float(np.cos(np.radians(30.0)))  # ... and how close to the ax
 _NOT_AXIS = "the paper's method handles seams along x, y or z only"
 
 
-def _not_found(seam: MapSeam, reason: str) -> SeamEstimate:
-    return SeamEstimate(seam.id, SeamStatus.NOT_FOUND, reason)
+def _not_found(seam: MapSeam, reason: str, code: Reason = Reason.NO_SUPPORT) -> SeamEstimate:
+    return SeamEstimate(seam.id, SeamStatus.NOT_FOUND, reason, code=code)
 
 
 def second_most_frequent(values: FloatArray, bin_m: float) -> float:
@@ -144,7 +144,7 @@ class PaperLocator:
         del rng
         axes = self.axes(scene, seam)
         if isinstance(axes, str):
-            return _not_found(seam, axes)
+            return _not_found(seam, axes, Reason.NOT_SUPPORTED)
         c, a = axes
         pts = np.asarray(scene.cloud.points)
         s0 = np.asarray(seam.p_start)

@@ -27,7 +27,7 @@ from cell.geometry import FloatArray
 from cell.seams._index import dense_index
 from cell.seams._lines import plane_intersection
 from cell.seams.base import SeamScene
-from cell.types import MapSeam, SeamEstimate, SeamStatus
+from cell.types import MapSeam, Reason, SeamEstimate, SeamStatus
 
 
 @dataclass(frozen=True)
@@ -99,6 +99,7 @@ class RansacLocator:
             return SeamEstimate(
                 seam.id,
                 SeamStatus.NOT_FOUND,
+                code=Reason.NO_SUPPORT,
                 reason=f"{len(P)} points near the seam, RANSAC needs {2 * o.min_inliers}",
             )
         th = o.thresholds(_spacing(P))
@@ -111,6 +112,7 @@ class RansacLocator:
             return SeamEstimate(
                 seam.id,
                 SeamStatus.NOT_FOUND,
+                code=Reason.NO_SUPPORT,
                 reason=f"no two planes along the map's weld faces near the seam in {o.runs} RANSAC runs "
                 f"({len(P)} points, planes of at least {th.min_inliers})",
             )

@@ -19,7 +19,7 @@ from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
-from cell.types import MapSeam, SeamEstimate, SeamStatus
+from cell.types import MapSeam, Reason, SeamEstimate, SeamStatus
 
 
 class OursLocator:
@@ -99,7 +99,8 @@ class OursLocator:
                 f"{joint.face_receiving} are parallel; a joint needs two faces that meet in a line"
             ) from None
         if against_table(n_a, n_b, seam, scene.table_z, o.map_tolerance_m):
-            return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, "the seam lies against the table"), NO_ERRORS
+            reason = "the seam lies against the table"
+            return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason, code=Reason.UNDERSIDE), NO_ERRORS
 
         pts = gather(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng, o)
 
@@ -205,9 +206,11 @@ class OursLocator:
             p_start=p0 + ends[0].s * t,
             p_end=p0 + ends[1].s * t,
             confidence=conf,
+            sigma_m=errors.lateral_m,
         )
         return estimate, errors
 
 
 def _not_found(seam_id: str, reason: str) -> tuple[SeamEstimate, SeamErrors]:
-    return SeamEstimate(seam_id, SeamStatus.NOT_FOUND, reason=reason), NO_ERRORS
+    """NOT_FOUND: the data does not hold the seam's faces or ends (``reason`` says which and why)."""
+    return SeamEstimate(seam_id, SeamStatus.NOT_FOUND, reason=reason, code=Reason.NO_SUPPORT), NO_ERRORS

@@ -25,7 +25,7 @@ from cell.seams import _extent, _lines
 from cell.seams.base import SeamScene
 from cell.seams.ours import OursLocator, OursOptions
 from cell.seams.ransac import RansacLocator, RansacOptions
-from cell.types import Box, SeamStatus
+from cell.types import Box, Reason, SeamStatus
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +68,7 @@ def test_ours_confidence_falls_with_support_and_missing_face_is_not_found(scenes
     n_b, d_b = scene.weldmap.part("B").box.face_plane("-y")
     off_b = np.abs(scene.dense.points @ n_b - d_b) > 0.012
     gone = OursLocator().locate(thinned(scene, off_b), seam, np.random.default_rng(0))
-    assert gone.status is SeamStatus.NOT_FOUND
+    assert gone.status is SeamStatus.NOT_FOUND and gone.code is Reason.NO_SUPPORT
     assert "B -y" in gone.reason
 
 
@@ -114,7 +114,7 @@ def test_ours_places_an_unseen_face_from_its_edge(scenes: dict) -> None:
     n_top, d_top = box_a.face_plane("+z")
     rim = ((hidden.dense.points @ n_top - d_top) > -0.015) & box_a.contains(hidden.dense.points, margin=0.01)
     gone = OursLocator().locate(thinned(hidden, ~rim), seam, np.random.default_rng(0))
-    assert gone.status is SeamStatus.NOT_FOUND
+    assert gone.status is SeamStatus.NOT_FOUND and gone.code is Reason.NO_SUPPORT
     assert "face A +z" in gone.reason and "edge" in gone.reason
 
 
@@ -144,7 +144,7 @@ def test_ours_refuses_an_unseen_face_whose_edge_is_not_defined(
 ) -> None:
     scene, _ = scene_with(boxes, render_opts)
     est = OursLocator().locate(scene, scene.weldmap.seam(TOP), np.random.default_rng(0))
-    assert est.status is SeamStatus.NOT_FOUND
+    assert est.status is SeamStatus.NOT_FOUND and est.code is Reason.NO_SUPPORT
     assert "face A +z is seen by no usable camera" in est.reason
     assert "its edge is not defined well enough" in est.reason and why in est.reason, est.reason
 
@@ -175,7 +175,7 @@ def test_ours_takes_no_end_where_the_cloud_stops(scenes: dict) -> None:
     x_cut = float(CASES["axis-aligned"][0][0, 3]) + 0.02  # through A (x 0.262..0.342 m)
     cut = thinned(scene, scene.dense.points[:, 0] < x_cut)
     est = OursLocator().locate(cut, seam, np.random.default_rng(0))
-    assert est.status is SeamStatus.NOT_FOUND
+    assert est.status is SeamStatus.NOT_FOUND and est.code is Reason.NO_SUPPORT
     assert "the seam's end is not seen" in est.reason and "workspace" in est.reason, est.reason
     # Given the workspace, the same; a workspace that the cloud does not reach is not a cut.
     lo, hi = np.array([-1.0, -1.0, -1.0]), np.array([x_cut, 1.0, 2.0])

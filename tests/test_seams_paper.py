@@ -15,7 +15,7 @@ from cell.seams.metrics import segment_errors
 from cell.seams.paper import PaperLocator, axis_faces, second_most_frequent
 from cell.seams.truth import true_seams
 from cell.seams.visibility import visibility
-from cell.types import Box, Cloud, MapSeam, Part, SeamStatus, WeldMap
+from cell.types import Box, Cloud, MapSeam, Part, Reason, SeamStatus, WeldMap
 
 MM = 0.001
 VOXEL = 0.01  # [m], as the paper
@@ -175,7 +175,7 @@ def test_empty_region_is_not_found() -> None:
         s.id, s.p_start + np.array([0.0, -0.5, 0.0]), s.p_end + np.array([0.0, -0.5, 0.0])
     )  # 0.5 m off: nothing there
     est = PaperLocator().locate(scene, away, np.random.default_rng(0))
-    assert est.status is SeamStatus.NOT_FOUND
+    assert est.status is SeamStatus.NOT_FOUND and est.code is Reason.NO_SUPPORT
     assert "outer mask" in est.reason and est.p_start.size == 0
 
 
@@ -185,7 +185,7 @@ def test_diagonal_seam_is_not_found() -> None:
     s = scene.weldmap.seam("POST_L>TOP_RAIL:+z")
     diagonal = MapSeam("DIAG", s.p_start, s.p_start + np.array([0.05, 0.03, 0.0]))  # 31 deg off x
     est = PaperLocator().locate(scene, diagonal, np.random.default_rng(0))
-    assert est.status is SeamStatus.NOT_FOUND
+    assert est.status is SeamStatus.NOT_FOUND and est.code is Reason.NOT_SUPPORTED
     assert est.reason == "the paper's method handles seams along x, y or z only"
     nearly = MapSeam("NEAR", s.p_start, s.p_start + np.array([0.08, 0.008, 0.0]))  # 5.7 deg off x: still "along x"
     assert PaperLocator().locate(scene, nearly, np.random.default_rng(0)).status is SeamStatus.FOUND

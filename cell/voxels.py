@@ -8,45 +8,11 @@ with outliers).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.types import Cloud
-
-IntArray = npt.NDArray[np.int64]
-
-
-@dataclass(frozen=True)
-class VoxelTable:
-    """Where the voxels of a cloud in voxel order (:func:`voxel_order`) lie.
-
-    voxel_m : edge of a voxel [m].
-    origin : (3,) integer coordinates of the grid's corner voxel: voxel (i, j, k) of the frame's grid
-        (``floor(p / voxel_m)``) has the key ``((i - o0) * dims[1] + (j - o1)) * dims[2] + (k - o2)``.
-    dims : (3,) voxels along x, y, z.
-    keys : (m,) keys of the occupied voxels, increasing.
-    starts : (m + 1,) voxel v holds the points ``starts[v]:starts[v + 1]`` of the ordered cloud.
-    lo, hi : (3,) bounds of the points [m].
-    """
-
-    voxel_m: float
-    origin: tuple[int, int, int]
-    dims: tuple[int, int, int]
-    keys: IntArray
-    starts: IntArray
-    lo: FloatArray
-    hi: FloatArray
-
-    def __len__(self) -> int:
-        return len(self.keys)
-
-    @property
-    def counts(self) -> IntArray:
-        """(m,) points in each voxel."""
-        return np.diff(self.starts)
+from cell.types.sensing import VoxelTable
 
 
 def voxel_order(cloud: Cloud, voxel_m: float) -> tuple[Cloud, VoxelTable]:

@@ -15,8 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray, invert, look_at, make_pose, rot_x, rot_z, transform_points
-from cell.seams.base import Joint, SeamScene
-from cell.types import Box, Cloud, MapSeam, Part, WeldMap
+from cell.types import Box, Cloud, Joint, MapSeam, Part, SeamScene, WeldMap
 
 TOP = "A>B:+z"  # along x, on A's top
 SIDE = "A>B:+x"  # along z, on A's +x side

@@ -19,9 +19,9 @@ from synthetic_joint import CASES, SIDE, TOP, errors, make_scene, thinned, voxel
 from cell import scenario as sc
 from cell.geometry import transform_points
 from cell.scenario import Scenario
-from cell.seams.base import BatchSeamLocator, SeamLocator, SeamScene
+from cell.seams.base import BatchSeamLocator, SeamLocator
 from cell.seams.registry import METHODS, make_locator
-from cell.types import Reason, SeamEstimate, SeamStatus
+from cell.types import Reason, SeamEstimate, SeamScene, SeamStatus
 
 
 @dataclass(frozen=True)

@@ -22,10 +22,9 @@ from synthetic_joint import (
 
 from cell.geometry import make_pose, rot_z
 from cell.seams import _extent, _lines
-from cell.seams.base import SeamScene
 from cell.seams.ours import OursLocator, OursOptions
 from cell.seams.ransac import RansacLocator, RansacOptions
-from cell.types import Box, Reason, SeamStatus
+from cell.types import Box, Reason, SeamScene, SeamStatus
 
 
 @pytest.fixture(scope="module")

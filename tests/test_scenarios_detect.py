@@ -14,8 +14,7 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.seams.metrics import MetricsSummary, SeamMetrics
-from cell.types import SeamEstimate, SeamStatus
+from cell.types import MetricsSummary, SeamEstimate, SeamMetrics, SeamStatus
 
 pytestmark = pytest.mark.scenario
 

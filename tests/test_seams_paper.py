@@ -9,13 +9,12 @@ import pytest
 from cell.geometry import invert, make_pose, transform_points
 from cell.scenario import PaperLocatorSpec
 from cell.seams._features import cloud_features
-from cell.seams.base import SeamScene
 from cell.seams.joint import find_joints
 from cell.seams.metrics import segment_errors
 from cell.seams.paper import PaperLocator, axis_faces, second_most_frequent
 from cell.seams.truth import true_seams
 from cell.seams.visibility import visibility
-from cell.types import Box, Cloud, MapSeam, Part, Reason, SeamStatus, WeldMap
+from cell.types import Box, Cloud, MapSeam, Part, Reason, SeamScene, SeamStatus, WeldMap
 
 MM = 0.001
 VOXEL = 0.01  # [m], as the paper

@@ -8,12 +8,11 @@ import pytest
 
 from cell.errors import MapError
 from cell.geometry import invert, make_pose, rot_z, transform_points
-from cell.seams.base import Joint
 from cell.seams.joint import fillet_bisector, find_joints, weld_faces
 from cell.seams.metrics import evaluate, seam_metrics, segment_errors, summarise
 from cell.seams.truth import true_seams
 from cell.seams.visibility import UNDERSIDE_REASON, visibility
-from cell.types import Box, MapSeam, Part, SeamEstimate, SeamStatus, WeldMap
+from cell.types import Box, Joint, MapSeam, Part, SeamEstimate, SeamStatus, WeldMap
 
 MM = 0.001
 

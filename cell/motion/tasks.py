@@ -12,7 +12,7 @@ from cell.types import SeamEstimate, SeamStatus, WeldMap
 from cell.types.plan import SeamTask
 
 if TYPE_CHECKING:
-    from cell.seams.base import Joint
+    from cell.types import Joint
 
 
 def seam_tasks(

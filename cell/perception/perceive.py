@@ -23,8 +23,8 @@ from cell.perception.deproject import clouds_in_robot_frame
 from cell.perception.preprocess import downsample, preprocess
 from cell.perception.splice import Spliced, splice
 from cell.scenario import PerceptionSpec
-from cell.types import Cloud, DepthImage
-from cell.voxels import VoxelTable, voxel_order
+from cell.types import Cloud, DepthImage, VoxelTable
+from cell.voxels import voxel_order
 
 
 @dataclass(frozen=True)

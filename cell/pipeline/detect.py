@@ -11,10 +11,8 @@ from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
 from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
-from cell.seams.base import SeamScene
-from cell.seams.metrics import MetricsSummary, SeamMetrics
 from cell.station import Station, open_station
-from cell.types import Reason, SeamEstimate, SeamStatus, WeldMap
+from cell.types import MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus, WeldMap
 
 Progress = Callable[[str], None]
 

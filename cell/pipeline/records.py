@@ -12,10 +12,18 @@ from typing import TYPE_CHECKING
 from cell.errors import CellError
 from cell.geometry import FloatArray
 from cell.scenario import Scenario
-from cell.seams.base import Joint, SeamScene
-from cell.seams.metrics import MetricsSummary, SeamMetrics
 from cell.station.ports import Arm
-from cell.types import DepthImage, Part, SeamEstimate, SeamStatus, WeldMap
+from cell.types import (
+    DepthImage,
+    Joint,
+    MetricsSummary,
+    Part,
+    SeamEstimate,
+    SeamMetrics,
+    SeamScene,
+    SeamStatus,
+    WeldMap,
+)
 
 if TYPE_CHECKING:
     from cell.perception import Alignment, Perceived

@@ -1,9 +1,9 @@
 """Seams: pair each map seam with its joint, tell whether a camera can see it, locate it, and score it.
 
 The public names are listed in ``__all__`` and load on first use (``from cell.seams import OursLocator`` imports
-only the ours locator's modules, as :func:`make_locator` does): the locators and their options, the scene they read
-(:class:`SeamScene`), the registry (:data:`METHODS`, :func:`make_locator`), joints, truth and metrics. Visibility is
-the module :mod:`cell.seams.visibility` (its function ``visibility`` shares the module's name, so the package does
+only the ours locator's modules, as :func:`make_locator` does): the locators and their options, the registry
+(:data:`METHODS`, :func:`make_locator`), joints, truth and metrics; the values they read and return (the scene,
+joints, estimates, metrics) are in :mod:`cell.types`. Visibility is the module :mod:`cell.seams.visibility` (its function ``visibility`` shares the module's name, so the package does
 not re-export it). The modules with a leading underscore are this package's own; nothing outside it imports them.
 """
 
@@ -13,9 +13,9 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from cell.seams.base import BatchSeamLocator, Joint, SeamLocator, SeamScene
+    from cell.seams.base import BatchSeamLocator, SeamLocator
     from cell.seams.joint import fillet_bisector, find_joints, weld_faces
-    from cell.seams.metrics import MetricsSummary, SeamMetrics, evaluate, seam_metrics, segment_errors, summarise
+    from cell.seams.metrics import evaluate, seam_metrics, segment_errors, summarise
     from cell.seams.ours import OursLocator, OursOptions, SeamErrors
     from cell.seams.paper import PaperLocator
     from cell.seams.ransac import RansacLocator, RansacOptions
@@ -25,14 +25,10 @@ if TYPE_CHECKING:
 
 _HOME = {
     "BatchSeamLocator": "base",
-    "Joint": "base",
     "SeamLocator": "base",
-    "SeamScene": "base",
     "fillet_bisector": "joint",
     "find_joints": "joint",
     "weld_faces": "joint",
-    "MetricsSummary": "metrics",
-    "SeamMetrics": "metrics",
     "evaluate": "metrics",
     "seam_metrics": "metrics",
     "segment_errors": "metrics",
@@ -53,8 +49,6 @@ __all__ = [
     "METHODS",
     "UNDERSIDE_REASON",
     "BatchSeamLocator",
-    "Joint",
-    "MetricsSummary",
     "OursLocator",
     "OursOptions",
     "PaperLocator",
@@ -62,8 +56,6 @@ __all__ = [
     "RansacOptions",
     "SeamErrors",
     "SeamLocator",
-    "SeamMetrics",
-    "SeamScene",
     "evaluate",
     "fillet_bisector",
     "find_joints",

@@ -12,14 +12,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.seams import INDEX_SHARES
 from cell.geometry import FloatArray, make_pose
-from cell.seams.base import SeamScene
-from cell.types import Box, Cloud
-from cell.voxels import VoxelTable, voxel_order
+from cell.types import Box, Cloud, SeamScene, VoxelTable
+from cell.voxels import voxel_order
 
 _BOX_KEY = "cell.seams._index.cloud_box"
 _INDEX_KEY = "cell.seams._index.dense_index"
-INDEX_SHARES = (0.25, 0.5, 1.0)  # shares of the dense cloud a query may ask for (1 / k: every k-th point)
 INDEX_VOXEL_M = 0.01  # voxel of an index built here (perception hands on its own, ``PerceptionSpec.voxel_m``)
 
 IntArray = npt.NDArray[np.intp]

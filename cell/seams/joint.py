@@ -14,8 +14,7 @@ import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.seams.base import Joint
-from cell.types import BOX_FACES, MapSeam, Part, WeldMap
+from cell.types import BOX_FACES, Joint, MapSeam, Part, WeldMap
 
 _ANTIPARALLEL_COS = float(np.cos(np.radians(5.0)))  # end face vs receiving face: within 5 deg of opposite
 

@@ -10,31 +10,14 @@ the seam reversed).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from cell.geometry import FloatArray, point_line_distance
 from cell.types import SeamEstimate, SeamStatus
+from cell.types.seams import MetricsSummary, SeamMetrics
 
 _MM = 1000.0
-
-
-@dataclass(frozen=True)
-class SeamMetrics:
-    """One seam's errors [mm] (NaN when the seam was not found) and the locator's time [ms]."""
-
-    id: str
-    status: SeamStatus
-    paper_me_mm: float
-    endpoint_mm: float
-    lateral_mm: float
-    time_ms: float
-    swapped: bool = False
-
-    @property
-    def found(self) -> bool:
-        return self.status is SeamStatus.FOUND
 
 
 def segment_errors(
@@ -76,27 +59,6 @@ def evaluate(
     if missing:
         raise KeyError(f"no true seam for {', '.join(missing)}; true seams: {', '.join(truths)}")
     return {e.id: seam_metrics(e, *truths[e.id]) for e in estimates if e.status is SeamStatus.FOUND}
-
-
-@dataclass(frozen=True)
-class MetricsSummary:
-    """Summary over a set of seams.
-
-    seams : all seams; visible : those not NOT_VISIBLE (the locator ran on them); found : FOUND ones.
-    Errors [mm] are over the found seams (NaN when none); the median time [ms] is over the visible seams.
-    """
-
-    seams: int
-    visible: int
-    found: int
-    paper_me_mean_mm: float
-    paper_me_p95_mm: float
-    endpoint_mean_mm: float
-    lateral_mean_mm: float
-    time_ms_per_seam_median: float
-
-    def as_dict(self) -> dict[str, float | int]:
-        return asdict(self)
 
 
 def _mean(v: list[float]) -> float:

@@ -14,8 +14,7 @@ import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray, invert, transform_points
-from cell.seams.base import Joint
-from cell.types import Box, Part, WeldMap
+from cell.types import Box, Joint, Part, WeldMap
 
 
 def _axis_sign(face: str) -> tuple[int, float]:

@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cell.seams.base import Joint
-from cell.types import Box, WeldMap
+from cell.types import Box, Joint, WeldMap
 
 UNDERSIDE_REASON = "underside: the seam lies against the table; flip the part to weld it"
 

@@ -12,8 +12,8 @@ from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 from cell.types.robot import JointLimits, Kinematics
-from cell.types.seams import Reason, SeamEstimate, SeamStatus
-from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage
+from cell.types.seams import Joint, MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus
+from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
 from cell.types.trajectory import PathProfile, Trajectory
 
 __all__ = [
@@ -24,23 +24,28 @@ __all__ = [
     "DepthImage",
     "Event",
     "Execution",
+    "Joint",
     "JointLimits",
     "Kinematics",
     "MapSeam",
+    "MetricsSummary",
     "Part",
     "PathProfile",
     "PlanReason",
     "Reason",
     "Rescan",
     "SeamEstimate",
+    "SeamMetrics",
     "SeamOutcome",
     "SeamRescan",
+    "SeamScene",
     "SeamStatus",
     "SeamTask",
     "Segment",
     "SegmentKind",
     "Trajectory",
     "Viewpoint",
+    "VoxelTable",
     "WeldMap",
     "WeldPlan",
     "WeldQuality",

@@ -7,11 +7,15 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
 from cell.geometry import FloatArray, readonly
+from cell.types.map import WeldMap
+from cell.types.sensing import Cloud, VoxelTable
 
 
 class SeamStatus(enum.StrEnum):
@@ -61,3 +65,86 @@ class SeamEstimate:
         object.__setattr__(self, "p_end", readonly(self.p_end))
         if self.status is SeamStatus.FOUND and (self.p_start.shape != (3,) or self.p_end.shape != (3,)):
             raise ValueError(f"seam {self.id}: a found seam needs start and end points")
+
+
+@dataclass(frozen=True)
+class Joint:
+    """How a seam of the map is made: the edge of one part's face meeting another part's face.
+
+    abutting : name of the part whose end meets the other (part A); the seam runs along an edge of its end face.
+    receiving : name of the part it meets (part B); the seam lies on one of B's faces.
+    face_abutting : A's box face (``"+x"``...``"-z"``) that meets B at the seam (for a T fillet, the face the torch
+        sees on A, e.g. its top ``"+z"``).
+    face_receiving : B's box face the seam lies on (its outward normal points towards A).
+    end_face : A's face that faces B across the gap (parallel to ``face_receiving``).
+    """
+
+    seam_id: str
+    abutting: str
+    receiving: str
+    face_abutting: str
+    face_receiving: str
+    end_face: str
+
+
+@dataclass(frozen=True)
+class SeamScene:
+    """Everything a locator may look at, all in the robot frame R.
+
+    cloud : the spliced, filtered, voxel-downsampled cloud (what the paper's method uses).
+    dense : every camera's registered, filtered points, not merged and not downsampled (full resolution, per-point
+        camera index): what our locator and the map alignment read.
+    weldmap : the welding map aligned to the cloud (frame ``"R"``).
+    joints : seam id -> :class:`Joint`.
+    table_z : height of the table top in R [m] (seams against it cannot be seen).
+    dense_voxels : where the voxels of ``dense`` lie in it, when perception handed it on in voxel order (None:
+        a locator that needs it orders ``dense`` itself).
+    cache : per-scene scratch space a locator may fill once and reuse for every seam (e.g. a KD-tree);
+        it is the one mutable member, and only ever holds values derived from the fields above.
+    """
+
+    cloud: Cloud
+    dense: Cloud
+    weldmap: WeldMap
+    joints: Mapping[str, Joint]
+    table_z: float
+    dense_voxels: VoxelTable | None = None
+    cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class SeamMetrics:
+    """One seam's errors [mm] (NaN when the seam was not found) and the locator's time [ms]."""
+
+    id: str
+    status: SeamStatus
+    paper_me_mm: float
+    endpoint_mm: float
+    lateral_mm: float
+    time_ms: float
+    swapped: bool = False
+
+    @property
+    def found(self) -> bool:
+        return self.status is SeamStatus.FOUND
+
+
+@dataclass(frozen=True)
+class MetricsSummary:
+    """Summary over a set of seams.
+
+    seams : all seams; visible : those not NOT_VISIBLE (the locator ran on them); found : FOUND ones.
+    Errors [mm] are over the found seams (NaN when none); the median time [ms] is over the visible seams.
+    """
+
+    seams: int
+    visible: int
+    found: int
+    paper_me_mean_mm: float
+    paper_me_p95_mm: float
+    endpoint_mean_mm: float
+    lateral_mean_mm: float
+    time_ms_per_seam_median: float
+
+    def as_dict(self) -> dict[str, float | int]:
+        return asdict(self)

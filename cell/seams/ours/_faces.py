@@ -13,11 +13,10 @@ import numpy.typing as npt
 from cell.geometry import FloatArray
 from cell.seams._batch import fit_offsets, tilt_fits
 from cell.seams._edge import place_from_edge
-from cell.seams.base import Joint, SeamScene
 from cell.seams.ours._planes import Face, FitRequest, Fitted, Selection, Tilt, Tilted
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.options import OursOptions
-from cell.types import Box, MapSeam
+from cell.types import Box, Joint, MapSeam, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]

@@ -12,10 +12,9 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
 from cell.seams._lines import plane_intersection
-from cell.seams.base import Joint, SeamScene
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
-from cell.types import Box, MapSeam
+from cell.types import Box, Joint, MapSeam, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 _Z = np.array([0.0, 0.0, 1.0])

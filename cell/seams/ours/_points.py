@@ -12,9 +12,8 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.seams._index import cloud_box, dense_index
-from cell.seams.base import Joint, SeamScene
 from cell.seams.ours.options import OursOptions
-from cell.types import Box
+from cell.types import Box, Joint, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]

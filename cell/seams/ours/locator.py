@@ -11,7 +11,6 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams.base import SeamScene
 from cell.seams.ours._ends import find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line
@@ -19,7 +18,7 @@ from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
-from cell.types import MapSeam, Reason, SeamEstimate, SeamStatus
+from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
 class OursLocator:

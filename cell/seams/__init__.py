@@ -3,8 +3,9 @@
 The public names are listed in ``__all__`` and load on first use (``from cell.seams import OursLocator`` imports
 only the ours locator's modules, as :func:`make_locator` does): the locators and their options, the registry
 (:data:`METHODS`, :func:`make_locator`), joints, truth and metrics; the values they read and return (the scene,
-joints, estimates, metrics) are in :mod:`cell.types`. Visibility is the module :mod:`cell.seams.visibility` (its function ``visibility`` shares the module's name, so the package does
-not re-export it). The modules with a leading underscore are this package's own; nothing outside it imports them.
+joints, estimates, metrics) are in :mod:`cell.types`. Visibility is the module :mod:`cell.seams.visibility` (its
+function ``visibility`` shares the module's name, so the package does not re-export it). The modules with a
+leading underscore are this package's own; nothing outside it imports them.
 """
 
 from __future__ import annotations

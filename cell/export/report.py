@@ -6,18 +6,16 @@ import json
 import math
 import os
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from cell.errors import CellError
-from cell.pipeline import Detection, WeldRun
-
-if TYPE_CHECKING:
-    from cell.rescan import Rescan
-from cell.types import SeamStatus
+from cell.pipeline.records import Detection, WeldRun
+from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus
 
 REPORT_VERSION = 1
 
@@ -31,32 +29,34 @@ def _pt(p: np.ndarray) -> list[float | None]:
     return [_r(float(x), 7) for x in p]
 
 
-def detection_report(det: Detection) -> dict[str, Any]:
-    """The ``cell detect`` report as a JSON-ready dict (schema in the README)."""
-    seams = []
-    for est in det.estimates:
-        entry: dict[str, Any] = {
-            "id": est.id,
-            "status": est.status.value,
-            "reason": est.reason,
-            "reason_code": est.code.value if est.code is not None else None,
-        }
-        if est.status is SeamStatus.FOUND:
-            entry["detected"] = {"start": _pt(est.p_start), "end": _pt(est.p_end)}
-            entry["confidence"] = _r(est.confidence, 4)
-            entry["sigma_mm"] = _r(est.sigma_m * 1000.0, 4)
-        truth = det.truths.get(est.id)  # none when the station knows no truth (real data)
-        if truth is not None:
-            entry["truth"] = {"start": _pt(truth[0]), "end": _pt(truth[1])}
-        m = det.metrics.get(est.id)
-        if m is not None:
-            entry["error_mm"] = {
-                "paper_me": _r(m.paper_me_mm, 4),
-                "endpoint": _r(m.endpoint_mm, 4),
-                "lateral": _r(m.lateral_mm, 4),
-            }
-        entry["time_ms"] = _r(est.time_s * 1000.0, 3)
-        seams.append(entry)
+def _errors(m: SeamMetrics) -> dict[str, float | None]:
+    return {"paper_me": _r(m.paper_me_mm, 4), "endpoint": _r(m.endpoint_mm, 4), "lateral": _r(m.lateral_mm, 4)}
+
+
+def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
+    """A seam's detection fields: status and reason (text and code), the located segment, truth and errors."""
+    est = rec.estimate
+    entry: dict[str, Any] = {
+        "id": rec.id,
+        "status": est.status.value,
+        "reason": est.reason,
+        "reason_code": est.code.value if est.code is not None else None,
+    }
+    if est.status is SeamStatus.FOUND:
+        entry["detected"] = {"start": _pt(est.p_start), "end": _pt(est.p_end)}
+        entry["confidence"] = _r(est.confidence, 4)
+        entry["sigma_mm"] = _r(est.sigma_m * 1000.0, 4)
+    if rec.truth is not None:  # none when the station knows no truth (real data)
+        entry["truth"] = {"start": _pt(rec.truth[0]), "end": _pt(rec.truth[1])}
+    if rec.metrics is not None:
+        entry["error_mm"] = _errors(rec.metrics)
+    entry["time_ms"] = _r(est.time_s * 1000.0, 3)
+    return entry
+
+
+def detection_report(det: Detection, records: Sequence[SeamRecord] | None = None) -> dict[str, Any]:
+    """The ``cell detect`` report as a JSON-ready dict (schema in the README), one entry per seam record."""
+    seams = [_seam_entry(rec) for rec in (records if records is not None else det.records())]
     s = det.summary
     summary = {
         "seams": len(det.estimates),
@@ -81,27 +81,26 @@ def detection_report(det: Detection) -> dict[str, Any]:
         "summary": summary,
         "timings_s": {k: _r(v, 4) for k, v in det.timings.items()},
         "error": _error(det.error),
+        # What ran: the whole scenario as resolved (every default filled in, the --method/--noise/--rescan
+        # overrides applied), so a report says exactly which configuration produced it.
+        "config": det.scenario.model_dump(mode="json"),
     }
 
 
-def _add_rescan(rep: dict[str, Any], first: Detection | None, rs: Rescan | None) -> None:
+def _add_rescan(rep: dict[str, Any], records: Sequence[SeamRecord], first: Detection | None, rs: Rescan | None) -> None:
     """Before/after figures of the close-up re-scan: per seam ``rescan`` and ``error_mm_before``, and at the top
     ``rescan`` (counts, robot time) and ``summary_before_rescan``."""
     if rs is None or first is None:
         rep["rescan"] = None
         return
-    by_id = {r.id: r for r in rs.seams}
+    by_id = {rec.id: rec for rec in records}
     for entry in rep["seams"]:
-        r = by_id.get(entry["id"])
+        rec = by_id[entry["id"]]
+        r = rec.rescan
         if r is None:
             continue
-        before = first.metrics.get(entry["id"])
-        if before is not None:
-            entry["error_mm_before"] = {
-                "paper_me": _r(before.paper_me_mm, 4),
-                "endpoint": _r(before.endpoint_mm, 4),
-                "lateral": _r(before.lateral_mm, 4),
-            }
+        if rec.first_metrics is not None:
+            entry["error_mm_before"] = _errors(rec.first_metrics)
         entry["rescan"] = {
             "used": r.used,
             "weight": _r(r.weight, 3),
@@ -123,6 +122,7 @@ def _add_rescan(rep: dict[str, Any], first: Detection | None, rs: Rescan | None)
         "motion_s": _r(rs.motion_s, 3),
         "returned_to_scan_pose": rs.returned,
         "note": rs.note,
+        "escalated_mm": _r(rs.escalated_mm, 3),
     }
 
 
@@ -147,31 +147,37 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
     """The ``cell weld`` / ``cell preview`` report: the detection report plus, per seam, ``welded``, ``reason``,
     ``tcp_error_mm`` {rms, max} of the executed tool path against the true seam and ``weld_time_s``; at the top,
     ``cycle_time_s``, ``events``, the gate's ``violations`` and the ``error`` that stopped the run (or null)."""
-    rep = detection_report(run.detection)
+    records = run.records()
+    rep = detection_report(run.detection, records)
     plan = run.plan
-    for entry, w in zip(rep["seams"], run.seams, strict=True):
+    for entry, rec in zip(rep["seams"], records, strict=True):
+        w = rec.weld
+        if w is None:
+            raise ValueError(f"seam {rec.id}: a weld run without a weld record")
         entry["planned"] = w.planned
         entry["welded"] = w.welded
         if not w.welded:
             # The detection's reason says why a seam was not found; the weld's why it was not welded.
             entry["weld_reason"] = w.reason
-        if plan is not None:
-            o = next((o for o in plan.seams if o.seam_id == w.id), None)
-            if o is not None and o.feasible:
-                entry["torch"] = {
-                    "work_angle_deg": _r(math.degrees(o.work_angle), 2),
-                    "travel_angle_deg": _r(math.degrees(o.travel_angle), 2),
-                    "spin_deg": _r(math.degrees(o.spin), 2),
-                    "reversed": o.reversed,
-                }
-            elif o is not None and o.p_fail.size == 3:
+            entry["weld_reason_code"] = w.code.value if w.code is not None else None
+        o = rec.outcome
+        if o is not None and o.feasible:
+            entry["torch"] = {
+                "work_angle_deg": _r(math.degrees(o.work_angle), 2),
+                "travel_angle_deg": _r(math.degrees(o.travel_angle), 2),
+                "spin_deg": _r(math.degrees(o.spin), 2),
+                "reversed": o.reversed,
+            }
+        elif o is not None:
+            entry["plan_reason_code"] = o.code.value if o.code is not None else None
+            if o.p_fail.size == 3:
                 entry["failing_point"] = _pt(o.p_fail)
         if w.quality is not None:
             q = w.quality
             entry["tcp_error_mm"] = {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)}
             entry["weld_time_s"] = _r(q.weld_time_s, 3)
             entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
-    _add_rescan(rep, run.first_detection, run.rescan)
+    _add_rescan(rep, records, run.first_detection, run.rescan)
     ex = run.execution
     rep["welded"] = sum(w.welded for w in run.seams)
     rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
@@ -189,8 +195,12 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
 
 def rescan_report(before: Detection, after: Detection, rs: Rescan) -> dict[str, Any]:
     """The ``cell rescan`` report: the detection report of the fused estimates, with the figures before."""
-    rep = detection_report(after)
-    only_rescanned = {r.id for r in rs.seams}
-    rep["seams"] = [s for s in rep["seams"] if s["id"] in only_rescanned]
-    _add_rescan(rep, before, rs)
+    rescans = {r.id: r for r in rs.seams}
+    records = [
+        replace(rec, first=rescans[rec.id].before, first_metrics=before.metrics.get(rec.id), rescan=rescans[rec.id])
+        for rec in after.records()
+        if rec.id in rescans
+    ]
+    rep = detection_report(after, records)
+    _add_rescan(rep, records, before, rs)
     return rep

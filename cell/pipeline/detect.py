@@ -67,7 +67,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     timings: dict[str, float] = {}
     t = time.perf_counter()
     progress("splicing point clouds")
-    perceived = perceive(cap.images, sc.X_WR, sc.perception)
+    perceived = perceive(cap.images, sc.X_WR, sc.perception, sc.perception.health)
     timings["perceive_s"] = time.perf_counter() - t
 
     t = time.perf_counter()
@@ -81,7 +81,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     weldmap_R = cap.weldmap.transformed(X_RM, "R")
     # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
     # parts that are simply not there are named, and their seams are never searched.
-    check_alignment_unique(weldmap_R, perceived.registered, alignment)
+    check_alignment_unique(weldmap_R, perceived.registered, alignment, sc.perception.symmetry)
     missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception)
     timings["align_s"] = time.perf_counter() - t
 
@@ -127,7 +127,7 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
             timed[seam.id] = replace(est, time_s=time.perf_counter() - t)
     out = tuple(hidden[seam.id] if seam.id in hidden else timed[seam.id] for seam in ss.weldmap.seams)
     # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
-    return screen(ss, out, scene.missing)
+    return screen(ss, out, scene.missing, scenario.perception.screen)
 
 
 def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:
@@ -166,9 +166,12 @@ def detect(
 
     station, weldmap : a running cell and the map it was built around (both built here when not given).
     """
+    from cell.seams.registry import with_method
+
     if noise is not None:
         scenario = scenario.with_noise(noise)
-    method = method or scenario.locator.method
+    scenario = with_method(scenario, method)  # a --method runs with its spec's defaults, and the report says so
+    method = scenario.locator.method
     t_all = time.perf_counter()
     cap = capture(scenario, gui=gui, progress=progress, station=station, weldmap=weldmap)
     try:
@@ -195,6 +198,7 @@ def detect(
         timings=timings,
         lost_cameras=tuple(scene.perceived.lost_described()),
         scene=scene,
+        joints=cap.joints,
     )
 
 
@@ -228,4 +232,5 @@ def _failed_detection(cap: Capture, method: str, error: CellError, seconds: floa
         summary=summary,
         timings={"capture_s": cap.seconds, "total_s": seconds},
         error=error,
+        joints=cap.joints,
     )

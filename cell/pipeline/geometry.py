@@ -33,4 +33,4 @@ def motion_scene(arm: Arm, det: Detection) -> MotionScene:
 
     sc = det.scenario
     obstacles = tuple(cell_obstacles(det.weldmap_R, sc.X_WR, sc.table.center_m, sc.table.size_m))
-    return MotionScene(obstacles, CollisionChecker(arm.model, obstacles))
+    return MotionScene(obstacles, CollisionChecker(arm.model, obstacles, sc.motion.plan.collision))

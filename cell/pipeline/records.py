@@ -6,7 +6,7 @@ Values only (frozen dataclasses); the stages that fill them live beside this mod
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from cell.errors import CellError
@@ -24,11 +24,12 @@ from cell.types import (
     SeamStatus,
     WeldMap,
 )
+from cell.types.run import SeamRecord, SeamWeld
 
 if TYPE_CHECKING:
     from cell.perception import Alignment, Perceived
     from cell.rescan import Rescan
-    from cell.types.execution import Execution, WeldQuality
+    from cell.types.execution import Execution
     from cell.types.plan import WeldPlan
     from cell.types.trajectory import Trajectory
 
@@ -73,24 +74,27 @@ class Detection:
     lost_cameras: tuple[str, ...] = ()
     scene: Scene | None = None
     error: CellError | None = None  # perception or alignment failed: no seam was searched (report still written)
+    joints: Mapping[str, Joint] = field(default_factory=dict)  # seam id -> how it is made
+
+    def records(self) -> tuple[SeamRecord, ...]:
+        """One :class:`~cell.types.SeamRecord` per seam of the map, in map order: seam, joint, estimate, truth,
+        metrics."""
+        return tuple(
+            SeamRecord(
+                seam=self.weldmap_R.seam(e.id),
+                joint=self.joints.get(e.id),
+                estimate=e,
+                truth=self.truths.get(e.id),
+                metrics=self.metrics.get(e.id),
+            )
+            for e in self.estimates
+        )
 
     @property
     def complete(self) -> bool:
         """Every seam that can be seen was found, with every camera working (a lost camera is a degraded run)."""
         undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
         return not self.lost_cameras and all(e.status not in undone for e in self.estimates)
-
-
-@dataclass(frozen=True)
-class SeamWeld:
-    """What became of one seam in ``cell weld``: planned and welded, or why not; how well (executed TCP vs the true
-    seam)."""
-
-    id: str
-    planned: bool
-    welded: bool
-    reason: str = ""
-    quality: WeldQuality | None = None
 
 
 @dataclass(frozen=True)
@@ -122,14 +126,33 @@ class WeldRun:
             return 0.0
         return self.execution.duration + (self.rescan.motion_s if self.rescan is not None else 0.0)
 
+    def records(self) -> tuple[SeamRecord, ...]:
+        """One :class:`~cell.types.SeamRecord` per seam, in map order, with everything the run knows of it: the
+        detection's record, the estimate before the re-scan and what the close-up did, the planner's outcome and
+        the weld."""
+        rescans = {r.id: r for r in self.rescan.seams} if self.rescan is not None else {}
+        first = self.first_detection
+        outcomes = {o.seam_id: o for o in self.plan.seams} if self.plan is not None else {}
+        welds = {w.id: w for w in self.seams}
+        out = []
+        for rec in self.detection.records():
+            r = rescans.get(rec.id)
+            out.append(
+                replace(
+                    rec,
+                    first=r.before if r is not None else None,
+                    first_metrics=first.metrics.get(rec.id) if r is not None and first is not None else None,
+                    rescan=r,
+                    outcome=outcomes.get(rec.id),
+                    weld=welds.get(rec.id),
+                )
+            )
+        return tuple(out)
+
     @property
     def complete(self) -> bool:
         """Every seam that can be seen was welded (for a preview: planned) and nothing failed."""
-        vis = [
-            w
-            for w, e in zip(self.seams, self.detection.estimates, strict=True)
-            if e.status is not SeamStatus.NOT_VISIBLE
-        ]
+        vis = [r.weld for r in self.records() if r.estimate.status is not SeamStatus.NOT_VISIBLE]
         executed = self.execution is not None
-        done = all(w.welded if executed else w.planned for w in vis)
+        done = all(w is not None and (w.welded if executed else w.planned) for w in vis)
         return self.error is None and self.detection.complete and done

@@ -143,8 +143,8 @@ def rescan_seams(
     from cell.motion.timing import ptp
     from cell.seams.registry import make_locator
 
-    o = options or RescanOptions()
     sc = detection.scenario
+    o = options or sc.rescan.closeup
     arm = station.arm
     if arm is None:
         raise ScenarioError(f"scenario {sc.name!r} has no robot to carry the camera: set robot.urdf")

@@ -12,11 +12,12 @@ from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import detect, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
-from cell.pipeline.records import Detection, SeamWeld, WeldRun
+from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.rescan import rescan_detection
 from cell.scenario import Scenario
 from cell.station import Station, open_station
 from cell.types import SeamStatus
+from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
     from cell.types.execution import Execution
@@ -63,14 +64,16 @@ def plan_for(
     obstacles, checker = motion.obstacles, motion.checker
     progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
-    plan = plan_welds(arm.model, tasks, arm.q_home, process, obstacles, rng=sc.rng("plan"), checker=checker)
+    plan = plan_welds(
+        arm.model, tasks, arm.q_home, process, obstacles, options=sc.motion.plan, rng=sc.rng("plan"), checker=checker
+    )
     pre = ptp(arm.q_scan if q_start is None else q_start, arm.q_home, arm.model.limits, dt=0.001)
     problems = []
     hit = checker.check_path(pre.q, pre.times)
     if hit is not None:
         problems.append(f"move from the arm's position to home collides: {hit.describe()}")
     progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
-    problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker)]
+    problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)]
     return plan, pre, tuple(problems)
 
 
@@ -97,24 +100,27 @@ def _seam_welds(
     out = []
     for est in det.estimates:
         if est.status is SeamStatus.NOT_VISIBLE:
-            out.append(SeamWeld(est.id, False, False, est.reason))  # e.g. against the table: needs a flip
+            out.append(SeamWeld(est.id, False, False, est.reason, code=WeldReason.NOT_VISIBLE))  # against the table
             continue
         if est.status is not SeamStatus.FOUND:
-            out.append(SeamWeld(est.id, False, False, f"not located ({est.status.value}): {est.reason}"))
+            why = f"not located ({est.status.value}): {est.reason}"
+            out.append(SeamWeld(est.id, False, False, why, code=WeldReason.NOT_LOCATED))
             continue
         doubtful = est.confidence < sc.rescan.weld_min_confidence
         if doubtful and ex is not None:
             why = f"low_confidence: {est.confidence:.2f} < {sc.rescan.weld_min_confidence:.2f} after the re-scan"
-            out.append(SeamWeld(est.id, False, False, why))
+            out.append(SeamWeld(est.id, False, False, why, code=WeldReason.LOW_CONFIDENCE))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
         if outcome is None or not outcome.feasible:
             reason = outcome.reason if outcome is not None else refused or "not planned"
-            out.append(SeamWeld(est.id, False, False, reason))
+            code = WeldReason.NOT_EXECUTED if outcome is None and refused else WeldReason.NOT_PLANNED
+            out.append(SeamWeld(est.id, False, False, reason, code=code))
             continue
         if ex is None or plan is None:
             note = f"; confidence {est.confidence:.2f}: would be re-scanned before welding" if doubtful else ""
-            out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note))
+            code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
+            out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note, code=code))
             continue
         seg = next(g for g in plan.segments if g.arc_on and g.seam_id == est.id)
         t0, t1 = pre_s + seg.t0, pre_s + seg.t1
@@ -145,6 +151,8 @@ def weld(
     """
     t_all = time.perf_counter()
     sc = scenario.with_noise(noise) if noise else scenario
+    if rescan is not None:  # the override is what ran: the report's configuration says so
+        sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": rescan})})
     weldmap = read_weldmap(sc)
     with open_station(sc, weldmap, gui=gui) as station:
         det = detect(sc, method, progress=progress, station=station, weldmap=weldmap)
@@ -161,7 +169,7 @@ def weld(
             t = time.perf_counter()
             motion = motion_scene(station.arm, det)  # once: every re-scan view, the plan and the gate use it
             setup_s = time.perf_counter() - t
-            mode = rescan or sc.rescan.mode
+            mode = sc.rescan.mode
             if mode != "none" and execute_plan:
                 rs, det = rescan_detection(station, det, mode, motion=motion, progress=progress)
                 timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)

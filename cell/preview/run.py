@@ -15,7 +15,7 @@ from cell.preview.joint_plots import render_joint_plots
 from cell.preview.views import seam_views
 
 if TYPE_CHECKING:
-    from cell.pipeline import WeldRun
+    from cell.pipeline.records import WeldRun
 
 
 def write_run(run: WeldRun, out_dir: str | Path) -> list[Path]:
@@ -28,7 +28,7 @@ def write_run(run: WeldRun, out_dir: str | Path) -> list[Path]:
     if det.scene is None:
         raise det.error if det.error is not None else SensorError("nothing to draw: the run perceived no cloud")
     cloud = det.scene.perceived.dense.points
-    views = seam_views(det.estimates, det.truths)
+    views = seam_views(run.records())
     poses = dict(run.torch_paths)
     if run.execution is not None:
         ex = run.execution

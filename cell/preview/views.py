@@ -7,14 +7,14 @@ figures (:mod:`cell.preview.figures`, :mod:`cell.preview.joint_plots`) and the H
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.types import Box, SeamEstimate, WeldMap
+from cell.types import Box, SeamRecord, WeldMap
 
 MM = 1000.0  # [mm/m]
 STATUS_COLOURS = {"found": "#2ca02c", "not_found": "#d62728", "not_visible": "#ff7f0e", "occluded": "#9467bd"}
@@ -40,13 +40,11 @@ class SeamView(NamedTuple):
     truth_end: npt.ArrayLike | None = None
 
 
-def seam_views(
-    estimates: Sequence[SeamEstimate], truths: Mapping[str, tuple[FloatArray, FloatArray]]
-) -> list[SeamView]:
-    """SeamViews from a locator's estimates and the true seams (id -> (start, end) in R)."""
+def seam_views(records: Sequence[SeamRecord]) -> list[SeamView]:
+    """SeamViews from a run's seam records: each estimate in R, with its true seam when the truth is known."""
     out = []
-    for e in estimates:
-        t = truths.get(e.id)
+    for rec in records:
+        e, t = rec.estimate, rec.truth
         out.append(SeamView(e.id, str(e.status), e.p_start, e.p_end, *(t if t is not None else (None, None))))
     return out
 

@@ -12,6 +12,7 @@ from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 from cell.types.robot import JointLimits, Kinematics
+from cell.types.run import SeamRecord, SeamWeld, WeldReason
 from cell.types.seams import Joint, MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
 from cell.types.trajectory import PathProfile, Trajectory
@@ -37,10 +38,12 @@ __all__ = [
     "SeamEstimate",
     "SeamMetrics",
     "SeamOutcome",
+    "SeamRecord",
     "SeamRescan",
     "SeamScene",
     "SeamStatus",
     "SeamTask",
+    "SeamWeld",
     "Segment",
     "SegmentKind",
     "Trajectory",
@@ -49,4 +52,5 @@ __all__ = [
     "WeldMap",
     "WeldPlan",
     "WeldQuality",
+    "WeldReason",
 ]

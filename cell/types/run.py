@@ -1,0 +1,69 @@
+"""One record per seam: everything a run knows about it, joined once by id.
+
+The stages make the parts (the map its seam and joint, a locator its estimate, the re-scan its close-up, the
+planner its outcome, the arm its weld); the pipeline joins them here, and reports and pictures read only these
+records. Frame ``R`` (robot base), metres; millimetres where a name says ``_mm``.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from cell.geometry import FloatArray
+from cell.types.execution import WeldQuality
+from cell.types.map import MapSeam
+from cell.types.plan import SeamOutcome
+from cell.types.rescan import SeamRescan
+from cell.types.seams import Joint, SeamEstimate, SeamMetrics
+
+
+class WeldReason(enum.StrEnum):
+    """Why a seam was not welded, as a code (the detail text says more)."""
+
+    NOT_VISIBLE = "not_visible"  # no camera can see it on this side (against the table)
+    NOT_LOCATED = "not_located"  # visible, but not found (its estimate says why)
+    LOW_CONFIDENCE = "low_confidence"  # found, but still too uncertain after the re-scan
+    NOT_PLANNED = "not_planned"  # the planner could not weld it (its outcome's code says why)
+    NOT_EXECUTED = "not_executed"  # planned, but the run stopped before the arm moved (the run's error says why)
+    PREVIEW = "preview"  # planned in a dry run: nothing moves
+
+
+@dataclass(frozen=True)
+class SeamWeld:
+    """What became of one seam in ``cell weld``: planned and welded, or why not (``code`` and the detail
+    ``reason``); how well (the executed TCP against the true seam, when the truth is known)."""
+
+    id: str
+    planned: bool
+    welded: bool
+    reason: str = ""
+    quality: WeldQuality | None = None
+    code: WeldReason | None = None
+
+
+@dataclass(frozen=True)
+class SeamRecord:
+    """Everything one run knows about one seam.
+
+    seam : the aligned map's seam; joint : how it is made (None when the map does not say).
+    estimate : what the cell uses now (the fused estimate after a re-scan); truth : the as-built seam (start,
+        end) when the station knows it; metrics : the estimate's errors against it (found seams with a truth).
+    first, first_metrics : the estimate before the re-scan and its errors (None when the seam was not re-scanned).
+    rescan : what the close-up did; outcome : the planner's word on it; weld : what became of it.
+    """
+
+    seam: MapSeam
+    joint: Joint | None
+    estimate: SeamEstimate
+    truth: tuple[FloatArray, FloatArray] | None = None
+    metrics: SeamMetrics | None = None
+    first: SeamEstimate | None = None
+    first_metrics: SeamMetrics | None = None
+    rescan: SeamRescan | None = None
+    outcome: SeamOutcome | None = None
+    weld: SeamWeld | None = None
+
+    @property
+    def id(self) -> str:
+        return self.seam.id

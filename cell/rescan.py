@@ -22,64 +22,21 @@ estimate and pose, W for the simulator; metres, radians, seconds.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.config.rescan import CONFIDENCE_THRESHOLD, RescanOptions
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, invert
-from cell.motion.viewpoint import ViewOptions, ViewTarget
-from cell.seams.base import SeamScene
-from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamStatus
+from cell.motion.viewpoint import ViewTarget
+from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamScene, SeamStatus
 from cell.types.rescan import Rescan, SeamRescan
 
 if TYPE_CHECKING:
     from cell.scenario import Scenario
-
-# Below this confidence a seam is worth a close look (benchmarks/bench_confidence.py: 144 seams of fence1-exact,
-# fence1 and fence2, realistic noise; 20 fall below it, with 2 of the 3 seams more than 0.15 mm off). A scenario
-# can override it (``rescan.confidence_threshold``).
-CONFIDENCE_THRESHOLD = 0.55
-
-# Options of the "ours" locator for a close-up cloud (~0.2 mm noise and ~0.35 mm pixels at 0.35 m instead of
-# ~4 mm and ~1.6 mm at 1.6 m): the standard error that earns full confidence and the bands cut along edges and
-# corners shrink with the sensor. The noise assumed before it is measured (sensor_sigma_m) stays: it also sets
-# the first pass's gate, which must span the aligned map's local error (up to ~8 mm on fence1's posts).
-CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
-    "target_se_m": 0.00002,
-    "edge_band_m": 0.002,
-    "corner_band_m": 0.003,
-}
-_FIRST_TARGET_SE_M = 0.0002  # OursOptions.target_se_m: the first estimate's confidence scale [m]
-
-
-@dataclass(frozen=True)
-class RescanOptions:
-    """Options of the close-up re-scan (lengths [m]).
-
-    first_floor_m : standard deviation the first estimate has whatever its confidence says: the fixed cameras'
-        calibration, which no confidence sees (0.3-1 mm / 0.03-0.1 deg on real cells, REFERENCE section 2; the
-        default 0.2 mm is about what the exact simulated cameras give at high confidence).
-    closeup_floor_m : the same for the close-up (the arm's pose accuracy and hand-eye calibration on a real cell;
-        exact kinematics in the simulator).
-    first_scale_m, closeup_scale_m : the locator's standard error at confidence 1/2 for each kind of cloud.
-    """
-
-    confidence_threshold: float = CONFIDENCE_THRESHOLD  # for callers: seams_to_rescan(det, this)
-    camera: str | None = None  # the eye-in-hand camera; None: the scenario's only one
-    crop_margin_m: float = 0.08  # the box around the seam grown by this (the locator's tube and end search)
-    min_points: int = 2000  # fewer points in that box: nothing seen
-    first_floor_m: float = 0.0002
-    closeup_floor_m: float = 0.00002
-    first_scale_m: float = _FIRST_TARGET_SE_M
-    closeup_scale_m: float = 0.00002
-    closeup_locator_options: Mapping[str, Mapping[str, float | int | str | bool]] = field(
-        default_factory=lambda: {"ours": CLOSEUP_OURS_OPTIONS}
-    )
-    return_to_scan: bool = True
-    view: ViewOptions = field(default_factory=ViewOptions)
 
 
 # -- uncertainty and fusion --------------------------------------------------------------------------------
@@ -170,12 +127,12 @@ def eye_in_hand_camera(scenario: Scenario, name: str | None = None) -> str:
 
 def closeup_scenario(scenario: Scenario, method: str, options: RescanOptions) -> Scenario:
     """The scenario with the locator options for close-up clouds merged in (only for the locator ``method``)."""
+    from cell.seams.registry import with_options
+
     extra = options.closeup_locator_options.get(method)
     if not extra:
         return scenario
-    opts: dict[str, dict[str, Any]] = {k: dict(v) for k, v in scenario.locator.options.items()}
-    opts[method] = {**opts.get(method, {}), **extra}
-    return scenario.model_copy(update={"locator": scenario.locator.model_copy(update={"options": opts})})
+    return with_options(scenario, method, extra)
 
 
 def crop_around(points_R: FloatArray, seam: MapSeam, margin: float) -> np.ndarray:

@@ -20,7 +20,7 @@ from cell import scenario as sc
 from cell.geometry import transform_points
 from cell.scenario import Scenario
 from cell.seams.base import BatchSeamLocator, SeamLocator
-from cell.seams.registry import METHODS, make_locator
+from cell.seams.registry import METHODS, make_locator, with_options
 from cell.types import Reason, SeamEstimate, SeamScene, SeamStatus
 
 
@@ -72,10 +72,10 @@ def scenario_for_the_joint(options: dict[str, dict[str, Any]] | None = None) -> 
     ws = base.perception.workspace.model_copy(
         update={"min_m": tuple(corners_W.min(0)), "max_m": tuple(corners_W.max(0))}
     )
-    locator = base.locator.model_copy(update={"options": options or {}})
-    return base.model_copy(
-        update={"perception": base.perception.model_copy(update={"workspace": ws}), "locator": locator}
-    )
+    out = base.model_copy(update={"perception": base.perception.model_copy(update={"workspace": ws})})
+    for method, overrides in (options or {}).items():  # method -> its options (the scenario then runs that one)
+        out = with_options(out, method, overrides)
+    return out
 
 
 def as_perceived(scene: SeamScene) -> SeamScene:

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cell import scenario as sc
+from cell.config import OursSettings
 from cell.errors import ScenarioError
 
 FENCE1 = (sc.SCENARIO_DIR / "fence1.yaml").read_text()
@@ -100,3 +102,133 @@ def test_camera_focal_length_from_fov() -> None:
     np.testing.assert_allclose(X[:3, 3], cam.eye_m)
     forward = np.subtract(cam.target_m, cam.eye_m)
     np.testing.assert_allclose(X[:3, 2], forward / np.linalg.norm(forward))
+
+
+# -- typed configuration: every stage's options are keys of the scenario ------------------------------------------
+
+
+def with_keys(text: str) -> str:
+    """fence1 with ``text`` (top-level YAML keys) appended."""
+    return FENCE1 + "\n" + text
+
+
+@pytest.mark.parametrize(
+    ("text", "key", "close"),
+    [
+        ("locator: {method: ours, options: {tube_radus_m: 0.05}}", "locator.options.tube_radus_m", "tube_radius_m"),
+        ("locator: {method: ransac, options: {run: 5}}", "locator.options.run", "runs"),
+        ("locator: {method: paper, option: {}}", "locator.option", "options"),
+        ("motion: {gate: {rate_hzz: 500.0}}", "motion.gate.rate_hzz", "rate_hz"),
+        (
+            "motion: {plan: {collision: {part_inflaton: 0.003}}}",
+            "motion.plan.collision.part_inflaton",
+            "part_inflation",
+        ),
+        ("rescan: {closeup: {view: {distance_m: [0.4]}}}", "rescan.closeup.view.distance_m", "distances_m"),
+        ("export: {krl: {load_k: 2.0}}", "export.krl.load_k", "load_kg"),
+        ("simulation: {bead: {radius: 0.002}}", "simulation.bead.radius", "radius_m"),
+    ],
+)
+def test_a_typo_inside_an_options_class_names_the_key_and_the_valid_ones(text: str, key: str, close: str) -> None:
+    with pytest.raises(ScenarioError) as exc:
+        load_text(with_keys(text))
+    msg = str(exc.value)
+    assert f"unknown key {key!r} (did you mean {close!r}?)" in msg
+    assert "valid keys there: " in msg and close in msg.split("valid keys there: ")[1].split(", ")
+    assert "\n" not in msg
+
+
+def test_a_typo_in_perception_checks_and_closeup_options_is_named_too() -> None:
+    perception = "perception:\n  workspace: {min_m: [-0.70, -0.55, 0.905], max_m: [1.0, 0.55, 1.20]}\n"
+    text = FENCE1.split("perception:")[0] + perception + "  health: {min_agreemnt: 0.4}\n"
+    with pytest.raises(ScenarioError, match=r"unknown key 'perception.health.min_agreemnt' \(did you mean"):
+        load_text(text)
+    with pytest.raises(ScenarioError, match=r"ours: unknown key 'target_se' \(did you mean 'target_se_m'\?\)"):
+        load_text(with_keys("rescan: {closeup: {closeup_locator_options: {ours: {target_se: 0.001}}}}"))
+    with pytest.raises(ScenarioError, match=r"locator.method 'ourz' is unknown \(did you mean 'ours'\?\)"):
+        load_text(with_keys("locator: {method: ourz}"))
+
+
+def test_option_values_are_checked_when_the_file_is_loaded() -> None:
+    for text in (
+        "locator: {method: paper, options: {frequency_bin_m: 0.0}}",  # a Bounds range
+        "locator: {method: ours, options: {sample_share: 0.3}}",  # not a layer of the index
+        "locator: {method: ransac, options: {cloud: sparse}}",
+        "export: {krl: {arc_markers: shout}}",
+    ):
+        with pytest.raises(ScenarioError) as exc:
+            load_text(with_keys(text))
+        assert text.split(":")[0] in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_every_options_class_is_reachable_from_the_scenario_with_its_defaults() -> None:
+    from cell import config
+
+    s = load_text(FENCE1)
+    assert s.perception.health == config.HealthOptions()
+    assert s.perception.symmetry == config.SymmetryOptions()
+    assert s.perception.screen == config.ScreenOptions()
+    assert s.motion.plan == config.PlanOptions() and s.motion.plan.collision == config.CollisionOptions()
+    assert s.motion.gate == config.GateOptions()
+    assert s.rescan.closeup == config.RescanOptions() and s.rescan.closeup.view == config.ViewOptions()
+    assert s.export.krl == config.KrlOptions()
+    assert s.simulation.bead == config.BeadStyle()
+    assert s.locator == sc.OursLocatorSpec() and s.locator.options == config.OursSettings()
+    # One number each: the re-scan threshold, ours' confidence scale, the stick-out.
+    assert s.rescan.confidence_threshold == config.CONFIDENCE_THRESHOLD
+    assert s.rescan.closeup.first_scale_m == config.OursSettings().target_se_m
+    assert s.rescan.closeup.closeup_scale_m == config.CLOSEUP_OURS_OPTIONS["target_se_m"]
+    assert s.robot.stickout_mm == config.STICKOUT_MM
+    # Set in the file, they arrive typed.
+    s = load_text(with_keys("motion: {gate: {rate_hz: 500}}\nlocator: {method: ransac, options: {runs: 5}}"))
+    assert s.motion.gate == config.GateOptions(rate_hz=500.0)
+    assert s.locator == sc.RansacLocatorSpec(options=config.RansacOptions(runs=5))
+
+
+def test_the_method_names_come_from_one_registry() -> None:
+    import typer
+
+    from cell.cli.common import check_method
+    from cell.seams.registry import LOCATORS, METHODS, locator_spec, with_method
+
+    assert tuple(LOCATORS) == METHODS
+    assert {name: sc.spec_method(entry.spec) for name, entry in LOCATORS.items()} == {m: m for m in METHODS}
+    assert {sc.spec_method(s) for s in sc.LOCATOR_SPECS} == set(METHODS)  # the scenario's union, member for member
+    with pytest.raises(typer.BadParameter, match=", ".join(METHODS)):
+        check_method("ourz")
+    # Another method than the scenario's runs with its own defaults, and the scenario says which ran.
+    s = load_text(with_keys("locator: {method: ours, options: {target_se_m: 0.001}}"))
+    assert locator_spec(s, "ours") is s.locator
+    assert locator_spec(s, "ransac") == sc.RansacLocatorSpec()
+    assert with_method(s, "paper").locator == sc.PaperLocatorSpec()
+    assert with_method(s, None) is s
+
+
+def test_the_closeup_merges_its_options_into_the_scenarios_locator() -> None:
+    from cell.rescan import closeup_scenario
+
+    s = load_text(with_keys("locator: {method: ours, options: {tube_radius_m: 0.05}}"))
+    close = closeup_scenario(s, "ours", s.rescan.closeup).locator.options
+    assert (close.target_se_m, close.edge_band_m, close.corner_band_m) == (0.00002, 0.002, 0.003)
+    assert close.tube_radius_m == 0.05  # the scenario's own
+    assert closeup_scenario(s, "paper", s.rescan.closeup) is s  # no close-up options for the paper's
+
+
+@pytest.mark.scenario
+def test_a_scenario_option_reaches_its_stage_and_the_report_records_it() -> None:
+    """Through pipeline.detect: the seam screen's threshold, built from its defaults before the scenario held it,
+    turns every found seam into LOW_CONFIDENCE; the report's config is the scenario as resolved."""
+    from cell import pipeline
+    from cell.export.report import detection_report
+    from cell.types import Reason, SeamStatus
+
+    s = load_text(with_keys("locator: {method: ours, options: {target_se_m: 0.0003}}"))
+    perception = s.perception.model_copy(update={"screen": replace(s.perception.screen, min_confidence=1.0)})
+    det = pipeline.detect(s.model_copy(update={"perception": perception}))
+    visible = [e for e in det.estimates if e.status is not SeamStatus.NOT_VISIBLE]
+    assert len(visible) == 12 and all(e.code is Reason.LOW_CONFIDENCE for e in visible)
+    config = detection_report(det)["config"]
+    assert config["perception"]["screen"]["min_confidence"] == 1.0
+    assert config["locator"] == {"method": "ours", "options": {**asdict(OursSettings()), "target_se_m": 0.0003}}
+    assert config["motion"]["gate"]["rate_hz"] == 1000.0  # every default filled in
+    assert sc.from_dict(config, sc.SCENARIO_DIR) == det.scenario  # the record loads back as what ran

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cell.config import PaperOptions
 from cell.geometry import invert, make_pose, transform_points
-from cell.scenario import PaperLocatorSpec
 from cell.seams._features import cloud_features
 from cell.seams.joint import find_joints
 from cell.seams.metrics import segment_errors
@@ -116,7 +116,7 @@ def test_finds_seams_along_x_y_and_z_on_the_exact_part(grid: tuple[float, float,
     design = junction()
     scene = scene_of(design, design, grid)
     truth = truth_R(design, design)
-    locator = PaperLocator(PaperLocatorSpec())
+    locator = PaperLocator(PaperOptions())
     seams = visible_seams(scene)
     assert len(seams) == 6  # the two seams against the table are not searched
     rng = np.random.default_rng(0)

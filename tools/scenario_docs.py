@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import argparse
 import ast
+import collections.abc
+import dataclasses
 import inspect
 import io
 import re
@@ -71,10 +73,40 @@ class Row:
     default: str
     range: str
     description: str
+    variant: bool = False  # the row that opens one member of a union (its keys follow)
 
 
 def _is_model(tp: Any) -> bool:
-    return isinstance(tp, type) and issubclass(tp, BaseModel)
+    """A scenario model or an options dataclass of :mod:`cell.config` (a sub-model of the scenario)."""
+    return isinstance(tp, type) and (issubclass(tp, BaseModel) or dataclasses.is_dataclass(tp))
+
+
+@dataclass(frozen=True)
+class _DataclassField:
+    """A dataclass field seen as a pydantic ``FieldInfo`` (the attributes this generator reads)."""
+
+    annotation: Any
+    default: Any
+    default_factory: Any
+    metadata: list[Any]
+    description: str | None = None
+    exclude: bool = False
+    discriminator: str | None = None
+
+
+def _fields(model: type) -> dict[str, Any]:
+    """Field name -> its FieldInfo (a model) or a :class:`_DataclassField` (an options dataclass; the bounds of an
+    ``Annotated[T, Bounds(...)]`` become its metadata, as pydantic does for a model's field)."""
+    if issubclass(model, BaseModel):
+        return dict(model.model_fields)
+    hints = typing.get_type_hints(model, include_extras=True)
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(model):
+        tp, meta = _strip_annotated(hints[f.name])
+        default = f.default if f.default is not dataclasses.MISSING else PydanticUndefined
+        factory = f.default_factory if f.default_factory is not dataclasses.MISSING else None
+        out[f.name] = _DataclassField(tp, default, factory, meta)
+    return out
 
 
 def _strip_annotated(tp: Any) -> tuple[Any, list[Any]]:
@@ -118,7 +150,7 @@ def _type_name(tp: Any) -> str:
             name = f"[{_type_name(args[0])}, ...]"
         else:
             name = "[" + ", ".join(_type_name(a) for a in args) + "]"
-    elif get_origin(tp) in (dict, typing.Mapping):
+    elif get_origin(tp) in (dict, typing.Mapping, collections.abc.Mapping):
         _, value = get_args(tp)
         name = f"map of name -> {_type_name(value)}"
     elif get_origin(tp) in (list, typing.Sequence):
@@ -143,10 +175,10 @@ def _yaml_value(v: Any) -> str:
     if isinstance(v, str):
         return f'"{v}"'
     if isinstance(v, float):
-        return repr(v)
+        return repr(float(v))
     if isinstance(v, tuple | list):
         return "[" + ", ".join(_yaml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
+    if isinstance(v, typing.Mapping):
         return "{" + ", ".join(f"{k}: {_yaml_value(x)}" for k, x in v.items()) + "}"
     return str(v)
 
@@ -158,7 +190,7 @@ def _default(field: FieldInfo) -> str:
         value = field.default_factory()  # type: ignore[call-arg]
     else:
         return "required"
-    if isinstance(value, BaseModel):
+    if isinstance(value, BaseModel) or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
         models, _ = _models_in(field.annotation)
         return "the defaults below" if len(models) < 2 else f"the defaults of {type(value).__name__}"
     return _yaml_value(value)
@@ -172,7 +204,7 @@ def _unit(name: str, text: str) -> str:
     return next((unit for suffix, unit in _SUFFIX_UNITS if name.endswith(suffix)), "")
 
 
-def _defining_class(model: type[BaseModel], name: str) -> type[BaseModel]:
+def _defining_class(model: type, name: str) -> type:
     """The class of ``model``'s MRO whose body declares field ``name`` (sub-models may inherit fields)."""
     for klass in model.__mro__:
         if name in vars(klass).get("__annotations__", {}):
@@ -253,7 +285,7 @@ def _choices_paragraph(klass: type, annotation: Any) -> str:
     return ""
 
 
-def _description(model: type[BaseModel], name: str, field: FieldInfo) -> str:
+def _description(model: type, name: str, field: Any) -> str:
     klass = _defining_class(model, name)
     entry = _docstring_entries(klass).get(name, "") or _choices_paragraph(klass, field.annotation)
     parts = [field.description or "", entry, _source_comments(klass).get(name, "")]
@@ -264,7 +296,7 @@ def _description(model: type[BaseModel], name: str, field: FieldInfo) -> str:
     return _rst_to_md(" ".join(seen))
 
 
-def _models_in(tp: Any) -> tuple[list[type[BaseModel]], str]:
+def _models_in(tp: Any) -> tuple[list[type], str]:
     """The sub-models an annotation leads to and the path step they sit under (``""`` or ``.<name>``)."""
     tp, _ = _strip_annotated(tp)
     if _is_model(tp):
@@ -272,7 +304,7 @@ def _models_in(tp: Any) -> tuple[list[type[BaseModel]], str]:
     if _is_union(tp):
         found = [m for a in get_args(tp) for m in _models_in(a)[0]]
         return found, ""
-    if get_origin(tp) in (dict, typing.Mapping):
+    if get_origin(tp) in (dict, typing.Mapping, collections.abc.Mapping):
         models, step = _models_in(get_args(tp)[1])
         return models, ".<name>" + step
     if get_origin(tp) in (tuple, list, typing.Sequence):
@@ -291,9 +323,9 @@ def _variant(model: type[BaseModel], field: FieldInfo) -> str:
     return model.__name__
 
 
-def rows(model: type[BaseModel], prefix: str = "") -> Iterator[Row]:
+def rows(model: type, prefix: str = "") -> Iterator[Row]:
     """Every key under ``model`` (depth first, in declaration order), ``prefix`` its dotted path so far."""
-    for name, field in model.model_fields.items():
+    for name, field in _fields(model).items():
         if field.exclude:  # set by the loader, never written in a file
             continue
         key = f"{prefix}{name}"
@@ -312,7 +344,8 @@ def rows(model: type[BaseModel], prefix: str = "") -> Iterator[Row]:
         for sub in models:
             if len(models) > 1:
                 summary = _rst_to_md(_class_summary(sub))
-                yield Row(f"{key}{step}", sub.__name__, "", "", "", f"when `{_variant(sub, field)}`: {summary}")
+                variant = f"when `{_variant(sub, field)}`: {summary}"
+                yield Row(f"{key}{step}", sub.__name__, "", "", "", variant, variant=True)
             yield from rows(sub, f"{key}{step}.")
 
 
@@ -352,10 +385,14 @@ def render() -> str:
         "",
     ]
     all_rows = list(rows(top))
-    scalars = [r for r in all_rows if "." not in r.key]
+    scalars = [r for r in all_rows if "." not in r.key and not r.variant]
     lines += _table(scalars)
     for head in scalars:
-        sub = [r for r in all_rows if r.key.startswith(head.key + ".") or r.key.startswith(head.key + "[")]
+        sub = [
+            r
+            for r in all_rows
+            if r.key.startswith((head.key + ".", head.key + "[")) or (r.variant and r.key.startswith(head.key))
+        ]
         if not sub:
             continue
         lines += ["", f"## `{head.key}`", "", _cell(head.description), ""]

@@ -122,7 +122,8 @@ def _finish_run(run: WeldRun, json_path: Path | None, krl: Path | None, *, title
         from cell.export.trajectory import write_json as write_traj
 
         name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in run.detection.scenario.name).upper()
-        src, dat = write_krl(run.plan, run.arm.model, krl, name[:24], X_WR=run.detection.scenario.X_WR)
+        sc = run.detection.scenario
+        src, dat = write_krl(run.plan, run.arm.model, krl, name[:24], X_WR=sc.X_WR, options=sc.export.krl)
         traj_json = write_traj(run.plan, krl / "trajectory.json")
         traj_csv = write_csv(run.plan, krl / "trajectory.csv")
         err.print(f"[dim]· robot program: {src}, {dat}; trajectory: {traj_json}, {traj_csv}[/]")

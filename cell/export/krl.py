@@ -25,31 +25,18 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.export import KrlOptions
 from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
 from cell.types.plan import WeldPlan
 from cell.types.robot import Kinematics
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,23}")
 _X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (x along the wire)
-
-
-@dataclass(frozen=True)
-class KrlOptions:
-    """load_kg, load_cm_mm: payload on the flange ($LOAD: torch 1.8 kg + camera 0.1 kg, centre of mass from
-    robots/build_kr5_arc.py); arc_markers: "comment" or "call"; ptp_percent: PTP velocity/acceleration in
-    percent of the axis maxima (the plan's PTP moves use the full limits)."""
-
-    load_kg: float = 1.9
-    load_cm_mm: tuple[float, float, float] = (110.0, 0.0, 0.0)
-    arc_markers: Literal["comment", "call"] = "comment"
-    ptp_percent: int = 100
 
 
 def _f(v: float) -> str:

@@ -31,25 +31,10 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
+from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
 from cell.motion.robot import RobotModel
 from cell.types import Part
-
-
-@dataclass(frozen=True)
-class CollisionOptions:
-    """part_inflation, table_inflation [m]: growth of obstacle boxes on every side; tcp_clearance [m]: torch
-    shapes within this distance of the wire tip are cut away; max_step [m]: most an arm point may move between
-    two checks; min_clearance [m]: a distance below this counts as contact; table_name: which obstacle is the
-    table."""
-
-    part_inflation: float = 0.002
-    table_inflation: float = 0.0
-    tcp_clearance: float = 0.035
-    max_step: float = 0.05
-    min_clearance: float = 0.0
-    table_name: str = "TABLE"
-    tcp_frame: str = "torch_tcp"
 
 
 @dataclass(frozen=True)

@@ -18,22 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.motion import IKOptions
 from cell.errors import IKError
 from cell.geometry import FloatArray, axis_angle_to_matrix, readonly
 from cell.motion.robot import RobotModel
-
-
-@dataclass(frozen=True)
-class IKOptions:
-    """Solver settings (defaults suit a 6-axis arm of about 1.5 m reach)."""
-
-    pos_tol: float = 1e-5  # [m] 0.01 mm
-    rot_tol: float = np.radians(0.01)  # [rad] 0.01 deg
-    max_iters: int = 60  # per attempt
-    restarts: int = 12  # extra attempts from random configurations, only when an rng is given
-    damping: float = 1e-6  # lambda^2 of the damped least squares [m^2]
-    max_step: float = 0.5  # [rad] largest joint change per iteration
-    restart_margin: float = np.radians(5.0)  # [rad] random restarts stay this far inside the limits
 
 
 class IKSolveError(IKError):

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.motion import STICKOUT_MM
 from cell.errors import PlanError
 from cell.geometry import FloatArray, make_pose, readonly, rot_z
 from cell.scenario import ProcessSpec
@@ -58,7 +59,7 @@ class WeldProcess:
     approach_speed: float
 
     @classmethod
-    def from_spec(cls, spec: ProcessSpec, stickout_mm: float = 15.0) -> WeldProcess:
+    def from_spec(cls, spec: ProcessSpec, stickout_mm: float = STICKOUT_MM) -> WeldProcess:
         """SI values from the scenario's process spec; ``stickout_mm`` is the scenario's robot.stickout_mm."""
         return cls(
             travel_speed=spec.travel_speed_mm_s / 1000.0,

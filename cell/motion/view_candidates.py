@@ -15,42 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.motion import ViewOptions
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, transform_points
 from cell.motion.robot import RobotModel
 from cell.types import CameraIntrinsics, Part
 from cell.types.plan import SeamTask
-
-
-@dataclass(frozen=True)
-class ViewOptions:
-    """Candidate grid and acceptance thresholds of a close-up view (lengths [m], angles [deg])."""
-
-    distances_m: tuple[float, ...] = (0.36, 0.40, 0.44, 0.33)  # D415 minimum range ~0.3 m; TCP 0.3 m ahead
-    preferred_distance_m: float = 0.36
-    tilts_deg: tuple[float, ...] = (0.0, 15.0, -15.0, 30.0, -30.0)  # about the seam, towards face A (+) or B
-    slants_deg: tuple[float, ...] = (0.0, 20.0, -20.0, 40.0, -40.0)  # along the seam
-    # The seam's angle in the image (a turn about the line of sight to its midpoint, which stays put): the
-    # wrist reaches some of these and not others.
-    rolls_deg: tuple[float, ...] = (0.0, 180.0, 20.0, -20.0, 160.0, -160.0, 40.0, -40.0, 140.0, -140.0)
-    image_offset_deg: float = 11.0  # the seam's midpoint this far above the image centre (torch below)
-    max_incidence_deg: float = 72.0  # largest angle between a line of sight and a weld face's normal
-    face_strip_m: float = 0.03  # width of each weld face next to the seam that must be in view
-    end_margin_m: float = 0.01  # the seam's line beyond its ends that must be in view
-    image_margin_px: float = 24.0  # kept free along the image border
-    torch_radius_m: float = 0.03  # the torch's radius about its axis, with margin (URDF body: 22 mm)
-    torch_margin_px: float = 12.0
-    occlusion_margin_m: float = 0.001  # parts grown by this for the line-of-sight test
-    distance_weight_deg_per_m: float = 200.0  # score: 10 deg of incidence for 5 cm off the preferred distance
-    camera_frame: str = "camera_optical"
-    tcp_frame: str = "torch_tcp"
-    flange_frame: str = "tool0"
-    dt: float = 0.004  # [s] sample period of the move
-
-    def __post_init__(self) -> None:
-        if not self.distances_m or min(self.distances_m) <= 0.0:
-            raise ValueError(f"view distances_m must be positive, got {self.distances_m}")
-        if not 0.0 < self.max_incidence_deg < 90.0:
-            raise ValueError(f"max_incidence_deg must be in (0, 90), got {self.max_incidence_deg}")
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from cell.config.perception import SymmetryOptions
 from cell.errors import AlignmentError
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception.align import Alignment, sample_map
@@ -45,17 +46,6 @@ class Alternative:
     support_chosen: float
     support_alt: float
     n_distinct: int
-
-
-@dataclass(frozen=True)
-class SymmetryOptions:
-    """Thresholds of :func:`check_alignment_unique`; lengths [m]."""
-
-    band_m: float = 0.01  # a map sample is supported if a cloud point lies this near
-    spacing_m: float = 0.005  # map sample spacing
-    min_self_overlap: float = 0.6  # alternatives that keep less of the map on itself are not near-symmetries
-    min_margin: float = 0.3  # the chosen fit must be supported this much more than any alternative
-    min_distinct: int = 50  # fewer telling samples: the map is exactly symmetric there (see the docstring)
 
 
 def _candidates(weldmap_R: WeldMap, centre: FloatArray) -> list[tuple[FloatArray, str]]:

@@ -18,21 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from cell.config.perception import HealthOptions
 from cell.perception.preprocess import downsample
 from cell.types import Cloud, DepthImage
-
-
-@dataclass(frozen=True)
-class HealthOptions:
-    """Thresholds of the camera checks (defaults suit D4xx-class depth cameras at 1-2.5 m)."""
-
-    min_valid_fraction: float = 0.01  # fewer valid pixels: the camera is dead or blinded
-    max_constant_fraction: float = 0.5  # more valid pixels reading one identical value: stuck sensor
-    rough_jump_m: float = 0.05  # a depth step to a neighbour pixel larger than this (and 5 % of the depth) ...
-    max_rough_fraction: float = 0.2  # ... on more than this share of neighbour pairs: not a scene, garbage
-    agree_voxel_m: float = 0.005  # clouds are compared on a grid of this [m] (averages the depth noise)
-    agree_tol_m: float = 0.01  # a point agrees with another camera if that camera has a point this near [m]
-    min_agreement: float = 0.5  # share of a camera's points that must agree with some other camera
 
 
 @dataclass(frozen=True)

@@ -8,23 +8,12 @@ map does not know lies over it (:func:`foreign_points`), or when the locator its
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 
+from cell.config.perception import ScreenOptions
 from cell.geometry import FloatArray
-from cell.seams.base import SeamScene
-from cell.types import Cloud, Reason, SeamEstimate, SeamStatus, WeldMap
-
-
-@dataclass(frozen=True)
-class ScreenOptions:
-    """Thresholds of :func:`screen`; lengths [m]."""
-
-    radius_m: float = 0.06  # look this far around the seam for points of unknown objects (the locator's tube)
-    margin_m: float = 0.02  # a point further than this from every part of the map is foreign (3 sigma at 2 m)
-    min_foreign: int = 40  # this many foreign points (a few cm^2 of surface) near a seam: it is occluded
-    min_confidence: float = 0.1  # found seams below this confidence are not trusted
+from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
 
 
 def foreign_points(

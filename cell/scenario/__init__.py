@@ -7,7 +7,9 @@ key and what is valid. Lengths in the file are metres (keys end in ``_m``) or mi
 """
 
 # cell_specs: what the cell is (map, part as built, table, robot, cameras, sensor model); run_specs: how it works
-# (process, perception, locator, re-scan, simulated faults); model: the Scenario itself; loading: files and names.
+# (process, perception, re-scan, motion, export, simulation, simulated faults); locator_specs: which locator and its
+# options; model: the Scenario itself; loading: files and names. The options classes of the stages are
+# cell.config's dataclasses, composed here as sub-models.
 
 from cell.scenario.cell_specs import (
     CameraSpec,
@@ -21,37 +23,54 @@ from cell.scenario.cell_specs import (
     WorkspaceSpec,
 )
 from cell.scenario.loading import REPO_ROOT, SCENARIO_DIR, available, from_dict, from_yaml, load, resolve
+from cell.scenario.locator_specs import (
+    LOCATOR_SPECS,
+    AnyLocatorSpec,
+    LocatorSpec,
+    OursLocatorSpec,
+    PaperLocatorSpec,
+    RansacLocatorSpec,
+    spec_method,
+)
 from cell.scenario.model import Scenario
 from cell.scenario.run_specs import (
     CameraFaultSpec,
+    ExportSpec,
     FaultsSpec,
-    LocatorSpec,
+    MotionSpec,
     OccluderSpec,
-    PaperLocatorSpec,
     PerceptionSpec,
     ProcessSpec,
     RescanSpec,
+    SimulationSpec,
 )
 
 __all__ = [
+    "LOCATOR_SPECS",
     "REPO_ROOT",
     "SCENARIO_DIR",
+    "AnyLocatorSpec",
     "CameraFaultSpec",
     "CameraSpec",
     "Deviation",
+    "ExportSpec",
     "ExtrinsicErrorSpec",
     "FaultsSpec",
     "LocatorSpec",
     "MapSpec",
+    "MotionSpec",
     "NoiseSpec",
     "OccluderSpec",
+    "OursLocatorSpec",
     "PaperLocatorSpec",
     "PerceptionSpec",
     "PoseSpec",
     "ProcessSpec",
+    "RansacLocatorSpec",
     "RescanSpec",
     "RobotSpec",
     "Scenario",
+    "SimulationSpec",
     "TableSpec",
     "WorkspaceSpec",
     "available",
@@ -59,4 +78,5 @@ __all__ = [
     "from_yaml",
     "load",
     "resolve",
+    "spec_method",
 ]

@@ -9,6 +9,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from cell.config import STICKOUT_MM
 from cell.geometry import FloatArray, look_at, pose_from_xyz_rpy
 from cell.scenario.base import Model, NonNeg, Pos, Vec3
 
@@ -60,7 +61,7 @@ class RobotSpec(Model):
     home_deg: tuple[float, ...] | None = None
     # Wire stick-out [mm] beyond the contact tip in the URDF's torch_tcp (robots/build_kr5_arc.py STICKOUT): the
     # torch planner stands the TCP off the seam by contact_tip_distance_mm minus this (0 by default).
-    stickout_mm: Pos = 15.0
+    stickout_mm: Pos = STICKOUT_MM
 
 
 class NoiseSpec(Model):

@@ -3,9 +3,12 @@ names the key and what is valid there."""
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
+import types
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal, Union, get_args, get_origin, get_type_hints
 
 import yaml
 from pydantic import BaseModel, ValidationError
@@ -15,47 +18,84 @@ from cell.scenario.model import Scenario
 
 REPO_ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO_DIR = REPO_ROOT / "scenarios"
+_UNKNOWN_KEY = ("extra_forbidden", "unexpected_keyword_argument")
 
 
-def _format_loc(loc: tuple[int | str, ...]) -> str:
-    return ".".join(str(p) for p in loc) or "<top level>"
+def _members(tp: Any) -> list[Any]:
+    """The concrete types an annotation may hold: ``Annotated[X, ...]`` -> X, ``A | B | None`` -> A, B."""
+    if get_origin(tp) is Annotated:
+        return _members(get_args(tp)[0])
+    if get_origin(tp) in (Union, types.UnionType):
+        return [m for a in get_args(tp) if a is not type(None) for m in _members(a)]
+    return [tp]
 
 
-def _valid_keys(model: type[BaseModel], loc: tuple[int | str, ...]) -> list[str]:
-    """Field names valid at ``loc`` (the location of an unknown key), by walking the model tree."""
-    current: Any = model
-    free_key = False  # the next part of loc is a free dict key (a camera or part name)
-    for part in loc[:-1]:
-        if free_key:
-            free_key = False
-            continue
-        if not (isinstance(current, type) and issubclass(current, BaseModel)) or not isinstance(part, str):
-            return []
-        f = current.model_fields.get(part)
-        if f is None:
-            return []
-        ann = f.annotation
-        args = getattr(ann, "__args__", ())
-        free_key = getattr(ann, "__origin__", None) is dict
-        # dict[str, Model] -> Model after the free key; Model | None -> Model
-        candidates = [a for a in (ann, *args) if isinstance(a, type) and issubclass(a, BaseModel)]
-        current = candidates[0] if candidates else ann
-    if isinstance(current, type) and issubclass(current, BaseModel):
-        return [k for k in current.model_fields if k != "base_dir"]
-    return []
+def _keys(tp: Any) -> dict[str, Any] | None:
+    """Key -> annotation of a scenario model or an options dataclass; None for anything else."""
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        return {k: f.annotation for k, f in tp.model_fields.items() if not f.exclude}
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
+        hints = get_type_hints(tp, include_extras=True)
+        return {f.name: hints[f.name] for f in dataclasses.fields(tp)}
+    return None
+
+
+def _tag(tp: Any) -> str | None:
+    """The ``method`` a member of a discriminated union is told by (pydantic puts it in the error's loc)."""
+    keys = _keys(tp)
+    method = keys.get("method") if keys else None
+    values = get_args(method) if get_origin(method) is Literal else ()
+    return str(values[0]) if len(values) == 1 else None
+
+
+def _walk(model: type[BaseModel], loc: tuple[int | str, ...]) -> tuple[list[str], str]:
+    """(keys valid at ``loc``, the location of an unknown key; ``loc`` as written in the file), by walking the
+    models and options dataclasses. pydantic puts the chosen member's tag in a discriminated union's loc
+    (``locator.ours.options``): the file has no such key, so the path leaves it out."""
+    current: list[Any] = [model]
+    path: list[str] = []
+    for i, part in enumerate(loc):
+        step: list[Any] = []
+        tag = False
+        for tp in (m for c in current for m in _members(c)):
+            origin, keys = get_origin(tp), _keys(tp)
+            if origin in (dict, Mapping):  # a free key (a camera or part name)
+                step.append(get_args(tp)[1])
+            elif origin in (tuple, list) and isinstance(part, int):
+                step.extend(a for a in get_args(tp) if a is not Ellipsis)
+            elif keys is not None and part in keys:
+                step.append(keys[str(part)])
+            elif _tag(tp) == part:  # the member of a discriminated union that was chosen
+                step.append(tp)
+                tag = True
+        if not tag:
+            path.append(str(part))
+        if i < len(loc) - 1:
+            current = step
+    for tp in (m for c in current for m in _members(c)):
+        keys = _keys(tp)
+        if keys is not None:
+            return list(keys), ".".join(path) or "<top level>"
+    return [], ".".join(path) or "<top level>"
 
 
 def _explain(err: ValidationError, source: str) -> str:
     errors = err.errors()
-    # An unknown (misspelled) key explains the rest (the real key then shows up as missing): report it first.
-    e = next((x for x in errors if x["type"] == "extra_forbidden"), errors[0])
+    # An unknown (misspelled) key explains the rest (the real key then shows up as missing): report it first. A
+    # model says extra_forbidden, an options dataclass unexpected_keyword_argument.
+    e = next((x for x in errors if x["type"] in _UNKNOWN_KEY), errors[0])
     loc = tuple(e["loc"])
-    where = _format_loc(loc)
-    if e["type"] == "extra_forbidden":
-        valid = _valid_keys(Scenario, loc)
+    valid, where = _walk(Scenario, loc)
+    if e["type"] in _UNKNOWN_KEY:
         close = difflib.get_close_matches(str(loc[-1]), valid, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         return f"{source}: unknown key {where!r}{hint}; valid keys there: {', '.join(valid)}"
+    if e["type"] == "union_tag_invalid":  # locator.method names no registered locator
+        tags = [s.strip("'") for s in str(e.get("ctx", {}).get("expected_tags", "")).split(", ") if s]
+        tag = str(e.get("ctx", {}).get("tag", ""))
+        close = difflib.get_close_matches(tag, tags, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        return f"{source}: {where}.method {tag!r} is unknown{hint}; valid: {', '.join(tags)}"
     if e["type"] == "missing":
         return f"{source}: missing key {where!r}"
     more = f" (+{len(errors) - 1} more problems)" if len(errors) > 1 else ""

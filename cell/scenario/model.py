@@ -12,7 +12,16 @@ from pydantic import Field, field_validator, model_validator
 from cell.geometry import FloatArray
 from cell.scenario.base import Model
 from cell.scenario.cell_specs import CameraSpec, Deviation, MapSpec, RobotSpec, TableSpec
-from cell.scenario.run_specs import FaultsSpec, LocatorSpec, PerceptionSpec, ProcessSpec, RescanSpec
+from cell.scenario.locator_specs import LocatorSpec, OursLocatorSpec
+from cell.scenario.run_specs import (
+    ExportSpec,
+    FaultsSpec,
+    MotionSpec,
+    PerceptionSpec,
+    ProcessSpec,
+    RescanSpec,
+    SimulationSpec,
+)
 
 
 class Scenario(Model):
@@ -29,8 +38,11 @@ class Scenario(Model):
     process: ProcessSpec = ProcessSpec()
     cameras: dict[str, CameraSpec]
     perception: PerceptionSpec
-    locator: LocatorSpec = LocatorSpec()
+    locator: LocatorSpec = OursLocatorSpec()  # which locator runs (``method``) and its options
     rescan: RescanSpec = RescanSpec()
+    motion: MotionSpec = MotionSpec()
+    export: ExportSpec = ExportSpec()
+    simulation: SimulationSpec = SimulationSpec()
     faults: FaultsSpec = FaultsSpec()
     # Set by the loader: the folder the file lives in (paths inside are relative to it).
     base_dir: str = Field(default=".", exclude=True)

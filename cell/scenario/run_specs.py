@@ -3,14 +3,28 @@ plays. Lengths in metres (``_m``) or millimetres (``_mm``), angles in degrees (`
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationError, model_validator
 
+from cell.config import (
+    CONFIDENCE_THRESHOLD,
+    BeadStyle,
+    GateOptions,
+    HealthOptions,
+    KrlOptions,
+    PlanOptions,
+    RescanOptions,
+    ScreenOptions,
+    SymmetryOptions,
+)
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import WorkspaceSpec
+from cell.scenario.locator_specs import LOCATOR_SPECS, spec_method
 
 
 class ProcessSpec(Model):
@@ -37,7 +51,7 @@ class ProcessSpec(Model):
 
 
 class PerceptionSpec(Model):
-    """Splicing and preprocessing (paper sections 3.2-3.5)."""
+    """Splicing and preprocessing (paper sections 3.2-3.5), and the checks that turn bad data into reasons."""
 
     workspace: WorkspaceSpec
     icp_max_correspondence_m: Pos = 0.001  # paper: 1 mm
@@ -48,22 +62,9 @@ class PerceptionSpec(Model):
     align_max_correspondence_m: Pos = 0.02  # map-to-cloud ICP
     align_iterations: Annotated[int, Field(ge=1, le=1000)] = 60
     align_min_fitness: Annotated[float, Field(ge=0.0, le=1.0)] = 0.5
-
-
-class PaperLocatorSpec(Model):
-    """Options of the paper's locator (section 3.6); masks are (across, along) half-widths... as in eq. 5-6 [m]."""
-
-    outer_mask_m: tuple[Pos, Pos] = (0.03, 0.05)
-    inner_mask_m: tuple[Pos, Pos] = (0.015, 0.03)
-    frequency_bin_m: Pos = 0.001
-
-
-class LocatorSpec(Model):
-    """Which locator runs by default and its options."""
-
-    method: Literal["paper", "ransac", "ours"] = "ours"  # ours beats both (README, cell bench)
-    paper: PaperLocatorSpec = PaperLocatorSpec()
-    options: dict[str, dict[str, float | int | str | bool]] = Field(default_factory=dict)
+    health: HealthOptions = HealthOptions()  # is a camera's data fit to splice (dead, stuck, garbage, bumped)
+    symmetry: SymmetryOptions = SymmetryOptions()  # is the map's fit unique (no near-symmetry fits as well)
+    screen: ScreenOptions = ScreenOptions()  # which found seams must not be welded (occluded, doubtful)
 
 
 class RescanSpec(Model):
@@ -74,14 +75,38 @@ class RescanSpec(Model):
     weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
     escalate_mm : in ``low`` mode, a close-up that disagrees with the first estimate by more than this [mm]
         triggers a re-scan of every visible seam.
+    closeup : how each close-up is taken, located and fused (:class:`~cell.config.rescan.RescanOptions`).
     """
 
     mode: Literal["none", "low", "all"] = "low"
-    confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = 0.55  # benchmarks/bench_confidence.py
+    # Calibrated by benchmarks/bench_confidence.py (cell.config.rescan.CONFIDENCE_THRESHOLD says how).
+    confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = CONFIDENCE_THRESHOLD
     weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
     # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
     # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.
     escalate_mm: Annotated[float, Field(gt=0.0)] = 0.5
+    closeup: RescanOptions = RescanOptions()
+
+    @model_validator(mode="after")
+    def _closeup_locator_options(self) -> RescanSpec:
+        """Each method's close-up options must be options of that method (checked now, not at the re-scan)."""
+        specs = {spec_method(s): s for s in LOCATOR_SPECS}
+        for method, extra in self.closeup.closeup_locator_options.items():
+            where = f"closeup.closeup_locator_options.{method}"
+            spec = specs.get(method)
+            if spec is None:
+                raise ValueError(f"{where}: no locator {method!r}; valid: {', '.join(specs)}")
+            valid = [f.name for f in dataclasses.fields(spec().options)]
+            for key in extra:
+                if key not in valid:
+                    close = difflib.get_close_matches(key, valid, n=1)
+                    hint = f" (did you mean {close[0]!r}?)" if close else ""
+                    raise ValueError(f"{where}: unknown key {key!r}{hint}; valid keys there: {', '.join(valid)}")
+            try:
+                spec.model_validate({"method": method, "options": dict(extra)})
+            except ValidationError as e:
+                raise ValueError(f"{where}: {e.errors()[0]['msg']}") from None
+        return self
 
 
 class CameraFaultSpec(Model):
@@ -121,3 +146,23 @@ class FaultsSpec(Model):
     cameras: dict[str, CameraFaultSpec] = Field(default_factory=dict)
     occluders: dict[str, OccluderSpec] = Field(default_factory=dict)
     missing_parts: tuple[str, ...] = ()
+
+
+class MotionSpec(Model):
+    """Motion: the welding planner (with the collision model every motion of the run is checked against) and the
+    safety gate the plan must pass."""
+
+    plan: PlanOptions = PlanOptions()
+    gate: GateOptions = GateOptions()
+
+
+class ExportSpec(Model):
+    """What the cell writes for the controller: the KUKA KRL program (``cell weld --krl``)."""
+
+    krl: KrlOptions = KrlOptions()
+
+
+class SimulationSpec(Model):
+    """How the simulator draws what it plays (no effect on any figure)."""
+
+    bead: BeadStyle = BeadStyle()

@@ -4,18 +4,17 @@ frequencies.
 Everything is in the robot frame R, metres. The features of a mask's points (KD-tree, point spacing, normals,
 boundary points: :mod:`cell.seams._features`) are computed with numpy/scipy for each mask, as the paper's step 2
 does ("from the masked point cloud, extract boundary points"); every threshold derives from the cloud's own point
-spacing (the voxel size of a voxel-downsampled cloud) or from :class:`PaperLocatorSpec`.
+spacing (the voxel size of a voxel-downsampled cloud) or from :class:`~cell.config.seams.PaperOptions`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from cell.config.seams import PaperOptions
 from cell.geometry import FloatArray
-from cell.scenario import PaperLocatorSpec
 from cell.seams._features import cloud_features
-from cell.seams.base import SeamScene
-from cell.types import MapSeam, Reason, SeamEstimate, SeamStatus
+from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 AXIS_TOLERANCE_DEG = 10.0  # a seam within this of x, y or z counts as "along" it
 MIN_MASK_POINTS = 8  # fewer cloud points than this in the outer mask: nothing to measure
@@ -134,8 +133,8 @@ class PaperLocator:
 
     name = "paper"
 
-    def __init__(self, spec: PaperLocatorSpec | None = None, *, strict: bool = False) -> None:
-        self.spec = spec if spec is not None else PaperLocatorSpec()
+    def __init__(self, spec: PaperOptions | None = None, *, strict: bool = False) -> None:
+        self.spec = spec if spec is not None else PaperOptions()
         self.strict = strict
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:

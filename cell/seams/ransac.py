@@ -22,57 +22,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cell.errors import MapError, ScenarioError
+from cell.config.seams import RansacOptions
+from cell.config.seams import RansacThresholds as _Thresholds
+from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._index import dense_index
 from cell.seams._lines import plane_intersection
-from cell.seams.base import SeamScene
-from cell.types import MapSeam, Reason, SeamEstimate, SeamStatus
-
-
-@dataclass(frozen=True)
-class RansacOptions:
-    """Options of :class:`RansacLocator`; lengths [m]."""
-
-    cloud: str = "voxel"  # "voxel": the paper's 1 cm cloud (scene.cloud); "dense": full resolution
-    runs: int = 3  # independent runs per seam; the median is reported (paper: three)
-    region_m: float = 0.05  # points within this distance of the map's seam segment (extended as far) are used
-    distance_m: float = 0.003  # least RANSAC inlier distance ...
-    distance_spacings: float = 0.3  # ... or this many point spacings, whichever is larger
-    min_plane_area_m2: float = 0.0008  # a plane needs the points of this much area (8 cm^2) ...
-    min_inliers: int = 6  # ... and at least this many points; a smaller plane ends the segmentation
-    iterations: int = 300  # hypotheses per plane
-    max_planes: int = 5  # planes segmented per region
-    sample_points: int = 4000  # points used to score hypotheses (all region points are used for the refits)
-    parallel_deg: float = 30.0  # planes closer than this in angle count as parallel
-    match_deg: float = 20.0  # a plane matches a map face when their normals are this close
-    match_offset_m: float = 0.01  # ... and it passes this close to the map's seam
-    clip_radius_m: float = 0.015  # inliers this near the line (or 2 spacings) give its extent ...
-    clip_band_m: float = 0.006  # ... unless this near the other plane (or 0.6 spacings): the corner
-    clip_quantile: float = 0.01  # ... from this quantile to 1 - this (0: the extreme inliers)
-
-    def __post_init__(self) -> None:
-        if self.cloud not in ("dense", "voxel"):
-            raise ScenarioError(f"ransac option cloud is {self.cloud!r}; valid: 'dense', 'voxel'")
-        if self.runs < 1 or self.iterations < 1 or self.max_planes < 2 or self.min_inliers < 3:
-            raise ScenarioError("ransac options need runs >= 1, iterations >= 1, max_planes >= 2 and min_inliers >= 3")
-
-    def thresholds(self, spacing: float) -> _Thresholds:
-        """The spacing-dependent thresholds for a cloud of point spacing ``spacing`` [m]."""
-        return _Thresholds(
-            distance=max(self.distance_m, self.distance_spacings * spacing),
-            min_inliers=max(self.min_inliers, int(self.min_plane_area_m2 / spacing**2)),
-            clip_radius=max(self.clip_radius_m, 2.0 * spacing),
-            clip_band=max(self.clip_band_m, 0.6 * spacing),
-        )
-
-
-@dataclass(frozen=True)
-class _Thresholds:
-    distance: float  # RANSAC inlier distance [m]
-    min_inliers: int  # least plane [points]
-    clip_radius: float  # [m]
-    clip_band: float  # [m]
+from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,6 @@ Frames: ``W`` world, ``R`` robot base (URDF root link, KUKA $ROBROOT). Units: me
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +24,7 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 from scipy.spatial.transform import Rotation
 
+from cell.config.sim import BeadStyle
 from cell.errors import PlanError, ScenarioError
 from cell.geometry import FloatArray, make_pose, readonly
 from cell.sim.execution import _check_trajectory, _events, _interp_rows, _record_times
@@ -50,15 +50,6 @@ def _matrices_from_quats(quats: npt.ArrayLike) -> FloatArray:
 
 def _pose(position: Sequence[float], quat_xyzw: Sequence[float]) -> FloatArray:
     return make_pose(_matrices_from_quats(quat_xyzw)[0], position)
-
-
-@dataclass(frozen=True)
-class BeadStyle:
-    """How the weld bead is drawn: capsules of ``radius_m`` [m] along chords of about ``step_m`` [m]."""
-
-    radius_m: float = 0.003
-    step_m: float = 0.005
-    rgba: tuple[float, float, float, float] = (0.9, 0.1, 0.1, 1.0)
 
 
 def _chord_points(path: FloatArray, step: float) -> FloatArray:

@@ -77,7 +77,7 @@ class SimStation:
     ) -> Execution:
         if not bead:
             return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=None)
-        return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt)
+        return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=self.scenario.simulation.bead)
 
     def joint_state(self) -> FloatArray:
         return np.asarray(self.sim.robot.q, dtype=float)

@@ -14,6 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
+from cell.config.motion import GateOptions
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
@@ -52,20 +53,6 @@ class Violation:
     def __str__(self) -> str:
         j = f" {self.joint}" if self.joint else ""
         return f"{self.kind}{j} at t = {self.t:.3f} s: {self.what}"
-
-
-@dataclass(frozen=True)
-class GateOptions:
-    """rate_hz: re-sampling rate; rel_tol: relative slack on the velocity/acceleration/jerk limits; start_tol
-    [rad]; rest_tol [rad/s] (and [rad/s^2] for the acceleration) for an exact stop; min_manipulability [m^3];
-    lin_step [m]: TCP travel between singularity checks on LIN segments."""
-
-    rate_hz: float = 1000.0
-    rel_tol: float = 0.01
-    start_tol: float = 1e-4
-    rest_tol: float = 1e-6
-    min_manipulability: float = 0.01
-    lin_step: float = 0.002
 
 
 def resample_times(times: FloatArray, rate_hz: float) -> FloatArray:

@@ -1,0 +1,41 @@
+"""Options of every stage, as small frozen dataclasses with their defaults: what a scenario can set.
+
+One module per stage (``perception``, ``motion``, ``seams``, ``rescan``, ``export``, ``sim``); stdlib and numpy
+only, nothing of the project but :mod:`cell.errors` (an import-linter contract), so :mod:`cell.scenario` composes
+them into the scenario's model and every stage imports its options from here without an import cycle. The
+scenario loader validates them (unknown keys, types, the ranges of :class:`~cell.config.bounds.Bounds`) and
+the report records them as resolved. Run-time values a stage also needs (ours' workspace crop) are not options.
+"""
+
+from cell.config.bounds import Bounds, check_bounds
+from cell.config.export import KrlOptions
+from cell.config.motion import STICKOUT_MM, CollisionOptions, GateOptions, IKOptions, PlanOptions, ViewOptions
+from cell.config.perception import HealthOptions, ScreenOptions, SymmetryOptions
+from cell.config.rescan import CLOSEUP_OURS_OPTIONS, CLOSEUP_TARGET_SE_M, CONFIDENCE_THRESHOLD, RescanOptions
+from cell.config.seams import INDEX_SHARES, OursSettings, PaperOptions, RansacOptions, RansacThresholds
+from cell.config.sim import BeadStyle
+
+__all__ = [
+    "CLOSEUP_OURS_OPTIONS",
+    "CLOSEUP_TARGET_SE_M",
+    "CONFIDENCE_THRESHOLD",
+    "INDEX_SHARES",
+    "STICKOUT_MM",
+    "BeadStyle",
+    "Bounds",
+    "CollisionOptions",
+    "GateOptions",
+    "HealthOptions",
+    "IKOptions",
+    "KrlOptions",
+    "OursSettings",
+    "PaperOptions",
+    "PlanOptions",
+    "RansacOptions",
+    "RansacThresholds",
+    "RescanOptions",
+    "ScreenOptions",
+    "SymmetryOptions",
+    "ViewOptions",
+    "check_bounds",
+]

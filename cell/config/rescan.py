@@ -1,0 +1,56 @@
+"""Options of the close-up re-scan (:mod:`cell.rescan`, the loop in :mod:`cell.pipeline.rescan`); lengths [m]."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from cell.config.motion import ViewOptions
+from cell.config.seams import OursSettings
+
+# Below this confidence a seam is worth a close look (benchmarks/bench_confidence.py: 144 seams of fence1-exact,
+# fence1 and fence2, realistic noise; 20 fall below it, with 2 of the 3 seams more than 0.15 mm off). A scenario
+# can override it (``rescan.confidence_threshold``).
+CONFIDENCE_THRESHOLD = 0.55
+
+# The standard error that earns a close-up full confidence [m]: ours' target_se_m on a close-up cloud, and the
+# re-scan's confidence scale of a close-up.
+CLOSEUP_TARGET_SE_M = 0.00002
+
+# Options of the "ours" locator for a close-up cloud (~0.2 mm noise and ~0.35 mm pixels at 0.35 m instead of
+# ~4 mm and ~1.6 mm at 1.6 m): the standard error that earns full confidence and the bands cut along edges and
+# corners shrink with the sensor. The noise assumed before it is measured (sensor_sigma_m) stays: it also sets
+# the first pass's gate, which must span the aligned map's local error (up to ~8 mm on fence1's posts).
+CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
+    "target_se_m": CLOSEUP_TARGET_SE_M,
+    "edge_band_m": 0.002,
+    "corner_band_m": 0.003,
+}
+
+
+@dataclass(frozen=True)
+class RescanOptions:
+    """Options of the close-up re-scan (lengths [m]).
+
+    first_floor_m : standard deviation the first estimate has whatever its confidence says: the fixed cameras'
+        calibration, which no confidence sees (0.3-1 mm / 0.03-0.1 deg on real cells, docs/reference.md section
+        2; the default 0.2 mm is about what the exact simulated cameras give at high confidence).
+    closeup_floor_m : the same for the close-up (the arm's pose accuracy and hand-eye calibration on a real cell;
+        exact kinematics in the simulator).
+    first_scale_m, closeup_scale_m : the locator's standard error at confidence 1/2 for each kind of cloud (the
+        first: ours' default ``target_se_m``).
+    closeup_locator_options : locator name -> options merged into that locator's for a close-up cloud.
+    """
+
+    camera: str | None = None  # the eye-in-hand camera; None: the scenario's only one
+    crop_margin_m: float = 0.08  # the box around the seam grown by this (the locator's tube and end search)
+    min_points: int = 2000  # fewer points in that box: nothing seen
+    first_floor_m: float = 0.0002
+    closeup_floor_m: float = 0.00002
+    first_scale_m: float = OursSettings.target_se_m
+    closeup_scale_m: float = CLOSEUP_TARGET_SE_M
+    closeup_locator_options: Mapping[str, Mapping[str, float | int | str | bool]] = field(
+        default_factory=lambda: {"ours": CLOSEUP_OURS_OPTIONS}
+    )
+    return_to_scan: bool = True  # go back to the scan configuration after the last view (when that move is free)
+    view: ViewOptions = field(default_factory=ViewOptions)

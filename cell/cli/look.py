@@ -75,7 +75,9 @@ def bench(
     scenarios: Annotated[
         list[str] | None, typer.Argument(help="Scenarios to run (default: fence1-exact fence1 fence2).")
     ] = None,
-    methods: Annotated[str, typer.Option(help="Comma-separated locators.")] = "paper,ransac,ours",
+    methods: Annotated[
+        str | None, typer.Option(help="Comma-separated locators (default: every registered one).")
+    ] = None,
     noise: NoiseOpt = None,
     extrinsics: Annotated[
         str, typer.Option(help="Comma-separated calibration errors of the fixed cameras: exact or MM/DEG.")
@@ -93,7 +95,7 @@ def bench(
 
     with cell_errors():
         names = scenarios or ["fence1-exact", "fence1", "fence2"]
-        wanted = [m.strip() for m in methods.split(",") if m.strip()]
+        wanted = [m.strip() for m in methods.split(",") if m.strip()] if methods else list(METHODS)
         bad = [m for m in wanted if m not in METHODS]
         if bad:
             raise typer.BadParameter(f"{', '.join(bad)}; valid: {', '.join(METHODS)}", param_hint="--methods")

@@ -1,6 +1,5 @@
-"""Close-up re-scan: view planning on a tiny inline cell (distance, looking into the joint, reachable, clear of the
-torch and of collisions), fusion weights, and on a real scenario: the close-up improves a seam; a failed close-up
-keeps the first estimate."""
+"""Close-up re-scan on a tiny inline cell: view planning (distance, looking into the joint, reachable, clear of the
+torch and of collisions), fusion weights and which seams are re-scanned. On fence1: tests/scenario/test_closeup.py."""
 
 from __future__ import annotations
 
@@ -12,7 +11,6 @@ import numpy as np
 import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
-from cell import scenario as sc
 from cell.errors import PlanError
 from cell.geometry import invert, make_pose, transform_points
 from cell.motion.collision import CollisionChecker
@@ -24,14 +22,11 @@ from cell.motion.viewpoint import (
     plan_view,
     torch_axis_in_camera,
 )
-from cell.pipeline import rescan_seams, rescanned
 from cell.rescan import (
-    RescanOptions,
     fuse,
     seams_to_rescan,
     sigma_from_confidence,
 )
-from cell.seams.metrics import segment_errors
 from cell.sim.camera import intrinsics_for
 from cell.types import Box, Part, SeamEstimate, SeamStatus
 
@@ -164,64 +159,3 @@ def test_seams_to_rescan_takes_low_confidence_and_missed_visible_seams() -> None
     )
     assert seams_to_rescan(estimates, 0.55) == ["b", "c"]
     assert seams_to_rescan(estimates, math.inf) == ["a", "b", "c"]
-
-
-# -- the real pipeline ---------------------------------------------------------------------------------------
-
-
-@pytest.fixture(scope="module")
-def fence1() -> Any:
-    from cell.pipeline import detect, read_weldmap
-    from cell.station import open_station
-
-    scenario = sc.load("fence1")
-    weldmap = read_weldmap(scenario)
-    with open_station(scenario, weldmap) as station:
-        det = detect(scenario, station=station, weldmap=weldmap)
-        yield station, det
-
-
-@pytest.mark.scenario
-def test_rescan_improves_the_least_confident_seam_and_returns_the_arm(fence1: Any) -> None:
-    station, det = fence1
-    worst = min((e for e in det.estimates if e.status is SeamStatus.FOUND), key=lambda e: e.confidence)
-    rs = rescan_seams(station, det, [worst.id])
-    (r,) = rs.seams
-    assert r.reason == "" and r.viewpoint is not None and r.closeup is not None and r.weight > 0.5
-    truth = det.truths[worst.id]
-    lat0 = segment_errors(r.before.p_start, r.before.p_end, *truth)[2]
-    _, end1, lat1, _ = segment_errors(r.fused.p_start, r.fused.p_end, *truth)
-    assert lat1 < lat0 and lat1 < 0.1 and end1 < 0.3  # [mm]
-    assert r.motion_s > 0.0 and len(rs.executions) == 2  # to the view, and back
-    assert rs.returned and np.allclose(station.joint_state(), station.arm.q_scan, atol=1e-9)
-    after = rescanned(det, rs)
-    assert after.metrics[worst.id].lateral_mm == pytest.approx(lat1)
-    assert [e.id for e in after.estimates] == [e.id for e in det.estimates]
-
-
-@pytest.mark.scenario
-def test_a_closeup_that_sees_nothing_keeps_the_first_estimate(fence1: Any) -> None:
-    station, det = fence1
-    seam = next(e for e in det.estimates if e.status is SeamStatus.FOUND)
-    rs = rescan_seams(station, det, [seam.id], options=RescanOptions(min_points=10**8))
-    (r,) = rs.seams
-    assert r.reason.startswith("nothing seen") and r.fused is r.before and r.weight == 0.0
-    assert next(e for e in rs.estimates if e.id == seam.id) is seam
-
-
-@pytest.mark.scenario
-def test_rescan_undoes_the_fixed_cameras_calibration_error() -> None:
-    """Fixed cameras off by 1 mm / 0.1 deg: the arm's camera (posed by the robot's kinematics) brings every seam
-    back under 0.5 mm lateral (issue acceptance), and improves the mean."""
-    from cell import pipeline
-    from cell.station import open_station
-
-    scn = sc.load("faults/extrinsics-fixed-off")
-    weldmap = pipeline.read_weldmap(scn)
-    with open_station(scn, weldmap) as station:
-        det = pipeline.detect(scn, station=station, weldmap=weldmap)
-        ids = [e.id for e in det.estimates if e.status is SeamStatus.FOUND]
-        after = rescanned(det, rescan_seams(station, det, ids))
-    assert after.summary.found == 12
-    assert after.summary.lateral_mean_mm < 0.5
-    assert after.summary.lateral_mean_mm < det.summary.lateral_mean_mm

@@ -17,7 +17,7 @@ from cell.geometry import FloatArray, invert, make_pose, rot_y, rot_z
 from cell.motion.ik import IKOptions, IKSolveError, solve_ik, solve_path
 from cell.motion.robot import RobotModel
 
-ROBOTS = Path(__file__).resolve().parent.parent / "robots"
+ROBOTS = Path(__file__).resolve().parents[2] / "robots"
 URDF = ROBOTS / "kr5_arc.urdf"
 HOME = np.radians([0.0, -90.0, 90.0, 0.0, 0.0, 0.0])  # KUKA home: upper arm up, forearm forward
 

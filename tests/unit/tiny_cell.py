@@ -14,7 +14,7 @@ import numpy as np
 from cell.geometry import make_pose
 from cell.types import Box, Part
 
-URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
+URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"
 HOME = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
 TABLE = Part("TABLE", Box(make_pose(p=[0.0, 1.05, -0.05]), np.array([2.0, 1.2, 0.1])))
 RAIL = Part("RAIL", Box(make_pose(p=[0.0, 0.92, 0.03]), np.array([0.4, 0.1, 0.06])))

@@ -20,7 +20,7 @@ from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess
 from cell.types import Box, Part
 
-URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
+URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"
 HOME = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
 OBSTACLES = (
     Part("TABLE", Box(make_pose(p=[0.0, 1.05, -0.05]), np.array([2.0, 1.2, 0.1]))),

@@ -24,7 +24,7 @@ from cell.errors import CellError, MapError, ScenarioError
 from cell.types import WeldMap
 from cell.weldmap import read_map
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 DXF = (REPO / "maps" / "fence1.dxf").read_bytes()
 DXF_LINES = DXF.decode("ascii").splitlines(keepends=True)
 SCENARIO = (sc.SCENARIO_DIR / "fence1.yaml").read_text()

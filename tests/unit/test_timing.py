@@ -21,7 +21,7 @@ from cell.motion.timing import (
     ptp_duration,
 )
 
-URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
+URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"
 REL = 1e-9  # relative slack on limits for floating-point rounding
 
 

@@ -1,0 +1,96 @@
+"""What every test folder shares: the helper modules of ``tests/`` on the import path, and the session's scenes.
+
+``tests/unit/`` holds the fast tests (property tests, tiny inline cells, synthetic clouds: no simulator render of
+a whole scenario); ``tests/scenario/`` runs the real pipeline headless on the shipped scenarios (marked
+``scenario``). A shipped scenario that several tests read is captured and perceived once per session here, and
+shared read-only: the values are frozen dataclasses with read-only arrays. A test that needs a running station
+opens its own (:func:`fence1_station`); none is shared, so no result depends on the order the tests run in.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal
+
+import pytest
+
+if TYPE_CHECKING:
+    from cell import pipeline
+    from cell.geometry import FloatArray
+    from cell.scenario import Scenario
+    from cell.station import SimStation
+
+HERE = Path(__file__).resolve().parent
+if str(HERE) not in sys.path:  # dxf_factory, fakes: used from more than one folder
+    sys.path.insert(0, str(HERE))
+
+Noise = Literal["none", "realistic"]
+
+
+@dataclass(frozen=True)
+class Perceived:
+    """A scenario captured and perceived once: the scene every locator reads and the true seams (frame R, m)."""
+
+    scenario: Scenario
+    scene: pipeline.Scene
+    truths: Mapping[str, tuple[FloatArray, FloatArray]]
+
+
+@pytest.fixture(scope="session")
+def fence1_run() -> pipeline.WeldRun:
+    """``cell weld fence1`` once per session: detection, re-scan, plan, gate and execution (read-only)."""
+    from cell import pipeline
+    from cell import scenario as sc
+
+    return pipeline.weld(sc.load("fence1"))
+
+
+@pytest.fixture(scope="session")
+def fence1_detection(fence1_run: pipeline.WeldRun) -> pipeline.Detection:
+    """fence1's ``pipeline.detect`` result: the weld's own detection, before its re-scan (``first_detection``)."""
+    det = fence1_run.first_detection
+    if det is None or det.scene is None:
+        raise RuntimeError(f"fence1's detection kept no scene: {fence1_run.error}")
+    return det
+
+
+@pytest.fixture(scope="session")
+def perceived(request: pytest.FixtureRequest) -> Callable[[str, Noise], Perceived]:
+    """``perceived(name, noise)``: scenario ``name`` with that noise, captured and perceived once per session
+    (``pipeline.capture`` + ``pipeline.build_scene``); fence1 as shipped (realistic) is the weld's detection."""
+    from cell import pipeline
+    from cell import scenario as sc
+
+    cache: dict[tuple[str, Noise], Perceived] = {}
+
+    def get(name: str, noise: Noise) -> Perceived:
+        if (name, noise) not in cache:
+            s = sc.load(name)
+            if s.with_noise(noise) == sc.load("fence1"):
+                det: pipeline.Detection = request.getfixturevalue("fence1_detection")
+                if det.scene is None:
+                    raise RuntimeError("fence1's detection kept no scene")
+                cache[name, noise] = Perceived(det.scenario, det.scene, det.truths)
+            else:
+                cap = pipeline.capture(s.with_noise(noise))
+                scene = pipeline.build_scene(cap)
+                cache[name, noise] = Perceived(cap.scenario, scene, pipeline.truths(cap, scene.seam_scene.weldmap))
+        return cache[name, noise]
+
+    return get
+
+
+@pytest.fixture
+def fence1_station(fence1_detection: pipeline.Detection) -> Iterator[SimStation]:
+    """A running fence1 cell of the test's own, as the session's detection left its station: the arm at its scan
+    configuration and every camera one image on (a close-up draws the same noise as it does in ``cell weld``)."""
+    from cell import pipeline
+    from cell.station import open_station
+
+    scn = fence1_detection.scenario
+    with open_station(scn, pipeline.read_weldmap(scn)) as station:
+        station.capture()
+        yield station

@@ -232,3 +232,18 @@ def test_a_scenario_option_reaches_its_stage_and_the_report_records_it() -> None
     assert config["locator"] == {"method": "ours", "options": {**asdict(OursSettings()), "target_se_m": 0.0003}}
     assert config["motion"]["gate"]["rate_hz"] == 1000.0  # every default filled in
     assert sc.from_dict(config, sc.SCENARIO_DIR) == det.scenario  # the record loads back as what ran
+
+
+@pytest.mark.scenario
+def test_a_gate_option_reaches_the_safety_gate() -> None:
+    """Through pipeline.weld (a preview): a manipulability bar no arm clears makes the gate, built from its defaults
+    before the scenario held it, refuse the plan for singularities."""
+    from cell import pipeline
+    from cell.errors import PlanError
+    from cell.export.report import weld_report
+    from cell.motion.gate import ViolationKind
+
+    run = pipeline.weld(load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}")), execute_plan=False)
+    assert isinstance(run.error, PlanError) and run.violations
+    assert {v.split()[0] for v in run.violations} == {ViolationKind.SINGULARITY.value}
+    assert weld_report(run)["config"]["motion"]["gate"]["min_manipulability"] == 1.0

@@ -1,50 +1,26 @@
-"""The re-scan policy (which seams, when to escalate) and that ``cell weld`` and ``cell rescan`` share it.
+"""The re-scan policy: which seams, and when to escalate to every visible seam.
 
-The policy is tested against a fake station loop: ``rescan_seams`` replaced by one that "re-scans" by moving each
-seam a chosen distance, so the escalation branch is exercised without a simulator. The scenario test then proves
-both commands go through the one path: the same fake, seen from ``pipeline.weld`` and from ``cell rescan``.
+The policy is tested against a fake station loop (tests/fakes.py): ``rescan_seams`` replaced by one that
+"re-scans" by moving each seam a chosen distance, so the escalation branch is exercised without a simulator. That
+``cell weld`` and ``cell rescan`` share it: tests/scenario/test_rescan_path.py.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
+from fakes import FakeLoop
 
 import cell.pipeline.rescan as loop
-from cell import scenario as sc
 from cell.pipeline import Detection, evaluate, rescan_detection
-from cell.rescan import Rescan, SeamRescan
 from cell.types import SeamEstimate, SeamStatus, WeldMap
 
 
 def _found(seam_id: str, confidence: float, y: float = 0.0) -> SeamEstimate:
     return SeamEstimate(seam_id, SeamStatus.FOUND, "", np.array([0.0, y, 0.0]), np.array([0.1, y, 0.0]), confidence)
-
-
-class FakeLoop:
-    """Stands in for the station-driving loop: a close-up of seam ``s`` lands ``shift_m[s]`` [m] off the first."""
-
-    def __init__(self, shift_m: dict[str, float]) -> None:
-        self.shift_m = shift_m
-        self.calls: list[list[str]] = []
-
-    def __call__(self, station: Any, det: Any, ids: Sequence[str], **_: Any) -> Rescan:
-        self.calls.append(list(ids))
-        seams = []
-        by_id = {e.id: e for e in det.estimates}
-        for sid in ids:
-            first = by_id[sid]
-            dy = np.array([0.0, self.shift_m.get(sid, 0.0), 0.0])
-            close = replace(first, p_start=first.p_start + dy, p_end=first.p_end + dy, confidence=0.99)
-            seams.append(SeamRescan(sid, first, close, close, 1.0, None, 1.0, 0.0))
-        fused = {r.id: r.fused for r in seams}
-        estimates = tuple(fused.get(e.id, e) for e in det.estimates)
-        return Rescan(tuple(seams), estimates, (), (), np.zeros(6), True)
 
 
 def _detection(confidences: dict[str, float]) -> Any:
@@ -76,44 +52,3 @@ def test_no_escalation_when_the_closeups_agree_or_every_seam_was_asked_for(monke
     monkeypatch.setattr(loop, "rescan_seams", chosen)
     rescan_detection(None, _detection({"a": 0.9, "b": 0.3}), "low", seam_ids=["a"])  # type: ignore[arg-type]
     assert chosen.calls == [["a"], ["b"]]  # chosen seams, and the same escalation
-
-
-@pytest.mark.scenario
-def test_weld_and_the_rescan_command_share_the_rescan_path(monkeypatch: Any, tmp_path: Any) -> None:
-    """Both commands hand their re-scan to ``cell.pipeline.rescan``: a close-up that disagrees escalates in both."""
-    import json
-
-    from typer.testing import CliRunner
-
-    from cell import pipeline
-    from cell.cli import app
-
-    scn = sc.load("fence1")
-    det = pipeline.detect(scn)
-    confidences = sorted(e.confidence for e in det.estimates if e.status is SeamStatus.FOUND)
-    # Exactly one doubtful seam (the least confident), whose close-up lands 3 mm off: the fixed cameras are wrong.
-    rescan = scn.rescan.model_copy(
-        update={"mode": "low", "confidence_threshold": (confidences[0] + confidences[1]) / 2}
-    )
-    scn = scn.model_copy(update={"rescan": rescan})
-    calls: list[list[str]] = []
-
-    def first_disagrees(station: Any, det: Any, ids: Sequence[str], **kw: Any) -> Rescan:
-        fake = FakeLoop({ids[0]: 0.003} if not calls else {})
-        out = fake(station, det, ids, **kw)
-        calls.extend(fake.calls)
-        return out
-
-    monkeypatch.setattr(loop, "rescan_seams", first_disagrees)
-    run = pipeline.weld(scn)
-    assert run.rescan is not None and run.rescan.escalated_mm == pytest.approx(3.0, abs=1e-6)
-    assert [len(c) for c in calls] == [1, 11]  # the doubtful seam, then the other 11 visible ones
-    # cell rescan --seams ONE: the chosen seam, then (it disagreed) every other visible seam, as in weld.
-    calls.clear()
-    out = tmp_path / "r.json"
-    res = CliRunner().invoke(
-        app, ["rescan", "fence1", "--seams", calls_first := det.estimates[0].id, "--json", str(out)]
-    )
-    assert res.exit_code == 0, res.output
-    assert calls[0] == [calls_first] and [len(c) for c in calls] == [1, 11]
-    assert json.loads(out.read_text())["rescan"]["seams"] == 12

@@ -1,0 +1,53 @@
+"""``cell weld`` and ``cell rescan`` share one re-scan path (``cell.pipeline.rescan``): a close-up that disagrees
+with the fixed cameras escalates to every visible seam in both, seen through the same fake loop (tests/fakes.py)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fakes import FakeLoop
+from typer.testing import CliRunner
+
+import cell.pipeline.rescan as loop
+from cell import pipeline
+from cell.cli import app
+from cell.rescan import Rescan
+from cell.types import SeamStatus
+
+
+def test_weld_and_the_rescan_command_share_the_rescan_path(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, fence1_detection: pipeline.Detection
+) -> None:
+    det = fence1_detection
+    scn = det.scenario
+    confidences = sorted(e.confidence for e in det.estimates if e.status is SeamStatus.FOUND)
+    # Exactly one doubtful seam (the least confident), whose close-up lands 3 mm off: the fixed cameras are wrong.
+    rescan = scn.rescan.model_copy(
+        update={"mode": "low", "confidence_threshold": (confidences[0] + confidences[1]) / 2}
+    )
+    scn = scn.model_copy(update={"rescan": rescan})
+    calls: list[list[str]] = []
+
+    def first_disagrees(station: Any, det: Any, ids: Sequence[str], **kw: Any) -> Rescan:
+        fake = FakeLoop({ids[0]: 0.003} if not calls else {})
+        out = fake(station, det, ids, **kw)
+        calls.extend(fake.calls)
+        return out
+
+    monkeypatch.setattr(loop, "rescan_seams", first_disagrees)
+    run = pipeline.weld(scn)
+    assert run.rescan is not None and run.rescan.escalated_mm == pytest.approx(3.0, abs=1e-6)
+    assert [len(c) for c in calls] == [1, 11]  # the doubtful seam, then the other 11 visible ones
+    # cell rescan --seams ONE: the chosen seam, then (it disagreed) every other visible seam, as in weld.
+    calls.clear()
+    out = tmp_path / "r.json"
+    res = CliRunner().invoke(
+        app, ["rescan", "fence1", "--seams", calls_first := det.estimates[0].id, "--json", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    assert calls[0] == [calls_first] and [len(c) for c in calls] == [1, 11]
+    assert json.loads(out.read_text())["rescan"]["seams"] == 12

@@ -34,6 +34,19 @@ class CollisionOptions:
 
 
 @dataclass(frozen=True)
+class IKOptions:
+    """Solver settings (defaults suit a 6-axis arm of about 1.5 m reach)."""
+
+    pos_tol: float = 1e-5  # [m] 0.01 mm
+    rot_tol: float = np.radians(0.01)  # [rad] 0.01 deg
+    max_iters: int = 60  # per attempt
+    restarts: int = 12  # extra attempts from random configurations, only when an rng is given
+    damping: float = 1e-6  # lambda^2 of the damped least squares [m^2]
+    max_step: float = 0.5  # [rad] largest joint change per iteration
+    restart_margin: float = np.radians(5.0)  # [rad] random restarts stay this far inside the limits
+
+
+@dataclass(frozen=True)
 class PlanOptions:
     """Planner settings (the cell-specific welding figures live in the scenario's ``process``)."""
 
@@ -52,19 +65,7 @@ class PlanOptions:
     dt: float = 0.001  # [s] sample period: 1 kHz, the rate the safety gate re-samples at
     # The collision model of the whole run: the plan, the safety gate and every close-up view use one checker.
     collision: CollisionOptions = field(default_factory=CollisionOptions)
-
-
-@dataclass(frozen=True)
-class IKOptions:
-    """Solver settings (defaults suit a 6-axis arm of about 1.5 m reach)."""
-
-    pos_tol: float = 1e-5  # [m] 0.01 mm
-    rot_tol: float = np.radians(0.01)  # [rad] 0.01 deg
-    max_iters: int = 60  # per attempt
-    restarts: int = 12  # extra attempts from random configurations, only when an rng is given
-    damping: float = 1e-6  # lambda^2 of the damped least squares [m^2]
-    max_step: float = 0.5  # [rad] largest joint change per iteration
-    restart_margin: float = np.radians(5.0)  # [rad] random restarts stay this far inside the limits
+    ik: IKOptions = field(default_factory=IKOptions)  # every IK of the plan (and the arm's scan configuration)
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,7 @@ class ViewOptions:
     tcp_frame: str = "torch_tcp"
     flange_frame: str = "tool0"
     dt: float = 0.004  # [s] sample period of the move
+    ik: IKOptions = field(default_factory=IKOptions)  # the camera pose's IK
 
     def __post_init__(self) -> None:
         if not self.distances_m or min(self.distances_m) <= 0.0:

@@ -153,11 +153,11 @@ class SeamSearch:
         return best_fail
 
     def _ik(self, X: FloatArray, seed: FloatArray, restarts: bool = False) -> FloatArray:
-        return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None)
+        return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None, options=self.opt.ik)
 
     def solve_line(self, X: FloatArray, q0: FloatArray, what: str, offset: float, step: float) -> FloatArray:
         """:func:`~cell.motion.lines.solve_line` with this search's arm and joint step bound."""
-        return solve_line(self.robot, X, q0, what, offset, step, self.opt.max_joint_step)
+        return solve_line(self.robot, X, q0, what, offset, step, self.opt.max_joint_step, ik=self.opt.ik)
 
     def solve_candidate(
         self, task: SeamTask, cand: Candidate, X: FloatArray, q0: FloatArray

@@ -15,7 +15,7 @@ from scipy.interpolate import CubicSpline
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.failures import LineError, SeamFailure, unreachable
-from cell.motion.ik import solve_ik
+from cell.motion.ik import IKOptions, solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile
 from cell.types.plan import PlanReason
@@ -29,8 +29,11 @@ def solve_line(
     offset: float,
     step: float,
     max_joint_step: float,
+    *,
+    ik: IKOptions | None = None,
 ) -> FloatArray:
-    """Warm-started IK (n, dof) [rad] along poses X (n, 4, 4) in R from q0 (the solution at X[0]).
+    """Warm-started IK (n, dof) [rad] along poses X (n, 4, 4) in R from q0 (the solution at X[0]), with the solver
+    settings ``ik`` (its defaults when None).
 
     what : the line's name in messages (seam, approach, depart, lift); step [m] between poses; offset [m] where
     the line starts on the candidate's path (the failure's progress). Raises :class:`LineError` when IK fails
@@ -40,7 +43,7 @@ def solve_line(
     lim = robot.limits
     for i in range(1, len(X)):
         try:
-            q = solve_ik(robot, X[i], out[-1])
+            q = solve_ik(robot, X[i], out[-1], options=ik)
         except IKError as exc:
             raise LineError(unreachable(exc, X[i], i * step, offset + i * step, what)) from exc
         jump = np.abs(q - out[-1])

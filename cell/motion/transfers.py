@@ -166,7 +166,7 @@ class Transfers:
         X_top = X.copy()
         X_top[2, 3] = height
         poses = line_poses(X, X_top, opt.line_spacing)
-        knots = solve_line(robot, poses, q, "lift", 0.0, rise / (len(poses) - 1), opt.max_joint_step)
+        knots = solve_line(robot, poses, q, "lift", 0.0, rise / (len(poses) - 1), opt.max_joint_step, ik=opt.ik)
         if up:
             tr, v = line_trajectory(
                 robot,

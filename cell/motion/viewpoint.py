@@ -36,7 +36,7 @@ import numpy.typing as npt
 from cell.errors import IKError, PlanError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
-from cell.motion.ik import solve_ik
+from cell.motion.ik import IKOptions, solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.view_candidates import (
@@ -114,7 +114,7 @@ def plan_view(
     for pass_, top in ((1, cands[:max_candidates]), (2, cands[:restart_candidates])):
         for c in top:
             tried += 1
-            q = _ik(model, c.X_RC, seeds, o.camera_frame, rng if pass_ == 2 else None)
+            q = _ik(model, c.X_RC, seeds, o.camera_frame, rng if pass_ == 2 else None, o.ik)
             if q is None:
                 why[ViewRejection.UNREACHABLE] = why.get(ViewRejection.UNREACHABLE, 0) + 1
                 continue
@@ -139,13 +139,18 @@ def plan_view(
 
 
 def _ik(
-    model: RobotModel, X_RC: FloatArray, seeds: Sequence[FloatArray], frame: str, rng: np.random.Generator | None
+    model: RobotModel,
+    X_RC: FloatArray,
+    seeds: Sequence[FloatArray],
+    frame: str,
+    rng: np.random.Generator | None,
+    ik: IKOptions,
 ) -> FloatArray | None:
     """Joint values for the camera pose from the first seed that converges (with restarts when ``rng`` is
     given), or None: an unreachable candidate is an expected outcome here, not an error."""
     for seed in seeds:
         try:
-            return np.asarray(solve_ik(model, X_RC, seed, frame=frame, rng=rng), dtype=float)
+            return np.asarray(solve_ik(model, X_RC, seed, frame=frame, rng=rng, options=ik), dtype=float)
         except IKError:
             if rng is not None:
                 return None  # the restarts do not depend on the seed: one round is enough

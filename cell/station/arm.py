@@ -43,5 +43,5 @@ def load_arm(scenario: Scenario) -> Arm:
     eye = [name for name, cam in scenario.cameras.items() if cam.mount == "eye_in_hand"]
     if eye:
         X_RC = invert(scenario.X_WR) @ scenario.cameras[eye[0]].X_WC
-        q_scan = scan_configuration(model, X_RC, q_home, rng=scenario.rng("scan"))
+        q_scan = scan_configuration(model, X_RC, q_home, rng=scenario.rng("scan"), ik=scenario.motion.plan.ik)
     return Arm(model, q_home, np.asarray(q_scan, dtype=float))

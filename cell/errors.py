@@ -23,6 +23,10 @@ code  meaning
 
 from __future__ import annotations
 
+import enum
+import math
+from collections.abc import Mapping
+
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
@@ -62,15 +66,42 @@ class MapUnitsError(MapError):
 
 
 class SensorError(CellError, RuntimeError):
-    """A camera returned no image, or an image with no usable points."""
+    """A camera returned no image, or an image with no usable points.
+
+    lost : camera name -> why it was dropped (empty when the failure is not one camera's).
+    """
 
     exit_code = 13
 
+    def __init__(self, message: str, *, lost: Mapping[str, str] | None = None) -> None:
+        super().__init__(message)
+        self.lost = dict(lost or {})
+
+
+class AlignmentFailure(enum.StrEnum):
+    """Why the map could not be aligned to the cloud."""
+
+    NO_PARTS = "no_parts"  # the map has nothing to align
+    TOO_FEW_POINTS = "too_few_points"  # the cloud has almost nothing to align to
+    LOW_FITNESS = "low_fitness"  # too little of the cloud lies on the aligned map's surfaces
+    TILTED = "tilted"  # the fit would tilt a part lying on the table
+    AMBIGUOUS = "ambiguous"  # a shifted or turned map fits (almost) as well: a near-symmetry
+    OFF_CLOUD = "off_cloud"  # the aligned map does not lie on the cloud (parts half seen)
+
 
 class AlignmentError(CellError, RuntimeError):
-    """The welding map could not be aligned to the point cloud with enough fitness."""
+    """The welding map could not be aligned to the point cloud: ``code`` says how, ``value`` and ``needed`` give
+    the figure that decided it (a fitness, a coverage, an angle [rad]; nan where none applies)."""
 
     exit_code = 14
+
+    def __init__(
+        self, message: str, *, code: AlignmentFailure, value: float = math.nan, needed: float = math.nan
+    ) -> None:
+        super().__init__(message)
+        self.code = code
+        self.value = value
+        self.needed = needed
 
 
 class MotionError(CellError, RuntimeError):

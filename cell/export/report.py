@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import enum
 import json
 import math
 import os
@@ -127,8 +128,19 @@ def _add_rescan(rep: dict[str, Any], records: Sequence[SeamRecord], first: Detec
 
 
 def _error(e: CellError | None) -> dict[str, Any] | None:
-    """The failure that stopped a run early (the seams still say why each was not done), or None."""
-    return None if e is None else {"type": type(e).__name__, "message": e.message, "exit_code": e.exit_code}
+    """The failure that stopped a run early (the seams still say why each was not done), or None: its class,
+    message and exit code, and the fields it carries (a code, the figure that decided it, the lost cameras)."""
+    if e is None:
+        return None
+    out: dict[str, Any] = {"type": type(e).__name__, "message": e.message, "exit_code": e.exit_code}
+    for key, value in vars(e).items():
+        if isinstance(value, str | bool | int):  # enum codes are str
+            out[key] = str(value) if isinstance(value, enum.Enum) else value
+        elif isinstance(value, float):
+            out[key] = _r(value, 6)
+        elif isinstance(value, dict) and all(isinstance(v, str) for v in value.values()):
+            out[key] = {str(k): v for k, v in value.items()}
+    return out
 
 
 def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cell.errors import AlignmentError
+from cell.errors import AlignmentError, AlignmentFailure
 from cell.geometry import FloatArray, invert, matrix_to_rpy, readonly, transform_points
 from cell.perception import _open3d
 from cell.perception.preprocess import downsample
@@ -135,14 +135,21 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
     if weldmap_R.frame != "R" or cloud.frame != "R":
         raise ValueError(f"align_map: map and cloud must be in R, not {weldmap_R.frame!r}, {cloud.frame!r}")
     if not weldmap_R.parts:
-        raise AlignmentError(f"map {weldmap_R.source!r} has no parts to align to the cloud")
+        raise AlignmentError(
+            f"map {weldmap_R.source!r} has no parts to align to the cloud", code=AlignmentFailure.NO_PARTS
+        )
     thresholds = [spec.align_max_correspondence_m * f for f in STAGES]
     finest = thresholds[-1]
     if len(cloud) > _MAX_SOURCE:  # thin a dense cloud: a grid of the finest distance, then every k-th point
         cloud = downsample(cloud, finest)
         cloud = cloud.select(np.arange(0, len(cloud), math.ceil(len(cloud) / _MAX_SOURCE)))
     if len(cloud) < 3:
-        raise AlignmentError(f"map alignment needs a cloud of at least 3 points, got {len(cloud)}")
+        raise AlignmentError(
+            f"map alignment needs a cloud of at least 3 points, got {len(cloud)}",
+            code=AlignmentFailure.TOO_FEW_POINTS,
+            value=len(cloud),
+            needed=3,
+        )
     target, target_normals = sample_map(weldmap_R, _SPACING_PER_FINEST * finest, finest)
     X_MC = np.eye(4)  # moves cloud points onto the map (p_map = X_MC p_cloud)
     for threshold in thresholds:
@@ -154,7 +161,10 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
     if fitness < spec.align_min_fitness:
         raise AlignmentError(
             f"map-to-cloud ICP reached fitness {fitness:.3f} within {band * 1000:.1f} mm, "
-            f"needs at least {spec.align_min_fitness:.3f} (is the part on the table, inside the workspace?)"
+            f"needs at least {spec.align_min_fitness:.3f} (is the part on the table, inside the workspace?)",
+            code=AlignmentFailure.LOW_FITNESS,
+            value=fitness,
+            needed=spec.align_min_fitness,
         )
     X_RR_corr = invert(X_MC)
     roll, pitch, _ = matrix_to_rpy(X_RR_corr[:3, :3])
@@ -162,6 +172,9 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
         raise AlignmentError(
             f"map-to-cloud ICP tilts the part by roll {math.degrees(roll):.2f} / pitch "
             f"{math.degrees(pitch):.2f} deg; at most {math.degrees(MAX_TILT_RAD):.1f} deg is accepted "
-            "for a part lying on the table"
+            "for a part lying on the table",
+            code=AlignmentFailure.TILTED,
+            value=max(abs(roll), abs(pitch)),
+            needed=MAX_TILT_RAD,
         )
     return Alignment(X_RR_corr, fitness, rmse)

@@ -21,7 +21,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cell.config.perception import SymmetryOptions
-from cell.errors import AlignmentError
+from cell.errors import AlignmentError, AlignmentFailure
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception.align import Alignment, sample_map
 from cell.scenario import PerceptionSpec
@@ -128,7 +128,10 @@ def check_alignment_unique(
                 f"ambiguous map alignment: the map {alt.label} {better} (cloud covers {alt.support_alt:.0%} of the "
                 f"surfaces that tell the fits apart, against {alt.support_chosen:.0%} for the chosen fit, "
                 f"fitness {alignment.fitness:.2f}); every seam could be on its neighbour's joint: place the part "
-                "against its fixture stops and re-scan"
+                "against its fixture stops and re-scan",
+                code=AlignmentFailure.AMBIGUOUS,
+                value=alt.support_chosen - alt.support_alt,
+                needed=o.min_margin,
             )
     return alts
 
@@ -187,6 +190,9 @@ def check_parts_seen(
         raise AlignmentError(
             f"the aligned map does not lie on the cloud: share of each part's top with points: {worst} (needs "
             f"{min_seen:.0%}, or under {min_coverage:.0%} for a missing part): part displaced beyond what the "
-            "alignment corrects, running out of the workspace, or covered"
+            "alignment corrects, running out of the workspace, or covered",
+            code=AlignmentFailure.OFF_CLOUD,
+            value=min(coverage.values(), default=0.0),
+            needed=min_seen,
         )
     return missing

@@ -92,7 +92,7 @@ def perceive(
     lost = tuple(name for name in clouds if name in why)
     timings["clouds"] = time.perf_counter() - t
     if len(lost) == len(clouds):
-        raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in lost))
+        raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in lost), lost=why)
     t = time.perf_counter()
     spliced = splice({n: c for n, c in clouds.items() if n not in lost}, images, X_WR, spec)
     timings["splice"] = time.perf_counter() - t

@@ -66,10 +66,8 @@ def fuse(
     1 / (1 + (sigma / scale_m)^2) of the fused sigma, on the first estimate's confidence scale.
     """
     ok1 = first.status is SeamStatus.FOUND and math.isfinite(sigma_first)
-    ok2 = closeup is not None and closeup.status is SeamStatus.FOUND and math.isfinite(sigma_closeup)
-    if not ok2:
+    if closeup is None or closeup.status is not SeamStatus.FOUND or not math.isfinite(sigma_closeup):
         return first, 0.0
-    assert closeup is not None
     if not ok1:
         conf = 1.0 / (1.0 + (sigma_closeup / scale_m) ** 2)
         return replace(closeup, confidence=conf, reason=f"close-up only; {closeup.reason}"), 1.0

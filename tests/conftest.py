@@ -10,33 +10,21 @@ opens its own (:func:`fence1_station`); none is shared, so no result depends on 
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import pytest
 
 if TYPE_CHECKING:
     from cell import pipeline
-    from cell.geometry import FloatArray
-    from cell.scenario import Scenario
     from cell.station import SimStation
 
 HERE = Path(__file__).resolve().parent
-if str(HERE) not in sys.path:  # dxf_factory, fakes: used from more than one folder
+if str(HERE) not in sys.path:  # the helper modules (dxf_factory, fakes, pinhole, scenes): used from several folders
     sys.path.insert(0, str(HERE))
 
-Noise = Literal["none", "realistic"]
-
-
-@dataclass(frozen=True)
-class Perceived:
-    """A scenario captured and perceived once: the scene every locator reads and the true seams (frame R, m)."""
-
-    scenario: Scenario
-    scene: pipeline.Scene
-    truths: Mapping[str, tuple[FloatArray, FloatArray]]
+from scenes import Noise, Perceived  # noqa: E402  (after the path set-up above)
 
 
 @pytest.fixture(scope="session")
@@ -73,11 +61,12 @@ def perceived(request: pytest.FixtureRequest) -> Callable[[str, Noise], Perceive
                 det: pipeline.Detection = request.getfixturevalue("fence1_detection")
                 if det.scene is None:
                     raise RuntimeError("fence1's detection kept no scene")
-                cache[name, noise] = Perceived(det.scenario, det.scene, det.truths)
+                cache[name, noise] = Perceived(det.scenario, det.scene, det.truths, None)
             else:
                 cap = pipeline.capture(s.with_noise(noise))
                 scene = pipeline.build_scene(cap)
-                cache[name, noise] = Perceived(cap.scenario, scene, pipeline.truths(cap, scene.seam_scene.weldmap))
+                truths = pipeline.truths(cap, scene.seam_scene.weldmap)
+                cache[name, noise] = Perceived(cap.scenario, scene, truths, cap)
         return cache[name, noise]
 
     return get

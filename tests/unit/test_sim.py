@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from pinhole import deproject, pixel_rays_W
 
 from cell import scenario as scn
 from cell.errors import SensorError
@@ -51,19 +52,6 @@ def tiny_scenario(tmp_path: Path, noise: str = "none", t_mm: float = 0.0, r_deg:
 def noiseless(tmp_path: Path) -> Iterator[SimCell]:
     with SimCell(tiny_scenario(tmp_path), [Part("BOX", BOX)]) as sim:
         yield sim
-
-
-def pixel_rays_W(image: DepthImage) -> FloatArray:
-    """(H, W, 3) ray directions in W with unit z in the optical frame (so that p_W = eye + depth * ray)."""
-    k = image.intrinsics
-    u, v = np.meshgrid(np.arange(k.width), np.arange(k.height))
-    rays_C = np.stack([(u - k.cx) / k.fx, (v - k.cy) / k.fy, np.ones(u.shape)], axis=-1)
-    return np.asarray(rays_C @ image.X_WC[:3, :3].T)
-
-
-def deproject(image: DepthImage) -> FloatArray:
-    """(H, W, 3) pinhole back-projection of every pixel into W [m] (invalid: camera centre)."""
-    return image.X_WC[:3, 3] + image.depth[..., None].astype(float) * pixel_rays_W(image)
 
 
 def _horizontal_hit(image: DepthImage, z_plane: float) -> tuple[FloatArray, FloatArray]:
@@ -183,24 +171,3 @@ def test_two_cells_do_not_share_a_client(tmp_path: Path) -> None:
         assert with_box.client.getNumBodies() == 3 and empty.client.getNumBodies() == 2
         assert "BOX" not in empty.bodies
         assert not np.array_equal(with_box.capture("oblique").depth, empty.capture("oblique").depth)
-
-
-def test_fence1_exact_cameras_see_the_parts() -> None:
-    """The real scenario's cameras render the as-built fence (skipped until the map exists)."""
-    map_path = scn.SCENARIO_DIR.parent / "maps" / "fence1.dxf"
-    if not map_path.is_file():
-        pytest.skip("maps/fence1.dxf not generated yet")
-    from cell.asbuilt import as_built_parts
-    from cell.weldmap import read_map
-
-    scenario = scn.load("fence1-exact").with_noise("none")
-    parts = as_built_parts(read_map(scenario.map_path, units=scenario.map.units), scenario)
-    with SimCell(scenario, parts) as sim:
-        for name, image in sim.capture_all().items():
-            p_W = deproject(image)[image.depth > 0]
-            on_parts = np.zeros(len(p_W), bool)
-            for part in parts:
-                on_parts |= part.box.contains(p_W, margin=0.001)
-            assert on_parts.sum() > 10_000, name
-            above = p_W[:, 2] > scenario.table.top_z + 0.002
-            assert on_parts[above].mean() > 0.999, name  # what stands on the table is the fence

@@ -1,8 +1,11 @@
-"""Scenario tests of the main job: `cell weld fence1` and `cell preview fence1`, headless, on real simulated data."""
+"""Scenario tests of the main job: `cell weld fence1` and `cell preview fence1`, headless, on real simulated data.
+
+fence1 is welded once per session (``fence1_run`` in tests/conftest.py): the run's tests and the CLI's report and
+robot program all read that one run; the preview and the two-cameras-dead fault are runs of their own.
+"""
 
 from __future__ import annotations
 
-import functools
 import json
 from pathlib import Path
 
@@ -13,18 +16,11 @@ from typer.testing import CliRunner
 from cell import pipeline
 from cell import scenario as sc
 from cell.cli import app
-from cell.types import SeamStatus
-
-pytestmark = pytest.mark.scenario
+from cell.types import SeamStatus, WeldReason
 
 
-@functools.cache
-def fence1_run() -> pipeline.WeldRun:
-    return pipeline.weld(sc.load("fence1"))
-
-
-def test_every_visible_seam_is_welded_within_a_millimetre() -> None:
-    run = fence1_run()
+def test_every_visible_seam_is_welded_within_a_millimetre(fence1_run: pipeline.WeldRun) -> None:
+    run = fence1_run
     assert run.error is None and not run.violations
     assert run.complete
     visible = [e.id for e in run.detection.estimates if e.status is not SeamStatus.NOT_VISIBLE]
@@ -32,17 +28,18 @@ def test_every_visible_seam_is_welded_within_a_millimetre() -> None:
     speed = run.detection.scenario.process.travel_speed_mm_s
     for w in run.seams:
         if w.id not in visible:
-            assert not w.welded and "flip" in w.reason
+            assert not w.welded and w.code is WeldReason.NOT_VISIBLE and "flip" in w.reason  # says what to do
             continue
         assert w.welded, f"{w.id}: {w.reason}"
         assert w.quality is not None
         # Executed tool path against the TRUE seam (perception, alignment, IK and playback errors all included).
-        assert w.quality.tcp_rms_mm <= 1.0, w.id
-        assert abs(w.quality.speed_mm_s - speed) <= 0.02 * speed, w.id
+        assert w.quality.tcp_rms_mm <= 1.0, w.id  # the acceptance figure
+        assert w.quality.tcp_max_mm < 0.4, w.id  # measured up to 0.20 mm (rms up to 0.08 mm)
+        assert abs(w.quality.speed_mm_s - speed) <= 0.001 * speed, w.id  # measured within 0.001 mm/s
 
 
-def test_events_and_cycle_time() -> None:
-    run = fence1_run()
+def test_events_and_cycle_time(fence1_run: pipeline.WeldRun) -> None:
+    run = fence1_run
     ex = run.execution
     assert ex is not None and run.plan is not None
     kinds = [e.kind for e in ex.events]
@@ -60,8 +57,8 @@ def test_events_and_cycle_time() -> None:
     assert all(b <= a for b, a in zip(off[:-1], on[1:], strict=True))
 
 
-def test_executed_joints_stay_within_limits_at_1khz() -> None:
-    run = fence1_run()
+def test_executed_joints_stay_within_limits_at_1khz(fence1_run: pipeline.WeldRun) -> None:
+    run = fence1_run
     assert run.plan is not None and run.arm is not None
     traj, _ = run.plan.joint_trajectory()
     lim = run.arm.model.limits
@@ -71,11 +68,25 @@ def test_executed_joints_stay_within_limits_at_1khz() -> None:
     assert np.all(np.abs(traj.qd) <= lim.v_max * (1 + 1e-6))
 
 
-def test_weld_cli_writes_report_and_robot_program(tmp_path: Path) -> None:
+def test_weld_cli_writes_report_and_robot_program(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_run: pipeline.WeldRun
+) -> None:
+    """``cell weld fence1`` hands the scenario to ``pipeline.weld`` and writes what it returns: the session's run
+    stands in for a second one (the CLI's arguments are checked as it passes them)."""
+    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+
+    def weld(scenario: sc.Scenario, method: str | None = None, **kw: object) -> pipeline.WeldRun:
+        asked.append((scenario, method, kw))
+        return fence1_run
+
+    monkeypatch.setattr(pipeline, "weld", weld)
     runner = CliRunner()
     report, krl = tmp_path / "r.json", tmp_path / "krl"
     result = runner.invoke(app, ["weld", "fence1", "--json", str(report), "--krl", str(krl)])
     assert result.exit_code == 0, result.stderr
+    ((scenario, method, kw),) = asked
+    assert scenario == sc.load("fence1") and method is None
+    assert kw["noise"] is None and kw["rescan"] is None and kw["gui"] is False
     data = json.loads(report.read_text())
     assert data["welded"] == 12 and data["error"] is None
     assert data["cycle_time_s"] > 0 and data["events"]
@@ -102,10 +113,13 @@ def test_preview_draws_and_moves_nothing(tmp_path: Path) -> None:
 def test_both_fixed_cameras_dead_still_welds_nothing_wrong() -> None:
     """Only the arm's camera is left: the close-up re-scan carries the cell; the run is partial (cameras lost)."""
     run = pipeline.weld(sc.load("faults/two-cameras-dead"))
-    assert {c.split(":")[0] for c in run.detection.lost_cameras} == {"cam_left", "cam_right"}
+    assert run.detection.scene is not None
+    assert set(run.detection.scene.perceived.lost) == {"cam_left", "cam_right"}
     assert not run.complete  # a degraded run never exits 0
     for w in run.seams:
         if w.welded:
             assert w.quality is not None and w.quality.tcp_max_mm <= 1.0, w.id
+            assert w.quality.tcp_max_mm < 0.08, w.id  # measured up to 0.04 mm: the close-ups carry it
         else:
-            assert w.reason, w.id
+            assert w.code is WeldReason.NOT_VISIBLE and w.reason, w.id  # measured: the four underside seams
+    assert sum(w.welded for w in run.seams) == 12

@@ -30,7 +30,8 @@ def test_rescan_improves_the_least_confident_seam_and_returns_the_arm(
     truth = det.truths[worst.id]
     lat0 = segment_errors(r.before.p_start, r.before.p_end, *truth)[2]
     _, end1, lat1, _ = segment_errors(r.fused.p_start, r.fused.p_end, *truth)
-    assert lat1 < lat0 and lat1 < 0.1 and end1 < 0.3  # [mm]
+    # [mm] measured: lateral 0.070 before, 0.010 after, end points 0.014 after (the close-up weighs 0.98)
+    assert lat1 < lat0 and lat1 < 0.02 and end1 < 0.03 and r.weight > 0.95
     assert r.motion_s > 0.0 and len(rs.executions) == 2  # to the view, and back
     assert station.arm is not None
     assert rs.returned and np.allclose(station.joint_state(), station.arm.q_scan, atol=1e-9)
@@ -61,5 +62,6 @@ def test_rescan_undoes_the_fixed_cameras_calibration_error() -> None:
         ids = [e.id for e in det.estimates if e.status is SeamStatus.FOUND]
         after = rescanned(det, rescan_seams(station, det, ids))
     assert after.summary.found == 12
-    assert after.summary.lateral_mean_mm < 0.5
+    assert max(m.lateral_mm for m in after.metrics.values()) < 0.5  # the acceptance figure, every seam
+    assert after.summary.lateral_mean_mm < 0.03  # measured 0.014 mm (0.089 mm before the re-scan)
     assert after.summary.lateral_mean_mm < det.summary.lateral_mean_mm

@@ -180,8 +180,9 @@ def test_gate_refuses_a_move_over_the_velocity_limit(robot: RobotModel, plan: We
     worst = max(vel, key=lambda v: v.excess / robot.limits.v_max[robot.joint_names.index(v.joint)])
     j = robot.joint_names.index(worst.joint)
     assert worst.excess == pytest.approx(np.max(np.abs(tr.qd[:, j])) * 1.5 - robot.limits.v_max[j] * 1.01, rel=0.05)
-    with pytest.raises(PlanError, match="velocity"):
+    with pytest.raises(GateRefusedError) as refused:
         check_plan(robot, fast, HOME)
+    assert list(refused.value.violations) == found and "velocity" in refused.value.message
 
 
 def test_gate_refuses_a_collision(robot: RobotModel, plan: WeldPlan) -> None:

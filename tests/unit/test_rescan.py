@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
-from cell.errors import PlanError
 from cell.geometry import invert, make_pose, transform_points
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
@@ -83,18 +82,6 @@ def test_torch_lies_ahead_of_the_camera_on_its_axis(robot: RobotModel) -> None:
     tip = axis[-1]
     assert 0.25 < tip[2] < 0.35  # the TCP about 0.3 m ahead of the camera
     assert math.hypot(tip[0], tip[1]) < 0.01  # on the optical axis: why views put the seam off-centre
-
-
-def test_unreachable_seam_raises_a_plan_error_naming_it(robot: RobotModel, checker: CollisionChecker) -> None:
-    far = ViewTarget("far", np.array([-0.03, 2.6, 0.06]), np.array([0.03, 2.6, 0.06]), TOP.n_a, TOP.n_b)
-    with pytest.raises(PlanError, match=r"seam far: none of \d+ close-up views works \(.*unreachable"):
-        plan_view(robot, checker, far, HOME, K, (), 0.0, rng=np.random.default_rng(0), restart_candidates=2)
-
-
-def test_a_part_in_the_line_of_sight_rules_views_out(robot: RobotModel, checker: CollisionChecker) -> None:
-    wall = Part("WALL", Box(make_pose(p=[0.0, 0.6, 0.3]), np.array([1.0, 0.6, 0.6])))  # over the whole joint
-    with pytest.raises(PlanError, match="no close-up view sees the seam"):
-        plan_view(robot, checker, TOP, HOME, K, (wall,), 0.0, rng=np.random.default_rng(0))
 
 
 def test_segment_box_test() -> None:

@@ -33,6 +33,9 @@ def test_an_unreachable_seam_counts_its_rejected_views(robot: RobotModel) -> Non
     e = err.value
     assert isinstance(e, PlanError) and e.seam_id == "far" and e.tried > 0
     assert e.rejected[ViewRejection.UNREACHABLE] > 0 and sum(e.rejected.values()) == e.tried
+    # The words the re-scan report gives (the counts by their ViewRejection value).
+    assert e.message.startswith(f"seam far: none of {e.tried} close-up views works (")
+    assert f"{e.rejected[ViewRejection.UNREACHABLE]} unreachable" in e.message
 
 
 def test_no_geometric_candidate_is_a_view_error_with_nothing_tried(robot: RobotModel) -> None:
@@ -40,3 +43,4 @@ def test_no_geometric_candidate_is_a_view_error_with_nothing_tried(robot: RobotM
     with pytest.raises(NoViewError) as err:
         plan_view(robot, CollisionChecker(robot, OBSTACLES), TOP, HOME, K, (wall,), 0.0, rng=np.random.default_rng(0))
     assert err.value.seam_id == "top" and err.value.tried == 0 and err.value.rejected == {}
+    assert "no close-up view sees the seam" in err.value.message  # the words the re-scan report gives

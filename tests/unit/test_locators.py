@@ -180,7 +180,7 @@ def test_ours_takes_no_end_where_the_cloud_stops(scenes: dict) -> None:
     lo, hi = np.array([-1.0, -1.0, -1.0]), np.array([x_cut, 1.0, 2.0])
     ws = Box(make_pose(p=(lo + hi) / 2.0), hi - lo)
     est = OursLocator(OursOptions(workspace_R=ws)).locate(cut, seam, np.random.default_rng(0))
-    assert est.status is SeamStatus.NOT_FOUND and "workspace" in est.reason
+    assert est.status is SeamStatus.NOT_FOUND and est.code is Reason.NO_SUPPORT and "workspace" in est.reason
     hi_wide = np.array([x_cut + 0.2, 1.0, 2.0])
     wide = Box(make_pose(p=(lo + hi_wide) / 2.0), hi_wide - lo)
     thin = OursLocator(OursOptions(workspace_R=wide)).locate(cut, seam, np.random.default_rng(0))

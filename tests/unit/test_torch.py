@@ -26,7 +26,7 @@ def _angle_to_plane(v: np.ndarray, n: np.ndarray) -> float:
 
 
 def test_process_defaults_follow_the_reference_figures() -> None:
-    # REFERENCE.md section 4: 8-10 mm/s, work 45 deg, travel 5-15 deg, CTWD 12-20 mm; section 7: 250 mm/s.
+    # docs/reference.md section 4: 8-10 mm/s, work 45 deg, travel 5-15 deg, CTWD 12-20 mm; section 7: 250 mm/s.
     assert 0.008 <= PROCESS.travel_speed <= 0.010
     assert math.isclose(math.degrees(PROCESS.work_angle), 45.0)
     assert 5.0 <= math.degrees(PROCESS.travel_angle) <= 15.0

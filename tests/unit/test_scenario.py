@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cell import scenario as sc
-from cell.config import OursSettings
 from cell.errors import ScenarioError
 
 FENCE1 = (sc.SCENARIO_DIR / "fence1.yaml").read_text()
@@ -96,7 +94,7 @@ def test_rng_streams_are_reproducible_and_independent() -> None:
 
 def test_camera_focal_length_from_fov() -> None:
     cam = sc.load("fence1").cameras["cam_right"]
-    # f_px = 0.5 * width / tan(HFOV / 2) (REFERENCE section 2): D415 1280 px, 65 deg -> about 1004.6 px.
+    # f_px = 0.5 * width / tan(HFOV / 2) (docs/reference.md section 2): D415 1280 px, 65 deg -> about 1004.6 px.
     assert cam.fx_px == pytest.approx(0.5 * 1280 / np.tan(np.radians(65) / 2))
     X = cam.X_WC
     np.testing.assert_allclose(X[:3, 3], cam.eye_m)
@@ -212,38 +210,3 @@ def test_the_closeup_merges_its_options_into_the_scenarios_locator() -> None:
     assert (close.target_se_m, close.edge_band_m, close.corner_band_m) == (0.00002, 0.002, 0.003)
     assert close.tube_radius_m == 0.05  # the scenario's own
     assert closeup_scenario(s, "paper", s.rescan.closeup) is s  # no close-up options for the paper's
-
-
-@pytest.mark.scenario
-def test_a_scenario_option_reaches_its_stage_and_the_report_records_it() -> None:
-    """Through pipeline.detect: the seam screen's threshold, built from its defaults before the scenario held it,
-    turns every found seam into LOW_CONFIDENCE; the report's config is the scenario as resolved."""
-    from cell import pipeline
-    from cell.export.report import detection_report
-    from cell.types import Reason, SeamStatus
-
-    s = load_text(with_keys("locator: {method: ours, options: {target_se_m: 0.0003}}"))
-    perception = s.perception.model_copy(update={"screen": replace(s.perception.screen, min_confidence=1.0)})
-    det = pipeline.detect(s.model_copy(update={"perception": perception}))
-    visible = [e for e in det.estimates if e.status is not SeamStatus.NOT_VISIBLE]
-    assert len(visible) == 12 and all(e.code is Reason.LOW_CONFIDENCE for e in visible)
-    config = detection_report(det)["config"]
-    assert config["perception"]["screen"]["min_confidence"] == 1.0
-    assert config["locator"] == {"method": "ours", "options": {**asdict(OursSettings()), "target_se_m": 0.0003}}
-    assert config["motion"]["gate"]["rate_hz"] == 1000.0  # every default filled in
-    assert sc.from_dict(config, sc.SCENARIO_DIR) == det.scenario  # the record loads back as what ran
-
-
-@pytest.mark.scenario
-def test_a_gate_option_reaches_the_safety_gate() -> None:
-    """Through pipeline.weld (a preview): a manipulability bar no arm clears makes the gate, built from its defaults
-    before the scenario held it, refuse the plan for singularities."""
-    from cell import pipeline
-    from cell.errors import PlanError
-    from cell.export.report import weld_report
-    from cell.motion.gate import ViolationKind
-
-    run = pipeline.weld(load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}")), execute_plan=False)
-    assert isinstance(run.error, PlanError) and run.violations
-    assert {v.split()[0] for v in run.violations} == {ViolationKind.SINGULARITY.value}
-    assert weld_report(run)["config"]["motion"]["gate"]["min_manipulability"] == 1.0

@@ -1,7 +1,7 @@
 """Rigid transforms and small geometry helpers, numpy only.
 
-Conventions (STYLE.md): ``X_AB`` is the 4x4 homogeneous pose of frame B in frame A, so ``X_AC = X_AB @ X_BC``;
-``p_AS`` are points S expressed in A, shape (n, 3) [m]. Angles are radians inside the package.
+Conventions (docs/architecture.md): ``X_AB`` is the 4x4 homogeneous pose of frame B in frame A, so
+``X_AC = X_AB @ X_BC``; ``p_AS`` are points S expressed in A, shape (n, 3) [m]. Angles are radians inside the package.
 Roll-pitch-yaw is the fixed-axis X-Y-Z convention: ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
 """
 

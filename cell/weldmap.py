@@ -1,6 +1,6 @@
 """DXF welding map -> :class:`~cell.types.WeldMap` (frame ``M``, metres). The only module importing ezdxf.
 
-What a welding map holds (REFERENCE.md section 6):
+What a welding map holds (docs/reference.md section 6):
 
 - seams: LINE entities whose effective colour is red (ACI 1, BYLAYER on a red layer, BYBLOCK in a red
   INSERT, or true colour ``#FF0000``); id from XDATA ``WELDCELL`` (group 1000), else ``seam-<handle>``

@@ -1,4 +1,4 @@
-"""KUKA KRL export of a welding plan (REFERENCE.md section 5): ``NAME.src`` and ``NAME.dat``.
+"""KUKA KRL export of a welding plan (docs/reference.md section 5): ``NAME.src`` and ``NAME.dat``.
 
 What the program does, in order: ``BAS(#INITMOV, 0)``; ``$TOOL``, ``$BASE`` and ``$LOAD`` set explicitly; the
 first motion is a fully defined ``PTP`` to the home configuration (an E6AXIS with all axes: block coincidence);

@@ -40,7 +40,8 @@ def plan_for(
     motion: MotionScene | None = None,
     progress: Progress = _quiet,
 ) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
-    """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (REFERENCE section 7).
+    """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
+    section 7).
 
     q_start : where the arm is now (default: its scan configuration). motion : the run's obstacles and checker
     (built here when not given). Returns the plan, the move from q_start to

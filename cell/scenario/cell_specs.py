@@ -65,7 +65,7 @@ class RobotSpec(Model):
 
 
 class NoiseSpec(Model):
-    """Depth sensor model (REFERENCE.md section 2). ``active_stereo`` follows the RealSense D4xx error model."""
+    """Depth sensor model (docs/reference.md section 2). ``active_stereo`` follows the RealSense D4xx error model."""
 
     model: Literal["none", "active_stereo", "structured_light"] = "active_stereo"
     baseline_m: Pos = 0.055  # D415 [m]

@@ -28,7 +28,7 @@ from cell.scenario.locator_specs import LOCATOR_SPECS, spec_method
 
 
 class ProcessSpec(Model):
-    """The arc welding process: speeds, torch angles and offsets (REFERENCE.md sections 4 and 7).
+    """The arc welding process: speeds, torch angles and offsets (docs/reference.md sections 4 and 7).
 
     Angles follow the welding convention: the work angle is measured from face B (the receiving part's face) in
     the plane perpendicular to the seam; the travel angle tilts the torch along the seam, positive = push (the

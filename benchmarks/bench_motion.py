@@ -2,6 +2,9 @@
 
     .venv/bin/python benchmarks/bench_motion.py [--json PATH] [--seed N]
 
+The rows go to ``--json`` (default ``benchmarks/results/motion.json``: ``primitives``, one row per case with a
+stable ``key``, and ``plans``, one row per scenario), which ``tools/readme_results.py`` renders into the README.
+
 Goals (issue "Motion"): warm-started IK median <= 0.5 ms per pose; ptp computation <= 100 us.
 Times are wall-clock per call on this machine (single thread); the table gives median, 90th percentile, max.
 
@@ -13,7 +16,6 @@ and without collision checks: planning time, cycle and arc time, gate times.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -21,12 +23,14 @@ from pathlib import Path
 import numpy as np
 
 from cell.errors import IKError
+from cell.export.report import write_json
 from cell.geometry import FloatArray, make_pose, rot_y, rot_z
 from cell.motion.ik import solve_ik, solve_path
 from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile, ptp, ptp_duration
 
 URDF = Path(__file__).resolve().parent.parent / "robots" / "kr5_arc.urdf"
+RESULTS = Path(__file__).resolve().parent / "results"
 HOME = np.radians([0.0, -90.0, 90.0, 0.0, 0.0, 0.0])
 
 
@@ -49,9 +53,11 @@ def _seams(rng: np.random.Generator, n_seams: int, step: float) -> list[FloatArr
     return seams
 
 
-def _stats(name: str, seconds: list[float], goal_s: float | None) -> dict[str, object]:
+def _stats(key: str, name: str, seconds: list[float], goal_s: float | None) -> dict[str, object]:
+    """One case's times [us]: median, 90th percentile, max, and the goal met (``key`` names the case for readers)."""
     us = np.array(seconds) * 1e6
     row: dict[str, object] = {
+        "key": key,
         "case": name,
         "n": len(us),
         "median_us": float(np.median(us)),
@@ -94,9 +100,9 @@ def run(seed: int) -> list[dict[str, object]]:
         per_pose_path.append(
             _timed(lambda t=targets: solve_path(robot, t, HOME, rng=np.random.default_rng(seed))) / len(targets)
         )
-    rows.append(_stats(f"IK warm, full pose ({seams} seams, 2 mm)", warm, 0.5e-3))
-    rows.append(_stats("IK warm, free torch axis", warm_free, 0.5e-3))
-    rows.append(_stats("solve_path, per pose", per_pose_path, 0.5e-3))
+    rows.append(_stats("ik_warm", f"IK warm, full pose ({seams} seams, 2 mm)", warm, 0.5e-3))
+    rows.append(_stats("ik_warm_free_axis", "IK warm, free torch axis", warm_free, 0.5e-3))
+    rows.append(_stats("solve_path_per_pose", "solve_path, per pose", per_pose_path, 0.5e-3))
 
     # Cold IK: random reachable poses from the home pose, with seeded restarts.
     cold, failed = [], 0
@@ -111,17 +117,25 @@ def run(seed: int) -> list[dict[str, object]]:
         except IKError:
             failed += 1
         cold.append(time.perf_counter() - t0)
-    rows.append(_stats("IK cold from home, restarts", cold, None))
+    rows.append(_stats("ik_cold", "IK cold from home, restarts", cold, None))
     rows[-1]["failed"] = failed
 
     # Ruckig: point-to-point moves between random configurations (rest to rest), sampled at 4 ms.
     lim = robot.limits
     pairs = [(lim.sample(rng), lim.sample(rng)) for _ in range(300)]
-    rows.append(_stats("ptp incl. 4 ms sampling", [_timed(lambda a=a, b=b: ptp(a, b, lim)) for a, b in pairs], 100e-6))
+    rows.append(
+        _stats(
+            "ptp_sampled",
+            "ptp incl. 4 ms sampling",
+            [_timed(lambda a=a, b=b: ptp(a, b, lim)) for a, b in pairs],
+            100e-6,
+        )
+    )
     durations = [ptp(a, b, lim).duration for a, b in pairs[:50]]
     rows[-1]["mean_motion_s"] = float(np.mean(durations))
     rows.append(
         _stats(
+            "ptp_duration",
             "ptp_duration (checks + Ruckig solve)",
             [_timed(lambda a=a, b=b: ptp_duration(a, b, lim)) for a, b in pairs],
             100e-6,
@@ -129,6 +143,7 @@ def run(seed: int) -> list[dict[str, object]]:
     )
     rows.append(
         _stats(
+            "path_profile",
             "path_profile 150 mm at 8 mm/s",
             [_timed(lambda: path_profile(0.15, 0.008, 0.5, 5.0)) for _ in range(100)],
             None,
@@ -192,7 +207,7 @@ def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, o
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", type=Path, help="also write the rows to this JSON file")
+    parser.add_argument("--json", type=Path, default=RESULTS / "motion.json", help="write the rows to this JSON file")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     rows = run(args.seed)
@@ -215,8 +230,7 @@ def main() -> None:
             f"{p['scenario']:<14} {p['seams']:>5} {p['planned']:>7} {p['planning_s']:>7.2f} {p['cycle_s']:>8.1f} "
             f"{p['arc_s']:>7.1f} {p['gate_s']:>7.2f} {p['collision_check_s']:>9.2f} {p['violations']:>5}"
         )
-    if args.json:
-        args.json.write_text(json.dumps({"primitives": rows, "plans": plans}, indent=2))
+    print(f"wrote {write_json(args.json, {'primitives': rows, 'plans': plans})}")
 
 
 if __name__ == "__main__":

@@ -129,7 +129,7 @@ class Transfers:
         self.robot, self.process, self.checker, self.opt = robot, process, checker, options
         self.q_home = q_home
         self.strategies = tuple(strategies)
-        tops = [float(np.max(o.box.corners()[:, 2])) for o in obstacles]
+        tops = [float(np.max(o.vertices()[:, 2])) for o in obstacles]
         self.lift_z = (max(tops) if tops else 0.0) + options.transfer_lift
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:

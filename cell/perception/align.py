@@ -94,7 +94,7 @@ def sample_map(weldmap: WeldMap, spacing_m: float, contact_margin_m: float) -> t
         keep = n[:, 2] > -_DOWN_COS
         for j, other in enumerate(weldmap.parts):
             if j != i:
-                keep &= ~other.box.contains(p, contact_margin_m)
+                keep &= ~other.contains(p, contact_margin_m)
         points.append(p[keep])
         normals.append(n[keep])
     if not points:

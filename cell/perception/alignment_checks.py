@@ -151,7 +151,7 @@ def part_coverage(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, band_m
         # Leave out where another part covers it (in contact) or stands over it.
         for other in weldmap_R.parts:
             if other is not part and len(top):
-                top = top[~other.box.contains(top, band_m)]
+                top = top[~other.contains(top, band_m)]
         if tree is None or len(top) == 0:
             out[part.name] = 0.0
             continue

@@ -37,7 +37,7 @@ def foreign_points(
     near = np.linalg.norm(Q - (a + t[:, None] * ab), axis=1) <= o.radius_m
     Q = Q[near & (Q[:, 2] > table_z + o.margin_m)]
     for part in weldmap_R.parts:
-        Q = Q[~part.box.contains(Q, o.margin_m)]
+        Q = Q[~part.contains(Q, o.margin_m)]
     return len(Q)
 
 

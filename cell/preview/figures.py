@@ -24,7 +24,6 @@ from cell.preview.views import (
     TRUTH_COLOUR,
     Line,
     SeamView,
-    box_edges,
     label_groups,
     seam_lines,
     thin,
@@ -86,7 +85,7 @@ def _draw_2d(
         cloud[:, i], cloud[:, j], c=cloud[:, k], s=point_size, cmap="viridis", linewidths=0, rasterized=True, zorder=1
     )
     for part in weldmap.parts:
-        for e in box_edges(part.box) * MM:
+        for e in part.edges() * MM:
             ax.plot(e[:, i], e[:, j], color=BOX_COLOUR, lw=0.6, zorder=2)
     for tcp in tcp_paths.values():
         p = np.asarray(tcp, dtype=float).reshape(-1, 3) * MM
@@ -134,7 +133,7 @@ def _draw_3d(
         rasterized=True,
     )
     for part in weldmap.parts:
-        for e in box_edges(part.box) * MM:
+        for e in part.edges() * MM:
             ax.plot(e[:, 0], e[:, 1], e[:, 2], color=BOX_COLOUR, lw=0.6)
     for ln in lines:
         ax.plot(
@@ -154,7 +153,7 @@ def _draw_3d(
                 ax.plot(*seg.T, color=colour, lw=1.2)
     lo, hi = cloud.min(axis=0), cloud.max(axis=0)
     for part in weldmap.parts:
-        c = part.box.corners() * MM
+        c = part.vertices() * MM
         lo, hi = np.minimum(lo, c.min(axis=0)), np.maximum(hi, c.max(axis=0))
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])

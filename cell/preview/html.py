@@ -22,7 +22,6 @@ from cell.preview.views import (
     STATUS_COLOURS,
     TRUTH_COLOUR,
     SeamView,
-    box_edges,
     seam_lines,
     thin,
     torch_glyphs,
@@ -77,7 +76,7 @@ def render_html(
             hoverinfo="skip",
         )
     ]
-    edges = np.concatenate([box_edges(p.box) for p in weldmap_R.parts]) * MM if weldmap_R.parts else None
+    edges = np.concatenate([p.edges() for p in weldmap_R.parts]) * MM if weldmap_R.parts else None
     if edges is not None:
         x, y, z = _segments_trace(edges)
         traces.append(

@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.types import Box, SeamRecord, WeldMap
+from cell.types import SeamRecord, WeldMap
 
 MM = 1000.0  # [mm/m]
 STATUS_COLOURS = {"found": "#2ca02c", "not_found": "#d62728", "not_visible": "#ff7f0e", "occluded": "#9467bd"}
@@ -83,13 +83,6 @@ def thin(points: npt.ArrayLike, max_points: int) -> FloatArray:
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     step = max(int(np.ceil(len(p) / max(max_points, 1))), 1)
     return p[::step]
-
-
-def box_edges(box: Box) -> FloatArray:
-    """(12, 2, 3) edges of a box [m]: corner pairs whose indices differ in one bit."""
-    c = box.corners()
-    pairs = [(i, i | bit) for i in range(8) for bit in (1, 2, 4) if not i & bit]
-    return np.array([[c[i], c[j]] for i, j in pairs])
 
 
 def torch_glyphs(poses: npt.ArrayLike) -> FloatArray:

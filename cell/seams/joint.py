@@ -24,7 +24,7 @@ def _face_axis(face: str) -> int:
 
 
 def _on_plane(part: Part, face: str, pts: FloatArray, tol: float) -> bool:
-    n, d = part.box.face_plane(face)
+    n, d = part.face_plane(face)
     return bool(np.all(np.abs(pts @ n - d) <= tol))
 
 
@@ -33,19 +33,19 @@ def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: flo
     residuals."""
     pts = np.stack([seam.p_start, seam.p_end])
     # Both parts of a joint hold the seam within the gap (plus tolerance): only those are worth a look.
-    parts = tuple(p for p in parts if np.all(p.box.contains(pts, margin=max_gap + tol)))
+    parts = tuple(p for p in parts if np.all(p.contains(pts, margin=max_gap + tol)))
     found: list[tuple[float, Joint]] = []
     for b in parts:
         for face_b in BOX_FACES:
-            n_b, d_b = b.box.face_plane(face_b)
+            n_b, d_b = b.face_plane(face_b)
             res_b = np.abs(pts @ n_b - d_b)
-            if np.any(res_b > tol) or not np.all(b.box.contains(pts, margin=tol)):
+            if np.any(res_b > tol) or not np.all(b.contains(pts, margin=tol)):
                 continue
             for a in parts:
                 if a.name == b.name:
                     continue
                 for end_face in BOX_FACES:
-                    n_e, d_e = a.box.face_plane(end_face)
+                    n_e, d_e = a.face_plane(end_face)
                     if float(n_e @ n_b) > -_ANTIPARALLEL_COS:
                         continue
                     gap = pts @ n_e - d_e  # how far the seam lies in front of A's end face
@@ -53,12 +53,12 @@ def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: flo
                         continue
                     # The seam, pushed back onto A's end face, must lie on that face (on one of its edges).
                     q = pts - np.outer(gap, n_e)
-                    if not np.all(a.box.contains(q, margin=tol)):
+                    if not np.all(a.contains(q, margin=tol)):
                         continue
                     for face_a in BOX_FACES:
                         if _face_axis(face_a) == _face_axis(end_face):
                             continue
-                        n_a, d_a = a.box.face_plane(face_a)
+                        n_a, d_a = a.face_plane(face_a)
                         res_a = np.abs(pts @ n_a - d_a)
                         if np.any(res_a > tol):
                             continue
@@ -95,8 +95,8 @@ def weld_faces(weldmap: WeldMap, joint: Joint) -> tuple[FloatArray, float, Float
     d_a).
     n_b, d_b : the same for the receiving part's ``face_receiving``.
     """
-    n_a, d_a = weldmap.part(joint.abutting).box.face_plane(joint.face_abutting)
-    n_b, d_b = weldmap.part(joint.receiving).box.face_plane(joint.face_receiving)
+    n_a, d_a = weldmap.part(joint.abutting).face_plane(joint.face_abutting)
+    n_b, d_b = weldmap.part(joint.receiving).face_plane(joint.face_receiving)
     return n_a, d_a, n_b, d_b
 
 

@@ -232,7 +232,7 @@ class PaperLocator:
             return 1 - k, k
         joint = scene.joints.get(seam.id)
         if joint is not None:
-            n_b, _ = scene.weldmap.part(joint.receiving).box.face_plane(joint.face_receiving)
+            n_b, _ = scene.weldmap.part(joint.receiving).face_plane(joint.face_receiving)
             if np.hypot(n_b[0], n_b[1]) > 0.5:
                 c = int(np.argmax(np.abs(n_b[:2])))
                 return c, 1 - c

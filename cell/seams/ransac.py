@@ -91,8 +91,8 @@ class RansacLocator:
             raise MapError(
                 f"seam {seam.id} has no joint; joints known for: {', '.join(sorted(scene.joints)) or 'none'}"
             )
-        n_a, _ = scene.weldmap.part(joint.abutting).box.face_plane(joint.face_abutting)
-        n_b, _ = scene.weldmap.part(joint.receiving).box.face_plane(joint.face_receiving)
+        n_a, _ = scene.weldmap.part(joint.abutting).face_plane(joint.face_abutting)
+        n_b, _ = scene.weldmap.part(joint.receiving).face_plane(joint.face_receiving)
         return n_a, n_b
 
     def _region(self, scene: SeamScene, seam: MapSeam) -> FloatArray:

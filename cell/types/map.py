@@ -68,14 +68,51 @@ class Box:
 
 @dataclass(frozen=True)
 class Part:
-    """A designed part of the welding map: a closed body, fitted by an oriented box.
+    """A designed part of the welding map: a closed body, in the frame the owning map is expressed in.
 
     name : stable identifier (DXF layer or block name, upper case).
-    box : the box in the frame the owning map is expressed in.
+    box : the body, an oriented box today.
+
+    The methods below are what a stage may ask of any body (a face's plane by name, which points lie inside, its
+    vertices and edges, its centre and bounding radius, the body in another frame); stages use them, not the box,
+    so a polyhedral body can take the box's place. What still reads ``box`` is box-specific by nature: rendering and
+    collision shapes, the locators' box-frame tubes, the as-built deviations of a box's edge lengths.
     """
 
     name: str
     box: Box
+
+    def face_plane(self, face: str) -> tuple[FloatArray, float]:
+        """Outward unit normal n (3,) and offset d [m] of the face named ``face``: it lies in n . p = d."""
+        return self.box.face_plane(face)
+
+    def contains(self, p: npt.ArrayLike, margin: float = 0.0) -> npt.NDArray[np.bool_]:
+        """Which points (n, 3) lie inside the body grown by ``margin`` [m]."""
+        return self.box.contains(p, margin)
+
+    def vertices(self) -> FloatArray:
+        """(k, 3) the body's vertices [m]."""
+        return self.box.corners()
+
+    def edges(self) -> FloatArray:
+        """(m, 2, 3) the body's edges as end-point pairs [m]."""
+        c = self.box.corners()  # corner pairs whose indices differ in one bit
+        pairs = [(i, i | bit) for i in range(8) for bit in (1, 2, 4) if not i & bit]
+        return np.array([[c[i], c[j]] for i, j in pairs])
+
+    @property
+    def center(self) -> FloatArray:
+        """(3,) the body's centre [m] (the centroid of its volume)."""
+        return self.box.center
+
+    @property
+    def radius(self) -> float:
+        """The radius [m] of a sphere about :attr:`center` that holds the whole body."""
+        return 0.5 * float(np.linalg.norm(self.box.size))
+
+    def transformed(self, X_CA: FloatArray) -> Part:
+        """The same part expressed in frame C, given the pose X_CA of its current frame A in C."""
+        return Part(self.name, self.box.transformed(X_CA))
 
 
 @dataclass(frozen=True)
@@ -124,7 +161,7 @@ class WeldMap:
     def transformed(self, X_AF: FloatArray, frame: str) -> WeldMap:
         """The whole map expressed in frame ``frame`` given the pose X_AF of its current frame F in A."""
         return WeldMap(
-            parts=tuple(Part(p.name, p.box.transformed(X_AF)) for p in self.parts),
+            parts=tuple(p.transformed(X_AF) for p in self.parts),
             seams=tuple(s.transformed(X_AF) for s in self.seams),
             units=self.units,
             source=self.source,

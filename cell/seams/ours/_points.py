@@ -100,7 +100,7 @@ def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
     out = scene.cache.get(_SPHERES_KEY)
     if out is None:
         parts = scene.weldmap.parts
-        centres = np.array([p.box.center for p in parts]).reshape(-1, 3)
-        radii = np.array([0.5 * float(np.linalg.norm(p.box.size)) for p in parts])
+        centres = np.array([p.center for p in parts]).reshape(-1, 3)
+        radii = np.array([p.radius for p in parts])
         out = scene.cache[_SPHERES_KEY] = (centres, radii)
     return out

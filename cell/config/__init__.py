@@ -10,7 +10,7 @@ the report records them as resolved. Run-time values a stage also needs (ours' w
 from cell.config.bounds import Bounds, check_bounds
 from cell.config.export import KrlOptions
 from cell.config.motion import STICKOUT_MM, CollisionOptions, GateOptions, IKOptions, PlanOptions, ViewOptions
-from cell.config.perception import HealthOptions, ScreenOptions, SymmetryOptions
+from cell.config.perception import CoverageOptions, HealthOptions, ScreenOptions, SymmetryOptions
 from cell.config.rescan import CLOSEUP_OURS_OPTIONS, CLOSEUP_TARGET_SE_M, CONFIDENCE_THRESHOLD, RescanOptions
 from cell.config.seams import INDEX_SHARES, OursSettings, PaperOptions, RansacOptions, RansacThresholds
 from cell.config.sim import BeadStyle
@@ -24,6 +24,7 @@ __all__ = [
     "BeadStyle",
     "Bounds",
     "CollisionOptions",
+    "CoverageOptions",
     "GateOptions",
     "HealthOptions",
     "IKOptions",

@@ -1,5 +1,5 @@
-"""Options of perception's checks (:mod:`cell.perception`): camera health, the map fit's uniqueness, the seam
-screen. Lengths [m]."""
+"""Options of perception's checks (:mod:`cell.perception`): camera health, the map fit's uniqueness, whether the
+map lies on the cloud, the seam screen. Lengths [m]."""
 
 from __future__ import annotations
 
@@ -38,3 +38,11 @@ class ScreenOptions:
     margin_m: float = 0.02  # a point further than this from every part of the map is foreign (3 sigma at 2 m)
     min_foreign: int = 40  # this many foreign points (a few cm^2 of surface) near a seam: it is occluded
     min_confidence: float = 0.1  # found seams below this confidence are not trusted
+
+
+@dataclass(frozen=True)
+class CoverageOptions:
+    """Thresholds of :func:`~cell.perception.check_parts_seen`: shares of each part's top that hold points."""
+
+    min_coverage: float = 0.1  # less: the part is missing (its seams are not searched)
+    min_seen: float = 0.6  # between the two: the map lies half off the cloud (alignment refused)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cell.config.perception import SymmetryOptions
+from cell.config.perception import CoverageOptions, SymmetryOptions
 from cell.errors import AlignmentError, AlignmentFailure
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception.align import Alignment, sample_map
@@ -172,16 +172,19 @@ def missing_parts(coverage: Mapping[str, float], min_coverage: float = 0.1, min_
 
 
 def check_parts_seen(
-    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, min_coverage: float = 0.1, min_seen: float = 0.6
+    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, options: CoverageOptions | None = None
 ) -> dict[str, str]:
     """After alignment: refuse a map that does not lie where the cloud is; name the parts that are missing.
 
-    weldmap_R : the map as aligned (frame R); cloud : the dense cloud (frame R).
-    A part whose top is covered less than ``min_seen`` but more than ``min_coverage`` lies half on, half off
-    the cloud: the map settled in a wrong place (part displaced beyond what alignment corrects), or the part
-    runs out of the workspace: AlignmentError. So it is when more than half of the parts are missing. Returns
-    the missing parts (covered less than ``min_coverage``): name -> reason; their seams must be NOT_FOUND.
+    weldmap_R : the map as aligned (frame R); cloud : the dense cloud (frame R); options : the coverage thresholds
+    (:class:`~cell.config.CoverageOptions`). A part whose top is covered less than ``min_seen`` but more than
+    ``min_coverage`` lies half on, half off the cloud: the map settled in a wrong place (part displaced beyond what
+    alignment corrects), or the part runs out of the workspace: AlignmentError. So it is when more than half of the
+    parts are missing. Returns the missing parts (covered less than ``min_coverage``): name -> reason; their seams
+    must be NOT_FOUND.
     """
+    o = options if options is not None else CoverageOptions()
+    min_coverage, min_seen = o.min_coverage, o.min_seen
     coverage = part_coverage(weldmap_R, cloud, spec)
     partial = {n: c for n, c in coverage.items() if min_coverage <= c < min_seen}
     missing = missing_parts(coverage, min_coverage)

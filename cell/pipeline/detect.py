@@ -82,7 +82,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
     # parts that are simply not there are named, and their seams are never searched.
     check_alignment_unique(weldmap_R, perceived.registered, alignment, sc.perception.symmetry)
-    missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception)
+    missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception, sc.perception.coverage)
     timings["align_s"] = time.perf_counter() - t
 
     seam_scene = SeamScene(

@@ -13,6 +13,7 @@ from pydantic import Field, ValidationError, model_validator
 from cell.config import (
     CONFIDENCE_THRESHOLD,
     BeadStyle,
+    CoverageOptions,
     GateOptions,
     HealthOptions,
     KrlOptions,
@@ -64,6 +65,7 @@ class PerceptionSpec(Model):
     align_min_fitness: Annotated[float, Field(ge=0.0, le=1.0)] = 0.5
     health: HealthOptions = HealthOptions()  # is a camera's data fit to splice (dead, stuck, garbage, bumped)
     symmetry: SymmetryOptions = SymmetryOptions()  # is the map's fit unique (no near-symmetry fits as well)
+    coverage: CoverageOptions = CoverageOptions()  # does the aligned map lie on the cloud; which parts are missing
     screen: ScreenOptions = ScreenOptions()  # which found seams must not be welded (occluded, doubtful)
 
 

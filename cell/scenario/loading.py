@@ -130,7 +130,8 @@ def from_dict(data: Any, base_dir: Path, source: str = "<scenario>") -> Scenario
     except ValidationError as err:
         raise ScenarioError(_explain(err, source)) from None
     if not scenario.map_path.is_file():
-        raise ScenarioError(f"{source}: map.file {scenario.map.file!r} does not exist (looked at {scenario.map_path})")
+        looked = ", then ".join(str(p) for p in dict.fromkeys(scenario.map_candidates))
+        raise ScenarioError(f"{source}: map.file {scenario.map.file!r} does not exist (looked at {looked})")
     return scenario
 
 

@@ -23,6 +23,8 @@ from cell.scenario.run_specs import (
     SimulationSpec,
 )
 
+MAP_DIR = Path(__file__).resolve().parents[2] / "maps"  # the repository's welding maps
+
 
 class Scenario(Model):
     """A whole cell: map, as-built part, table, robot, cameras, seed and algorithm options."""
@@ -64,8 +66,15 @@ class Scenario(Model):
         return self
 
     @property
+    def map_candidates(self) -> tuple[Path, ...]:
+        """Where ``map.file`` is looked for, in order: relative to the scenario's folder, then by its name in the
+        repository's ``maps/`` (so a scenario copied elsewhere still finds a shipped map)."""
+        return ((Path(self.base_dir) / self.map.file).resolve(), MAP_DIR / Path(self.map.file).name)
+
+    @property
     def map_path(self) -> Path:
-        return (Path(self.base_dir) / self.map.file).resolve()
+        """The map file: the first of :attr:`map_candidates` that exists (the first if none does)."""
+        return next((p for p in self.map_candidates if p.is_file()), self.map_candidates[0])
 
     @property
     def X_WR(self) -> FloatArray:

@@ -32,6 +32,7 @@ if TYPE_CHECKING:
     from cell.types.execution import Execution
     from cell.types.plan import WeldPlan
     from cell.types.trajectory import Trajectory
+    from cell.types.view import CellView
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,7 @@ class WeldRun:
     arm: Arm | None = None
     first_detection: Detection | None = None  # before the re-scan (the same as detection when none ran)
     rescan: Rescan | None = None
+    view: CellView | None = None  # the table, the robot's shapes at its poses and the cameras, for pictures
 
     @property
     def cycle_time_s(self) -> float:

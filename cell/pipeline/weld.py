@@ -14,6 +14,7 @@ from cell.pipeline.detect import detect, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.rescan import rescan_detection
+from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
 from cell.station import Station, open_station
 from cell.types import SeamStatus
@@ -196,7 +197,8 @@ def weld(
         seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused, sc)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
-        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs)
+        view = cell_view(sc, station.arm, plan)
+        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs, view)
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

@@ -16,11 +16,14 @@ from cell.types.run import SeamRecord, SeamWeld, WeldReason
 from cell.types.seams import Joint, MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
 from cell.types.trajectory import PathProfile, Trajectory
+from cell.types.view import CameraView, CellView, RobotPose, Shape, ShapeKind
 
 __all__ = [
     "BOX_FACES",
     "Box",
     "CameraIntrinsics",
+    "CameraView",
+    "CellView",
     "Cloud",
     "DepthImage",
     "Event",
@@ -35,6 +38,7 @@ __all__ = [
     "PlanReason",
     "Reason",
     "Rescan",
+    "RobotPose",
     "SeamEstimate",
     "SeamMetrics",
     "SeamOutcome",
@@ -46,6 +50,8 @@ __all__ = [
     "SeamWeld",
     "Segment",
     "SegmentKind",
+    "Shape",
+    "ShapeKind",
     "Trajectory",
     "Viewpoint",
     "VoxelTable",

@@ -1,0 +1,79 @@
+"""Commands that set a cell up: ``cell init`` (a scenario for one's own welding map) and ``cell scenario check``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from cell.cli.common import app, cell_errors, err, out
+
+scenario_app = typer.Typer(no_args_is_help=True, help="Scenario files (YAML).")
+app.add_typer(scenario_app, name="scenario")
+
+
+@app.command()
+def init(
+    map_file: Annotated[Path, typer.Argument(help="The welding map (DXF) to write a scenario for.")],
+    out_path: Annotated[
+        Path | None, typer.Option("--out", "-o", help="The scenario file to write (default: MAP's name .yaml here).")
+    ] = None,
+    units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite the scenario file if it exists.")] = False,
+) -> None:
+    """Write a scenario for any welding map: table, robot and cameras placed around the part, the workspace
+    computed, a comment on every key. Then `cell scenario check FILE` and `cell weld FILE`."""
+    from cell import scenario as sc
+    from cell.scenario.init import scenario_text
+
+    target = out_path if out_path is not None else Path(f"{map_file.stem}.yaml")
+    if target.suffix not in (".yaml", ".yml"):
+        raise typer.BadParameter(f"{str(target)!r} must end in .yaml or .yml", param_hint="--out")
+    if target.exists() and not force:
+        raise typer.BadParameter(f"{str(target)!r} exists (--force overwrites it)", param_hint="--out")
+    if not map_file.is_file():
+        raise typer.BadParameter(f"no file {str(map_file)!r}", param_hint="MAP_FILE")
+    with cell_errors():
+        text, lay = scenario_text(map_file, target.absolute(), units=units)
+        scn = sc.from_yaml(text, target.absolute().parent, target.name)  # what is written loads as it is
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_text(text, encoding="utf-8")
+        except OSError as e:
+            raise typer.BadParameter(f"cannot write {str(target)!r}: {e.strerror}", param_hint="--out") from None
+        size = lay.table_size
+        err.print(
+            f"[dim]· wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras, table {size[0]:.1f} x "
+            f"{size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, {lay.X_WR_xyz[1]:.2f}) m[/]",
+            soft_wrap=True,
+        )
+        if lay.unreachable_risk:
+            err.print(f"[yellow]warning[/]: a seam lies {lay.far_seam_m:.2f} m from the robot base", soft_wrap=True)
+        err.print(f"[dim]· next: cell scenario check {target}; cell weld {target}[/]", soft_wrap=True)
+
+
+@scenario_app.command("check")
+def check(
+    file: Annotated[str, typer.Argument(help="A scenario YAML path (or a shipped scenario's name).")],
+) -> None:
+    """Validate a scenario: every key, the map it names (found and readable), and the layout (the part on the
+    table and inside the workspace, its seams within the arm's reach). Exit 0 when it loads; problems of the
+    layout are printed as warnings."""
+    from cell import pipeline
+    from cell import scenario as sc
+    from cell.scenario.init import check_layout
+
+    with cell_errors():
+        scn = sc.load(file)
+        weldmap = pipeline.read_weldmap(scn)
+        problems = check_layout(scn, weldmap)
+        for p in problems:
+            err.print(f"[yellow]warning[/]: {p}", soft_wrap=True)
+        fixed = sum(c.mount == "fixed" for c in scn.cameras.values())
+        verdict = "ok" if not problems else f"{len(problems)} warning(s)"
+        out.print(
+            f"{verdict}: {file}: map {scn.map_path} ({len(weldmap.parts)} parts, {len(weldmap.seams)} seams), "
+            f"{fixed} fixed camera(s), {len(scn.cameras) - fixed} on the arm",
+            soft_wrap=True,
+        )

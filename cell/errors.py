@@ -10,7 +10,8 @@ code  meaning
 ====  =========================================================================
 0     everything asked for was done
 1     internal error (a bug: please report it with the traceback)
-2     command-line usage error (typer/click)
+2     command-line usage error (typer/click, or a bad value checked before any work), or an output path that
+      cannot be written (checked before the run; a write that fails late still writes every other output)
 3     partial result: the report is written; some seams were not found/welded, or a stage failed after capture
 10    scenario file invalid (unknown key, value out of range, missing file)
 11    welding map (DXF) unreadable or invalid
@@ -18,6 +19,7 @@ code  meaning
 13    camera/sensor failure (no image, no points)
 14    map-to-cloud alignment failed
 15    motion: IK, timing or plan failed as a whole
+130   interrupted (Ctrl-C): the partial report of the stage reached is written where --json asked
 ====  =========================================================================
 """
 
@@ -31,6 +33,7 @@ EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_PARTIAL = 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 
 
 class CellError(Exception):
@@ -45,6 +48,23 @@ class CellError(Exception):
     @property
     def message(self) -> str:
         return str(self.args[0])
+
+
+class UsageError(CellError, ValueError):
+    """A command-line value that cannot work (a seam not in the map, unknown units, --gui without a display),
+    found before any work is done."""
+
+    exit_code = EXIT_USAGE
+
+
+class OutputError(CellError, OSError):
+    """An output path cannot be written (found before the run when it can be; ``path`` is the one asked for)."""
+
+    exit_code = EXIT_USAGE
+
+    def __init__(self, message: str, *, path: str = "") -> None:
+        super().__init__(message)
+        self.path = path
 
 
 class ScenarioError(CellError, ValueError):

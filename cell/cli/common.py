@@ -1,33 +1,102 @@
-"""What every command shares: the typer apps, the consoles, the error handler, option parsing.
+"""What every command shares: the typer apps, the consoles, the global options, error handling, option parsing.
 
 Heavy packages (pybullet, open3d, pinocchio) are imported inside the commands so ``cell --help`` is instant.
-Progress goes to stderr, results to stdout. Every :class:`~cell.errors.CellError` becomes a one-line message and its
-documented exit code (see :mod:`cell.errors`); nothing else is caught, so a bug still shows its traceback.
+Progress goes to stderr (and to ``--log-file``), results to stdout. Every :class:`~cell.errors.CellError` becomes
+a one-line message and its documented exit code (see :mod:`cell.errors`); nothing else is caught, so a bug still
+shows its traceback.
 """
 
 from __future__ import annotations
 
+import logging
+import os
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Annotated, Literal
 
 import typer
 from rich.console import Console
 
-from cell.errors import CellError
+from cell.errors import CellError, UsageError
 
+CONTEXT = {"help_option_names": ["-h", "--help"]}
 app = typer.Typer(
-    add_completion=False,
     no_args_is_help=True,
+    context_settings=CONTEXT,
     help="Robotic weld cell: find weld seams with depth cameras and a DXF welding map, in simulation.",
 )
-map_app = typer.Typer(no_args_is_help=True, help="Welding maps (DXF).")
+map_app = typer.Typer(no_args_is_help=True, context_settings=CONTEXT, help="Welding maps (DXF).")
 app.add_typer(map_app, name="map")
 
+# No fixed width: tables take the terminal's (rich falls back to 80 columns, or $COLUMNS, when not a terminal).
 err = Console(stderr=True, highlight=False)
-out = Console(highlight=False, width=140)
+out = Console(highlight=False)
+log = logging.getLogger("cell")
 
 NoiseOpt = Annotated[str | None, typer.Option("--noise", help="Override the scenario's noise model: none | realistic.")]
+FormatOpt = Annotated[str, typer.Option("--format", help="How the result table is printed: table | json | csv.")]
+TableFormat = Literal["table", "json", "csv"]
+
+
+@dataclass
+class Settings:
+    """The global options of this invocation (reset by every ``cell ...``)."""
+
+    quiet: bool = False
+    verbose: bool = False
+
+
+settings = Settings()
+_handlers: list[logging.Handler] = []
+
+
+def configure(*, quiet: bool, verbose: bool, log_file: Path | None) -> None:
+    """Set this invocation's verbosity and log file; results go back to stdout (``--json -`` moves them)."""
+    settings.quiet, settings.verbose = quiet, verbose
+    out.stderr = False
+    for h in _handlers:
+        log.removeHandler(h)
+        h.close()
+    _handlers.clear()
+    log.setLevel(logging.DEBUG)
+    log.propagate = False
+    if log_file is not None:
+        try:
+            handler = logging.FileHandler(log_file, encoding="utf-8")
+        except OSError as e:
+            err.print(f"[bold red]error[/]: cannot write the log file {str(log_file)!r}: {e.strerror or e}")
+            raise typer.Exit(2) from None
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"))
+        log.addHandler(handler)
+        _handlers.append(handler)
+
+
+def results_to_stderr() -> None:
+    """stdout carries a JSON document (``--json -``): tables and summaries go to stderr instead."""
+    out.stderr = True
+
+
+def say(msg: str) -> None:
+    """A progress line: stderr (unless --quiet) and the log file. Never hard-wrapped."""
+    log.info(msg)
+    if not settings.quiet:
+        err.print(f"[dim]· {msg}[/]", soft_wrap=True)
+
+
+def detail(msg: str) -> None:
+    """A detail line: stderr with --verbose only, the log file always."""
+    log.debug(msg)
+    if settings.verbose and not settings.quiet:
+        err.print(f"[dim]  {msg}[/]", soft_wrap=True, markup=False)
+
+
+def fail_line(msg: str) -> None:
+    """The last line of a failed command: what went wrong (always shown, also with --quiet)."""
+    log.error(msg)
+    err.print(msg, soft_wrap=True, markup=False, highlight=False)
 
 
 @contextmanager
@@ -36,14 +105,12 @@ def cell_errors() -> Iterator[None]:
     try:
         yield
     except CellError as e:
+        log.error(e.message)
         err.print(f"[bold red]error[/]: {e.message}", soft_wrap=True)
         raise typer.Exit(e.exit_code) from None
 
 
 def progress() -> Callable[[str], None]:
-    def say(msg: str) -> None:
-        err.print(f"[dim]· {msg}[/]")
-
     return say
 
 
@@ -63,8 +130,20 @@ def parse_rescan_mode(value: str | None) -> Literal["none", "low", "all"] | None
     return "none" if value == "none" else ("low" if value == "low" else "all")
 
 
+def parse_format(value: str) -> TableFormat:
+    if value not in ("table", "json", "csv"):
+        raise UsageError(f"--format {value!r}; valid: table, json, csv")
+    return "table" if value == "table" else ("json" if value == "json" else "csv")
+
+
 def check_method(method: str | None) -> None:
     from cell.seams.registry import METHODS
 
     if method is not None and method not in METHODS:
         raise typer.BadParameter(f"{method!r}; valid: {', '.join(METHODS)}", param_hint="--method")
+
+
+def check_display(gui: bool) -> None:
+    """``--gui`` needs a display: without one the simulator's window kills the process, so refuse first."""
+    if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+        raise UsageError("--gui needs a display and $DISPLAY is not set; run without --gui (or under xvfb-run)")

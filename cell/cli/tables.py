@@ -1,12 +1,19 @@
-"""The tables and summary lines the commands print (from the JSON reports, so screen and file agree)."""
+"""The tables and summary lines the commands print (from the JSON reports, so screen and file agree).
+
+``--format table`` (rich, as wide as the terminal), ``json`` (a list of rows, column name -> value, numbers as
+numbers and ``-`` as null) or ``csv`` (a header row, then one row per seam); json and csv print no summary.
+"""
 
 from __future__ import annotations
 
+import csv
+import json
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from rich.table import Table
 
-from cell.cli.common import out
+from cell.cli.common import TableFormat, out
 
 if TYPE_CHECKING:
     from cell.pipeline import Detection
@@ -37,12 +44,38 @@ def print_rescan(rep: dict) -> None:
     )
 
 
-def print_weld(rep: dict, title: str) -> None:
+def _value(cell: str) -> str | float | None:
+    if cell == "-":
+        return None
+    try:
+        return float(cell)
+    except ValueError:
+        return cell
+
+
+def _emit(t: Table, columns: Sequence[str], rows: Sequence[Sequence[str]], fmt: TableFormat) -> bool:
+    """Print the rows in ``fmt``; True when it was a rich table (then the summary lines follow)."""
+    if fmt == "table":
+        for row in rows:
+            t.add_row(*row)
+        out.print(t)
+        return True
+    if fmt == "json":
+        out.file.write(json.dumps([dict(zip(columns, map(_value, r), strict=True)) for r in rows], indent=2) + "\n")
+    else:
+        w = csv.writer(out.file, lineterminator="\n")
+        w.writerow(columns)
+        w.writerows(rows)
+    out.file.flush()
+    return False
+
+
+def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
     t = Table(
         title=f"{title} {rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
         title_justify="left",
     )
-    for col in (
+    columns = (
         "seam",
         "detected",
         "paper ME mm",
@@ -52,23 +85,28 @@ def print_weld(rep: dict, title: str) -> None:
         "TCP max mm",
         "weld s",
         "why not",
-    ):
+    )
+    for col in columns:
         t.add_column(col, justify="left" if col in ("seam", "detected", "welded", "why not") else "right")
+    rows = []
     for s in rep["seams"]:
         e = s.get("error_mm", {})
         tcp = s.get("tcp_error_mm", {})
-        t.add_row(
-            s["id"],
-            s["status"],
-            _fmt(e.get("paper_me")),
-            _fmt(e.get("lateral")),
-            "yes" if s["welded"] else ("planned" if s.get("planned") else "no"),
-            _fmt(tcp.get("rms")),
-            _fmt(tcp.get("max")),
-            _fmt(s.get("weld_time_s"), 1),
-            s.get("weld_reason", ""),
+        rows.append(
+            (
+                s["id"],
+                s["status"],
+                _fmt(e.get("paper_me")),
+                _fmt(e.get("lateral")),
+                "yes" if s["welded"] else ("planned" if s.get("planned") else "no"),
+                _fmt(tcp.get("rms")),
+                _fmt(tcp.get("max")),
+                _fmt(s.get("weld_time_s"), 1),
+                s.get("weld_reason", ""),
+            )
         )
-    out.print(t)
+    if not _emit(t, columns, rows, fmt):
+        return
     m = rep["summary"]
     cyc = rep["cycle_time_s"] if rep["cycle_time_s"] else rep["planned_cycle_time_s"]
     out.print(
@@ -89,29 +127,35 @@ def _fmt(v: float | None, nd: int = 2) -> str:
     return "-" if v is None else f"{v:.{nd}f}"
 
 
-def print_detection(det: Detection) -> None:
+def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
+    """The detection table of a Detection or of its report."""
     from cell.export.report import detection_report
 
-    rep = detection_report(det)
+    rep = det if isinstance(det, dict) else detection_report(det)
     t = Table(
         title=f"{rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
         title_justify="left",
     )
-    for col in ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason"):
+    columns = ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason")
+    for col in columns:
         t.add_column(col, justify="right" if col not in ("seam", "status", "reason") else "left")
+    rows = []
     for s in rep["seams"]:
         e = s.get("error_mm", {})
-        t.add_row(
-            s["id"],
-            s["status"],
-            _fmt(e.get("paper_me")),
-            _fmt(e.get("endpoint")),
-            _fmt(e.get("lateral")),
-            _fmt(s.get("confidence")),
-            _fmt(s["time_ms"], 1) if s["status"] == "found" else "-",
-            s["reason"],
+        rows.append(
+            (
+                s["id"],
+                s["status"],
+                _fmt(e.get("paper_me")),
+                _fmt(e.get("endpoint")),
+                _fmt(e.get("lateral")),
+                _fmt(s.get("confidence")),
+                _fmt(s["time_ms"], 1) if s["status"] == "found" else "-",
+                s["reason"],
+            )
         )
-    out.print(t)
+    if not _emit(t, columns, rows, fmt):
+        return
     m = rep["summary"]
     out.print(
         f"found {m['found']}/{m['visible']} visible ({m['seams']} seams) · paper ME mean"

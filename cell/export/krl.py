@@ -25,13 +25,17 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.config.export import KrlOptions
+from cell.export.atomic import write_atomic
 from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
+from cell.provenance import header_lines
 from cell.types.plan import WeldPlan
 from cell.types.robot import Kinematics
 
@@ -68,10 +72,12 @@ def krl_program(
     *,
     X_WR: npt.ArrayLike | None = None,
     options: KrlOptions | None = None,
+    provenance: Mapping[str, Any] | None = None,
 ) -> tuple[str, str]:
     """(src, dat) texts of the program ``name`` (a KRL name: a letter or _, then letters, digits, _; at most 24).
 
     X_WR : (4, 4) the robot's mounting in the cell's world, only written as a comment.
+    provenance : what made the program (:func:`cell.provenance.provenance`): comment lines in both headers.
     Raises ValueError for an invalid name or a plan without motion.
     """
     if not _NAME.fullmatch(name):
@@ -92,6 +98,8 @@ def krl_program(
         ";- Units mm, deg; A, B, C = rotations about Z, Y, X. Points: tool in the robot base frame ($ROBROOT).",
         ";- $BASE = $NULLFRAME assumes $ROBROOT = $WORLD (default machine data).",
     ]
+    made_by = header_lines(provenance) if provenance is not None else []
+    src += made_by
     if X_WR is not None:
         src.append(f";- Robot mounting in the cell (X_WR): {frame_text(X_WR)}")
     src.append(
@@ -114,7 +122,7 @@ def krl_program(
         "",
         "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
     ]
-    dat = [f"DEFDAT {name} PUBLIC", f"DECL E6AXIS XHOME={_e6axis(plan.q_home)}"]
+    dat = [f"DEFDAT {name} PUBLIC", *made_by, f"DECL E6AXIS XHOME={_e6axis(plan.q_home)}"]
     n = 0
     last_speed = -1.0
     current = ""
@@ -161,12 +169,13 @@ def write_krl(
     *,
     X_WR: npt.ArrayLike | None = None,
     options: KrlOptions | None = None,
+    provenance: Mapping[str, Any] | None = None,
 ) -> tuple[Path, Path]:
-    """Write ``NAME.src`` and ``NAME.dat`` (upper-case name, CRLF line ends as on the controller); their paths."""
-    src, dat = krl_program(plan, robot, name, X_WR=X_WR, options=options)
+    """Write ``NAME.src`` and ``NAME.dat`` (upper-case name, CRLF line ends as on the controller, each file
+    atomically); their paths. OutputError when a file cannot be written."""
+    src, dat = krl_program(plan, robot, name, X_WR=X_WR, options=options, provenance=provenance)
     d = Path(directory)
-    d.mkdir(parents=True, exist_ok=True)
     paths = (d / f"{name.upper()}.src", d / f"{name.upper()}.dat")
     for path, text in zip(paths, (src, dat), strict=True):
-        path.write_bytes(text.replace("\n", "\r\n").encode("ascii", errors="replace"))
+        write_atomic(path, text.replace("\n", "\r\n").encode("ascii", errors="replace"), what="robot program")
     return paths

@@ -5,8 +5,7 @@ from __future__ import annotations
 import enum
 import json
 import math
-import os
-import tempfile
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -15,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from cell.errors import CellError
+from cell.export.atomic import write_atomic
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus
 
@@ -55,8 +55,12 @@ def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
     return entry
 
 
-def detection_report(det: Detection, records: Sequence[SeamRecord] | None = None) -> dict[str, Any]:
-    """The ``cell detect`` report as a JSON-ready dict (schema in the README), one entry per seam record."""
+def detection_report(
+    det: Detection, records: Sequence[SeamRecord] | None = None, *, provenance: Mapping[str, Any] | None = None
+) -> dict[str, Any]:
+    """The ``cell detect`` report as a JSON-ready dict (schema in the README), one entry per seam record.
+
+    provenance : what made it (:func:`cell.provenance.provenance`), stored under ``provenance`` (null if None)."""
     seams = [_seam_entry(rec) for rec in (records if records is not None else det.records())]
     s = det.summary
     summary = {
@@ -71,6 +75,7 @@ def detection_report(det: Detection, records: Sequence[SeamRecord] | None = None
     }
     return {
         "report_version": REPORT_VERSION,
+        "provenance": dict(provenance) if provenance is not None else None,
         "scenario": det.scenario.name,
         "method": det.method,
         "noise": det.scenario.noise,
@@ -143,24 +148,26 @@ def _error(e: CellError | None) -> dict[str, Any] | None:
     return out
 
 
+STDOUT = "-"  # the path that means standard output
+
+
 def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
-    """Write JSON atomically (a crash never leaves half a report), creating parent folders."""
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=p.name, dir=p.parent)
-    with os.fdopen(fd, "w", encoding="utf-8") as f:
-        json.dump(data, f, indent=2)
-        f.write("\n")
-    os.replace(tmp, p)
-    return p
+    """Write JSON atomically (a crash never leaves half a report), creating parent folders, with the umask's
+    permissions; ``-`` writes it to standard output. OutputError (one line) when the file cannot be written."""
+    text = json.dumps(data, indent=2) + "\n"
+    if str(path) == STDOUT:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return Path(STDOUT)
+    return write_atomic(path, text.encode("utf-8"), what="report")
 
 
-def weld_report(run: WeldRun) -> dict[str, Any]:
+def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The ``cell weld`` / ``cell preview`` report: the detection report plus, per seam, ``welded``, ``reason``,
     ``tcp_error_mm`` {rms, max} of the executed tool path against the true seam and ``weld_time_s``; at the top,
     ``cycle_time_s``, ``events``, the gate's ``violations`` and the ``error`` that stopped the run (or null)."""
     records = run.records()
-    rep = detection_report(run.detection, records)
+    rep = detection_report(run.detection, records, provenance=provenance)
     plan = run.plan
     for entry, rec in zip(rep["seams"], records, strict=True):
         w = rec.weld
@@ -205,7 +212,9 @@ def weld_report(run: WeldRun) -> dict[str, Any]:
     return rep
 
 
-def rescan_report(before: Detection, after: Detection, rs: Rescan) -> dict[str, Any]:
+def rescan_report(
+    before: Detection, after: Detection, rs: Rescan, *, provenance: Mapping[str, Any] | None = None
+) -> dict[str, Any]:
     """The ``cell rescan`` report: the detection report of the fused estimates, with the figures before."""
     rescans = {r.id: r for r in rs.seams}
     records = [
@@ -213,6 +222,6 @@ def rescan_report(before: Detection, after: Detection, rs: Rescan) -> dict[str, 
         for rec in after.records()
         if rec.id in rescans
     ]
-    rep = detection_report(after, records)
+    rep = detection_report(after, records, provenance=provenance)
     _add_rescan(rep, records, before, rs)
     return rep

@@ -13,17 +13,12 @@ pose out of the fixed cameras' way before capturing.
 
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType, TracebackType
 
 import numpy as np
 import numpy.typing as npt
-import pybullet
-from pybullet_utils.bullet_client import BulletClient
 from scipy.spatial.transform import Rotation
 
 from cell.errors import ScenarioError, SensorError
@@ -32,6 +27,7 @@ from cell.scenario import CameraSpec, Scenario
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.noise import apply_noise, perturb_pose
+from cell.sim.quiet import BulletClient, pybullet, silenced_fds
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
 from cell.types.execution import Execution
@@ -44,24 +40,6 @@ _PART_RGBA = (0.7, 0.72, 0.75, 1.0)
 _OCCLUDER_RGBA = (0.2, 0.3, 0.8, 1.0)
 DEFAULT_BEAD = BeadStyle()
 EYE_IN_HAND_LINK = "camera_optical"  # the arm's optical frame of the eye-in-hand camera (z forward, y down)
-
-
-@contextlib.contextmanager
-def _stdout_to_stderr() -> Iterator[None]:
-    """Point file descriptor 1 at stderr for the duration (C libraries write to the descriptor, not sys.stdout)."""
-    sys.stdout.flush()
-    try:
-        saved = os.dup(1)
-    except OSError:  # no real stdout (embedded, closed): nothing to protect
-        yield
-        return
-    try:
-        os.dup2(2, 1)
-        yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
 
 
 class SimCell:
@@ -87,7 +65,7 @@ class SimCell:
             )
         self.scenario = scenario
         self.parts_W: tuple[Part, ...] = tuple(parts_W)
-        with _stdout_to_stderr():  # pybullet's C code prints "argv[0]=" on stdout, which carries our results
+        with silenced_fds():  # pybullet's banners: not on stdout (it carries our results), not on stderr
             self._client: BulletClient | None = BulletClient(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
         self._bodies: dict[str, int] = {}
         self._noise_rngs: dict[str, np.random.Generator] = {}

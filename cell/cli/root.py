@@ -1,0 +1,56 @@
+"""The ``cell`` command itself: its global options (``--version``, ``-q``, ``-v``, ``--log-file``) and the
+entry point that turns every failure into a last line of stderr saying why, and its exit code."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import click
+import typer
+
+from cell.cli.common import app, configure, err, fail_line
+from cell.errors import EXIT_INTERRUPTED, EXIT_USAGE
+
+
+def _version(value: bool) -> None:
+    if value:
+        from cell.provenance import version_text
+
+        typer.echo(version_text())
+        raise typer.Exit()
+
+
+@app.callback()
+def root(
+    version: Annotated[
+        bool,
+        typer.Option("--version", callback=_version, is_eager=True, help="Print the version (and git commit)."),
+    ] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress lines: results and errors only.")] = False,
+    verbose: Annotated[bool, typer.Option("--verbose", "-v", help="More detail: the files read and written.")] = False,
+    log_file: Annotated[
+        Path | None, typer.Option("--log-file", help="Also write the progress, with times, to this file.")
+    ] = None,
+) -> None:
+    """Robotic weld cell: find weld seams with depth cameras and a DXF welding map, in simulation."""
+    configure(quiet=quiet, verbose=verbose, log_file=log_file)
+
+
+def main() -> None:
+    """Console-script entry point: a usage error is one ``error:`` line (exit 2), Ctrl-C exits 130."""
+    try:
+        code = app(standalone_mode=False)
+    except click.exceptions.UsageError as e:
+        if e.ctx is not None:
+            err.print(f"Try '{e.ctx.command_path} -h' for help.", markup=False, highlight=False)
+        fail_line(f"error: {e.format_message()}")
+        sys.exit(EXIT_USAGE)
+    except click.exceptions.ClickException as e:
+        fail_line(f"error: {e.format_message()}")
+        sys.exit(e.exit_code)
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        fail_line(f"exit {EXIT_INTERRUPTED}: interrupted")
+        sys.exit(EXIT_INTERRUPTED)
+    sys.exit(code if isinstance(code, int) else 0)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from dxf_factory import design, make_maps, scaled
 from typer.testing import CliRunner
 
 from cell import scenario as sc
@@ -107,3 +108,29 @@ def test_cell_scenario_check_reports_problems(tmp_path: Path) -> None:
     typo.write_text(text.replace("seed: 1", "sede: 1"))
     result = runner.invoke(app, ["scenario", "check", str(typo)])
     assert result.exit_code == 10 and "did you mean 'seed'" in result.stderr
+
+
+def test_a_map_without_units_drawn_off_its_origin(tmp_path: Path) -> None:
+    """A drawing in cm with no $INSUNITS, its parts far from its origin: --units is needed and kept in the file;
+    the part still lands centred at (0.15, 0.0) on the table top."""
+    parts, seams = design("fence2")
+    parts, seams = scaled(parts, seams, 0.1)  # mm -> cm
+    shift = np.array([50.0, -30.0, 10.0])  # [cm]
+
+    def moved(p: tuple[float, float, float]) -> tuple[float, float, float]:
+        x, y, z = np.asarray(p) + shift
+        return (float(x), float(y), float(z))
+
+    parts = {n: (moved(lo), moved(hi)) for n, (lo, hi) in parts.items()}
+    seams = [(i, moved(p), moved(q)) for i, p, q in seams]
+    dxf = make_maps.write_map(tmp_path / "mine.dxf", parts, seams, units=None)
+    out = tmp_path / "mine.yaml"
+    result = runner.invoke(app, ["init", str(dxf), "--out", str(out)])
+    assert result.exit_code == 12, result.stderr  # no known units
+    assert not out.exists()
+    result = runner.invoke(app, ["init", str(dxf), "--out", str(out), "--units", "cm"])
+    assert result.exit_code == 0, result.stderr
+    s = sc.load(out)
+    assert s.map.file == "mine.dxf" and s.map.units == "cm"
+    assert s.map.X_WM.xyz_m == pytest.approx((-0.65 - 0.5, -0.36 + 0.3, 0.9 - 0.1))
+    assert check_layout(s, read_map(s.map_path, units="cm")) == []

@@ -80,20 +80,25 @@ def weld_row(name: str) -> Row:
         run = pipeline.weld(sc.load(name))
     except CellError as e:  # the CLI prints the message and exits with the error's code; no report
         return {"scenario": name, "exit_code": e.exit_code, "error": {"type": type(e).__name__, "message": e.message}}
-    rep = weld_report(run)
+    return report_row(weld_report(run), exit_code(run))
+
+
+def report_row(rep: Row, code: int) -> Row:
+    """The row of one ``cell weld`` report ``rep`` (its JSON as a dict) whose command exited with ``code``."""
     seams = [_seam_row(s) for s in rep["seams"]]
     rescan = rep["rescan"]
     tcp_max = [s["tcp_max_mm"] for s in seams if s["welded"] and s["tcp_max_mm"] is not None]
     return {
-        "scenario": name,
+        "scenario": rep["scenario"],
         "method": rep["method"],
         "noise": rep["noise"],
-        "exit_code": exit_code(run),
+        "exit_code": code,
         "seams_in_map": rep["summary"]["seams"],
         "visible": rep["summary"]["visible"],
         "found": rep["summary"]["found"],
         "welded": rep["welded"],
         "status_counts": dict(Counter(s["status"] for s in seams)),
+        "weld_reason_counts": dict(Counter(s["weld_reason_code"] for s in seams if not s["welded"])),
         "tcp_max_mm": max(tcp_max) if tcp_max else None,
         "cycle_time_s": rep["cycle_time_s"],
         "arc_time_s": rep["arc_time_s"],
@@ -124,10 +129,14 @@ def rescan_row(name: str) -> Row:
         if det.error is not None:
             raise det.error
         rs, after = pipeline.rescan_detection(station, det, "all")
-    rep = rescan_report(det, after, rs)
+    return rescan_report_row(rescan_report(det, after, rs))
+
+
+def rescan_report_row(rep: Row) -> Row:
+    """The row of one ``cell rescan`` report ``rep`` (its JSON as a dict)."""
     b, a = rep["summary_before_rescan"], rep["summary"]
     return {
-        "scenario": name,
+        "scenario": rep["scenario"],
         "method": rep["method"],
         "noise": rep["noise"],
         "seams": rep["rescan"]["seams"],
@@ -159,7 +168,8 @@ def main(argv: list[str] | None = None) -> int:
     names = [n.strip() for n in args.scenarios.split(",") if n.strip()] if args.scenarios else default()
     rows = [make(n) for n in names]
     for r in rows:
-        brief = {k: r.get(k) for k in ("scenario", "exit_code", "welded", "visible", "seams", "used", "motion_s")}
+        keys = ("scenario", "exit_code", "welded", "visible", "used", "motion_s", "tcp_max_mm", "cycle_time_s")
+        brief = {k: r.get(k) for k in keys}
         print(" ".join(f"{k}={v}" for k, v in brief.items() if v is not None))
     print(f"wrote {write_json(args.json or RESULTS / filename, rows)}")
     return 0

@@ -10,7 +10,11 @@ Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->``
 - ``table1``: Table 1 with realistic noise and exact calibration (``latest.json``, the ``exact`` rows);
 - ``table1-noise-none``: the same with noise-free depth (``noise-none.json``);
 - ``calibration``: our locator under calibration error (``latest.json``, ``ours``, every other extrinsics row);
-- ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``).
+- ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``);
+- ``rescan``, ``confidence``, ``weld``, ``motion``, ``faults``: the tables of the cell's own commands
+  (``rescan.json``, ``weld.json``, ``faults.json`` by ``benchmarks/bench_cell.py``; ``confidence.json`` by
+  ``benchmarks/bench_confidence.py``; ``motion.json`` by ``benchmarks/bench_motion.py``), rendered by
+  ``tools/readme_cell_tables.py``.
 
 The Table 1 blocks are :func:`cell.bench.markdown_table` of the rows, the renderer that also writes
 ``benchmarks/results/*.md``; the scaling block is the README's one-line-per-scenario summary of
@@ -28,10 +32,14 @@ from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parent.parent
-if str(REPO) not in sys.path:  # run as a script from anywhere: the package is the repository's
-    sys.path.insert(0, str(REPO))
+TOOLS = Path(__file__).resolve().parent
+for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the repository's, and tools/ its own
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
 
-from cell.bench import markdown_table  # noqa: E402  (after the path set-up above)
+import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
+
+from cell.bench import markdown_table  # noqa: E402
 
 README = REPO / "README.md"
 RESULTS = REPO / "benchmarks" / "results"
@@ -49,6 +57,13 @@ def _load(results: Path, name: str) -> Rows:
     data = json.loads((results / name).read_text(encoding="utf-8"))
     if not isinstance(data, list):
         raise ValueError(f"{results / name}: expected a JSON list of rows, got {type(data).__name__}")
+    return data
+
+
+def _load_object(results: Path, name: str) -> dict[str, Any]:
+    data = json.loads((results / name).read_text(encoding="utf-8"))
+    if not isinstance(data, dict):
+        raise ValueError(f"{results / name}: expected a JSON object, got {type(data).__name__}")
     return data
 
 
@@ -95,11 +110,21 @@ def scaling(results: Path) -> str:
     return scaling_table(_load(results, "scaling.json"))
 
 
+def weld(results: Path) -> str:
+    """Welding fence1: the first run of ``weld.json``, per seam, and its cycle-time line."""
+    return cell_tables.weld_table(_load(results, "weld.json")[0])
+
+
 BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "table1": table1,
     "table1-noise-none": table1_noise_none,
     "calibration": calibration,
+    "rescan": lambda results: cell_tables.rescan_table(_load(results, "rescan.json")),
+    "confidence": lambda results: cell_tables.confidence_table(_load_object(results, "confidence.json")),
+    "weld": weld,
+    "motion": lambda results: cell_tables.motion_table(_load_object(results, "motion.json")),
     "scaling": scaling,
+    "faults": lambda results: cell_tables.faults_table(_load(results, "faults.json")),
 }
 
 

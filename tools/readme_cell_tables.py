@@ -1,0 +1,225 @@
+"""The README's tables of the cell's own commands, rendered from ``benchmarks/results/`` (used by
+``tools/readme_results.py``, which puts them between the README's markers).
+
+- ``rescan``: the close-up re-scan, before -> after (``rescan.json``, ``benchmarks/bench_cell.py rescan``);
+- ``confidence``: the confidence thresholds (``confidence.json``, ``benchmarks/bench_confidence.py``);
+- ``weld``: welding fence1, per seam, and the cycle-time line under it (``weld.json``, ``bench_cell.py weld``);
+- ``motion``: the motion primitives (``motion.json``, ``benchmarks/bench_motion.py``);
+- ``faults``: every fault scenario (``faults.json``, ``bench_cell.py faults``).
+
+Every figure comes from the JSON. What the JSON cannot hold is written here by hand, kept apart in the mappings
+below: how the README names a scenario (the fault each one injects) and a short note where the README says more
+than the data can (the "what the cell does" column is otherwise one sentence template per kind of outcome).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+Row = Mapping[str, Any]
+
+# ---- written by hand: what the results cannot say ---------------------------------------------------------------
+
+# The re-scan table's scenario column, where the README says what the scenario is.
+RESCAN_LABELS: Mapping[str, str] = {
+    "faults/extrinsics-off": "faults/extrinsics-off (every camera, the arm's included, off by 1 mm / 0.1 deg)",
+}
+# The fault table's rows, in the README's order: the scenario and the fault it injects.
+FAULT_LABELS: Mapping[str, str] = {
+    "faults/camera-dead": "camera-dead (cam_left)",
+    "faults/camera-frozen": "camera-frozen (cam_left)",
+    "faults/two-cameras-dead": "two-cameras-dead (both fixed cameras)",
+    "faults/camera-random": "camera-random (cam_right)",
+    "faults/camera-salt": "camera-salt (eye-in-hand, 40 % salt)",
+    "faults/camera-bumped": "camera-bumped (cam_right 15 mm / 1.5 deg)",
+    "faults/extrinsics-off": "extrinsics-off (every camera 1 mm / 0.1 deg)",
+    "faults/extrinsics-fixed-off": "extrinsics-fixed-off (fixed cameras 1 mm / 0.1 deg)",
+    "faults/occluded": "occluded (a clamp and a cable)",
+    "faults/missing-part": "missing-part (POST_R not built)",
+    "faults/displaced": "displaced (60 mm / 4 deg)",
+    "faults/displaced-far": "displaced-far (120 mm)",
+    "faults/ladder-shifted": "ladder-shifted (one rung pitch)",
+}
+# A note after the generated sentence, where the README says what the figures mean.
+FAULT_NOTES: Mapping[str, str] = {
+    "faults/two-cameras-dead": "the eye-in-hand camera carries the cell",
+    "faults/camera-salt": "the eye-in-hand camera, dropped from the scan, still serves up close",
+    "faults/displaced": "the alignment re-finds the part",
+}
+# The motion table's rows: the case's key in motion.json, the README's name for it, whether it shows the goal.
+MOTION_ROWS: Sequence[tuple[str, str, bool]] = (
+    ("ik_warm", "IK, warm-started along seams, full pose", True),
+    ("ik_warm_free_axis", "IK, warm-started, torch axis free", True),
+    ("ik_cold", "IK, cold from home with seeded restarts", False),
+    ("ptp_duration", "Ruckig jerk-limited PTP: solve (with limit checks)", True),
+    ("ptp_sampled", "Ruckig PTP solve + sampling at 4 ms", False),
+)
+
+# ---- sentence templates: a short phrase per reason code or kind of outcome ----------------------------------------
+
+# Why a seam was not welded, by its detection's reason code, then by its weld reason code.
+WHY_NOT: Mapping[str, str] = {
+    "underside": "against the table (flip)",
+    "low_confidence": "`low_confidence`",
+    "not_planned": "not planned",
+}
+# What a refusal refuses, by the error's type.
+REFUSES: Mapping[str, str] = {"AlignmentError": "refuses the alignment", "SensorError": "refuses the images"}
+
+
+def _f(v: float | None, nd: int) -> str:
+    return "-" if v is None else f"{v:.{nd}f}"
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}" if n == 1 else f"{n} {word}s"
+
+
+def rescan_table(rows: Sequence[Row]) -> str:
+    """Per scenario: mean lateral and end point error before -> after [mm], robot time [s]."""
+    lines = [
+        "| scenario | mean lateral before -> after [mm] | mean endpoint before -> after [mm] | robot time [s] |",
+        "|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {RESCAN_LABELS.get(r['scenario'], r['scenario'])} | "
+            f"{_f(r['lateral_mean_mm_before'], 3)} -> {_f(r['lateral_mean_mm_after'], 3)} | "
+            f"{_f(r['endpoint_mean_mm_before'], 3)} -> {_f(r['endpoint_mean_mm_after'], 3)} | {_f(r['motion_s'], 1)} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def confidence_table(data: Row) -> str:
+    """Per threshold: seams below it, seams over ``big_mm`` among them, the largest lateral error above it."""
+    lines = [
+        f"| threshold | seams below (re-scanned) | of the {data['big']} over {data['big_mm']} mm caught | "
+        "max lateral above it [mm] |",
+        "|---|---|---|---|",
+    ]
+    for t in data["thresholds"]:
+        lines.append(f"| {t['threshold']:.2f} | {t['below']} | {t['caught']} | {_f(t['max_lateral_above_mm'], 3)} |")
+    return "\n".join(lines) + "\n"
+
+
+def _why_not(s: Row) -> str:
+    for code in (s.get("reason_code"), s.get("weld_reason_code")):
+        if isinstance(code, str) and code in WHY_NOT:
+            return WHY_NOT[code]
+    return str(s.get("weld_reason") or "not welded")
+
+
+def _cycle_line(r: Row) -> str:
+    t, rs = r["timings_s"], r["rescan"]
+    if rs and rs["seams"]:
+        rescan = f"close-up re-scan of {_plural(rs['seams'], 'seam')} {_f(rs['motion_s'], 1)} s"
+    else:
+        rescan = "no close-up re-scan"
+    return (
+        f"Cycle time {_f(r['cycle_time_s'], 1)} s of robot motion (arc {_f(r['arc_time_s'], 1)} s, {rescan}); "
+        f"wall time {_f(t.get('total_s'), 1)} s headless (capture {_f(t.get('capture_s'), 1)}, perceive "
+        f"{_f(t.get('perceive_s'), 1)}, align {_f(t.get('align_s'), 1)}, locate {_f(t.get('locate_s'), 2)}, re-scan "
+        f"{_f(t.get('rescan_s', 0.0), 1)}, plan and safety gate {_f(t.get('plan_s'), 1)}, execute "
+        f"{_f(t.get('execute_s'), 2)} s)."
+    )
+
+
+def weld_table(r: Row) -> str:
+    """One line per seam of a ``cell weld`` run, then its cycle-time line."""
+    lines = [
+        "| seam | located: paper ME / lateral [mm] | welded | executed TCP vs true seam: RMS / max [mm] | "
+        "travel speed [mm/s] | weld time [s] |",
+        "|---|---|---|---|---|---|",
+    ]
+    for s in r["seams"]:
+        located = f"{_f(s['paper_me_mm'], 3)} / {_f(s['lateral_mm'], 3)}" if s["paper_me_mm"] is not None else "-"
+        if s["welded"]:
+            lines.append(
+                f"| {s['id']} | {located} | yes | {_f(s['tcp_rms_mm'], 3)} / {_f(s['tcp_max_mm'], 3)} | "
+                f"{_f(s['travel_speed_mm_s'], 4)} | {_f(s['weld_time_s'], 3)} |"
+            )
+        else:
+            lines.append(f"| {s['id']} | {located} | no: {_why_not(s)} | - | - | - |")
+    return "\n".join(lines) + "\n\n" + _cycle_line(r) + "\n"
+
+
+def _time(us: float) -> str:
+    """A call's time as the README writes it: whole microseconds below 0.5 ms, else milliseconds, 3 digits."""
+    return f"{us:.0f} us" if us < 500.0 else f"{us / 1000.0:.3g} ms"
+
+
+def motion_table(data: Row) -> str:
+    """The motion primitives' median and 90th percentile (and goal), the fence1 plan, the cycle times."""
+    by_key = {p["key"]: p for p in data["primitives"]}
+    lines = ["| case | median | p90 | goal |", "|---|---|---|---|"]
+    for key, label, show_goal in MOTION_ROWS:
+        p = by_key[key]
+        goal = f" {_time(p['goal_us'])} " if show_goal and "goal_us" in p else " "
+        lines.append(f"| {label} | {_time(p['median_us'])} | {_time(p['p90_us'])} |{goal}|")
+    plans = data["plans"]
+    first = plans[0]
+    lines.append(
+        f"| welding plan of {first['scenario']} (designed seams): {first['planned']}/{first['seams']} planned | "
+        f"{first['planning_s']:.1f} s | | |"
+    )
+    names = " / ".join(p["scenario"] for p in plans)
+    cycles = " / ".join(f"{p['cycle_s']:.1f} s ({p['arc_s']:.1f} s)" for p in plans)
+    lines.append(f"| cycle time {names} (arc time) | {cycles} | | |")
+    return "\n".join(lines) + "\n"
+
+
+def fault_sentence(r: Row) -> str:
+    """What the cell does in a fault scenario, from the facts of its row (one template per kind of outcome)."""
+    parts: list[str] = []
+    counts = r.get("status_counts", {})
+    err = r.get("error")
+    if err is not None:
+        refusal = f'{REFUSES.get(err["type"], "stops")} ("{err["message"]}")'
+        if r.get("found", 0) == 0 and counts.get("not_found", 0) == r.get("visible"):
+            refusal += ", every seam `not_found` with that reason"
+        parts.append(refusal)
+    if r.get("lost_cameras"):
+        parts.append("drops " + _lost(r["lost_cameras"]))
+    for status, key in (("occluded", "occluded_reasons"), ("not_found", "not_found_reasons")):
+        n, reasons = counts.get(status, 0), r.get(key, [])
+        if n and err is None:
+            why = f' ("{reasons[0]}")' if len(reasons) == 1 else " with the reason"
+            parts.append(f"{_plural(n, 'seam')} `{status}`{why}, never welded")
+    rs = r.get("rescan")
+    if rs and rs["seams"]:
+        used = f"{rs['used']} used" if rs["used"] else "none used"
+        if rs["escalated_mm"]:
+            parts.append(f"a close-up disagrees by {rs['escalated_mm']:.2f} mm: re-scans every seam up close ({used})")
+        else:
+            parts.append(f"re-scans {_plural(rs['seams'], 'seam')} up close ({used})")
+    low = r.get("weld_reason_counts", {}).get("low_confidence", 0)
+    if low:
+        parts.append(f"{_plural(low, 'seam')} `low_confidence`, not welded")
+    if not parts:
+        parts.append("welds every visible seam")
+    note = FAULT_NOTES.get(r["scenario"])
+    return "; ".join([*parts, note] if note else parts)
+
+
+def _lost(described: Sequence[str]) -> str:
+    """``"name: reason"`` of each lost camera as ``name ("reason")``, cameras with the same reason together."""
+    by_reason: dict[str, list[str]] = {}
+    for d in described:
+        name, _, why = d.partition(": ")
+        by_reason.setdefault(why, []).append(name)
+    return ", ".join(" and ".join(names) + (f' ("{why}")' if why else "") for why, names in by_reason.items())
+
+
+def faults_table(rows: Sequence[Row]) -> str:
+    """One line per fault scenario (the README's order first): what the cell does, welded, worst TCP error, exit."""
+    order = {name: k for k, name in enumerate(FAULT_LABELS)}
+    lines = [
+        "| scenario (`scenarios/faults/`) | what the cell does | welded | worst executed TCP error [mm] | exit |",
+        "|---|---|---|---|---|",
+    ]
+    for r in sorted(rows, key=lambda r: (order.get(r["scenario"], len(order)), r["scenario"])):
+        label = FAULT_LABELS.get(r["scenario"], r["scenario"].removeprefix("faults/"))
+        welded = f"{r['welded']}/{r['visible']}" if "welded" in r else "-"
+        lines.append(f"| {label} | {fault_sentence(r)} | {welded} | {_f(r.get('tcp_max_mm'), 2)} | {r['exit_code']} |")
+    return "\n".join(lines) + "\n"

@@ -112,8 +112,10 @@ def resolve(name_or_path: str | Path) -> Path:
     candidate = SCENARIO_DIR / f"{name_or_path}.yaml"
     if candidate.is_file():
         return candidate
-    known = ", ".join(available())
-    raise ScenarioError(f"no scenario named {str(name_or_path)!r}; available: {known}")
+    names = available()
+    close = difflib.get_close_matches(str(name_or_path), names, n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise ScenarioError(f"no scenario named {str(name_or_path)!r}{hint}; available: {', '.join(names)}")
 
 
 def available() -> list[str]:

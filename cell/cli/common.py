@@ -35,6 +35,7 @@ app.add_typer(map_app, name="map")
 err = Console(stderr=True, highlight=False)
 out = Console(highlight=False)
 log = logging.getLogger("cell")
+log.addHandler(logging.NullHandler())  # the console lines are printed here; only --log-file adds a handler
 
 NoiseOpt = Annotated[str | None, typer.Option("--noise", help="Override the scenario's noise model: none | realistic.")]
 FormatOpt = Annotated[str, typer.Option("--format", help="How the result table is printed: table | json | csv.")]

@@ -2,14 +2,34 @@
 
 from __future__ import annotations
 
+import datetime as dt
+from functools import partial
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
-from cell.cli.common import NoiseOpt, app, cell_errors, check_method, err, map_app, out, parse_noise, progress
+from cell.cli.common import (
+    FormatOpt,
+    NoiseOpt,
+    app,
+    cell_errors,
+    check_method,
+    detail,
+    fail_line,
+    map_app,
+    out,
+    parse_format,
+    parse_noise,
+    progress,
+    say,
+)
+from cell.cli.explain import detection_exit
+from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
 from cell.cli.tables import print_detection
-from cell.errors import EXIT_PARTIAL
+from cell.errors import EXIT_INTERRUPTED, UsageError
+
+BENCH_SAVED = Path("benchmarks/results/latest.json")  # what --save writes (the README's Table 1 is made from it)
 
 
 @app.command()
@@ -20,7 +40,7 @@ def scenarios() -> None:
     with cell_errors():
         for name in sc.available():
             s = sc.load(name)
-            out.print(f"{name:28s} {s.description}")
+            out.print(f"{name:28s} {s.description}", soft_wrap=True)
 
 
 @map_app.command("info")
@@ -29,9 +49,11 @@ def map_info(
     units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
 ) -> None:
     """Print the units, parts and seams of a DXF welding map."""
-    from cell.weldmap import describe, read_map
+    from cell.weldmap import METRES_PER_UNIT, describe, read_map
 
     with cell_errors():
+        if units is not None and units not in METRES_PER_UNIT:
+            raise UsageError(f"--units {units!r}; valid: {', '.join(METRES_PER_UNIT)}")
         out.print(describe(read_map(path, units=units)), soft_wrap=True)
 
 
@@ -42,32 +64,61 @@ def detect(
         str | None, typer.Option(help="Seam locator: paper, ransac or ours (default: the scenario's).")
     ] = None,
     noise: NoiseOpt = None,
-    json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Write the JSON report here ('-': stdout, the table to stderr).")
+    ] = None,
     save_cloud: Annotated[Path | None, typer.Option(help="Write the spliced cloud (robot frame) as PLY.")] = None,
+    fmt: FormatOpt = "table",
 ) -> None:
     """Capture the cell, splice the clouds, align the map and locate every seam; report errors against truth."""
     from cell import pipeline
     from cell import scenario as sc
-    from cell.export.report import detection_report, write_json
+    from cell.export.report import detection_report
+    from cell.provenance import provenance
 
     with cell_errors():
+        table = parse_format(fmt)
+        check_file(json_path, "--json")
+        check_file(save_cloud, "--save-cloud", stdout_ok=False)
         scn = sc.load(scenario)
         check_method(method)
-        det = pipeline.detect(scn, method, noise=parse_noise(noise), progress=progress())
-        if json_path is not None:
-            write_json(json_path, detection_report(det))
-            err.print(f"[dim]· report written to {json_path}[/]")
-        if save_cloud is not None and det.scene is not None:
-            from cell.perception import save_ply
-
-            save_ply(det.scene.perceived.dense, save_cloud)
-            err.print(f"[dim]· spliced cloud written to {save_cloud}[/]")
-        print_detection(det)
+        scn = scn.with_noise(n) if (n := parse_noise(noise)) else scn
+        prov = provenance(scn, scenario_file=sc.resolve(scenario))
+        detail(f"scenario {prov['scenario_file']} (sha256 {prov['scenario_sha256']}), map {prov['map_file']}")
+        stage, writer = Stage(), Writer()
+        det: pipeline.Detection | None = None
+        try:
+            det = pipeline.detect(scn, method, progress=stage)
+            rep = detection_report(det, provenance=prov)
+            writer.report(json_path, rep)
+            if save_cloud is not None and det.scene is not None:
+                cloud = det.scene.perceived.dense
+                if writer.attempt(lambda: _save_cloud(cloud, save_cloud)) is not None:
+                    say(f"spliced cloud written to {save_cloud}")
+            print_detection(rep, table)
+        except KeyboardInterrupt:
+            done = detection_report(det, provenance=prov) if det is not None else None
+            on_interrupt(writer, json_path, done or interrupted_report(scn, method, stage.last, prov), stage.last)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
     if det.error is not None:  # the report says which seams and why: partial, with the cause in report.error
-        err.print(f"[bold red]error[/]: {det.error.message}", soft_wrap=True)
-        raise typer.Exit(EXIT_PARTIAL)
-    if not det.complete:
-        raise typer.Exit(EXIT_PARTIAL)
+        fail_line(f"error: {det.error.message}")
+    finish(writer, None if det.complete and det.error is None else detection_exit(rep))
+
+
+def _save_cloud(cloud: Any, path: Path) -> Path:
+    from cell.perception import save_ply
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_ply(cloud, path)
+    return path
+
+
+def bench_folder(out_dir: Path | None, now: dt.datetime | None = None) -> Path:
+    """Where ``cell bench`` writes: ``--out DIR``, else ``runs/bench-<UTC time>/`` (untracked: .gitignore)."""
+    if out_dir is not None:
+        return out_dir
+    stamp = (now or dt.datetime.now(dt.UTC)).astimezone(dt.UTC).strftime("%Y%m%dT%H%M%SZ")
+    return Path("runs") / f"bench-{stamp}"
 
 
 @app.command()
@@ -83,14 +134,25 @@ def bench(
         str, typer.Option(help="Comma-separated calibration errors of the fixed cameras: exact or MM/DEG.")
     ] = "exact",
     repeat: Annotated[int, typer.Option(min=1, help="Runs per locator (each seam's fastest).")] = 1,
-    json_path: Annotated[Path, typer.Option("--json", help="Where to write the rows.")] = Path(
-        "benchmarks/results/latest.json"
-    ),
+    out_dir: Annotated[
+        Path | None, typer.Option("--out", help="Run folder for the rows (default: runs/bench-<UTC time>/).")
+    ] = None,
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Also write the rows (and their .md table) to this file.")
+    ] = None,
+    save: Annotated[
+        bool, typer.Option("--save", help=f"Also write the rows to {BENCH_SAVED} (the README's Table 1 source).")
+    ] = False,
 ) -> None:
-    """Table 1 of the paper, reproduced and extended: every locator on the same clouds in one run."""
+    """Table 1 of the paper, reproduced and extended: every locator on the same clouds in one run.
+
+    Writes bench.json, bench.md and provenance.json into a run folder; tracked files only with --save or --json.
+    """
     from cell import bench as b
     from cell import scenario as sc
+    from cell.export.atomic import write_atomic
     from cell.export.report import write_json
+    from cell.provenance import provenance
     from cell.seams.registry import METHODS
 
     with cell_errors():
@@ -103,16 +165,30 @@ def bench(
             exts = [b.Extrinsics.parse(e.strip()) for e in extrinsics.split(",")]
         except ValueError as e:
             raise typer.BadParameter(str(e), param_hint="--extrinsics") from None
-        rows = b.run(
-            [sc.load(n) for n in names],
-            wanted,
-            noise=parse_noise(noise),
-            extrinsics=exts,
-            repeat=repeat,
-            progress=progress(),
-        )
-        write_json(json_path, rows)
+        folder = bench_folder(out_dir)
+        check_folder(folder, "--out")
+        check_file(json_path, "--json", stdout_ok=False)
+        loaded = [sc.load(n) for n in names]
+        prov: dict[str, Any] = provenance(None)
+        prov["scenarios"] = [
+            {k: v for k, v in provenance(s, scenario_file=sc.resolve(n)).items() if k in _PER_SCENARIO} | {"name": n}
+            for n, s in zip(names, loaded, strict=True)
+        ]
+        rows = b.run(loaded, wanted, noise=parse_noise(noise), extrinsics=exts, repeat=repeat, progress=progress())
         md = b.markdown_table(rows)
-        json_path.with_suffix(".md").write_text(md, encoding="utf-8")
+        made_by = f"<!-- made by cell {prov['version']}, commit {prov['commit']}, {prov['timestamp_utc']}: "
+        made_by += f"{prov['command']} -->\n"
+        writer = Writer()
+        targets = [folder / "bench.json"] + [p for p in (json_path, BENCH_SAVED if save else None) if p is not None]
+        for target in targets:
+            if writer.attempt(partial(write_json, target, rows)) is not None:
+                md_path = target.with_suffix(".md")
+                text = (made_by + md) if target.parent == folder else md
+                writer.attempt(partial(write_atomic, md_path, text.encode("utf-8"), what="table"))
+                say(f"rows written to {target} and {md_path}")
+        writer.attempt(lambda: write_json(folder / "provenance.json", prov))
         out.print(md, soft_wrap=True)
-        err.print(f"[dim]· rows written to {json_path} and {json_path.with_suffix('.md')}[/]")
+    finish(writer, None)
+
+
+_PER_SCENARIO = ("seed", "scenario_file", "scenario_sha256", "map_file", "map_sha256")

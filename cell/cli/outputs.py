@@ -16,8 +16,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
+import typer
+
 from cell.cli.common import detail, fail_line, results_to_stderr, say
-from cell.errors import EXIT_INTERRUPTED, OutputError
+from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, OutputError
 
 if TYPE_CHECKING:
     from cell.scenario import Scenario
@@ -159,3 +161,16 @@ def on_interrupt(writer: Writer, path: Path | None, report: Mapping[str, Any], w
         f"exit {EXIT_INTERRUPTED}: interrupted (Ctrl-C) during: {what}"
         + (f"; partial report in {path}" if path is not None and str(path) != STDOUT and not writer.failures else "")
     )
+
+
+def finish(writer: Writer, partial: str | None) -> None:
+    """End a command: the partial run's explanation, then any lost output's (exit 2 wins: an output is gone);
+    exit 3 when only partial; return when everything asked for was done."""
+    if partial is not None:
+        fail_line(partial)
+    lost = writer.explanation()
+    if lost is not None:
+        fail_line(lost)
+        raise typer.Exit(EXIT_USAGE)
+    if partial is not None:
+        raise typer.Exit(EXIT_PARTIAL)

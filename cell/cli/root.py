@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 from typing import Annotated
 
-import click
 import typer
 
 from cell.cli.common import app, configure, err, fail_line
@@ -42,15 +41,16 @@ def main() -> None:
     """Console-script entry point: a usage error is one ``error:`` line (exit 2), Ctrl-C exits 130."""
     try:
         code = app(standalone_mode=False)
-    except click.exceptions.UsageError as e:
-        if e.ctx is not None:
-            err.print(f"Try '{e.ctx.command_path} -h' for help.", markup=False, highlight=False)
-        fail_line(f"error: {e.format_message()}")
-        sys.exit(EXIT_USAGE)
-    except click.exceptions.ClickException as e:
-        fail_line(f"error: {e.format_message()}")
-        sys.exit(e.exit_code)
-    except (click.exceptions.Abort, KeyboardInterrupt):
+    except typer.Abort:
+        fail_line(f"exit {EXIT_INTERRUPTED}: interrupted")
+        sys.exit(EXIT_INTERRUPTED)
+    except typer.TyperException as e:  # typer's click: a usage error (no such option, bad value) or another
+        ctx = getattr(e, "ctx", None)
+        if ctx is not None:
+            err.print(f"Try '{ctx.command_path} -h' for help.", markup=False, highlight=False)
+        fail_line(f"error: {e.format_message() if hasattr(e, 'format_message') else e}")
+        sys.exit(int(getattr(e, "exit_code", EXIT_USAGE)))
+    except KeyboardInterrupt:
         fail_line(f"exit {EXIT_INTERRUPTED}: interrupted")
         sys.exit(EXIT_INTERRUPTED)
     sys.exit(code if isinstance(code, int) else 0)

@@ -40,7 +40,8 @@ def print_rescan(rep: dict) -> None:
         f"{rep['rescan']['seams']} seams re-scanned ({rep['rescan']['used']} used) · mean lateral"
         f" {_fmt(b['lateral_mean_mm'], 3)} -> {_fmt(a['lateral_mean_mm'], 3)} mm · mean endpoint"
         f" {_fmt(b['endpoint_mean_mm'], 3)} -> {_fmt(a['endpoint_mean_mm'], 3)} mm · robot time"
-        f" {_fmt(rep['rescan']['motion_s'], 1)} s"
+        f" {_fmt(rep['rescan']['motion_s'], 1)} s",
+        soft_wrap=True,
     )
 
 
@@ -112,7 +113,8 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
     out.print(
         f"welded {rep['welded']}/{m['visible']} visible seams ({m['seams']} in the map) · located {m['found']} · "
         f"paper ME mean {_fmt(m['paper_me_mean_mm'])} mm · cycle time {_fmt(cyc, 1)} s"
-        + ("" if rep["cycle_time_s"] else " (planned)")
+        + ("" if rep["cycle_time_s"] else " (planned)"),
+        soft_wrap=True,
     )
     print_timings(rep)
 
@@ -120,7 +122,10 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
 def print_timings(rep: dict) -> None:
     """The stage times of a report, one line."""
     tim = rep["timings_s"]
-    out.print("time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None))
+    out.print(
+        "time: " + " · ".join(f"{k.removesuffix('_s')} {v:.2f} s" for k, v in tim.items() if v is not None),
+        soft_wrap=True,
+    )
 
 
 def _fmt(v: float | None, nd: int = 2) -> str:
@@ -161,6 +166,7 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
         f"found {m['found']}/{m['visible']} visible ({m['seams']} seams) · paper ME mean"
         f" {_fmt(m['paper_me_mean_mm'])} mm (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint"
         f" {_fmt(m['endpoint_mean_mm'])} mm · lateral"
-        f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)"
+        f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)",
+        soft_wrap=True,
     )
     print_timings(rep)

@@ -7,13 +7,18 @@ importing this package costs nothing.
 - :mod:`cell.preview.views`: what is drawn (colours, seams as lines, thinned cloud, box edges, torch glyphs).
 - :mod:`cell.preview.figures`: the overview PNGs (top view, perspective, one close-up per seam).
 - :mod:`cell.preview.joint_plots`: the joint plot PNG (positions and velocities against the limits).
-- :mod:`cell.preview.html`: the interactive 3D view (plotly, one self-contained HTML file).
+- :mod:`cell.preview.html`: the interactive 3D view (plotly): cloud, map, seams, and with the run's
+  :class:`~cell.types.CellView` the table, the robot (:mod:`cell.preview.solids`, :mod:`cell.preview.cell3d`) and
+  the cameras, framed to the part.
+- :mod:`cell.preview.results`: the results table (one row per seam).
+- :mod:`cell.preview.page`: :func:`write_page`, one self-contained HTML page of a run (results, 3D, joints).
 - :mod:`cell.preview.run`: :func:`write_run`, every picture of a ``cell weld`` / ``cell preview`` run.
 """
 
 from cell.preview.figures import render_overview
 from cell.preview.html import render_html
 from cell.preview.joint_plots import render_joint_plots
+from cell.preview.page import write_page
 from cell.preview.run import write_run
 from cell.preview.views import (
     ARC_COLOUR,
@@ -40,5 +45,6 @@ __all__ = [
     "render_joint_plots",
     "render_overview",
     "seam_views",
+    "write_page",
     "write_run",
 ]

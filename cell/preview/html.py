@@ -1,6 +1,6 @@
-"""The interactive 3D view of a run (plotly): one self-contained HTML file, plotly.js inline.
+"""The interactive 3D view of a run (plotly): the figure, or one self-contained HTML file, plotly.js inline.
 
-plotly is imported inside :func:`render_html`, so importing this module costs nothing. Input in the robot frame
+plotly is imported inside the functions, so importing this module costs nothing. Input in the robot frame
 R [m], drawn in millimetres.
 """
 
@@ -14,6 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
+from cell.preview.cell3d import cell_traces, framed_scene, path_slider, view_bounds
 from cell.preview.views import (
     AXIS_COLOURS,
     BOX_COLOUR,
@@ -26,7 +27,7 @@ from cell.preview.views import (
     thin,
     torch_glyphs,
 )
-from cell.types import WeldMap
+from cell.types import CellView, WeldMap
 
 
 def _segments_trace(segs: FloatArray) -> tuple[list[float | None], list[float | None], list[float | None]]:
@@ -41,20 +42,22 @@ def _segments_trace(segs: FloatArray) -> tuple[list[float | None], list[float | 
     return xs, ys, zs
 
 
-def render_html(
+def figure_3d(
     cloud_R: npt.ArrayLike,
     weldmap_R: WeldMap,
     seams: Sequence[SeamView | tuple[Any, ...]],
     torch_poses: Mapping[str, npt.ArrayLike],
     tcp_paths: Mapping[str, npt.ArrayLike],
-    out_path: str | Path,
     *,
     title: str = "",
     max_points: int = 30_000,
-) -> Path:
-    """One interactive 3D view (cloud, part boxes, seams by status, true ends, torch axes, tool paths) in R [mm],
-    as a self-contained HTML file (plotly.js inline: it opens without a network). Arguments as
-    :func:`render_overview`. Returns ``out_path``."""
+    view: CellView | None = None,
+    hover: Mapping[str, str] | None = None,
+) -> Any:
+    """The interactive 3D view (a plotly ``Figure``) in R [mm]: cloud, part boxes, seams by status (hover: the
+    seam's ``hover`` text), true ends, torch axes, tool paths; with ``view`` also the table, the robot's links
+    (a slider moves them along the path) and the camera frusta, and the camera framed to the part. Arguments as
+    :func:`render_overview`."""
     import plotly.graph_objects as go
 
     cloud = thin(cloud_R, max_points) * MM
@@ -91,7 +94,9 @@ def render_html(
         x, y, z = _segments_trace(np.array([ln.pts for ln in mine]))
         text: list[str | None] = []
         for ln in mine:
-            text += [ln.id, ln.id, None]
+            tip = (hover or {}).get(ln.id, "")
+            tip = f"{ln.id}<br>{tip}" if tip else ln.id
+            text += [tip, tip, None]
         traces.append(
             go.Scatter3d(
                 x=x,
@@ -133,26 +138,67 @@ def render_html(
                     hoverinfo="skip",
                 )
             )
-    for key, tcp in tcp_paths.items():
-        p = np.asarray(tcp, dtype=float).reshape(-1, 3) * MM
-        if len(p):
-            traces.append(
-                go.Scatter3d(
-                    x=p[:, 0],
-                    y=p[:, 1],
-                    z=p[:, 2],
-                    mode="lines",
-                    name=f"tool path {key}",
-                    line={"color": PATH_COLOUR, "width": 3},
-                )
+    paths = [(str(key), np.asarray(tcp, dtype=float).reshape(-1, 3) * MM) for key, tcp in tcp_paths.items()]
+    paths = [(key, p) for key, p in paths if len(p)]
+    if paths:  # one trace (one legend entry), the paths apart by None breaks, each named in its hover text
+        xyz: list[list[float | None]] = [[], [], []]
+        names: list[str | None] = []
+        for key, p in paths:
+            for i in range(3):
+                xyz[i] += [*np.round(p[:, i], 1).tolist(), None]
+            names += [f"tool path {key}"] * len(p) + [None]
+        traces.append(
+            go.Scatter3d(
+                x=xyz[0],
+                y=xyz[1],
+                z=xyz[2],
+                mode="lines",
+                name="tool path",
+                text=names,
+                hoverinfo="text",
+                line={"color": PATH_COLOUR, "width": 3},
             )
-    fig = go.Figure(traces)
-    fig.update_layout(
-        title=title or "weld cell preview (robot frame R, mm)",
-        scene={"aspectmode": "data", "xaxis_title": "x_R [mm]", "yaxis_title": "y_R [mm]", "zaxis_title": "z_R [mm]"},
-        legend={"itemsizing": "constant"},
-        margin={"l": 0, "r": 0, "t": 40, "b": 0},
-    )
+        )
+    layout: dict[str, Any] = {
+        "title": {"text": title or "weld cell preview (robot frame R, mm)"},
+        "legend": {"itemsizing": "constant", "groupclick": "togglegroup"},
+        "margin": {"l": 0, "r": 0, "t": 40, "b": 0},
+        "scene": {
+            "aspectmode": "data",
+            "xaxis": {"title": {"text": "x_R [mm]"}},
+            "yaxis": {"title": {"text": "y_R [mm]"}},
+            "zaxis": {"title": {"text": "z_R [mm]"}},
+        },
+    }
+    if view is not None:
+        extra, links = cell_traces(view)
+        first_link = len(traces) + (1 if view.table is not None else 0)
+        traces += extra
+        slider = path_slider(view, links, first_link)
+        if slider is not None:
+            layout["sliders"] = [slider]
+        lo, hi = view_bounds(view)
+        drawn = np.vstack([cloud.reshape(-1, 3), lo[None], hi[None]]) if view.poses or view.table else cloud
+        part = np.vstack([p.vertices() for p in weldmap_R.parts]) * MM if weldmap_R.parts else cloud
+        layout["scene"] = framed_scene(drawn.min(axis=0), drawn.max(axis=0), part.min(axis=0), part.max(axis=0))
+    return go.Figure(traces, layout)
+
+
+def render_html(
+    cloud_R: npt.ArrayLike,
+    weldmap_R: WeldMap,
+    seams: Sequence[SeamView | tuple[Any, ...]],
+    torch_poses: Mapping[str, npt.ArrayLike],
+    tcp_paths: Mapping[str, npt.ArrayLike],
+    out_path: str | Path,
+    *,
+    title: str = "",
+    max_points: int = 30_000,
+    view: CellView | None = None,
+) -> Path:
+    """The 3D view of :func:`figure_3d` alone, as a self-contained HTML file (plotly.js inline: it opens without
+    a network). Returns ``out_path``."""
+    fig = figure_3d(cloud_R, weldmap_R, seams, torch_poses, tcp_paths, title=title, max_points=max_points, view=view)
     path = Path(out_path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.write_html(str(path), include_plotlyjs=True, full_html=True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -22,10 +23,12 @@ def render_joint_plots(
     *,
     arc_on: npt.ArrayLike | None = None,
     title: str = "",
+    bands: Sequence[tuple[float, float, str]] = (),
 ) -> Path:
     """Joint positions [deg] and velocities [deg/s] over time, one row per joint, limits shaded red.
 
     times : (n,) [s]; q : (n, dof) [rad]; qd : (n, dof) [rad/s]; arc_on : optional (n,) bool, shaded yellow.
+    bands : (start, end [s], seam id) of each weld: the seam's name is written above its band in the top row.
     Position axes fit the motion (a limit far away is named in the row title); velocity axes always show the
     limits. Returns ``out_path``.
     """
@@ -68,6 +71,10 @@ def render_joint_plots(
         for ax in (ax_q, ax_v):
             ax.grid(True, lw=0.3, alpha=0.5)
             ax.tick_params(labelsize=7)
+    for a, b, seam in bands:
+        for ax in axes[0]:
+            ax.text((a + b) / 2.0, 1.02, seam, transform=ax.get_xaxis_transform(), rotation=90, fontsize=6,
+                    ha="center", va="bottom")  # fmt: skip
     axes[-1][0].set_xlabel("time [s]")
     axes[-1][1].set_xlabel("time [s]")
     handles = [Patch(color="#d62728", alpha=0.15, label="outside the limits")]

@@ -1,0 +1,163 @@
+"""The page of a run (cell.preview.page) and the cell around the part (cell.pipeline.scene_view), on the tiny T
+joint of test_preview and the real KR 5 arc: a DOM check of the figure data the page embeds."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from page_dom import read
+from test_preview import SEAMS, WELDMAP, surface_cloud, torch_along
+
+from cell import scenario as sc
+from cell.geometry import FloatArray, make_pose
+from cell.motion.robot import RobotModel
+from cell.pipeline import Detection, WeldRun
+from cell.pipeline.scene_view import cameras_R, cell_view, urdf_shapes
+from cell.preview.html import figure_3d
+from cell.preview.page import write_page
+from cell.preview.results import results_rows
+from cell.station.arm import robot_urdf
+from cell.station.ports import Arm
+from cell.types import (
+    Box,
+    CellView,
+    MetricsSummary,
+    SeamEstimate,
+    SeamMetrics,
+    SeamOutcome,
+    SeamStatus,
+    SeamWeld,
+    ShapeKind,
+    WeldReason,
+)
+
+SCENARIO = sc.load("fence1")
+
+
+@pytest.fixture(scope="module")
+def arm() -> Arm:
+    model = RobotModel.from_urdf(robot_urdf(SCENARIO))
+    q = np.radians(np.asarray(SCENARIO.robot.home_deg, dtype=float))
+    return Arm(model, q, q)
+
+
+def test_urdf_shapes_and_camera_frusta() -> None:
+    shapes = urdf_shapes(robot_urdf(SCENARIO))
+    links = {s.link for s in shapes}
+    assert {"base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6", "torch"} <= links
+    base = next(s for s in shapes if s.link == "base_link")
+    assert base.kind is ShapeKind.BOX and np.allclose(base.size, [0.34, 0.34, 0.2]) and base.X_LS[2, 3] == 0.1
+    assert {s.kind for s in shapes} == {ShapeKind.BOX, ShapeKind.CYLINDER}
+    assert any(s.rgba[:3] == (1.0, 0.4, 0.0) for s in shapes)  # the URDF's named material "orange"
+    cams = {c.name: c for c in cameras_R(SCENARIO)}
+    assert set(cams) == set(SCENARIO.cameras)
+    for name, c in cams.items():
+        spec = SCENARIO.cameras[name]
+        f = c.frustum()
+        eye_R = np.asarray(spec.eye_m) - SCENARIO.X_WR[:3, 3]  # X_WR is a translation in fence1
+        assert np.allclose(f[0], eye_R)
+        ray_l, ray_r = f[1] - f[0], f[2] - f[0]  # top-left and top-right: the horizontal field of view
+        x = c.X_RC[:3, 0]
+        across = math.atan2(ray_r @ x, ray_r @ c.X_RC[:3, 2]) - math.atan2(ray_l @ x, ray_l @ c.X_RC[:3, 2])
+        assert math.degrees(across) == pytest.approx(spec.hfov_deg, abs=0.1)
+        assert np.mean(f[1:], axis=0) @ c.X_RC[:3, 2] - f[0] @ c.X_RC[:3, 2] == pytest.approx(c.range_m)
+
+
+def test_cell_view_poses_are_the_arms_forward_kinematics(arm: Arm) -> None:
+    view = cell_view(SCENARIO, arm, None)
+    assert view.table is not None and view.table.center[2] == pytest.approx(-0.05)  # top at the base's height
+    assert len(view.poses) == 1 and view.poses[0].label == "scan pose"
+    assert np.allclose(view.poses[0].X_RL["torch"], arm.model.fk(arm.q_scan, "torch"))
+    assert set(view.poses[0].X_RL) == set(view.links)
+
+
+def test_3d_view_draws_the_cell_and_frames_the_part(arm: Arm) -> None:
+    view = cell_view(SCENARIO, arm, None)
+    # The tiny T joint stands about a metre in front of the robot, as fence1's part does.
+    shift = make_pose(p=[0.0, 1.0, 1.0])
+    weldmap = WELDMAP.transformed(shift, "R")
+    cloud = surface_cloud(np.random.default_rng(3), 800) + shift[:3, 3]
+    fig = figure_3d(cloud, weldmap, [], {}, {}, view=view).to_dict()
+    names = [t.get("name") for t in fig["data"]]
+    assert "table" in names and "camera cam_left" in names and "camera eye_in_hand" in names
+    assert [n for n in names if str(n).startswith("robot ")] == [f"robot {link}" for link in view.links]
+    scene = fig["layout"]["scene"]
+    # plotly's camera lives in the scene box: each axis spans its aspect ratio, centred on 0 (range mid-point).
+    lo = np.array([scene[f"{a}axis"]["range"][0] for a in "xyz"])
+    hi = np.array([scene[f"{a}axis"]["range"][1] for a in "xyz"])
+    aspect = np.array([scene["aspectratio"][a] for a in "xyz"])
+
+    def to_scene(p_mm: FloatArray) -> FloatArray:
+        return np.asarray((p_mm - (lo + hi) / 2.0) / (hi - lo) * aspect)
+
+    eye = np.array([scene["camera"]["eye"][a] for a in "xyz"])
+    centre = np.array([scene["camera"]["center"][a] for a in "xyz"])
+    corners = np.vstack([p.vertices() for p in weldmap.parts]) * 1000.0
+    axis = (centre - eye) / np.linalg.norm(centre - eye)
+    for p in to_scene(corners):  # every corner of the part inside the vertical field of view (45 deg)
+        ray = (p - eye) / np.linalg.norm(p - eye)
+        assert math.degrees(math.acos(np.clip(ray @ axis, -1, 1))) < 22.5
+    # ... and the part fills a good share of it (not a speck in a view of the whole cell).
+    rays = [(p - eye) / np.linalg.norm(p - eye) for p in to_scene(corners)]
+    assert max(math.degrees(math.acos(np.clip(r @ axis, -1, 1))) for r in rays) > 10.0
+    assert np.all(to_scene(np.array(view_points(view))) >= -aspect / 2 - 1e-9)  # nothing drawn outside the axes
+
+
+def view_points(view: CellView) -> list[FloatArray]:
+    pts: list[FloatArray] = [c.frustum()[k] * 1000.0 for c in view.cameras for k in range(5)]
+    if view.table is not None:
+        pts += list(view.table.corners() * 1000.0)
+    return pts
+
+
+def tiny_run() -> WeldRun:
+    """A preview-like run of the tiny T joint: one seam found and planned, one not found, one not visible."""
+    front = SEAMS[0]
+    est = (
+        SeamEstimate("S_front", SeamStatus.FOUND, "", front.p_start, front.p_end, 0.9, sigma_m=0.00012),
+        SeamEstimate("S_back", SeamStatus.NOT_FOUND, "no edge in the cloud"),
+        SeamEstimate("S_left", SeamStatus.NOT_VISIBLE, "against the table"),
+    )
+    metrics = {"S_front": SeamMetrics("S_front", SeamStatus.FOUND, 0.31, 0.4, 0.2, 1.0)}
+    summary = MetricsSummary(3, 2, 1, 0.31, 0.31, 0.4, 0.2, 1.0)
+    truths = {s.id: (s.p_start, s.p_end) for s in SEAMS[:2]}
+    det = Detection(SCENARIO, "ours", WELDMAP, est, truths, metrics, summary)
+    welds = (
+        SeamWeld("S_front", True, False, "planned (preview)", code=WeldReason.PREVIEW),
+        SeamWeld("S_back", False, False, "not located", code=WeldReason.NOT_LOCATED),
+        SeamWeld("S_left", False, False, "flip the part", code=WeldReason.NOT_VISIBLE),
+    )
+    table = Box(make_pose(p=[0.0, 0.0, -1.07]), np.array([1.0, 0.6, 0.1]))
+    view = CellView(table=table, cameras=cameras_R(SCENARIO))
+    X = torch_along(front)
+    return WeldRun(det, welds, torch_paths={"S_front": X}, view=view)
+
+
+def test_page_has_results_table_and_cell_figure(tmp_path: Path) -> None:
+    run = tiny_run()
+    out = write_page(run, tmp_path / "page" / "cell.html", title="tiny T joint")
+    text = out.read_text(encoding="utf-8")
+    assert 'src="https://' not in text and text.count("Plotly.newPlot") >= 1  # plotly.js inline, offline
+    figs, rows = read(out)
+    assert set(figs) == {"cell3d"}  # no plan: no joint plots
+    names = [t.get("name") for t in figs["cell3d"]["data"]]
+    assert {"table", "camera cam_right", "seams found", "seams not found", "seams not visible"} <= set(names)
+    assert [r["seam"] for r in rows] == ["S_front", "S_back", "S_left"]
+    assert [r["status"] for r in rows] == ["found", "not_found", "not_visible"]
+    front = dict(zip(["seam", "status", "sigma", "error", "weld", "work", "travel"], rows[0]["cells"], strict=True))
+    assert front["sigma"] == "0.12" and front["error"] == "0.31" and front["weld"] == "planned"
+    assert rows[1]["cells"][4] == "not located" and rows[2]["cells"][4] == "not visible"
+    hover = next(t for t in figs["cell3d"]["data"] if t.get("name") == "seams found")["text"][0]
+    assert "S_front" in hover and "sigma 0.12 mm" in hover
+
+
+def test_results_rows_give_torch_angles() -> None:
+    run = tiny_run()
+    o = SeamOutcome("S_front", True, work_angle=math.radians(45.0), travel_angle=math.radians(-10.0))
+    rec = run.records()[0]
+    row = results_rows([replace(rec, outcome=o)])[0]
+    assert row["work angle [deg]"] == "45.0" and row["travel angle [deg]"] == "-10.0"

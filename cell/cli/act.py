@@ -1,26 +1,67 @@
-"""Commands that move the arm (or plan to): ``cell weld``, ``cell preview``, ``cell rescan``."""
+"""Commands that move the arm (or plan to): ``cell weld``, ``cell preview``, ``cell rescan``.
+
+Each checks its output paths before any work, writes the report first (it survives any later failure), then
+every other output on its own, and on Ctrl-C writes the report of the stage it reached (exit 130).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from cell.cli.common import NoiseOpt, app, cell_errors, check_method, err, parse_noise, parse_rescan_mode, progress
+from cell.cli.common import (
+    FormatOpt,
+    NoiseOpt,
+    TableFormat,
+    app,
+    cell_errors,
+    check_display,
+    check_method,
+    detail,
+    fail_line,
+    parse_format,
+    parse_noise,
+    parse_rescan_mode,
+    say,
+)
+from cell.cli.explain import weld_exit
+from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
 from cell.cli.tables import print_rescan, print_weld
-from cell.errors import EXIT_PARTIAL
+from cell.errors import EXIT_INTERRUPTED, UsageError
 
 if TYPE_CHECKING:
     from cell.pipeline import WeldRun
+    from cell.scenario import Scenario
+
+ScenarioArg = Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")]
+MethodOpt = Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")]
+JsonOpt = Annotated[
+    Path | None, typer.Option("--json", help="Write the JSON report here ('-': stdout, the table to stderr).")
+]
+
+
+def _load(scenario: str, method: str | None, noise: str | None) -> tuple[Scenario, dict[str, Any]]:
+    """The scenario as given (overrides are the pipeline's to apply) and the provenance of the run."""
+    from cell import scenario as sc
+    from cell.provenance import provenance
+
+    scn = sc.load(scenario)
+    check_method(method)
+    n = parse_noise(noise)
+    prov = provenance(scn.with_noise(n) if n else scn, scenario_file=sc.resolve(scenario))
+    detail(f"scenario {prov['scenario_file']} (sha256 {prov['scenario_sha256']}), map {prov['map_file']}")
+    return scn, prov
 
 
 @app.command()
 def weld(
-    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
-    method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
+    scenario: ScenarioArg,
+    method: MethodOpt = None,
     noise: NoiseOpt = None,
-    json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
+    json_path: JsonOpt = None,
     krl: Annotated[
         Path | None, typer.Option(help="Write the KUKA KRL program (.src/.dat) and the trajectory (JSON, CSV) here.")
     ] = None,
@@ -28,115 +69,178 @@ def weld(
         str | None, typer.Option(help="Re-scan before welding: none | low (below the confidence threshold) | all.")
     ] = None,
     gui: Annotated[bool, typer.Option(help="Open the PyBullet window (needs a display).")] = False,
+    fmt: FormatOpt = "table",
     html: Annotated[
         Path | None, typer.Option("--html", help="Write one page to look at (results, 3D cell, joints) here.")
     ] = None,
 ) -> None:
     """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation."""
     from cell import pipeline
-    from cell import scenario as sc
 
     with cell_errors():
-        scn = sc.load(scenario)
-        check_method(method)
-        run = pipeline.weld(
-            scn, method, noise=parse_noise(noise), rescan=parse_rescan_mode(rescan), progress=progress(), gui=gui
-        )
-        if html is not None:
-            from cell.preview import write_page
-
-            err.print(f"[dim]· page written to {write_page(run, html)}[/]")
-        _finish_run(run, json_path, krl, title="weld")
+        table = parse_format(fmt)
+        mode = parse_rescan_mode(rescan)
+        check_display(gui)
+        check_file(json_path, "--json")
+        check_folder(krl, "--krl")
+        check_file(html, "--html", stdout_ok=False)
+        scn, prov = _load(scenario, method, noise)
+        stage, writer = Stage(), Writer()
+        run: WeldRun | None = None
+        try:
+            run = pipeline.weld(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
+            partial = _finish_run(run, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table)
+            if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
+                say(f"page: {html}")
+        except KeyboardInterrupt:
+            _interrupted(run, scn, method, stage, prov, writer, json_path)
+    finish(writer, partial)
 
 
 @app.command("rescan")
 def rescan_cmd(
-    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    scenario: ScenarioArg,
     seams: Annotated[
         str | None, typer.Option(help="Comma-separated seam ids (default: the scenario's rescan.mode choice).")
     ] = None,
     all_seams: Annotated[bool, typer.Option("--all", help="Re-scan every visible seam.")] = False,
-    method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
+    method: MethodOpt = None,
     noise: NoiseOpt = None,
-    json_path: Annotated[Path | None, typer.Option("--json", help="Write the JSON report here.")] = None,
+    json_path: JsonOpt = None,
 ) -> None:
     """Only the close-up re-scan: detect, look again at seams with the eye-in-hand camera, compare before/after.
 
     The same re-scan as ``cell weld`` (its selection and its escalation when a close-up disagrees).
     """
     from cell import pipeline
-    from cell import scenario as sc
-    from cell.export.report import rescan_report, write_json
+    from cell.export.report import detection_report, rescan_report
     from cell.station import open_station
 
     with cell_errors():
-        scn = sc.load(scenario)
-        check_method(method)
+        check_file(json_path, "--json")
+        scn, prov = _load(scenario, method, noise)
         scn = scn.with_noise(n) if (n := parse_noise(noise)) else scn
         ids = [s.strip() for s in seams.split(",") if s.strip()] if seams else None
         weldmap = pipeline.read_weldmap(scn)
         unknown = sorted(set(ids or ()) - {s.id for s in weldmap.seams})
-        if unknown:
+        if unknown:  # before any capture
             valid = ", ".join(s.id for s in weldmap.seams)
-            raise typer.BadParameter(f"no seam {', '.join(unknown)} in the map; seams: {valid}", param_hint="--seams")
-        with open_station(scn, weldmap) as station:
-            det = pipeline.detect(scn, method, progress=progress(), station=station, weldmap=weldmap)
-            if det.error is not None:
-                raise det.error
-            mode: pipeline.RescanMode = "all" if all_seams else "low"
-            rs, after = pipeline.rescan_detection(station, det, mode, seam_ids=ids, progress=progress())
-        rep = rescan_report(det, after, rs)
-        if json_path is not None:
-            write_json(json_path, rep)
-            err.print(f"[dim]· report written to {json_path}[/]")
-        print_rescan(rep)
+            raise UsageError(f"--seams: no seam {', '.join(unknown)} in the map; seams: {valid}")
+        stage, writer = Stage(), Writer()
+        det: pipeline.Detection | None = None
+        try:
+            with open_station(scn, weldmap) as station:
+                det = pipeline.detect(scn, method, progress=stage, station=station, weldmap=weldmap)
+                if det.error is not None:
+                    writer.report(json_path, detection_report(det, provenance=prov))
+                    raise det.error
+                rmode: pipeline.RescanMode = "all" if all_seams else "low"
+                rs, after = pipeline.rescan_detection(station, det, rmode, seam_ids=ids, progress=stage)
+            rep = rescan_report(det, after, rs, provenance=prov)
+            writer.report(json_path, rep)
+            print_rescan(rep)
+        except KeyboardInterrupt:
+            done = detection_report(det, provenance=prov) if det is not None else None
+            on_interrupt(writer, json_path, done or interrupted_report(scn, method, stage.last, prov), stage.last)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
+    finish(writer, None)
 
 
 @app.command()
 def preview(
-    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    scenario: ScenarioArg,
     out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures and the report.")] = Path("preview"),
-    method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
+    method: MethodOpt = None,
     noise: NoiseOpt = None,
+    fmt: FormatOpt = "table",
 ) -> None:
     """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots."""
     from cell import pipeline
-    from cell import scenario as sc
     from cell.preview import write_run
 
     with cell_errors():
-        scn = sc.load(scenario)
-        check_method(method)
-        run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=progress())
-        progress()(f"drawing pictures into {out_dir}/")
-        paths = write_run(run, out_dir)
-        _finish_run(run, out_dir / "report.json", None, title="preview")
-        for p in paths:
-            err.print(f"[dim]· {p}[/]")
+        table = parse_format(fmt)
+        check_folder(out_dir, "--out")
+        scn, prov = _load(scenario, method, noise)
+        stage, writer = Stage(), Writer()
+        run: WeldRun | None = None
+        json_path = out_dir / "report.json"
+        try:
+            run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
+            partial = _finish_run(run, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
+            stage(f"drawing pictures into {out_dir}/")
+            done = run
+            paths = writer.attempt(lambda: write_run(done, out_dir)) or []
+            for p in paths:
+                say(str(p))
+        except KeyboardInterrupt:
+            _interrupted(run, scn, method, stage, prov, writer, json_path)
+    finish(writer, partial)
 
 
-def _finish_run(run: WeldRun, json_path: Path | None, krl: Path | None, *, title: str) -> None:
-    """Write what was asked (report first: it survives any later failure), print the table, exit with the code."""
-    from cell.export.report import weld_report, write_json
+def _interrupted(
+    run: WeldRun | None,
+    scn: Scenario,
+    method: str | None,
+    stage: Stage,
+    prov: Mapping[str, Any],
+    writer: Writer,
+    json_path: Path | None,
+) -> None:
+    """Ctrl-C: the run's report if the pipeline returned, else what ran and where it stopped; exit 130."""
+    from cell.export.report import weld_report
 
-    rep = weld_report(run)
-    if json_path is not None:
-        write_json(json_path, rep)
-        err.print(f"[dim]· report written to {json_path}[/]")
+    rep = weld_report(run, provenance=prov) if run is not None else interrupted_report(scn, method, stage.last, prov)
+    on_interrupt(writer, json_path, rep, stage.last)
+    raise typer.Exit(EXIT_INTERRUPTED) from None
+
+
+def _finish_run(
+    run: WeldRun,
+    json_path: Path | None,
+    krl: Path | None,
+    *,
+    title: str,
+    provenance: Mapping[str, Any],
+    writer: Writer,
+    fmt: TableFormat,
+) -> str | None:
+    """Write what was asked (report first: it survives any later failure; each output on its own), print the
+    table; the last line's explanation when the run is partial (None when complete)."""
+    from cell.export.report import weld_report
+
+    rep = weld_report(run, provenance=provenance)
+    writer.report(json_path, rep)
     if krl is not None and run.plan is not None and run.plan.segments and run.arm is not None:
-        from cell.export.krl import write_krl
-        from cell.export.trajectory import write_csv
-        from cell.export.trajectory import write_json as write_traj
-
-        name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in run.detection.scenario.name).upper()
-        sc = run.detection.scenario
-        src, dat = write_krl(run.plan, run.arm.model, krl, name[:24], X_WR=sc.X_WR, options=sc.export.krl)
-        traj_json = write_traj(run.plan, krl / "trajectory.json")
-        traj_csv = write_csv(run.plan, krl / "trajectory.csv")
-        err.print(f"[dim]· robot program: {src}, {dat}; trajectory: {traj_json}, {traj_csv}[/]")
-    print_weld(rep, title)
+        written = writer.attempt(lambda: _write_program(run, krl, provenance))
+        if written is not None:
+            say(f"robot program: {written[0]}, {written[1]}; trajectory: {written[2]}, {written[3]}")
+    print_weld(rep, title, fmt)
     if run.error is not None:  # the report says which seams and why: partial, with the cause in report.error
-        err.print(f"[bold red]error[/]: {run.error.message}", soft_wrap=True)
-        raise typer.Exit(EXIT_PARTIAL)
-    if not run.complete:
-        raise typer.Exit(EXIT_PARTIAL)
+        fail_line(f"error: {run.error.message}")
+    return None if run.complete and run.error is None else weld_exit(rep)
+
+
+def _write_page(run: WeldRun | None, path: Path) -> Path:
+    """The run's page (results, 3D cell, joint plots: :func:`cell.preview.write_page`)."""
+    from cell.preview import write_page
+
+    if run is None:
+        raise ValueError("no run to draw")
+    return write_page(run, path)
+
+
+def _write_program(run: WeldRun, krl: Path, provenance: Mapping[str, Any]) -> tuple[Path, Path, Path, Path]:
+    """The KRL program (provenance in its header) and the trajectory as JSON and CSV, into ``krl``."""
+    from cell.export.krl import write_krl
+    from cell.export.trajectory import write_csv
+    from cell.export.trajectory import write_json as write_traj
+
+    if run.plan is None or run.arm is None:
+        raise ValueError("no plan to write")
+    sc = run.detection.scenario
+    name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in sc.name).upper()
+    src, dat = write_krl(
+        run.plan, run.arm.model, krl, name[:24], X_WR=sc.X_WR, options=sc.export.krl, provenance=provenance
+    )
+    return src, dat, write_traj(run.plan, krl / "trajectory.json"), write_csv(run.plan, krl / "trajectory.csv")

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 from dxf_factory import design, make_maps
@@ -91,3 +93,165 @@ def test_unknown_scenario_and_method(tmp_path: Path) -> None:
     assert_one_line_error(code, err, 10, "fence1")
     code, _, err = invoke("detect", "fence1", "--method", "magic")
     assert code == 2 and "paper" in err
+
+
+def test_unknown_scenario_name_gets_did_you_mean() -> None:
+    code, _, err = invoke("detect", "fence11")
+    assert_one_line_error(code, err, 10, "did you mean 'fence1'?")
+
+
+def test_version_and_short_help() -> None:
+    from cell.provenance import version
+
+    code, out, _ = invoke("--version")
+    assert code == 0 and out.startswith(f"cell {version()}")
+    code, out, _ = invoke("weld", "-h")
+    assert code == 0 and "--json" in out
+    code, out, _ = invoke("-h")
+    assert code == 0 and "--install-completion" in out and "--log-file" in out
+
+
+@pytest.mark.parametrize(
+    ("args", "option"),
+    [
+        (("detect", "fence1", "--json", "{file}/r.json"), "--json"),
+        (("detect", "fence1", "--save-cloud", "{dir}"), "--save-cloud"),
+        (("detect", "fence1", "--save-cloud", "-"), "--save-cloud"),
+        (("weld", "fence1", "--json", "{dir}"), "--json"),
+        (("weld", "fence1", "--krl", "{file}"), "--krl"),
+        (("weld", "fence1", "--krl", "{file}/krl"), "--krl"),
+        (("preview", "fence1", "--out", "{file}"), "--out"),
+        (("rescan", "fence1", "--json", "{file}/sub/r.json"), "--json"),
+        (("bench", "fence1", "--out", "{file}"), "--out"),
+    ],
+)
+def test_unwritable_output_exits_2_before_any_work(tmp_path: Path, args: tuple[str, ...], option: str) -> None:
+    """A path under a file, a folder where a file goes, a file where a folder goes: one line, exit 2, at once."""
+    import time
+
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    argv = [a.format(file=a_file, dir=tmp_path) for a in args]
+    t0 = time.perf_counter()
+    code, _, err = invoke(*argv)
+    assert time.perf_counter() - t0 < 1.0  # nothing was captured
+    assert_one_line_error(code, err, 2, option)
+    assert ".part" not in err and "tmp" not in err.replace(str(tmp_path), "")
+
+
+def test_usage_errors_exit_2_before_any_work(monkeypatch: pytest.MonkeyPatch) -> None:
+    code, _, err = invoke("map", "info", str(REPO / "maps" / "fence1.dxf"), "--units", "ft")
+    assert_one_line_error(code, err, 2, "--units", "mm")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    code, _, err = invoke("weld", "fence1", "--gui")
+    assert_one_line_error(code, err, 2, "--gui", "DISPLAY")
+    code, _, err = invoke("rescan", "fence1", "--seams", "BOGUS")
+    assert_one_line_error(code, err, 2, "--seams", "BOGUS", "POST_L>TOP_RAIL:+x")
+    code, _, err = invoke("detect", "fence1", "--format", "xml")
+    assert_one_line_error(code, err, 2, "--format", "csv")
+
+
+def test_the_console_script_ends_a_usage_error_with_one_error_line() -> None:
+    """Through ``cell.cli.main`` (typer's own parsing errors): the last line of stderr says why, no box."""
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-c", "from cell.cli import main; main()", "weld", "fence1", "--bogus"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 2
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("error:") and "--bogus" in last, done.stderr
+    assert "Traceback" not in done.stderr and "╭" not in done.stderr
+
+
+def _interrupt_after(stage: str) -> Any:
+    def run(*_: object, progress: Any, **__: object) -> None:
+        progress("building the cell")
+        progress(stage)
+        raise KeyboardInterrupt
+
+    return run
+
+
+@pytest.mark.parametrize("command", ["detect", "weld"])
+def test_ctrl_c_writes_the_partial_report_and_exits_130(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, command: str
+) -> None:
+    from cell import pipeline
+
+    monkeypatch.setattr(pipeline, command, _interrupt_after("aligning the welding map to the cloud"))
+    report, log = tmp_path / "r.json", tmp_path / "run.log"
+    code, _, err = invoke("--log-file", str(log), command, "fence1", "--json", str(report))
+    assert code == 130, err
+    assert err.strip().splitlines()[-1].startswith("exit 130: interrupted")
+    data = json.loads(report.read_text())
+    assert data["interrupted"]["stage"] == "aligning the welding map to the cloud"
+    assert data["error"]["exit_code"] == 130 and data["scenario"] == "fence1" and data["seams"] == []
+    assert data["provenance"]["seed"] == data["config"]["seed"]
+    assert "building the cell" in log.read_text()
+
+
+def test_quiet_keeps_progress_off_stderr_and_in_the_log(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from cell import pipeline
+
+    monkeypatch.setattr(pipeline, "detect", _interrupt_after("splicing point clouds"))
+    log = tmp_path / "run.log"
+    code, _, err = invoke("-q", "--log-file", str(log), "detect", "fence1")
+    assert code == 130
+    assert "building the cell" not in err and "building the cell" in log.read_text()
+    assert err.strip().splitlines() == ["exit 130: interrupted (Ctrl-C) during: splicing point clouds"]
+    code, _, err = invoke("detect", "fence1")  # the next invocation starts from the defaults
+    assert "building the cell" in err
+
+
+def test_reports_are_written_whole_with_the_umask_permissions(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import os
+
+    from cell.errors import OutputError
+    from cell.export.report import write_json
+
+    old = os.umask(0o027)
+    try:
+        p = write_json(tmp_path / "sub" / "r.json", {"a": 1})
+    finally:
+        os.umask(old)
+    assert p.stat().st_mode & 0o777 == 0o640
+    assert json.loads(p.read_text()) == {"a": 1}
+    assert list((tmp_path / "sub").iterdir()) == [p]  # no temporary file left
+    write_json("-", {"b": [1, 2]})
+    assert json.loads(capsys.readouterr().out) == {"b": [1, 2]}
+    with pytest.raises(OutputError) as e:
+        write_json(p / "r.json", {})  # under a file
+    assert e.value.path == str(p / "r.json") and ".part" not in e.value.message
+
+
+def test_the_exit_line_names_lost_cameras_and_undone_seams() -> None:
+    from cell.cli.explain import detection_exit, weld_exit
+
+    seams = [
+        {"status": "found", "reason_code": None, "welded": True, "planned": True},
+        {"status": "found", "reason_code": None, "welded": False, "weld_reason_code": "low_confidence"},
+        {"status": "occluded", "reason_code": "occluded", "welded": False, "weld_reason_code": "not_located"},
+        {"status": "not_visible", "reason_code": "underside", "welded": False, "weld_reason_code": "not_visible"},
+    ]
+    rep = {
+        "seams": seams,
+        "lost_cameras": ["cam_left: 0 valid pixels"],
+        "error": None,
+        "summary": {"found": 2, "visible": 3},
+        "welded": 1,
+    }
+    assert detection_exit(rep) == (
+        "exit 3: camera cam_left lost (0 valid pixels); 1 seam occluded (occluded: 1); 2/3 visible found"
+    )
+    assert weld_exit(rep) == (
+        "exit 3: camera cam_left lost (0 valid pixels); 2 seams not welded (low_confidence: 1, not_located: 1);"
+        " 1/3 welded"
+    )

@@ -7,10 +7,16 @@ from typing import Annotated
 
 import typer
 
-from cell.cli.common import app, cell_errors, err, out
+from cell.cli.common import CONTEXT, app, cell_errors, err, log, out, say
 
-scenario_app = typer.Typer(no_args_is_help=True, help="Scenario files (YAML).")
+scenario_app = typer.Typer(no_args_is_help=True, context_settings=CONTEXT, help="Scenario files (YAML).")
 app.add_typer(scenario_app, name="scenario")
+
+
+def _warn(msg: str) -> None:
+    """A warning line: stderr (also with --quiet) and the log file."""
+    log.warning(msg)
+    err.print(f"[yellow]warning[/]: {msg}", soft_wrap=True, highlight=False)
 
 
 @app.command()
@@ -25,7 +31,9 @@ def init(
     """Write a scenario for any welding map: table, robot and cameras placed around the part, the workspace
     computed, a comment on every key. Then `cell scenario check FILE` and `cell weld FILE`."""
     from cell import scenario as sc
+    from cell.export.atomic import write_atomic
     from cell.scenario.init import scenario_text
+    from cell.weldmap import METRES_PER_UNIT
 
     target = out_path if out_path is not None else Path(f"{map_file.stem}.yaml")
     if target.suffix not in (".yaml", ".yml"):
@@ -34,23 +42,20 @@ def init(
         raise typer.BadParameter(f"{str(target)!r} exists (--force overwrites it)", param_hint="--out")
     if not map_file.is_file():
         raise typer.BadParameter(f"no file {str(map_file)!r}", param_hint="MAP_FILE")
+    if units is not None and units not in METRES_PER_UNIT:
+        raise typer.BadParameter(f"{units!r}; valid: {', '.join(METRES_PER_UNIT)}", param_hint="--units")
     with cell_errors():
         text, lay = scenario_text(map_file, target.absolute(), units=units)
         scn = sc.from_yaml(text, target.absolute().parent, target.name)  # what is written loads as it is
-        try:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_text(text, encoding="utf-8")
-        except OSError as e:
-            raise typer.BadParameter(f"cannot write {str(target)!r}: {e.strerror}", param_hint="--out") from None
+        write_atomic(target, text.encode("utf-8"), what="scenario")
         size = lay.table_size
-        err.print(
-            f"[dim]· wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras, table {size[0]:.1f} x "
-            f"{size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, {lay.X_WR_xyz[1]:.2f}) m[/]",
-            soft_wrap=True,
+        say(
+            f"wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras, table {size[0]:.1f} x "
+            f"{size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, {lay.X_WR_xyz[1]:.2f}) m"
         )
         if lay.unreachable_risk:
-            err.print(f"[yellow]warning[/]: a seam lies {lay.far_seam_m:.2f} m from the robot base", soft_wrap=True)
-        err.print(f"[dim]· next: cell scenario check {target}; cell weld {target}[/]", soft_wrap=True)
+            _warn(f"a seam lies {lay.far_seam_m:.2f} m from the robot base: it may be unreachable")
+        say(f"next: cell scenario check {target}; cell weld {target}")
 
 
 @scenario_app.command("check")
@@ -69,7 +74,7 @@ def check(
         weldmap = pipeline.read_weldmap(scn)
         problems = check_layout(scn, weldmap)
         for p in problems:
-            err.print(f"[yellow]warning[/]: {p}", soft_wrap=True)
+            _warn(p)
         fixed = sum(c.mount == "fixed" for c in scn.cameras.values())
         verdict = "ok" if not problems else f"{len(problems)} warning(s)"
         out.print(

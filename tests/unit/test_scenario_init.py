@@ -95,6 +95,8 @@ def test_cell_init_writes_a_scenario_that_checks(tmp_path: Path) -> None:
     assert again.exit_code == 2 and "--force" in again.stderr  # never overwrites unasked
     assert runner.invoke(app, ["init", str(FENCE2), "--out", str(out), "--force"]).exit_code == 0
     assert runner.invoke(app, ["init", str(tmp_path / "none.dxf"), "--out", str(tmp_path / "n.yaml")]).exit_code == 2
+    bad_units = runner.invoke(app, ["init", str(FENCE2), "--out", str(tmp_path / "u.yaml"), "--units", "ft"])
+    assert bad_units.exit_code == 2 and not (tmp_path / "u.yaml").exists()
 
 
 def test_cell_scenario_check_reports_problems(tmp_path: Path) -> None:

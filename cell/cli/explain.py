@@ -52,7 +52,7 @@ def weld_exit(rep: Mapping[str, Any]) -> str:
     """Why ``cell weld`` (or ``cell preview``) exits 3: the error, lost cameras, seams not welded by reason code;
     then how many visible seams were welded (planned, for a preview)."""
     visible = [s for s in rep["seams"] if s["status"] != "not_visible"]
-    preview = bool(visible) and all(s.get("weld_reason_code") == "preview" for s in visible if not s["welded"])
+    preview = not any(s["welded"] for s in visible) and any(s.get("weld_reason_code") == "preview" for s in visible)
     if preview:
         undone = Counter(str(s.get("weld_reason_code")) for s in visible if not s.get("planned"))
     else:

@@ -2,14 +2,21 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
+import subprocess
+from collections.abc import Callable
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
+from cell import pipeline
+from cell import scenario as sc
 from cell.cli import app
 
 runner = CliRunner()
+REPO = Path(__file__).resolve().parents[2]
 
 
 def invoke(*args: str) -> tuple[int, str, str]:
@@ -54,3 +61,81 @@ def test_alignment_failure_still_writes_every_seam_with_its_reason(tmp_path: Pat
     assert all(s["status"] in ("not_found", "not_visible") for s in data["seams"])
     assert all(s["reason"] for s in data["seams"])
     assert not any("detected" in s for s in data["seams"])
+
+
+def _weld_returning(run: pipeline.WeldRun, then: Callable[[], object]) -> Callable[..., pipeline.WeldRun]:
+    """``pipeline.weld`` standing in: the session's run, after ``then`` (what goes wrong late in the run)."""
+
+    def weld(*_: object, **__: object) -> pipeline.WeldRun:
+        then()
+        return run
+
+    return weld
+
+
+def test_weld_report_to_stdout_with_provenance_in_report_and_program(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_run: pipeline.WeldRun
+) -> None:
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: None))
+    krl = tmp_path / "krl"
+    code, out, err = invoke("weld", "fence1", "--json", "-", "--krl", str(krl), "--format", "json")
+    assert code == 0, err
+    data = json.loads(out)  # stdout is the report alone: the table (here as JSON rows) went to stderr
+    assert data["welded"] == 12 and '"seam": "POST_L>TOP_RAIL:+x"' in err
+    prov = data["provenance"]
+    assert prov["seed"] == data["config"]["seed"]
+    assert prov["scenario_sha256"] == hashlib.sha256(sc.resolve("fence1").read_bytes()).hexdigest()
+    assert prov["map_sha256"] == hashlib.sha256(sc.load("fence1").map_path.read_bytes()).hexdigest()
+    src = (krl / "WELD_FENCE1.src").read_text()
+    assert prov["commit"] in src and prov["scenario_sha256"] in src and prov["map_sha256"] in src
+    assert prov["map_sha256"] in (krl / "WELD_FENCE1.dat").read_text()
+
+
+def test_a_late_failure_loses_only_its_own_output(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_run: pipeline.WeldRun
+) -> None:
+    """The report's folder (then the program's) turns into a file during the run: the other output is still
+    written, exit 2, and the last line names what was lost."""
+    report, krl = tmp_path / "rep" / "r.json", tmp_path / "krl"
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: report.parent.write_text("")))
+    code, _, err = invoke("weld", "fence1", "--json", str(report), "--krl", str(krl))
+    assert code == 2, err
+    assert "Traceback" not in err and ".part" not in err
+    assert err.strip().splitlines()[-1].startswith(f"exit 2: could not write '{report}'")
+    assert (krl / "WELD_FENCE1.src").is_file() and (krl / "trajectory.csv").is_file()
+
+    report, krl = tmp_path / "r2.json", tmp_path / "krl2"
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: krl.write_text("")))
+    code, _, err = invoke("weld", "fence1", "--json", str(report), "--krl", str(krl))
+    assert code == 2, err
+    assert err.strip().splitlines()[-1].startswith("exit 2: could not write")
+    assert json.loads(report.read_text())["welded"] == 12
+
+
+def test_a_lost_camera_is_named_on_the_last_line() -> None:
+    code, _, err = invoke("detect", "faults/camera-dead")
+    assert code == 3, err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("exit 3: camera cam_left lost (") and last.endswith("12/12 visible found"), last
+
+
+def test_bench_writes_its_run_folder_and_leaves_tracked_files_alone(tmp_path: Path) -> None:
+    def status() -> str:
+        return subprocess.run(
+            ["git", "-C", str(REPO), "status", "--porcelain", "--", "benchmarks"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+
+    before = status()
+    run = tmp_path / "run"
+    code, out, err = invoke("bench", "fence1-exact", "--methods", "ours", "--repeat", "1", "--out", str(run))
+    assert code == 0, err
+    assert status() == before
+    rows = json.loads((run / "bench.json").read_text())
+    assert [(r["scenario"], r["method"]) for r in rows] == [("fence1-exact", "ours")]
+    prov = json.loads((run / "provenance.json").read_text())
+    assert [s["name"] for s in prov["scenarios"]] == ["fence1-exact"] and prov["scenarios"][0]["map_sha256"]
+    assert (run / "bench.md").read_text().startswith("<!-- made by cell ")
+    assert "| fence1-exact |" in out

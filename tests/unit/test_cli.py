@@ -255,3 +255,28 @@ def test_the_exit_line_names_lost_cameras_and_undone_seams() -> None:
         "exit 3: camera cam_left lost (0 valid pixels); 2 seams not welded (low_confidence: 1, not_located: 1);"
         " 1/3 welded"
     )
+
+
+def test_the_exit_line_of_a_run_that_welded_everything_or_only_planned() -> None:
+    from cell.cli.explain import weld_exit
+
+    welded = {"status": "found", "welded": True, "planned": True}
+    rep = {"seams": [welded] * 2, "lost_cameras": ["cam_left: dead"], "error": None, "welded": 2}
+    assert weld_exit(rep) == "exit 3: camera cam_left lost (dead); 2/2 welded"
+    planned = {"status": "found", "welded": False, "planned": True, "weld_reason_code": "preview"}
+    refused = {"status": "found", "welded": False, "planned": False, "weld_reason_code": "not_planned"}
+    rep = {"seams": [planned, refused], "lost_cameras": [], "error": None, "welded": 0}
+    assert weld_exit(rep) == "exit 3: 1 seam not planned (not_planned: 1); 1/2 planned"
+
+
+def test_bench_writes_an_untracked_run_folder_by_default() -> None:
+    import datetime as dt
+    import subprocess
+
+    from cell.cli.look import bench_folder
+
+    folder = bench_folder(None, dt.datetime(2026, 1, 2, 3, 4, 5, tzinfo=dt.UTC))
+    assert folder == Path("runs/bench-20260102T030405Z")
+    assert bench_folder(Path("x")) == Path("x")
+    ignored = subprocess.run(["git", "-C", str(REPO), "check-ignore", "-q", str(folder / "bench.json")], check=False)
+    assert ignored.returncode == 0  # .gitignore has /runs/

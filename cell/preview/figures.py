@@ -38,15 +38,18 @@ if TYPE_CHECKING:
 _PANEL_POINTS = 6000  # cloud points drawn in one seam close-up
 
 
-def _legend_handles(has_truth: bool, has_torch: bool, has_path: bool) -> list[Any]:
+def _legend_handles(statuses: set[str], has_truth: bool, has_torch: bool, has_path: bool) -> list[Any]:
+    """Legend entries for what is drawn only: the seam statuses present, truth, torch axes, tool paths."""
     from matplotlib.lines import Line2D
 
-    h: list[Any] = [
-        Line2D([], [], color=STATUS_COLOURS["found"], lw=2.5, label="seam found (estimate)"),
-        Line2D([], [], color=STATUS_COLOURS["not_found"], lw=2.0, ls="--", label="not found (map)"),
-        Line2D([], [], color=STATUS_COLOURS["not_visible"], lw=2.0, ls="--", label="not visible (map)"),
-        Line2D([], [], color=BOX_COLOUR, lw=0.8, label="map parts (aligned)"),
-    ]
+    h: list[Any] = []
+    if "found" in statuses:
+        h.append(Line2D([], [], color=STATUS_COLOURS["found"], lw=2.5, label="seam found (estimate)"))
+    for status in ("not_found", "not_visible", "occluded"):
+        if status in statuses:
+            label = f"{status.replace('_', ' ')} (map)"
+            h.append(Line2D([], [], color=STATUS_COLOURS[status], lw=2.0, ls="--", label=label))
+    h.append(Line2D([], [], color=BOX_COLOUR, lw=0.8, label="map parts (aligned)"))
     if has_truth:
         h.append(Line2D([], [], color=TRUTH_COLOUR, marker="x", ls="", label="true seam ends"))
     if has_torch:
@@ -56,6 +59,39 @@ def _legend_handles(has_truth: bool, has_torch: bool, has_path: bool) -> list[An
     if has_path:
         h.append(Line2D([], [], color=PATH_COLOUR, lw=1.0, ls=":", label="tool path"))
     return h
+
+
+_LABEL_OFFSETS = ((5, 5), (5, -14), (-5, 5), (-5, -14), (14, 16), (14, -26), (-14, 16), (-14, -26), (30, 0), (-30, 0))
+
+
+def place_labels(fig: Figure, ax: Axes, labels: Sequence[tuple[str, tuple[float, float]]]) -> list[Any]:
+    """Seam labels at their points (data coordinates of ``ax``), each moved to the first of a few offsets
+    [points] where its box overlaps no label placed before it (the figure is laid out once to measure them).
+    Returns the annotations."""
+    anns = [
+        ax.annotate(
+            text, (x, y), xytext=_LABEL_OFFSETS[0], textcoords="offset points", fontsize=7, zorder=7,
+            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8},
+        )
+        for text, (x, y) in labels
+    ]  # fmt: skip
+    for a in anns:
+        a.set_in_layout(False)  # labels never move the axes
+    if not anns:
+        return anns
+    fig.canvas.draw()  # the layout (constrained) is final only once drawn
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    placed: list[Any] = []
+    for a in anns:
+        for dx, dy in _LABEL_OFFSETS:
+            a.set_position((dx, dy))
+            a.set_horizontalalignment("left" if dx >= 0 else "right")
+            a.set_verticalalignment("bottom" if dy >= 0 else "top")
+            box = a.get_window_extent(renderer)
+            if not any(box.overlaps(b) for b in placed):
+                break
+        placed.append(a.get_window_extent(renderer))
+    return anns
 
 
 def new_figure(width_in: float, height_in: float) -> Figure:
@@ -181,7 +217,7 @@ def _draw_seam_panel(
     mid = ln.pts.mean(axis=0)
     half = max(0.6 * float(np.linalg.norm(ln.pts[1] - ln.pts[0])), 30.0) + 20.0  # [mm]
     near = thin(cloud[np.all(np.abs(cloud - mid) < half, axis=1)], _PANEL_POINTS)
-    _draw_2d(
+    sc = _draw_2d(
         ax,
         ij,
         near,
@@ -199,6 +235,10 @@ def _draw_seam_panel(
     ax.set_ylim(mid[ij[1]] - half, mid[ij[1]] + half)
     ax.tick_params(labelsize=6)
     ax.set_title(f"{index}. {ln.id}\n{detail}", fontsize=7, color=STATUS_COLOURS[ln.status])
+    if len(near):  # colour is the depth along the axis the panel does not show
+        cb = ax.figure.colorbar(sc, ax=ax, shrink=0.8, pad=0.02, aspect=30)
+        cb.set_label(f"{'xyz'[3 - ij[0] - ij[1]]}_R [mm]", fontsize=6)
+        cb.ax.tick_params(labelsize=5)
 
 
 def render_overview(
@@ -235,6 +275,7 @@ def render_overview(
     lines = seam_lines(seams, weldmap_R)
     n_found = sum(ln.status == "found" for ln in lines)
     handles = _legend_handles(
+        {ln.status for ln in lines},
         any(ln.truth is not None for ln in lines),
         any(len(np.asarray(p).reshape(-1, 16)) for p in torch_poses.values()),
         any(len(np.asarray(p).reshape(-1, 3)) for p in tcp_paths.values()),
@@ -248,20 +289,11 @@ def render_overview(
     fig = new_figure(12.0, 7.0)
     ax = fig.add_subplot()
     sc = _draw_2d(ax, (0, 1), cloud, weldmap_R, lines, torch_poses, tcp_paths, point_size=1.0)
-    for text, (x, y) in label_groups(lines):
-        ax.annotate(
-            text,
-            (x, y),
-            xytext=(5, 5),
-            textcoords="offset points",
-            fontsize=7,
-            zorder=7,
-            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.7},
-        )
     fig.colorbar(sc, ax=ax, label="height z_R [mm]", shrink=0.7, pad=0.02)
     fig.suptitle(f"{head}top view in the robot frame R")
     ax.set_title(caption(len(cloud)), fontsize=9)
     fig.legend(handles=handles, loc="outside right upper", fontsize=8, frameon=False)
+    place_labels(fig, ax, label_groups(lines))
     written.append(out / "overview_top.png")
     fig.savefig(written[-1])
 
@@ -288,7 +320,7 @@ def render_overview(
             )
         for ax_unused in list(grid.flat)[len(lines) :]:
             ax_unused.set_axis_off()
-        fig.suptitle(f"{head}every seam close up (R frame; colour = depth along the unseen axis)")
+        fig.suptitle(f"{head}every seam close up (R frame; colour = depth along the axis not shown)")
         fig.legend(handles=handles, loc="outside right upper", fontsize=8, frameon=False)
         written.append(out / "overview_seams.png")
         fig.savefig(written[-1])

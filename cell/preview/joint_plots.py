@@ -71,6 +71,9 @@ def render_joint_plots(
         for ax in (ax_q, ax_v):
             ax.grid(True, lw=0.3, alpha=0.5)
             ax.tick_params(labelsize=7)
+    pad = 6.0 + 3.8 * max((len(seam) for _, _, seam in bands), default=0)  # [pt] rotated labels under the titles
+    for ax in axes[0]:
+        ax.set_title(ax.get_title(), fontsize=8, pad=pad)
     for a, b, seam in bands:
         for ax in axes[0]:
             ax.text((a + b) / 2.0, 1.02, seam, transform=ax.get_xaxis_transform(), rotation=90, fontsize=6,

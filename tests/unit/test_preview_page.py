@@ -161,3 +161,31 @@ def test_results_rows_give_torch_angles() -> None:
     rec = run.records()[0]
     row = results_rows([replace(rec, outcome=o)])[0]
     assert row["work angle [deg]"] == "45.0" and row["travel angle [deg]"] == "-10.0"
+
+
+def test_seam_labels_do_not_overlap() -> None:
+    from cell.preview.figures import new_figure, place_labels
+
+    fig = new_figure(6.0, 4.0)
+    ax = fig.add_subplot()
+    ax.set_xlim(0.0, 100.0)
+    ax.set_ylim(0.0, 100.0)
+    labels = [("1,3,4", (50.0, 50.0)), ("2", (51.0, 50.0)), ("5,7,8", (50.0, 51.0)), ("6", (52.0, 49.0))]
+    anns = place_labels(fig, ax, labels)
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    boxes = [a.get_window_extent(renderer) for a in anns]
+    assert len(boxes) == 4
+    assert not any(boxes[i].overlaps(boxes[j]) for i in range(4) for j in range(i + 1, 4))
+
+
+def test_overview_legend_lists_only_what_is_drawn(tmp_path: Path) -> None:
+    from test_preview import colour_fraction
+
+    from cell.preview import STATUS_COLOURS, SeamView, render_overview
+
+    found = [SeamView(s.id, "found", s.p_start, s.p_end) for s in SEAMS]
+    cloud = surface_cloud(np.random.default_rng(4), 500)
+    top = render_overview(cloud, WELDMAP, found, {}, {}, tmp_path)[0]
+    assert colour_fraction(top, STATUS_COLOURS["found"]) > 1e-4
+    for status in ("not_found", "not_visible", "occluded"):  # no seam of theirs: no legend entry in their colour
+        assert colour_fraction(top, STATUS_COLOURS[status]) == 0.0, status

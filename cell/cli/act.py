@@ -26,6 +26,7 @@ from cell.cli.common import (
     parse_noise,
     parse_rescan_mode,
     say,
+    was_interrupted,
 )
 from cell.cli.explain import weld_exit
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
@@ -92,7 +93,9 @@ def weld(
             partial = _finish_run(run, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table)
             if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
                 say(f"page: {html}")
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, ImportError) as e:
+            if not was_interrupted(e):
+                raise
             _interrupted(run, scn, method, stage, prov, writer, json_path)
     finish(writer, partial)
 
@@ -139,7 +142,9 @@ def rescan_cmd(
             rep = rescan_report(det, after, rs, provenance=prov)
             writer.report(json_path, rep)
             print_rescan(rep)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, ImportError) as e:
+            if not was_interrupted(e):
+                raise
             done = detection_report(det, provenance=prov) if det is not None else None
             on_interrupt(writer, json_path, done or interrupted_report(scn, method, stage.last, prov), stage.last)
             raise typer.Exit(EXIT_INTERRUPTED) from None
@@ -173,7 +178,9 @@ def preview(
             paths = writer.attempt(lambda: write_run(done, out_dir)) or []
             for p in paths:
                 say(str(p))
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, ImportError) as e:
+            if not was_interrupted(e):
+                raise
             _interrupted(run, scn, method, stage, prov, writer, json_path)
     finish(writer, partial)
 

@@ -8,8 +8,10 @@ shows its traceback.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
+import signal
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -44,10 +46,21 @@ TableFormat = Literal["table", "json", "csv"]
 
 @dataclass
 class Settings:
-    """The global options of this invocation (reset by every ``cell ...``)."""
+    """The global options of this invocation (reset by every ``cell ...``); ``interrupted`` once Ctrl-C came."""
 
     quiet: bool = False
     verbose: bool = False
+    interrupted: bool = False
+
+
+def _on_sigint(signum: int, frame: object) -> None:
+    settings.interrupted = True
+    raise KeyboardInterrupt
+
+
+def was_interrupted(e: BaseException) -> bool:
+    """Ctrl-C, also when it arrived inside a C extension's import (which turns it into an ImportError)."""
+    return isinstance(e, KeyboardInterrupt) or settings.interrupted
 
 
 settings = Settings()
@@ -56,7 +69,9 @@ _handlers: list[logging.Handler] = []
 
 def configure(*, quiet: bool, verbose: bool, log_file: Path | None) -> None:
     """Set this invocation's verbosity and log file; results go back to stdout (``--json -`` moves them)."""
-    settings.quiet, settings.verbose = quiet, verbose
+    settings.quiet, settings.verbose, settings.interrupted = quiet, verbose, False
+    with contextlib.suppress(ValueError):  # only the main thread may set a handler (it is the default's twin)
+        signal.signal(signal.SIGINT, _on_sigint)
     out.stderr = False
     for h in _handlers:
         log.removeHandler(h)

@@ -23,6 +23,7 @@ from cell.cli.common import (
     parse_noise,
     progress,
     say,
+    was_interrupted,
 )
 from cell.cli.explain import detection_exit
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
@@ -96,7 +97,9 @@ def detect(
                 if writer.attempt(lambda: _save_cloud(cloud, save_cloud)) is not None:
                     say(f"spliced cloud written to {save_cloud}")
             print_detection(rep, table)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, ImportError) as e:
+            if not was_interrupted(e):
+                raise
             done = detection_report(det, provenance=prov) if det is not None else None
             on_interrupt(writer, json_path, done or interrupted_report(scn, method, stage.last, prov), stage.last)
             raise typer.Exit(EXIT_INTERRUPTED) from None

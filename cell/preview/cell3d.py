@@ -113,18 +113,16 @@ def path_slider(view: CellView, links: list[str], first_index: int) -> dict[str,
     }
 
 
-def view_bounds(view: CellView) -> tuple[FloatArray, FloatArray]:
-    """(lo, hi) (3,) [mm] of the table, the robot at every pose and the camera frusta (empty view: zeros)."""
-    pts: list[FloatArray] = []
+def view_points(view: CellView) -> FloatArray:
+    """(n, 3) [mm]: the table's corners, the robot's vertices at every pose and the camera frusta ((0, 3) when
+    the view has none): what the axes must hold."""
+    pts: list[FloatArray] = [np.zeros((0, 3))]
     if view.table is not None:
         pts.append(view.table.corners() * MM)
     for pose in view.poses:
         pts += [m.vertices for m in link_meshes(view.shapes, pose).values()]
     pts += [cam.frustum() * MM for cam in view.cameras]
-    if not pts:
-        return np.zeros(3), np.zeros(3)
-    p = np.vstack(pts)
-    return p.min(axis=0), p.max(axis=0)
+    return np.vstack(pts)
 
 
 def framed_scene(lo: FloatArray, hi: FloatArray, part_lo: FloatArray, part_hi: FloatArray) -> dict[str, Any]:

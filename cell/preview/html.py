@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.preview.cell3d import cell_traces, framed_scene, path_slider, view_bounds
+from cell.preview.cell3d import cell_traces, framed_scene, path_slider, view_points
 from cell.preview.views import (
     AXIS_COLOURS,
     BOX_COLOUR,
@@ -170,6 +170,8 @@ def figure_3d(
             "zaxis": {"title": {"text": "z_R [mm]"}},
         },
     }
+    part = np.vstack([p.vertices() for p in weldmap_R.parts]) * MM if weldmap_R.parts else cloud.reshape(-1, 3)
+    drawn = [cloud.reshape(-1, 3), part]
     if view is not None:
         extra, links = cell_traces(view)
         first_link = len(traces) + (1 if view.table is not None else 0)
@@ -177,10 +179,11 @@ def figure_3d(
         slider = path_slider(view, links, first_link)
         if slider is not None:
             layout["sliders"] = [slider]
-        lo, hi = view_bounds(view)
-        drawn = np.vstack([cloud.reshape(-1, 3), lo[None], hi[None]]) if view.poses or view.table else cloud
-        part = np.vstack([p.vertices() for p in weldmap_R.parts]) * MM if weldmap_R.parts else cloud
-        layout["scene"] = framed_scene(drawn.min(axis=0), drawn.max(axis=0), part.min(axis=0), part.max(axis=0))
+        drawn.append(view_points(view))
+    everything = np.vstack(drawn)
+    if len(part) and len(everything):  # the camera framed to the part, the axes over everything drawn
+        lo, hi = everything.min(axis=0), everything.max(axis=0)
+        layout["scene"] = framed_scene(lo, hi, part.min(axis=0), part.max(axis=0))
     return go.Figure(traces, layout)
 
 

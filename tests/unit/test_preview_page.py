@@ -17,6 +17,7 @@ from cell.geometry import FloatArray, make_pose
 from cell.motion.robot import RobotModel
 from cell.pipeline import Detection, WeldRun
 from cell.pipeline.scene_view import cameras_R, cell_view, urdf_shapes
+from cell.preview.cell3d import view_points
 from cell.preview.html import figure_3d
 from cell.preview.page import write_page
 from cell.preview.results import results_rows
@@ -104,14 +105,15 @@ def test_3d_view_draws_the_cell_and_frames_the_part(arm: Arm) -> None:
     # ... and the part fills a good share of it (not a speck in a view of the whole cell).
     rays = [(p - eye) / np.linalg.norm(p - eye) for p in to_scene(corners)]
     assert max(math.degrees(math.acos(np.clip(r @ axis, -1, 1))) for r in rays) > 10.0
-    assert np.all(to_scene(np.array(view_points(view))) >= -aspect / 2 - 1e-9)  # nothing drawn outside the axes
-
-
-def view_points(view: CellView) -> list[FloatArray]:
-    pts: list[FloatArray] = [c.frustum()[k] * 1000.0 for c in view.cameras for k in range(5)]
-    if view.table is not None:
-        pts += list(view.table.corners() * 1000.0)
-    return pts
+    inside = to_scene(np.vstack([view_points(view), cloud * 1000.0]))  # nothing drawn outside the axes
+    assert np.all(np.abs(inside) <= aspect / 2 + 1e-9)
+    # Without the cell (a run that carries no view) the camera is framed to the part too.
+    bare = figure_3d(cloud, weldmap, [], {}, {}).to_dict()["layout"]["scene"]
+    lo2 = np.array([bare[f"{a}axis"]["range"][0] for a in "xyz"])
+    hi2 = np.array([bare[f"{a}axis"]["range"][1] for a in "xyz"])
+    aspect2 = np.array([bare["aspectratio"][a] for a in "xyz"])
+    centre2 = np.array([bare["camera"]["center"][a] for a in "xyz"]) / aspect2 * (hi2 - lo2) + (lo2 + hi2) / 2.0
+    assert np.allclose(centre2, (corners.min(axis=0) + corners.max(axis=0)) / 2.0, atol=1e-6)
 
 
 def tiny_run() -> WeldRun:
@@ -189,3 +191,13 @@ def test_overview_legend_lists_only_what_is_drawn(tmp_path: Path) -> None:
     assert colour_fraction(top, STATUS_COLOURS["found"]) > 1e-4
     for status in ("not_found", "not_visible", "occluded"):  # no seam of theirs: no legend entry in their colour
         assert colour_fraction(top, STATUS_COLOURS[status]) == 0.0, status
+
+
+def test_scan_pose_holds_the_eye_in_hand_camera_where_its_frustum_starts() -> None:
+    from cell.station.arm import load_arm
+
+    arm = load_arm(SCENARIO)  # q_scan by IK on the camera's viewpoint
+    view = cell_view(SCENARIO, arm, None)
+    (cam,) = (c for c in view.cameras if c.mount == "eye_in_hand")
+    X_R_link = view.poses[0].X_RL["camera_link"]  # the drawn camera body at the scan pose
+    assert np.linalg.norm(X_R_link[:3, 3] - cam.frustum()[0]) < 0.01  # measured 3e-6 m (the optical origin)

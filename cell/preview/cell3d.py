@@ -21,6 +21,7 @@ TABLE_COLOUR = "#c8b89a"
 CAMERA_COLOUR = "#6a3d9a"
 _FOVY = math.pi / 4.0  # plotly's vertical field of view
 _VIEW_DIR = np.array([0.55, 1.0, 1.15])  # from the far side of the table, above: the robot behind the part
+_FRAME_MARGIN = 1.6  # the part's bounding sphere fills 1/1.6 of the view's height: the robot behind it in view
 
 
 def _r(a: FloatArray) -> list[float]:
@@ -140,7 +141,7 @@ def framed_scene(lo: FloatArray, hi: FloatArray, part_lo: FloatArray, part_hi: F
     c_mm = (np.asarray(part_lo) + np.asarray(part_hi)) / 2.0
     radius = 0.5 * float(np.linalg.norm(np.asarray(part_hi) - np.asarray(part_lo))) * scale
     centre = (c_mm - mid) * scale
-    eye = centre + _VIEW_DIR / np.linalg.norm(_VIEW_DIR) * (1.1 * radius / math.sin(_FOVY / 2.0))
+    eye = centre + _VIEW_DIR / np.linalg.norm(_VIEW_DIR) * (_FRAME_MARGIN * radius / math.sin(_FOVY / 2.0))
 
     def vec(v: FloatArray) -> dict[str, float]:
         return {"x": float(v[0]), "y": float(v[1]), "z": float(v[2])}

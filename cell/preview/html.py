@@ -74,7 +74,7 @@ def figure_3d(
                 "color": cloud[:, 2],
                 "colorscale": "Viridis",
                 "opacity": 0.6,
-                "colorbar": {"title": "z_R [mm]", "x": 1.0},
+                "colorbar": {"title": {"text": "z_R [mm]"}, "x": 1.0, "xanchor": "right", "len": 0.6},
             },
             hoverinfo="skip",
         )
@@ -161,7 +161,15 @@ def figure_3d(
         )
     layout: dict[str, Any] = {
         "title": {"text": title or "weld cell preview (robot frame R, mm)"},
-        "legend": {"itemsizing": "constant", "groupclick": "togglegroup"},
+        # legend on the left, the cloud's colour bar on the right: never over each other
+        "legend": {
+            "itemsizing": "constant",
+            "groupclick": "togglegroup",
+            "x": 0.0,
+            "xanchor": "left",
+            "y": 1.0,
+            "bgcolor": "rgba(255,255,255,0.7)",
+        },
         "margin": {"l": 0, "r": 0, "t": 40, "b": 0},
         "scene": {
             "aspectmode": "data",

@@ -149,6 +149,8 @@ def test_usage_errors_exit_2_before_any_work(monkeypatch: pytest.MonkeyPatch) ->
     assert_one_line_error(code, err, 2, "--seams", "BOGUS", "POST_L>TOP_RAIL:+x")
     code, _, err = invoke("detect", "fence1", "--format", "xml")
     assert_one_line_error(code, err, 2, "--format", "csv")
+    code, _, err = invoke("--log-file", str(REPO / "README.md" / "x.log"), "scenarios")
+    assert_one_line_error(code, err, 2, "log file")
 
 
 def test_the_console_script_ends_a_usage_error_with_one_error_line() -> None:

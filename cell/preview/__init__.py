@@ -6,6 +6,7 @@ importing this package costs nothing.
 
 - :mod:`cell.preview.views`: what is drawn (colours, seams as lines, thinned cloud, box edges, torch glyphs).
 - :mod:`cell.preview.figures`: the overview PNGs (top view, perspective, one close-up per seam).
+- :mod:`cell.preview.labels`: seam labels that do not overlap.
 - :mod:`cell.preview.joint_plots`: the joint plot PNG (positions and velocities against the limits).
 - :mod:`cell.preview.html`: the interactive 3D view (plotly): cloud, map, seams, and with the run's
   :class:`~cell.types.CellView` the table, the robot (:mod:`cell.preview.solids`, :mod:`cell.preview.cell3d`) and

@@ -166,7 +166,8 @@ def test_results_rows_give_torch_angles() -> None:
 
 
 def test_seam_labels_do_not_overlap() -> None:
-    from cell.preview.figures import new_figure, place_labels
+    from cell.preview.figures import new_figure
+    from cell.preview.labels import place_labels
 
     fig = new_figure(6.0, 4.0)
     ax = fig.add_subplot()

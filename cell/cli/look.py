@@ -153,8 +153,7 @@ def bench(
     """
     from cell import bench as b
     from cell import scenario as sc
-    from cell.export.atomic import write_atomic
-    from cell.export.report import write_json
+    from cell.export import write_atomic, write_json
     from cell.provenance import provenance
     from cell.seams.registry import METHODS
 

@@ -11,9 +11,9 @@ moves the arm for it; this module holds the values it computes):
 3. deproject it with the image's believed pose, keep the points in a box around the seam (``crop_margin_m``),
    and run the same locator on a local :class:`SeamScene` (this close cloud, the same aligned map and joints);
 4. fuse the close-up estimate with the first by inverse variance (:func:`fuse`): each estimate's standard
-   deviation comes from its confidence (:func:`sigma_from_confidence`) and a floor for what the confidence
-   cannot see (the fixed cameras' calibration, the arm's accuracy). A failed close-up keeps the first estimate;
-   a low-confidence one gets a small weight.
+   deviation is its locator's calibrated sigma (``SeamEstimate.sigma_m``, :mod:`cell.seams.sigma`; the close-up's
+   its own, with the close-up's floor). A failed close-up keeps the first estimate; an uncertain one gets a small
+   weight. The fused estimate carries the fused sigma, which the weld gate reads.
 
 Finally the arm goes back to its scan configuration (when that move is free). Frames: R (robot base) for every
 estimate and pose, W for the simulator; metres, radians, seconds.
@@ -42,20 +42,6 @@ if TYPE_CHECKING:
 # -- uncertainty and fusion --------------------------------------------------------------------------------
 
 
-def sigma_from_confidence(confidence: float, scale_m: float, floor_m: float) -> float:
-    """Standard deviation [m] of a seam estimate from its confidence in (0, 1].
-
-    The "ours" locator's confidence falls as 1 / (1 + (se / target_se)^2) with the standard error se of the
-    seam line (other factors: support, noise, ends, multiply in); inverting that gives
-    se = scale * sqrt(1 / c - 1), added in quadrature to ``floor_m``. Confidence 0 gives infinity.
-    """
-    if not 0.0 <= confidence <= 1.0 or not math.isfinite(confidence):
-        raise ValueError(f"confidence must be in [0, 1], got {confidence}")
-    if confidence <= 0.0:
-        return math.inf
-    return math.hypot(scale_m * math.sqrt(1.0 / confidence - 1.0), floor_m)
-
-
 def fuse(
     first: SeamEstimate, closeup: SeamEstimate | None, sigma_first: float, sigma_closeup: float, scale_m: float
 ) -> tuple[SeamEstimate, float]:
@@ -63,7 +49,8 @@ def fuse(
 
     An estimate that is not FOUND, or has an infinite sigma, has no weight. The fused ends are matched (a
     reversed close-up is turned round) and weighted w = s1^2 / (s1^2 + s2^2); the fused confidence is
-    1 / (1 + (sigma / scale_m)^2) of the fused sigma, on the first estimate's confidence scale.
+    1 / (1 + (sigma / scale_m)^2) of the fused sigma, on the first estimate's confidence scale, and the fused
+    sigma is its ``sigma_m`` (a close-up alone keeps its own).
     """
     ok1 = first.status is SeamStatus.FOUND and math.isfinite(sigma_first)
     if closeup is None or closeup.status is not SeamStatus.FOUND or not math.isfinite(sigma_closeup):
@@ -87,6 +74,7 @@ def fuse(
         p_end=(1.0 - w) * first.p_end + w * b,
         confidence=1.0 / (1.0 + (sigma / scale_m) ** 2),
         time_s=first.time_s + closeup.time_s,
+        sigma_m=sigma,
     )
     return fused, float(w)
 
@@ -94,16 +82,27 @@ def fuse(
 # -- which seams ---------------------------------------------------------------------------------------------
 
 
-def seams_to_rescan(estimates: Sequence[SeamEstimate], threshold: float = CONFIDENCE_THRESHOLD) -> list[str]:
-    """Ids of the seams worth a close look: found with confidence below ``threshold``, or visible but not found.
+def seams_to_rescan(
+    estimates: Sequence[SeamEstimate], threshold: float = CONFIDENCE_THRESHOLD, max_sigma_m: float = math.inf
+) -> list[str]:
+    """Ids of the seams worth a close look: found with confidence below ``threshold`` or a sigma over
+    ``max_sigma_m`` [m] (too uncertain to weld, :func:`within_tolerance`), or visible but not found.
 
     ``threshold=math.inf`` selects every visible seam. Seams no camera can see (against the table) are left out.
     """
     out = []
     for e in estimates:
-        if e.status is SeamStatus.NOT_FOUND or (e.status is SeamStatus.FOUND and e.confidence < threshold):
+        if e.status is SeamStatus.NOT_FOUND or (
+            e.status is SeamStatus.FOUND and (e.confidence < threshold or not within_tolerance(e, max_sigma_m))
+        ):
             out.append(e.id)
     return out
+
+
+def within_tolerance(estimate: SeamEstimate, max_sigma_m: float) -> bool:
+    """Whether a found estimate is certain enough to weld: its sigma at most ``max_sigma_m`` [m] (the weld
+    tolerance over the bound's factor, ``RescanSpec.max_sigma_m``)."""
+    return estimate.status is SeamStatus.FOUND and estimate.sigma_m <= max_sigma_m
 
 
 # -- the re-scan ----------------------------------------------------------------------------------------------
@@ -173,11 +172,12 @@ def occluders(scene: SeamScene, seam_id: str) -> tuple[Part, ...]:
     return tuple(p for p in scene.weldmap.parts if p.name not in (joint.abutting, joint.receiving))
 
 
-def estimate_sigma(est: SeamEstimate | None, scale_m: float, floor_m: float) -> float:
-    """Standard deviation [m] of an estimate for fusion: infinite when there is none or it was not found."""
+def estimate_sigma(est: SeamEstimate | None) -> float:
+    """Standard deviation [m] of an estimate for fusion: its locator's sigma; infinite when there is none or it
+    was not found."""
     if est is None or est.status is not SeamStatus.FOUND:
         return math.inf
-    return sigma_from_confidence(est.confidence, scale_m, floor_m)
+    return est.sigma_m
 
 
 __all__ = [
@@ -193,6 +193,6 @@ __all__ = [
     "fuse",
     "occluders",
     "seams_to_rescan",
-    "sigma_from_confidence",
     "view_target",
+    "within_tolerance",
 ]

@@ -10,6 +10,7 @@ Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->``
 - ``table1``: Table 1 with realistic noise and exact calibration (``latest.json``, the ``exact`` rows);
 - ``table1-noise-none``: the same with noise-free depth (``noise-none.json``);
 - ``calibration``: our locator under calibration error (``latest.json``, ``ours``, every other extrinsics row);
+- ``coverage``: each locator's sigma against its true errors (``coverage.json``, by ``benchmarks/bench_coverage.py``);
 - ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``);
 - ``rescan``, ``confidence``, ``weld``, ``motion``, ``faults``: the tables of the cell's own commands
   (``rescan.json``, ``weld.json``, ``faults.json`` by ``benchmarks/bench_cell.py``; ``confidence.json`` by
@@ -110,6 +111,27 @@ def scaling(results: Path) -> str:
     return scaling_table(_load(results, "scaling.json"))
 
 
+# How the coverage table names a group of seams (``coverage.json``'s ``group``).
+COVERAGE_GROUPS: Mapping[str, str] = {"scenarios": "scenarios", "faults": "fence1's faults", "all": "all"}
+
+
+def coverage(results: Path) -> str:
+    """Each locator's sigma against its true errors (``coverage.json``, by ``benchmarks/bench_coverage.py``)."""
+    data = _load_object(results, "coverage.json")
+    lines = [
+        "| method | seams | found | lateral within 2 sigma | within 3 sigma | endpoint within 2 sigma "
+        "| median sigma [mm] | max lateral [mm] |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in data["coverage"]:
+        lines.append(
+            f"| {r['method']} | {COVERAGE_GROUPS.get(r['group'], r['group'])} | {r['found']} "
+            f"| {r['lateral_2sigma']:.0%} | {r['lateral_3sigma']:.0%} | {r['endpoint_2sigma']:.0%} "
+            f"| {r['sigma_median_mm']:.3f} | {r['lateral_max_mm']:.3f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 def weld(results: Path) -> str:
     """Welding fence1: the first run of ``weld.json``, per seam, and its cycle-time line."""
     return cell_tables.weld_table(_load(results, "weld.json")[0])
@@ -121,6 +143,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "calibration": calibration,
     "rescan": lambda results: cell_tables.rescan_table(_load(results, "rescan.json")),
     "confidence": lambda results: cell_tables.confidence_table(_load_object(results, "confidence.json")),
+    "coverage": coverage,
     "weld": weld,
     "motion": lambda results: cell_tables.motion_table(_load_object(results, "motion.json")),
     "scaling": scaling,

@@ -17,6 +17,17 @@ CONFIDENCE_THRESHOLD = 0.55
 # re-scan's confidence scale of a close-up.
 CLOSEUP_TARGET_SE_M = 0.00002
 
+# The weld gate (docs/reference.md section 4: an arc-welded seam must be found to about half the wire diameter,
+# +-0.5 mm): a seam is welded only when BOUND_SIGMAS times its sigma is within WELD_TOLERANCE_MM; a scenario can
+# override both (``rescan.weld_tolerance_mm``, ``rescan.bound_sigmas``).
+WELD_TOLERANCE_MM = 0.5
+BOUND_SIGMAS = 3.0
+
+# Ours' sigma floor up close [m]: the arm's pose accuracy and hand-eye calibration on a real cell (exact kinematics
+# in the simulator); the close-ups of fence1, fence1-exact and fence2 end 0.006-0.017 mm off on average (README,
+# the re-scan table), and the fixed cameras' calibration, which the first pass's floor stands for, does not apply.
+CLOSEUP_SIGMA_FLOOR_M = 0.00002
+
 # Options of the "ours" locator for a close-up cloud (~0.2 mm noise and ~0.35 mm pixels at 0.35 m instead of
 # ~4 mm and ~1.6 mm at 1.6 m): the standard error that earns full confidence and the bands cut along edges and
 # corners shrink with the sensor. The noise assumed before it is measured (sensor_sigma_m) stays: it also sets
@@ -25,6 +36,7 @@ CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
     "target_se_m": CLOSEUP_TARGET_SE_M,
     "edge_band_m": 0.002,
     "corner_band_m": 0.003,
+    "sigma_floor_m": CLOSEUP_SIGMA_FLOOR_M,
 }
 
 
@@ -32,23 +44,16 @@ CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
 class RescanOptions:
     """Options of the close-up re-scan (lengths [m]).
 
-    first_floor_m : standard deviation the first estimate has whatever its confidence says: the fixed cameras'
-        calibration, which no confidence sees (0.3-1 mm / 0.03-0.1 deg on real cells, docs/reference.md section
-        2; the default 0.2 mm is about what the exact simulated cameras give at high confidence).
-    closeup_floor_m : the same for the close-up (the arm's pose accuracy and hand-eye calibration on a real cell;
-        exact kinematics in the simulator).
-    first_scale_m, closeup_scale_m : the locator's standard error at confidence 1/2 for each kind of cloud (the
-        first: ours' default ``target_se_m``).
+    first_scale_m : the confidence scale of a fused estimate (confidence 1/2 at this sigma: ours' default
+        ``target_se_m``). The fusion weighs each estimate by its locator's own sigma (``SeamEstimate.sigma_m``,
+        :mod:`cell.seams.sigma`).
     closeup_locator_options : locator name -> options merged into that locator's for a close-up cloud.
     """
 
     camera: str | None = None  # the eye-in-hand camera; None: the scenario's only one
     crop_margin_m: float = 0.08  # the box around the seam grown by this (the locator's tube and end search)
     min_points: int = 2000  # fewer points in that box: nothing seen
-    first_floor_m: float = 0.0002
-    closeup_floor_m: float = 0.00002
     first_scale_m: float = OursSettings.target_se_m
-    closeup_scale_m: float = CLOSEUP_TARGET_SE_M
     closeup_locator_options: Mapping[str, Mapping[str, float | int | str | bool]] = field(
         default_factory=lambda: {"ours": CLOSEUP_OURS_OPTIONS}
     )

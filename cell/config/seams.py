@@ -98,6 +98,9 @@ class OursSettings:
     max_points: int = 40000  # random subsample of the tube above this
     max_fit_points: int = 1000  # a plane is fitted to an even stride of its support above this
     target_se_m: float = 0.0002  # standard error of the seam's position that still earns full confidence
+    # Added in quadrature to the standard error for the reported sigma: what the fit cannot see (calibration, tilt);
+    # 0.05 mm puts 96 % of the scenarios' seams within 2 sigma (benchmarks/bench_coverage.py, cell/seams/sigma.py).
+    sigma_floor_m: float = 0.00005
     min_edge_points: int = 20  # fewer points just inside an edge: it does not place an unseen face
     max_edge_strays: float = 0.3  # more density beyond an edge (share of that inside): it places nothing
     edge_pitch_factor: float = 0.15  # an edge's sampling error, in point pitches on its face [-] (0.29: aligned grid)

@@ -109,9 +109,7 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan
     t = time.perf_counter()
     est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
     est = replace(est, time_s=time.perf_counter() - t)
-    s1 = estimate_sigma(first, o.first_scale_m, o.first_floor_m)
-    s2 = estimate_sigma(est, o.closeup_scale_m, o.closeup_floor_m)
-    fused, w = fuse(first, est, s1, s2, o.first_scale_m)
+    fused, w = fuse(first, est, estimate_sigma(first), estimate_sigma(est), o.first_scale_m)
     reason = "" if w > 0.0 else f"close-up not used: {est.reason or est.status.value}"
     return SeamRescan(seam_id, first, est, fused, w, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
 
@@ -201,7 +199,8 @@ def rescan_detection(
     """Re-scan the seams worth a closer look with the eye-in-hand camera and return the detection with the fused
     estimates: the one re-scan path of ``cell weld`` and ``cell rescan``.
 
-    mode : ``low``: the seams below ``rescan.confidence_threshold`` or not found; ``all``: every visible seam.
+    mode : ``low``: the seams below ``rescan.confidence_threshold``, those whose bound (``rescan.bound_sigmas``
+    sigma) exceeds ``rescan.weld_tolerance_mm``, and those not found; ``all``: every visible seam.
     seam_ids : these seams instead of the mode's choice (``cell rescan --seams``).
     Escalation (unless ``all``): a close-up that moves its seam by more than ``rescan.escalate_mm`` shows the fixed
     cameras cannot be trusted here (calibration off, a bumped camera): every other visible seam is re-scanned too.
@@ -210,7 +209,8 @@ def rescan_detection(
     if seam_ids is not None:
         ids = list(seam_ids)
     else:
-        ids = seams_to_rescan(det.estimates, math.inf if mode == "all" else sc.rescan.confidence_threshold)
+        threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
+        ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
     rs = rescan_seams(station, det, ids, motion=motion, progress=progress)
     after = rescanned(det, rs)

@@ -15,9 +15,10 @@ from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.rescan import rescan_detection
 from cell.pipeline.scene_view import cell_view
+from cell.rescan import within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import SeamStatus
+from cell.types import SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
@@ -92,10 +93,30 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
     return station.execute(times, q, arc_on, marks=marks, record_dt=0.01)
 
 
+def _doubt(est: SeamEstimate, sc: Scenario) -> str:
+    """Why a found seam is too uncertain to weld ("" when it may be welded): its bound (``rescan.bound_sigmas``
+    times its calibrated sigma) over ``rescan.weld_tolerance_mm``, or its confidence under
+    ``rescan.weld_min_confidence``."""
+    r = sc.rescan
+    if not within_tolerance(est, r.max_sigma_m):
+        bound_mm = r.bound_sigmas * est.sigma_m * 1000.0
+        return f"bound {r.bound_sigmas:g} sigma = {bound_mm:.2f} mm > weld tolerance {r.weld_tolerance_mm:g} mm"
+    if est.confidence < r.weld_min_confidence:
+        return f"confidence {est.confidence:.2f} < {r.weld_min_confidence:.2f}"
+    return ""
+
+
 def _seam_welds(
-    det: Detection, plan: WeldPlan | None, ex: Execution | None, pre_s: float, refused: str, sc: Scenario
+    det: Detection,
+    plan: WeldPlan | None,
+    ex: Execution | None,
+    pre_s: float,
+    refused: str,
+    sc: Scenario,
+    gated: bool,
 ) -> tuple[SeamWeld, ...]:
-    """Per seam: welded (with its quality against the true seam) or the reason it was not."""
+    """Per seam: welded (with its quality against the true seam) or the reason it was not. gated : the weld gate
+    applied (not a preview): a found seam too uncertain to weld is ``low_confidence``."""
     from cell.motion.quality import weld_quality
 
     X_RW = invert(det.scenario.X_WR)
@@ -108,10 +129,9 @@ def _seam_welds(
             why = f"not located ({est.status.value}): {est.reason}"
             out.append(SeamWeld(est.id, False, False, why, code=WeldReason.NOT_LOCATED))
             continue
-        doubtful = est.confidence < sc.rescan.weld_min_confidence
-        if doubtful and ex is not None:
-            why = f"low_confidence: {est.confidence:.2f} < {sc.rescan.weld_min_confidence:.2f} after the re-scan"
-            out.append(SeamWeld(est.id, False, False, why, code=WeldReason.LOW_CONFIDENCE))
+        doubtful = _doubt(est, sc)
+        if doubtful and gated:
+            out.append(SeamWeld(est.id, False, False, f"low_confidence: {doubtful}", code=WeldReason.LOW_CONFIDENCE))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
         if outcome is None or not outcome.feasible:
@@ -120,7 +140,7 @@ def _seam_welds(
             out.append(SeamWeld(est.id, False, False, reason, code=code))
             continue
         if ex is None or plan is None:
-            note = f"; confidence {est.confidence:.2f}: would be re-scanned before welding" if doubtful else ""
+            note = f"; {doubtful}: would be re-scanned before welding" if doubtful else ""
             code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
             out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note, code=code))
             continue
@@ -149,7 +169,8 @@ def weld(
 
     A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
     every seam's reason, so the report can still be written. A seam whose confidence stays below
-    ``rescan.weld_min_confidence`` after the re-scan is not welded (``low_confidence``).
+    ``rescan.weld_min_confidence``, or whose bound (``rescan.bound_sigmas`` times its calibrated sigma) stays over
+    ``rescan.weld_tolerance_mm``, after the re-scan is not welded (``low_confidence``).
     """
     t_all = time.perf_counter()
     sc = scenario.with_noise(noise) if noise else scenario
@@ -176,25 +197,26 @@ def weld(
                 rs, det = rescan_detection(station, det, mode, motion=motion, progress=progress)
                 timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so.
-            low = {
-                e.id
-                for e in det.estimates
-                if e.status is SeamStatus.FOUND and e.confidence < sc.rescan.weld_min_confidence and execute_plan
-            }
+            low = {e.id for e in det.estimates if e.status is SeamStatus.FOUND and _doubt(e, sc) and execute_plan}
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
-            plan, pre, violations = plan_for(station, det, skip=low, q_start=q_start, motion=motion, progress=progress)
-            timings["plan_s"] = setup_s + time.perf_counter() - t
-            if violations:
-                raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
-            if execute_plan:
-                t = time.perf_counter()
-                ex = execute(station, plan, pre, progress=progress)
-                timings["execute_s"] = time.perf_counter() - t
+            if low and not any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates):
+                progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)")
+            else:
+                plan, pre, violations = plan_for(
+                    station, det, skip=low, q_start=q_start, motion=motion, progress=progress
+                )
+                timings["plan_s"] = setup_s + time.perf_counter() - t
+                if violations:
+                    raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
+                if execute_plan:
+                    t = time.perf_counter()
+                    ex = execute(station, plan, pre, progress=progress)
+                    timings["execute_s"] = time.perf_counter() - t
         except CellError as e:
             error = e
         refused = f"not executed: {error.message}" if error is not None else ""
-        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused, sc)
+        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused, sc, execute_plan)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)

@@ -22,6 +22,7 @@ from cell.config import (
     ScreenOptions,
     SymmetryOptions,
 )
+from cell.config.rescan import BOUND_SIGMAS, WELD_TOLERANCE_MM
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import WorkspaceSpec
@@ -70,10 +71,13 @@ class PerceptionSpec(Model):
 
 
 class RescanSpec(Model):
-    """Close-up re-scan before welding and the confidence gate (cell.rescan; calibration in its docstring).
+    """Close-up re-scan before welding and the weld gate (cell.rescan; calibration in its docstring).
 
-    mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` (and visible seams not
-        found), ``all`` every visible seam, ``none`` nothing.
+    mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` or whose bound
+        (``bound_sigmas`` sigma) exceeds ``weld_tolerance_mm`` (and visible seams not found), ``all`` every visible
+        seam, ``none`` nothing.
+    weld_tolerance_mm, bound_sigmas : after the re-scan, a seam whose locator's sigma (calibrated,
+        cell/seams/sigma.py) times ``bound_sigmas`` exceeds ``weld_tolerance_mm`` is not welded (``low_confidence``).
     weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
     escalate_mm : in ``low`` mode, a close-up that disagrees with the first estimate by more than this [mm]
         triggers a re-scan of every visible seam.
@@ -84,10 +88,17 @@ class RescanSpec(Model):
     # Calibrated by benchmarks/bench_confidence.py (cell.config.rescan.CONFIDENCE_THRESHOLD says how).
     confidence_threshold: Annotated[float, Field(ge=0.0, le=1.0)] = CONFIDENCE_THRESHOLD
     weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
+    weld_tolerance_mm: Annotated[float, Field(gt=0.0)] = WELD_TOLERANCE_MM
+    bound_sigmas: Annotated[float, Field(gt=0.0)] = BOUND_SIGMAS
     # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
     # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.
     escalate_mm: Annotated[float, Field(gt=0.0)] = 0.5
     closeup: RescanOptions = RescanOptions()
+
+    @property
+    def max_sigma_m(self) -> float:
+        """The largest sigma [m] a seam may have and be welded: ``weld_tolerance_mm`` / ``bound_sigmas``."""
+        return self.weld_tolerance_mm / 1000.0 / self.bound_sigmas
 
     @model_validator(mode="after")
     def _closeup_locator_options(self) -> RescanSpec:

@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from cell.seams.paper import PaperLocator
     from cell.seams.ransac import RansacLocator, RansacOptions
     from cell.seams.registry import METHODS, make_locator
+    from cell.seams.sigma import ours_sigma, paper_sigma, ransac_sigma
     from cell.seams.truth import true_seams
     from cell.seams.visibility import UNDERSIDE_REASON
 
@@ -42,6 +43,9 @@ _HOME = {
     "RansacOptions": "ransac",
     "METHODS": "registry",
     "make_locator": "registry",
+    "ours_sigma": "sigma",
+    "paper_sigma": "sigma",
+    "ransac_sigma": "sigma",
     "true_seams": "truth",
     "UNDERSIDE_REASON": "visibility",
 }
@@ -61,6 +65,9 @@ __all__ = [
     "fillet_bisector",
     "find_joints",
     "make_locator",
+    "ours_sigma",
+    "paper_sigma",
+    "ransac_sigma",
     "seam_metrics",
     "segment_errors",
     "summarise",

@@ -14,6 +14,7 @@ import numpy as np
 from cell.config.seams import PaperOptions
 from cell.geometry import FloatArray
 from cell.seams._features import cloud_features
+from cell.seams.sigma import paper_sigma
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 AXIS_TOLERANCE_DEG = 10.0  # a seam within this of x, y or z counts as "along" it
@@ -187,7 +188,7 @@ class PaperLocator:
         start[c], start[a] = across, along
         # Step 5: the end from the map's seam vector.
         end = start + (np.asarray(seam.p_end) - s0)
-        return SeamEstimate(seam.id, SeamStatus.FOUND, "", start, end, confidence)
+        return SeamEstimate(seam.id, SeamStatus.FOUND, "", start, end, confidence, sigma_m=paper_sigma(confidence))
 
     def _along_from_far_face(
         self,

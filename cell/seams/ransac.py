@@ -28,6 +28,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._index import dense_index
 from cell.seams._lines import plane_intersection
+from cell.seams.sigma import ransac_sigma
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
@@ -79,10 +80,11 @@ class RansacLocator:
         return SeamEstimate(
             seam.id,
             SeamStatus.FOUND,
-            reason=f"{len(results)}/{o.runs} runs",
+            reason=f"{len(results)}/{o.runs} runs, spread {spread * 1000:.3f} mm",
             p_start=med[0],
             p_end=med[1],
             confidence=conf,
+            sigma_m=ransac_sigma(),
         )
 
     def _map_normals(self, scene: SeamScene, seam: MapSeam) -> tuple[FloatArray, FloatArray]:

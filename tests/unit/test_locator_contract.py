@@ -34,26 +34,32 @@ class Contract:
     lateral_m, along_m : bounds on a found seam's lateral and end errors [m], about twice the largest measured.
     tracks_support : its confidence falls when the cloud is thinned (else only: removing a weld face does not
         raise it).
-    reports_sigma : a found seam carries the locator's own standard error across it (``sigma_m``), which grows
-        when the cloud is thinned; else ``sigma_m`` is inf.
+    sigma_tracks_support : the sigma a found seam carries (every locator's, calibrated: cell/seams/sigma.py) is the
+        locator's own standard error across it, which grows when the cloud is thinned; else a fixed value.
     """
 
     any_orientation: bool
     lateral_m: float
     along_m: float
     tracks_support: bool
-    reports_sigma: bool
+    sigma_tracks_support: bool
 
 
 CONTRACTS = {
     # Measured: lateral <= 0.11 mm, ends <= 0.31 mm; thinned to 30 %: confidence 0.02-0.25 lower, sigma 1.8-2.2 x.
-    "ours": Contract(any_orientation=True, lateral_m=0.0005, along_m=0.002, tracks_support=True, reports_sigma=True),
+    "ours": Contract(
+        any_orientation=True, lateral_m=0.0005, along_m=0.002, tracks_support=True, sigma_tracks_support=True
+    ),
     # On the 1 cm voxel cloud: lateral <= 5.1 mm, ends <= 35 mm (the ends are the weak part). Its confidence is the
     # runs' agreement: thinned to 30 % it rose in 5 of 6 seams.
-    "ransac": Contract(any_orientation=True, lateral_m=0.012, along_m=0.07, tracks_support=False, reports_sigma=False),
+    "ransac": Contract(
+        any_orientation=True, lateral_m=0.012, along_m=0.07, tracks_support=False, sigma_tracks_support=False
+    ),
     # Axis-aligned: lateral <= 2.6 mm, ends <= 3.1 mm; its confidence counts the faces it read, not their points.
     # (On the tilted part it reports the seam along x 10.6 mm off at confidence 1: parts square to R only.)
-    "paper": Contract(any_orientation=False, lateral_m=0.006, along_m=0.007, tracks_support=False, reports_sigma=False),
+    "paper": Contract(
+        any_orientation=False, lateral_m=0.006, along_m=0.007, tracks_support=False, sigma_tracks_support=False
+    ),
 }
 # Options under which a locator draws from its generator on the synthetic joint (ours subsamples only big tubes).
 RNG_OPTIONS: dict[str, dict[str, Any]] = {"ours": {"max_points": 3000}}
@@ -111,7 +117,7 @@ def check_estimate(est: SeamEstimate, seam_id: str, method: str) -> None:
         assert est.p_start.shape == (3,) and est.p_end.shape == (3,)
         assert np.all(np.isfinite(est.p_start)) and np.all(np.isfinite(est.p_end))
         assert est.code is None
-        assert (0.0 < est.sigma_m < math.inf) if CONTRACTS[method].reports_sigma else est.sigma_m == math.inf
+        assert 0.0 < est.sigma_m < math.inf
     else:
         assert isinstance(est.code, Reason) and est.reason
 
@@ -178,7 +184,7 @@ def test_thinning_the_cloud_lowers_confidence(
     assert full.status is SeamStatus.FOUND
     if thin.status is SeamStatus.FOUND:
         assert thin.confidence < full.confidence, (full.confidence, thin.confidence)
-        if CONTRACTS[method].reports_sigma:
+        if CONTRACTS[method].sigma_tracks_support:
             assert thin.sigma_m > 1.3 * full.sigma_m, (full.sigma_m, thin.sigma_m)  # 30 % of the points: ~1.8 x
 
 

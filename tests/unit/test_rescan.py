@@ -22,10 +22,12 @@ from cell.motion.viewpoint import (
     torch_axis_in_camera,
 )
 from cell.rescan import (
+    estimate_sigma,
     fuse,
     seams_to_rescan,
-    sigma_from_confidence,
+    within_tolerance,
 )
+from cell.seams.sigma import PAPER_SIGMA_M, PAPER_SIGMA_UNSEEN_M, ours_sigma, paper_sigma
 from cell.sim.camera import intrinsics_for
 from cell.types import Box, Part, SeamEstimate, SeamStatus
 
@@ -94,20 +96,23 @@ def test_segment_box_test() -> None:
 # -- uncertainty and fusion ------------------------------------------------------------------------------
 
 
-def _est(p0: Any, p1: Any, conf: float, status: SeamStatus = SeamStatus.FOUND) -> SeamEstimate:
+def _est(
+    p0: Any, p1: Any, conf: float, status: SeamStatus = SeamStatus.FOUND, sigma_m: float = math.inf
+) -> SeamEstimate:
     if status is not SeamStatus.FOUND:
         return SeamEstimate("s", status, "not seen")
-    return SeamEstimate("s", status, "", np.asarray(p0, float), np.asarray(p1, float), conf)
+    return SeamEstimate("s", status, "", np.asarray(p0, float), np.asarray(p1, float), conf, sigma_m=sigma_m)
 
 
-def test_sigma_falls_with_confidence_to_its_floor() -> None:
-    s = [sigma_from_confidence(c, 2e-4, 1e-4) for c in (0.1, 0.3, 0.55, 0.8, 1.0)]
-    assert all(a > b for a, b in itertools.pairwise(s))
-    assert s[-1] == pytest.approx(1e-4)
-    assert sigma_from_confidence(0.5, 2e-4, 0.0) == pytest.approx(2e-4)  # the scale is the sigma at c = 1/2
-    assert math.isinf(sigma_from_confidence(0.0, 2e-4, 1e-4))
-    with pytest.raises(ValueError):
-        sigma_from_confidence(1.5, 2e-4, 1e-4)
+def test_sigma_models_and_the_fusion_reads_the_locators_sigma() -> None:
+    s = [ours_sigma(se, 5e-5) for se in (0.0, 1e-5, 1e-4, 1e-3)]
+    assert all(a < b for a, b in itertools.pairwise(s))
+    assert s[0] == pytest.approx(5e-5) and s[-1] == pytest.approx(math.hypot(1e-3, 5e-5))
+    assert math.isinf(ours_sigma(math.inf, 5e-5))
+    assert paper_sigma(1.0) == paper_sigma(0.9) == PAPER_SIGMA_M
+    assert paper_sigma(0.75) == paper_sigma(0.5) == PAPER_SIGMA_UNSEEN_M
+    assert estimate_sigma(_est([0, 0, 0], [0.1, 0, 0], 0.2, sigma_m=3e-4)) == 3e-4  # not from the confidence
+    assert math.isinf(estimate_sigma(None)) and math.isinf(estimate_sigma(_est(None, None, 0.0, SeamStatus.NOT_FOUND)))
 
 
 def test_fusion_weights_by_inverse_variance_and_turns_a_reversed_closeup_round() -> None:
@@ -119,22 +124,24 @@ def test_fusion_weights_by_inverse_variance_and_turns_a_reversed_closeup_round()
     np.testing.assert_allclose(fused.p_end, [0.1, 0.0027, 0], atol=1e-12)
     sigma = math.sqrt(9e-8 * 1e-8 / 1e-7)
     assert fused.confidence == pytest.approx(1.0 / (1.0 + (sigma / 2e-4) ** 2))
+    assert fused.sigma_m == pytest.approx(sigma)  # what the weld gate reads
     even, w_even = fuse(first, _est([0, 0.002, 0], [0.1, 0.002, 0], 0.5), 1e-4, 1e-4, 2e-4)
     assert w_even == pytest.approx(0.5) and even.p_start[1] == pytest.approx(0.001)
 
 
 def test_failed_or_weak_closeup_keeps_the_first_estimate() -> None:
     first = _est([0, 0, 0], [0.1, 0, 0], 0.8)
-    s1 = sigma_from_confidence(0.8, 2e-4, 2e-4)
+    s1 = math.hypot(1e-4, 2e-4)
     for failed in (None, _est(None, None, 0.0, SeamStatus.NOT_FOUND)):
         fused, w = fuse(first, failed, s1, 1e-5, 2e-4)
         assert fused is first and w == 0.0
     weak = _est([0, 0.01, 0], [0.1, 0.01, 0], 0.001)  # a 10 mm wrong close-up the locator barely believes
-    fused, w = fuse(first, weak, s1, sigma_from_confidence(0.001, 2e-5, 2e-5), 2e-4)
+    fused, w = fuse(first, weak, s1, 6e-4, 2e-4)
     assert w < 0.2 and fused.p_start[1] < 0.002
     # A visible seam the fixed cameras missed: the close-up alone.
-    only, w_only = fuse(_est(None, None, 0.0, SeamStatus.NOT_FOUND), first, math.inf, 1e-4, 2e-4)
-    assert w_only == 1.0 and only.status is SeamStatus.FOUND
+    alone = _est([0, 0, 0], [0.1, 0, 0], 0.8, sigma_m=1e-4)
+    only, w_only = fuse(_est(None, None, 0.0, SeamStatus.NOT_FOUND), alone, math.inf, 1e-4, 2e-4)
+    assert w_only == 1.0 and only.status is SeamStatus.FOUND and only.sigma_m == 1e-4
 
 
 def test_seams_to_rescan_takes_low_confidence_and_missed_visible_seams() -> None:
@@ -146,3 +153,12 @@ def test_seams_to_rescan_takes_low_confidence_and_missed_visible_seams() -> None
     )
     assert seams_to_rescan(estimates, 0.55) == ["b", "c"]
     assert seams_to_rescan(estimates, math.inf) == ["a", "b", "c"]
+
+
+def test_a_seam_whose_bound_exceeds_the_tolerance_is_rescanned_whatever_its_confidence() -> None:
+    sure = SeamEstimate("a", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 1.0, sigma_m=1e-4)
+    vague = SeamEstimate("b", SeamStatus.FOUND, "", np.zeros(3), np.ones(3), 1.0, sigma_m=9e-4)  # the paper's
+    max_sigma = 0.5e-3 / 3.0  # 0.5 mm at 3 sigma
+    assert within_tolerance(sure, max_sigma) and not within_tolerance(vague, max_sigma)
+    assert seams_to_rescan((sure, vague), 0.55, max_sigma) == ["b"]
+    assert seams_to_rescan((sure, vague), 0.55) == []  # no tolerance given: the confidence alone

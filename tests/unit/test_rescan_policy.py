@@ -20,12 +20,15 @@ from cell.types import SeamEstimate, SeamStatus, WeldMap
 
 
 def _found(seam_id: str, confidence: float, y: float = 0.0) -> SeamEstimate:
-    return SeamEstimate(seam_id, SeamStatus.FOUND, "", np.array([0.0, y, 0.0]), np.array([0.1, y, 0.0]), confidence)
+    p0, p1 = np.array([0.0, y, 0.0]), np.array([0.1, y, 0.0])
+    return SeamEstimate(seam_id, SeamStatus.FOUND, "", p0, p1, confidence, sigma_m=1e-4)  # within 0.5 mm at 3 sigma
 
 
 def _detection(confidences: dict[str, float]) -> Any:
     estimates = (*(_found(k, c) for k, c in confidences.items()), SeamEstimate("under", SeamStatus.NOT_VISIBLE))
-    scenario: Any = SimpleNamespace(rescan=SimpleNamespace(confidence_threshold=0.55, escalate_mm=0.5))
+    scenario: Any = SimpleNamespace(
+        rescan=SimpleNamespace(confidence_threshold=0.55, escalate_mm=0.5, max_sigma_m=0.5e-3 / 3.0)
+    )
     _, summary = evaluate(estimates, {})
     return Detection(scenario, "ours", WeldMap((), (), "mm", "inline"), estimates, {}, {}, summary)
 

@@ -175,7 +175,7 @@ def test_every_options_class_is_reachable_from_the_scenario_with_its_defaults() 
     # One number each: the re-scan threshold, ours' confidence scale, the stick-out.
     assert s.rescan.confidence_threshold == config.CONFIDENCE_THRESHOLD
     assert s.rescan.closeup.first_scale_m == config.OursSettings().target_se_m
-    assert s.rescan.closeup.closeup_scale_m == config.CLOSEUP_OURS_OPTIONS["target_se_m"]
+    assert s.rescan.closeup.closeup_locator_options["ours"]["target_se_m"] == config.CLOSEUP_TARGET_SE_M
     assert s.robot.stickout_mm == config.STICKOUT_MM
     # Set in the file, they arrive typed.
     s = load_text(with_keys("motion: {gate: {rate_hz: 500}}\nlocator: {method: ransac, options: {runs: 5}}"))

@@ -18,6 +18,7 @@ from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
+from cell.seams.sigma import ours_sigma
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
@@ -205,7 +206,7 @@ class OursLocator:
             p_start=p0 + ends[0].s * t,
             p_end=p0 + ends[1].s * t,
             confidence=conf,
-            sigma_m=errors.lateral_m,
+            sigma_m=ours_sigma(errors.lateral_m, o.sigma_floor_m),
         )
         return estimate, errors
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -59,6 +60,23 @@ class Perceived:
 
     registered: Cloud = field(default_factory=lambda: Cloud(np.zeros((0, 3)), "R"))
     registered_voxels: VoxelTable | None = None
+
+    def splice_corrections(self) -> dict[str, dict[str, Any]]:
+        """Per registered camera, what the splice did to its calibration (for reports): ``applied`` (bool),
+        ``applied_mm`` and ``estimated_mm`` (RMS displacement of the overlap by the applied / the estimated
+        correction), ``directions`` (kept / constrained of the six), ``refused`` (``""`` or the test that refused
+        it, :data:`cell.perception.splice.REFUSALS`), onto which cameras (``target``)."""
+        return {
+            r.source: {
+                "target": list(r.target),
+                "applied": r.accepted,
+                "applied_mm": round(r.applied_shift_m * 1e3, 4),
+                "estimated_mm": round(r.shift_m * 1e3, 4),
+                "directions": f"{r.constrained}/{r.directions_constrained}",
+                "refused": r.refused,
+            }
+            for r in self.spliced.registrations
+        }
 
 
 def perceive(

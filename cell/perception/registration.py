@@ -13,9 +13,17 @@ what the registration found.
   target are thinned to an even stride of at most :data:`_PROBE_POINTS` / :data:`_TARGET_POINTS` points.
 
 A correction's motion along a direction the overlap does not constrain (a view of top faces alone says nothing
-about a shift along them) is dropped: that direction stays as calibrated. :func:`significance` measures how
-much the data support what is left (shift, patch-robust chi-square, patch misfit before and after); the splice
-decides from those whether to apply it.
+about a shift along them) is dropped: that direction stays as calibrated. So is its motion along a constrained
+direction that the data do not support on its own: in the eigenvectors of the information matrix of the
+point-to-plane problem, a direction is kept only if its part of the motion lowers the patch misfit by
+:data:`MIN_DIRECTION_DROP` of the misfit at the calibration (removing it alone from the correction raises the
+misfit that much), unless the whole correction lowers the misfit by :data:`CLEAR_DROP` (a real calibration
+error). The sensor's noise is not independent from patch to patch (flying pixels behind every edge a
+camera sees, seen from one side only), so a long part seen along its length gives a shift along it of 0.5-3 mm
+with a chi-square in the hundreds and no gain in misfit: the misfit, not the chi-square, tells a calibration
+error from that. :func:`significance` measures how much the data support what is left (shift, patch-robust
+chi-square and the smallest per-direction z score, patch misfit before and after); the splice decides from those
+whether to apply it.
 """
 
 from __future__ import annotations
@@ -40,6 +48,8 @@ _MAD_TO_SIGMA = 1.4826  # median absolute deviation -> standard deviation (Gauss
 _NORMAL_RADIUS_VOXELS = 2.0  # target normals from neighbours within this many voxels
 _NORMAL_NEIGHBOURS = 50  # ... at most this many (the nearest)
 _MIN_NOISE_M = 1e-4  # [m] floor of the measured noise (noise-free synthetic clouds)
+MIN_DIRECTION_DROP = 0.001  # a constrained direction is kept only if its motion lowers the patch misfit by this
+CLEAR_DROP = 0.15  # ... unless the whole correction lowers the patch misfit by this share (a calibration error)
 
 
 @dataclass(frozen=True)
@@ -122,9 +132,15 @@ def _constrained(p: FloatArray, n: FloatArray, w: FloatArray) -> tuple[FloatArra
     """
     centre = p.mean(axis=0)
     lever = max(float(np.sqrt(np.mean(np.sum((p - centre) ** 2, axis=1)))), 1e-9)
-    J = np.hstack([np.cross(p - centre, n) / lever, n])
+    J = _jacobian(p, n, centre, lever)
     vals, vecs = np.linalg.eigh((J.T * w) @ J)
     return J, vecs[:, vals >= _WEAK_DIRECTION * max(float(vals.sum()), 1e-300)], centre, lever
+
+
+def _jacobian(p: FloatArray, n: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
+    """(k, 6) point-to-plane Jacobian of points p (k, 3) on planes n (k, 3) in the coordinates of
+    :func:`_constrained` about ``centre`` (3,) with ``lever`` [m]."""
+    return np.hstack([np.cross(p - centre, n) / lever, n])
 
 
 def _restricted(X: FloatArray, D: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
@@ -148,20 +164,26 @@ def significance(
     """The part of the correction X_icp (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3))
     that the overlap constrains, and how much the data support it (all in R).
 
-    Returns (X (4, 4): X_icp without its motion along directions the overlap does not constrain; diagnostics
-    constrained, shift_m, chi2, misfit_before_m, misfit_m of X, see :class:`cell.perception.splice.Registration`).
+    Returns (X (4, 4): X_icp without its motion along directions the overlap does not constrain or the data do
+    not support (:func:`_supported`); diagnostics directions_constrained, constrained (the directions kept),
+    shift_m, chi2, z_min, misfit_before_m, misfit_m of X, see :class:`cell.perception.splice.Registration`).
     The chi-square is a sandwich (patch-robust) covariance of a point-to-plane least-squares estimate at X:
     Tukey-weighted residuals, one score per patch of ``patch_m`` and surface direction, in the constrained
     directions.
     """
     reach, k = settings.reach_m, settings.tukey_k_m
-    info = {"constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "misfit_before_m": math.inf, "misfit_m": math.inf}
+    info = {"constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "z_min": 0.0}
+    info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
     p0, n0, r0 = _plane_residuals(probe, target, normals, reach, np.eye(4))
     p, n, r = _plane_residuals(probe, target, normals, reach, X_icp)
     if len(r0) < _MIN_OVERLAP or len(r) < _MIN_OVERLAP:
         return np.eye(4), info
     info["misfit_before_m"] = _patch_misfit(r0, _tukey(r0, k), _patch_keys(p0, n0, patch_m))
     _, D, centre, lever = _constrained(p, n, _tukey(r, k))
+    info["directions_constrained"] = float(D.shape[1])
+    D = _supported(probe, target, normals, X_icp, D, centre, lever, settings, patch_m, info["misfit_before_m"])
+    if D.shape[1] == 0:
+        return np.eye(4), info
     X = _restricted(X_icp, D, centre, lever)
     p, n, r = _plane_residuals(probe, target, normals, reach, X)
     if len(r) < _MIN_OVERLAP:
@@ -170,18 +192,54 @@ def significance(
     patch = _patch_keys(p, n, patch_m)
     info["misfit_m"] = _patch_misfit(r, w, patch)
     info["shift_m"] = float(np.sqrt(np.mean(np.sum((transform_points(X, probe) - probe) ** 2, axis=1))))
-    J, D, centre, lever = _constrained(p, n, w)
-    Jd = J @ D
+    Jd = _jacobian(p, n, centre, lever) @ D  # the kept directions, as they were chosen
     score = np.stack([np.bincount(patch, w * r * Jd[:, j], int(patch.max()) + 1) for j in range(D.shape[1])], 1)
     c0 = transform_points(invert(X), centre[None])[0]
     est = D.T @ np.concatenate([Rotation.from_matrix(X[:3, :3]).as_rotvec() * lever, centre - c0])
     try:
         H_inv = np.linalg.inv((Jd.T * w) @ Jd)
-        chi2 = float(est @ np.linalg.solve(H_inv @ (score.T @ score) @ H_inv, est))
+        cov = H_inv @ (score.T @ score) @ H_inv
+        chi2 = float(est @ np.linalg.solve(cov, est))
+        z_min = float(np.min(np.abs(est) / np.sqrt(np.maximum(np.diag(cov), 1e-300))))
     except np.linalg.LinAlgError:
-        chi2 = 0.0
-    info |= {"constrained": float(D.shape[1]), "chi2": chi2}
+        chi2, z_min = 0.0, 0.0
+    info |= {"constrained": float(D.shape[1]), "chi2": chi2, "z_min": z_min}
     return X, info
+
+
+def _supported(
+    probe: FloatArray,
+    target: FloatArray,
+    normals: FloatArray,
+    X_icp: FloatArray,
+    D: FloatArray,
+    centre: FloatArray,
+    lever: float,
+    settings: RegistrationSettings,
+    patch_m: float,
+    misfit_before_m: float,
+) -> FloatArray:
+    """The columns of D (6, d) (eigenvectors of the information matrix, coordinates of :func:`_constrained`)
+    along which X_icp's motion lowers the patch misfit on its own: removing that direction's part from the
+    correction raises the misfit by at least :data:`MIN_DIRECTION_DROP` x ``misfit_before_m``; all of them when
+    the whole correction lowers the misfit by :data:`CLEAR_DROP` or more (a miscalibration of 1 mm / 0.1 deg
+    lowers it by 20-40 %, what the sensor's edges fake by 0-10 %: a real error's small components along weak
+    directions do not lower the misfit on their own, yet they matter far from the overlap). Returns (6, d')."""
+    c0 = transform_points(invert(X_icp), centre[None])[0]
+    e = D.T @ np.concatenate([Rotation.from_matrix(X_icp[:3, :3]).as_rotvec() * lever, centre - c0])
+
+    def misfit(keep: npt.NDArray[np.bool_]) -> float:
+        kept = D[:, keep] @ e[keep]
+        R = Rotation.from_rotvec(kept[:3] / lever).as_matrix()
+        p, n, r = _plane_residuals(probe, target, normals, settings.reach_m, make_pose(R, c0 + kept[3:] - R @ c0))
+        return _patch_misfit(r, _tukey(r, settings.tukey_k_m), _patch_keys(p, n, patch_m)) if len(r) else math.inf
+
+    every = np.ones(D.shape[1], dtype=bool)
+    full = misfit(every)
+    if full <= (1.0 - CLEAR_DROP) * misfit_before_m:  # a calibration error explains the misfit: every direction
+        return D
+    gain = np.array([misfit(every & (np.arange(len(every)) != j)) - full for j in range(len(every))])
+    return D[:, gain >= MIN_DIRECTION_DROP * misfit_before_m]
 
 
 def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tuple[FloatArray, dict[str, float]]:
@@ -195,8 +253,8 @@ def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tu
     """
     probe = np.asarray(source, dtype=np.float64)[:: max(1, math.ceil(len(source) / _PROBE_POINTS))]
     sub = np.asarray(target, dtype=np.float64)[:: max(1, math.ceil(len(target) / _TARGET_POINTS))]
-    info = {"overlap": 0.0, "noise_m": 0.0, "constrained": 0.0, "shift_m": 0.0, "chi2": 0.0}
-    info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
+    info = {"overlap": 0.0, "noise_m": 0.0, "constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0}
+    info |= {"chi2": 0.0, "z_min": 0.0, "misfit_before_m": math.inf, "misfit_m": math.inf}
     if len(probe) < _MIN_OVERLAP or len(sub) < _MIN_OVERLAP:
         return np.eye(4), info
     settings = registration_settings(spec, 0.0)

@@ -11,11 +11,14 @@ weighs each camera by its own noise loses nothing to the merge.
 Each camera is registered onto the cameras before it by :func:`cell.perception.registration.register` (open3d's
 ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says); its motion along directions the
 overlap does not constrain is dropped there. Whichever ICP, the correction is *applied* only when it is
-significant (a test, not a solver): its displacement of the overlap exceeds :data:`MIN_SHIFT_M`, its chi-square
-against a covariance that treats every patch of ``merge_cell_m`` as one independent measurement (edges, flying
-pixels and shadows bias whole patches, not single points) exceeds :data:`SIGNIFICANCE_CHI2`, and the patch
-misfit (point-to-plane) drops by at least :data:`MIN_MISFIT_DROP`. With exact extrinsics nothing is applied; a
-miscalibration of 0.3-1 mm / 0.03-0.1 deg is taken out.
+significant (a test, not a solver): at least one direction lowers the misfit on its own (the registration keeps
+only those), its displacement of the overlap exceeds :data:`MIN_SHIFT_M`, its chi-square against a covariance
+that treats every patch of ``merge_cell_m`` as one independent measurement (edges, flying pixels and shadows
+bias whole patches, not single points) exceeds :data:`SIGNIFICANCE_CHI2`, and the patch misfit (point-to-plane)
+drops by at least :data:`MIN_MISFIT_DROP`. (A z score per kept direction, ``Registration.z_min``, is reported but
+not tested: a real miscalibration can have a component near zero along one direction.) With
+exact extrinsics nothing is applied, also for long parts seen along their length (``scenarios/long-*.yaml``);
+a miscalibration of 1 mm / 0.1 deg is taken out. ``Registration.refused`` says which test refused a correction.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ MOUNTS = ("fixed", "eye_in_hand")
 MIN_SHIFT_M = 0.0001  # [m] a correction moving the overlap by less than this (RMS) is not applied
 SIGNIFICANCE_CHI2 = 50.0  # a correction is applied only above this chi-square (patch-robust covariance)
 MIN_MISFIT_DROP = 0.05  # ... and only if it lowers the patch misfit by at least this fraction
+REFUSALS = ("no_overlap", "no_supported_direction", "too_small", "not_significant", "no_misfit_gain")
 
 
 @dataclass(frozen=True)
@@ -53,6 +57,10 @@ class Registration:
         extrinsics and after ``X_estimated``.
     accepted : whether the correction was applied (see the module docstring).
     noise_m : robust standard deviation of the point-to-plane residuals in the overlap [m] (calibrated).
+    directions_constrained : directions the overlap constrains, of which ``constrained`` lower the misfit on
+        their own and are kept in ``X_estimated`` (the others stay as calibrated).
+    z_min : the smallest z score of ``X_estimated``'s motion along a kept direction (patch-robust).
+    refused : ``""`` when applied, else the first test that refused it (one of :data:`REFUSALS`).
     """
 
     source: str
@@ -67,10 +75,34 @@ class Registration:
     misfit_m: float
     accepted: bool
     noise_m: float = 0.0
+    directions_constrained: int = 0
+    z_min: float = 0.0
+    refused: str = ""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "X_corr", readonly(self.X_corr))
         object.__setattr__(self, "X_estimated", readonly(self.X_estimated))
+
+    @property
+    def applied_shift_m(self) -> float:
+        """RMS displacement of the overlap by the applied correction [m] (0 when refused)."""
+        return self.shift_m if self.accepted else 0.0
+
+
+def refusal(info: Mapping[str, float]) -> str:
+    """``""`` if a registration's diagnostics (:func:`cell.perception.registration.register`) pass every test of
+    the module docstring, else the first that fails (one of :data:`REFUSALS`)."""
+    if info["overlap"] <= 0.0 or info["directions_constrained"] <= 0.0:
+        return "no_overlap"
+    if info["constrained"] <= 0.0:
+        return "no_supported_direction"
+    if info["shift_m"] < MIN_SHIFT_M:
+        return "too_small"
+    if info["chi2"] < SIGNIFICANCE_CHI2:
+        return "not_significant"
+    if not info["misfit_m"] <= (1.0 - MIN_MISFIT_DROP) * info["misfit_before_m"]:
+        return "no_misfit_gain"
+    return ""
 
 
 @dataclass(frozen=True)
@@ -138,11 +170,8 @@ def splice(
     for k, name in enumerate(order[1:], start=1):
         part = slice(bounds[k], bounds[k + 1])
         X, info = register(points[part], points[: bounds[k]], spec)
-        accepted = (
-            info["shift_m"] >= MIN_SHIFT_M
-            and info["chi2"] >= SIGNIFICANCE_CHI2
-            and info["misfit_m"] <= (1.0 - MIN_MISFIT_DROP) * info["misfit_before_m"]
-        )
+        refused = refusal(info)
+        accepted = not refused
         X_corr = X if accepted else np.eye(4)
         registrations.append(
             Registration(
@@ -158,6 +187,9 @@ def splice(
                 info["misfit_m"],
                 accepted,
                 info["noise_m"],
+                int(info["directions_constrained"]),
+                info["z_min"],
+                refused,
             )
         )
         if accepted:

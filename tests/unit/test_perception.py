@@ -37,8 +37,8 @@ from cell.perception import (
 )
 from cell.perception.merge import predicted_noise, prioritised_merge
 from cell.perception.preprocess import radius_outlier_mask, z_range_R
-from cell.perception.registration import register, registration_settings
-from cell.perception.splice import MIN_SHIFT_M, splice_order
+from cell.perception.registration import register, registration_settings, significance
+from cell.perception.splice import MIN_SHIFT_M, REFUSALS, refusal, splice_order
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
 
@@ -445,3 +445,48 @@ def test_perceive_end_to_end_and_lost_camera() -> None:
     }
     with pytest.raises(SensorError, match=r"cam_right.*cam_left.*eye_in_hand"):
         perceive(dark, X_WR, SPEC)
+
+
+def _rail_samples(rng: np.random.Generator, offset_m: np.ndarray) -> np.ndarray:
+    """Random samples (n, 3) [m] of a 1.4 m rail of 80 x 80 mm seen along its length: its top, both long sides
+    and the one end face towards the camera, 1 mm of noise along each face's normal, moved by ``offset_m``."""
+    faces = []
+    for axis, sign, area in ((2, 1.0, 0.112), (1, 1.0, 0.112), (1, -1.0, 0.112), (0, 1.0, 0.0064)):
+        k = int(area / 0.003**2)
+        p = rng.uniform([-0.7, -0.04, -0.04], [0.7, 0.04, 0.04], (k, 3))
+        p[:, axis] = sign * (0.7 if axis == 0 else 0.04) + rng.normal(0.0, 0.001, k)
+        faces.append(p)
+    return np.concatenate(faces) + offset_m
+
+
+def test_significance_keeps_only_directions_that_lower_the_misfit() -> None:
+    """A rail seen along its length constrains a shift along it only through its small end face. An estimate
+    that moves the cloud along the rail (as flying pixels behind every edge seen from one end push it) is
+    dropped there and stays as calibrated; a real offset across the rail is kept. An estimate the data do not
+    support in any direction is refused with the reason."""
+    rng = np.random.default_rng(3)
+    target = _rail_samples(rng, np.zeros(3))
+    normals = _open3d.estimate_normals(target, 0.02, 50)
+    settings = registration_settings(SPEC, 0.001)
+    along = make_pose(p=[0.002, 0.0, 0.0])  # 2 mm along the rail, unsupported
+    exact = _rail_samples(rng, np.zeros(3))
+    X, info = significance(exact, target, normals, along, settings, SPEC.merge_cell_m)
+    assert np.array_equal(X, np.eye(4)) and info["constrained"] == 0 and info["directions_constrained"] == 5
+    assert refusal(info | {"overlap": 1.0}) == "no_supported_direction"
+    low = _rail_samples(rng, np.array([0.0, 0.0, 0.0003]))  # 0.3 mm high: a real calibration error
+    X, info = significance(low, target, normals, make_pose(p=[0.002, 0.0, -0.0003]), settings, SPEC.merge_cell_m)
+    assert abs(X[0, 3]) < 2e-5 and abs(X[2, 3] + 0.0003) < 3e-5  # the shift along the rail dropped, z kept
+    assert info["constrained"] == 2 and info["directions_constrained"] == 5  # (the roll about the rail is free)
+    assert info["misfit_m"] < 0.9 * info["misfit_before_m"] and info["z_min"] > 10.0
+
+
+def test_refusal_names_the_first_failing_test() -> None:
+    ok = {"overlap": 5000.0, "directions_constrained": 6.0, "constrained": 3.0, "shift_m": 0.001}
+    ok |= {"chi2": 500.0, "z_min": 8.0, "misfit_before_m": 0.0006, "misfit_m": 0.0004}
+    assert refusal(ok) == ""
+    assert refusal(ok | {"overlap": 0.0}) == "no_overlap"
+    assert refusal(ok | {"constrained": 0.0}) == "no_supported_direction"
+    assert refusal(ok | {"shift_m": MIN_SHIFT_M / 2}) == "too_small"
+    assert refusal(ok | {"chi2": 10.0}) == "not_significant" and refusal(ok | {"z_min": 0.5}) == ""
+    assert refusal(ok | {"misfit_m": 0.00059}) == "no_misfit_gain"
+    assert set(REFUSALS) >= {refusal(ok | {"overlap": 0.0}), "no_misfit_gain"}

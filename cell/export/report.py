@@ -83,6 +83,8 @@ def detection_report(
         "units": "m",
         "X_WR": [[_r(v, 9) for v in row] for row in det.scenario.X_WR],
         "lost_cameras": list(det.lost_cameras),
+        # Per registered camera: the splice's correction of its calibration, applied or refused and why.
+        "splice": det.scene.perceived.splice_corrections() if det.scene is not None else None,
         "seams": seams,
         "summary": summary,
         "timings_s": {k: _r(v, 4) for k, v in det.timings.items()},

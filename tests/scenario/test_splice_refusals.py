@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scenes import Scenes
 
 from cell import pipeline
 from cell import scenario as sc
+from cell.export import detection_report
 from cell.perception import perceive
 from cell.perception.splice import REFUSALS
 
@@ -24,11 +24,15 @@ def _perceived(name: str) -> dict[str, dict[str, object]]:
     return perceive(cap.images, s.X_WR, s.perception, s.perception.health).splice_corrections()
 
 
-def test_fence1_exact_extrinsics_nothing_applied(perceived: Scenes) -> None:
-    regs = perceived("fence1", "realistic").scene.perceived.spliced.registrations
+def test_fence1_exact_extrinsics_nothing_applied(fence1_detection: pipeline.Detection) -> None:
+    assert fence1_detection.scene is not None
+    regs = fence1_detection.scene.perceived.spliced.registrations
     assert len(regs) == 2
     for r in regs:
         assert not r.accepted and r.refused in REFUSALS and np.array_equal(r.X_corr, np.eye(4))
+    splice = detection_report(fence1_detection)["splice"]  # the report says so, per camera
+    assert set(splice) == {"cam_left", "cam_right"}
+    assert all(c["applied"] is False and c["refused"] in REFUSALS for c in splice.values())
 
 
 @pytest.mark.parametrize("name", ["long-fence1", "long-ladder"])

@@ -156,8 +156,8 @@ def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, o
     """Plan every visible designed seam of each scenario; times [s]."""
     from cell import scenario as sc
     from cell.geometry import invert
-    from cell.motion.checks import find_violations
     from cell.motion.collision import CollisionChecker
+    from cell.motion.gate import find_violations
     from cell.motion.plan import SeamTask, cell_obstacles, plan_welds
     from cell.motion.torch import WeldProcess
     from cell.seams.joint import find_joints, weld_faces

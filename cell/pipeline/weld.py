@@ -50,7 +50,7 @@ def plan_for(
     home that precedes it, and the gate's violations (empty when the plan may run). PlanError when nothing can be
     planned at all.
     """
-    from cell.motion.checks import find_violations
+    from cell.motion.gate import find_violations
     from cell.motion.plan import plan_welds, seam_tasks
     from cell.motion.timing import ptp
     from cell.motion.torch import WeldProcess

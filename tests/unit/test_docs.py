@@ -3,37 +3,26 @@ result tables from benchmarks/results/. A model or a result changed without rege
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
 import shutil
-import sys
 from pathlib import Path
 from types import ModuleType
 
 import pytest
+from tools_loader import load_tool
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _tool(name: str) -> ModuleType:
-    """A script of tools/ as a module (tools/ is not a package)."""
-    spec = importlib.util.spec_from_file_location(f"tools_{name}", REPO / "tools" / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.fixture(scope="module")
 def scenario_docs() -> ModuleType:
-    return _tool("scenario_docs")
+    return load_tool("scenario_docs")
 
 
 @pytest.fixture(scope="module")
 def readme_results() -> ModuleType:
-    return _tool("readme_results")
+    return load_tool("readme_results")
 
 
 def test_scenarios_md_is_generated_from_the_models(scenario_docs: ModuleType) -> None:
@@ -120,7 +109,7 @@ def test_every_citation_of_the_reference_names_a_section_it_has() -> None:
 
 
 def test_no_citation_of_the_design_notes_is_left() -> None:
-    fix_citations = _tool("fix_citations")
+    fix_citations = load_tool("fix_citations")
     assert fix_citations.main(["--check"]) == 0, "run .venv/bin/python tools/fix_citations.py"
 
 

@@ -4,31 +4,21 @@ makes the README check fail until the tables are rendered again."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shutil
-import sys
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import pytest
+from tools_loader import load_tool
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _tool(name: str) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(f"tools_{name}", REPO / "tools" / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.fixture(scope="module")
 def tables() -> ModuleType:
-    return _tool("readme_cell_tables")
+    return load_tool("readme_cell_tables")
 
 
 def _fault(**over: Any) -> dict[str, Any]:
@@ -122,7 +112,7 @@ def test_a_seam_not_welded_says_why_by_its_code(tables: ModuleType) -> None:
 
 
 def test_readme_check_fails_on_a_changed_fault_result(tmp_path: Path) -> None:
-    readme_results = _tool("readme_results")
+    readme_results = load_tool("readme_results")
     results = tmp_path / "results"
     shutil.copytree(REPO / "benchmarks" / "results", results)
     rows = json.loads((results / "faults.json").read_text(encoding="utf-8"))

@@ -1,0 +1,24 @@
+"""The scripts of ``tools/`` as modules, for the tests that check what they generate (tools/ is not a package)."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def load_tool(name: str) -> ModuleType:
+    """``tools/NAME.py`` imported as the module ``tools_NAME`` (once per session)."""
+    key = f"tools_{name}"
+    if key in sys.modules:
+        return sys.modules[key]
+    spec = importlib.util.spec_from_file_location(key, REPO / "tools" / f"{name}.py")
+    if spec is None or spec.loader is None:
+        raise ImportError(f"no tool {name!r} in {REPO / 'tools'}")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[key] = module
+    spec.loader.exec_module(module)
+    return module

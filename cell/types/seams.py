@@ -46,7 +46,8 @@ class SeamEstimate:
     reason : the detail, for people; code : the reason as a :class:`Reason` (None for a found seam).
     p_start, p_end : (3,) [m] when ``status`` is FOUND; empty arrays otherwise.
     confidence : in [0, 1]; 0 when not found.
-    sigma_m : the locator's own standard error of the seam line across it [m] (inf when it reports none).
+    sigma_m : the locator's calibrated standard deviation of the seam line across it [m] (``cell/seams/sigma.py``;
+        inf when it gives none).
     time_s : wall time the locator spent on this seam [s].
     """
 

@@ -118,7 +118,8 @@ def _cycle_line(r: Row) -> str:
         rescan = "no close-up re-scan"
     return (
         f"Cycle time {_f(r['cycle_time_s'], 1)} s of robot motion (arc {_f(r['arc_time_s'], 1)} s, {rescan}); "
-        f"wall time {_f(t.get('total_s'), 1)} s headless (capture {_f(t.get('capture_s'), 1)}, perceive "
+        f"pipeline wall time {_f(t.get('total_s'), 1)} s headless, Python start-up not counted "
+        f"(capture {_f(t.get('capture_s'), 1)}, perceive "
         f"{_f(t.get('perceive_s'), 1)}, align {_f(t.get('align_s'), 1)}, locate {_f(t.get('locate_s'), 2)}, re-scan "
         f"{_f(t.get('rescan_s', 0.0), 1)}, plan and safety gate {_f(t.get('plan_s'), 1)}, execute "
         f"{_f(t.get('execute_s'), 2)} s)."

@@ -27,7 +27,7 @@ def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
         raise ScenarioError(
             f"deviations name unknown part(s) {', '.join(unknown)}; parts of the map: {', '.join(sorted(names))}"
         )
-    X_WM = scenario.X_WM @ scenario.map.placement_error.X  # true placement, not the nominal one
+    X_WM = scenario.X_WM @ scenario.simulation.placement_error.X  # true placement, not the nominal one
     table_top = scenario.table.top_z
     parts = []
     for part in weldmap_M.parts:

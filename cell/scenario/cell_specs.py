@@ -31,7 +31,6 @@ class MapSpec(Model):
     file: str
     units: Literal["mm", "cm", "m", "in"] | None = None  # only used when the DXF declares no $INSUNITS
     X_WM: PoseSpec = PoseSpec()  # nominal placement of the drawing on the table (what the cell is told)
-    placement_error: PoseSpec = PoseSpec()  # where the part really lies, relative to X_WM (ground truth only)
 
 
 class Deviation(Model):

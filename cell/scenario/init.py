@@ -152,7 +152,6 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
         (f"name: {_str(name)}", "shown in reports"),
         (f"description: {_str(f'Written by cell init for {Path(map_file).name}')}", "one line for `cell scenarios`"),
         ("seed: 1", "every random draw (sensor noise, RANSAC) derives from it"),
-        ("noise: realistic", "simulated depth noise: realistic (RealSense D4xx model) | none"),
         ("map:", "the welding map and where the cell is told it lies"),
         (f"  file: {_str(map_file)}", "looked for beside this file, then by name in the repository's maps/"),
     ]
@@ -162,14 +161,6 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
         ("  X_WM:", "nominal pose of the drawing's origin in the world"),
         (f"    xyz_m: {_vec(lay.X_WM_xyz)}", "part centred at (0.15, 0.0), its underside on the table top [m]"),
         ("    rpy_deg: [0.0, 0.0, 0.0]", "roll, pitch, yaw [deg]: as drawn"),
-        ("  placement_error:", "simulation: where the part really lies relative to X_WM"),
-        ("    xyz_m: [0.0, 0.0, 0.0]", "[m]: e.g. [0.005, -0.003, 0.0]"),
-        ("    rpy_deg: [0.0, 0.0, 0.0]", "[deg]: e.g. [0.0, 0.0, 0.3]"),
-        (
-            "deviations: {}",
-            f"simulation: part -> as built minus drawn, e.g. {weldmap.parts[0].name}: {{size_mm: [2.0, 0.0, 0.0]}}"
-            f" (parts: {parts})",
-        ),
         ("table:", "the welding table, a box"),
         (f"  center_m: {_vec(lay.table_center)}", "its centre in the world [m]"),
         (f"  size_m: {_vec(lay.table_size)}", "the part's footprint + 0.2 m a side, at least 2.0 x 1.2 [m]"),
@@ -197,6 +188,16 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
         ("  workspace:", "only points inside this box are kept"),
         (f"    min_m: {_vec(lo)}", "the part's bounds - 0.15 m; 5 mm above the table top [m]"),
         (f"    max_m: {_vec(hi)}", "the part's bounds + 0.15 m; 0.2 m above its top [m]"),
+        ("simulation:", "what only a simulation knows (a real cell is told none of it)"),
+        ("  noise: realistic", "simulated depth noise: realistic (RealSense D4xx model) | none"),
+        ("  placement_error:", "where the part really lies relative to map.X_WM"),
+        ("    xyz_m: [0.0, 0.0, 0.0]", "[m]: e.g. [0.005, -0.003, 0.0]"),
+        ("    rpy_deg: [0.0, 0.0, 0.0]", "[deg]: e.g. [0.0, 0.0, 0.3]"),
+        (
+            "  deviations: {}",
+            f"part -> as built minus drawn, e.g. {weldmap.parts[0].name}: {{size_mm: [2.0, 0.0, 0.0]}}"
+            f" (parts: {parts})",
+        ),
     ]
     return rows
 

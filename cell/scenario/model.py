@@ -32,9 +32,7 @@ class Scenario(Model):
     name: str
     description: str = ""
     seed: Annotated[int, Field(ge=0)]
-    noise: Literal["none", "realistic"] = "realistic"
     map: MapSpec
-    deviations: dict[str, Deviation] = Field(default_factory=dict)
     table: TableSpec
     robot: RobotSpec = RobotSpec()
     process: ProcessSpec = ProcessSpec()
@@ -45,7 +43,6 @@ class Scenario(Model):
     motion: MotionSpec = MotionSpec()
     export: ExportSpec = ExportSpec()
     simulation: SimulationSpec = SimulationSpec()
-    faults: FaultsSpec = FaultsSpec()
     # Set by the loader: the folder the file lives in (paths inside are relative to it).
     base_dir: str = Field(default=".", exclude=True)
 
@@ -61,7 +58,8 @@ class Scenario(Model):
         unknown = sorted(set(self.faults.cameras) - set(self.cameras))
         if unknown:
             raise ValueError(
-                f"faults.cameras names unknown camera(s) {', '.join(unknown)}; cameras: {', '.join(self.cameras)}"
+                f"simulation.faults.cameras names unknown camera(s) {', '.join(unknown)}; "
+                f"cameras: {', '.join(self.cameras)}"
             )
         return self
 
@@ -75,6 +73,21 @@ class Scenario(Model):
     def map_path(self) -> Path:
         """The map file: the first of :attr:`map_candidates` that exists (the first if none does)."""
         return next((p for p in self.map_candidates if p.is_file()), self.map_candidates[0])
+
+    @property
+    def noise(self) -> Literal["none", "realistic"]:
+        """``simulation.noise``: the depth sensors' error model on or off."""
+        return self.simulation.noise
+
+    @property
+    def deviations(self) -> dict[str, Deviation]:
+        """``simulation.deviations``: part name -> how it was built differently from the drawing."""
+        return self.simulation.deviations
+
+    @property
+    def faults(self) -> FaultsSpec:
+        """``simulation.faults``: the failures the simulation plays."""
+        return self.simulation.faults
 
     @property
     def X_WR(self) -> FloatArray:
@@ -92,5 +105,13 @@ class Scenario(Model):
         """
         return np.random.default_rng([self.seed, zlib.crc32(purpose.encode())])
 
+    def with_simulation(self, **changes: object) -> Scenario:
+        """The scenario with these ``simulation`` keys changed (``noise=``, ``faults=``, ``deviations=``,
+        ``placement_error=``); an unknown key is a ValueError, not a silently ignored attribute."""
+        unknown = sorted(set(changes) - set(SimulationSpec.model_fields))
+        if unknown:
+            raise ValueError(f"no simulation key {', '.join(unknown)}; valid: {', '.join(SimulationSpec.model_fields)}")
+        return self.model_copy(update={"simulation": self.simulation.model_copy(update=changes)})
+
     def with_noise(self, noise: Literal["none", "realistic"]) -> Scenario:
-        return self.model_copy(update={"noise": noise})
+        return self.with_simulation(noise=noise)

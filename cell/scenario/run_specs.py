@@ -25,7 +25,7 @@ from cell.config import (
 from cell.config.rescan import BOUND_SIGMAS, WELD_TOLERANCE_MM
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
-from cell.scenario.cell_specs import WorkspaceSpec
+from cell.scenario.cell_specs import Deviation, PoseSpec, WorkspaceSpec
 from cell.scenario.locator_specs import LOCATOR_SPECS, spec_method
 
 
@@ -176,6 +176,12 @@ class ExportSpec(Model):
 
 
 class SimulationSpec(Model):
-    """How the simulator draws what it plays (no effect on any figure)."""
+    """What only a simulation knows: how the part was really built and placed, the sensors' noise, the faults it
+    plays, how it draws the weld. A real cell is told none of this; everything else in the scenario is what a real
+    cell is told."""
 
-    bead: BeadStyle = BeadStyle()
+    noise: Literal["none", "realistic"] = "realistic"  # the depth sensors' error model on or off
+    deviations: dict[str, Deviation] = Field(default_factory=dict)  # part name -> as built minus drawn
+    placement_error: PoseSpec = PoseSpec()  # where the part really lies, relative to map.X_WM (ground truth only)
+    faults: FaultsSpec = FaultsSpec()
+    bead: BeadStyle = BeadStyle()  # how the weld bead is drawn (no effect on any figure)

@@ -176,6 +176,6 @@ def test_a_ladder_one_rung_off_is_refused_as_ambiguous() -> None:
 def test_every_camera_broken_is_a_sensor_error() -> None:
     s = sc.load("faults/camera-dead")
     faults = s.faults.model_copy(update={"cameras": {n: sc.CameraFaultSpec(mode="dead") for n in s.cameras}})
-    det = pipeline.detect(half_resolution(s).model_copy(update={"faults": faults}))
+    det = pipeline.detect(half_resolution(s).with_simulation(faults=faults))
     assert_nothing_searched(Outcome(det, {e.id: e for e in det.estimates}, {}, {}), SensorError)
     assert det.error is not None and "no usable camera: cam_right: no usable image" in det.error.message

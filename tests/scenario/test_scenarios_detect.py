@@ -64,7 +64,7 @@ def test_realistic_noise_runs_and_reports_honest_figures(perceived: Scenes, name
 def test_alignment_recovers_the_placement_error(perceived: Scenes) -> None:
     p = perceived("fence2", "realistic")
     s, scene = p.scenario, p.scene
-    X_RM_true = np.linalg.inv(s.X_WR) @ s.X_WM @ s.map.placement_error.X
+    X_RM_true = np.linalg.inv(s.X_WR) @ s.X_WM @ s.simulation.placement_error.X
     # fence2 lies 12 mm / 8 mm / 0.8 deg off its nominal place; the aligned map must be far closer than that.
     # (Parts carry their own deviations too: measured 2.5 mm of the 14.4 mm, the bound about twice that.)
     dp = np.linalg.norm(scene.X_RM[:3, 3] - X_RM_true[:3, 3])

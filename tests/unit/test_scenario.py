@@ -43,9 +43,9 @@ def test_names_and_paths_resolve_to_the_same_scenario() -> None:
             ("    eye_m: [1.0", "    eyes_m: [1.0"),
             "unknown key 'cameras.cam_right.eyes_m' (did you mean 'eye_m'?)",
         ),
-        (("TOP_RAIL:    {size_mm", "TOP_RAIL:    {sizes_mm"), "unknown key 'deviations.TOP_RAIL.sizes_mm'"),
+        (("TOP_RAIL:    {size_mm", "TOP_RAIL:    {sizes_mm"), "unknown key 'simulation.deviations.TOP_RAIL.sizes_mm'"),
         (("seed: 12", "seed: -3"), "seed: Input should be greater than or equal to 0"),
-        (("noise: realistic", "noise: loud"), "noise: Input should be 'none' or 'realistic'"),
+        (("noise: realistic", "noise: loud"), "simulation.noise: Input should be 'none' or 'realistic'"),
         (
             ("file: ../maps/fence1.dxf", "file: ../maps/nope.dxf"),
             "map.file '../maps/nope.dxf' does not exist",

@@ -33,7 +33,7 @@ def test_the_layout_for_fence2_is_the_shipped_fence2_cell(tmp_path: Path) -> Non
     assert written.cameras == shipped.cameras
     assert written.perception.workspace == shipped.perception.workspace
     # What only a simulation knows is left at a healthy, exactly built cell.
-    assert written.deviations == {} and written.map.placement_error == sc.PoseSpec()
+    assert written.deviations == {} and written.simulation.placement_error == sc.PoseSpec()
     assert written.faults == sc.FaultsSpec() and written.noise == "realistic"
     assert check_layout(written, read_map(FENCE2)) == [] and not lay.unreachable_risk
 

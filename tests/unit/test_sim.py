@@ -24,7 +24,7 @@ BOX_TOP = 1.0  # [m]
 TINY = """
 name: tiny
 seed: 7
-noise: {noise}
+simulation: {{noise: {noise}}}
 map: {{file: dummy.dxf}}
 table: {{center_m: [0.0, 0.0, 0.85], size_m: [1.2, 0.8, 0.1]}}
 cameras:

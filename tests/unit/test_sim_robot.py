@@ -28,7 +28,7 @@ LINKS = ("base_link", "link_2", "link_4", "tool0", "torch_tcp", "camera_optical"
 TINY = """
 name: tiny_robot
 seed: 3
-noise: none
+simulation: {noise: none}
 map: {file: dummy.dxf}
 table: {center_m: [0.0, 0.0, 0.85], size_m: [1.2, 0.8, 0.1]}
 cameras:

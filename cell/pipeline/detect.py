@@ -14,10 +14,10 @@ from cell.scenario import Scenario
 from cell.station import Station, open_station
 from cell.types import MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus, WeldMap
 
-Progress = Callable[[str], None]
+Progress = Callable[[str], None]  # a stage's progress messages (the CLI prints them on stderr)
 
 
-def _quiet(_: str) -> None:
+def quiet(_: str) -> None:
     return None
 
 
@@ -32,7 +32,7 @@ def capture(
     scenario: Scenario,
     *,
     gui: bool = False,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
     station: Station | None = None,
     weldmap: WeldMap | None = None,
 ) -> Capture:
@@ -59,7 +59,7 @@ def table_z_R(scenario: Scenario) -> float:
     return float((invert(scenario.X_WR) @ [0.0, 0.0, scenario.table.top_z, 1.0])[2])
 
 
-def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
+def build_scene(cap: Capture, *, progress: Progress = quiet) -> Scene:
     """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints."""
     from cell.perception import align_map, check_alignment_unique, check_parts_seen, perceive
 
@@ -96,7 +96,7 @@ def build_scene(cap: Capture, *, progress: Progress = _quiet) -> Scene:
     return Scene(seam_scene, perceived, alignment, X_RM, timings, missing)
 
 
-def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = _quiet) -> tuple[SeamEstimate, ...]:
+def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = quiet) -> tuple[SeamEstimate, ...]:
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
     from cell.perception import screen
     from cell.seams.base import BatchSeamLocator
@@ -157,7 +157,7 @@ def detect(
     method: str | None = None,
     *,
     noise: Literal["none", "realistic"] | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
     gui: bool = False,
     station: Station | None = None,
     weldmap: WeldMap | None = None,

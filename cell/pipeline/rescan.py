@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
@@ -18,7 +18,7 @@ import numpy as np
 
 from cell.errors import CellError, ScenarioError
 from cell.geometry import FloatArray, readonly
-from cell.pipeline.detect import evaluate
+from cell.pipeline.detect import Progress, evaluate, quiet
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, Scene
 from cell.rescan import (
@@ -43,12 +43,7 @@ if TYPE_CHECKING:
     from cell.types.execution import Execution
     from cell.types.trajectory import Trajectory
 
-Progress = Callable[[str], None]
 RescanMode = Literal["low", "all"]
-
-
-def _quiet(_: str) -> None:
-    return None
 
 
 @dataclass
@@ -127,7 +122,7 @@ def rescan_seams(
     *,
     options: RescanOptions | None = None,
     motion: MotionScene | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
 ) -> Rescan:
     """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`).
 
@@ -194,7 +189,7 @@ def rescan_detection(
     *,
     seam_ids: Sequence[str] | None = None,
     motion: MotionScene | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
 ) -> tuple[Rescan, Detection]:
     """Re-scan the seams worth a closer look with the eye-in-hand camera and return the detection with the fused
     estimates: the one re-scan path of ``cell weld`` and ``cell rescan``.

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Collection
+from collections.abc import Collection
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray, invert, transform_points
-from cell.pipeline.detect import detect, read_weldmap
+from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.rescan import rescan_detection
@@ -26,12 +26,6 @@ if TYPE_CHECKING:
     from cell.types.plan import WeldPlan
     from cell.types.trajectory import Trajectory
 
-Progress = Callable[[str], None]
-
-
-def _quiet(_: str) -> None:
-    return None
-
 
 def plan_for(
     station: Station,
@@ -40,7 +34,7 @@ def plan_for(
     skip: Collection[str] = (),
     q_start: FloatArray | None = None,
     motion: MotionScene | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
 ) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
     section 7).
@@ -80,7 +74,7 @@ def plan_for(
     return plan, pre, tuple(problems)
 
 
-def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = _quiet) -> Execution:
+def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = quiet) -> Execution:
     """Drive the simulated arm: the move from the scan pose to home, then the welding program; arc where planned."""
     traj, arc = plan.joint_trajectory()
     times = np.concatenate([pre.times, traj.times[1:] + pre.duration])
@@ -161,7 +155,7 @@ def weld(
     noise: Literal["none", "realistic"] | None = None,
     rescan: Literal["none", "low", "all"] | None = None,
     execute_plan: bool = True,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
     gui: bool = False,
 ) -> WeldRun:
     """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a

@@ -1,12 +1,12 @@
-"""Generate the welding maps in ``maps/`` (fence1, fence2, ladder) and variants of them for tests.
+"""Generate the welding maps in ``maps/`` (fence1, fence2, ladder, tee) and variants of them for tests.
 
 Run from the repository root::
 
-    .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, maps/fence2.dxf, maps/ladder.dxf
+    .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, fence2.dxf, ladder.dxf, tee.dxf
     .venv/bin/python tools/make_maps.py --out DIR  # somewhere else
 
 Conventions of every map: drawing units mm (``$INSUNITS`` = 4), map frame M with its origin at the fence
-corner and z = 0 on the table top. Parts are axis-aligned box tubes drawn as AutoCAD-style 3DSOLIDs (ACIS
+corner and z = 0 on the table top (the tee's frame is its CAD's: see :data:`TEE_PARTS`). Parts are axis-aligned box tubes drawn as AutoCAD-style 3DSOLIDs (ACIS
 data written with ``ezdxf.acis``) on a layer named after the part (colour 7). Seams are red 3D LINEs
 (colour 1 set explicitly) on layer ``WELD_SEAMS`` (colour 1), each carrying its id as XDATA (appid
 ``WELDCELL``, group 1000), e.g. ``POST_L>TOP_RAIL:+z``: abutting part, receiving part, and the abutting
@@ -81,6 +81,19 @@ FENCE2_JUNCTIONS: tuple[Junction, ...] = (
     ("POST_2", "RAIL_A"),
     ("POST_2", "RAIL_B"),
 )
+
+
+# The tee of the real scans (../shared/real-scans/README.md): two 2 in (50.8 mm) square tubes, the CAD frame's
+# origin at the centre of the horizontal tube's cross-section under the vertical tube's axis, x along the
+# horizontal tube, z up (so the table is at z = -25.4 mm). Its welds are the two fillets where the vertical
+# tube's walls at x = +-25.4 mm meet the horizontal tube's top face; the walls at y = +-25.4 mm are flush with
+# the horizontal tube's sides (no fillet there), so those two lines are not seams.
+TEE_PARTS: dict[str, BoxSpec] = {
+    "H_TUBE": ((-76.2, -25.4, -25.4), (184.15, 25.4, 25.4)),  # 260.35 mm long, lying on the table
+    "V_TUBE": ((-25.4, -25.4, 25.4), (25.4, 25.4, 241.3)),  # 215.9 mm long, standing on H_TUBE's top face
+}
+TEE_JUNCTIONS: tuple[Junction, ...] = (("V_TUBE", "H_TUBE"),)
+TEE_SEAM_FACES = ("+x", "-x")  # the abutting faces whose seams are fillets
 
 
 def ladder_design(
@@ -361,7 +374,16 @@ def designs() -> dict[str, tuple[dict[str, BoxSpec], tuple[Junction, ...]]]:
         "fence1": (FENCE1_PARTS, FENCE1_JUNCTIONS),
         "fence2": (FENCE2_PARTS, FENCE2_JUNCTIONS),
         "ladder": ladder_design(),
+        "tee": (TEE_PARTS, TEE_JUNCTIONS),
     }
+
+
+def design_seams(name: str, parts: Mapping[str, BoxSpec], junctions: Iterable[Junction]) -> list[SeamSpec]:
+    """The seams of design ``name``: every junction's, but for the tee only its two fillets (TEE_SEAM_FACES)."""
+    seams = all_seams(parts, junctions)
+    if name == "tee":
+        seams = [s for s in seams if s[0].rsplit(":", 1)[1] in TEE_SEAM_FACES]
+    return seams
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -370,7 +392,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     for name, (parts, junctions) in designs().items():
-        seams = all_seams(parts, junctions)
+        seams = design_seams(name, parts, junctions)
         path = write_map(args.out / f"{name}.dxf", parts, seams)
         print(f"{path}: {len(parts)} parts, {len(junctions)} junctions, {len(seams)} seams")
     return 0

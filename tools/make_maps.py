@@ -5,11 +5,11 @@ Run from the repository root::
     .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, fence2.dxf, ladder.dxf, tee.dxf
     .venv/bin/python tools/make_maps.py --out DIR  # somewhere else
 
-Conventions of every map: drawing units mm (``$INSUNITS`` = 4), map frame M with its origin at the fence
-corner and z = 0 on the table top (the tee's frame is its CAD's: see :data:`TEE_PARTS`). Parts are axis-aligned box tubes drawn as AutoCAD-style 3DSOLIDs (ACIS
-data written with ``ezdxf.acis``) on a layer named after the part (colour 7). Seams are red 3D LINEs
-(colour 1 set explicitly) on layer ``WELD_SEAMS`` (colour 1), each carrying its id as XDATA (appid
-``WELDCELL``, group 1000), e.g. ``POST_L>TOP_RAIL:+z``: abutting part, receiving part, and the abutting
+Conventions of every map: drawing units mm (``$INSUNITS`` = 4), map frame M with its origin at the fence corner and
+z = 0 on the table top (the tee's frame is its CAD's: see :data:`TEE_PARTS`). Parts are axis-aligned box tubes
+drawn as AutoCAD-style 3DSOLIDs (ACIS data written with ``ezdxf.acis``) on a layer named after the part (colour 7).
+Seams are red 3D LINEs (colour 1 set explicitly) on layer ``WELD_SEAMS`` (colour 1), each carrying its id as XDATA
+(appid ``WELDCELL``, group 1000), e.g. ``POST_L>TOP_RAIL:+z``: abutting part, receiving part, and the abutting
 part's box face the seam runs along.
 
 The output is byte-stable for a given ezdxf version: ezdxf's fixed-metadata option pins the header dates,

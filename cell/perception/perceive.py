@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from cell.errors import SensorError
-from cell.geometry import FloatArray
+from cell.geometry import FloatArray, invert
 from cell.perception.camera_health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame
 from cell.perception.preprocess import downsample, preprocess
@@ -44,6 +44,7 @@ class Perceived:
         index), in voxel order: what a locator that weighs each camera by its own noise reads.
     registered_voxels : where ``registered``'s voxels (``spec.voxel_m``) lie in it (what such a locator's tube
         queries read).
+    origins_R : camera name -> (3,) its optical centre in R as calibrated (how far a seam is from it).
     """
 
     dense: Cloud
@@ -60,6 +61,7 @@ class Perceived:
 
     registered: Cloud = field(default_factory=lambda: Cloud(np.zeros((0, 3)), "R"))
     registered_voxels: VoxelTable | None = None
+    origins_R: dict[str, FloatArray] = field(default_factory=dict)
 
     def splice_corrections(self) -> dict[str, dict[str, Any]]:
         """Per registered camera, what the splice did to its calibration (for reports): ``applied`` (bool),
@@ -124,6 +126,17 @@ def perceive(
     downsampled = downsample(dense, spec.voxel_m)
     registered, registered_voxels = voxel_order(registered, spec.voxel_m)
     timings["downsample"] = time.perf_counter() - t
+    X_RW = invert(np.asarray(X_WR, dtype=float))
+    origins_R = {name: (X_RW @ np.asarray(image.X_WC, dtype=float))[:3, 3] for name, image in images.items()}
     return Perceived(
-        dense, downsampled, clouds, spliced, lost, timings, {n: why[n] for n in lost}, registered, registered_voxels
+        dense,
+        downsampled,
+        clouds,
+        spliced,
+        lost,
+        timings,
+        {n: why[n] for n in lost},
+        registered,
+        registered_voxels,
+        origins_R,
     )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
@@ -9,6 +10,7 @@ from typing import Literal
 
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
+from cell.perception.calibration import PoseUncertainty, with_calibration
 from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
 from cell.station import Station, open_station
@@ -127,7 +129,18 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
             timed[seam.id] = replace(est, time_s=time.perf_counter() - t)
     out = tuple(hidden[seam.id] if seam.id in hidden else timed[seam.id] for seam in ss.weldmap.seams)
     # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
-    return screen(ss, out, scene.missing, scenario.perception.screen)
+    out = screen(ss, out, scene.missing, scenario.perception.screen)
+    # A seam resting on one camera carries that camera's calibration error (the locator's sigma cannot see it).
+    p = scene.perceived
+    return with_calibration(out, p.registered, p.origins_R, pose_uncertainties(scenario), p.spliced.registrations)
+
+
+def pose_uncertainties(scenario: Scenario) -> dict[str, PoseUncertainty]:
+    """Camera name -> how well its pose is known (the scenario's ``cameras.<name>.calibration``), in SI units."""
+    return {
+        name: PoseUncertainty(cam.calibration.translation_mm * 1e-3, math.radians(cam.calibration.rotation_deg))
+        for name, cam in scenario.cameras.items()
+    }
 
 
 def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:

@@ -17,8 +17,9 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from cell.errors import CellError, ScenarioError
-from cell.geometry import FloatArray, readonly
-from cell.pipeline.detect import Progress, evaluate, quiet
+from cell.geometry import FloatArray, invert, readonly
+from cell.perception.calibration import PoseUncertainty, closeup_sigma
+from cell.pipeline.detect import Progress, evaluate, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, Scene
 from cell.rescan import (
@@ -104,6 +105,8 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan
     t = time.perf_counter()
     est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
     est = replace(est, time_s=time.perf_counter() - t)
+    X_RC = invert(det.scenario.X_WR) @ image.X_WC
+    est = closeup_sigma(est, X_RC[:3, 3], pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty()))
     fused, w = fuse(first, est, estimate_sigma(first), estimate_sigma(est), o.first_scale_m)
     reason = "" if w > 0.0 else f"close-up not used: {est.reason or est.status.value}"
     return SeamRescan(seam_id, first, est, fused, w, vp, vp.move.duration, time.perf_counter() - t0, reason, n)

@@ -12,6 +12,7 @@ key and what is valid. Lengths in the file are metres (keys end in ``_m``) or mi
 # cell.config's dataclasses, composed here as sub-models.
 
 from cell.scenario.cell_specs import (
+    CalibrationSpec,
     CameraSpec,
     Deviation,
     ExtrinsicErrorSpec,
@@ -50,6 +51,7 @@ __all__ = [
     "REPO_ROOT",
     "SCENARIO_DIR",
     "AnyLocatorSpec",
+    "CalibrationSpec",
     "CameraFaultSpec",
     "CameraSpec",
     "Deviation",

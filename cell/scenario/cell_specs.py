@@ -84,6 +84,16 @@ class ExtrinsicErrorSpec(Model):
     rotation_deg: NonNeg = 0.0
 
 
+class CalibrationSpec(Model):
+    """How well a camera's pose is known: the residual of its calibration as a calibration report states it (RMS of
+    the whole error, translation and rotation). What the cell is told, not what the simulation draws
+    (``extrinsic_error``). A seam seen by this camera alone carries it in its sigma (:mod:`cell.perception.
+    calibration`); 0 (the default) says the calibration is within the locator's own floor."""
+
+    translation_mm: NonNeg = 0.0
+    rotation_deg: NonNeg = 0.0
+
+
 class CameraSpec(Model):
     """A depth camera looking from ``eye_m`` at ``target_m`` (world) with a pinhole of the given size and field."""
 
@@ -100,6 +110,7 @@ class CameraSpec(Model):
     far_m: Pos = 4.0
     noise: NoiseSpec = NoiseSpec()
     extrinsic_error: ExtrinsicErrorSpec = ExtrinsicErrorSpec()
+    calibration: CalibrationSpec = CalibrationSpec()
 
     @model_validator(mode="after")
     def _check(self) -> CameraSpec:

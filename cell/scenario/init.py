@@ -42,6 +42,8 @@ ROBOT_BEHIND_EDGE_M = 0.45  # robot base in front of the table's near edge [m]
 ROBOT_HOME_DEG = (-90.0, -100.0, 100.0, 0.0, 45.0, 0.0)  # arm over the table, torch well above the parts
 REACH_M = 1.45  # horizontal base-to-seam distance the shipped fences still weld at [m]
 CAMERA_ABOVE_TOP_M = 1.0
+_CALIBRATION = "    calibration: {translation_mm: 0.0, rotation_deg: 0.0}"
+_CALIBRATION_NOTE = "RMS residual from your calibration report: seams seen by it alone carry it in sigma"
 CAMERA_SIDE_M = 0.85  # fixed camera to the point it looks at, along x [m]
 CAMERA_SECTION_M = 1.6  # longest part one pair of fixed cameras covers [m]
 EYE_IN_HAND_ABOVE_TOP_M = 1.05
@@ -177,6 +179,7 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
             (f"    eye_m: {_vec(eye)}", "where it is [m]"),
             (f"    target_m: {_vec(target)}", "the point it looks at [m]"),
             ("    up: [0.0, 1.0, 0.0]", "portrait: the image's up is +y, so near and far ends are in view"),
+            (_CALIBRATION, _CALIBRATION_NOTE),
         ]
     eye, target = lay.eye_in_hand
     rows += [
@@ -184,6 +187,7 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
         ("    mount: eye_in_hand", "rides on the arm; the arm is solved for the pose below"),
         (f"    eye_m: {_vec(eye)}", "scan pose: above and in front of the part's centre [m]"),
         (f"    target_m: {_vec(target)}", "the point it looks at [m]"),
+        (_CALIBRATION, _CALIBRATION_NOTE),
         ("perception:", "how the clouds are cropped and processed"),
         ("  workspace:", "only points inside this box are kept"),
         (f"    min_m: {_vec(lo)}", "the part's bounds - 0.15 m; 5 mm above the table top [m]"),

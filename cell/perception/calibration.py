@@ -1,0 +1,144 @@
+"""The cameras' calibration in each seam's sigma: a seam seen by one camera only carries that camera's error.
+
+A locator's sigma (:mod:`cell.seams.sigma`) is calibrated on cells whose cameras are placed exactly; what it
+cannot see is how well each camera's pose is known. The scenario says that per camera
+(``cameras.<name>.calibration``: the RMS residual of its calibration, translation ``t`` and rotation ``theta``).
+A pose error moves every point the camera sees rigidly: at range ``r`` from the camera by ``t`` plus
+``r * theta``, in a direction nobody knows, so along any one axis (across the seam) by
+
+    sigma_cam = sqrt(t^2 + (r * theta)^2) / sqrt(3)
+
+(an RMS error spread evenly over three axes). Which cameras a seam rests on is counted from the registered cloud
+(per-point camera index) within :data:`SUPPORT_RADIUS_M` of the located segment; camera ``c`` holds the share
+``w_c`` of those points. A camera the splice registered and *corrected* (``Registration.accepted``) now sits where
+its reference camera puts it, so it inherits the reference's error: cameras tied to one reference make one error
+source with the summed share. Independent sources add in quadrature,
+
+    sigma_cal = sqrt(sum_g (W_g * sigma_g)^2),
+
+so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
+cameras about 1 / sqrt(2) of it. The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``. With every
+calibration at 0 (the default) nothing changes and nothing is computed.
+
+The close-up of a re-scan (:func:`closeup_sigma`) is seen by the arm's camera alone, at its close range. (Its
+fusion with the first estimate treats the two as independent; when both rest on the same camera's calibration the
+fused sigma is optimistic by at most that camera's term, which the close-up's own range keeps small.)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.perception.splice import Registration
+from cell.types import Cloud, SeamEstimate, SeamStatus
+
+SUPPORT_RADIUS_M = 0.015  # points within this of the located segment are the seam's support (both faces' strips)
+
+
+@dataclass(frozen=True)
+class PoseUncertainty:
+    """How well one camera's pose is known: RMS translation [m] and rotation [rad] of its calibration residual."""
+
+    translation_m: float = 0.0
+    rotation_rad: float = 0.0
+
+    def sigma_at(self, range_m: float) -> float:
+        """Per-axis standard deviation [m] of a point at ``range_m`` from the camera (module docstring)."""
+        return math.hypot(self.translation_m, range_m * self.rotation_rad) / math.sqrt(3.0)
+
+    @property
+    def zero(self) -> bool:
+        return self.translation_m == 0.0 and self.rotation_rad == 0.0
+
+
+def reference_of(registrations: Sequence[Registration]) -> dict[str, str]:
+    """Camera name -> the camera whose calibration its points rest on: a corrected camera its registration's
+    reference (the first target, followed through), every other camera itself."""
+    tied: dict[str, str] = {}
+    for r in registrations:
+        if r.accepted and r.target:
+            ref = r.target[0]
+            tied[r.source] = tied.get(ref, ref)
+    return tied
+
+
+def calibration_sigma(
+    shares: Mapping[str, float],
+    mid_R: FloatArray,
+    origins_R: Mapping[str, FloatArray],
+    uncertainty: Mapping[str, PoseUncertainty],
+    tied: Mapping[str, str],
+) -> float:
+    """sigma_cal [m] of a seam at ``mid_R`` whose support is split ``shares`` (camera -> fraction) between cameras
+    (module docstring). A camera with no stated uncertainty or no known origin contributes nothing."""
+    groups: dict[str, float] = {}
+    for camera, w in shares.items():
+        source = tied.get(camera, camera)
+        groups[source] = groups.get(source, 0.0) + w
+    total = 0.0
+    for source, w in groups.items():
+        u = uncertainty.get(source)
+        origin = origins_R.get(source)
+        if u is None or u.zero or origin is None:
+            continue
+        total += (w * u.sigma_at(float(np.linalg.norm(np.asarray(mid_R) - origin)))) ** 2
+    return math.sqrt(total)
+
+
+def support_shares(
+    cloud: Cloud, p0: FloatArray, p1: FloatArray, radius_m: float = SUPPORT_RADIUS_M
+) -> dict[str, float]:
+    """Camera name -> share of ``cloud``'s points within ``radius_m`` of the segment p0-p1 (empty: none near)."""
+    lo = np.minimum(p0, p1) - radius_m
+    hi = np.maximum(p0, p1) + radius_m
+    pts = cloud.points
+    box = np.all((pts >= lo) & (pts <= hi), axis=1)
+    near, cams = pts[box], cloud.camera[box]
+    t = p1 - p0
+    length2 = float(t @ t)
+    s = np.clip(((near - p0) @ t) / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros(len(near))
+    d = np.linalg.norm(near - (p0 + s[:, None] * t), axis=1)
+    cams = cams[d <= radius_m]
+    cams = cams[cams >= 0]
+    if cams.size == 0:
+        return {}
+    idx, counts = np.unique(cams, return_counts=True)
+    return {cloud.cameras[int(i)]: float(c) / float(cams.size) for i, c in zip(idx, counts, strict=True)}
+
+
+def with_calibration(
+    estimates: Sequence[SeamEstimate],
+    registered: Cloud,
+    origins_R: Mapping[str, FloatArray],
+    uncertainty: Mapping[str, PoseUncertainty],
+    registrations: Sequence[Registration],
+) -> tuple[SeamEstimate, ...]:
+    """Every found seam's sigma with its cameras' calibration in quadrature (module docstring); the estimates
+    unchanged when no camera states an uncertainty."""
+    if all(u.zero for u in uncertainty.values()):
+        return tuple(estimates)
+    tied = reference_of(registrations)
+    out = []
+    for est in estimates:
+        if est.status is not SeamStatus.FOUND or not math.isfinite(est.sigma_m):
+            out.append(est)
+            continue
+        shares = support_shares(registered, est.p_start, est.p_end)
+        mid = 0.5 * (est.p_start + est.p_end)
+        cal = calibration_sigma(shares, mid, origins_R, uncertainty, tied)
+        out.append(replace(est, sigma_m=math.hypot(est.sigma_m, cal)) if cal > 0.0 else est)
+    return tuple(out)
+
+
+def closeup_sigma(est: SeamEstimate, origin_R: FloatArray, uncertainty: PoseUncertainty) -> SeamEstimate:
+    """A close-up estimate (one camera, at ``origin_R``) with that camera's calibration in its sigma."""
+    if est.status is not SeamStatus.FOUND or uncertainty.zero or not math.isfinite(est.sigma_m):
+        return est
+    mid = 0.5 * (est.p_start + est.p_end)
+    cal = uncertainty.sigma_at(float(np.linalg.norm(mid - np.asarray(origin_R))))
+    return replace(est, sigma_m=math.hypot(est.sigma_m, cal))

@@ -1,0 +1,92 @@
+"""A seam seen by one camera only carries that camera's calibration error in its sigma (cell.perception.calibration)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cell.perception.calibration import (
+    PoseUncertainty,
+    calibration_sigma,
+    closeup_sigma,
+    reference_of,
+    support_shares,
+    with_calibration,
+)
+from cell.perception.splice import Registration
+from cell.types import Cloud, SeamEstimate, SeamStatus
+
+MM, DEG = 1e-3, math.radians(1.0)
+ORIGINS = {"a": np.array([0.0, 0.0, 1.0]), "b": np.array([1.0, 0.0, 1.0]), "ref": np.array([0.0, -1.0, 1.0])}
+
+
+def _registration(source: str, target: str, accepted: bool) -> Registration:
+    return Registration(source, (target,), np.eye(4), np.eye(4), 100, 6, 1e-4, 1.0, 1e-4, 1e-4, accepted)
+
+
+def _cloud(counts: dict[str, int], rng: np.random.Generator) -> Cloud:
+    """Points along the x axis near a seam from (0, 0, 0) to (0.1, 0, 0), ``counts`` per camera, plus far ones."""
+    names = tuple(counts)
+    pts, cams = [], []
+    for k, (_, n) in enumerate(counts.items()):
+        p = np.column_stack([rng.uniform(0.0, 0.1, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-0.01, 0.01, n)])
+        pts.append(p)
+        cams.append(np.full(n, k, np.int16))
+    far = np.column_stack([rng.uniform(0.0, 0.1, 50), np.full(50, 0.2), np.zeros(50)])  # 20 cm away: not support
+    pts.append(far)
+    cams.append(np.full(50, 0, np.int16))
+    return Cloud(np.vstack(pts), "R", np.concatenate(cams), names)
+
+
+def test_the_per_axis_sigma_grows_with_range_as_the_rotation_error_does() -> None:
+    u = PoseUncertainty(1.0 * MM, 0.1 * DEG)
+    assert math.isclose(u.sigma_at(0.0), 1.0 * MM / math.sqrt(3.0))
+    # 0.1 deg at 1.3 m is 2.27 mm: with the 1 mm, 2.48 mm in all, 1.43 mm along one axis
+    assert math.isclose(u.sigma_at(1.3), math.hypot(1.0, 1300 * 0.1 * DEG) * MM / math.sqrt(3.0))
+    assert 1.42 * MM < u.sigma_at(1.3) < 1.44 * MM
+    assert PoseUncertainty().zero and PoseUncertainty().sigma_at(2.0) == 0.0
+
+
+def test_support_is_counted_per_camera_near_the_segment_only() -> None:
+    rng = np.random.default_rng(0)
+    cloud = _cloud({"a": 300, "b": 100}, rng)
+    shares = support_shares(cloud, np.zeros(3), np.array([0.1, 0.0, 0.0]))
+    assert math.isclose(shares["a"], 0.75) and math.isclose(shares["b"], 0.25)  # the far 50 of "a" not counted
+    assert support_shares(cloud, np.array([0.0, 1.0, 0.0]), np.array([0.1, 1.0, 0.0])) == {}
+
+
+def test_one_camera_carries_all_its_error_two_independent_cameras_share_it() -> None:
+    u = {"a": PoseUncertainty(1.0 * MM, 0.1 * DEG), "b": PoseUncertainty(1.0 * MM, 0.1 * DEG)}
+    mid = np.zeros(3)
+    alone = calibration_sigma({"a": 1.0}, mid, ORIGINS, u, {})
+    assert math.isclose(alone, u["a"].sigma_at(1.0))
+    halves = calibration_sigma({"a": 0.5, "b": 0.5}, mid, ORIGINS, u, {})
+    expected = math.hypot(0.5 * u["a"].sigma_at(1.0), 0.5 * u["b"].sigma_at(math.sqrt(2.0)))
+    assert math.isclose(halves, expected) and halves < alone
+
+
+def test_a_corrected_camera_inherits_its_reference_and_an_uncorrected_one_keeps_its_own() -> None:
+    u = {"a": PoseUncertainty(1.0 * MM, 0.1 * DEG), "ref": PoseUncertainty()}
+    tied = reference_of([_registration("a", "ref", accepted=True)])
+    assert tied == {"a": "ref"}
+    assert calibration_sigma({"a": 1.0}, np.zeros(3), ORIGINS, u, tied) == 0.0  # now where the exact reference is
+    refused = reference_of([_registration("a", "ref", accepted=False)])
+    assert refused == {}
+    assert calibration_sigma({"a": 1.0}, np.zeros(3), ORIGINS, u, refused) > 0.5 * MM
+
+
+def test_found_seams_gain_the_term_in_quadrature_others_are_untouched() -> None:
+    rng = np.random.default_rng(1)
+    cloud = _cloud({"a": 200}, rng)
+    found = SeamEstimate("s", SeamStatus.FOUND, "", np.zeros(3), np.array([0.1, 0.0, 0.0]), 0.9, sigma_m=0.05 * MM)
+    lost = SeamEstimate("t", SeamStatus.NOT_FOUND, "no support")
+    u = {"a": PoseUncertainty(1.0 * MM, 0.1 * DEG)}
+    out = with_calibration([found, lost], cloud, ORIGINS, u, [])
+    cal = u["a"].sigma_at(float(np.linalg.norm(np.array([0.05, 0.0, 0.0]) - ORIGINS["a"])))
+    assert math.isclose(out[0].sigma_m, math.hypot(0.05 * MM, cal))
+    assert out[1] is lost
+    nothing = with_calibration([found], cloud, ORIGINS, {"a": PoseUncertainty()}, [])
+    assert nothing[0] is found  # no stated uncertainty: not even computed
+    close = closeup_sigma(found, np.array([0.05, 0.0, 0.3]), u["a"])
+    assert math.isclose(close.sigma_m, math.hypot(0.05 * MM, u["a"].sigma_at(0.3)))

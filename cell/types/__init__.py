@@ -10,6 +10,7 @@ Every stage imports its values from here and nothing here imports a stage (an im
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
+from cell.types.procedure import Weave, WeldPass, WeldProcedure
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 from cell.types.robot import JointLimits, Kinematics
 from cell.types.run import SeamRecord, SeamWeld, WeldReason
@@ -55,8 +56,11 @@ __all__ = [
     "Trajectory",
     "Viewpoint",
     "VoxelTable",
+    "Weave",
     "WeldMap",
+    "WeldPass",
     "WeldPlan",
+    "WeldProcedure",
     "WeldQuality",
     "WeldReason",
 ]

@@ -17,6 +17,7 @@ import numpy.typing as npt
 
 from cell.errors import PlanError
 from cell.geometry import FloatArray, readonly
+from cell.types.procedure import WeldProcedure
 from cell.types.trajectory import Trajectory
 
 SegmentKind = Literal["move", "approach", "weld", "depart"]
@@ -49,7 +50,8 @@ class SeamTask:
 class Segment:
     """One motion of the plan. kind: move (PTP) | approach | weld | depart (LIN); t0 [s] its start in the plan;
     speed [m/s] the TCP speed of a LIN (0 for PTP); X_end (4, 4) the TCP pose at its end in R; arc_on: the arc
-    burns during this segment (welds only: on at its start, off at its end, both at rest)."""
+    burns during this segment (welds only: on at its start, off at its end, both at rest); procedure: the weld
+    procedure a weld segment runs (None: the process defaults), pass_index: which of its passes (0: the root)."""
 
     kind: SegmentKind
     seam_id: str
@@ -58,6 +60,8 @@ class Segment:
     X_end: FloatArray
     speed: float = 0.0
     arc_on: bool = False
+    procedure: WeldProcedure | None = None
+    pass_index: int = 0
 
     @property
     def t1(self) -> float:

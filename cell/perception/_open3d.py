@@ -170,3 +170,49 @@ def read_ply(path: Path) -> tuple[FloatArray, npt.NDArray[np.int32] | None]:
     points = pc.point.positions.numpy().astype(np.float64).reshape(-1, 3)
     camera = pc.point.camera.numpy().astype(np.int32).reshape(-1) if "camera" in pc.point else None
     return points, camera
+
+
+def fpfh_ransac(
+    source: npt.ArrayLike,
+    source_normals: npt.ArrayLike,
+    target: npt.ArrayLike,
+    target_normals: npt.ArrayLike,
+    voxel_m: float,
+    seed: int,
+    iterations: int = 100_000,
+) -> FloatArray:
+    """(4, 4) X_TS from a global registration of ``source`` onto ``target`` (points (n, 3) with oriented unit
+    normals (n, 3), both on a grid of about ``voxel_m``): FPFH features (radius 5 voxels) matched by RANSAC
+    (open3d's ``registration_ransac_based_on_feature_matching``, 3-point hypotheses, inliers within 1.5 voxels,
+    edge-length and distance checkers), ``iterations`` hypotheses at most, open3d's random stream seeded with
+    ``seed`` (open3d's only generator; the result may still vary with thread scheduling)."""
+    o3d = _o3d()
+    reg = o3d.pipelines.registration
+    o3d.utility.random.seed(int(seed))
+    src, tgt = _legacy_cloud(source, source_normals), _legacy_cloud(target, target_normals)
+    search = o3d.geometry.KDTreeSearchParamHybrid(radius=5.0 * float(voxel_m), max_nn=100)
+    f_src = reg.compute_fpfh_feature(src, search)
+    f_tgt = reg.compute_fpfh_feature(tgt, search)
+    distance = 1.5 * float(voxel_m)
+    result = reg.registration_ransac_based_on_feature_matching(
+        src,
+        tgt,
+        f_src,
+        f_tgt,
+        True,
+        distance,
+        reg.TransformationEstimationPointToPoint(False),
+        3,
+        [reg.CorrespondenceCheckerBasedOnEdgeLength(0.9), reg.CorrespondenceCheckerBasedOnDistance(distance)],
+        reg.RANSACConvergenceCriteria(int(iterations), 0.999),
+    )
+    return np.array(result.transformation)
+
+
+def read_pcd(path: Path) -> FloatArray:
+    """Points (n, 3) float64 of a PCD file, as written (NaN rows kept; read as PCD whatever its name)."""
+    o3d = _o3d()
+    pc = o3d.t.io.read_point_cloud(str(path), format="pcd", remove_nan_points=False, remove_infinite_points=False)
+    if "positions" not in pc.point:
+        return np.zeros((0, 3))
+    return np.asarray(pc.point.positions.numpy(), dtype=np.float64).reshape(-1, 3)

@@ -7,6 +7,7 @@ code that talks to the station's ports (:mod:`cell.station`). The CLI is a thin 
 :func:`locate`).
 """
 
+from cell.pipeline.cloud import locate_cloud
 from cell.pipeline.detect import build_scene, capture, detect, evaluate, locate, read_weldmap, table_z_R, truths
 from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun
 from cell.pipeline.rescan import RescanMode, rescan_detection, rescan_seams, rescanned
@@ -25,6 +26,7 @@ __all__ = [
     "evaluate",
     "execute",
     "locate",
+    "locate_cloud",
     "plan_for",
     "read_weldmap",
     "rescan_detection",

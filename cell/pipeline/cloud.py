@@ -1,0 +1,317 @@
+"""Locate a welding map's seams in a point cloud someone brings (a laser scan, a lidar sweep, any sensor's cloud):
+the same stages as :func:`cell.pipeline.detect` from the map alignment on, without a station or a simulator.
+
+The cloud is unorganised (no intrinsics, no view direction), in metres, in its own frame F. The steps:
+
+1. the table plane from the data and the cloud's noise on it (:func:`cell.perception.unorganised.find_table`); the
+   cloud is levelled (frame L: the table's normal is +z, the table at one height) so that "up" and "the table's
+   height" mean what the stages take them to mean; the point spacing along and between scan lines;
+2. the options from the data (:mod:`cell.pipeline.cloud_setup`): the ICP's correspondences and our locator's
+   noise and sigma floor from the measured noise and spacing;
+3. the nominal placement ``X_FM_nominal`` put flat on the found table (a part rests on it: its roll and pitch in L
+   are zero, its underside at the table's height); the cloud cropped to the placed map's bounds grown by
+   :data:`MARGIN_M` (and, above the table, by its noise);
+4. the map aligned by the usual staged ICP and its checks (fitness, tilt, ambiguity, parts seen); with no nominal
+   placement, or one whose fit is poor (:data:`POOR_FITNESS`), a global registration (FPFH + RANSAC,
+   :func:`cell.perception.unorganised.global_pose`) first;
+5. every seam of the aligned map located (our locator by default), screened (occluders, missing parts, doubt), and
+   carried back into F. A seam no data supports is NOT_FOUND or NOT_VISIBLE with the reason, never invented.
+
+Nothing here imports the simulator.
+"""
+
+from __future__ import annotations
+
+import time
+import zlib
+from collections.abc import Mapping
+from dataclasses import fields, replace
+
+import numpy as np
+
+from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
+from cell.geometry import FloatArray, invert, make_pose, transform_points
+from cell.perception.align import Alignment, align_map
+from cell.perception.alignment_checks import check_alignment_unique, check_parts_seen
+from cell.perception.preprocess import downsample
+from cell.perception.seam_screen import screen
+from cell.perception.unorganised import TablePlane, find_table, global_placement, levelling, on_table
+from cell.perception.unorganised import sampling as spacing_of
+from cell.pipeline.cloud_setup import cloud_scenario, ours_overrides
+from cell.pipeline.detect import Progress, evaluate, quiet
+from cell.pipeline.records import Detection
+from cell.scenario import Scenario
+from cell.seams.joint import find_joints
+from cell.seams.visibility import visibility
+from cell.types import Box, Cloud, Joint, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
+from cell.voxels import voxel_order
+
+MARGIN_M = 0.1  # the crop around the placed map's bounds, horizontally and above [m]
+POOR_FITNESS = 0.6  # a fit from the nominal placement below this fitness is retried from a global registration
+MIN_POINTS = 200  # fewer points than this: no cloud to locate anything in
+_FRAME = "R"  # the stages' name for the frame they work in (here the levelled frame L)
+
+
+def locate_cloud(
+    cloud: Cloud,
+    weldmap: WeldMap,
+    X_FM_nominal: FloatArray | None,
+    *,
+    name: str = "cloud",
+    method: str | None = None,
+    viewpoint_F: FloatArray | None = None,
+    truth_F: Mapping[str, tuple[FloatArray, FloatArray]] | None = None,
+    progress: Progress = quiet,
+) -> Detection:
+    """Locate ``weldmap``'s seams (frame M, as drawn) in ``cloud`` (unorganised, metres, frame F = ``cloud.frame``).
+
+    X_FM_nominal : (4, 4) nominal pose of the drawing's origin in F, or None (global registration).
+    method : the locator (None: ours). viewpoint_F : (3,) where the sensor was (orients the normals; None: the
+    heuristic of :func:`~cell.perception.unorganised.orient_normals`). truth_F : seam id -> true ends (3,), (3,) in
+    F [m]: the detection is measured against them (no truth, no error fields).
+
+    Returns the usual :class:`Detection`, in F, with a scenario synthesised for the cloud. SensorError for a cloud
+    with too few or non-finite points or no table; an alignment that fails is returned as the detection's
+    ``error`` with every seam NOT_FOUND (or NOT_VISIBLE), as :func:`cell.pipeline.detect` does.
+    """
+    t_all = time.perf_counter()
+    timings: dict[str, float] = {}
+    method = method or "ours"
+    P_F = np.asarray(cloud.points, dtype=np.float64)
+    if len(P_F) < MIN_POINTS:
+        raise SensorError(f"cloud {name!r} has {len(P_F)} points; at least {MIN_POINTS} are needed")
+    if not np.all(np.isfinite(P_F)):
+        raise SensorError(f"cloud {name!r} has {int(np.sum(~np.isfinite(P_F).all(axis=1)))} non-finite points")
+    rng = np.random.default_rng([0, zlib.crc32(f"cloud/{name}".encode())])
+
+    t = time.perf_counter()
+    progress(f"finding the table plane in {len(P_F)} points")
+    table = find_table(P_F, rng)
+    X_LF = levelling(table)
+    X_FL = invert(X_LF)
+    P_L = transform_points(X_LF, P_F)
+    table_z = float(table.offset)  # the table's height in L
+    along, between = spacing_of(P_L, _levelled(table, X_LF))
+    noise = table.sigma_m
+    progress(
+        f"table tilted {np.degrees(table.tilt_rad):.2f} deg, noise {noise * 1e3:.2f} mm RMS, spacing "
+        f"{along * 1e3:.1f} mm along / {between * 1e3:.1f} mm between lines"
+    )
+    above = P_L[:, 2] > table_z + max(0.005, 3.0 * noise)
+    timings["table_s"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    joints = find_joints(weldmap)
+    viewpoint_L = transform_points(X_LF, np.reshape(viewpoint_F, (1, 3)))[0] if viewpoint_F is not None else None
+    X_LM0 = on_table(X_LF @ X_FM_nominal, weldmap, table_z) if X_FM_nominal is not None else None
+    spec_scenario = _scenario(
+        name, weldmap, X_FL, X_LM0, P_L, above, table, viewpoint_L, (noise, along, between), method
+    )
+    spec = spec_scenario.perception
+    alignment: Alignment | None = None
+    error: CellError | None = None
+    if X_LM0 is not None:
+        crop = _crop(P_L, above, weldmap.transformed(X_LM0, _FRAME))
+        try:
+            alignment = align_map(weldmap.transformed(X_LM0, _FRAME), Cloud(P_L[crop], _FRAME), spec)
+        except AlignmentError as e:
+            error = e
+    if alignment is None or alignment.fitness < POOR_FITNESS:
+        progress("global registration of the map (FPFH + RANSAC)")
+        X_LM_g = global_placement(P_L[above], weldmap, table_z, viewpoint_L, rng)
+        crop_g = _crop(P_L, above, weldmap.transformed(X_LM_g, _FRAME))
+        try:
+            found = align_map(weldmap.transformed(X_LM_g, _FRAME), Cloud(P_L[crop_g], _FRAME), spec)
+            if alignment is None or found.fitness > alignment.fitness:
+                alignment, X_LM0, error = found, X_LM_g, None
+        except AlignmentError as e:
+            error = error if alignment is not None else e
+    timings["align_s"] = time.perf_counter() - t
+
+    scenario = spec_scenario
+    if alignment is None or X_LM0 is None:
+        assert error is not None
+        return _failed(scenario, weldmap, joints, X_FL, X_LM0, table_z, method, error, timings, t_all)
+    X_LM = alignment.X_RR_corr @ X_LM0
+    map_L = weldmap.transformed(X_LM, _FRAME)
+    crop = _crop(P_L, above, map_L)
+    dense_L = Cloud(P_L[crop], _FRAME)
+    scenario = _scenario(name, weldmap, X_FL, X_LM, P_L, above, table, viewpoint_L, (noise, along, between), method)
+    try:
+        check_alignment_unique(map_L, dense_L, alignment, spec.symmetry)
+        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage)
+    except AlignmentError as e:
+        return _failed(scenario, weldmap, joints, X_FL, X_LM, table_z, method, e, timings, t_all)
+
+    t = time.perf_counter()
+    progress(f"locating {len(map_L.seams)} seams ({method})")
+    ordered, voxels = voxel_order(dense_L, spec.voxel_m)
+    ss = SeamScene(downsample(dense_L, spec.voxel_m), ordered, map_L, joints, table_z, voxels)
+    estimates = _locate(ss, scenario, method, _workspace_L(P_L, crop), missing)
+    timings["locate_s"] = time.perf_counter() - t
+    estimates_F = tuple(_carried(e, X_FL) for e in estimates)
+    truth = dict(truth_F) if truth_F is not None else {}
+    metrics, summary = evaluate(estimates_F, truth)
+    timings["total_s"] = time.perf_counter() - t_all
+    return Detection(
+        scenario=scenario,
+        method=method,
+        weldmap_R=weldmap.transformed(X_FL @ X_LM, cloud.frame),
+        estimates=estimates_F,
+        truths=truth,
+        metrics=metrics,
+        summary=summary,
+        timings=timings,
+        joints=joints,
+    )
+
+
+def _levelled(table: TablePlane, X_LF: FloatArray) -> TablePlane:
+    """The table plane expressed in L."""
+    return replace(table, normal=X_LF[:3, :3] @ table.normal)
+
+
+def _crop(P_L: FloatArray, above: np.ndarray, map_L: WeldMap) -> np.ndarray:
+    """Points above the table within the placed map's bounds grown by MARGIN_M (not below: the table is cut)."""
+    v = np.vstack([p.vertices() for p in map_L.parts])
+    lo, hi = v.min(axis=0) - MARGIN_M, v.max(axis=0) + MARGIN_M
+    return above & np.all((lo <= P_L) & (hi >= P_L), axis=1)
+
+
+def _workspace_L(P_L: FloatArray, crop: np.ndarray) -> Box:
+    """The crop's box (frame L): where our locator must not take the cloud's end for the part's end."""
+    lo, hi = P_L[crop].min(axis=0), P_L[crop].max(axis=0)
+    return Box(make_pose(p=(lo + hi) / 2.0), hi - lo)
+
+
+def _scenario(
+    name: str,
+    weldmap: WeldMap,
+    X_FL: FloatArray,
+    X_LM: FloatArray | None,
+    P_L: FloatArray,
+    above: np.ndarray,
+    table: TablePlane,
+    viewpoint_L: FloatArray | None,
+    measured: tuple[float, float, float],
+    method: str,
+) -> Scenario:
+    """The synthesised scenario (frame F as the world), with the options from the data's ``measured`` noise and
+    spacing along and between lines [m]."""
+    from cell.seams.registry import with_method, with_options
+
+    X = X_LM if X_LM is not None else make_pose(p=np.median(P_L[above], axis=0))
+    map_L = weldmap.transformed(X, _FRAME)
+    crop = _crop(P_L, above, map_L)
+    if not crop.any():
+        crop = above
+    corners_L = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+    lo, hi = P_L[crop].min(axis=0), P_L[crop].max(axis=0)
+    box_F = transform_points(X_FL, lo + corners_L * (hi - lo))
+    T = P_L[table.inliers]
+    t_lo, t_hi = T.min(axis=0), T.max(axis=0)
+    top = float(table.offset)
+    centre_F = transform_points(X_FL, np.array([[(t_lo[0] + t_hi[0]) / 2, (t_lo[1] + t_hi[1]) / 2, top - 0.05]]))[0]
+    size = (float(t_hi[0] - t_lo[0]), float(t_hi[1] - t_lo[1]), 0.1)
+    eye_L = viewpoint_L if viewpoint_L is not None else np.median(P_L[crop], axis=0) + np.array([0.0, 0.0, 1.0])
+    eye_F = transform_points(X_FL, np.reshape(eye_L, (1, 3)))[0]
+    noise, along, between = measured
+    workspace_F = (box_F.min(axis=0), box_F.max(axis=0))
+    sc = cloud_scenario(name, weldmap, X_FL @ X, workspace_F, (centre_F, size), eye_F, noise)
+    sc = with_method(sc, method)
+    return with_options(sc, "ours", ours_overrides(noise, along, between)) if method == "ours" else sc
+
+
+def _locate(
+    ss: SeamScene, scenario: Scenario, method: str, workspace_L: Box, missing: Mapping[str, str]
+) -> tuple[SeamEstimate, ...]:
+    """Every seam of ``ss``'s map located by ``method`` (ours cut at ``workspace_L``) and screened."""
+    from cell.seams.base import BatchSeamLocator, SeamLocator
+    from cell.seams.ours import OursLocator, OursOptions
+    from cell.seams.registry import locator_spec, make_locator
+
+    if method == "ours":
+        opts = locator_spec(scenario, "ours").options
+        settings = {f.name: getattr(opts, f.name) for f in fields(opts)}
+        locator: SeamLocator = OursLocator(OursOptions(**settings, workspace_R=workspace_L))
+    else:
+        locator = make_locator(method, scenario)
+    rng = scenario.rng(f"locator/{method}")
+    out: dict[str, SeamEstimate] = {}
+    for seam in ss.weldmap.seams:
+        visible, why = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
+        if not visible:
+            out[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE)
+    todo = [s for s in ss.weldmap.seams if s.id not in out]
+    if isinstance(locator, BatchSeamLocator) and todo:
+        t = time.perf_counter()
+        found = locator.locate_many(ss, todo, rng)
+        dt = (time.perf_counter() - t) / len(todo)
+        out.update({e.id: replace(e, time_s=dt) for e in found})
+    else:
+        for seam in todo:
+            t = time.perf_counter()
+            out[seam.id] = replace(locator.locate(ss, seam, rng), time_s=time.perf_counter() - t)
+    estimates = tuple(_unseen_reason(out[s.id]) for s in ss.weldmap.seams)
+    return screen(ss, estimates, missing, scenario.perception.screen)
+
+
+def _unseen_reason(est: SeamEstimate) -> SeamEstimate:
+    """A weld face not seen is not placed from an edge here (NO_EDGES): say so instead of the edge's count."""
+    cut = est.reason.find(" and its edge is not defined well enough")
+    if est.status is not SeamStatus.NOT_FOUND or cut < 0:
+        return est
+    why = "; in a cloud without a camera's per-pixel density an unseen face is not placed from an edge"
+    return replace(est, reason=est.reason[:cut] + ": shadowed or hidden from the sensor" + why)
+
+
+def _carried(est: SeamEstimate, X_FL: FloatArray) -> SeamEstimate:
+    """The estimate with its ends carried from L into F."""
+    if est.status is not SeamStatus.FOUND:
+        return est
+    ends = transform_points(X_FL, np.vstack([est.p_start, est.p_end]))
+    return replace(est, p_start=ends[0], p_end=ends[1])
+
+
+def _failed(
+    scenario: Scenario,
+    weldmap: WeldMap,
+    joints: Mapping[str, Joint],
+    X_FL: FloatArray,
+    X_LM: FloatArray | None,
+    table_z: float,
+    method: str,
+    error: CellError,
+    timings: dict[str, float],
+    t_all: float,
+) -> Detection:
+    """No seam searched (the map could not be aligned): every seam NOT_FOUND with the reason (NOT_VISIBLE when the
+    drawing alone says it lies against the table)."""
+    X = X_LM if X_LM is not None else np.eye(4)
+    map_L = weldmap.transformed(X, _FRAME)
+    estimates = []
+    for seam in map_L.seams:
+        visible, why = visibility(map_L, joints[seam.id], table_z)
+        if visible or X_LM is None:
+            msg = f"no seam search: {error.message}"
+            estimates.append(SeamEstimate(seam.id, SeamStatus.NOT_FOUND, msg, code=Reason.NO_SEARCH))
+        else:
+            estimates.append(SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE))
+    metrics, summary = evaluate(estimates, {})
+    timings["total_s"] = time.perf_counter() - t_all
+    frame = "F"
+    return Detection(
+        scenario=scenario,
+        method=method,
+        weldmap_R=weldmap.transformed(X_FL @ X, frame),
+        estimates=tuple(estimates),
+        truths={},
+        metrics=metrics,
+        summary=summary,
+        timings=timings,
+        error=error,
+        joints=joints,
+    )
+
+
+__all__ = ["MARGIN_M", "POOR_FITNESS", "AlignmentFailure", "locate_cloud"]

@@ -1,0 +1,115 @@
+"""What :func:`cell.pipeline.cloud.locate_cloud` derives from a brought cloud before it looks for seams: the
+options that fit the data (its noise and density, not the D415's constants) and the scenario that stands for the
+cell the cloud came from (so that the usual report describes the run).
+
+Options from the data (the table's noise sigma and the point spacing between scan lines, both measured on the
+table by :mod:`cell.perception.unorganised`):
+
+- the map-to-cloud ICP's largest correspondence: 20 mm, or 20 noise sigma when that is more, so its three stages
+  (1, 1/4, 1/10 of it) keep the finest above 2 noise sigma and the fitness band (the middle stage) above 5;
+- our locator: told the measured noise (``sensor_sigma_m``); reads every point (``sample_share`` 1: a line
+  scanner's cloud is sparse); a face is seen with the points of 30 mm^2 of it at the cloud's density
+  (:func:`min_face_points`); a weld face must be seen (``min_edge_points`` out of reach: placing an unseen face
+  from an edge needs a depth camera's per-pixel density, and a shadowed face is not a face); the sigma floor is
+  :func:`sigma_floor` (what a fit of such a cloud cannot see), and the standard error that still earns full
+  confidence is that floor too (the D415's 0.2 mm would mark every seam of a 1 mm-noise cloud as doubtful: a
+  statistical error below what the sensor resolves at all is as good as it gets);
+- the parts-seen check: a part's top counts as seen from :data:`MIN_SEEN` of it covered (open tubes).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.geometry import FloatArray, matrix_to_rpy
+from cell.scenario import Scenario
+from cell.types import WeldMap
+
+ALIGN_NOISE_SIGMAS = 20.0  # the ICP's largest correspondence, in noise sigmas (at least the default 20 mm)
+# The sigma floor's parts [-]: the noise of one scan line (each line is a rigid arm pose: its error does not
+# average out along it) and the spacing between lines across the seam (where the corner falls between two lines).
+FLOOR_NOISE_SHARE = 1.0
+FLOOR_SPACING_SHARE = 1.0 / math.sqrt(12.0)  # RMS of a uniform position within one spacing
+# A part's top half covered is a map placed half off the cloud for a depth camera over solid boxes; a real tube is
+# open at its ends, and its top shows only its rim (the scans' vertical tube: 37-46 % of its top within 1 cm).
+MIN_SEEN = 0.3
+NO_EDGES = 10**9  # min_edge_points that no edge reaches: a weld face must be seen
+MIN_FACE_AREA_M2 = 30e-6  # a weld face is seen with the points of 30 mm^2 of it (the default 30 at a 1 mm pitch)
+
+
+def sigma_floor(noise_m: float, between_m: float) -> float:
+    """The floor of a found seam's sigma [m] in such a cloud: the noise of one scan line and the RMS position of
+    the corner within the spacing between lines, in quadrature (``FLOOR_*``). Calibrated on the three real scans
+    (benchmarks/bench_real_scans.py): their errors against an independent fit are of this size, where the
+    locator's own statistical error (thousands of points) is ten times smaller."""
+    spacing = between_m if math.isfinite(between_m) else 0.0
+    return math.hypot(FLOOR_NOISE_SHARE * noise_m, FLOOR_SPACING_SHARE * spacing)
+
+
+def min_face_points(along_m: float, between_m: float) -> int:
+    """The fewest points that make a weld face seen in a cloud of this spacing [m]: those of MIN_FACE_AREA_M2 at
+    its density (a sparse line scan has a third of the points a 1 mm grid would), within 8..30 (the default)."""
+    if not (math.isfinite(along_m) and math.isfinite(between_m)) or along_m * between_m <= 0.0:
+        return 30
+    return int(min(30, max(8, math.ceil(MIN_FACE_AREA_M2 / (along_m * between_m)))))
+
+
+def ours_overrides(noise_m: float, along_m: float, between_m: float) -> dict[str, Any]:
+    """Our locator's options for a cloud of this noise and point spacing along / between lines [m] (module
+    docstring)."""
+    floor = float(sigma_floor(noise_m, between_m))
+    return {
+        "sensor_sigma_m": float(max(noise_m, 2e-4)),
+        "min_face_points": min_face_points(along_m, between_m),
+        "sample_share": 1.0,
+        "min_edge_points": NO_EDGES,
+        "sigma_floor_m": floor,
+        "target_se_m": floor,
+    }
+
+
+def _pose(X: FloatArray) -> dict[str, list[float]]:
+    rpy = np.degrees(matrix_to_rpy(X[:3, :3]))
+    return {"xyz_m": [float(v) for v in X[:3, 3]], "rpy_deg": [float(v) for v in rpy]}
+
+
+def cloud_scenario(
+    name: str,
+    weldmap: WeldMap,
+    X_FM: FloatArray,
+    workspace_F: tuple[FloatArray, FloatArray],
+    table_F: tuple[FloatArray, tuple[float, float, float]],
+    eye_F: FloatArray,
+    noise_m: float,
+) -> Scenario:
+    """The scenario that describes a run on a brought cloud: the world is the cloud's frame F (the robot base at
+    its origin, no arm model), the map at ``X_FM`` (4, 4) [m], the workspace ``workspace_F`` (lo, hi) (3,) that the
+    cloud was cropped to, the table ``table_F`` (centre, size) (3,) found in the data, one fixed "sensor" at
+    ``eye_F`` (3,) looking at the part (the cloud's, for the record: nothing is rendered), no simulation.
+    ``noise_m`` goes into the map-to-cloud ICP's settings (module docstring)."""
+    lo, hi = (np.asarray(v, dtype=np.float64) for v in workspace_F)
+    target = (X_FM @ np.array([*np.mean([p.center for p in weldmap.parts], axis=0), 1.0]))[:3]
+    eye = np.asarray(eye_F, dtype=np.float64)
+    if np.linalg.norm(eye - target) < 0.1:
+        eye = target + np.array([0.0, 0.0, 1.0])
+    source = weldmap.source
+    data: dict[str, Any] = {
+        "name": name,
+        "description": f"a brought point cloud ({name}) against {Path(source).name}",
+        "seed": 0,
+        "map": {"file": source, "units": weldmap.units, "X_WM": _pose(X_FM)},
+        "table": {"center_m": [float(v) for v in table_F[0]], "size_m": [float(max(v, 1e-3)) for v in table_F[1]]},
+        "cameras": {"sensor": {"eye_m": [float(v) for v in eye], "target_m": [float(v) for v in target]}},
+        "perception": {
+            "workspace": {"min_m": [float(v) for v in lo], "max_m": [float(v) for v in hi]},
+            "align_max_correspondence_m": float(max(0.02, ALIGN_NOISE_SIGMAS * noise_m)),
+            "coverage": {"min_seen": MIN_SEEN},
+        },
+        "simulation": {"noise": "none"},
+        "base_dir": str(Path(source).parent) if source else ".",
+    }
+    return Scenario.model_validate(data)

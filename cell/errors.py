@@ -19,6 +19,8 @@ code  meaning
 13    camera/sensor failure (no image, no points)
 14    map-to-cloud alignment failed
 15    motion: IK, timing or plan failed as a whole
+16    recorded capture folder unreadable or invalid (a file missing, an image not a 16-bit PNG, sizes that
+      disagree with its CameraInfo, an unknown format version)
 130   interrupted (Ctrl-C): the partial report of the stage reached is written where --json asked
 ====  =========================================================================
 """
@@ -122,6 +124,17 @@ class AlignmentError(CellError, RuntimeError):
         self.code = code
         self.value = value
         self.needed = needed
+
+
+class CaptureError(CellError, ValueError):
+    """A recorded capture folder (docs/capture.md) cannot be read: a file missing, an image that is not a 16-bit
+    PNG or disagrees with its CameraInfo, an unknown format or version. ``path`` names the file at fault."""
+
+    exit_code = 16
+
+    def __init__(self, message: str, *, path: str = "") -> None:
+        super().__init__(message)
+        self.path = path
 
 
 class MotionError(CellError, RuntimeError):

@@ -1,0 +1,93 @@
+"""Depth images as 16-bit PNG files: integer depth units, 0 = invalid (the RealSense / ROS ``16UC1`` convention).
+
+A depth z [m] is stored as ``round(z / depth_scale_m)``; reading gives ``float32(units * depth_scale_m)``, the same
+float64 product then float32 cast the simulator's noise model quantises with (:mod:`cell.sim.noise`), so a depth
+on the scale's grid comes back bit-identical. pillow is the only library that touches the files.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.errors import CaptureError
+
+MAX_UNITS = 65535  # the largest depth a 16-bit PNG holds, in depth units
+
+
+@dataclass(frozen=True)
+class Encoded:
+    """A depth image in depth units and what the encoding lost.
+
+    units : (H, W) uint16 depth units (0 = invalid).
+    off_grid : valid pixels whose depth was not a whole number of units (they come back rounded).
+    max_rounding_m : the largest change rounding made to such a pixel [m] (at most half a unit).
+    too_far : pixels beyond ``MAX_UNITS`` units, stored as invalid (0).
+    not_finite : NaN, infinite or negative pixels, stored as invalid (0).
+    """
+
+    units: npt.NDArray[np.uint16]
+    off_grid: int
+    max_rounding_m: float
+    too_far: int
+    not_finite: int
+
+
+def to_metres(units: npt.NDArray[np.uint16], depth_scale_m: float) -> npt.NDArray[np.float32]:
+    """(H, W) float32 depth [m] from depth units (0 stays 0)."""
+    return (units.astype(np.float64) * depth_scale_m).astype(np.float32)
+
+
+def encode(depth_m: npt.ArrayLike, depth_scale_m: float) -> Encoded:
+    """Depth [m] (H, W) -> depth units at ``depth_scale_m`` [m per unit], with what was lost (:class:`Encoded`)."""
+    if not depth_scale_m > 0.0:
+        raise ValueError(f"depth_scale_m must be > 0, got {depth_scale_m}")
+    z = np.asarray(depth_m, dtype=np.float64)
+    bad = ~np.isfinite(z) | (z < 0.0)
+    z = np.where(bad, 0.0, z)
+    n = np.round(z / depth_scale_m)
+    far = n > MAX_UNITS
+    n[far] = 0.0
+    units = n.astype(np.uint16)
+    ok = (units > 0) & ~far & ~bad
+    back = to_metres(units, depth_scale_m)
+    off = ok & (back != np.asarray(depth_m, dtype=np.float32))
+    rounding = float(np.max(np.abs(back[off].astype(np.float64) - z[off]))) if off.any() else 0.0
+    return Encoded(units, int(off.sum()), rounding, int(far.sum()), int(bad.sum()))
+
+
+def write_png(path: Path, units: npt.NDArray[np.uint16]) -> None:
+    """Write (H, W) uint16 depth units as a 16-bit greyscale PNG."""
+    from PIL import Image
+
+    Image.fromarray(np.ascontiguousarray(units, dtype=np.uint16)).save(path, format="PNG")
+
+
+def read_png(path: Path) -> npt.NDArray[np.uint16]:
+    """(H, W) uint16 depth units of a 16-bit greyscale PNG; CaptureError if it is missing, not a PNG or not 16-bit
+    single-channel."""
+    from PIL import Image, UnidentifiedImageError
+
+    if not path.is_file():
+        raise CaptureError(f"depth image {path} is missing; valid: the file capture.json names", path=str(path))
+    try:
+        with Image.open(path) as im:
+            fmt, mode = im.format, im.mode
+            if fmt != "PNG":
+                raise CaptureError(f"depth image {path} is {fmt or 'not an image'}; valid: a PNG", path=str(path))
+            if mode not in ("I;16", "I;16B", "I;16L"):
+                raise CaptureError(
+                    f"depth image {path} has pixel mode {mode}; valid: 16-bit single-channel (I;16) depth units",
+                    path=str(path),
+                )
+            units = np.asarray(im, dtype=np.uint16)
+    except CaptureError:
+        raise
+    except UnidentifiedImageError:
+        raise CaptureError(f"depth image {path} is not an image; valid: a 16-bit PNG", path=str(path)) from None
+    except (OSError, SyntaxError, ValueError) as e:  # truncated or corrupt data
+        raise CaptureError(f"depth image {path} cannot be read ({e}); valid: a 16-bit PNG", path=str(path)) from None
+    return units

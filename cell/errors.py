@@ -11,7 +11,8 @@ code  meaning
 0     everything asked for was done
 1     internal error (a bug: please report it with the traceback)
 2     command-line usage error (typer/click, or a bad value checked before any work), or an output path that
-      cannot be written (checked before the run; a write that fails late still writes every other output)
+      cannot be written (checked before the run; a write that fails late still writes every other output),
+      or a brought point cloud file that cannot be used (``CloudFileError``: read before any work)
 3     partial result: the report is written; some seams were not found/welded, or a stage failed after capture
 10    scenario file invalid (unknown key, value out of range, missing file)
 11    welding map (DXF) unreadable or invalid
@@ -66,6 +67,28 @@ class OutputError(CellError, OSError):
 
     def __init__(self, message: str, *, path: str = "") -> None:
         super().__init__(message)
+        self.path = path
+
+
+class CloudFault(enum.StrEnum):
+    """Why a brought point cloud file (``cell locate CLOUD``) cannot be used."""
+
+    MISSING = "missing"  # no such file, or not a file
+    NOT_A_CLOUD = "not_a_cloud"  # neither PLY nor PCD by its content
+    MALFORMED = "malformed"  # a PLY/PCD header or body that does not hold what it says (truncated, no x y z)
+    UNSUPPORTED = "unsupported"  # a valid variant this reader does not read
+    EMPTY = "empty"  # no points at all
+    NOT_FINITE = "not_finite"  # every point has a NaN or infinite coordinate
+    UNITS = "units"  # a size no cell's cloud has in the stated units (millimetres read as metres)
+
+
+class CloudFileError(UsageError):
+    """A brought point cloud file cannot be used: ``code`` says why, ``path`` names the file. Exit 2: it is an
+    input of the command line, read before any work."""
+
+    def __init__(self, message: str, *, code: CloudFault, path: str = "") -> None:
+        super().__init__(message)
+        self.code = code
         self.path = path
 
 

@@ -1,0 +1,175 @@
+"""Point cloud files people bring (``cell locate CLOUD``): PLY or PCD, ASCII or binary, read into a :class:`Cloud`.
+
+:func:`read_cloud` knows the format by the file's content, not its name: a PLY file starts with the line ``ply``,
+a PCD file with its header (``#`` comments, then ``VERSION``/``FIELDS``/... up to ``DATA``). Both are parsed here
+with numpy: open3d's PLY reader returns uninitialised memory for a truncated file or an ``inf`` token (and prints
+to stderr), which a brought file must never turn into points. Only PCD's ``binary_compressed`` body (LZF) is
+decoded by open3d, after its sizes are checked here. CRLF line ends are tolerated; fields other than x, y, z
+(intensity, normals, colour, padding) are ignored.
+
+Units: the file's numbers are read in ``units`` (``m`` by default) and scaled to metres. A cloud reaching beyond
+:data:`PLAUSIBLE_M` (20 m) from its frame's origin, or spanning more than that, is refused (a 260 mm part written in
+millimetres and read as metres is 260 m long); so is one spanning less than :data:`SMALLEST_M` (1 mm). Rows with a
+NaN or infinite coordinate are dropped, with a warning, when finite rows remain; a file with none is refused.
+Every refusal is a one-line :class:`~cell.errors.CloudFileError` with its :class:`~cell.errors.CloudFault`.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.errors import CloudFault, CloudFileError, UsageError
+from cell.perception._cloud_formats import Body, parse_pcd, parse_ply
+from cell.types import Cloud
+
+UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}  # metres per unit of the file
+PLAUSIBLE_M = 20.0  # [m] no cloud of a weld cell reaches (or spans) this far from its frame's origin
+SMALLEST_M = 1e-3  # [m] a cloud spanning less than this cannot show a part
+_FRAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+
+
+class CloudFileWarning(UserWarning):
+    """Something of a brought cloud file was dropped (rows with NaN or infinite coordinates)."""
+
+
+def check_units(units: str) -> float:
+    """Metres per unit of ``units`` (``m``, ``cm``, ``mm``, ``in``); UsageError for anything else."""
+    if units not in UNITS:
+        raise UsageError(f"--units {units!r}; valid: {', '.join(UNITS)}")
+    return UNITS[units]
+
+
+def check_frame(frame: str) -> str:
+    """``frame`` if it is a frame name (a letter, then letters, digits or ``_``); UsageError otherwise."""
+    if not _FRAME.match(frame):
+        raise UsageError(f"--frame {frame!r}; valid: a frame name such as F or R (a letter, then letters or digits)")
+    return frame
+
+
+def _sniff(path: Path, head: bytes) -> str:
+    """``ply`` or ``pcd`` from the first bytes of the file; CloudFileError when it is neither."""
+    first = head.split(b"\n", 1)[0].rstrip(b"\r")
+    if first == b"ply":
+        return "ply"
+    for raw in head.split(b"\n"):
+        line = raw.strip()
+        if not line or line.startswith(b"#"):
+            continue
+        if line.split()[0] in (b"VERSION", b"FIELDS"):
+            return "pcd"
+        break
+    shown = first[:40].decode("ascii", errors="replace")
+    raise CloudFileError(
+        f"point cloud {str(path)!r} is neither PLY nor PCD (it starts with {shown!r}); valid: a PLY file (first"
+        " line 'ply') or a PCD file (header VERSION, FIELDS, ... DATA)",
+        code=CloudFault.NOT_A_CLOUD,
+        path=str(path),
+    )
+
+
+def _points(path: Path, body: Body) -> npt.NDArray[np.float64]:
+    if body.compressed:  # PCD binary_compressed: the sizes are checked, open3d decodes the LZF body
+        from cell.perception import _open3d
+
+        points = _open3d.read_pcd(path)
+        if len(points) != body.count:
+            raise CloudFileError(
+                f"point cloud {str(path)!r}: open3d decoded {len(points)} points of the {body.count} its header"
+                " states; valid: an intact binary_compressed PCD (or save it as ascii or binary)",
+                code=CloudFault.MALFORMED,
+                path=str(path),
+            )
+        return points
+    assert body.xyz is not None
+    return body.xyz
+
+
+def read_cloud(
+    path: str | Path, *, units: str = "m", frame: str = "F", warn: Callable[[str], None] | None = None
+) -> Cloud:
+    """The points of a PLY or PCD file as a :class:`Cloud` in ``frame``, in metres.
+
+    path : the file (its format is known by content; see the module docstring for what is read and refused).
+    units : the unit of the file's numbers: ``m`` (default), ``cm``, ``mm`` or ``in``.
+    frame : the name of the data's own frame (``F`` by default: the frame the file's coordinates are in).
+    warn : called with one line when rows are dropped (default: a :class:`CloudFileWarning`).
+
+    Returns points (n, 3) [m] in ``frame``, finite, in file order, with no camera index (-1).
+    Raises :class:`~cell.errors.CloudFileError` (exit 2) for a file that cannot be used, and
+    :class:`~cell.errors.UsageError` for unknown ``units`` or a bad ``frame`` name.
+    """
+    path = Path(path)
+    scale = check_units(units)
+    check_frame(frame)
+    if not path.is_file():
+        what = "is a folder" if path.is_dir() else "does not exist"
+        raise CloudFileError(
+            f"point cloud {str(path)!r} {what}; valid: a PLY or PCD file", code=CloudFault.MISSING, path=str(path)
+        )
+    data = path.read_bytes()
+    if not data.strip():
+        raise CloudFileError(
+            f"point cloud {str(path)!r} is empty ({len(data)} bytes); valid: a PLY or PCD file with points",
+            code=CloudFault.EMPTY,
+            path=str(path),
+        )
+    kind = _sniff(path, data[:4096])
+    body = parse_ply(path, data) if kind == "ply" else parse_pcd(path, data)
+    if body.count == 0:
+        raise CloudFileError(
+            f"point cloud {str(path)!r} holds no points (its {kind.upper()} header says 0); valid: a cloud with points",
+            code=CloudFault.EMPTY,
+            path=str(path),
+        )
+    xyz = _points(path, body)
+    finite = np.all(np.isfinite(xyz), axis=1)
+    kept = int(finite.sum())
+    if kept == 0:
+        raise CloudFileError(
+            f"point cloud {str(path)!r}: all {len(xyz)} points have NaN or infinite coordinates; valid: a cloud with"
+            " finite points",
+            code=CloudFault.NOT_FINITE,
+            path=str(path),
+        )
+    if kept < len(xyz):
+        msg = f"point cloud {str(path)!r}: dropped {len(xyz) - kept} of {len(xyz)} points (NaN or infinite)"
+        if warn is None:
+            warnings.warn(msg, CloudFileWarning, stacklevel=2)
+        else:
+            warn(msg)
+    p_F = xyz[finite] * scale
+    check_plausible(p_F, path, units)
+    return Cloud(p_F, frame)
+
+
+def check_plausible(p_F: npt.NDArray[np.float64], path: Path, units: str) -> None:
+    """Refuse points (n, 3) [m] no weld cell's cloud has: beyond :data:`PLAUSIBLE_M` from the origin or across,
+    or spanning less than :data:`SMALLEST_M`. The message says which ``--units`` would fix it."""
+    reach = float(np.max(np.abs(p_F)))
+    span = float(np.max(np.ptp(p_F, axis=0)))
+    size = max(reach, span)
+    if size > PLAUSIBLE_M:
+        if units == "m" and size * UNITS["mm"] <= PLAUSIBLE_M:
+            hint = "looks like millimetres: pass --units mm"
+        else:
+            hint = "check --units"
+        raise CloudFileError(
+            f"point cloud {str(path)!r} spans {span:.4g} m and reaches {reach:.4g} m from its origin read in"
+            f" {units}, beyond {PLAUSIBLE_M:g} m: {hint}; valid: --units {', '.join(UNITS)}",
+            code=CloudFault.UNITS,
+            path=str(path),
+        )
+    if span < SMALLEST_M:
+        hint = "if the file is in metres, drop --units" if units != "m" else "a single spot, not a part"
+        raise CloudFileError(
+            f"point cloud {str(path)!r} spans only {span * 1e3:.3g} mm read in {units} ({hint}); valid: a cloud"
+            f" at least {SMALLEST_M * 1e3:g} mm across",
+            code=CloudFault.UNITS,
+            path=str(path),
+        )

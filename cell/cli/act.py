@@ -42,6 +42,15 @@ MethodOpt = Annotated[str | None, typer.Option(help="Seam locator (default: the 
 JsonOpt = Annotated[
     Path | None, typer.Option("--json", help="Write the JSON report here ('-': stdout, the table to stderr).")
 ]
+RerunOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--rerun",
+        metavar="FILE.rrd",
+        help="Write a Rerun recording (cloud, map, cameras, robot and tool path on a timeline) here; needs the"
+        " optional extra: uv sync --extra rerun, or pip install 'weld-cell\\[rerun]'.",  # help is rich markup
+    ),
+]
 
 
 def _load(scenario: str, method: str | None, noise: str | None) -> tuple[Scenario, dict[str, Any]]:
@@ -74,6 +83,7 @@ def weld(
     html: Annotated[
         Path | None, typer.Option("--html", help="Write one page to look at (results, 3D cell, joints) here.")
     ] = None,
+    rerun_path: RerunOpt = None,
 ) -> None:
     """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation."""
     from cell import pipeline
@@ -85,6 +95,7 @@ def weld(
         check_file(json_path, "--json")
         check_folder(krl, "--krl")
         check_file(html, "--html", stdout_ok=False)
+        _check_rerun(rerun_path)
         scn, prov = _load(scenario, method, noise)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
@@ -93,6 +104,7 @@ def weld(
             partial = _finish_run(run, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table)
             if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
                 say(f"page: {html}")
+            _write_rerun(run, rerun_path, writer)
         except (KeyboardInterrupt, ImportError) as e:
             if not was_interrupted(e):
                 raise
@@ -158,6 +170,7 @@ def preview(
     method: MethodOpt = None,
     noise: NoiseOpt = None,
     fmt: FormatOpt = "table",
+    rerun_path: RerunOpt = None,
 ) -> None:
     """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots."""
     from cell import pipeline
@@ -166,6 +179,7 @@ def preview(
     with cell_errors():
         table = parse_format(fmt)
         check_folder(out_dir, "--out")
+        _check_rerun(rerun_path)
         scn, prov = _load(scenario, method, noise)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
@@ -173,6 +187,7 @@ def preview(
         try:
             run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
             partial = _finish_run(run, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
+            _write_rerun(run, rerun_path, writer)  # before the pictures: it needs no cloud, they do
             stage(f"drawing pictures into {out_dir}/")
             done = run
             paths = writer.attempt(lambda: write_run(done, out_dir)) or []
@@ -235,6 +250,26 @@ def _write_page(run: WeldRun | None, path: Path) -> Path:
     if run is None:
         raise ValueError("no run to draw")
     return write_page(run, path)
+
+
+def _check_rerun(path: Path | None) -> None:
+    """Before the run: ``--rerun`` needs rerun-sdk installed and a file it can write (UsageError/OutputError)."""
+    if path is None:
+        return
+    from cell.preview.rerun import require_rerun
+
+    require_rerun()
+    check_file(path, "--rerun", stdout_ok=False)
+
+
+def _write_rerun(run: WeldRun, path: Path | None, writer: Writer) -> None:
+    """The run's Rerun recording (:func:`cell.preview.rerun.record_run`), if asked for; its failure is the writer's."""
+    if path is None:
+        return
+    from cell.preview.rerun import record_run
+
+    if writer.attempt(lambda: record_run(run, path)) is not None:
+        say(f"rerun recording: {path}")
 
 
 def _write_program(run: WeldRun, krl: Path, provenance: Mapping[str, Any]) -> tuple[Path, Path, Path, Path]:

@@ -1,0 +1,142 @@
+"""fence1's Rerun recording (``cell weld fence1 --rerun FILE.rrd``), read back with rerun's own reader.
+
+The session's weld of fence1 (``fence1_run``) is recorded once; the file is opened with
+``rerun.chunk.RrdReader`` and its entities compared with the run's values: the cloud, the map's parts, the
+seams by status, the cameras, the robot's links posed on the ``time`` timeline over the whole motion, the tool
+path and the arc.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from cell import pipeline
+from cell.geometry import invert, transform_points
+from cell.types import SeamStatus
+
+rerun = pytest.importorskip("rerun")
+import pyarrow as pa  # noqa: E402  (rerun's own dependency)
+from rerun.chunk import RrdReader  # noqa: E402
+
+from cell.preview.rerun import APPLICATION_ID, RATE_HZ, record_run, recording_id  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def recorded(fence1_run: pipeline.WeldRun, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    """The recording of fence1's weld and its columns by entity path: ``{path: {column: [values per row]}}``
+    (static and temporal rows of an entity concatenated in file order)."""
+    path = record_run(fence1_run, tmp_path_factory.mktemp("rerun") / "fence1.rrd")
+    cols: dict[str, dict[str, list[Any]]] = defaultdict(lambda: defaultdict(list))
+    for chunk in RrdReader(path).store().stream():
+        batch = chunk.to_record_batch()
+        for name in batch.schema.names:
+            col = batch.column(name)
+            if pa.types.is_duration(col.type):  # a timeline: seconds
+                cols[chunk.entity_path][name] += (col.cast(pa.int64()).to_numpy() / 1e9).tolist()
+            elif not name.startswith("rerun."):
+                cols[chunk.entity_path][name] += col.to_pylist()
+    return path, cols
+
+
+def test_the_file_is_one_recording_of_this_run(
+    recorded: tuple[Path, dict[str, Any]], fence1_run: pipeline.WeldRun
+) -> None:
+    path, _ = recorded
+    assert 1_000_000 < path.stat().st_size < 9_000_000  # measured 5.9 MB: 312k cloud points, 2758 poses
+    (entry,) = RrdReader(path).recordings()
+    assert entry.application_id == APPLICATION_ID
+    assert entry.recording_id == recording_id(fence1_run) == recording_id(fence1_run)
+
+
+def test_cloud_map_seams_table_and_cameras(recorded: tuple[Path, dict[str, Any]], fence1_run: pipeline.WeldRun) -> None:
+    _, cols = recorded
+    det = fence1_run.detection
+    assert det.scene is not None
+    dense = np.asarray(det.scene.perceived.dense.points)
+    (cloud,) = cols["/cell/cloud"]["Points3D:positions"]
+    assert len(cloud) == len(dense) > 100_000
+    np.testing.assert_allclose(np.asarray(cloud)[::997], dense[::997], atol=1e-6)  # stored as float32
+    (labels,) = cols["/cell/map/parts"]["Boxes3D:labels"]
+    assert labels == [p.name for p in det.weldmap_R.parts]
+    (centres,) = cols["/cell/map/parts"]["Boxes3D:centers"]
+    np.testing.assert_allclose(centres, [p.box.X_AB[:3, 3] for p in det.weldmap_R.parts], atol=1e-6)
+    by_status: dict[str, list[str]] = defaultdict(list)
+    for e in det.estimates:
+        by_status[str(e.status)].append(e.id)
+    assert set(by_status) == {"found", "not_visible"}
+    for status, ids in by_status.items():
+        assert cols[f"/cell/seams/{status}"]["LineStrips3D:labels"] == [ids]
+    found = {e.id: e for e in det.estimates if e.status is SeamStatus.FOUND}
+    (strips,) = cols["/cell/seams/found"]["LineStrips3D:strips"]
+    for sid, strip in zip(by_status["found"], strips, strict=True):
+        np.testing.assert_allclose(strip, [found[sid].p_start, found[sid].p_end], atol=1e-6)
+    assert len(cols["/cell/seams/truth"]["LineStrips3D:labels"][0]) == len(det.truths)
+    assert cols["/cell/table"]["Boxes3D:centers"]
+    assert fence1_run.view is not None
+    for cam in fence1_run.view.cameras:
+        c = cols[f"/cell/cameras/{cam.name}"]
+        np.testing.assert_allclose(c["Transform3D:translation"][0][0], cam.X_RC[:3, 3], atol=1e-6)
+        assert c["Pinhole:resolution"][0][0] == [cam.intrinsics.width, cam.intrinsics.height]
+
+
+def test_robot_links_move_on_the_timeline_over_the_whole_motion(
+    recorded: tuple[Path, dict[str, Any]], fence1_run: pipeline.WeldRun
+) -> None:
+    _, cols = recorded
+    ex, view, arm = fence1_run.execution, fence1_run.view, fence1_run.arm
+    assert ex is not None and view is not None and arm is not None
+    for link in ("base_link", "link_1", "link_3", "link_6", "torch"):
+        assert any(p.startswith(f"/cell/robot/{link}/") for p in cols), link  # its shapes
+        c = cols[f"/cell/robot/{link}"]
+        t = np.array(c["time"])
+        assert t[0] == pytest.approx(0.0) and t[-1] == pytest.approx(ex.duration, abs=1e-6)
+        assert np.all(np.diff(t) > 0.0) and len(t) == pytest.approx(ex.duration * RATE_HZ, rel=0.05)
+    # the poses are the arm's at those instants: link_6 at the last instant is where the executed q puts it
+    X = arm.model.fk_frames(ex.q[-1], ("link_6",))["link_6"]
+    np.testing.assert_allclose(cols["/cell/robot/link_6"]["Transform3D:translation"][-1][0], X[:3, 3], atol=1e-6)
+    # the TCP now and the executed tool path agree with the station's record (frame R)
+    p_R = transform_points(invert(fence1_run.detection.scenario.X_WR), ex.tcp_W)
+    np.testing.assert_allclose(cols["/cell/tcp/now"]["Points3D:positions"][-1][0], p_R[-1], atol=2e-3)
+    (path,) = cols["/cell/tcp/path"]["LineStrips3D:strips"]
+    assert len(path[0]) == len(p_R)
+
+
+def test_arc_on_intervals_one_strip_per_weld(
+    recorded: tuple[Path, dict[str, Any]], fence1_run: pipeline.WeldRun
+) -> None:
+    _, cols = recorded
+    plan = fence1_run.plan
+    assert plan is not None
+    welds = [s for s in plan.segments if s.arc_on]
+    (strips,) = cols["/cell/tcp/arc_on"]["LineStrips3D:strips"]
+    assert len(strips) == len(welds) == 12
+    arc = np.array(cols["/plots/arc"]["Scalars:scalars"]).ravel()
+    assert set(arc) == {0.0, 1.0} and 0.2 < arc.mean() < 0.9
+    texts = [x for row in cols["/log"]["TextLog:text"] for x in row]
+    for kind in ("arc_on", "arc_off"):  # every switch named by its seam, in welding order
+        seams = [x.split()[1] for x in texts if x.startswith(kind)]
+        assert seams == [s.seam_id for s in welds]
+
+
+def test_a_preview_records_the_plan_on_the_same_timeline(fence1_run: pipeline.WeldRun, tmp_path: Path) -> None:
+    """Without an execution (``cell preview``) the motion is the plan's: the move home, then the program."""
+    ex, plan, pre = fence1_run.execution, fence1_run.plan, fence1_run.pre_move
+    assert ex is not None and plan is not None and pre is not None
+    path = record_run(replace(fence1_run, execution=None), tmp_path / "preview.rrd")
+    store = RrdReader(path).store()
+    (entry,) = RrdReader(path).recordings()
+    assert entry.recording_id != recording_id(fence1_run)  # a preview is another recording than the weld
+    seen: dict[str, Any] = {}
+    for chunk in store.stream():
+        batch = chunk.to_record_batch()
+        seen[chunk.entity_path] = batch
+    t = seen["/cell/robot/link_6"].column("time").cast(pa.int64()).to_numpy() / 1e9
+    assert t[0] == 0.0 and t[-1] == pytest.approx(pre.duration + plan.cycle_time, abs=1e-6)
+    assert t[-1] == pytest.approx(ex.duration, abs=0.01)
+    assert len(seen["/cell/tcp/arc_on"].column("LineStrips3D:strips").to_pylist()[0]) == 12

@@ -1,10 +1,14 @@
 """Jerk-limited timing with Ruckig: the only module that imports ruckig.
 
 Only state-to-state motions are used (docs/reference.md section 9): Ruckig's intermediate waypoints call a
-remote service. A point-to-point move is one Ruckig solve over all joints; a weld along a seam is timed by
-a one-axis profile of the path length s(t) (:func:`path_profile`) that the planner maps through IK. Every
-Ruckig result is checked: anything but Working/Finished raises :class:`~cell.errors.TimingError` with the
-result's name.
+remote service. A point-to-point move from rest to rest is timed as a KRC4 drives a PTP (docs/reference.md
+section 9): a straight line in joint space, q(t) = q0 + u(t) (q1 - q0), every axis starting and stopping
+together, u(t) one jerk-limited profile from 0 to 1 whose limits are the tightest of the axes' limits scaled
+by their share of the move (the leading axis at its limit, the others proportionally slower). A move with
+boundary velocities (not a KRC PTP) is one Ruckig solve over all joints, phase-synchronised where the
+velocities allow it. A weld along a seam is timed by a one-axis profile of the path length s(t)
+(:func:`path_profile`) that the planner maps through IK. Every Ruckig result is checked: anything but
+Working/Finished raises :class:`~cell.errors.TimingError` with the result's name.
 
 Units: joints [rad], [rad/s], [rad/s^2], [rad/s^3]; path length [m], [m/s], [m/s^2], [m/s^3]; time [s].
 """
@@ -87,14 +91,14 @@ def _at_times(traj: ruckig.Trajectory, times: FloatArray) -> tuple[FloatArray, F
     return p + tau * (v + tau * (a / 2.0 + tau * j / 6.0)), v + tau * (a + tau * j / 2.0), a + tau * j
 
 
-def _ptp_solve(
+def _checked_states(
     q0: npt.ArrayLike,
     q1: npt.ArrayLike,
     limits: JointLimits,
     v0: npt.ArrayLike | None,
     v1: npt.ArrayLike | None,
-) -> tuple[ruckig.Trajectory, FloatArray, FloatArray]:
-    """Checked inputs -> Ruckig trajectory within all limits, and the goal (q1, v1) as arrays."""
+) -> tuple[FloatArray, FloatArray]:
+    """(2, dof) positions and velocities of start and goal; TimingError when outside the limits."""
     dof = limits.dof
     q = np.array([_vec("q0", q0, dof), _vec("q1", q1, dof)])  # (2, dof): start, goal
     v = np.array([_vec("v0", v0, dof), _vec("v1", v1, dof)])
@@ -107,6 +111,33 @@ def _ptp_solve(
         )
     if (np.abs(v) > limits.v_max * (1 + 1e-9)).any():
         raise TimingError("ptp start or goal velocity exceeds the joint velocity limits")
+    return q, v
+
+
+def _line_solve(q: FloatArray, limits: JointLimits) -> ruckig.Trajectory | None:
+    """The profile u(t) from rest at 0 to rest at 1 of the straight joint line q[0] -> q[1] (None: no motion).
+
+    Axis j moves dq_j u(t), so its velocity, acceleration and jerk are dq_j times u's: u's limits are the
+    smallest of v_max_j / |dq_j| (and likewise for a and j) over the moving axes. The line stays inside the
+    position limits (a box holding both ends), and a rest-to-rest profile never overshoots its target.
+    """
+    dq = np.abs(q[1] - q[0])
+    moving = dq > 0.0
+    if not moving.any():
+        return None
+    inp = ruckig.InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [0.0], [0.0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [1.0], [0.0], [0.0]
+    inp.max_velocity = [float(np.min(limits.v_max[moving] / dq[moving]))]
+    inp.max_acceleration = [float(np.min(limits.a_max[moving] / dq[moving]))]
+    inp.max_jerk = [float(np.min(limits.j_max[moving] / dq[moving]))]
+    return _solve(inp, "point-to-point move")
+
+
+def _ruckig_solve(q: FloatArray, v: FloatArray, limits: JointLimits) -> ruckig.Trajectory:
+    """A move with boundary velocities: one Ruckig solve over all joints within all limits (phase-synchronised
+    when the start and goal states allow it, else time-synchronised)."""
+    dof = limits.dof
     inp = ruckig.InputParameter(dof)
     zeros = [0.0] * dof
     inp.current_position, inp.current_velocity, inp.current_acceleration = q[0].tolist(), v[0].tolist(), zeros
@@ -115,6 +146,7 @@ def _ptp_solve(
     inp.max_acceleration = limits.a_max.tolist()
     inp.max_jerk = limits.j_max.tolist()
     inp.min_position, inp.max_position = limits.q_min.tolist(), limits.q_max.tolist()
+    inp.synchronization = ruckig.Synchronization.Phase
     traj = _solve(inp, "point-to-point move")
     # Ruckig returns Working even when a joint overshoots its range (a start velocity towards a near limit
     # that cannot be braked in time): check the exact extrema of each joint's profile.
@@ -127,7 +159,7 @@ def _ptp_solve(
         raise TimingError(
             f"ptp move leaves the position limits at {', '.join(over)} (the start velocity cannot be braked in time)"
         )
-    return traj, q[1], v[1]
+    return traj
 
 
 def ptp(
@@ -139,19 +171,35 @@ def ptp(
     v1: npt.ArrayLike | None = None,
     dt: float = DEFAULT_DT,
 ) -> Trajectory:
-    """Time-optimal jerk-limited joint move from (q0, v0, 0) to (q1, v1, 0), all joints arriving together.
+    """Jerk-limited joint move from (q0, v0, 0) to (q1, v1, 0), all joints starting and arriving together.
 
-    q0, q1 : (dof,) [rad] within the position limits; v0, v1 : (dof,) [rad/s], default rest.
-    Velocity, acceleration, jerk and position stay within ``limits``; sampled every ``dt`` [s] plus the exact
-    end. Raises TimingError when the states are outside the limits or Ruckig finds no trajectory.
+    q0, q1 : (dof,) [rad] within the position limits; v0, v1 : (dof,) [rad/s], default rest. From rest to rest
+    (the default) it is a KRC PTP: every sample lies on the straight joint line q0 -> q1 (see the module
+    docstring), the fastest such move within the limits. Velocity, acceleration, jerk and position stay within
+    ``limits``; sampled every ``dt`` [s] plus the exact end. Raises TimingError when the states are outside the
+    limits or Ruckig finds no trajectory.
     """
-    traj, q1a, v1a = _ptp_solve(q0, q1, limits, v0, v1)
+    q, v = _checked_states(q0, q1, limits, v0, v1)
+    if not v.any():
+        line = _line_solve(q, limits)
+        if line is None:
+            z = np.zeros((1, limits.dof))
+            return Trajectory(np.zeros(1), q[1][None, :], z, z.copy())
+        times = _sample_times(float(line.duration), dt)
+        u, ud, udd = (x[:, 0] for x in _at_times(line, times))
+        if abs(u[-1] - 1.0) > _END_TOL or abs(ud[-1]) > _END_TOL:
+            raise TimingError("Ruckig's point-to-point profile does not end at rest at the goal")
+        dq = q[1] - q[0]
+        qs, qds, qdds = q[0] + u[:, None] * dq, ud[:, None] * dq, udd[:, None] * dq
+        qs[-1], qds[-1], qdds[-1] = q[1], 0.0, 0.0  # the goal exactly, not up to rounding
+        return Trajectory(times, qs, qds, qdds)
+    traj = _ruckig_solve(q, v, limits)
     times = _sample_times(float(traj.duration), dt)
-    q, qd, qdd = _at_times(traj, times)
-    if np.max(np.abs(q[-1] - q1a)) > _END_TOL or np.max(np.abs(qd[-1] - v1a)) > _END_TOL:
+    qs, qds, qdds = _at_times(traj, times)
+    if np.max(np.abs(qs[-1] - q[1])) > _END_TOL or np.max(np.abs(qds[-1] - v[1])) > _END_TOL:
         raise TimingError("Ruckig's point-to-point move does not end at the goal state")
-    q[-1], qd[-1], qdd[-1] = q1a, v1a, 0.0  # the goal exactly, not up to rounding
-    return Trajectory(times, q, qd, qdd)
+    qs[-1], qds[-1], qdds[-1] = q[1], v[1], 0.0  # the goal exactly, not up to rounding
+    return Trajectory(times, qs, qds, qdds)
 
 
 def ptp_duration(
@@ -163,7 +211,23 @@ def ptp_duration(
     v1: npt.ArrayLike | None = None,
 ) -> float:
     """Duration [s] of :func:`ptp` for the same move, without sampling it (cheap: for ordering and costs)."""
-    return float(_ptp_solve(q0, q1, limits, v0, v1)[0].duration)
+    q, v = _checked_states(q0, q1, limits, v0, v1)
+    if not v.any():
+        line = _line_solve(q, limits)
+        return 0.0 if line is None else float(line.duration)
+    return float(_ruckig_solve(q, v, limits).duration)
+
+
+def ptp_line_deviation(q_path: npt.ArrayLike) -> float:
+    """Largest distance [rad] of any joint of a path (n, dof) from the straight joint segment between its first
+    and last rows: per sample, q minus its nearest point on the segment, the largest absolute component."""
+    Q = np.asarray(q_path, dtype=float)
+    d = Q[-1] - Q[0]
+    n2 = float(d @ d)
+    if n2 == 0.0:
+        return float(np.max(np.abs(Q - Q[0])))
+    u = np.clip((Q - Q[0]) @ d / n2, 0.0, 1.0)
+    return float(np.max(np.abs(Q - Q[0] - u[:, None] * d[None, :])))
 
 
 def path_profile(

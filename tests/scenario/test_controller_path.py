@@ -1,0 +1,47 @@
+"""The path the controller drives, on the session's fence1 run (``fence1_run``): every PTP move the simulator
+played lies on the straight joint line a KRC4 PTP drives between its ends, the gate checked those same samples,
+and the hose package's A6 window held."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cell import pipeline
+from cell.motion.gate import GateInput, GateOptions
+from cell.motion.timing import ptp_line_deviation
+
+MAX_PTP_DEVIATION = np.radians(0.01)  # [rad] the acceptance bound (measured: 0 up to rounding, < 1e-12 deg)
+
+
+def _executed(run: pipeline.WeldRun, t0: float, t1: float, ends: np.ndarray) -> np.ndarray:
+    """The executed joint samples within [t0, t1] of the run's clock, with the planned ends (n, dof) [rad]."""
+    ex = run.execution
+    assert ex is not None
+    inside = (ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9)
+    return np.vstack([ends[0], ex.q[inside], ends[-1]])
+
+
+def test_every_executed_ptp_move_is_the_krc_joint_line(fence1_run: pipeline.WeldRun) -> None:
+    run = fence1_run
+    plan, pre = run.plan, run.pre_move
+    assert plan is not None and pre is not None and run.execution is not None and not run.violations
+    moves = [s for s in plan.segments if s.kind == "move" and s.trajectory.duration > 0.0]
+    assert len(moves) >= 12  # home -> first seam, between seams, last seam -> home
+    worst = ptp_line_deviation(_executed(run, 0.0, pre.duration, pre.q))  # scan pose -> home is a PTP too
+    for s in moves:
+        q = _executed(run, pre.duration + s.t0, pre.duration + s.t1, s.trajectory.q)
+        assert len(q) > 10
+        worst = max(worst, ptp_line_deviation(q))
+        # synchronised axes: every moving axis starts and stops with the move (none at rest inside it)
+        dq = s.trajectory.q[-1] - s.trajectory.q[0]
+        moving = np.abs(dq) > 1e-6
+        inner = s.trajectory.qd[1:-1][:, moving]
+        assert np.all(inner * np.sign(dq[moving]) > 0.0)
+    assert worst <= MAX_PTP_DEVIATION, np.degrees(worst)
+    # The gate checks the same path: its 1 kHz re-sampling of the plan lies on the same lines.
+    assert run.arm is not None
+    gate = GateInput(run.arm.model, plan, pre.q[-1], None, GateOptions())
+    r = gate.resampled
+    for s in moves:
+        inside = (r.t >= s.t0) & (r.t <= s.t1)
+        assert inside.sum() > 10 and ptp_line_deviation(r.q[inside]) <= MAX_PTP_DEVIATION

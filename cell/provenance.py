@@ -81,11 +81,15 @@ def provenance(
     scenario_file: str | Path | None = None,
     argv: Sequence[str] | None = None,
     now: dt.datetime | None = None,
+    inputs: Mapping[str, str | Path] | None = None,
 ) -> dict[str, Any]:
     """The record of what made an output (JSON-ready): ``tool`` and ``version`` (package metadata), ``commit``
     (git, or ``unknown``), ``timestamp_utc`` (ISO 8601, seconds), ``command`` (the command line as typed, shell
     quoted), ``seed`` (the scenario's), ``scenario_file`` and ``scenario_sha256``, ``map_file`` and
-    ``map_sha256`` (null where there is no such file). The resolved configuration is the report's ``config``."""
+    ``map_sha256`` (null where there is no such file). The resolved configuration is the report's ``config``.
+
+    inputs : more input files by kind (``{"cloud": path, "map": path}`` for a brought cloud): each adds (or,
+    for ``map``, sets) ``<kind>_file`` (resolved) and ``<kind>_sha256``."""
     stamp = (now or dt.datetime.now(dt.UTC)).astimezone(dt.UTC).replace(microsecond=0)
     words = list(sys.argv if argv is None else argv)
     if words:
@@ -102,6 +106,10 @@ def provenance(
         "scenario_sha256": sha256_file(scenario_file),
         "map_file": str(map_file) if map_file is not None else None,
         "map_sha256": sha256_file(map_file),
+    } | {
+        key: value
+        for kind, path in (inputs or {}).items()
+        for key, value in ((f"{kind}_file", str(Path(path).resolve())), (f"{kind}_sha256", sha256_file(path)))
     }
 
 

@@ -8,6 +8,9 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from cell.geometry import transform_points
+from cell.types import WeldMap
+
 Points = npt.NDArray[np.float64]
 
 
@@ -100,3 +103,41 @@ def box_surface(rng: np.random.Generator, n: int, size_m: tuple[float, float, fl
     axis = rng.integers(0, 3, size=n)
     p[np.arange(n), axis] = np.where(rng.random(n) < 0.5, -1.0, 1.0) * half[axis]
     return p
+
+
+def map_cloud(
+    weldmap: WeldMap,
+    X_FM: npt.NDArray[np.float64],
+    rng: np.random.Generator,
+    *,
+    pitch_m: float,
+    noise_m: float,
+    table_margin_m: float = 0.1,
+) -> Points:
+    """A scanner's cloud (n, 3) [m] in F of a map's parts lying at X_FM on a table (the plane z = 0 of M): points
+    on every box face at about ``pitch_m`` spacing (uniformly at random), none inside another part or under the
+    table, the table around the parts' footprint grown by ``table_margin_m``, Gaussian noise ``noise_m`` per axis."""
+    clouds = []
+    for part in weldmap.parts:
+        box = part.box
+        for axis in range(3):
+            u, v = (a for a in range(3) if a != axis)
+            n = max(1, int(box.size[u] * box.size[v] / pitch_m**2))
+            for sign in (-1.0, 1.0):
+                p_B = (rng.random((n, 3)) - 0.5) * box.size
+                p_B[:, axis] = sign * box.size[axis] / 2.0
+                clouds.append(transform_points(box.X_AB, p_B))
+    p_M = np.vstack(clouds)
+    inside = np.zeros(len(p_M), bool)
+    for part in weldmap.parts:
+        inside |= part.contains(p_M, margin=-1e-4)
+    p_M = p_M[~inside & (p_M[:, 2] > 1e-4)]
+    corners = np.vstack([part.vertices() for part in weldmap.parts])
+    lo, hi = corners.min(axis=0)[:2] - table_margin_m, corners.max(axis=0)[:2] + table_margin_m
+    n = int(np.prod(hi - lo) / pitch_m**2)
+    table = np.column_stack([rng.uniform(lo, hi, size=(n, 2)), np.zeros(n)])
+    under = np.zeros(n, bool)
+    for part in weldmap.parts:
+        under |= part.contains(table, margin=1e-4)
+    p_M = np.vstack([p_M, table[~under]])
+    return transform_points(X_FM, p_M) + rng.normal(0.0, noise_m, size=p_M.shape)

@@ -60,7 +60,11 @@ def detection_report(
 ) -> dict[str, Any]:
     """The ``cell detect`` report as a JSON-ready dict (schema in the README), one entry per seam record.
 
-    provenance : what made it (:func:`cell.provenance.provenance`), stored under ``provenance`` (null if None)."""
+    provenance : what made it (:func:`cell.provenance.provenance`), stored under ``provenance`` (null if None).
+
+    ``frame`` names the frame of every point and pose of the report: ``R`` (the robot base) for a scenario's run,
+    the cloud's own frame for a brought cloud (``cell locate``: ``F`` unless ``--frame`` says otherwise). Without
+    ground truth (real data) the seams have no ``truth`` or ``error_mm`` and the summary's errors are null."""
     seams = [_seam_entry(rec) for rec in (records if records is not None else det.records())]
     s = det.summary
     summary = {
@@ -79,7 +83,7 @@ def detection_report(
         "scenario": det.scenario.name,
         "method": det.method,
         "noise": det.scenario.noise,
-        "frame": "R",
+        "frame": det.weldmap_R.frame,
         "units": "m",
         "X_WR": [[_r(v, 9) for v in row] for row in det.scenario.X_WR],
         "lost_cameras": list(det.lost_cameras),

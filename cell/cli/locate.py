@@ -1,0 +1,238 @@
+"""``cell locate CLOUD --map MAP.dxf``: the map's seams located in a point cloud someone brings (docs/locate.md).
+
+The cloud (PLY or PCD, :func:`cell.perception.cloud_files.read_cloud`) is in its own frame F (``--frame``); the
+report's points are in F, in metres, and carry no truth or error fields unless ``--truth FILE.json`` gives the
+true seams (millimetres, in F). Everything that can be checked is checked before any work (exit 2): the outputs,
+the options, the map's existence, the cloud file, the truth file. Nothing here imports the simulator.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import numpy as np
+import typer
+
+from cell.cli.common import (
+    FormatOpt,
+    app,
+    cell_errors,
+    check_method,
+    detail,
+    err,
+    fail_line,
+    log,
+    out,
+    parse_format,
+    say,
+    was_interrupted,
+)
+from cell.cli.explain import detection_exit
+from cell.cli.outputs import Stage, Writer, check_file, finish, on_interrupt
+from cell.cli.placement import PlaceOpt, PlaceRpyOpt, placement
+from cell.errors import EXIT_INTERRUPTED, UsageError
+from cell.geometry import FloatArray
+
+if TYPE_CHECKING:
+    from cell.pipeline import Detection
+    from cell.types import Cloud
+
+TRUTH_UNITS = "mm"  # a truth file's coordinates (docs/locate.md)
+
+
+@app.command()
+def locate(
+    cloud_path: Annotated[Path, typer.Argument(metavar="CLOUD", help="A point cloud: PLY or PCD, ascii or binary.")],
+    map_path: Annotated[Path, typer.Option("--map", help="The welding map (DXF) of the part in the cloud.")],
+    place: PlaceOpt = None,
+    place_rpy: PlaceRpyOpt = None,
+    units: Annotated[str, typer.Option(help="Units of the cloud file's numbers: m, cm, mm, in.")] = "m",
+    map_units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
+    frame: Annotated[str, typer.Option(help="The name of the cloud's own frame (the report's frame).")] = "F",
+    viewpoint: Annotated[
+        str | None, typer.Option(help="Where the sensor was, X,Y,Z in mm in the cloud's frame (orients normals).")
+    ] = None,
+    method: Annotated[str | None, typer.Option(help="Seam locator: paper, ransac or ours (default: ours).")] = None,
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Write the JSON report here ('-': stdout, the table to stderr).")
+    ] = None,
+    save_cloud: Annotated[
+        Path | None, typer.Option(help="Write the cloud as read (metres, finite points, its frame) as PLY.")
+    ] = None,
+    truth: Annotated[
+        Path | None, typer.Option(help="True seams (JSON: seam id -> start, end in mm in the cloud's frame).")
+    ] = None,
+    fmt: FormatOpt = "table",
+) -> None:
+    """Locate the welding map's seams in a point cloud you bring (a laser scan, any sensor's cloud).
+
+    --place is the nominal pose of the drawing's origin in the cloud's frame; without it the map is found by a
+    global registration. Exit 3 when a seam that can be seen was not found (the report says why).
+    """
+    from cell.export.report import detection_report
+    from cell.perception.cloud_files import check_frame, check_units, read_cloud
+    from cell.pipeline.cloud import locate_cloud
+    from cell.provenance import provenance
+    from cell.weldmap import METRES_PER_UNIT, read_map
+
+    with cell_errors():
+        table = parse_format(fmt)
+        check_file(json_path, "--json")
+        check_file(save_cloud, "--save-cloud", stdout_ok=False)
+        check_units(units)
+        check_frame(frame)
+        if map_units is not None and map_units not in METRES_PER_UNIT:
+            raise UsageError(f"--map-units {map_units!r}; valid: {', '.join(METRES_PER_UNIT)}")
+        X_FM = placement(place, place_rpy)
+        viewpoint_F = parse_viewpoint(viewpoint)
+        check_method(method)
+        for path, option in ((map_path, "--map"), (truth, "--truth")):
+            if path is not None and not path.is_file():
+                raise UsageError(f"{option} {str(path)!r} does not exist; valid: an existing file")
+        cloud = read_cloud(cloud_path, units=units, frame=frame, warn=_warn)
+        weldmap = read_map(map_path, units=map_units)
+        truth_F = read_truth(truth, [s.id for s in weldmap.seams], frame) if truth is not None else None
+        inputs: dict[str, Path] = {"cloud": cloud_path, "map": map_path} | ({"truth": truth} if truth else {})
+        prov = provenance(None, inputs=inputs)
+        detail(f"cloud {prov['cloud_file']} (sha256 {prov['cloud_sha256']}), map {prov['map_file']}")
+        say(f"{len(cloud)} points in frame {frame} read from {cloud_path}")
+        stage, writer = Stage(), Writer()
+        det: Detection | None = None
+        try:
+            det = locate_cloud(
+                cloud, weldmap, X_FM, name=cloud_path.stem, method=method, viewpoint_F=viewpoint_F,
+                truth_F=truth_F, progress=stage,
+            )  # fmt: skip
+            rep = detection_report(det, provenance=prov)
+            writer.report(json_path, rep)
+            if save_cloud is not None and writer.attempt(lambda: _save_cloud(cloud, save_cloud)) is not None:
+                say(f"cloud written to {save_cloud}")
+            print_located(rep, table)
+        except (KeyboardInterrupt, ImportError) as e:
+            if not was_interrupted(e):
+                raise
+            done = detection_report(det, provenance=prov) if det is not None else None
+            rep = done or interrupted_report(cloud_path.stem, method, frame, stage.last, prov)
+            on_interrupt(writer, json_path, rep, stage.last)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
+    if det.error is not None:  # the report says which seams and why: partial, with the cause in report.error
+        fail_line(f"error: {det.error.message}")
+    finish(writer, None if det.complete and det.error is None else detection_exit(rep))
+
+
+def _warn(msg: str) -> None:
+    """A warning line: stderr (also with --quiet) and the log file."""
+    log.warning(msg)
+    err.print(f"[yellow]warning[/]: {msg}", soft_wrap=True, highlight=False, markup=False)
+
+
+def parse_viewpoint(text: str | None) -> FloatArray | None:
+    """``--viewpoint X,Y,Z`` [mm] as (3,) [m], or None; UsageError when it is not three finite numbers."""
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise UsageError(f"--viewpoint {text!r}; valid: X,Y,Z in mm in the cloud's frame (three numbers)")
+    return np.array(values) * 1e-3
+
+
+def _point_mm(value: Any) -> list[float] | None:
+    if not isinstance(value, list) or len(value) != 3:
+        return None
+    if not all(isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in value):
+        return None
+    return [float(v) for v in value]
+
+
+def read_truth(path: Path, seam_ids: list[str], frame: str) -> dict[str, tuple[FloatArray, FloatArray]]:
+    """A truth file (docs/locate.md): ``{"units": "mm", "frame": F, "seams": {id: {"start": [x, y, z], "end":
+    [x, y, z]}}}`` with every seam of the map, in millimetres in the cloud's frame; returns id -> ends (3,) [m].
+    UsageError (one line) for anything else."""
+    shown = str(path)
+    form = 'valid: {"units": "mm", "frame": ..., "seams": {"<seam id>": {"start": [x, y, z], "end": [x, y, z]}}}'
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise UsageError(f"--truth {shown!r} is not readable JSON ({e}); {form}") from None
+    if not isinstance(data, dict) or not isinstance(data.get("seams"), dict):
+        raise UsageError(f"--truth {shown!r} has no 'seams' object; {form}")
+    if data.get("units", TRUTH_UNITS) != TRUTH_UNITS:
+        raise UsageError(f"--truth {shown!r}: units {data.get('units')!r}; valid: {TRUTH_UNITS!r}")
+    if data.get("frame", frame) != frame:
+        raise UsageError(f"--truth {shown!r} is in frame {data.get('frame')!r}, the cloud in {frame!r}; valid: {frame}")
+    seams: Mapping[str, Any] = data["seams"]
+    unknown = [k for k in seams if k not in seam_ids]
+    missing = [k for k in seam_ids if k not in seams]
+    if unknown or missing:
+        what = f"seams not in the map: {', '.join(unknown)}" if unknown else f"no truth for {', '.join(missing)}"
+        raise UsageError(f"--truth {shown!r}: {what}; valid: every seam of the map: {', '.join(seam_ids)}")
+    out_F: dict[str, tuple[FloatArray, FloatArray]] = {}
+    for seam_id, entry in seams.items():
+        ends = [_point_mm(entry.get(k)) if isinstance(entry, dict) else None for k in ("start", "end")]
+        if ends[0] is None or ends[1] is None:
+            raise UsageError(f"--truth {shown!r}: seam {seam_id!r} needs start and end of three numbers; {form}")
+        out_F[seam_id] = (np.array(ends[0]) * 1e-3, np.array(ends[1]) * 1e-3)
+    return out_F
+
+
+def _save_cloud(cloud: Cloud, path: Path) -> Path:
+    from cell.perception import save_ply
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_ply(cloud, path)
+    return path
+
+
+def interrupted_report(
+    name: str, method: str | None, frame: str, stage: str, prov: Mapping[str, Any] | None
+) -> dict[str, Any]:
+    """The report of a ``cell locate`` stopped by Ctrl-C before it returned: what ran, where it stopped, no seams
+    (the keys of ``cell detect``'s interrupted report; no scenario, so ``config`` and ``noise`` are null)."""
+    from cell.export.report import REPORT_VERSION
+
+    return {
+        "report_version": REPORT_VERSION,
+        "provenance": dict(prov) if prov is not None else None,
+        "scenario": name,
+        "method": method or "ours",
+        "noise": None,
+        "frame": frame,
+        "units": "m",
+        "interrupted": {"stage": stage},
+        "seams": [],
+        "summary": None,
+        "error": {
+            "type": "KeyboardInterrupt",
+            "message": f"interrupted (Ctrl-C) during: {stage}",
+            "exit_code": EXIT_INTERRUPTED,
+        },
+        "config": None,
+    }
+
+
+def print_located(rep: dict[str, Any], fmt: str) -> None:
+    """``cell detect``'s table (and its json/csv rows); in table form also the located ends and sigma in the
+    report's frame [mm]."""
+    from rich.table import Table
+
+    from cell.cli.tables import print_detection
+
+    table_fmt = parse_format(fmt)
+    print_detection(rep, table_fmt)
+    found = [s for s in rep["seams"] if s["status"] == "found"]
+    if table_fmt != "table" or not found:
+        return
+    t = Table(title=f"located seams · frame {rep['frame']} · mm", title_justify="left")
+    for col in ("seam", "start x y z", "end x y z", "sigma"):
+        t.add_column(col, justify="left" if col == "seam" else "right")
+    for s in found:
+        ends = [" ".join(f"{v * 1e3:.1f}" for v in s["detected"][k]) for k in ("start", "end")]
+        t.add_row(s["id"], *ends, f"{s['sigma_mm']:.2f}" if s.get("sigma_mm") is not None else "-")
+    out.print(t)

@@ -222,9 +222,15 @@ def global_placement(
     voxel_m: float = 0.005,
 ) -> FloatArray:
     """(4, 4) X_LM: where ``weldmap`` lies among ``points_L`` (n, 3, the points above the table, levelled frame L)
-    with no nominal placement: the map put on the table at the points' median, then :func:`global_pose` on a
+    with no nominal placement: the points no higher above the table than the map's parts (the rest is something
+    else), the map put on the table at their median, then :func:`global_pose` on a
     ``voxel_m`` grid (normals by :func:`orient_normals`), the result put back flat on the table."""
-    cloud = downsample(Cloud(points_L, "L"), voxel_m).points
+    height = max(float(p.vertices()[:, 2].max()) for p in weldmap.parts) - min(
+        float(p.vertices()[:, 2].min()) for p in weldmap.parts
+    )
+    P = np.asarray(points_L)
+    P = P[P[:, 2] <= table_z + height + 2.0 * voxel_m]  # nothing of the part stands higher than the map's parts
+    cloud = downsample(Cloud(P, "L"), voxel_m).points
     normals = orient_normals(_open3d.estimate_normals(cloud, 2.5 * voxel_m, 30), cloud, viewpoint_L)
     centre = np.median(cloud, axis=0)
     X0 = on_table(make_pose(p=(centre[0], centre[1], 0.0)), weldmap, table_z)

@@ -1,10 +1,10 @@
 """The torch search for one seam (step 1 and 2 of :func:`cell.motion.plan.plan_welds`).
 
-1. Candidates (:func:`candidate_groups`): both weld directions x spins about the torch axis (``spin_step``
-   apart, within the process's spin tolerance) x work/travel angles (nominal first, then widened in
-   ``angle_step`` steps within their tolerances, docs/reference.md section 7). A candidate whose torch (placed by
-   pose alone) hits a part or the table at a seam end is dropped without IK; the rest get IK at the weld start,
-   ranked by manipulability.
+1. Candidates (:func:`candidate_groups`): both weld directions (one if not ``process.reversible``) x spins
+   about the torch axis (``spin_step`` apart, within the process's spin tolerance) x work/travel angles
+   (nominal first, then widened in ``angle_step`` steps within their tolerances, docs/reference.md section 7).
+   A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK;
+   the rest get IK at the weld start, ranked by manipulability.
 2. The best candidates are solved along the seam (warm-started IK every ``spacing``, no joint jump beyond
    ``max_joint_step``), along the approach line (back along the torch axis to ``process.approach``) and the
    depart line, checked against singularities and for collisions (conservative advancement between knots).
@@ -68,7 +68,8 @@ def candidate_groups(process: WeldProcess, options: PlanOptions) -> list[list[Ca
     spins = sorted(  # ordered so that neighbours warm-start each other's IK; pi and -pi coincide
         {round(s, 12) for s in _offsets(pr.spin_tol, opt.spin_step) if -math.pi + 1e-9 < s <= math.pi + 1e-9}
     )
-    return [[Candidate(rev, sp, w, a) for rev in (False, True) for sp in spins] for w, a in angles]
+    directions = (False, True) if pr.reversible else (False,)
+    return [[Candidate(rev, sp, w, a) for rev in directions for sp in spins] for w, a in angles]
 
 
 @dataclass(frozen=True)

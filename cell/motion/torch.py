@@ -43,7 +43,9 @@ class WeldProcess:
     """The welding process in SI units, built from a :class:`~cell.scenario.ProcessSpec` (the one conversion).
 
     travel_speed [m/s]; work_angle, travel_angle [rad]; *_tol [rad] how far the planner may move them;
-    ctwd, stickout, approach, depart [m]; approach_speed [m/s]; spin_tol [rad] (pi: fully free).
+    ctwd, stickout, approach, depart [m]; approach_speed [m/s]; spin_tol [rad] (pi: fully free);
+    reversible: the planner may weld the seam either way (False: only from p_start to p_end, e.g. a vertical
+    seam its procedure welds upwards).
     """
 
     travel_speed: float
@@ -57,6 +59,7 @@ class WeldProcess:
     approach: float
     depart: float
     approach_speed: float
+    reversible: bool = True
 
     @classmethod
     def from_spec(cls, spec: ProcessSpec, stickout_mm: float = STICKOUT_MM) -> WeldProcess:

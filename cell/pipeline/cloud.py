@@ -131,7 +131,7 @@ def locate_cloud(
     scenario = spec_scenario
     if alignment is None or X_LM0 is None:
         assert error is not None
-        return _failed(scenario, weldmap, joints, X_FL, X_LM0, table_z, method, error, timings, t_all)
+        return _failed(scenario, weldmap, joints, X_FL, X_LM0, table_z, method, error, timings, t_all, cloud.frame)
     X_LM = alignment.X_RR_corr @ X_LM0
     map_L = weldmap.transformed(X_LM, _FRAME)
     crop = _crop(P_L, above, map_L)
@@ -141,7 +141,7 @@ def locate_cloud(
         check_alignment_unique(map_L, dense_L, alignment, spec.symmetry)
         missing = check_parts_seen(map_L, dense_L, spec, spec.coverage)
     except AlignmentError as e:
-        return _failed(scenario, weldmap, joints, X_FL, X_LM, table_z, method, e, timings, t_all)
+        return _failed(scenario, weldmap, joints, X_FL, X_LM, table_z, method, e, timings, t_all, cloud.frame)
 
     t = time.perf_counter()
     progress(f"locating {len(map_L.seams)} seams ({method})")
@@ -284,6 +284,7 @@ def _failed(
     error: CellError,
     timings: dict[str, float],
     t_all: float,
+    frame: str,
 ) -> Detection:
     """No seam searched (the map could not be aligned): every seam NOT_FOUND with the reason (NOT_VISIBLE when the
     drawing alone says it lies against the table)."""
@@ -299,7 +300,6 @@ def _failed(
             estimates.append(SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE))
     metrics, summary = evaluate(estimates, {})
     timings["total_s"] = time.perf_counter() - t_all
-    frame = "F"
     return Detection(
         scenario=scenario,
         method=method,

@@ -92,8 +92,13 @@ def _tf_tree(reader: Any, bag: Path) -> TfTree:
             tr, q = t.transform.translation, t.transform.rotation
             try:
                 X = pose_from_quaternion([tr.x, tr.y, tr.z], [q.x, q.y, q.z, q.w])
-                tree.add(t.header.frame_id, t.child_frame_id, X, static=conn.topic.endswith("tf_static"),
-                         stamp_ns=stamp_ns(t))  # fmt: skip
+                tree.add(
+                    t.header.frame_id,
+                    t.child_frame_id,
+                    X,
+                    static=conn.topic.endswith("tf_static"),
+                    stamp_ns=stamp_ns(t),
+                )
             except (TfError, ValueError) as e:
                 raise fail(bag, f"{conn.topic}, {t.header.frame_id} -> {t.child_frame_id}: {e}") from None
     return tree
@@ -141,16 +146,21 @@ def read_bag(
     time : pick each camera's image recorded nearest this many seconds after the bag's start (default: the first).
     """
     from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.rosbag2 import ReaderError
     from rosbags.typesys import Stores, get_typestore
 
     bag = Path(bag)
     if not bag.exists():
         raise fail(bag, "no such file or directory; valid: a rosbag2 folder (metadata.yaml) or its .db3/.mcap file")
     try:
-        with AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
-            return _read(reader, bag, depth_topics, base_frame, time, progress)
-    except AnyReaderError as e:
+        reader = AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+        reader.open()
+    except (AnyReaderError, ReaderError, OSError) as e:  # rosbags says FileNotFoundError for a folder without metadata
         raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
+    try:
+        return _read(reader, bag, depth_topics, base_frame, time, progress)
+    finally:
+        reader.close()
 
 
 def _read(
@@ -181,7 +191,9 @@ def _read(
         if picked is None:
             raise fail(bag, f"{topic} holds no message")
         msg: Any = reader.deserialize(picked[1], IMAGE)
-        if depth_topics is None and str(msg.encoding) not in DEPTH_SCALE_M:
+        if str(msg.encoding) not in DEPTH_SCALE_M:
+            if depth_topics is not None:  # asked for by name: refused (depth_of says what is valid)
+                depth_of(msg, bag, topic)
             skipped.append(f"{topic} ({msg.encoding})")
             continue
         chosen[topic] = (picked[0], msg)
@@ -205,8 +217,9 @@ def _read(
         k = intrinsics_of(info, bag, info_topic)
         depth = depth_of(msg, bag, topic)
         if depth.shape != (k.height, k.width):
-            raise fail(bag, f"{topic} is {depth.shape[1]} x {depth.shape[0]} px, its CameraInfo says "
-                        f"{k.width} x {k.height}")  # fmt: skip
+            raise fail(
+                bag, f"{topic} is {depth.shape[1]} x {depth.shape[0]} px, its CameraInfo says {k.width} x {k.height}"
+            )
         frame = frame_name(str(msg.header.frame_id) or str(info.header.frame_id))
         if not frame:
             raise fail(bag, f"{topic} names no frame (header.frame_id is empty): its pose cannot be looked up")

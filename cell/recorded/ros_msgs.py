@@ -59,8 +59,11 @@ def depth_of(msg: Any, bag: Path, topic: str) -> npt.NDArray[np.float32]:
     dtype = np.dtype(_DTYPE[enc]).newbyteorder(">" if msg.is_bigendian else "<")
     data = np.asarray(msg.data, dtype=np.uint8)
     if h <= 0 or w <= 0 or step < w * dtype.itemsize or data.size < step * h:
-        raise fail(bag, f"{topic}: a {w} x {h} {enc} image needs {w * dtype.itemsize} bytes a row, "
-                    f"holds step {step} and {data.size} bytes")  # fmt: skip
+        raise fail(
+            bag,
+            f"{topic}: a {w} x {h} {enc} image needs {w * dtype.itemsize} bytes a row, "
+            f"holds step {step} and {data.size} bytes",
+        )
     rows = data[: step * h].reshape(h, step)[:, : w * dtype.itemsize]
     raw = np.ascontiguousarray(rows).view(dtype).reshape(h, w).astype(np.float64)
     depth = raw * DEPTH_SCALE_M[enc]
@@ -73,8 +76,11 @@ def intrinsics_of(info: Any, bag: Path, topic: str) -> CameraIntrinsics:
     K = np.asarray(info.k, dtype=float).reshape(3, 3)
     D = np.asarray(info.d, dtype=float)
     if D.size and np.any(D != 0.0):
-        raise fail(bag, f"{topic}: distortion {info.distortion_model} D = {np.round(D, 6).tolist()} is not zero; "
-                    "only undistorted (rectified) depth is read: record image_rect_raw, whose D is zero")  # fmt: skip
+        raise fail(
+            bag,
+            f"{topic}: distortion {info.distortion_model} D = {np.round(D, 6).tolist()} is not zero; "
+            "only undistorted (rectified) depth is read: record image_rect_raw, whose D is zero",
+        )
     ok = K[0, 0] > 0 and K[1, 1] > 0 and K[0, 1] == 0 and np.allclose(K[2], [0, 0, 1]) and np.all(np.isfinite(K))
     if not ok:
         raise fail(bag, f"{topic}: K = {K.ravel().tolist()} is not a pinhole without skew (fx, fy > 0, K[0,1] = 0)")

@@ -36,6 +36,7 @@ from cell.errors import UsageError
 from cell.export.atomic import write_atomic
 from cell.geometry import FloatArray, invert, transform_points
 from cell.preview.page import draw_inputs
+from cell.preview.timeline import Motion, motion, quaternions_xyzw, subsample
 from cell.preview.views import ARC_COLOUR, MM, PATH_COLOUR, STATUS_COLOURS, TRUTH_COLOUR, seam_lines, thin
 from cell.types import CellView, ShapeKind
 
@@ -47,7 +48,7 @@ INSTALL_HINT = "uv sync --extra rerun, or pip install 'weld-cell[rerun]'"
 RATE_HZ = 20.0  # robot poses per second of motion on the timeline
 MAX_POINTS = 400_000  # cloud points kept (every k-th beyond this)
 TCP = "torch_tcp"
-Motion = tuple[FloatArray, FloatArray, npt.NDArray[np.bool_], tuple[tuple[float, str], ...]]
+EYE = "camera_optical"  # the arm's optical frame of its eye-in-hand camera (as the simulator names it)
 LinkPoses = Callable[[FloatArray, tuple[str, ...]], Mapping[str, FloatArray]]
 
 
@@ -71,75 +72,6 @@ def _rgb(hex_colour: str) -> tuple[int, int, int]:
     return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
 
 
-def quaternions_xyzw(R: npt.ArrayLike) -> FloatArray:
-    """(n, 4) unit quaternions (x, y, z, w) of rotation matrices (n, 3, 3) (Shepperd's method)."""
-    m = np.asarray(R, dtype=float).reshape(-1, 3, 3)
-    tr = np.trace(m, axis1=1, axis2=2)
-    d = np.stack([m[:, 0, 0], m[:, 1, 1], m[:, 2, 2], tr], axis=1)
-    k = np.argmax(d, axis=1)
-    q = np.empty((len(m), 4))
-    for i in range(len(m)):
-        a = m[i]
-        if k[i] == 3:
-            s = 2.0 * np.sqrt(1.0 + tr[i])
-            q[i] = [(a[2, 1] - a[1, 2]) / s, (a[0, 2] - a[2, 0]) / s, (a[1, 0] - a[0, 1]) / s, 0.25 * s]
-        else:
-            j, n = (k[i] + 1) % 3, (k[i] + 2) % 3
-            s = 2.0 * np.sqrt(max(1.0 + a[k[i], k[i]] - a[j, j] - a[n, n], 1e-12))
-            v = np.empty(4)
-            v[k[i]] = 0.25 * s
-            v[j] = (a[j, k[i]] + a[k[i], j]) / s
-            v[n] = (a[n, k[i]] + a[k[i], n]) / s
-            v[3] = (a[n, j] - a[j, n]) / s
-            q[i] = v
-    q *= np.where(q[:, 3:4] < 0.0, -1.0, 1.0)
-    return np.asarray(q / np.linalg.norm(q, axis=1, keepdims=True))
-
-
-def motion(run: WeldRun) -> Motion | None:
-    """The arm's motion on the recording's time axis: times (n,) [s], q (n, dof) [rad], arc (n,) and the marks
-    (time, text); what the arm did when it moved, else the plan's (move from the scan pose home, then the
-    program); None without a plan."""
-    ex, plan, pre = run.execution, run.plan, run.pre_move
-    if ex is not None:
-        done = tuple((float(e.t), _event_text(run, e.t, e.kind, e.detail)) for e in ex.events)
-        return np.asarray(ex.times, dtype=float), np.asarray(ex.q, dtype=float), np.asarray(ex.arc_on), done
-    if plan is None or not plan.segments:
-        return None
-    traj, arc = plan.joint_trajectory()
-    t0 = pre.duration if pre is not None else 0.0
-    times, q = traj.times + t0, np.asarray(traj.q)
-    on = np.asarray(arc)
-    if pre is not None:
-        times = np.concatenate([pre.times, times[1:]])
-        q = np.concatenate([pre.q, q[1:]])
-        on = np.concatenate([np.zeros(len(pre.times), bool), on[1:]])
-    marks: list[tuple[float, str]] = [(0.0, "move scan -> home")] if pre is not None else []
-    for s in plan.segments:
-        marks.append((t0 + s.t0, f"{s.kind} {s.seam_id}".strip()))
-        if s.arc_on:
-            marks += [(t0 + s.t0, f"arc_on {s.seam_id}"), (t0 + s.t1, f"arc_off {s.seam_id}")]
-    return times, q, on, tuple(sorted(marks))
-
-
-def _event_text(run: WeldRun, t: float, kind: str, detail: str) -> str:
-    """An execution event as a line of the log: a move mark as it is, an arc switch with its seam's id."""
-    if kind == "move":
-        return detail
-    off = run.pre_move.duration if run.pre_move is not None else 0.0
-    welds = [s for s in run.plan.segments if s.arc_on] if run.plan is not None else []
-    seam = next((s.seam_id for s in welds if min(abs(off + s.t0 - t), abs(off + s.t1 - t)) < 0.02), "")
-    return f"{kind} {seam} ({detail})" if seam else f"{kind} ({detail})"
-
-
-def subsample(times: FloatArray, arc: npt.NDArray[np.bool_], rate_hz: float) -> npt.NDArray[np.intp]:
-    """Indices of the samples kept: the first at or after every 1/rate_hz, every arc switch (both sides), the last."""
-    grid = np.arange(times[0], times[-1], 1.0 / rate_hz)
-    idx = np.searchsorted(times, grid - 1e-9)
-    switch = np.flatnonzero(np.diff(arc.astype(np.int8)) != 0)
-    return np.unique(np.clip(np.r_[idx, switch, switch + 1, len(times) - 1], 0, len(times) - 1))
-
-
 def _height_colours(p: npt.ArrayLike) -> npt.NDArray[np.uint8]:
     z = np.asarray(p, dtype=float).reshape(-1, 3)[:, 2]
     u = (z - z.min()) / max(float(np.ptp(z)), 1e-9) if len(z) else z
@@ -147,8 +79,9 @@ def _height_colours(p: npt.ArrayLike) -> npt.NDArray[np.uint8]:
     return np.asarray(lo + u[:, None] * (hi - lo), dtype=np.uint8)
 
 
-def _log_scene(rec: Any, rr: Any, run: WeldRun, max_points: int) -> None:
-    """The static cell: cloud, table, map parts, seams, cameras."""
+def _log_scene(rec: Any, rr: Any, run: WeldRun, max_points: int, moving: frozenset[str]) -> None:
+    """The static cell: cloud, table, map parts, seams, cameras (those in ``moving`` ride on the arm: their pose is
+    on the timeline)."""
     det = run.detection
     cloud, views, _, _ = draw_inputs(run)
     rec.log("cell", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
@@ -196,7 +129,8 @@ def _log_scene(rec: Any, rr: Any, run: WeldRun, max_points: int) -> None:
     for cam in view.cameras:
         k = cam.intrinsics
         path = f"cell/cameras/{cam.name}"
-        rec.log(path, rr.Transform3D(translation=cam.X_RC[:3, 3], mat3x3=cam.X_RC[:3, :3]), static=True)
+        if cam.name not in moving:
+            rec.log(path, rr.Transform3D(translation=cam.X_RC[:3, 3], mat3x3=cam.X_RC[:3, :3]), static=True)
         rec.log(
             path,
             rr.Pinhole(
@@ -230,30 +164,31 @@ def _log_robot_shapes(rec: Any, rr: Any, view: CellView) -> None:
             rec.log(f"cell/robot/{link}/{kind.value}", arch, static=True)
 
 
-def _log_motion(rec: Any, rr: Any, run: WeldRun, rate_hz: float, fk: LinkPoses | None) -> float:
-    """The robot's links, the TCP, the arc and the joints on the ``time`` timeline; the seconds it spans."""
+def _log_motion(
+    rec: Any, rr: Any, run: WeldRun, mo: Motion | None, rate_hz: float, fk: LinkPoses | None, moving: frozenset[str]
+) -> None:
+    """The robot's links, the cameras riding on it, the TCP, the arc and the joints on the ``time`` timeline."""
     view = run.view or CellView()
-    mo = motion(run)
     if mo is None:
         if view.poses:  # no motion: the scan pose at time 0
             rec.set_time("time", duration=0.0)
             for link, X in view.poses[0].X_RL.items():
                 rec.log(f"cell/robot/{link}", rr.Transform3D(translation=X[:3, 3], mat3x3=X[:3, :3]))
-        return 0.0
+        return
     times, q, arc, marks = mo
     idx = subsample(times, arc, rate_hz)
-    t = times[idx]
-    col = [rr.TimeColumn("time", duration=t)]
+    col = [rr.TimeColumn("time", duration=times[idx])]
     if fk is not None:
-        links = tuple(dict.fromkeys((*view.links, TCP)))
+        links = _frames(run, (*view.links, TCP, EYE))
         poses = [fk(q[i], links) for i in idx]
-        for link in links:
-            if link == TCP or link not in poses[0]:
-                continue
+        paths = [(link, f"cell/robot/{link}") for link in links if link not in (TCP, EYE)]
+        paths += [(EYE, f"cell/cameras/{name}") for name in sorted(moving) if EYE in links]
+        for link, path in paths:
             X = np.array([p[link] for p in poses])
-            cols = rr.Transform3D.columns(translation=X[:, :3, 3], mat3x3=X[:, :3, :3])
-            rec.send_columns(f"cell/robot/{link}", indexes=col, columns=cols)
-        if TCP in poses[0]:
+            rec.send_columns(
+                path, indexes=col, columns=rr.Transform3D.columns(translation=X[:, :3, 3], mat3x3=X[:, :3, :3])
+            )
+        if TCP in links:
             p_now = np.array([p[TCP][:3, 3] for p in poses])
             rec.send_columns("cell/tcp/now", indexes=col, columns=rr.Points3D.columns(positions=p_now))
     _log_tool_path(rec, rr, run, times, q, arc, fk)
@@ -264,7 +199,12 @@ def _log_motion(rec: Any, rr: Any, run: WeldRun, rate_hz: float, fk: LinkPoses |
     for tm, text in marks:
         rec.set_time("time", duration=tm)
         rec.log("log", rr.TextLog(text, level="INFO"))
-    return float(times[-1] - times[0])
+
+
+def _frames(run: WeldRun, wanted: tuple[str, ...]) -> tuple[str, ...]:
+    """The frames of ``wanted`` the run's arm has (all of them when the run carries no arm), each once."""
+    have = set(run.arm.model.frame_names) if run.arm is not None else None
+    return tuple(f for f in dict.fromkeys(wanted) if have is None or f in have)
 
 
 def _log_tool_path(
@@ -274,8 +214,8 @@ def _log_tool_path(
     ex = run.execution
     if ex is not None:
         p = transform_points(invert(run.detection.scenario.X_WR), ex.tcp_W)
-    elif fk is not None:
-        keep = subsample(times, arc, 100.0)
+    elif fk is not None and TCP in _frames(run, (TCP,)):
+        keep = subsample(times, arc, 50.0)
         p, arc = np.array([fk(q[i], (TCP,))[TCP][:3, 3] for i in keep]), arc[keep]
     else:
         return
@@ -284,6 +224,21 @@ def _log_tool_path(
     welds = [p[a : b + 1] for a, b in zip(edges[::2], edges[1::2], strict=True) if b > a]
     if welds:
         rec.log("cell/tcp/arc_on", rr.LineStrips3D(welds, colors=_rgb(ARC_COLOUR), radii=0.003), static=True)
+
+
+def _blueprint() -> Any:
+    """The default layout: the cell in 3D beside the joints, the arc and the log, all on the ``time`` timeline."""
+    import rerun.blueprint as rrb
+
+    side = rrb.Vertical(
+        rrb.TimeSeriesView(origin="plots/joints", name="joints [deg]"),
+        rrb.TimeSeriesView(origin="plots/arc", name="arc on"),
+        rrb.TextLogView(origin="log", name="motion"),
+        row_shares=[3, 1, 2],
+    )
+    return rrb.Blueprint(
+        rrb.Horizontal(rrb.Spatial3DView(origin="cell", name="cell (frame R)"), side, column_shares=[3, 2])
+    )
 
 
 def record_run(
@@ -304,10 +259,15 @@ def record_run(
     rec.set_log_time_enabled(False)  # the wall clock would make the "time" timeline one of two
     stream = rr.binary_stream(recording=rec)
     rec.send_recording_name(f"{det.scenario.name} · {det.method} · {'weld' if run.execution else 'preview'}")
-    _log_scene(rec, rr, run, max_points)
+    mo = motion(run)
+    cams = run.view.cameras if run.view is not None else ()
+    on_arm = fk is not None and mo is not None and EYE in _frames(run, (EYE,))
+    moving = frozenset(c.name for c in cams if c.mount == "eye_in_hand" and on_arm)
+    _log_scene(rec, rr, run, max_points, moving)
     if run.view is not None:
         _log_robot_shapes(rec, rr, run.view)
-    _log_motion(rec, rr, run, rate_hz, fk)
+    _log_motion(rec, rr, run, mo, rate_hz, fk, moving)
+    rec.send_blueprint(_blueprint(), make_active=True, make_default=True)
     data = stream.read(flush=True)
     rec.disconnect()
     return write_atomic(path, bytes(data or b""), what="Rerun recording")

@@ -52,6 +52,8 @@ def test_the_file_is_one_recording_of_this_run(
     (entry,) = RrdReader(path).recordings()
     assert entry.application_id == APPLICATION_ID
     assert entry.recording_id == recording_id(fence1_run) == recording_id(fence1_run)
+    (layout,) = RrdReader(path).blueprints()  # the default layout: 3D cell, joints, arc, log
+    assert layout.application_id == APPLICATION_ID
 
 
 def test_cloud_map_seams_table_and_cameras(recorded: tuple[Path, dict[str, Any]], fence1_run: pipeline.WeldRun) -> None:
@@ -81,8 +83,10 @@ def test_cloud_map_seams_table_and_cameras(recorded: tuple[Path, dict[str, Any]]
     assert fence1_run.view is not None
     for cam in fence1_run.view.cameras:
         c = cols[f"/cell/cameras/{cam.name}"]
-        np.testing.assert_allclose(c["Transform3D:translation"][0][0], cam.X_RC[:3, 3], atol=1e-6)
         assert c["Pinhole:resolution"][0][0] == [cam.intrinsics.width, cam.intrinsics.height]
+        if cam.mount == "fixed":  # static; the eye-in-hand camera rides on the arm (next test)
+            (X,) = c["Transform3D:translation"]
+            np.testing.assert_allclose(X[0], cam.X_RC[:3, 3], atol=1e-6)
 
 
 def test_robot_links_move_on_the_timeline_over_the_whole_motion(
@@ -97,9 +101,14 @@ def test_robot_links_move_on_the_timeline_over_the_whole_motion(
         t = np.array(c["time"])
         assert t[0] == pytest.approx(0.0) and t[-1] == pytest.approx(ex.duration, abs=1e-6)
         assert np.all(np.diff(t) > 0.0) and len(t) == pytest.approx(ex.duration * RATE_HZ, rel=0.05)
-    # the poses are the arm's at those instants: link_6 at the last instant is where the executed q puts it
-    X = arm.model.fk_frames(ex.q[-1], ("link_6",))["link_6"]
-    np.testing.assert_allclose(cols["/cell/robot/link_6"]["Transform3D:translation"][-1][0], X[:3, 3], atol=1e-6)
+    # the poses are the arm's at those instants: link_6 and the eye-in-hand camera where the executed q puts them
+    X = arm.model.fk_frames(ex.q[-1], ("link_6", "camera_optical"))
+    np.testing.assert_allclose(
+        cols["/cell/robot/link_6"]["Transform3D:translation"][-1][0], X["link_6"][:3, 3], atol=1e-6
+    )
+    eye = cols["/cell/cameras/eye_in_hand"]
+    assert len(eye["time"]) == len(cols["/cell/robot/link_6"]["time"])
+    np.testing.assert_allclose(eye["Transform3D:translation"][-1][0], X["camera_optical"][:3, 3], atol=1e-6)
     # the TCP now and the executed tool path agree with the station's record (frame R)
     p_R = transform_points(invert(fence1_run.detection.scenario.X_WR), ex.tcp_W)
     np.testing.assert_allclose(cols["/cell/tcp/now"]["Points3D:positions"][-1][0], p_R[-1], atol=2e-3)
@@ -140,3 +149,16 @@ def test_a_preview_records_the_plan_on_the_same_timeline(fence1_run: pipeline.We
     assert t[0] == 0.0 and t[-1] == pytest.approx(pre.duration + plan.cycle_time, abs=1e-6)
     assert t[-1] == pytest.approx(ex.duration, abs=0.01)
     assert len(seen["/cell/tcp/arc_on"].column("LineStrips3D:strips").to_pylist()[0]) == 12
+
+
+def test_a_run_that_failed_early_still_records_what_it_has(fence1_run: pipeline.WeldRun, tmp_path: Path) -> None:
+    """Perception lost and nothing planned: the map, the seams as the map draws them, the cell and the robot at
+    its scan pose, no cloud, no motion (``--rerun`` is written whatever happens)."""
+    det = replace(fence1_run.detection, scene=None)
+    run = replace(fence1_run, detection=det, plan=None, execution=None, pre_move=None)
+    path = record_run(run, tmp_path / "failed.rrd")
+    entities = {c.entity_path: c for c in RrdReader(path).store().stream()}
+    assert "/cell/cloud" not in entities and "/cell/tcp/path" not in entities and "/plots/arc" not in entities
+    assert {"/cell/map/parts", "/cell/seams/found", "/cell/table", "/cell/cameras/eye_in_hand"} <= set(entities)
+    base = entities["/cell/robot/link_3"]
+    assert base.num_rows == 1 and base.timeline_names == ["time"]

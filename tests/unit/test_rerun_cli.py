@@ -15,7 +15,8 @@ from cell import pipeline
 from cell.cli import app
 from cell.errors import UsageError
 from cell.geometry import rpy_to_matrix
-from cell.preview.rerun import quaternions_xyzw, require_rerun, subsample
+from cell.preview.rerun import require_rerun
+from cell.preview.timeline import quaternions_xyzw, subsample
 
 runner = CliRunner()
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import datetime as dt
 from functools import partial
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -27,8 +27,12 @@ from cell.cli.common import (
 )
 from cell.cli.explain import detection_exit
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
+from cell.cli.placement import PlaceOpt, PlaceRpyOpt
 from cell.cli.tables import print_detection
 from cell.errors import EXIT_INTERRUPTED, UsageError
+
+if TYPE_CHECKING:
+    from cell.station import Station
 
 BENCH_SAVED = Path("benchmarks/results/latest.json")  # what --save writes (the README's Table 1 is made from it)
 
@@ -60,7 +64,9 @@ def map_info(
 
 @app.command()
 def detect(
-    scenario: Annotated[str, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path.")],
+    scenario: Annotated[
+        str | None, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path (not with --capture).")
+    ] = None,
     method: Annotated[
         str | None, typer.Option(help="Seam locator: paper, ransac or ours (default: the scenario's).")
     ] = None,
@@ -70,8 +76,21 @@ def detect(
     ] = None,
     save_cloud: Annotated[Path | None, typer.Option(help="Write the spliced cloud (robot frame) as PLY.")] = None,
     fmt: FormatOpt = "table",
+    capture_dir: Annotated[
+        Path | None,
+        typer.Option("--capture", help="A capture folder (`cell capture`, docs/capture.md) instead of SCENARIO."),
+    ] = None,
+    map_path: Annotated[
+        Path | None, typer.Option("--map", help="With --capture: this DXF map instead of the capture's.")
+    ] = None,
+    place: PlaceOpt = None,
+    place_rpy: PlaceRpyOpt = None,
 ) -> None:
-    """Capture the cell, splice the clouds, align the map and locate every seam; report errors against truth."""
+    """Capture the cell, splice the clouds, align the map and locate every seam; report errors against truth.
+
+    With --capture DIR the images are the recorded ones (no simulator); --map and --place (the map's nominal pose
+    in the capture's robot frame) override the capture's cell, and are needed when it has no cell.yaml.
+    """
     from cell import pipeline
     from cell import scenario as sc
     from cell.export.report import detection_report
@@ -81,15 +100,25 @@ def detect(
         table = parse_format(fmt)
         check_file(json_path, "--json")
         check_file(save_cloud, "--save-cloud", stdout_ok=False)
-        scn = sc.load(scenario)
+        station: Station | None = None
+        if capture_dir is not None:
+            from cell.cli.capture import replay
+
+            scn, station, scenario_file = replay(scenario, capture_dir, map_path, place, place_rpy, noise)
+        elif scenario is None or map_path is not None or place is not None or place_rpy is not None:
+            raise UsageError("give SCENARIO, or --capture DIR (which --map and --place go with)")
+        else:
+            scn, scenario_file = sc.load(scenario), sc.resolve(scenario)
         check_method(method)
         scn = scn.with_noise(n) if (n := parse_noise(noise)) else scn
-        prov = provenance(scn, scenario_file=sc.resolve(scenario))
+        prov = provenance(scn, scenario_file=scenario_file)
+        if capture_dir is not None:
+            prov["capture"] = str(capture_dir.resolve())
         detail(f"scenario {prov['scenario_file']} (sha256 {prov['scenario_sha256']}), map {prov['map_file']}")
         stage, writer = Stage(), Writer()
         det: pipeline.Detection | None = None
         try:
-            det = pipeline.detect(scn, method, progress=stage)
+            det = pipeline.detect(scn, method, progress=stage, station=station)
             rep = detection_report(det, provenance=prov)
             writer.report(json_path, rep)
             if save_cloud is not None and det.scene is not None:

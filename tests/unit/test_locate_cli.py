@@ -169,3 +169,21 @@ def test_an_unwritable_output_exits_2_before_reading(tiny: Path, tmp_path: Path)
     assert_one_line_error(code, err, 2, "--json", "is a folder")
     code, _, err = invoke("locate", str(tiny), "--map", str(FENCE1), "--save-cloud", "-")
     assert_one_line_error(code, err, 2, "--save-cloud")
+
+
+def test_ctrl_c_writes_the_interrupted_report(tiny: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import cell.pipeline.cloud
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        kwargs["progress"]("finding the table plane")  # type: ignore[operator]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cell.pipeline.cloud, "locate_cloud", interrupted)
+    report = tmp_path / "r.json"
+    code, _, err = invoke("locate", str(tiny), "--map", str(FENCE1), "--frame", "R", "--json", str(report))
+    assert code == 130 and "Traceback" not in err
+    assert err.strip().splitlines()[-1].startswith("exit 130: interrupted (Ctrl-C) during: finding the table plane")
+    rep = json.loads(report.read_text())
+    assert rep["interrupted"] == {"stage": "finding the table plane"} and rep["frame"] == "R" and rep["seams"] == []
+    assert rep["error"]["exit_code"] == 130 and rep["provenance"]["cloud_file"] == str(tiny)
+

@@ -161,3 +161,27 @@ def test_detect_on_a_bad_capture_is_one_line_and_its_exit_code(tmp_path: Path) -
     assert result.exit_code == 2 and "both given" in result.stderr
     result = runner.invoke(app, ["detect"])
     assert result.exit_code == 2
+
+
+def test_the_cell_file_gives_back_the_scenario_and_takes_a_new_placement(tmp_path: Path) -> None:
+    from cell import scenario as sc
+    from cell.recorded.cell_file import cell_yaml
+
+    fence1 = sc.load("fence1")
+    folder = write_capture(
+        tmp_path, images(np.random.default_rng(8)), fence1.X_WR, cell_yaml=cell_yaml(fence1), map_file=fence1.map_path
+    )
+    assert (folder / "fence1.dxf").read_bytes() == fence1.map_path.read_bytes()  # the map beside cell.yaml
+    rec = read_capture(folder)
+    scn = replay_scenario(rec)
+    assert "\nsimulation:" not in (rec.cell_yaml or "") and scn.map_path == (folder / "fence1.dxf").resolve()
+    told = fence1.model_dump(exclude={"simulation", "base_dir", "map"})
+    assert (
+        scn.model_dump(exclude={"simulation", "base_dir", "map"}) == told and scn.X_WM.tolist() == fence1.X_WM.tolist()
+    )
+    X_RM = pose_from_xyz_rpy([-0.69, 0.66, 0.0], [0.0, 0.0, 0.02])
+    moved = replay_scenario(rec, X_RM=X_RM)
+    assert np.allclose(moved.X_WM, fence1.X_WR @ X_RM, atol=1e-12)
+    other = read_capture(write_capture(tmp_path / "b", rec.images, X_WR, cell_yaml=rec.cell_yaml))
+    with pytest.raises(CaptureError, match="X_WR disagrees"):  # cell.yaml's robot is not where the capture says
+        replay_scenario(other, map_path=fence1.map_path)

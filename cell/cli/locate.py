@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import numpy as np
 import typer
+from rich.markup import escape
 
 from cell.cli.common import (
     FormatOpt,
@@ -127,7 +128,7 @@ def locate(
 def _warn(msg: str) -> None:
     """A warning line: stderr (also with --quiet) and the log file."""
     log.warning(msg)
-    err.print(f"[yellow]warning[/]: {msg}", soft_wrap=True, highlight=False, markup=False)
+    err.print(f"[yellow]warning[/]: {escape(msg)}", soft_wrap=True, highlight=False)
 
 
 def parse_viewpoint(text: str | None) -> FloatArray | None:
@@ -156,7 +157,9 @@ def read_truth(path: Path, seam_ids: list[str], frame: str) -> dict[str, tuple[F
     [x, y, z]}}}`` with every seam of the map, in millimetres in the cloud's frame; returns id -> ends (3,) [m].
     UsageError (one line) for anything else."""
     shown = str(path)
-    form = 'valid: {"units": "mm", "frame": ..., "seams": {"<seam id>": {"start": [x, y, z], "end": [x, y, z]}}}'
+    form = (
+        'valid: JSON {"units": "mm", "frame": ..., "seams": {"<seam id>": {"start": <3 numbers>, "end": <3 numbers>}}}'
+    )
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:

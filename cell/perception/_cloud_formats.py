@@ -103,12 +103,18 @@ def parse_ply(path: Path, data: bytes) -> Body:
         raise _fail(path, f"PLY format {fmt!r}", f"format {', '.join(_PLY_FORMATS)}")
     names = [e[0] for e in elements]
     if "vertex" not in names:
-        raise _fail(path, f"its PLY header has no vertex element (elements: {names})", "an element vertex")
+        raise _fail(
+            path, f"its PLY header has no vertex element (elements: {', '.join(names) or 'none'})", "an element vertex"
+        )
     v = names.index("vertex")
     count, props = elements[v][1], elements[v][2]
     columns = [p[0] for p in props]
     if not {"x", "y", "z"} <= set(columns):
-        raise _fail(path, f"its vertex element has no x, y, z (properties: {columns})", "properties x, y, z")
+        raise _fail(
+            path,
+            f"its vertex element has no x, y, z (properties: {', '.join(columns) or 'none'})",
+            "properties x, y, z",
+        )
     if any(kind == "list" for e in elements[: v + 1] for _, kind in e[2]):
         raise _fail(
             path,
@@ -150,7 +156,9 @@ def parse_pcd(path: Path, data: bytes) -> Body:
             head[words[0].upper()] = words[1:]
     fields = head.get("FIELDS", [])
     if not {"x", "y", "z"} <= set(fields):
-        raise _fail(path, f"its PCD FIELDS are {fields}, without x y z", "FIELDS including x y z")
+        raise _fail(
+            path, f"its PCD FIELDS are {' '.join(fields) or 'missing'}, without x y z", "FIELDS including x y z"
+        )
     counts = head.get("COUNT", ["1"] * len(fields))
     sizes, types = head.get("SIZE", []), head.get("TYPE", [])
     if not len(sizes) == len(types) == len(counts) == len(fields):

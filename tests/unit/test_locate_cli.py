@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 
 from cell.cli import app
 from cell.geometry import pose_from_xyz_rpy, transform_points
+from cell.perception.cloud_files import read_cloud
 from cell.weldmap import read_map
 
 runner = CliRunner()
@@ -81,7 +82,8 @@ def test_locate_finds_fence1_in_a_synthetic_scan(scan: tuple[Path, Path, dict], 
     assert max(offsets.values()) < 1.0, offsets  # measured: 0.03-0.1 mm at a 5 mm pitch, 0.3 mm noise
     assert rep["summary"]["found"] == 12 and rep["summary"]["paper_me_mean_mm"] is None
     assert out.startswith("seam,status,") and len(out.strip().splitlines()) == 17
-    assert saved.is_file() and saved.stat().st_size > 12 * 1000
+    used = read_cloud(saved, frame="F")  # the cloud as given to the pipeline: every point of the file, in metres
+    assert len(used) == len(read_cloud(cloud)) and np.allclose(used.points, read_cloud(cloud).points)
 
 
 def test_locate_with_truth_reports_errors(scan: tuple[Path, Path, dict]) -> None:
@@ -150,7 +152,10 @@ def test_millimetres_by_mistake_name_the_fix(tmp_path: Path) -> None:
     assert_one_line_error(code, err, 2, "looks like millimetres: pass --units mm")
 
 
-def test_bad_truth_files_exit_2(tiny: Path, tmp_path: Path) -> None:
+def test_bad_truth_files_exit_2(tmp_path: Path) -> None:
+    p = np.random.default_rng(0).random((50, 3)) * 0.3
+    p[[4, 9], 0] = np.nan  # dropped, with a warning, before the truth file is read
+    tiny = pcd_ascii(tmp_path / "tiny.pcd", p)
     truth = tmp_path / "truth.json"
     for content, needle in (
         ("{not json", "not readable JSON"),
@@ -162,6 +167,7 @@ def test_bad_truth_files_exit_2(tiny: Path, tmp_path: Path) -> None:
         truth.write_text(content)
         code, _, err = invoke("locate", str(tiny), "--map", str(FENCE1), "--truth", str(truth))
         assert_one_line_error(code, err, 2, "--truth", needle)
+        assert "warning: point cloud" in err and "dropped 2 of 50 points" in err
 
 
 def test_an_unwritable_output_exits_2_before_reading(tiny: Path, tmp_path: Path) -> None:
@@ -186,4 +192,3 @@ def test_ctrl_c_writes_the_interrupted_report(tiny: Path, tmp_path: Path, monkey
     rep = json.loads(report.read_text())
     assert rep["interrupted"] == {"stage": "finding the table plane"} and rep["frame"] == "R" and rep["seams"] == []
     assert rep["error"]["exit_code"] == 130 and rep["provenance"]["cloud_file"] == str(tiny)
-

@@ -1,7 +1,8 @@
-"""A run's motion as a timeline, numpy only: what the arm did (or would do), subsampled, with its marks.
+"""A run's motion as a timeline, numpy only: what the arm did (or would do), subsampled, with its marks; and the
+quaternions of rotation matrices that the Rerun recording (:mod:`cell.preview.rerun`) logs.
 
-Values of the run only (its execution, else its plan and the move home before it); the Rerun recording
-(:mod:`cell.preview.rerun`) logs them. Time [s] is the execution's: 0 where the move home starts.
+Values of the run only (its execution, else its plan and the move home before it). Time [s] is the execution's:
+0 where the move home starts.
 """
 
 from __future__ import annotations

@@ -120,13 +120,14 @@ def test_arc_on_intervals_one_strip_per_weld(
     recorded: tuple[Path, dict[str, Any]], fence1_run: pipeline.WeldRun
 ) -> None:
     _, cols = recorded
-    plan = fence1_run.plan
+    plan, ex = fence1_run.plan, fence1_run.execution
     assert plan is not None
     welds = [s for s in plan.segments if s.arc_on]
     (strips,) = cols["/cell/tcp/arc_on"]["LineStrips3D:strips"]
-    assert len(strips) == len(welds) == 12
+    assert len(strips) == len(welds) > 0  # one strip per weld the arm made (fence1: 12)
     arc = np.array(cols["/plots/arc"]["Scalars:scalars"]).ravel()
-    assert set(arc) == {0.0, 1.0} and 0.2 < arc.mean() < 0.9
+    assert set(arc) == {0.0, 1.0}
+    assert ex is not None and arc.mean() == pytest.approx(plan.arc_time / ex.duration, abs=0.02)  # even in time
     texts = [x for row in cols["/log"]["TextLog:text"] for x in row]
     for kind in ("arc_on", "arc_off"):  # every switch named by its seam, in welding order
         seams = [x.split()[1] for x in texts if x.startswith(kind)]
@@ -148,7 +149,11 @@ def test_a_preview_records_the_plan_on_the_same_timeline(fence1_run: pipeline.We
     t = seen["/cell/robot/link_6"].column("time").cast(pa.int64()).to_numpy() / 1e9
     assert t[0] == 0.0 and t[-1] == pytest.approx(pre.duration + plan.cycle_time, abs=1e-6)
     assert t[-1] == pytest.approx(ex.duration, abs=0.01)
-    assert len(seen["/cell/tcp/arc_on"].column("LineStrips3D:strips").to_pylist()[0]) == 12
+    assert (
+        len(seen["/cell/tcp/arc_on"].column("LineStrips3D:strips").to_pylist()[0])
+        == len([s for s in plan.segments if s.arc_on])
+        > 0
+    )
 
 
 def test_a_run_that_failed_early_still_records_what_it_has(fence1_run: pipeline.WeldRun, tmp_path: Path) -> None:

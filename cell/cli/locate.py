@@ -47,7 +47,7 @@ TRUTH_UNITS = "mm"  # a truth file's coordinates (docs/locate.md)
 
 @app.command()
 def locate(
-    cloud_path: Annotated[Path, typer.Argument(metavar="CLOUD", help="A point cloud: PLY or PCD, ascii or binary.")],
+    cloud: Annotated[Path, typer.Argument(metavar="CLOUD", help="A point cloud: PLY or PCD, ascii or binary.")],
     map_path: Annotated[Path, typer.Option("--map", help="The welding map (DXF) of the part in the cloud.")],
     place: PlaceOpt = None,
     place_rpy: PlaceRpyOpt = None,
@@ -83,7 +83,7 @@ def locate(
     with cell_errors():
         table = parse_format(fmt)
         check_file(json_path, "--json")
-        check_file(save_cloud, "--save-cloud", stdout_ok=False)
+        check_file(save_cloud, "--save-cloud_F", stdout_ok=False)
         check_units(units)
         check_frame(frame)
         if map_units is not None and map_units not in METRES_PER_UNIT:
@@ -94,30 +94,30 @@ def locate(
         for path, option in ((map_path, "--map"), (truth, "--truth")):
             if path is not None and not path.is_file():
                 raise UsageError(f"{option} {str(path)!r} does not exist; valid: an existing file")
-        cloud = read_cloud(cloud_path, units=units, frame=frame, warn=_warn)
+        cloud_F = read_cloud(cloud, units=units, frame=frame, warn=_warn)
         weldmap = read_map(map_path, units=map_units)
         truth_F = read_truth(truth, [s.id for s in weldmap.seams], frame) if truth is not None else None
-        inputs: dict[str, Path] = {"cloud": cloud_path, "map": map_path} | ({"truth": truth} if truth else {})
+        inputs: dict[str, Path] = {"cloud": cloud, "map": map_path} | ({"truth": truth} if truth else {})
         prov = provenance(None, inputs=inputs)
         detail(f"cloud {prov['cloud_file']} (sha256 {prov['cloud_sha256']}), map {prov['map_file']}")
-        say(f"{len(cloud)} points in frame {frame} read from {cloud_path}")
+        say(f"{len(cloud_F)} points in frame {frame} read from {cloud}")
         stage, writer = Stage(), Writer()
         det: Detection | None = None
         try:
             det = locate_cloud(
-                cloud, weldmap, X_FM, name=cloud_path.stem, method=method, viewpoint_F=viewpoint_F,
+                cloud_F, weldmap, X_FM, name=cloud.stem, method=method, viewpoint_F=viewpoint_F,
                 truth_F=truth_F, progress=stage,
             )  # fmt: skip
             rep = detection_report(det, provenance=prov)
             writer.report(json_path, rep)
-            if save_cloud is not None and writer.attempt(lambda: _save_cloud(cloud, save_cloud)) is not None:
+            if save_cloud is not None and writer.attempt(lambda: _save_cloud(cloud_F, save_cloud)) is not None:
                 say(f"cloud written to {save_cloud}")
             print_located(rep, table)
         except (KeyboardInterrupt, ImportError) as e:
             if not was_interrupted(e):
                 raise
             done = detection_report(det, provenance=prov) if det is not None else None
-            rep = done or interrupted_report(cloud_path.stem, method, frame, stage.last, prov)
+            rep = done or interrupted_report(cloud.stem, method, frame, stage.last, prov)
             on_interrupt(writer, json_path, rep, stage.last)
             raise typer.Exit(EXIT_INTERRUPTED) from None
     if det.error is not None:  # the report says which seams and why: partial, with the cause in report.error

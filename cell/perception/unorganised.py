@@ -12,9 +12,8 @@ what a depth camera's intrinsics and viewing direction give for free.
 - :func:`orient_normals`: unit normals turned by a stated heuristic, since no view direction is known: towards
   ``viewpoint`` when one is given; else towards +z for faces within about 70 degrees of horizontal and, for steep
   faces, away from the centroid of the points (outwards on a convex part).
-- :func:`global_pose`: where the map lies with no usable nominal placement: FPFH features and RANSAC
-  (Open3D's feature matching through :mod:`cell.perception._open3d`), flattened to a turn about the vertical
-  (a part lies on the table), refined by point-to-plane ICP, the best of a few seeded tries by fitness.
+
+Where the map lies with no usable placement: :mod:`cell.perception.global_placement`.
 
 All in one frame (the cloud's, or the levelled one), metres.
 """
@@ -28,14 +27,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cell.errors import SensorError
-from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
+from cell.geometry import FloatArray, make_pose
 from cell.perception import _open3d
-from cell.perception.align import sample_map
 from cell.perception.preprocess import downsample
-from cell.types import Cloud, WeldMap
+from cell.types import Cloud
 
 _NORMAL_RADIUS_M = 0.01  # neighbourhood of a point's normal for the table search
 _NORMAL_NEIGHBOURS = 30
+_GRID_M = 0.003  # the table's hypotheses are drawn from the cloud on this grid
 _UP_COS = math.cos(math.radians(20.0))  # a table candidate's normal within 20 deg of +z
 _STEEP_COS = math.cos(math.radians(70.0))  # |n_z| below this: a steep face (oriented away from the centroid)
 
@@ -73,19 +72,19 @@ def find_table(
 ) -> TablePlane:
     """The largest near-horizontal plane of ``points`` (n, 3): the table (see the module docstring).
 
-    RANSAC on the points whose local normal is within 20 degrees of +z (``iterations`` hypotheses from ``rng``,
-    inliers within ``threshold_m``), then a least-squares refit of the inliers, the noise measured, and the
-    inliers taken again within ``inlier_sigmas`` noise scales. SensorError when no such plane holds a tenth of
-    the candidates.
+    RANSAC on the points whose local normal is within 20 degrees of +z (of the cloud on a 3 mm grid;
+    ``iterations`` hypotheses from ``rng``, inliers within ``threshold_m``), then a least-squares refit of all
+    the cloud's inliers, the noise measured, and the inliers taken again within ``inlier_sigmas`` noise scales.
+    SensorError when no such plane holds a tenth of the candidates.
     """
     P = np.asarray(points, dtype=np.float64)
     if len(P) < 100:
         raise SensorError(f"a table plane needs at least 100 points, the cloud has {len(P)}")
-    n = _open3d.estimate_normals(P, _NORMAL_RADIUS_M, _NORMAL_NEIGHBOURS)
-    cand = np.flatnonzero(np.abs(n[:, 2]) >= _UP_COS)
-    if len(cand) < 100:
-        raise SensorError(f"no horizontal surface in the cloud ({len(cand)} points face up): no table to stand on")
-    Q = P[cand]
+    G = downsample(Cloud(P, "F"), _GRID_M).points  # hypotheses from a grid of the cloud: its normals are cheaper
+    n = _open3d.estimate_normals(G, _NORMAL_RADIUS_M, _NORMAL_NEIGHBOURS)
+    Q = G[np.abs(n[:, 2]) >= _UP_COS]
+    if len(Q) < 30:
+        raise SensorError(f"no horizontal surface in the cloud ({len(Q)} points face up): no table to stand on")
     best, best_count = None, 0
     for _ in range(iterations):
         a, b, c = Q[rng.choice(len(Q), 3, replace=False)]
@@ -163,77 +162,3 @@ def orient_normals(normals: FloatArray, points: FloatArray, viewpoint: FloatArra
         flip = np.where(steep, np.einsum("ij,ij->i", n, out) < 0.0, n[:, 2] < 0.0)
     n[flip] *= -1.0
     return n
-
-
-def flatten_to_yaw(X: FloatArray) -> FloatArray:
-    """(4, 4) the rigid motion X with its rotation reduced to its turn about z (roll and pitch dropped)."""
-    yaw = math.atan2(float(X[1, 0]), float(X[0, 0]))
-    out = make_pose(rpy_to_matrix((0.0, 0.0, yaw)))
-    out[:3, 3] = X[:3, 3]
-    return out
-
-
-def global_pose(
-    cloud: FloatArray,
-    cloud_normals: FloatArray,
-    samples: FloatArray,
-    sample_normals: FloatArray,
-    rng: np.random.Generator,
-    *,
-    voxel_m: float = 0.005,
-    tries: int = 4,
-    fitness_m: float = 0.005,
-) -> tuple[FloatArray, float]:
-    """(X, fitness): the rigid motion that moves the map's ``samples`` (m, 3, outward ``sample_normals``) onto
-    ``cloud`` (n, 3, oriented ``cloud_normals``), and the share of the samples within ``fitness_m`` of a cloud
-    point after it. Each of ``tries`` FPFH + RANSAC matches (on a ``voxel_m`` grid, seeded from ``rng``) is
-    flattened to a turn about z and refined by point-to-plane ICP (20, 8 and 3 voxels); the best is kept."""
-    best, best_fit = np.eye(4), -1.0
-    tree = cKDTree(np.asarray(cloud))
-    for _ in range(tries):
-        seed = int(rng.integers(0, 2**31 - 1))
-        X = _open3d.fpfh_ransac(samples, sample_normals, cloud, cloud_normals, voxel_m, seed)
-        X = flatten_to_yaw(X)
-        for k in (4.0, 2.0, 0.6):
-            X = _open3d.icp(samples, cloud, k * voxel_m, 30, X, None).X_TS
-            X = flatten_to_yaw(X)
-        moved = transform_points(X, samples)
-        fit = float(np.mean(np.isfinite(tree.query(moved, distance_upper_bound=fitness_m)[0])))
-        if fit > best_fit:
-            best, best_fit = X, fit
-    return best, best_fit
-
-
-def on_table(X_LM: FloatArray, weldmap: WeldMap, table_z: float) -> FloatArray:
-    """(4, 4) the placement X_LM (frame L: levelled, the table at height ``table_z`` [m]) of ``weldmap`` flattened
-    to a turn about z, its lowest part corner on the table: a part rests on the table."""
-    X = flatten_to_yaw(X_LM)
-    low = min(float(transform_points(X, p.vertices())[:, 2].min()) for p in weldmap.parts)
-    X[2, 3] += table_z - low
-    return X
-
-
-def global_placement(
-    points_L: FloatArray,
-    weldmap: WeldMap,
-    table_z: float,
-    viewpoint_L: FloatArray | None,
-    rng: np.random.Generator,
-    voxel_m: float = 0.005,
-) -> FloatArray:
-    """(4, 4) X_LM: where ``weldmap`` lies among ``points_L`` (n, 3, the points above the table, levelled frame L)
-    with no nominal placement: the points no higher above the table than the map's parts (the rest is something
-    else), the map put on the table at their median, then :func:`global_pose` on a
-    ``voxel_m`` grid (normals by :func:`orient_normals`), the result put back flat on the table."""
-    height = max(float(p.vertices()[:, 2].max()) for p in weldmap.parts) - min(
-        float(p.vertices()[:, 2].min()) for p in weldmap.parts
-    )
-    P = np.asarray(points_L)
-    P = P[P[:, 2] <= table_z + height + 2.0 * voxel_m]  # nothing of the part stands higher than the map's parts
-    cloud = downsample(Cloud(P, "L"), voxel_m).points
-    normals = orient_normals(_open3d.estimate_normals(cloud, 2.5 * voxel_m, 30), cloud, viewpoint_L)
-    centre = np.median(cloud, axis=0)
-    X0 = on_table(make_pose(p=(centre[0], centre[1], 0.0)), weldmap, table_z)
-    samples, sample_normals = sample_map(weldmap.transformed(X0, "L"), voxel_m, voxel_m)
-    X, _ = global_pose(cloud, normals, samples, sample_normals, rng, voxel_m=voxel_m)
-    return on_table(X @ X0, weldmap, table_z)

@@ -12,8 +12,9 @@ The cloud is unorganised (no intrinsics, no view direction), in metres, in its o
    are zero, its underside at the table's height); the cloud cropped to the placed map's bounds grown by
    :data:`MARGIN_M` (and, above the table, by its noise);
 4. the map aligned by the usual staged ICP and its checks (fitness, tilt, ambiguity, parts seen); with no nominal
-   placement, or one whose fit is poor (:data:`POOR_FITNESS`), a global registration (FPFH + RANSAC,
-   :func:`cell.perception.unorganised.global_pose`) first;
+   placement, or one whose fit is poor (:data:`POOR_FITNESS`), a global registration first
+   (:mod:`cell.perception.global_placement`: a height-image search over turns and shifts on the table, then FPFH +
+   RANSAC if that fits poorly), each candidate aligned and the one explaining the most points kept;
 5. every seam of the aligned map located (our locator by default), screened (occluders, missing parts, doubt), and
    carried back into F. A seam no data supports is NOT_FOUND or NOT_VISIBLE with the reason, never invented.
 
@@ -33,14 +34,15 @@ from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
 from cell.geometry import FloatArray, invert, make_pose, transform_points
 from cell.perception.align import Alignment, align_map
 from cell.perception.alignment_checks import check_alignment_unique, check_parts_seen
+from cell.perception.global_placement import fpfh_candidates, height_candidates, on_table
 from cell.perception.preprocess import downsample
 from cell.perception.seam_screen import screen
-from cell.perception.unorganised import TablePlane, find_table, global_placement, levelling, on_table
+from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
 from cell.pipeline.cloud_setup import cloud_scenario, ours_overrides
 from cell.pipeline.detect import Progress, evaluate, quiet
 from cell.pipeline.records import Detection
-from cell.scenario import Scenario
+from cell.scenario import PerceptionSpec, Scenario
 from cell.seams.joint import find_joints
 from cell.seams.visibility import visibility
 from cell.types import Box, Cloud, Joint, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
@@ -117,15 +119,15 @@ def locate_cloud(
         except AlignmentError as e:
             error = e
     if alignment is None or alignment.fitness < POOR_FITNESS:
-        progress("global registration of the map (FPFH + RANSAC)")
-        X_LM_g = global_placement(P_L[above], weldmap, table_z, viewpoint_L, rng)
-        crop_g = _crop(P_L, above, weldmap.transformed(X_LM_g, _FRAME))
-        try:
-            found = align_map(weldmap.transformed(X_LM_g, _FRAME), Cloud(P_L[crop_g], _FRAME), spec)
-            if alignment is None or found.fitness > alignment.fitness:
-                alignment, X_LM0, error = found, X_LM_g, None
-        except AlignmentError as e:
-            error = error if alignment is not None else e
+        progress("global registration of the map (height image, FPFH + RANSAC)")
+        best = _global(P_L, above, weldmap, table_z, viewpoint_L, rng, spec)
+        if best is not None and (alignment is None or best[1].fitness > alignment.fitness):
+            X_LM0, alignment, error = best[0], best[1], None
+        elif alignment is None and error is None:
+            error = AlignmentError(
+                "no placement of the map fits the cloud (global registration: no candidate aligned)",
+                code=AlignmentFailure.LOW_FITNESS,
+            )
     timings["align_s"] = time.perf_counter() - t
 
     scenario = spec_scenario
@@ -169,6 +171,40 @@ def locate_cloud(
 def _levelled(table: TablePlane, X_LF: FloatArray) -> TablePlane:
     """The table plane expressed in L."""
     return replace(table, normal=X_LF[:3, :3] @ table.normal)
+
+
+def _global(
+    P_L: FloatArray,
+    above: np.ndarray,
+    weldmap: WeldMap,
+    table_z: float,
+    viewpoint_L: FloatArray | None,
+    rng: np.random.Generator,
+    spec: PerceptionSpec,
+) -> tuple[FloatArray, Alignment] | None:
+    """The best global candidate (:mod:`cell.perception.global_placement`) as aligned by the staged ICP: the one
+    whose fit explains the most points of the cloud (fitness times the points of its crop); None when none
+    aligns. The height-image search first; FPFH + RANSAC only when none of its candidates fits well (on the real
+    scans FPFH proposed the part turned by 180 degrees and took 5 s; the height image 0.3 s, right every time)."""
+    best: tuple[FloatArray, Alignment] | None = None
+    best_count = -1.0
+    searches = (
+        lambda: height_candidates(P_L[above], weldmap, table_z),
+        lambda: fpfh_candidates(P_L[above], weldmap, table_z, viewpoint_L, rng),
+    )
+    for search in searches:
+        for X0 in search():
+            crop = _crop(P_L, above, weldmap.transformed(X0, _FRAME))
+            try:
+                fit = align_map(weldmap.transformed(X0, _FRAME), Cloud(P_L[crop], _FRAME), spec)
+            except AlignmentError:
+                continue
+            count = fit.fitness * int(crop.sum())
+            if count > best_count:
+                best, best_count = (X0, fit), count
+        if best is not None and best[1].fitness >= POOR_FITNESS:
+            break  # the height image's fit is good: FPFH is not asked
+    return best
 
 
 def _crop(P_L: FloatArray, above: np.ndarray, map_L: WeldMap) -> np.ndarray:

@@ -19,6 +19,7 @@ a pinhole: record the rectified depth (``image_rect_raw``), whose D is zero.
 
 from __future__ import annotations
 
+import sqlite3
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -87,7 +88,7 @@ def _tf_tree(reader: Any, bag: Path) -> TfTree:
     tree = TfTree()
     conns = [c for c in reader.connections if c.msgtype == TF_MESSAGE]
     for conn, _, raw in reader.messages(connections=conns):
-        msg: Any = reader.deserialize(raw, conn.msgtype)
+        msg = _decode(reader, raw, conn.msgtype, bag, conn.topic)
         for t in msg.transforms:
             tr, q = t.transform.translation, t.transform.rotation
             try:
@@ -102,6 +103,14 @@ def _tf_tree(reader: Any, bag: Path) -> TfTree:
             except (TfError, ValueError) as e:
                 raise fail(bag, f"{conn.topic}, {t.header.frame_id} -> {t.child_frame_id}: {e}") from None
     return tree
+
+
+def _decode(reader: Any, raw: Any, msgtype: str, bag: Path, topic: str) -> Any:
+    """The message of ``raw`` bytes; a CaptureError when they do not decode as ``msgtype`` (a damaged bag)."""
+    try:
+        return reader.deserialize(raw, msgtype)
+    except Exception as e:  # rosbags raises SerdeError, or struct/index errors on truncated data
+        raise fail(bag, f"a {msgtype} message on {topic} does not decode ({type(e).__name__}: {e})") from None
 
 
 def _pick(reader: Any, conns: Sequence[Any], target_ns: int | None) -> tuple[int, Any] | None:
@@ -137,6 +146,7 @@ def read_bag(
     depth_topics: Sequence[str] | None = None,
     base_frame: str | None = None,
     time: float | None = None,
+    max_tf_gap_s: float = 0.1,
     progress: Progress = _quiet,
 ) -> BagCapture:
     """One depth image per camera of a ROS 2 bag, posed in ``base_frame`` (module docstring).
@@ -144,6 +154,8 @@ def read_bag(
     depth_topics : the Image topics to read (default: every Image topic whose encoding is a depth encoding).
     base_frame : the robot base's tf frame (default ``base_link`` when tf has it, else the root of the tf tree).
     time : pick each camera's image recorded nearest this many seconds after the bag's start (default: the first).
+    max_tf_gap_s : refuse a camera whose moving tf sample nearest its stamp is further from it than this [s] (the
+        arm's pose at the image would be a guess).
     """
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.rosbag2 import ReaderError
@@ -152,13 +164,17 @@ def read_bag(
     bag = Path(bag)
     if not bag.exists():
         raise fail(bag, "no such file or directory; valid: a rosbag2 folder (metadata.yaml) or its .db3/.mcap file")
+    if bag.suffix == ".bag":
+        raise fail(bag, "a ROS 1 bag is not read; valid: a ROS 2 bag (`rosbags-convert` turns one into the other)")
     try:
         reader = AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
     except (AnyReaderError, ReaderError, OSError) as e:  # rosbags says FileNotFoundError for a folder without metadata
         raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
     try:
-        return _read(reader, bag, depth_topics, base_frame, time, progress)
+        return _read(reader, bag, depth_topics, base_frame, time, max_tf_gap_s, progress)
+    except (AnyReaderError, ReaderError, OSError, sqlite3.Error) as e:  # storage damaged past its index
+        raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
     finally:
         reader.close()
 
@@ -169,6 +185,7 @@ def _read(
     depth_topics: Sequence[str] | None,
     base_frame: str | None,
     time: float | None,
+    max_tf_gap_s: float,
     progress: Progress,
 ) -> BagCapture:
     by_topic: dict[str, list[Any]] = {}
@@ -190,7 +207,7 @@ def _read(
         picked = _pick(reader, by_topic[topic], target_ns)
         if picked is None:
             raise fail(bag, f"{topic} holds no message")
-        msg: Any = reader.deserialize(picked[1], IMAGE)
+        msg = _decode(reader, picked[1], IMAGE, bag, topic)
         if str(msg.encoding) not in DEPTH_SCALE_M:
             if depth_topics is not None:  # asked for by name: refused (depth_of says what is valid)
                 depth_of(msg, bag, topic)
@@ -213,7 +230,7 @@ def _read(
         info_raw = _pick(reader, by_topic[info_topic], ts)
         if info_raw is None:
             raise fail(bag, f"{info_topic} holds no message")
-        info: Any = reader.deserialize(info_raw[1], CAMERA_INFO)
+        info = _decode(reader, info_raw[1], CAMERA_INFO, bag, info_topic)
         k = intrinsics_of(info, bag, info_topic)
         depth = depth_of(msg, bag, topic)
         if depth.shape != (k.height, k.width):
@@ -228,6 +245,12 @@ def _read(
             look = tree.lookup(base, frame, stamp)
         except TfError as e:
             raise fail(bag, f"{topic}: {e}") from None
+        if look.max_gap_ns > max_tf_gap_s * 1e9:
+            raise fail(
+                bag,
+                f"{topic}: the tf sample of {', '.join(look.moving)} nearest the image is "
+                f"{look.max_gap_ns * 1e-9:.3f} s from its stamp; valid: within max_tf_gap_s = {max_tf_gap_s:g} s",
+            )
         mount = "eye_in_hand" if look.moving else "fixed"
         name = names[topic]
         image = DepthImage(camera=name, depth=depth, intrinsics=k, X_WC=look.X_BF, mount=mount)
@@ -245,19 +268,23 @@ def capture_from_bag(
     depth_topics: Sequence[str] | None = None,
     base_frame: str | None = None,
     time: float | None = None,
+    max_tf_gap_s: float = 0.1,
 ) -> Path:
     """Read a ROS 2 bag (:func:`read_bag`) and write its cameras as a capture folder at ``out_dir``; returns it.
 
     The world is the robot base (X_WR identity: the bag's poses are in ``base_frame``). A ``16UC1`` image keeps
     its millimetre grid (its PNG's depth scale is 1 mm: the replay reads back the very floats); a ``32FC1`` image
     is stored at 0.1 mm (rounded by up to 0.05 mm: ``progress`` says so). An eye-in-hand camera whose tf chain
-    passes through the flange frame (``tool0``) records the flange's pose at its stamp. The provenance names
+    passes through the flange frame (``tool0``) records the flange's pose at its stamp. ``depth_topics``,
+    ``base_frame``, ``time`` and ``max_tf_gap_s`` are :func:`read_bag`'s. The provenance names
     the bag, the base frame and, per camera, its topic, stamp, frame and moving transforms.
     """
     from cell.provenance import provenance
     from cell.recorded.layout import DEFAULT_DEPTH_SCALE_M, FLANGE_FRAME, write_capture
 
-    read = read_bag(bag, depth_topics=depth_topics, base_frame=base_frame, time=time, progress=progress)
+    read = read_bag(
+        bag, depth_topics=depth_topics, base_frame=base_frame, time=time, max_tf_gap_s=max_tf_gap_s, progress=progress
+    )
     flange: dict[str, npt.NDArray[np.float64]] = {}
     for name, cam in read.cameras.items():
         if cam.image.mount == "eye_in_hand" and FLANGE_FRAME in read.tree.ancestors(cam.frame_id):

@@ -28,17 +28,18 @@ def fail(bag: Path, what: str) -> CaptureError:
 
 def camera_names(topics: Sequence[str]) -> dict[str, str]:
     """Image topic -> camera name: the topic's first namespace component (``/cam_right/depth/image_rect_raw`` ->
-    ``cam_right``) when that tells the topics apart, else the whole namespace joined by ``_``; characters outside
-    ``[A-Za-z0-9_-]`` become ``_`` (the name is part of file names)."""
+    ``cam_right``) when that tells the topics apart, else the namespace joined by ``_``, else the whole topic;
+    characters outside ``[A-Za-z0-9_-]`` become ``_`` (the name is part of file names)."""
 
     def clean(s: str) -> str:
         return re.sub(r"[^A-Za-z0-9_-]", "_", s) or "camera"
 
-    parts = {t: [p for p in t.split("/") if p] for t in topics}
-    first = {t: clean(p[0] if len(p) > 1 else p[0] if p else "camera") for t, p in parts.items()}
-    if len(set(first.values())) == len(topics):
-        return first
-    return {t: clean("_".join(p[:-1]) if len(p) > 1 else "_".join(p)) for t, p in parts.items()}
+    parts = {t: [p for p in t.split("/") if p] or ["camera"] for t in topics}
+    for pick in (lambda p: p[0], lambda p: "_".join(p[:-1]) or p[0], lambda p: "_".join(p)):
+        names = {t: clean(pick(p)) for t, p in parts.items()}
+        if len(set(names.values())) == len(names):
+            return names
+    return {t: f"{name}_{i}" for i, (t, name) in enumerate(names.items())}  # topics equal once cleaned
 
 
 def info_topic_of(image_topic: str) -> str:

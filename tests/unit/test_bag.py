@@ -17,6 +17,7 @@ from cell.errors import CaptureError
 from cell.geometry import pose_from_xyz_rpy
 from cell.recorded import read_capture
 from cell.recorded.bag import capture_from_bag, read_bag
+from cell.recorded.ros_msgs import camera_names
 from cell.recorded.tf_tree import TfError, TfTree, pose_from_quaternion, quaternion_of
 from cell.types import CameraIntrinsics
 
@@ -185,6 +186,30 @@ def test_bad_bags_are_one_line_capture_errors(tmp_path: Path) -> None:
     _refused(mono, r"encoding 'mono8'; valid depth encodings: 16UC1", depth_topics=["/cam/depth/image_raw"])
     _refused(mono, r"/nope is not an sensor_msgs/msg/Image topic", depth_topics=["/nope"])
     _refused(bag(tmp_path, [*tree_msgs(), *good], "base"), r"base frame 'robot' is not in tf", base_frame="robot")
+
+
+def test_stale_tf_damaged_data_ros1_and_name_clashes(tmp_path: Path) -> None:
+    late = T0 + 3 * S  # 2 s after the arm's last tf sample: its pose at the image is not known
+    stale = bag(tmp_path, [*tree_msgs(), *camera("arm_cam", "eih_optical", late, 1.0)], "stale")
+    _refused(stale, r"base_link->link_6 nearest the image is 2.000 s from its stamp; valid: within max_tf_gap_s")
+    assert read_bag(stale, max_tf_gap_s=3.0).cameras["arm_cam"].tf.max_gap_ns == 2 * S
+    damaged = rf.Message("/cam/depth/image_raw", "sensor_msgs/msg/Image", T0, None)
+    with rf.Writer(tmp_path / "damaged", version=9) as writer:
+        conn = writer.add_connection(damaged.topic, damaged.msgtype, typestore=rf.TYPESTORE)
+        writer.write(conn, T0, b"\x00\x01\x00\x00 not cdr")
+    _refused(tmp_path / "damaged", r"a sensor_msgs/msg/Image message on /cam/depth/image_raw does not decode")
+    ros1 = tmp_path / "old.bag"
+    ros1.write_bytes(b"#ROSBAG V2.0\n")
+    _refused(ros1, "a ROS 1 bag is not read")
+    assert camera_names(["/a/depth/image_raw", "/b/depth/image_raw"]) == {
+        "/a/depth/image_raw": "a",
+        "/b/depth/image_raw": "b",
+    }
+    assert camera_names(["/cam/depth/image_raw", "/cam/ir/image_raw"]) == {
+        "/cam/depth/image_raw": "cam_depth",
+        "/cam/ir/image_raw": "cam_ir",
+    }
+    assert camera_names(["/cam/depth", "/cam/depth2"]) == {"/cam/depth": "cam_depth", "/cam/depth2": "cam_depth2"}
 
 
 def test_cli_converts_a_bag_and_refuses_a_bad_one(two_cameras: Path, tmp_path: Path) -> None:

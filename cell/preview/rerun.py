@@ -1,7 +1,7 @@
 """A Rerun recording of a run (``cell weld --rerun FILE.rrd``, ``cell preview --rerun FILE.rrd``).
 
-The only module that imports ``rerun`` (an optional extra: ``pip install 'weld-cell[rerun]'``), and only inside
-its functions. It writes, from the values the HTML page draws (the run's records and its
+The only module that imports ``rerun`` (the optional extra ``rerun``: ``pip install 'weld-cell[rerun]'``), and
+only inside its functions. It writes, from the values the HTML page draws (the run's records and its
 :class:`~cell.types.CellView`), everything in the robot frame R [m] under ``cell/``:
 
 - ``cell/cloud``: the dense cloud (coloured by height); ``cell/table``; ``cell/map/parts``: the aligned map's
@@ -47,7 +47,8 @@ if TYPE_CHECKING:
     from cell.pipeline.records import WeldRun
 
 APPLICATION_ID = "weld-cell"
-INSTALL_HINT = "uv sync --extra rerun, or pip install 'weld-cell[rerun]'"
+# no square brackets: the CLI prints error messages as rich markup, which would eat "[rerun]" of weld-cell's extra
+INSTALL_HINT = "uv sync --extra rerun (the extra), or pip install 'rerun-sdk>=0.24,<0.42'"
 RATE_HZ = 20.0  # robot poses per second of motion on the timeline
 MAX_POINTS = 400_000  # cloud points kept (every k-th beyond this)
 TCP = "torch_tcp"

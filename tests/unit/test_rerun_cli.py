@@ -55,9 +55,14 @@ def test_rerun_without_rerun_sdk_is_a_usage_error_naming_the_extra(
     tmp_path: Path, no_run: None, monkeypatch: pytest.MonkeyPatch, command: str
 ) -> None:
     monkeypatch.setitem(sys.modules, "rerun", None)  # `import rerun` raises ImportError
-    _one_error_line([command, "fence1", "--rerun", str(tmp_path / "x.rrd")], "--rerun", "uv sync --extra rerun")
+    _one_error_line(
+        [command, "fence1", "--rerun", str(tmp_path / "x.rrd")],
+        "--rerun",
+        "uv sync --extra rerun",
+        "'rerun-sdk>=0.24,<0.42'",
+    )
     assert not (tmp_path / "x.rrd").exists()
-    with pytest.raises(UsageError, match=re.escape("pip install 'weld-cell[rerun]'")):
+    with pytest.raises(UsageError, match=re.escape("pip install 'rerun-sdk>=0.24,<0.42'")):
         require_rerun()
 
 

@@ -16,9 +16,10 @@ import typer
 from cell.cli.common import NoiseOpt, app, cell_errors, detail, err, log, parse_noise, say
 from cell.cli.outputs import check_folder
 from cell.cli.placement import placement
-from cell.errors import UsageError
+from cell.errors import CellError, OutputError, UsageError
 
 if TYPE_CHECKING:
+    from cell import pipeline
     from cell.scenario import Scenario
     from cell.station.recorded import RecordedStation
 
@@ -91,8 +92,6 @@ def write_simulated(
     """Simulate the scenario's cell, capture with every camera (the arm at its scan pose: the eye-in-hand camera's
     flange pose is recorded) and write the capture folder with its cell.yaml, map and truth; returns the folder."""
     from cell import pipeline
-    from cell.recorded.cell_file import cell_yaml
-    from cell.recorded.layout import write_capture
     from cell.station import open_station
 
     weldmap = pipeline.read_weldmap(scn)
@@ -103,6 +102,25 @@ def write_simulated(
         if station.arm is not None:  # the arm holds the eye-in-hand cameras where it is now (its scan pose)
             X_RF = station.arm.model.fk(station.joint_state(), "tool0")
             flange = {n: X_RF for n, im in cap.images.items() if im.mount == "eye_in_hand"}
+    try:
+        return _write(out_dir, cap, scn, source, provenance, flange)
+    except OSError as e:  # the folder was checked before the run: a disk that filled, a folder removed meanwhile
+        if isinstance(e, CellError):
+            raise
+        raise OutputError(f"--out {str(out_dir)!r}: cannot write ({e.strerror or e})", path=str(out_dir)) from None
+
+
+def _write(
+    out_dir: Path,
+    cap: pipeline.Capture,
+    scn: Scenario,
+    source: str,
+    provenance: dict[str, Any] | None,
+    flange: dict[str, Any],
+) -> Path:
+    from cell.recorded.cell_file import cell_yaml
+    from cell.recorded.layout import write_capture
+
     # The noise model quantises each camera's depth to its depth_unit_m: the PNG is written at that scale, so the
     # replay reads back the very floats (a depth off that grid is rounded to 0.1 mm, and write_capture warns).
     scales = {n: scn.cameras[n].noise.depth_unit_m if scn.noise == "realistic" else 0.0 for n in cap.images}

@@ -92,6 +92,13 @@ def replay_scenario(rec: RecordedCapture, *, map_path: Path | None = None, X_RM:
             f"{source}: robot.X_WR disagrees with the capture's X_WR; valid: the pose capture.json records",
             path=source,
         )
+    unknown = [name for name in rec.images if name not in scenario.cameras]
+    if unknown:  # its calibration and mount would be unknown: refuse rather than guess
+        raise CaptureError(
+            f"{source}: camera(s) {', '.join(unknown)} of the capture are not in its cameras; valid: "
+            f"{', '.join(scenario.cameras)}",
+            path=source,
+        )
     return scenario
 
 

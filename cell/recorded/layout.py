@@ -122,7 +122,7 @@ def write_capture(
         if enc.off_grid:
             warn(
                 f"camera {name}: {enc.off_grid} depths not on the {scale * 1e3:g} mm grid of its PNG: the replay "
-                f"differs from this capture by up to {enc.max_rounding_m * 1e3:.3g} mm (half a unit at most)"
+                f"differs from this capture by up to {enc.max_rounding_m * 1e3:.3g} mm (each rounded to a whole unit)"
             )
         if enc.too_far:
             warn(f"camera {name}: {enc.too_far} depths beyond {65535 * scale:g} m stored as invalid (0)")
@@ -148,7 +148,7 @@ def write_capture(
     if cell_yaml is not None:
         (folder / CELL).write_text(cell_yaml, encoding="utf-8")
         index["cell"] = CELL
-        if map_file is not None:
+        if map_file is not None and Path(map_file).resolve() != (folder / Path(map_file).name).resolve():
             shutil.copyfile(map_file, folder / Path(map_file).name)
     if truth_parts_W is not None:
         (folder / TRUTH).write_text(dumps(f.truth_json(tuple(truth_parts_W))), encoding="utf-8")

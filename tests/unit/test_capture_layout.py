@@ -25,10 +25,12 @@ UNIT = 0.0001  # [m] the simulated D415's depth unit
 X_WR = pose_from_xyz_rpy([0.15, -1.05, 0.9], [0.0, 0.0, 0.3])
 
 
-def images(rng: np.random.Generator, *, on_grid: bool = True) -> dict[str, DepthImage]:
-    """Two small cameras with depths on the 0.1 mm grid as the noise model leaves them (or off it)."""
+def images(
+    rng: np.random.Generator, *, on_grid: bool = True, names: tuple[str, str] = ("left", "hand")
+) -> dict[str, DepthImage]:
+    """Two small cameras (fixed, eye-in-hand) with depths on the 0.1 mm grid as the noise model leaves them."""
     out = {}
-    for name, mount, eye in (("left", "fixed", [-0.7, 0.0, 2.0]), ("hand", "eye_in_hand", [0.15, -0.45, 2.05])):
+    for name, mount, eye in ((names[0], "fixed", [-0.7, 0.0, 2.0]), (names[1], "eye_in_hand", [0.15, -0.45, 2.05])):
         intr = CameraIntrinsics(32, 24, 30.5, 30.5, 15.5, 11.5)
         z = rng.uniform(0.8, 2.5, (24, 32))
         z = np.round(z / UNIT) * UNIT if on_grid else z  # what cell.sim.noise does, float64 then float32
@@ -168,9 +170,8 @@ def test_the_cell_file_gives_back_the_scenario_and_takes_a_new_placement(tmp_pat
     from cell.recorded.cell_file import cell_yaml
 
     fence1 = sc.load("fence1")
-    folder = write_capture(
-        tmp_path, images(np.random.default_rng(8)), fence1.X_WR, cell_yaml=cell_yaml(fence1), map_file=fence1.map_path
-    )
+    imgs = images(np.random.default_rng(8), names=("cam_left", "eye_in_hand"))
+    folder = write_capture(tmp_path, imgs, fence1.X_WR, cell_yaml=cell_yaml(fence1), map_file=fence1.map_path)
     assert (folder / "fence1.dxf").read_bytes() == fence1.map_path.read_bytes()  # the map beside cell.yaml
     rec = read_capture(folder)
     scn = replay_scenario(rec)
@@ -185,3 +186,8 @@ def test_the_cell_file_gives_back_the_scenario_and_takes_a_new_placement(tmp_pat
     other = read_capture(write_capture(tmp_path / "b", rec.images, X_WR, cell_yaml=rec.cell_yaml))
     with pytest.raises(CaptureError, match="X_WR disagrees"):  # cell.yaml's robot is not where the capture says
         replay_scenario(other, map_path=fence1.map_path)
+    stranger = read_capture(
+        write_capture(tmp_path / "c", images(np.random.default_rng(9)), fence1.X_WR, cell_yaml=rec.cell_yaml)
+    )
+    with pytest.raises(CaptureError, match="left, hand of the capture are not in its cameras"):
+        replay_scenario(stranger, map_path=fence1.map_path)  # a camera the cell does not know: no calibration, refused

@@ -54,7 +54,7 @@ def _header_lines(path: Path, data: bytes, last: bytes, kind: str) -> tuple[list
         raw = data[at:end].rstrip(b"\r")
         at = end + 1
         lines.append(raw.decode("ascii", errors="replace"))
-        if raw.split(b" ", 1)[0] == last:
+        if raw.split()[:1] == [last]:
             return lines, at
     raise _fail(path, f"its {kind} header has no {last.decode()!r} line", f"a complete {kind} header")
 

@@ -21,6 +21,7 @@ from typing import Annotated, Literal
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from cell.errors import CellError, UsageError
 
@@ -99,7 +100,7 @@ def say(msg: str) -> None:
     """A progress line: stderr (unless --quiet) and the log file. Never hard-wrapped."""
     log.info(msg)
     if not settings.quiet:
-        err.print(f"[dim]· {msg}[/]", soft_wrap=True)
+        err.print(f"[dim]· {escape(msg)}[/]", soft_wrap=True)
 
 
 def detail(msg: str) -> None:
@@ -122,7 +123,7 @@ def cell_errors() -> Iterator[None]:
         yield
     except CellError as e:
         log.error(e.message)
-        err.print(f"[bold red]error[/]: {e.message}", soft_wrap=True)
+        err.print(f"[bold red]error[/]: {escape(e.message)}", soft_wrap=True)
         raise typer.Exit(e.exit_code) from None
 
 

@@ -48,7 +48,7 @@ if TYPE_CHECKING:
 
 APPLICATION_ID = "weld-cell"
 # no square brackets: the CLI prints error messages as rich markup, which would eat "[rerun]" of weld-cell's extra
-INSTALL_HINT = "uv sync --extra rerun (the extra), or pip install 'rerun-sdk>=0.24,<0.42'"
+INSTALL_HINT = "pip install 'weld-cell[rerun]' (in a checkout: uv sync --extra rerun)"
 RATE_HZ = 20.0  # robot poses per second of motion on the timeline
 MAX_POINTS = 400_000  # cloud points kept (every k-th beyond this)
 TCP = "torch_tcp"

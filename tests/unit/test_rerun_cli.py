@@ -59,10 +59,10 @@ def test_rerun_without_rerun_sdk_is_a_usage_error_naming_the_extra(
         [command, "fence1", "--rerun", str(tmp_path / "x.rrd")],
         "--rerun",
         "uv sync --extra rerun",
-        "'rerun-sdk>=0.24,<0.42'",
+        "pip install 'weld-cell[rerun]'",  # the brackets reach the terminal: messages are printed escaped
     )
     assert not (tmp_path / "x.rrd").exists()
-    with pytest.raises(UsageError, match=re.escape("pip install 'rerun-sdk>=0.24,<0.42'")):
+    with pytest.raises(UsageError, match=re.escape("pip install 'weld-cell[rerun]'")):
         require_rerun()
 
 

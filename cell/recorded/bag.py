@@ -87,6 +87,8 @@ def _tf_tree(reader: Any, bag: Path) -> TfTree:
     """Every transform of the bag's TFMessage topics (``*tf_static`` topics static, the others stamped)."""
     tree = TfTree()
     conns = [c for c in reader.connections if c.msgtype == TF_MESSAGE]
+    if not conns:
+        return tree  # (rosbags reads every message when given no connection)
     for conn, _, raw in reader.messages(connections=conns):
         msg = _decode(reader, raw, conn.msgtype, bag, conn.topic)
         for t in msg.transforms:
@@ -128,6 +130,8 @@ def _pick(reader: Any, conns: Sequence[Any], target_ns: int | None) -> tuple[int
 
 def _base_frame(tree: TfTree, base_frame: str | None, bag: Path) -> str:
     frames = tree.frames
+    if not frames:
+        raise fail(bag, f"holds no tf ({TF_MESSAGE} on /tf_static or /tf): the cameras' poses cannot be looked up")
     if base_frame is not None:
         if frame_name(base_frame) not in frames:
             raise fail(bag, f"base frame {base_frame!r} is not in tf; frames in tf: {', '.join(frames) or 'none'}")
@@ -136,7 +140,7 @@ def _base_frame(tree: TfTree, base_frame: str | None, bag: Path) -> str:
         return DEFAULT_BASE
     if len(tree.roots) == 1:
         return tree.roots[0]
-    roots = ", ".join(tree.roots) or "none (no tf in the bag)"
+    roots = ", ".join(tree.roots) or "none: tf has a loop"
     raise fail(bag, f"no {DEFAULT_BASE!r} frame and {len(tree.roots)} tf roots ({roots}); name the base frame")
 
 

@@ -166,6 +166,7 @@ def test_bad_bags_are_one_line_capture_errors(tmp_path: Path) -> None:
             ],
             r"no tf path from 'base_link' to 'lost_optical'",
         ),
+        "no_tf": (good, r"holds no tf \(tf2_msgs/msg/TFMessage on /tf_static or /tf\)"),
         "no_frame": ([*tree_msgs(), *camera("cam", "unknown_optical", t, 1.0)], r"'unknown_optical' is not in tf"),
         "size": (
             [*tree_msgs(), rf.image("/cam/depth/image_rect_raw", "fixed_optical", np.ones((4, 8)), t), good[1]],

@@ -15,6 +15,7 @@ import numpy as np
 
 from cell.errors import CellError
 from cell.export.atomic import write_atomic
+from cell.export.procedure_report import procedure_entry
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus
 
@@ -202,6 +203,7 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
             entry["tcp_error_mm"] = {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)}
             entry["weld_time_s"] = _r(q.weld_time_s, 3)
             entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
+        entry.update(procedure_entry(w))  # the weld procedure it got and the bead per pass
     _add_rescan(rep, records, run.first_detection, run.rescan)
     ex = run.execution
     rep["welded"] = sum(w.welded for w in run.seams)

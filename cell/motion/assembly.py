@@ -20,6 +20,7 @@ from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess
 from cell.motion.transfers import Piece, TransferFail, Transfers
 from cell.types.plan import Segment
+from cell.types.procedure import WeldProcedure
 
 
 def seam_pieces(robot: RobotModel, process: WeldProcess, options: PlanOptions, sol: SeamSolution) -> list[Piece]:
@@ -56,33 +57,42 @@ def seam_pieces(robot: RobotModel, process: WeldProcess, options: PlanOptions, s
 def assemble(
     transfers: Transfers,
     ordered: Sequence[str],
-    solved: Mapping[str, SeamSolution],
+    ends: Mapping[str, tuple[FloatArray, FloatArray]],
     seam_parts: Mapping[str, Sequence[Piece]],
     q_home: FloatArray,
+    procedures: Mapping[str, WeldProcedure] | None = None,
 ) -> tuple[list[Segment], tuple[str, str, TransferFail] | None]:
     """Segments back to back from home through the seams in ``ordered`` back home; or, with the segments so far,
-    the first transfer (from id, to id; "" = home) that found no free way."""
+    the first transfer (from id, to id; "" = home) that found no free way.
+
+    ends : seam id -> (dof,) where its motion starts (the first approach) and ends (the last depart) [rad].
+    procedures : seam id -> its weld procedure, carried by the seam's segments; a seam's pieces are its passes
+    in order (each from its approach to its depart, then the move to the next): the pass index of a segment."""
     segments: list[Segment] = []
+    procs = procedures or {}
     t = 0.0
 
-    def add(sid: str, piece: Piece) -> None:
+    def add(sid: str, piece: Piece, pass_index: int = 0) -> None:
         nonlocal t
         kind, tr, speed, X_end = piece
         if tr.duration <= 0.0:
             return
-        segments.append(Segment(kind, sid, tr, t, readonly(X_end), speed, kind == "weld"))
+        seg = Segment(kind, sid, tr, t, readonly(X_end), speed, kind == "weld", procs.get(sid), pass_index)
+        segments.append(seg)
         t += tr.duration
 
     q, prev = q_home, ""
     for sid in [*ordered, ""]:
-        q_next = solved[sid].q_approach[0] if sid else q_home
+        q_next = ends[sid][0] if sid else q_home
         moves = transfers.move(q, q_next)
         if isinstance(moves, TransferFail):
             return segments, (prev, sid, moves)
         for piece in moves:
             add(sid, piece)
         if sid:
+            k = -1
             for piece in seam_parts[sid]:
-                add(sid, piece)
-            q, prev = solved[sid].q_depart[-1], sid
+                k += piece.kind == "approach"
+                add(sid, piece, max(k, 0))
+            q, prev = ends[sid][1], sid
     return segments, None

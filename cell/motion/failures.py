@@ -26,6 +26,7 @@ _WORD = {
     PlanReason.COLLISION: "collision",
     PlanReason.TRANSFER_COLLISION: "collision",
     PlanReason.TIMING: "timing",
+    PlanReason.NO_PROCEDURE: "no procedure",
 }
 
 

@@ -21,27 +21,31 @@ Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 
 from __future__ import annotations
 
+import math
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.errors import PlanError, TimingError
 from cell.geometry import readonly
-from cell.motion.assembly import assemble, seam_pieces
+from cell.motion.assembly import assemble
 from cell.motion.candidates import SeamSearch, SeamSolution
 from cell.motion.collision import CollisionChecker
 from cell.motion.failures import SeamFailure, reason_text
 from cell.motion.lines import line_trajectory
 from cell.motion.order import seam_order
+from cell.motion.passes import pass_pieces, solve_passes
 from cell.motion.plan_options import PlanOptions
+from cell.motion.procedures import NoProcedure, SeamProcedure
 from cell.motion.robot import RobotModel
 from cell.motion.scan import scan_configuration
 from cell.motion.scene import cell_obstacles
 from cell.motion.tasks import seam_tasks
 from cell.motion.torch import WeldProcess
-from cell.motion.transfers import Piece, Transfers
+from cell.motion.transfers import Piece, TransferFail, Transfers
 from cell.types import Part
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 
@@ -56,12 +60,17 @@ def plan_welds(
     options: PlanOptions | None = None,
     rng: np.random.Generator | None = None,
     checker: CollisionChecker | None = None,
+    procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
     tasks : the seams, in R (underside seams are not passed in: the caller marks them "needs a flip").
     q_home : (dof,) [rad] where the program starts and ends. obstacles : parts and table, boxes in R.
     rng : for IK restarts (deterministic for a seeded generator; default seed 0).
+    procedures : seam id -> the weld procedure it got (:mod:`cell.motion.procedures`): its travel speed and
+        torch angles drive the search, its direction fixes a vertical seam's, its passes and weave become one
+        weld segment per pass; a NoProcedure is the seam's reason (no_procedure). A seam not in it is welded
+        with ``process`` alone, one pass on the seam line.
     Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
     SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
     """
@@ -74,37 +83,49 @@ def plan_welds(
     hit = checker.check(q0)
     if hit is not None:
         raise PlanError(f"home configuration is in collision: {hit.describe()}")
-    search = SeamSearch(robot, process, checker, opt, rng or np.random.default_rng(0))
+    rng = rng or np.random.default_rng(0)
+    chosen = procedures or {}
     outcomes: dict[str, SeamOutcome] = {}
-    solved: dict[str, SeamSolution] = {}
+    solved: dict[str, tuple[SeamSolution, ...]] = {}  # per pass
+    searches: dict[str, SeamSearch] = {}
     for task in tasks:
-        res = search.plan_seam(task, q0)
+        sel = chosen.get(task.id)
+        if isinstance(sel, NoProcedure):
+            outcomes[task.id] = _failed(task.id, PlanReason.NO_PROCEDURE, sel.reason, task.p_start)
+            continue
+        search = searches[task.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng)
+        found = search.plan_seam(sel.oriented(task) if sel else task, q0)
+        res = found if isinstance(found, SeamFailure) or sel is None else solve_passes(search, found, sel.procedure)
         if isinstance(res, SeamFailure):
             outcomes[task.id] = _failed(task.id, res.code, res.where, res.p_R)
         else:
-            solved[task.id] = res
+            solved[task.id] = res if isinstance(res, tuple) else (res,)
 
     transfers = Transfers(robot, process, checker, opt, obstacles, q0)
     seam_parts: dict[str, list[Piece]] = {}
     for sid in list(solved):
+        sel = chosen.get(sid)
+        proc = sel.procedure if isinstance(sel, SeamProcedure) else None
         try:
-            seam_parts[sid] = seam_pieces(robot, process, opt, solved[sid])
+            parts = pass_pieces(robot, searches[sid].process, opt, transfers, solved[sid], proc)
         except TimingError as exc:
-            sol = solved.pop(sid)
-            outcomes[sid] = _failed(sid, PlanReason.TIMING, exc.message, sol.X_weld[0][:3, 3])
+            sols = solved.pop(sid)
+            outcomes[sid] = _failed(sid, PlanReason.TIMING, exc.message, sols[0].X_weld[0][:3, 3])
+            continue
+        if isinstance(parts, TransferFail):
+            solved.pop(sid)
+            detail = f"no free move between two passes: {parts.reason}"
+            outcomes[sid] = _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
+            continue
+        seam_parts[sid] = parts
+    ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
+    seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
     forbidden: set[tuple[str, str]] = set()
     while True:
         ids = list(solved)
-        order = seam_order(
-            ids,
-            [solved[i].q_approach[0] for i in ids],
-            [solved[i].q_depart[-1] for i in ids],
-            q0,
-            robot,
-            forbidden,
-        )
+        order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden)
         ordered = [ids[k] for k in order]
-        segments, failed = assemble(transfers, ordered, solved, seam_parts, q0)
+        segments, failed = assemble(transfers, ordered, ends, seam_parts, q0, seam_procs)
         if failed is None:
             break
         a, b, why = failed
@@ -116,17 +137,18 @@ def plan_welds(
         direction = "to" if b else "from"
         detail = f"no free transfer move {direction} the seam: {why.reason}"
         outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
-    for sid, sol in solved.items():
-        c = sol.cand
+    for sid, sols in solved.items():
+        c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
+        swapped = isinstance(sel, SeamProcedure) and sel.reverse  # the search saw the task's ends swapped
         outcomes[sid] = SeamOutcome(
             sid,
             True,
             "",
             np.zeros(0),
-            c.reversed,
+            c.reversed != swapped,
             c.spin,
-            process.work_angle + c.work_offset,
-            process.travel_angle + c.travel_offset,
+            pr.work_angle + c.work_offset,
+            pr.travel_angle + c.travel_offset,
         )
     return WeldPlan(
         joint_names=robot.joint_names,
@@ -135,6 +157,29 @@ def plan_welds(
         seams=tuple(outcomes[t.id] for t in tasks),
         order=tuple(ordered),
         planning_s=time.perf_counter() - t_start,
+    )
+
+
+def seam_process(process: WeldProcess, sel: SeamProcedure | None) -> WeldProcess:
+    """The process a seam is searched and welded with: ``process`` with its procedure's travel speed and torch
+    angles, and one direction only where the procedure fixes it (a vertical seam).
+
+    A fixed direction takes away the other direction's torch tilts: the travel-angle tolerance then grows by twice
+    the nominal angle, so the search may drag as far as it could have pushed the other way (the same torch
+    orientations: a vertical-up weld that starts at the table holds the torch as a downhill one ended there,
+    20 deg down). Nominal angles are still tried first."""
+    if sel is None:
+        return process
+    p = sel.procedure
+    travel = math.radians(p.travel_angle_deg)
+    tol = process.travel_angle_tol + (2.0 * abs(travel) if sel.fixed_direction else 0.0)
+    return replace(
+        process,
+        travel_speed=p.travel_speed_mm_s / 1000.0,
+        work_angle=math.radians(p.work_angle_deg),
+        travel_angle=travel,
+        travel_angle_tol=tol,
+        reversible=not sel.fixed_direction,
     )
 
 

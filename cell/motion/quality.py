@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import numpy.typing as npt
 
@@ -21,18 +23,28 @@ def distance_to_segment(p: npt.ArrayLike, a: npt.ArrayLike, b: npt.ArrayLike) ->
 
 
 def weld_quality(
-    times: npt.ArrayLike, tcp_R: npt.ArrayLike, truth_start: npt.ArrayLike, truth_end: npt.ArrayLike
+    times: npt.ArrayLike,
+    tcp_R: npt.ArrayLike,
+    truth_start: npt.ArrayLike,
+    truth_end: npt.ArrayLike,
+    offsets_R: npt.ArrayLike | None = None,
 ) -> WeldQuality:
-    """Quality of one weld from the records taken while its arc burned.
+    """Quality of one weld (one pass) from the records taken while its arc burned.
 
     times : (n,) record times [s]; tcp_R : (n, 3) tool positions in R [m] (n >= 2); truth : the true seam in R [m].
+    offsets_R : (n, 3) [m] where the plan meant each record to lie off the seam (the pass's offset and the weave,
+        :func:`cell.motion.weave.intended_offsets`); the TCP error and the travel speed are measured on the
+        records minus these (against the seam plus the intended weave and offset), the length on the path as
+        driven. None: on the seam line.
     """
     t = np.asarray(times, dtype=float)
-    p = np.asarray(tcp_R, dtype=float)
+    raw = np.asarray(tcp_R, dtype=float)
+    p = raw if offsets_R is None else raw - np.asarray(offsets_R, dtype=float)
     if len(t) < 2:
         raise ValueError("a weld needs at least two tool records")
     d = distance_to_segment(p, truth_start, truth_end) * _MM
     step = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    driven = np.linalg.norm(np.diff(raw, axis=0), axis=1)
     dt = np.diff(t)
     speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0) * _MM
     cruise = speed[speed > 0.5 * speed.max()] if speed.size and speed.max() > 0 else speed
@@ -40,7 +52,23 @@ def weld_quality(
         tcp_rms_mm=float(np.sqrt(np.mean(d**2))),
         tcp_max_mm=float(d.max()),
         weld_time_s=float(t[-1] - t[0]),
-        length_mm=float(step.sum() * _MM),
+        length_mm=float(driven.sum() * _MM),
         speed_mm_s=float(np.median(cruise)) if cruise.size else 0.0,
         samples=len(t),
+    )
+
+
+def combined(passes: Sequence[WeldQuality]) -> WeldQuality:
+    """All passes of one seam as one figure: the TCP error over every record (RMS weighted by samples, the
+    largest), the arc time and driven length summed, the first pass's travel speed."""
+    if not passes:
+        raise ValueError("a weld needs at least one pass")
+    n = sum(q.samples for q in passes)
+    return WeldQuality(
+        tcp_rms_mm=float(np.sqrt(sum(q.tcp_rms_mm**2 * q.samples for q in passes) / n)),
+        tcp_max_mm=max(q.tcp_max_mm for q in passes),
+        weld_time_s=sum(q.weld_time_s for q in passes),
+        length_mm=sum(q.length_mm for q in passes),
+        speed_mm_s=passes[0].speed_mm_s,
+        samples=n,
     )

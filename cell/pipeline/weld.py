@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -22,8 +22,9 @@ from cell.types import SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
+    from cell.motion.procedures import NoProcedure, SeamProcedure
     from cell.types.execution import Execution
-    from cell.types.plan import WeldPlan
+    from cell.types.plan import SeamTask, Segment, WeldPlan
     from cell.types.trajectory import Trajectory
 
 
@@ -62,7 +63,15 @@ def plan_for(
     progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     plan = plan_welds(
-        arm.model, tasks, arm.q_home, process, obstacles, options=sc.motion.plan, rng=sc.rng("plan"), checker=checker
+        arm.model,
+        tasks,
+        arm.q_home,
+        process,
+        obstacles,
+        options=sc.motion.plan,
+        rng=sc.rng("plan"),
+        checker=checker,
+        procedures=seam_procedures(sc, det, tasks),
     )
     pre = ptp(arm.q_scan if q_start is None else q_start, arm.q_home, arm.model.limits, dt=0.001)
     problems = []
@@ -72,6 +81,19 @@ def plan_for(
     progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
     problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)]
     return plan, pre, tuple(problems)
+
+
+def seam_procedures(sc: Scenario, det: Detection, tasks: Sequence[SeamTask]) -> dict[str, SeamProcedure | NoProcedure]:
+    """The weld procedure of every task (the scenario's WPS table, or its one row from ``process:``): by the
+    joint type the aligned map gives, the position against gravity in R, the leg ``process.leg_mm`` (or
+    ``process.seam_leg_mm`` of the seam)."""
+    from cell.motion.procedures import joint_type, select_procedures
+
+    ss = det.scene.seam_scene if det.scene is not None else None
+    kinds = {t.id: joint_type(ss.weldmap, ss.joints[t.id]) for t in tasks if ss and t.id in ss.joints}
+    legs = {t.id: sc.process.seam_leg_mm.get(t.id, sc.process.leg_mm) for t in tasks}
+    up_R = np.asarray(sc.X_WR[:3, :3]).T @ np.array([0.0, 0.0, 1.0])  # against gravity (W's z) in R
+    return select_procedures(tasks, kinds, legs, sc.weld_procedures(), up_R)
 
 
 def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = quiet) -> Execution:
@@ -111,9 +133,13 @@ def _seam_welds(
 ) -> tuple[SeamWeld, ...]:
     """Per seam: welded (with its quality against the true seam) or the reason it was not. gated : the weld gate
     applied (not a preview): a found seam too uncertain to weld is ``low_confidence``."""
-    from cell.motion.quality import weld_quality
+    from cell.motion.plan import seam_tasks
+    from cell.motion.quality import combined, weld_quality
 
     X_RW = invert(det.scenario.X_WR)
+    ss = det.scene.seam_scene if det.scene is not None else None
+    found = [e for e in det.estimates if e.status is SeamStatus.FOUND]
+    tasks = {t.id: t for t in seam_tasks(found, ss.weldmap, ss.joints, ss.table_z)} if ss is not None else {}
     out = []
     for est in det.estimates:
         if est.status is SeamStatus.NOT_VISIBLE:
@@ -138,14 +164,33 @@ def _seam_welds(
             code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
             out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note, code=code))
             continue
-        seg = next(g for g in plan.segments if g.arc_on and g.seam_id == est.id)
-        t0, t1 = pre_s + seg.t0, pre_s + seg.t1
-        k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
-        tcp_R = transform_points(X_RW, ex.tcp_W[k])
+        welds = [g for g in plan.segments if g.arc_on and g.seam_id == est.id]
         truth = det.truths.get(est.id)  # none on a station that knows no truth: welded, quality unmeasured
-        quality = weld_quality(ex.times[k], tcp_R, *truth) if truth is not None else None
-        out.append(SeamWeld(est.id, True, True, "", quality))
+        passes = []
+        for seg in welds:
+            if truth is None:
+                break
+            t0, t1 = pre_s + seg.t0, pre_s + seg.t1
+            k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
+            tcp_R = transform_points(X_RW, ex.tcp_W[k])
+            offsets = _intended(tasks.get(est.id), outcome.reversed, seg, tcp_R)
+            passes.append(weld_quality(ex.times[k], tcp_R, truth[0], truth[1], offsets))
+        quality = combined(passes) if passes else None
+        out.append(SeamWeld(est.id, True, True, "", quality, procedure=welds[0].procedure, passes=tuple(passes)))
     return tuple(out)
+
+
+def _intended(task: SeamTask | None, reversed_: bool, seg: Segment, tcp_R: FloatArray) -> FloatArray | None:
+    """Where the plan meant each TCP record of a weld segment to lie off the seam (its pass's offset and the
+    weave), from the planned seam (None without a procedure or a task: on the seam line)."""
+    from cell.motion.weave import cross_section, intended_offsets
+
+    if seg.procedure is None or task is None:
+        return None
+    a, b = (task.p_end, task.p_start) if reversed_ else (task.p_start, task.p_end)
+    d = (b - a) / task.length
+    e_R, b_R = cross_section(d, task.n_a, task.n_b)
+    return intended_offsets(tcp_R, a, d, task.length, seg.procedure, seg.pass_index, e_R, b_R)
 
 
 def weld(

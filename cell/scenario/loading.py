@@ -15,6 +15,7 @@ from pydantic import BaseModel, ValidationError
 
 from cell.errors import ScenarioError
 from cell.scenario.model import Scenario
+from cell.scenario.procedure_specs import with_procedures_file
 
 REPO_ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO_DIR = REPO_ROOT / "scenarios"
@@ -127,6 +128,7 @@ def from_dict(data: Any, base_dir: Path, source: str = "<scenario>") -> Scenario
     """Validate a parsed YAML mapping into a :class:`Scenario`; paths inside resolve against ``base_dir``."""
     if not isinstance(data, dict):
         raise ScenarioError(f"{source}: a scenario must be a YAML mapping of keys, got {type(data).__name__}")
+    data = with_procedures_file(data, base_dir, source)
     try:
         scenario = Scenario.model_validate({**data, "base_dir": str(base_dir)})
     except ValidationError as err:

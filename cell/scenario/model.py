@@ -13,6 +13,7 @@ from cell.geometry import FloatArray
 from cell.scenario.base import Model
 from cell.scenario.cell_specs import CameraSpec, Deviation, MapSpec, RobotSpec, TableSpec
 from cell.scenario.locator_specs import LocatorSpec, OursLocatorSpec
+from cell.scenario.procedure_specs import ProcedureSpec, default_procedure
 from cell.scenario.run_specs import (
     ExportSpec,
     FaultsSpec,
@@ -22,6 +23,7 @@ from cell.scenario.run_specs import (
     RescanSpec,
     SimulationSpec,
 )
+from cell.types.procedure import WeldProcedure
 
 MAP_DIR = Path(__file__).resolve().parents[2] / "maps"  # the repository's welding maps
 
@@ -36,6 +38,9 @@ class Scenario(Model):
     table: TableSpec
     robot: RobotSpec = RobotSpec()
     process: ProcessSpec = ProcessSpec()
+    # The WPS table: the first row that fits a seam (joint, position, leg) welds it; none: one row from process.
+    procedures: tuple[ProcedureSpec, ...] = ()
+    procedures_file: str | None = None  # a YAML list of rows beside the scenario, read into procedures
     cameras: dict[str, CameraSpec]
     perception: PerceptionSpec
     locator: LocatorSpec = OursLocatorSpec()  # which locator runs (``method``) and its options
@@ -62,6 +67,22 @@ class Scenario(Model):
                 f"cameras: {', '.join(self.cameras)}"
             )
         return self
+
+    @field_validator("procedures")
+    @classmethod
+    def _procedure_names(cls, v: tuple[ProcedureSpec, ...]) -> tuple[ProcedureSpec, ...]:
+        names = [p.name for p in v]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ValueError(f"each procedure name once; {', '.join(twice)} given more than once")
+        return v
+
+    def weld_procedures(self) -> tuple[WeldProcedure, ...]:
+        """The WPS table as values (rows in order), or the one procedure made from ``process:``."""
+        pr = self.process
+        if not self.procedures:
+            return (default_procedure(pr.travel_speed_mm_s, pr.work_angle_deg, pr.travel_angle_deg),)
+        return tuple(p.to_procedure(pr.work_angle_deg, pr.travel_angle_deg) for p in self.procedures)
 
     @property
     def map_candidates(self) -> tuple[Path, ...]:

@@ -50,6 +50,8 @@ class ProcessSpec(Model):
     approach_mm: Annotated[float, Field(gt=0.0, le=500.0)] = 50.0  # back along the torch axis before the seam
     depart_mm: Annotated[float, Field(gt=0.0, le=500.0)] = 50.0  # back along the torch axis after the seam
     approach_speed_mm_s: Annotated[float, Field(gt=0.0, le=250.0)] = 250.0  # reduced speed, ISO 10218 (s. 7)
+    leg_mm: Annotated[float, Field(gt=0.0, le=30.0)] = 4.0  # the fillet leg a seam asks for: picks its WPS row
+    seam_leg_mm: dict[str, Annotated[float, Field(gt=0.0, le=30.0)]] = Field(default_factory=dict)  # per seam id
 
 
 class PerceptionSpec(Model):

@@ -78,6 +78,7 @@ class PlanReason(StrEnum):
     COLLISION = "collision"  # the torch or the arm collides at the seam, on the approach or the depart
     TRANSFER_COLLISION = "transfer_collision"  # no collision-free transfer move to or from the seam
     TIMING = "timing"  # a line cannot be timed within the joint limits (e.g. the weld at the travel speed)
+    NO_PROCEDURE = "no_procedure"  # no row of the WPS table fits the seam (joint type, position, leg)
 
 
 @dataclass(frozen=True)

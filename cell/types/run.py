@@ -14,6 +14,7 @@ from cell.geometry import FloatArray
 from cell.types.execution import WeldQuality
 from cell.types.map import MapSeam
 from cell.types.plan import SeamOutcome
+from cell.types.procedure import WeldProcedure
 from cell.types.rescan import SeamRescan
 from cell.types.seams import Joint, SeamEstimate, SeamMetrics
 
@@ -32,7 +33,9 @@ class WeldReason(enum.StrEnum):
 @dataclass(frozen=True)
 class SeamWeld:
     """What became of one seam in ``cell weld``: planned and welded, or why not (``code`` and the detail
-    ``reason``); how well (the executed TCP against the true seam, when the truth is known)."""
+    ``reason``); how well (the executed TCP against the true seam, when the truth is known: all passes together
+    in ``quality``, each pass's bead in ``passes``, in pass order); the weld ``procedure`` it got (None: the
+    plan used none)."""
 
     id: str
     planned: bool
@@ -40,6 +43,8 @@ class SeamWeld:
     reason: str = ""
     quality: WeldQuality | None = None
     code: WeldReason | None = None
+    procedure: WeldProcedure | None = None
+    passes: tuple[WeldQuality, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,98 @@
+"""A seam's weld procedure executed: its passes (each at its offset in the cross-section, weaving if the procedure
+weaves) solved along the seam like the weld line, and their motions in order (values in, values out).
+
+The torch search (:mod:`cell.motion.candidates`) picks how to hold the torch on the seam line (direction, spin,
+angles). :func:`solve_passes` keeps that candidate and solves every pass with it: the torch poses of the seam at
+knots fine enough for the weave (:func:`cell.motion.weave.knot_spacing`), moved by the pass's offsets and weave,
+then IK, approach, depart, singularity and collision checks exactly as for the seam line
+(:meth:`SeamSearch.solve_candidate`). A procedure of one pass at the root without a weave is the seam line
+itself: its solution is returned unchanged. :func:`pass_pieces` times the passes (each weld at its pass's travel
+speed, rest to rest: its own arc on and off) with a transfer between one pass's depart and the next's approach.
+
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from cell.errors import IKError
+from cell.motion.assembly import seam_pieces
+from cell.motion.candidates import SeamSearch, SeamSolution
+from cell.motion.failures import SeamFailure, unreachable
+from cell.motion.ik import solve_ik
+from cell.motion.plan_options import PlanOptions
+from cell.motion.robot import RobotModel
+from cell.motion.torch import WeldProcess, torch_poses
+from cell.motion.transfers import Piece, TransferFail, Transfers
+from cell.motion.weave import cross_section, knot_spacing, offset_poses, pass_speed
+from cell.types.procedure import WeldProcedure
+
+
+def is_plain(procedure: WeldProcedure) -> bool:
+    """One pass at the root without a weave: the weld is the seam line."""
+    p = procedure.passes
+    return not procedure.weave.active and len(p) == 1 and p[0].lateral_mm == 0.0 and p[0].lift_mm == 0.0
+
+
+def solve_passes(
+    search: SeamSearch, sol: SeamSolution, procedure: WeldProcedure
+) -> tuple[SeamSolution, ...] | SeamFailure:
+    """One solution per pass of ``procedure`` with the candidate of ``sol`` (the seam line solved), or the first
+    pass's failure (its text names the pass)."""
+    if is_plain(procedure):
+        return (sol,)
+    task, cand, pr = sol.task, sol.cand, search.process
+    a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
+    e_R, b_R = cross_section(b - a, task.n_a, task.n_b)
+    out: list[SeamSolution] = []
+    for k in range(len(procedure.passes)):
+        X_line = torch_poses(
+            a,
+            b,
+            task.n_a,
+            task.n_b,
+            pr,
+            spin=cand.spin,
+            work_offset=cand.work_offset,
+            travel_offset=cand.travel_offset,
+            spacing=knot_spacing(procedure, k, search.opt.spacing),
+        )
+        X = offset_poses(X_line, task.length, procedure, k, e_R, b_R)
+        seed = out[-1].q_weld[0] if out else sol.q_weld[0]
+        try:
+            q0 = solve_ik(search.robot, X[0], seed, options=search.opt.ik)
+        except IKError as exc:
+            return _named(unreachable(exc, X[0], 0.0, 0.0), k)
+        res = search.solve_candidate(task, cand, X, q0)
+        if isinstance(res, SeamFailure):
+            return _named(res, k)
+        out.append(res)
+    return tuple(out)
+
+
+def _named(fail: SeamFailure, k: int) -> SeamFailure:
+    return replace(fail, where=f"pass {k + 1}: {fail.where}")
+
+
+def pass_pieces(
+    robot: RobotModel,
+    process: WeldProcess,
+    options: PlanOptions,
+    transfers: Transfers,
+    passes: tuple[SeamSolution, ...],
+    procedure: WeldProcedure | None,
+) -> list[Piece] | TransferFail:
+    """Approach, weld and depart of every pass, timed, with a transfer (arc off) between passes; the travel speed
+    of each pass is its own or the procedure's (``process``'s without a procedure). Raises TimingError when a
+    weld cannot be timed; a TransferFail when no free move joins two passes."""
+    pieces: list[Piece] = []
+    for k, sol in enumerate(passes):
+        pr = process if procedure is None else replace(process, travel_speed=pass_speed(procedure, k))
+        if k:
+            moves = transfers.move(passes[k - 1].q_depart[-1], sol.q_approach[0])
+            if isinstance(moves, TransferFail):
+                return moves
+            pieces += moves
+        pieces += seam_pieces(robot, pr, options, sol)
+    return pieces

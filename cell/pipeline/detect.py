@@ -4,23 +4,20 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from typing import Literal
 
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
 from cell.perception.calibration import PoseUncertainty, with_calibration
+from cell.pipeline.evaluation import evaluate
+from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus, WeldMap
+from cell.types import Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
 
-Progress = Callable[[str], None]  # a stage's progress messages (the CLI prints them on stderr)
-
-
-def quiet(_: str) -> None:
-    return None
+__all__ = ["Progress", "build_scene", "capture", "detect", "evaluate", "locate", "quiet", "read_weldmap", "truths"]
 
 
 def read_weldmap(scenario: Scenario) -> WeldMap:
@@ -151,18 +148,6 @@ def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, Floa
         return {}
     design_W = cap.weldmap.transformed(cap.scenario.X_WM, "W")
     return true_seams(design_W, cap.joints, cap.parts_W, cap.scenario.X_WR)
-
-
-def evaluate(
-    estimates: Sequence[SeamEstimate], truth: Mapping[str, tuple[FloatArray, FloatArray]]
-) -> tuple[dict[str, SeamMetrics], MetricsSummary]:
-    """Per-seam metrics of the found seams and the summary (paper ME, endpoint, lateral, time); no metrics when the
-    station knows no truth (``truth`` empty)."""
-    from cell.seams.metrics import evaluate as metrics_of
-    from cell.seams.metrics import summarise
-
-    per_seam = metrics_of(estimates, truth) if truth else {}
-    return per_seam, summarise(estimates, per_seam)
 
 
 def detect(

@@ -71,9 +71,14 @@ def _emit(t: Table, columns: Sequence[str], rows: Sequence[Sequence[str]], fmt: 
     return False
 
 
+def _frame(rep: dict) -> str:
+    """The frame every point of a report is in (R for a scenario run, the cloud's own for cell locate)."""
+    return str(rep.get("frame", "R"))
+
+
 def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
     t = Table(
-        title=f"{title} {rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
+        title=f"{title} {rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame {_frame(rep)}",
         title_justify="left",
     )
     columns = (
@@ -138,7 +143,7 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
 
     rep = det if isinstance(det, dict) else detection_report(det)
     t = Table(
-        title=f"{rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame R",
+        title=f"{rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame {_frame(rep)}",
         title_justify="left",
     )
     columns = ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason")

@@ -7,7 +7,8 @@ table by :mod:`cell.perception.unorganised`):
 
 - the map-to-cloud ICP's largest correspondence: 20 mm, or 20 noise sigma when that is more, so its three stages
   (1, 1/4, 1/10 of it) keep the finest above 2 noise sigma and the fitness band (the middle stage) above 5;
-- our locator: told the measured noise (``sensor_sigma_m``); reads every point (``sample_share`` 1: a line
+- our locator: told the measured noise (``sensor_sigma_m``); looks at a tube about the seam that holds
+  :data:`TUBE_LINES` scan lines across; reads every point (``sample_share`` 1: a line
   scanner's cloud is sparse); a face is seen with the points of 30 mm^2 of it at the cloud's density
   (:func:`min_face_points`); a weld face must be seen (``min_edge_points`` out of reach: placing an unseen face
   from an edge needs a depth camera's per-pixel density, and a shadowed face is not a face); the sigma floor is
@@ -38,6 +39,10 @@ FLOOR_SPACING_SHARE = 1.0 / math.sqrt(12.0)  # RMS of a uniform position within 
 # open at its ends, and its top shows only its rim (the scans' vertical tube: 37-46 % of its top within 1 cm).
 MIN_SEEN = 0.3
 NO_EDGES = 10**9  # min_edge_points that no edge reaches: a weld face must be seen
+# The locator's tube about the seam holds this many scan lines across (within 60..150 mm): 60 mm (the default, for
+# a depth camera's 1-2 mm pitch) held 14-30 points of the scans' grazing wall (x0y24), its seam found or refused by a
+# hair as the placement moved by 1 cm; 100 mm (28 lines of 3.6 mm) finds it from every placement tried.
+TUBE_LINES = 28.0
 MIN_FACE_AREA_M2 = 30e-6  # a weld face is seen with the points of 30 mm^2 of it (the default 30 at a 1 mm pitch)
 
 
@@ -62,7 +67,9 @@ def ours_overrides(noise_m: float, along_m: float, between_m: float) -> dict[str
     """Our locator's options for a cloud of this noise and point spacing along / between lines [m] (module
     docstring)."""
     floor = float(sigma_floor(noise_m, between_m))
+    tube = min(0.15, max(0.06, TUBE_LINES * between_m)) if math.isfinite(between_m) else 0.06
     return {
+        "tube_radius_m": float(tube),
         "sensor_sigma_m": float(max(noise_m, 2e-4)),
         "min_face_points": min_face_points(along_m, between_m),
         "sample_share": 1.0,

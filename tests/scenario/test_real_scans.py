@@ -34,12 +34,24 @@ def bench() -> ModuleType:
     return module
 
 
-@pytest.mark.parametrize("stem", ["x0y24", "x4y24_45", "longclamps_x4y24_45"])
-def test_the_seen_fillet_is_found_within_its_sigma_and_the_hidden_one_is_not(bench: Any, stem: str) -> None:
+@pytest.mark.parametrize(
+    ("stem", "offset"),
+    [
+        ("x0y24", (0.0, 0.0, 0.0)),
+        ("x0y24", (-10.0, 0.0, -1.0)),  # 1 cm and 1 deg further off (the sparse wall's seam was once lost so)
+        ("x4y24_45", (0.0, 0.0, 0.0)),
+        ("longclamps_x4y24_45", (0.0, 0.0, 0.0)),
+    ],
+)
+def test_the_seen_fillet_is_found_within_its_sigma_and_the_hidden_one_is_not(
+    bench: Any, stem: str, offset: tuple[float, float, float]
+) -> None:
     file, origin, yaw, seen = bench.SCANS[stem]
     cloud = bench.read_scan(bench.scans_dir() / file)
     X_FM = bench.nominal(origin, yaw)
-    det = locate_cloud(cloud, read_map(bench.MAP), X_FM, name=stem)
+    dx, dy, dyaw = offset
+    X_place = bench.nominal((origin[0] + dx, origin[1] + dy, origin[2]), yaw + dyaw)
+    det = locate_cloud(cloud, read_map(bench.MAP), X_place, name=stem)
     assert det.error is None
     est = {e.id: e for e in det.estimates}
     e = est[seen]
@@ -48,11 +60,11 @@ def test_the_seen_fillet_is_found_within_its_sigma_and_the_hidden_one_is_not(ben
     assert 1.2e-3 < e.sigma_m < 2.2e-3
     line = bench.independent_line(np.asarray(cloud.points), X_FM, 1.0 if seen.endswith("+x") else -1.0)
     lateral_mm = bench.lateral_mm(np.vstack([e.p_start, e.p_end]), line["p0"], line["t"])
-    assert lateral_mm < 2.0 * e.sigma_m * 1e3  # measured 0.9-1.5 mm
+    assert lateral_mm < 2.0 * e.sigma_m * 1e3  # measured 0.83-1.36 mm
     assert 45e-3 < float(np.linalg.norm(e.p_end - e.p_start)) < 56e-3  # the 50.8 mm wall
     (hidden,) = (k for k in est if k != seen)
     assert est[hidden].status in (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
     assert est[hidden].reason
-    # The located seam stays within 1 mm of the drawing as the alignment placed it (measured 0.05-0.24 mm).
+    # The located seam stays within 1 mm of the drawing as the alignment placed it (measured 0.12-0.36 mm).
     cad = det.weldmap_R.seam(seen)
     assert bench.lateral_mm(np.vstack([e.p_start, e.p_end]), cad.p_start, cad.direction) < 1.0

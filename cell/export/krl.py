@@ -1,30 +1,28 @@
 """KUKA KRL export of a welding plan (docs/reference.md section 5): ``NAME.src`` and ``NAME.dat``.
 
-What the program does, in order: ``BAS(#INITMOV, 0)``; ``$TOOL``, ``$BASE`` and ``$LOAD`` set explicitly; the
-first motion is a fully defined ``PTP`` to the home configuration (an E6AXIS with all axes: block coincidence);
-then per seam: PTP transfer(s), ``LIN`` approach at the reduced speed ending in an exact stop at the weld
-start, the arc-on marker, ``LIN`` weld at the travel speed (``$VEL.CP`` in m/s), the arc-off marker at the exact
-stop at the weld end, ``LIN`` depart; finally ``PTP`` home. No motion is approximated (no ``C_PTP``/``C_DIS``):
-every point is an exact stop, so the controller path is the planned one up to its own timing.
+The program, in order: a header (what made it: scenario, version, commit, date), a setup block with the values
+to enter before the first run (TOOL_DATA / LOAD_DATA / BASE_DATA [n], XHOME in $config.dat, each weld's
+procedure), the standard INI fold (the stop-message interrupt, ``BAS(#INITMOV, 0)``), ``BAS(#TOOL, n)`` and
+``BAS(#BASE, n)``, a guard that $config.dat's XHOME is the planned home, ``$H_POS = XHOME`` and ``PTP XHOME``
+(the first motion: fully defined, block coincidence); then per seam (its id in a comment at its block): PTP
+transfer(s) to E6AXIS points, the LIN approach ending at an exact stop at the weld start, the LIN weld(s), the LIN
+depart; finally ``PTP XHOME``. No motion is approximated: every point is an exact stop.
 
-Conventions: units mm and degrees; A, B, C are rotations about Z, Y, X (``R = Rz(A) Ry(B) Rx(C)``, the
-``matrix_to_rpy`` yaw/pitch/roll). Cartesian points are poses of the tool in the robot base frame R, which
-is KUKA's $ROBROOT; ``$BASE = $NULLFRAME`` then assumes ``$ROBROOT = $WORLD`` (the default machine data; the
-cell's X_WR is written as a comment). The tool frame follows KUKA's default tool direction #X: its x axis is
-the wire (the ``torch_tcp`` z axis), so ``$TOOL`` = pose of ``torch_tcp`` turned by -90 deg about y, in the
-flange frame (``tool0`` = $FLANGE). S and T (status, turn) are not written: LIN motions ignore them and every
-PTP goes to an axis-specific E6AXIS point.
+The arc (``KrlOptions.arc``): ``arctech`` writes KUKA.ArcTech's inline forms: ARC_ON on the approach (ignition
+at its end), ARC_SWI on every weld motion followed by another one of the same burning arc (its data set holds
+the next motion's procedure: a pass or data change), ARC_OFF on the last weld motion (crater at its end), each
+with its weld data set (``WDATn``, :mod:`cell.export.krl_data`). ``signals`` switches a power source without
+ArcTech: ``$OUT[n]`` on, ``WAIT FOR $IN[m]`` (arc established) with a timeout and an error branch that switches
+the arc off and halts, the crater as a wait, ``$OUT[n]`` off.
 
-Arc markers are plain by default: comment lines ``;ARC_ON seam <id>`` / ``;ARC_OFF seam <id>`` that an
-integrator replaces with the ArcTech commands of the controller's version (those dialects are
-version-specific); ``arc_markers="call"`` writes plain subroutine calls ``WELD_ARC_ON( )`` / ``WELD_ARC_OFF( )``
-instead, which the cell's own KRL library must then provide.
+Points: every LIN point is an E6POS of the tool in the part's base (BASE_DATA[n] = the aligned map's pose, so a
+touch-up of that one base moves every seam), with S and T from the planned joint configuration
+(:mod:`cell.export.status_turn`); every PTP point an E6AXIS. The tool frame follows KUKA's default tool direction
+#X: its x axis is the wire (the ``torch_tcp`` z axis).
 """
 
 from __future__ import annotations
 
-import math
-import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -33,36 +31,240 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.config.export import KrlOptions
-from cell.export.atomic import write_atomic
-from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
+from cell.export.krl_data import X_TOOL, arc_data, e6axis, e6pos, frame_text, num, procedure_line
+from cell.export.program import ProgramJob, procedure_of, write_texts
+from cell.export.status_turn import ArmGeometry, status_turn
+from cell.geometry import invert, make_pose
 from cell.provenance import header_lines
-from cell.types.plan import WeldPlan
+from cell.types.plan import Segment, WeldPlan
 from cell.types.robot import Kinematics
 
-_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,23}")
-_X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (x along the wire)
+HOME_TOL_DEG = 0.5  # the guard's tolerance between $config.dat's XHOME and the planned home
+_ARC = {
+    "on": ("ARCON", "arconlin", "ArcOn"),
+    "swi": ("ARCSWI", "arcswilin", "ArcSwi"),
+    "off": ("ARCOFF", "arcofflin", "ArcOff"),
+}
 
 
-def _f(v: float) -> str:
-    s = f"{v:.3f}"
-    return "0.000" if s == "-0.000" else s
+class _Program:
+    """The two files' lines as they are built."""
+
+    def __init__(self, job: ProgramJob) -> None:
+        self.job, self.opt = job, job.options
+        self.src: list[str] = []
+        self.dat: list[str] = [f"DEFDAT {job.name} PUBLIC"]
+        self.n = 0  # points
+        self.w = 0  # weld data sets
+        self.geo = ArmGeometry.of(job.robot)
+        self.X_BR = invert(job.X_RB)
+        self.last_vel = -1.0
+
+    def point(self, seg: Segment) -> str:
+        """Declare the segment's end as the next point (E6POS in the base for a LIN, E6AXIS for a PTP); its name."""
+        self.n += 1
+        name = f"XP{self.n}"
+        q = seg.trajectory.q[-1]
+        if seg.kind == "move":
+            self.dat.append(f"DECL E6AXIS {name}={e6axis(q)}")
+        else:
+            s, t = status_turn(self.job.robot, q, self.geo)
+            self.dat.append(f"DECL E6POS {name}={e6pos(self.X_BR @ np.asarray(seg.X_end) @ X_TOOL, s, t)}")
+        return name
+
+    def plain_lin(self, seg: Segment, note: str) -> None:
+        if abs(seg.speed - self.last_vel) > 1e-9:
+            self.src.append(f"$VEL.CP = {seg.speed:.4f} ; [m/s] {seg.speed * 1000:.1f} mm/s")
+            self.last_vel = seg.speed
+        self.src.append(f"LIN {self.point(seg)} ; {note}")
+
+    def arc_fold(self, kind: str, seg: Segment, data_of: Segment) -> None:
+        """One ArcTech inline form: ``kind`` on | swi | off, the motion to the end of ``seg``, the weld data of
+        ``data_of``'s procedure."""
+        fold, provider, step = _ARC[kind]
+        p = procedure_of(data_of)
+        self.w += 1
+        wdat = f"WDAT{self.w}"
+        self.dat.append(arc_data(wdat, kind, p, self.opt.job_mode, self.opt.param_set))
+        xp = self.point(seg)
+        pname = xp[1:]
+        motion = "PTP" if seg.kind == "move" else "LIN"
+        ti, bi = self.opt.tool_index, self.opt.base_index
+        vel = f"{seg.speed:.4f}" if kind == "on" else "gArcBasVelDefinition"
+        self.dat += [
+            f'DECL FDAT F{pname}={{TOOL_NO {ti},BASE_NO {bi},IPO_FRAME #BASE,POINT2[] " "}}',
+            f"DECL LDAT LCPDAT{self.n}={{VEL {num(max(seg.speed, 1e-4), 4)},ACC 100.0,APO_DIST 100.0,APO_FAC 50.0,"
+            "AXIS_VEL 100.0,AXIS_ACC 100.0,ORI_TYP #VAR,CIRC_TYP #BASE,JERK_FAC 50.0,GEAR_JERK 100.0,EXAX_IGN 0}",
+            f'DECL stArcDat_T W{pname}={{WdatId[] "W{pname}"}}',
+        ]
+        args = f"{wdat}, W{pname}"
+        self.src += [
+            f";FOLD {fold} {wdat} {motion} {pname} CPDAT{self.n} Tool[{ti}] Base[{bi}] ;%{{PE}} seam {seg.seam_id}",
+            ";FOLD Parameters ;%{h}",
+            f";Params IlfProvider=kukaroboter.arctech.{provider}; Kuka.IsGlobalPoint=False; Kuka.PointName={pname};"
+            f" Kuka.BlendingEnabled=False; Kuka.MoveDataName=CPDAT{self.n}; Kuka.VelocityPath={num(seg.speed, 4)};"
+            f" Kuka.CurrentCDSetIndex=0; Kuka.MovementParameterFieldEnabled=True; ArcTech.WdatVarName={wdat}",
+            ";ENDFOLD",
+            "$BWDSTART = FALSE",
+            f"LDAT_ACT = LCPDAT{self.n}",
+            f"FDAT_ACT = F{pname}",
+            f"BAS(#CP_PARAMS, {vel})",
+            "SET_CD_PARAMS (0)",
+        ]
+        if kind == "on":
+            self.src += [
+                f"TRIGGER WHEN DISTANCE = 1 DELAY = ArcGetDelay(#PreDefinition, {wdat}) DO"
+                f" ArcMainNG(#PreDefinition, {args}) PRIO = -1",
+                f"TRIGGER WHEN PATH = ArcGetPath(#OnTheFlyArcOn, {wdat}) DELAY = ArcGetDelay(#GasPreflow, {wdat}) DO"
+                f" ArcMainNG(#GasPreflow, {args}) PRIO = -1",
+                f"TRIGGER WHEN PATH = ArcGetPath(#OnTheFlyArcOn, {wdat}) DELAY = 0 DO ArcMainNG(#ArcOnMoveStd,"
+                f" {args}) PRIO = -1",
+            ]
+        elif kind == "swi":
+            self.src.append(f"TRIGGER WHEN DISTANCE = 1 DELAY = 0 DO ArcMainNG(#ArcSwiMoveStd, {args}) PRIO = -1")
+        else:
+            self.src += [
+                f"TRIGGER WHEN PATH = ArcGetPath(#ArcOffBefore, {wdat}) DELAY = 0 DO"
+                f" ArcMainNG(#ArcOffBeforeOffStd, {args}) PRIO = -1",
+                f"TRIGGER WHEN PATH = ArcGetPath(#OnTheFlyArcOff, {wdat}) DELAY = 0 DO ArcMainNG(#ArcOffMoveStd,"
+                f" {args}) PRIO = -1",
+            ]
+        self.src += [
+            f"ArcMainNG(#{step}BeforeMoveStd, {args})",
+            f"{motion} {xp}",
+            f"ArcMainNG(#{step}AfterMoveStd, {args})",
+            ";ENDFOLD",
+        ]
+        self.last_vel = -1.0  # the inline form set the path velocity itself
+
+    def signal_on(self, seg: Segment, p_seg: Segment) -> None:
+        """Plain I/O: the arc on at the weld start, the wait for the arc with its timeout and error branch."""
+        o, i, ms = self.opt.arc_on_output, self.opt.arc_ok_input, round(self.opt.arc_timeout_s * 1000.0)
+        p = procedure_of(p_seg)
+        self.src += [
+            f";- arc on, seam {seg.seam_id}: set the power source to {p.name} (setup block)",
+            f"$OUT[{o}] = TRUE",
+            "$TIMER_STOP[1] = TRUE",
+            f"$TIMER[1] = -{ms}",
+            "$TIMER_STOP[1] = FALSE",
+            f"WAIT FOR $IN[{i}] OR $TIMER_FLAG[1]",
+            "$TIMER_STOP[1] = TRUE",
+            f"IF NOT $IN[{i}] THEN",
+            f"  $OUT[{o}] = FALSE",
+            f"  HALT ; no arc within {self.opt.arc_timeout_s:g} s at the start of seam {seg.seam_id}: arc off, stopped",
+            "ENDIF",
+        ]
+        if p.crater_start_s > 0.0:
+            self.src.append(f"WAIT SEC {num(p.crater_start_s)} ; hot start at rest")
+
+    def signal_off(self, seg: Segment) -> None:
+        p = procedure_of(seg)
+        if p.crater_end_s > 0.0:
+            self.src.append(f"WAIT SEC {num(p.crater_end_s)} ; crater fill at rest")
+        self.src.append(f"$OUT[{self.opt.arc_on_output}] = FALSE ; arc off, seam {seg.seam_id}")
 
 
-def frame_text(X: npt.ArrayLike) -> str:
-    """``{X .., Y .., Z .., A .., B .., C ..}`` of a pose (4, 4) [m] in mm and degrees."""
-    X = np.asarray(X, dtype=float)
-    roll, pitch, yaw = np.degrees(matrix_to_rpy(X[:3, :3]))
-    x, y, z = X[:3, 3] * 1000.0
-    return f"{{X {_f(x)}, Y {_f(y)}, Z {_f(z)}, A {_f(yaw)}, B {_f(pitch)}, C {_f(roll)}}}"
+def _setup_block(job: ProgramJob, plan_segments: tuple[Segment, ...]) -> list[str]:
+    opt = job.options
+    q_any = job.plan.segments[0].trajectory.q[0]
+    X_FT = invert(job.robot.fk(q_any, "tool0")) @ job.robot.fk(q_any, "torch_tcp") @ X_TOOL
+    cm = frame_text(make_pose(p=np.asarray(opt.load_cm_mm) / 1000.0))
+    lines = [
+        ";FOLD SETUP: the values to enter before the first run",
+        f";- TOOL_DATA[{opt.tool_index}] = {frame_text(X_FT)} ; torch TCP in $FLANGE, tool direction #X = the wire",
+        f";- LOAD_DATA[{opt.tool_index}] = {{M {opt.load_kg:.3f}, CM {cm}, J {{X 0.0, Y 0.0, Z 0.0}}}}",
+        f";- BASE_DATA[{opt.base_index}] = {frame_text(job.X_RB)} ; the part (aligned map) in $WORLD = $ROBROOT",
+        f";- XHOME = {e6axis(job.plan.q_home)} ; in $config.dat; the program sets $H_POS = XHOME",
+    ]
+    if job.X_WR is not None:
+        lines.append(f";- robot mounting in the cell (X_WR, information only) = {frame_text(job.X_WR)}")
+    if opt.arc == "signals":
+        lines.append(
+            f";- arc: $OUT[{opt.arc_on_output}] on/off, $IN[{opt.arc_ok_input}] arc established (timeout"
+            f" {opt.arc_timeout_s:g} s)"
+        )
+    seen: set[tuple[str, int]] = set()
+    for seg in plan_segments:
+        if seg.kind == "weld":
+            p = procedure_of(seg)
+            if (p.name, seg.pass_index) not in seen:
+                seen.add((p.name, seg.pass_index))
+                lines.append(f";- {procedure_line(p, seg.pass_index)}")
+    return [*lines, ";ENDFOLD"]
 
 
-def _e6pos(X: FloatArray) -> str:
-    return frame_text(X)[:-1] + ", E1 0.0, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}"
+def krl_texts(job: ProgramJob) -> tuple[str, str]:
+    """(src, dat) texts of the job's program (module docstring)."""
+    opt, plan = job.options, job.plan
+    b = _Program(job)
+    made_by = header_lines(job.provenance) if job.provenance is not None else []
+    b.src += [
+        "&ACCESS RVP",
+        "&REL 1",
+        f"DEF {job.name}( )",
+        ";- Generated by the weld cell (cell.export.krl)"
+        " from a WeldPlan that passed the safety gate; units mm, deg; A, B, C = rotations about Z, Y, X.",
+        *made_by,
+        *_setup_block(job, plan.segments),
+    ]
+    b.dat[1:1] = made_by
+    b.dat.append(f"DECL E6AXIS XHOME_PLAN={e6axis(plan.q_home)} ; the planned home (XHOME must equal it)")
+    far = " OR ".join(f"(ABS(XHOME.A{i} - XHOME_PLAN.A{i}) > {HOME_TOL_DEG})" for i in range(1, 7))
+    b.src += [
+        ";FOLD INI", ";FOLD BASISTECH INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
+        "INTERRUPT ON 3", "BAS(#INITMOV, 0)", ";ENDFOLD (BASISTECH INI)", ";FOLD USER INI", ";ENDFOLD (USER INI)",
+        ";ENDFOLD (INI)", "",
+        f"BAS(#TOOL, {opt.tool_index})", f"BAS(#BASE, {opt.base_index})",
+        f"BAS(#VEL_PTP, {opt.ptp_percent})", f"BAS(#ACC_PTP, {opt.ptp_percent})",
+        f"IF {far} THEN",
+        "  HALT ; $config.dat's XHOME is not the planned home XHOME_PLAN (setup block): correct it first",
+        "ENDIF",
+        "$H_POS = XHOME",
+        "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
+    ]  # fmt: skip
+    segs = plan.segments
+    current = ""
+    for k, seg in enumerate(segs):
+        nxt = segs[k + 1] if k + 1 < len(segs) else None
+        if seg.seam_id and seg.seam_id != current:
+            current = seg.seam_id
+            b.src += ["", f";- seam {current}"]
+        arc_next = nxt is not None and nxt.kind == "weld"
+        if seg.kind == "weld":
+            if opt.arc == "arctech":
+                b.arc_fold("swi" if arc_next and nxt is not None else "off", seg, nxt if arc_next and nxt else seg)
+                continue
+            b.plain_lin(seg, f"weld, seam {seg.seam_id}")
+            if nxt is not None and arc_next:
+                b.src.append(f";- {procedure_line(procedure_of(nxt), nxt.pass_index)} (set on the power source)")
+            else:
+                b.signal_off(seg)
+            continue
+        if seg.kind == "move" and nxt is None and np.allclose(seg.trajectory.q[-1], plan.q_home, atol=1e-9):
+            b.src += ["", "PTP XHOME ; back home"]
+            continue
+        if arc_next and nxt is not None and opt.arc == "arctech":
+            b.arc_fold("on", seg, nxt)
+            continue
+        if seg.kind == "move":
+            b.src.append(f"PTP {b.point(seg)} ; transfer")
+        else:
+            b.plain_lin(seg, "approach, exact stop at the weld start" if arc_next else seg.kind)
+        if arc_next and nxt is not None:
+            b.signal_on(nxt, nxt)
+    b.src += ["END", ""]
+    b.dat += ["ENDDAT", ""]
+    return "\n".join(b.src), "\n".join(b.dat)
 
 
-def _e6axis(q: FloatArray) -> str:
-    a = ", ".join(f"A{i + 1} {_f(v)}" for i, v in enumerate(np.degrees(q)))
-    return f"{{{a}, E1 0.0, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+class KrlPost:
+    """The KUKA KRL post-processor (:class:`~cell.export.program.PostProcessor`): ``NAME.src`` and ``NAME.dat``."""
+
+    name = "krl"
+
+    def texts(self, job: ProgramJob) -> dict[str, str]:
+        src, dat = krl_texts(job)
+        return {f"{job.name}.src": src, f"{job.name}.dat": dat}
 
 
 def krl_program(
@@ -70,95 +272,23 @@ def krl_program(
     robot: Kinematics,
     name: str,
     *,
+    X_RB: npt.ArrayLike | None = None,
     X_WR: npt.ArrayLike | None = None,
     options: KrlOptions | None = None,
     provenance: Mapping[str, Any] | None = None,
 ) -> tuple[str, str]:
-    """(src, dat) texts of the program ``name`` (a KRL name: a letter or _, then letters, digits, _; at most 24).
+    """(src, dat) texts of the program ``name`` for ``plan`` (:class:`~cell.types.plan.WeldPlan`).
 
+    X_RB : (4, 4) the part's base in R (default: the identity, the base is $ROBROOT).
     X_WR : (4, 4) the robot's mounting in the cell's world, only written as a comment.
-    provenance : what made the program (:func:`cell.provenance.provenance`): comment lines in both headers.
     Raises ValueError for an invalid name or a plan without motion.
     """
-    if not _NAME.fullmatch(name):
-        raise ValueError(
-            f"KRL program name {name!r} is invalid: 1-24 characters, a letter or _ first, then letters, digits, _"
-        )
-    if not plan.segments:
-        raise ValueError("the plan has no motion: nothing to export")
-    opt = options or KrlOptions()
-    name = name.upper()
-    q_any = plan.segments[0].trajectory.q[0]
-    X_FT = invert(robot.fk(q_any, "tool0")) @ robot.fk(q_any, "torch_tcp") @ _X_TOOL
-    src = [
-        "&ACCESS RVP",
-        "&REL 1",
-        f"DEF {name}( )",
-        ";- Generated by the weld cell (cell.export.krl) from a WeldPlan that passed the safety gate.",
-        ";- Units mm, deg; A, B, C = rotations about Z, Y, X. Points: tool in the robot base frame ($ROBROOT).",
-        ";- $BASE = $NULLFRAME assumes $ROBROOT = $WORLD (default machine data).",
-    ]
-    made_by = header_lines(provenance) if provenance is not None else []
-    src += made_by
-    if X_WR is not None:
-        src.append(f";- Robot mounting in the cell (X_WR): {frame_text(X_WR)}")
-    src.append(
-        ";- ARC_ON / ARC_OFF: "
-        + (
-            "comment markers, replace with the controller's ArcTech commands."
-            if opt.arc_markers == "comment"
-            else "plain calls WELD_ARC_ON( ) / WELD_ARC_OFF( ), to be provided."
-        )
-    )
-    cm = make_pose(p=np.asarray(opt.load_cm_mm) / 1000.0)
-    src += [
-        "",
-        "BAS(#INITMOV, 0)",
-        f"$TOOL = {frame_text(X_FT)}",
-        "$BASE = $NULLFRAME",
-        f"$LOAD = {{M {opt.load_kg:.3f}, CF {frame_text(cm)}, J {{X 0.0, Y 0.0, Z 0.0}}}}",
-        f"BAS(#VEL_PTP, {opt.ptp_percent})",
-        f"BAS(#ACC_PTP, {opt.ptp_percent})",
-        "",
-        "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
-    ]
-    dat = [f"DEFDAT {name} PUBLIC", *made_by, f"DECL E6AXIS XHOME={_e6axis(plan.q_home)}"]
-    n = 0
-    last_speed = -1.0
-    current = ""
-    for k, seg in enumerate(plan.segments):
-        if seg.seam_id != current and seg.seam_id:
-            current = seg.seam_id
-            src += ["", f";- seam {current}"]
-        if seg.kind == "move":
-            if seg is plan.segments[-1] and np.allclose(seg.trajectory.q[-1], plan.q_home, atol=1e-9):
-                src += ["", "PTP XHOME ; back home"]
-                continue
-            n += 1
-            dat.append(f"DECL E6AXIS XP{n}={_e6axis(seg.trajectory.q[-1])}")
-            src.append(f"PTP XP{n}")
-            continue
-        if abs(seg.speed - last_speed) > 1e-9:
-            src.append(f"$VEL.CP = {seg.speed:.4f} ; [m/s] {seg.speed * 1000:.1f} mm/s")
-            last_speed = seg.speed
-        if seg.kind == "weld":
-            src.append(_marker("ON", seg.seam_id, opt))
-        n += 1
-        dat.append(f"DECL E6POS XP{n}={_e6pos(np.asarray(seg.X_end) @ _X_TOOL)}")
-        before_weld = k + 1 < len(plan.segments) and plan.segments[k + 1].kind == "weld"
-        note = "approach, exact stop at the weld start" if before_weld else seg.kind
-        src.append(f"LIN XP{n} ; {note}")
-        if seg.kind == "weld":
-            src.append(_marker("OFF", seg.seam_id, opt))
-    src += ["END", ""]
-    dat += ["ENDDAT", ""]
-    return "\n".join(src), "\n".join(dat)
-
-
-def _marker(which: str, seam_id: str, opt: KrlOptions) -> str:
-    if opt.arc_markers == "call":
-        return f"WELD_ARC_{which}( ) ; seam {seam_id}"
-    return f";ARC_{which} seam {seam_id}"
+    job = ProgramJob(
+        plan, robot, name, X_RB=np.eye(4) if X_RB is None else np.asarray(X_RB, dtype=float),
+        X_WR=None if X_WR is None else np.asarray(X_WR, dtype=float), options=options or KrlOptions(),
+        provenance=provenance,
+    )  # fmt: skip
+    return krl_texts(job)
 
 
 def write_krl(
@@ -167,15 +297,14 @@ def write_krl(
     directory: str | Path,
     name: str,
     *,
+    X_RB: npt.ArrayLike | None = None,
     X_WR: npt.ArrayLike | None = None,
     options: KrlOptions | None = None,
     provenance: Mapping[str, Any] | None = None,
 ) -> tuple[Path, Path]:
-    """Write ``NAME.src`` and ``NAME.dat`` (upper-case name, CRLF line ends as on the controller, each file
-    atomically); their paths. OutputError when a file cannot be written."""
-    src, dat = krl_program(plan, robot, name, X_WR=X_WR, options=options, provenance=provenance)
-    d = Path(directory)
-    paths = (d / f"{name.upper()}.src", d / f"{name.upper()}.dat")
-    for path, text in zip(paths, (src, dat), strict=True):
-        write_atomic(path, text.replace("\n", "\r\n").encode("ascii", errors="replace"), what="robot program")
-    return paths
+    """Write ``NAME.src`` and ``NAME.dat`` (upper-case name, CRLF line ends, each file atomically); their paths.
+    OutputError when a file cannot be written."""
+    src, dat = krl_program(plan, robot, name, X_RB=X_RB, X_WR=X_WR, options=options, provenance=provenance)
+    up = name.upper()
+    paths = write_texts({f"{up}.src": src, f"{up}.dat": dat}, directory)
+    return paths[0], paths[1]

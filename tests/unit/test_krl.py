@@ -1,4 +1,5 @@
-"""KUKA KRL export (structure a controller needs) and the joint trajectory JSON/CSV export."""
+"""KUKA KRL export (structure a controller needs: INI fold, TOOL/BASE by index, ArcTech's arc statements with
+their weld data, S and T), the plain-signal arc mode, and the joint trajectory JSON/CSV export."""
 
 from __future__ import annotations
 
@@ -13,8 +14,9 @@ import pytest
 
 from cell import scenario as sc
 from cell.export.krl import KrlOptions, krl_program, write_krl
+from cell.export.status_turn import status_turn
 from cell.export.trajectory import write_csv, write_json
-from cell.geometry import make_pose, rpy_to_matrix
+from cell.geometry import make_pose, rot_z, rpy_to_matrix
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds
 from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess
@@ -75,9 +77,11 @@ def test_files_have_matching_names_and_blocks(robot: RobotModel, plan: WeldPlan,
     assert lines[-1] == "END"
     dlines = [ln.strip() for ln in dat.splitlines() if ln.strip()]
     assert dlines[0] == f"DEFDAT {dat_path.stem} PUBLIC" and dlines[-1] == "ENDDAT"
-    # every point used in the program is declared, and every declared point is used
+    # every point used in the program is declared, and every declared point is used; XHOME is $config.dat's,
+    # XHOME_PLAN the planned home the program compares it with
     used = set(re.findall(r"^(?:PTP|LIN) (\w+)", "\n".join(lines), flags=re.M))
-    assert used == set(_points(dat))
+    assert used - {"XHOME"} | {"XHOME_PLAN"} == set(_points(dat))
+    assert "XHOME" in used and "XHOME_PLAN." in src
 
 
 def test_initialisation_precedes_a_fully_defined_first_ptp(robot: RobotModel, plan: WeldPlan) -> None:
@@ -87,64 +91,122 @@ def test_initialisation_precedes_a_fully_defined_first_ptp(robot: RobotModel, pl
     motions = [i for i, ln in enumerate(lines) if re.match(r"(PTP|LIN|CIRC|SPTP|SLIN) ", ln)]
     first = motions[0]
     before = lines[:first]
-    assert "BAS(#INITMOV, 0)" in before
-    for var in ("$TOOL = ", "$BASE = ", "$LOAD = "):
-        assert any(ln.startswith(var) for ln in before), var
-    assert lines[first].startswith("PTP ")
-    p = _points(dat)[lines[first].split()[1]]
+    init = [
+        "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
+        "INTERRUPT ON 3",
+        "BAS(#INITMOV, 0)",
+        "BAS(#TOOL, 1)",  # TOOL_DATA[1] / LOAD_DATA[1], BASE_DATA[1] by index: values in the setup block
+        "BAS(#BASE, 1)",
+        "$H_POS = XHOME",
+    ]
+    assert [ln for ln in before if ln in init] == init  # in this order
+    setup = re.findall(r"^;- (TOOL_DATA|LOAD_DATA|BASE_DATA)\[1\] = \{", src, flags=re.M)
+    assert setup == ["TOOL_DATA", "LOAD_DATA", "BASE_DATA"]
+    assert lines[first] == "PTP XHOME"
+    p = _points(dat)["XHOME_PLAN"]
     assert [f"A{i}" for i in range(1, 7)] == [k for k in p if k.startswith("A")]  # all six axes
     np.testing.assert_allclose([p[f"A{i}"] for i in range(1, 7)], np.degrees(HOME), atol=1e-3)  # degrees
     assert lines[-2].startswith("PTP XHOME")  # and back home at the end
 
 
-def test_welds_are_lin_at_weld_speed_between_arc_markers(robot: RobotModel, plan: WeldPlan) -> None:
-    src, dat = krl_program(plan, robot, "W")
-    lines = [ln.strip() for ln in src.splitlines() if ln.strip()]
-    on = [i for i, ln in enumerate(lines) if ln.startswith(";ARC_ON")]
-    off = [i for i, ln in enumerate(lines) if ln.startswith(";ARC_OFF")]
-    assert len(on) == len(off) == 2
+def _folds(src: str) -> list[tuple[str, str, str, list[str]]]:
+    """ArcTech inline forms of a .src: (ARCON | ARCSWI | ARCOFF, weld data set, seam id, the fold's code lines)."""
+    out: list[tuple[str, str, str, list[str]]] = []
+    body: list[str] = []
+    head: tuple[str, str, str] | None = None
+    for ln in (ln.strip() for ln in src.splitlines()):
+        m = re.match(r";FOLD (ARCON|ARCSWI|ARCOFF) (\w+) .* seam (\S+)$", ln)
+        if m is not None:
+            head, body = (m.group(1), m.group(2), m.group(3)), []
+        elif head is not None and ln == ";ENDFOLD" and body and body[-1].startswith("ArcMainNG(#Arc"):
+            out.append((head[0], head[1], head[2], body))
+            head = None
+        elif head is not None and not ln.startswith(";"):
+            body.append(ln)
+    return out
+
+
+def _decl(dat: str, name: str) -> str:
+    return next(ln for ln in dat.splitlines() if ln.startswith("DECL ") and f" {name}=" in ln)
+
+
+def test_each_weld_is_arc_on_then_off_with_declared_weld_data(robot: RobotModel, plan: WeldPlan) -> None:
+    X_RB = make_pose(rot_z(0.4), [0.05, 0.8, 0.01])  # the part's base: every LIN point is written in it
+    src, dat = krl_program(plan, robot, "W", X_RB=X_RB)
+    folds = _folds(src)
+    assert [(f[0], f[2]) for f in folds] == [(k, s) for s in plan.order for k in ("ARCON", "ARCOFF")]
+    assert sorted(plan.order) == ["side", "top"]
     pts = _points(dat)
-    for i, k in zip(on, off, strict=True):
-        assert k == i + 2 and lines[i + 1].startswith("LIN ")  # exactly one weld motion between the markers
-        vel = [ln for ln in lines[:i] if ln.startswith("$VEL.CP")][-1]
-        assert float(vel.split("=")[1].split(";")[0]) == pytest.approx(PROCESS.travel_speed)  # m/s
-        before = [ln for ln in lines[:i] if re.match(r"(PTP|LIN) ", ln)][-1]
-        assert before.startswith("LIN ") and "C_DIS" not in before and "C_VEL" not in before  # exact stop
-        seam_id = lines[i].split()[-1]
+    for (on, wd_on, seam_id, body_on), (off, wd_off, _, body_off) in zip(folds[::2], folds[1::2], strict=True):
+        for kind, wdat, body in ((on, wd_on, body_on), (off, wd_off, body_off)):
+            motions = [ln for ln in body if re.match(r"(PTP|LIN) ", ln)]
+            assert len(motions) == 1 and "C_DIS" not in motions[0]  # one motion, an exact stop
+            step = "ArcOn" if kind == "ARCON" else "ArcOff"
+            assert body[-3] == f"ArcMainNG(#{step}BeforeMoveStd, {wdat}, W{motions[0].split()[1][1:]})"
+            assert body[-1].startswith(f"ArcMainNG(#{step}AfterMoveStd, {wdat},")
+        # ARC_ON's data set: ignition and the weld's path velocity (the process' travel speed, m/s); ARC_OFF's:
+        # the crater
+        d_on, d_off = _decl(dat, wd_on), _decl(dat, wd_off)
+        assert d_on.startswith(f"DECL stArcDat_T {wd_on}=") and "Strike {" in d_on and "Weave {" in d_on
+        vel = re.search(r"Weld \{[^}]*Velocity " + NUM, d_on)
+        assert vel is not None
+        v = float(vel.group(1))
+        assert v == pytest.approx(PROCESS.travel_speed, abs=1e-5)
+        assert "Crater {" in d_off and "CraterTime 0.300" in d_off
+        # the weld runs from ARC_ON's point (the ignition) to ARC_OFF's, the seam's ends, in the base
+        start, end = (pts[next(ln for ln in b if ln.startswith("LIN ")).split()[1]] for b in (body_on, body_off))
         task = next(t for t in SEAMS if t.id == seam_id)
-        start, end = (pts[ln.split()[1]] for ln in (before, lines[i + 1]))
-        xyz = [np.array([p["X"], p["Y"], p["Z"]]) for p in (start, end)]
-        # millimetres: the weld end points are the seam's end points x 1000
-        got = sorted([tuple(np.round(x, 1)) for x in xyz])
-        want = sorted([tuple(np.round(p * 1000.0, 1)) for p in (task.p_start, task.p_end)])
-        np.testing.assert_allclose(got, want, atol=0.05)
+        got = [X_RB @ np.array([p["X"], p["Y"], p["Z"], 1000.0]) for p in (start, end)]
+        want = [np.append(p * 1000.0, 1000.0) for p in (task.p_start, task.p_end)]
+        np.testing.assert_allclose(sorted(map(tuple, got)), sorted(map(tuple, want)), atol=0.01)
     for p in pts.values():  # plausible units: mm within the arm's reach, angles in degrees
         if "X" in p:
             assert np.linalg.norm([p["X"], p["Y"], p["Z"]]) < 2000.0
             assert all(-180.0 <= p[k] <= 180.0 for k in "ABC")
 
 
+def test_every_e6pos_has_the_status_and_turn_of_its_planned_configuration(robot: RobotModel, plan: WeldPlan) -> None:
+    _, dat = krl_program(plan, robot, "W")
+    pts = _points(dat)
+    lins = [s for s in plan.segments if s.kind != "move"]
+    e6pos = [name for name in pts if "S" in pts[name]]
+    assert len(e6pos) == len(lins) and all("T" in pts[n] for n in e6pos)
+    for name, seg in zip(sorted(e6pos, key=lambda n: int(n[2:])), lins, strict=True):
+        assert (pts[name]["S"], pts[name]["T"]) == status_turn(robot, seg.trajectory.q[-1])
+
+
 def test_abc_are_rotations_about_z_y_x_with_x_along_the_wire(robot: RobotModel, plan: WeldPlan) -> None:
     src, dat = krl_program(plan, robot, "W")
     pts = _points(dat)
     weld = next(s for s in plan.segments if s.kind == "weld")
-    i = [ln.strip() for ln in src.splitlines()].index(f";ARC_OFF seam {weld.seam_id}")
-    name = [ln.strip() for ln in src.splitlines()][i - 1].split()[1]
-    p = pts[name]
+    off = next(f for f in _folds(src) if f[0] == "ARCOFF" and f[2] == weld.seam_id)
+    p = pts[next(ln for ln in off[3] if ln.startswith("LIN ")).split()[1]]
     R = rpy_to_matrix(np.radians([p["C"], p["B"], p["A"]]))  # Rz(A) Ry(B) Rx(C)
     np.testing.assert_allclose(R[:, 0], weld.X_end[:3, 2], atol=1e-4)  # KUKA tool direction X = the wire
-    m = re.search(r"\$TOOL = \{X " + NUM + ", Y " + NUM + ", Z " + NUM, src)
+    m = re.search(r"TOOL_DATA\[1\] = \{X " + NUM + ", Y " + NUM + ", Z " + NUM, src)
     assert m is not None
     X_FT = np.linalg.inv(robot.fk(HOME, "tool0")) @ robot.fk(HOME, "torch_tcp")
     np.testing.assert_allclose([float(v) for v in m.groups()], X_FT[:3, 3] * 1000.0, atol=1e-3)
 
 
-def test_call_markers_and_bad_names(robot: RobotModel, plan: WeldPlan) -> None:
-    src, _ = krl_program(plan, robot, "W", options=KrlOptions(arc_markers="call"))
-    calls = [ln.split(";")[0].strip() for ln in src.splitlines() if ln.startswith("WELD_ARC_")]
-    assert calls == ["WELD_ARC_ON( )", "WELD_ARC_OFF( )"] * 2
+def test_plain_signal_arc_waits_for_the_arc_with_a_timeout_and_bad_names(robot: RobotModel, plan: WeldPlan) -> None:
+    opt = KrlOptions(arc="signals", arc_on_output=7, arc_ok_input=9, arc_timeout_s=1.5)
+    src, _ = krl_program(plan, robot, "W", options=opt)
+    code = [ln.split(";")[0].strip() for ln in src.splitlines()]
+    code = [ln for ln in code if ln]
+    assert "ArcMainNG" not in src and code.count("$OUT[7] = TRUE") == 2 and code.count("$OUT[7] = FALSE") == 4
+    for i in (k for k, ln in enumerate(code) if ln == "$OUT[7] = TRUE"):
+        block = code[i : i + 12]
+        assert block[1:7] == [
+            "$TIMER_STOP[1] = TRUE", "$TIMER[1] = -1500", "$TIMER_STOP[1] = FALSE",
+            "WAIT FOR $IN[9] OR $TIMER_FLAG[1]", "$TIMER_STOP[1] = TRUE", "IF NOT $IN[9] THEN",
+        ]  # fmt: skip
+        assert block[7:10] == ["$OUT[7] = FALSE", "HALT", "ENDIF"]  # the error branch: arc off, stop
+        weld = next(k for k in range(i, len(code)) if code[k].startswith("LIN "))
+        assert code[weld - 1] == f"$VEL.CP = {PROCESS.travel_speed:.4f}"
+        assert code[weld + 1 : weld + 3] == ["WAIT SEC 0.300", "$OUT[7] = FALSE"]  # crater, then arc off
     for bad in ("1WELD", "WELD-1", "", "A" * 25):
-        with pytest.raises(ValueError, match="KRL program name"):
+        with pytest.raises(ValueError, match="program name"):
             krl_program(plan, robot, bad)
 
 

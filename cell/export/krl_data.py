@@ -1,0 +1,108 @@
+"""The KRL texts of values: frames, E6POS / E6AXIS points, and KUKA.ArcTech's data (docs/reference.md section 5).
+
+Units mm and degrees; A, B, C are rotations about Z, Y, X (``R = Rz(A) Ry(B) Rx(C)``). ArcTech's weld data
+(``stArcDat_T``, ArcTech Basic 3.x) in the .dat: an ARC_ON set holds ``Strike`` (ignition: start time at rest,
+gas pre-flow), ``Weld`` (path velocity in m/s and the power source's channels) and ``Weave``; an ARC_SWI set
+``Weld`` and ``Weave`` of the part after it; an ARC_OFF set ``Crater`` (fill time, post-flow, burn-back). The
+channels are the power source's, as configured in WorkVisual; this cell writes Channel1 = wire feed [m/min],
+Channel2 = voltage [V], Channel3 = current [A].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray, make_pose, matrix_to_rpy, rot_y
+from cell.types.procedure import WeavePattern, WeldProcedure
+
+X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (KUKA tool direction #X: x along the wire)
+PREFLOW_S = 0.3  # gas pre-flow before ignition [s]
+POSTFLOW_S = 0.5  # gas post-flow after the crater [s]
+BURNBACK_S = 0.05  # wire burn-back after the arc [s]
+_WEAVE: dict[WeavePattern, str] = {"none": "#None", "zigzag": "#Triangle", "triangle": "#Triangle", "circle": "#Spiral"}
+
+
+def num(v: float, digits: int = 3) -> str:
+    """A REAL as KRL reads it (no ``-0.000``)."""
+    s = f"{v:.{digits}f}"
+    return s[1:] if s.startswith("-") and float(s) == 0.0 else s
+
+
+def frame_text(X: npt.ArrayLike) -> str:
+    """``{X .., Y .., Z .., A .., B .., C ..}`` of a pose (4, 4) [m] in mm and degrees."""
+    X = np.asarray(X, dtype=float)
+    roll, pitch, yaw = np.degrees(matrix_to_rpy(X[:3, :3]))
+    x, y, z = X[:3, 3] * 1000.0
+    return f"{{X {num(x)}, Y {num(y)}, Z {num(z)}, A {num(yaw)}, B {num(pitch)}, C {num(roll)}}}"
+
+
+def e6pos(X: FloatArray, s: int, t: int) -> str:
+    """An E6POS of a pose (4, 4) [m] with Status and Turn (external axes 0)."""
+    return frame_text(X)[:-1] + f", S {s}, T {t}, E1 0.0, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+
+
+def e6axis(q: FloatArray) -> str:
+    """An E6AXIS of joint values (6,) [rad] in degrees (external axes 0)."""
+    a = ", ".join(f"A{i + 1} {num(v)}" for i, v in enumerate(np.degrees(q)))
+    return f"{{{a}, E1 0.0, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+
+
+def _channels(p: WeldProcedure) -> str:
+    ch = [p.wire_feed_m_min, p.voltage_v, p.current_a, 0.0, 0.0, 0.0, 0.0, 0.0]
+    return ",".join(f"Channel{i + 1} {num(v)}" for i, v in enumerate(ch))
+
+
+def _ids(job_mode: str, param_set: str) -> str:
+    return f'JobModeId[] "{job_mode}",ParamSetId[] "{param_set}"'
+
+
+def weave_text(p: WeldProcedure) -> str:
+    """ArcTech's ``Weave``: pattern, wavelength along the seam [mm], amplitude (half the width) [mm], dwells [s]."""
+    w = p.weave
+    if not w.active:
+        return "Weave {Pattern #None,Length 4.0,Amplitude 0.0,Angle 0.0,LeftSideDelay 0.0,RightSideDelay 0.0}"
+    length = p.travel_speed_mm_s / w.frequency_hz
+    return (
+        f"Weave {{Pattern {_WEAVE[w.pattern]},Length {num(length)},Amplitude {num(w.width_mm / 2.0)},Angle 0.0,"
+        f"LeftSideDelay {num(w.dwell_s[0])},RightSideDelay {num(w.dwell_s[1])}}}"
+    )
+
+
+def weld_text(p: WeldProcedure, job_mode: str, param_set: str) -> str:
+    """ArcTech's ``Weld``: the path velocity [m/s] and the channels."""
+    v = p.travel_speed_mm_s / 1000.0
+    return f"Weld {{{_ids(job_mode, param_set)},Velocity {num(v, 5)},{_channels(p)}}}"
+
+
+def arc_data(name: str, kind: str, p: WeldProcedure, job_mode: str, param_set: str) -> str:
+    """``DECL stArcDat_T name={...}`` of an ARC_ON (``on``), ARC_SWI (``swi``) or ARC_OFF (``off``) statement."""
+    head = f'DECL stArcDat_T {name}={{WdatId[] "{name}",'
+    if kind == "on":
+        strike = (
+            f"Strike {{{_ids(job_mode, param_set)},StartTime {num(p.crater_start_s)},PreFlowTime {num(PREFLOW_S)},"
+            f"{_channels(p)},PurgeTime 0.0}}"
+        )
+        return head + f"{strike},{weld_text(p, job_mode, param_set)},{weave_text(p)}}}"
+    if kind == "swi":
+        return head + f"{weld_text(p, job_mode, param_set)},{weave_text(p)}}}"
+    if kind == "off":
+        crater = (
+            f"Crater {{{_ids(job_mode, param_set)},CraterTime {num(p.crater_end_s)},PostflowTime {num(POSTFLOW_S)},"
+            f"{_channels(p)},BurnBackTime {num(BURNBACK_S)}}}"
+        )
+        return head + crater + "}"
+    raise ValueError(f"arc statement kind {kind!r} is not on, swi or off")
+
+
+def procedure_line(p: WeldProcedure, pass_index: int) -> str:
+    """One comment line naming a procedure's figures (the setup block and each weld block)."""
+    w = p.weave
+    weave = f"{w.pattern} {w.width_mm:g} mm at {w.frequency_hz:g} Hz" if w.active else "none"
+    return (
+        f"procedure {p.name} pass {pass_index + 1}/{len(p.passes)}: {p.process}, {p.wire}; {p.current_a:g} A,"
+        f" {p.voltage_v:g} V, wire {p.wire_feed_m_min:g} m/min, {p.travel_speed_mm_s:g} mm/s, leg {p.leg_mm:g} mm,"
+        f" weave {weave}, craters {p.crater_start_s:g}/{p.crater_end_s:g} s"
+    )

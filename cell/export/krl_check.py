@@ -1,0 +1,168 @@
+"""``cell krl check``: re-read a KRL program (:mod:`cell.export.krl_read`) and list what would stop it or weld wrong.
+
+Checks, each a :class:`Finding` code:
+- ``files``: a .src without its .dat; the DEF / DEFDAT name differs from the file name;
+- ``syntax``: a line the reader cannot read; ``structure``: no END / ENDDAT (a truncated file), unbalanced FOLDs;
+- ``init``: the stop-message interrupt (``GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )``,
+  ``INTERRUPT ON 3``) and ``BAS(#INITMOV, 0)`` before the first motion, which must be a PTP to an axis point;
+- ``undeclared``: a motion to a point the .dat does not declare (``XHOME`` is $config.dat's);
+- ``arc``: every ArcTech ARC_ON is followed by ARC_SWI ... ARC_OFF before any other ARC_ON or a PTP, each with a
+  declared ``stArcDat_T`` weld data set of the right parts (Strike / Weld / Crater); in the plain-signal mode every
+  ``$OUT[n] = TRUE`` is followed by a ``WAIT FOR $IN[m]`` and switched off again; the program ends with the arc off;
+- ``status_turn``: an E6POS without S or T; with the arm's kinematics (:func:`check_kinematics`), S and T that
+  are not the configuration the arm reaches the point in, tracked from the axis point before it;
+- ``kinematics``: a point the arm cannot reach, or no setup values (TOOL_DATA / BASE_DATA) to check against.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from cell.export.krl_read import Decl, KrlFile, Statement, read_krl
+
+GLOBAL_POINTS = frozenset({"XHOME"})
+_ARC_FOLD = re.compile(r"^(ARCON|ARCSWI|ARCOFF)\s+(\w+)", re.I)
+_PARTS = {"ARCON": ("STRIKE", "WELD"), "ARCSWI": ("WELD",), "ARCOFF": ("CRATER",)}
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One thing wrong: the file, its line (0: the file as a whole), a code (module docstring) and the detail."""
+
+    file: str
+    line: int
+    code: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}: {self.code}: {self.message}"
+
+
+@dataclass(frozen=True)
+class Program:
+    """A program read from disk: its name, the two files read and their file names."""
+
+    name: str
+    src: KrlFile
+    dat: KrlFile
+    src_name: str
+    dat_name: str
+
+
+def read_programs(directory: Path) -> tuple[list[Program], list[Finding]]:
+    """Every ``NAME.src`` of the folder with its ``NAME.dat``; findings for a .src without .dat."""
+    programs, findings = [], []
+    for src in sorted(directory.glob("*.src")) + sorted(directory.glob("*.SRC")):
+        dat = next((p for p in (src.with_suffix(".dat"), src.with_suffix(".DAT")) if p.is_file()), None)
+        if dat is None:
+            findings.append(Finding(src.name, 0, "files", f"no {src.stem}.dat beside {src.name}"))
+            continue
+        s = read_krl(src.read_text(encoding="ascii", errors="replace"), "src")
+        d = read_krl(dat.read_text(encoding="ascii", errors="replace"), "dat")
+        programs.append(Program(src.stem, s, d, src.name, dat.name))
+    return programs, findings
+
+
+def check_program(p: Program) -> list[Finding]:
+    """Every check but the kinematics (module docstring)."""
+    out = [Finding(p.src_name, pr.line, "syntax", pr.message) for pr in p.src.problems]
+    out += [Finding(p.dat_name, pr.line, "syntax", pr.message) for pr in p.dat.problems]
+    for f, fname, word in ((p.src, p.src_name, "DEF"), (p.dat, p.dat_name, "DEFDAT")):
+        if f.module is None:
+            out.append(Finding(fname, 0, "files", f"no {word} line"))
+        elif f.module.upper() != p.name.upper():
+            out.append(Finding(fname, 0, "files", f"{word} {f.module} differs from the file name {p.name}"))
+        if not f.closed:
+            end = "END" if f.kind == "src" else "ENDDAT"
+            out.append(Finding(fname, 0, "structure", f"no {end}: the file is truncated or not closed"))
+        if f.open_folds:
+            out.append(Finding(fname, 0, "structure", f"{f.open_folds} FOLD(s) never closed by ENDFOLD"))
+    out += _check_init(p)
+    out += _check_points(p)
+    out += _check_arc(p)
+    return out
+
+
+def _motions(f: KrlFile) -> Iterator[Statement]:
+    return (s for s in f.statements if s.kind in ("PTP", "LIN", "CIRC", "SPTP", "SLIN", "SCIRC"))
+
+
+def _check_init(p: Program) -> list[Finding]:
+    first = next(_motions(p.src), None)
+    before = [s for s in p.src.statements if first is None or s.line < first.line]
+    texts = [re.sub(r"\s+", " ", s.text.upper()) for s in before]
+    out = []
+    for want, what in (
+        ("GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )", "the stop-message interrupt declaration"),
+        ("INTERRUPT ON 3", "INTERRUPT ON 3"),
+    ):
+        if want not in texts:
+            out.append(Finding(p.src_name, 0, "init", f"{what} is missing before the first motion"))
+    if not any(t.replace(" ", "").startswith("BAS(#INITMOV,0") for t in texts):
+        out.append(Finding(p.src_name, 0, "init", "BAS(#INITMOV, 0) is missing before the first motion"))
+    if first is not None:
+        d = _decl(p, first.point)
+        axis = isinstance(first.point, dict) or (d is not None and d.type in ("E6AXIS", "AXIS"))
+        if first.kind not in ("PTP", "SPTP") or not (axis or _name(first.point) in GLOBAL_POINTS):
+            out.append(Finding(p.src_name, first.line, "init", "the first motion must be a PTP to an axis point"))
+    return out
+
+
+def _name(point: object) -> str:
+    return point.upper() if isinstance(point, str) else ""
+
+
+def _decl(p: Program, point: object) -> Decl | None:
+    return p.dat.decls.get(_name(point)) or p.src.decls.get(_name(point))
+
+
+def _check_points(p: Program) -> list[Finding]:
+    out = []
+    for s in _motions(p.src):
+        if isinstance(s.point, str) and s.point.upper() not in GLOBAL_POINTS and _decl(p, s.point) is None:
+            out.append(Finding(p.src_name, s.line, "undeclared", f"{s.kind} {s.point}: {s.point} is not declared"))
+    for d in p.dat.decls.values():
+        if d.type in ("E6POS", "POS") and isinstance(d.value, dict) and not {"S", "T"} <= set(d.value):
+            out.append(Finding(p.dat_name, d.line, "status_turn", f"{d.name} has no S and T"))
+    return out
+
+
+def _check_arc(p: Program) -> list[Finding]:
+    out: list[Finding] = []
+    burning_since = 0  # line of the arc's start, 0 when off
+    waited, depth = True, 0  # the arc-established input waited for; IF depth (an error branch is no arc off)
+    for s in p.src.statements:
+        depth += (s.kind == "IF") - (s.kind == "ENDIF")
+        if s.kind == "FOLD" and (m := _ARC_FOLD.match(s.folds[-1] if s.folds else "")):
+            kind, wdat = m.group(1).upper(), m.group(2)
+            if kind == "ARCON" and burning_since:
+                out.append(Finding(p.src_name, s.line, "arc", f"ARC_ON while the arc of line {burning_since} burns"))
+            if kind != "ARCON" and not burning_since:
+                out.append(Finding(p.src_name, s.line, "arc", f"{kind[:3]}_{kind[3:]} with no arc burning"))
+            d = p.dat.decls.get(wdat.upper())
+            if d is None or d.type != "STARCDAT_T" or not isinstance(d.value, dict):
+                out.append(Finding(p.src_name, s.line, "arc", f"weld data set {wdat} is not declared (stArcDat_T)"))
+            elif missing := [part for part in _PARTS[kind] if part not in d.value]:
+                out.append(Finding(p.dat_name, d.line, "arc", f"{wdat} has no {', '.join(missing)} data"))
+            burning_since = s.line if kind != "ARCOFF" else 0
+            continue
+        up = re.sub(r"\s+", "", s.text.upper())
+        if depth and s.kind == "ASSIGN":
+            continue
+        if s.kind == "ASSIGN" and re.match(r"^\$OUT\[\d+\]=TRUE", up):
+            burning_since, waited = s.line, False
+        elif s.kind == "WAIT" and "$IN[" in up:
+            waited = True
+        elif s.kind == "ASSIGN" and re.match(r"^\$OUT\[\d+\]=FALSE", up):
+            burning_since = 0 if waited else burning_since
+        elif s.kind in ("PTP", "SPTP") and burning_since and not any(_ARC_FOLD.match(f) for f in s.folds):
+            out.append(Finding(p.src_name, s.line, "arc", f"PTP while the arc of line {burning_since} burns"))
+        elif s.kind in ("LIN", "CIRC") and burning_since and not waited:
+            out.append(Finding(p.src_name, s.line, "arc", "welding motion before WAIT FOR the arc-established input"))
+            waited = True
+    if burning_since:
+        out.append(Finding(p.src_name, burning_since, "arc", "the arc switched on here is never switched off"))
+    return out

@@ -75,6 +75,9 @@ def weld(
     krl: Annotated[
         Path | None, typer.Option(help="Write the KUKA KRL program (.src/.dat) and the trajectory (JSON, CSV) here.")
     ] = None,
+    controller: Annotated[
+        str, typer.Option(help="The --krl program's language: krl (KUKA .src/.dat) | rapid (ABB RAPID .mod).")
+    ] = "krl",
     rescan: Annotated[
         str | None, typer.Option(help="Re-scan before welding: none | low (below the confidence threshold) | all.")
     ] = None,
@@ -94,6 +97,8 @@ def weld(
         check_display(gui)
         check_file(json_path, "--json")
         check_folder(krl, "--krl")
+        if controller not in ("krl", "rapid"):
+            raise UsageError(f"--controller {controller!r} is unknown; valid: krl, rapid")
         check_file(html, "--html", stdout_ok=False)
         _check_rerun(rerun_path)
         scn, prov = _load(scenario, method, noise)
@@ -101,7 +106,9 @@ def weld(
         run: WeldRun | None = None
         try:
             run = pipeline.weld(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
-            partial = _finish_run(run, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table)
+            partial = _finish_run(
+                run, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
+            )
             if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
                 say(f"page: {html}")
             _write_rerun(run, rerun_path, writer)
@@ -226,6 +233,7 @@ def _finish_run(
     provenance: Mapping[str, Any],
     writer: Writer,
     fmt: TableFormat,
+    controller: str = "krl",
 ) -> str | None:
     """Write what was asked (report first: it survives any later failure; each output on its own), print the
     table; the last line's explanation when the run is partial (None when complete)."""
@@ -234,9 +242,9 @@ def _finish_run(
     rep = weld_report(run, provenance=provenance)
     writer.report(json_path, rep)
     if krl is not None and run.plan is not None and run.plan.segments and run.arm is not None:
-        written = writer.attempt(lambda: _write_program(run, krl, provenance))
+        written = writer.attempt(lambda: _write_program(run, krl, provenance, controller))
         if written is not None:
-            say(f"robot program: {written[0]}, {written[1]}; trajectory: {written[2]}, {written[3]}")
+            say(f"robot program: {', '.join(map(str, written[:-2]))}; trajectory: {written[-2]}, {written[-1]}")
     print_weld(rep, title, fmt)
     if run.error is not None:  # the report says which seams and why: partial, with the cause in report.error
         fail_line(f"error: {run.error.message}")
@@ -272,9 +280,13 @@ def _write_rerun(run: WeldRun, path: Path | None, writer: Writer) -> None:
         say(f"rerun recording: {path}")
 
 
-def _write_program(run: WeldRun, krl: Path, provenance: Mapping[str, Any]) -> tuple[Path, Path, Path, Path]:
-    """The KRL program (provenance in its header) and the trajectory as JSON and CSV, into ``krl``."""
-    from cell.export.krl import write_krl
+def _write_program(run: WeldRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
+    """The robot program for ``controller`` (provenance in its header; the weld points in the part's base, the
+    aligned map) and the trajectory as JSON and CSV, into ``krl``."""
+    import numpy as np
+
+    from cell.export.post import write_program
+    from cell.export.program import ProgramJob
     from cell.export.trajectory import write_csv
     from cell.export.trajectory import write_json as write_traj
 
@@ -282,7 +294,8 @@ def _write_program(run: WeldRun, krl: Path, provenance: Mapping[str, Any]) -> tu
         raise ValueError("no plan to write")
     sc = run.detection.scenario
     name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in sc.name).upper()
-    src, dat = write_krl(
-        run.plan, run.arm.model, krl, name[:24], X_WR=sc.X_WR, options=sc.export.krl, provenance=provenance
-    )
-    return src, dat, write_traj(run.plan, krl / "trajectory.json"), write_csv(run.plan, krl / "trajectory.csv")
+    scene = run.detection.scene
+    X_RB = scene.X_RM if scene is not None else np.eye(4)
+    job = ProgramJob(run.plan, run.arm.model, name[:24], X_RB, sc.X_WR, sc.export.krl, provenance)
+    paths = write_program(controller, job, krl)
+    return [*paths, write_traj(run.plan, krl / "trajectory.json"), write_csv(run.plan, krl / "trajectory.csv")]

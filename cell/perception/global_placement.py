@@ -12,7 +12,9 @@ turn about z and a shift in x, y: three unknowns. Two searches propose them:
   part (clamps, the table's holes): they add to every placement alike.
 - :func:`fpfh_candidates`: FPFH features and RANSAC (Open3D's feature matching through
   :mod:`cell.perception._open3d`) between the map's surface samples and the cloud, a few seeded tries, each
-  flattened to a turn about z and refined by point-to-point ICP.
+  flattened to a turn about z and refined by point-to-point ICP. On the tee (the real scans and a synthetic scan
+  of it) its candidates came out turned by about 180 degrees or 5-10 cm off: it is asked only when the height
+  image's candidates fit poorly, and whatever it proposes must still win the staged ICP's fit.
 
 Each candidate is put flat on the table (:func:`on_table`).
 """
@@ -38,11 +40,13 @@ TOP_TURNS = 4  # turns whose best shift is proposed, ...
 DISTINCT_DEG, DISTINCT_M = 20.0, 0.03  # ... each this far from a better one in turn or in shift
 
 
-def flatten_to_yaw(X: FloatArray) -> FloatArray:
-    """(4, 4) the rigid motion X with its rotation reduced to its turn about z (roll and pitch dropped)."""
+def flatten_to_yaw(X: FloatArray, pivot: FloatArray | None = None) -> FloatArray:
+    """(4, 4) the rigid motion X with its rotation reduced to its turn about z (roll and pitch dropped), moving
+    ``pivot`` (3,) where X moves it (None: the frame's origin)."""
     yaw = math.atan2(float(X[1, 0]), float(X[0, 0]))
     out = make_pose(rpy_to_matrix((0.0, 0.0, yaw)))
-    out[:3, 3] = X[:3, 3]
+    c = np.zeros(3) if pivot is None else np.asarray(pivot, dtype=np.float64)
+    out[:3, 3] = X[:3, :3] @ c + X[:3, 3] - out[:3, :3] @ c
     return out
 
 
@@ -142,12 +146,13 @@ def fpfh_candidates(
     X0 = on_table(make_pose(p=(centre[0], centre[1], 0.0)), weldmap, table_z)
     samples, sample_normals = sample_map(weldmap.transformed(X0, "L"), voxel_m, voxel_m)
     tree = cKDTree(cloud)
+    pivot = samples.mean(axis=0)  # the map's samples turn about their centre, not about L's far origin
     scored = []
     for _ in range(tries):
         seed = int(rng.integers(0, 2**31 - 1))
-        X = flatten_to_yaw(_open3d.fpfh_ransac(samples, sample_normals, cloud, normals, voxel_m, seed))
+        X = flatten_to_yaw(_open3d.fpfh_ransac(samples, sample_normals, cloud, normals, voxel_m, seed), pivot)
         for k in (4.0, 2.0, 0.6):
-            X = flatten_to_yaw(_open3d.icp(samples, cloud, k * voxel_m, 30, X, None).X_TS)
+            X = flatten_to_yaw(_open3d.icp(samples, cloud, k * voxel_m, 30, X, None).X_TS, pivot)
         fit = float(np.mean(np.isfinite(tree.query(transform_points(X, samples), distance_upper_bound=voxel_m)[0])))
         scored.append((fit, on_table(X @ X0, weldmap, table_z)))
     scored.sort(key=lambda f: -f[0])

@@ -111,6 +111,9 @@ def write_capture(
     bad = [n for n in images if not _NAME.match(n)]
     if bad:
         raise CaptureError(f"camera name(s) {', '.join(map(repr, bad))} cannot name a file; valid: [A-Za-z0-9_.-]+")
+    mounts = [f"{n}: {im.mount!r}" for n, im in images.items() if im.mount not in MOUNTS]
+    if mounts:
+        raise CaptureError(f"camera mount(s) {', '.join(mounts)}; valid: {', '.join(MOUNTS)}")
     folder.mkdir(parents=True, exist_ok=True)
     for stale in (INDEX, CELL, TRUTH):  # an index is written last: a folder with one is complete
         (folder / stale).unlink(missing_ok=True)
@@ -260,7 +263,7 @@ def _optional_text(folder: Path, data: Mapping[str, Any], key: str, path: Path) 
 
 def dumps(data: Mapping[str, Any]) -> str:
     """Indented JSON with each list of numbers on one line (a pose row, a K), floats as Python's repr (exact)."""
-    text = json.dumps(data, indent=1)
+    text = json.dumps(data, indent=1, default=str)  # a path or a time in a provenance record: its text
     return _NUMBER_LIST.sub(lambda m: "[" + ", ".join(v.strip() for v in m.group(1).split(",")) + "]", text) + "\n"
 
 

@@ -191,3 +191,13 @@ def test_the_cell_file_gives_back_the_scenario_and_takes_a_new_placement(tmp_pat
     )
     with pytest.raises(CaptureError, match="left, hand of the capture are not in its cameras"):
         replay_scenario(stranger, map_path=fence1.map_path)  # a camera the cell does not know: no calibration, refused
+
+
+def test_what_cannot_be_read_back_is_not_written(tmp_path: Path) -> None:
+    imgs = images(np.random.default_rng(10))
+    odd = imgs["left"]
+    with pytest.raises(CaptureError, match="mount"):
+        write_capture(tmp_path / "a", {"left": DepthImage("left", odd.depth, odd.intrinsics, odd.X_WC, "tripod")}, X_WR)
+    with pytest.raises(CaptureError, match="cannot name a file"):
+        write_capture(tmp_path / "b", {"left/../x": odd}, X_WR)
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()

@@ -10,7 +10,7 @@ The cloud is unorganised (no intrinsics, no view direction), in metres, in its o
    noise and sigma floor from the measured noise and spacing;
 3. the nominal placement ``X_FM_nominal`` put flat on the found table (a part rests on it: its roll and pitch in L
    are zero, its underside at the table's height); the cloud cropped to the placed map's bounds grown by
-   :data:`MARGIN_M` (and, above the table, by its noise);
+   :data:`cell.pipeline.cloud_setup.MARGIN_M` (and, above the table, by its noise);
 4. the map aligned by the usual staged ICP and its checks (fitness, tilt, ambiguity, parts seen); with no nominal
    placement, or one whose fit is poor (:data:`POOR_FITNESS`), a global registration first
    (:mod:`cell.perception.global_placement`: a height-image search over turns and shifts on the table, then FPFH +
@@ -39,7 +39,8 @@ from cell.perception.preprocess import downsample
 from cell.perception.seam_screen import screen
 from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
-from cell.pipeline.cloud_setup import cloud_scenario, ours_overrides
+from cell.pipeline.cloud_setup import FRAME as _FRAME
+from cell.pipeline.cloud_setup import crop_mask, scenario_for
 from cell.pipeline.detect import Progress, evaluate, quiet
 from cell.pipeline.records import Detection
 from cell.scenario import PerceptionSpec, Scenario
@@ -48,10 +49,8 @@ from cell.seams.visibility import visibility
 from cell.types import Box, Cloud, Joint, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
 from cell.voxels import voxel_order
 
-MARGIN_M = 0.1  # the crop around the placed map's bounds, horizontally and above [m]
 POOR_FITNESS = 0.6  # a fit from the nominal placement below this fitness is retried from a global registration
 MIN_POINTS = 200  # fewer points than this: no cloud to locate anything in
-_FRAME = "R"  # the stages' name for the frame they work in (here the levelled frame L)
 
 
 def locate_cloud(
@@ -106,14 +105,14 @@ def locate_cloud(
     joints = find_joints(weldmap)
     viewpoint_L = transform_points(X_LF, np.reshape(viewpoint_F, (1, 3)))[0] if viewpoint_F is not None else None
     X_LM0 = on_table(X_LF @ X_FM_nominal, weldmap, table_z) if X_FM_nominal is not None else None
-    spec_scenario = _scenario(
+    spec_scenario = scenario_for(
         name, weldmap, X_FL, X_LM0, P_L, above, table, viewpoint_L, (noise, along, between), method
     )
     spec = spec_scenario.perception
     alignment: Alignment | None = None
     error: CellError | None = None
     if X_LM0 is not None:
-        crop = _crop(P_L, above, weldmap.transformed(X_LM0, _FRAME))
+        crop = crop_mask(P_L, above, weldmap.transformed(X_LM0, _FRAME))
         try:
             alignment = align_map(weldmap.transformed(X_LM0, _FRAME), Cloud(P_L[crop], _FRAME), spec)
         except AlignmentError as e:
@@ -136,9 +135,9 @@ def locate_cloud(
         return _failed(scenario, weldmap, joints, X_FL, X_LM0, table_z, method, error, timings, t_all, cloud.frame)
     X_LM = alignment.X_RR_corr @ X_LM0
     map_L = weldmap.transformed(X_LM, _FRAME)
-    crop = _crop(P_L, above, map_L)
+    crop = crop_mask(P_L, above, map_L)
     dense_L = Cloud(P_L[crop], _FRAME)
-    scenario = _scenario(name, weldmap, X_FL, X_LM, P_L, above, table, viewpoint_L, (noise, along, between), method)
+    scenario = scenario_for(name, weldmap, X_FL, X_LM, P_L, above, table, viewpoint_L, (noise, along, between), method)
     try:
         check_alignment_unique(map_L, dense_L, alignment, spec.symmetry)
         missing = check_parts_seen(map_L, dense_L, spec, spec.coverage)
@@ -194,7 +193,7 @@ def _global(
     )
     for search in searches:
         for X0 in search():
-            crop = _crop(P_L, above, weldmap.transformed(X0, _FRAME))
+            crop = crop_mask(P_L, above, weldmap.transformed(X0, _FRAME))
             try:
                 fit = align_map(weldmap.transformed(X0, _FRAME), Cloud(P_L[crop], _FRAME), spec)
             except AlignmentError:
@@ -207,55 +206,10 @@ def _global(
     return best
 
 
-def _crop(P_L: FloatArray, above: np.ndarray, map_L: WeldMap) -> np.ndarray:
-    """Points above the table within the placed map's bounds grown by MARGIN_M (not below: the table is cut)."""
-    v = np.vstack([p.vertices() for p in map_L.parts])
-    lo, hi = v.min(axis=0) - MARGIN_M, v.max(axis=0) + MARGIN_M
-    return above & np.all((lo <= P_L) & (hi >= P_L), axis=1)
-
-
 def _workspace_L(P_L: FloatArray, crop: np.ndarray) -> Box:
     """The crop's box (frame L): where our locator must not take the cloud's end for the part's end."""
     lo, hi = P_L[crop].min(axis=0), P_L[crop].max(axis=0)
     return Box(make_pose(p=(lo + hi) / 2.0), hi - lo)
-
-
-def _scenario(
-    name: str,
-    weldmap: WeldMap,
-    X_FL: FloatArray,
-    X_LM: FloatArray | None,
-    P_L: FloatArray,
-    above: np.ndarray,
-    table: TablePlane,
-    viewpoint_L: FloatArray | None,
-    measured: tuple[float, float, float],
-    method: str,
-) -> Scenario:
-    """The synthesised scenario (frame F as the world), with the options from the data's ``measured`` noise and
-    spacing along and between lines [m]."""
-    from cell.seams.registry import with_method, with_options
-
-    X = X_LM if X_LM is not None else make_pose(p=np.median(P_L[above], axis=0))
-    map_L = weldmap.transformed(X, _FRAME)
-    crop = _crop(P_L, above, map_L)
-    if not crop.any():
-        crop = above
-    corners_L = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
-    lo, hi = P_L[crop].min(axis=0), P_L[crop].max(axis=0)
-    box_F = transform_points(X_FL, lo + corners_L * (hi - lo))
-    T = P_L[table.inliers]
-    t_lo, t_hi = T.min(axis=0), T.max(axis=0)
-    top = float(table.offset)
-    centre_F = transform_points(X_FL, np.array([[(t_lo[0] + t_hi[0]) / 2, (t_lo[1] + t_hi[1]) / 2, top - 0.05]]))[0]
-    size = (float(t_hi[0] - t_lo[0]), float(t_hi[1] - t_lo[1]), 0.1)
-    eye_L = viewpoint_L if viewpoint_L is not None else np.median(P_L[crop], axis=0) + np.array([0.0, 0.0, 1.0])
-    eye_F = transform_points(X_FL, np.reshape(eye_L, (1, 3)))[0]
-    noise, along, between = measured
-    workspace_F = (box_F.min(axis=0), box_F.max(axis=0))
-    sc = cloud_scenario(name, weldmap, X_FL @ X, workspace_F, (centre_F, size), eye_F, noise)
-    sc = with_method(sc, method)
-    return with_options(sc, "ours", ours_overrides(noise, along, between)) if method == "ours" else sc
 
 
 def _locate(
@@ -350,4 +304,4 @@ def _failed(
     )
 
 
-__all__ = ["MARGIN_M", "POOR_FITNESS", "AlignmentFailure", "locate_cloud"]
+__all__ = ["POOR_FITNESS", "locate_cloud"]

@@ -263,14 +263,17 @@ def weld(
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:
-    """Planned torch poses X_RT (n, 4, 4) along each weld, every ``step_s`` of arc time (for pictures and reports)."""
+    """Planned torch poses X_RT (n, 4, 4) along each weld (its passes in order), every ``step_s`` of arc time (for
+    pictures and reports)."""
     if station.arm is None:
         return {}
     model = station.arm.model
-    out = {}
+    out: dict[str, FloatArray] = {}
     for seg in plan.segments:
         if seg.arc_on:
             tr = seg.trajectory
             k = np.unique(np.r_[np.searchsorted(tr.times, np.arange(0.0, tr.duration, step_s)), len(tr.times) - 1])
-            out[seg.seam_id] = np.stack([model.fk(tr.q[i]) for i in k])
+            poses = np.stack([model.fk(tr.q[i]) for i in k])
+            prev = out.get(seg.seam_id)  # a multi-pass seam: its passes one after the other
+            out[seg.seam_id] = poses if prev is None else np.concatenate([prev, poses])
     return out

@@ -163,6 +163,9 @@ def replay(
     if map_path is not None and not map_path.is_file():
         raise UsageError(f"--map {str(map_path)!r} is not a file; valid: a DXF welding map")
     station = RecordedStation.open(folder)
+    rec = station.recorded
+    truth = "with" if rec.truth_parts_W is not None else "without"
+    say(f"replaying the capture {folder}: {', '.join(rec.images)}, {truth} ground truth (no simulator)")
     scn = replay_scenario(station.recorded, map_path=map_path, X_RM=X_RM)
     cell_file = folder / CELL if station.recorded.cell_yaml is not None else None
     return scn, station, cell_file

@@ -159,12 +159,14 @@ def _seam_welds(
             code = WeldReason.NOT_EXECUTED if outcome is None and refused else WeldReason.NOT_PLANNED
             out.append(SeamWeld(est.id, False, False, reason, code=code))
             continue
+        welds = [g for g in plan.segments if g.arc_on and g.seam_id == est.id] if plan is not None else []
         if ex is None or plan is None:
             note = f"; {doubtful}: would be re-scanned before welding" if doubtful else ""
             code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
-            out.append(SeamWeld(est.id, True, False, (refused or "planned, not executed (preview)") + note, code=code))
+            why = (refused or "planned, not executed (preview)") + note
+            proc = welds[0].procedure if welds else None
+            out.append(SeamWeld(est.id, True, False, why, code=code, procedure=proc))
             continue
-        welds = [g for g in plan.segments if g.arc_on and g.seam_id == est.id]
         truth = det.truths.get(est.id)  # none on a station that knows no truth: welded, quality unmeasured
         passes = []
         for seg in welds:

@@ -99,7 +99,8 @@ class _Program:
         ]
         args = f"{wdat}, W{pname}"
         self.src += [
-            f";FOLD {fold} {wdat} {motion} {pname} CPDAT{self.n} Tool[{ti}] Base[{bi}] ;%{{PE}} seam {seg.seam_id}",
+            f";FOLD {fold} {wdat} {motion} {pname} CPDAT{self.n} Tool[{ti}] Base[{bi}] ;%{{PE}} seam {seg.seam_id}"
+            f" {p.name} pass {data_of.pass_index + 1}/{len(p.passes)}",
             ";FOLD Parameters ;%{h}",
             f";Params IlfProvider=kukaroboter.arctech.{provider}; Kuka.IsGlobalPoint=False; Kuka.PointName={pname};"
             f" Kuka.BlendingEnabled=False; Kuka.MoveDataName=CPDAT{self.n}; Kuka.VelocityPath={num(seg.speed, 4)};"

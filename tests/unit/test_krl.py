@@ -115,7 +115,7 @@ def _folds(src: str) -> list[tuple[str, str, str, list[str]]]:
     body: list[str] = []
     head: tuple[str, str, str] | None = None
     for ln in (ln.strip() for ln in src.splitlines()):
-        m = re.match(r";FOLD (ARCON|ARCSWI|ARCOFF) (\w+) .* seam (\S+)$", ln)
+        m = re.match(r";FOLD (ARCON|ARCSWI|ARCOFF) (\w+) .* seam (\S+) ", ln)
         if m is not None:
             head, body = (m.group(1), m.group(2), m.group(3)), []
         elif head is not None and ln == ";ENDFOLD" and body and body[-1].startswith("ArcMainNG(#Arc"):

@@ -5,7 +5,8 @@ Checks, each a :class:`Finding` code:
 - ``syntax``: a line the reader cannot read; ``structure``: no END / ENDDAT (a truncated file), unbalanced FOLDs;
 - ``init``: the stop-message interrupt (``GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )``,
   ``INTERRUPT ON 3``) and ``BAS(#INITMOV, 0)`` before the first motion, which must be a PTP to an axis point;
-- ``undeclared``: a motion to a point the .dat does not declare (``XHOME`` is $config.dat's);
+- ``undeclared``: a motion to a point the .dat does not declare (``XHOME`` is $config.dat's), or an inline
+  form's LDAT / FDAT / PDAT or ArcTech data the .dat does not declare;
 - ``arc``: every ArcTech ARC_ON is followed by ARC_SWI ... ARC_OFF before any other ARC_ON or a PTP, each with a
   declared ``stArcDat_T`` weld data set of the right parts (Strike / Weld / Crater); in the plain-signal mode every
   ``$OUT[n] = TRUE`` is followed by a ``WAIT FOR $IN[m]`` and switched off again; the program ends with the arc off;
@@ -124,6 +125,15 @@ def _check_points(p: Program) -> list[Finding]:
     for s in _motions(p.src):
         if isinstance(s.point, str) and s.point.upper() not in GLOBAL_POINTS and _decl(p, s.point) is None:
             out.append(Finding(p.src_name, s.line, "undeclared", f"{s.kind} {s.point}: {s.point} is not declared"))
+    for s in p.src.statements:  # the inline forms' motion data, point data and ArcTech data sets
+        names: list[str] = []
+        if s.kind == "ASSIGN" and (m := re.match(r"^\s*([LFP]DAT_ACT)\s*=\s*(\w+)\s*$", s.text, re.I)):
+            names = [m.group(2)]
+        elif s.kind in ("ARCMAIN", "TRIGGER") and (m := re.search(r"ArcMainNG\s*\(\s*#\w+\s*,([^)]*)\)", s.text)):
+            names = [a.strip() for a in m.group(1).split(",")]
+        for name in names:
+            if _decl(p, name) is None:
+                out.append(Finding(p.src_name, s.line, "undeclared", f"{name} is not declared"))
     for d in p.dat.decls.values():
         if d.type in ("E6POS", "POS") and isinstance(d.value, dict) and not {"S", "T"} <= set(d.value):
             out.append(Finding(p.dat_name, d.line, "status_turn", f"{d.name} has no S and T"))

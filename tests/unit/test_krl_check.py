@@ -139,3 +139,23 @@ def test_rapid_module_structure(robot: RobotModel, two_pass_plan: WeldPlan, tmp_
     targets = [ln for ln in lines if ln.startswith("CONST robtarget")]
     assert all(re.search(r"\],\[-?\d+,-?\d+,-?\d+,[0-7]\],\[9E9", ln) for ln in targets)  # confdata on each
     assert "wd2 := [8.00,0,[0,0,21.50,7.00,0,170.0,0,0,0]" in path.read_text()
+
+
+def test_inline_form_data_must_be_declared_and_the_command_line(
+    robot: RobotModel, two_pass_plan: WeldPlan, tmp_path: Path
+) -> None:
+    from typer.testing import CliRunner
+
+    from cell.cli import app
+    from cell.cli.krl import EXIT_CHECK_FAILED
+
+    _, dat_path = write_krl(two_pass_plan, robot, tmp_path, "forms")
+    name = re.search(r"^DECL FDAT (\w+)=", dat_path.read_text(), flags=re.M).group(1)  # type: ignore[union-attr]
+    dat_path.write_text(re.sub(rf"^DECL FDAT {name}=.*\n", "", dat_path.read_text(), flags=re.M))
+    assert _check(tmp_path, robot) == [("undeclared", f"{name} is not declared")]
+    runner = CliRunner()
+    result = runner.invoke(app, ["krl", "check", str(tmp_path)])
+    assert result.exit_code == EXIT_CHECK_FAILED and result.stdout.strip().endswith(f"{name} is not declared")
+    assert runner.invoke(app, ["krl", "check", str(tmp_path / "none")]).exit_code == 2
+    (tmp_path / "empty").mkdir()
+    assert runner.invoke(app, ["krl", "check", str(tmp_path / "empty")]).exit_code == 2

@@ -62,6 +62,10 @@ class PlanOptions:
     line_accel: float = 2.0  # [m/s^2] approach/depart
     line_jerk: float = 20.0  # [m/s^3]
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
+    # The hose package's A6 window: A6 stays within a6_window of a6_center (cable travel of the dress pack wound
+    # round the wrist); each seam's free spin and wrist are chosen to keep it there. inf: no limit.
+    a6_window: float = math.radians(185.0)  # [rad] either side of the centre
+    a6_center: float = 0.0  # [rad] A6 where the hose package hangs untwisted
     dt: float = 0.001  # [s] sample period: 1 kHz, the rate the safety gate re-samples at
     # The collision model of the whole run: the plan, the safety gate and every close-up view use one checker.
     collision: CollisionOptions = field(default_factory=CollisionOptions)

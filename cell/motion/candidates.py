@@ -8,6 +8,7 @@
 2. The best candidates are solved along the seam (warm-started IK every ``spacing``, no joint jump beyond
    ``max_joint_step``), along the approach line (back along the torch axis to ``process.approach``) and the
    depart line, checked against singularities and for collisions (conservative advancement between knots).
+   A candidate whose A6 leaves the hose window anywhere on approach, seam or depart fails.
    The first candidate that passes is kept (:class:`SeamSolution`); otherwise the failure that got furthest
    (:class:`~cell.motion.failures.SeamFailure`), e.g. ``unreachable: IK did not converge at 35.0 mm along the
    seam``.
@@ -31,7 +32,10 @@ from cell.motion.lines import solve_line
 from cell.motion.plan_options import PlanOptions
 from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess, back_off, line_poses, torch_poses
+from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
 from cell.types.plan import PlanReason, SeamTask
+
+_GOOD = 0.8  # candidates within this share of the best start manipulability are ranked by their wrist
 
 
 @dataclass(frozen=True)
@@ -100,13 +104,37 @@ class SeamSearch:
         rng: np.random.Generator,
     ) -> None:
         self.robot, self.process, self.checker, self.opt, self.rng = robot, process, checker, options, rng
+        self.window = HoseWindow(options.a6_center, options.a6_window)
+
+    def _reference(self, q_seed: FloatArray) -> FloatArray:
+        """The wrist every seam is held near: q_seed (dof,) [rad] with A6 at the hose window's centre."""
+        q_ref = np.array(q_seed, dtype=float)
+        q_ref[-1] = self.window.center
+        return q_ref
+
+    def _ranked(
+        self, found: list[tuple[Candidate, FloatArray, FloatArray]], q_ref: FloatArray
+    ) -> list[tuple[Candidate, FloatArray, FloatArray]]:
+        """The candidates (cand, X, q0) in the order to solve them: A6 at the start within the hose window first;
+        then those whose manipulability at the start is within ``_GOOD`` of the group's best, nearest the
+        reference wrist q_ref (dof,) first; then the rest by manipulability."""
+        manip = [self.robot.manipulability(q0) for _, _, q0 in found]
+        best = max(manip, default=0.0)
+
+        def key(k: int) -> tuple[bool, bool, float, float]:
+            q0 = found[k][2]
+            good = manip[k] >= _GOOD * best
+            return self.window.excess(q0) > 0.0, not good, wrist_cost(q0, q_ref) if good else 0.0, -manip[k]
+
+        return [found[k] for k in sorted(range(len(found)), key=key)]
 
     def plan_seam(self, task: SeamTask, q_seed: FloatArray) -> SeamSolution | SeamFailure:
         """The first candidate that passes, or the failure that got furthest; q_seed (dof,) [rad] seeds IK."""
         best_fail: SeamFailure | None = None
         pr, opt = self.process, self.opt
+        q_ref = self._reference(q_seed)
         for group in candidate_groups(pr, opt):
-            ranked: list[tuple[float, Candidate, FloatArray, FloatArray]] = []
+            found: list[tuple[Candidate, FloatArray, FloatArray]] = []
             q_prev: FloatArray | None = None
             for cand in group:
                 a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
@@ -142,9 +170,9 @@ class SeamSearch:
                         best_fail = better(best_fail, unreachable(exc, X[0], 0.0, 0.0))
                         continue
                 q_prev = q0
-                ranked.append((self.robot.manipulability(q0), cand, X, q0))
-            ranked.sort(key=lambda r: -r[0])
-            for _, cand, X, q0 in ranked[: opt.max_full]:
+                q0 = nearest_wrist(self.robot, q0, q_ref, self.window)
+                found.append((cand, X, q0))
+            for cand, X, q0 in self._ranked(found, q_ref)[: opt.max_full]:
                 res = self.solve_candidate(task, cand, X, q0)
                 if isinstance(res, SeamSolution):
                     return res
@@ -203,5 +231,16 @@ class SeamSearch:
                 f"{hit.a} vs {hit.b} at {where_on_path(s_path[hit.index], task.length)} (p_R = {mm(hit.p_R)} mm)",
                 hit.p_R,
                 float(s_path[hit.index]),
+            )
+        over = np.abs(path[:, -1] - self.window.center) - self.window.half_width
+        k = int(np.argmax(over))
+        if over[k] > 0.0:
+            return SeamFailure(
+                PlanReason.IK_FAILED,
+                f"A6 leaves the hose package window ({np.degrees(self.window.center):.0f} "
+                f"+- {np.degrees(self.window.half_width):.0f} deg) by {np.degrees(over[k]):.1f} deg "
+                f"at {where_on_path(s_path[k], task.length)}",
+                poses[k][:3, 3].copy(),
+                float(s_path[k]),
             )
         return SeamSolution(task, cand, X, q_app, q_weld, q_dep, X_app, X_dep)

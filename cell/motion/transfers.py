@@ -3,8 +3,11 @@
 A transfer is a Ruckig point-to-point move (KRL PTP) where the direct move is free. Where it collides, the next
 strategy is tried, in order (:data:`DEFAULT_STRATEGIES`): straight up (a LIN, as a depart) to ``transfer_lift``
 above the highest obstacle, across (PTP) and straight down (a LIN, as an approach); the same one
-``transfer_lift`` higher; PTP via home. When every strategy collides or fails, the last one's contact (or error)
-is the :class:`TransferFail`; the planner then re-orders the seams, or drops the seam.
+``transfer_lift`` higher; PTP via home. A strategy whose motions take A6 further out of the hose package's window
+(:class:`~cell.motion.wrist.HoseWindow`) than its two ends are fails too (a PTP between ends inside the window
+stays inside: it is a straight joint line; a vertical line's IK may turn A6). When every strategy collides or
+fails, the last one's contact (or error) is the :class:`TransferFail`; the planner then re-orders the seams, or
+drops the seam.
 
 Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 """
@@ -26,6 +29,7 @@ from cell.motion.plan_options import PlanOptions
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.torch import WeldProcess, line_poses
+from cell.motion.wrist import HoseWindow
 from cell.types import Part
 from cell.types.plan import SegmentKind
 
@@ -129,6 +133,7 @@ class Transfers:
         self.robot, self.process, self.checker, self.opt = robot, process, checker, options
         self.q_home = q_home
         self.strategies = tuple(strategies)
+        self.window = HoseWindow(options.a6_center, options.a6_window)
         tops = [float(np.max(o.vertices()[:, 2])) for o in obstacles]
         self.lift_z = (max(tops) if tops else 0.0) + options.transfer_lift
 
@@ -142,6 +147,10 @@ class Transfers:
             except (IKError, TimingError, LineError) as exc:
                 fail = TransferFail(f"{strategy.name}: {exc}", fail.p_R)
                 continue
+            wound = self._wound(pieces, q_a, q_b)
+            if wound is not None:
+                fail = TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
+                continue
             hit = next(
                 (
                     h
@@ -154,6 +163,22 @@ class Transfers:
                 return [pc for pc in pieces if pc.trajectory.duration > 0.0]
             fail = TransferFail(hit.describe(), hit.p_R)
         return fail
+
+    def _wound(self, pieces: list[Piece], q_a: FloatArray, q_b: FloatArray) -> TransferFail | None:
+        """Why the motions take A6 further out of the hose window than their ends q_a, q_b are (None: they do
+        not), with the TCP p_R (3,) [m] where it is furthest out."""
+        allowed = max(self.window.excess(q_a), self.window.excess(q_b)) + 1e-9
+        q = np.concatenate([pc.trajectory.q for pc in pieces])
+        over = np.abs(q[:, -1] - self.window.center) - self.window.half_width
+        k = int(np.argmax(over))
+        if over[k] <= allowed:
+            return None
+        w = self.window
+        why = (
+            f"A6 leaves the hose package window ({np.degrees(w.center):.0f} +- {np.degrees(w.half_width):.0f} deg)"
+            f" by {np.degrees(over[k]):.1f} deg"
+        )
+        return TransferFail(why, self.robot.fk(q[k])[:3, 3].copy())
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is

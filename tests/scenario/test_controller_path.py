@@ -45,3 +45,15 @@ def test_every_executed_ptp_move_is_the_krc_joint_line(fence1_run: pipeline.Weld
     for s in moves:
         inside = (r.t >= s.t0) & (r.t <= s.t1)
         assert inside.sum() > 10 and ptp_line_deviation(r.q[inside]) <= MAX_PTP_DEVIATION
+
+
+def test_a6_stays_in_the_hose_window_without_wrist_flips(fence1_run: pipeline.WeldRun) -> None:
+    run = fence1_run
+    assert run.plan is not None and run.execution is not None
+    opt = run.detection.scenario.motion.plan
+    a6 = run.execution.q[:, 5]
+    assert np.all(np.abs(a6 - opt.a6_center) <= opt.a6_window)  # default: 0 +- 185 deg
+    assert np.ptp(a6) <= np.radians(165.0)  # measured 148 deg (387 deg before the window and the wrist choice)
+    # no flip between neighbouring seams: A4 at consecutive weld starts never swings near half a turn
+    starts = np.array([s.trajectory.q[0] for s in run.plan.segments if s.kind == "weld"])
+    assert np.max(np.abs(np.diff(starts[:, 3]))) <= np.radians(110.0)  # measured 88 deg (185 deg before)

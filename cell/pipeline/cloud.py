@@ -278,12 +278,13 @@ def _failed(
 ) -> Detection:
     """No seam searched (the map could not be aligned): every seam NOT_FOUND with the reason (NOT_VISIBLE when the
     drawing alone says it lies against the table)."""
-    X = X_LM if X_LM is not None else np.eye(4)
+    # With no placement the drawing still tells which seams lie against the table: as drawn, on the table.
+    X = X_LM if X_LM is not None else on_table(np.eye(4), weldmap, table_z)
     map_L = weldmap.transformed(X, _FRAME)
     estimates = []
     for seam in map_L.seams:
         visible, why = visibility(map_L, joints[seam.id], table_z)
-        if visible or X_LM is None:
+        if visible:
             msg = f"no seam search: {error.message}"
             estimates.append(SeamEstimate(seam.id, SeamStatus.NOT_FOUND, msg, code=Reason.NO_SEARCH))
         else:

@@ -133,10 +133,15 @@ def cloud_scenario(
     return Scenario.model_validate(data)
 
 
-def crop_mask(P_L: FloatArray, above: np.ndarray, map_L: WeldMap) -> np.ndarray:
-    """Points above the table within the placed map's bounds grown by MARGIN_M (not below: the table is cut)."""
+def crop_bounds(map_L: WeldMap) -> tuple[FloatArray, FloatArray]:
+    """(lo, hi) (3,) [m]: the placed map's bounds grown by MARGIN_M (its frame)."""
     v = np.vstack([p.vertices() for p in map_L.parts])
-    lo, hi = v.min(axis=0) - MARGIN_M, v.max(axis=0) + MARGIN_M
+    return v.min(axis=0) - MARGIN_M, v.max(axis=0) + MARGIN_M
+
+
+def crop_mask(P_L: FloatArray, above: np.ndarray, map_L: WeldMap) -> np.ndarray:
+    """Points above the table within :func:`crop_bounds` (not below: the table is cut)."""
+    lo, hi = crop_bounds(map_L)
     return above & np.all((lo <= P_L) & (hi >= P_L), axis=1)
 
 
@@ -153,25 +158,23 @@ def scenario_for(
     method: str,
 ) -> Scenario:
     """The scenario of a run on a brought cloud (:func:`cloud_scenario`) from what was measured in the levelled
-    frame L: the map at ``X_LM`` (None: at the points' median), the crop about it, the table's inliers, the
-    viewpoint; X_FL (4, 4) carries them into F. With the options from the data's ``measured`` noise and
-    spacing along and between lines [m]."""
+    frame L: the map at ``X_LM`` (None: at the points' median), the crop about it (:func:`crop_bounds`, from the
+    table up), the table's inliers, the viewpoint; X_FL (4, 4) carries them into F. With the options from the
+    data's ``measured`` noise and spacing along and between lines [m]."""
     from cell.seams.registry import with_method, with_options
 
-    X = X_LM if X_LM is not None else make_pose(p=np.median(P_L[above], axis=0))
+    X = X_LM if X_LM is not None else make_pose(p=np.median(P_L[above] if above.any() else P_L, axis=0))
     map_L = weldmap.transformed(X, FRAME)
-    crop = crop_mask(P_L, above, map_L)
-    if not crop.any():
-        crop = above
     corners_L = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
-    lo, hi = P_L[crop].min(axis=0), P_L[crop].max(axis=0)
+    lo, hi = crop_bounds(map_L)
+    lo[2] = max(float(lo[2]), float(table.offset))  # the table itself is cut away
     box_F = transform_points(X_FL, lo + corners_L * (hi - lo))
     T = P_L[table.inliers]
     t_lo, t_hi = T.min(axis=0), T.max(axis=0)
     top = float(table.offset)
     centre_F = transform_points(X_FL, np.array([[(t_lo[0] + t_hi[0]) / 2, (t_lo[1] + t_hi[1]) / 2, top - 0.05]]))[0]
     size = (float(t_hi[0] - t_lo[0]), float(t_hi[1] - t_lo[1]), 0.1)
-    eye_L = viewpoint_L if viewpoint_L is not None else np.median(P_L[crop], axis=0) + np.array([0.0, 0.0, 1.0])
+    eye_L = viewpoint_L if viewpoint_L is not None else (lo + hi) / 2.0 + np.array([0.0, 0.0, 1.0])
     eye_F = transform_points(X_FL, np.reshape(eye_L, (1, 3)))[0]
     noise, along, between = measured
     workspace_F = (box_F.min(axis=0), box_F.max(axis=0))

@@ -86,3 +86,12 @@ def test_global_registration_recovers_a_part_far_from_any_placement(
     assert np.linalg.norm(X[:3, 3] - X_FM[:3, 3]) < 0.003
     assert math.degrees(math.atan2(X[1, 0], X[0, 0])) == pytest.approx(10.0, abs=0.5)
     assert [e.status for e in det.estimates].count(SeamStatus.FOUND) >= 1, [e.reason for e in det.estimates]
+
+
+def test_a_table_with_no_part_on_it_gives_reasons_not_seams() -> None:
+    P = _table(np.random.default_rng(2))
+    weldmap = read_map(MAP)
+    for X0 in (None, make_pose(p=(0.0, -0.6, 0.0254 + TOP_Z))):
+        det = locate_cloud(Cloud(P, "F"), weldmap, X0, name="bare")
+        assert det.error is not None
+        assert all(e.status is SeamStatus.NOT_FOUND and e.reason for e in det.estimates)

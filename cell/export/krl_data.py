@@ -5,7 +5,7 @@ Units mm and degrees; A, B, C are rotations about Z, Y, X (``R = Rz(A) Ry(B) Rx(
 gas pre-flow), ``Weld`` (path velocity in m/s and the power source's channels) and ``Weave``; an ARC_SWI set
 ``Weld`` and ``Weave`` of the part after it; an ARC_OFF set ``Crater`` (fill time, post-flow, burn-back). The
 channels are the power source's, as configured in WorkVisual; this cell writes Channel1 = wire feed [m/min],
-Channel2 = voltage [V], Channel3 = current [A].
+Channel2 = voltage [V], Channel3 = current [A]. The setup fold (values to enter before the first run) is here too.
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from cell.geometry import FloatArray, make_pose, matrix_to_rpy, rot_y
+from cell.export.program import ProgramJob, procedure_of
+from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
 from cell.types.procedure import WeavePattern, WeldProcedure
 
 X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (KUKA tool direction #X: x along the wire)
@@ -106,3 +107,33 @@ def procedure_line(p: WeldProcedure, pass_index: int) -> str:
         f" {p.voltage_v:g} V, wire {p.wire_feed_m_min:g} m/min, {p.travel_speed_mm_s:g} mm/s, leg {p.leg_mm:g} mm,"
         f" weave {weave}, craters {p.crater_start_s:g}/{p.crater_end_s:g} s"
     )
+
+
+def setup_block(job: ProgramJob) -> list[str]:
+    """The setup fold: TOOL_DATA / LOAD_DATA / BASE_DATA [n] and XHOME to enter, each weld's procedure."""
+    opt = job.options
+    q_any = job.plan.segments[0].trajectory.q[0]
+    X_FT = invert(job.robot.fk(q_any, "tool0")) @ job.robot.fk(q_any, "torch_tcp") @ X_TOOL
+    cm = frame_text(make_pose(p=np.asarray(opt.load_cm_mm) / 1000.0))
+    lines = [
+        ";FOLD SETUP: the values to enter before the first run",
+        f";- TOOL_DATA[{opt.tool_index}] = {frame_text(X_FT)} ; torch TCP in $FLANGE, tool direction #X = the wire",
+        f";- LOAD_DATA[{opt.tool_index}] = {{M {opt.load_kg:.3f}, CM {cm}, J {{X 0.0, Y 0.0, Z 0.0}}}}",
+        f";- BASE_DATA[{opt.base_index}] = {frame_text(job.X_RB)} ; the part (aligned map) in $WORLD = $ROBROOT",
+        f";- XHOME = {e6axis(job.plan.q_home)} ; in $config.dat; the program sets $H_POS = XHOME",
+    ]
+    if job.X_WR is not None:
+        lines.append(f";- robot mounting in the cell (X_WR, information only) = {frame_text(job.X_WR)}")
+    if opt.arc == "signals":
+        lines.append(
+            f";- arc: $OUT[{opt.arc_on_output}] on/off, $IN[{opt.arc_ok_input}] arc established (timeout"
+            f" {opt.arc_timeout_s:g} s)"
+        )
+    seen: set[tuple[str, int]] = set()
+    for seg in job.plan.segments:
+        if seg.kind == "weld":
+            p = procedure_of(seg)
+            if (p.name, seg.pass_index) not in seen:
+                seen.add((p.name, seg.pass_index))
+                lines.append(f";- {procedure_line(p, seg.pass_index)}")
+    return [*lines, ";ENDFOLD"]

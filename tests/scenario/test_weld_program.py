@@ -59,8 +59,8 @@ def test_every_welded_seam_has_its_arc_statements_and_the_check_passes(
     segs = fence1_run.plan.segments
     welded = [s.seam_id for k, s in enumerate(segs) if s.kind == "weld" and segs[k - 1].kind != "weld"]
     assert sorted(set(welded)) == sorted(fence1_run.plan.order)  # every welded seam: one arc per pass
-    on = re.findall(r"^;FOLD ARCON (\w+) .* seam (\S+) ", src, flags=re.M)
-    off = re.findall(r"^;FOLD ARCOFF (\w+) .* seam (\S+) ", src, flags=re.M)
+    on = [m[::-1] for m in re.findall(r"^;- ARC_ON seam (\S+) .*\n;FOLD ARCON (\w+) ", src, flags=re.M)]
+    off = [m[::-1] for m in re.findall(r"^;- ARC_OFF seam (\S+) .*\n;FOLD ARCOFF (\w+) ", src, flags=re.M)]
     assert [s for _, s in on] == welded == [s for _, s in off]  # one ARC_ON ... ARC_OFF per welded seam
     for wdat, _ in on + off:
         assert re.search(rf"^DECL stArcDat_T {wdat}=", dat, flags=re.M)

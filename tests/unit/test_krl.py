@@ -114,10 +114,13 @@ def _folds(src: str) -> list[tuple[str, str, str, list[str]]]:
     out: list[tuple[str, str, str, list[str]]] = []
     body: list[str] = []
     head: tuple[str, str, str] | None = None
+    seam = ""
     for ln in (ln.strip() for ln in src.splitlines()):
-        m = re.match(r";FOLD (ARCON|ARCSWI|ARCOFF) (\w+) .* seam (\S+) ", ln)
-        if m is not None:
-            head, body = (m.group(1), m.group(2), m.group(3)), []
+        m = re.match(r";FOLD (ARCON|ARCSWI|ARCOFF) (\w+) ", ln)
+        if (c := re.match(r";- ARC_(?:ON|SWI|OFF) seam (\S+) ", ln)) is not None:
+            seam = c.group(1)  # the comment line before each inline form names its seam
+        elif m is not None:
+            head, body = (m.group(1), m.group(2), seam), []
         elif head is not None and ln == ";ENDFOLD" and body and body[-1].startswith("ArcMainNG(#Arc"):
             out.append((head[0], head[1], head[2], body))
             head = None

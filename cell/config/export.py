@@ -15,10 +15,12 @@ class KrlOptions:
 
     load_kg, load_cm_mm : payload on the flange (torch 1.8 kg + camera 0.1 kg, centre of mass from
         robots/build_kr5_arc.py): the values to enter with the tool data.
-    arc : ``arctech`` writes KUKA.ArcTech's ARC_ON / ARC_SWI / ARC_OFF inline forms with a weld data set per
-        procedure in the .dat; ``signals`` drives a power source without ArcTech through plain I/O: ``$OUT``
-        [``arc_on_output``] switches the arc on, ``$IN`` [``arc_ok_input``] says the arc burns, waited for at most
-        ``arc_timeout_s`` before the program switches the arc off and halts.
+    arc : ``arctech`` writes KUKA.ArcTech's ARC_ON / ARC_SWI / ARC_OFF inline forms, each with its weld data set
+        (from the segment's procedure) in the .dat; ``signals`` drives a power source without ArcTech through
+        plain I/O (``cell krl check`` reads both).
+    arc_on_output, arc_ok_input, arc_timeout_s : the plain-signal mode's ``$OUT[n]`` that switches the arc on,
+        ``$IN[m]`` that says it burns, and how long [s] the program waits for it before it switches the arc off
+        and halts.
     tool_index, base_index : TOOL_DATA[n] / BASE_DATA[n] the program selects (BAS(#TOOL, n), BAS(#BASE, n)); the
         values to enter there are printed in the program's setup block. The base is the part: the aligned map.
     job_mode, param_set : ArcTech's JobModeId and ParamSetId of every weld data set (power-source specific names,

@@ -18,11 +18,12 @@ class KrlOptions:
     arc : ``arctech`` writes KUKA.ArcTech's ARC_ON / ARC_SWI / ARC_OFF inline forms, each with its weld data set
         (from the segment's procedure) in the .dat; ``signals`` drives a power source without ArcTech through
         plain I/O (``cell krl check`` reads both).
-    arc_on_output, arc_ok_input, arc_timeout_s : the plain-signal mode's ``$OUT[n]`` that switches the arc on,
-        ``$IN[m]`` that says it burns, and how long [s] the program waits for it before it switches the arc off
-        and halts.
-    tool_index, base_index : TOOL_DATA[n] / BASE_DATA[n] the program selects (BAS(#TOOL, n), BAS(#BASE, n)); the
-        values to enter there are printed in the program's setup block. The base is the part: the aligned map.
+    arc_on_output, arc_ok_input, arc_timeout_s : the plain-signal mode's output number (``$OUT``) that switches
+        the arc on, input number (``$IN``) that says it burns, and how long in seconds the program waits for it
+        before it switches the arc off and halts.
+    tool_index, base_index : the TOOL_DATA and BASE_DATA index the program selects (``BAS(#TOOL, index)``,
+        ``BAS(#BASE, index)``); the values to enter there are printed in the program's setup block. The base is the
+        part: the aligned map.
     job_mode, param_set : ArcTech's JobModeId and ParamSetId of every weld data set (power-source specific names,
         as configured in WorkVisual).
     ptp_percent : PTP velocity/acceleration in percent of the axis maxima (the plan's PTP moves use the full

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import time
 import zlib
-from collections.abc import Mapping
-from dataclasses import fields, replace
+from collections.abc import Callable, Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -36,18 +36,35 @@ from cell.perception.align import Alignment, align_map
 from cell.perception.alignment_checks import check_alignment_unique, check_parts_seen
 from cell.perception.global_placement import fpfh_candidates, height_candidates, on_table
 from cell.perception.preprocess import downsample
-from cell.perception.seam_screen import screen
 from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
+from cell.pipeline.cloud_seams import evaluate, locate_seams
 from cell.pipeline.cloud_setup import FRAME as _FRAME
 from cell.pipeline.cloud_setup import crop_mask, scenario_for
-from cell.pipeline.detect import Progress, evaluate, quiet
 from cell.pipeline.records import Detection
 from cell.scenario import PerceptionSpec, Scenario
 from cell.seams.joint import find_joints
 from cell.seams.visibility import visibility
-from cell.types import Box, Cloud, Joint, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
+from cell.types import (
+    Box,
+    Cloud,
+    Joint,
+    Reason,
+    SeamEstimate,
+    SeamScene,
+    SeamStatus,
+    WeldMap,
+)
 from cell.voxels import voxel_order
+
+# The same type and default as cell.pipeline.detect's, written here: detect imports the station (the simulator),
+# which a brought cloud must never pull in.
+Progress = Callable[[str], None]
+
+
+def quiet(_: str) -> None:
+    return None
+
 
 POOR_FITNESS = 0.6  # a fit from the nominal placement below this fitness is retried from a global registration
 MIN_POINTS = 200  # fewer points than this: no cloud to locate anything in
@@ -148,7 +165,7 @@ def locate_cloud(
     progress(f"locating {len(map_L.seams)} seams ({method})")
     ordered, voxels = voxel_order(dense_L, spec.voxel_m)
     ss = SeamScene(downsample(dense_L, spec.voxel_m), ordered, map_L, joints, table_z, voxels)
-    estimates = _locate(ss, scenario, method, _workspace_L(P_L, crop), missing)
+    estimates = locate_seams(ss, scenario, method, _workspace_L(P_L, crop), missing)
     timings["locate_s"] = time.perf_counter() - t
     estimates_F = tuple(_carried(e, X_FL) for e in estimates)
     truth = dict(truth_F) if truth_F is not None else {}
@@ -210,49 +227,6 @@ def _workspace_L(P_L: FloatArray, crop: np.ndarray) -> Box:
     """The crop's box (frame L): where our locator must not take the cloud's end for the part's end."""
     lo, hi = P_L[crop].min(axis=0), P_L[crop].max(axis=0)
     return Box(make_pose(p=(lo + hi) / 2.0), hi - lo)
-
-
-def _locate(
-    ss: SeamScene, scenario: Scenario, method: str, workspace_L: Box, missing: Mapping[str, str]
-) -> tuple[SeamEstimate, ...]:
-    """Every seam of ``ss``'s map located by ``method`` (ours cut at ``workspace_L``) and screened."""
-    from cell.seams.base import BatchSeamLocator, SeamLocator
-    from cell.seams.ours import OursLocator, OursOptions
-    from cell.seams.registry import locator_spec, make_locator
-
-    if method == "ours":
-        opts = locator_spec(scenario, "ours").options
-        settings = {f.name: getattr(opts, f.name) for f in fields(opts)}
-        locator: SeamLocator = OursLocator(OursOptions(**settings, workspace_R=workspace_L))
-    else:
-        locator = make_locator(method, scenario)
-    rng = scenario.rng(f"locator/{method}")
-    out: dict[str, SeamEstimate] = {}
-    for seam in ss.weldmap.seams:
-        visible, why = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
-        if not visible:
-            out[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE)
-    todo = [s for s in ss.weldmap.seams if s.id not in out]
-    if isinstance(locator, BatchSeamLocator) and todo:
-        t = time.perf_counter()
-        found = locator.locate_many(ss, todo, rng)
-        dt = (time.perf_counter() - t) / len(todo)
-        out.update({e.id: replace(e, time_s=dt) for e in found})
-    else:
-        for seam in todo:
-            t = time.perf_counter()
-            out[seam.id] = replace(locator.locate(ss, seam, rng), time_s=time.perf_counter() - t)
-    estimates = tuple(_unseen_reason(out[s.id]) for s in ss.weldmap.seams)
-    return screen(ss, estimates, missing, scenario.perception.screen)
-
-
-def _unseen_reason(est: SeamEstimate) -> SeamEstimate:
-    """A weld face not seen is not placed from an edge here (NO_EDGES): say so instead of the edge's count."""
-    cut = est.reason.find(" and its edge is not defined well enough")
-    if est.status is not SeamStatus.NOT_FOUND or cut < 0:
-        return est
-    why = "; in a cloud without a camera's per-pixel density an unseen face is not placed from an edge"
-    return replace(est, reason=est.reason[:cut] + ": shadowed or hidden from the sensor" + why)
 
 
 def _carried(est: SeamEstimate, X_FL: FloatArray) -> SeamEstimate:

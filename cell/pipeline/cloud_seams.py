@@ -1,0 +1,71 @@
+"""The seams of a brought cloud's aligned map, located and screened (for :func:`cell.pipeline.cloud.locate_cloud`),
+and measured against a truth when one is given: the steps of :func:`cell.pipeline.detect.locate` and
+:func:`~cell.pipeline.detect.evaluate` without their module's import of the station (a brought cloud never pulls in
+the simulator), our locator built with the crop of the brought cloud rather than a scenario's workspace."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import fields, replace
+
+from cell.geometry import FloatArray
+from cell.perception.seam_screen import screen
+from cell.scenario import Scenario
+from cell.seams.visibility import visibility
+from cell.types import Box, MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus
+
+
+def locate_seams(
+    ss: SeamScene, scenario: Scenario, method: str, workspace_L: Box, missing: Mapping[str, str]
+) -> tuple[SeamEstimate, ...]:
+    """Every seam of ``ss``'s map (frame L) located by ``method`` (ours with the scenario's options, cut at
+    ``workspace_L``), the underside ones NOT_VISIBLE, then screened (missing parts, occluders, doubt)."""
+    from cell.seams.base import BatchSeamLocator, SeamLocator
+    from cell.seams.ours import OursLocator, OursOptions
+    from cell.seams.registry import locator_spec, make_locator
+
+    if method == "ours":
+        opts = locator_spec(scenario, "ours").options
+        settings = {f.name: getattr(opts, f.name) for f in fields(opts)}
+        locator: SeamLocator = OursLocator(OursOptions(**settings, workspace_R=workspace_L))
+    else:
+        locator = make_locator(method, scenario)
+    rng = scenario.rng(f"locator/{method}")
+    out: dict[str, SeamEstimate] = {}
+    for seam in ss.weldmap.seams:
+        visible, why = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
+        if not visible:
+            out[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE)
+    todo = [s for s in ss.weldmap.seams if s.id not in out]
+    if isinstance(locator, BatchSeamLocator) and todo:
+        t = time.perf_counter()
+        found = locator.locate_many(ss, todo, rng)
+        dt = (time.perf_counter() - t) / len(todo)
+        out.update({e.id: replace(e, time_s=dt) for e in found})
+    else:
+        for seam in todo:
+            t = time.perf_counter()
+            out[seam.id] = replace(locator.locate(ss, seam, rng), time_s=time.perf_counter() - t)
+    estimates = tuple(unseen_reason(out[s.id]) for s in ss.weldmap.seams)
+    return screen(ss, estimates, missing, scenario.perception.screen)
+
+
+def unseen_reason(est: SeamEstimate) -> SeamEstimate:
+    """A weld face not seen is not placed from an edge here (NO_EDGES): say so instead of the edge's count."""
+    cut = est.reason.find(" and its edge is not defined well enough")
+    if est.status is not SeamStatus.NOT_FOUND or cut < 0:
+        return est
+    why = "; in a cloud without a camera's per-pixel density an unseen face is not placed from an edge"
+    return replace(est, reason=est.reason[:cut] + ": shadowed or hidden from the sensor" + why)
+
+
+def evaluate(
+    estimates: Sequence[SeamEstimate], truth: Mapping[str, tuple[FloatArray, FloatArray]]
+) -> tuple[dict[str, SeamMetrics], MetricsSummary]:
+    """Per-seam metrics against ``truth`` (none when it is empty) and the summary (as cell.pipeline.detect's)."""
+    from cell.seams.metrics import evaluate as metrics_of
+    from cell.seams.metrics import summarise
+
+    per_seam = metrics_of(estimates, truth) if truth else {}
+    return per_seam, summarise(estimates, per_seam)

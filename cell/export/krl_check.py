@@ -7,9 +7,10 @@ Checks, each a :class:`Finding` code:
   ``INTERRUPT ON 3``) and ``BAS(#INITMOV, 0)`` before the first motion, which must be a PTP to an axis point;
 - ``undeclared``: a motion to a point the .dat does not declare (``XHOME`` is $config.dat's), or an inline
   form's LDAT / FDAT / PDAT or ArcTech data the .dat does not declare;
-- ``arc``: every ArcTech ARC_ON is followed by ARC_SWI ... ARC_OFF before any other ARC_ON or a PTP, each with a
-  declared ``stArcDat_T`` weld data set of the right parts (Strike / Weld / Crater); in the plain-signal mode every
-  ``$OUT[n] = TRUE`` is followed by a ``WAIT FOR $IN[m]`` and switched off again; the program ends with the arc off;
+- ``arc``: every ArcTech ARC_ON is followed by ARC_SWI ... ARC_OFF before any other ARC_ON or a PTP, each holding
+  one motion and a declared ``stArcDat_T`` weld data set of the right parts (Strike / Weld / Crater); in the
+  plain-signal mode every ``$OUT[n] = TRUE`` is followed by a ``WAIT FOR $IN[m]`` and switched off again; the
+  program ends with the arc off;
 - ``status_turn``: an E6POS without S or T; with the arm's kinematics (:func:`check_kinematics`), S and T that
   are not the configuration the arm reaches the point in, tracked from the axis point before it;
 - ``kinematics``: a point the arm cannot reach, or no setup values (TOOL_DATA / BASE_DATA) to check against.
@@ -157,6 +158,10 @@ def _check_arc(p: Program) -> list[Finding]:
                 out.append(Finding(p.src_name, s.line, "arc", f"weld data set {wdat} is not declared (stArcDat_T)"))
             elif missing := [part for part in _PARTS[kind] if part not in d.value]:
                 out.append(Finding(p.dat_name, d.line, "arc", f"{wdat} has no {', '.join(missing)} data"))
+            motions = [m for m in _motions(p.src) if s.folds[-1] in m.folds]
+            if len(motions) != 1:
+                out.append(Finding(p.src_name, s.line, "arc", f"{kind[:3]}_{kind[3:]} holds {len(motions)} motions,"
+                                   " not one"))  # fmt: skip
             burning_since = s.line if kind != "ARCOFF" else 0
             continue
         up = re.sub(r"\s+", "", s.text.upper())

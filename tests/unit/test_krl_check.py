@@ -159,3 +159,13 @@ def test_inline_form_data_must_be_declared_and_the_command_line(
     assert runner.invoke(app, ["krl", "check", str(tmp_path / "none")]).exit_code == 2
     (tmp_path / "empty").mkdir()
     assert runner.invoke(app, ["krl", "check", str(tmp_path / "empty")]).exit_code == 2
+
+
+def test_an_arc_statement_without_its_motion(robot: RobotModel, two_pass_plan: WeldPlan, tmp_path: Path) -> None:
+    src_path, _ = write_krl(two_pass_plan, robot, tmp_path, "nomove")
+    text = src_path.read_text()
+    i = text.index(";FOLD ARCSWI ")
+    j = text.index("\nLIN ", i)
+    src_path.write_text(text[:j] + text[text.index("\n", j + 1) :])  # the switch's LIN deleted
+    found = _check(tmp_path, robot)
+    assert ("arc", "ARC_SWI holds 0 motions, not one") in found

@@ -30,6 +30,7 @@ from cell.geometry import FloatArray, invert
 from cell.provenance import header_lines
 from cell.types.plan import Segment
 from cell.types.procedure import WeavePattern, WeldProcedure
+from cell.types.robot import Kinematics
 
 _SHAPE: dict[WeavePattern, int] = {"none": 0, "zigzag": 1, "triangle": 3, "circle": 4}
 _EXT = "[9E9,9E9,9E9,9E9,9E9,9E9]"
@@ -48,9 +49,8 @@ def pose_text(X: FloatArray) -> str:
     return f"[[{','.join(_n(v) for v in p)}],[{','.join(_n(v, 6) for v in q)}]]"
 
 
-def confdata(job: ProgramJob, q: FloatArray) -> str:
-    """``[cf1, cf4, cf6, cfx]`` of the configuration q (6,) [rad] (module docstring)."""
-    r = job.robot
+def confdata(r: Kinematics, q: FloatArray) -> str:
+    """``[cf1, cf4, cf6, cfx]`` of the configuration q (6,) [rad] of the arm r (module docstring)."""
     quarter = [math.floor(math.degrees(q[i]) / 90.0 + 1e-9) for i in (0, 3, 5)]
     X_RA1 = r.fk(q, A1_FRAME)
     p_w, p2, p3 = (invert(X_RA1) @ np.append(r.fk(q, f)[:3, 3], 1.0) for f in (WRIST_FRAME, A2_FRAME, A3_FRAME))
@@ -126,7 +126,7 @@ def rapid_text(job: ProgramJob) -> str:
             continue
         n += 1
         X = X_BR @ np.asarray(seg.X_end) if seg.kind != "move" else X_BR @ robot.fk(q, "torch_tcp")
-        decl.append(f"  CONST robtarget p{n} := [{pose_text(X)[1:-1]},{confdata(job, q)},{_EXT}];")
+        decl.append(f"  CONST robtarget p{n} := [{pose_text(X)[1:-1]},{confdata(robot, q)},{_EXT}];")
         wobj = "tWeld \\WObj:=wobjPart"
         arc_next = nxt is not None and nxt.kind == "weld"
         if seg.kind == "weld":

@@ -54,3 +54,22 @@ def test_a5_beyond_half_a_turn_counts_by_kukas_ranges(robot: RobotModel) -> None
         q = base.copy()
         q[4] = math.radians(a5)
         assert status_turn(robot, q)[0] & 4 == bit2, a5
+
+
+@pytest.mark.parametrize(
+    ("axes_deg", "conf"),
+    [
+        ((0, -90, 90, 0, 0, 0), "[0,0,0,0]"),  # wrist in front of axis 1 and of the lower arm, axis 5 not negative
+        ((-100, -90, 90, 95, -30, -200), "[-2,1,-3,1]"),  # quarter turns floor(angle / 90), axis 5 negative
+        ((0, -150, 20, 0, 0, 0), "[0,0,0,4]"),  # the wrist behind axis 1 (the overhead area), still ahead of the arm
+        # lower arm leaning 30 deg forward, forearm bent back past its line (A3 -10): the wrist at x = +579 mm,
+        # 227 mm behind the lower arm's line
+        ((0, -60, -10, 0, 10, 0), "[0,0,0,2]"),
+    ],
+)
+def test_rapid_confdata_of_hand_worked_configurations(
+    robot: RobotModel, axes_deg: tuple[float, ...], conf: str
+) -> None:
+    from cell.export.rapid import confdata
+
+    assert confdata(robot, np.radians(axes_deg)) == conf

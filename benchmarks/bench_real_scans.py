@@ -62,6 +62,7 @@ SCANS: dict[str, tuple[str, tuple[float, float, float], float, str]] = {
 BOXES = {"wall": ((-14.0, 14.0), (-18.0, 18.0), (30.0, 200.0)), "top": ((8.0, 60.0), (-18.0, 18.0), (12.0, 32.0))}
 PLANE_BAND_MM = 3.0  # a plane's RANSAC inliers, before the least-squares refits
 WALL_X_MM = 25.4
+SLAB_M = 0.03  # the pictures show the points of a slab this thick about the seam's middle (the y walls: 25 mm)
 # Placements tried about the README's (dx, dy [mm], dyaw [deg]): the alignment must absorb them.
 OFFSETS = (
     (10.0, 0.0, 1.0),
@@ -230,7 +231,7 @@ def placements(cloud: Cloud, weldmap: Any, origin: Any, yaw: float, seen: str, r
 
 
 def picture(stem: str, P_F: FloatArray, est: Any, cad: Any, ind: dict[str, Any], folder: Path) -> Path:
-    """A PNG of the points in a 40 mm slab about the seam's middle, seen along the independent line: the located
+    """A PNG of the points in a SLAB_M slab about the seam's middle, seen along the independent line: the located
     seam, the independent line and the aligned CAD's seam as markers (mm from the independent line)."""
     import matplotlib
 
@@ -243,27 +244,31 @@ def picture(stem: str, P_F: FloatArray, est: Any, cad: Any, ind: dict[str, Any],
     across = np.cross(up, t)
     mid = p0 + t * 0.5 * (ind["extent"][0] + ind["extent"][1])
     d = P_F - mid
-    near = (np.abs(d @ t) < 0.02) & (np.abs(d @ across) < 0.07) & (np.abs(d @ up) < 0.07)
+    near = (np.abs(d @ t) < SLAB_M / 2) & (np.abs(d @ across) < 0.07) & (np.abs(d @ up) < 0.07)
 
     def uv(p: FloatArray) -> tuple[float, float]:
         q = np.asarray(p) - mid
         q = q - (q @ t) * t
         return float(q @ across * 1e3), float(q @ up * 1e3)
 
-    fig, ax = plt.subplots(figsize=(5.0, 4.4), dpi=90)
-    ax.scatter(d[near] @ across * 1e3, d[near] @ up * 1e3, s=2, c="0.55", lw=0, label="scan points (40 mm slab)")
-    ax.plot(*uv(p0), "k+", ms=14, mew=2, label="independent two-plane line")
-    c = uv(0.5 * (cad.p_start + cad.p_end))
-    ax.plot(*c, "bx", ms=10, mew=2, label="CAD seam (as aligned)")
-    if est.status is SeamStatus.FOUND:
-        m = uv(0.5 * (est.p_start + est.p_end))
-        ax.add_patch(plt.Circle(m, 2.0 * est.sigma_m * 1e3, fill=False, color="r", lw=1))
-        ax.plot(*m, "ro", ms=5, label=f"located (2 sigma = {2e3 * est.sigma_m:.1f} mm)")
-    ax.set_aspect("equal")
-    ax.set_xlabel("across the seam [mm]")
-    ax.set_ylabel("up [mm]")
-    ax.set_title(f"{stem}: {est.id}", fontsize=9)
-    ax.legend(fontsize=7, loc="upper right")
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 4.4), dpi=80)
+    for ax, half in zip(axes, (70.0, 6.0), strict=True):  # the whole corner, and zoomed on the seam
+        label = f"scan points ({SLAB_M * 1e3:.0f} mm slab)"
+        ax.scatter(d[near] @ across * 1e3, d[near] @ up * 1e3, s=2 if half > 10 else 8, c="0.55", lw=0, label=label)
+        ax.plot(*uv(p0), "k+", ms=14, mew=2, label="independent two-plane line")
+        ax.plot(*uv(0.5 * (cad.p_start + cad.p_end)), "bx", ms=10, mew=2, label="CAD seam (as aligned)")
+        if est.status is SeamStatus.FOUND:
+            m = uv(0.5 * (est.p_start + est.p_end))
+            ax.add_patch(plt.Circle(m, 2.0 * est.sigma_m * 1e3, fill=False, color="r", lw=1))
+            ax.plot(*m, "ro", ms=5, label=f"located (circle: 2 sigma = {2e3 * est.sigma_m:.1f} mm)")
+        ax.set_xlim(-half, half)
+        ax.set_ylim(-half, half)
+        ax.set_aspect("equal")
+        ax.set_xlabel("across the seam [mm]")
+        ax.set_ylabel("up [mm]")
+    axes[0].set_title(f"{stem}: {est.id}", fontsize=9)
+    axes[1].set_title("zoomed on the seam", fontsize=9)
+    axes[0].legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     folder.mkdir(parents=True, exist_ok=True)
     out = folder / f"{stem}.png"

@@ -18,8 +18,9 @@ map is ``maps/tee.dxf`` (drawn from the README's CAD sizes), the nominal placeme
   the located ends from that line, across it; along: the located ends against where face A's points along the
   line end (rough: one end is often shadowed);
 - the hidden fillet's status and reason (it must not be found);
-- the same from placements up to 2.8 cm and 3 degrees off the README's (:data:`OFFSETS`): how often the seen
-  fillet is found and how far it moves, and with no placement at all (the global registration).
+- the same from placements up to 2.8 cm and 3 degrees off the README's, and turned by 90 and 180 degrees
+  (:data:`OFFSETS`): how often the seen fillet is found and how far it moves, and with no placement at all (the
+  global registration).
 
 Results to ``--json`` (default ``benchmarks/results/real_scans.json``), a picture per scan (the points in a slab
 about the seam, seen along it, with the located seam, the independent line and the aligned CAD's seam) to
@@ -71,6 +72,8 @@ OFFSETS = (
     (0.0, -10.0, 1.0),
     (-15.0, 10.0, -2.0),
     (20.0, -20.0, 3.0),
+    (0.0, 0.0, 90.0),
+    (0.0, 0.0, 180.0),
 )
 
 

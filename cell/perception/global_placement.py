@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import correlate
+import scipy.fft as sfft
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
@@ -35,7 +35,8 @@ from cell.perception.unorganised import orient_normals
 from cell.types import Cloud, WeldMap
 
 YAW_STEP_DEG = 5.0  # turns tried by the height-image search
-CELL_M = 0.005  # its cells
+CELL_M, CELL_MAX_M = 0.005, 0.02  # its cells: the map's footprint diagonal over CELLS_ACROSS, within these
+CELLS_ACROSS = 100
 TOP_TURNS = 4  # turns whose best shift is proposed, ...
 DISTINCT_DEG, DISTINCT_M = 20.0, 0.03  # ... each this far from a better one in turn or in shift
 
@@ -78,36 +79,41 @@ def height_candidates(points_L: FloatArray, weldmap: WeldMap, table_z: float) ->
     if len(P) == 0:
         return []
     top = _map_height(weldmap, table_z)
-    # The map's height image about its origin: its parts' tops on a fine grid of their footprints.
     X0 = on_table(np.eye(4), weldmap, table_z)
+    v = np.vstack([transform_points(X0, p.vertices()) for p in weldmap.parts])
+    cell = min(CELL_MAX_M, max(CELL_M, float(np.linalg.norm(np.ptp(v[:, :2], axis=0))) / CELLS_ACROSS))
+    # The map's height image about its origin: its parts' tops on a grid of half cells over their footprints.
     samples = []
     for part in weldmap.parts:
         box = part.box
-        v = transform_points(X0, part.vertices())
-        h = float(v[:, 2].max()) - table_z
-        u = np.arange(-box.size[0] / 2, box.size[0] / 2 + 1e-9, CELL_M / 2)
-        w = np.arange(-box.size[1] / 2, box.size[1] / 2 + 1e-9, CELL_M / 2)
+        h = float(transform_points(X0, part.vertices())[:, 2].max()) - table_z
+        u = np.arange(-box.size[0] / 2, box.size[0] / 2 + 1e-9, cell / 2)
+        w = np.arange(-box.size[1] / 2, box.size[1] / 2 + 1e-9, cell / 2)
         uu, ww = np.meshgrid(u, w, indexing="ij")
         q_B = np.column_stack([uu.ravel(), ww.ravel(), np.full(uu.size, box.size[2] / 2)])
         q = transform_points(X0 @ box.X_AB, q_B)
         samples.append(np.column_stack([q[:, :2], np.full(len(q), h)]))
     S = np.vstack(samples)
-    R = math.ceil(float(np.linalg.norm(S[:, :2], axis=1).max()) / CELL_M) + 1
-    lo = P[:, :2].min(axis=0) - R * CELL_M
-    shape = tuple(int(v) for v in np.ceil((P[:, :2].max(axis=0) + R * CELL_M - lo) / CELL_M) + 1)
+    R = math.ceil(float(np.linalg.norm(S[:, :2], axis=1).max()) / cell) + 1
+    # The cloud's height image, padded by the map's reach R: the map's origin may sit on any cell of the points.
+    lo = P[:, :2].min(axis=0) - R * cell
+    shape = tuple(int(v) for v in np.ceil((P[:, :2].max(axis=0) + R * cell - lo) / cell) + 1)
     C = np.zeros(shape)
-    ij = np.floor((P[:, :2] - lo) / CELL_M).astype(int)
+    ij = np.floor((P[:, :2] - lo) / cell).astype(int)
     np.maximum.at(C, (ij[:, 0], ij[:, 1]), np.clip(P[:, 2] - table_z, 0.0, top))
+    size = (shape[0] + 2 * R, shape[1] + 2 * R)
+    F_C = sfft.rfft2(C, s=size)
     found = []
     for yaw in np.radians(np.arange(0.0, 360.0, YAW_STEP_DEG)):
         c, s = math.cos(yaw), math.sin(yaw)
         xy = S[:, :2] @ np.array([[c, s], [-s, c]])
         K = np.zeros((2 * R + 1, 2 * R + 1))
-        kij = np.floor(xy / CELL_M + 0.5).astype(int) + R
+        kij = np.floor(xy / cell + 0.5).astype(int) + R
         np.maximum.at(K, (kij[:, 0], kij[:, 1]), S[:, 2])
-        score = correlate(C, K, mode="same", method="fft")
+        # score[u] = sum_a C[u + a] K[a]: the map's origin (K's centre R) on C's cell u + R.
+        score = sfft.irfft2(F_C * np.conj(sfft.rfft2(K, s=size)), s=size)[: shape[0] - 2 * R, : shape[1] - 2 * R]
         best = np.unravel_index(int(np.argmax(score)), score.shape)
-        found.append((float(score[best]), yaw, lo + (np.array(best, dtype=np.float64) + 0.5) * CELL_M))
+        found.append((float(score[best]), yaw, lo + (np.array(best, dtype=np.float64) + R + 0.5) * cell))
     found.sort(key=lambda f: -f[0])
     kept: list[tuple[float, FloatArray]] = []
     for _, yaw, xy in found:  # the best turns that differ from a better one (by DISTINCT_DEG or DISTINCT_M)

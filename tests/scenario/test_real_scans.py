@@ -39,6 +39,7 @@ def bench() -> ModuleType:
     [
         ("x0y24", (0.0, 0.0, 0.0)),
         ("x0y24", (-10.0, 0.0, -1.0)),  # 1 cm and 1 deg further off (the sparse wall's seam was once lost so)
+        ("x4y24_45", (0.0, 0.0, 180.0)),  # turned round: the ICP alone settled there, the seams' ids swapped
         ("x4y24_45", (0.0, 0.0, 0.0)),
         ("longclamps_x4y24_45", (0.0, 0.0, 0.0)),
     ],

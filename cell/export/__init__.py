@@ -1,15 +1,19 @@
-"""What the cell writes: the JSON report (:mod:`cell.export.report`), the KUKA KRL program (:mod:`cell.export.krl`)
-and the joint trajectory as JSON and CSV (:mod:`cell.export.trajectory`); reports and programs are written whole
-(:mod:`cell.export.atomic`). Values in, files out: these modules read the vocabulary and the run records, never a
-stage (an import-linter contract)."""
+"""What the cell writes: the JSON report (:mod:`cell.export.report`), the robot program through a post-processor
+(:mod:`cell.export.program`, :mod:`cell.export.post`: KUKA KRL in :mod:`cell.export.krl`, ABB RAPID in
+:mod:`cell.export.rapid`; :mod:`cell.export.krl_check` re-reads a KRL program) and the joint trajectory as JSON and
+CSV (:mod:`cell.export.trajectory`); reports and programs are written whole (:mod:`cell.export.atomic`). Values in,
+files out: these modules read the vocabulary and the run records, never a stage (an import-linter contract)."""
 
 from cell.export.atomic import write_atomic
 from cell.export.krl import write_krl
+from cell.export.post import write_program
+from cell.export.program import ProgramJob
 from cell.export.report import detection_report, rescan_report, weld_report, write_json
 from cell.export.trajectory import write_csv
 from cell.export.trajectory import write_json as write_trajectory_json
 
 __all__ = [
+    "ProgramJob",
     "detection_report",
     "rescan_report",
     "weld_report",
@@ -17,5 +21,6 @@ __all__ = [
     "write_csv",
     "write_json",
     "write_krl",
+    "write_program",
     "write_trajectory_json",
 ]

@@ -18,9 +18,13 @@ a2 = -0.120, b = 0, c1 = 0.400, c2 = 0.600, c3 = 0.620, c4 = 0.115. The URDF pla
 A3 c2 further along the upper arm, A4 -a2 above the A3 axis, A5 c3 along the forearm and the flange c4
 beyond A5; tests/test_ik.py checks the forward kinematics against the OPW closed form.
 
-Collision and visual geometry are boxes and cylinders of roughly the real outline (no meshes); masses are
-rough estimates (the data sheet gives 127 kg in total) for the simulator only; inertias follow from the
-primitives.
+Geometry (docs/reference.md section 3): ``ENVELOPE`` is the real arm's outline, per link a few boxes and
+cylinders (lengths from the kinematics above, widths and heights the cell's estimates of the data sheet's
+dimension drawing, on the generous side), the dress pack (hose package) along the upper arm and the forearm,
+and a typical 22 deg-neck MAG torch to size. The visual shapes are the envelope; the collision shapes are the
+envelope grown by ``ARM_MARGIN`` on every side (the torch, whose nozzle must reach into the fillet, by
+``TORCH_MARGIN``), so they enclose the real arm (tests/unit/test_arm_envelope.py). Masses are rough estimates
+(the data sheet gives 127 kg in total) for the simulator only; inertias follow from the primitives.
 """
 
 from __future__ import annotations
@@ -58,12 +62,18 @@ ACCEL_PER_SPEED = 2.5  # [1/s]
 JERK_PER_ACCEL = 10.0  # [1/s]
 
 # Torch: a straight body along the flange x axis, then neck and wire bent by NECK_BEND towards -z of tool0.
+# A typical 22 deg-neck MAG torch for a 5 kg arm: a shock sensor (collision breaker) and clamp of about 70 mm
+# diameter on the flange, a 50 mm body, a 32 mm neck tube, a 25 mm gas nozzle.
 TORCH_BODY = 0.250  # flange to the bend [m]
 NECK_BEND = math.radians(22.0)  # [rad]
 NECK, NOZZLE, STICKOUT = 0.085, 0.030, 0.015  # bend to nozzle, nozzle length, contact tip to wire tip [m]
+SENSOR_LENGTH, SENSOR_RADIUS = 0.090, 0.035  # shock sensor and clamp on the flange [m]
+BODY_RADIUS, NECK_RADIUS, NOZZLE_RADIUS = 0.025, 0.016, 0.0125  # [m]
 # Eye-in-hand depth camera (RealSense D415 outline) above the torch body, pitched down to the wire tip.
 CAMERA_XYZ = (0.100, 0.0, 0.080)  # [m] in tool0
 CAMERA_PITCH = math.radians(25.0)  # [rad] about tool0 y: x (the viewing direction) tilted towards the torch tip
+ARM_MARGIN = 0.010  # [m] the arm's collision shapes: its envelope grown by this on every side
+TORCH_MARGIN = 0.0  # [m] the torch's: modelled to size (its nozzle reaches a few mm from both faces of a fillet)
 
 
 @dataclass(frozen=True)
@@ -75,13 +85,27 @@ class Shape:
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
+    def grown(self, margin: float) -> Shape:
+        """The same shape ``margin`` [m] larger on every side."""
+        if self.kind == "box":
+            return Shape("box", tuple(d + 2.0 * margin for d in self.dims), self.xyz, self.rpy)
+        r, h = self.dims
+        return Shape("cylinder", (r + margin, h + 2.0 * margin), self.xyz, self.rpy)
 
-def _along_x(r: float, x0: float, x1: float) -> Shape:
-    return Shape("cylinder", (r, x1 - x0), ((x0 + x1) / 2.0, 0.0, 0.0), (0.0, math.pi / 2.0, 0.0))
+
+def _along_x(r: float, x0: float, x1: float, y: float = 0.0, z: float = 0.0) -> Shape:
+    return Shape("cylinder", (r, x1 - x0), ((x0 + x1) / 2.0, y, z), (0.0, math.pi / 2.0, 0.0))
 
 
-def _along_y(r: float, length: float) -> Shape:
-    return Shape("cylinder", (r, length), (0.0, 0.0, 0.0), (math.pi / 2.0, 0.0, 0.0))
+def _along_y(r: float, length: float, x: float = 0.0) -> Shape:
+    return Shape("cylinder", (r, length), (x, 0.0, 0.0), (math.pi / 2.0, 0.0, 0.0))
+
+
+def _box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> Shape:
+    """The box between corners lo and hi [m]."""
+    size = tuple(b - a for a, b in zip(lo, hi, strict=True))
+    centre = tuple((a + b) / 2.0 for a, b in zip(lo, hi, strict=True))
+    return Shape("box", size, centre)  # type: ignore[arg-type]
 
 
 def _torch_shapes() -> tuple[Shape, ...]:
@@ -91,11 +115,11 @@ def _torch_shapes() -> tuple[Shape, ...]:
     neck_c = bend + d * NECK / 2.0
     nozzle_c = bend + d * (NECK + NOZZLE / 2.0)
     return (
-        Shape("box", (0.050, 0.080, 0.080), (0.025, 0.0, 0.0)),  # clamp and collision breaker on the flange
-        _along_x(0.022, 0.050, TORCH_BODY),  # torch body
+        _along_x(SENSOR_RADIUS, 0.0, SENSOR_LENGTH),  # clamp and shock sensor on the flange
+        _along_x(BODY_RADIUS, SENSOR_LENGTH, TORCH_BODY + BODY_RADIUS * math.tan(NECK_BEND / 2.0)),  # body
         Shape("box", (0.020, 0.030, 0.040), (CAMERA_XYZ[0], 0.0, 0.042)),  # camera bracket
-        Shape("cylinder", (0.016, NECK), tuple(neck_c), (0.0, pitch, 0.0)),  # bent neck
-        Shape("cylinder", (0.011, NOZZLE), tuple(nozzle_c), (0.0, pitch, 0.0)),  # gas nozzle
+        Shape("cylinder", (NECK_RADIUS, NECK), tuple(neck_c), (0.0, pitch, 0.0)),  # bent neck
+        Shape("cylinder", (NOZZLE_RADIUS, NOZZLE), tuple(nozzle_c), (0.0, pitch, 0.0)),  # gas nozzle
     )
 
 
@@ -106,26 +130,48 @@ def torch_tcp_xyz_rpy() -> tuple[tuple[float, ...], tuple[float, ...]]:
     return tuple(tip), (0.0, math.pi / 2.0 + NECK_BEND, 0.0)
 
 
-# (link, mass [kg], colour, shapes). Link frames: see the module docstring (arm drawn at zero joints).
-LINKS: tuple[tuple[str, float, str, tuple[Shape, ...]], ...] = (
-    ("base_link", 35.0, "grey", (Shape("box", (0.34, 0.34, 0.20), (0.0, 0.0, 0.10)),)),
-    (
-        "link_1",
-        30.0,
-        "orange",
-        (
-            Shape("cylinder", (0.15, 0.17), (0.0, 0.0, -0.115)),  # carousel, above the base
-            Shape("box", (0.28, 0.26, 0.14), (0.08, 0.0, 0.0)),  # shoulder housing around A2
-        ),
+# The real arm's outline per link [m], in the link frames at zero joints (arm stretched along +x; see the module
+# docstring); docs/reference.md section 3 gives the figures. Lengths follow the kinematics; widths and heights
+# are estimates of the dimension drawing, rounded up.
+ENVELOPE: dict[str, tuple[Shape, ...]] = {
+    "base_link": (_box((-0.17, -0.17, 0.0), (0.17, 0.17, 0.22)),),  # foot and A1 gear, 340 x 340 x 220
+    "link_1": (  # frame at A2's height (400 mm above the mounting face), A2 180 mm ahead
+        Shape("cylinder", (0.165, 0.18), (0.0, 0.0, -0.11)),  # carousel, 330 mm across, down to the base
+        _box((-0.10, -0.15, -0.13), (0.30, 0.15, 0.13)),  # shoulder and the A2 gear, 300 mm wide
+        _box((-0.24, -0.09, -0.15), (-0.08, 0.09, 0.10)),  # A1 and A2 motors behind the axis
     ),
-    ("link_2", 18.0, "orange", (_along_y(0.10, 0.18), Shape("box", (0.60, 0.12, 0.16), (0.30, 0.0, 0.0)))),
-    # elbow and the A4-A6 motors
-    ("link_3", 14.0, "orange", (Shape("box", (0.30, 0.18, 0.26), (-0.01, 0.0, 0.07)),)),
-    ("link_4", 6.0, "orange", (_along_x(0.065, 0.15, 0.55),)),  # forearm tube
-    ("link_5", 2.5, "orange", (_along_y(0.055, 0.13), Shape("box", (0.08, 0.09, 0.09), (0.06, 0.0, 0.0)))),
-    ("link_6", 0.4, "grey", (_along_x(0.04, -0.015, 0.0),)),  # flange disk behind the flange face
-    ("torch", 1.8, "dark", _torch_shapes()),
-    ("camera_link", 0.1, "black", (Shape("box", (0.023, 0.099, 0.020)),)),
+    "link_2": (  # upper arm, A2 to A3 (600 mm)
+        _along_y(0.12, 0.22),  # A2 hub, 240 mm across
+        _box((0.0, -0.085, -0.075), (0.60, 0.085, 0.075)),  # arm 170 x 150 mm
+        _along_y(0.10, 0.20, x=0.60),  # A3 hub
+        _along_x(0.035, 0.05, 0.55, z=0.13),  # dress pack (hose package) along the upper arm's back, 70 mm
+    ),
+    "link_3": (  # elbow: A3 hub, the A4 to A6 motors behind it, the forearm's root; A4 axis 120 mm above A3
+        _box((-0.18, -0.10, -0.11), (0.14, 0.10, 0.21)),
+        _along_x(0.035, -0.15, 0.10, z=0.245),  # the dress pack over the elbow
+    ),
+    "link_4": (  # forearm about A4, to A5 (620 mm)
+        _along_x(0.07, 0.15, 0.56),  # tube, 140 mm across (its root inside the elbow housing)
+        _along_x(0.03, 0.15, 0.50, z=0.10),  # the hose package's sleeve on the forearm
+    ),
+    "link_5": (_along_y(0.06, 0.14), _box((0.0, -0.05, -0.05), (0.10, 0.05, 0.05))),  # wrist: A5 hub, A6 gear
+    "link_6": (_along_x(0.04, -0.015, 0.0),),  # flange disk behind the flange face
+    "torch": _torch_shapes(),
+    "camera_link": (Shape("box", (0.023, 0.099, 0.020)),),
+}
+LINK_MARGIN = {name: (TORCH_MARGIN if name in ("torch", "camera_link") else ARM_MARGIN) for name in ENVELOPE}
+
+# (link, mass [kg], colour). Link frames: see the module docstring (arm drawn at zero joints).
+MASSES: tuple[tuple[str, float, str], ...] = (
+    ("base_link", 35.0, "grey"),
+    ("link_1", 30.0, "orange"),
+    ("link_2", 18.0, "orange"),
+    ("link_3", 14.0, "orange"),
+    ("link_4", 6.0, "orange"),
+    ("link_5", 2.5, "orange"),
+    ("link_6", 0.4, "grey"),
+    ("torch", 1.8, "dark"),
+    ("camera_link", 0.1, "black"),
 )
 # Links that are frames only; they get a negligible inertia so that simulators do not invent one (PyBullet
 # assumes 1 kg for a link without <inertial>).
@@ -193,7 +239,15 @@ def _geometry(parent: ET.Element, s: Shape) -> None:
         ET.SubElement(g, "cylinder", radius=_num(s.dims[0]), length=_num(s.dims[1]))
 
 
-def _link(robot: ET.Element, name: str, mass: float, colour: str | None, shapes: tuple[Shape, ...]) -> None:
+def _link(
+    robot: ET.Element,
+    name: str,
+    mass: float,
+    colour: str | None,
+    shapes: tuple[Shape, ...],
+    margin: float = 0.0,
+) -> None:
+    """A link whose visual shapes are ``shapes`` and whose collision shapes are those grown by ``margin`` [m]."""
     link = ET.SubElement(robot, "link", name=name)
     inertial = ET.SubElement(link, "inertial")
     if shapes:
@@ -207,9 +261,10 @@ def _link(robot: ET.Element, name: str, mass: float, colour: str | None, shapes:
     ET.SubElement(inertial, "inertia", {k: _num(float(inertia[i])) for k, i in zip(names, idx, strict=True)})
     for tag in ("visual", "collision"):
         for s in shapes:
+            g = s.grown(margin) if tag == "collision" else s
             el = ET.SubElement(link, tag)
-            _origin(el, s.xyz, s.rpy)
-            _geometry(el, s)
+            _origin(el, g.xyz, g.rpy)
+            _geometry(el, g)
             if tag == "visual" and colour is not None:
                 ET.SubElement(el, "material", name=colour)
 
@@ -227,8 +282,8 @@ def build_urdf() -> str:
     robot.append(ET.Comment(" Generated by robots/build_kr5_arc.py: edit that script, not this file. "))
     for name, rgba in COLOURS.items():
         ET.SubElement(ET.SubElement(robot, "material", name=name), "color", rgba=rgba)
-    for name, mass, colour, shapes in LINKS:
-        _link(robot, name, mass, colour, shapes)
+    for name, mass, colour in MASSES:
+        _link(robot, name, mass, colour, ENVELOPE[name], LINK_MARGIN[name])
     for name in FRAME_LINKS:
         _link(robot, name, 0.001, None, ())
     _fixed(robot, "base_link", "base", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))  # $ROBROOT

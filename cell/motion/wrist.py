@@ -5,9 +5,10 @@ A spherical wrist reaches one flange pose in several ways (docs/reference.md sec
 turn a whole revolution within their +-350 deg ranges, and the wrist may flip (A4 + 180 deg, -A5, A6 + 180 deg).
 They hold the torch alike, but not the hose package: the dress pack winds round A6, so A6 must stay within a
 window of cable travel around its reference (``PlanOptions.a6_window`` either side of ``a6_center``), and a
-flip between neighbouring seams swings A4 by half a turn. The torch search therefore holds every seam's torch
-with the equivalent nearest one reference wrist shared by all seams (A4 of the home configuration, A6 at the
-window's centre), so any two seams are near each other whatever their order.
+flip between neighbouring seams (A5 changing sign, KUKA's status bit 2) swings A4 by half a turn. The torch
+search therefore holds every seam's torch with A6 in the window, the wrist on the reference's side (A5 of the
+home configuration's sign) and, among those, the equivalent nearest one reference wrist shared by all seams
+(A4 of the home configuration, A6 at the window's centre), so seams are near each other whatever their order.
 
 Joints [rad]; the wrist is the last three joints (A4, A5, A6).
 """
@@ -75,8 +76,13 @@ def wrist_cost(q: FloatArray, q_ref: FloatArray) -> float:
     return float(abs(q[-3] - q_ref[-3]) + abs(q[-1] - q_ref[-1]))
 
 
+def flipped(q: FloatArray, q_ref: FloatArray) -> bool:
+    """Whether q's wrist (dof,) is flipped against q_ref's: A5 of the other sign (KUKA's status bit 2)."""
+    return bool(np.sign(q[-2]) * np.sign(q_ref[-2]) < 0.0)
+
+
 def nearest_wrist(robot: RobotModel, q: FloatArray, q_ref: FloatArray, window: HoseWindow) -> FloatArray:
-    """The equivalent of q (dof,) nearest the reference wrist q_ref (dof,), preferring those with A6 in the
-    window (q itself when none is within the limits)."""
+    """The equivalent of q (dof,) to hold the torch with: A6 in the window first, then the wrist not flipped
+    against the reference q_ref (dof,), then nearest it (q itself when no equivalent is within the limits)."""
     cands = wrist_equivalents(robot, q) or [np.asarray(q, dtype=float)]
-    return min(cands, key=lambda c: (window.excess(c) > 0.0, wrist_cost(c, q_ref)))
+    return min(cands, key=lambda c: (window.excess(c) > 0.0, flipped(c, q_ref), wrist_cost(c, q_ref)))

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import time
 import zlib
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -38,9 +38,11 @@ from cell.perception.global_placement import DISTINCT_DEG, DISTINCT_M, fpfh_cand
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
-from cell.pipeline.cloud_seams import evaluate, locate_seams
+from cell.pipeline.cloud_seams import locate_seams
 from cell.pipeline.cloud_setup import FRAME as _FRAME
 from cell.pipeline.cloud_setup import crop_mask, scenario_for
+from cell.pipeline.evaluation import evaluate
+from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Detection
 from cell.scenario import PerceptionSpec, Scenario
 from cell.seams.joint import find_joints
@@ -56,15 +58,6 @@ from cell.types import (
     WeldMap,
 )
 from cell.voxels import voxel_order
-
-# The same type and default as cell.pipeline.detect's, written here: detect imports the station (the simulator),
-# which a brought cloud must never pull in.
-Progress = Callable[[str], None]
-
-
-def quiet(_: str) -> None:
-    return None
-
 
 POOR_FITNESS = 0.6  # a fit from the nominal placement below this fitness is retried from a global registration
 CHALLENGE_MARGIN = 1.05  # a fit elsewhere must explain this many times the placement's fit's points to replace it

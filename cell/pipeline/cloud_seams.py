@@ -1,19 +1,17 @@
-"""The seams of a brought cloud's aligned map, located and screened (for :func:`cell.pipeline.cloud.locate_cloud`),
-and measured against a truth when one is given: the steps of :func:`cell.pipeline.detect.locate` and
-:func:`~cell.pipeline.detect.evaluate` without their module's import of the station (a brought cloud never pulls in
-the simulator), our locator built with the crop of the brought cloud rather than a scenario's workspace."""
+"""The seams of a brought cloud's aligned map, located and screened (for :func:`cell.pipeline.cloud.locate_cloud`):
+the steps of :func:`cell.pipeline.detect.locate` without its module's import of the station (a brought cloud never
+pulls in the simulator), our locator built with the crop of the brought cloud rather than a scenario's workspace."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import fields, replace
 
-from cell.geometry import FloatArray
 from cell.perception.seam_screen import screen
 from cell.scenario import Scenario
 from cell.seams.visibility import visibility
-from cell.types import Box, MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus
+from cell.types import Box, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
 def locate_seams(
@@ -58,14 +56,3 @@ def unseen_reason(est: SeamEstimate) -> SeamEstimate:
         return est
     why = "; in a cloud without a camera's per-pixel density an unseen face is not placed from an edge"
     return replace(est, reason=est.reason[:cut] + ": shadowed or hidden from the sensor" + why)
-
-
-def evaluate(
-    estimates: Sequence[SeamEstimate], truth: Mapping[str, tuple[FloatArray, FloatArray]]
-) -> tuple[dict[str, SeamMetrics], MetricsSummary]:
-    """Per-seam metrics against ``truth`` (none when it is empty) and the summary (as cell.pipeline.detect's)."""
-    from cell.seams.metrics import evaluate as metrics_of
-    from cell.seams.metrics import summarise
-
-    per_seam = metrics_of(estimates, truth) if truth else {}
-    return per_seam, summarise(estimates, per_seam)

@@ -83,14 +83,9 @@ def scans_dir() -> Path:
 
 
 def read_scan(path: Path) -> Cloud:
-    """The scan's points (metres, the robot base frame, named ``base``): the cell's cloud reader when there is one,
-    else the ASCII PCD body read by numpy (the files are ``x y z`` rows after ``DATA ascii``)."""
-    try:
-        from cell.perception.cloud_files import read_cloud
-    except ImportError:
-        lines = path.read_text().splitlines()
-        start = next(i for i, line in enumerate(lines) if line.strip().lower().startswith("data")) + 1
-        return Cloud(np.loadtxt(lines[start:], dtype=np.float64).reshape(-1, 3), "base")
+    """The scan's points (metres, the robot base frame, named ``base``), read as ``cell locate`` reads them."""
+    from cell.perception.cloud_files import read_cloud
+
     return read_cloud(path, frame="base")
 
 

@@ -59,15 +59,25 @@ def _offsets(tol: float, step: float) -> list[float]:
 
 
 def candidate_groups(process: WeldProcess, options: PlanOptions) -> list[list[Candidate]]:
-    """Candidate groups, one per (work, travel) angle setting, nominal first then widening."""
+    """Candidate groups, one per (work, travel) angle setting, nominal first then widening. With one direction
+    only (not ``process.reversible``) a travel offset also counts by its distance from the mirrored nominal (the
+    other direction's tilt of the torch: push a in one direction is drag -a in the other), so the search widens
+    about both as it would have with both directions free."""
     pr, opt = process, options
+
+    def cost(wa: tuple[float, float]) -> tuple[float, float]:
+        w, a = wa
+        if pr.reversible:
+            return abs(w) + abs(a), abs(w)
+        return round(abs(w) + min(abs(a), abs(a + 2.0 * pr.travel_angle)), 9), abs(w)
+
     angles = sorted(
         (
             (w, a)
             for w in _offsets(pr.work_angle_tol, opt.angle_step)
             for a in _offsets(pr.travel_angle_tol, opt.angle_step)
         ),
-        key=lambda wa: (abs(wa[0]) + abs(wa[1]), abs(wa[0])),
+        key=cost,
     )
     spins = sorted(  # ordered so that neighbours warm-start each other's IK; pi and -pi coincide
         {round(s, 12) for s in _offsets(pr.spin_tol, opt.spin_step) if -math.pi + 1e-9 < s <= math.pi + 1e-9}

@@ -4,15 +4,20 @@ passes the plan."""
 
 from __future__ import annotations
 
+import math
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.geometry import point_line_distance
+from cell.motion.candidates import candidate_groups
 from cell.motion.collision import CollisionChecker
 from cell.motion.gate import find_violations
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds
+from cell.motion.plan_options import PlanOptions
 from cell.motion.procedures import NoProcedure, select_procedures
 from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess
@@ -104,3 +109,15 @@ def test_a_seam_without_a_procedure_is_a_reason(robot: RobotModel) -> None:
     assert isinstance(sel["top"], NoProcedure)
     plan = plan_welds(robot, [TOP], HOME, PROCESS, OBSTACLES, procedures=sel)
     assert plan.outcome("top").code is PlanReason.NO_PROCEDURE and not plan.segments
+
+
+def test_one_direction_widens_about_the_mirrored_nominal_too() -> None:
+    opt = PlanOptions()
+    fixed = replace(PROCESS, reversible=False, travel_angle_tol=PROCESS.travel_angle_tol + 2 * PROCESS.travel_angle)
+    groups = candidate_groups(fixed, opt)
+    travel = [round(math.degrees(PROCESS.travel_angle + g[0].travel_offset)) for g in groups if g[0].work_offset == 0]
+    assert travel[:2] == [10, -10]  # the nominal push first, then the same tilt dragging (the other direction's)
+    assert travel.index(-20) < travel.index(25)  # -20 is 10 deg from the mirror, 25 is 15 deg from the nominal
+    assert all(not c.reversed for g in groups for c in g)
+    free = candidate_groups(PROCESS, opt)  # both directions: ordered by the offset alone, as before
+    assert [round(math.degrees(g[0].travel_offset)) for g in free if g[0].work_offset == 0][:3] == [0, 5, -5]

@@ -63,12 +63,12 @@ JERK_PER_ACCEL = 10.0  # [1/s]
 
 # Torch: a straight body along the flange x axis, then neck and wire bent by NECK_BEND towards -z of tool0.
 # A typical 22 deg-neck MAG torch for a 5 kg arm: a shock sensor (collision breaker) and clamp of about 70 mm
-# diameter on the flange, a 50 mm body, a 32 mm neck tube, a 25 mm gas nozzle.
+# diameter on the flange, a 44 mm body, a 32 mm neck tube, a 25 mm gas nozzle.
 TORCH_BODY = 0.250  # flange to the bend [m]
 NECK_BEND = math.radians(22.0)  # [rad]
 NECK, NOZZLE, STICKOUT = 0.085, 0.030, 0.015  # bend to nozzle, nozzle length, contact tip to wire tip [m]
 SENSOR_LENGTH, SENSOR_RADIUS = 0.090, 0.035  # shock sensor and clamp on the flange [m]
-BODY_RADIUS, NECK_RADIUS, NOZZLE_RADIUS = 0.025, 0.016, 0.0125  # [m]
+BODY_RADIUS, NECK_RADIUS, NOZZLE_RADIUS = 0.022, 0.016, 0.0125  # [m]
 # Eye-in-hand depth camera (RealSense D415 outline) above the torch body, pitched down to the wire tip.
 CAMERA_XYZ = (0.100, 0.0, 0.080)  # [m] in tool0
 CAMERA_PITCH = math.radians(25.0)  # [rad] about tool0 y: x (the viewing direction) tilted towards the torch tip

@@ -107,7 +107,7 @@ class ViewOptions:
     face_strip_m: float = 0.03  # width of each weld face next to the seam that must be in view
     end_margin_m: float = 0.01  # the seam's line beyond its ends that must be in view
     image_margin_px: float = 24.0  # kept free along the image border
-    torch_radius_m: float = 0.03  # the torch's radius about its axis, with margin (URDF body: 25 mm)
+    torch_radius_m: float = 0.03  # the torch's radius about its axis, with margin (URDF body: 22 mm)
     torch_margin_px: float = 12.0
     occlusion_margin_m: float = 0.001  # parts grown by this for the line-of-sight test
     distance_weight_deg_per_m: float = 200.0  # score: 10 deg of incidence for 5 cm off the preferred distance

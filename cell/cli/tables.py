@@ -71,6 +71,12 @@ def _emit(t: Table, columns: Sequence[str], rows: Sequence[Sequence[str]], fmt: 
     return False
 
 
+def _data(rep: dict) -> str:
+    """What the data were: the simulated noise, or where they came from when nothing was simulated."""
+    noise = rep.get("noise")
+    return f"noise {noise}" if noise is not None else f"data: {rep.get('source', 'recorded')}"
+
+
 def _frame(rep: dict) -> str:
     """The frame every point of a report is in (R for a scenario run, the cloud's own for cell locate)."""
     return str(rep.get("frame", "R"))
@@ -78,7 +84,7 @@ def _frame(rep: dict) -> str:
 
 def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
     t = Table(
-        title=f"{title} {rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame {_frame(rep)}",
+        title=f"{title} {rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
         title_justify="left",
     )
     columns = (
@@ -143,7 +149,7 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
 
     rep = det if isinstance(det, dict) else detection_report(det)
     t = Table(
-        title=f"{rep['scenario']} · method {rep['method']} · noise {rep['noise']} · frame {_frame(rep)}",
+        title=f"{rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
         title_justify="left",
     )
     columns = ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason")

@@ -83,7 +83,9 @@ def detection_report(
         "provenance": dict(provenance) if provenance is not None else None,
         "scenario": det.scenario.name,
         "method": det.method,
-        "noise": det.scenario.noise,
+        "source": det.source,
+        # The sensor noise this run simulated: none was simulated for a replayed capture or a brought cloud.
+        "noise": det.scenario.noise if det.source == "simulation" else None,
         "frame": det.weldmap_R.frame,
         "units": "m",
         "X_WR": [[_r(v, 9) for v in row] for row in det.scenario.X_WR],

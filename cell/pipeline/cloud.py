@@ -187,6 +187,7 @@ def locate_cloud(
         summary=summary,
         timings=timings,
         joints=joints,
+        source="cloud",
     )
 
 
@@ -320,6 +321,7 @@ def _failed(
         timings=timings,
         error=error,
         joints=joints,
+        source="cloud",
     )
 
 

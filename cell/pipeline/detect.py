@@ -48,9 +48,14 @@ def capture(
         progress(f"building the cell of {scenario.name}")
         with open_station(scenario, weldmap, gui=gui) as st:
             return capture(scenario, progress=progress, station=st, weldmap=weldmap)
-    progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
+    if station.source == "simulation":
+        progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
+    else:
+        progress(f"reading {len(scenario.cameras)} depth cameras' images ({station.source})")
     images = station.capture()
-    return Capture(scenario, weldmap, find_joints(weldmap), station.truth(), images, time.perf_counter() - t0)
+    return Capture(
+        scenario, weldmap, find_joints(weldmap), station.truth(), images, time.perf_counter() - t0, station.source
+    )
 
 
 def table_z_R(scenario: Scenario) -> float:
@@ -197,6 +202,7 @@ def detect(
         lost_cameras=tuple(scene.perceived.lost_described()),
         scene=scene,
         joints=cap.joints,
+        source=cap.source,
     )
 
 
@@ -231,4 +237,5 @@ def _failed_detection(cap: Capture, method: str, error: CellError, seconds: floa
         timings={"capture_s": cap.seconds, "total_s": seconds},
         error=error,
         joints=cap.joints,
+        source=cap.source,
     )

@@ -46,6 +46,7 @@ class Capture:
     parts_W: tuple[Part, ...] | None  # as built, world frame (ground truth), None when unknown
     images: Mapping[str, DepthImage]
     seconds: float
+    source: str = "simulation"  # where the images came from (Station.source)
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,7 @@ class Detection:
     scene: Scene | None = None
     error: CellError | None = None  # perception or alignment failed: no seam was searched (report still written)
     joints: Mapping[str, Joint] = field(default_factory=dict)  # seam id -> how it is made
+    source: str = "simulation"  # the data's origin: simulation | capture (replayed) | cloud (brought) | camera
 
     def records(self) -> tuple[SeamRecord, ...]:
         """One :class:`~cell.types.SeamRecord` per seam of the map, in map order: seam, joint, estimate, truth,

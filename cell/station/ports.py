@@ -47,6 +47,12 @@ class Station(Protocol):
         """The robot, or None for a cell without one (cameras only)."""
         ...
 
+    @property
+    def source(self) -> str:
+        """Where its images come from: ``simulation`` (rendered now, with the scenario's noise), ``capture`` (a
+        recorded folder) or ``camera`` (a real cell's)."""
+        ...
+
     def capture(self) -> Mapping[str, DepthImage]:
         """One depth image from every camera, by name; the arm (if any) first goes to its scan configuration."""
         ...

@@ -46,6 +46,10 @@ class RecordedStation:
     def arm(self) -> Arm | None:
         return None
 
+    @property
+    def source(self) -> str:
+        return "capture"
+
     def capture(self) -> dict[str, DepthImage]:
         """The recorded image of every camera, by name (the same values every call)."""
         return dict(self.recorded.images)

@@ -53,6 +53,10 @@ class SimStation:
     def arm(self) -> Arm | None:
         return self._arm
 
+    @property
+    def source(self) -> str:
+        return "simulation"
+
     def capture(self) -> dict[str, DepthImage]:
         """One image from every camera; the arm (if any) holds the eye-in-hand camera at its scan pose."""
         if self._arm is not None:

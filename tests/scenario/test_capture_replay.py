@@ -20,9 +20,10 @@ from cell.recorded import read_capture
 from cell.recorded.cell_file import replay_scenario
 from cell.station.recorded import RecordedStation
 
-# What a replay may change: when and how long (provenance, timings), the map file's name (copied beside cell.yaml)
-# and the simulation section the capture's cell.yaml leaves out (a replay simulates nothing).
-UNCOMPARED = ("provenance", "timings_s", "time_ms", "time_ms_per_seam_median")
+# What a replay may change: when and how long (provenance, timings), the map file's name (copied beside cell.yaml),
+# the simulation section the capture's cell.yaml leaves out, and what the data were (a replay simulates nothing: its
+# source is "capture" and its noise null, checked below).
+UNCOMPARED = ("provenance", "timings_s", "time_ms", "time_ms_per_seam_median", "source", "noise")
 
 
 def numbers(report: dict[str, Any]) -> dict[str, Any]:
@@ -73,7 +74,10 @@ def test_a_fence1_capture_replays_to_the_same_report(tmp_path: Path, fence1_dete
     assert 0.01 < np.linalg.norm((np.linalg.inv(rec.X_RF["eye_in_hand"]) @ rec.X_RC("eye_in_hand"))[:3, 3]) < 0.3
     det = replayed(folder)
     assert det.error is None and det.summary.found > 0
-    assert numbers(detection_report(det)) == numbers(detection_report(fence1_detection))
+    replay, simulated = detection_report(det), detection_report(fence1_detection)
+    assert (replay["source"], replay["noise"]) == ("capture", None)
+    assert (simulated["source"], simulated["noise"]) == ("simulation", "realistic")
+    assert numbers(replay) == numbers(simulated)
 
 
 def test_a_fault_capture_replays_to_the_same_report_without_the_simulator(

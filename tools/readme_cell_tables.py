@@ -224,3 +224,25 @@ def faults_table(rows: Sequence[Row]) -> str:
         welded = f"{r['welded']}/{r['visible']}" if "welded" in r else "-"
         lines.append(f"| {label} | {fault_sentence(r)} | {welded} | {_f(r.get('tcp_max_mm'), 2)} | {r['exit_code']} |")
     return "\n".join(lines) + "\n"
+
+
+def real_scans_table(data: Row) -> str:
+    """The tee's fillets in the three real lidar scans (``real_scans.json``): the seen fillet against an independent
+    two-plane fit and against the aligned CAD, its sigma, the hidden fillet's status, the placements tried."""
+    lines = [
+        "| scan | points | seen fillet | vs independent line [mm] | vs aligned CAD [mm] | sigma [mm] | hidden fillet "
+        "| other placements found |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for s in data["scans"]:
+        seen = s["seen"]
+        hidden = next(k for k in s if k.startswith(seen.split(":")[0] + ":") and k != seen)
+        f = s["found"]
+        p = s["placements"]
+        found = f"{p['found'] + (p['without_placement']['status'] == 'found')}/{p['tried'] + 1}"
+        lines.append(
+            f"| {s['scan']} | {s['points']:,} | {seen.split(':')[1]} {s[seen]['status'].replace('_', ' ')} "
+            f"| {f['lateral_vs_independent_mm']:.2f} | {f['lateral_vs_cad_mm']:.2f} | {f['sigma_mm']:.2f} "
+            f"| {hidden.split(':')[1]} {s[hidden]['status'].replace('_', ' ')} | {found} |"
+        )
+    return "\n".join(lines) + "\n"

@@ -40,6 +40,20 @@ def capture(
         Path | None, typer.Option("--from-bag", help="Convert this ROS 2 bag instead of simulating SCENARIO.")
     ] = None,
     noise: NoiseOpt = None,
+    depth_topic: Annotated[
+        list[str] | None,
+        typer.Option("--depth-topic", help="A bag's depth image topic to take (repeat; default: every one, by name)."),
+    ] = None,
+    base_frame: Annotated[
+        str | None, typer.Option(help="The bag's robot base frame (default: base_link, else the tf tree's root).")
+    ] = None,
+    at_time: Annotated[
+        float | None,
+        typer.Option("--time", help="Take each camera's image nearest this time [s from the bag's start]."),
+    ] = None,
+    max_tf_gap: Annotated[
+        float, typer.Option(help="Largest gap [s] between an image and the moving transform used for it.")
+    ] = 0.1,
 ) -> None:
     """Write what the cameras saw as a capture folder: 16-bit depth PNGs, CameraInfo, poses, cell.yaml, truth.
 
@@ -52,27 +66,26 @@ def capture(
             raise UsageError("give SCENARIO or --from-bag BAG (one of them); valid: cell capture fence1 --out DIR")
         if from_bag is not None and noise is not None:
             raise UsageError("--noise simulates a sensor; a bag holds what its cameras saw; valid: leave it out")
+        bag_only = {"--depth-topic": depth_topic, "--base-frame": base_frame, "--time": at_time}
+        if from_bag is None and (given := [k for k, v in bag_only.items() if v is not None]):
+            raise UsageError(f"{', '.join(given)} only apply to --from-bag BAG; valid: leave them out for SCENARIO")
+        if max_tf_gap <= 0.0:
+            raise UsageError(f"--max-tf-gap {max_tf_gap}; valid: a positive number of seconds")
         check_folder(out_dir, "--out")
         t0 = time.perf_counter()
         if from_bag is not None:
-            folder = _from_bag(from_bag, out_dir)
+            options = {"depth_topics": depth_topic, "base_frame": base_frame, "time": at_time}
+            folder = _from_bag(from_bag, out_dir, max_tf_gap_s=max_tf_gap, **options)
         else:
             assert scenario is not None
             folder = _simulated(scenario, out_dir, parse_noise(noise))
         say(f"capture written to {folder} ({time.perf_counter() - t0:.1f} s)")
 
 
-def _from_bag(bag: Path, out_dir: Path) -> Path:
-    import importlib
+def _from_bag(bag: Path, out_dir: Path, **options: Any) -> Path:
+    from cell.recorded.bag import capture_from_bag
 
-    try:
-        convert = getattr(importlib.import_module("cell.recorded.bag"), "capture_from_bag", None)
-    except ImportError:
-        convert = None
-    if convert is None:
-        raise UsageError("--from-bag is not available in this version (cell.recorded.bag); valid: SCENARIO")
-    folder: Path = convert(bag, out_dir, progress=say)
-    return folder
+    return capture_from_bag(bag, out_dir, progress=say, **options)
 
 
 def _simulated(name: str, out_dir: Path, noise: Any) -> Path:

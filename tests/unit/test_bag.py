@@ -218,6 +218,21 @@ def test_cli_converts_a_bag_and_refuses_a_bad_one(two_cameras: Path, tmp_path: P
     result = CliRunner().invoke(app, ["capture", "--from-bag", str(two_cameras), "--out", str(out)])
     assert result.exit_code == 0, result.output
     assert set(read_capture(out).images) == {"fixed_cam", "arm_cam"}
+    one = tmp_path / "one"  # the bag's options reach the reader: one topic, a named base frame
+    argv = [
+        "capture",
+        "--from-bag",
+        str(two_cameras),
+        "--out",
+        str(one),
+        "--depth-topic",
+        "/arm_cam/depth/image_rect_raw",
+    ]
+    result = CliRunner().invoke(app, [*argv, "--base-frame", "base_link", "--max-tf-gap", "0.05"])
+    assert result.exit_code == 0, result.output
+    assert set(read_capture(one).images) == {"arm_cam"}
+    result = CliRunner().invoke(app, ["capture", "fence1", "--out", str(tmp_path / "c3"), "--time", "1.0"])
+    assert result.exit_code == 2 and "--time only apply to --from-bag" in result.output
     notes = tmp_path / "notes.txt"
     notes.write_text("not a bag")
     result = CliRunner().invoke(app, ["capture", "--from-bag", str(notes), "--out", str(tmp_path / "c2")])

@@ -157,6 +157,8 @@ def locate_cloud(
         assert error is not None
         return _failed(scenario, weldmap, joints, X_FL, X_LM0, table_z, method, error, timings, t_all, cloud.frame)
     X_LM = alignment.X_RR_corr @ X_LM0
+    if X_FM_nominal is not None:
+        progress(_placement_error(X_FM_nominal, X_FL @ X_LM))
     map_L = weldmap.transformed(X_LM, _FRAME)
     crop = crop_mask(P_L, above, map_L)
     dense_L = Cloud(P_L[crop], _FRAME)
@@ -189,6 +191,14 @@ def locate_cloud(
         joints=joints,
         source="cloud",
     )
+
+
+def _placement_error(X_FM_nominal: FloatArray, X_FM: FloatArray) -> str:
+    """How far the part was found from the placement given (a line for the progress log)."""
+    X_d = invert(X_FM_nominal) @ X_FM
+    shift_mm = 1000.0 * float(np.linalg.norm(X_FM[:3, 3] - X_FM_nominal[:3, 3]))
+    angle_deg = float(np.degrees(np.arccos(np.clip((np.trace(X_d[:3, :3]) - 1.0) / 2.0, -1.0, 1.0))))
+    return f"the part lies {shift_mm:.1f} mm and {angle_deg:.1f} deg from the placement given"
 
 
 def _levelled(table: TablePlane, X_LF: FloatArray) -> TablePlane:

@@ -35,7 +35,7 @@ from cell.motion.torch import WeldProcess, back_off, line_poses, torch_poses
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
 from cell.types.plan import PlanReason, SeamTask
 
-_GOOD = 0.8  # candidates within this share of the best start manipulability are ranked by their wrist
+_GOOD = 0.6  # candidates within this share of the best start manipulability are ranked by their wrist
 
 
 @dataclass(frozen=True)

@@ -56,8 +56,8 @@ def test_the_hose_window_steers_the_free_spin(robot: RobotModel) -> None:
     free = plan_welds(robot, tasks, HOME, PROCESS, OBSTACLES)
     a6_free = np.concatenate([s.trajectory.q[:, 5] for s in free.segments])
     assert all(o.feasible for o in free.seams)
-    centre, half = math.radians(-45.0), math.radians(50.0)  # home's A6 (0) inside, the free plan's outside
-    assert np.min(a6_free) < centre - half  # measured -105 deg
+    centre, half = math.radians(30.0), math.radians(60.0)  # home's A6 (0) inside, the free plan's outside
+    assert np.min(a6_free) < centre - half  # measured -82 deg
     steered = plan_welds(robot, tasks, HOME, PROCESS, OBSTACLES, options=PlanOptions(a6_window=half, a6_center=centre))
     assert all(o.feasible for o in steered.seams)
     assert {o.spin for o in steered.seams} != {o.spin for o in free.seams}  # other spins keep A6 in the window

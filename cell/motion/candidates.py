@@ -4,7 +4,11 @@
    about the torch axis (``spin_step`` apart, within the process's spin tolerance) x work/travel angles
    (nominal first, then widened in ``angle_step`` steps within their tolerances, docs/reference.md section 7).
    A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK;
-   the rest get IK at the weld start, ranked by manipulability.
+   the rest get IK at the weld start, each held with the wrist equivalent (:mod:`cell.motion.wrist`: A4 and A6
+   turned by whole turns, the flipped wrist) with A6 in the hose package's window, on home's side of the wrist
+   (A5's sign) and nearest the reference wrist every seam shares. They are ranked: A6 in the window first, then
+   those within ``_GOOD`` of the best start manipulability, nearest that reference first (so the free spin
+   keeps A6 near the window's centre), then the rest by manipulability.
 2. The best candidates are solved along the seam (warm-started IK every ``spacing``, no joint jump beyond
    ``max_joint_step``), along the approach line (back along the torch axis to ``process.approach``) and the
    depart line, checked against singularities and for collisions (conservative advancement between knots).

@@ -9,12 +9,20 @@ then IK, approach, depart, singularity and collision checks exactly as for the s
 itself: its solution is returned unchanged. :func:`pass_pieces` times the passes (each weld at its pass's travel
 speed, rest to rest: its own arc on and off) with a transfer between one pass's depart and the next's approach.
 
+The craters are part of each pass's weld segment (arc on): the torch holds at rest at the weld start for the
+procedure's ``crater_start_s`` (hot start) before it travels, and at the weld end for ``crater_end_s`` (crater
+fill) before the arc goes off (:func:`with_craters`). The segment stays one motion (one LIN in a program, whose
+controller holds the craters itself from the weld data); its duration, the cycle time and the arc time include
+the holds.
+
 Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+
+import numpy as np
 
 from cell.errors import IKError
 from cell.motion.assembly import seam_pieces
@@ -27,6 +35,7 @@ from cell.motion.torch import WeldProcess, torch_poses
 from cell.motion.transfers import Piece, TransferFail, Transfers
 from cell.motion.weave import cross_section, knot_spacing, offset_poses, pass_speed
 from cell.types.procedure import WeldProcedure
+from cell.types.trajectory import Trajectory
 
 
 def is_plain(procedure: WeldProcedure) -> bool:
@@ -95,4 +104,23 @@ def pass_pieces(
                 return moves
             pieces += moves
         pieces += seam_pieces(robot, pr, options, sol)
+        if procedure is not None:
+            pieces[-2] = with_craters(pieces[-2], procedure.crater_start_s, procedure.crater_end_s, options.dt)
     return pieces
+
+
+def with_craters(weld: Piece, start_s: float, end_s: float, dt: float) -> Piece:
+    """The weld piece with the torch held at rest at its first sample for ``start_s`` [s] and at its last for
+    ``end_s`` [s] (each rounded to whole sample periods ``dt`` [s]); the weld itself shifted, unchanged."""
+    tr = weld.trajectory
+    n0, n1 = round(start_s / dt), round(end_s / dt)
+    if n0 == 0 and n1 == 0:
+        return weld
+    dof = tr.dof
+    times = np.concatenate([np.arange(n0) * dt, n0 * dt + tr.times, tr.duration + n0 * dt + np.arange(1, n1 + 1) * dt])
+    q = np.concatenate([np.repeat(tr.q[:1], n0, axis=0), tr.q, np.repeat(tr.q[-1:], n1, axis=0)])
+    zeros = np.zeros((n0 + len(tr.times) + n1, dof))
+    qd, qdd = zeros.copy(), zeros.copy()
+    qd[n0 : n0 + len(tr.times)] = tr.qd
+    qdd[n0 : n0 + len(tr.times)] = tr.qdd
+    return weld._replace(trajectory=Trajectory(times, q, qd, qdd))

@@ -30,9 +30,15 @@ SIDE = SeamTask(*SIDE_SEAM)
 SIDE_DOWN = SeamTask("side", SIDE.p_end, SIDE.p_start, SIDE.n_a, SIDE.n_b)  # drawn downwards
 PROCESS = WeldProcess.from_spec(sc.ProcessSpec())
 WEAVE = WeldProcedure(
-    "weave", position="PF", travel_speed_mm_s=4.0, travel_angle_deg=-20.0, weave=Weave("zigzag", 4.0, 1.0, (0.15, 0.15))
+    "weave",
+    position="PF",
+    travel_speed_mm_s=4.0,
+    travel_angle_deg=-20.0,
+    weave=Weave("zigzag", 4.0, 1.0, (0.15, 0.15)),
+    crater_start_s=0.2,
+    crater_end_s=0.5,
 )
-TWO = WeldProcedure("two", position="PB", passes=(WeldPass(), WeldPass(1.0, 2.5, 8.0)))
+TWO = WeldProcedure("two", position="PB", passes=(WeldPass(), WeldPass(1.0, 2.5, 8.0)))  # craters 0 / 0.3 s
 
 
 @pytest.fixture(scope="module")
@@ -98,6 +104,27 @@ def test_weave_across_the_seam(plan: WeldPlan, robot: RobotModel) -> None:
     # against the seam plus the intended weave, the planned TCP is on the line
     off = intended_offsets(p, a, d, SIDE.length, WEAVE, 0, e, bis)
     assert float(np.max(point_line_distance(p - off, a, b))) < 5e-5
+
+
+def _held_s(q: np.ndarray, dt: float) -> tuple[float, float]:
+    """How long [s] a joint path stays at its first and at its last sample."""
+    moved = np.flatnonzero(np.any(np.abs(q - q[0]) > 1e-12, axis=1))
+    left = np.flatnonzero(np.any(np.abs(q - q[-1]) > 1e-12, axis=1))
+    return moved[0] * dt, (len(q) - 1 - left[-1]) * dt
+
+
+def test_craters_held_at_rest_with_the_arc_on(plan: WeldPlan) -> None:
+    welds = [s for s in plan.segments if s.arc_on]
+    for seg in welds:
+        p = seg.procedure
+        assert p is not None
+        start, end = _held_s(seg.trajectory.q, PlanOptions().dt)
+        # the hold, plus the first/last sample of the rest-to-rest ramp (it leaves its knot by less than 1e-12)
+        assert start == pytest.approx(p.crater_start_s, abs=0.003), (seg.seam_id, seg.pass_index)
+        assert end == pytest.approx(p.crater_end_s, abs=0.003), (seg.seam_id, seg.pass_index)
+        assert np.all(seg.trajectory.qd[: round(p.crater_start_s / PlanOptions().dt)] == 0.0)
+    side = next(s for s in welds if s.seam_id == "side")
+    assert side.trajectory.duration > SIDE.length / 0.004 + 0.7  # 15 s at 4 mm/s, its ramps and the 0.7 s of craters
 
 
 def test_the_gate_passes_weave_and_passes(plan: WeldPlan, robot: RobotModel) -> None:

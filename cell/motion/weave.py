@@ -4,12 +4,26 @@ plus the weave across it (values in, arrays out; no IK here).
 The cross-section of a fillet along d (unit, the weld direction) with faces of outward normals n_a, n_b has two
 axes (:func:`cross_section`): the bisector ``b`` (out of the root, between the faces) and ``e`` across it,
 perpendicular to d and b, towards face A (``e`` points where face A rises from the root). A pass lies at
-``lateral`` along e and ``lift`` along b; a ``zigzag`` weave moves the TCP along e between -width/2 and
-+width/2, its phase a function of the distance s along the seam at the travel speed v: a dwell at +width/2 (the
-face A side: ``dwell_s[0]``), a crossing, a dwell at -width/2 (``dwell_s[1]``), a crossing back, once per
-period 1/f. The crossings follow a quintic smootherstep (zero velocity and acceleration at the dwells: the path
-is C2, so the arm's joint accelerations stay bounded), and the width fades in and out over the first and last
-wavelength (v/f, at most a quarter of the seam), so the pass starts and ends on its line at rest.
+``lateral`` along e and ``lift`` along b; the weave adds to it (:func:`weave_offsets`), its phase a function of
+the time s / v at the distance s along the seam at the travel speed v, one period 1/f, the first dwell
+(``dwell_s[0]``) on the face A side (+e), the second (``dwell_s[1]``) on the other:
+
+* ``zigzag``: along e between -width/2 and +width/2: a dwell at +width/2, a crossing, a dwell at -width/2, a
+  crossing back. The crossings follow a quintic smootherstep (zero velocity and acceleration at the dwells: the
+  path is C2, so the arm's joint accelerations stay bounded), and the width fades in and out over the first and
+  last wavelength (v/f, at most a quarter of the seam), so the pass starts and ends on its line at rest.
+* ``triangle``: what ArcTech's ``#Triangle`` drives (the program's weave data: pattern, wavelength v/f,
+  amplitude width/2, the side delays; no fade, so none here): from the pass line straight out to +width/2, a
+  dwell, straight across to -width/2, a dwell, straight back to the line; straight legs at constant lateral
+  speed, sharp turns.
+* ``circle``: a circle of the width's diameter in the cross-section plane (e, b) through the pass line, its
+  centre width/2 out of the root along b (so the wire never dips into the root): from the line round to +width/2
+  (a dwell there), over the top (width out of the root), to -width/2 (a dwell), back down to the line, at
+  constant angular speed between the dwells.
+
+The triangle and the circle start on the pass line at full width and end on it: past the last time the pattern
+crosses the line (at most half a wavelength before the weld end for the triangle, one for the circle) the TCP
+travels on the line, so the weld's end point (the program's LIN point) lies on the pass line.
 
 Frames: R the robot base; lengths [m], time [s]; the procedure's millimetres converted here.
 """
@@ -52,14 +66,46 @@ def pass_speed(procedure: WeldProcedure, pass_index: int) -> float:
 def weave_lateral(s: npt.ArrayLike, length: float, weave: Weave, speed: float) -> FloatArray:
     """Lateral offset [m] (along e) of the weave at distances s (n,) [m] along a seam of ``length`` [m] welded at
     ``speed`` [m/s]; zeros when the weave is not active."""
+    return weave_offsets(s, length, weave, speed)[0]
+
+
+def weave_offsets(s: npt.ArrayLike, length: float, weave: Weave, speed: float) -> tuple[FloatArray, FloatArray]:
+    """(lateral along e, lift along b) (n,) each [m] of the weave at distances s (n,) [m] along a seam of
+    ``length`` [m] welded at ``speed`` [m/s] (module docstring: the patterns); zeros when it is not active."""
     s = np.asarray(s, dtype=float)
+    zero = np.zeros_like(s)
     if not weave.active:
-        return np.zeros_like(s)
+        return zero, zero
     half = 0.5 * weave.width_mm * _MM
     period = 1.0 / weave.frequency_hz
     dl, dr = weave.dwell_s
+    t = s / speed
+    tau = np.mod(t, period)
+    if weave.pattern == "zigzag":
+        return _zigzag(s, length, tau, half, period, dl, dr, speed), zero
+    t_end = length / speed
+    if weave.pattern == "triangle":
+        r = 0.5 * (period - dl - dr)  # one crossing [s]
+        lat = np.interp(tau, [0.0, 0.5 * r, 0.5 * r + dl, 1.5 * r + dl, 1.5 * r + dl + dr, period],
+                        [0.0, half, half, -half, -half, 0.0])  # fmt: skip
+        # the line is crossed at every period's start and in the middle of the crossing from +half to -half
+        k = np.floor(t_end / period)
+        last = k * period + (r + dl if t_end - k * period >= r + dl else 0.0)
+        return np.where(t <= last + 1e-12, lat, 0.0), zero
+    if weave.pattern == "circle":
+        qt = 0.25 * (period - dl - dr)  # a quarter turn [s]
+        phi = np.interp(tau, [0.0, qt, qt + dl, 3.0 * qt + dl, 3.0 * qt + dl + dr, period],
+                        [0.0, 0.5 * np.pi, 0.5 * np.pi, 1.5 * np.pi, 1.5 * np.pi, 2.0 * np.pi])  # fmt: skip
+        on = t <= np.floor(t_end / period) * period + 1e-12  # whole turns only: back on the line at the end
+        return np.where(on, half * np.sin(phi), 0.0), np.where(on, half * (1.0 - np.cos(phi)), 0.0)
+    raise ValueError(f"weave pattern {weave.pattern!r} is not none, zigzag, triangle or circle")
+
+
+def _zigzag(
+    s: FloatArray, length: float, tau: FloatArray, half: float, period: float, dl: float, dr: float, speed: float
+) -> FloatArray:
+    """The zigzag's lateral offset [m] (module docstring) at distances s [m], phase times tau [s]."""
     r = 0.5 * (period - dl - dr)  # one crossing [s]
-    tau = np.mod(s / speed, period)
     # +half (dwell left), falling to -half, -half (dwell right), rising to +half
     w = np.where(
         tau < dl,
@@ -86,17 +132,21 @@ def pass_offsets(
     """(n, 3) [m] in R: where the TCP of pass ``pass_index`` lies off the seam line at distances s (n,) [m]
     along it: the pass's lateral and lift offsets plus the weave (at the pass's travel speed)."""
     wp: WeldPass = procedure.passes[pass_index]
-    lat = wp.lateral_mm * _MM + weave_lateral(s, length, procedure.weave, pass_speed(procedure, pass_index))
-    return np.asarray(np.outer(lat, np.asarray(e_R, dtype=float)) + wp.lift_mm * _MM * np.asarray(b_R)[None, :])
+    w_lat, w_lift = weave_offsets(s, length, procedure.weave, pass_speed(procedure, pass_index))
+    lat, lift = wp.lateral_mm * _MM + w_lat, wp.lift_mm * _MM + w_lift
+    return np.asarray(np.outer(lat, np.asarray(e_R, dtype=float)) + np.outer(lift, np.asarray(b_R, dtype=float)))
 
 
 def knot_spacing(procedure: WeldProcedure, pass_index: int, spacing: float) -> float:
-    """Spacing [m] of the IK knots along a pass: ``spacing``, or 1/24 of the weave's wavelength when smaller
-    (so the spline through the knots follows the weave)."""
+    """Spacing [m] of the IK knots along a pass: ``spacing``, or a fraction of the weave's wavelength when smaller
+    (so the spline through the knots follows the weave): 1/24 for the smooth zigzag, 1/20 for the triangle's and
+    the circle's sharp turns, which the spline rounds over about one knot: finer knots would follow them closer
+    (0.1 mm at 1/20 on a 4 mm weave at 1 Hz) but raise the joints' jerk there as the square of the knot count
+    (about 70 % of the KR 5 arc's jerk limits at 1/20 on the tiny cell's seam, 85 % at 1/24)."""
     if not procedure.weave.active:
         return spacing
     wavelength = pass_speed(procedure, pass_index) / procedure.weave.frequency_hz
-    return min(spacing, wavelength / 24.0)
+    return min(spacing, wavelength / (24.0 if procedure.weave.pattern == "zigzag" else 20.0))
 
 
 def offset_poses(

@@ -21,12 +21,15 @@ from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 
 class WeaveSpec(Model):
-    """Oscillation across the seam in the joint's cross-section (perpendicular to the fillet's bisector):
-    ``zigzag`` side to side with smooth (half-cosine) turns and a dwell at each side, the torch travelling on
-    along the seam meanwhile. ``width_mm`` peak to peak, ``frequency_hz`` full side-to-side-and-back cycles per
-    second, ``dwell_s`` [left, right] (their sum below one period)."""
+    """Oscillation of the torch while it travels on along the seam (:mod:`cell.motion.weave`): ``zigzag`` side to
+    side across the bisector with smooth turns, fading in and out over the first and last wavelength;
+    ``triangle`` side to side on straight legs with sharp turns, at full width from the start (ArcTech's
+    #Triangle); ``circle`` round a circle of the width's diameter in the joint's cross-section, from the pass line
+    out of the root and back, at a constant angular speed (no dwells). ``width_mm`` peak to peak,
+    ``frequency_hz`` full cycles per second, ``dwell_s`` [left (face A side), right] at the sides (their sum below
+    80 % of one period)."""
 
-    pattern: Literal["none", "zigzag"] = "none"  # none: a straight bead
+    pattern: Literal["none", "zigzag", "triangle", "circle"] = "none"  # none: a straight bead
     width_mm: Annotated[float, Field(ge=0.0, le=30.0)] = 0.0
     frequency_hz: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0  # side-to-side-and-back cycles per second
     dwell_s: tuple[NonNeg, NonNeg] = (0.0, 0.0)
@@ -37,6 +40,11 @@ class WeaveSpec(Model):
             if self.width_mm <= 0.0 or self.frequency_hz <= 0.0:
                 raise ValueError(f"a {self.pattern} weave needs width_mm > 0 and frequency_hz > 0")
             period = 1.0 / self.frequency_hz
+            if self.pattern == "circle" and sum(self.dwell_s) > 0.0:
+                raise ValueError(
+                    "a circle weave takes no dwells (dwell_s [0, 0]): its TCP circles at a constant angular speed; "
+                    "for dwells at the sides use zigzag or triangle"
+                )
             if sum(self.dwell_s) >= 0.8 * period:
                 raise ValueError(
                     f"weave dwells {self.dwell_s[0]:g} + {self.dwell_s[1]:g} s leave no time to cross in one period "

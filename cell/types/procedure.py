@@ -20,8 +20,10 @@ Position = Literal["PA", "PB", "PF", "PG", "any"]
 
 @dataclass(frozen=True)
 class Weave:
-    """Oscillation of the torch across the seam, in the joint's cross-section: ``pattern`` (none: a straight
-    bead), full ``width_mm`` (peak to peak), ``frequency_hz``, dwell at each side ``dwell_s`` (left, right)."""
+    """Oscillation of the torch while it travels along the seam: ``pattern`` (none: a straight bead; zigzag:
+    across the seam with smooth turns, fading in and out; triangle: across on straight legs with sharp turns;
+    circle: round a circle in the joint's cross-section; :mod:`cell.motion.weave`), full ``width_mm`` (peak to
+    peak; the circle's diameter), ``frequency_hz``, dwell at each side ``dwell_s`` (left, right)."""
 
     pattern: WeavePattern = "none"
     width_mm: float = 0.0

@@ -20,11 +20,41 @@ from cell.geometry import FloatArray
 
 @cache
 def _o3d() -> Any:
-    import open3d
+    """open3d's compiled core (``open3d.pybind``: geometry, pipelines, core, io, utility, t), loaded on first use.
 
+    ``import open3d`` runs the package's ``__init__``, which imports ``open3d.visualization`` and through it
+    dash and plotly: 0.9 s on the 2-core bench machine, of which the compiled core is 0.3 s. The core is one
+    extension module next to that ``__init__``; it is loaded from its file without running the package (when
+    open3d is already imported, its own is taken). Everything this module uses lives in it.
+    """
+    import importlib.machinery
+    import importlib.util
+    import sys
+
+    core = sys.modules.get("open3d.pybind")
+    if core is None:
+        spec = importlib.util.find_spec("open3d")
+        if spec is None or not spec.submodule_search_locations:
+            raise ImportError("open3d is not installed (pip install open3d)")
+        folder = Path(next(iter(spec.submodule_search_locations)))
+        found = [folder / f"pybind{s}" for s in importlib.machinery.EXTENSION_SUFFIXES]
+        path = next((p for p in found if p.is_file()), None)
+        core_spec = importlib.util.spec_from_file_location("open3d.pybind", path) if path else None
+        if core_spec is None or core_spec.loader is None:
+            import open3d  # an unusual layout: the whole package, visualization and all
+
+            core = open3d.pybind
+        else:
+            core = importlib.util.module_from_spec(core_spec)
+            sys.modules["open3d.pybind"] = core  # a later ``import open3d`` takes this one, never a second copy
+            try:
+                core_spec.loader.exec_module(core)
+            except BaseException:
+                del sys.modules["open3d.pybind"]
+                raise
     # open3d prints warnings on stdout; the cell reports through returned values instead.
-    open3d.utility.set_verbosity_level(open3d.utility.VerbosityLevel.Error)
-    return open3d
+    core.utility.set_verbosity_level(core.utility.VerbosityLevel.Error)
+    return core
 
 
 def _array(a: npt.ArrayLike, dtype: type = np.float64) -> npt.NDArray:

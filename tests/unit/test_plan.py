@@ -93,7 +93,9 @@ def test_seam_reachable_only_with_a_rotated_torch(robot: RobotModel) -> None:
     assert got.feasible and abs(got.spin) > math.radians(30.0)
     weld = next(s for s in p.segments if s.kind == "weld")
     z_torch = robot.fk(weld.trajectory.q[0])[:3, 2]
-    np.testing.assert_allclose(z_torch, weld.X_end[:3, 2], atol=1e-6)  # same torch axis, only turned about it
+    # Same torch axis, only turned about it: within the IK's rotation tolerance (0.01 deg = 1.7e-4 rad; the wrist
+    # that keeps A6 in its hose window is solved to that tolerance, measured 1e-5).
+    np.testing.assert_allclose(z_torch, weld.X_end[:3, 2], atol=2e-4)
 
 
 def test_weld_runs_on_the_seam_at_the_travel_speed(robot: RobotModel, plan: WeldPlan) -> None:
@@ -205,7 +207,10 @@ def test_gate_refuses_a_joint_jump(robot: RobotModel, plan: WeldPlan) -> None:
     found = find_violations(robot, jumped, HOME, options=GateOptions())
     jumps = [v for v in found if v.kind is ViolationKind.JUMP]
     assert [v.joint for v in jumps] == ["joint_a4"] and jumps[0].what.startswith("moves 11.")
-    assert jumps[0].t == pytest.approx(jumped.segments[k].t0 + tr.times[len(q) // 2])
+    # The spike has two edges (into the bad sample and out of it, 1 ms apart); which is the larger step depends on
+    # which way A4 is moving there.
+    t_spike = jumped.segments[k].t0 + tr.times[len(q) // 2]
+    assert t_spike - 1e-9 <= jumps[0].t <= t_spike + 0.0011
 
 
 def test_gate_refuses_arc_on_while_moving(robot: RobotModel, plan: WeldPlan) -> None:

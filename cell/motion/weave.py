@@ -17,9 +17,10 @@ the time s / v at the distance s along the seam at the travel speed v, one perio
   dwell, straight across to -width/2, a dwell, straight back to the line; straight legs at constant lateral
   speed, sharp turns.
 * ``circle``: a circle of the width's diameter in the cross-section plane (e, b) through the pass line, its
-  centre width/2 out of the root along b (so the wire never dips into the root): from the line round to +width/2
-  (a dwell there), over the top (width out of the root), to -width/2 (a dwell), back down to the line, at
-  constant angular speed between the dwells.
+  centre width/2 out of the root along b (so the wire never dips into the root): from the line round to +width/2,
+  over the top (width out of the root), to -width/2, back down to the line, one turn a period at a constant
+  angular speed, no dwells; the first turn eases in from rest and the last eases out to rest (where the TCP
+  joins the line at the travel speed a sharp start or stop of the circle would jerk the arm beyond its limits).
 
 The triangle and the circle start on the pass line at full width and end on it: past the last time the pattern
 crosses the line (at most half a wavelength before the weld end for the triangle, one for the circle) the TCP
@@ -93,12 +94,29 @@ def weave_offsets(s: npt.ArrayLike, length: float, weave: Weave, speed: float) -
         last = k * period + (r + dl if t_end - k * period >= r + dl else 0.0)
         return np.where(t <= last + 1e-12, lat, 0.0), zero
     if weave.pattern == "circle":
-        qt = 0.25 * (period - dl - dr)  # a quarter turn [s]
-        phi = np.interp(tau, [0.0, qt, qt + dl, 3.0 * qt + dl, 3.0 * qt + dl + dr, period],
-                        [0.0, 0.5 * np.pi, 0.5 * np.pi, 1.5 * np.pi, 1.5 * np.pi, 2.0 * np.pi])  # fmt: skip
-        on = t <= np.floor(t_end / period) * period + 1e-12  # whole turns only: back on the line at the end
+        if dl or dr:
+            raise ValueError(f"a circle weave has no dwells, got dwell_s {weave.dwell_s}")
+        turns = np.floor(t_end / period + 1e-9)  # whole turns only: back on the line at the end
+        phi = 2.0 * np.pi * _circle_turns(t / period, turns)
+        on = t <= turns * period + 1e-12
         return np.where(on, half * np.sin(phi), 0.0), np.where(on, half * (1.0 - np.cos(phi)), 0.0)
     raise ValueError(f"weave pattern {weave.pattern!r} is not none, zigzag, triangle or circle")
+
+
+def _ease_out(u: FloatArray) -> FloatArray:
+    """0 -> 1 over u in [0, 1] leaving at slope 1 (no curvature) and arriving at rest (slope and curvature 0)."""
+    return np.asarray(u + u**3 * (4.0 + u * (-7.0 + 3.0 * u)))
+
+
+def _circle_turns(n: FloatArray, turns: float) -> FloatArray:
+    """The circle's phase [turns] at n [periods] over ``turns`` whole turns: one turn a period, the first turn
+    eased in from rest and the last eased out to rest (C2 where the TCP joins the pass line), a single turn a
+    smootherstep."""
+    if turns <= 1.0:
+        return _smootherstep(n)
+    first = 1.0 - _ease_out(1.0 - np.clip(n, 0.0, 1.0))
+    last = turns - 1.0 + _ease_out(np.clip(n - (turns - 1.0), 0.0, 1.0))
+    return np.asarray(np.where(n < 1.0, first, np.where(n > turns - 1.0, last, n)))
 
 
 def _zigzag(
@@ -139,14 +157,14 @@ def pass_offsets(
 
 def knot_spacing(procedure: WeldProcedure, pass_index: int, spacing: float) -> float:
     """Spacing [m] of the IK knots along a pass: ``spacing``, or a fraction of the weave's wavelength when smaller
-    (so the spline through the knots follows the weave): 1/24 for the smooth zigzag, 1/20 for the triangle's and
-    the circle's sharp turns, which the spline rounds over about one knot: finer knots would follow them closer
+    (so the spline through the knots follows the weave): 1/24 for the smooth zigzag and circle, 1/20 for the
+    triangle's sharp turns, which the spline rounds over about one knot: finer knots would follow them closer
     (0.1 mm at 1/20 on a 4 mm weave at 1 Hz) but raise the joints' jerk there as the square of the knot count
     (about 70 % of the KR 5 arc's jerk limits at 1/20 on the tiny cell's seam, 85 % at 1/24)."""
     if not procedure.weave.active:
         return spacing
     wavelength = pass_speed(procedure, pass_index) / procedure.weave.frequency_hz
-    return min(spacing, wavelength / (24.0 if procedure.weave.pattern == "zigzag" else 20.0))
+    return min(spacing, wavelength / (20.0 if procedure.weave.pattern == "triangle" else 24.0))
 
 
 def offset_poses(

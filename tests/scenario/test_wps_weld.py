@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from cell import pipeline
 from cell import scenario as sc
@@ -40,6 +41,15 @@ def test_weave_and_two_passes_welded_with_a_bead_per_pass(
     assert abs(weave.passes[0].speed_mm_s - 3.0) < 0.01  # the procedure's travel speed along the seam
     assert weave.passes[0].length_mm > 2.5 * weave.passes[0].speed_mm_s * weave.passes[0].weld_time_s  # weaving
     assert [round(q.speed_mm_s, 1) for q in two.passes] == [7.0, 8.0]  # the cap pass at its own speed
+    # the arc time of a pass: its length at its speed, the ramps (0.05-0.08 s) and the craters held at rest
+    for w in (weave, two):
+        segs = [g for g in plan.segments if g.seam_id == w.id and g.kind in ("approach", "weld")]
+        for k, q in enumerate(w.passes):
+            app, weld = segs[2 * k], segs[2 * k + 1]
+            travel = float(np.linalg.norm(weld.X_end[:3, 3] - app.X_end[:3, 3])) / weld.speed
+            p = w.procedure
+            assert p is not None
+            assert q.weld_time_s - travel == pytest.approx(p.crater_start_s + p.crater_end_s + 0.065, abs=0.025)
 
     # The simulator's bead: the two-pass seam has a bead on the root and one 2.5 mm out of it.
     X_RW = invert(scn.X_WR)

@@ -215,6 +215,12 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
     )
     rep["arc_time_s"] = _r(ex.arc_time, 3) if ex is not None else None
     rep["weld_order"] = list(plan.order) if plan is not None else []
+    # How far each axis travels over the plan (A6: the hose package's wind-up), [deg].
+    rep["joint_range_deg"] = (
+        {n: [_r(math.degrees(lo), 2), _r(math.degrees(hi), 2)] for n, (lo, hi) in plan.joint_ranges().items()}
+        if plan is not None
+        else None
+    )
     rep["events"] = [{"t_s": _r(e.t, 4), "kind": e.kind, "detail": e.detail} for e in ex.events] if ex else []
     rep["violations"] = list(run.violations)
     rep["error"] = _error(run.error)

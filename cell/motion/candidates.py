@@ -250,7 +250,7 @@ class SeamSearch:
         k = int(np.argmax(over))
         if over[k] > 0.0:
             return SeamFailure(
-                PlanReason.IK_FAILED,
+                PlanReason.HOSE_WINDOW,
                 f"A6 leaves the hose package window ({np.degrees(self.window.center):.0f} "
                 f"+- {np.degrees(self.window.half_width):.0f} deg) by {np.degrees(over[k]):.1f} deg "
                 f"at {where_on_path(s_path[k], task.length)}",

@@ -27,6 +27,7 @@ _WORD = {
     PlanReason.TRANSFER_COLLISION: "collision",
     PlanReason.TIMING: "timing",
     PlanReason.NO_PROCEDURE: "no procedure",
+    PlanReason.HOSE_WINDOW: "hose window",
 }
 
 

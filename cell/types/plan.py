@@ -79,6 +79,7 @@ class PlanReason(StrEnum):
     TRANSFER_COLLISION = "transfer_collision"  # no collision-free transfer move to or from the seam
     TIMING = "timing"  # a line cannot be timed within the joint limits (e.g. the weld at the travel speed)
     NO_PROCEDURE = "no_procedure"  # no row of the WPS table fits the seam (joint type, position, leg)
+    HOSE_WINDOW = "hose_window"  # A6 would leave the hose package's window of cable travel
 
 
 @dataclass(frozen=True)
@@ -120,6 +121,13 @@ class WeldPlan:
     @property
     def arc_time(self) -> float:
         return sum(s.trajectory.duration for s in self.segments if s.arc_on)
+
+    def joint_ranges(self) -> dict[str, tuple[float, float]]:
+        """Joint name -> (lowest, highest) value [rad] over the whole plan (how far A6 winds its hose package)."""
+        if not self.segments:
+            return {n: (float(q), float(q)) for n, q in zip(self.joint_names, self.q_home, strict=True)}
+        q = np.vstack([s.trajectory.q for s in self.segments])
+        return {n: (float(q[:, j].min()), float(q[:, j].max())) for j, n in enumerate(self.joint_names)}
 
     def outcome(self, seam_id: str) -> SeamOutcome:
         for o in self.seams:

@@ -54,6 +54,8 @@ def test_a6_stays_in_the_hose_window_without_wrist_flips(fence1_run: pipeline.We
     a6 = run.execution.q[:, 5]
     assert np.all(np.abs(a6 - opt.a6_center) <= opt.a6_window)  # default: 0 +- 185 deg
     assert np.ptp(a6) <= np.radians(285.0)  # measured 267 deg (387 deg before the window and the wrist choice)
+    lo, hi = run.plan.joint_ranges()["joint_a6"]  # what the report gives as joint_range_deg
+    assert lo <= a6.min() + 1e-6 and a6.max() - 1e-6 <= hi and hi - lo <= np.radians(285.0)
     # no flip between seams: A5 keeps home's sign (KUKA's status bit 2) at every weld, and A4 at consecutive weld
     # starts never swings near half a turn
     starts = np.array([s.trajectory.q[0] for s in run.plan.segments if s.kind == "weld"])

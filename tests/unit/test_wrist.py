@@ -69,4 +69,4 @@ def test_a_seam_that_cannot_keep_a6_in_the_window_is_refused(robot: RobotModel) 
     fixed = WeldProcess.from_spec(sc.ProcessSpec(work_angle_tol_deg=0.0, travel_angle_tol_deg=0.0))
     tight = PlanOptions(a6_window=math.radians(3.0), a6_center=math.radians(170.0))  # no spin lands there
     out = plan_welds(robot, [SeamTask(*TOP_SEAM)], HOME, fixed, OBSTACLES, options=tight).outcome("top")
-    assert not out.feasible and out.code is PlanReason.IK_FAILED and "hose package window" in out.reason
+    assert not out.feasible and out.code is PlanReason.HOSE_WINDOW and "hose package window" in out.reason

@@ -43,9 +43,9 @@ def test_weave_and_two_passes_welded_with_a_bead_per_pass(
     assert [round(q.speed_mm_s, 1) for q in two.passes] == [7.0, 8.0]  # the cap pass at its own speed
     # the arc time of a pass: its length at its speed, the ramps (0.05-0.08 s) and the craters held at rest
     for w in (weave, two):
-        segs = [g for g in plan.segments if g.seam_id == w.id and g.kind in ("approach", "weld")]
+        lines = [g for g in plan.segments if g.seam_id == w.id and g.kind in ("approach", "weld")]
         for k, q in enumerate(w.passes):
-            app, weld = segs[2 * k], segs[2 * k + 1]
+            app, weld = lines[2 * k], lines[2 * k + 1]
             travel = float(np.linalg.norm(weld.X_end[:3, 3] - app.X_end[:3, 3])) / weld.speed
             p = w.procedure
             assert p is not None

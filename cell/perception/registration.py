@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
+from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from cell.geometry import FloatArray, invert, make_pose, transform_points
@@ -88,16 +89,19 @@ def registration_settings(spec: PerceptionSpec, noise_m: float) -> RegistrationS
 
 
 def _plane_residuals(
-    probe: FloatArray, target: FloatArray, normals: FloatArray, reach_m: float, X: FloatArray
+    probe: FloatArray, tree: cKDTree, target: FloatArray, normals: FloatArray, reach_m: float, X: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Point-to-plane residuals of the probe points moved by X against their nearest target points within reach.
 
-    Returns (moved probe points (k, 3), their target normals (k, 3), signed residuals (k,) [m]).
+    tree : the KD-tree of ``target``, built once per registration (a registration asks 10-12 times). Returns
+    (moved probe points (k, 3), their target normals (k, 3), signed residuals (k,) [m]).
     """
-    pairs = _open3d.correspondences(probe, target, reach_m, X)
-    moved = transform_points(X, probe[pairs[:, 0]])
-    n = normals[pairs[:, 1]]
-    return moved, n, np.einsum("ij,ij->i", moved - target[pairs[:, 1]], n)
+    moved = transform_points(X, probe)
+    dist, nearest = tree.query(moved, distance_upper_bound=reach_m)
+    paired = np.isfinite(dist)
+    moved, at = moved[paired], nearest[paired]
+    n = normals[at]
+    return moved, n, np.einsum("ij,ij->i", moved - target[at], n)
 
 
 def _patch_keys(points: FloatArray, normals: FloatArray, patch_m: float) -> npt.NDArray[np.intp]:
@@ -162,6 +166,7 @@ def significance(
     X_icp: FloatArray,
     settings: RegistrationSettings,
     patch_m: float,
+    tree: cKDTree | None = None,
 ) -> tuple[FloatArray, dict[str, float]]:
     """The part of the correction X_icp (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3))
     that the overlap constrains, and how much the data support it (all in R).
@@ -171,23 +176,24 @@ def significance(
     shift_m, chi2, z_min, misfit_before_m, misfit_m of X, see :class:`cell.perception.splice.Registration`).
     The chi-square is a sandwich (patch-robust) covariance of a point-to-plane least-squares estimate at X:
     Tukey-weighted residuals, one score per patch of ``patch_m`` and surface direction, in the constrained
-    directions.
+    directions. ``tree`` : the KD-tree of ``target`` when the caller has one (built here otherwise).
     """
     reach, k = settings.reach_m, settings.tukey_k_m
+    tree = cKDTree(target) if tree is None else tree
     info = {"constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "z_min": 0.0}
     info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
-    p0, n0, r0 = _plane_residuals(probe, target, normals, reach, np.eye(4))
-    p, n, r = _plane_residuals(probe, target, normals, reach, X_icp)
+    p0, n0, r0 = _plane_residuals(probe, tree, target, normals, reach, np.eye(4))
+    p, n, r = _plane_residuals(probe, tree, target, normals, reach, X_icp)
     if len(r0) < _MIN_OVERLAP or len(r) < _MIN_OVERLAP:
         return np.eye(4), info
     info["misfit_before_m"] = _patch_misfit(r0, _tukey(r0, k), _patch_keys(p0, n0, patch_m))
     _, D, centre, lever = _constrained(p, n, _tukey(r, k))
     info["directions_constrained"] = float(D.shape[1])
-    D = _supported(probe, target, normals, X_icp, D, centre, lever, settings, patch_m, info["misfit_before_m"])
+    D = _supported(probe, tree, target, normals, X_icp, D, centre, lever, settings, patch_m, info["misfit_before_m"])
     if D.shape[1] == 0:
         return np.eye(4), info
     X = _restricted(X_icp, D, centre, lever)
-    p, n, r = _plane_residuals(probe, target, normals, reach, X)
+    p, n, r = _plane_residuals(probe, tree, target, normals, reach, X)
     if len(r) < _MIN_OVERLAP:
         return np.eye(4), info
     w = _tukey(r, k)
@@ -211,6 +217,7 @@ def significance(
 
 def _supported(
     probe: FloatArray,
+    tree: cKDTree,
     target: FloatArray,
     normals: FloatArray,
     X_icp: FloatArray,
@@ -233,7 +240,7 @@ def _supported(
     def misfit(keep: npt.NDArray[np.bool_]) -> float:
         kept = D[:, keep] @ e[keep]
         R = Rotation.from_rotvec(kept[:3] / lever).as_matrix()
-        p, n, r = _plane_residuals(probe, target, normals, settings.reach_m, make_pose(R, c0 + kept[3:] - R @ c0))
+        p, n, r = _plane_residuals(probe, tree, target, normals, settings.reach_m, make_pose(R, c0 + kept[3:] - R @ c0))
         return _patch_misfit(r, _tukey(r, settings.tukey_k_m), _patch_keys(p, n, patch_m)) if len(r) else math.inf
 
     every = np.ones(D.shape[1], dtype=bool)
@@ -261,7 +268,8 @@ def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tu
         return np.eye(4), info
     settings = registration_settings(spec, 0.0)
     normals = _open3d.estimate_normals(sub, settings.normal_radius_m, _NORMAL_NEIGHBOURS)
-    _, _, r0 = _plane_residuals(probe, sub, normals, settings.reach_m, np.eye(4))
+    tree = cKDTree(sub)
+    _, _, r0 = _plane_residuals(probe, tree, sub, normals, settings.reach_m, np.eye(4))
     info["overlap"] = float(len(r0))
     if len(r0) < _MIN_OVERLAP:
         return np.eye(4), info
@@ -273,5 +281,5 @@ def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tu
         X = _open3d.icp(source, target, corr, spec.icp_iterations).X_TS
     else:
         X = _open3d.icp(probe, sub, corr, spec.icp_iterations, None, normals, settings.tukey_k_m).X_TS
-    X, stats = significance(probe, sub, normals, X, settings, spec.merge_cell_m)
+    X, stats = significance(probe, sub, normals, X, settings, spec.merge_cell_m, tree)
     return X, info | stats

@@ -51,7 +51,8 @@ def test_urdf_shapes_and_camera_frusta() -> None:
     links = {s.link for s in shapes}
     assert {"base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6", "torch"} <= links
     base = next(s for s in shapes if s.link == "base_link")
-    assert base.kind is ShapeKind.BOX and np.allclose(base.size, [0.34, 0.34, 0.2]) and base.X_LS[2, 3] == 0.1
+    # the base as robots/build_kr5_arc.py draws it: 340 x 340 x 220 mm, standing on the mounting face
+    assert base.kind is ShapeKind.BOX and np.allclose(base.size, [0.34, 0.34, 0.22]) and base.X_LS[2, 3] == 0.11
     assert {s.kind for s in shapes} == {ShapeKind.BOX, ShapeKind.CYLINDER}
     assert any(s.rgba[:3] == (1.0, 0.4, 0.0) for s in shapes)  # the URDF's named material "orange"
     cams = {c.name: c for c in cameras_R(SCENARIO)}

@@ -25,7 +25,8 @@ class WeaveSpec(Model):
     side across the bisector with smooth turns, fading in and out over the first and last wavelength;
     ``triangle`` side to side on straight legs with sharp turns, at full width from the start (ArcTech's
     #Triangle); ``circle`` round a circle of the width's diameter in the joint's cross-section, from the pass line
-    out of the root and back, at a constant angular speed (no dwells). ``width_mm`` peak to peak,
+    out of the root and back, at a constant angular speed (no dwells; the first and last turns eased in and out
+    from rest). ``width_mm`` peak to peak,
     ``frequency_hz`` full cycles per second, ``dwell_s`` [left (face A side), right] at the sides (their sum below
     80 % of one period)."""
 

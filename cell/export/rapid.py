@@ -32,7 +32,10 @@ from cell.types.plan import Segment
 from cell.types.procedure import WeavePattern, WeldProcedure
 from cell.types.robot import Kinematics
 
-_SHAPE: dict[WeavePattern, int] = {"none": 0, "zigzag": 1, "triangle": 3, "circle": 4}
+# ABB weavedata.weave_shape: 1 is the sideways (horizontal) zigzag, a triangle wave across the seam, which is what
+# both our zigzag and our triangle are (ABB's 2 and 3, V-shaped and triangular, rise out of the seam's plane: none of
+# ours); 4 is ABB's circular weave (docs/reference.md section 5).
+_SHAPE: dict[WeavePattern, int] = {"none": 0, "zigzag": 1, "triangle": 1, "circle": 4}
 _EXT = "[9E9,9E9,9E9,9E9,9E9,9E9]"
 
 

@@ -44,9 +44,17 @@ def test_events_and_cycle_time(fence1_run: pipeline.WeldRun) -> None:
     assert ex is not None and run.plan is not None
     kinds = [e.kind for e in ex.events]
     assert kinds.count("arc_on") == kinds.count("arc_off") == 12
-    # The arc burns only during the welds: arc time is the welded length at the travel speed (ramps aside).
+    # The arc burns only during the welds: arc time is the welded length at the travel speed (ramps aside) plus
+    # the craters each procedure holds at rest (hot start, crater fill).
     lengths = sum(w.quality.length_mm for w in run.seams if w.quality is not None)
-    assert ex.arc_time == pytest.approx(lengths / run.detection.scenario.process.travel_speed_mm_s, rel=0.02)
+    craters = sum(
+        w.procedure.crater_start_s + w.procedure.crater_end_s
+        for w in run.seams
+        if w.quality is not None and w.procedure is not None
+    )
+    assert craters > 0.0
+    travel = lengths / run.detection.scenario.process.travel_speed_mm_s
+    assert ex.arc_time == pytest.approx(travel + craters, rel=0.02)
     rescan_s = run.rescan.motion_s if run.rescan is not None else 0.0
     assert run.pre_move is not None
     assert run.cycle_time_s == pytest.approx(run.plan.cycle_time + run.pre_move.duration + rescan_s, abs=0.02)

@@ -13,12 +13,21 @@ it found and its mean paper ME / lateral error against the simulator's ground tr
 for the locators (outside every locate time): the voxel grid and the voxel order. Single thread, wall clock.
 A locator that finds a scene's seams together (ours) charges each seam an equal share of the whole batch; its
 seams are also located one by one (``ms_per_seam_alone_median``: the median seam alone, fastest run).
+
+Perception per stage (``row["perception"]``, the fastest of ``--repeat`` runs of each on the same capture, wall
+and CPU seconds; the CPU of open3d's threads counts too): ``perceive``'s own steps (``clouds``: deproject, crop
+and the camera checks; ``splice``; ``preprocess``: Z passthrough and the isolated-point filter; ``downsample``),
+the map alignment (``align_map``) and its two checks (``check_unique``, ``check_parts_seen``), and loading
+open3d's core (``open3d_import_s``, once per process: the first scenario's). ``detect_vs_capture`` is issue 16's
+acceptance figure from the first (cold) run: perceive + align + locate (ours) against capture.
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
+import subprocess
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -26,11 +35,62 @@ from typing import Any
 from cell import pipeline
 from cell import scenario as sc
 from cell.export.report import write_json
+from cell.geometry import invert
+from cell.perception import align_map, check_alignment_unique, check_parts_seen, perceive
 from cell.perception.preprocess import downsample
 from cell.seams.base import BatchSeamLocator
 from cell.seams.registry import make_locator
 from cell.types import SeamEstimate, SeamStatus
 from cell.voxels import voxel_order
+
+
+def _fastest(run: Any, repeat: int) -> tuple[Any, float, float]:
+    """(result, fastest wall [s], fastest CPU [s]) of ``repeat`` calls of ``run()``."""
+    wall, cpu, out = [], [], None
+    for _ in range(max(1, repeat)):
+        t, c = time.perf_counter(), time.process_time()
+        out = run()
+        wall.append(time.perf_counter() - t)
+        cpu.append(time.process_time() - c)
+    return out, min(wall), min(cpu)
+
+
+def open3d_import_s() -> float:
+    """Seconds to load open3d as the cell does (:mod:`cell.perception._open3d`), in a fresh interpreter with
+    numpy already imported (in this process it is loaded once, inside the first ``perceive``)."""
+    code = (
+        "import time, numpy\nfrom cell.perception import _open3d\n"
+        "t = time.perf_counter(); _open3d._o3d(); print(time.perf_counter() - t)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return float(done.stdout.strip().splitlines()[-1])
+
+
+def perception_stages(cap: pipeline.Capture, repeat: int) -> dict[str, Any]:
+    """Wall and CPU seconds of each perception stage on one capture (module docstring), fastest of ``repeat``."""
+    s = cap.scenario
+    out: dict[str, Any] = {"open3d_import_s": open3d_import_s()}
+    runs = []
+    for _ in range(max(1, repeat)):
+        c = time.process_time()
+        per = perceive(cap.images, s.X_WR, s.perception, s.perception.health)
+        runs.append((per.timings, time.process_time() - c))
+    for key in runs[0][0]:
+        out[key] = {"wall_s": min(r[0][key] for r in runs)}
+    out["perceive"] = {"wall_s": min(sum(r[0].values()) for r in runs), "cpu_s": min(r[1] for r in runs)}
+    weldmap = cap.weldmap.transformed(invert(s.X_WR) @ s.X_WM, "R")
+    alignment, wall, cpu = _fastest(lambda: align_map(weldmap, per.registered, s.perception), repeat)
+    out["align_map"] = {"wall_s": wall, "cpu_s": cpu}
+    aligned = cap.weldmap.transformed(alignment.X_RR_corr @ invert(s.X_WR) @ s.X_WM, "R")
+    checks = {
+        "check_unique": lambda: check_alignment_unique(aligned, per.registered, alignment, s.perception.symmetry),
+        "check_parts_seen": lambda: check_parts_seen(aligned, per.registered, s.perception, s.perception.coverage),
+    }
+    for key, check in checks.items():
+        _, wall, cpu = _fastest(check, repeat)
+        out[key] = {"wall_s": wall, "cpu_s": cpu}
+    out["points"] = {"registered": len(per.registered), "dense": len(per.dense), "voxel": len(per.downsampled)}
+    return out
 
 
 def bench(name: str, methods: list[str], noise: str, repeat: int) -> dict[str, Any]:
@@ -55,6 +115,7 @@ def bench(name: str, methods: list[str], noise: str, repeat: int) -> dict[str, A
         "build_scene_s": build_s,
         "methods": {},
     }
+    row["perception"] = perception_stages(cap, repeat)
     # What perception makes for the locators (in no locate time): the paper's and RANSAC's voxel cloud, the
     # voxel-ordered dense cloud ours reads.
     per = scene.perceived
@@ -101,7 +162,29 @@ def bench(name: str, methods: list[str], noise: str, repeat: int) -> dict[str, A
                     times.append(time.perf_counter() - t)
                 alone.append(statistics.median(times) * 1000.0)
             row["methods"][method]["ms_per_seam_alone_median"] = min(alone)
+    if "ours" in row["methods"]:
+        first = sum(e.time_s for e in all_runs["ours"][0])
+        row["detect_vs_capture"] = {
+            "capture_s": row["capture_s"],
+            "perceive_align_locate_s": row["perceive_s"] + row["align_s"] + first,
+        }
     return row
+
+
+def perception_table(rows: list[dict[str, Any]]) -> str:
+    """Markdown: per scenario, each perception stage's fastest wall (and CPU) time [ms]."""
+    keys = ("clouds", "splice", "preprocess", "downsample", "perceive", "align_map", "check_unique", "check_parts_seen")
+    head = "| scenario | open3d import | " + " | ".join(keys) + " |\n|---|---|" + "---|" * len(keys) + "\n"
+    lines = []
+    for r in rows:
+        p = r["perception"]
+        cells = []
+        for k in keys:
+            v = p.get(k, {})
+            cpu = f" ({v['cpu_s'] * 1000:.0f})" if "cpu_s" in v else ""
+            cells.append(f"{v.get('wall_s', float('nan')) * 1000:.0f}{cpu}")
+        lines.append(f"| {r['scenario']} | {p['open3d_import_s'] * 1000:.0f} | " + " | ".join(cells) + " |")
+    return head + "\n".join(lines) + "\n"
 
 
 def table(rows: list[dict[str, Any]]) -> str:
@@ -134,6 +217,15 @@ def main() -> None:
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     rows = [bench(n.strip(), methods, args.noise, args.repeat) for n in args.scenarios.split(",") if n.strip()]
     print(table(rows))
+    print("perception per stage, fastest wall ms (CPU ms):")
+    print(perception_table(rows))
+    for r in rows:
+        if "detect_vs_capture" in r:
+            d = r["detect_vs_capture"]
+            print(
+                f"{r['scenario']}: perceive + align + locate (ours) {d['perceive_align_locate_s']:.2f} s "
+                f"against capture {d['capture_s']:.2f} s"
+            )
     for r in rows:
         print(
             f"{r['scenario']}: perception's voxel grid (paper, ransac) {r['voxel_grid_ms']:.1f} ms, "

@@ -28,14 +28,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.errors import IKError, PlanError
-from cell.geometry import FloatArray
+from cell.geometry import FloatArray, make_pose, readonly, rot_z
 from cell.motion.collision import CollisionChecker
 from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
 from cell.motion.ik import solve_ik
 from cell.motion.lines import solve_line
 from cell.motion.plan_options import PlanOptions
+from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
-from cell.motion.torch import WeldProcess, back_off, line_poses, torch_poses
+from cell.motion.torch import WeldProcess, back_off, line_poses, torch_rotation
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
 from cell.types.plan import PlanReason, SeamTask
 
@@ -116,9 +117,11 @@ class SeamSearch:
         checker: CollisionChecker,
         options: PlanOptions,
         rng: np.random.Generator,
+        reach: ReachModel | None = None,
     ) -> None:
         self.robot, self.process, self.checker, self.opt, self.rng = robot, process, checker, options, rng
         self.window = HoseWindow(options.a6_center, options.a6_window)
+        self.reach = reach
 
     def _reference(self, q_seed: FloatArray) -> FloatArray:
         """The wrist every seam is held near: q_seed (dof,) [rad] with A6 at the hose window's centre."""
@@ -143,34 +146,58 @@ class SeamSearch:
         return [found[k] for k in sorted(range(len(found)), key=key)]
 
     def plan_seam(self, task: SeamTask, q_seed: FloatArray) -> SeamSolution | SeamFailure:
-        """The first candidate that passes, or the failure that got furthest; q_seed (dof,) [rad] seeds IK."""
-        best_fail: SeamFailure | None = None
+        """The first candidate that passes, or the failure that got furthest; q_seed (dof,) [rad] seeds IK.
+
+        With a reach model, a seam out of reach for every torch within the process's angles fails at once
+        (BEYOND_REACH, no candidate built), and a candidate whose wrist centre is out of reach anywhere along the
+        seam is dropped before IK."""
         pr, opt = self.process, self.opt
+        if self.reach is not None:
+            out = seam_reach(self.reach, task, pr)
+            if out is not None:
+                return out
+        best_fail: SeamFailure | None = None
         q_ref = self._reference(q_seed)
+        rotations: dict[tuple[bool, float, float], FloatArray] = {}
         for group in candidate_groups(pr, opt):
             found: list[tuple[Candidate, FloatArray, FloatArray]] = []
             q_prev: FloatArray | None = None
             for cand in group:
                 a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
-                X = torch_poses(
-                    a,
-                    b,
-                    task.n_a,
-                    task.n_b,
-                    pr,
-                    spin=cand.spin,
-                    work_offset=cand.work_offset,
-                    travel_offset=cand.travel_offset,
-                    spacing=opt.spacing,
-                )
-                hit_start = self.checker.torch_clear(X[0], q_seed)
-                hit = hit_start or self.checker.torch_clear(X[-1], q_seed)
+                key = (cand.reversed, cand.work_offset, cand.travel_offset)
+                if key not in rotations:  # the spin-free rotation, shared by the group's spins
+                    rotations[key] = torch_rotation(
+                        (b - a) / task.length,
+                        task.n_a,
+                        task.n_b,
+                        pr.work_angle + cand.work_offset,
+                        pr.travel_angle + cand.travel_offset,
+                    )
+                R = rotations[key] @ rot_z(cand.spin)
+                ends = _poses(a, b, R, pr.standoff, 2)
+                hit_start = self.checker.torch_clear(ends[0], q_seed)
+                hit = hit_start or self.checker.torch_clear(ends[-1], q_seed)
                 if hit is not None:
-                    end = "start" if hit_start is not None else "end"
-                    where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
-                    # ranks below an IK failure at the start: the pose was not even tried
-                    best_fail = better(best_fail, SeamFailure(PlanReason.COLLISION, where, hit.p_R, -1e-3))
+                    if best_fail is None or best_fail.progress < -1e-3 - 1e-9:  # else it would not be kept
+                        end = "start" if hit_start is not None else "end"
+                        where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
+                        # ranks below an IK failure at the start: the pose was not even tried
+                        best_fail = better(best_fail, SeamFailure(PlanReason.COLLISION, where, hit.p_R, -1e-3))
                     continue
+                X = _poses(a, b, R, pr.standoff, max(2, math.ceil(task.length / opt.spacing - 1e-9) + 1))
+                if self.reach is not None:
+                    over = self.reach.pose_excess(X)
+                    k = int(np.argmax(over))
+                    if over[k] > 0.0:
+                        s_k = k * task.length / (len(X) - 1)
+                        where = (
+                            f"beyond reach: the wrist centre lies {over[k] * 1000:.0f} mm beyond the shoulder's "
+                            f"reach at {s_k * 1000:.1f} mm along the seam"
+                        )
+                        best_fail = better(
+                            best_fail, SeamFailure(PlanReason.BEYOND_REACH, where, X[k][:3, 3].copy(), -0.5e-3)
+                        )
+                        continue
                 q0: FloatArray | None = None
                 if q_prev is not None:  # warm start from the neighbouring candidate
                     try:
@@ -258,3 +285,14 @@ class SeamSearch:
                 float(s_path[k]),
             )
         return SeamSolution(task, cand, X, q_app, q_weld, q_dep, X_app, X_dep)
+
+
+def _poses(a: FloatArray, b: FloatArray, R: FloatArray, standoff: float, n: int) -> FloatArray:
+    """n torch poses (n, 4, 4) of orientation R_RT (3, 3) from seam point a to b (3,) [m], evenly spaced, the wire
+    tip ``standoff`` [m] back along the torch axis (as :func:`~cell.motion.torch.torch_poses` places them)."""
+    length = float(np.linalg.norm(b - a))
+    d = (b - a) / length
+    p = a + np.outer(np.linspace(0.0, length, n), d) - standoff * R[:, 2]
+    out = np.repeat(make_pose(R)[None], n, axis=0)
+    out[:, :3, 3] = p
+    return readonly(out)

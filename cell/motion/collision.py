@@ -110,6 +110,8 @@ class CollisionChecker:
         self._radius = self._joint_radii()
         self._tool_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == self._model.njoints - 1]
         self._obstacle_ids = list(range(self._n_robot, len(objs)))
+        self._tool = _ToolShapes.build(self, self._tool_shapes)
+        self._boxes = _Boxes.build(geom, self._obstacle_ids)
 
     # -- set-up ------------------------------------------------------------------------------------------------
 
@@ -251,25 +253,82 @@ class CollisionChecker:
 
     def torch_clear(self, X_RT: npt.ArrayLike, q_ref: npt.ArrayLike) -> Contact | None:
         """Contact of the tool-side shapes (everything rigid with the flange) against the obstacles when the TCP
-        is at X_RT (4, 4), without IK: the tool's shapes are placed from a reference configuration q_ref."""
+        is at X_RT (4, 4), without IK (q_ref (dof,) is carried in the contact). The tool's shapes are placed
+        from their fixed poses in the TCP frame; an obstacle box farther from a shape's bounding sphere than the
+        clearance threshold is skipped without a distance query (the broad phase: only the few parts near the
+        torch cost a query, however many parts the cell holds)."""
         X_RT = np.asarray(X_RT, dtype=float)
-        q_ref = np.asarray(q_ref, dtype=float)
-        pin.forwardKinematics(self._model, self._data, q_ref)
-        pin.updateFramePlacements(self._model, self._data)
-        pin.updateGeometryPlacements(self._model, self._data, self._geom, self._gdata)
-        X_ref_T = np.array(self._data.oMf[self._tcp_frame].homogeneous)
-        move = X_RT @ invert(X_ref_T)  # carries the tool from its reference pose to the target
+        tool, boxes = self._tool, self._boxes
+        X_RG = X_RT[None] @ tool.X_TG  # (m, 4, 4)
+        c_R = np.einsum("mij,mj->mi", X_RG[:, :3, :3], tool.centre_G) + X_RG[:, :3, 3]
+        lower = boxes.sphere_distance(c_R, tool.radius)  # (m, k) lower bounds on the distances
         req = coal.DistanceRequest()
         best: Contact | None = None
-        for i in self._tool_shapes:
-            X_RG = move @ np.array(self._gdata.oMg[i].homogeneous)
-            Tg = coal.Transform3s(X_RG[:3, :3], X_RG[:3, 3])
-            for k in self._obstacle_ids:
-                obj = self._geom.geometryObjects[k]
-                To = coal.Transform3s(np.array(obj.placement.rotation), np.array(obj.placement.translation))
-                res = coal.DistanceResult()
-                dist = coal.distance(self._geom.geometryObjects[i].geometry, Tg, obj.geometry, To, req, res)
-                if dist <= self.options.min_clearance and (best is None or dist < best.depth):
-                    p = readonly(np.array(res.getNearestPoint1()))
-                    best = Contact(self.link_of[i], self.link_of[k], float(dist), p, readonly(q_ref))
+        for a, k in zip(*np.nonzero(lower <= self.options.min_clearance), strict=True):
+            i, j = self._tool_shapes[a], self._obstacle_ids[k]
+            Tg = coal.Transform3s(X_RG[a, :3, :3], X_RG[a, :3, 3])
+            res = coal.DistanceResult()
+            dist = coal.distance(tool.shapes[a], Tg, boxes.shapes[k], boxes.T[k], req, res)
+            if dist <= self.options.min_clearance and (best is None or dist < best.depth):
+                p = readonly(np.array(res.getNearestPoint1()))
+                best = Contact(self.link_of[i], self.link_of[j], float(dist), p, readonly(np.asarray(q_ref)))
         return best
+
+
+@dataclass(frozen=True)
+class _ToolShapes:
+    """The tool-side collision shapes: their poses X_TG (m, 4, 4) in the TCP frame, bounding spheres (centre in
+    G (m, 3), radius (m,)) [m], and the coal shapes."""
+
+    X_TG: FloatArray
+    centre_G: FloatArray
+    radius: FloatArray
+    shapes: tuple[object, ...]
+
+    @staticmethod
+    def build(checker: CollisionChecker, ids: Sequence[int]) -> _ToolShapes:
+        m, data, geom = checker._model, checker._data, checker._geom
+        gdata = pin.GeometryData(geom)
+        q = pin.neutral(m)
+        pin.forwardKinematics(m, data, q)
+        pin.updateFramePlacements(m, data)
+        pin.updateGeometryPlacements(m, data, geom, gdata)
+        X_TR = invert(np.array(data.oMf[checker._tcp_frame].homogeneous))
+        X, cen, rad, shapes = [], [], [], []
+        for i in ids:
+            g = geom.geometryObjects[i].geometry
+            g.computeLocalAABB()
+            lo, hi = np.array(g.aabb_local.min_), np.array(g.aabb_local.max_)
+            X.append(X_TR @ np.array(gdata.oMg[i].homogeneous))
+            cen.append((lo + hi) / 2.0)
+            rad.append(float(np.linalg.norm(hi - lo)) / 2.0)
+            shapes.append(g)
+        return _ToolShapes(np.array(X).reshape(-1, 4, 4), np.array(cen).reshape(-1, 3), np.array(rad), tuple(shapes))
+
+
+@dataclass(frozen=True)
+class _Boxes:
+    """The obstacle boxes as placed in R: rotation R_RB (k, 3, 3), centre (k, 3), half sizes (k, 3) [m] (grown),
+    their coal shapes and transforms."""
+
+    R_RB: FloatArray
+    centre: FloatArray
+    half: FloatArray
+    shapes: tuple[object, ...]
+    T: tuple[object, ...]
+
+    @staticmethod
+    def build(geom: pin.GeometryModel, ids: Sequence[int]) -> _Boxes:
+        objs = [geom.geometryObjects[k] for k in ids]
+        R = np.array([np.array(o.placement.rotation) for o in objs]).reshape(-1, 3, 3)
+        c = np.array([np.array(o.placement.translation) for o in objs]).reshape(-1, 3)
+        half = np.array([np.array(o.geometry.halfSide) for o in objs]).reshape(-1, 3)
+        T = tuple(coal.Transform3s(R[k], c[k]) for k in range(len(objs)))
+        return _Boxes(R, c, half, tuple(o.geometry for o in objs), T)
+
+    def sphere_distance(self, c_R: FloatArray, radius: FloatArray) -> FloatArray:
+        """(m, k) [m]: distance from each sphere (centres c_R (m, 3), radii (m,)) to each box, a lower bound on
+        the distance of anything inside the sphere (negative or zero when they may touch)."""
+        local = np.einsum("kji,mkj->mki", self.R_RB, c_R[:, None, :] - self.centre[None])
+        out = np.linalg.norm(np.maximum(np.abs(local) - self.half[None], 0.0), axis=2)
+        return np.asarray(out - radius[:, None])

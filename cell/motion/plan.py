@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
 
-from cell.errors import PlanError, TimingError
+from cell.errors import MotionError, PlanError, TimingError
 from cell.geometry import readonly
 from cell.motion.assembly import assemble
 from cell.motion.candidates import SeamSearch, SeamSolution
@@ -40,6 +40,7 @@ from cell.motion.order import seam_order
 from cell.motion.passes import pass_pieces, solve_passes
 from cell.motion.plan_options import PlanOptions
 from cell.motion.procedures import NoProcedure, SeamProcedure
+from cell.motion.reach import ReachModel
 from cell.motion.robot import RobotModel
 from cell.motion.scan import scan_configuration
 from cell.motion.scene import cell_obstacles
@@ -61,6 +62,7 @@ def plan_welds(
     rng: np.random.Generator | None = None,
     checker: CollisionChecker | None = None,
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
+    on_seam: Callable[[int, int], None] | None = None,
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -71,6 +73,7 @@ def plan_welds(
         torch angles drive the search, its direction fixes a vertical seam's, its passes and weave become one
         weld segment per pass; a NoProcedure is the seam's reason (no_procedure). A seam not in it is welded
         with ``process`` alone, one pass on the seam line.
+    on_seam : called with (seams searched, seams in all) after each seam's torch search (a progress bar).
     Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
     SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
     """
@@ -88,18 +91,23 @@ def plan_welds(
     outcomes: dict[str, SeamOutcome] = {}
     solved: dict[str, tuple[SeamSolution, ...]] = {}  # per pass
     searches: dict[str, SeamSearch] = {}
-    for task in tasks:
+    reach = reach_model(robot)
+    for n_done, task in enumerate(tasks, 1):
+        if on_seam is not None and n_done > 1:
+            on_seam(n_done - 1, len(tasks))
         sel = chosen.get(task.id)
         if isinstance(sel, NoProcedure):
             outcomes[task.id] = _failed(task.id, PlanReason.NO_PROCEDURE, sel.reason, task.p_start)
             continue
-        search = searches[task.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng)
+        search = searches[task.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
         found = search.plan_seam(sel.oriented(task) if sel else task, q0)
         res = found if isinstance(found, SeamFailure) or sel is None else solve_passes(search, found, sel.procedure)
         if isinstance(res, SeamFailure):
             outcomes[task.id] = _failed(task.id, res.code, res.where, res.p_R)
         else:
             solved[task.id] = res if isinstance(res, tuple) else (res,)
+    if on_seam is not None and tasks:
+        on_seam(len(tasks), len(tasks))
 
     transfers = Transfers(robot, process, checker, opt, obstacles, q0)
     seam_parts: dict[str, list[Piece]] = {}
@@ -158,6 +166,15 @@ def plan_welds(
         order=tuple(ordered),
         planning_s=time.perf_counter() - t_start,
     )
+
+
+def reach_model(robot: RobotModel) -> ReachModel | None:
+    """The arm's reach pre-check (:mod:`cell.motion.reach`, about 10 ms to build), None for an arm it does not
+    fit (no spherical wrist, other frame names): the search then goes straight to IK."""
+    try:
+        return ReachModel.from_robot(robot)
+    except (ValueError, MotionError):
+        return None
 
 
 def seam_process(process: WeldProcess, sel: SeamProcedure | None) -> WeldProcess:

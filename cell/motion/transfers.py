@@ -136,8 +136,18 @@ class Transfers:
         self.window = HoseWindow(options.a6_center, options.a6_window)
         tops = [float(np.max(o.vertices()[:, 2])) for o in obstacles]
         self.lift_z = (max(tops) if tops else 0.0) + options.transfer_lift
+        # Each move searched once: the planner re-assembles its order after a failing transfer and asks again
+        # for every transfer it kept (without this, n re-orderings cost n times the whole plan's transfers).
+        self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
+        """:meth:`search`, remembered per (q_a, q_b)."""
+        key = (np.asarray(q_a, dtype=float).tobytes(), np.asarray(q_b, dtype=float).tobytes())
+        if key not in self._memo:
+            self._memo[key] = self.search(q_a, q_b)
+        return self._memo[key]
+
+    def search(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """The first strategy's motions q_a -> q_b that collide with nothing (zero-length ones left out); the
         last contact, or error, when every way collides."""
         fail = TransferFail("no collision-free way found", np.zeros(3))
@@ -215,3 +225,16 @@ class Transfers:
             dt=opt.dt,
         )
         return Piece("approach", tr, v, X)
+
+
+def joined(pieces: Sequence[Piece]) -> Trajectory:
+    """One trajectory of timed motions put back to back (each starts where the last ended, at rest)."""
+    times, q, qd, qdd, t0 = [], [], [], [], 0.0
+    for k, pc in enumerate(pieces):
+        tr, skip = pc.trajectory, int(k > 0)  # a piece's first sample is the last one's final sample
+        times.append(tr.times[skip:] + t0)
+        q.append(tr.q[skip:])
+        qd.append(tr.qd[skip:])
+        qdd.append(tr.qdd[skip:])
+        t0 += tr.duration
+    return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))

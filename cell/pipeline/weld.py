@@ -49,6 +49,7 @@ def plan_for(
     from cell.motion.plan import plan_welds, seam_tasks
     from cell.motion.timing import ptp
     from cell.motion.torch import WeldProcess
+    from cell.motion.transfers import TransferFail, Transfers, joined
 
     sc = det.scenario
     arm = station.arm
@@ -73,11 +74,17 @@ def plan_for(
         checker=checker,
         procedures=seam_procedures(sc, det, tasks),
     )
-    pre = ptp(arm.q_scan if q_start is None else q_start, arm.q_home, arm.model.limits, dt=0.001)
+    q_now = arm.q_scan if q_start is None else q_start
     problems = []
-    hit = checker.check_path(pre.q, pre.times)
-    if hit is not None:
-        problems.append(f"move from the arm's position to home collides: {hit.describe()}")
+    # The move home takes the transfers' ways (direct, lifted over the parts): a close-up view can leave the
+    # torch low between parts, where the direct move collides. When no way is free, nothing can move: the whole
+    # plan is refused (the start state, not a seam).
+    way = Transfers(arm.model, process, checker, sc.motion.plan, obstacles, arm.q_home).move(q_now, arm.q_home)
+    if isinstance(way, TransferFail):
+        pre = ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
+        problems.append(f"move from the arm's position to home collides whichever way: {way.reason}")
+    else:
+        pre = joined(way) if way else ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
     progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
     problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)]
     return plan, pre, tuple(problems)

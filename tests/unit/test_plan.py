@@ -58,7 +58,8 @@ def test_unreachable_seam_is_reported_and_the_others_planned(plan: WeldPlan) -> 
     far = plan.outcome("far")
     assert not far.feasible
     assert far.code is PlanReason.BEYOND_REACH
-    assert far.reason.startswith("unreachable: IK did not converge at 0.0 mm along the seam")  # the report's text
+    # the report's text: refused by the reach pre-check, before any IK
+    assert far.reason.startswith("unreachable: beyond reach: at 0.0 mm along the seam the wrist centre lies")
     assert np.linalg.norm(far.p_fail - FAR.p_start) < 0.03  # the failing point, in R
     assert plan.outcome("top").feasible and plan.outcome("side").feasible
     assert plan.outcome("top").code is None and plan.outcome("side").code is None

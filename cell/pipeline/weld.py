@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -24,7 +25,7 @@ from cell.types.run import SeamWeld, WeldReason
 if TYPE_CHECKING:
     from cell.motion.procedures import NoProcedure, SeamProcedure
     from cell.types.execution import Execution
-    from cell.types.plan import SeamTask, Segment, WeldPlan
+    from cell.types.plan import SeamOutcome, SeamTask, Segment, WeldPlan
     from cell.types.trajectory import Trajectory
 
 
@@ -46,6 +47,7 @@ def plan_for(
     planned at all.
     """
     from cell.motion.gate import find_violations
+    from cell.motion.gate.blame import blamed_seams
     from cell.motion.plan import plan_welds, seam_tasks
     from cell.motion.timing import ptp
     from cell.motion.torch import WeldProcess
@@ -63,17 +65,6 @@ def plan_for(
     obstacles, checker = motion.obstacles, motion.checker
     progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
-    plan = plan_welds(
-        arm.model,
-        tasks,
-        arm.q_home,
-        process,
-        obstacles,
-        options=sc.motion.plan,
-        rng=sc.rng("plan"),
-        checker=checker,
-        procedures=seam_procedures(sc, det, tasks),
-    )
     q_now = arm.q_scan if q_start is None else q_start
     problems = []
     # The move home takes the transfers' ways (direct, lifted over the parts): a close-up view can leave the
@@ -85,9 +76,54 @@ def plan_for(
         problems.append(f"move from the arm's position to home collides whichever way: {way.reason}")
     else:
         pre = joined(way) if way else ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
-    progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
-    problems += [str(v) for v in find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)]
+    dropped: dict[str, SeamOutcome] = {}
+    for _ in range(_GATE_ROUNDS):
+        kept = [t for t in tasks if t.id not in dropped]
+        plan = plan_welds(
+            arm.model,
+            kept,
+            arm.q_home,
+            process,
+            obstacles,
+            options=sc.motion.plan,
+            rng=sc.rng("plan"),
+            checker=checker,
+            procedures=seam_procedures(sc, det, kept),
+            on_seam=seam_counter(progress) if not dropped else None,
+        )
+        progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
+        found = find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)
+        blamed = blamed_seams(plan, found)
+        if blamed is None:  # none, or one that concerns the whole plan
+            break
+        # A violation in one seam's motions (its transfer, its weld) drops that seam; the rest are planned again.
+        progress(f"safety gate: dropping {', '.join(blamed)} (their own motions violate it), planning the rest")
+        dropped.update(blamed)
+    outcomes = {o.seam_id: o for o in plan.seams} | dropped
+    plan = replace(plan, seams=tuple(outcomes[t.id] for t in tasks if t.id in outcomes))
+    problems += [str(v) for v in found]
     return plan, pre, tuple(problems)
+
+
+_GATE_ROUNDS = 4  # plans tried: after the third round of drops the gate's word is final
+
+
+def seam_counter(progress: Progress) -> Callable[[int, int], None]:
+    """How the planner's count of seams searched reaches the user: ``progress.count(what, done, total)`` when
+    the callable has one (a bar: the CLI draws it on a terminal), else a line ``planned k/n seams`` through
+    ``progress`` at every tenth of the seams and at the end."""
+    count = getattr(progress, "count", None)
+    if callable(count):
+        return lambda done, total: count("planning seams", done, total)
+    shown = [-1]
+
+    def line(done: int, total: int) -> None:
+        tenth = 10 * done // max(total, 1)
+        if tenth > shown[0] or done == total:
+            shown[0] = tenth
+            progress(f"planned {done}/{total} seams")
+
+    return line
 
 
 def seam_procedures(sc: Scenario, det: Detection, tasks: Sequence[SeamTask]) -> dict[str, SeamProcedure | NoProcedure]:

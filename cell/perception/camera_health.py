@@ -96,7 +96,7 @@ def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None)
     """
     o = options if options is not None else HealthOptions()
     grids = {n: np.asarray(downsample(c, o.agree_voxel_m).points) for n, c in clouds.items() if len(c) > 0}
-    trees = {n: cKDTree(p) for n, p in grids.items()}
+    trees = {n: cKDTree(p, balanced_tree=False, compact_nodes=False) for n, p in grids.items()}
     shortcut = o.agree_voxel_m * math.sqrt(3.0) * (1.0 + 1e-6) <= o.agree_tol_m
     keys = {n: _voxel_keys(p, o.agree_voxel_m) for n, p in grids.items()} if shortcut else {}
     out: dict[tuple[str, str], float] = {}

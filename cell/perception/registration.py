@@ -179,7 +179,7 @@ def significance(
     directions. ``tree`` : the KD-tree of ``target`` when the caller has one (built here otherwise).
     """
     reach, k = settings.reach_m, settings.tukey_k_m
-    tree = cKDTree(target) if tree is None else tree
+    tree = cKDTree(target, balanced_tree=False, compact_nodes=False) if tree is None else tree
     info = {"constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "z_min": 0.0}
     info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
     p0, n0, r0 = _plane_residuals(probe, tree, target, normals, reach, np.eye(4))
@@ -268,7 +268,7 @@ def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tu
         return np.eye(4), info
     settings = registration_settings(spec, 0.0)
     normals = _open3d.estimate_normals(sub, settings.normal_radius_m, _NORMAL_NEIGHBOURS)
-    tree = cKDTree(sub)
+    tree = cKDTree(sub, balanced_tree=False, compact_nodes=False)  # built in half the time, same answers
     _, _, r0 = _plane_residuals(probe, tree, sub, normals, settings.reach_m, np.eye(4))
     info["overlap"] = float(len(r0))
     if len(r0) < _MIN_OVERLAP:

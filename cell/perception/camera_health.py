@@ -105,7 +105,7 @@ def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None)
             if a == b:
                 continue
             near = np.isin(keys[a], keys[b]) if shortcut else np.zeros(len(pa), dtype=bool)
-            dist, _ = tree.query(pa[~near], distance_upper_bound=o.agree_tol_m)
+            dist, _ = tree.query(pa[~near], distance_upper_bound=o.agree_tol_m, workers=-1)
             out[(a, b)] = float((np.count_nonzero(near) + np.count_nonzero(np.isfinite(dist))) / len(pa))
     return out
 

@@ -94,7 +94,7 @@ def radius_outlier_mask(points: FloatArray, radius_m: float, min_neighbours: int
         tree = cKDTree(candidates, balanced_tree=False, compact_nodes=False)
         # Each query point finds itself: the (min_neighbours + 1)-th nearest within the radius (bound included).
         dist, _ = tree.query(
-            points[doubtful], k=min_neighbours + 1, distance_upper_bound=np.nextafter(radius_m, np.inf)
+            points[doubtful], k=min_neighbours + 1, distance_upper_bound=np.nextafter(radius_m, np.inf), workers=-1
         )
         keep[doubtful] = np.isfinite(np.reshape(dist, (len(doubtful), -1))[:, -1])
     return keep

@@ -97,7 +97,7 @@ def _plane_residuals(
     (moved probe points (k, 3), their target normals (k, 3), signed residuals (k,) [m]).
     """
     moved = transform_points(X, probe)
-    dist, nearest = tree.query(moved, distance_upper_bound=reach_m)
+    dist, nearest = tree.query(moved, distance_upper_bound=reach_m, workers=-1)  # every core: same answers
     paired = np.isfinite(dist)
     moved, at = moved[paired], nearest[paired]
     n = normals[at]

@@ -163,41 +163,11 @@ class SeamSearch:
             found: list[tuple[Candidate, FloatArray, FloatArray]] = []
             q_prev: FloatArray | None = None
             for cand in group:
-                a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
-                key = (cand.reversed, cand.work_offset, cand.travel_offset)
-                if key not in rotations:  # the spin-free rotation, shared by the group's spins
-                    rotations[key] = torch_rotation(
-                        (b - a) / task.length,
-                        task.n_a,
-                        task.n_b,
-                        pr.work_angle + cand.work_offset,
-                        pr.travel_angle + cand.travel_offset,
-                    )
-                R = rotations[key] @ rot_z(cand.spin)
-                ends = _poses(a, b, R, pr.standoff, 2)
-                hit_start = self.checker.torch_clear(ends[0], q_seed)
-                hit = hit_start or self.checker.torch_clear(ends[-1], q_seed)
-                if hit is not None:
-                    if best_fail is None or best_fail.progress < -1e-3 - 1e-9:  # else it would not be kept
-                        end = "start" if hit_start is not None else "end"
-                        where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
-                        # ranks below an IK failure at the start: the pose was not even tried
-                        best_fail = better(best_fail, SeamFailure(PlanReason.COLLISION, where, hit.p_R, -1e-3))
+                placed = self._place(task, cand, rotations, q_seed, best_fail)
+                if not isinstance(placed, np.ndarray):
+                    best_fail = best_fail if placed is None else better(best_fail, placed)
                     continue
-                X = _poses(a, b, R, pr.standoff, max(2, math.ceil(task.length / opt.spacing - 1e-9) + 1))
-                if self.reach is not None:
-                    over = self.reach.pose_excess(X)
-                    k = int(np.argmax(over))
-                    if over[k] > 0.0:
-                        s_k = k * task.length / (len(X) - 1)
-                        where = (
-                            f"beyond reach: the wrist centre lies {over[k] * 1000:.0f} mm beyond the shoulder's "
-                            f"reach at {s_k * 1000:.1f} mm along the seam"
-                        )
-                        best_fail = better(
-                            best_fail, SeamFailure(PlanReason.BEYOND_REACH, where, X[k][:3, 3].copy(), -0.5e-3)
-                        )
-                        continue
+                X = placed
                 q0: FloatArray | None = None
                 if q_prev is not None:  # warm start from the neighbouring candidate
                     try:
@@ -221,6 +191,71 @@ class SeamSearch:
         if best_fail is None:  # cannot happen: there is always the nominal candidate, and it passes or fails
             raise PlanError(f"seam {task.id}: the torch search tried no candidate")
         return best_fail
+
+    def placeable(self, task: SeamTask, q_seed: FloatArray) -> SeamFailure | None:
+        """None when some candidate's torch can be placed on the seam (the reach pre-check, clear of the obstacles
+        at both weld ends, its wrist centre in reach all along: what :meth:`plan_seam` checks before any IK);
+        else the failure :meth:`plan_seam` would report, found without IK (tens of ms for a seam that fails)."""
+        pr = self.process
+        if self.reach is not None:
+            out = seam_reach(self.reach, task, pr)
+            if out is not None:
+                return out
+        best_fail: SeamFailure | None = None
+        rotations: dict[tuple[bool, float, float], FloatArray] = {}
+        for group in candidate_groups(pr, self.opt):
+            for cand in group:
+                placed = self._place(task, cand, rotations, q_seed, best_fail)
+                if isinstance(placed, np.ndarray):
+                    return None
+                best_fail = best_fail if placed is None else better(best_fail, placed)
+        return best_fail
+
+    def _place(
+        self,
+        task: SeamTask,
+        cand: Candidate,
+        rotations: dict[tuple[bool, float, float], FloatArray],
+        q_seed: FloatArray,
+        best_fail: SeamFailure | None,
+    ) -> FloatArray | SeamFailure | None:
+        """The candidate's weld poses X_RT (n, 4, 4) when its torch clears the obstacles at both weld ends and
+        its wrist centre is in reach all along the seam; else why not (None: a torch collision that would not
+        be kept over ``best_fail``). rotations : the spin-free torch rotations so far, shared by a group's spins."""
+        pr, opt = self.process, self.opt
+        a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
+        key = (cand.reversed, cand.work_offset, cand.travel_offset)
+        if key not in rotations:
+            rotations[key] = torch_rotation(
+                (b - a) / task.length,
+                task.n_a,
+                task.n_b,
+                pr.work_angle + cand.work_offset,
+                pr.travel_angle + cand.travel_offset,
+            )
+        R = rotations[key] @ rot_z(cand.spin)
+        ends = _poses(a, b, R, pr.standoff, 2)
+        hit_start = self.checker.torch_clear(ends[0], q_seed)
+        hit = hit_start or self.checker.torch_clear(ends[-1], q_seed)
+        if hit is not None:
+            if best_fail is not None and best_fail.progress >= -1e-3 - 1e-9:
+                return None  # the failure kept so far ranks at least as high: no need to word this one
+            end = "start" if hit_start is not None else "end"
+            where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
+            # ranks below an IK failure at the start: the pose was not even tried
+            return SeamFailure(PlanReason.COLLISION, where, hit.p_R, -1e-3)
+        X = _poses(a, b, R, pr.standoff, max(2, math.ceil(task.length / opt.spacing - 1e-9) + 1))
+        if self.reach is not None:
+            over = self.reach.pose_excess(X)
+            k = int(np.argmax(over))
+            if over[k] > 0.0:
+                s_k = k * task.length / (len(X) - 1)
+                where = (
+                    f"beyond reach: the wrist centre lies {over[k] * 1000:.0f} mm beyond the shoulder's "
+                    f"reach at {s_k * 1000:.1f} mm along the seam"
+                )
+                return SeamFailure(PlanReason.BEYOND_REACH, where, X[k][:3, 3].copy(), -0.5e-3)
+        return X
 
     def _ik(self, X: FloatArray, seed: FloatArray, restarts: bool = False) -> FloatArray:
         return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None, options=self.opt.ik)

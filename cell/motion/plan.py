@@ -168,6 +168,33 @@ def plan_welds(
     )
 
 
+def unplaceable(
+    robot: RobotModel,
+    tasks: Sequence[SeamTask],
+    q_home: npt.ArrayLike,
+    process: WeldProcess,
+    checker: CollisionChecker,
+    *,
+    options: PlanOptions | None = None,
+    procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
+) -> dict[str, str]:
+    """Seam id -> the reason :func:`plan_welds` would give, for the seams no torch can be placed on (out of
+    reach, or the torch against a part or the table at a weld end for every candidate): found without IK, the
+    same search's first steps with the same process per seam. A seam with no procedure is not judged here."""
+    reach, opt, chosen = reach_model(robot), options or PlanOptions(), procedures or {}
+    q0 = np.asarray(q_home, dtype=float)
+    out: dict[str, str] = {}
+    for task in tasks:
+        sel = chosen.get(task.id)
+        if isinstance(sel, NoProcedure):
+            continue
+        search = SeamSearch(robot, seam_process(process, sel), checker, opt, np.random.default_rng(0), reach)
+        fail = search.placeable(sel.oriented(task) if sel else task, q0)
+        if fail is not None:
+            out[task.id] = fail.reason()
+    return out
+
+
 def reach_model(robot: RobotModel) -> ReachModel | None:
     """The arm's reach pre-check (:mod:`cell.motion.reach`, about 10 ms to build), None for an arm it does not
     fit (no spherical wrist, other frame names): the search then goes straight to IK."""

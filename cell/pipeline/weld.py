@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import math
 import time
-from collections.abc import Callable, Collection, Sequence
+from collections.abc import Callable, Collection
 from dataclasses import replace
 from typing import TYPE_CHECKING, Literal
 
@@ -13,17 +14,16 @@ from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
+from cell.pipeline.placeable import rescan_weldable, seam_procedures, unweldable
 from cell.pipeline.records import Detection, WeldRun
-from cell.pipeline.rescan import rescan_detection
 from cell.pipeline.scene_view import cell_view
-from cell.rescan import within_tolerance
+from cell.rescan import seams_to_rescan, within_tolerance
 from cell.scenario import Scenario
-from cell.station import Station, open_station
+from cell.station import Arm, Station, open_station
 from cell.types import SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
-    from cell.motion.procedures import NoProcedure, SeamProcedure
     from cell.types.execution import Execution
     from cell.types.plan import SeamOutcome, SeamTask, Segment, WeldPlan
     from cell.types.trajectory import Trajectory
@@ -124,19 +124,6 @@ def seam_counter(progress: Progress) -> Callable[[int, int], None]:
             progress(f"planned {done}/{total} seams")
 
     return line
-
-
-def seam_procedures(sc: Scenario, det: Detection, tasks: Sequence[SeamTask]) -> dict[str, SeamProcedure | NoProcedure]:
-    """The weld procedure of every task (the scenario's WPS table, or its one row from ``process:``): by the
-    joint type the aligned map gives, the position against gravity in R, the leg ``process.leg_mm`` (or
-    ``process.seam_leg_mm`` of the seam)."""
-    from cell.motion.procedures import joint_type, select_procedures
-
-    ss = det.scene.seam_scene if det.scene is not None else None
-    kinds = {t.id: joint_type(ss.weldmap, ss.joints[t.id]) for t in tasks if ss and t.id in ss.joints}
-    legs = {t.id: sc.process.seam_leg_mm.get(t.id, sc.process.leg_mm) for t in tasks}
-    up_R = np.asarray(sc.X_WR[:3, :3]).T @ np.array([0.0, 0.0, 1.0])  # against gravity (W's z) in R
-    return select_procedures(tasks, kinds, legs, sc.weld_procedures(), up_R)
 
 
 def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = quiet) -> Execution:
@@ -277,11 +264,20 @@ def weld(
             motion = motion_scene(station.arm, det)  # once: every re-scan view, the plan and the gate use it
             setup_s = time.perf_counter() - t
             mode = sc.rescan.mode
+            hopeless: dict[str, str] = {}
             if mode != "none" and execute_plan:
-                rs, det = rescan_detection(station, det, mode, motion=motion, progress=progress)
-                timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
-            # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so.
-            low = {e.id for e in det.estimates if e.status is SeamStatus.FOUND and _doubt(e, sc) and execute_plan}
+                hopeless = _hopeless(station.arm, det, mode, motion, progress)
+                done = rescan_weldable(station, det, mode, hopeless, motion=motion, progress=progress)
+                if done is not None:
+                    rs, det = done
+                    timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
+            # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so. A seam no
+            # torch can be placed on is planned too: the planner refuses it with its own reason.
+            low = {
+                e.id
+                for e in det.estimates
+                if e.status is SeamStatus.FOUND and _doubt(e, sc) and execute_plan and e.id not in hopeless
+            }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
             if low and not any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates):
@@ -305,6 +301,20 @@ def weld(
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)
         return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs, view)
+
+
+def _hopeless(
+    arm: Arm, det: Detection, mode: Literal["low", "all"], motion: MotionScene, progress: Progress
+) -> dict[str, str]:
+    """The seams the re-scan mode picks that no torch can be placed on (the planner would refuse them whatever a
+    close-up found), with the planner's reason."""
+    sc = det.scenario
+    threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
+    ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
+    hopeless = unweldable(arm, det, ids, motion)
+    if hopeless:
+        progress(f"not re-scanning {len(hopeless)} of {len(ids)} seams no torch can be placed on (planned to say why)")
+    return hopeless
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

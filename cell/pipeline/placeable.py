@@ -1,0 +1,106 @@
+"""Which found seams no torch can be placed on (:func:`unweldable`), so the arm spends no close-up re-scan on
+them (:func:`rescan_weldable`): the planner would refuse them whatever the close-up found (out of reach, or the
+torch against a part or the table at a weld end for every torch orientation the process allows; a few mm of seam
+position change neither). And the weld procedure of every task (:func:`seam_procedures`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Collection, Mapping, Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from cell.pipeline.detect import Progress, quiet
+from cell.pipeline.geometry import MotionScene
+from cell.pipeline.records import Detection
+from cell.pipeline.rescan import RescanMode, rescan_detection
+from cell.rescan import seams_to_rescan
+from cell.scenario import Scenario
+from cell.station import Arm, Station
+from cell.types import SeamEstimate, SeamStatus
+
+if TYPE_CHECKING:
+    from cell.motion.procedures import NoProcedure, SeamProcedure
+    from cell.types.plan import SeamTask
+    from cell.types.rescan import Rescan
+
+
+def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, str]:
+    """Seam id -> the planner's reason, for those of ``seam_ids`` (found seams only) no torch can be placed on."""
+    from cell.motion.plan import seam_tasks, unplaceable
+    from cell.motion.torch import WeldProcess
+
+    if det.scene is None:
+        return {}
+    sc, ss = det.scenario, det.scene.seam_scene
+    wanted = [e for e in det.estimates if e.id in seam_ids]
+    tasks = seam_tasks(wanted, ss.weldmap, ss.joints, ss.table_z)
+    process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
+    procs = seam_procedures(sc, det, tasks)
+    return unplaceable(arm.model, tasks, arm.q_home, process, motion.checker, options=sc.motion.plan, procedures=procs)
+
+
+def seam_procedures(sc: Scenario, det: Detection, tasks: Sequence[SeamTask]) -> dict[str, SeamProcedure | NoProcedure]:
+    """The weld procedure of every task (the scenario's WPS table, or its one row from ``process:``): by the
+    joint type the aligned map gives, the position against gravity in R, the leg ``process.leg_mm`` (or
+    ``process.seam_leg_mm`` of the seam)."""
+    from cell.motion.procedures import joint_type, select_procedures
+
+    ss = det.scene.seam_scene if det.scene is not None else None
+    kinds = {t.id: joint_type(ss.weldmap, ss.joints[t.id]) for t in tasks if ss and t.id in ss.joints}
+    legs = {t.id: sc.process.seam_leg_mm.get(t.id, sc.process.leg_mm) for t in tasks}
+    up_R = np.asarray(sc.X_WR[:3, :3]).T @ np.array([0.0, 0.0, 1.0])  # against gravity (W's z) in R
+    return select_procedures(tasks, kinds, legs, sc.weld_procedures(), up_R)
+
+
+def rescan_weldable(
+    station: Station,
+    det: Detection,
+    mode: RescanMode,
+    hopeless: Mapping[str, str],
+    *,
+    motion: MotionScene,
+    progress: Progress = quiet,
+) -> tuple[Rescan, Detection] | None:
+    """:func:`~cell.pipeline.rescan.rescan_detection` without the ``hopeless`` seams (id -> why no torch can be
+    placed on it): neither the mode's choice nor an escalation re-scans them. None when nothing is left to re-scan.
+    """
+    sc = det.scenario
+    threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
+    ids = [i for i in seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m) if i not in hopeless]
+    if mode == "all" or not hopeless:  # nothing left out: the re-scan as it always was
+        return rescan_detection(station, det, mode, seam_ids=ids, motion=motion, progress=progress)
+    if not ids:
+        return None
+    # "all" with the seams given: the same re-scan, without its escalation (done here, without the hopeless)
+    rs, after = rescan_detection(station, det, "all", seam_ids=ids, motion=motion, progress=progress)
+    shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
+    rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids and i not in hopeless]
+    if shift_mm <= sc.rescan.escalate_mm or not rest:
+        return rs, after
+    progress(
+        f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
+        f" {len(rest)} seams a torch can be placed on too"
+    )
+    more, after = rescan_detection(station, after, "all", seam_ids=rest, motion=motion, progress=progress)
+    merged = replace(
+        more,
+        seams=rs.seams + more.seams,
+        moves=rs.moves + more.moves,
+        executions=rs.executions + more.executions,
+        note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
+        timings={k: rs.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*rs.timings, *more.timings}},
+        escalated_mm=shift_mm,
+    )
+    return merged, after
+
+
+def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
+    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing)."""
+    if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
+        return 0.0
+    a = np.stack([before.p_start, before.p_end])
+    b = np.stack([closeup.p_start, closeup.p_end])
+    return float(min(np.linalg.norm(a - b, axis=1).max(), np.linalg.norm(a - b[::-1], axis=1).max()))

@@ -6,7 +6,7 @@ position change neither). And the weld procedure of every task (:func:`seam_proc
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -59,27 +59,37 @@ def rescan_weldable(
     station: Station,
     det: Detection,
     mode: RescanMode,
-    hopeless: Mapping[str, str],
     *,
     motion: MotionScene,
     progress: Progress = quiet,
-) -> tuple[Rescan, Detection] | None:
-    """:func:`~cell.pipeline.rescan.rescan_detection` without the ``hopeless`` seams (id -> why no torch can be
-    placed on it): neither the mode's choice nor an escalation re-scans them. None when nothing is left to re-scan.
-    """
+) -> tuple[Rescan | None, Detection, dict[str, str]]:
+    """:func:`~cell.pipeline.rescan.rescan_detection` without the seams no torch can be placed on: neither the
+    mode's choice nor an escalation re-scans them. Returns the re-scan (None when nothing was left to re-scan),
+    the detection after it, and those seams (id -> the planner's reason)."""
     sc = det.scenario
+    arm = station.arm
+    if arm is None:  # rescan_detection says so
+        return (*rescan_detection(station, det, mode, motion=motion, progress=progress), {})
     threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
-    ids = [i for i in seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m) if i not in hopeless]
+    chosen = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
+    hopeless = _hopeless(arm, det, chosen, motion, progress)
+    ids = [i for i in chosen if i not in hopeless]
     if mode == "all" or not hopeless:  # nothing left out: the re-scan as it always was
-        return rescan_detection(station, det, mode, seam_ids=ids, motion=motion, progress=progress)
+        rs, after = rescan_detection(station, det, mode, seam_ids=ids, motion=motion, progress=progress)
+        return rs, after, hopeless
     if not ids:
-        return None
+        return None, det, hopeless
     # "all" with the seams given: the same re-scan, without its escalation (done here, without the hopeless)
     rs, after = rescan_detection(station, det, "all", seam_ids=ids, motion=motion, progress=progress)
     shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
     rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids and i not in hopeless]
     if shift_mm <= sc.rescan.escalate_mm or not rest:
-        return rs, after
+        return rs, after, hopeless
+    more_hopeless = _hopeless(arm, after, rest, motion, progress)
+    hopeless |= more_hopeless
+    rest = [i for i in rest if i not in more_hopeless]
+    if not rest:
+        return rs, after, hopeless
     progress(
         f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
         f" {len(rest)} seams a torch can be placed on too"
@@ -94,7 +104,15 @@ def rescan_weldable(
         timings={k: rs.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*rs.timings, *more.timings}},
         escalated_mm=shift_mm,
     )
-    return merged, after
+    return merged, after, hopeless
+
+
+def _hopeless(arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene, progress: Progress) -> dict[str, str]:
+    """:func:`unweldable` of ``ids``, said on ``progress`` when there are any."""
+    found = unweldable(arm, det, ids, motion)
+    if found:
+        progress(f"not re-scanning {len(found)} of {len(ids)} seams no torch can be placed on (planned to say why)")
+    return found
 
 
 def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Collection
 from dataclasses import replace
@@ -14,12 +13,12 @@ from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
-from cell.pipeline.placeable import rescan_weldable, seam_procedures, unweldable
+from cell.pipeline.placeable import rescan_weldable, seam_procedures
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.scene_view import cell_view
-from cell.rescan import seams_to_rescan, within_tolerance
+from cell.rescan import within_tolerance
 from cell.scenario import Scenario
-from cell.station import Arm, Station, open_station
+from cell.station import Station, open_station
 from cell.types import SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
@@ -266,10 +265,8 @@ def weld(
             mode = sc.rescan.mode
             hopeless: dict[str, str] = {}
             if mode != "none" and execute_plan:
-                hopeless = _hopeless(station.arm, det, mode, motion, progress)
-                done = rescan_weldable(station, det, mode, hopeless, motion=motion, progress=progress)
-                if done is not None:
-                    rs, det = done
+                rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
+                if rs is not None:
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so. A seam no
             # torch can be placed on is planned too: the planner refuses it with its own reason.
@@ -301,20 +298,6 @@ def weld(
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)
         return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs, view)
-
-
-def _hopeless(
-    arm: Arm, det: Detection, mode: Literal["low", "all"], motion: MotionScene, progress: Progress
-) -> dict[str, str]:
-    """The seams the re-scan mode picks that no torch can be placed on (the planner would refuse them whatever a
-    close-up found), with the planner's reason."""
-    sc = det.scenario
-    threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
-    ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
-    hopeless = unweldable(arm, det, ids, motion)
-    if hopeless:
-        progress(f"not re-scanning {len(hopeless)} of {len(ids)} seams no torch can be placed on (planned to say why)")
-    return hopeless
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

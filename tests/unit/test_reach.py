@@ -186,3 +186,27 @@ def test_a_gate_violation_is_its_seams() -> None:
     assert jerk is not None and jerk["a"].code is PlanReason.TIMING
     assert blamed_seams(plan, [Violation(ViolationKind.START_STATE, "off", 0.0)]) is None  # the whole plan
     assert blamed_seams(plan, []) is None
+
+
+def test_the_checks_broad_phase_keeps_every_answer(robot: RobotModel) -> None:
+    rng = np.random.default_rng(5)
+    boxes = [
+        Part(f"B{k}", Box(make_pose(p=rng.uniform([-0.8, 0.3, 0.0], [0.8, 1.3, 0.5])), rng.uniform(0.02, 0.2, 3)))
+        for k in range(30)
+    ]
+    checker = CollisionChecker(robot, boxes)
+    lim, mc, step = robot.limits, checker.options.min_clearance, checker.options.max_step
+    contacts = 0
+    for _ in range(300):
+        q = lim.q_min + (lim.q_max - lim.q_min) * rng.random(6)
+        d = checker._distances(q)  # every pair queried
+        obs, slf = d[checker._pairs.obstacle].min(), d[checker._pairs.self_].min()
+        want = 0.0 if d.min() <= mc else min(min(obs, slf / 2.0) - mc, step)
+        got, hit = checker._step_bound(q)
+        assert (hit is not None) == (d.min() <= mc)
+        assert (checker.check(q) is not None) == (d.min() <= mc)
+        assert got == pytest.approx(want, abs=2e-6)  # coal's one-pair and all-pair queries differ by < 1 um
+        if hit is not None:
+            contacts += 1
+            assert hit.depth == pytest.approx(d.min(), abs=2e-6)
+    assert 30 < contacts < 270

@@ -29,7 +29,7 @@ import numpy as np
 
 from cell.errors import IKError, PlanError
 from cell.geometry import FloatArray, make_pose, readonly, rot_z
-from cell.motion.collision import CollisionChecker
+from cell.motion.collision import CollisionChecker, Contact
 from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
 from cell.motion.ik import solve_ik
 from cell.motion.lines import solve_line
@@ -162,8 +162,10 @@ class SeamSearch:
         for group in candidate_groups(pr, opt):
             found: list[tuple[Candidate, FloatArray, FloatArray]] = []
             q_prev: FloatArray | None = None
-            for cand in group:
-                placed = self._place(task, cand, rotations, q_seed, best_fail)
+            for cand, (R, hit_start, hit_end) in zip(
+                group, self._torch_tests(task, group, rotations, q_seed, _wording(best_fail)), strict=True
+            ):
+                placed = self._place(task, cand, R, hit_start, hit_end, best_fail)
                 if not isinstance(placed, np.ndarray):
                     best_fail = best_fail if placed is None else better(best_fail, placed)
                     continue
@@ -204,39 +206,73 @@ class SeamSearch:
         best_fail: SeamFailure | None = None
         rotations: dict[tuple[bool, float, float], FloatArray] = {}
         for group in candidate_groups(pr, self.opt):
-            for cand in group:
-                placed = self._place(task, cand, rotations, q_seed, best_fail)
+            for cand, (R, hit_start, hit_end) in zip(
+                group, self._torch_tests(task, group, rotations, q_seed, _wording(best_fail)), strict=True
+            ):
+                placed = self._place(task, cand, R, hit_start, hit_end, best_fail)
                 if isinstance(placed, np.ndarray):
                     return None
                 best_fail = best_fail if placed is None else better(best_fail, placed)
         return best_fail
 
+    def _torch_tests(
+        self,
+        task: SeamTask,
+        group: list[Candidate],
+        rotations: dict[tuple[bool, float, float], FloatArray],
+        q_seed: FloatArray,
+        worded: bool = True,
+    ) -> list[tuple[FloatArray, Contact | None, Contact | None]]:
+        """Per candidate of a group: its torch rotation R_RT (3, 3) and the torch's contact with the obstacles at
+        the weld start and at the weld end (placed by pose alone; all the group's poses in one query).
+        rotations : the spin-free torch rotations so far, shared by a group's spins. worded : the deepest
+        contact of each pose (for the failure's words), else its first (a failure kept already ranks higher)."""
+        pr = self.process
+        Rs, starts, ends = [], [], []
+        for cand in group:
+            a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
+            key = (cand.reversed, cand.work_offset, cand.travel_offset)
+            if key not in rotations:
+                rotations[key] = torch_rotation(
+                    (b - a) / task.length,
+                    task.n_a,
+                    task.n_b,
+                    pr.work_angle + cand.work_offset,
+                    pr.travel_angle + cand.travel_offset,
+                )
+            R = rotations[key] @ rot_z(cand.spin)
+            X = _poses(a, b, R, pr.standoff, 2)
+            Rs.append(R)
+            starts.append(X[0])
+            ends.append(X[1])
+        at_start = self.checker.torch_clear_many(np.array(starts), q_seed, first=not worded)
+        clear = [k for k, h in enumerate(at_start) if h is None]  # the end is tested only where the start is clear
+        at_end: list[Contact | None] = [None] * len(group)
+        if clear:
+            for k, h in zip(
+                clear,
+                self.checker.torch_clear_many(np.array([ends[k] for k in clear]), q_seed, not worded),
+                strict=True,
+            ):
+                at_end[k] = h
+        return [(Rs[k], at_start[k], at_end[k]) for k in range(len(group))]
+
     def _place(
         self,
         task: SeamTask,
         cand: Candidate,
-        rotations: dict[tuple[bool, float, float], FloatArray],
-        q_seed: FloatArray,
+        R: FloatArray,
+        hit_start: Contact | None,
+        hit_end: Contact | None,
         best_fail: SeamFailure | None,
     ) -> FloatArray | SeamFailure | None:
-        """The candidate's weld poses X_RT (n, 4, 4) when its torch clears the obstacles at both weld ends and
-        its wrist centre is in reach all along the seam; else why not (None: a torch collision that would not
-        be kept over ``best_fail``). rotations : the spin-free torch rotations so far, shared by a group's spins."""
+        """The candidate's weld poses X_RT (n, 4, 4) (torch rotation R (3, 3)) when its torch clears the
+        obstacles at both weld ends (``hit_start``, ``hit_end``: the contacts there) and its wrist centre is in
+        reach all along the seam; else why not (None: a torch collision that would not be kept over
+        ``best_fail``)."""
         pr, opt = self.process, self.opt
         a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
-        key = (cand.reversed, cand.work_offset, cand.travel_offset)
-        if key not in rotations:
-            rotations[key] = torch_rotation(
-                (b - a) / task.length,
-                task.n_a,
-                task.n_b,
-                pr.work_angle + cand.work_offset,
-                pr.travel_angle + cand.travel_offset,
-            )
-        R = rotations[key] @ rot_z(cand.spin)
-        ends = _poses(a, b, R, pr.standoff, 2)
-        hit_start = self.checker.torch_clear(ends[0], q_seed)
-        hit = hit_start or self.checker.torch_clear(ends[-1], q_seed)
+        hit = hit_start or hit_end
         if hit is not None:
             if best_fail is not None and best_fail.progress >= -1e-3 - 1e-9:
                 return None  # the failure kept so far ranks at least as high: no need to word this one
@@ -331,3 +367,9 @@ def _poses(a: FloatArray, b: FloatArray, R: FloatArray, standoff: float, n: int)
     out = np.repeat(make_pose(R)[None], n, axis=0)
     out[:, :3, 3] = p
     return readonly(out)
+
+
+def _wording(best_fail: SeamFailure | None) -> bool:
+    """Whether a torch collision found now could become the seam's failure (else only whether it collides
+    matters): no failure kept yet, or one that ranks below a torch collision."""
+    return best_fail is None or best_fail.progress < -1e-3 - 1e-9

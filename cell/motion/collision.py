@@ -296,21 +296,31 @@ class CollisionChecker:
         from their fixed poses in the TCP frame; an obstacle box farther from a shape's bounding sphere than the
         clearance threshold is skipped without a distance query (the broad phase: only the few parts near the
         torch cost a query, however many parts the cell holds)."""
-        X_RT = np.asarray(X_RT, dtype=float)
+        return self.torch_clear_many(np.asarray(X_RT, dtype=float)[None], q_ref)[0]
+
+    def torch_clear_many(self, X_RT: npt.ArrayLike, q_ref: npt.ArrayLike, first: bool = False) -> list[Contact | None]:
+        """:meth:`torch_clear` of every TCP pose X_RT (m, 4, 4), the broad phase of all of them in one query.
+        first : a pose's first contact found instead of its deepest (enough to know that it collides)."""
+        X_RT = np.asarray(X_RT, dtype=float).reshape(-1, 4, 4)
         tool, boxes = self._tool, self._boxes
-        X_RG = X_RT[None] @ tool.X_TG  # (m, 4, 4)
-        c_R = np.einsum("mij,mj->mi", X_RG[:, :3, :3], tool.centre_G) + X_RG[:, :3, 3]
-        lower = boxes.sphere_distance(c_R, tool.radius)  # (m, k) lower bounds on the distances
+        X_RG = X_RT[:, None] @ tool.X_TG[None]  # (m, shapes, 4, 4)
+        c_R = np.einsum("msij,sj->msi", X_RG[..., :3, :3], tool.centre_G) + X_RG[..., :3, 3]
+        m, n_s = X_RG.shape[:2]
+        lower = boxes.sphere_distance(c_R.reshape(-1, 3), np.tile(tool.radius, m)).reshape(m, n_s, -1)
         req = coal.DistanceRequest()
-        best: Contact | None = None
-        for a, k in zip(*np.nonzero(lower <= self.options.min_clearance), strict=True):
+        q = readonly(np.asarray(q_ref, dtype=float))
+        best: list[Contact | None] = [None] * m
+        for p, a, k in zip(*np.nonzero(lower <= self.options.min_clearance), strict=True):
+            if first and best[p] is not None:
+                continue
             i, j = self._tool_shapes[a], self._obstacle_ids[k]
-            Tg = coal.Transform3s(X_RG[a, :3, :3], X_RG[a, :3, 3])
+            Tg = coal.Transform3s(X_RG[p, a, :3, :3], X_RG[p, a, :3, 3])
             res = coal.DistanceResult()
             dist = coal.distance(tool.shapes[a], Tg, boxes.shapes[k], boxes.T[k], req, res)
-            if dist <= self.options.min_clearance and (best is None or dist < best.depth):
-                p = readonly(np.array(res.getNearestPoint1()))
-                best = Contact(self.link_of[i], self.link_of[j], float(dist), p, readonly(np.asarray(q_ref)))
+            b = best[p]
+            if dist <= self.options.min_clearance and (b is None or dist < b.depth):
+                pt = readonly(np.array(res.getNearestPoint1()))
+                best[p] = Contact(self.link_of[i], self.link_of[j], float(dist), pt, q)
         return best
 
 

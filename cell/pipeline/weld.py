@@ -159,9 +159,11 @@ def _seam_welds(
     refused: str,
     sc: Scenario,
     gated: bool,
+    unplaceable: Collection[str] = (),
 ) -> tuple[SeamWeld, ...]:
     """Per seam: welded (with its quality against the true seam) or the reason it was not. gated : the weld gate
-    applied (not a preview): a found seam too uncertain to weld is ``low_confidence``."""
+    applied (not a preview): a found seam too uncertain to weld is ``low_confidence``, but one no torch can be
+    placed on (``unplaceable``: planned anyway) gets the planner's reason."""
     from cell.motion.plan import seam_tasks
     from cell.motion.quality import combined, weld_quality
 
@@ -179,7 +181,7 @@ def _seam_welds(
             out.append(SeamWeld(est.id, False, False, why, code=WeldReason.NOT_LOCATED))
             continue
         doubtful = _doubt(est, sc)
-        if doubtful and gated:
+        if doubtful and gated and est.id not in unplaceable:
             out.append(SeamWeld(est.id, False, False, f"low_confidence: {doubtful}", code=WeldReason.LOW_CONFIDENCE))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
@@ -254,6 +256,7 @@ def weld(
         plan = pre = ex = None
         violations: tuple[str, ...] = ()
         error: CellError | None = None
+        hopeless: dict[str, str] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
         try:
             if det.error is not None:
                 raise det.error
@@ -263,7 +266,6 @@ def weld(
             motion = motion_scene(station.arm, det)  # once: every re-scan view, the plan and the gate use it
             setup_s = time.perf_counter() - t
             mode = sc.rescan.mode
-            hopeless: dict[str, str] = {}
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
                 if rs is not None:
@@ -293,7 +295,8 @@ def weld(
         except CellError as e:
             error = e
         refused = f"not executed: {error.message}" if error is not None else ""
-        seams = _seam_welds(det, plan, ex, pre.duration if pre is not None else 0.0, refused, sc, execute_plan)
+        pre_s = pre.duration if pre is not None else 0.0
+        seams = _seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)

@@ -228,7 +228,7 @@ class SeamSearch:
         rotations : the spin-free torch rotations so far, shared by a group's spins. worded : the deepest
         contact of each pose (for the failure's words), else its first (a failure kept already ranks higher)."""
         pr = self.process
-        Rs, starts, ends = [], [], []
+        Rs, tips_a, tips_b = [], [], []
         for cand in group:
             a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
             key = (cand.reversed, cand.work_offset, cand.travel_offset)
@@ -240,18 +240,24 @@ class SeamSearch:
                     pr.work_angle + cand.work_offset,
                     pr.travel_angle + cand.travel_offset,
                 )
-            R = rotations[key] @ rot_z(cand.spin)
-            X = _poses(a, b, R, pr.standoff, 2)
-            Rs.append(R)
-            starts.append(X[0])
-            ends.append(X[1])
-        at_start = self.checker.torch_clear_many(np.array(starts), q_seed, first=not worded)
+            Rs.append(rotations[key] @ rot_z(cand.spin))
+            tips_a.append(a)
+            tips_b.append(a + task.length * ((b - a) / task.length))  # as _poses places the last pose
+        # the two end poses of every candidate, as _poses places them (wire tip standoff back along z)
+        R_all = np.array(Rs)
+        back = pr.standoff * R_all[:, :, 2]
+        starts = np.zeros((len(group), 4, 4))
+        starts[:, :3, :3], starts[:, 3, 3] = R_all, 1.0
+        ends = starts.copy()
+        starts[:, :3, 3] = np.array(tips_a) - back
+        ends[:, :3, 3] = np.array(tips_b) - back
+        at_start = self.checker.torch_clear_many(starts, q_seed, first=not worded)
         clear = [k for k, h in enumerate(at_start) if h is None]  # the end is tested only where the start is clear
         at_end: list[Contact | None] = [None] * len(group)
         if clear:
             for k, h in zip(
                 clear,
-                self.checker.torch_clear_many(np.array([ends[k] for k in clear]), q_seed, not worded),
+                self.checker.torch_clear_many(ends[clear], q_seed, not worded),
                 strict=True,
             ):
                 at_end[k] = h

@@ -185,6 +185,8 @@ def test_a_gate_violation_is_its_seams() -> None:
     jerk = blamed_seams(plan, [Violation(ViolationKind.JERK, "too much", 2.5, "a1")])
     assert jerk is not None and jerk["a"].code is PlanReason.TIMING
     assert blamed_seams(plan, [Violation(ViolationKind.START_STATE, "off", 0.0)]) is None  # the whole plan
+    both = [Violation(ViolationKind.SINGULARITY, "x", 2.5), Violation(ViolationKind.SINGULARITY, "x", 5.5)]
+    assert blamed_seams(plan, both) is None  # every seam at fault: the whole plan is refused
     assert blamed_seams(plan, []) is None
 
 

@@ -3,7 +3,7 @@ refused as a whole (:func:`blamed_seams`).
 
 A violation during a seam's approach, weld, depart or the transfer that leads to it is that seam's; one during
 the last move home is the last seam's (the transfer from it). A start-state violation concerns the whole plan:
-it has no seam.
+it has no seam; so do violations that blame every seam of the plan.
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ def seam_of(plan: WeldPlan, v: Violation) -> str:
 
 def blamed_seams(plan: WeldPlan, violations: Sequence[Violation]) -> dict[str, SeamOutcome] | None:
     """Per seam to drop, its outcome with the first violation as the reason; None when some violation concerns
-    the whole plan (then the plan is refused) or there is none."""
+    the whole plan (then the plan is refused), when every seam of the plan is at fault (nothing would be left:
+    the reason is the whole's, e.g. a gate threshold no pose meets), or there is none."""
     out: dict[str, SeamOutcome] = {}
     for v in violations:
         sid = seam_of(plan, v)
@@ -49,6 +50,8 @@ def blamed_seams(plan: WeldPlan, violations: Sequence[Violation]) -> dict[str, S
         code = PlanReason.TRANSFER_COLLISION if transfer else _CODE.get(v.kind, PlanReason.TIMING)
         detail = f"the safety gate: {v}"
         out[sid] = SeamOutcome(sid, False, reason_text(code, detail), readonly(seg.X_end[:3, 3].copy()), code=code)
+    if set(out) >= set(plan.order):  # every seam at fault: a reason that concerns the whole (e.g. a gate setting)
+        return None
     return out or None
 
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import typer
 
+from cell.cli.bar import Bar
 from cell.cli.common import detail, fail_line, results_to_stderr, say
 from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, OutputError
 
@@ -115,9 +116,11 @@ class Writer:
 
 @dataclass
 class Stage:
-    """The progress callback of a run that remembers the last stage it reached (for Ctrl-C's report)."""
+    """The progress callback of a run that remembers the last stage it reached (for Ctrl-C's report); its ``count``
+    draws a stage's count (the planner's seams planned / total) as a bar on a terminal."""
 
     last: str = "starting"
+    count: Bar = field(default_factory=Bar)
 
     def __call__(self, msg: str) -> None:
         self.last = msg

@@ -30,8 +30,9 @@ def test_rescan_improves_the_least_confident_seam_and_returns_the_arm(
     truth = det.truths[worst.id]
     lat0 = segment_errors(r.before.p_start, r.before.p_end, *truth)[2]
     _, end1, lat1, _ = segment_errors(r.fused.p_start, r.fused.p_end, *truth)
-    # [mm] measured: lateral 0.070 before, 0.010 after, end points 0.014 after (the close-up weighs 0.98)
-    assert lat1 < lat0 and lat1 < 0.02 and end1 < 0.03 and r.weight > 0.95
+    # [mm] measured: lateral 0.094 before, 0.033 after (the close-up weighs over 0.95); 0.070 and 0.010 before the
+    # arm model grew to the real arm's size (it hides more of the part from the fixed cameras)
+    assert lat1 < 0.5 * lat0 and lat1 < 0.05 and end1 < 0.05 and r.weight > 0.95
     assert r.motion_s > 0.0 and len(rs.executions) == 2  # to the view, and back
     assert station.arm is not None
     assert rs.returned and np.allclose(station.joint_state(), station.arm.q_scan, atol=1e-9)

@@ -246,3 +246,23 @@ def real_scans_table(data: Row) -> str:
             f"| {hidden.split(':')[1]} {s[hidden]['status'].replace('_', ' ')} | {found} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def planning_table(data: Row) -> str:
+    """Planning per scenario (``planning.json``): seams asked and planned, the refusals by code, the planner's CPU
+    time in all and per planned seam, the reach pre-check per seam, and the wall time of the whole ``cell weld``."""
+    walls = {r["scenario"]: r for r in data.get("weld_runs", [])}
+    lines = [
+        "| scenario | seams asked | planned | refused (code: seams) | planning CPU [s] | per planned seam [s] "
+        "| reach pre-check [us/seam] | cell weld wall [s], welded |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in data["rows"]:
+        refused = ", ".join(f"{k}: {v}" for k, v in sorted(r["refused_by_code"].items())) or "-"
+        w = walls.get(r["scenario"])
+        weld = f"{w['wall_s']:.0f}, {w['welded']}/{w['visible']}" if w else "-"
+        lines.append(
+            f"| {r['scenario']} | {r['seams_asked']} | {r['seams_planned']} | {refused} | {r['planning_cpu_s']:.1f} "
+            f"| {r['cpu_s_per_planned_seam']:.2f} | {r['reach_precheck_us_per_seam']:.0f} | {weld} |"
+        )
+    return "\n".join(lines) + "\n"

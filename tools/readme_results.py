@@ -148,6 +148,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "motion": lambda results: cell_tables.motion_table(_load_object(results, "motion.json")),
     "scaling": scaling,
     "faults": lambda results: cell_tables.faults_table(_load(results, "faults.json")),
+    "planning": lambda results: cell_tables.planning_table(_load_object(results, "planning.json")),
     "real-scans": lambda results: cell_tables.real_scans_table(_load_object(results, "real_scans.json")),
 }
 

@@ -33,28 +33,9 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
+from cell.motion.contact import Contact, advance_along, sphere_box_distance
 from cell.motion.robot import RobotModel
 from cell.types import Part
-
-
-@dataclass(frozen=True)
-class Contact:
-    """A collision: link ``a`` against ``b`` (a link or an obstacle name), distance ``depth`` [m] (<= the
-    threshold; negative = penetration), witness point p_R (3,) on ``a`` [m], at sample ``index`` of the path
-    checked and, when the path was timed, time ``t`` [s]; q (dof,) the configuration."""
-
-    a: str
-    b: str
-    depth: float
-    p_R: FloatArray
-    q: FloatArray
-    index: int = 0
-    t: float = float("nan")
-
-    def describe(self) -> str:
-        p = np.round(self.p_R * 1000.0, 1).tolist()
-        when = f" at t = {self.t:.3f} s" if np.isfinite(self.t) else ""
-        return f"{self.a} vs {self.b} at p_R = {p} mm (distance {self.depth * 1000:.1f} mm){when}"
 
 
 @dataclass
@@ -260,35 +241,7 @@ class CollisionChecker:
         between two checks (near contact the check spacing shrinks to this, so a touch thinner than it can be
         missed). Returns None when the whole path is clear.
         """
-        Q = np.asarray(q_path, dtype=float)
-        T = None if times is None else np.asarray(times, dtype=float)
-        i, frac = 0, 0.0  # current position: Q[i] + frac (Q[i+1] - Q[i])
-        n = len(Q)
-        while True:
-            q = Q[i] if frac == 0.0 or i + 1 >= n else Q[i] + frac * (Q[i + 1] - Q[i])
-            step, hit = self._step_bound(q)
-            if hit is not None:
-                t = float("nan") if T is None else float(T[i] + frac * (T[min(i + 1, n - 1)] - T[i]))
-                return Contact(hit.a, hit.b, hit.depth, hit.p_R, hit.q, i, t)
-            budget = max(step, min_step)
-            # advance along the path until the motion bound uses the budget
-            while i + 1 < n:
-                seg = self.motion_bound(Q[i + 1] - Q[i])
-                left = (1.0 - frac) * seg
-                if left <= budget:
-                    budget -= left
-                    i, frac = i + 1, 0.0
-                    continue
-                frac += budget / seg
-                break
-            else:
-                if frac == 0.0 and budget >= 0.0:
-                    # reached the last sample: check it once more exactly (it may be within the budget)
-                    _, hit = self._step_bound(Q[-1])
-                    if hit is not None:
-                        t = float("nan") if T is None else float(T[-1])
-                        return Contact(hit.a, hit.b, hit.depth, hit.p_R, hit.q, n - 1, t)
-                    return None
+        return advance_along(self._step_bound, self.motion_bound, q_path, times, min_step)
 
     def torch_clear(self, X_RT: npt.ArrayLike, q_ref: npt.ArrayLike) -> Contact | None:
         """Contact of the tool-side shapes (everything rigid with the flange) against the obstacles when the TCP
@@ -376,8 +329,5 @@ class _Boxes:
         return _Boxes(R, c, half, tuple(o.geometry for o in objs), T)
 
     def sphere_distance(self, c_R: FloatArray, radius: FloatArray) -> FloatArray:
-        """(m, k) [m]: distance from each sphere (centres c_R (m, 3), radii (m,)) to each box, a lower bound on
-        the distance of anything inside the sphere (negative or zero when they may touch)."""
-        local = np.einsum("kji,mkj->mki", self.R_RB, c_R[:, None, :] - self.centre[None])
-        out = np.linalg.norm(np.maximum(np.abs(local) - self.half[None], 0.0), axis=2)
-        return np.asarray(out - radius[:, None])
+        """(m, k) [m]: :func:`cell.motion.contact.sphere_box_distance` to each of these boxes."""
+        return sphere_box_distance(self.R_RB, self.centre, self.half, c_R, radius)

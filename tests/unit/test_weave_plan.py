@@ -13,7 +13,7 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.geometry import point_line_distance
-from cell.motion.candidates import candidate_groups
+from cell.motion.torch_candidates import candidate_groups
 from cell.motion.collision import CollisionChecker
 from cell.motion.gate import find_violations
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds

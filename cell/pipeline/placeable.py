@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -15,7 +14,7 @@ import numpy as np
 from cell.pipeline.detect import Progress, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
-from cell.pipeline.rescan import RescanMode, rescan_detection
+from cell.pipeline.rescan import RescanMode, escalated, rescan_detection
 from cell.rescan import seams_to_rescan
 from cell.scenario import Scenario
 from cell.station import Arm, Station
@@ -95,16 +94,7 @@ def rescan_weldable(
         f" {len(rest)} seams a torch can be placed on too"
     )
     more, after = rescan_detection(station, after, "all", seam_ids=rest, motion=motion, progress=progress)
-    merged = replace(
-        more,
-        seams=rs.seams + more.seams,
-        moves=rs.moves + more.moves,
-        executions=rs.executions + more.executions,
-        note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
-        timings={k: rs.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*rs.timings, *more.timings}},
-        escalated_mm=shift_mm,
-    )
-    return merged, after, hopeless
+    return escalated(rs, more, shift_mm), after, hopeless
 
 
 def _hopeless(arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene, progress: Progress) -> dict[str, str]:

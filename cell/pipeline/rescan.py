@@ -221,16 +221,22 @@ def rescan_detection(
         )
         more = rescan_seams(station, after, rest, motion=motion, progress=progress)
         after = rescanned(after, more)
-        rs = replace(
-            more,
-            seams=rs.seams + more.seams,
-            moves=rs.moves + more.moves,
-            executions=rs.executions + more.executions,
-            note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
-            timings={k: rs.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*rs.timings, *more.timings}},
-            escalated_mm=shift_mm,
-        )
+        rs = escalated(rs, more, shift_mm)
     return rs, after
+
+
+def escalated(first: Rescan, more: Rescan, shift_mm: float) -> Rescan:
+    """One re-scan of ``first``'s seams and then ``more``'s, escalated because a close-up of ``first`` moved its
+    seam by ``shift_mm`` [mm]."""
+    return replace(
+        more,
+        seams=first.seams + more.seams,
+        moves=first.moves + more.moves,
+        executions=first.executions + more.executions,
+        note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
+        timings={k: first.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*first.timings, *more.timings}},
+        escalated_mm=shift_mm,
+    )
 
 
 def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:

@@ -13,7 +13,6 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.geometry import point_line_distance
-from cell.motion.torch_candidates import candidate_groups
 from cell.motion.collision import CollisionChecker
 from cell.motion.gate import find_violations
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds
@@ -21,6 +20,7 @@ from cell.motion.plan_options import PlanOptions
 from cell.motion.procedures import NoProcedure, select_procedures
 from cell.motion.robot import RobotModel
 from cell.motion.torch import WeldProcess
+from cell.motion.torch_candidates import candidate_groups
 from cell.motion.weave import cross_section, intended_offsets
 from cell.types.plan import PlanReason
 from cell.types.procedure import Weave, WeldPass, WeldProcedure

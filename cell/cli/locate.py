@@ -33,7 +33,7 @@ from cell.cli.common import (
     was_interrupted,
 )
 from cell.cli.explain import detection_exit
-from cell.cli.outputs import Stage, Writer, check_file, finish, on_interrupt
+from cell.cli.outputs import Stage, Writer, check_file, finish, on_interrupt, stopped_report
 from cell.cli.placement import PlaceOpt, PlaceRpyOpt, placement
 from cell.errors import EXIT_INTERRUPTED, UsageError
 from cell.geometry import FloatArray
@@ -198,26 +198,7 @@ def interrupted_report(
 ) -> dict[str, Any]:
     """The report of a ``cell locate`` stopped by Ctrl-C before it returned: what ran, where it stopped, no seams
     (the keys of ``cell detect``'s interrupted report; no scenario, so ``config`` and ``noise`` are null)."""
-    from cell.export.report import REPORT_VERSION
-
-    return {
-        "report_version": REPORT_VERSION,
-        "provenance": dict(prov) if prov is not None else None,
-        "scenario": name,
-        "method": method or "ours",
-        "noise": None,
-        "frame": frame,
-        "units": "m",
-        "interrupted": {"stage": stage},
-        "seams": [],
-        "summary": None,
-        "error": {
-            "type": "KeyboardInterrupt",
-            "message": f"interrupted (Ctrl-C) during: {stage}",
-            "exit_code": EXIT_INTERRUPTED,
-        },
-        "config": None,
-    }
+    return stopped_report(name, method or "ours", stage, prov, frame=frame)
 
 
 def print_located(rep: dict[str, Any], fmt: str) -> None:

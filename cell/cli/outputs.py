@@ -132,15 +132,37 @@ def interrupted_report(
 ) -> dict[str, Any]:
     """The report of a run stopped by Ctrl-C before its stages returned: what ran, where it stopped, no seam
     results (README "Report": ``interrupted``, ``error`` with exit code 130)."""
+    return stopped_report(
+        scenario.name,
+        method or scenario.locator.method,
+        stage,
+        provenance,
+        noise=scenario.noise,
+        config=scenario.model_dump(mode="json"),
+    )
+
+
+def stopped_report(
+    name: str,
+    method: str,
+    stage: str,
+    provenance: Mapping[str, Any] | None,
+    *,
+    noise: str | None = None,
+    frame: str = "R",
+    config: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The keys of every interrupted report (a scenario run's, or ``cell locate``'s without a scenario: no noise,
+    no config, the cloud's frame)."""
     from cell.export.report import REPORT_VERSION
 
     return {
         "report_version": REPORT_VERSION,
         "provenance": dict(provenance) if provenance is not None else None,
-        "scenario": scenario.name,
-        "method": method or scenario.locator.method,
-        "noise": scenario.noise,
-        "frame": "R",
+        "scenario": name,
+        "method": method,
+        "noise": noise,
+        "frame": frame,
         "units": "m",
         "interrupted": {"stage": stage},
         "seams": [],
@@ -150,7 +172,7 @@ def interrupted_report(
             "message": f"interrupted (Ctrl-C) during: {stage}",
             "exit_code": EXIT_INTERRUPTED,
         },
-        "config": scenario.model_dump(mode="json"),
+        "config": dict(config) if config is not None else None,
     }
 
 

@@ -26,6 +26,7 @@ from cell.config.rescan import BOUND_SIGMAS, WELD_TOLERANCE_MM
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import Deviation, PoseSpec, WorkspaceSpec
+from cell.scenario.flip_specs import FlipPlacementSpec
 from cell.scenario.locator_specs import LOCATOR_SPECS, spec_method
 
 
@@ -187,3 +188,4 @@ class SimulationSpec(Model):
     placement_error: PoseSpec = PoseSpec()  # where the part really lies, relative to map.X_WM (ground truth only)
     faults: FaultsSpec = FaultsSpec()
     bead: BeadStyle = BeadStyle()  # how the weld bead is drawn (no effect on any figure)
+    flip_placement: FlipPlacementSpec = FlipPlacementSpec()  # the operator's error setting the turned part down

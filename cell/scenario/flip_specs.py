@@ -1,0 +1,40 @@
+"""Turning the part for its second side (docs/flip.md): what the cell is told (``flip:``) and what only a
+simulation knows (``simulation.flip_placement``: how far off the operator sets the turned part down)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from pydantic import Field
+
+from cell.scenario.base import Model
+
+
+class TackSpec(Model):
+    """Tack welds laid before the turn, holding the parts together (a cycle-time figure: they are not drawn)."""
+
+    count: Annotated[int, Field(ge=0, le=100)] = 0  # tacks per part before the turn
+    length_mm: Annotated[float, Field(gt=0.0, le=100.0)] = 10.0  # each tack's length
+
+
+class FlipSpec(Model):
+    """Whether and how the part may be turned over for the seams its first side leaves against the table.
+
+    allowed : false for a part too heavy (or too awkward) to turn: the seams left keep their reason.
+    operator_s : the operator's time to turn the part and confirm [s], counted in the job's cycle time.
+    tacks : tack welds before the turn.
+    """
+
+    allowed: bool = True
+    operator_s: Annotated[float, Field(ge=0.0, le=7200.0)] = 120.0  # the operator turns the part [s]
+    tacks: TackSpec = TackSpec()
+    max_tilt_deg: Annotated[float, Field(ge=0.0, le=20.0)] = 5.0  # largest lean of the turned part accepted
+
+
+class FlipPlacementSpec(Model):
+    """How far off its nominal turned pose the operator sets the part down (ground truth only): a horizontal
+    offset of ``offset_mm`` in a direction and a turn of ``rotation_deg`` about the vertical of a sign, both drawn
+    from ``Scenario.rng("flip")``."""
+
+    offset_mm: Annotated[float, Field(ge=0.0, le=200.0)] = 0.0  # horizontal placement error after the turn
+    rotation_deg: Annotated[float, Field(ge=0.0, le=30.0)] = 0.0  # turn about the vertical after the turn

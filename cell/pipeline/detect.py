@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Literal
 
@@ -15,7 +16,9 @@ from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
+from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
+
+Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
 
 __all__ = ["Progress", "build_scene", "capture", "detect", "evaluate", "locate", "quiet", "read_weldmap", "truths"]
 
@@ -63,8 +66,13 @@ def table_z_R(scenario: Scenario) -> float:
     return float((invert(scenario.X_WR) @ [0.0, 0.0, scenario.table.top_z, 1.0])[2])
 
 
-def build_scene(cap: Capture, *, progress: Progress = quiet) -> Scene:
-    """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints."""
+def build_scene(
+    cap: Capture, *, progress: Progress = quiet, X_RM_nominal: FloatArray | None = None, seed: Seed | None = None
+) -> Scene:
+    """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints.
+
+    X_RM_nominal : where the map is believed to lie (default: the scenario's ``map.X_WM``; the turned part's pose
+    on its second side); seed : a search of the cloud near it for a start the ICP can converge from."""
     from cell.perception import align_map, check_alignment_unique, check_parts_seen, perceive
 
     sc = cap.scenario
@@ -76,7 +84,9 @@ def build_scene(cap: Capture, *, progress: Progress = quiet) -> Scene:
 
     t = time.perf_counter()
     progress("aligning the welding map to the cloud")
-    X_RM_nominal = invert(sc.X_WR) @ sc.X_WM
+    X_RM_nominal = invert(sc.X_WR) @ sc.X_WM if X_RM_nominal is None else X_RM_nominal
+    if seed is not None:
+        X_RM_nominal = seed(perceived.registered, X_RM_nominal)
     weldmap_nominal_R = cap.weldmap.transformed(X_RM_nominal, "R")
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
     # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud.
@@ -164,10 +174,13 @@ def detect(
     gui: bool = False,
     station: Station | None = None,
     weldmap: WeldMap | None = None,
+    X_RM_nominal: FloatArray | None = None,
+    seed: Seed | None = None,
 ) -> Detection:
     """Capture, perceive, align and locate every seam of the scenario's welding map; measure against truth.
 
     station, weldmap : a running cell and the map it was built around (both built here when not given).
+    X_RM_nominal, seed : the map's believed pose and a search near it (:func:`build_scene`).
     """
     from cell.seams.registry import with_method
 
@@ -178,11 +191,11 @@ def detect(
     t_all = time.perf_counter()
     cap = capture(scenario, gui=gui, progress=progress, station=station, weldmap=weldmap)
     try:
-        scene = build_scene(cap, progress=progress)
+        scene = build_scene(cap, progress=progress, X_RM_nominal=X_RM_nominal, seed=seed)
     except (SensorError, AlignmentError) as e:
         # No seam can be searched, but every seam is still reported, with the reason; nothing is invented.
         progress(f"no seam search: {e.message}")
-        return _failed_detection(cap, method, e, time.perf_counter() - t_all)
+        return _failed_detection(cap, method, e, time.perf_counter() - t_all, X_RM_nominal)
     estimates = locate(scene, scenario, method, progress=progress)
     weldmap_R = scene.seam_scene.weldmap
     truth = truths(cap, weldmap_R)
@@ -206,13 +219,15 @@ def detect(
     )
 
 
-def _failed_detection(cap: Capture, method: str, error: CellError, seconds: float) -> Detection:
+def _failed_detection(
+    cap: Capture, method: str, error: CellError, seconds: float, X_RM: FloatArray | None = None
+) -> Detection:
     """A detection whose perception or alignment failed: every seam NOT_FOUND (underside ones NOT_VISIBLE, which
     the drawing alone tells) with the reason, against the nominal map."""
     from cell.seams.visibility import visibility
 
     sc = cap.scenario
-    weldmap_R = cap.weldmap.transformed(invert(sc.X_WR) @ sc.X_WM, "R")
+    weldmap_R = cap.weldmap.transformed(invert(sc.X_WR) @ sc.X_WM if X_RM is None else X_RM, "R")
     joints = cap.joints
     table_z = table_z_R(sc)
     estimates = []

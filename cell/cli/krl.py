@@ -1,7 +1,10 @@
-"""``cell krl check DIR``: re-read the KRL programs in a folder and list what is wrong with them.
+"""``cell krl check FOLDER_OR_FILE``: re-read KRL programs and list what is wrong with them.
+
+A folder: every program in it. A file (``NAME.src`` or ``NAME.dat``): that program and, when it is a main program
+calling others (a part turned over between sides, docs/programs.md), every program it calls from its folder.
 
 Exit codes: 0 when every program passes; :data:`EXIT_CHECK_FAILED` (4) with one line per finding
-(``FILE:LINE: code: detail``, on stdout) when not; 2 when DIR holds no program (or is no folder).
+(``FILE:LINE: code: detail``, on stdout) when not; 2 when the path holds no program (or does not exist).
 """
 
 from __future__ import annotations
@@ -22,24 +25,32 @@ app.add_typer(krl_app, name="krl")
 
 @krl_app.command("check")
 def check(
-    directory: Annotated[
-        Path, typer.Argument(help="A folder with NAME.src and NAME.dat (as `cell weld --krl` writes).")
+    target: Annotated[
+        Path,
+        typer.Argument(
+            metavar="FOLDER_OR_FILE",
+            help="A folder with NAME.src and NAME.dat (as `cell weld --krl` writes), or one program's NAME.src:"
+            " a main program is checked with every program it calls.",
+        ),
     ],
     robot: Annotated[
         str, typer.Option(help="The arm's URDF in the repository's robots/ folder (S, T and reach are checked on it).")
     ] = "kr5_arc.urdf",
 ) -> None:
-    """Re-read every program of DIR: names, structure, the INI fold, points declared, arc on ... off with declared
-    weld data sets, S and T of every E6POS against the arm's kinematics. Exit 4 with one line per finding."""
-    from cell.export.krl_check import check_program, read_programs
-    from cell.export.krl_kin import check_kinematics
+    """Re-read every program: names, structure, the INI fold, points declared, arc on ... off with declared weld
+    data sets, S and T of every E6POS against the arm's kinematics; a main program's calls (each called program
+    exists and is checked), the operator's stop between two sides, home at its start and end; TOOL_DATA and
+    BASE_DATA the programs agree on. Exit 4 with one line per finding."""
+    from cell.export.krl_calls import check_all, read_target
 
     with cell_errors():
-        if not directory.is_dir():
-            raise UsageError(f"{str(directory)!r} is not a folder with KRL programs")
-        programs, findings = read_programs(directory)
+        if target.is_file() and target.suffix.lower() not in (".src", ".dat"):
+            raise UsageError(f"{str(target)!r} is not a KRL program: give NAME.src (or its folder)")
+        if not target.exists():
+            raise UsageError(f"{str(target)!r} does not exist: give a folder with KRL programs or a NAME.src")
+        programs, findings = read_target(target)
         if not programs and not findings:
-            raise UsageError(f"{str(directory)!r} holds no KRL program (NAME.src with NAME.dat)")
+            raise UsageError(f"{str(target)!r} holds no KRL program (NAME.src with NAME.dat)")
         from cell.motion.robot import RobotModel
         from cell.station.arm import ROBOT_DIR
 
@@ -47,14 +58,14 @@ def check(
         if not urdf.is_file():
             known = ", ".join(sorted(p.name for p in ROBOT_DIR.glob("*.urdf")))
             raise UsageError(f"--robot {robot!r} is not in robots/; available: {known}")
-        model = RobotModel.from_urdf(urdf)
-        for p in programs:
-            findings += check_program(p)
-            findings += check_kinematics(p, model)
+        findings += check_all(programs, RobotModel.from_urdf(urdf))
         for f in findings:
             out.print(str(f), soft_wrap=True, highlight=False, markup=False)
         names = ", ".join(p.name for p in programs)
         if findings:
-            say(f"{len(findings)} finding(s) in {directory}: {names}")
+            say(f"{len(findings)} finding(s) in {target}: {names}")
             raise typer.Exit(EXIT_CHECK_FAILED)
-        say(f"{names}: passed (structure, INI, points, arc statements and weld data, S and T on {robot})")
+        say(
+            f"{names}: passed (structure, INI, points, arc statements and weld data, S and T on {robot}, calls and"
+            " operator stops)"
+        )

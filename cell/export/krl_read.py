@@ -5,7 +5,8 @@ It reads ``&`` header lines, ``DEF name( )`` / ``END``, ``DEFDAT name [PUBLIC]``
 ``#enums`` and booleans), ``;FOLD`` / ``;ENDFOLD`` comments (kept as fold markers, their header text with them),
 the setup block's ``;- NAME[n] = {...}`` lines, and one statement a line (motions ``PTP``/``LIN``/``CIRC``/
 ``SPTP``/``SLIN`` with their point, ``ArcMainNG(...)``, ``TRIGGER``, ``WAIT``, ``IF``/``ENDIF``, ``HALT``,
-assignments, calls). Lines it cannot read become :class:`Problem` values, never exceptions.
+the loops (``WHILE``, ``REPEAT``/``UNTIL``, ``LOOP``, ``FOR``), assignments, calls: another program's
+``NAME( )``). Lines it cannot read become :class:`Problem` values, never exceptions.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ _IDENT = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 _MOTION = re.compile(r"^(PTP|LIN|CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL)\s+(.*)$", re.I)
 _DECL = re.compile(r"^DECL\s+(?:GLOBAL\s+)?(\w+)\s+(\w+)(\[[^\]]*\])?\s*(?:=\s*(.*))?$", re.I)
 _SETUP = re.compile(r"^;-\s*(\w+)(?:\[(\d+)\])?\s*=\s*(\{.*\})")
+_CONTROL = ("WHILE", "ENDWHILE", "REPEAT", "UNTIL", "LOOP", "ENDLOOP", "FOR", "ENDFOR", "EXIT")
+_CALL = re.compile(r"^(\w+)\s*\(")
 
 
 @dataclass(frozen=True)
@@ -43,8 +46,15 @@ class Decl:
 @dataclass(frozen=True)
 class Statement:
     """One statement: ``kind`` (``PTP``, ``LIN``, ... for motions; ``ARCMAIN``, ``TRIGGER``, ``WAIT``, ``IF``,
-    ``ENDIF``, ``HALT``, ``ASSIGN``, ``CALL``, ``FOLD``, ``ENDFOLD``, ``INTERRUPT``), the text, its line, the
-    motion's point (a name, or an inline structure) and the fold headers it sits in (outermost first)."""
+    ``ENDIF``, ``HALT``, ``ASSIGN``, ``CALL``, ``FOLD``, ``ENDFOLD``, ``INTERRUPT``; the loops' ``WHILE`` /
+    ``ENDWHILE``, ``REPEAT`` / ``UNTIL``, ``LOOP`` / ``ENDLOOP``, ``FOR`` / ``ENDFOR``, ``EXIT``), the text, its
+    line, the motion's point (a name, or an inline structure) and the fold headers it sits in (outermost first)."""
+
+    @property
+    def callee(self) -> str | None:
+        """The routine a ``CALL`` statement calls (``NAME( )``, ``BAS(...)``), upper-case; None for other kinds."""
+        m = _CALL.match(self.text) if self.kind == "CALL" else None
+        return m.group(1).upper() if m is not None else None
 
     kind: str
     text: str
@@ -219,7 +229,7 @@ def _statement(f: KrlFile, code: str, n: int, folds: tuple[str, ...]) -> None:
         return
     head = up.split("(")[0].split()[0] if up.split() else up
     kinds = {"ARCMAINNG": "ARCMAIN", "GLOBAL": "INTERRUPT", "BAS": "CALL"}
-    kinds.update((k, k) for k in ("TRIGGER", "WAIT", "IF", "ENDIF", "ELSE", "HALT", "INTERRUPT"))
+    kinds.update((k, k) for k in ("TRIGGER", "WAIT", "IF", "ENDIF", "ELSE", "HALT", "INTERRUPT", *_CONTROL))
     if head in kinds:
         f.statements.append(Statement(kinds[head], code, n, folds=folds))
         return

@@ -1,0 +1,199 @@
+"""``cell krl check`` across programs: a main program calling others (docs/programs.md), and what programs that run
+on one controller must agree on.
+
+Checks, each a :class:`~cell.export.krl_check.Finding` code:
+- ``call``: a call ``NAME( )`` to a routine that is neither a program read (in the folder) nor a KSS routine this
+  checker knows (:data:`KSS_ROUTINES`); a program that calls itself;
+- ``operator_stop``: two welding programs called one after the other with no operator stop between them. A stop is
+  a ``HALT`` outside any IF or loop, a ``WAIT FOR`` an input (an operator's button), an acknowledgement message
+  (``Set_KrlMsg(#QUIT, ...)``) or a dialog (``Set_KrlDlg``) followed by a loop waiting on ``Exists_KrlMsg`` /
+  ``Exists_KrlDlg``, or KSS's message-library routines ``MsgQuit`` / ``MsgDialog`` (they return once answered);
+- ``home``: a main program that does not start or end at home (``PTP XHOME`` before its first call, or a first
+  called program that starts there; the same after its last call);
+- ``setup``: two programs giving the same TOOL_DATA[n] or BASE_DATA[n] different values in their setup blocks (the
+  controller holds one value per index: a turned part's side needs its own base index).
+
+:func:`read_target` reads a folder (every program) or one file (that program and, from its folder, every program it
+calls, in turn); :func:`check_all` runs every check of :mod:`cell.export.krl_check`, :mod:`cell.export.krl_kin` and
+this module on what was read.
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from collections.abc import Collection, Sequence
+from pathlib import Path
+from typing import Any
+
+from cell.export.krl_check import Finding, Program, check_program, read_programs
+from cell.export.krl_kin import check_kinematics
+from cell.export.krl_read import Statement, read_krl
+from cell.types.robot import Kinematics
+
+KSS_ROUTINES = frozenset(
+    {"BAS", "SET_CD_PARAMS", "IR_STOPM", "ERR_CLEAR", "ARCMAINNG", "SET_KRLMSG", "SET_KRLDLG", "CLEAR_KRLMSG",
+     "EXISTS_KRLMSG", "EXISTS_KRLDLG", "CLEAR_MSGBUFFER", "MSGNOTIFY", "MSGSTATE", "MSGQUIT", "MSGDIALOG",
+     "MSGLOOP", "MSGWAIT"}
+)  # fmt: skip
+_OPEN = {"IF", "WHILE", "REPEAT", "LOOP", "FOR"}
+_CLOSE = {"ENDIF", "ENDWHILE", "UNTIL", "ENDLOOP", "ENDFOR"}
+_WAITING = ("EXISTS_KRLMSG(", "EXISTS_KRLDLG(")
+
+
+def _find_src(folder: Path, name: str) -> Path | None:
+    return next((p for p in sorted(folder.glob("*")) if p.suffix.lower() == ".src" and p.stem.upper() == name), None)
+
+
+def read_program(src: Path) -> tuple[Program | None, list[Finding]]:
+    """The program of one ``NAME.src`` (or its ``NAME.dat``) with its .dat; a finding when the .dat is missing."""
+    src = _find_src(src.parent, src.stem.upper()) or src
+    dat = next((p for p in (src.with_suffix(".dat"), src.with_suffix(".DAT")) if p.is_file()), None)
+    if not src.is_file() or src.suffix.lower() != ".src":
+        return None, [Finding(src.name, 0, "files", f"no {src.stem}.src: give a program's .src (or its folder)")]
+    if dat is None:
+        return None, [Finding(src.name, 0, "files", f"no {src.stem}.dat beside {src.name}")]
+    s = read_krl(src.read_text(encoding="ascii", errors="replace"), "src")
+    d = read_krl(dat.read_text(encoding="ascii", errors="replace"), "dat")
+    return Program(src.stem, s, d, src.name, dat.name), []
+
+
+def program_calls(p: Program) -> list[tuple[str, Statement]]:
+    """The calls of routines other than KSS's (:data:`KSS_ROUTINES`) in order: (upper-case name, statement)."""
+    return [(s.callee, s) for s in p.src.statements if s.callee is not None and s.callee not in KSS_ROUTINES]
+
+
+def read_target(path: Path) -> tuple[list[Program], list[Finding]]:
+    """A folder's programs, or one program file and every program it calls (from its folder, in turn)."""
+    if path.is_dir():
+        return read_programs(path)
+    first, findings = read_program(path)
+    programs: list[Program] = []
+    todo = [first] if first is not None else []
+    while todo:
+        p = todo.pop(0)
+        programs.append(p)
+        for name, _ in program_calls(p):
+            if any(q.name.upper() == name for q in programs + todo):
+                continue
+            src = _find_src(path.parent, name)
+            if src is not None:
+                q, more = read_program(src)
+                findings += more
+                todo += [q] if q is not None else []
+    return programs, findings
+
+
+def _welds(p: Program) -> bool:
+    """Whether the program switches an arc on (an ArcTech ARC_ON fold or a plain ``$OUT[n] = TRUE``)."""
+    return any(
+        (s.kind == "FOLD" and re.match(r"^ARCON\b", s.folds[-1] if s.folds else "", re.I))
+        or (s.kind == "ASSIGN" and re.match(r"^\$OUT\[\d+\]\s*=\s*TRUE", s.text, re.I))
+        for s in p.src.statements
+    )
+
+
+def _stops(between: Sequence[Statement]) -> bool:
+    """Whether these statements stop for the operator (module docstring)."""
+    depth, asked = 0, False
+    for s in between:
+        t = re.sub(r"\s+", "", s.text.upper())
+        if depth == 0 and (
+            s.kind == "HALT"
+            or (s.kind == "WAIT" and t.startswith("WAITFOR") and "$IN[" in t)
+            or t.startswith(("MSGQUIT(", "MSGDIALOG("))
+            or re.match(r"^\w+=MSG(QUIT|DIALOG)\(", t)
+        ):
+            return True
+        if "SET_KRLMSG(#QUIT" in t or "SET_KRLDLG(" in t:
+            asked = True
+        if asked and s.kind in ("WHILE", "UNTIL") and any(w in t for w in _WAITING):
+            return True
+        depth += (s.kind in _OPEN) - (s.kind in _CLOSE)
+    return False
+
+
+_MOVES = ("PTP", "SPTP", "LIN", "SLIN", "CIRC", "SCIRC")
+
+
+def _at_home(motions: Sequence[Statement], last: bool) -> bool | None:
+    """Whether the first (``last``: the last) of these motions is ``PTP XHOME``; None when there is none."""
+    if not motions:
+        return None
+    s = motions[-1] if last else motions[0]
+    return s.kind in ("PTP", "SPTP") and isinstance(s.point, str) and s.point.upper() == "XHOME"
+
+
+def _motions(p: Program) -> list[Statement]:
+    return [s for s in p.src.statements if s.kind in _MOVES]
+
+
+def check_calls(p: Program, programs: Collection[Program]) -> list[Finding]:
+    """The checks of a program calling others (module docstring): ``call``, ``operator_stop``, ``home``."""
+    by_name = {q.name.upper(): q for q in programs}
+    calls = program_calls(p)
+    out: list[Finding] = []
+    for name, s in calls:
+        if name == p.name.upper():
+            out.append(Finding(p.src_name, s.line, "call", f"{p.name} calls itself"))
+        elif name not in by_name:
+            out.append(Finding(p.src_name, s.line, "call", f"{name}( ) is neither a program in the folder nor a KSS"
+                               " routine this checker knows"))  # fmt: skip
+    called = [(n, s) for n, s in calls if n in by_name and n != p.name.upper()]
+    welding = [(n, s) for n, s in called if _welds(by_name[n])]
+    for (a, sa), (b, sb) in itertools.pairwise(welding):
+        if not _stops([s for s in p.src.statements if sa.line < s.line < sb.line]):
+            msg = f"{b} runs after {a} with no operator stop between them (HALT, a message or dialog waited for,"
+            out.append(Finding(p.src_name, sb.line, "operator_stop", msg + " or WAIT FOR an input)"))
+    if called:
+        for last, (n, s) in ((False, called[0]), (True, called[-1])):
+            mine = [m for m in _motions(p) if (m.line > s.line if last else m.line < s.line)]
+            ok = _at_home(mine, last) if mine else _at_home(_motions(by_name[n]), last)
+            if not ok:
+                where, side = ("end", "after") if last else ("start", "before")
+                out.append(Finding(p.src_name, s.line, "home", f"{p.name} does not {where} at home: no PTP XHOME"
+                                   f" {side} {n}( ), nor in {n} itself"))  # fmt: skip
+    return out
+
+
+def _values_differ(a: Any, b: Any) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() != b.keys() or any(_values_differ(a[k], b[k]) for k in a)
+    if isinstance(a, float) and isinstance(b, float):
+        return abs(a - b) > 1e-6
+    return bool(a != b)
+
+
+def check_setup(programs: Sequence[Program]) -> list[Finding]:
+    """TOOL_DATA[n] / BASE_DATA[n] given different values by two programs (module docstring)."""
+    first: dict[str, tuple[Program, Any]] = {}
+    out = []
+    for p in programs:
+        for key, v in p.src.setup.items():
+            if not key.startswith(("TOOL_DATA[", "BASE_DATA[")):
+                continue
+            if key not in first:
+                first[key] = (p, v)
+            elif _values_differ(first[key][1], v):
+                msg = f"{key} differs from {first[key][0].name}'s: the controller holds one value per index"
+                out.append(Finding(p.src_name, 0, "setup", msg + " (give each base of the part its own index)"))
+    return out
+
+
+def is_main(p: Program, programs: Collection[Program]) -> bool:
+    """Whether the program calls another of ``programs``."""
+    names = {q.name.upper() for q in programs} - {p.name.upper()}
+    return any(n in names for n, _ in program_calls(p))
+
+
+def check_all(programs: Sequence[Program], robot: Kinematics) -> list[Finding]:
+    """Every check on every program: :func:`~cell.export.krl_check.check_program`, the kinematics (but for a main
+    program without Cartesian points of its own: it has nothing to check there), the calls and the shared setup."""
+    out: list[Finding] = []
+    for p in programs:
+        out += check_program(p)
+        cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
+        if cartesian or not is_main(p, programs):
+            out += check_kinematics(p, robot)
+        out += check_calls(p, programs)
+    return out + check_setup(programs)

@@ -7,6 +7,7 @@ edges, origin at its centre). Metres and radians.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -70,8 +71,10 @@ class Box:
 class Part:
     """A designed part of the welding map: a closed body, in the frame the owning map is expressed in.
 
-    name : stable identifier (DXF layer or block name, upper case).
+    name : stable identifier (DXF layer or block name, in the drawing's case).
     box : the body, an oriented box today.
+    drawn_as : how the map drew it (``"3DSOLID"``, ``"MESH"``, ``"POLYFACE"``, ``"3DFACE"``; ``""`` when not read
+        from a drawing).
 
     The methods below are what a stage may ask of any body (a face's plane by name, which points lie inside, its
     vertices and edges, its centre and bounding radius, the body in another frame); stages use them, not the box,
@@ -81,6 +84,7 @@ class Part:
 
     name: str
     box: Box
+    drawn_as: str = ""
 
     def face_plane(self, face: str) -> tuple[FloatArray, float]:
         """Outward unit normal n (3,) and offset d [m] of the face named ``face``: it lies in n . p = d."""
@@ -112,7 +116,7 @@ class Part:
 
     def transformed(self, X_CA: FloatArray) -> Part:
         """The same part expressed in frame C, given the pose X_CA of its current frame A in C."""
-        return Part(self.name, self.box.transformed(X_CA))
+        return Part(self.name, self.box.transformed(X_CA), self.drawn_as)
 
 
 @dataclass(frozen=True)
@@ -144,12 +148,24 @@ class MapSeam:
         return MapSeam(self.id, transform_points(X_CA, self.p_start), transform_points(X_CA, self.p_end))
 
 
+class UnsupportedSeam(NamedTuple):
+    """A seam the map draws that the cell cannot weld (an arc, a seam on a fixture): its id and why, in one line."""
+
+    id: str
+    reason: str
+
+
 @dataclass(frozen=True)
 class WeldMap:
     """A welding map: designed parts and weld seams, all in ``frame`` (``M`` as drawn, ``R`` once aligned).
 
-    units : the drawing units the file declared (or the scenario stated), e.g. ``"mm"``; geometry here is in metres.
+    units : the drawing units used (the file's ``$INSUNITS`` or the caller's override), e.g. ``"mm"``; geometry here
+        is in metres.
     source : where it was read from.
+    fixtures : clamps, stops and jigs drawn on the fixture layers: obstacles for the arm, never parts (never
+        aligned, never welded).
+    unsupported : seams drawn but not weldable (arcs, splines, seams on a fixture), each with its reason.
+    warnings : one line each: what the reader skipped or doubted (also logged on ``cell.weldmap``).
     """
 
     parts: tuple[Part, ...]
@@ -157,6 +173,9 @@ class WeldMap:
     units: str
     source: str
     frame: str = "M"
+    fixtures: tuple[Part, ...] = ()
+    unsupported: tuple[UnsupportedSeam, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     def transformed(self, X_AF: FloatArray, frame: str) -> WeldMap:
         """The whole map expressed in frame ``frame`` given the pose X_AF of its current frame F in A."""
@@ -166,6 +185,9 @@ class WeldMap:
             units=self.units,
             source=self.source,
             frame=frame,
+            fixtures=tuple(f.transformed(X_AF) for f in self.fixtures),
+            unsupported=self.unsupported,
+            warnings=self.warnings,
         )
 
     def part(self, name: str) -> Part:

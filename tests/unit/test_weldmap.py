@@ -21,10 +21,11 @@ MM = 1e-3
 
 
 def check_design(m: WeldMap, parts: dict[str, make_maps.BoxSpec], seams: list[make_maps.SeamSpec]) -> None:
-    """``m`` holds exactly the designed parts and seams (given in mm), in metres, axes along M's."""
-    assert [p.name for p in m.parts] == [n.upper() for n in parts]
+    """``m`` holds exactly the designed parts (named in the layers' case) and seams (given in mm), in metres, axes
+    along M's."""
+    assert [p.name for p in m.parts] == list(parts)
     for name, (lo, hi) in parts.items():
-        box = m.part(name.upper()).box
+        box = m.part(name).box
         np.testing.assert_allclose(box.size, (np.array(hi) - lo) * MM, atol=TOL)
         np.testing.assert_allclose(box.center, (np.array(hi) + lo) / 2 * MM, atol=TOL)
         np.testing.assert_allclose(box.X_AB[:3, :3], np.eye(3), atol=1e-9)
@@ -132,9 +133,23 @@ def test_layer_names_in_any_case(tmp_path: Path) -> None:
 def test_units_scale_the_geometry(tmp_path: Path, units: str, code: int, factor: float) -> None:
     parts, seams = design("fence1")
     path = make_maps.write_map(tmp_path / "v.dxf", *scaled(parts, seams, factor), units=code)
-    m = read_map(path, units="mm")  # the file's units win over the override
-    assert m.units == units
+    m = read_map(path)
+    assert m.units == units and m.warnings == ()
     check_design(m, parts, seams)
+    assert read_map(path, units=units).warnings == ()  # an override that agrees says nothing
+
+
+def test_the_callers_units_win_over_declared_ones_with_a_warning(tmp_path: Path) -> None:
+    # Drawn in metres, declared in inches: the parts came out 36 mm long, silently.
+    parts, seams = design("fence1")
+    path = make_maps.write_map(tmp_path / "v.dxf", *scaled(parts, seams, 1e-3), units=1)
+    doubted = read_map(path)
+    assert doubted.units == "in"
+    assert any("only 35.6 mm across in in" in w and "--units m" in w for w in doubted.warnings), doubted.warnings
+    m = read_map(path, units="m")
+    assert m.units == "m"
+    check_design(m, parts, seams)
+    assert len(m.warnings) == 1 and "$INSUNITS=1 (in); read in m as asked" in m.warnings[0]
 
 
 @pytest.mark.parametrize("code", [None, 0])
@@ -156,8 +171,10 @@ def test_unknown_units_override_is_refused() -> None:
 def test_unsupported_declared_units_are_refused(tmp_path: Path) -> None:
     parts, seams = design("fence1")
     path = make_maps.write_map(tmp_path / "v.dxf", parts, seams, units=2)  # feet
-    with pytest.raises(MapUnitsError, match=r"\$INSUNITS=2"):
-        read_map(path, units="mm")
+    with pytest.raises(MapUnitsError, match=r"\$INSUNITS=2.*cell map info .* --units mm"):
+        read_map(path)
+    m = read_map(path, units="mm")  # the caller's units make it usable
+    assert m.units == "mm" and "$INSUNITS=2" in m.warnings[0]
 
 
 def test_seam_ids_fall_back_to_handles(tmp_path: Path) -> None:
@@ -187,10 +204,11 @@ def test_bodies_on_one_layer_get_a_suffix_and_minsert_expands(tmp_path: Path) ->
     doc.saveas(tmp_path / "v.dxf")
     m = read_map(tmp_path / "v.dxf")
     names = [p.name for p in m.parts]
-    assert names[:5] == ["TOP_RAIL", "POST_L_1", "POST_R", "BOTTOM_RAIL", "POST_L_2"]
-    assert names[5:] == ["CLAMP_1", "CLAMP_2", "CLAMP_3"]
+    assert names == ["TOP_RAIL", "POST_L_1", "POST_R", "BOTTOM_RAIL", "POST_L_2"]
     np.testing.assert_allclose(m.part("POST_L_2").box.center, [0.025, 0.925, 0.025], atol=TOL)
-    np.testing.assert_allclose(m.part("CLAMP_3").box.center, [0.085, -0.090, 0.015], atol=TOL)
+    # a block named CLAMP* is a fixture (an obstacle), never a part
+    assert [f.name for f in m.fixtures] == ["CLAMP_1", "CLAMP_2", "CLAMP_3"]
+    np.testing.assert_allclose(m.fixtures[2].box.center, [0.085, -0.090, 0.015], atol=TOL)
 
 
 def test_byblock_seams_take_the_colour_of_their_insert(tmp_path: Path) -> None:
@@ -332,9 +350,9 @@ def test_duplicate_seam_ids(tmp_path: Path) -> None:
 
 def test_a_solid_without_flat_faces(monkeypatch: pytest.MonkeyPatch) -> None:
     # ezdxf meshes only the flat faces of an ACIS body: a cylinder or sphere comes back empty
-    from cell import weldmap
+    from cell.weldmap import _meshes
 
-    monkeypatch.setattr(weldmap.acis, "mesh_from_body", lambda body: [MeshTransformer()])
+    monkeypatch.setattr(_meshes.acis, "mesh_from_body", lambda body: [MeshTransformer()])
     _refused(MAPS / "fence1.dxf", MapError, "3DSOLID", "TOP_RAIL", "no flat faces")
 
 
@@ -345,4 +363,10 @@ def test_a_part_that_is_not_a_box(tmp_path: Path) -> None:
     mesh.vertices[7] = mesh.vertices[7] + (0, 0, 20)  # a wedge, not a box
     mesh.render_mesh(doc.modelspace(), dxfattribs={"layer": "Wedge"})
     doc.saveas(tmp_path / "v.dxf")
-    _refused(tmp_path / "v.dxf", MapError, "part WEDGE is not a box", "v.dxf")
+    m = read_map(tmp_path / "v.dxf")  # it holds no seam: skipped, with a warning naming it
+    assert [p.name for p in m.parts] == list(parts)
+    [w] = m.warnings
+    assert "MESH" in w and "on layer Wedge: part Wedge is not a box" in w and "skipped" in w
+    doc.modelspace().add_line((0, 900, 50), (50, 900, 50), dxfattribs={"color": 1})  # now it holds a seam
+    doc.saveas(tmp_path / "v.dxf")
+    _refused(tmp_path / "v.dxf", MapError, "MESH", "on layer Wedge: part Wedge is not a box", "v.dxf", "holds seam")

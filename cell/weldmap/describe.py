@@ -1,0 +1,63 @@
+"""The text of ``cell map info``: units, parts and fixtures (type, size, centre), seams, unsupported seams."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from cell.geometry import FloatArray, matrix_to_rpy
+from cell.types import Part, WeldMap
+
+
+def _fmt(v: FloatArray, f: str = "8.1f") -> str:
+    return "(" + ", ".join(format(float(x), f) for x in v) + ")"
+
+
+def _bodies(title: str, bodies: tuple[Part, ...]) -> list[str]:
+    lines = [f"{title}: {len(bodies)}"]
+    width = max((len(p.name) for p in bodies), default=4)
+    for p in bodies:
+        size = " x ".join(f"{s * 1000:.1f}" for s in p.box.size)
+        kind = f"box ({p.drawn_as})" if p.drawn_as else "box"
+        line = f"  {p.name:<{width}}  {kind:<16} {size:>24} mm  centre {_fmt(p.box.center * 1000)}"
+        R = p.box.X_AB[:3, :3]
+        if not np.allclose(R, np.eye(3), atol=1e-9):
+            line += "  rpy " + _fmt(np.degrees(matrix_to_rpy(R)), ".2f") + " deg"
+        lines.append(line)
+    return lines
+
+
+def touching(weldmap: WeldMap, margin_m: float = 0.006) -> dict[str, list[str]]:
+    """The parts each seam touches (its ends and middle within ``margin_m`` of the part), by seam id."""
+    out = {}
+    for s in weldmap.seams:
+        pts = np.array([s.p_start, s.p_end, (s.p_start + s.p_end) / 2.0])
+        out[s.id] = [p.name for p in weldmap.parts if bool(np.all(p.contains(pts, margin_m)))]
+    return out
+
+
+def describe(weldmap: WeldMap, joints: Mapping[str, str] | None = None) -> str:
+    """Multi-line summary for ``cell map info``: file, units, parts and fixtures (box size and centre [mm]), seams
+    [mm] with the joint of each (``joints``: seam id -> text, e.g. ``T POST_L > TOP_RAIL``; else the parts each
+    seam touches), then the unsupported seams and why."""
+    lines = [
+        f"file:  {weldmap.source}",
+        f"units: {weldmap.units} (shown in mm, frame {weldmap.frame})",
+        *_bodies("parts", weldmap.parts),
+    ]
+    if weldmap.fixtures:
+        lines += _bodies("fixtures", weldmap.fixtures)
+    lines.append(f"seams: {len(weldmap.seams)}")
+    width = max((len(s.id) for s in weldmap.seams), default=4)
+    on = touching(weldmap) if joints is None else {}
+    for s in weldmap.seams:
+        note = joints.get(s.id, "no joint") if joints is not None else " + ".join(on[s.id]) or "touches no part"
+        lines.append(
+            f"  {s.id:<{width}}  {s.length * 1000:8.1f} mm  from {_fmt(s.p_start * 1000)}"
+            f"  dir {_fmt(s.direction, '+.3f')}  {note}"
+        )
+    if weldmap.unsupported:
+        lines.append(f"unsupported seams: {len(weldmap.unsupported)}")
+        lines += [f"  {u.id}: {u.reason}" for u in weldmap.unsupported]
+    return "\n".join(lines)

@@ -1,0 +1,238 @@
+"""DXF welding map -> :class:`~cell.types.WeldMap`: content first, then units, then geometry, then roles."""
+
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+from ezdxf.document import Drawing
+
+from cell.errors import MapError
+from cell.geometry import FloatArray
+from cell.types import Box, MapSeam, Part, WeldMap
+from cell.types.map import UnsupportedSeam
+from cell.weldmap._load import MALFORMED, ezdxf_to_log, load, log
+from cell.weldmap._walk import Found, RawBody, RawSeam, Reader
+from cell.weldmap.boxfit import bounding_box, fit_box, open_edges, zero_area_faces
+from cell.weldmap.roles import LayerPatterns, LayerRoles, body_role
+from cell.weldmap.units import METRES_PER_UNIT, extent_warning, resolve_units
+
+MIN_SEAM_LENGTH = 1e-6  # [m]
+FLAT_REL = 1e-6  # a drawing whose z extent is below this fraction of its extent is flat
+MAX_COORD_M = 1e4  # 10 km: no welding cell is larger; a coordinate beyond is a broken file
+TOUCH_M = 0.006  # a seam point this close to a body [m] touches it (the joint finder's largest gap)
+WHAT = (
+    "a welding map holds red 3D LINEs or polylines (the seams) and 3D bodies "
+    "(3DSOLID, MESH, POLYFACE or 3DFACE: the parts)"
+)
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n:,} {word}" + ("" if n == 1 else "s")
+
+
+def summary(found: Found) -> str:
+    """What a drawing holds, for a message: e.g. ``10,052 LINEs, none red; no 3D bodies``."""
+    k = found.kinds
+    red = "none" if found.red == 0 else f"{found.red:,}"
+    text = f"{_plural(k['LINE'], 'LINE')}, {red} red"
+    others = [(n, c) for n, c in k.most_common() if n not in ("LINE", "INSERT", "3DSOLID", "MESH", "3DFACE")]
+    if others:
+        text += ", also " + ", ".join(f"{c:,} {n}" for n, c in others[:3])
+    bodies = len(found.bodies)
+    return text + ("; no 3D bodies" if bodies == 0 else f"; {_plural(bodies, '3D body')}".replace("bodys", "bodies"))
+
+
+def _points(found: Found) -> FloatArray:
+    pts = [p for s in found.seams for p in (s.a, s.b)]
+    pts += [v for b in found.bodies if b.mesh is not None for v in b.mesh[0]]
+    return np.array(pts, dtype=float).reshape(-1, 3)
+
+
+def _check_content(found: Found, doc: Drawing, src: str) -> None:
+    if len(doc.modelspace()) == 0:
+        raise MapError(f"{src}: the drawing is empty (truncated or blank?); {WHAT}")
+    if not found.seams and not found.unsupported and not found.bodies:
+        raise MapError(f"{src}: not a welding map: {summary(found)}; {WHAT}")
+    P = _points(found)
+    if len(P) and float(np.ptp(P[:, 2])) <= FLAT_REL * float(np.ptp(P, axis=0).max()):
+        raise MapError(f"{src}: the drawing is flat (all z equal), a 2D drawing: {summary(found)}; {WHAT} in 3D")
+    if not found.seams and not found.unsupported:
+        raise MapError(f"{src}: no red weld seams ({summary(found)}); {WHAT}")
+    if not found.bodies:
+        raise MapError(f"{src}: no parts ({summary(found)}); {WHAT}")
+
+
+def _check_extent(found: Found, scale: float, src: str) -> None:
+    far = [(s.where, max(np.abs(s.a).max(), np.abs(s.b).max())) for s in found.seams]
+    far += [(b.where, np.abs(b.mesh[0]).max()) for b in found.bodies if b.mesh is not None]
+    for where, c in far:
+        if c * scale > MAX_COORD_M:
+            raise MapError(
+                f"{src}: {where} has a coordinate {c * scale:.3g} m from the origin, beyond 10 km; "
+                "a welding map is a few metres across (a broken number?)"
+            )
+
+
+def _seams(found: Found, scale: float, src: str) -> list[tuple[MapSeam, RawSeam]]:
+    seams = []
+    for raw in found.seams:
+        s = MapSeam(raw.id, raw.a * scale, raw.b * scale)
+        if s.length < MIN_SEAM_LENGTH:
+            raise MapError(f"{src}: seam {raw.id} has zero length ({raw.where}); a seam needs two distinct end points")
+        seams.append((s, raw))
+    ids = Counter([s.id for s, _ in seams] + [i for i, _ in found.unsupported])
+    dup = [i for i, n in ids.items() if n > 1]
+    if dup:
+        raise MapError(f"{src}: seam id {dup[0]} appears {ids[dup[0]]} times; seam ids must be unique")
+    return seams
+
+
+def _touches(box: Box, pts: FloatArray) -> bool:
+    return bool(np.all(box.contains(pts, TOUCH_M)))
+
+
+def _near(vertices: FloatArray | None, pts: FloatArray) -> bool:
+    if vertices is None:
+        return False
+    lo, hi = vertices.min(axis=0) - TOUCH_M, vertices.max(axis=0) + TOUCH_M
+    return bool(np.any(np.all((pts >= lo) & (pts <= hi), axis=1)))
+
+
+def _named(found: list[tuple[RawBody, Box]]) -> list[Part]:
+    count = Counter(b.name for b, _ in found)
+    index: Counter[str] = Counter()
+    parts = []
+    for b, box in found:
+        index[b.name] += 1
+        parts.append(Part(f"{b.name}_{index[b.name]}" if count[b.name] > 1 else b.name, box, b.drawn_as))
+    return parts
+
+
+def _bodies(
+    found: Found, spec: LayerPatterns, scale: float, src: str, warnings: list[str]
+) -> tuple[list[Part], list[Part], list[tuple[RawBody, FloatArray | None, str]]]:
+    parts: list[tuple[RawBody, Box]] = []
+    fixtures: list[tuple[RawBody, Box]] = []
+    bad: list[tuple[RawBody, FloatArray | None, str]] = []  # parts that are no box: (body, vertices [m], why)
+    for b in found.bodies:
+        role = body_role(b.name, b.layer, spec)
+        if role == "ignored":
+            warnings.append(f"{src}: {b.where} ignored: neither a parts nor a fixtures layer (map.layers)")
+            continue
+        if b.mesh is None:
+            if role == "fixture":
+                warnings.append(f"{src}: fixture {b.where} {b.reason}; it is no obstacle for the arm")
+            else:
+                bad.append((b, None, b.reason))
+            continue
+        v, faces = b.mesh[0] * scale, b.mesh[1]
+        try:
+            box = fit_box(v, faces, b.name)
+        except MapError as exc:
+            why = exc.message.removeprefix(f"part {b.name} ")
+            if n_open := open_edges(v, faces):
+                why += f" (not closed: {_plural(n_open, 'edge')} on one face only)"
+            if role == "part":
+                bad.append((b, v, why))
+                continue
+            box = bounding_box(v)
+            warnings.append(f"{src}: fixture {b.where} {why}; its bounding box is the obstacle")
+        if zero := zero_area_faces(v, faces):
+            warnings.append(f"{src}: {b.where} has {_plural(zero, 'zero-area face')} (ignored)")
+        (parts if role == "part" else fixtures).append((b, box))
+    return _named(parts), _named(fixtures), bad
+
+
+def _place(
+    seams: list[tuple[MapSeam, RawSeam]],
+    parts: list[Part],
+    fixtures: list[Part],
+    bad: list[tuple[RawBody, FloatArray | None, str]],
+    src: str,
+    warnings: list[str],
+) -> tuple[list[MapSeam], list[UnsupportedSeam]]:
+    """Seams on parts stay; seams on a fixture become unsupported; a body that is no box refuses the map only when
+    it holds a seam (or may: an unreadable body when a seam touches no part), else it is skipped with a warning."""
+    kept, unsupported, loose = [], [], []
+    for s, raw in seams:
+        pts = np.array([s.p_start, s.p_end, (s.p_start + s.p_end) / 2.0])
+        on = [p for p in parts if _touches(p.box, pts)]
+        fx = [f for f in fixtures if _touches(f.box, pts)]
+        if fx and len(on) < 2:
+            why = f"{raw.where}: on fixture {fx[0].name}: a fixture is never welded (map.layers says what is a part)"
+            unsupported.append(UnsupportedSeam(s.id, why))
+            continue
+        kept.append(s)
+        if not on:
+            loose.append((s, pts))
+    for b, v, why in bad:
+        held = [s.id for s, raw in seams if _near(v, np.array([s.p_start, s.p_end]))]
+        if held:
+            raise MapError(
+                f"{src}: {b.where}: part {b.name} {why}; it holds seam {held[0]}: parts must be boxes "
+                "(a body that holds no seam is skipped with a warning)"
+            )
+        if v is None and loose:
+            raise MapError(
+                f"{src}: {b.where} {why}; seam {loose[0][0].id} touches no part that could be read, "
+                "so it may lie on this body"
+            )
+        warnings.append(f"{src}: {b.where}: part {b.name} {why}; skipped (it holds no seam)")
+    for s, _ in loose:
+        warnings.append(f"{src}: seam {s.id} touches no part (within {TOUCH_M * 1000:.0f} mm)")
+    return kept, unsupported
+
+
+def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns | None = None) -> WeldMap:
+    """Read a DXF welding map into a :class:`WeldMap` in frame ``M`` [m].
+
+    units : ``"mm"``, ``"cm"``, ``"m"`` or ``"in"`` (``--units`` / ``map.units``); wins over the file's
+        ``$INSUNITS``, with a warning when they disagree. layers : which layers hold parts, fixtures and seams
+        (the scenario's ``map.layers``; default :class:`LayerRoles`).
+    Raises MapError (MapUnitsError for units) with a one-line message on any unreadable or unusable file; what
+    was skipped or doubted is in ``WeldMap.warnings`` and logged on ``cell.weldmap``.
+    """
+    path = Path(path)
+    src = str(path)
+    spec: LayerPatterns = layers if layers is not None else LayerRoles()
+    with ezdxf_to_log():
+        doc = load(path)
+        try:
+            found = Reader(doc, src, spec).read(doc.modelspace())
+            code = int(doc.header.get("$INSUNITS", 0) or 0)
+        except MapError:
+            raise
+        except MALFORMED as exc:
+            raise MapError(f"{src}: malformed DXF content ({type(exc).__name__}: {exc})") from None
+    _check_content(found, doc, src)
+    unit, warnings = resolve_units(code, units, src)
+    scale = METRES_PER_UNIT[unit]
+    _check_extent(found, scale, src)
+    P = _points(found)
+    if len(P) and (w := extent_warning(float(np.ptp(P, axis=0).max()), unit, src)):
+        warnings.append(w)
+    seams = _seams(found, scale, src)
+    parts, fixtures, bad = _bodies(found, spec, scale, src, warnings)
+    kept, on_fixtures = _place(seams, parts, fixtures, bad, src, warnings)
+    unsupported = [UnsupportedSeam(i, why) for i, why in found.unsupported] + on_fixtures
+    if not kept:
+        first = unsupported[0] if unsupported else UnsupportedSeam("?", "")
+        raise MapError(
+            f"{src}: no seam can be welded: {_plural(len(unsupported), 'seam')} unsupported ({first.reason})"
+        )
+    if not parts:
+        raise MapError(f"{src}: no parts (every body is a fixture or skipped); {WHAT}")
+    for w in warnings:
+        log.warning(w)
+    return WeldMap(
+        parts=tuple(parts),
+        seams=tuple(kept),
+        units=unit,
+        source=src,
+        frame="M",
+        fixtures=tuple(fixtures),
+        unsupported=tuple(unsupported),
+        warnings=tuple(warnings),
+    )

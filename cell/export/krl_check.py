@@ -14,6 +14,9 @@ Checks, each a :class:`Finding` code:
 - ``status_turn``: an E6POS without S or T; with the arm's kinematics (:func:`check_kinematics`), S and T that
   are not the configuration the arm reaches the point in, tracked from the axis point before it;
 - ``kinematics``: a point the arm cannot reach, or no setup values (TOOL_DATA / BASE_DATA) to check against.
+
+A main program calling others (a part turned over between sides) is checked across programs in
+:mod:`cell.export.krl_calls`.
 """
 
 from __future__ import annotations

@@ -63,10 +63,10 @@ def _check(controller: str, jobs: Sequence[ProgramJob], main_name: str, flip_mes
         if job.name in seen:
             raise ValueError(f"two sides are both called {job.name}; each side needs its own program name")
         seen.add(job.name)
-    if len(flip_message) > MESSAGE_MAX or not _MESSAGE.fullmatch(flip_message) or '"' in flip_message:
+    if len(flip_message) > MESSAGE_MAX or not _MESSAGE.fullmatch(flip_message) or set('"\\') & set(flip_message):
         raise ValueError(
             f"flip message {flip_message[:40]!r}... is invalid: at most {MESSAGE_MAX} printable ASCII characters"
-            " without a double quote"
+            " without a double quote or backslash"
         )
     if not flip_message.strip():
         raise ValueError("the flip message is empty: say what the operator must do before the next side")
@@ -196,7 +196,7 @@ def rapid_main_text(main: str, jobs: Sequence[ProgramJob], side_texts: Sequence[
                 lines += [f'    TPWrite "{message}";', "    Stop;"]
             else:
                 lines += [
-                    f'    TPWrite "{main}: {after} done, {before} next";',
+                    f'    TPWrite "{after} done, {before} next";',
                     f'    TPReadFK nKey, "{message}", "Turned", stEmpty, stEmpty, stEmpty, "Abort";',
                     "    IF nKey <> 1 THEN",
                     f'      TPWrite "Aborted by the operator: {before} not welded";',

@@ -97,6 +97,7 @@ def test_rapid_main_module_calls_both_sides_and_waits_for_the_operator(sides: li
     assert main[ask + 1 : ask + 5][1:] == ['TPWrite "Aborted by the operator: WELD_T_B not welded";', "EXIT;",
                                             "ENDIF"]  # fmt: skip
     assert main[b + 1].startswith("MoveAbsJ jHome") and main[b + 2] == "ENDPROC"
+    assert all(len(t) <= 80 for t in re.findall(r'"([^"]*)"', texts["WELD_T.mod"]))  # TPWrite's and TPReadFK's limit
     for name, job in zip(("WELD_T_A", "WELD_T_B"), sides, strict=True):
         side = texts[f"{name}.mod"]
         assert "PROC main()" not in side and f"  PROC {name}_RUN()" in side
@@ -118,7 +119,8 @@ def test_rapid_main_module_calls_both_sides_and_waits_for_the_operator(sides: li
         ("krl", "weld_t_a", ("WELD_T_A", "B"), MESSAGE, "side program WELD_T_A has the main program's name"),
         ("rapid", "WELD_T", ("A", "a"), MESSAGE, "two sides are both called A"),
         ("krl", "WELD_T", ("A", "B"), "x" * 81, "at most 80 printable ASCII"),
-        ("krl", "WELD_T", ("A", "B"), 'say "turned"', "without a double quote"),
+        ("krl", "WELD_T", ("A", "B"), 'say "turned"', "without a double quote or backslash"),
+        ("rapid", "WELD_T", ("A", "B"), "C:\\part", "without a double quote or backslash"),
         ("krl", "WELD_T", ("A", "B"), "  ", "the flip message is empty"),
         ("fanuc", "WELD_T", ("A", "B"), MESSAGE, "controller 'fanuc' is unknown; valid: krl, rapid"),
     ],

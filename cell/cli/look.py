@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+from rich.markup import escape
 
 from cell.cli.common import (
     FormatOpt,
@@ -16,6 +17,7 @@ from cell.cli.common import (
     cell_errors,
     check_method,
     detail,
+    err,
     fail_line,
     map_app,
     out,
@@ -33,6 +35,7 @@ from cell.errors import EXIT_INTERRUPTED, UsageError
 
 if TYPE_CHECKING:
     from cell.station import Station
+    from cell.types import WeldMap
 
 BENCH_SAVED = Path("benchmarks/results/latest.json")  # what --save writes (the README's Table 1 is made from it)
 
@@ -51,15 +54,51 @@ def scenarios() -> None:
 @map_app.command("info")
 def map_info(
     path: Annotated[Path, typer.Argument(help="A DXF welding map.")],
-    units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
+    units: Annotated[
+        str | None, typer.Option(help="Units the DXF is drawn in (mm, cm, m, in); wins over its $INSUNITS.")
+    ] = None,
+    scenario: Annotated[
+        str | None, typer.Option(help="Read the map as this scenario does: its map.layers and map.units.")
+    ] = None,
 ) -> None:
-    """Print the units, parts and seams of a DXF welding map."""
+    """Print the units, parts, fixtures and seams (with their joints) of a DXF welding map, and what it skipped."""
     from cell.weldmap import METRES_PER_UNIT, describe, read_map
 
     with cell_errors():
         if units is not None and units not in METRES_PER_UNIT:
             raise UsageError(f"--units {units!r}; valid: {', '.join(METRES_PER_UNIT)}")
-        out.print(describe(read_map(path, units=units)), soft_wrap=True)
+        layers = None
+        if scenario is not None:
+            from cell import scenario as sc
+
+            spec = sc.load(scenario).map
+            layers, units = spec.layers, units if units is not None else spec.units
+        weldmap = read_map(path, units=units, layers=layers)
+        for line in weldmap.warnings:
+            err.print(f"[yellow]warning[/]: {escape(line)}", soft_wrap=True)
+        out.print(describe(weldmap, _joints(weldmap)), soft_wrap=True, markup=False, highlight=False)
+
+
+def _joints(weldmap: WeldMap) -> dict[str, str]:
+    """Each seam's joint for ``map info``: type, dihedral, abutting > receiving part (seams no two faces hold: none)."""
+    import math
+    from dataclasses import replace
+
+    from cell.errors import MapError
+    from cell.motion.procedures import joint_type
+    from cell.seams.joint import find_joints
+
+    text = {}
+    for s in weldmap.seams:
+        try:
+            joint = find_joints(replace(weldmap, seams=(s,)))[s.id]
+        except MapError:
+            continue
+        a, b = weldmap.part(joint.abutting), weldmap.part(joint.receiving)
+        n_a, n_b = a.face_plane(joint.face_abutting)[0], b.face_plane(joint.face_receiving)[0]
+        dihedral = 180.0 - math.degrees(math.acos(max(-1.0, min(1.0, float(n_a @ n_b)))))
+        text[s.id] = f"{joint_type(weldmap, joint)} {dihedral:.0f} deg  {joint.abutting} > {joint.receiving}"
+    return text
 
 
 @app.command()

@@ -27,7 +27,7 @@ def read_weldmap(scenario: Scenario) -> WeldMap:
     """The scenario's welding map as drawn (frame M): the pipeline reads it, the station is built around it."""
     from cell.weldmap import read_map
 
-    return read_map(scenario.map_path, units=scenario.map.units)
+    return read_map(scenario.map_path, units=scenario.map.units, layers=scenario.map.layers)
 
 
 def capture(

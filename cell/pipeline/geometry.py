@@ -32,5 +32,6 @@ def motion_scene(arm: Arm, det: Detection) -> MotionScene:
     from cell.motion.scene import cell_obstacles
 
     sc = det.scenario
-    obstacles = tuple(cell_obstacles(det.weldmap_R, sc.X_WR, sc.table.center_m, sc.table.size_m))
+    obstacles = cell_obstacles(det.weldmap_R, sc.X_WR, sc.table.center_m, sc.table.size_m)
+    obstacles = (*obstacles, *det.weldmap_R.fixtures)  # clamps and stops (map.layers): obstacles, never parts
     return MotionScene(obstacles, CollisionChecker(arm.model, obstacles, sc.motion.plan.collision))

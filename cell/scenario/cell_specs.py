@@ -12,6 +12,7 @@ from pydantic import Field, model_validator
 from cell.config import STICKOUT_MM
 from cell.geometry import FloatArray, look_at, pose_from_xyz_rpy
 from cell.scenario.base import Model, NonNeg, Pos, Vec3
+from cell.scenario.layer_specs import LayerSpec
 
 
 class PoseSpec(Model):
@@ -29,7 +30,8 @@ class MapSpec(Model):
     """The welding map: a DXF file (relative to the scenario file) and where its origin sits in the world."""
 
     file: str
-    units: Literal["mm", "cm", "m", "in"] | None = None  # only used when the DXF declares no $INSUNITS
+    units: Literal["mm", "cm", "m", "in"] | None = None  # the DXF's units; wins over its $INSUNITS, with a warning
+    layers: LayerSpec = LayerSpec()  # which layers hold parts, fixtures (obstacles) and seams: docs/maps.md
     X_WM: PoseSpec = PoseSpec()  # nominal placement of the drawing on the table (what the cell is told)
 
 

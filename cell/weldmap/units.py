@@ -8,6 +8,7 @@ from cell.errors import MapUnitsError
 
 UNITS_BY_INSUNITS = {1: "in", 4: "mm", 5: "cm", 6: "m"}
 METRES_PER_UNIT = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254}
+NAMES = {"mm": "millimetres", "cm": "centimetres", "m": "metres", "in": "inches"}
 PLAUSIBLE_EXTENT_M = (0.1, 20.0)  # a robot-welded assembly across its map, smallest and largest [m]
 
 
@@ -52,13 +53,15 @@ def extent_warning(extent_units: float, unit: str, source: str) -> str | None:
         return None
     fits = [u for u, k in METRES_PER_UNIT.items() if lo <= extent_units * k <= hi]
     if not fits:
-        return f"{source}: the map is {extent_m:.3g} m across in {unit}, no welded part's size in any units"
+        return (
+            f"{source}: read in {NAMES[unit]}, the map is {extent_m:.3g} m across, no welded part's size in any units"
+        )
     best = min(fits, key=lambda u: abs(math.log(extent_units * METRES_PER_UNIT[u])))
     return (
-        f"{source}: the map is only {extent_m * 1000:.3g} mm across in {unit}"
+        f"{source}: read in {NAMES[unit]}, the map is only {extent_m * 1000:.3g} mm across"
         if extent_m < lo
-        else f"{source}: the map is {extent_m:.3g} m across in {unit}"
+        else f"{source}: read in {NAMES[unit]}, the map is {extent_m:.3g} m across"
     ) + (
-        f"; if it is drawn in {best} ({extent_units * METRES_PER_UNIT[best] * 1000:.0f} mm across), "
+        f"; if it is drawn in {NAMES[best]} ({extent_units * METRES_PER_UNIT[best] * 1000:.0f} mm across), "
         f"read it with {_how(source, best)}"
     )

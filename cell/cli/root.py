@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from cell.cli import sweep as _sweep  # noqa: F401 - registers ``cell sweep`` (a tolerance study on Ray)
 from cell.cli.common import app, configure, err, fail_line
 from cell.errors import EXIT_INTERRUPTED, EXIT_USAGE
 

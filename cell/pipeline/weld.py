@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Mapping
+from contextlib import nullcontext
 from dataclasses import replace
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -16,6 +17,7 @@ from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.scene_view import cell_view
+from cell.pipeline.two_sided import restricted
 from cell.rescan import within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station, open_station
@@ -235,6 +237,9 @@ def weld(
     execute_plan: bool = True,
     progress: Progress = quiet,
     gui: bool = False,
+    station: Station | None = None,
+    detect_options: Mapping[str, Any] | None = None,
+    only: Collection[str] | None = None,
 ) -> WeldRun:
     """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a
     preview) weld. ``rescan`` overrides the scenario's ``rescan.mode``.
@@ -243,14 +248,20 @@ def weld(
     every seam's reason, so the report can still be written. A seam whose confidence stays below
     ``rescan.weld_min_confidence``, or whose bound (``rescan.bound_sigmas`` times its calibrated sigma) stays over
     ``rescan.weld_tolerance_mm``, after the re-scan is not welded (``low_confidence``).
+
+    station : a running cell to weld on (left open; built and closed here when None). detect_options : keywords
+    for :func:`detect` (a turned part's ``X_RM_nominal`` and ``seed``). only : the seam ids this run is about
+    (a second side's: the others are neither re-scanned, planned nor reported).
     """
     t_all = time.perf_counter()
     sc = scenario.with_noise(noise) if noise else scenario
     if rescan is not None:  # the override is what ran: the report's configuration says so
         sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": rescan})})
     weldmap = read_weldmap(sc)
-    with open_station(sc, weldmap, gui=gui) as station:
-        det = detect(sc, method, progress=progress, station=station, weldmap=weldmap)
+    with open_station(sc, weldmap, gui=gui) if station is None else nullcontext(station) as station:
+        det = detect(sc, method, progress=progress, station=station, weldmap=weldmap, **(detect_options or {}))
+        if only is not None:
+            det = restricted(det, only)
         first, rs = det, None
         timings = dict(det.timings)
         plan = pre = ex = None

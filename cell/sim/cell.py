@@ -262,6 +262,24 @@ class SimCell:
             self.client.removeBody(b)
         self._beads.clear()
 
+    def move_part(self, X_W_new_old: FloatArray) -> tuple[Part, ...]:
+        """Move the part (every built part, one rigid body now, and every bead drawn on it) by the rigid motion
+        X_W_new_old (4, 4) in W: the part turned over and set down again. Returns the parts as they now lie (the
+        new ground truth); the table, the ground and the occluders stay where they are."""
+        X = np.asarray(X_W_new_old, dtype=float)
+        names = {p.name for p in self.parts_W}
+        bodies = [b for n, b in self._bodies.items() if n in names] + list(self._beads)
+        for body in bodies:
+            pos, quat = self.client.getBasePositionAndOrientation(body)
+            X_old = make_pose(Rotation.from_quat(quat).as_matrix(), np.asarray(pos, dtype=float))
+            X_new = X @ X_old
+            q_new = Rotation.from_matrix(X_new[:3, :3]).as_quat()
+            self.client.resetBasePositionAndOrientation(
+                body, [float(v) for v in X_new[:3, 3]], [float(v) for v in q_new]
+            )
+        self.parts_W = tuple(p.transformed(X) for p in self.parts_W)
+        return self.parts_W
+
     def capture_from_link(self, camera: str, link: str = EYE_IN_HAND_LINK) -> DepthImage:
         """One depth image from ``camera`` rendered from the arm's link frame ``link`` (optical convention:
         z forward, x right, y down), with the camera's noise and calibration error as in :meth:`capture`."""

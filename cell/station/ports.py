@@ -9,6 +9,7 @@ same ports for simulation and hardware):
 - :meth:`Station.capture_eye_in_hand`: one image from a camera on the arm, wherever the arm is now;
 - :meth:`Station.execute`: drive the arm along a timed joint trajectory (arc on where asked) and record it;
 - :meth:`Station.joint_state`: where the arm is;
+- :meth:`Station.turn_part`: the part turned over for its second side (an operator's job on a real cell);
 - :meth:`Station.truth`: the as-built parts, when the station knows them (a simulation does; a real cell does not).
 
 Frames: W world, R robot base; metres, radians, seconds.
@@ -80,6 +81,12 @@ class Station(Protocol):
         marks (time [s], text) are logged as events; ``bead`` lays the weld where the arc is on (a move with the
         arc off lays none either way). The arm stays at the last configuration.
         """
+        ...
+
+    def turn_part(self, X_W_turn: FloatArray) -> None:
+        """Have the part turned over (an operator's job) by the nominal rigid motion X_W_turn (4, 4) in W and
+        set down again; where it really lies is for a new capture to find. A station that cannot (a recording)
+        raises :class:`~cell.errors.UsageError`."""
         ...
 
     def joint_state(self) -> FloatArray:

@@ -79,6 +79,12 @@ class RecordedStation:
             f"a recorded capture cannot move the arm ({self.recorded.folder}); valid: detect on it, weld on a cell"
         )
 
+    def turn_part(self, X_W_turn: FloatArray) -> None:
+        raise UsageError(
+            f"a recorded capture cannot turn the part over ({self.recorded.folder}); valid: --sides first on a"
+            " recording, both sides on a cell"
+        )
+
     def joint_state(self) -> FloatArray:
         """(0,): a recorded capture has no arm to ask."""
         return np.zeros(0)

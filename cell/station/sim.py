@@ -39,6 +39,7 @@ class SimStation:
         self.parts_W: tuple[Part, ...] = as_built_parts(weldmap, scenario)
         self.sim: SimCell = SimCell(scenario, self.parts_W, gui=gui)
         self._arm: Arm | None = None
+        self.X_W_turned: FloatArray | None = None  # the true motion of the last turn (ground truth)
         try:
             if with_robot and scenario.robot.urdf is not None:
                 self._arm = load_arm(scenario)
@@ -82,6 +83,25 @@ class SimStation:
         if not bead:
             return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=None)
         return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=self.scenario.simulation.bead)
+
+    def turn_part(self, X_W_turn: FloatArray) -> None:
+        """The operator turns the part over: the as-built part (its beads on it) moves by the nominal turn
+        X_W_turn (4, 4) in W, settles on its own hull and is set down with ``simulation.flip_placement``'s error
+        (drawn from ``Scenario.rng("flip")``); :meth:`truth` moves with it."""
+        from cell.sim.flip import turned_pose
+
+        sim = self.scenario.simulation
+        X = turned_pose(
+            self.parts_W,
+            self.sim.bead_segments(),
+            sim.bead.radius_m,
+            X_W_turn,
+            self.scenario.table.top_z,
+            sim.flip_placement,
+            self.scenario.rng("flip"),
+        )
+        self.parts_W = self.sim.move_part(X)
+        self.X_W_turned = X
 
     def joint_state(self) -> FloatArray:
         return np.asarray(self.sim.robot.q, dtype=float)

@@ -9,7 +9,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from cell.geometry import FloatArray, readonly
+import numpy as np
+
+from cell.geometry import FloatArray, invert, readonly
 
 
 @dataclass(frozen=True)
@@ -21,7 +23,7 @@ class FlipPlan:
     tilt_rad : how far the part leans after the turn, resting on the convex hull facet under its centre of mass
         (0 when its new lowest faces lie flat on the table).
     X_RM_after : (4, 4) the map's nominal pose after the turn (turned about the part's centre, set down at the
-        same place); the second alignment starts from it.
+        same place); the second alignment starts from it. X_RM_before : (4, 4) the aligned map on side A.
     exposed : seam ids (left after side A) that face up after the turn and will be searched on side B.
     left : seam id -> why it stays out even after the turn (still against the table, facing down, out of the
         table).
@@ -34,6 +36,7 @@ class FlipPlan:
     angle_rad: float
     tilt_rad: float
     X_RM_after: FloatArray
+    X_RM_before: FloatArray
     exposed: tuple[str, ...]
     left: Mapping[str, str] = field(default_factory=dict)
     stable: bool = True
@@ -43,6 +46,12 @@ class FlipPlan:
     def __post_init__(self) -> None:
         object.__setattr__(self, "axis_R", readonly(self.axis_R))
         object.__setattr__(self, "X_RM_after", readonly(self.X_RM_after))
+        object.__setattr__(self, "X_RM_before", readonly(self.X_RM_before))
+
+    @property
+    def X_R_turn(self) -> FloatArray:
+        """(4, 4) the nominal rigid motion of the part in R the turn makes (X_R_after_before)."""
+        return np.asarray(self.X_RM_after @ invert(self.X_RM_before))
 
     @property
     def go(self) -> bool:

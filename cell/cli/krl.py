@@ -36,11 +36,19 @@ def check(
     robot: Annotated[
         str, typer.Option(help="The arm's URDF in the repository's robots/ folder (S, T and reach are checked on it).")
     ] = "kr5_arc.urdf",
+    e1_limits: Annotated[
+        tuple[float, float] | None,
+        typer.Option(
+            metavar="MIN MAX",
+            help="The linear track's E1 limits in mm: every point's E1 must lie within them (default: the limits"
+            " the program states in its header, if any).",
+        ),
+    ] = None,
 ) -> None:
     """Re-read every program: names, structure, the INI fold, points declared, arc on ... off with declared weld
     data sets, S and T of every E6POS against the arm's kinematics; a main program's calls (each called program
     exists and is checked), the operator's stop between two sides, home at its start and end; TOOL_DATA and
-    BASE_DATA the programs agree on. Exit 4 with one line per finding."""
+    BASE_DATA the programs agree on; E1 of every point on a linear track. Exit 4 with one line per finding."""
     from cell.export.krl_calls import check_all, read_target
 
     with cell_errors():
@@ -58,7 +66,9 @@ def check(
         if not urdf.is_file():
             known = ", ".join(sorted(p.name for p in ROBOT_DIR.glob("*.urdf")))
             raise UsageError(f"--robot {robot!r} is not in robots/; available: {known}")
-        findings += check_all(programs, RobotModel.from_urdf(urdf))
+        if e1_limits is not None and not e1_limits[0] <= 0.0 <= e1_limits[1]:
+            raise UsageError(f"--e1-limits {e1_limits[0]:g} {e1_limits[1]:g}: MIN <= 0 <= MAX [mm] (0: the base at R)")
+        findings += check_all(programs, RobotModel.from_urdf(urdf), e1_limits)
         for f in findings:
             out.print(str(f), soft_wrap=True, highlight=False, markup=False)
         names = ", ".join(p.name for p in programs)

@@ -186,12 +186,15 @@ def is_main(p: Program, programs: Collection[Program]) -> bool:
     return any(n in names for n, _ in program_calls(p))
 
 
-def check_all(programs: Sequence[Program], robot: Kinematics) -> list[Finding]:
-    """Every check on every program: :func:`~cell.export.krl_check.check_program`, the kinematics (but for a main
-    program without Cartesian points of its own: it has nothing to check there), the calls and the shared setup."""
+def check_all(
+    programs: Sequence[Program], robot: Kinematics, e1_limits_mm: tuple[float, float] | None = None
+) -> list[Finding]:
+    """Every check on every program: :func:`~cell.export.krl_check.check_program` (E1 within ``e1_limits_mm``
+    [mm] when given), the kinematics (but for a main program without Cartesian points of its own: it has nothing
+    to check there), the calls and the shared setup."""
     out: list[Finding] = []
     for p in programs:
-        out += check_program(p)
+        out += check_program(p, e1_limits_mm)
         cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
         if cartesian or not is_main(p, programs):
             out += check_kinematics(p, robot)

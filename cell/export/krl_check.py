@@ -14,6 +14,10 @@ Checks, each a :class:`Finding` code:
 - ``status_turn``: an E6POS without S or T; with the arm's kinematics (:func:`check_kinematics`), S and T that
   are not the configuration the arm reaches the point in, tracked from the axis point before it;
 - ``kinematics``: a point the arm cannot reach, or no setup values (TOOL_DATA / BASE_DATA) to check against.
+- ``track``: the linear track's external axis E1 [mm] (docs/track.md). A program states its track in a header
+  comment (``;- Linear track E1 ... limits MIN .. MAX mm``) or the check is given the limits: then every E6POS and
+  E6AXIS must carry E1, within the limits (the given ones win over the stated ones); a program that states no
+  track and is given none must leave every E1 at 0 (a cell without the axis cannot reach such a point).
 
 A main program calling others (a part turned over between sides) is checked across programs in
 :mod:`cell.export.krl_calls`.
@@ -31,6 +35,10 @@ from cell.export.krl_read import Decl, KrlFile, Statement, read_krl
 GLOBAL_POINTS = frozenset({"XHOME"})
 _ARC_FOLD = re.compile(r"^(ARCON|ARCSWI|ARCOFF)\s+(\w+)", re.I)
 _PARTS = {"ARCON": ("STRIKE", "WELD"), "ARCSWI": ("WELD",), "ARCOFF": ("CRATER",)}
+_TRACK = re.compile(r"\blinear track E1\b", re.I)
+_TRACK_LIMITS = re.compile(r"\blimits\s+([+-]?\d+(?:\.\d*)?)\s*\.\.\s*([+-]?\d+(?:\.\d*)?)\s*mm\b", re.I)
+_EXT_TYPES = ("E6POS", "E6AXIS")
+E1_TOL_MM = 0.001  # E1 is written to 0.001 mm
 
 
 @dataclass(frozen=True)
@@ -71,8 +79,9 @@ def read_programs(directory: Path) -> tuple[list[Program], list[Finding]]:
     return programs, findings
 
 
-def check_program(p: Program) -> list[Finding]:
-    """Every check but the kinematics (module docstring)."""
+def check_program(p: Program, e1_limits_mm: tuple[float, float] | None = None) -> list[Finding]:
+    """Every check but the kinematics (module docstring); ``e1_limits_mm`` the linear track's E1 limits [mm] when
+    the check is given them."""
     out = [Finding(p.src_name, pr.line, "syntax", pr.message) for pr in p.src.problems]
     out += [Finding(p.dat_name, pr.line, "syntax", pr.message) for pr in p.dat.problems]
     for f, fname, word in ((p.src, p.src_name, "DEF"), (p.dat, p.dat_name, "DEFDAT")):
@@ -88,6 +97,43 @@ def check_program(p: Program) -> list[Finding]:
     out += _check_init(p)
     out += _check_points(p)
     out += _check_arc(p)
+    out += check_track(p, e1_limits_mm)
+    return out
+
+
+def stated_track(p: Program) -> tuple[bool, tuple[float, float] | None]:
+    """Whether the program's comments state a linear track E1, and its limits [mm] when they give them."""
+    limits, stated = None, False
+    for _, text in p.src.comments:
+        if _TRACK.search(text):
+            stated = True
+            if (m := _TRACK_LIMITS.search(text)) is not None:
+                limits = (float(m.group(1)), float(m.group(2)))
+    return stated, limits
+
+
+def check_track(p: Program, e1_limits_mm: tuple[float, float] | None = None) -> list[Finding]:
+    """E1 of every E6POS / E6AXIS against the track the program states or the check is given (module docstring)."""
+    stated, limits = stated_track(p)
+    limits = e1_limits_mm if e1_limits_mm is not None else limits
+    track = stated or limits is not None
+    points = [(d.name, d.line, p.dat_name, d.value) for d in p.dat.decls.values() if d.type in _EXT_TYPES]
+    points += [(f"the point of line {s.line}", s.line, p.src_name, s.point) for s in _motions(p.src)
+               if isinstance(s.point, dict)]  # fmt: skip
+    out = []
+    for name, line, fname, v in points:
+        if not isinstance(v, dict):
+            continue
+        e1 = v.get("E1")
+        if not track:
+            if isinstance(e1, float) and abs(e1) > E1_TOL_MM:
+                out.append(Finding(fname, line, "track", f"{name}: E1 {e1:g} mm but the program states no linear"
+                                   " track (and none was given)"))  # fmt: skip
+        elif not isinstance(e1, float):
+            out.append(Finding(fname, line, "track", f"{name} has no E1: the program runs on a linear track"))
+        elif limits is not None and not limits[0] - E1_TOL_MM <= e1 <= limits[1] + E1_TOL_MM:
+            out.append(Finding(fname, line, "track", f"{name}: E1 {e1:g} mm is outside the track's limits"
+                               f" {limits[0]:g} .. {limits[1]:g} mm"))  # fmt: skip
     return out
 
 

@@ -66,7 +66,8 @@ class Statement:
 @dataclass
 class KrlFile:
     """One file read: its module name (DEF/DEFDAT), whether it reached END/ENDDAT, declarations by upper-case
-    name, statements in order, the setup block's values by ``NAME[n]`` and the problems found."""
+    name, statements in order, the setup block's values by ``NAME[n]``, the problems found and the whole-line
+    comments (the header states a linear track's limits there)."""
 
     kind: str  # "src" | "dat"
     module: str | None = None
@@ -76,6 +77,7 @@ class KrlFile:
     setup: dict[str, Any] = field(default_factory=dict)
     problems: list[Problem] = field(default_factory=list)
     open_folds: int = 0
+    comments: list[tuple[int, str]] = field(default_factory=list)  # (line, text) of each whole-line comment
 
 
 class _Values:
@@ -183,6 +185,8 @@ def read_krl(text: str, kind: str) -> KrlFile:
                 key = m.group(1).upper() + (f"[{m.group(2)}]" if m.group(2) else "")
                 with contextlib.suppress(ValueError):  # a free comment that only looks like a setup line
                     f.setup[key] = parse_value(m.group(3))
+            if comment and not up_comment.startswith((";FOLD", ";ENDFOLD")):
+                f.comments.append((n, comment))
             continue
         if f.closed:
             f.problems.append(Problem(n, f"text after {'END' if kind == 'src' else 'ENDDAT'}: {code!r}"))

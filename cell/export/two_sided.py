@@ -42,6 +42,7 @@ StopKind = Literal["message", "halt"]
 MESSAGE_MAX = 80  # KRL KrlMsg_T.Msg_Txt[] and RAPID's TPWrite / TPReadFK text: at most 80 characters
 _MESSAGE = re.compile(r"[ -~]*")  # printable ASCII
 MESSAGE_NR = 1  # the message number the KRL acknowledgement message shows
+HOME_TOL_E1_MM = 0.5  # the home guard's tolerance on a linear track's E1 [mm], as a side program's
 
 
 def _check(controller: str, jobs: Sequence[ProgramJob], main_name: str, flip_message: str, stop: str) -> str:
@@ -124,6 +125,8 @@ def krl_main_texts(main: str, jobs: Sequence[ProgramJob], message: str, stop: St
     made_by = header_lines(first.provenance) if first.provenance is not None else []
     names = ", ".join(j.name for j in jobs)
     far = " OR ".join(f"(ABS(XHOME.A{i} - XHOME_PLAN.A{i}) > {HOME_TOL_DEG})" for i in range(1, 7))
+    if getattr(first.plan, "track", None) is not None:  # on a linear track, home is at E1 = 0 too (docs/track.md)
+        far += f" OR (ABS(XHOME.E1 - XHOME_PLAN.E1) > {HOME_TOL_E1_MM})"
     src = [
         "&ACCESS RVP",
         "&REL 1",

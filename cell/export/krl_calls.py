@@ -8,6 +8,7 @@ Checks, each a :class:`~cell.export.krl_check.Finding` code:
   a ``HALT`` outside any IF or loop, a ``WAIT FOR`` an input (an operator's button), an acknowledgement message
   (``Set_KrlMsg(#QUIT, ...)``) or a dialog (``Set_KrlDlg``) followed by a loop waiting on ``Exists_KrlMsg`` /
   ``Exists_KrlDlg``, or KSS's message-library routines ``MsgQuit`` / ``MsgDialog`` (they return once answered);
+  the message such a call shows is not declared (``KrlMsg_T``) or its text is over 80 characters;
 - ``home``: a main program that does not start or end at home (``PTP XHOME`` before its first call, or a first
   called program that starts there; the same after its last call);
 - ``setup``: two programs giving the same TOOL_DATA[n] or BASE_DATA[n] different values in their setup blocks (the
@@ -39,6 +40,8 @@ KSS_ROUTINES = frozenset(
 _OPEN = {"IF", "WHILE", "REPEAT", "LOOP", "FOR"}
 _CLOSE = {"ENDIF", "ENDWHILE", "UNTIL", "ENDLOOP", "ENDFOR"}
 _WAITING = ("EXISTS_KRLMSG(", "EXISTS_KRLDLG(")
+_SET_MSG = re.compile(r"Set_KrlMsg\s*\(\s*#\w+\s*,\s*(\w+)|Set_KrlDlg\s*\(\s*(\w+)", re.I)
+MSG_TXT_MAX = 80  # KrlMsg_T.Msg_Txt[] is a CHAR[80]
 
 
 def _find_src(folder: Path, name: str) -> Path | None:
@@ -128,6 +131,25 @@ def _motions(p: Program) -> list[Statement]:
     return [s for s in p.src.statements if s.kind in _MOVES]
 
 
+def _check_messages(p: Program) -> list[Finding]:
+    """Each message a ``Set_KrlMsg`` / ``Set_KrlDlg`` shows is a declared KrlMsg_T with a text of at most 80
+    characters (``Msg_Txt[]`` is a CHAR[80])."""
+    out = []
+    for s in p.src.statements:
+        m = _SET_MSG.search(s.text)
+        if m is None:
+            continue
+        name = m.group(1) or m.group(2)
+        d = p.dat.decls.get(name.upper()) or p.src.decls.get(name.upper())
+        if d is None or d.type != "KRLMSG_T":
+            out.append(Finding(p.src_name, s.line, "operator_stop", f"the message {name} is not declared (KrlMsg_T)"))
+        elif isinstance(d.value, dict) and len(str(d.value.get("MSG_TXT", ""))) > MSG_TXT_MAX:
+            n = len(str(d.value["MSG_TXT"]))
+            out.append(Finding(p.dat_name, d.line, "operator_stop", f"{name}'s text has {n} characters, over the"
+                               f" {MSG_TXT_MAX} of Msg_Txt[]"))  # fmt: skip
+    return out
+
+
 def check_calls(p: Program, programs: Collection[Program]) -> list[Finding]:
     """The checks of a program calling others (module docstring): ``call``, ``operator_stop``, ``home``."""
     by_name = {q.name.upper(): q for q in programs}
@@ -139,6 +161,7 @@ def check_calls(p: Program, programs: Collection[Program]) -> list[Finding]:
         elif name not in by_name:
             out.append(Finding(p.src_name, s.line, "call", f"{name}( ) is neither a program in the folder nor a KSS"
                                " routine this checker knows"))  # fmt: skip
+    out += _check_messages(p)
     called = [(n, s) for n, s in calls if n in by_name and n != p.name.upper()]
     welding = [(n, s) for n, s in called if _welds(by_name[n])]
     for (a, sa), (b, sb) in itertools.pairwise(welding):
@@ -180,12 +203,6 @@ def check_setup(programs: Sequence[Program]) -> list[Finding]:
     return out
 
 
-def is_main(p: Program, programs: Collection[Program]) -> bool:
-    """Whether the program calls another of ``programs``."""
-    names = {q.name.upper() for q in programs} - {p.name.upper()}
-    return any(n in names for n, _ in program_calls(p))
-
-
 def check_all(
     programs: Sequence[Program], robot: Kinematics, e1_limits_mm: tuple[float, float] | None = None
 ) -> list[Finding]:
@@ -196,7 +213,7 @@ def check_all(
     for p in programs:
         out += check_program(p, e1_limits_mm)
         cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
-        if cartesian or not is_main(p, programs):
+        if cartesian or not program_calls(p):
             out += check_kinematics(p, robot)
         out += check_calls(p, programs)
     return out + check_setup(programs)

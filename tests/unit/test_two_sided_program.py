@@ -186,6 +186,13 @@ def test_checker_finds_a_missing_side_an_unknown_call_a_missing_stop_and_a_share
     _edit(main, "CLEAN_TORCH( )", "IF $IN[5] THEN\nHALT\nENDIF")
     _edit(main, "PTP XHOME ; back home", "")
     assert [c for c, _ in _check(main, robot)] == ["operator_stop"]
+    # the message shown must be declared, with a text that fits Msg_Txt[] (CHAR[80])
+    write_two_sided("krl", sides, "WELD_T", MESSAGE, tmp_path)
+    dat = tmp_path / "WELD_T.dat"
+    _edit(dat, f'"{MESSAGE}"', f'"{MESSAGE}{"!" * (81 - len(MESSAGE))}"')
+    assert _check(main, robot) == [("operator_stop", "FLIP_MSG's text has 81 characters, over the 80 of Msg_Txt[]")]
+    _edit(dat, "DECL KrlMsg_T FLIP_MSG=", "DECL KrlMsg_T OTHER_MSG=")
+    assert _check(main, robot) == [("operator_stop", "the message FLIP_MSG is not declared (KrlMsg_T)")]
     # two sides on one base index with different poses: the controller holds one BASE_DATA[1]
     shared = tmp_path / "shared"
     for job in sides:

@@ -24,11 +24,14 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Collection, Sequence
+from dataclasses import replace as dc_replace
 from pathlib import Path
 from typing import Any
 
-from cell.export.krl_check import Finding, Program, check_program, read_programs
-from cell.export.krl_kin import check_kinematics
+import numpy as np
+
+from cell.export.krl_check import Finding, Program, check_program, read_programs, stated_axis
+from cell.export.krl_kin import check_kinematics, frame_of
 from cell.export.krl_read import Statement, read_krl
 from cell.types.robot import Kinematics
 
@@ -42,6 +45,7 @@ _CLOSE = {"ENDIF", "ENDWHILE", "UNTIL", "ENDLOOP", "ENDFOR"}
 _WAITING = ("EXISTS_KRLMSG(", "EXISTS_KRLDLG(")
 _SET_MSG = re.compile(r"Set_KrlMsg\s*\(\s*#\w+\s*,\s*(\w+)|Set_KrlDlg\s*\(\s*(\w+)", re.I)
 MSG_TXT_MAX = 80  # KrlMsg_T.Msg_Txt[] is a CHAR[80]
+_BASE = re.compile(r"^BAS\s*\(\s*#BASE\s*,\s*(\d+)\s*\)", re.I)
 
 
 def _find_src(folder: Path, name: str) -> Path | None:
@@ -203,6 +207,27 @@ def check_setup(programs: Sequence[Program]) -> list[Finding]:
     return out
 
 
+def fixed_base(p: Program) -> Program:
+    """The program as an arm on a fixed base sees it: on a linear track whose axis the header states
+    (:func:`~cell.export.krl_check.stated_axis`), each E6POS moved back by its E1 along the axis, so that the
+    kinematic check (:mod:`cell.export.krl_kin`) finds the configuration the arm reaches it in from where the
+    carriage put the base. The program itself when it states no track axis or no base to turn the axis into."""
+    axis = stated_axis(p)
+    bi = next((m.group(1) for s in p.src.statements if (m := _BASE.match(s.text))), None)
+    base = p.src.setup.get(f"BASE_DATA[{bi}]") if bi is not None else None
+    if axis is None or not isinstance(base, dict):
+        return p
+    R_BR = frame_of(base)[:3, :3].T
+    decls = dict(p.dat.decls)
+    for key, d in p.dat.decls.items():
+        e1 = d.value.get("E1") if d.type in ("E6POS", "POS") and isinstance(d.value, dict) else None
+        if isinstance(e1, float) and e1 != 0.0:
+            shift_B = R_BR @ (-e1 * np.asarray(axis))  # [mm]
+            moved = {**d.value, **{k: float(d.value.get(k, 0.0)) + v for k, v in zip("XYZ", shift_B, strict=True)}}
+            decls[key] = dc_replace(d, value=moved)
+    return dc_replace(p, dat=dc_replace(p.dat, decls=decls))
+
+
 def check_all(
     programs: Sequence[Program], robot: Kinematics, e1_limits_mm: tuple[float, float] | None = None
 ) -> list[Finding]:
@@ -214,6 +239,6 @@ def check_all(
         out += check_program(p, e1_limits_mm)
         cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
         if cartesian or not program_calls(p):
-            out += check_kinematics(p, robot)
+            out += check_kinematics(fixed_base(p), robot)
         out += check_calls(p, programs)
     return out + check_setup(programs)

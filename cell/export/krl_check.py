@@ -37,6 +37,7 @@ _ARC_FOLD = re.compile(r"^(ARCON|ARCSWI|ARCOFF)\s+(\w+)", re.I)
 _PARTS = {"ARCON": ("STRIKE", "WELD"), "ARCSWI": ("WELD",), "ARCOFF": ("CRATER",)}
 _TRACK = re.compile(r"\blinear track E1\b", re.I)
 _TRACK_LIMITS = re.compile(r"\blimits\s+([+-]?\d+(?:\.\d*)?)\s*\.\.\s*([+-]?\d+(?:\.\d*)?)\s*mm\b", re.I)
+_TRACK_AXIS = re.compile(r"\baxis\s*\[([^\]]*)\]", re.I)
 _EXT_TYPES = ("E6POS", "E6AXIS")
 E1_TOL_MM = 0.001  # E1 is written to 0.001 mm
 
@@ -110,6 +111,20 @@ def stated_track(p: Program) -> tuple[bool, tuple[float, float] | None]:
             if (m := _TRACK_LIMITS.search(text)) is not None:
                 limits = (float(m.group(1)), float(m.group(2)))
     return stated, limits
+
+
+def stated_axis(p: Program) -> tuple[float, float, float] | None:
+    """The linear track's direction the program's header states (``axis [x, y, z] in $ROBROOT``), a unit vector in
+    the robot base at E1 = 0; None when it states none."""
+    for _, text in p.src.comments:
+        if _TRACK.search(text) and (m := _TRACK_AXIS.search(text)) is not None:
+            try:
+                x, y, z = (float(v) for v in m.group(1).split(","))
+            except ValueError:
+                return None
+            n = (x * x + y * y + z * z) ** 0.5
+            return (x / n, y / n, z / n) if n > 1e-9 else None
+    return None
 
 
 def check_track(p: Program, e1_limits_mm: tuple[float, float] | None = None) -> list[Finding]:

@@ -7,14 +7,18 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from test_krl import HOME, OBSTACLES, PROCESS, SEAMS, URDF
 from typer.testing import CliRunner
 
 from cell.cli import app
+from cell.export.krl_calls import check_all, fixed_base
 from cell.export.krl_check import Program, check_program, read_programs, stated_track
+from cell.export.krl_kin import check_kinematics
 from cell.export.post import write_program
 from cell.export.program import ProgramJob
+from cell.geometry import make_pose, rot_z
 from cell.motion.plan import plan_welds
 from cell.motion.robot import RobotModel
 
@@ -82,3 +86,39 @@ def test_cli_takes_the_limits(written: Path, tmp_path: Path) -> None:
     assert r.exit_code == 4 and re.search(r"^T\.dat:\d+: track: XP1: E1 80 mm is outside", r.stdout, flags=re.M)
     assert runner.invoke(app, ["krl", "check", str(tmp_path), "--e1-limits", "-50", "100"]).exit_code == 0
     assert runner.invoke(app, ["krl", "check", str(tmp_path), "--e1-limits", "5", "100"]).exit_code == 2
+
+
+def test_the_kinematic_check_moves_the_base_by_e1_along_the_stated_axis(tmp_path: Path) -> None:
+    """Every Cartesian point moved 3 m along the track (far out of the arm's reach from the base at E1 = 0) with
+    E1 = 3000 mm: the arm, carried there, reaches each as planned; without the carriage it reaches none."""
+    robot = RobotModel.from_urdf(URDF)
+    X_RB = make_pose(rot_z(np.pi / 2), [0.1, 0.0, 0.0])  # a turned base: the axis is turned into it
+    job = ProgramJob(plan_welds(robot, SEAMS[:1], HOME, PROCESS, OBSTACLES), robot, "T", X_RB=X_RB)
+    write_program("krl", job, tmp_path)
+    shift_B = X_RB[:3, :3].T @ np.array([3000.0, 0.0, 0.0])  # [mm] along the track's axis (x of R)
+
+    def moved(m: re.Match[str]) -> str:
+        xyz = [float(v) + d for v, d in zip(m.group(2, 3, 4), shift_B, strict=True)]
+        return f"{m.group(1)}{{X {xyz[0]:.3f}, Y {xyz[1]:.3f}, Z {xyz[2]:.3f}{m.group(5)}, E1 3000.0"
+
+    dat = (tmp_path / "T.dat").read_text()
+    pattern = r"^(DECL E6POS \w+=)\{X ([-\d.]+), Y ([-\d.]+), Z ([-\d.]+)(.*?), E1 [-\d.]+"
+    dat, n = re.subn(pattern, moved, dat, flags=re.M)
+    assert n >= 3
+    (tmp_path / "T.dat").write_text(dat)
+    src = (tmp_path / "T.src").read_text()
+    (tmp_path / "T.src").write_text(src.replace("DEF T( )\n", f"DEF T( )\n{TRACK.replace('1500.0', '5000.0')}\n"))
+    programs, _ = read_programs(tmp_path)
+    assert check_all(programs, robot) == []
+    fixed = fixed_base(programs[0]).dat.decls
+    original = read_programs(written_dir(tmp_path, job))[0][0].dat.decls
+    for name, d in original.items():
+        if d.type == "E6POS":
+            assert all(abs(fixed[name].value[k] - d.value[k]) < 2e-3 for k in "XYZ"), name
+    assert {f.code for f in check_kinematics(programs[0], robot)} == {"kinematics"}  # the base left at E1 = 0
+
+
+def written_dir(tmp_path: Path, job: ProgramJob) -> Path:
+    d = tmp_path / "original"
+    write_program("krl", job, d)
+    return d

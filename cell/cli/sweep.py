@@ -62,7 +62,8 @@ def sweep(
         check_folder(out, "--out")
         scn = sc.load(scenario)
         weldmap = pipeline.read_weldmap(scn)
-        spec = SweepSpec(scn, weldmap, n, words, st, method, sha256_file(scn.map_path))  # type: ignore[arg-type]
+        digests = sha256_file(scn.map_path), sha256_file(sc.resolve(scenario))
+        spec = SweepSpec(scn, weldmap, n, words, st, method, *digests)  # type: ignore[arg-type]
         bar = Bar()
         study = Study(
             spec,

@@ -31,14 +31,21 @@ def dumps(obj: Any) -> str:
 
 
 def sweep_params(
-    scenario: Scenario, map_sha256: str | None, vary: tuple[str, ...], stage: str, method: str | None
+    scenario: Scenario,
+    map_sha256: str | None,
+    vary: tuple[str, ...],
+    stage: str,
+    method: str | None,
+    scenario_sha256: str | None = None,
 ) -> dict[str, Any]:
-    """What makes two sweeps the same sweep (N aside: run k is the same run whatever N is)."""
-    content = dumps(scenario.model_dump(mode="json"))
+    """What makes two sweeps the same sweep (N aside: run k is the same run whatever N is). scenario_sha256 :
+    the scenario file's digest (default: of the loaded scenario's values, which a new default key changes)."""
+    if scenario_sha256 is None:
+        scenario_sha256 = hashlib.sha256(dumps(scenario.model_dump(mode="json")).encode()).hexdigest()
     return {
         "format": FORMAT,
         "scenario": scenario.name,
-        "scenario_sha256": hashlib.sha256(content.encode()).hexdigest(),
+        "scenario_sha256": scenario_sha256,
         "map_sha256": map_sha256,
         "seed": scenario.seed,
         "vary": list(vary),

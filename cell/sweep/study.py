@@ -34,6 +34,7 @@ class SweepSpec:
     stage: Stage
     method: str | None = None
     map_sha256: str | None = None
+    scenario_sha256: str | None = None  # the scenario file's (None: of its values)
 
 
 @dataclass
@@ -57,7 +58,7 @@ class Study:
         from cell.sweep.engine import EngineInfo, engine_version, run_sweep
 
         s = self.spec
-        params = sweep_params(s.scenario, s.map_sha256, s.vary, s.stage, s.method)
+        params = sweep_params(s.scenario, s.map_sha256, s.vary, s.stage, s.method, s.scenario_sha256)
         self.store = store = open_store(self.out, params, fresh=fresh, warn=self.warn)
         todo = [variation(s.scenario, s.weldmap_M, k, s.vary) for k in range(s.n) if k not in store.lines]
         done = sum(1 for k in store.lines if k < s.n)

@@ -61,6 +61,7 @@ def run_sweep(
     try:
         if address is None:
             ray.init(
+                address="local",  # a Ray of its own, even when a cluster runs on this machine
                 num_cpus=cpus_local,
                 include_dashboard=False,
                 log_to_driver=False,

@@ -15,22 +15,19 @@ import typer
 from cell.cli.common import (
     FormatOpt,
     NoiseOpt,
-    TableFormat,
     app,
     cell_errors,
     check_display,
     check_method,
     detail,
-    fail_line,
     parse_format,
     parse_noise,
     parse_rescan_mode,
     say,
     was_interrupted,
 )
-from cell.cli.explain import weld_exit
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
-from cell.cli.tables import print_rescan, print_weld
+from cell.cli.tables import print_rescan
 from cell.errors import EXIT_INTERRUPTED, UsageError
 
 if TYPE_CHECKING:
@@ -50,6 +47,9 @@ RerunOpt = Annotated[
         help="Write a Rerun recording (cloud, map, cameras, robot and tool path on a timeline) here; needs the"
         " optional extra: uv sync --extra rerun, or pip install 'weld-cell\\[rerun]'.",  # help is rich markup
     ),
+]
+SidesOpt = Annotated[
+    str, typer.Option(help="first: weld what the part shows as it lies | all: then turn it over for the rest.")
 ]
 
 
@@ -87,9 +87,14 @@ def weld(
         Path | None, typer.Option("--html", help="Write one page to look at (results, 3D cell, joints) here.")
     ] = None,
     rerun_path: RerunOpt = None,
+    sides: SidesOpt = "all",
 ) -> None:
-    """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation."""
+    """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation;
+    then turn the part over for the seams against the table and weld its other side (``--sides all``)."""
     from cell import pipeline
+    from cell.cli.sides import finish_two_sided, parse_sides
+    from cell.pipeline.sides import weld_part
+    from cell.pipeline.two_sided import TwoSidedRun
 
     with cell_errors():
         table = parse_format(fmt)
@@ -101,13 +106,19 @@ def weld(
             raise UsageError(f"--controller {controller!r} is unknown; valid: krl, rapid")
         check_file(html, "--html", stdout_ok=False)
         _check_rerun(rerun_path)
+        side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
         try:
-            run = pipeline.weld(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
-            partial = _finish_run(
-                run, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
+            if side_opt == "first":  # side A alone, as the part lies
+                run = pipeline.weld(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
+                job = TwoSidedRun(run)
+            else:
+                job = weld_part(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
+                run = job.side_a  # the page and the recording show side A
+            partial = finish_two_sided(
+                job, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
             )
             if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
                 say(f"page: {html}")
@@ -178,26 +189,39 @@ def preview(
     noise: NoiseOpt = None,
     fmt: FormatOpt = "table",
     rerun_path: RerunOpt = None,
+    sides: SidesOpt = "all",
 ) -> None:
-    """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots."""
+    """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots, and of
+    the planned turn with side B's seams at their nominal turned place (``--sides all``)."""
     from cell import pipeline
+    from cell.cli.sides import finish_two_sided, parse_sides
+    from cell.pipeline.sides import weld_part
+    from cell.pipeline.two_sided import TwoSidedRun
     from cell.preview import write_run
+    from cell.preview.flip import write_flip
 
     with cell_errors():
         table = parse_format(fmt)
         check_folder(out_dir, "--out")
         _check_rerun(rerun_path)
+        side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
         json_path = out_dir / "report.json"
         try:
-            run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
-            partial = _finish_run(run, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
+            if side_opt == "first":
+                run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
+                job = TwoSidedRun(run)
+            else:
+                job = weld_part(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
+                run = job.side_a
+            partial = finish_two_sided(job, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
             _write_rerun(run, rerun_path, writer)  # before the pictures: it needs no cloud, they do
             stage(f"drawing pictures into {out_dir}/")
             done = run
             paths = writer.attempt(lambda: write_run(done, out_dir)) or []
+            paths += writer.attempt(lambda: write_flip(job, out_dir)) or []
             for p in paths:
                 say(str(p))
         except (KeyboardInterrupt, ImportError) as e:
@@ -222,33 +246,6 @@ def _interrupted(
     rep = weld_report(run, provenance=prov) if run is not None else interrupted_report(scn, method, stage.last, prov)
     on_interrupt(writer, json_path, rep, stage.last)
     raise typer.Exit(EXIT_INTERRUPTED) from None
-
-
-def _finish_run(
-    run: WeldRun,
-    json_path: Path | None,
-    krl: Path | None,
-    *,
-    title: str,
-    provenance: Mapping[str, Any],
-    writer: Writer,
-    fmt: TableFormat,
-    controller: str = "krl",
-) -> str | None:
-    """Write what was asked (report first: it survives any later failure; each output on its own), print the
-    table; the last line's explanation when the run is partial (None when complete)."""
-    from cell.export.report import weld_report
-
-    rep = weld_report(run, provenance=provenance)
-    writer.report(json_path, rep)
-    if krl is not None and run.plan is not None and run.plan.segments and run.arm is not None:
-        written = writer.attempt(lambda: _write_program(run, krl, provenance, controller))
-        if written is not None:
-            say(f"robot program: {', '.join(map(str, written[:-2]))}; trajectory: {written[-2]}, {written[-1]}")
-    print_weld(rep, title, fmt)
-    if run.error is not None:  # the report says which seams and why: partial, with the cause in report.error
-        fail_line(f"error: {run.error.message}")
-    return None if run.complete and run.error is None else weld_exit(rep)
 
 
 def _write_page(run: WeldRun | None, path: Path) -> Path:
@@ -278,24 +275,3 @@ def _write_rerun(run: WeldRun, path: Path | None, writer: Writer) -> None:
 
     if writer.attempt(lambda: record_run(run, path)) is not None:
         say(f"rerun recording: {path}")
-
-
-def _write_program(run: WeldRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
-    """The robot program for ``controller`` (provenance in its header; the weld points in the part's base, the
-    aligned map) and the trajectory as JSON and CSV, into ``krl``."""
-    import numpy as np
-
-    from cell.export.post import write_program
-    from cell.export.program import ProgramJob
-    from cell.export.trajectory import write_csv
-    from cell.export.trajectory import write_json as write_traj
-
-    if run.plan is None or run.arm is None:
-        raise ValueError("no plan to write")
-    sc = run.detection.scenario
-    name = "WELD_" + "".join(ch if ch.isalnum() else "_" for ch in sc.name).upper()
-    scene = run.detection.scene
-    X_RB = scene.X_RM if scene is not None else np.eye(4)
-    job = ProgramJob(run.plan, run.arm.model, name[:24], X_RB, sc.X_WR, sc.export.krl, provenance)
-    paths = write_program(controller, job, krl)
-    return [*paths, write_traj(run.plan, krl / "trajectory.json"), write_csv(run.plan, krl / "trajectory.csv")]

@@ -3,26 +3,14 @@ run after the operator turned the part, and what the second alignment measured. 
 
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 from cell.errors import CellError
-from cell.pipeline.records import Detection, WeldRun
+from cell.pipeline.records import WeldRun
 from cell.types import SeamStatus, WeldMap
 from cell.types.flip import FlipPlan, FlipResult
 from cell.types.run import SeamRecord
-
-
-def restricted(det: Detection, ids: Collection[str]) -> Detection:
-    """The detection of only the seams ``ids`` (a second side's): their estimates, truths and metrics."""
-    from cell.pipeline.evaluation import evaluate
-
-    keep = set(ids)
-    estimates = tuple(e for e in det.estimates if e.id in keep)
-    truths = {k: v for k, v in det.truths.items() if k in keep}
-    _, summary = evaluate(estimates, truths)
-    metrics = {k: v for k, v in det.metrics.items() if k in keep}
-    return replace(det, estimates=estimates, truths=truths, metrics=metrics, summary=summary)
 
 
 @dataclass(frozen=True)

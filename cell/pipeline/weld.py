@@ -16,8 +16,8 @@ from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
 from cell.pipeline.records import Detection, WeldRun
+from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
-from cell.pipeline.two_sided import restricted
 from cell.rescan import within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station, open_station

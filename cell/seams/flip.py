@@ -25,6 +25,9 @@ from cell.types.flip import FlipPlan
 
 _FACING_DOWN_Z = -0.2  # a fillet whose bisector points further down than this cannot be reached from above
 _TURNS = (math.pi, math.pi / 2.0, -math.pi / 2.0)  # half turn first, then onto a side
+# The part must not tip over when nudged: tilted this far about the nearest edge of its support, its centre of
+# mass still lies over the support (an upright fence on a 100 mm rail is not a resting part).
+MIN_TIP_RAD = math.radians(15.0)
 
 
 def principal_axes(weldmap_R: WeldMap) -> FloatArray:
@@ -115,13 +118,16 @@ def plan_flip(
             left = {sid: _why_left(turned, joints[sid], table_z, table_xy) for sid in remaining}
             left = {sid: why for sid, why in left.items() if why}
             exposed = tuple(sid for sid in remaining if sid not in left)
-            stable = margin > 0.0 and tilt <= max_tilt_rad
+            height = float((X[:3, :3] @ com + X[:3, 3])[2]) - table_z
+            tip = math.atan2(margin, max(height, 1e-9))
+            stable = margin > 0.0 and tilt <= max_tilt_rad and tip >= MIN_TIP_RAD
             reason = ""
             if not stable:
                 reason = (
                     f"turned {math.degrees(angle):+.0f} deg about its {name} axis the part would lean "
                     f"{math.degrees(tilt):.1f} deg (at most {math.degrees(max_tilt_rad):.1f}) with its centre of "
-                    f"mass {margin * 1000:+.0f} mm inside its support"
+                    f"mass {margin * 1000:+.0f} mm inside its support, {height * 1000:.0f} mm up (tips over at "
+                    f"{math.degrees(tip):.0f} deg, needs {math.degrees(MIN_TIP_RAD):.0f})"
                 )
             plan = FlipPlan(name, axes[:, k], angle, tilt, X @ X_RM, X_RM, exposed, left, stable=stable, reason=reason)
             score = (len(exposed) if stable else -1, -rank)

@@ -34,6 +34,12 @@ MALFORMED = (
 )
 
 
+def kind_of(exc: BaseException) -> str:
+    """An exception's type as a message names it (``struct.error``, ``AssertionError``)."""
+    t = type(exc)
+    return t.__name__ if t.__module__ == "builtins" else f"{t.__module__.split('.')[0]}.{t.__name__}"
+
+
 class _Forward(logging.Handler):
     """Hands ezdxf's records to ``cell.weldmap`` as DEBUG lines (the log file has them; stderr never)."""
 
@@ -72,4 +78,4 @@ def load(path: Path) -> Drawing:
     except (OSError, UnicodeDecodeError) as exc:
         raise MapError(f"{path}: not a readable DXF file ({exc}); expected an ASCII or binary DXF") from None
     except Exception as exc:  # ezdxf raises assorted errors on malformed input; never show a traceback
-        raise MapError(f"{path}: not a valid DXF file ({type(exc).__name__}: {exc})") from None
+        raise MapError(f"{path}: not a valid DXF file ({kind_of(exc)}: {exc})") from None

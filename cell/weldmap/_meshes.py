@@ -10,7 +10,7 @@ from ezdxf.entities import DXFGraphic
 from ezdxf.render import MeshBuilder
 
 from cell.geometry import FloatArray
-from cell.weldmap._load import MALFORMED
+from cell.weldmap._load import MALFORMED, kind_of
 
 Mesh = tuple[FloatArray, list[tuple[int, ...]]]
 BODY_TYPES = ("3DSOLID", "MESH", "POLYLINE", "3DFACE")
@@ -50,7 +50,7 @@ def body_meshes(e: DXFGraphic, dxfversion: str) -> list[Mesh]:
             hint = (
                 "ezdxf cannot read this binary ACIS solid: save the drawing as DXF R2000-R2010 or export bodies as MESH"
             )
-        raise UnreadableBodyError(f"cannot be read ({type(exc).__name__}: {exc}); {hint}") from None
+        raise UnreadableBodyError(f"cannot be read ({kind_of(exc)}: {exc}); {hint}") from None
     builders = [m for m in builders if m.vertices and m.faces]
     if not builders:  # e.g. a cylinder or sphere: ezdxf meshes only the flat faces of ACIS bodies
         raise UnreadableBodyError("has no flat faces (a curved solid?); expected a polyhedral body (a box)")

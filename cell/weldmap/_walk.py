@@ -90,7 +90,8 @@ def _layer_is_red(layer: Layer) -> bool:
 
 
 def _apply(X: FloatArray, p: FloatArray) -> FloatArray:
-    return np.asarray(p @ X[:3, :3].T + X[:3, 3])
+    with np.errstate(all="ignore"):  # an infinite coordinate gives NaN here: _finite names the entity
+        return np.asarray(p @ X[:3, :3].T + X[:3, 3])
 
 
 def _finite(p: FloatArray, where: Where, source: str) -> FloatArray:

@@ -12,7 +12,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.types import Box, MapSeam, Part, WeldMap
 from cell.types.map import UnsupportedSeam
-from cell.weldmap._load import MALFORMED, ezdxf_to_log, load, log
+from cell.weldmap._load import MALFORMED, ezdxf_to_log, kind_of, load, log
 from cell.weldmap._walk import Found, RawBody, RawSeam, Reader
 from cell.weldmap.boxfit import bounding_box, fit_box, open_edges, zero_area_faces
 from cell.weldmap.roles import LayerPatterns, LayerRoles, body_role
@@ -55,6 +55,7 @@ def _check_content(found: Found, doc: Drawing, src: str) -> None:
         raise MapError(f"{src}: the drawing is empty (truncated or blank?); {WHAT}")
     if not found.seams and not found.unsupported and not found.bodies:
         raise MapError(f"{src}: not a welding map: {summary(found)}; {WHAT}")
+    _check_extent(found, None, src)
     P = _points(found)
     if len(P) and float(np.ptp(P[:, 2])) <= FLAT_REL * float(np.ptp(P, axis=0).max()):
         raise MapError(f"{src}: the drawing is flat (all z equal), a 2D drawing: {summary(found)}; {WHAT} in 3D")
@@ -64,14 +65,21 @@ def _check_content(found: Found, doc: Drawing, src: str) -> None:
         raise MapError(f"{src}: no parts ({summary(found)}); {WHAT}")
 
 
-def _check_extent(found: Found, scale: float, src: str) -> None:
+def _check_extent(found: Found, scale: float | None, src: str) -> None:
+    """Refuse a coordinate beyond 10 km (``scale`` None: before the units are known, beyond 10 km in any units)."""
     far = [(s.where, max(np.abs(s.a).max(), np.abs(s.b).max())) for s in found.seams]
     far += [(b.where, np.abs(b.mesh[0]).max()) for b in found.bodies if b.mesh is not None]
+    least = min(METRES_PER_UNIT.values())
     for where, c in far:
-        if c * scale > MAX_COORD_M:
+        if scale is None and c * least > MAX_COORD_M:
+            raise MapError(
+                f"{src}: {where} has a coordinate {c:.3g} from the origin, beyond 10 km in any units; "
+                "a welding map is a few metres across (a broken number?)"
+            )
+        if scale is not None and c * scale > MAX_COORD_M:
             raise MapError(
                 f"{src}: {where} has a coordinate {c * scale:.3g} m from the origin, beyond 10 km; "
-                "a welding map is a few metres across (a broken number?)"
+                "a welding map is a few metres across (a broken number? other units?)"
             )
 
 
@@ -165,8 +173,8 @@ def _place(
             unsupported.append(UnsupportedSeam(s.id, why))
             continue
         kept.append(s)
-        if not on:
-            loose.append((s, pts))
+        if len(on) < 2:  # a seam joins two parts: the other one may be a body that could not be read
+            loose.append((s, on))
     for b, v, why in bad:
         held = [s.id for s, raw in seams if _near(v, np.array([s.p_start, s.p_end]))]
         if held:
@@ -176,12 +184,13 @@ def _place(
             )
         if v is None and loose:
             raise MapError(
-                f"{src}: {b.where} {why}; seam {loose[0][0].id} touches no part that could be read, "
-                "so it may lie on this body"
+                f"{src}: {b.where} {why}; seam {loose[0][0].id} touches {len(loose[0][1])} of the two parts it "
+                "joins, so it may lie on this body"
             )
         warnings.append(f"{src}: {b.where}: part {b.name} {why}; skipped (it holds no seam)")
-    for s, _ in loose:
-        warnings.append(f"{src}: seam {s.id} touches no part (within {TOUCH_M * 1000:.0f} mm)")
+    for s, on in loose:
+        what = f"only part {on[0].name}" if on else "no part"
+        warnings.append(f"{src}: seam {s.id} touches {what} (within {TOUCH_M * 1000:.0f} mm); a seam joins two parts")
     return kept, unsupported
 
 
@@ -197,6 +206,8 @@ def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns |
     path = Path(path)
     src = str(path)
     spec: LayerPatterns = layers if layers is not None else LayerRoles()
+    if units is not None:  # a bad override is the caller's error: refused before reading the file
+        resolve_units(0, units, src)
     with ezdxf_to_log():
         doc = load(path)
         try:
@@ -205,7 +216,7 @@ def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns |
         except MapError:
             raise
         except MALFORMED as exc:
-            raise MapError(f"{src}: malformed DXF content ({type(exc).__name__}: {exc})") from None
+            raise MapError(f"{src}: malformed DXF content ({kind_of(exc)}: {exc})") from None
     _check_content(found, doc, src)
     unit, warnings = resolve_units(code, units, src)
     scale = METRES_PER_UNIT[unit]

@@ -1,7 +1,8 @@
 """Property tests (hypothesis): mangled inputs give a valid result or one clear CellError, never a traceback.
 
 Inputs: mutated copies of maps/fence1.dxf for :func:`cell.weldmap.read_map` (byte flips, truncation, deleted,
-duplicated and swapped lines, swapped group codes, random text) and of scenarios/fence1.yaml for
+duplicated and swapped lines, duplicated spans, lines swapped far apart, swapped group codes, random text, extreme
+numbers in coordinates) and of scenarios/fence1.yaml for
 :func:`cell.scenario.from_yaml` (deleted or misspelled keys, wrong types, out-of-range values, random YAML).
 Deterministic (derandomize) and bounded: each example has a 2 s deadline.
 """
@@ -22,11 +23,14 @@ from hypothesis import strategies as st
 from cell import scenario as sc
 from cell.errors import CellError, MapError, ScenarioError
 from cell.types import WeldMap
-from cell.weldmap import read_map
+from cell.weldmap import MAX_COORD_M, read_map
 
 REPO = Path(__file__).resolve().parents[2]
 DXF = (REPO / "maps" / "fence1.dxf").read_bytes()
 DXF_LINES = DXF.decode("ascii").splitlines(keepends=True)
+# the value lines of coordinates (after group codes 10-38: x, y, z of points): where extreme numbers go
+COORD_LINES = [i + 1 for i, line in enumerate(DXF_LINES[:-1]) if line.strip() in {str(c) for c in range(10, 39)}]
+EXTREME = ["nan", "inf", "-inf", "1e300", "-1e300", "1e12", "-3.4e38", "1e-320", "0"]
 SCENARIO = (sc.SCENARIO_DIR / "fence1.yaml").read_text()
 SCENARIO_DATA = yaml.safe_load(SCENARIO)
 
@@ -61,6 +65,10 @@ def check_map(data: bytes, units: str | None = None) -> None:
     assert weldmap.parts and weldmap.seams
     for s in weldmap.seams:
         assert np.all(np.isfinite(s.p_start)) and np.all(np.isfinite(s.p_end)) and s.length > 0
+        assert max(np.abs(s.p_start).max(), np.abs(s.p_end).max()) <= MAX_COORD_M  # plausible: within 10 km
+    for p in (*weldmap.parts, *weldmap.fixtures):
+        corners = p.box.corners()
+        assert np.all(np.isfinite(corners)) and np.abs(corners).max() <= MAX_COORD_M + p.radius
 
 
 # -- DXF mutations ------------------------------------------------------------------------------------------
@@ -97,6 +105,43 @@ def line_edits(draw: st.DrawFn) -> bytes:
         if not lines:
             break
     return "".join(lines).encode("ascii", "replace")
+
+
+@st.composite
+def spans_and_numbers(draw: st.DrawFn) -> bytes:
+    """What an outsider's tools do to a file: a span of lines duplicated, lines swapped far apart, coordinates
+    replaced by extreme numbers (NaN, infinities, 1e300: the reader must refuse them, naming the entity)."""
+    lines = list(DXF_LINES)
+    for _ in range(draw(st.integers(1, 4))):
+        kind = draw(st.sampled_from(["span", "far_swap", "extreme", "extreme"]))
+        if kind == "span":
+            i = draw(st.integers(0, len(lines) - 1))
+            n = draw(st.integers(2, 60))
+            j = draw(st.integers(0, len(lines)))
+            lines[j:j] = lines[i : i + n]
+        elif kind == "far_swap":
+            i, j = draw(st.integers(0, len(lines) - 1)), draw(st.integers(0, len(lines) - 1))
+            lines[i], lines[j] = lines[j], lines[i]
+        else:
+            i = draw(st.sampled_from(COORD_LINES))
+            if i < len(lines):
+                lines[i] = draw(st.sampled_from(EXTREME)) + "\n"
+    return "".join(lines).encode("ascii", "replace")
+
+
+@FUZZ
+@given(spans_and_numbers())
+def test_dxf_with_duplicated_spans_and_extreme_numbers(data: bytes) -> None:
+    check_map(data)
+
+
+@pytest.mark.parametrize("value", ["nan", "-inf", "1e12"])
+def test_an_extreme_coordinate_is_refused_or_harmless(value: str) -> None:
+    # Bug (issue 12): NaN, infinite and 1e12-metre coordinates were accepted into the map.
+    for i in COORD_LINES[:: max(1, len(COORD_LINES) // 3)]:
+        lines = list(DXF_LINES)
+        lines[i] = value + "\n"
+        check_map("".join(lines).encode("ascii"))
 
 
 @FUZZ

@@ -54,14 +54,20 @@ def write_risk(path: Path, weldmap_M: WeldMap, summary: Mapping[str, Any]) -> Pa
 
     def risk(sid: str) -> float:
         p = seams[sid].get("probability_within_tolerance")
-        return -1.0 if p is None else float(p)
+        return -1.0 if p is None or not seams[sid].get("probability_found") else float(p)
 
-    for sid in sorted(ids, key=risk, reverse=True):  # the riskiest last: drawn on top
+    shift = _spread(weldmap_M, ids)
+    for sid in sorted(ids, key=risk, reverse=True):  # the riskiest last: drawn on top; never found: grey, first
         seam = weldmap_M.seam(sid)
         p = risk(sid)
-        a, b = np.asarray(seam.p_start) * _MM, np.asarray(seam.p_end) * _MM
-        colour = "0.6" if p < 0 else cmap(norm(p))
-        ax.plot([a[0], b[0]], [a[1], b[1]], color=colour, linewidth=4, solid_capstyle="round")
+        a, b = np.asarray(seam.p_start)[:2] * _MM + shift[sid], np.asarray(seam.p_end)[:2] * _MM + shift[sid]
+        style = (
+            {"color": "0.6", "linewidth": 2, "linestyle": ":"} if p < 0 else {"color": cmap(norm(p)), "linewidth": 4}
+        )
+        if np.linalg.norm(b - a) < 1.0:  # a vertical seam seen from above: a point
+            ax.plot([a[0]], [a[1]], marker="o", markersize=6, color=style["color"])
+        else:
+            ax.plot([a[0], b[0]], [a[1], b[1]], solid_capstyle="round", **style)
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm] (map M)")
     ax.set_ylabel("y [mm]")
@@ -73,6 +79,24 @@ def write_risk(path: Path, weldmap_M: WeldMap, summary: Mapping[str, Any]) -> Pa
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _spread(weldmap_M: WeldMap, ids: Sequence[str], step_mm: float = 14.0) -> dict[str, np.ndarray]:
+    """Per seam, a shift [mm] in the top view: seams that would cover each other from above (the sides of one
+    joint) are set side by side, ``step_mm`` apart across their direction."""
+    groups: dict[tuple[int, int], list[str]] = {}
+    for sid in ids:
+        m = weldmap_M.seam(sid)
+        mid = (np.asarray(m.p_start)[:2] + np.asarray(m.p_end)[:2]) / 2.0 * _MM
+        groups.setdefault((round(mid[0] / 20.0), round(mid[1] / 20.0)), []).append(sid)
+    out: dict[str, np.ndarray] = {}
+    for members in groups.values():
+        for i, sid in enumerate(members):
+            m = weldmap_M.seam(sid)
+            d = (np.asarray(m.p_end) - np.asarray(m.p_start))[:2]
+            across = np.array([-d[1], d[0]]) / np.linalg.norm(d) if np.linalg.norm(d) > 1e-6 else np.array([1.0, 0.0])
+            out[sid] = across * step_mm * (i - (len(members) - 1) / 2.0)
+    return out
 
 
 def _bars(ax: Any, ids: Sequence[str], seams: Mapping[str, Any], stage: str) -> None:

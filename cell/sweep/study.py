@@ -115,7 +115,7 @@ class Study:
         summary = self.summary()
         path = self.out / SUMMARY
         tmp = path.with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(summary, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+        tmp.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")  # seams in map order
         os.replace(tmp, path)
         self._summary_t = time.monotonic()
         if pictures and self.store is not None:

@@ -9,7 +9,7 @@ import pytest
 from cell import scenario as sc
 from cell.errors import UsageError
 from cell.geometry import make_pose
-from cell.sweep import VARY_WORDS, Tolerances, parse_vary, varied, variation, variations
+from cell.sweep import VARY_WORDS, Tolerances, parse_vary, variation, variations, varied
 from cell.types import Box, MapSeam, Part, WeldMap
 
 RAIL = Part("TOP_RAIL", Box(make_pose(p=[0.7, 0.75, 0.05]), np.array([1.4, 0.1, 0.1])))
@@ -68,7 +68,7 @@ def test_varied_scenario_carries_the_drawn_values(fence1: sc.Scenario) -> None:
 
 def test_parse_vary() -> None:
     assert parse_vary("seed, tolerances") == ("tolerances", "seed")  # canonical order
-    with pytest.raises(UsageError, match="unknown word.*colour.*valid: tolerances, placement"):
+    with pytest.raises(UsageError, match=r"unknown word.*colour.*valid: tolerances, placement"):
         parse_vary("tolerances,colour")
     with pytest.raises(UsageError, match="nothing to vary"):
         parse_vary(" , ")

@@ -207,6 +207,8 @@ def test_cli_checks_a_main_file_and_its_sides(sides: list[ProgramJob], tmp_path:
     runner = CliRunner()
     ok = runner.invoke(app, ["krl", "check", str(tmp_path / "WELD_T.src")])
     assert ok.exit_code == 0 and "WELD_T, WELD_T_A, WELD_T_B: passed" in ok.stderr
+    ok = runner.invoke(app, ["krl", "check", str(tmp_path / "WELD_T.dat")])  # its .dat does too
+    assert ok.exit_code == 0 and "WELD_T, WELD_T_A, WELD_T_B: passed" in ok.stderr, ok.stdout + ok.stderr
     _edit(tmp_path / "WELD_T.src", "WELD_T_B( )", "WELD_T_C( )")
     bad = runner.invoke(app, ["krl", "check", str(tmp_path / "WELD_T.src")])
     assert bad.exit_code == 4 and "WELD_T.src:" in bad.stdout and ": call: WELD_T_C( ) is neither" in bad.stdout

@@ -17,6 +17,7 @@ class LayerSpec(Model):
     is ignored with a warning. A LINE or polyline is a seam when it is red or lies on a ``seams`` layer.
     """
 
-    parts: Patterns | None = None  # None: every body not on a fixture layer is a part
-    fixtures: Patterns = Field(default=("FIXTURE*", "CLAMP*", "JIG*", "STOP*"))  # = cell.weldmap's defaults
+    parts: Patterns | None = None  # layers (or blocks) of the parts; null: every body not on a fixture layer
+    # layers (or blocks) of the fixtures: obstacles for the arm, never parts (cell.weldmap's defaults)
+    fixtures: Patterns = Field(default=("FIXTURE*", "CLAMP*", "JIG*", "STOP*"))
     seams: Patterns = ()  # layers whose lines are seams whatever their colour (red lines always are)

@@ -40,15 +40,22 @@ def frame_text(X: npt.ArrayLike) -> str:
     return f"{{X {num(x)}, Y {num(y)}, Z {num(z)}, A {num(yaw)}, B {num(pitch)}, C {num(roll)}}}"
 
 
-def e6pos(X: FloatArray, s: int, t: int) -> str:
-    """An E6POS of a pose (4, 4) [m] with Status and Turn (external axes 0)."""
-    return frame_text(X)[:-1] + f", S {s}, T {t}, E1 0.0, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+def e6pos(X: FloatArray, s: int, t: int, e1: float = 0.0) -> str:
+    """An E6POS of a pose (4, 4) [m] with Status and Turn; E1 the linear track's position [m] (written in mm),
+    the other external axes 0."""
+    return frame_text(X)[:-1] + f", S {s}, T {t}, E1 {_e1(e1)}, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
 
 
-def e6axis(q: FloatArray) -> str:
-    """An E6AXIS of joint values (6,) [rad] in degrees (external axes 0)."""
+def e6axis(q: FloatArray, e1: float = 0.0) -> str:
+    """An E6AXIS of joint values (6,) [rad] in degrees; E1 the linear track's position [m] (written in mm), the
+    other external axes 0."""
     a = ", ".join(f"A{i + 1} {num(v)}" for i, v in enumerate(np.degrees(q)))
-    return f"{{{a}, E1 0.0, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+    return f"{{{a}, E1 {_e1(e1)}, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+
+
+def _e1(e1: float) -> str:
+    """E1 [m] as KRL writes it, in mm (0 as the unused axes are: ``0.0``)."""
+    return num(e1 * 1000.0) if e1 != 0.0 else "0.0"
 
 
 def _channels(p: WeldProcedure) -> str:

@@ -36,6 +36,8 @@ from cell.geometry import FloatArray, invert, readonly
 from cell.motion.contact import Contact, advance_along, sphere_box_distance
 from cell.motion.robot import RobotModel
 from cell.types import Part
+from cell.types.track import LinearTrack
+from cell.types.trajectory import Trajectory
 
 
 @dataclass
@@ -108,6 +110,9 @@ class CollisionChecker:
         self._pair_first = np.array([p.first for p in pairs], dtype=int)
         self._pair_second = np.array([p.second for p in pairs], dtype=int)
         self._is_obstacle_pair = self._pair_second >= self._n_robot
+        self._base_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == 0]
+        self._base_offset = np.zeros(3)
+        self.set_base(robot.base_offset_R)
 
     # -- set-up ------------------------------------------------------------------------------------------------
 
@@ -161,6 +166,59 @@ class CollisionChecker:
                 reach += float(np.linalg.norm(m.jointPlacements[j].translation))
                 j = m.parents[j]
         return readonly(r)
+
+    # -- the base on a linear track (docs/track.md) -------------------------------------------------------------
+
+    @property
+    def base_offset_R(self) -> FloatArray:
+        """(3,) [m]: where the arm's base stands in R now (0: the base at R)."""
+        return readonly(self._base_offset.copy())
+
+    def set_base(self, offset_R: npt.ArrayLike) -> None:
+        """Move the arm's base (its first joint and the shapes fixed to the base) to ``offset_R`` (3,) [m] in R, as
+        a linear track carries it; the obstacles stay where they are (nothing is rebuilt). Self-collision is
+        unchanged by a translation of the whole arm; the torch test (:meth:`torch_clear`) takes poses in R and
+        needs no base at all."""
+        d = np.asarray(offset_R, dtype=float).reshape(3)
+        move = d - self._base_offset
+        if not np.any(move):
+            return
+        M = self._model.jointPlacements[1]
+        self._model.jointPlacements[1] = pin.SE3(np.array(M.rotation), np.array(M.translation) + move)
+        for i in self._base_shapes:
+            obj = self._geom.geometryObjects[i]
+            P = obj.placement
+            obj.placement = pin.SE3(np.array(P.rotation), np.array(P.translation) + move)
+        self._base_offset = d.copy()
+
+    def check_trajectory(self, traj: Trajectory, track: LinearTrack | None = None) -> Contact | None:
+        """:meth:`check_path` of a timed motion with the base where the track puts it at every sample
+        (``traj.e1`` along ``track.axis_R``; without either, where the base stands now). A motion of the track
+        itself is advanced conservatively in (q, E1): a step moves no arm point more than the joints' bound plus
+        |delta E1|. The base is left where it was."""
+        if traj.e1 is None or track is None:
+            return self.check_path(traj.q, traj.times)
+        keep = self._base_offset.copy()
+        e1 = np.asarray(traj.e1, dtype=float)
+        try:
+            if np.ptp(e1) == 0.0:
+                self.set_base(track.offset_R(float(e1[0])))
+                return self.check_path(traj.q, traj.times)
+            dof = traj.dof
+
+            def step_bound(x: FloatArray) -> tuple[float, Contact | None]:
+                self.set_base(track.offset_R(float(x[dof])))
+                return self._step_bound(x[:dof])
+
+            def motion(dx: FloatArray) -> float:
+                return self.motion_bound(dx[:dof]) + abs(float(dx[dof]))
+
+            hit = advance_along(step_bound, motion, np.column_stack([traj.q, e1]), traj.times)
+            if hit is None:
+                return None
+            return Contact(hit.a, hit.b, hit.depth, hit.p_R, readonly(np.asarray(hit.q)[:dof]), hit.index, hit.t)
+        finally:
+            self.set_base(keep)
 
     # -- queries ---------------------------------------------------------------------------------------------
 

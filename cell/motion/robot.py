@@ -27,6 +27,7 @@ class RobotModel:
 
     def __init__(self, model: pin.Model, limits: JointLimits, source: Path) -> None:
         self._model = model
+        self.base_offset_R: FloatArray = readonly(np.zeros(3))  # where the base stands in R (a linear track)
         self._data = model.createData()
         self.limits = limits
         self.source = source
@@ -65,6 +66,24 @@ class RobotModel:
             raise ScenarioError(f"robot URDF {path}: every joint needs finite lower < upper position limits")
         lim_path = Path(limits_path) if limits_path is not None else path.with_suffix(".limits.yaml")
         return cls(model, load_limits(lim_path, names, q_min, q_max, v_urdf), path)
+
+    def shifted(self, offset_R: npt.ArrayLike) -> RobotModel:
+        """The same arm with its base moved by ``offset_R`` (3,) [m] in R, as a linear track carries it
+        (docs/track.md): every pose it returns (:meth:`fk`, :meth:`pose_and_jacobian`, :meth:`reach_bound`) is
+        still in R, X_RF = translation(offset) @ X_Re_F. The joint axes keep their directions, so Jacobians and
+        manipulability are those of the unshifted arm. A new model (this one is unchanged)."""
+        d = np.asarray(offset_R, dtype=float)
+        if d.shape != (3,) or not np.all(np.isfinite(d)):
+            raise ValueError(f"robot {self.name}: a base offset is 3 finite values [m], got {d.shape}")
+        model = pin.Model(self._model)
+        move = d - self.base_offset_R
+        model.jointPlacements[1] = _translated(model.jointPlacements[1], move)
+        for fr in model.frames:
+            if fr.parentJoint == 0:  # frames fixed to the base (base_link, its children)
+                fr.placement = _translated(fr.placement, move)
+        out = RobotModel(model, self.limits, self.source)
+        out.base_offset_R = readonly(d.copy())
+        return out
 
     @property
     def dof(self) -> int:
@@ -170,3 +189,8 @@ class RobotModel:
     def integrate(self, q: npt.ArrayLike, dq: npt.ArrayLike) -> FloatArray:
         """q (+) dq on the configuration space (plain addition for revolute joints), as a new array."""
         return np.array(pin.integrate(self._model, self._q(q), np.asarray(dq, dtype=float)))
+
+
+def _translated(M: pin.SE3, d: FloatArray) -> pin.SE3:
+    """translation(d) * M: the placement M moved by d [m] in its parent's axes."""
+    return pin.SE3(np.array(M.rotation), np.array(M.translation) + d)

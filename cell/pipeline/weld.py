@@ -6,6 +6,7 @@ import time
 from collections.abc import Callable, Collection, Mapping
 from contextlib import nullcontext
 from dataclasses import replace
+from functools import partial
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -52,6 +53,7 @@ def plan_for(
     from cell.motion.plan import plan_welds, seam_tasks
     from cell.motion.timing import ptp
     from cell.motion.torch import WeldProcess
+    from cell.motion.track import plan_on_track
     from cell.motion.transfers import TransferFail, Transfers, joined
 
     sc = det.scenario
@@ -80,7 +82,9 @@ def plan_for(
     dropped: dict[str, SeamOutcome] = {}
     for _ in range(_GATE_ROUNDS):
         kept = [t for t in tasks if t.id not in dropped]
-        plan = plan_welds(
+        track = sc.robot.track.track(sc.X_WR) if sc.robot.track is not None else None
+        planner = plan_welds if track is None else partial(plan_on_track, track=track)  # docs/track.md
+        plan = planner(
             arm.model,
             kept,
             arm.q_home,
@@ -137,7 +141,8 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
         (pre.duration + seg.t0, f"{seg.kind} {seg.seam_id}".strip()) for seg in plan.segments
     ]
     progress(f"executing {plan.cycle_time + pre.duration:.1f} s of robot motion in the simulator")
-    return station.execute(times, q, arc_on, marks=marks, record_dt=0.01)
+    e1 = None if traj.e1 is None else np.concatenate([np.zeros(len(pre.times)), traj.e1[1:]])  # the track's E1
+    return station.execute(times, q, arc_on, marks=marks, record_dt=0.01, e1=e1)
 
 
 def _doubt(est: SeamEstimate, sc: Scenario) -> str:
@@ -279,6 +284,8 @@ def weld(
             mode = sc.rescan.mode
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
+                if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
+                    hopeless = {i: why for i, why in hopeless.items() if "beyond reach" not in why}
                 if rs is not None:
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so. A seam no
@@ -326,6 +333,8 @@ def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[s
             tr = seg.trajectory
             k = np.unique(np.r_[np.searchsorted(tr.times, np.arange(0.0, tr.duration, step_s)), len(tr.times) - 1])
             poses = np.stack([model.fk(tr.q[i]) for i in k])
+            if plan.track is not None:  # the base where the track put it (poses in R: the base at E1 = 0)
+                poses[:, :3, 3] += plan.track.offset_R(seg.e1_end)
             prev = out.get(seg.seam_id)  # a multi-pass seam: its passes one after the other
             out[seg.seam_id] = poses if prev is None else np.concatenate([prev, poses])
     return out

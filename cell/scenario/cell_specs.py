@@ -13,6 +13,7 @@ from cell.config import STICKOUT_MM
 from cell.geometry import FloatArray, look_at, pose_from_xyz_rpy
 from cell.scenario.base import Model, NonNeg, Pos, Vec3
 from cell.scenario.layer_specs import LayerSpec
+from cell.scenario.track_specs import TrackSpec
 
 
 class PoseSpec(Model):
@@ -63,6 +64,7 @@ class RobotSpec(Model):
     # Wire stick-out [mm] beyond the contact tip in the URDF's torch_tcp (robots/build_kr5_arc.py STICKOUT): the
     # torch planner stands the TCP off the seam by contact_tip_distance_mm minus this (0 by default).
     stickout_mm: Pos = STICKOUT_MM
+    track: TrackSpec | None = None  # a linear track (external axis E1) under the base: docs/track.md
 
 
 class NoiseSpec(Model):

@@ -126,11 +126,32 @@ class SimRobot:
         # pose of the root link frame in its inertial frame (getBasePositionAndOrientation gives the latter)
         dyn = client.getDynamicsInfo(self.body, -1)
         self._X_inertial_base = np.linalg.inv(_pose(dyn[3], dyn[4]))
+        base = client.getBasePositionAndOrientation(self.body)
+        self._base0 = (np.array(base[0], dtype=float), [float(v) for v in base[1]])
+        self._track_W: FloatArray | None = None  # unit axis in W of a linear track under the base
+        self._e1_next: FloatArray | None = None
         self.set_q(q)
 
     @property
     def dof(self) -> int:
         return len(self.joint_names)
+
+    def on_track(self, axis_W: npt.ArrayLike) -> None:
+        """The base rides a linear track along ``axis_W`` (3,) in W: E1 = 0 is where it was loaded (X_WR)."""
+        a = np.asarray(axis_W, dtype=float)
+        self._track_W = a / np.linalg.norm(a)
+
+    def set_e1(self, e1: float) -> None:
+        """Put the base at E1 = e1 [m] on its track (a translation of the whole arm along the axis)."""
+        if self._track_W is None:
+            raise ScenarioError(f"robot {self.name} has no linear track: E1 = {e1 * 1000:.1f} mm cannot be set")
+        p0, orn = self._base0
+        self._c.resetBasePositionAndOrientation(self.body, [float(v) for v in p0 + e1 * self._track_W], orn)
+
+    def stage_e1(self, e1: npt.ArrayLike | None) -> None:
+        """E1 [m] per sample (n,) of the next :meth:`play` (the track moves the base as it plays); None: the
+        base stays where it is."""
+        self._e1_next = None if e1 is None else np.asarray(e1, dtype=float)
 
     @property
     def link_names(self) -> tuple[str, ...]:
@@ -192,16 +213,22 @@ class SimRobot:
     ) -> Execution:
         """Play a timed joint trajectory kinematically and record the tool path (see ``SimCell.execute``)."""
         t_in, q_in, arc_in = _check_trajectory(times, q, arc_on, self.dof)
+        e1_in, self._e1_next = self._e1_next, None
+        if e1_in is not None and (e1_in.shape != t_in.shape or not np.all(np.isfinite(e1_in))):
+            raise ValueError(f"execute: e1 must be ({len(t_in)},) finite values [m], got {e1_in.shape}")
         tcp = self.link_index(tcp_link)
         bad = self.limit_violation(q_in)
         if bad:
             raise PlanError(f"trajectory leaves the joint limits of robot {self.name}: {bad}")
         t_rec = _record_times(t_in, arc_in, record_dt)
         q_rec = _interp_rows(t_rec, t_in, q_in)
+        e1_rec = None if e1_in is None else np.interp(t_rec, t_in, e1_in)
         arc_rec = arc_in[np.searchsorted(t_in, t_rec, side="right") - 1]
         pos = np.empty((len(t_rec), 3))
         quat = np.empty((len(t_rec), 4))
         for k, qk in enumerate(q_rec):
+            if e1_rec is not None and (k == 0 or e1_rec[k] != e1_rec[k - 1]):
+                self.set_e1(float(e1_rec[k]))  # the track carries the base
             self._c.resetJointStatesMultiDof(self.body, self._joint_ids, [[float(v)] for v in qk])
             if tcp < 0:
                 p, o = self._c.getBasePositionAndOrientation(self.body)

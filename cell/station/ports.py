@@ -75,11 +75,13 @@ class Station(Protocol):
         marks: Sequence[tuple[float, str]] = (),
         record_dt: float = 0.01,
         bead: bool = True,
+        e1: npt.ArrayLike | None = None,
     ) -> Execution:
         """Drive the arm along times (n,) [s], q (n, dof) [rad], arc on (n,) bool; record the tool.
 
         marks (time [s], text) are logged as events; ``bead`` lays the weld where the arc is on (a move with the
-        arc off lays none either way). The arm stays at the last configuration.
+        arc off lays none either way). e1 : (n,) [m] the linear track's E1 at each time (the base rides along,
+        docs/track.md), None: the base stays. The arm stays at the last configuration.
         """
         ...
 

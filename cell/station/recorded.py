@@ -74,6 +74,7 @@ class RecordedStation:
         marks: Sequence[tuple[float, str]] = (),
         record_dt: float = 0.01,
         bead: bool = True,
+        e1: npt.ArrayLike | None = None,
     ) -> Execution:
         raise UsageError(
             f"a recorded capture cannot move the arm ({self.recorded.folder}); valid: detect on it, weld on a cell"

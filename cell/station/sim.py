@@ -43,9 +43,11 @@ class SimStation:
         try:
             if with_robot and scenario.robot.urdf is not None:
                 self._arm = load_arm(scenario)
-                self.sim.load_robot(
+                robot = self.sim.load_robot(
                     robot_urdf(scenario), scenario.X_WR, self._arm.q_scan, joint_names=self._arm.model.joint_names
                 )
+                if scenario.robot.track is not None:
+                    robot.on_track(scenario.robot.track.axis_W)
         except BaseException:
             self.sim.close()
             raise
@@ -79,7 +81,10 @@ class SimStation:
         marks: Sequence[tuple[float, str]] = (),
         record_dt: float = 0.01,
         bead: bool = True,
+        e1: npt.ArrayLike | None = None,
     ) -> Execution:
+        if e1 is not None:
+            self.sim.robot.stage_e1(e1)  # the track moves the base as the trajectory plays
         if not bead:
             return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=None)
         return self.sim.execute(times, q, arc_on, marks=marks, record_dt=record_dt, bead=self.scenario.simulation.bead)

@@ -18,6 +18,7 @@ import numpy.typing as npt
 from cell.errors import PlanError
 from cell.geometry import FloatArray, readonly
 from cell.types.procedure import WeldProcedure
+from cell.types.track import LinearTrack
 from cell.types.trajectory import Trajectory
 
 SegmentKind = Literal["move", "approach", "weld", "depart"]
@@ -67,6 +68,12 @@ class Segment:
     def t1(self) -> float:
         return self.t0 + self.trajectory.duration
 
+    @property
+    def e1_end(self) -> float:
+        """E1 [m] of the linear track at the segment's end (0 without a track)."""
+        e1 = self.trajectory.e1
+        return float(e1[-1]) if e1 is not None else 0.0
+
 
 class PlanReason(StrEnum):
     """Why a seam could not be planned: the code of a :class:`SeamOutcome` (its ``reason`` gives the detail)."""
@@ -104,7 +111,9 @@ class SeamOutcome:
 class WeldPlan:
     """An ordered, timed welding program. segments: back to back (each starts where the previous ends, at rest);
     seams: one outcome per seam asked for, in input order; order: ids of the welded seams in welding order;
-    planning_s: wall time spent planning [s]."""
+    planning_s: wall time spent planning [s]. track: the linear track the base rides on (None: a fixed base);
+    then every segment's trajectory carries E1 (``Trajectory.e1``), and the poses (X_end) stay in R, the base at
+    E1 = 0."""
 
     joint_names: tuple[str, ...]
     q_home: FloatArray
@@ -112,6 +121,7 @@ class WeldPlan:
     seams: tuple[SeamOutcome, ...]
     order: tuple[str, ...]
     planning_s: float = 0.0
+    track: LinearTrack | None = None
 
     @property
     def cycle_time(self) -> float:
@@ -171,10 +181,21 @@ class WeldPlan:
         times = np.concatenate(parts_t)
         times[0] = 0.0
         keep = np.concatenate([[True], np.diff(times) > 1e-12])  # zero-length segments add no sample
+        e1 = None
+        if any(s.trajectory.e1 is not None for s in self.segments):
+            e1 = np.concatenate(
+                [
+                    (s.trajectory.e1 if s.trajectory.e1 is not None else np.zeros(len(s.trajectory.times)))[
+                        0 if k == 0 else 1 :
+                    ]
+                    for k, s in enumerate(self.segments)
+                ]
+            )[keep]
         traj = Trajectory(
             times[keep],
             np.concatenate(parts_q)[keep],
             np.concatenate(parts_qd)[keep],
             np.concatenate(parts_qdd)[keep],
+            e1,
         )
         return traj, self.arc_at(traj.times)

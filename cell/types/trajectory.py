@@ -56,13 +56,15 @@ class Trajectory:
     """A timed joint trajectory sampled at a fixed period (the last interval may be shorter).
 
     times : (n,) [s], from 0 to ``duration``; q : (n, dof) [rad]; qd : (n, dof) [rad/s]; qdd : (n, dof)
-    [rad/s^2].
+    [rad/s^2]. e1 : (n,) [m] the linear track's external axis E1 at each sample (:mod:`cell.types.track`), None
+    for an arm without a track (E1 = 0 throughout).
     """
 
     times: FloatArray
     q: FloatArray
     qd: FloatArray
     qdd: FloatArray
+    e1: FloatArray | None = None
 
     def __post_init__(self) -> None:
         for key in ("times", "q", "qd", "qdd"):
@@ -70,6 +72,11 @@ class Trajectory:
         check_samples(self.times, self.q, self.qd, self.qdd)
         if self.q.ndim != 2:
             raise ValueError(f"Trajectory q must be (n, dof), got {self.q.shape}")
+        if self.e1 is not None:
+            e1 = readonly(self.e1)
+            if e1.shape != self.times.shape or not np.all(np.isfinite(e1)):
+                raise ValueError(f"Trajectory e1 must be ({len(self.times)},) finite values [m], got {e1.shape}")
+            object.__setattr__(self, "e1", e1)
 
     @property
     def duration(self) -> float:
@@ -89,6 +96,19 @@ class Trajectory:
         if np.ndim(t) == 0:
             return q[0], qd[0], qdd[0]
         return q, qd, qdd
+
+    def e1_at(self, t: npt.ArrayLike) -> FloatArray:
+        """E1 [m] at times t [s] (clamped), shaped like t: linear between samples (a track move is sampled every
+        few ms), 0 without a track."""
+        ts = np.asarray(t, dtype=float)
+        if self.e1 is None:
+            return np.zeros(ts.shape)
+        return np.asarray(np.interp(ts, self.times, self.e1), dtype=float)
+
+    def with_e1(self, e1: float | npt.ArrayLike) -> Trajectory:
+        """The same motion with E1 [m] at every sample: a constant, or (n,) values."""
+        arr = np.broadcast_to(np.asarray(e1, dtype=float), self.times.shape).copy()
+        return Trajectory(self.times, self.q, self.qd, self.qdd, arr)
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ class Collisions:
             return []
         out: list[Violation] = []
         for seg in gate.plan.segments:
-            hit = gate.checker.check_path(seg.trajectory.q, seg.trajectory.times)
+            hit = gate.checker.check_trajectory(seg.trajectory, gate.plan.track)  # the base where E1 puts it
             if hit is not None:
                 out.append(
                     Violation(

@@ -132,7 +132,9 @@ def write_errors(path: Path, lines: Sequence[Mapping[str, Any]], seam_ids: Seque
     for ax, sid in zip(axes.flat, shown, strict=False):
         ax.hist(errs[sid], bins=20, color="tab:blue")
         ax.axvline(tol_mm, color="tab:red", linestyle="--", linewidth=1)
-        ax.set_title(sid, fontsize=7)
+        within = float(np.mean(np.asarray(errs[sid]) <= tol_mm))
+        ax.set_title(f"{sid}: {within:.0%} of {len(errs[sid])} found within", fontsize=7)
+        ax.set_xlim(left=0.0)
         ax.tick_params(labelsize=6)
     for ax in list(axes.flat)[len(shown) :]:
         ax.axis("off")

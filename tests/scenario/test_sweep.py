@@ -13,7 +13,7 @@ import pytest
 from cell import pipeline
 from cell import scenario as sc
 from cell.sweep.study import Study, SweepSpec
-from cell.sweep.task import run_task
+from cell.sweep.task import run_task, weld_seams
 from cell.sweep.variations import VARY_WORDS, variation
 
 
@@ -44,3 +44,20 @@ def test_sweep_on_ray_records_failed_runs(tmp_path: Path, monkeypatch: pytest.Mo
 
     monkeypatch.setattr("cell.sweep.engine.run_sweep", no_ray)
     assert Study(spec, tmp_path, count=lambda d, n: None, say=print, warn=print).run()["done"] == 2
+
+
+def test_a_weld_runs_seams_as_a_sweep_line(fence1_run: pipeline.WeldRun) -> None:
+    """The session's fence1 weld read as a sweep's ``weld`` line and as a ``plan`` line: the planned torch path's
+    TCP error against the true seam is the executed one's (the arm follows its plan), and a seam against the
+    table is neither found nor planned."""
+    scn = fence1_run.detection.scenario
+    weld = weld_seams(fence1_run, scn, "weld")
+    plan = weld_seams(fence1_run, scn, "plan")
+    welded = [s for s, r in weld.items() if r["welded"]]
+    assert len(welded) == 12 and all(weld[s]["weld_rms_mm"] is not None for s in welded)
+    for s in welded:
+        assert plan[s]["plan_tcp_rms_mm"] == pytest.approx(weld[s]["weld_rms_mm"], abs=0.1)
+        assert weld[s]["found"] and weld[s]["within_tolerance"] == (weld[s]["lateral_mm"] <= 0.5)
+    under = weld["POST_L>TOP_RAIL:-z"]
+    assert not under["found"] and not under["planned"] and under["code"] == "not_visible"
+    json.dumps(weld, allow_nan=False)  # plain JSON values

@@ -71,8 +71,8 @@ def run_sweep(
         else:
             ray.init(address=address, log_to_driver=False, logging_level=logging.ERROR)
     except (ConnectionError, RuntimeError, ValueError) as e:
-        where = f"the Ray cluster at {address!r}" if address else "a local Ray"
-        raise UsageError(f"--address: cannot start or reach {where} ({' '.join(str(e).split())[:200]})") from None
+        where = f"--address: cannot reach the Ray cluster at {address!r}" if address else "cannot start a local Ray"
+        raise UsageError(f"{where} ({' '.join(str(e).split())[:200]})") from None
     try:
         cpus = int(ray.cluster_resources().get("CPU", cpus_local))
         info = EngineInfo("ray", str(ray.__version__), address or "local", cpus)

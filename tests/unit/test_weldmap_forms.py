@@ -14,7 +14,9 @@ import pytest
 from dxf_factory import design, make_maps
 
 from cell.errors import MapError
+from cell.geometry import make_pose
 from cell.scenario.layer_specs import LayerSpec
+from cell.types import Box
 from cell.weldmap import DEFAULT_FIXTURE_LAYERS, RED_ACI, LayerRoles, read_map
 
 TOL = 1e-6  # [m]
@@ -243,3 +245,31 @@ def test_ezdxf_log_goes_to_ours_not_stderr(
     assert capfd.readouterr().err == ""
     assert any(r.name == "cell.weldmap" and "ezdxf warning: invalid handle 0" in r.getMessage() for r in caplog.records)
     assert logging.getLogger("ezdxf").propagate  # restored after reading
+
+
+# --- part names keep their case: the scenario's deviations still find their parts ------------------------------
+
+
+def test_deviation_keys_match_part_names_ignoring_case_unless_ambiguous() -> None:
+    from dataclasses import replace
+
+    from cell import scenario as sc
+    from cell.asbuilt import as_built_parts
+    from cell.errors import ScenarioError
+    from cell.types import Part, WeldMap
+
+    base = sc.load("fence1-exact")
+    parts = tuple(Part(n.title(), make_maps_box(lo, hi)) for n, (lo, hi) in PARTS.items())  # Top_Rail, Post_L...
+    weldmap = WeldMap(parts, (), "mm", "test")
+    grown = base.with_simulation(deviations={"TOP_RAIL": sc.Deviation(size_mm=(10.0, 0.0, 0.0))})
+    built = {p.name: p for p in as_built_parts(weldmap, grown)}
+    np.testing.assert_allclose(built["Top_Rail"].box.size[0], 1.41, atol=TOL)
+    exact = replace(weldmap, parts=(*parts, Part("TOP_RAIL", parts[0].box)))  # an exact match wins
+    assert {p.name: p for p in as_built_parts(exact, grown)}["Top_Rail"].box.size[0] == pytest.approx(1.4)
+    with pytest.raises(ScenarioError, match=r"deviations\.TOP_RAIL matches parts Top_Rail, top_rail ignoring case"):
+        as_built_parts(replace(weldmap, parts=(*parts, Part("top_rail", parts[0].box))), grown)
+
+
+def make_maps_box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> Box:
+    lo_m, hi_m = np.array(lo) * 1e-3, np.array(hi) * 1e-3
+    return Box(make_pose(p=(lo_m + hi_m) / 2.0), hi_m - lo_m)

@@ -73,7 +73,8 @@ def sides_line(rep: Mapping[str, Any]) -> str:
         )
     elif f is not None:
         parts.append(f"no turn: {f['reason']}")
-    parts.append(f"job {rep['job_time_s']:.1f} s with the operator")
+    if f is not None and f["made"]:
+        parts.append(f"job {rep['job_time_s']:.1f} s with the operator's turn")
     return " · ".join(parts)
 
 
@@ -97,15 +98,19 @@ def write_programs(run: TwoSidedRun, krl: Path, provenance: Mapping[str, Any], c
     runs = [(k, wr) for k, wr in runs if wr.plan is not None and wr.plan.segments and wr.arm is not None]
     if not runs:
         raise ValueError("no plan to write")
-    jobs, trajectories = [], []
+    jobs = []
     for side, wr in runs:
         assert wr.plan is not None and wr.arm is not None
         X_RB = wr.detection.scene.X_RM if wr.detection.scene is not None else np.eye(4)
         name = base if len(runs) == 1 else f"{base}_{side}"
         jobs.append(ProgramJob(wr.plan, wr.arm.model, name, X_RB, sc.X_WR, sc.export.krl, provenance))
-        stem = "trajectory" if len(runs) == 1 else f"trajectory_{side}"
-        trajectories += [write_json(wr.plan, krl / f"{stem}.json"), write_csv(wr.plan, krl / f"{stem}.csv")]
     if len(jobs) == 1:
-        return [*write_program(controller, jobs[0], krl), *trajectories]
-    assert run.plan is not None
-    return [*write_two_sided(controller, jobs, base, flip_message(run.plan), krl), *trajectories]
+        written = write_program(controller, jobs[0], krl)
+    else:
+        assert run.plan is not None
+        written = write_two_sided(controller, jobs, base, flip_message(run.plan), krl)
+    for side, wr in runs:  # after the programs: they make the folder
+        assert wr.plan is not None
+        stem = "trajectory" if len(runs) == 1 else f"trajectory_{side}"
+        written += [write_json(wr.plan, krl / f"{stem}.json"), write_csv(wr.plan, krl / f"{stem}.csv")]
+    return list(written)

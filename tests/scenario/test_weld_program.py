@@ -27,7 +27,7 @@ def program(tmp_path_factory: pytest.TempPathFactory, fence1_run: pipeline.WeldR
     mp = pytest.MonkeyPatch()
     mp.setattr(pipeline, "weld", lambda *_, **__: fence1_run)
     try:
-        result = runner.invoke(app, ["weld", "fence1", "--krl", str(krl)])
+        result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--krl", str(krl)])
     finally:
         mp.undo()
     assert result.exit_code in (0, 3), result.stderr
@@ -119,7 +119,9 @@ def test_rapid_module_of_the_same_plan(tmp_path: Path, fence1_run: pipeline.Weld
     mp = pytest.MonkeyPatch()
     mp.setattr(pipeline, "weld", lambda *_, **__: fence1_run)
     try:
-        result = runner.invoke(app, ["weld", "fence1", "--krl", str(tmp_path), "--controller", "rapid"])
+        result = runner.invoke(
+            app, ["weld", "fence1", "--sides", "first", "--krl", str(tmp_path), "--controller", "rapid"]
+        )
     finally:
         mp.undo()
     assert result.exit_code in (0, 3), result.stderr

@@ -32,6 +32,11 @@ STAGES = (1.0, 0.25, 0.1)  # max correspondence per ICP stage, as fractions of s
 # 1.5-2 m, docs/reference.md section 2) leaves only about half of a well-aligned cloud within the finest 2 mm.
 _FITNESS_STAGE = 1
 _SPACING_PER_FINEST = 1.5  # map sample spacing, in units of the finest stage's max correspondence
+# The stages before the last pair with map samples twice as far apart (6 mm by default): a cloud point's nearest
+# sample on its face then lies at most 4.2 mm aside, inside the middle stage's 5 mm; the last stage, which sets
+# the fit, keeps the fine samples. Same fits (fence1, fence2, extrinsics-off: within 4 um) for half the coarse
+# stages' cost. Three times as far apart (9 mm, beyond the middle stage's reach) put fence2's fit 5 mm off.
+_COARSE_SPACING = 2.0
 _DOWN_COS = 0.5  # faces whose outward normal is within 60 deg of -z (R) point down into the table
 _MAX_SOURCE = 30_000  # larger clouds are thinned to about this many points (finest-distance grid, then stride)
 # Source points of each stage but the last, an even stride of the thinned cloud: a coarse stage only brings the
@@ -119,7 +124,9 @@ def surface_fit(
     """
     if len(points) == 0:
         return 0.0, 0.0
-    dist, idx = cKDTree(samples).query(points, distance_upper_bound=spacing_m + threshold_m)
+    # Every core answers (the same nearest samples). The tree stays balanced: samples on a box edge are there
+    # twice (once per face, with its normal), and which of the two an unbalanced tree returns differs.
+    dist, idx = cKDTree(samples).query(points, distance_upper_bound=spacing_m + threshold_m, workers=-1)
     near = np.isfinite(dist)
     d = np.abs(np.einsum("ij,ij->i", points[near] - samples[idx[near]], normals[idx[near]]))
     inlier = d <= threshold_m
@@ -134,7 +141,7 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
     Pass the dense filtered cloud (``Perceived.dense``): 1 cm voxel centroids sit inside the parts at their
     edges and bias the fit by millimetres. Clouds over 30 000 points are first put on a grid of the finest
     correspondence distance (2 mm by default), then thinned to about 30 000 points; the coarse stages use an even
-    stride of those (8 000 and 15 000 points), the finest all of them.
+    stride of those (8 000 and 15 000 points) against map samples twice as far apart, the finest all of them.
 
     Raises :class:`AlignmentError` when the fit's fitness stays below ``spec.align_min_fitness`` or it tilts
     the map by more than 2 degrees.
@@ -158,12 +165,15 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
             needed=3,
         )
     target, target_normals = sample_map(weldmap_R, _SPACING_PER_FINEST * finest, finest)
+    coarse = sample_map(weldmap_R, _COARSE_SPACING * _SPACING_PER_FINEST * finest, finest)
     X_MC = np.eye(4)  # moves cloud points onto the map (p_map = X_MC p_cloud)
     points = np.asarray(cloud.points)
     for stage, threshold in enumerate(thresholds):
+        last = stage == len(thresholds) - 1
         limit = _COARSE_SOURCE[stage] if stage < min(len(_COARSE_SOURCE), len(thresholds) - 1) else len(points)
         source = points[:: max(1, math.ceil(len(points) / limit))]
-        X_MC = _open3d.icp(source, target, threshold, spec.align_iterations, X_MC, target_normals).X_TS
+        samples, normals = (target, target_normals) if last else coarse
+        X_MC = _open3d.icp(source, samples, threshold, spec.align_iterations, X_MC, normals).X_TS
     band = thresholds[_FITNESS_STAGE]
     fitness, rmse = surface_fit(
         transform_points(X_MC, cloud.points), target, target_normals, band, _SPACING_PER_FINEST * finest

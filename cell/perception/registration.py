@@ -167,6 +167,7 @@ def significance(
     settings: RegistrationSettings,
     patch_m: float,
     tree: cKDTree | None = None,
+    calibrated: tuple[FloatArray, FloatArray, FloatArray] | None = None,
 ) -> tuple[FloatArray, dict[str, float]]:
     """The part of the correction X_icp (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3))
     that the overlap constrains, and how much the data support it (all in R).
@@ -176,13 +177,16 @@ def significance(
     shift_m, chi2, z_min, misfit_before_m, misfit_m of X, see :class:`cell.perception.splice.Registration`).
     The chi-square is a sandwich (patch-robust) covariance of a point-to-plane least-squares estimate at X:
     Tukey-weighted residuals, one score per patch of ``patch_m`` and surface direction, in the constrained
-    directions. ``tree`` : the KD-tree of ``target`` when the caller has one (built here otherwise).
+    directions. ``tree`` : the KD-tree of ``target`` when the caller has one (built here otherwise);
+    ``calibrated`` : :func:`_plane_residuals` of ``probe`` at the identity when the caller has them (with that tree).
     """
     reach, k = settings.reach_m, settings.tukey_k_m
     tree = cKDTree(target, balanced_tree=False, compact_nodes=False) if tree is None else tree
     info = {"constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "z_min": 0.0}
     info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
-    p0, n0, r0 = _plane_residuals(probe, tree, target, normals, reach, np.eye(4))
+    if calibrated is None:
+        calibrated = _plane_residuals(probe, tree, target, normals, reach, np.eye(4))
+    p0, n0, r0 = calibrated
     p, n, r = _plane_residuals(probe, tree, target, normals, reach, X_icp)
     if len(r0) < _MIN_OVERLAP or len(r) < _MIN_OVERLAP:
         return np.eye(4), info
@@ -269,7 +273,8 @@ def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tu
     settings = registration_settings(spec, 0.0)
     normals = _open3d.estimate_normals(sub, settings.normal_radius_m, _NORMAL_NEIGHBOURS)
     tree = cKDTree(sub, balanced_tree=False, compact_nodes=False)  # built in half the time, same answers
-    _, _, r0 = _plane_residuals(probe, tree, sub, normals, settings.reach_m, np.eye(4))
+    calibrated = _plane_residuals(probe, tree, sub, normals, settings.reach_m, np.eye(4))
+    r0 = calibrated[2]
     info["overlap"] = float(len(r0))
     if len(r0) < _MIN_OVERLAP:
         return np.eye(4), info
@@ -281,5 +286,5 @@ def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tu
         X = _open3d.icp(source, target, corr, spec.icp_iterations).X_TS
     else:
         X = _open3d.icp(probe, sub, corr, spec.icp_iterations, None, normals, settings.tukey_k_m).X_TS
-    X, stats = significance(probe, sub, normals, X, settings, spec.merge_cell_m, tree)
+    X, stats = significance(probe, sub, normals, X, settings, spec.merge_cell_m, tree, calibrated)
     return X, info | stats

@@ -24,9 +24,11 @@ a miscalibration of 1 mm / 0.1 deg is taken out. ``Registration.refused`` says w
 from __future__ import annotations
 
 from collections.abc import Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.errors import SensorError
 from cell.geometry import FloatArray, invert, readonly, transform_points
@@ -164,9 +166,30 @@ def splice(
     camera = np.concatenate([np.full(len(clouds[n]), index[n], np.int16) for n in order])
     bounds = np.cumsum([0] + [len(clouds[n]) for n in order])
     eyes = {i: X[:3, 3] for i, X in X_RC.items()}
+    with ThreadPoolExecutor(max_workers=1) as beside:
+        # Normals from plane fits twice the voxel wide (a voxel-wide fit of 2-3 mm noise is as noisy as the depth),
+        # of the points as calibrated (a copy: the registrations move them), fitted on a core of their own while
+        # the registrations run; only the merge reads them.
+        fitted = beside.submit(surface_normals, points.copy(), camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
+        registrations = _register_in_order(points, bounds, order, index, X_RC, spec)
+        normals = fitted.result()
+    registered = Cloud(points, "R", camera, cameras)
+    keep = prioritised_merge(points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
+    kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}
+    return Spliced(registered.select(keep), registered, tuple(registrations), kept)
+
+
+def _register_in_order(
+    points: FloatArray,
+    bounds: npt.NDArray[np.intp],
+    order: tuple[str, ...],
+    index: Mapping[str, int],
+    X_RC: dict[int, FloatArray],
+    spec: PerceptionSpec,
+) -> list[Registration]:
+    """Register each camera's points (``points[bounds[k]:bounds[k + 1]]``, cameras in ``order``) onto those of the
+    cameras before it; an accepted correction moves its points and its pose in ``X_RC`` (both in place)."""
     registrations = []
-    # Normals from plane fits twice the voxel wide (a voxel-wide fit of 2-3 mm noise is as noisy as the depth).
-    normals = surface_normals(points, camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
     for k, name in enumerate(order[1:], start=1):
         part = slice(bounds[k], bounds[k + 1])
         X, info = register(points[part], points[: bounds[k]], spec)
@@ -195,7 +218,4 @@ def splice(
         if accepted:
             points[part] = transform_points(X_corr, points[part])
             X_RC[index[name]] = X_corr @ X_RC[index[name]]
-    registered = Cloud(points, "R", camera, cameras)
-    keep = prioritised_merge(points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
-    kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}
-    return Spliced(registered.select(keep), registered, tuple(registrations), kept)
+    return registrations

@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from page_dom import read
-from shared_runs import Preview
 from typer.testing import CliRunner
 
 from cell import pipeline
@@ -67,9 +66,9 @@ def test_weld_html_page(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_
     check_page(page, fence1_run)
 
 
-def test_preview_page(fence1_preview: Preview) -> None:
-    """``cell preview`` writes the same page as ``cell.html`` beside its PNGs: the session's preview of fence1
-    (``fence1_preview``, the real pipeline's plan, nothing moved), checked against the run it drew."""
-    assert fence1_preview.exit_code == 0, fence1_preview.stderr
-    assert fence1_preview.run.execution is None
-    check_page(fence1_preview.folder / "cell.html", fence1_preview.run)
+def test_preview_page(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_run: pipeline.WeldRun) -> None:
+    """``cell preview`` writes the same page as ``cell.html`` beside its PNGs."""
+    monkeypatch.setattr(pipeline, "weld", lambda *a, **kw: fence1_run)
+    result = CliRunner().invoke(app, ["preview", "fence1", "--sides", "first", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.stderr
+    check_page(tmp_path / "cell.html", fence1_run)

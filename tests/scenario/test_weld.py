@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from shared_runs import Preview
 from typer.testing import CliRunner
 
 from cell import pipeline
@@ -106,15 +105,14 @@ def test_weld_cli_writes_report_and_robot_program(
     assert json.loads((krl / "trajectory.json").read_text())["joint_names"][0] == "joint_a1"
 
 
-def test_preview_draws_and_moves_nothing(fence1_preview: Preview) -> None:
-    """``cell preview fence1``, run once per session (``fence1_preview``: its page is also checked in
-    test_fence1_page.py)."""
-    result, out = fence1_preview, fence1_preview.folder
+def test_preview_draws_and_moves_nothing(tmp_path: Path) -> None:
+    runner = CliRunner()
+    result = runner.invoke(app, ["preview", "fence1", "--out", str(tmp_path)])
     assert result.exit_code == 0, result.stderr
     for name in ("overview_top.png", "overview_3d.png", "overview_seams.png", "joints.png"):
-        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "plotly" in (out / "cell.html").read_text()[:200000]
-    data = json.loads((out / "report.json").read_text())
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "plotly" in (tmp_path / "cell.html").read_text()[:200000]
+    data = json.loads((tmp_path / "report.json").read_text())
     assert data["cycle_time_s"] == 0 and data["events"] == []
     assert all(not s["welded"] for s in data["seams"])
     assert sum(s["planned"] for s in data["seams"]) == 12

@@ -63,8 +63,9 @@ def face_points(e: DXFGraphic) -> FloatArray:
     return p[:3] if np.array_equal(p[3], p[2]) else p
 
 
-def group_faces(faces: Sequence[FloatArray], tol: float) -> list[Mesh]:
-    """3DFACEs (each (k, 3), one frame) grouped into bodies by shared corners (within ``tol``), as meshes."""
+def group_faces(faces: Sequence[FloatArray], tol: float) -> list[tuple[Mesh, list[int]]]:
+    """3DFACEs (each (k, 3), one frame) grouped into bodies by shared corners (within ``tol``): each body's mesh and
+    the indices of its faces in ``faces``."""
     if not faces:
         return []
     pts = np.concatenate(faces)
@@ -87,13 +88,15 @@ def group_faces(faces: Sequence[FloatArray], tol: float) -> list[Mesh]:
         for a in v[1:]:
             parent[root(a)] = root(v[0])
     groups: dict[int, list[list[int]]] = {}
-    for v in spans:
+    members: dict[int, list[int]] = {}
+    for k, v in enumerate(spans):
         groups.setdefault(root(v[0]), []).append(v)
+        members.setdefault(root(v[0]), []).append(k)
     first = {int(g): n for n, g in reversed(list(enumerate(ids)))}  # a point of each merged corner
-    meshes: list[Mesh] = []
-    for face_ids in groups.values():
+    meshes: list[tuple[Mesh, list[int]]] = []
+    for r, face_ids in groups.items():
         used = sorted({i for v in face_ids for i in v})
         local = {g: k for k, g in enumerate(used)}
         vertices = np.array([pts[first[g]] for g in used])
-        meshes.append((vertices, [tuple(local[i] for i in v) for v in face_ids]))
+        meshes.append(((vertices, [tuple(local[i] for i in v) for v in face_ids]), members[r]))
     return meshes

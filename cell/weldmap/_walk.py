@@ -110,16 +110,19 @@ class Reader:
         self.layer_red = {layer.dxf.name.lower(): _layer_is_red(layer) for layer in doc.layers}
         self.layer_name = {layer.dxf.name.lower(): str(layer.dxf.name) for layer in doc.layers}
         self.found = Found()
-        self._faces: defaultdict[tuple[str, str, tuple[str, ...]], list[FloatArray]] = defaultdict(list)
+        self._faces: defaultdict[tuple[str, str, tuple[str, ...]], list[tuple[FloatArray, str]]] = defaultdict(list)
 
     def read(self, entities: Iterable[DXFGraphic]) -> Found:
         self._walk(entities, _Ctx(X=np.eye(4)))
         from cell.weldmap._meshes import group_faces
 
         for (name, layer, handles), faces in self._faces.items():
-            tol = 1e-6 * max(1.0, float(np.abs(np.concatenate(faces)).max()))
-            for k, mesh in enumerate(group_faces(faces, tol), start=1):
-                where = Where("3DFACE", ".".join((*handles, f"group{k}")), layer)
+            points = [p for p, _ in faces]
+            tol = 1e-6 * max(1.0, float(np.abs(np.concatenate(points)).max()))
+            for mesh, members in group_faces(points, tol):
+                first = ".".join((*handles, faces[members[0]][1]))
+                more = f" (and {len(members) - 1} more)" if len(members) > 1 else ""
+                where = Where("3DFACE", first + more, layer)
                 self.found.bodies.append(RawBody(name, layer, where, "3DFACE", mesh))
         return self.found
 
@@ -137,7 +140,7 @@ class Reader:
                     self.found.unsupported.append((self._seam_id(e, ctx), f"{self._where(e, ctx)}: {_CURVED}"))
             elif kind == "3DFACE":
                 p = _finite(_apply(ctx.X, face_points(e)), self._where(e, ctx), self.source)
-                self._faces[(self._name(e, ctx), self._layer(e, ctx), ctx.handles)].append(p)
+                self._faces[(self._name(e, ctx), self._layer(e, ctx), ctx.handles)].append((p, e.dxf.handle or "?"))
             elif is_body(e):
                 self._body(e, ctx)
 

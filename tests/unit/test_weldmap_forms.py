@@ -116,6 +116,13 @@ def test_a_3dface_model_reads_as_boxes(tmp_path: Path) -> None:
     assert [(p.name, p.drawn_as) for p in m.parts] == [(n, "3DFACE") for n in PARTS]
     lo, hi = PARTS["TOP_RAIL"]
     np.testing.assert_allclose(m.part("TOP_RAIL").box.size, (np.array(hi) - lo) * 1e-3, atol=TOL)
+    lids = [e for e in doc.modelspace().query("3DFACE") if e.dxf.layer == "POST_L"][-2:]
+    for e in lids:  # POST_L loses a face: an open body, named by its first face's handle
+        doc.modelspace().delete_entity(e)
+    with pytest.raises(MapError) as exc:
+        read_map(_save(doc, tmp_path))
+    first = next(e for e in doc.modelspace().query("3DFACE") if e.dxf.layer == "POST_L").dxf.handle
+    _one_line(exc, f"3DFACE {first} (and 9 more) on layer POST_L", "not a closed box", "holds seam POST_L>")
 
 
 def test_a_polyface_in_a_rotated_block(tmp_path: Path) -> None:

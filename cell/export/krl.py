@@ -228,7 +228,9 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
             b.arc_fold("on", seg, nxt)
             continue
         if seg.kind == "move":
-            track = f" (track to E1 = {seg.e1_end * 1000:.1f} mm)" if not seg.seam_id and plan.track else ""
+            e1 = seg.trajectory.e1
+            moves = e1 is not None and float(np.ptp(e1)) > 0.0  # the carriage moves (the arm at home)
+            track = f" (track to E1 = {seg.e1_end * 1000:.1f} mm)" if moves else ""
             b.src.append(f"PTP {b.point(seg)} ; transfer{track}")
         else:
             b.plain_lin(seg, "approach, exact stop at the weld start" if arc_next else seg.kind)

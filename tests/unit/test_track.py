@@ -11,7 +11,7 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
-from cell.errors import IKError
+from cell.errors import IKError, ScenarioError
 from cell.export.krl import krl_program
 from cell.export.program import ProgramJob
 from cell.export.rapid import rapid_text
@@ -148,3 +148,15 @@ def test_krl_and_rapid_carry_e1(robot: RobotModel, far_plan: tuple) -> None:
     mod = rapid_text(ProgramJob(plan, robot, "TRACK"))
     eax = {float(m) for m in re.findall(r"robtarget p\d+ := \[.*\],\[([-\d.]+),9E9", mod)}
     assert eax == weld_e1 and "jHome := [[" in mod and ",[0.000,9E9" in mod
+
+
+def test_the_scenario_states_the_track() -> None:
+    text = (sc.SCENARIO_DIR / "fence1.yaml").read_text()
+    anchor = "  X_WR: {xyz_m: [0.15, -1.05, 0.90]}"
+    assert anchor in text
+    ok = sc.from_yaml(text.replace(anchor, anchor + "\n  track: {min_mm: -300, max_mm: 1500}"), sc.SCENARIO_DIR)
+    assert ok.robot.track is not None
+    track = ok.robot.track.track(ok.X_WR)
+    assert (track.e1_min, track.e1_max, track.v_max) == (-0.3, 1.5, 0.5) and np.allclose(track.axis_R, [1, 0, 0])
+    with pytest.raises(ScenarioError, match="min_mm"):  # E1 = 0 (the base at X_WR) must lie on the track
+        sc.from_yaml(text.replace(anchor, anchor + "\n  track: {min_mm: 100, max_mm: 1500}"), sc.SCENARIO_DIR)

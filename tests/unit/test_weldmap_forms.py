@@ -280,3 +280,20 @@ def test_deviation_keys_match_part_names_ignoring_case_unless_ambiguous() -> Non
 def make_maps_box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> Box:
     lo_m, hi_m = np.array(lo) * 1e-3, np.array(hi) * 1e-3
     return Box(make_pose(p=(lo_m + hi_m) / 2.0), hi_m - lo_m)
+
+
+def test_degenerate_and_self_intersecting_faces(tmp_path: Path) -> None:
+    doc = make_maps.build_map({k: v for k, v in PARTS.items() if k != "POST_L"}, SEAMS, solid="mesh")
+    mesh = make_maps.box_mesh(*PARTS["POST_L"])
+    mesh.faces = [*mesh.faces, (0, 1, 1)]  # a sliver: zero area
+    mesh.render_mesh(doc.modelspace(), dxfattribs={"layer": "POST_L"})
+    m = read_map(_save(doc, tmp_path))
+    [w] = m.warnings
+    assert "MESH" in w and "on layer POST_L has 1 zero-area face (ignored)" in w
+    post = doc.modelspace().query("MESH")[-1]
+    doc.modelspace().delete_entity(post)
+    mesh.faces = [(0, 2, 3, 1), (4, 5, 6, 7), *mesh.faces[2:6]]  # the lid's corners out of order: a bow tie
+    mesh.render_mesh(doc.modelspace(), dxfattribs={"layer": "POST_L"})
+    with pytest.raises(MapError) as exc:
+        read_map(_save(doc, tmp_path))
+    _one_line(exc, "MESH", "on layer POST_L: part POST_L is not a closed box", "holds seam POST_L>")

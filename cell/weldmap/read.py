@@ -97,8 +97,14 @@ def _seams(found: Found, scale: float, src: str) -> list[tuple[MapSeam, RawSeam]
     return seams
 
 
-def _touches(box: Box, pts: FloatArray) -> bool:
-    return bool(np.all(box.contains(pts, TOUCH_M)))
+def _touching(boxes: list[Part], pts: FloatArray) -> np.ndarray:
+    """(n_seams, n_boxes) whether each seam's points (n_seams, k, 3) all lie within TOUCH_M of each box."""
+    out = np.zeros((len(pts), len(boxes)), dtype=bool)
+    for j, part in enumerate(boxes):
+        X, half = part.box.X_AB, part.box.size / 2.0 + TOUCH_M
+        p_B = (pts - X[:3, 3]) @ X[:3, :3]  # into the box frame
+        out[:, j] = np.all(np.abs(p_B) <= half, axis=(1, 2))
+    return out
 
 
 def _near(vertices: FloatArray | None, pts: FloatArray) -> bool:
@@ -164,10 +170,11 @@ def _place(
     """Seams on parts stay; seams on a fixture become unsupported; a body that is no box refuses the map only when
     it holds a seam (or may: an unreadable body when a seam touches no part), else it is skipped with a warning."""
     kept, unsupported, loose = [], [], []
-    for s, raw in seams:
-        pts = np.array([s.p_start, s.p_end, (s.p_start + s.p_end) / 2.0])
-        on = [p for p in parts if _touches(p.box, pts)]
-        fx = [f for f in fixtures if _touches(f.box, pts)]
+    pts = np.array([[s.p_start, s.p_end, (s.p_start + s.p_end) / 2.0] for s, _ in seams]).reshape(-1, 3, 3)
+    on_parts, on_fixtures = _touching(parts, pts), _touching(fixtures, pts)
+    for i, (s, raw) in enumerate(seams):
+        on = [p for p, t in zip(parts, on_parts[i], strict=True) if t]
+        fx = [f for f, t in zip(fixtures, on_fixtures[i], strict=True) if t]
         if fx and len(on) < 2:
             why = f"{raw.where}: on fixture {fx[0].name}: a fixture is never welded (map.layers says what is a part)"
             unsupported.append(UnsupportedSeam(s.id, why))

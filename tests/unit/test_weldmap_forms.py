@@ -297,3 +297,11 @@ def test_degenerate_and_self_intersecting_faces(tmp_path: Path) -> None:
     with pytest.raises(MapError) as exc:
         read_map(_save(doc, tmp_path))
     _one_line(exc, "MESH", "on layer POST_L: part POST_L is not a closed box", "holds seam POST_L>")
+
+
+def test_a_map_of_curves_only_has_no_seam_to_weld(tmp_path: Path) -> None:
+    doc = make_maps.build_map(PARTS, [], solid="mesh")
+    doc.modelspace().add_circle((240, 700, 80), 30, dxfattribs={"color": 1})
+    with pytest.raises(MapError) as exc:
+        read_map(_save(doc, tmp_path))
+    _one_line(exc, "no seam can be welded: 1 seam unsupported (CIRCLE", "a curved seam")

@@ -33,10 +33,11 @@ class EngineInfo:
 
 
 def engine_version() -> str:
-    """Ray's version (without starting it)."""
-    import ray
+    """Ray's version, from its installed metadata (neither imported nor started: a sweep with nothing left to
+    run needs no Ray)."""
+    from importlib.metadata import version
 
-    return str(ray.__version__)
+    return version("ray")
 
 
 def run_sweep(

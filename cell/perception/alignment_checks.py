@@ -9,12 +9,14 @@ For the pipeline, after :func:`cell.perception.align.align_map`:
 - :func:`check_parts_seen` (:func:`part_coverage`, :func:`missing_parts`): how much of each part's top the
   cloud covers; a part with almost none while the others are well covered is not on the table (its seams are
   NOT_FOUND, never invented); parts half covered mean the map lies in the wrong place (AlignmentError).
+- :func:`check_alignment`: both, side by side.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,21 +87,23 @@ def alignment_alternatives(
     samples, _ = sample_map(weldmap_R, o.spacing_m, o.spacing_m)
     if len(samples) == 0 or len(cloud) == 0:
         return []
-    # Unbalanced trees build in half the time and answer "anything within the band?" the same.
+    # Unbalanced trees build in half the time and answer "anything within the band?" the same (every query here
+    # asks only that, on every core).
     map_tree = cKDTree(samples, balanced_tree=False, compact_nodes=False)
     cloud_tree = cKDTree(np.asarray(cloud.points), balanced_tree=False, compact_nodes=False)
-    near_cloud = np.isfinite(cloud_tree.query(samples, distance_upper_bound=o.band_m)[0])
+    near_cloud = np.isfinite(cloud_tree.query(samples, distance_upper_bound=o.band_m, workers=-1)[0])
     out = []
     for T, label in _candidates(weldmap_R, samples.mean(axis=0)):
         moved = transform_points(T, samples)
-        on_map = np.isfinite(map_tree.query(moved, distance_upper_bound=o.band_m)[0])
+        on_map = np.isfinite(map_tree.query(moved, distance_upper_bound=o.band_m, workers=-1)[0])
         self_overlap = float(on_map.mean())
         if self_overlap < o.min_self_overlap:
             continue
         # Samples only the chosen map has (the alternative puts nothing there) and only the alternative has.
-        only_chosen = ~np.isfinite(cKDTree(moved).query(samples, distance_upper_bound=o.band_m)[0])
+        moved_tree = cKDTree(moved, balanced_tree=False, compact_nodes=False)
+        only_chosen = ~np.isfinite(moved_tree.query(samples, distance_upper_bound=o.band_m, workers=-1)[0])
         only_alt = ~on_map
-        alt_near = np.isfinite(cloud_tree.query(moved[only_alt], distance_upper_bound=o.band_m)[0])
+        alt_near = np.isfinite(cloud_tree.query(moved[only_alt], distance_upper_bound=o.band_m, workers=-1)[0])
         n = int(min(only_chosen.sum(), only_alt.sum()))
         s_chosen = float(near_cloud[only_chosen].mean()) if only_chosen.any() else 0.0
         s_alt = float(alt_near.mean()) if only_alt.any() else 0.0
@@ -156,7 +160,7 @@ def part_coverage(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, band_m
         if tree is None or len(top) == 0:
             out[part.name] = 0.0
             continue
-        out[part.name] = float(np.mean(np.isfinite(tree.query(top, distance_upper_bound=band_m)[0])))
+        out[part.name] = float(np.mean(np.isfinite(tree.query(top, distance_upper_bound=band_m, workers=-1)[0])))
     return out
 
 
@@ -200,3 +204,18 @@ def check_parts_seen(
             needed=min_seen,
         )
     return missing
+
+
+def check_alignment(weldmap_R: WeldMap, cloud: Cloud, alignment: Alignment, spec: PerceptionSpec) -> dict[str, str]:
+    """Both checks of an aligned map, :func:`check_alignment_unique` and :func:`check_parts_seen` (with the spec's
+    ``symmetry`` and ``coverage`` options), side by side on two cores (scipy's KD-trees let go of the interpreter
+    lock); what they answer and raise is what they would one after the other: the uniqueness check's refusal
+    first. Returns the missing parts (name -> reason)."""
+    with ThreadPoolExecutor(max_workers=1) as beside:
+        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage)
+        try:
+            check_alignment_unique(weldmap_R, cloud, alignment, spec.symmetry)
+        except AlignmentError:
+            seen.cancel()
+            raise
+        return seen.result()

@@ -73,7 +73,7 @@ def build_scene(
 
     X_RM_nominal : where the map is believed to lie (default: the scenario's ``map.X_WM``; the turned part's pose
     on its second side); seed : a search of the cloud near it for a start the ICP can converge from."""
-    from cell.perception import align_map, check_alignment_unique, check_parts_seen, perceive
+    from cell.perception import align_map, check_alignment, perceive
 
     sc = cap.scenario
     timings: dict[str, float] = {}
@@ -95,8 +95,7 @@ def build_scene(
     weldmap_R = cap.weldmap.transformed(X_RM, "R")
     # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
     # parts that are simply not there are named, and their seams are never searched.
-    check_alignment_unique(weldmap_R, perceived.registered, alignment, sc.perception.symmetry)
-    missing = check_parts_seen(weldmap_R, perceived.registered, sc.perception, sc.perception.coverage)
+    missing = check_alignment(weldmap_R, perceived.registered, alignment, sc.perception)
     timings["align_s"] = time.perf_counter() - t
 
     seam_scene = SeamScene(

@@ -17,14 +17,22 @@ seams are also located one by one (``ms_per_seam_alone_median``: the median seam
 Perception per stage (``row["perception"]``, the fastest of ``--repeat`` runs of each on the same capture, wall
 and CPU seconds; the CPU of open3d's threads counts too): ``perceive``'s own steps (``clouds``: deproject, crop
 and the camera checks; ``splice``; ``preprocess``: Z passthrough and the isolated-point filter; ``downsample``),
-the map alignment (``align_map``) and its two checks (``check_unique``, ``check_parts_seen``), and loading
+the map alignment (``align_map``) and its two checks (``check_unique``, ``check_parts_seen``; side by side as the
+pipeline runs them, ``check_alignment``), and loading
 open3d's core (``open3d_import_s``, once per process: the first scenario's). ``detect_vs_capture`` is issue 16's
 acceptance figure from the first (cold) run: perceive + align + locate (ours) against capture.
+
+Planning (``row["planning"]``): the seams ours found are planned and gated as ``cell weld`` does
+(``pipeline.weld.plan_for`` on the same station: torch search, IK, timing, order, transfers, the safety gate), once;
+seams asked for, planned and refused per reason code, planning CPU and wall seconds in all, per planned seam and per
+seam asked for. Each row also keeps the machine's load average when it was measured (the machine may be shared).
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
+import os
 import statistics
 import subprocess
 import sys
@@ -36,11 +44,16 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export.report import write_json
 from cell.geometry import invert
-from cell.perception import align_map, check_alignment_unique, check_parts_seen, perceive
+from cell.perception import align_map, check_alignment, check_alignment_unique, check_parts_seen, perceive
 from cell.perception.preprocess import downsample
+from cell.pipeline.detect import read_weldmap
+from cell.pipeline.geometry import motion_scene
+from cell.pipeline.weld import plan_for
+from cell.scenario import Scenario
 from cell.seams.base import BatchSeamLocator
 from cell.seams.registry import make_locator
-from cell.types import SeamEstimate, SeamStatus
+from cell.station import Station, open_station
+from cell.types import SeamEstimate, SeamStatus, WeldMap
 from cell.voxels import voxel_order
 
 
@@ -85,6 +98,7 @@ def perception_stages(cap: pipeline.Capture, repeat: int) -> dict[str, Any]:
     checks = {
         "check_unique": lambda: check_alignment_unique(aligned, per.registered, alignment, s.perception.symmetry),
         "check_parts_seen": lambda: check_parts_seen(aligned, per.registered, s.perception, s.perception.coverage),
+        "check_alignment": lambda: check_alignment(aligned, per.registered, alignment, s.perception),
     }
     for key, check in checks.items():
         _, wall, cpu = _fastest(check, repeat)
@@ -93,10 +107,50 @@ def perception_stages(cap: pipeline.Capture, repeat: int) -> dict[str, Any]:
     return out
 
 
+def planning(
+    station: Station, cap: pipeline.Capture, scene: pipeline.Scene, estimates: tuple[SeamEstimate, ...]
+) -> Any:
+    """Plan and gate the found seams of ``estimates`` (ours) as ``cell weld`` does: counts and CPU / wall [s]
+    (module docstring); None when the station has no arm."""
+    if station.arm is None:
+        return None
+    s = cap.scenario
+    truth = pipeline.truths(cap, scene.seam_scene.weldmap)
+    metrics, summary = pipeline.evaluate(estimates, truth)
+    det = pipeline.Detection(
+        s, "ours", scene.seam_scene.weldmap, estimates, truth, metrics, summary, scene=scene, joints=cap.joints
+    )
+    t, c = time.perf_counter(), time.process_time()
+    plan, _, problems = plan_for(station, det, motion=motion_scene(station.arm, det))
+    cpu, wall = time.process_time() - c, time.perf_counter() - t
+    planned = sum(1 for o in plan.seams if o.feasible)
+    asked = len(plan.seams)
+    return {
+        "seams_asked": asked,
+        "seams_planned": planned,
+        "refused_by_code": dict(sorted(collections.Counter(str(o.code) for o in plan.seams if not o.feasible).items())),
+        "gate_problems": len(problems),
+        "cpu_s": cpu,
+        "wall_s": wall,
+        "cpu_s_per_planned_seam": cpu / max(planned, 1),
+        "wall_s_per_planned_seam": wall / max(planned, 1),
+        "cpu_s_per_seam_asked": cpu / max(asked, 1),
+    }
+
+
 def bench(name: str, methods: list[str], noise: str, repeat: int) -> dict[str, Any]:
-    """One row: the scenario's size, its stage times [s] and, per method, ms per seam and accuracy."""
+    """One row: the scenario's size, its stage times [s], per method ms per seam and accuracy, and planning."""
     s = sc.load(name).with_noise("none" if noise == "none" else "realistic")
-    cap = pipeline.capture(s)
+    weldmap = read_weldmap(s)
+    with open_station(s, weldmap) as station:
+        return _bench(name, station, s, weldmap, methods, repeat)
+
+
+def _bench(
+    name: str, station: Station, s: Scenario, weldmap: WeldMap, methods: list[str], repeat: int
+) -> dict[str, Any]:
+    """:func:`bench` on a running station built around ``weldmap``."""
+    cap = pipeline.capture(s, station=station, weldmap=weldmap)
     t = time.perf_counter()
     scene = pipeline.build_scene(cap)
     build_s = time.perf_counter() - t
@@ -168,12 +222,24 @@ def bench(name: str, methods: list[str], noise: str, repeat: int) -> dict[str, A
             "capture_s": row["capture_s"],
             "perceive_align_locate_s": row["perceive_s"] + row["align_s"] + first,
         }
+        row["planning"] = planning(station, cap, scene, all_runs["ours"][0])
+    row["load_average_1_5_15"] = [round(x, 2) for x in os.getloadavg()]
     return row
 
 
 def perception_table(rows: list[dict[str, Any]]) -> str:
     """Markdown: per scenario, each perception stage's fastest wall (and CPU) time [ms]."""
-    keys = ("clouds", "splice", "preprocess", "downsample", "perceive", "align_map", "check_unique", "check_parts_seen")
+    keys = (
+        "clouds",
+        "splice",
+        "preprocess",
+        "downsample",
+        "perceive",
+        "align_map",
+        "check_unique",
+        "check_parts_seen",
+        "check_alignment",
+    )
     head = "| scenario | open3d import | " + " | ".join(keys) + " |\n|---|---|" + "---|" * len(keys) + "\n"
     lines = []
     for r in rows:
@@ -225,6 +291,14 @@ def main() -> None:
             print(
                 f"{r['scenario']}: perceive + align + locate (ours) {d['perceive_align_locate_s']:.2f} s "
                 f"against capture {d['capture_s']:.2f} s"
+            )
+    for r in rows:
+        p = r.get("planning")
+        if p:
+            print(
+                f"{r['scenario']}: planned {p['seams_planned']}/{p['seams_asked']} found seams, planning CPU "
+                f"{p['cpu_s']:.2f} s (wall {p['wall_s']:.2f} s), {p['cpu_s_per_planned_seam']:.3f} s CPU per planned "
+                f"seam; refused {p['refused_by_code']}"
             )
     for r in rows:
         print(

@@ -11,7 +11,8 @@ Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->``
 - ``table1-noise-none``: the same with noise-free depth (``noise-none.json``);
 - ``calibration``: our locator under calibration error (``latest.json``, ``ours``, every other extrinsics row);
 - ``coverage``: each locator's sigma against its true errors (``coverage.json``, by ``benchmarks/bench_coverage.py``);
-- ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``);
+- ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``): size,
+  capture, perception, alignment, issue 16's perceive + align + locate against capture, the locators, planning;
 - ``rescan``, ``confidence``, ``weld``, ``motion``, ``faults``: the tables of the cell's own commands
   (``rescan.json``, ``weld.json``, ``faults.json`` by ``benchmarks/bench_cell.py``; ``confidence.json`` by
   ``benchmarks/bench_confidence.py``; ``motion.json`` by ``benchmarks/bench_motion.py``), rendered by
@@ -85,23 +86,35 @@ def calibration(results: Path) -> str:
     )
 
 
+def _planning_cells(p: Mapping[str, Any] | None) -> str:
+    """``planned / asked | CPU s per planned seam`` of a scaling row's planning (dashes without an arm)."""
+    if not p:
+        return "- | -"
+    return f"{p['seams_planned']} / {p['seams_asked']} | {p['cpu_s_per_planned_seam']:.3f}"
+
+
 def scaling_table(rows: Sequence[Mapping[str, Any]]) -> str:
-    """One line per scenario: size, perception and alignment [s], and per method found and ms per seam."""
+    """One line per scenario: size, capture, perception and alignment [s], perceive + align + locate against
+    capture (issue 16's figure, the first run), per method found and ms per seam, and planning per seam."""
     head = (
-        "| scenario | seams / visible | points dense / 1 cm | perceive s | align s | "
-        "ours: found, ms/seam median, lateral mm | paper: found, ms/seam | ransac: found, ms/seam |\n"
-        "|---|---|---|---|---|---|---|---|\n"
+        "| scenario | seams / visible | points dense / 1 cm | capture s | perceive s | align s | "
+        "perceive + align + locate / capture | ours: found, ms/seam median, lateral mm | paper: found, ms/seam | "
+        "ransac: found, ms/seam | planned / found | planning CPU s / planned seam |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     )
     lines = []
     for r in rows:
         m = r["methods"]
         ours, paper, ransac = (m[k] for k in SCALING_METHODS)
+        d = r.get("detect_vs_capture")
+        ratio = f"{d['perceive_align_locate_s'] / d['capture_s']:.2f}" if d else "-"
         lines.append(
             f"| {SCALING_LABELS.get(r['scenario'], r['scenario'])} | {r['seams']} / {r['visible']} | "
-            f"{r['points_dense']:,} / {r['points_voxel']:,} | {r['perceive_s']:.2f} | {r['align_s']:.2f} | "
+            f"{r['points_dense']:,} / {r['points_voxel']:,} | {r['capture_s']:.2f} | {r['perceive_s']:.2f} | "
+            f"{r['align_s']:.2f} | {ratio} | "
             f"{ours['found']}, {ours['ms_per_seam_median']:.2f}, {ours['lateral_mean_mm']:.3f} | "
             f"{paper['found']}, {paper['ms_per_seam_median']:.2f} | "
-            f"{ransac['found']}, {ransac['ms_per_seam_median']:.2f} |"
+            f"{ransac['found']}, {ransac['ms_per_seam_median']:.2f} | {_planning_cells(r.get('planning'))} |"
         )
     return head + "\n".join(lines) + "\n"
 

@@ -89,14 +89,17 @@ def near_seed(weldmap_M: WeldMap, table_z: float):  # type: ignore[no-untyped-de
 
 
 def flip_result(plan: FlipPlan, run: WeldRun, weldmap_M: WeldMap) -> FlipResult | None:
-    """The placement the second alignment measured against the plan's nominal turned pose (None: no alignment)."""
+    """The placement the second alignment measured against the plan's nominal turned pose: the shift of the
+    part's centre and the turn about the vertical (None: no alignment)."""
     scene = run.detection.scene
     if scene is None:
         return None
-    centre_M = np.mean([p.center for p in weldmap_M.parts], axis=0)
-    nominal_c = transform_points(plan.X_RM_after, centre_M)
-    found_c = transform_points(scene.X_RM, centre_M)
+    from cell.seams.flip import pivot
+
+    # The part's centre (the middle of its extent, the turn's pivot) at its nominal turned place and where found.
+    nominal_c = pivot(weldmap_M.transformed(plan.X_RM_after, "R"))
     D = scene.X_RM @ invert(plan.X_RM_after)
+    found_c = transform_points(D, nominal_c)
     rotation = math.atan2(float(D[1, 0]), float(D[0, 0]))
     offset = float(np.linalg.norm((found_c - nominal_c)[:2]))
     return FlipResult(offset, rotation, scene.alignment.fitness, scene.X_RM)

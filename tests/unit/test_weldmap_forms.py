@@ -305,3 +305,24 @@ def test_a_map_of_curves_only_has_no_seam_to_weld(tmp_path: Path) -> None:
     with pytest.raises(MapError) as exc:
         read_map(_save(doc, tmp_path))
     _one_line(exc, "no seam can be welded: 1 seam unsupported (CIRCLE", "a curved seam")
+
+
+def test_fixtures_are_obstacles_of_the_motion_scene() -> None:
+    from types import SimpleNamespace
+
+    from cell import scenario as sc
+    from cell.motion.robot import RobotModel
+    from cell.pipeline.geometry import motion_scene
+    from cell.station.arm import robot_urdf
+    from cell.types import Part, WeldMap
+
+    scn = sc.load("fence1-exact")
+    model = RobotModel.from_urdf(robot_urdf(scn))
+    q = np.radians(np.asarray(scn.robot.home_deg, dtype=float))
+    p_R = model.fk(q, "tool0")[:3, 3]  # a clamp drawn right where the flange is at home
+    clamp = Part("CLAMP_1", Box(make_pose(p=p_R), np.array([0.2, 0.2, 0.2])))
+    weldmap_R = WeldMap((), (), "mm", "test", "R", fixtures=(clamp,))
+    scene = motion_scene(SimpleNamespace(model=model), SimpleNamespace(scenario=scn, weldmap_R=weldmap_R))  # type: ignore[arg-type]
+    assert "CLAMP_1" in scene.checker.obstacle_names
+    contact = scene.checker.check(q)
+    assert contact is not None and "CLAMP_1" in (contact.a, contact.b)

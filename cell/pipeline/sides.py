@@ -12,6 +12,7 @@ from typing import Literal
 
 import numpy as np
 
+from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import Progress, quiet, read_weldmap, table_z_R
 from cell.pipeline.records import WeldRun
@@ -142,7 +143,10 @@ def weld_part(
         if not execute_plan or a.error is not None:
             err = None if not execute_plan else a.error
             return TwoSidedRun(a, plan, error=err, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
-        b = _side_b(station, sc, method, rescan, plan, weldmap, progress)
+        try:
+            b = _side_b(station, sc, method, rescan, plan, weldmap, progress)
+        except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
+            return TwoSidedRun(a, plan, error=e, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
         result = flip_result(plan, b, weldmap)
         return TwoSidedRun(a, plan, b, result, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
 

@@ -22,13 +22,15 @@ class FlipSpec(Model):
 
     allowed : false for a part too heavy (or too awkward) to turn: the seams left keep their reason.
     operator_s : the operator's time to turn the part and confirm [s], counted in the job's cycle time.
-    tacks : tack welds before the turn.
+    tacks : tack welds before the turn (their time, count x (length / travel speed + 3 s), is added to the job's).
+    max_tilt_deg : the largest lean of the turned part (resting on the hull facet under its centre of mass)
+        accepted; a turn that leans more is not made.
     """
 
     allowed: bool = True
-    operator_s: Annotated[float, Field(ge=0.0, le=7200.0)] = 120.0  # the operator turns the part [s]
+    operator_s: Annotated[float, Field(ge=0.0, le=7200.0)] = 120.0
     tacks: TackSpec = TackSpec()
-    max_tilt_deg: Annotated[float, Field(ge=0.0, le=20.0)] = 5.0  # largest lean of the turned part accepted
+    max_tilt_deg: Annotated[float, Field(ge=0.0, le=20.0)] = 5.0
 
 
 class FlipPlacementSpec(Model):

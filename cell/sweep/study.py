@@ -50,6 +50,7 @@ class Study:
     workers: int | None = None
     engine: dict[str, Any] | None = None
     store: RunStore | None = None
+    code: str = ""  # the commit the sweep was started from (``+dirty``: with edits)
     _summary_t: float = 0.0
     _pictures_t: float = 0.0
 
@@ -62,6 +63,9 @@ class Study:
         self.store = store = open_store(self.out, params, fresh=fresh, warn=self.warn)
         todo = [variation(s.scenario, s.weldmap_M, k, s.vary) for k in range(s.n) if k not in store.lines]
         done = sum(1 for k in store.lines if k < s.n)
+        from cell.provenance import git_commit
+
+        self.code = git_commit()  # the driver's checkout: the workers' numbers come from the code they import
         self.engine = {"engine": "ray", "engine_version": engine_version(), "address": self.address or "local"}
         if done:
             self.say(f"resuming {self.out}: {done} of {s.n} runs already there, {len(todo)} to run")
@@ -69,6 +73,7 @@ class Study:
 
         def started(info: EngineInfo) -> None:
             self.engine = {"engine": info.engine, "engine_version": info.engine_version, "address": info.address}
+            self.engine["cpus"] = info.cpus
             self.say(f"Ray {info.engine_version} ({info.address}, {info.cpus} CPUs): {len(todo)} runs")
 
         def finished(result: dict[str, Any]) -> None:
@@ -105,7 +110,7 @@ class Study:
             [m.id for m in s.weldmap_M.seams],
             n=s.n,
             stage=s.stage,
-            engine=self.engine or {},
+            engine={**(self.engine or {}), "code": self.code},
             sweep={**store.params, "key": store.key},
             weld_tolerance_mm=s.scenario.rescan.weld_tolerance_mm,
         )

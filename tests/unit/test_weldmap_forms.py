@@ -235,22 +235,18 @@ def test_ezdxf_failures_become_map_errors(tmp_path: Path, monkeypatch: pytest.Mo
 
 
 def test_ezdxf_log_goes_to_ours_not_stderr(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
 ) -> None:
-    from cell.weldmap import _load
-
-    path = make_maps.write_map(tmp_path / "v.dxf", PARTS, SEAMS, solid="mesh")
-    real = _load.ezdxf.readfile
-
-    def chatty(p: Path) -> object:
-        logging.getLogger("ezdxf").warning("invalid handle 0")
-        return real(p)
-
-    monkeypatch.setattr(_load.ezdxf, "readfile", chatty)
+    path = _save(_doc(in_blocks=True), tmp_path)
+    text = path.read_text()
+    at = text.index("\n  0\nENDBLK\n")  # a block without its ENDBLK: ezdxf warns, and reads on
+    path.write_text(text[:at] + text[text.index("\n  0\n", at + 5) :])
     with caplog.at_level(logging.DEBUG, logger="cell.weldmap"):
         read_map(path)
-    assert capfd.readouterr().err == ""
-    assert any(r.name == "cell.weldmap" and "ezdxf warning: invalid handle 0" in r.getMessage() for r in caplog.records)
+    assert capfd.readouterr().err == ""  # the old reader let ezdxf print "Missing required ENDBLK ..." here
+    assert any(
+        r.name == "cell.weldmap" and "ezdxf warning: Missing required ENDBLK" in r.getMessage() for r in caplog.records
+    )
     assert logging.getLogger("ezdxf").propagate  # restored after reading
 
 

@@ -137,6 +137,7 @@ def krl_main_texts(main: str, jobs: Sequence[ProgramJob], message: str, stop: St
         ";FOLD INI", ";FOLD BASISTECH INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
         "INTERRUPT ON 3", "BAS(#INITMOV, 0)", ";ENDFOLD (BASISTECH INI)", ";FOLD USER INI", ";ENDFOLD (USER INI)",
         ";ENDFOLD (INI)", "",
+        f"BAS(#TOOL, {opt.tool_index}) ; the torch's TOOL_DATA and LOAD_DATA (the sides' setup blocks)",
         f"BAS(#VEL_PTP, {opt.ptp_percent})", f"BAS(#ACC_PTP, {opt.ptp_percent})",
         f"IF {far} THEN",
         "  HALT ; $config.dat's XHOME is not the planned home XHOME_PLAN: correct it first",

@@ -69,6 +69,7 @@ def test_krl_main_runs_side_a_stops_for_the_operator_then_runs_side_b(sides: lis
     b = _index(src, r"^WELD_T_B\( \)$", wait)
     back = _index(src, r"^PTP XHOME\b", b)
     assert _index(src, r"^BAS\(#INITMOV, 0\)$") < home < a < msg < wait < b < back and src[back + 1] == "END"
+    assert _index(src, r"^BAS\(#TOOL, 1\) ;") < home  # the torch's load for the moves home
     assert [ln for ln in src if re.fullmatch(r"\w+\( \)", ln)] == ["WELD_T_A( )", "WELD_T_B( )"]
     assert f'Msg_Txt[] "{MESSAGE}"' in dat and "VL_Stop TRUE" in dat and "Clear_P_Reset TRUE" in dat
     # side A is the post's own program; side B has its own base index, since its base (the turned part) differs

@@ -79,9 +79,14 @@ def test_polylines_are_chains_of_straight_seams_and_curves_are_unsupported(tmp_p
     p3.set_xdata("WELDCELL", [(1000, "POST_L>TOP_RAIL:corner")])
     msp.add_arc((240, 700, 0), 40, 0, 180, dxfattribs={"color": 1, "layer": "WELD_SEAMS"})
     spline = msp.add_spline([(0, 0, 0), (100, 50, 0), (200, 0, 10)], dxfattribs={"color": 1})
+    # drawn from below (extrusion -z, as mirrored views export it): its own x and elevation are mirrored
+    flip = msp.add_lwpolyline([(-1120, 700), (-1200, 700)], dxfattribs={"color": 1})
+    flip.dxf.extrusion, flip.dxf.elevation = (0.0, 0.0, -1.0), -80.0
     m = read_map(_save(doc, tmp_path))
     ids = [s.id for s in m.seams]
-    assert ids == [f"seam-{lw.dxf.handle}.1", "POST_L>TOP_RAIL:corner.1", "POST_L>TOP_RAIL:corner.2"]
+    assert ids[:3] == [f"seam-{lw.dxf.handle}.1", "POST_L>TOP_RAIL:corner.1", "POST_L>TOP_RAIL:corner.2"]
+    assert ids[3:] == [f"seam-{flip.dxf.handle}.1"]
+    np.testing.assert_allclose([m.seams[3].p_start, m.seams[3].p_end], [[1.12, 0.7, 0.08], [1.2, 0.7, 0.08]], atol=TOL)
     np.testing.assert_allclose([m.seams[0].p_start, m.seams[0].p_end], [[0.2, 0.7, 0.08], [0.28, 0.7, 0.08]])
     np.testing.assert_allclose(m.seams[2].p_end, [0.2, 0.7, 0.08])
     reasons = dict(m.unsupported)

@@ -21,7 +21,7 @@ def test_init_then_weld_welds_fence2s_visible_seams(tmp_path: Path, monkeypatch:
     scenario, report = tmp_path / "f2.yaml", tmp_path / "r.json"
     result = runner.invoke(app, ["init", str(REPO / "maps" / "fence2.dxf"), "--out", str(scenario)])
     assert result.exit_code == 0, result.stderr
-    result = runner.invoke(app, ["weld", str(scenario), "--json", str(report)])
+    result = runner.invoke(app, ["weld", str(scenario), "--sides", "first", "--json", str(report)])
     assert result.exit_code == 0, result.stderr
     data = json.loads(report.read_text())
     assert data["error"] is None and data["welded"] == 12 and len(data["seams"]) == 16

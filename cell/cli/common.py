@@ -68,6 +68,19 @@ settings = Settings()
 _handlers: list[logging.Handler] = []
 
 
+class _MapWarnings(logging.Handler):
+    """The welding map reader's warnings (a units doubt, a skipped body, a curve not welded) as ``warning:`` lines
+    on stderr, whichever command read the map (unless --quiet)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if not settings.quiet:
+            err.print(f"[yellow]warning[/]: {escape(record.getMessage())}", soft_wrap=True)
+
+
+_map_warnings = _MapWarnings(logging.WARNING)
+logging.getLogger("cell.weldmap").addHandler(_map_warnings)
+
+
 def configure(*, quiet: bool, verbose: bool, log_file: Path | None) -> None:
     """Set this invocation's verbosity and log file; results go back to stdout (``--json -`` moves them)."""
     settings.quiet, settings.verbose, settings.interrupted = quiet, verbose, False

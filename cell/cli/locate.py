@@ -52,7 +52,9 @@ def locate(
     place: PlaceOpt = None,
     place_rpy: PlaceRpyOpt = None,
     units: Annotated[str, typer.Option(help="Units of the cloud file's numbers: m, cm, mm, in.")] = "m",
-    map_units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
+    map_units: Annotated[
+        str | None, typer.Option(help="Units the DXF is drawn in (mm, cm, m, in); wins over its $INSUNITS.")
+    ] = None,
     frame: Annotated[str, typer.Option(help="The name of the cloud's own frame (the report's frame).")] = "F",
     viewpoint: Annotated[
         str | None, typer.Option(help="Where the sensor was, X,Y,Z in mm in the cloud's frame (orients normals).")

@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.markup import escape
 
 from cell.cli.common import (
     FormatOpt,
@@ -17,7 +16,6 @@ from cell.cli.common import (
     cell_errors,
     check_method,
     detail,
-    err,
     fail_line,
     map_app,
     out,
@@ -73,9 +71,7 @@ def map_info(
 
             spec = sc.load(scenario).map
             layers, units = spec.layers, units if units is not None else spec.units
-        weldmap = read_map(path, units=units, layers=layers)
-        for line in weldmap.warnings:
-            err.print(f"[yellow]warning[/]: {escape(line)}", soft_wrap=True)
+        weldmap = read_map(path, units=units, layers=layers)  # its warnings print through cli.common's handler
         out.print(describe(weldmap, _joints(weldmap)), soft_wrap=True, markup=False, highlight=False)
 
 

@@ -25,7 +25,9 @@ def init(
     out_path: Annotated[
         Path | None, typer.Option("--out", "-o", help="The scenario file to write (default: MAP's name .yaml here).")
     ] = None,
-    units: Annotated[str | None, typer.Option(help="Units if the DXF declares none: mm, cm, m, in.")] = None,
+    units: Annotated[
+        str | None, typer.Option(help="Units the DXF is drawn in (mm, cm, m, in); wins over its $INSUNITS.")
+    ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite the scenario file if it exists.")] = False,
 ) -> None:
     """Write a scenario for any welding map: table, robot and cameras placed around the part, the workspace

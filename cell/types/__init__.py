@@ -8,7 +8,7 @@ Every stage imports its values from here and nothing here imports a stage (an im
 """
 
 from cell.types.execution import Event, Execution, WeldQuality
-from cell.types.map import BOX_FACES, Box, MapSeam, Part, WeldMap
+from cell.types.map import BOX_FACES, Box, MapSeam, Part, UnsupportedSeam, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
@@ -54,6 +54,7 @@ __all__ = [
     "Shape",
     "ShapeKind",
     "Trajectory",
+    "UnsupportedSeam",
     "Viewpoint",
     "VoxelTable",
     "Weave",

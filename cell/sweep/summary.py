@@ -34,7 +34,8 @@ def _share(flags: Sequence[bool]) -> float | None:
 
 def seam_summary(recs: Sequence[Mapping[str, Any]], stage: str) -> dict[str, Any]:
     """One seam over the runs that have it: the probabilities, the error percentiles of the runs that found it,
-    the three most frequent reasons (numbers stripped, so the same cause counts once)."""
+    the three most frequent reasons it was not found, planned or welded (numbers stripped, so the same cause
+    counts once)."""
     out: dict[str, Any] = {
         "runs": len(recs),
         "probability_found": _share([bool(r.get("found")) for r in recs]),
@@ -48,10 +49,19 @@ def seam_summary(recs: Sequence[Mapping[str, Any]], stage: str) -> dict[str, Any
             out[name] = percentiles(vals)
     reasons: Counter[str] = Counter()
     for r in recs:
+        if not _undone(r, stage):  # a seam found and planned (welded) has notes, not reasons
+            continue
         for why in r.get("reasons", ()):
             reasons[_gist(why)] += 1
     out["reasons"] = [{"reason": why, "runs": n} for why, n in reasons.most_common(3)]
     return out
+
+
+def _undone(rec: Mapping[str, Any], stage: str) -> bool:
+    """The seam was not found, or (plan, weld) not planned, or (weld) not welded in this run."""
+    if not rec.get("found"):
+        return True
+    return (stage != "detect" and not rec.get("planned")) or (stage == "weld" and not rec.get("welded"))
 
 
 def _brief(error: Mapping[str, Any] | None) -> dict[str, Any]:

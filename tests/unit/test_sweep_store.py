@@ -20,7 +20,8 @@ from cell.sweep.summary import summarize
 
 
 def _seam(found: bool, lateral: float | None, within: bool, planned: bool = True) -> dict[str, Any]:
-    return {"found": found, "lateral_mm": lateral, "within_tolerance": within, "planned": planned, "reasons": []}
+    why = ["seen by 0 cameras" if not found else "ends from side face / side face"]
+    return {"found": found, "lateral_mm": lateral, "within_tolerance": within, "planned": planned, "reasons": why}
 
 
 def _result(k: int, seams: dict[str, Any] | None = None, error: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -91,7 +92,9 @@ def test_summary_probabilities_from_hand_made_runs() -> None:
         _result(0, {"A": _seam(True, 0.2, True), "B": _seam(False, None, False, False)})["line"],
         _result(1, {"A": _seam(True, 0.6, False), "B": _seam(True, 0.1, True)})["line"],
         _result(2, {"A": _seam(True, 0.4, True), "B": _seam(False, None, False, False)})["line"],
-        _result(3, {"A": _seam(False, None, False, False), "B": _seam(False, None, False, False)})["line"],
+        _result(3, {"A": _seam(False, None, False, False), "B": {**_seam(False, None, False, False), "reasons": []}})[
+            "line"
+        ],
         _result(4, error={"type": "WorkerCrashedError", "message": "died", "exit_code": 1})["line"],
         _result(9, {"A": _seam(True, 9.0, False)})["line"],  # beyond n: not counted
     ]
@@ -103,3 +106,5 @@ def test_summary_probabilities_from_hand_made_runs() -> None:
     assert a["probability_planned"] == 0.75 and a["probability_welded"] is None  # nothing moved in a plan sweep
     assert a["lateral_mm"]["p50"] == pytest.approx(0.4) and a["lateral_mm"]["max"] == pytest.approx(0.6)
     assert b["probability_found"] == 0.25 and b["lateral_mm"]["max"] == pytest.approx(0.1)
+    # the reasons are those of the runs that did not find (plan) it, numbers aside; a found seam's notes are not
+    assert b["reasons"] == [{"reason": "seen by # cameras", "runs": 2}]

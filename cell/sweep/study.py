@@ -56,6 +56,7 @@ class Study:
 
     def run(self, *, fresh: bool = False) -> dict[str, Any]:
         """Run what is missing of runs 0 .. n-1 and return the summary (written to ``summary.json``)."""
+        from cell.provenance import git_commit
         from cell.sweep.engine import EngineInfo, engine_version, run_sweep
 
         s = self.spec
@@ -63,8 +64,6 @@ class Study:
         self.store = store = open_store(self.out, params, fresh=fresh, warn=self.warn)
         todo = [variation(s.scenario, s.weldmap_M, k, s.vary) for k in range(s.n) if k not in store.lines]
         done = sum(1 for k in store.lines if k < s.n)
-        from cell.provenance import git_commit
-
         self.code = git_commit()  # the driver's checkout: the workers' numbers come from the code they import
         self.engine = {"engine": "ray", "engine_version": engine_version(), "address": self.address or "local"}
         if done:

@@ -25,6 +25,7 @@ if str(HERE) not in sys.path:  # the helper modules (dxf_factory, fakes, pinhole
     sys.path.insert(0, str(HERE))
 
 from scenes import Noise, Perceived  # noqa: E402  (after the path set-up above)
+from shared_runs import Preview, half_resolution  # noqa: E402
 
 
 @pytest.fixture(scope="session")
@@ -83,3 +84,46 @@ def fence1_station(fence1_detection: pipeline.Detection) -> Iterator[SimStation]
     with open_station(scn, pipeline.read_weldmap(scn)) as station:
         station.capture()
         yield station
+
+
+@pytest.fixture(scope="session")
+def detected() -> Callable[..., pipeline.Detection]:
+    """``detected(name, half=False)``: ``pipeline.detect`` of scenario ``name`` as shipped, once per session (read
+    only), for the tests of several modules that detect the same cell (faults, the CLI's reports, the splice);
+    ``half``: its cameras at half resolution (tests/resolution.py)."""
+    from cell import pipeline
+    from cell import scenario as sc
+
+    cache: dict[tuple[str, bool], pipeline.Detection] = {}
+
+    def get(name: str, half: bool = False) -> pipeline.Detection:
+        if (name, half) not in cache:
+            s = sc.load(name)
+            cache[name, half] = pipeline.detect(half_resolution(s) if half else s)
+        return cache[name, half]
+
+    return get
+
+
+@pytest.fixture(scope="session")
+def fence1_preview(tmp_path_factory: pytest.TempPathFactory) -> Preview:
+    """``cell preview fence1`` once per session through the real pipeline (a preview plans and moves nothing); the
+    run it drew is caught on its way to ``cell.preview.write_run``, the pictures and page drawn as they would be."""
+    from typer.testing import CliRunner
+
+    import cell.preview
+    from cell.cli import app
+
+    drawn: list[pipeline.WeldRun] = []
+    write_run = cell.preview.write_run
+
+    def spy(run: pipeline.WeldRun, out_dir: str | Path) -> list[Path]:
+        drawn.append(run)
+        return write_run(run, out_dir)
+
+    folder = tmp_path_factory.mktemp("preview")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(cell.preview, "write_run", spy)
+        result = CliRunner().invoke(app, ["preview", "fence1", "--out", str(folder)])
+    assert len(drawn) == 1, result.stderr
+    return Preview(folder, result.exit_code, result.stderr, drawn[0])

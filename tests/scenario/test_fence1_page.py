@@ -1,8 +1,9 @@
 """The page of fence1 (``cell weld fence1 --html``, ``cell preview fence1``): a DOM check of the figures it embeds.
 
-The session's weld of fence1 (``fence1_run``) stands in for the pipeline's run, so no second weld is needed: the
-page shows the robot (its URDF links, moved along the plan by a slider), the table, the cameras' frusta, the
-results table with one row per seam, and the joint plots with every weld's arc-on band labelled by its seam.
+The session's weld of fence1 (``fence1_run``) stands in for the pipeline's run, so no second weld is needed, and
+``cell preview``'s page is the session's preview (``fence1_preview``, the one test_weld.py checks): the page shows
+the robot (its URDF links, moved along the plan by a slider), the table, the cameras' frusta, the results table
+with one row per seam, and the joint plots with every weld's arc-on band labelled by its seam.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from page_dom import read
+from shared_runs import Preview
 from typer.testing import CliRunner
 
 from cell import pipeline
@@ -66,9 +68,9 @@ def test_weld_html_page(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_
     check_page(page, fence1_run)
 
 
-def test_preview_page(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_run: pipeline.WeldRun) -> None:
-    """``cell preview`` writes the same page as ``cell.html`` beside its PNGs."""
-    monkeypatch.setattr(pipeline, "weld", lambda *a, **kw: fence1_run)
-    result = CliRunner().invoke(app, ["preview", "fence1", "--sides", "first", "--out", str(tmp_path)])
-    assert result.exit_code == 0, result.stderr
-    check_page(tmp_path / "cell.html", fence1_run)
+def test_preview_page(fence1_preview: Preview) -> None:
+    """``cell preview`` writes the same page as ``cell.html`` beside its PNGs: the session's preview of fence1
+    (``fence1_preview``, the real pipeline's plan, nothing moved), checked against the run it drew."""
+    assert fence1_preview.exit_code == 0, fence1_preview.stderr
+    assert fence1_preview.run.execution is None
+    check_page(fence1_preview.folder / "cell.html", fence1_preview.run)

@@ -1,7 +1,8 @@
 """Scenario tests of the main job: `cell weld fence1` and `cell preview fence1`, headless, on real simulated data.
 
 fence1 is welded once per session (``fence1_run`` in tests/conftest.py): the run's tests and the CLI's report and
-robot program all read that one run; the preview and the two-cameras-dead fault are runs of their own.
+robot program all read that one run; the preview is the session's too (``fence1_preview``: test_fence1_page.py
+checks its page), and the two-cameras-dead fault is a run of its own.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from shared_runs import Preview
 from typer.testing import CliRunner
 
 from cell import pipeline
@@ -105,14 +107,15 @@ def test_weld_cli_writes_report_and_robot_program(
     assert json.loads((krl / "trajectory.json").read_text())["joint_names"][0] == "joint_a1"
 
 
-def test_preview_draws_and_moves_nothing(tmp_path: Path) -> None:
-    runner = CliRunner()
-    result = runner.invoke(app, ["preview", "fence1", "--out", str(tmp_path)])
+def test_preview_draws_and_moves_nothing(fence1_preview: Preview) -> None:
+    """``cell preview fence1``, run once per session (``fence1_preview``: its page is also checked in
+    test_fence1_page.py)."""
+    result, out = fence1_preview, fence1_preview.folder
     assert result.exit_code == 0, result.stderr
     for name in ("overview_top.png", "overview_3d.png", "overview_seams.png", "joints.png"):
-        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "plotly" in (tmp_path / "cell.html").read_text()[:200000]
-    data = json.loads((tmp_path / "report.json").read_text())
+        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "plotly" in (out / "cell.html").read_text()[:200000]
+    data = json.loads((out / "report.json").read_text())
     assert data["cycle_time_s"] == 0 and data["events"] == []
     assert all(not s["welded"] for s in data["seams"])
     assert sum(s["planned"] for s in data["seams"]) == 12

@@ -50,9 +50,35 @@ def test_detect_writes_the_report_contract(tmp_path: Path) -> None:
     assert cloud.stat().st_size > 10_000
 
 
-def test_alignment_failure_still_writes_every_seam_with_its_reason(tmp_path: Path) -> None:
+def _detect_returning(
+    det: pipeline.Detection, asked: list[tuple[sc.Scenario, str | None, dict[str, object]]]
+) -> Callable[..., pipeline.Detection]:
+    """``pipeline.detect`` standing in: ``det`` (a detection the session ran once), the CLI's arguments kept."""
+
+    def detect(scenario: sc.Scenario, method: str | None = None, **kw: object) -> pipeline.Detection:
+        asked.append((scenario, method, kw))
+        return det
+
+    return detect
+
+
+def _asked_for(asked: list[tuple[sc.Scenario, str | None, dict[str, object]]], name: str) -> None:
+    """The CLI asked ``pipeline.detect`` once for scenario ``name`` as shipped, its own method, a cell of its own."""
+    ((scenario, method, kw),) = asked
+    assert scenario == sc.load(name) and method is None and kw.get("station") is None
+
+
+def test_alignment_failure_still_writes_every_seam_with_its_reason(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, detected: Callable[..., pipeline.Detection]
+) -> None:
+    """``cell detect faults/displaced-far``: the session's detection of it at half resolution (tests/conftest.py's
+    ``detected``, which test_faults.py asserts is refused as well) stands in for the pipeline's: what is checked
+    here, the report and the exit of a refused alignment, does not depend on the cameras' resolution."""
+    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+    monkeypatch.setattr(pipeline, "detect", _detect_returning(detected("faults/displaced-far", True), asked))
     report = tmp_path / "out.json"
     code, _, err = invoke("detect", "faults/displaced-far", "--json", str(report))
+    _asked_for(asked, "faults/displaced-far")
     assert code == 3, err  # partial: the report is written, the cause is in it
     assert "error:" in err and "Traceback" not in err
     data = json.loads(report.read_text())
@@ -112,8 +138,15 @@ def test_a_late_failure_loses_only_its_own_output(
     assert json.loads(report.read_text())["welded"] == 12
 
 
-def test_a_lost_camera_is_named_on_the_last_line() -> None:
+def test_a_lost_camera_is_named_on_the_last_line(
+    monkeypatch: pytest.MonkeyPatch, detected: Callable[..., pipeline.Detection]
+) -> None:
+    """``cell detect faults/camera-dead``: the session's detection of it (``detected``, the one test_faults.py
+    checks) stands in for the pipeline's, the CLI's arguments checked as it passes them."""
+    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+    monkeypatch.setattr(pipeline, "detect", _detect_returning(detected("faults/camera-dead"), asked))
     code, _, err = invoke("detect", "faults/camera-dead")
+    _asked_for(asked, "faults/camera-dead")
     assert code == 3, err
     last = err.strip().splitlines()[-1]
     assert last.startswith("exit 3: camera cam_left lost (") and last.endswith("12/12 visible found"), last

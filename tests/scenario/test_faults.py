@@ -5,23 +5,27 @@ the alignment checks, locate, the screen), and asserts what the cell must report
 are not and why (the reason code), and that no found seam lies more than 1 mm from its true position; or, for a
 refusal, the error in the detection and every visible seam not searched. A check taken out of the pipeline fails
 here. The test-only shortcut: in the refusal tests cameras render at half resolution (the scenario files keep
-fence1's), which keeps the refusal tests to a few seconds on two cores. The fault scenario files themselves:
-tests/unit/test_fault_scenarios.py.
+fence1's), which keeps the refusal tests to a few seconds on two cores. Each detection runs once per session
+(``detected`` in tests/conftest.py), so the command-line tests of the same faults read it too. The fault scenario
+files themselves: tests/unit/test_fault_scenarios.py.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import pytest
+from shared_runs import half_resolution
 
 from cell import pipeline
 from cell import scenario as sc
 from cell.errors import AlignmentError, SensorError
 from cell.types import Reason, SeamEstimate, SeamStatus
 
+Detected = Callable[..., pipeline.Detection]  # the session's ``detected(name, half=False)`` (tests/conftest.py)
 MAX_ERROR_MM = 1.0  # a found seam further than this from the truth is a wrong seam (docs/reference.md section 4)
 
 
@@ -33,24 +37,15 @@ class Outcome:
     lost: dict[str, str]  # camera left out -> why
 
 
-def half_resolution(s: sc.Scenario) -> sc.Scenario:
-    cams = {
-        n: c.model_copy(update={"resolution": (c.resolution[0] // 2, c.resolution[1] // 2)})
-        for n, c in s.cameras.items()
-    }
-    return s.model_copy(update={"cameras": cams})
-
-
-def run(name: str, *, half: bool = False) -> Outcome:
+def run(detected: Detected, name: str, *, half: bool = False) -> Outcome:
     """``pipeline.detect`` on scenario ``name`` (``half``: cameras at half resolution, enough for the refusals,
-    not for sub-millimetre seams)."""
-    s = half_resolution(sc.load(name)) if half else sc.load(name)
-    det = pipeline.detect(s)
-    errors = {}
+    not for sub-millimetre seams), once per session (``detected``: test_cli_reports.py reads the same)."""
+    det = detected(name, half)
+    errors: dict[str, float] = {}
     for e in det.estimates:
         if e.status is SeamStatus.FOUND:
             a, b = det.truths[e.id]
-            errors[e.id] = 1000.0 * max(np.linalg.norm(e.p_start - a), np.linalg.norm(e.p_end - b))
+            errors[e.id] = 1000.0 * float(max(np.linalg.norm(e.p_start - a), np.linalg.norm(e.p_end - b)))
     lost = {}
     if det.scene is not None:
         perceived = det.scene.perceived
@@ -103,9 +98,9 @@ def underside(o: Outcome) -> set[str]:
     ],
 )
 def test_a_broken_camera_is_dropped_with_its_reason_and_the_rest_find_the_seams(
-    name: str, camera: str, why: str
+    detected: Detected, name: str, camera: str, why: str
 ) -> None:
-    o = run(name)
+    o = run(detected, name)
     assert list(o.lost) == [camera]
     assert why in o.lost[camera]  # camera health gives its verdict as text only (no code yet)
     assert o.detection.lost_cameras == (f"{camera}: {o.lost[camera]}",) and not o.detection.complete
@@ -115,8 +110,8 @@ def test_a_broken_camera_is_dropped_with_its_reason_and_the_rest_find_the_seams(
     assert max(o.errors_mm.values()) < 0.8  # measured 0.39-0.41 mm with two cameras left
 
 
-def test_calibration_error_of_1mm_and_0_1deg_is_the_accuracy_limit() -> None:
-    o = run("faults/extrinsics-off")
+def test_calibration_error_of_1mm_and_0_1deg_is_the_accuracy_limit(detected: Detected) -> None:
+    o = run(detected, "faults/extrinsics-off")
     assert not o.lost  # 1 mm / 0.1 deg is not a broken camera: every camera agrees within the noise
     assert len(o.errors_mm) == 12
     # Measured 1.1-1.8 mm at full resolution: the whole cloud inherits the reference camera's error, which no
@@ -131,8 +126,8 @@ def test_calibration_error_of_1mm_and_0_1deg_is_the_accuracy_limit() -> None:
         assert 1.2 < sigma_mm < 1.8 and m.lateral_mm < 2.0 * sigma_mm, (i, sigma_mm, m.lateral_mm)
 
 
-def test_occluded_seams_are_reported_never_invented() -> None:
-    o = run("faults/occluded")
+def test_occluded_seams_are_reported_never_invented(detected: Detected) -> None:
+    o = run(detected, "faults/occluded")
     st = statuses(o)
     clamp = ["POST_L>TOP_RAIL:+x", "POST_L>TOP_RAIL:-x", "POST_L>TOP_RAIL:+z"]
     cable = ["BOTTOM_RAIL>POST_R:+y", "BOTTOM_RAIL>POST_R:-y", "BOTTOM_RAIL>POST_R:+z"]
@@ -144,8 +139,8 @@ def test_occluded_seams_are_reported_never_invented() -> None:
     assert max(o.errors_mm.values()) < 0.4  # measured 0.19 mm
 
 
-def test_missing_part_seams_are_not_found_with_the_reason() -> None:
-    o = run("faults/missing-part")
+def test_missing_part_seams_are_not_found_with_the_reason(detected: Detected) -> None:
+    o = run(detected, "faults/missing-part")
     for i, e in o.estimates.items():
         if "POST_R" in i.split(":")[0].split(">"):
             assert e.status is SeamStatus.NOT_FOUND and e.code is Reason.PART_MISSING, (i, e.code)
@@ -155,24 +150,24 @@ def test_missing_part_seams_are_not_found_with_the_reason() -> None:
     assert max(o.errors_mm.values()) < 0.4  # measured 0.20 mm
 
 
-def test_a_part_displaced_60mm_4deg_is_refound() -> None:
-    o = run("faults/displaced")
+def test_a_part_displaced_60mm_4deg_is_refound(detected: Detected) -> None:
+    o = run(detected, "faults/displaced")
     assert_no_wrong_seam(o)
     assert len(o.errors_mm) == 12
     assert max(o.errors_mm.values()) < 0.4  # measured 0.18 mm
 
 
-def test_a_part_displaced_beyond_correction_is_refused() -> None:
+def test_a_part_displaced_beyond_correction_is_refused(detected: Detected) -> None:
     # The ICP settles where the posts fit and the rails do not. Its fitness is borderline (0.53 at full
     # resolution, 0.43 at half): either align_map's fitness floor or the parts-seen check must refuse it.
-    o = run("faults/displaced-far", half=True)
+    o = run(detected, "faults/displaced-far", half=True)
     assert_nothing_searched(o, AlignmentError)
     assert o.detection.error is not None
     assert re.search(r"fitness 0\.[0-4]\d+ within|does not lie on the cloud", o.detection.error.message)
 
 
-def test_a_ladder_one_rung_off_is_refused_as_ambiguous() -> None:
-    o = run("faults/ladder-shifted", half=True)
+def test_a_ladder_one_rung_off_is_refused_as_ambiguous(detected: Detected) -> None:
+    o = run(detected, "faults/ladder-shifted", half=True)
     assert_nothing_searched(o, AlignmentError)
     assert o.detection.error is not None
     # The README's documented refusal (the error carries no fields: its message is the contract).

@@ -8,6 +8,8 @@ scenario is ``benchmarks/bench_splice.py``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -43,8 +45,12 @@ def test_long_part_seen_along_its_length_nothing_applied(name: str) -> None:
         assert c["applied"] is False and c["applied_mm"] == 0.0 and c["refused"] in REFUSALS
 
 
-def test_miscalibrated_fixed_cameras_still_corrected() -> None:
-    corrections = _perceived("faults/extrinsics-fixed-off")
+def test_miscalibrated_fixed_cameras_still_corrected(detected: Callable[..., pipeline.Detection]) -> None:
+    """The session's detection of the cell (``detected``: test_closeup.py re-scans it), whose perception is
+    ``perceive`` of its capture."""
+    scene = detected("faults/extrinsics-fixed-off").scene
+    assert scene is not None
+    corrections = scene.perceived.splice_corrections()
     for name, c in corrections.items():
         assert c["applied"] is True and c["refused"] == "", name
         assert 1.2 < float(str(c["applied_mm"])) < 2.0 and c["directions"] == "6/6", name  # measured 1.55, 1.56

@@ -28,7 +28,8 @@ def _draw(ax: Axes, weldmap: WeldMap, colour_of: dict[str, str], axes: tuple[int
         c = part.box.corners()
         for a, b in _EDGES:
             ax.plot([c[a, i], c[b, i]], [c[a, j], c[b, j]], color="0.3", lw=0.6)
-    for seam in weldmap.seams:
+    grey = SIDE_COLOURS["left"]
+    for seam in sorted(weldmap.seams, key=lambda m: colour_of.get(m.id) != grey):  # a side's seams over the grey
         colour = colour_of.get(seam.id)
         if colour is None:
             continue

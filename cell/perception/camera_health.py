@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from cell.config.perception import HealthOptions
+from cell.geometry import FloatArray
 from cell.perception.preprocess import downsample
 from cell.types import Cloud, DepthImage
 
@@ -95,8 +97,16 @@ def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None)
     b also occupies agrees without a search (the two centroids lie in one voxel); only the others are searched.
     """
     o = options if options is not None else HealthOptions()
-    grids = {n: np.asarray(downsample(c, o.agree_voxel_m).points) for n, c in clouds.items() if len(c) > 0}
-    trees = {n: cKDTree(p, balanced_tree=False, compact_nodes=False) for n, p in grids.items()}
+    names = [n for n, c in clouds.items() if len(c) > 0]
+
+    def grid(name: str) -> tuple[FloatArray, cKDTree]:
+        p = np.asarray(downsample(clouds[name], o.agree_voxel_m).points)
+        return p, cKDTree(p, balanced_tree=False, compact_nodes=False)
+
+    with ThreadPoolExecutor(max_workers=2) as pool:  # two cameras at a time: sorts and tree builds drop the GIL
+        done = dict(zip(names, pool.map(grid, names), strict=True))
+    grids = {n: p for n, (p, _) in done.items()}
+    trees = {n: tree for n, (_, tree) in done.items()}
     shortcut = o.agree_voxel_m * math.sqrt(3.0) * (1.0 + 1e-6) <= o.agree_tol_m
     keys = {n: _voxel_keys(p, o.agree_voxel_m) for n, p in grids.items()} if shortcut else {}
     out: dict[tuple[str, str], float] = {}

@@ -18,6 +18,7 @@ import pytest
 
 from cell import scenario as sc
 from cell.cli.sides import write_programs
+from cell.errors import AlignmentError, AlignmentFailure
 from cell.export.report import two_sided_report
 from cell.geometry import invert
 from cell.pipeline import Detection
@@ -34,6 +35,7 @@ from cell.seams.visibility import visibility
 from cell.station.sim import SimStation
 from cell.types import SeamStatus
 from cell.types.flip import FlipPlan
+from cell.types.run import SeamWeld, WeldReason
 
 
 @pytest.fixture(scope="module")
@@ -145,3 +147,24 @@ def test_a_large_placement_error_is_found_and_every_seam_can_be_welded(
     assert det.summary.lateral_mean_mm is not None and det.summary.lateral_mean_mm <= 0.3
     wplan, _, violations = plan_for(station, det)
     assert not violations and all(o.feasible for o in wplan.seams) and len(wplan.seams) == 4
+
+
+def test_a_refused_second_alignment_welds_nothing_of_side_b_and_the_report_says_why(both: TwoSidedRun) -> None:
+    """Side B's alignment refused (an ambiguous fit): its seams carry the refusal, side A's stand, exit 14 in the
+    report, the job not complete (the CLI exits 3)."""
+    assert both.side_b is not None
+    err = AlignmentError("the turned map fits shifted by one rung as well", code=AlignmentFailure.AMBIGUOUS)
+    why = f"not located (not_found): no seam search: {err.message}"
+    failed = replace(
+        both.side_b,
+        error=err,
+        execution=None,
+        seams=tuple(SeamWeld(w.id, False, False, why, code=WeldReason.NOT_LOCATED) for w in both.side_b.seams),
+    )
+    job = replace(both, side_b=failed, result=None)
+    rep = two_sided_report(job)
+    assert not job.complete and rep["welded"] == 12 and rep["error"]["exit_code"] == 14
+    b = [s for s in rep["seams"] if s["side"] == "B"]
+    assert len(b) == 4 and not any(s["welded"] for s in b)
+    assert all("one rung" in s["weld_reason"] for s in b)
+    assert rep["flip"]["made"] and rep["flip"]["placement_error_mm"] is None

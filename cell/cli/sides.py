@@ -44,7 +44,7 @@ def finish_two_sided(
 ) -> str | None:
     """Write the report first, then the programs; print the table and one line per side; the exit's explanation
     when the job is partial (None when complete)."""
-    from cell.export.report import two_sided_report
+    from cell.export.flip_report import two_sided_report
 
     rep = two_sided_report(run, provenance=provenance)
     writer.report(json_path, rep)

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Literal
+from dataclasses import replace
+from typing import Any, Literal
 
 import numpy as np
 
 from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
-from cell.pipeline.detect import Progress, quiet, read_weldmap, table_z_R
+from cell.pipeline.detect import Progress, Seed, quiet, read_weldmap, table_z_R
 from cell.pipeline.records import WeldRun
 from cell.pipeline.two_sided import TwoSidedRun
 from cell.pipeline.weld import weld
@@ -60,7 +61,7 @@ def plan_turn(run: WeldRun) -> FlipPlan | None:
     )
 
 
-def near_seed(weldmap_M: WeldMap, table_z: float):  # type: ignore[no-untyped-def]
+def near_seed(weldmap_M: WeldMap, table_z: float) -> Seed:
     """A :data:`cell.pipeline.detect.Seed`: the height-image search of the cloud (turns and shifts on the table,
     :func:`cell.perception.global_placement.height_candidates`) for the turned map, its candidates within
     SEARCH_TURN_RAD and SEARCH_SHIFT_M of the nominal pose, the best by the share of the cloud on the map's
@@ -136,22 +137,28 @@ def weld_part(
         plan = plan_turn(a) if sides == "all" else None
         if plan is None:
             return TwoSidedRun(a, timings={"total_s": time.perf_counter() - t_all})
-        turned = weldmap.transformed(plan.X_RM_after, "R")
         tacks = sc.flip.tacks
-        tacks_s = tacks.count * (tacks.length_mm / sc.process.travel_speed_mm_s + TACK_MOVE_S)
-        common = {"operator_s": sc.flip.operator_s, "tacks_s": tacks_s, "turned_map": turned}
+        base = TwoSidedRun(
+            a,
+            plan,
+            operator_s=sc.flip.operator_s,
+            tacks_s=tacks.count * (tacks.length_mm / sc.process.travel_speed_mm_s + TACK_MOVE_S),
+            turned_map=weldmap.transformed(plan.X_RM_after, "R"),
+        )
+
+        def done(**fields: Any) -> TwoSidedRun:
+            return replace(base, timings={"total_s": time.perf_counter() - t_all}, **fields)
+
         if not plan.go:
             progress(f"no turn: {plan.reason}")
-            return TwoSidedRun(a, plan, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
-        if not execute_plan or a.error is not None:
-            err = None if not execute_plan else a.error
-            return TwoSidedRun(a, plan, error=err, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
+            return done()
+        if not execute_plan or a.error is not None:  # a preview moves nothing; a failed side A is not turned
+            return done(error=a.error if execute_plan else None)
         try:
             b = _side_b(station, sc, method, rescan, plan, weldmap, progress)
         except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
-            return TwoSidedRun(a, plan, error=e, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
-        result = flip_result(plan, b, weldmap)
-        return TwoSidedRun(a, plan, b, result, timings={"total_s": time.perf_counter() - t_all}, **common)  # type: ignore[arg-type]
+            return done(error=e)
+        return done(side_b=b, result=flip_result(plan, b, weldmap))
 
 
 def _side_b(

@@ -19,7 +19,7 @@ import pytest
 from cell import scenario as sc
 from cell.cli.sides import write_programs
 from cell.errors import AlignmentError, AlignmentFailure
-from cell.export.report import two_sided_report
+from cell.export.flip_report import two_sided_report
 from cell.geometry import invert
 from cell.pipeline import Detection
 from cell.pipeline.detect import detect, read_weldmap, table_z_R

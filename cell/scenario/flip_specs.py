@@ -40,3 +40,4 @@ class FlipPlacementSpec(Model):
 
     offset_mm: Annotated[float, Field(ge=0.0, le=200.0)] = 0.0  # horizontal placement error after the turn
     rotation_deg: Annotated[float, Field(ge=0.0, le=30.0)] = 0.0  # turn about the vertical after the turn
+    cameras_lost: tuple[str, ...] = ()  # cameras that go dead at the turn: side B is seen without them

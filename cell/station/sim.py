@@ -13,8 +13,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from cell.errors import ScenarioError
 from cell.geometry import FloatArray
 from cell.scenario import Scenario
+from cell.scenario.run_specs import CameraFaultSpec
 from cell.station.arm import load_arm, robot_urdf
 from cell.station.ports import Arm
 from cell.types import CameraIntrinsics, DepthImage, Part, WeldMap
@@ -107,6 +109,16 @@ class SimStation:
         )
         self.parts_W = self.sim.move_part(X)
         self.X_W_turned = X
+        lost = sim.flip_placement.cameras_lost
+        if lost:  # a camera lost at the turn: from now on it delivers no valid pixel
+            unknown = sorted(set(lost) - set(self.scenario.cameras))
+            if unknown:
+                raise ScenarioError(
+                    f"simulation.flip_placement.cameras_lost names unknown camera(s) {', '.join(unknown)}; "
+                    f"cameras: {', '.join(self.scenario.cameras)}"
+                )
+            dead = dict(sim.faults.cameras) | {name: CameraFaultSpec(mode="dead") for name in lost}
+            self.sim.scenario = self.scenario.with_simulation(faults=sim.faults.model_copy(update={"cameras": dead}))
 
     def joint_state(self) -> FloatArray:
         return np.asarray(self.sim.robot.q, dtype=float)

@@ -113,10 +113,13 @@ def test_a_forbidden_turn_keeps_twelve_and_the_reason(both: TwoSidedRun) -> None
 
 @pytest.fixture(scope="module")
 def large_error() -> Iterator[tuple[FlipPlan, Detection, SimStation]]:
-    """fence1 turned with a large placement error: the plan from the nominal map, the cell turned, side B's
-    detection (only the exposed seams)."""
+    """fence1 turned with a large placement error and its left camera lost at the turn: the plan from the
+    nominal map, the cell turned, side B's detection (only the exposed seams)."""
     scn = sc.load("fence1")
-    spec = scn.simulation.flip_placement.model_copy(update={"offset_mm": 30.0, "rotation_deg": 5.0})
+    lost = ("cam_left",)  # and a camera lost at the turn: side B is seen by the others
+    spec = scn.simulation.flip_placement.model_copy(
+        update={"offset_mm": 30.0, "rotation_deg": 5.0, "cameras_lost": lost}
+    )
     # The part lies exactly at its nominal place on side A, so the whole placement error after the turn is the
     # operator's.
     scn = scn.with_simulation(flip_placement=spec, placement_error=PoseSpec())
@@ -131,11 +134,12 @@ def large_error() -> Iterator[tuple[FlipPlan, Detection, SimStation]]:
         yield plan, restricted(det, plan.exposed), station
 
 
-def test_a_large_placement_error_is_found_and_every_seam_can_be_welded(
+def test_a_large_placement_error_and_a_camera_lost_at_the_turn_still_weld_every_seam(
     large_error: tuple[FlipPlan, Detection, SimStation],
 ) -> None:
     plan, det, station = large_error
     assert det.error is None and det.scene is not None
+    assert det.lost_cameras and "cam_left" in det.lost_cameras[0]
     wm = read_weldmap(det.scenario)
     res = flip_result(plan, WeldRun(det, ()), wm)
     assert res is not None

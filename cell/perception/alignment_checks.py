@@ -78,11 +78,18 @@ def _candidates(weldmap_R: WeldMap, centre: FloatArray) -> list[tuple[FloatArray
     return out
 
 
+def cloud_tree_of(cloud: Cloud) -> cKDTree:
+    """The KD-tree both checks query a cloud's points with (unbalanced: built in half the time, and the checks
+    only ask whether anything lies within their band, which any tree of the points answers the same)."""
+    return cKDTree(np.asarray(cloud.points), balanced_tree=False, compact_nodes=False)
+
+
 def alignment_alternatives(
-    weldmap_R: WeldMap, cloud: Cloud, options: SymmetryOptions | None = None
+    weldmap_R: WeldMap, cloud: Cloud, options: SymmetryOptions | None = None, cloud_tree: cKDTree | None = None
 ) -> list[Alternative]:
     """The aligned map's near-symmetries (self-overlap at least ``min_self_overlap``), each judged by the
-    cloud on the samples that distinguish it from the chosen fit. ``weldmap_R`` is the map as aligned."""
+    cloud on the samples that distinguish it from the chosen fit. ``weldmap_R`` is the map as aligned;
+    ``cloud_tree`` : a KD-tree of the cloud's points when the caller has one (:func:`cloud_tree`)."""
     o = options if options is not None else SymmetryOptions()
     samples, _ = sample_map(weldmap_R, o.spacing_m, o.spacing_m)
     if len(samples) == 0 or len(cloud) == 0:
@@ -90,7 +97,7 @@ def alignment_alternatives(
     # Unbalanced trees build in half the time and answer "anything within the band?" the same (every query here
     # asks only that, on every core).
     map_tree = cKDTree(samples, balanced_tree=False, compact_nodes=False)
-    cloud_tree = cKDTree(np.asarray(cloud.points), balanced_tree=False, compact_nodes=False)
+    cloud_tree = cloud_tree_of(cloud) if cloud_tree is None else cloud_tree
     near_cloud = np.isfinite(cloud_tree.query(samples, distance_upper_bound=o.band_m, workers=-1)[0])
     out = []
     for T, label in _candidates(weldmap_R, samples.mean(axis=0)):
@@ -112,7 +119,11 @@ def alignment_alternatives(
 
 
 def check_alignment_unique(
-    weldmap_R: WeldMap, cloud: Cloud, alignment: Alignment, options: SymmetryOptions | None = None
+    weldmap_R: WeldMap,
+    cloud: Cloud,
+    alignment: Alignment,
+    options: SymmetryOptions | None = None,
+    cloud_tree: cKDTree | None = None,
 ) -> list[Alternative]:
     """Refuse a map fit that a near-symmetry of the map explains about as well (AlignmentError naming it).
 
@@ -123,7 +134,7 @@ def check_alignment_unique(
     either way) is not refused: every seam lands on an identical joint. Returns the alternatives examined.
     """
     o = options if options is not None else SymmetryOptions()
-    alts = alignment_alternatives(weldmap_R, cloud, o)
+    alts = alignment_alternatives(weldmap_R, cloud, o, cloud_tree)
     for alt in alts:
         if alt.n_distinct < o.min_distinct:
             continue
@@ -141,13 +152,15 @@ def check_alignment_unique(
     return alts
 
 
-def part_coverage(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, band_m: float = 0.01) -> dict[str, float]:
+def part_coverage(
+    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, band_m: float = 0.01, cloud_tree: cKDTree | None = None
+) -> dict[str, float]:
     """Part name -> share of its upward faces' samples (top, in R) with a cloud point within ``band_m`` [m].
 
     Upward faces are seen by every camera above the table; a part that is on the table covers most of its top.
     """
     spacing = max(spec.voxel_m / 2.0, 0.002)
-    tree = cKDTree(np.asarray(cloud.points), balanced_tree=False, compact_nodes=False) if len(cloud) else None
+    tree = None if not len(cloud) else cloud_tree_of(cloud) if cloud_tree is None else cloud_tree
     out = {}
     for part in weldmap_R.parts:
         one = WeldMap((part,), (), weldmap_R.units, weldmap_R.source, weldmap_R.frame)
@@ -177,7 +190,11 @@ def missing_parts(coverage: Mapping[str, float], min_coverage: float = 0.1, min_
 
 
 def check_parts_seen(
-    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, options: CoverageOptions | None = None
+    weldmap_R: WeldMap,
+    cloud: Cloud,
+    spec: PerceptionSpec,
+    options: CoverageOptions | None = None,
+    cloud_tree: cKDTree | None = None,
 ) -> dict[str, str]:
     """After alignment: refuse a map that does not lie where the cloud is; name the parts that are missing.
 
@@ -190,7 +207,7 @@ def check_parts_seen(
     """
     o = options if options is not None else CoverageOptions()
     min_coverage, min_seen = o.min_coverage, o.min_seen
-    coverage = part_coverage(weldmap_R, cloud, spec)
+    coverage = part_coverage(weldmap_R, cloud, spec, cloud_tree=cloud_tree)
     partial = {n: c for n, c in coverage.items() if min_coverage <= c < min_seen}
     missing = missing_parts(coverage, min_coverage)
     if partial or len(missing) > len(coverage) / 2 or not coverage:
@@ -209,12 +226,13 @@ def check_parts_seen(
 def check_alignment(weldmap_R: WeldMap, cloud: Cloud, alignment: Alignment, spec: PerceptionSpec) -> dict[str, str]:
     """Both checks of an aligned map, :func:`check_alignment_unique` and :func:`check_parts_seen` (with the spec's
     ``symmetry`` and ``coverage`` options), side by side on two cores (scipy's KD-trees let go of the interpreter
-    lock); what they answer and raise is what they would one after the other: the uniqueness check's refusal
-    first. Returns the missing parts (name -> reason)."""
+    lock), reading one KD-tree of the cloud; what they answer and raise is what they would one after the other: the
+    uniqueness check's refusal first. Returns the missing parts (name -> reason)."""
+    tree = cloud_tree_of(cloud) if len(cloud) else None
     with ThreadPoolExecutor(max_workers=1) as beside:
-        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage)
+        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage, tree)
         try:
-            check_alignment_unique(weldmap_R, cloud, alignment, spec.symmetry)
+            check_alignment_unique(weldmap_R, cloud, alignment, spec.symmetry, tree)
         except AlignmentError:
             seen.cancel()
             raise

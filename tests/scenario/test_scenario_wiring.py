@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import asdict, replace
 
+import pytest
+
+from cell import pipeline
 from cell import scenario as sc
 from cell.config import OursSettings
 
@@ -38,15 +42,27 @@ def test_a_scenario_option_reaches_its_stage_and_the_report_records_it() -> None
     assert sc.from_dict(config, sc.SCENARIO_DIR) == det.scenario  # the record loads back as what ran
 
 
-def test_a_gate_option_reaches_the_safety_gate() -> None:
+def test_a_gate_option_reaches_the_safety_gate(
+    monkeypatch: pytest.MonkeyPatch, fence1_detection: pipeline.Detection
+) -> None:
     """Through pipeline.weld (a preview): a manipulability bar no arm clears makes the gate, built from its defaults
-    before the scenario held it, refuse the plan for singularities."""
-    from cell import pipeline
+    before the scenario held it, refuse the plan for singularities. The gate's option changes nothing before the
+    plan: the session's detection of fence1 stands in for the weld's own (handed on with the scenario it was given)."""
     from cell.errors import PlanError
     from cell.export.report import weld_report
     from cell.motion.gate import ViolationKind
 
-    run = pipeline.weld(load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}")), execute_plan=False)
+    scn = load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}"))
+    asked: list[sc.Scenario] = []
+
+    def detect(scenario: sc.Scenario, method: str | None = None, **_: object) -> pipeline.Detection:
+        asked.append(scenario)
+        return replace(fence1_detection, scenario=scenario)
+
+    monkeypatch.setattr(importlib.import_module("cell.pipeline.weld"), "detect", detect)
+    assert scn.model_copy(update={"motion": fence1_detection.scenario.motion}) == fence1_detection.scenario
+    run = pipeline.weld(scn, execute_plan=False)
+    assert asked == [scn]
     assert isinstance(run.error, PlanError) and run.violations
     assert {v.split()[0] for v in run.violations} == {ViolationKind.SINGULARITY.value}
     assert weld_report(run)["config"]["motion"]["gate"]["min_manipulability"] == 1.0

@@ -114,7 +114,8 @@ def weld_seams(run: WeldRun, sc: Scenario, stage: Stage) -> dict[str, dict[str, 
             rec["welded"] = bool(w.welded)
             rec["weld_rms_mm"] = _mm(w.quality.tcp_rms_mm) if w.quality is not None else None
         rec["code"] = code
-        if w.reason and code != "preview" and w.reason not in rec["reasons"]:  # a preview's words say nothing
+        # a preview's words say nothing, and "not located: <the estimate's reason>" says it twice
+        if w.reason and code != "preview" and not any(r in w.reason for r in rec["reasons"]):
             rec["reasons"] = [*rec["reasons"], w.reason]
     return out
 

@@ -27,26 +27,6 @@ if str(HERE) not in sys.path:  # the helper modules (dxf_factory, fakes, pinhole
 from scenes import Noise, Perceived  # noqa: E402  (after the path set-up above)
 from shared_runs import Preview, half_resolution  # noqa: E402
 
-# Test files that share a session run besides fence1's weld, kept on one worker when the suite runs on several
-# (pytest-xdist ``--dist loadgroup``): each run is then built once. Every other file is a group of its own, as
-# ``--dist loadfile`` would keep it, so a module's fixture is built once too.
-SHARED_RUNS = {
-    "test_weld.py": "fence1_preview",
-    "test_fence1_page.py": "fence1_preview",
-    "test_faults.py": "detected",
-    "test_cli_reports.py": "detected",
-    "test_closeup.py": "detected",
-    "test_splice_refusals.py": "detected",
-}
-
-
-@pytest.hookimpl(tryfirst=True)  # before xdist's own hook reads the groups (this conftest is registered first)
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Each test's ``xdist_group``: its file's shared run (``SHARED_RUNS``), else its file."""
-    for item in items:
-        group = SHARED_RUNS.get(item.path.name, str(item.path.relative_to(HERE)))
-        item.add_marker(pytest.mark.xdist_group(group))
-
 
 @pytest.fixture(scope="session")
 def fence1_run() -> pipeline.WeldRun:

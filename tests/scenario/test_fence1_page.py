@@ -1,13 +1,15 @@
 """The page of fence1 (``cell weld fence1 --html``, ``cell preview fence1``): a DOM check of the figures it embeds.
 
 The session's weld of fence1 (``fence1_run``) stands in for the pipeline's run, so no second weld is needed, and
-``cell preview``'s page is the session's preview (``fence1_preview``, the one test_weld.py checks): the page shows
-the robot (its URDF links, moved along the plan by a slider), the table, the cameras' frusta, the results table
-with one row per seam, and the joint plots with every weld's arc-on band labelled by its seam.
+``cell preview``'s page is the session's preview (``fence1_preview``, whose pictures and report are checked here
+too, in one file so that one worker builds it): the page shows the robot (its URDF links, moved along the plan by
+a slider), the table, the cameras' frusta, the results table with one row per seam, and the joint plots with every
+weld's arc-on band labelled by its seam.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -66,6 +68,19 @@ def test_weld_html_page(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_
     result = CliRunner().invoke(app, ["weld", "fence1", "--sides", "first", "--html", str(page)])
     assert result.exit_code == 0, result.stderr
     check_page(page, fence1_run)
+
+
+def test_preview_draws_and_moves_nothing(fence1_preview: Preview) -> None:
+    """``cell preview fence1``, run once per session (``fence1_preview``, whose page the next test checks)."""
+    result, out = fence1_preview, fence1_preview.folder
+    assert result.exit_code == 0, result.stderr
+    for name in ("overview_top.png", "overview_3d.png", "overview_seams.png", "joints.png"):
+        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "plotly" in (out / "cell.html").read_text()[:200000]
+    data = json.loads((out / "report.json").read_text())
+    assert data["cycle_time_s"] == 0 and data["events"] == []
+    assert all(not s["welded"] for s in data["seams"])
+    assert sum(s["planned"] for s in data["seams"]) == 12
 
 
 def test_preview_page(fence1_preview: Preview) -> None:

@@ -1,4 +1,5 @@
-"""Collision checking with coal (through Pinocchio's GeometryModel): the only module that imports coal.
+"""Collision checking with coal (through Pinocchio's GeometryModel): the checker (this module) and the torch's
+shapes and the obstacle boxes for the torch test (:mod:`cell.motion.collision.shapes`) are the only coal importers.
 
 What is checked, all in the robot base frame R [m]:
 
@@ -33,7 +34,8 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
-from cell.motion.contact import Contact, advance_along, sphere_box_distance
+from cell.motion.collision.shapes import Boxes, ToolShapes, torch_contacts
+from cell.motion.contact import Contact, advance_along
 from cell.motion.robot import RobotModel
 from cell.types import Part
 from cell.types.track import LinearTrack
@@ -93,8 +95,8 @@ class CollisionChecker:
         self._radius = self._joint_radii()
         self._tool_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == self._model.njoints - 1]
         self._obstacle_ids = list(range(self._n_robot, len(objs)))
-        self._tool = _ToolShapes.build(self, self._tool_shapes)
-        self._boxes = _Boxes.build(geom, self._obstacle_ids)
+        self._tool = ToolShapes.build(self._model, self._data, self._geom, self._tcp_frame, self._tool_shapes)
+        self._boxes = Boxes.build(geom, self._obstacle_ids)
         # The broad phase of a check: every robot shape's bounding sphere (centre in its own frame, radius), and
         # per pair its two shapes; a pair whose spheres (or sphere and box) are farther apart than what could
         # change the answer gets that lower bound instead of a distance query.
@@ -312,80 +314,14 @@ class CollisionChecker:
     def torch_clear_many(self, X_RT: npt.ArrayLike, q_ref: npt.ArrayLike, first: bool = False) -> list[Contact | None]:
         """:meth:`torch_clear` of every TCP pose X_RT (m, 4, 4), the broad phase of all of them in one query.
         first : a pose's first contact found instead of its deepest (enough to know that it collides)."""
-        X_RT = np.asarray(X_RT, dtype=float).reshape(-1, 4, 4)
-        tool, boxes = self._tool, self._boxes
-        X_RG = X_RT[:, None] @ tool.X_TG[None]  # (m, shapes, 4, 4)
-        c_R = np.einsum("msij,sj->msi", X_RG[..., :3, :3], tool.centre_G) + X_RG[..., :3, 3]
-        m, n_s = X_RG.shape[:2]
-        lower = boxes.sphere_distance(c_R.reshape(-1, 3), np.tile(tool.radius, m)).reshape(m, n_s, -1)
-        req = coal.DistanceRequest()
-        q = readonly(np.asarray(q_ref, dtype=float))
-        best: list[Contact | None] = [None] * m
-        for p, a, k in zip(*np.nonzero(lower <= self.options.min_clearance), strict=True):
-            if first and best[p] is not None:
-                continue
-            i, j = self._tool_shapes[a], self._obstacle_ids[k]
-            Tg = coal.Transform3s(X_RG[p, a, :3, :3], X_RG[p, a, :3, 3])
-            res = coal.DistanceResult()
-            dist = coal.distance(tool.shapes[a], Tg, boxes.shapes[k], boxes.T[k], req, res)
-            b = best[p]
-            if dist <= self.options.min_clearance and (b is None or dist < b.depth):
-                pt = readonly(np.array(res.getNearestPoint1()))
-                best[p] = Contact(self.link_of[i], self.link_of[j], float(dist), pt, q)
-        return best
-
-
-@dataclass(frozen=True)
-class _ToolShapes:
-    """The tool-side collision shapes: their poses X_TG (m, 4, 4) in the TCP frame, bounding spheres (centre in
-    G (m, 3), radius (m,)) [m], and the coal shapes."""
-
-    X_TG: FloatArray
-    centre_G: FloatArray
-    radius: FloatArray
-    shapes: tuple[object, ...]
-
-    @staticmethod
-    def build(checker: CollisionChecker, ids: Sequence[int]) -> _ToolShapes:
-        m, data, geom = checker._model, checker._data, checker._geom
-        gdata = pin.GeometryData(geom)
-        q = pin.neutral(m)
-        pin.forwardKinematics(m, data, q)
-        pin.updateFramePlacements(m, data)
-        pin.updateGeometryPlacements(m, data, geom, gdata)
-        X_TR = invert(np.array(data.oMf[checker._tcp_frame].homogeneous))
-        X, cen, rad, shapes = [], [], [], []
-        for i in ids:
-            g = geom.geometryObjects[i].geometry
-            g.computeLocalAABB()
-            lo, hi = np.array(g.aabb_local.min_), np.array(g.aabb_local.max_)
-            X.append(X_TR @ np.array(gdata.oMg[i].homogeneous))
-            cen.append((lo + hi) / 2.0)
-            rad.append(float(np.linalg.norm(hi - lo)) / 2.0)
-            shapes.append(g)
-        return _ToolShapes(np.array(X).reshape(-1, 4, 4), np.array(cen).reshape(-1, 3), np.array(rad), tuple(shapes))
-
-
-@dataclass(frozen=True)
-class _Boxes:
-    """The obstacle boxes as placed in R: rotation R_RB (k, 3, 3), centre (k, 3), half sizes (k, 3) [m] (grown),
-    their coal shapes and transforms."""
-
-    R_RB: FloatArray
-    centre: FloatArray
-    half: FloatArray
-    shapes: tuple[object, ...]
-    T: tuple[object, ...]
-
-    @staticmethod
-    def build(geom: pin.GeometryModel, ids: Sequence[int]) -> _Boxes:
-        objs = [geom.geometryObjects[k] for k in ids]
-        R = np.array([np.array(o.placement.rotation) for o in objs]).reshape(-1, 3, 3)
-        c = np.array([np.array(o.placement.translation) for o in objs]).reshape(-1, 3)
-        half = np.array([np.array(o.geometry.halfSide) for o in objs]).reshape(-1, 3)
-        T = tuple(coal.Transform3s(R[k], c[k]) for k in range(len(objs)))
-        return _Boxes(R, c, half, tuple(o.geometry for o in objs), T)
-
-    def sphere_distance(self, c_R: FloatArray, radius: FloatArray) -> FloatArray:
-        """(m, k) [m]: :func:`cell.motion.contact.sphere_box_distance` to each of these boxes."""
-        return sphere_box_distance(self.R_RB, self.centre, self.half, c_R, radius)
+        return torch_contacts(
+            self._tool,
+            self._boxes,
+            self._tool_shapes,
+            self._obstacle_ids,
+            self.link_of,
+            self.options.min_clearance,
+            X_RT,
+            q_ref,
+            first,
+        )

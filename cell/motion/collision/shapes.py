@@ -1,0 +1,108 @@
+"""The torch test's geometry: the tool-side collision shapes placed from the TCP, the obstacle boxes as placed in
+R, and the contacts of many TCP poses against them in one broad-phase query (no IK: the poses are in R, so
+wherever a linear track puts the base). Part of the coal adapter with :mod:`cell.motion.collision.checker`."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from cell.geometry import FloatArray, invert, readonly
+from cell.motion.contact import Contact, sphere_box_distance
+
+
+@dataclass(frozen=True)
+class ToolShapes:
+    """The tool-side collision shapes: their poses X_TG (m, 4, 4) in the TCP frame, bounding spheres (centre in
+    G (m, 3), radius (m,)) [m], and the coal shapes."""
+
+    X_TG: FloatArray
+    centre_G: FloatArray
+    radius: FloatArray
+    shapes: tuple[object, ...]
+
+    @staticmethod
+    def build(m: pin.Model, data: pin.Data, geom: pin.GeometryModel, tcp_frame: int, ids: Sequence[int]) -> ToolShapes:
+        """The shapes ``ids`` of ``geom`` (those rigid with the flange), placed at the neutral configuration."""
+        gdata = pin.GeometryData(geom)
+        q = pin.neutral(m)
+        pin.forwardKinematics(m, data, q)
+        pin.updateFramePlacements(m, data)
+        pin.updateGeometryPlacements(m, data, geom, gdata)
+        X_TR = invert(np.array(data.oMf[tcp_frame].homogeneous))
+        X, cen, rad, shapes = [], [], [], []
+        for i in ids:
+            g = geom.geometryObjects[i].geometry
+            g.computeLocalAABB()
+            lo, hi = np.array(g.aabb_local.min_), np.array(g.aabb_local.max_)
+            X.append(X_TR @ np.array(gdata.oMg[i].homogeneous))
+            cen.append((lo + hi) / 2.0)
+            rad.append(float(np.linalg.norm(hi - lo)) / 2.0)
+            shapes.append(g)
+        return ToolShapes(np.array(X).reshape(-1, 4, 4), np.array(cen).reshape(-1, 3), np.array(rad), tuple(shapes))
+
+
+@dataclass(frozen=True)
+class Boxes:
+    """The obstacle boxes as placed in R: rotation R_RB (k, 3, 3), centre (k, 3), half sizes (k, 3) [m] (grown),
+    their coal shapes and transforms."""
+
+    R_RB: FloatArray
+    centre: FloatArray
+    half: FloatArray
+    shapes: tuple[object, ...]
+    T: tuple[object, ...]
+
+    @staticmethod
+    def build(geom: pin.GeometryModel, ids: Sequence[int]) -> Boxes:
+        objs = [geom.geometryObjects[k] for k in ids]
+        R = np.array([np.array(o.placement.rotation) for o in objs]).reshape(-1, 3, 3)
+        c = np.array([np.array(o.placement.translation) for o in objs]).reshape(-1, 3)
+        half = np.array([np.array(o.geometry.halfSide) for o in objs]).reshape(-1, 3)
+        T = tuple(coal.Transform3s(R[k], c[k]) for k in range(len(objs)))
+        return Boxes(R, c, half, tuple(o.geometry for o in objs), T)
+
+    def sphere_distance(self, c_R: FloatArray, radius: FloatArray) -> FloatArray:
+        """(m, k) [m]: :func:`cell.motion.contact.sphere_box_distance` to each of these boxes."""
+        return sphere_box_distance(self.R_RB, self.centre, self.half, c_R, radius)
+
+
+def torch_contacts(
+    tool: ToolShapes,
+    boxes: Boxes,
+    tool_ids: Sequence[int],
+    obstacle_ids: Sequence[int],
+    link_of: Sequence[str],
+    min_clearance: float,
+    X_RT: npt.ArrayLike,
+    q_ref: npt.ArrayLike,
+    first: bool = False,
+) -> list[Contact | None]:
+    """The deepest contact (or with ``first`` the first found) of the tool's shapes against the boxes for every
+    TCP pose X_RT (m, 4, 4) [m], None where a pose is clear by ``min_clearance``. tool_ids / obstacle_ids: the
+    shapes' and boxes' indices in the checker's geometry model, link_of its names by index (for the contact)."""
+    X_RT = np.asarray(X_RT, dtype=float).reshape(-1, 4, 4)
+    X_RG = X_RT[:, None] @ tool.X_TG[None]  # (m, shapes, 4, 4)
+    c_R = np.einsum("msij,sj->msi", X_RG[..., :3, :3], tool.centre_G) + X_RG[..., :3, 3]
+    m, n_s = X_RG.shape[:2]
+    lower = boxes.sphere_distance(c_R.reshape(-1, 3), np.tile(tool.radius, m)).reshape(m, n_s, -1)
+    req = coal.DistanceRequest()
+    q = readonly(np.asarray(q_ref, dtype=float))
+    best: list[Contact | None] = [None] * m
+    for p, a, k in zip(*np.nonzero(lower <= min_clearance), strict=True):
+        if first and best[p] is not None:
+            continue
+        i, j = tool_ids[a], obstacle_ids[k]
+        Tg = coal.Transform3s(X_RG[p, a, :3, :3], X_RG[p, a, :3, 3])
+        res = coal.DistanceResult()
+        dist = coal.distance(tool.shapes[a], Tg, boxes.shapes[k], boxes.T[k], req, res)
+        b = best[p]
+        if dist <= min_clearance and (b is None or dist < b.depth):
+            pt = readonly(np.array(res.getNearestPoint1()))
+            best[p] = Contact(link_of[i], link_of[j], float(dist), pt, q)
+    return best

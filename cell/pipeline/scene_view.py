@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from cell.errors import ScenarioError
-from cell.geometry import invert, make_pose, pose_from_xyz_rpy
+from cell.geometry import FloatArray, invert, make_pose, pose_from_xyz_rpy
 from cell.scenario import Scenario
 from cell.station.ports import Arm
 from cell.types import Box, CameraIntrinsics, WeldPlan
@@ -93,8 +93,19 @@ def robot_poses(arm: Arm, links: tuple[str, ...], plan: WeldPlan | None, n: int 
             seg = next((s for s in plan.segments if s.t0 - 1e-9 <= t <= s.t1 + 1e-9), plan.segments[-1])
         what = f"weld {seg.seam_id}" if seg.arc_on else f"{seg.kind} {seg.seam_id}".strip()
         q, _, _ = plan.sample(float(t))
-        poses.append(RobotPose(f"{t:.1f} s · {what}", arm.model.fk_frames(q, links), float(t)))
+        frames = arm.model.fk_frames(q, links)
+        if plan.track is not None:  # the base where the carriage has it (docs/track.md): every link moves with it
+            d_R = plan.track.offset_R(float(seg.trajectory.e1_at(float(t) - seg.t0)))
+            frames = {k: _shifted(X, d_R) for k, X in frames.items()}
+        poses.append(RobotPose(f"{t:.1f} s · {what}", frames, float(t)))
     return tuple(poses)
+
+
+def _shifted(X_RL: FloatArray, d_R: FloatArray) -> FloatArray:
+    """X_RL (4, 4) moved by d_R (3,) [m] in R."""
+    X = np.array(X_RL, dtype=float)
+    X[:3, 3] += d_R
+    return X
 
 
 def cameras_R(scenario: Scenario) -> tuple[CameraView, ...]:

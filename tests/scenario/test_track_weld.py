@@ -71,3 +71,22 @@ def test_the_program_carries_the_track(run: pipeline.WeldRun) -> None:
     assert "Linear track E1" in src and "software limits -200.0 .. 1000.0 mm" in src
     e1 = {round(s.e1_end * 1000.0, 3) for s in plan.segments if s.arc_on}
     assert any(f"E1 {v:.3f}" in dat for v in e1 if v)
+
+
+def test_the_pictures_draw_the_arm_where_the_carriage_has_it(run: pipeline.WeldRun) -> None:
+    """The preview's robot poses follow the track: during a weld planned from E1 > 0.3 m every link stands that far
+    along the axis from where the arm's own kinematics would put it at the same joints."""
+    plan, view, arm = run.plan, run.view, run.arm
+    assert plan is not None and plan.track is not None and view is not None and arm is not None
+    far = [s for s in plan.segments if s.arc_on and s.e1_end > 0.3]
+    assert far
+    seg = far[0]
+    t = (seg.t0 + seg.t1) / 2.0
+    pose = min(view.poses[1:], key=lambda p: abs(p.t_s - t))
+    assert seg.t0 <= pose.t_s <= seg.t1
+    q, _, _ = plan.sample(pose.t_s)
+    links = tuple(pose.X_RL)
+    X0 = arm.model.fk_frames(q, links)
+    d_R = plan.track.offset_R(seg.e1_end)
+    for link in links:
+        np.testing.assert_allclose(np.asarray(pose.X_RL[link])[:3, 3] - X0[link][:3, 3], d_R, atol=1e-9)

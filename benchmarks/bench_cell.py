@@ -5,10 +5,12 @@
         [--json PATH]
     .venv/bin/python benchmarks/bench_cell.py faults [--scenarios faults/NAME,...] [--json PATH]
 
-``weld`` runs what ``cell weld SCENARIO`` runs (:func:`cell.pipeline.weld`, its report
-:func:`cell.export.report.weld_report`) and keeps per seam the located error, welded or why not, the executed
-TCP against the true seam, the travel speed and the weld time; per run the cycle, arc and re-scan robot times and
-the wall time of each stage (default ``benchmarks/results/weld.json``). ``rescan`` runs what
+``weld`` runs what ``cell weld SCENARIO`` runs, the whole part (:func:`cell.pipeline.sides.weld_part`: side A, the
+turn, side B; its report :func:`cell.export.flip_report.two_sided_report`) and keeps per seam its side, the located
+error, welded or why not, the executed TCP against the true seam, the travel speed and the weld time; per run the
+cycle, arc and re-scan robot times, the job time, the turn and what side B's alignment measured, and the wall time
+of each stage (default ``benchmarks/results/weld.json``). ``faults`` welds side A only (``cell weld --sides first``):
+a fault's table is about what the fault does to the part as it lies. ``rescan`` runs what
 ``cell rescan SCENARIO --all`` runs (detect, :func:`cell.pipeline.rescan_detection` on every visible seam, its report
 :func:`cell.export.report.rescan_report`): the mean lateral and end point error before and after, the robot time
 (``rescan.json``). ``faults`` runs ``cell weld`` on every scenario of ``scenarios/faults/`` and keeps what the
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
@@ -74,13 +77,41 @@ def _seam_row(s: Row) -> Row:
 
 
 def weld_row(name: str) -> Row:
-    """``cell weld NAME``: the run's figures from its report (see the module docstring)."""
-    _say(f"cell weld {name}")
+    """``cell weld NAME --sides first``: the run's figures from its report (see the module docstring)."""
+    _say(f"cell weld {name} --sides first")
     try:
         run = pipeline.weld(sc.load(name))
     except CellError as e:  # the CLI prints the message and exits with the error's code; no report
         return {"scenario": name, "exit_code": e.exit_code, "error": {"type": type(e).__name__, "message": e.message}}
     return report_row(weld_report(run), exit_code(run))
+
+
+def part_row(name: str) -> Row:
+    """``cell weld NAME`` (both sides): the whole part's figures from its report, with the turn's."""
+    from cell.export.flip_report import two_sided_report
+    from cell.pipeline.sides import weld_part
+
+    _say(f"cell weld {name}")
+    t = time.perf_counter()
+    try:
+        run = weld_part(sc.load(name))
+    except CellError as e:
+        return {"scenario": name, "exit_code": e.exit_code, "error": {"type": type(e).__name__, "message": e.message}}
+    wall_s = time.perf_counter() - t
+    rep = two_sided_report(run)
+    row = report_row(rep, EXIT_OK if run.complete else EXIT_PARTIAL)
+    for seam, entry in zip(row["seams"], rep["seams"], strict=True):
+        seam["side"] = entry.get("side", "A")
+    flip = rep.get("flip") or {}
+    keep = ("axis", "rotation_deg", "tilt_deg", "placement_error_mm", "placement_rotation_deg", "fitness", "operator_s")
+    row["flip"] = {k: flip.get(k) for k in keep} if flip else None
+    row["job_time_s"] = rep.get("job_time_s")
+    row["sides"] = {
+        k: {"welded": v["welded"], "seams": v["seams"], "cycle_time_s": v["cycle_time_s"], "timings_s": v["timings_s"]}
+        for k, v in rep.get("sides", {}).items()
+    }
+    row["wall_s"] = wall_s
+    return row
 
 
 def report_row(rep: Row, code: int) -> Row:
@@ -152,7 +183,7 @@ def rescan_report_row(rep: Row) -> Row:
 
 
 PARTS: dict[str, tuple[Callable[[str], Row], Callable[[], list[str]], str]] = {
-    "weld": (weld_row, lambda: ["fence1"], "weld.json"),
+    "weld": (part_row, lambda: ["fence1"], "weld.json"),
     "rescan": (rescan_row, lambda: list(RESCAN_SCENARIOS), "rescan.json"),
     "faults": (fault_row, fault_scenarios, "faults.json"),
 }

@@ -127,22 +127,49 @@ def _cycle_line(r: Row) -> str:
 
 
 def weld_table(r: Row) -> str:
-    """One line per seam of a ``cell weld`` run, then its cycle-time line."""
+    """One line per seam of a ``cell weld`` run (with its side when the part was turned), then its cycle-time
+    line (and the turn's)."""
+    two = "sides" in r
+    side_h, side_c = ("side | ", "---|") if two else ("", "")
     lines = [
-        "| seam | located: paper ME / lateral [mm] | welded | executed TCP vs true seam: RMS / max [mm] | "
+        f"| {side_h}seam | located: paper ME / lateral [mm] | welded | executed TCP vs true seam: RMS / max [mm] | "
         "travel speed [mm/s] | weld time [s] |",
-        "|---|---|---|---|---|---|",
+        f"|{side_c}---|---|---|---|---|---|",
     ]
-    for s in r["seams"]:
+    for s in sorted(r["seams"], key=lambda s: s.get("side", "A")) if two else r["seams"]:
+        side = f"{s.get('side', 'A')} | " if two else ""
         located = f"{_f(s['paper_me_mm'], 3)} / {_f(s['lateral_mm'], 3)}" if s["paper_me_mm"] is not None else "-"
         if s["welded"]:
             lines.append(
-                f"| {s['id']} | {located} | yes | {_f(s['tcp_rms_mm'], 3)} / {_f(s['tcp_max_mm'], 3)} | "
+                f"| {side}{s['id']} | {located} | yes | {_f(s['tcp_rms_mm'], 3)} / {_f(s['tcp_max_mm'], 3)} | "
                 f"{_f(s['travel_speed_mm_s'], 4)} | {_f(s['weld_time_s'], 3)} |"
             )
         else:
-            lines.append(f"| {s['id']} | {located} | no: {_why_not(s)} | - | - | - |")
-    return "\n".join(lines) + "\n\n" + _cycle_line(r) + "\n"
+            lines.append(f"| {side}{s['id']} | {located} | no: {_why_not(s)} | - | - | - |")
+    if not two:
+        return "\n".join(lines) + "\n\n" + _cycle_line(r) + "\n"
+    side_a = {**r, "cycle_time_s": r["sides"]["A"]["cycle_time_s"]}
+    text = "\n".join(lines) + "\n\nSide A: " + _cycle_line(side_a) + " " + _turn_line(r)
+    return text + "\n"
+
+
+def _turn_line(r: Row) -> str:
+    """The turn and side B of a two-sided ``cell weld`` row: welded per side, the turn, what side B's alignment
+    measured, side B's robot and wall time, the job time."""
+    sides, flip = r["sides"], r.get("flip")
+    a = sides.get("A", {})
+    if not flip or "B" not in sides:
+        return f"Side A welded {a.get('welded')}; no turn."
+    b = sides["B"]
+    tb = b.get("timings_s", {})
+    return (
+        f"Side A welded {a['welded']} seams; the part turned {_f(flip['rotation_deg'], 0)} deg about its "
+        f"{flip['axis']} axis (lean {_f(flip['tilt_deg'], 1)} deg); side B's alignment measured the operator's "
+        f"placement error at {_f(flip['placement_error_mm'], 1)} mm / {_f(flip['placement_rotation_deg'], 2)} deg "
+        f"(fitness {_f(flip['fitness'], 2)}); side B welded {b['welded']} seams in {_f(b['cycle_time_s'], 1)} s of "
+        f"robot motion (pipeline {_f(tb.get('total_s'), 1)} s). Job time {_f(r['job_time_s'], 1)} s with the "
+        f"operator's {_f(flip['operator_s'], 0)} s turn; the whole command's wall time {_f(r['wall_s'], 1)} s."
+    )
 
 
 def _time(us: float) -> str:

@@ -62,6 +62,9 @@ class PlanOptions:
     line_accel: float = 2.0  # [m/s^2] approach/depart
     line_jerk: float = 20.0  # [m/s^3]
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
+    # A seam ending on the table where the torch meets the table is welded from at most this far above it [m]
+    # (never more than a third of the seam); 0: such a seam is refused.
+    table_stand_off_max: float = 0.015
     # The hose package's A6 window: A6 stays within a6_window of a6_center (cable travel of the dress pack wound
     # round the wrist); each seam's free spin and wrist are chosen to keep it there. inf: no limit.
     a6_window: float = math.radians(185.0)  # [rad] either side of the centre

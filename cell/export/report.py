@@ -196,6 +196,7 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
                 "spin_deg": _r(math.degrees(o.spin), 2),
                 "reversed": o.reversed,
             }
+            entry["trimmed_mm"] = _r(o.trimmed * 1000.0, 2)  # not welded at the table end (the stand-off)
         elif o is not None:
             entry["plan_reason_code"] = o.code.value if o.code is not None else None
             if o.p_fail.size == 3:

@@ -10,7 +10,9 @@ Per seam (:func:`plan_welds`):
    weld start, then along the seam, the approach and the depart; singularity and collision checks. The first
    candidate that passes is kept; otherwise the seam is reported with the reason that got furthest, e.g.
    ``unreachable: IK did not converge at 35.0 mm along the seam``, and its code
-   (:class:`~cell.types.plan.PlanReason`).
+   (:class:`~cell.types.plan.PlanReason`). A seam that ends on the table and is refused because the torch meets
+   the table there for every candidate is searched again shortened at that end by the least stand-off that
+   clears the table (:mod:`cell.motion.stand_off`, at most ``table_stand_off_max``); its outcome's ``trimmed``.
 3. Timing (:mod:`cell.motion.lines`, :mod:`cell.motion.assembly`): approach, weld and depart are straight TCP
    lines (KRL LIN): a one-axis Ruckig profile of the path length s(t) mapped through a C2 spline of the IK knots
    q(s); the weld runs at exactly the travel speed between its rest-to-rest ramps. Transfers between seams and
@@ -52,6 +54,7 @@ from cell.motion.reach import ReachModel
 from cell.motion.robot import RobotModel
 from cell.motion.scan import scan_configuration
 from cell.motion.scene import cell_obstacles
+from cell.motion.stand_off import blocked_by_table, stand_off, table_top
 from cell.motion.tasks import seam_tasks
 from cell.motion.torch import WeldProcess
 from cell.motion.transfers import Piece, TransferFail, Transfers
@@ -100,6 +103,8 @@ def plan_welds(
     solved: dict[str, tuple[SeamSolution, ...]] = {}  # per pass
     searches: dict[str, SeamSearch] = {}
     reach = reach_model(robot)
+    table_z = table_top(obstacles, opt.collision.table_name)
+    trims: dict[str, float] = {}  # seam id -> the stand-off [m] it is welded from at its table end
     for n_done, task in enumerate(tasks, 1):
         if on_seam is not None and n_done > 1:
             on_seam(n_done - 1, len(tasks))
@@ -109,6 +114,10 @@ def plan_welds(
             continue
         search = searches[task.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
         found = search.plan_seam(sel.oriented(task) if sel else task, q0)
+        if isinstance(found, SeamFailure) and table_z is not None:
+            short = _table_stand_off(search, task, found, table_z, opt, sel, q0)
+            if short is not None:
+                found, trims[task.id] = short
         res = found if isinstance(found, SeamFailure) or sel is None else solve_passes(search, found, sel.procedure)
         if isinstance(res, SeamFailure):
             outcomes[task.id] = _failed(task.id, res.code, res.where, res.p_R)
@@ -165,6 +174,7 @@ def plan_welds(
             c.spin,
             pr.work_angle + c.work_offset,
             pr.travel_angle + c.travel_offset,
+            trimmed=trims.get(sid, 0.0),
         )
     return WeldPlan(
         joint_names=robot.joint_names,
@@ -185,6 +195,7 @@ def unplaceable(
     *,
     options: PlanOptions | None = None,
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
+    table_z: float | None = None,
 ) -> dict[str, str]:
     """Seam id -> the reason :func:`plan_welds` would give, for the seams no torch can be placed on (out of
     reach, or the torch against a part or the table at a weld end for every candidate): found without IK, the
@@ -198,6 +209,10 @@ def unplaceable(
             continue
         search = SeamSearch(robot, seam_process(process, sel), checker, opt, np.random.default_rng(0), reach)
         fail = search.placeable(sel.oriented(task) if sel else task, q0)
+        if fail is not None and table_z is not None and blocked_by_table(fail, opt.collision.table_name):
+            orient = sel.oriented if sel else _as_is
+            if stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0) is not None:
+                fail = None  # placed from the table stand-off, as plan_welds would
         if fail is not None:
             out[task.id] = fail.reason()
     return out
@@ -233,6 +248,32 @@ def seam_process(process: WeldProcess, sel: SeamProcedure | None) -> WeldProcess
         travel_angle_tol=tol,
         reversible=not sel.fixed_direction,
     )
+
+
+def _table_stand_off(
+    search: SeamSearch,
+    task: SeamTask,
+    fail: SeamFailure,
+    table_z: float,
+    opt: PlanOptions,
+    sel: SeamProcedure | None,
+    q0: npt.NDArray[np.float64],
+) -> tuple[SeamSolution, float] | None:
+    """The seam planned shortened at its table end (:mod:`cell.motion.stand_off`) and by how much [m], when its
+    failure is the torch against the table where it is placed; None otherwise or when the shortened seam does
+    not plan either (the seam keeps its failure)."""
+    if not blocked_by_table(fail, opt.collision.table_name):
+        return None
+    orient = sel.oriented if sel else _as_is
+    short = stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0)
+    if short is None:
+        return None
+    again = search.plan_seam(orient(short[0]), q0)
+    return None if isinstance(again, SeamFailure) else (again, short[1])
+
+
+def _as_is(task: SeamTask) -> SeamTask:
+    return task
 
 
 def _failed(seam_id: str, code: PlanReason, detail: str, p_R: npt.ArrayLike) -> SeamOutcome:

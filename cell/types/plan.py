@@ -94,7 +94,9 @@ class SeamOutcome:
     """What became of one seam: feasible, or the reason and the failing point p_fail (3,) in R (empty if none).
 
     For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]. code: why it
-    could not be planned (None when feasible); reason: the same in words, with where and by how much."""
+    could not be planned (None when feasible); reason: the same in words, with where and by how much.
+    trimmed : the length [m] not welded at the seam's table end (the torch's stand-off above the table,
+    :mod:`cell.motion.stand_off`); 0 for a seam welded whole."""
 
     seam_id: str
     feasible: bool
@@ -105,6 +107,7 @@ class SeamOutcome:
     work_angle: float = float("nan")
     travel_angle: float = float("nan")
     code: PlanReason | None = None
+    trimmed: float = 0.0
 
 
 @dataclass(frozen=True)

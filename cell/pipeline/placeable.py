@@ -38,7 +38,16 @@ def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: Moti
     tasks = seam_tasks(wanted, ss.weldmap, ss.joints, ss.table_z)
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     procs = seam_procedures(sc, det, tasks)
-    return unplaceable(arm.model, tasks, arm.q_home, process, motion.checker, options=sc.motion.plan, procedures=procs)
+    return unplaceable(
+        arm.model,
+        tasks,
+        arm.q_home,
+        process,
+        motion.checker,
+        options=sc.motion.plan,
+        procedures=procs,
+        table_z=ss.table_z,  # a seam the table stand-off lets a torch reach is placeable, as the planner has it
+    )
 
 
 def seam_procedures(sc: Scenario, det: Detection, tasks: Sequence[SeamTask]) -> dict[str, SeamProcedure | NoProcedure]:

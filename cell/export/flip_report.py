@@ -15,8 +15,9 @@ def two_sided_report(run: TwoSidedRun, *, provenance: Mapping[str, Any] | None =
     """The report of a whole part (issue 13): side A's :func:`weld_report` with every key kept, each seam's entry
     taken from the side that searched it and given its ``side`` (``"A"``/``"B"``), a ``flip`` block (the turn
     planned, the placement error the second alignment measured, its fitness, the seams left with why), ``sides``
-    (per side: welded, cycle time, the side's summary and error) and ``job_time_s`` (both sides' robot time, the
-    tacks and the operator's turn). ``welded`` and ``cycle_time_s`` count both sides."""
+    (per side: welded, cycle time, the side's summary and error) and ``job_time_s`` (both sides' robot time, side
+    A's with its tacks, and the operator's turn); ``flip.tacks`` lists the tacks laid before the turn. ``welded``
+    and ``cycle_time_s`` count both sides."""
     rep = weld_report(run.side_a, provenance=provenance)
     sides: dict[str, Any] = {"A": _side_entry(rep)}
     side_of = run.side_of()
@@ -85,4 +86,16 @@ def _flip_entry(run: TwoSidedRun) -> dict[str, Any] | None:
         "fitness": _r(res.fitness, 4) if res is not None else None,
         "operator_s": _r(run.operator_s, 3),
         "tacks_s": _r(run.tacks_s, 3),
+        "tacks": [
+            {
+                "id": t.id,
+                "seam": t.seam_id,
+                "end": t.end,
+                "length_mm": t.length_mm,
+                "planned": t.planned,
+                "welded": t.welded,
+                "reason": t.reason,
+            }
+            for t in run.tacks
+        ],
     }

@@ -12,6 +12,7 @@ from cell.motion.robot import RobotModel
 from cell.motion.timing import ptp_duration
 
 _PENALTY_S = 1e6  # [s] added to a transfer known to collide: used only when no order avoids it
+_AFTER_S = 1e9  # [s] added to every step that puts a seam of ``first`` after another seam (never chosen)
 
 
 def seam_order(
@@ -21,6 +22,7 @@ def seam_order(
     q_home: FloatArray,
     robot: RobotModel,
     forbidden: Collection[tuple[str, str]] = (),
+    first: Collection[str] = (),
 ) -> list[int]:
     """Seam order (indices into ``ids``) by point-to-point duration: greedy nearest from home, then 2-opt (home
     fixed at both ends).
@@ -28,6 +30,7 @@ def seam_order(
     entries, exits : (dof,) [rad] per seam, where its approach starts and its depart ends; q_home (dof,) [rad].
     forbidden : (from id, to id) transfers known to collide ("" = home); they cost a penalty, so they are used
     only when no order avoids them.
+    first : ids welded before every other (tack welds): the order runs through them, then through the rest.
     """
     n = len(entries)
     if n <= 1:
@@ -40,6 +43,11 @@ def seam_order(
     C = np.array([[dur(exits[i], entries[k], (ids[i], ids[k])) if i != k else 0.0 for k in range(n)] for i in range(n)])
     from_home = np.array([dur(q_home, e, ("", ids[k])) for k, e in enumerate(entries)])
     to_home = np.array([dur(x, q_home, (ids[k], "")) for k, x in enumerate(exits)])
+    lead = np.array([i in first for i in ids], dtype=bool)
+    if lead.any() and not lead.all():  # a seam of first after another one costs more than any valid order
+        C = C + _AFTER_S * (~lead[:, None] & lead[None, :])
+        from_home = from_home + _AFTER_S * ~lead
+        to_home = to_home + _AFTER_S * lead
 
     def cost(p: list[int]) -> float:
         return float(from_home[p[0]] + sum(C[p[i], p[i + 1]] for i in range(n - 1)) + to_home[p[-1]])
@@ -47,7 +55,8 @@ def seam_order(
     left, tour = set(range(n)), [int(np.argmin(from_home))]
     left.remove(tour[0])
     while left:
-        nxt = min(left, key=lambda k: C[tour[-1], k])
+        ahead = [k for k in left if lead[k]] or left
+        nxt = min(ahead, key=lambda k: C[tour[-1], k])
         tour.append(nxt)
         left.remove(nxt)
     best, improved = cost(tour), True

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -74,6 +74,7 @@ def plan_welds(
     checker: CollisionChecker | None = None,
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
     on_seam: Callable[[int, int], None] | None = None,
+    first: Collection[str] = (),
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -85,6 +86,7 @@ def plan_welds(
         weld segment per pass; a NoProcedure is the seam's reason (no_procedure). A seam not in it is welded
         with ``process`` alone, one pass on the seam line.
     on_seam : called with (seams searched, seams in all) after each seam's torch search (a progress bar).
+    first : task ids welded before all the others (tack welds, :mod:`cell.pipeline.tacks`).
     Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
     SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
     """
@@ -148,7 +150,7 @@ def plan_welds(
     forbidden: set[tuple[str, str]] = set()
     while True:
         ids = list(solved)
-        order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden)
+        order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)
         ordered = [ids[k] for k in order]
         segments, failed = assemble(transfers, ordered, ends, seam_parts, q0, seam_procs)
         if failed is None:

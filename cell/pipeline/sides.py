@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -16,19 +17,20 @@ import numpy as np
 from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import Progress, Seed, quiet, read_weldmap, table_z_R
-from cell.pipeline.records import WeldRun
+from cell.pipeline.records import Detection, WeldRun
+from cell.pipeline.tacks import Tack, choose_tacks, tack_records, tacks_time_s
 from cell.pipeline.two_sided import TwoSidedRun
 from cell.pipeline.weld import weld
 from cell.scenario import Scenario
 from cell.station import Station, open_station
 from cell.types import Cloud, SeamStatus, WeldMap
 from cell.types.flip import FlipPlan, FlipResult
+from cell.types.plan import SeamTask
 
 Sides = Literal["first", "all"]
 SEARCH_TURN_RAD = math.radians(15.0)  # how far off its nominal turned pose the second alignment looks for the part
 SEARCH_SHIFT_M = 0.15
 _SCORE_BAND_M = 0.01  # the band a start pose is scored in (cloud points near the map's surfaces)
-TACK_MOVE_S = 3.0  # a tack's approach and departure [s] (the tacks are a cycle-time figure, not simulated)
 
 
 def table_box_R(sc: Scenario) -> tuple[FloatArray, FloatArray]:
@@ -41,9 +43,13 @@ def table_box_R(sc: Scenario) -> tuple[FloatArray, FloatArray]:
 
 def plan_turn(run: WeldRun) -> FlipPlan | None:
     """The turn for the seams side A left against the table (None when none is left), from side A's aligned map."""
+    return _turn_for(run.detection)
+
+
+def _turn_for(det: Detection) -> FlipPlan | None:
+    """:func:`plan_turn` from side A's detection (before its welds are planned: the tacks depend on it)."""
     from cell.seams.flip import plan_flip
 
-    det = run.detection
     left = [e.id for e in det.estimates if e.status is SeamStatus.NOT_VISIBLE]
     if not left:
         return None
@@ -131,19 +137,28 @@ def weld_part(
     t_all = time.perf_counter()
     sc = scenario.with_noise(noise) if noise else scenario
     weldmap = read_weldmap(sc)
+    chosen: list[Tack] = []
+    spec = sc.flip.tacks
     with open_station(sc, weldmap, gui=gui) as station:
         # Through the package's name: what stands in for cell.pipeline.weld (a test's stub) stands in for side A.
-        a = pipeline.weld(sc, method, rescan=rescan, execute_plan=execute_plan, progress=progress, station=station)
+        # Tacks only when asked for and the part will be turned: their keyword only then (a stub need not know it).
+        extra: dict[str, Any] = (
+            {"tacks": tack_rule(spec.count, spec.length_mm / 1000.0, chosen)} if spec.count and sides == "all" else {}
+        )
+        a = pipeline.weld(
+            sc, method, rescan=rescan, execute_plan=execute_plan, progress=progress, station=station, **extra
+        )
         plan = plan_turn(a) if sides == "all" else None
         if plan is None:
             return TwoSidedRun(a, timings={"total_s": time.perf_counter() - t_all})
-        tacks = sc.flip.tacks
+        refused = f"not executed: {a.error.message}" if a.error is not None else ""
         base = TwoSidedRun(
             a,
             plan,
             operator_s=sc.flip.operator_s,
-            tacks_s=tacks.count * (tacks.length_mm / sc.process.travel_speed_mm_s + TACK_MOVE_S),
+            tacks_s=tacks_time_s(a.plan) if chosen else 0.0,
             turned_map=weldmap.transformed(plan.X_RM_after, "R"),
+            tacks=tack_records(chosen, a.plan, a.execution is not None, refused),
         )
 
         def done(**fields: Any) -> TwoSidedRun:
@@ -159,6 +174,24 @@ def weld_part(
         except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
             return done(error=e)
         return done(side_b=b, result=flip_result(plan, b, weldmap))
+
+
+def tack_rule(
+    count: int, length_m: float, chosen: list[Tack]
+) -> Callable[[Detection, Sequence[SeamTask]], Sequence[SeamTask]]:
+    """The tacks side A lays (:func:`cell.pipeline.weld.plan_for`'s ``tacks``): ``count`` of ``length_m`` on its
+    seams (:func:`cell.pipeline.tacks.choose_tacks`, each pair of parts its first tack before any gets a second)
+    when the turn will be made, none otherwise; what it chose is put in ``chosen`` (the run's record of them)."""
+
+    def rule(det: Detection, tasks: Sequence[SeamTask]) -> Sequence[SeamTask]:
+        turn = _turn_for(det)
+        chosen.clear()
+        if turn is not None and turn.go:
+            pairs = {i: f"{j.abutting}>{j.receiving}" for i, j in det.joints.items()}
+            chosen.extend(choose_tacks(tasks, count, length_m, pairs))
+        return [t.task for t in chosen]
+
+    return rule
 
 
 def _side_b(

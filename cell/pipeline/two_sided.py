@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, replace
 
 from cell.errors import CellError
 from cell.pipeline.records import WeldRun
+from cell.pipeline.tacks import TackRecord
 from cell.types import SeamStatus, WeldMap
 from cell.types.flip import FlipPlan, FlipResult
 from cell.types.run import SeamRecord
@@ -19,7 +20,9 @@ class TwoSidedRun:
 
     plan : the turn (None when nothing was left for a second side, or ``--sides first``). side_b : side B's run
     (None when no turn was made, or in a preview). result : the second alignment's measure of the placement.
-    operator_s, tacks_s : the operator's time to turn the part and the tack welds' time (scenario figures) [s].
+    operator_s : the operator's time to turn the part (the scenario's figure) [s]. tacks : the tack welds side A
+    laid first (:mod:`cell.pipeline.tacks`), each welded or why not; tacks_s their robot time in side A's plan
+    (moves, approaches, welds, departs) [s], a part of side A's cycle time.
     error : what stopped the job between the sides (the turn refused), or None.
     """
 
@@ -32,6 +35,7 @@ class TwoSidedRun:
     error: CellError | None = None
     timings: Mapping[str, float] = field(default_factory=dict)
     turned_map: WeldMap | None = None  # the map at its nominal pose after the turn (R), for previews
+    tacks: tuple[TackRecord, ...] = ()
 
     def side_of(self) -> dict[str, str]:
         """Seam id -> the side it belongs to: ``"B"`` for those side B searched, ``"A"`` for every other."""
@@ -65,9 +69,9 @@ class TwoSidedRun:
 
     @property
     def job_time_s(self) -> float:
-        """The whole job [s]: both sides' robot time, the tacks and the operator's turn (when it was made)."""
-        turned = self.side_b is not None
-        return self.cycle_time_s + (self.operator_s + self.tacks_s if turned else 0.0)
+        """The whole job [s]: both sides' robot time (side A's with its tacks) and the operator's turn (when it
+        was made)."""
+        return self.cycle_time_s + (self.operator_s if self.side_b is not None else 0.0)
 
     @property
     def complete(self) -> bool:

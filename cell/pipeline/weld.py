@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Mapping, Sequence
 from contextlib import nullcontext
 from dataclasses import replace
 from functools import partial
@@ -25,6 +25,8 @@ from cell.station import Station, open_station
 from cell.types import SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
+TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
+
 if TYPE_CHECKING:
     from cell.types.execution import Execution
     from cell.types.plan import SeamOutcome, SeamTask, Segment, WeldPlan
@@ -39,6 +41,7 @@ def plan_for(
     q_start: FloatArray | None = None,
     motion: MotionScene | None = None,
     progress: Progress = quiet,
+    tacks: TackRule | None = None,
 ) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
     section 7).
@@ -47,6 +50,9 @@ def plan_for(
     (built here when not given). Returns the plan, the move from q_start to
     home that precedes it, and the gate's violations (empty when the plan may run). PlanError when nothing can be
     planned at all.
+    tacks : the tack welds to lay first (:mod:`cell.pipeline.tacks`, from the seam tasks): welded before every
+        seam, each with its seam's procedure; the plan's outcomes list them after the seams (an arm on a track
+        lays none).
     """
     from cell.motion.gate import find_violations
     from cell.motion.gate.blame import blamed_seams
@@ -55,6 +61,7 @@ def plan_for(
     from cell.motion.torch import WeldProcess
     from cell.motion.track import plan_on_track
     from cell.motion.transfers import TransferFail, Transfers, joined
+    from cell.pipeline.tacks import tack_procedures
 
     sc = det.scenario
     arm = station.arm
@@ -66,7 +73,11 @@ def plan_for(
     tasks = seam_tasks([e for e in det.estimates if e.id not in skip], ss.weldmap, ss.joints, ss.table_z)
     motion = motion or motion_scene(arm, det)
     obstacles, checker = motion.obstacles, motion.checker
-    progress(f"planning {len(tasks)} seams (IK, timing, collisions)")
+    track = sc.robot.track.track(sc.X_WR) if sc.robot.track is not None else None
+    tack_tasks = tuple(tacks(det, tasks)) if tacks is not None and track is None else ()
+    progress(
+        f"planning {len(tasks)} seams{f' and {len(tack_tasks)} tacks' if tack_tasks else ''} (IK, timing, collisions)"
+    )
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     q_now = arm.q_scan if q_start is None else q_start
     problems = []
@@ -82,18 +93,20 @@ def plan_for(
     dropped: dict[str, SeamOutcome] = {}
     for _ in range(_GATE_ROUNDS):
         kept = [t for t in tasks if t.id not in dropped]
-        track = sc.robot.track.track(sc.X_WR) if sc.robot.track is not None else None
-        planner = plan_welds if track is None else partial(plan_on_track, track=track)  # docs/track.md
+        kept_tacks = [t for t in tack_tasks if t.id not in dropped]
+        procs = seam_procedures(sc, det, kept)
+        first = {t.id for t in kept_tacks}  # the tacks before every seam
+        planner = partial(plan_welds, first=first) if track is None else partial(plan_on_track, track=track)
         plan = planner(
             arm.model,
-            kept,
+            [*kept, *kept_tacks],
             arm.q_home,
             process,
             obstacles,
             options=sc.motion.plan,
             rng=sc.rng("plan"),
             checker=checker,
-            procedures=seam_procedures(sc, det, kept),
+            procedures=procs | tack_procedures(procs, kept_tacks),
             on_seam=seam_counter(progress) if not dropped else None,
         )
         progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
@@ -105,7 +118,7 @@ def plan_for(
         progress(f"safety gate: dropping {', '.join(blamed)} (their own motions violate it), planning the rest")
         dropped.update(blamed)
     outcomes = {o.seam_id: o for o in plan.seams} | dropped
-    plan = replace(plan, seams=tuple(outcomes[t.id] for t in tasks if t.id in outcomes))
+    plan = replace(plan, seams=tuple(outcomes[t.id] for t in (*tasks, *tack_tasks) if t.id in outcomes))
     problems += [str(v) for v in found]
     return plan, pre, tuple(problems)
 
@@ -245,6 +258,7 @@ def weld(
     station: Station | None = None,
     detect_options: Mapping[str, Any] | None = None,
     only: Collection[str] | None = None,
+    tacks: TackRule | None = None,
 ) -> WeldRun:
     """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a
     preview) weld. ``rescan`` overrides the scenario's ``rescan.mode``.
@@ -256,7 +270,8 @@ def weld(
 
     station : a running cell to weld on (left open; built and closed here when None). detect_options : keywords
     for :func:`detect` (a turned part's ``X_RM_nominal`` and ``seed``). only : the seam ids this run is about
-    (a second side's: the others are neither re-scanned, planned nor reported).
+    (a second side's: the others are neither re-scanned, planned nor reported). tacks : tack welds laid before
+    the seams (:func:`plan_for`).
     """
     t_all = time.perf_counter()
     sc = scenario.with_noise(noise) if noise else scenario
@@ -301,7 +316,7 @@ def weld(
                 progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)")
             else:
                 plan, pre, violations = plan_for(
-                    station, det, skip=low, q_start=q_start, motion=motion, progress=progress
+                    station, det, skip=low, q_start=q_start, motion=motion, progress=progress, tacks=tacks
                 )
                 timings["plan_s"] = setup_s + time.perf_counter() - t
                 if violations:

@@ -11,7 +11,8 @@ from cell.scenario.base import Model
 
 
 class TackSpec(Model):
-    """Tack welds laid before the turn, holding the parts together (a cycle-time figure: they are not drawn)."""
+    """Tack welds side A lays before the turn, holding the parts together (docs/flip.md section 1a): ``count``
+    tacks of ``length_mm`` each on its seams, before any full weld, when the part will be turned; none when 0."""
 
     count: Annotated[int, Field(ge=0, le=100)] = 0  # tacks per part before the turn
     length_mm: Annotated[float, Field(gt=0.0, le=100.0)] = 10.0  # each tack's length
@@ -22,7 +23,8 @@ class FlipSpec(Model):
 
     allowed : false for a part too heavy (or too awkward) to turn: the seams left keep their reason.
     operator_s : the operator's time to turn the part and confirm [s], counted in the job's cycle time.
-    tacks : tack welds before the turn (their time, count x (length / travel speed + 3 s), is added to the job's).
+    tacks : tack welds side A lays before any full weld when the part will be turned (planned and welded: their
+        time is part of side A's cycle time).
     max_tilt_deg : the largest lean of the turned part (resting on the hull facet under its centre of mass)
         accepted; a turn that leans more is not made.
     """

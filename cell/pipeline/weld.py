@@ -12,24 +12,23 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from cell.errors import CellError, PlanError, ScenarioError
-from cell.geometry import FloatArray, invert, transform_points
+from cell.geometry import FloatArray
 from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
+from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
-from cell.rescan import within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import SeamEstimate, SeamStatus
-from cell.types.run import SeamWeld, WeldReason
+from cell.types import SeamStatus
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
 if TYPE_CHECKING:
     from cell.types.execution import Execution
-    from cell.types.plan import SeamOutcome, SeamTask, Segment, WeldPlan
+    from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
     from cell.types.trajectory import Trajectory
 
 
@@ -158,94 +157,6 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
     return station.execute(times, q, arc_on, marks=marks, record_dt=0.01, e1=e1)
 
 
-def _doubt(est: SeamEstimate, sc: Scenario) -> str:
-    """Why a found seam is too uncertain to weld ("" when it may be welded): its bound (``rescan.bound_sigmas``
-    times its calibrated sigma) over ``rescan.weld_tolerance_mm``, or its confidence under
-    ``rescan.weld_min_confidence``."""
-    r = sc.rescan
-    if not within_tolerance(est, r.max_sigma_m):
-        bound_mm = r.bound_sigmas * est.sigma_m * 1000.0
-        return f"bound {r.bound_sigmas:g} sigma = {bound_mm:.2f} mm > weld tolerance {r.weld_tolerance_mm:g} mm"
-    if est.confidence < r.weld_min_confidence:
-        return f"confidence {est.confidence:.2f} < {r.weld_min_confidence:.2f}"
-    return ""
-
-
-def _seam_welds(
-    det: Detection,
-    plan: WeldPlan | None,
-    ex: Execution | None,
-    pre_s: float,
-    refused: str,
-    sc: Scenario,
-    gated: bool,
-    unplaceable: Collection[str] = (),
-) -> tuple[SeamWeld, ...]:
-    """Per seam: welded (with its quality against the true seam) or the reason it was not. gated : the weld gate
-    applied (not a preview): a found seam too uncertain to weld is ``low_confidence``, but one no torch can be
-    placed on (``unplaceable``: planned anyway) gets the planner's reason."""
-    from cell.motion.plan import seam_tasks
-    from cell.motion.quality import combined, weld_quality
-
-    X_RW = invert(det.scenario.X_WR)
-    ss = det.scene.seam_scene if det.scene is not None else None
-    found = [e for e in det.estimates if e.status is SeamStatus.FOUND]
-    tasks = {t.id: t for t in seam_tasks(found, ss.weldmap, ss.joints, ss.table_z)} if ss is not None else {}
-    out = []
-    for est in det.estimates:
-        if est.status is SeamStatus.NOT_VISIBLE:
-            out.append(SeamWeld(est.id, False, False, est.reason, code=WeldReason.NOT_VISIBLE))  # against the table
-            continue
-        if est.status is not SeamStatus.FOUND:
-            why = f"not located ({est.status.value}): {est.reason}"
-            out.append(SeamWeld(est.id, False, False, why, code=WeldReason.NOT_LOCATED))
-            continue
-        doubtful = _doubt(est, sc)
-        if doubtful and gated and est.id not in unplaceable:
-            out.append(SeamWeld(est.id, False, False, f"low_confidence: {doubtful}", code=WeldReason.LOW_CONFIDENCE))
-            continue
-        outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
-        if outcome is None or not outcome.feasible:
-            reason = outcome.reason if outcome is not None else refused or "not planned"
-            code = WeldReason.NOT_EXECUTED if outcome is None and refused else WeldReason.NOT_PLANNED
-            out.append(SeamWeld(est.id, False, False, reason, code=code))
-            continue
-        welds = [g for g in plan.segments if g.arc_on and g.seam_id == est.id] if plan is not None else []
-        if ex is None or plan is None:
-            note = f"; {doubtful}: would be re-scanned before welding" if doubtful else ""
-            code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
-            why = (refused or "planned, not executed (preview)") + note
-            proc = welds[0].procedure if welds else None
-            out.append(SeamWeld(est.id, True, False, why, code=code, procedure=proc))
-            continue
-        truth = det.truths.get(est.id)  # none on a station that knows no truth: welded, quality unmeasured
-        passes = []
-        for seg in welds:
-            if truth is None:
-                break
-            t0, t1 = pre_s + seg.t0, pre_s + seg.t1
-            k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
-            tcp_R = transform_points(X_RW, ex.tcp_W[k])
-            offsets = _intended(tasks.get(est.id), outcome.reversed, seg, tcp_R)
-            passes.append(weld_quality(ex.times[k], tcp_R, truth[0], truth[1], offsets))
-        quality = combined(passes) if passes else None
-        out.append(SeamWeld(est.id, True, True, "", quality, procedure=welds[0].procedure, passes=tuple(passes)))
-    return tuple(out)
-
-
-def _intended(task: SeamTask | None, reversed_: bool, seg: Segment, tcp_R: FloatArray) -> FloatArray | None:
-    """Where the plan meant each TCP record of a weld segment to lie off the seam (its pass's offset and the
-    weave), from the planned seam (None without a procedure or a task: on the seam line)."""
-    from cell.motion.weave import cross_section, intended_offsets
-
-    if seg.procedure is None or task is None:
-        return None
-    a, b = (task.p_end, task.p_start) if reversed_ else (task.p_start, task.p_end)
-    d = (b - a) / task.length
-    e_R, b_R = cross_section(d, task.n_a, task.n_b)
-    return intended_offsets(tcp_R, a, d, task.length, seg.procedure, seg.pass_index, e_R, b_R)
-
-
 def weld(
     scenario: Scenario,
     method: str | None = None,
@@ -308,7 +219,7 @@ def weld(
             low = {
                 e.id
                 for e in det.estimates
-                if e.status is SeamStatus.FOUND and _doubt(e, sc) and execute_plan and e.id not in hopeless
+                if e.status is SeamStatus.FOUND and doubt(e, sc) and execute_plan and e.id not in hopeless
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
@@ -329,27 +240,8 @@ def weld(
             error = e
         refused = f"not executed: {error.message}" if error is not None else ""
         pre_s = pre.duration if pre is not None else 0.0
-        seams = _seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless)
+        seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)
         return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs, view)
-
-
-def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:
-    """Planned torch poses X_RT (n, 4, 4) along each weld (its passes in order), every ``step_s`` of arc time (for
-    pictures and reports)."""
-    if station.arm is None:
-        return {}
-    model = station.arm.model
-    out: dict[str, FloatArray] = {}
-    for seg in plan.segments:
-        if seg.arc_on:
-            tr = seg.trajectory
-            k = np.unique(np.r_[np.searchsorted(tr.times, np.arange(0.0, tr.duration, step_s)), len(tr.times) - 1])
-            poses = np.stack([model.fk(tr.q[i]) for i in k])
-            if plan.track is not None:  # the base where the track put it (poses in R: the base at E1 = 0)
-                poses[:, :3, 3] += plan.track.offset_R(seg.e1_end)
-            prev = out.get(seg.seam_id)  # a multi-pass seam: its passes one after the other
-            out[seg.seam_id] = poses if prev is None else np.concatenate([prev, poses])
-    return out

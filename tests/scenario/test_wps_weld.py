@@ -13,7 +13,8 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export.procedure_report import procedure_entry
 from cell.geometry import invert, point_line_distance, transform_points
-from cell.pipeline.weld import _seam_welds, execute, plan_for
+from cell.pipeline.outcomes import seam_welds
+from cell.pipeline.weld import execute, plan_for
 from cell.station.sim import SimStation
 
 WEAVE, TWO = "BOTTOM_RAIL>POST_R:+y", "BOTTOM_RAIL>POST_R:+z"  # a vertical T fillet, a top corner fillet
@@ -31,7 +32,7 @@ def test_weave_and_two_passes_welded_with_a_bead_per_pass(
     start, end = (next(g for g in plan.segments if g.seam_id == WEAVE and g.kind == k) for k in ("approach", "weld"))
     assert end.X_end[2, 3] > start.X_end[2, 3] + 0.05  # welded upwards: the weld ends 60 mm above its start
     ex = execute(fence1_station, plan, pre)
-    welds = {w.id: w for w in _seam_welds(det, plan, ex, pre.duration, "", scn, False) if w.welded}
+    welds = {w.id: w for w in seam_welds(det, plan, ex, pre.duration, "", scn, False) if w.welded}
     weave, two = welds[WEAVE], welds[TWO]
     assert weave.procedure is not None and weave.procedure.name == "PF-weave" and len(weave.passes) == 1
     assert two.procedure is not None and two.procedure.name == "PB-2pass" and len(two.passes) == 2

@@ -107,4 +107,7 @@ def set_down(
     low = float((points @ X[:3, :3].T + X[:3, 3])[:, 2].min())
     shift = np.array([pivot[0] - moved_pivot[0], pivot[1] - moved_pivot[1], table_z - low])
     X[:3, 3] += shift
-    return X, tilt, margin
+    # To 1e-12 (a picometre; a millionth of a milliradian): the hull and the products above may differ in their
+    # last bits between processes (BLAS kernels by memory alignment), and a start that differs there can end an
+    # ICP elsewhere within its tolerance. Rounded, the same body rests at the same pose in every process.
+    return np.round(X, 12), tilt, margin

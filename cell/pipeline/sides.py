@@ -90,7 +90,7 @@ def near_seed(weldmap_M: WeldMap, table_z: float) -> Seed:
             samples, normals = sample_map(nominal.transformed(X, "R"), _SCORE_BAND_M / 2, _SCORE_BAND_M / 2)
             return surface_fit(points, samples, normals, _SCORE_BAND_M, _SCORE_BAND_M / 2)[0]
 
-        best = max(starts, key=score)
+        best = max(starts, key=lambda X: round(score(X), 9))  # near-ties to the first start, in every process
         return np.asarray(best @ X_RM)
 
     return seed

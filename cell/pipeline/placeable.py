@@ -14,11 +14,10 @@ import numpy as np
 from cell.pipeline.detect import Progress, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
-from cell.pipeline.rescan import RescanMode, escalated, rescan_detection
+from cell.pipeline.rescan import RescanMode, end_shift_m, escalated, rescan_detection
 from cell.rescan import seams_to_rescan
 from cell.scenario import Scenario
 from cell.station import Arm, Station
-from cell.types import SeamEstimate, SeamStatus
 
 if TYPE_CHECKING:
     from cell.motion.procedures import NoProcedure, SeamProcedure
@@ -89,7 +88,7 @@ def rescan_weldable(
         return None, det, hopeless
     # "all" with the seams given: the same re-scan, without its escalation (done here, without the hopeless)
     rs, after = rescan_detection(station, det, "all", seam_ids=ids, motion=motion, progress=progress)
-    shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
+    shift_mm = max((end_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
     rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids and i not in hopeless]
     if shift_mm <= sc.rescan.escalate_mm or not rest:
         return rs, after, hopeless
@@ -112,12 +111,3 @@ def _hopeless(arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene,
     if found:
         progress(f"not re-scanning {len(found)} of {len(ids)} seams no torch can be placed on (planned to say why)")
     return found
-
-
-def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
-    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing)."""
-    if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
-        return 0.0
-    a = np.stack([before.p_start, before.p_end])
-    b = np.stack([closeup.p_start, closeup.p_end])
-    return float(min(np.linalg.norm(a - b, axis=1).max(), np.linalg.norm(a - b[::-1], axis=1).max()))

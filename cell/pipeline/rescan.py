@@ -212,7 +212,7 @@ def rescan_detection(
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
     rs = rescan_seams(station, det, ids, motion=motion, progress=progress)
     after = rescanned(det, rs)
-    shift_mm = max((_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
+    shift_mm = max((end_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
     rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids]
     if mode == "low" and shift_mm > sc.rescan.escalate_mm and rest:
         progress(
@@ -239,7 +239,7 @@ def escalated(first: Rescan, more: Rescan, shift_mm: float) -> Rescan:
     )
 
 
-def _shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
+def end_shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
     """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing)."""
     if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
         return 0.0

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -137,28 +138,8 @@ def plan_flip(
     plan = best[1]
     if not plan.stable:
         why = f"no turn of the part rests stably: {plan.reason}"
-        return FlipPlan(
-            plan.axis,
-            plan.axis_R,
-            plan.angle_rad,
-            plan.tilt_rad,
-            plan.X_RM_after,
-            X_RM,
-            (),
-            dict.fromkeys(remaining, why),
-            stable=False,
-            reason=why,
-        )
+        return replace(plan, exposed=(), left=dict.fromkeys(remaining, why), reason=why)
     if not plan.exposed:
-        return FlipPlan(
-            plan.axis,
-            plan.axis_R,
-            plan.angle_rad,
-            plan.tilt_rad,
-            plan.X_RM_after,
-            X_RM,
-            (),
-            plan.left,
-            reason="no single turn exposes any seam left: " + "; ".join(f"{s}: {w}" for s, w in plan.left.items()),
-        )
+        why = "no single turn exposes any seam left: " + "; ".join(f"{s}: {w}" for s, w in plan.left.items())
+        return replace(plan, reason=why)
     return plan

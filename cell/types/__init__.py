@@ -8,7 +8,7 @@ Every stage imports its values from here and nothing here imports a stage (an im
 """
 
 from cell.types.execution import Event, Execution, WeldQuality
-from cell.types.map import BOX_FACES, Box, MapSeam, Part, UnsupportedSeam, WeldMap
+from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, UnsupportedSeam, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
@@ -37,6 +37,7 @@ __all__ = [
     "Part",
     "PathProfile",
     "PlanReason",
+    "Polyhedron",
     "Reason",
     "Rescan",
     "RobotPose",

@@ -2,6 +2,9 @@
 
 Frames: ``M`` welding map (DXF drawing), ``R`` robot base, ``W`` world, ``B`` a box part's own frame (axes along its
 edges, origin at its centre). Metres and radians.
+
+A part's body is a :class:`Box` (the fast special case) or a :class:`Polyhedron` (any closed planar-faced body); both
+answer the same methods (``face_names``, ``face_plane``, ``face_polygon``, ``triangles``, ``contains``, ...).
 """
 
 from __future__ import annotations
@@ -13,9 +16,21 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, invert, readonly, transform_points
+from cell.types.polyhedron import Polyhedron
+
+__all__ = ["BOX_FACES", "Box", "MapSeam", "Part", "Polyhedron", "UnsupportedSeam", "WeldMap"]
 
 # The six faces of a box, named by the outward normal in the box frame B.
 BOX_FACES: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
+# Each face's corners (indices into Box.corners(), bits (x, y, z)), counter-clockwise seen from outside.
+_BOX_POLYGONS: tuple[tuple[int, ...], ...] = (
+    (4, 6, 7, 5),
+    (0, 1, 3, 2),
+    (2, 3, 7, 6),
+    (0, 4, 5, 1),
+    (1, 5, 7, 3),
+    (0, 2, 6, 4),
+)
 
 
 def _face_axis_sign(face: str) -> tuple[int, float]:
@@ -66,57 +81,117 @@ class Box:
         p_B = transform_points(invert(self.X_AB), p_A)
         return np.all(np.abs(p_B) <= self.size / 2.0 + margin, axis=-1)
 
+    def face_names(self) -> tuple[str, ...]:
+        """The six faces' names (:data:`BOX_FACES`)."""
+        return BOX_FACES
+
+    def face_polygon(self, face: str) -> FloatArray:
+        """(4, 3) the face's corners, counter-clockwise seen from outside [m]."""
+        _face_axis_sign(face)
+        return np.array(self.corners()[list(_BOX_POLYGONS[BOX_FACES.index(face)])])
+
+    def triangles(self) -> npt.NDArray[np.intp]:
+        """(12, 3) indices into :meth:`corners`, two triangles per face, outward winding."""
+        return np.array([(f[0], f[k], f[k + 1]) for f in _BOX_POLYGONS for k in (1, 2)], dtype=np.intp)
+
+    @property
+    def radius(self) -> float:
+        """The radius [m] of the sphere about the centre through the corners."""
+        return 0.5 * float(np.linalg.norm(self.size))
+
+    def edges(self) -> FloatArray:
+        """(12, 2, 3) the box's edges as end-point pairs [m]."""
+        c = self.corners()  # corner pairs whose indices differ in one bit
+        pairs = [(i, i | bit) for i in range(8) for bit in (1, 2, 4) if not i & bit]
+        return np.array([[c[i], c[j]] for i, j in pairs])
+
+    def to_polyhedron(self) -> Polyhedron:
+        """The same body as a :class:`Polyhedron` whose faces keep the box's names (``"+x"``, ...)."""
+        return Polyhedron(self.corners(), _BOX_POLYGONS, BOX_FACES)
+
 
 @dataclass(frozen=True)
 class Part:
     """A designed part of the welding map: a closed body, in the frame the owning map is expressed in.
 
     name : stable identifier (DXF layer or block name, in the drawing's case).
-    box : the body, an oriented box today.
+    body : the body, a :class:`Box` (the fast special case) or a :class:`Polyhedron` (any closed planar-faced body).
     drawn_as : how the map drew it (``"3DSOLID"``, ``"MESH"``, ``"POLYFACE"``, ``"3DFACE"``; ``""`` when not read
         from a drawing).
 
-    The methods below are what a stage may ask of any body (a face's plane by name, which points lie inside, its
-    vertices and edges, its centre and bounding radius, the body in another frame); stages use them, not the box,
-    so a polyhedral body can take the box's place. What still reads ``box`` is box-specific by nature: rendering and
-    collision shapes, the locators' box-frame tubes, the as-built deviations of a box's edge lengths.
+    The methods below are what a stage may ask of any body (its faces by name, their planes and polygons, which
+    points lie inside, its vertices, triangles and edges, its centre and bounding radius, the body in another frame);
+    stages use them so a polyhedral body can take the box's place. What still reads :attr:`box` is box-specific by
+    nature and fails loudly (``TypeError``) on a polyhedral part: such a stage must check :attr:`is_box` first.
     """
 
     name: str
-    box: Box
+    body: Box | Polyhedron
     drawn_as: str = ""
+
+    @property
+    def is_box(self) -> bool:
+        """Whether the body is a :class:`Box`."""
+        return isinstance(self.body, Box)
+
+    @property
+    def box(self) -> Box:
+        """The body as a :class:`Box`; a ``TypeError`` naming the part when it is a polyhedron."""
+        if not isinstance(self.body, Box):
+            raise TypeError(f"part {self.name} is not a box (drawn as {self.drawn_as or 'a polyhedron'})")
+        return self.body
+
+    @property
+    def kind(self) -> str:
+        """``"box"`` or ``"mesh"`` (a polyhedron), for reports."""
+        return "box" if self.is_box else "mesh"
+
+    def face_names(self) -> tuple[str, ...]:
+        """The names of the body's faces (:data:`BOX_FACES` for a box, ``"f0"``, ``"f1"``, ... for a polyhedron)."""
+        return self.body.face_names()
 
     def face_plane(self, face: str) -> tuple[FloatArray, float]:
         """Outward unit normal n (3,) and offset d [m] of the face named ``face``: it lies in n . p = d."""
-        return self.box.face_plane(face)
+        return self.body.face_plane(face)
+
+    def face_polygon(self, face: str) -> FloatArray:
+        """(m, 3) the face's vertices in order, counter-clockwise seen from outside [m]."""
+        return self.body.face_polygon(face)
 
     def contains(self, p: npt.ArrayLike, margin: float = 0.0) -> npt.NDArray[np.bool_]:
         """Which points (n, 3) lie inside the body grown by ``margin`` [m]."""
-        return self.box.contains(p, margin)
+        return self.body.contains(p, margin)
 
     def vertices(self) -> FloatArray:
-        """(k, 3) the body's vertices [m]."""
-        return self.box.corners()
+        """(k, 3) the body's vertices [m] (a box's eight corners)."""
+        return self.body.corners() if isinstance(self.body, Box) else np.array(self.body.vertices)
+
+    def triangles(self) -> tuple[FloatArray, npt.NDArray[np.intp]]:
+        """The body's surface as triangles: vertices (k, 3) [m] and (t, 3) indices into them, outward winding."""
+        return self.vertices(), self.body.triangles()
 
     def edges(self) -> FloatArray:
-        """(m, 2, 3) the body's edges as end-point pairs [m]."""
-        c = self.box.corners()  # corner pairs whose indices differ in one bit
-        pairs = [(i, i | bit) for i in range(8) for bit in (1, 2, 4) if not i & bit]
-        return np.array([[c[i], c[j]] for i, j in pairs])
+        """(m, 2, 3) the body's (feature) edges as end-point pairs [m]."""
+        return self.body.edges()
 
     @property
     def center(self) -> FloatArray:
         """(3,) the body's centre [m] (the centroid of its volume)."""
-        return self.box.center
+        return np.asarray(self.body.center)
 
     @property
     def radius(self) -> float:
         """The radius [m] of a sphere about :attr:`center` that holds the whole body."""
-        return 0.5 * float(np.linalg.norm(self.box.size))
+        return self.body.radius
+
+    @property
+    def volume(self) -> float:
+        """The body's volume [m^3]."""
+        return float(np.prod(self.body.size)) if isinstance(self.body, Box) else self.body.volume
 
     def transformed(self, X_CA: FloatArray) -> Part:
         """The same part expressed in frame C, given the pose X_CA of its current frame A in C."""
-        return Part(self.name, self.box.transformed(X_CA), self.drawn_as)
+        return Part(self.name, self.body.transformed(X_CA), self.drawn_as)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,234 @@
+"""A closed body bounded by planar polygon faces: the general part model (a box is its fast special case).
+
+Frames: the body is given in a frame ``A`` (``M`` as drawn, ``R`` or ``W`` once moved). Metres.
+Faces are lists of vertex indices, counter-clockwise seen from outside; each face has a stable name (``"f0"``, ...).
+Numpy only (the types package imports no stage).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray, readonly, transform_points
+
+_CHUNK = 200_000  # point-triangle pairs evaluated at once in contains() (bounds the memory)
+
+
+def _newell(poly: FloatArray) -> FloatArray:
+    """Area-weighted normal (3,) of a planar polygon (m, 3) (Newell's method): 2 x area along the normal."""
+    nxt = np.roll(poly, -1, axis=0)
+    return np.asarray(np.cross(poly, nxt).sum(axis=0))
+
+
+def _ear_clip(uv: FloatArray) -> list[tuple[int, int, int]]:
+    """Triangles (local indices) of a simple counter-clockwise 2D polygon (m, 2), convex or not (ear clipping).
+
+    A convex polygon comes out as the fan from its first vertex; degenerate leftovers fall back to a fan.
+    """
+    idx = list(range(len(uv)))
+    out: list[tuple[int, int, int]] = []
+    guard = 0
+    while len(idx) > 3 and guard < 4 * len(uv) * len(uv):
+        guard += 1
+        m = len(idx)
+        for k in range(m):
+            i, j, l_ = idx[k], idx[(k + 1) % m], idx[(k + 2) % m]
+            a, b, c = uv[i], uv[j], uv[l_]
+            cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+            if cross <= 1e-15:
+                continue  # reflex or flat corner: not an ear
+            others = [q for q in idx if q not in (i, j, l_)]
+            if others and _any_in_triangle(uv[others], a, b, c):
+                continue
+            out.append((i, j, l_))
+            idx.pop((k + 1) % m)
+            break
+        else:
+            break
+    for k in range(1, len(idx) - 1):  # what is left (a triangle, or a degenerate rest): a fan
+        out.append((idx[0], idx[k], idx[k + 1]))
+    return out
+
+
+def _any_in_triangle(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> bool:
+    def side(u: FloatArray, v: FloatArray) -> FloatArray:
+        return np.asarray((v[0] - u[0]) * (p[:, 1] - u[1]) - (v[1] - u[1]) * (p[:, 0] - u[0]))
+
+    s1, s2, s3 = side(a, b), side(b, c), side(c, a)
+    return bool(np.any((s1 >= -1e-15) & (s2 >= -1e-15) & (s3 >= -1e-15)))
+
+
+def _point_triangle_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+    """Distances (n, t) from points p (n, 3) to triangles given by corners a, b, c (t, 3) each."""
+    ab, ac = b - a, c - a
+    n = np.cross(ab, ac)
+    nn = np.maximum(np.einsum("ij,ij->i", n, n), 1e-300)
+    ap = p[:, None, :] - a[None]
+    # inside the prism over the triangle: the distance to its plane
+    w = np.einsum("ntk,tk->nt", np.cross(ab[None], ap), n) / nn
+    v = np.einsum("ntk,tk->nt", np.cross(ap, ac[None]), n) / nn
+    inside = (v >= 0) & (w >= 0) & (v + w <= 1)
+    d_plane = np.abs(np.einsum("ntk,tk->nt", ap, n)) / np.sqrt(nn)
+    best = np.full(d_plane.shape, np.inf)
+    for s, e in ((a, b), (b, c), (c, a)):  # otherwise the nearest edge
+        se = e - s
+        ll = np.maximum(np.einsum("ij,ij->i", se, se), 1e-300)
+        sp = p[:, None, :] - s[None]
+        t = np.clip(np.einsum("ntk,tk->nt", sp, se) / ll, 0.0, 1.0)
+        q = sp - t[..., None] * se[None]
+        best = np.minimum(best, np.sqrt(np.einsum("ntk,ntk->nt", q, q)))
+    return np.asarray(np.where(inside, d_plane, best))
+
+
+@dataclass(frozen=True)
+class Polyhedron:
+    """A closed body bounded by planar polygon faces, in the frame A it is given in [m].
+
+    vertices : (k, 3) vertex positions in A [m].
+    faces : each face a planar polygon, vertex indices counter-clockwise seen from outside.
+    names : one stable name per face (``"f0"``, ``"f1"``, ...; coplanar triangles of a MESH merged into one face).
+    """
+
+    vertices: FloatArray
+    faces: tuple[tuple[int, ...], ...]
+    names: tuple[str, ...] = ()
+    _planes: FloatArray = field(init=False, repr=False, compare=False)
+    _tris: npt.NDArray[np.intp] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "vertices", readonly(self.vertices))
+        faces = tuple(tuple(int(i) for i in f) for f in self.faces)
+        object.__setattr__(self, "faces", faces)
+        if not self.names:
+            object.__setattr__(self, "names", tuple(f"f{i}" for i in range(len(faces))))
+        k = len(self.vertices)
+        if self.vertices.ndim != 2 or self.vertices.shape[1] != 3 or not np.all(np.isfinite(self.vertices)):
+            raise ValueError("Polyhedron needs finite (k, 3) vertices")
+        if len(faces) < 4 or len(self.names) != len(faces) or len(set(self.names)) != len(faces):
+            raise ValueError("Polyhedron needs at least 4 faces, each with its own name")
+        if any(len(f) < 3 or min(f) < 0 or max(f) >= k for f in faces):
+            raise ValueError(f"Polyhedron faces need 3 or more vertex indices in 0..{k - 1}")
+        planes = np.zeros((len(faces), 4))
+        tris: list[tuple[int, int, int]] = []
+        for i, f in enumerate(faces):
+            poly = self.vertices[list(f)]
+            nw = _newell(poly)
+            norm = float(np.linalg.norm(nw))
+            if norm <= 1e-18:
+                raise ValueError(f"Polyhedron face {self.names[i]} has zero area")
+            n = nw / norm
+            planes[i, :3], planes[i, 3] = n, float(n @ poly.mean(axis=0))
+            u = poly[1] - poly[0] if len(poly) > 1 else np.array([1.0, 0.0, 0.0])
+            u = u - (u @ n) * n
+            u = u / max(float(np.linalg.norm(u)), 1e-300)
+            v = np.cross(n, u)
+            uv = np.stack([poly @ u, poly @ v], axis=1)
+            tris.extend((f[a], f[b], f[c]) for a, b, c in _ear_clip(uv))
+        object.__setattr__(self, "_planes", readonly(planes))
+        object.__setattr__(self, "_tris", readonly(np.array(tris, dtype=np.intp).reshape(-1, 3), np.intp))
+
+    def _index(self, face: str) -> int:
+        try:
+            return self.names.index(face)
+        except ValueError:
+            raise ValueError(f"unknown face {face!r}; valid: {', '.join(self.names)}") from None
+
+    def face_names(self) -> tuple[str, ...]:
+        """The faces' names, in order."""
+        return self.names
+
+    def face_plane(self, face: str) -> tuple[FloatArray, float]:
+        """Outward unit normal n (3,) and offset d [m] of a face, so that the face lies in n . p = d."""
+        row = self._planes[self._index(face)]
+        return np.array(row[:3]), float(row[3])
+
+    def face_polygon(self, face: str) -> FloatArray:
+        """(m, 3) the face's vertices in order (counter-clockwise seen from outside) [m]."""
+        return np.array(self.vertices[list(self.faces[self._index(face)])])
+
+    def triangles(self) -> npt.NDArray[np.intp]:
+        """(t, 3) vertex indices of a triangulation of the faces, outward winding (a fan for a convex face)."""
+        return self._tris
+
+    def contains(self, p_A: npt.ArrayLike, margin: float = 0.0) -> npt.NDArray[np.bool_]:
+        """Which points (n, 3) lie inside the closed body (convex or not), grown by ``margin`` [m] (shrunk if < 0).
+
+        Inside means a winding number above one half (the solid angles of the triangles summed); the margin adds
+        (or removes) the points within ``|margin|`` of the surface.
+        """
+        p = np.asarray(p_A, dtype=float)
+        single = p.ndim == 1
+        p = p.reshape(-1, 3)
+        tri = self.vertices[self._tris]
+        a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+        out = np.zeros(len(p), dtype=bool)
+        step = max(1, _CHUNK // max(1, len(tri)))
+        for s in range(0, len(p), step):
+            q = p[s : s + step]
+            inside = self._winding(q, a, b, c) > 0.5
+            if margin != 0.0:
+                d = _point_triangle_distance(q, a, b, c).min(axis=1)
+                inside = (inside | (d <= margin)) if margin > 0 else (inside & (d >= -margin))
+            out[s : s + step] = inside
+        return out[0] if single else out
+
+    @staticmethod
+    def _winding(q: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+        """Generalised winding numbers (n,) of points q about the triangles (Van Oosterom and Strackee's angle)."""
+        ra, rb, rc = a[None] - q[:, None], b[None] - q[:, None], c[None] - q[:, None]
+        la, lb, lc = (np.linalg.norm(r, axis=-1) for r in (ra, rb, rc))
+        num = np.einsum("ntk,ntk->nt", ra, np.cross(rb, rc))
+        den = (
+            la * lb * lc
+            + np.einsum("ntk,ntk->nt", ra, rb) * lc
+            + np.einsum("ntk,ntk->nt", rb, rc) * la
+            + np.einsum("ntk,ntk->nt", rc, ra) * lb
+        )
+        return np.asarray(np.arctan2(num, den).sum(axis=1) / (2.0 * np.pi))
+
+    def transformed(self, X_CA: FloatArray) -> Polyhedron:
+        """The same body expressed in frame C, given the pose X_CA of its frame A in C."""
+        return Polyhedron(transform_points(X_CA, self.vertices), self.faces, self.names)
+
+    @property
+    def volume(self) -> float:
+        """The enclosed volume [m^3]."""
+        return self._volume_centroid()[0]
+
+    def _volume_centroid(self) -> tuple[float, FloatArray]:
+        o = self.vertices.mean(axis=0)
+        tri = self.vertices[self._tris] - o
+        v6 = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))  # 6 x signed tetrahedron volumes
+        vol = float(v6.sum()) / 6.0
+        if abs(vol) <= 1e-300:
+            return 0.0, np.asarray(o)
+        c = (v6[:, None] * tri.sum(axis=1)).sum(axis=0) / (4.0 * v6.sum())
+        return vol, np.asarray(c + o)
+
+    @property
+    def center(self) -> FloatArray:
+        """(3,) the centroid of the body's volume [m]."""
+        return self._volume_centroid()[1]
+
+    @property
+    def radius(self) -> float:
+        """The radius [m] of a sphere about :attr:`center` that holds the whole body."""
+        return float(np.max(np.linalg.norm(self.vertices - self.center, axis=1)))
+
+    def edges(self) -> FloatArray:
+        """(m, 2, 3) the body's feature edges (where two faces of different planes meet, or an open border) [m]."""
+        owners: dict[tuple[int, int], list[int]] = {}
+        for i, f in enumerate(self.faces):
+            for a, b in zip(f, f[1:] + f[:1], strict=True):
+                if a != b:
+                    owners.setdefault((min(a, b), max(a, b)), []).append(i)
+        out = []
+        for (a, b), fs in owners.items():
+            planes = self._planes[fs]
+            if len(fs) == 2 and np.allclose(planes[0], planes[1], atol=1e-9):
+                continue  # an edge inside one plane (a face split in two)
+            out.append((self.vertices[a], self.vertices[b]))
+        return np.array(out, dtype=float).reshape(-1, 2, 3)

@@ -10,11 +10,12 @@ from ezdxf.document import Drawing
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.types import Box, MapSeam, Part, WeldMap
+from cell.types import Box, MapSeam, Part, Polyhedron, WeldMap
 from cell.types.map import UnsupportedSeam
 from cell.weldmap._load import MALFORMED, ezdxf_to_log, kind_of, load, log
 from cell.weldmap._walk import Found, RawBody, RawSeam, Reader
-from cell.weldmap.boxfit import bounding_box, fit_box, open_edges, zero_area_faces
+from cell.weldmap.boxfit import BOX_TOL, bounding_box, fit_box, open_edges, zero_area_faces
+from cell.weldmap.polyfit import fit_polyhedron
 from cell.weldmap.roles import LayerPatterns, LayerRoles, body_role
 from cell.weldmap.units import METRES_PER_UNIT, extent_warning, resolve_units
 
@@ -101,6 +102,9 @@ def _touching(boxes: list[Part], pts: FloatArray) -> np.ndarray:
     """(n_seams, n_boxes) whether each seam's points (n_seams, k, 3) all lie within TOUCH_M of each box."""
     out = np.zeros((len(pts), len(boxes)), dtype=bool)
     for j, part in enumerate(boxes):
+        if not part.is_box:
+            out[:, j] = part.contains(pts.reshape(-1, 3), TOUCH_M).reshape(pts.shape[:2]).all(axis=1)
+            continue
         X, half = part.box.X_AB, part.box.size / 2.0 + TOUCH_M
         p_B = (pts - X[:3, 3]) @ X[:3, :3]  # into the box frame
         out[:, j] = np.all(np.abs(p_B) <= half, axis=(1, 2))
@@ -114,7 +118,7 @@ def _near(vertices: FloatArray | None, pts: FloatArray) -> bool:
     return bool(np.any(np.all((pts >= lo) & (pts <= hi), axis=1)))
 
 
-def _named(found: list[tuple[RawBody, Box]]) -> list[Part]:
+def _named(found: list[tuple[RawBody, Box | Polyhedron]]) -> list[Part]:
     count = Counter(b.name for b, _ in found)
     index: Counter[str] = Counter()
     parts = []
@@ -127,9 +131,9 @@ def _named(found: list[tuple[RawBody, Box]]) -> list[Part]:
 def _bodies(
     found: Found, spec: LayerPatterns, scale: float, src: str, warnings: list[str]
 ) -> tuple[list[Part], list[Part], list[tuple[RawBody, FloatArray | None, str]]]:
-    parts: list[tuple[RawBody, Box]] = []
-    fixtures: list[tuple[RawBody, Box]] = []
-    bad: list[tuple[RawBody, FloatArray | None, str]] = []  # parts that are no box: (body, vertices [m], why)
+    parts: list[tuple[RawBody, Box | Polyhedron]] = []
+    fixtures: list[tuple[RawBody, Box | Polyhedron]] = []
+    bad: list[tuple[RawBody, FloatArray | None, str]] = []  # parts that cannot be read: (body, vertices [m], why)
     for b in found.bodies:
         role = body_role(b.name, b.layer, spec)
         if role == "ignored":
@@ -142,20 +146,25 @@ def _bodies(
                 bad.append((b, None, b.reason))
             continue
         v, faces = b.mesh[0] * scale, b.mesh[1]
+        body: Box | Polyhedron
         try:
-            box = fit_box(v, faces, b.name)
+            body = fit_box(v, faces, b.name)
         except MapError as exc:
-            why = exc.message.removeprefix(f"part {b.name} ")
-            if n_open := open_edges(v, faces):
-                why += f" (not closed: {_plural(n_open, 'edge')} on one face only)"
-            if role == "part":
-                bad.append((b, v, why))
-                continue
-            box = bounding_box(v)
-            warnings.append(f"{src}: fixture {b.where} {why}; its bounding box is the obstacle")
+            if role == "part":  # not a box: a closed polyhedral body will do
+                try:
+                    body = fit_polyhedron(v, faces, b.name, BOX_TOL)
+                except MapError as poly_exc:
+                    bad.append((b, v, poly_exc.message.removeprefix(f"part {b.name} ")))
+                    continue
+            else:
+                why = exc.message.removeprefix(f"part {b.name} ")
+                if n_open := open_edges(v, faces):
+                    why += f" (not closed: {_plural(n_open, 'edge')} on one face only)"
+                body = bounding_box(v)
+                warnings.append(f"{src}: fixture {b.where} {why}; its bounding box is the obstacle")
         if zero := zero_area_faces(v, faces):
             warnings.append(f"{src}: {b.where} has {_plural(zero, 'zero-area face')} (ignored)")
-        (parts if role == "part" else fixtures).append((b, box))
+        (parts if role == "part" else fixtures).append((b, body))
     return _named(parts), _named(fixtures), bad
 
 
@@ -167,8 +176,9 @@ def _place(
     src: str,
     warnings: list[str],
 ) -> tuple[list[MapSeam], list[UnsupportedSeam]]:
-    """Seams on parts stay; seams on a fixture become unsupported; a body that is no box refuses the map only when
-    it holds a seam (or may: an unreadable body when a seam touches no part), else it is skipped with a warning."""
+    """Seams on parts stay; seams on a fixture become unsupported; a body that cannot be read (not closed,
+    self-intersecting, ...) refuses the map only when it holds a seam (or may: an unreadable body when a seam
+    touches no part), else it is skipped with a warning."""
     kept, unsupported, loose = [], [], []
     pts = np.array([[s.p_start, s.p_end, (s.p_start + s.p_end) / 2.0] for s, _ in seams]).reshape(-1, 3, 3)
     on_parts, on_fixtures = _touching(parts, pts), _touching(fixtures, pts)
@@ -186,7 +196,7 @@ def _place(
         held = [s.id for s, raw in seams if _near(v, np.array([s.p_start, s.p_end]))]
         if held:
             raise MapError(
-                f"{src}: {b.where}: part {b.name} {why}; it holds seam {held[0]}: parts must be boxes "
+                f"{src}: {b.where}: part {b.name} {why}; it holds seam {held[0]}: parts must be closed bodies "
                 "(a body that holds no seam is skipped with a warning)"
             )
         if v is None and loose:

@@ -364,10 +364,16 @@ def test_a_part_that_is_not_a_box(tmp_path: Path) -> None:
     mesh.vertices[7] = mesh.vertices[7] + (0, 0, 20)  # a wedge, not a box
     mesh.render_mesh(doc.modelspace(), dxfattribs={"layer": "Wedge"})
     doc.saveas(tmp_path / "v.dxf")
-    m = read_map(tmp_path / "v.dxf")  # it holds no seam: skipped, with a warning naming it
+    m = read_map(tmp_path / "v.dxf")  # a closed body that is not a box: a polyhedral part
+    assert [p.name for p in m.parts] == [*parts, "Wedge"] and not m.part("Wedge").is_box and not m.warnings
+    doc = make_maps.build_map(parts, seams)
+    mesh.faces = mesh.faces[1:]  # an open body: it holds no seam, so it is skipped with a warning naming it
+    mesh.render_mesh(doc.modelspace(), dxfattribs={"layer": "Wedge"})
+    doc.saveas(tmp_path / "v.dxf")
+    m = read_map(tmp_path / "v.dxf")
     assert [p.name for p in m.parts] == list(parts)
     [w] = m.warnings
-    assert "MESH" in w and "on layer Wedge: part Wedge is not a box" in w and "skipped" in w
+    assert "MESH" in w and "on layer Wedge: part Wedge is not closed" in w and "skipped" in w
     doc.modelspace().add_line((0, 900, 50), (50, 900, 50), dxfattribs={"color": 1})  # now it holds a seam
     doc.saveas(tmp_path / "v.dxf")
-    _refused(tmp_path / "v.dxf", MapError, "MESH", "on layer Wedge: part Wedge is not a box", "v.dxf", "holds seam")
+    _refused(tmp_path / "v.dxf", MapError, "MESH", "on layer Wedge: part Wedge is not closed", "v.dxf", "holds seam")

@@ -127,7 +127,7 @@ def test_a_3dface_model_reads_as_boxes(tmp_path: Path) -> None:
     with pytest.raises(MapError) as exc:
         read_map(_save(doc, tmp_path))
     first = next(e for e in doc.modelspace().query("3DFACE") if e.dxf.layer == "POST_L").dxf.handle
-    _one_line(exc, f"3DFACE {first} (and 9 more) on layer POST_L", "not a closed box", "holds seam POST_L>")
+    _one_line(exc, f"3DFACE {first} (and 9 more) on layer POST_L", "is not closed", "holds seam POST_L>")
 
 
 def test_a_polyface_in_a_rotated_block(tmp_path: Path) -> None:
@@ -297,7 +297,7 @@ def test_degenerate_and_self_intersecting_faces(tmp_path: Path) -> None:
     mesh.render_mesh(doc.modelspace(), dxfattribs={"layer": "POST_L"})
     with pytest.raises(MapError) as exc:
         read_map(_save(doc, tmp_path))
-    _one_line(exc, "MESH", "on layer POST_L: part POST_L is not a closed box", "holds seam POST_L>")
+    _one_line(exc, "MESH", "on layer POST_L: part POST_L is not closed", "holds seam POST_L>")
 
 
 def test_a_map_of_curves_only_has_no_seam_to_weld(tmp_path: Path) -> None:

@@ -1,31 +1,39 @@
 """How each seam of a welding map is made, from the geometry alone: which part abuts, which receives, which
 faces.
 
-A seam of a T (or corner) joint lies on a face of the receiving part B, where that face meets the plane of one
-of the side faces of the abutting part A, whose end face looks at B across a small gap. :func:`find_joints`
-recovers that :class:`~cell.seams.base.Joint` for every seam without reading the seam id; :func:`weld_faces`
-and :func:`fillet_bisector` give the two faces' planes and the direction out of the fillet corner (for the
-torch and the locators). All geometry is in the map's own frame (whatever ``weldmap.frame`` is), metres.
+A seam of a T, corner or lap fillet lies on a face of the receiving part B, where that face meets the plane of
+one of the side faces of the abutting part A, whose end face lies flat against B across a small gap (antiparallel
+to B's face: a mitred brace's end lies on the post). The two weld faces meet at any dihedral between
+``MIN_DIHEDRAL_DEG`` and ``MAX_DIHEDRAL_DEG`` (90 degrees for boxes). Faces are any of a part's
+:meth:`~cell.types.Part.face_names` (a box's ``"+x"``..., a polyhedron's ``"f0"``...). :func:`find_joints`
+recovers that :class:`~cell.types.Joint` for every seam without reading the seam id; :func:`weld_faces`,
+:func:`fillet_bisector`, :func:`dihedral` and :func:`weld_geometry` give the two faces' planes, the direction out
+of the fillet corner and the angle between the faces (for the torch and the locators); :func:`joint_kind` says T,
+corner or lap. All geometry is in the map's own frame (whatever ``weldmap.frame`` is), metres and radians.
 """
 
 from __future__ import annotations
+
+import math
+from typing import NamedTuple
 
 import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.types import BOX_FACES, Joint, MapSeam, Part, WeldMap
+from cell.types import Joint, MapSeam, Part, WeldMap
 
 _ANTIPARALLEL_COS = float(np.cos(np.radians(5.0)))  # end face vs receiving face: within 5 deg of opposite
+MIN_DIHEDRAL_DEG = 30.0  # the weld faces' angle: sharper than this is no fillet
+MAX_DIHEDRAL_DEG = 150.0  # flatter than this is a butt, not a fillet
+_COPLANAR_M = 0.003  # [m] how far two faces may lie apart and still be flush (a corner joint)
 
 
-def _face_axis(face: str) -> int:
-    return "xyz".index(face[1])
-
-
-def _on_plane(part: Part, face: str, pts: FloatArray, tol: float) -> bool:
-    n, d = part.face_plane(face)
-    return bool(np.all(np.abs(pts @ n - d) <= tol))
+def _planes(part: Part) -> tuple[tuple[str, ...], FloatArray, FloatArray]:
+    """The part's face names, outward normals (F, 3) and offsets (F,)."""
+    names = part.face_names()
+    planes = [part.face_plane(f) for f in names]
+    return names, np.array([n for n, _ in planes]), np.array([d for _, d in planes])
 
 
 def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: float) -> list[tuple[float, Joint]]:
@@ -34,20 +42,23 @@ def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: flo
     pts = np.stack([seam.p_start, seam.p_end])
     # Both parts of a joint hold the seam within the gap (plus tolerance): only those are worth a look.
     parts = tuple(p for p in parts if np.all(p.contains(pts, margin=max_gap + tol)))
+    planes = {p.name: _planes(p) for p in parts}
+    cos_lo, cos_hi = math.cos(math.radians(180.0 - MIN_DIHEDRAL_DEG)), math.cos(math.radians(180.0 - MAX_DIHEDRAL_DEG))
     found: list[tuple[float, Joint]] = []
     for b in parts:
-        for face_b in BOX_FACES:
-            n_b, d_b = b.face_plane(face_b)
-            res_b = np.abs(pts @ n_b - d_b)
-            if np.any(res_b > tol) or not np.all(b.contains(pts, margin=tol)):
+        names_b, N_b, D_b = planes[b.name]
+        res_B = np.abs(pts @ N_b.T - D_b)  # (2, F) each seam end off each face plane
+        for k_b in np.flatnonzero(np.all(res_B <= tol, axis=0)):
+            if not np.all(b.contains(pts, margin=tol)):
                 continue
+            n_b, res_b = N_b[k_b], res_B[:, k_b]
             for a in parts:
                 if a.name == b.name:
                     continue
-                for end_face in BOX_FACES:
-                    n_e, d_e = a.face_plane(end_face)
-                    if float(n_e @ n_b) > -_ANTIPARALLEL_COS:
-                        continue
+                names_a, N_a, D_a = planes[a.name]
+                res_A = np.abs(pts @ N_a.T - D_a)
+                for k_e in np.flatnonzero(N_a @ n_b <= -_ANTIPARALLEL_COS):
+                    n_e, d_e = N_a[k_e], D_a[k_e]
                     gap = pts @ n_e - d_e  # how far the seam lies in front of A's end face
                     if np.any(gap < -tol) or np.any(gap > max_gap + tol):
                         continue
@@ -55,22 +66,31 @@ def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: flo
                     q = pts - np.outer(gap, n_e)
                     if not np.all(a.contains(q, margin=tol)):
                         continue
-                    for face_a in BOX_FACES:
-                        if _face_axis(face_a) == _face_axis(end_face):
-                            continue
-                        n_a, d_a = a.face_plane(face_a)
-                        res_a = np.abs(pts @ n_a - d_a)
-                        if np.any(res_a > tol):
-                            continue
-                        score = float(np.mean(np.abs(gap)) + res_a.sum() + res_b.sum())
-                        found.append((score, Joint(seam.id, a.name, b.name, face_a, face_b, end_face)))
+                    c = N_a @ n_b  # cos of the angle between the normals: 180 deg - the dihedral
+                    ok = np.all(res_A <= tol, axis=0) & (c >= cos_lo) & (c <= cos_hi)
+                    for k_a in np.flatnonzero(ok):
+                        score = float(np.mean(np.abs(gap)) + res_A[:, k_a].sum() + res_b.sum())
+                        joint = Joint(seam.id, a.name, b.name, names_a[k_a], names_b[k_b], names_a[k_e])
+                        found.append((score, joint))
     return found
 
 
-def find_joints(weldmap: WeldMap, tol_m: float = 0.003, max_gap_m: float = 0.006) -> dict[str, Joint]:
-    """The :class:`Joint` of every seam of ``weldmap``, keyed by seam id, found from the part boxes alone.
+def _nearest_faces(seam: MapSeam, parts: tuple[Part, ...], n: int = 2) -> str:
+    """The ``n`` face planes nearest the seam (its ends' largest distance), for a message."""
+    pts = np.stack([seam.p_start, seam.p_end])
+    near = []
+    for p in parts:
+        names, N, D = _planes(p)
+        dist = np.abs(pts @ N.T - D).max(axis=0)
+        near += [(float(d), f"{p.name}:{f}") for d, f in zip(dist, names, strict=True)]
+    near.sort()
+    return ", ".join(f"{f} ({d * 1000:.1f} mm)" for d, f in near[:n]) or "none"
 
-    tol_m : how far [m] a seam end may lie off a face plane or outside a face rectangle.
+
+def find_joints(weldmap: WeldMap, tol_m: float = 0.003, max_gap_m: float = 0.006) -> dict[str, Joint]:
+    """The :class:`Joint` of every seam of ``weldmap``, keyed by seam id, found from the parts' faces alone.
+
+    tol_m : how far [m] a seam end may lie off a face plane or outside the body.
     max_gap_m : the largest gap [m] between the abutting part's end face and the receiving face.
     Raises :class:`MapError` naming the seam when a seam does not sit on two parts this way.
     """
@@ -82,7 +102,9 @@ def find_joints(weldmap: WeldMap, tol_m: float = 0.003, max_gap_m: float = 0.006
         if not found:
             raise MapError(
                 f"seam {seam.id!r} does not sit on two parts: no part face holds it with another part's end "
-                f"face across a gap of at most {max_gap_m * 1000:.1f} mm (tolerance {tol_m * 1000:.1f} mm)"
+                f"face across a gap of at most {max_gap_m * 1000:.1f} mm and a face at {MIN_DIHEDRAL_DEG:.0f} to "
+                f"{MAX_DIHEDRAL_DEG:.0f} deg (tolerance {tol_m * 1000:.1f} mm); nearest faces: "
+                f"{_nearest_faces(seam, weldmap.parts)}"
             )
         joints[seam.id] = min(found, key=lambda sj: sj[0])[1]
     return joints
@@ -109,3 +131,49 @@ def fillet_bisector(weldmap: WeldMap, joint: Joint) -> FloatArray:
     if norm < 1e-9:
         raise MapError(f"seam {joint.seam_id!r}: the weld faces are parallel, there is no fillet corner")
     return np.asarray(s / norm)
+
+
+def dihedral(weldmap: WeldMap, joint: Joint) -> float:
+    """The angle [rad] between the two weld faces, inside the fillet (pi/2 for a box T; about 0.61 and 2.53 on
+    either side of a brace at 35 degrees): pi minus the angle between their outward normals."""
+    n_a, _, n_b, _ = weld_faces(weldmap, joint)
+    return math.pi - math.acos(max(-1.0, min(1.0, float(n_a @ n_b))))
+
+
+class WeldGeometry(NamedTuple):
+    """The two weld faces of a joint in the map's frame: planes (n . p = d, outward unit normals), the unit
+    direction out of the fillet corner, and the dihedral [rad] between the faces."""
+
+    n_a: FloatArray
+    d_a: float
+    n_b: FloatArray
+    d_b: float
+    bisector: FloatArray
+    dihedral: float
+
+
+def weld_geometry(weldmap: WeldMap, joint: Joint) -> WeldGeometry:
+    """:func:`weld_faces`, :func:`fillet_bisector` and :func:`dihedral` of one joint at once."""
+    n_a, d_a, n_b, d_b = weld_faces(weldmap, joint)
+    return WeldGeometry(n_a, d_a, n_b, d_b, fillet_bisector(weldmap, joint), dihedral(weldmap, joint))
+
+
+def joint_kind(weldmap: WeldMap, joint: Joint) -> str:
+    """``T``, ``corner`` or ``lap`` for one seam's joint, for any bodies (parts and faces in the same frame).
+
+    lap: the abutting part rests on the receiving face with a thin side (its extent along the end face's normal is
+    smaller than along its weld face's normal); corner: the abutting part's face most opposite its weld face is
+    flush with a face of the receiving part (the outside of an L); T otherwise.
+    """
+    a, b = weldmap.part(joint.abutting), weldmap.part(joint.receiving)
+    n_end, _ = a.face_plane(joint.end_face)
+    n_a, _ = a.face_plane(joint.face_abutting)
+    h_end, h_a = a.vertices() @ n_end, a.vertices() @ n_a
+    if np.ptp(h_end) < np.ptp(h_a):
+        return "lap"
+    _, N_a, D_a = _planes(a)
+    k_o = int(np.argmin(N_a @ n_a))
+    n_o, d_o = N_a[k_o], D_a[k_o]
+    _, N_b, D_b = _planes(b)
+    flush = (N_b @ n_o > math.cos(math.radians(5.0))) & (np.abs(D_b - d_o) <= _COPLANAR_M)
+    return "corner" if bool(np.any(flush)) else "T"

@@ -32,18 +32,22 @@ MIN_TIP_RAD = math.radians(15.0)
 
 
 def principal_axes(weldmap_R: WeldMap) -> FloatArray:
-    """(3, 3) the part's principal axes as columns, longest extent first: the axes of its largest part's box
-    (a welded frame's members are drawn square to each other), ordered by the whole part's extent along them."""
-    big = max(weldmap_R.parts, key=lambda p: float(np.prod(p.box.size)))
-    axes = big.box.X_AB[:3, :3]
+    """(3, 3) the part's principal axes as columns, longest extent first: the axes of its largest box part's box
+    (a welded frame's members are drawn square to each other; with no box part, the principal axes of all the
+    vertices), ordered by the whole part's extent along them."""
     pts = np.concatenate([p.vertices() for p in weldmap_R.parts])
+    boxes = [p for p in weldmap_R.parts if p.is_box]
+    if boxes:
+        axes = max(boxes, key=lambda p: p.volume).box.X_AB[:3, :3]
+    else:
+        axes = np.linalg.svd(pts - pts.mean(axis=0), full_matrices=False)[2].T
     extent = np.ptp(pts @ axes, axis=0)
     return np.asarray(axes[:, np.argsort(-extent)])
 
 
 def centre_of_mass(weldmap_R: WeldMap) -> FloatArray:
-    """(3,) the part's centre of mass [m]: its parts' centres weighted by their box volumes (one steel)."""
-    vol = np.array([float(np.prod(p.box.size)) for p in weldmap_R.parts])
+    """(3,) the part's centre of mass [m]: its parts' centres weighted by their volumes (one steel)."""
+    vol = np.array([p.volume for p in weldmap_R.parts])
     centres = np.stack([p.center for p in weldmap_R.parts])
     return np.asarray((centres * vol[:, None]).sum(axis=0) / vol.sum())
 

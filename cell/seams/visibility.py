@@ -1,30 +1,26 @@
 """Which seams a camera above the table can see: a seam against the table cannot be seen (nor welded) as it
 lies.
 
-No axis names are assumed for the parts: a weld face is "on the table" when its actual outward normal points
-down (against the robot frame's +z, the direction in which ``table_z`` is measured) and the face lies at the
-table top.
+No axis names are assumed for the parts (boxes or polyhedra alike): a weld face is "on the table" when its
+actual outward normal points down (against the robot frame's +z, the direction in which ``table_z`` is
+measured) and every vertex of its polygon lies at the table top.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from cell.types import Box, Joint, WeldMap
+from cell.types import Joint, Part, WeldMap
 
 UNDERSIDE_REASON = "underside: the seam lies against the table; flip the part to weld it"
 
 
-def _face_on_table(box: Box, face: str, table_z: float, tol_m: float, down_cos: float) -> bool:
-    n, _ = box.face_plane(face)
+def _face_on_table(part: Part, face: str, table_z: float, tol_m: float, down_cos: float) -> bool:
+    """Whether the face's outward normal points down and every vertex of its polygon lies at the table top."""
+    n, _ = part.face_plane(face)
     if float(n[2]) > -down_cos:  # the outward normal does not point down into the table
         return False
-    axis = "xyz".index(face[1])
-    sign = 1.0 if face[0] == "+" else -1.0
-    corners = box.corners()
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-    on_face = corners[signs[:, axis] == sign]  # the face's 4 corners (Box.corners() bit order)
-    return bool(np.all(np.abs(on_face[:, 2] - table_z) <= tol_m))
+    return bool(np.all(np.abs(part.face_polygon(face)[:, 2] - table_z) <= tol_m))
 
 
 def visibility(
@@ -40,6 +36,6 @@ def visibility(
     """
     down_cos = float(np.cos(np.radians(max_tilt_deg)))
     for name, face in ((joint.abutting, joint.face_abutting), (joint.receiving, joint.face_receiving)):
-        if _face_on_table(weldmap_R.part(name).box, face, table_z, tol_m, down_cos):
+        if _face_on_table(weldmap_R.part(name), face, table_z, tol_m, down_cos):
             return False, UNDERSIDE_REASON
     return True, ""

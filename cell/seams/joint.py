@@ -15,6 +15,7 @@ corner or lap. All geometry is in the map's own frame (whatever ``weldmap.frame`
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -177,3 +178,17 @@ def joint_kind(weldmap: WeldMap, joint: Joint) -> str:
     _, N_b, D_b = _planes(b)
     flush = (N_b @ n_o > math.cos(math.radians(5.0))) & (np.abs(D_b - d_o) <= _COPLANAR_M)
     return "corner" if bool(np.any(flush)) else "T"
+
+
+def joint_notes(weldmap: WeldMap) -> dict[str, str]:
+    """Each seam's joint as ``cell map info`` shows it (:func:`cell.weldmap.describe`): type, dihedral [deg],
+    abutting > receiving part, e.g. ``T 90 deg  POST_L > TOP_RAIL``; a seam no two faces hold is left out."""
+    text = {}
+    for s in weldmap.seams:
+        try:
+            joint = find_joints(replace(weldmap, seams=(s,)))[s.id]
+        except MapError:
+            continue
+        deg = math.degrees(dihedral(weldmap, joint))
+        text[s.id] = f"{joint_kind(weldmap, joint)} {deg:.0f} deg  {joint.abutting} > {joint.receiving}"
+    return text

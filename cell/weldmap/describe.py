@@ -1,4 +1,5 @@
-"""The text of ``cell map info``: units, parts and fixtures (type, size, centre), seams, unsupported seams."""
+"""The text of ``cell map info``: units, parts and fixtures (type box or mesh, size, centre), seams with their joint
+(type T / corner / lap, dihedral), unsupported seams."""
 
 from __future__ import annotations
 
@@ -18,10 +19,15 @@ def _bodies(title: str, bodies: tuple[Part, ...]) -> list[str]:
     lines = [f"{title}: {len(bodies)}"]
     width = max((len(p.name) for p in bodies), default=4)
     for p in bodies:
-        size = " x ".join(f"{s * 1000:.1f}" for s in p.box.size)
-        kind = f"box ({p.drawn_as})" if p.drawn_as else "box"
-        line = f"  {p.name:<{width}}  {kind:<16} {size:>24} mm  centre {_fmt(p.box.center * 1000)}"
-        R = p.box.X_AB[:3, :3]
+        kind = f"{p.kind} ({p.drawn_as})" if p.drawn_as else p.kind
+        if p.is_box:
+            size = " x ".join(f"{s * 1000:.1f}" for s in p.box.size)
+            R = p.box.X_AB[:3, :3]
+        else:  # a polyhedron: the extent of its vertices along the map's axes, and its face count
+            size = "extent " + " x ".join(f"{s * 1000:.1f}" for s in np.ptp(p.vertices(), axis=0))
+            kind += f" {len(p.face_names())} faces"
+            R = np.eye(3)
+        line = f"  {p.name:<{width}}  {kind:<16} {size:>24} mm  centre {_fmt(p.center * 1000)}"
         if not np.allclose(R, np.eye(3), atol=1e-9):
             line += "  rpy " + _fmt(np.degrees(matrix_to_rpy(R)), ".2f") + " deg"
         lines.append(line)

@@ -1,7 +1,8 @@
 """The simulated cell: one object owns its PyBullet client, builds the as-built cell, renders depth cameras.
 
-The world frame W has z up; the ground is the plane z = 0. Bodies are static boxes found by name
-(``"ground"``, ``"table"`` and each part's name), never by index. Cameras render with PyBullet's TinyRenderer
+The world frame W has z up; the ground is the plane z = 0. Bodies are static, found by name (``"ground"``,
+``"table"``, each part's name and ``fixture:<name>`` for the map's fixtures), never by index: boxes as boxes, any
+other body from its mesh (:mod:`cell.sim.bodies`, docs/bodies.md). Cameras render with PyBullet's TinyRenderer
 (headless, CPU), also when a GUI is shown, because its sampling is the one :mod:`cell.sim.camera` models
 exactly.
 
@@ -24,6 +25,7 @@ from scipy.spatial.transform import Rotation
 from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
+from cell.sim.bodies import add_box, add_part
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.noise import apply_noise, perturb_pose
@@ -38,6 +40,8 @@ _GROUND_SIZE = (20.0, 20.0, 0.02)  # [m] a thin box whose top face is the plane 
 _RGBA = {GROUND: (0.35, 0.35, 0.35, 1.0), TABLE: (0.55, 0.45, 0.35, 1.0)}
 _PART_RGBA = (0.7, 0.72, 0.75, 1.0)
 _OCCLUDER_RGBA = (0.2, 0.3, 0.8, 1.0)
+_FIXTURE_RGBA = (0.45, 0.45, 0.47, 1.0)  # grey: clamps, stops and jigs
+FIXTURE_PREFIX = "fixture:"  # body names of the map's fixtures: ``fixture:<name>``
 DEFAULT_BEAD = BeadStyle()
 EYE_IN_HAND_LINK = "camera_optical"  # the arm's optical frame of the eye-in-hand camera (z forward, y down)
 
@@ -46,8 +50,10 @@ class SimCell:
     """The as-built cell in PyBullet.
 
     scenario : the cell (table, cameras, noise, seed).
-    parts_W : the as-built parts, boxes in W (``cell.asbuilt.as_built_parts``); names must be unique.
+    parts_W : the as-built parts in W (``cell.asbuilt.as_built_parts``), boxes or polyhedra; names must be unique.
     gui : show PyBullet's GUI (needs a display); headless ``DIRECT`` by default.
+    fixtures_W : the map's fixtures in W (``cell.asbuilt.as_built_fixtures``): clamps, stops, jigs, rendered grey as
+        bodies ``fixture:<name>`` so the cameras see them as in the real cell; they stay put when the part is turned.
     The scenario's ``faults:`` (:mod:`cell.sim.faults`) are applied here: parts in ``missing_parts`` are not
     built (``parts_W`` still lists them: it is the design as built), occluders are added as bodies
     ``occluder:<name>``, and a faulty camera's images are corrupted after the noise model.
@@ -55,7 +61,9 @@ class SimCell:
     Use as a context manager (``with SimCell(scenario, parts) as sim:``) or call :meth:`close`.
     """
 
-    def __init__(self, scenario: Scenario, parts_W: Sequence[Part], *, gui: bool = False) -> None:
+    def __init__(
+        self, scenario: Scenario, parts_W: Sequence[Part], *, gui: bool = False, fixtures_W: Sequence[Part] = ()
+    ) -> None:
         names = [p.name for p in parts_W]
         reserved = {GROUND, TABLE}
         clash = sorted({n for n in names if names.count(n) > 1 or n in reserved})
@@ -77,7 +85,9 @@ class SimCell:
         self._add_box(TABLE, Box(make_pose(p=table.center_m), np.array(table.size_m)), _RGBA[TABLE])
         # Faults (scenario ``faults:``): parts not built are left out, objects the map does not know are added.
         for part in built_parts(self.parts_W, scenario.faults):
-            self._add_box(part.name, part.box, _PART_RGBA)
+            self._bodies[part.name] = add_part(self.client, part, _PART_RGBA)
+        for fixture in fixtures_W:
+            self._bodies[FIXTURE_PREFIX + fixture.name] = add_part(self.client, fixture, _FIXTURE_RGBA)
         for name, box in occluder_boxes(scenario.faults):
             self._add_box(name, box, _OCCLUDER_RGBA)
 
@@ -96,27 +106,15 @@ class SimCell:
         return MappingProxyType(self._bodies)
 
     def body_id(self, name: str) -> int:
-        """The PyBullet body id of ``name`` (``"ground"``, ``"table"`` or a part name)."""
+        """The PyBullet body id of ``name`` (``"ground"``, ``"table"``, a part name or ``"fixture:<name>"``)."""
         if name not in self._bodies:
             raise KeyError(f"no body {name!r}; bodies: {', '.join(self._bodies)}")
         return self._bodies[name]
 
     def _add_box(self, name: str, box_W: Box, rgba: tuple[float, float, float, float]) -> int:
-        c = self.client
-        half = [float(h) for h in box_W.size / 2.0]
-        collision = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
-        visual = c.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=list(rgba))
-        # scipy and PyBullet both order quaternions (x, y, z, w): no conversion needed.
-        quat = Rotation.from_matrix(box_W.X_AB[:3, :3]).as_quat()
-        body = c.createMultiBody(
-            baseMass=0.0,
-            baseCollisionShapeIndex=collision,
-            baseVisualShapeIndex=visual,
-            basePosition=[float(v) for v in box_W.center],
-            baseOrientation=[float(v) for v in quat],
-        )
+        body = add_box(self.client, box_W, rgba)
         self._bodies[name] = body
-        return int(body)
+        return body
 
     # -- cameras ---------------------------------------------------------------------------------------------
 
@@ -265,7 +263,7 @@ class SimCell:
     def move_part(self, X_W_new_old: FloatArray) -> tuple[Part, ...]:
         """Move the part (every built part, one rigid body now, and every bead drawn on it) by the rigid motion
         X_W_new_old (4, 4) in W: the part turned over and set down again. Returns the parts as they now lie (the
-        new ground truth); the table, the ground and the occluders stay where they are."""
+        new ground truth); the table, the ground, the fixtures and the occluders stay where they are."""
         X = np.asarray(X_W_new_old, dtype=float)
         names = {p.name for p in self.parts_W}
         bodies = [b for n, b in self._bodies.items() if n in names] + list(self._beads)

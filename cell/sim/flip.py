@@ -28,6 +28,13 @@ def body_points(parts_W: Sequence[Part], beads_W: FloatArray, bead_radius_m: flo
     return np.concatenate(pts)
 
 
+def body_volume(part: Part) -> float:
+    """The volume [m^3] of a part's body: a box's edge lengths multiplied (exactly as before meshes), a polyhedron's
+    from its closed surface (signed tetrahedra from its triangles: :attr:`cell.types.Polyhedron.volume`, whose centre
+    of mass :attr:`cell.types.Part.center` is the same sum's centroid)."""
+    return float(np.prod(part.box.size)) if part.is_box else float(part.volume)
+
+
 def operator_error(spec: FlipPlacementSpec, rng: np.random.Generator, centre_W: FloatArray) -> FloatArray:
     """(4, 4) the operator's placement error in W: a turn of ``rotation_deg`` (its sign drawn) about the vertical
     through ``centre_W`` (3,), then a horizontal shift of ``offset_mm`` in a drawn direction."""
@@ -49,10 +56,10 @@ def turned_pose(
     rng: np.random.Generator,
 ) -> FloatArray:
     """(4, 4) X_W_new_old: the as-built part moved by the nominal turn X_W_turn (4, 4), settled on its own hull
-    (the as-built boxes and the beads differ a little from the drawing), set down on the table top and shifted
+    (the as-built bodies and the beads differ a little from the drawing), set down on the table top and shifted
     by the operator's error."""
     pts = transform_points(X_W_turn, body_points(parts_W, beads_W, bead_radius_m))
-    vol = np.array([float(np.prod(p.box.size)) for p in parts_W])
+    vol = np.array([body_volume(p) for p in parts_W])
     com = transform_points(X_W_turn, (np.stack([p.center for p in parts_W]) * vol[:, None]).sum(axis=0) / vol.sum())
     centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
     X_settle, _, _ = set_down(pts, com, np.eye(3), centre, table_top_z)

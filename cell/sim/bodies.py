@@ -1,0 +1,63 @@
+"""Static bodies of the simulated cell: a box as PyBullet's box, any other closed body from its mesh (docs/bodies.md).
+
+A polyhedral part is rendered from its triangles (``createVisualShape`` with ``GEOM_MESH``, vertices and indices, so
+the depth cameras see exactly its faces) and collided as a concave triangle mesh (``GEOM_FORCE_CONCAVE_TRIMESH``:
+allowed for static bodies, nothing here moves by physics). The mesh's vertices are given about the body's centroid
+and the body is placed there, so moving a body later (the part turned over) moves its base like a box's.
+
+Every body is static (mass 0); poses and vertices in the world W [m].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from cell.geometry import FloatArray
+from cell.sim.quiet import BulletClient, pybullet
+from cell.types import Box, Part
+
+Rgba = tuple[float, float, float, float]
+
+
+def _place(client: BulletClient, collision: int, visual: int, position: FloatArray, R: FloatArray) -> int:
+    # scipy and PyBullet both order quaternions (x, y, z, w): no conversion needed.
+    quat = Rotation.from_matrix(R).as_quat()
+    body = client.createMultiBody(
+        baseMass=0.0,
+        baseCollisionShapeIndex=collision,
+        baseVisualShapeIndex=visual,
+        basePosition=[float(v) for v in position],
+        baseOrientation=[float(v) for v in quat],
+    )
+    return int(body)
+
+
+def add_box(client: BulletClient, box_W: Box, rgba: Rgba) -> int:
+    """A static box body (its pose and size in W) coloured ``rgba``; returns the PyBullet body id."""
+    half = [float(h) for h in box_W.size / 2.0]
+    collision = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
+    visual = client.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=list(rgba))
+    return _place(client, collision, visual, box_W.center, box_W.X_AB[:3, :3])
+
+
+def add_mesh(client: BulletClient, vertices_W: FloatArray, triangles: np.ndarray, rgba: Rgba) -> int:
+    """A static body from a closed triangle mesh: vertices (k, 3) [m] in W, triangles (t, 3) vertex indices with
+    outward winding; placed at the vertices' mean. Returns the PyBullet body id."""
+    v = np.asarray(vertices_W, dtype=float)
+    origin = v.mean(axis=0)
+    local = [[float(c) for c in p] for p in v - origin]
+    idx = [int(i) for i in np.asarray(triangles, dtype=int).ravel()]
+    collision = client.createCollisionShape(
+        pybullet.GEOM_MESH, vertices=local, indices=idx, flags=pybullet.GEOM_FORCE_CONCAVE_TRIMESH
+    )
+    visual = client.createVisualShape(pybullet.GEOM_MESH, vertices=local, indices=idx, rgbaColor=list(rgba))
+    return _place(client, collision, visual, origin, np.eye(3))
+
+
+def add_part(client: BulletClient, part_W: Part, rgba: Rgba) -> int:
+    """A part (or fixture) in W as a static body: its box when it is a box, else its mesh."""
+    if part_W.is_box:
+        return add_box(client, part_W.box, rgba)
+    vertices, triangles = part_W.triangles()
+    return add_mesh(client, vertices, triangles, rgba)

@@ -3,8 +3,9 @@ shapes and the obstacle boxes for the torch test (:mod:`cell.motion.collision.sh
 
 What is checked, all in the robot base frame R [m]:
 
-* the arm's URDF collision shapes against obstacles: the as-perceived parts (boxes of the aligned welding map,
-  grown by ``part_inflation``) and the table (a fixture, known exactly: grown by ``table_inflation``);
+* the arm's URDF collision shapes against obstacles: the as-perceived parts (the aligned welding map's bodies,
+  boxes or polyhedra: :func:`cell.motion.collision.shapes.obstacle_shape`, grown by ``part_inflation``), its
+  fixtures (grown alike) and the table (known exactly: grown by ``table_inflation``);
 * the arm against itself, except pairs on the same or on adjacent links (``parentJoint`` equal, or one the
   parent of the other: their shapes touch at the joint by construction).
 
@@ -34,7 +35,7 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
-from cell.motion.collision.shapes import Boxes, ToolShapes, torch_contacts
+from cell.motion.collision.shapes import Bound, Boxes, ToolShapes, obstacle_shape, torch_contacts
 from cell.motion.contact import Contact, advance_along
 from cell.motion.robot import RobotModel
 from cell.types import Part
@@ -66,11 +67,12 @@ class CollisionChecker:
         self._trim_near_tcp(geom, tcp)
         self._n_robot = len(geom.geometryObjects)
         self.link_of: list[str] = [self._model.frames[o.parentFrame].name for o in geom.geometryObjects]
+        bounds: list[Bound] = []
         for part in obstacles:
             grow = opt.table_inflation if part.name == opt.table_name else opt.part_inflation
-            shape = coal.Box(np.asarray(part.box.size, dtype=float) + 2.0 * grow)
-            obj = pin.GeometryObject(part.name, 0, 0, pin.SE3(np.asarray(part.box.X_AB, dtype=float)), shape)
-            geom.addGeometryObject(obj)
+            shape, X_RG, bound = obstacle_shape(part, grow)
+            geom.addGeometryObject(pin.GeometryObject(part.name, 0, 0, pin.SE3(X_RG), shape))
+            bounds.append(bound)
             self.link_of.append(part.name)
         self.obstacle_names = tuple(p.name for p in obstacles)
         self._pairs = _Pairs()
@@ -96,7 +98,7 @@ class CollisionChecker:
         self._tool_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == self._model.njoints - 1]
         self._obstacle_ids = list(range(self._n_robot, len(objs)))
         self._tool = ToolShapes.build(self._model, self._data, self._geom, self._tcp_frame, self._tool_shapes)
-        self._boxes = Boxes.build(geom, self._obstacle_ids)
+        self._boxes = Boxes.build(geom, self._obstacle_ids, bounds)
         # The broad phase of a check: every robot shape's bounding sphere (centre in its own frame, radius), and
         # per pair its two shapes; a pair whose spheres (or sphere and box) are farther apart than what could
         # change the answer gets that lower bound instead of a distance query.

@@ -1,11 +1,17 @@
-"""The torch test's geometry: the tool-side collision shapes placed from the TCP, the obstacle boxes as placed in
-R, and the contacts of many TCP poses against them in one broad-phase query (no IK: the poses are in R, so
-wherever a linear track puts the base). Part of the coal adapter with :mod:`cell.motion.collision.checker`."""
+"""The torch test's geometry: the tool-side collision shapes placed from the TCP, the obstacles' coal shapes (a box
+as ``coal.Box``, a convex polyhedron as ``coal.Convex``, any other body as a ``coal.BVHModelOBBRSS`` triangle mesh,
+each grown by its margin: :mod:`cell.motion.collision.grow`) with their bounding boxes as placed in R, and the
+contacts of many TCP poses against them in one broad-phase query (no IK: the poses are in R, so wherever a linear
+track puts the base). Part of the coal adapter with :mod:`cell.motion.collision.checker`.
+
+A triangle mesh answers the distance to its surface: a shape wholly inside a non-convex body is not seen by one
+query (docs/bodies.md); along a motion from a clear start, conservative advancement meets the surface first."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import coal
 import numpy as np
@@ -13,7 +19,9 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from cell.geometry import FloatArray, invert, readonly
+from cell.motion.collision.grow import bounding_box, grown_convex, grown_mesh, is_convex
 from cell.motion.contact import Contact, sphere_box_distance
+from cell.types import Part, Polyhedron
 
 
 @dataclass(frozen=True)
@@ -47,10 +55,48 @@ class ToolShapes:
         return ToolShapes(np.array(X).reshape(-1, 4, 4), np.array(cen).reshape(-1, 3), np.array(rad), tuple(shapes))
 
 
+class Bound(NamedTuple):
+    """A box that holds an obstacle's grown shape, in R: rotation R_RB (3, 3), centre (3,), half sizes (3,) [m]."""
+
+    R_RB: FloatArray
+    centre: FloatArray
+    half: FloatArray
+
+
+def obstacle_shape(part: Part, grow: float) -> tuple[object, FloatArray, Bound]:
+    """The coal shape of an obstacle grown by ``grow`` [m], its placement X_RG (4, 4) and a box that holds it.
+
+    A box is a ``coal.Box`` at its pose (its bound: itself); any other body's vertices are given in R (placement
+    the identity): ``coal.Convex`` of its grown hull when it is convex, else a ``coal.BVHModelOBBRSS`` of its
+    triangles grown along the vertex normals; its bound is the grown vertices' axis-aligned box."""
+    if part.is_box:
+        box = part.box
+        size = np.asarray(box.size, dtype=float) + 2.0 * grow
+        X = np.asarray(box.X_AB, dtype=float)
+        return coal.Box(size), X, Bound(X[:3, :3], X[:3, 3], size / 2.0)
+    body = part.body
+    assert isinstance(body, Polyhedron)
+    if is_convex(body):
+        pts = grown_convex(body, grow)
+        vec = coal.StdVec_Vec3s()
+        for p in pts:
+            vec.append(np.asarray(p, dtype=float))
+        shape: object = coal.Convex.convexHull(vec, True, "")
+    else:
+        pts, tris = grown_mesh(body, grow)
+        bvh = coal.BVHModelOBBRSS()
+        bvh.beginModel(len(tris), len(pts))
+        bvh.addVertices(np.asarray(pts, dtype=float))
+        bvh.addTriangles(np.asarray(tris, dtype=np.int64))
+        bvh.endModel()
+        shape = bvh
+    return shape, np.eye(4), Bound(*bounding_box(pts))
+
+
 @dataclass(frozen=True)
 class Boxes:
-    """The obstacle boxes as placed in R: rotation R_RB (k, 3, 3), centre (k, 3), half sizes (k, 3) [m] (grown),
-    their coal shapes and transforms."""
+    """The obstacles' bounding boxes as placed in R: rotation R_RB (k, 3, 3), centre (k, 3), half sizes (k, 3) [m]
+    (grown; for a box obstacle the box itself), and the obstacles' coal shapes and transforms."""
 
     R_RB: FloatArray
     centre: FloatArray
@@ -59,12 +105,13 @@ class Boxes:
     T: tuple[object, ...]
 
     @staticmethod
-    def build(geom: pin.GeometryModel, ids: Sequence[int]) -> Boxes:
+    def build(geom: pin.GeometryModel, ids: Sequence[int], bounds: Sequence[Bound]) -> Boxes:
+        """The obstacles ``ids`` of ``geom`` with their bounds (one per obstacle, same order)."""
         objs = [geom.geometryObjects[k] for k in ids]
-        R = np.array([np.array(o.placement.rotation) for o in objs]).reshape(-1, 3, 3)
-        c = np.array([np.array(o.placement.translation) for o in objs]).reshape(-1, 3)
-        half = np.array([np.array(o.geometry.halfSide) for o in objs]).reshape(-1, 3)
-        T = tuple(coal.Transform3s(R[k], c[k]) for k in range(len(objs)))
+        R = np.array([b.R_RB for b in bounds], dtype=float).reshape(-1, 3, 3)
+        c = np.array([b.centre for b in bounds], dtype=float).reshape(-1, 3)
+        half = np.array([b.half for b in bounds], dtype=float).reshape(-1, 3)
+        T = tuple(coal.Transform3s(np.array(o.placement.rotation), np.array(o.placement.translation)) for o in objs)
         return Boxes(R, c, half, tuple(o.geometry for o in objs), T)
 
     def sphere_distance(self, c_R: FloatArray, radius: FloatArray) -> FloatArray:

@@ -1,9 +1,15 @@
 """Ground truth of the seams of the part as it was really built (simulation only; exact, no noise).
 
-The true seam of a joint is the edge of the abutting part A where its weld face ``face_abutting`` meets its
-``end_face`` (the edge nearest to the receiving part B), carried across the gap along A's end-face normal onto
-the plane of B's ``face_receiving``. Carrying it along A's own axis keeps the seam on both weld-face planes
-(the fillet corner); when A's end face is parallel to B's face it is the same as the orthogonal projection.
+Two boxes (the fast path, unchanged): the true seam of a joint is the edge of the abutting part A where its weld
+face ``face_abutting`` meets its ``end_face`` (the edge nearest to the receiving part B), carried across the gap
+along A's end-face normal onto the plane of B's ``face_receiving``. Carrying it along A's own axis keeps the seam
+on both weld-face planes (the fillet corner); when A's end face is parallel to B's face it is the same as the
+orthogonal projection.
+
+Any other pair of bodies (:func:`cell.seams._truth_faces.general_seam_W`, docs/bodies.md): the true seam lies on the
+line where the planes of the two as-built weld faces meet, clipped to their common extent along it: A's extent is
+that of its edge between ``face_abutting`` and ``end_face`` (the edge that meets B, across any gap), B's the chord
+of the line through B's face polygon, each grown by a small tolerance.
 """
 
 from __future__ import annotations
@@ -14,6 +20,7 @@ import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray, invert, transform_points
+from cell.seams._truth_faces import general_seam_W
 from cell.types import Box, Joint, Part, WeldMap
 
 
@@ -51,9 +58,11 @@ def _as_built(parts: Sequence[Part], name: str) -> Part:
 def true_seam_W(design: WeldMap, joint: Joint, parts_as_built_W: Sequence[Part]) -> tuple[FloatArray, FloatArray]:
     """One true seam, (p_start_W, p_end_W) (3,) each [m], in the same order as the map seam."""
     seam = design.seam(joint.seam_id)
-    a_design = design.part(joint.abutting).box
-    a = _as_built(parts_as_built_W, joint.abutting).box
-    b = _as_built(parts_as_built_W, joint.receiving).box
+    part_a, part_b = _as_built(parts_as_built_W, joint.abutting), _as_built(parts_as_built_W, joint.receiving)
+    design_a = design.part(joint.abutting)
+    if not (part_a.is_box and part_b.is_box and design_a.is_box):
+        return general_seam_W(seam, joint, design_a, part_a, part_b)
+    a_design, a, b = design_a.box, part_a.box, part_b.box
     p_lo, p_hi, k = abutting_edge(a, joint.face_abutting, joint.end_face)
     # Which end is the start: read the map seam's direction along the edge axis in A's own (design) frame.
     ends_B = transform_points(invert(a_design.X_AB), np.stack([seam.p_start, seam.p_end]))
@@ -77,7 +86,7 @@ def true_seams(
 
     design : the designed map (any frame; only its parts' own frames are used, to order start and end).
     joints : seam id -> :class:`Joint` (from :func:`cell.seams.joint.find_joints` on ``design``).
-    parts_as_built : the same parts (same names) as built, boxes in the world W.
+    parts_as_built : the same parts (same names, same kind of body) as built, in the world W.
     X_WR : (4, 4) pose of the robot base in the world.
     Returns seam id -> (p_start_R, p_end_R), (3,) each [m], for every seam of ``design``.
     """

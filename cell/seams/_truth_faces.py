@@ -1,0 +1,130 @@
+"""The true seam of a joint between any two bodies (boxes or polyhedra; docs/bodies.md), numpy only.
+
+The seam lies on the line L where the planes of the two as-built weld faces meet: A's ``face_abutting`` and B's
+``face_receiving``. It is clipped to the faces' common extent along L:
+
+* A's extent is the projection onto L of A's edge between ``face_abutting`` and ``end_face`` (the edge that meets
+  B; a gap or a small rotation moves it off L, its extent along L stays), exactly. Where those faces share no
+  edge, the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by
+  the tolerance;
+* B's extent is the chord of L through B's face polygon (L lies in B's plane), grown by the tolerance.
+
+Start and end follow the map seam, carried onto the as-built A by the rigid motion that best maps A's designed
+vertices onto its as-built ones (any frame of the design works: the side of a part turned over too).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cell.errors import MapError
+from cell.geometry import FloatArray, transform_points
+from cell.types import Joint, MapSeam, Part
+
+CLIP_TOL_M = 1e-4  # [m] how far past a face's polygon the seam may still reach (numerical slack)
+_SAME_POINT_M = 1e-9  # [m] two polygons' vertices closer than this are one vertex
+_MIN_SIN = 1e-6  # faces more nearly parallel than this meet in no line
+
+
+def best_rigid(p_from: FloatArray, p_to: FloatArray) -> FloatArray:
+    """(4, 4) the rigid motion that best maps points p_from (n, 3) onto p_to (n, 3) (least squares, Kabsch)."""
+    a, b = np.asarray(p_from, dtype=float), np.asarray(p_to, dtype=float)
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    U, _, Vt = np.linalg.svd((a - ca).T @ (b - cb))
+    D = np.diag([1.0, 1.0, float(np.sign(np.linalg.det(Vt.T @ U.T))) or 1.0])
+    R = Vt.T @ D @ U.T
+    X = np.eye(4)
+    X[:3, :3], X[:3, 3] = R, cb - R @ ca
+    return X
+
+
+def plane_line(
+    n_a: FloatArray, d_a: float, n_b: FloatArray, d_b: float, near: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The line where the planes n_a . p = d_a and n_b . p = d_b meet: its point nearest to ``near`` (3,) and its
+    unit direction n_a x n_b (3,). The planes must not be parallel (the caller checks)."""
+    u = np.cross(n_a, n_b)
+    u = u / np.linalg.norm(u)
+    G = np.array([[n_a @ n_a, n_a @ n_b], [n_b @ n_a, n_b @ n_b]])
+    alpha, beta = np.linalg.solve(G, [d_a - n_a @ near, d_b - n_b @ near])
+    p = near + alpha * n_a + beta * n_b
+    return np.asarray(p), np.asarray(u)
+
+
+def shared_edge(poly_1: FloatArray, poly_2: FloatArray) -> FloatArray | None:
+    """(2, 3) the two farthest-apart vertices the polygons (m, 3) share, or None when they share fewer than two."""
+    d = np.linalg.norm(poly_1[:, None, :] - poly_2[None, :, :], axis=-1)
+    common = poly_1[np.any(d <= _SAME_POINT_M, axis=1)]
+    if len(common) < 2:
+        return None
+    gap = np.linalg.norm(common[:, None, :] - common[None, :, :], axis=-1)
+    i, j = np.unravel_index(int(np.argmax(gap)), gap.shape)
+    return np.stack([common[i], common[j]])
+
+
+def _clip(uv: FloatArray, lo: float, hi: float) -> FloatArray:
+    """The 2D polygon (m, 2) (t along L, s across it) clipped to lo <= s <= hi (Sutherland-Hodgman)."""
+    pts = uv
+    for sign, bound in ((1.0, hi), (-1.0, -lo)):
+        if len(pts) == 0:
+            break
+        out = []
+        for k in range(len(pts)):
+            p, q = pts[k - 1], pts[k]
+            fp, fq = sign * p[1] - bound, sign * q[1] - bound
+            if fq <= 0.0:
+                if fp > 0.0:
+                    out.append(p + (q - p) * (fp / (fp - fq)))
+                out.append(q)
+            elif fp <= 0.0:
+                out.append(p + (q - p) * (fp / (fp - fq)))
+        pts = np.array(out).reshape(-1, 2)
+    return pts
+
+
+def polygon_extent(poly: FloatArray, n: FloatArray, p0: FloatArray, u: FloatArray, tol: float) -> tuple[float, float]:
+    """(t0, t1) [m] along the line p0 + t u of the part of a planar polygon (m, 3) (normal n) nearest to the line:
+    the polygon within ``tol`` of the line where it crosses it, else within ``tol`` of its nearest point's
+    distance; projected onto the line and grown by ``tol``."""
+    w = np.cross(n, u)
+    rel = poly - p0
+    uv = np.column_stack([rel @ u, rel @ w])
+    s = uv[:, 1]
+    c = 0.0 if s.min() <= 0.0 <= s.max() else float(s[np.argmin(np.abs(s))])
+    near = _clip(uv, c - tol, c + tol)
+    if len(near) == 0:  # pragma: no cover - the nearest vertex is always inside its own band
+        near = uv[np.argmin(np.abs(s - c))][None]
+    return float(near[:, 0].min()) - tol, float(near[:, 0].max()) + tol
+
+
+def general_seam_W(
+    seam: MapSeam, joint: Joint, design_a: Part, a: Part, b: Part, tol: float = CLIP_TOL_M
+) -> tuple[FloatArray, FloatArray]:
+    """The true seam (p_start_W, p_end_W) (3,) each [m] of ``joint`` between the as-built parts ``a`` (abutting) and
+    ``b`` (receiving) in W; ``seam`` and ``design_a`` are the map's seam and part A in one frame (any)."""
+    n_a, d_a = a.face_plane(joint.face_abutting)
+    n_b, d_b = b.face_plane(joint.face_receiving)
+    if np.linalg.norm(np.cross(n_a, n_b)) < _MIN_SIN:
+        raise MapError(
+            f"seam {joint.seam_id!r}: faces {joint.abutting}.{joint.face_abutting} and "
+            f"{joint.receiving}.{joint.face_receiving} are parallel as built; valid: weld faces that meet in a line"
+        )
+    X = best_rigid(design_a.vertices(), a.vertices())  # the design of A onto A as built
+    ends = transform_points(X, np.stack([seam.p_start, seam.p_end]))
+    p0, u = plane_line(n_a, d_a, n_b, d_b, ends.mean(axis=0))
+    edge = shared_edge(a.face_polygon(joint.face_abutting), a.face_polygon(joint.end_face))
+    if edge is not None:
+        t_edge = (edge - p0) @ u  # exact: A's edge ends the seam where it is the shorter
+        ta = (float(t_edge.min()), float(t_edge.max()))
+    else:
+        ta = polygon_extent(a.face_polygon(joint.face_abutting), n_a, p0, u, tol)
+    tb = polygon_extent(b.face_polygon(joint.face_receiving), n_b, p0, u, tol)
+    t0, t1 = max(ta[0], tb[0]), min(ta[1], tb[1])
+    if t1 <= t0:
+        raise MapError(
+            f"seam {joint.seam_id!r}: faces {joint.abutting}.{joint.face_abutting} and "
+            f"{joint.receiving}.{joint.face_receiving} do not overlap along the line where they meet as built"
+        )
+    if (ends[1] - ends[0]) @ u < 0.0:
+        t0, t1 = t1, t0
+    return np.asarray(p0 + t0 * u), np.asarray(p0 + t1 * u)

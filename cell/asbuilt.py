@@ -1,8 +1,14 @@
 """The part as it was really built: the map's designed parts with the scenario's deviations, placed in the world.
 
-Deviations are given per part in the part's own box frame B (size and offset in mm, rotation in degrees about the
-part centre). After the deviations, every part is dropped (or lifted) so that its lowest corner rests on the table:
-a part lies on the table, it does not float or sink into it. The result is the ground truth of the simulation.
+Deviations are given per part in the part's own frame (size and offset in mm, rotation in degrees about the part
+centre): a box's frame B (its centre, axes along its edges); for a polyhedral body its principal frame P (the volume
+centroid, axes along the eigenvectors of its vertices' covariance as drawn, largest spread first; docs/bodies.md), in
+which a size change scales the body about the centroid along each axis so that its extent changes by ``size_mm``.
+After the deviations, every part is dropped (or lifted) so that its lowest vertex rests on the table: a part lies on
+the table, it does not float or sink into it. The result is the ground truth of the simulation.
+
+The map's fixtures (clamps, stops, jigs) are placed where the part really lies, without deviations and without
+dropping (:func:`as_built_fixtures`).
 """
 
 from __future__ import annotations
@@ -10,37 +16,114 @@ from __future__ import annotations
 import numpy as np
 
 from cell.errors import ScenarioError
-from cell.geometry import make_pose, rpy_to_matrix
+from cell.geometry import FloatArray, invert, make_pose, rpy_to_matrix, transform_points
 from cell.scenario import Deviation, Scenario
-from cell.types import Box, Part, WeldMap
+from cell.types import Box, Part, Polyhedron, WeldMap
+
+# Which deviation keys each kind of body takes (the scenario's Deviation fields).
+VALID_KEYS = {"box": ("size_mm", "offset_mm", "rpy_deg"), "mesh": ("size_mm", "offset_mm", "rpy_deg")}
+_DISTINCT = 1e-6  # principal spreads closer than this (relative) do not define a size change's axes
 
 
 def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
     """The as-built parts in the world frame W.
 
     weldmap_M : the designed map, frame ``"M"``.
-    Returns one :class:`Part` per designed part, same names and order, boxes in W.
+    Returns one :class:`Part` per designed part, same names, order and kind of body (box or polyhedron), in W.
     """
     names = {p.name for p in weldmap_M.parts}
     deviations = _by_part(scenario.deviations, names)
-    X_WM = scenario.X_WM @ scenario.simulation.placement_error.X  # true placement, not the nominal one
+    X_WM = _true_placement(scenario)
     table_top = scenario.table.top_z
     parts = []
     for part in weldmap_M.parts:
         dev = deviations.get(part.name)
-        box_W = part.box.transformed(X_WM)
         if dev is not None:
-            size = box_W.size + np.asarray(dev.size_mm) / 1000.0
-            if np.any(size <= 0):
-                raise ScenarioError(f"deviations.{part.name}.size_mm makes the part's size non-positive")
-            # Offset and rotation are about the part's own centre, along its own axes.
-            X_B_Bdev = make_pose(rpy_to_matrix(np.radians(dev.rpy_deg)), np.asarray(dev.offset_mm) / 1000.0)
-            box_W = Box(box_W.X_AB @ X_B_Bdev, size)
-        lowest = float(box_W.corners()[:, 2].min())
-        X = box_W.X_AB.copy()
-        X[2, 3] += table_top - lowest  # rest on the table
-        parts.append(Part(part.name, Box(X, box_W.size)))
+            _check_keys(part, dev)
+        if part.is_box:
+            box_W = part.box.transformed(X_WM)
+            if dev is not None:
+                box_W = _deviated_box(part.name, box_W, dev)
+            lowest = float(box_W.corners()[:, 2].min())
+            X = box_W.X_AB.copy()
+            X[2, 3] += table_top - lowest  # rest on the table
+            parts.append(Part(part.name, Box(X, box_W.size), part.drawn_as))
+            continue
+        body = part.body
+        assert isinstance(body, Polyhedron)
+        v_W = transform_points(X_WM, _deviated_vertices(part.name, body, dev) if dev is not None else body.vertices)
+        v_W[:, 2] += table_top - float(v_W[:, 2].min())  # rest on the table
+        parts.append(Part(part.name, Polyhedron(v_W, body.faces, body.names), part.drawn_as))
     return tuple(parts)
+
+
+def as_built_fixtures(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
+    """The map's fixtures in W, where the part really lies (the scenario's placement with its error)."""
+    X_WM = _true_placement(scenario)
+    return tuple(f.transformed(X_WM) for f in weldmap_M.fixtures)
+
+
+def principal_frame(body: Polyhedron) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """A polyhedron's principal frame in its own frame A: the pose X_AP (4, 4) (origin the volume centroid, axes
+    the eigenvectors of the vertices' covariance, largest spread first, each axis's largest component positive,
+    right-handed), the vertices' extents (3,) [m] along those axes, and the spreads (eigenvalues, (3,) [m^2])."""
+    c = np.asarray(body.center, dtype=float)
+    v = np.asarray(body.vertices, dtype=float) - c
+    spread, E = np.linalg.eigh(np.cov(v.T, bias=True))
+    order = np.argsort(spread)[::-1]
+    spread, E = spread[order], E[:, order]
+    for i in (0, 1):
+        if E[np.argmax(np.abs(E[:, i])), i] < 0:
+            E[:, i] = -E[:, i]
+    E[:, 2] = np.cross(E[:, 0], E[:, 1])
+    v_P = v @ E
+    return make_pose(E, c), v_P.max(axis=0) - v_P.min(axis=0), spread
+
+
+def _deviated_vertices(name: str, body: Polyhedron, dev: Deviation) -> FloatArray:
+    """The body's vertices (k, 3) in its own frame after the deviation, taken in its principal frame P."""
+    X_AP, extent, spread = principal_frame(body)
+    size = np.asarray(dev.size_mm, dtype=float) / 1000.0
+    if np.any(size != 0.0):
+        gaps = np.abs(np.diff(spread)) <= _DISTINCT * max(float(spread[0]), 1e-300)
+        ambiguous = [i for i in range(3) if size[i] != 0.0 and ((i > 0 and gaps[i - 1]) or (i < 2 and gaps[i]))]
+        if ambiguous:
+            raise ScenarioError(
+                f"deviations.{name}.size_mm: part {name} is a mesh body whose principal axes "
+                f"{', '.join('xyz'[i] for i in ambiguous)} are not distinct (equal spreads), so a size change has no "
+                f"direction; valid for it: offset_mm and rpy_deg, or size_mm along distinct axes only"
+            )
+        if np.any(extent + size <= 0):
+            raise ScenarioError(f"deviations.{name}.size_mm makes the part's size non-positive")
+    scale = (extent + size) / extent
+    X_P_Pdev = make_pose(rpy_to_matrix(np.radians(dev.rpy_deg)), np.asarray(dev.offset_mm) / 1000.0)
+    v_P = transform_points(invert(X_AP), body.vertices) * scale
+    return transform_points(X_AP @ X_P_Pdev, v_P)
+
+
+def _deviated_box(name: str, box_W: Box, dev: Deviation) -> Box:
+    size = box_W.size + np.asarray(dev.size_mm) / 1000.0
+    if np.any(size <= 0):
+        raise ScenarioError(f"deviations.{name}.size_mm makes the part's size non-positive")
+    # Offset and rotation are about the part's own centre, along its own axes.
+    X_B_Bdev = make_pose(rpy_to_matrix(np.radians(dev.rpy_deg)), np.asarray(dev.offset_mm) / 1000.0)
+    return Box(box_W.X_AB @ X_B_Bdev, size)
+
+
+def _check_keys(part: Part, dev: Deviation) -> None:
+    """A deviation key this kind of body cannot take: a one-line ScenarioError naming the part and what is valid."""
+    valid = VALID_KEYS[part.kind]
+    extra = sorted(k for k in dev.model_dump(exclude_defaults=True) if k not in valid)
+    if extra:
+        raise ScenarioError(
+            f"deviations.{part.name}: {', '.join(extra)} cannot be applied to part {part.name}, a {part.kind} body; "
+            f"valid: {', '.join(valid)}"
+        )
+
+
+def _true_placement(scenario: Scenario) -> FloatArray:
+    """X_WM (4, 4): where the map really lies (the nominal placement with the operator's error)."""
+    return np.asarray(scenario.X_WM @ scenario.simulation.placement_error.X, dtype=float)
 
 
 def _by_part(deviations: dict[str, Deviation], names: set[str]) -> dict[str, Deviation]:

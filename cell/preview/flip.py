@@ -19,15 +19,13 @@ if TYPE_CHECKING:
     from cell.pipeline.two_sided import TwoSidedRun
 
 SIDE_COLOURS = {"A": "tab:blue", "B": "tab:orange", "left": "0.55"}
-_EDGES = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)]
 
 
 def _draw(ax: Axes, weldmap: WeldMap, colour_of: dict[str, str], axes: tuple[int, int]) -> None:
     i, j = axes
-    for part in weldmap.parts:
-        c = part.box.corners()
-        for a, b in _EDGES:
-            ax.plot([c[a, i], c[b, i]], [c[a, j], c[b, j]], color="0.3", lw=0.6)
+    for part in weldmap.parts:  # any body's feature edges (a box's twelve)
+        for e in part.edges():
+            ax.plot(e[:, i], e[:, j], color="0.3", lw=0.6)
     grey = SIDE_COLOURS["left"]
     for seam in sorted(weldmap.seams, key=lambda m: colour_of.get(m.id) != grey):  # a side's seams over the grey
         colour = colour_of.get(seam.id)

@@ -1,6 +1,8 @@
 """Reading the capture folder's JSON fields: every value checked, a one-line CaptureError naming the key otherwise.
 
 Poses are 4 x 4 row-major nested lists [m]; numbers are JSON floats (Python's repr, so they round-trip exactly).
+A truth file's part is a box (``X_WB``, ``size_m``) or a polyhedral body (``vertices_m``: (k, 3) nested lists in W,
+``faces``: vertex-index lists counter-clockwise seen from outside, ``face_names``), beside each other in one file.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import numpy as np
 
 from cell.errors import CaptureError
 from cell.geometry import FloatArray
-from cell.types import Box, CameraIntrinsics, Part
+from cell.types import Box, CameraIntrinsics, Part, Polyhedron
 
 TRUTH_FORMAT = "weld-cell-truth"
 TRUTH_VERSION = 1
@@ -114,8 +116,43 @@ def truth_json(parts_W: tuple[Part, ...] | list[Part]) -> dict[str, Any]:
         "version": TRUTH_VERSION,
         "frame": "W",
         "note": "ground truth for measuring only: perception never reads this file",
-        "parts": [{"name": p.name, "X_WB": p.box.X_AB.tolist(), "size_m": p.box.size.tolist()} for p in parts_W],
+        "parts": [_part_json(p) for p in parts_W],
     }
+
+
+def _part_json(part: Part) -> dict[str, Any]:
+    if part.is_box:
+        return {"name": part.name, "X_WB": part.box.X_AB.tolist(), "size_m": part.box.size.tolist()}
+    body = part.body
+    assert isinstance(body, Polyhedron)
+    return {
+        "name": part.name,
+        "drawn_as": part.drawn_as,
+        "vertices_m": np.asarray(body.vertices).tolist(),
+        "faces": [list(f) for f in body.faces],
+        "face_names": list(body.names),
+    }
+
+
+def _polyhedron(p: dict[str, Any], where: str, path: Path) -> Part:
+    """A polyhedral part of a truth file: finite vertices, faces of 3 or more valid indices, one name per face."""
+    verts = p.get("vertices_m")
+    if not isinstance(verts, list) or len(verts) < 4:
+        raise CaptureError(f"{path}: {where}.vertices_m is {_short(verts)}; valid: 4 or more [x, y, z]", path=str(path))
+    v = np.array([numbers(q, 3, f"{where}.vertices_m[{i}]", path) for i, q in enumerate(verts)])
+    faces, names = p.get("faces"), p.get("face_names")
+    if not isinstance(faces, list) or not all(
+        isinstance(f, list) and all(isinstance(i, int) and not isinstance(i, bool) for i in f) for f in faces
+    ):
+        raise CaptureError(f"{path}: {where}.faces is {_short(faces)}; valid: lists of vertex indices", path=str(path))
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise CaptureError(f"{path}: {where}.face_names is {_short(names)}; valid: one name per face", path=str(path))
+    drawn_as = p.get("drawn_as", "")
+    try:
+        body = Polyhedron(v, tuple(tuple(f) for f in faces), tuple(names))
+    except ValueError as e:
+        raise CaptureError(f"{path}: {where} is not a closed body ({e})", path=str(path)) from None
+    return Part(p["name"], body, drawn_as if isinstance(drawn_as, str) else "")
 
 
 def truth_parts(path: Path) -> tuple[Part, ...]:
@@ -130,7 +167,13 @@ def truth_parts(path: Path) -> tuple[Part, ...]:
     out = []
     for i, p in enumerate(parts):
         if not isinstance(p, dict) or not isinstance(p.get("name"), str):
-            raise CaptureError(f"{path}: parts[{i}] has no name; valid: {{name, X_WB, size_m}}", path=str(path))
+            raise CaptureError(
+                f"{path}: parts[{i}] has no name; valid: {{name, X_WB, size_m}} or {{name, vertices_m, faces}}",
+                path=str(path),
+            )
+        if "vertices_m" in p:
+            out.append(_polyhedron(p, f"parts[{i}]", path))
+            continue
         X_WB = pose(field(p, "X_WB", f"parts[{i}].", path), f"parts[{i}].X_WB", path)
         size = [
             positive(s, f"parts[{i}].size_m", path) for s in numbers(p.get("size_m"), 3, f"parts[{i}].size_m", path)

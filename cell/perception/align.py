@@ -1,10 +1,10 @@
 """Aligning the welding map to the point cloud (paper section 3.5).
 
-The map's part boxes are sampled into surface points with normals (faces pointing down into the table and face
-areas in contact with another part are left out: no camera can see them). ICP then runs with the *cloud as
-source and the map samples as target*, point-to-plane with the boxes' exact normals, coarse to fine, from the
-nominal placement (identity). The inverse of the ICP transform is the correction that moves the map onto the
-cloud.
+The map's parts (boxes or any polyhedral body) are sampled into surface points with normals (faces pointing
+down into the table and face areas in contact with another part are left out: no camera can see them). ICP then
+runs with the *cloud as source and the map samples as target*, point-to-plane with the faces' exact normals, coarse
+to fine, from the nominal placement (identity). The inverse of the ICP transform is the correction that moves the
+map onto the cloud.
 
 A part lies on the table, so the correction may turn it about the vertical only: a fit that tilts it by more
 than :data:`MAX_TILT_RAD` in roll or pitch is refused, as is a fit whose fitness stays below the scenario's
@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from cell.errors import AlignmentError, AlignmentFailure
@@ -24,7 +25,7 @@ from cell.geometry import FloatArray, invert, matrix_to_rpy, readonly, transform
 from cell.perception import _open3d
 from cell.perception.preprocess import downsample
 from cell.scenario import PerceptionSpec
-from cell.types import BOX_FACES, Box, Cloud, WeldMap
+from cell.types import BOX_FACES, Box, Cloud, Part, WeldMap
 
 MAX_TILT_RAD = math.radians(2.0)  # largest roll or pitch correction accepted for a part lying on the table
 STAGES = (1.0, 0.25, 0.1)  # max correspondence per ICP stage, as fractions of spec.align_max_correspondence_m
@@ -91,6 +92,47 @@ def sample_box_faces(box: Box, spacing_m: float) -> tuple[FloatArray, FloatArray
     return np.concatenate(points), np.concatenate(normals)
 
 
+def _in_polygon(uv: FloatArray, poly: FloatArray) -> npt.NDArray[np.bool_]:
+    """Which 2D points (n, 2) lie inside the simple polygon (m, 2) (even-odd crossings)."""
+    a, b = poly, np.roll(poly, -1, axis=0)
+    x, y = uv[:, None, 0], uv[:, None, 1]
+    straddle = (a[None, :, 1] > y) != (b[None, :, 1] > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x_cross = a[None, :, 0] + (y - a[None, :, 1]) * (b[None, :, 0] - a[None, :, 0]) / (
+            b[None, :, 1] - a[None, :, 1]
+        )
+    return np.asarray(np.count_nonzero(straddle & (x < x_cross), axis=1) % 2 == 1)
+
+
+def sample_part_faces(part: Part, spacing_m: float) -> tuple[FloatArray, FloatArray]:
+    """Samples (at most ``spacing_m`` apart, edges included) of every face of any body; a box's as
+    :func:`sample_box_faces`. Returns points (n, 3) and outward unit normals (n, 3) in the part's frame."""
+    if part.is_box:
+        return sample_box_faces(part.box, spacing_m)
+    points, normals = [], []
+    for face in part.face_names():
+        poly = part.face_polygon(face)
+        n, _ = part.face_plane(face)
+        u = poly[1] - poly[0]
+        u = u - (u @ n) * n
+        u /= np.linalg.norm(u)
+        v = np.cross(n, u)
+        uv = (poly - poly[0]) @ np.stack([u, v], axis=1)
+        lo, hi = uv.min(axis=0), uv.max(axis=0)
+        nu, nv = (max(2, math.ceil(float(e) / spacing_m) + 1) for e in hi - lo)
+        gu, gv = np.meshgrid(np.linspace(lo[0], hi[0], nu), np.linspace(lo[1], hi[1], nv), indexing="ij")
+        grid = np.stack([gu.reshape(-1), gv.reshape(-1)], axis=1)
+        inner = grid[_in_polygon(grid, uv)]
+        rim = []  # the edges, at the same spacing
+        for a, b in zip(uv, np.roll(uv, -1, axis=0), strict=True):
+            k = max(1, math.ceil(float(np.linalg.norm(b - a)) / spacing_m))
+            rim.append(a + np.linspace(0.0, 1.0, k, endpoint=False)[:, None] * (b - a))
+        q = np.concatenate([inner, *rim])
+        points.append(poly[0] + q[:, :1] * u + q[:, 1:] * v)
+        normals.append(np.broadcast_to(n, (len(q), 3)))
+    return np.concatenate(points), np.concatenate(normals)
+
+
 def sample_map(weldmap: WeldMap, spacing_m: float, contact_margin_m: float) -> tuple[FloatArray, FloatArray]:
     """Visible-surface samples of the map's parts: points (n, 3), outward unit normals (n, 3), map frame.
 
@@ -99,7 +141,7 @@ def sample_map(weldmap: WeldMap, spacing_m: float, contact_margin_m: float) -> t
     """
     points, normals = [], []
     for i, part in enumerate(weldmap.parts):
-        p, n = sample_box_faces(part.box, spacing_m)
+        p, n = sample_part_faces(part, spacing_m)
         keep = n[:, 2] > -_DOWN_COS
         for j, other in enumerate(weldmap.parts):
             # Parts whose bounding spheres lie apart cannot touch: only the others are asked about each sample.

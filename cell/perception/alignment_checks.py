@@ -52,7 +52,7 @@ class Alternative:
 
 def _candidates(weldmap_R: WeldMap, centre: FloatArray) -> list[tuple[FloatArray, str]]:
     """Rigid motions on the table that could map the drawing onto itself: 180 degrees about the vertical
-    through ``centre``, and shifts by the offset between two parts of the same size (a rung pitch)."""
+    through ``centre``, and shifts by the offset between two box parts of the same size (a rung pitch)."""
     out: list[tuple[FloatArray, str]] = []
     T = make_pose(p=centre) @ make_pose(rpy_to_matrix((0.0, 0.0, math.pi))) @ make_pose(p=-centre)
     out.append((T, "turned 180 deg about the vertical"))
@@ -60,7 +60,7 @@ def _candidates(weldmap_R: WeldMap, centre: FloatArray) -> list[tuple[FloatArray
     shifts: list[FloatArray] = []
     for i, a in enumerate(parts):
         for b in parts[i + 1 :]:
-            if np.allclose(np.sort(a.box.size), np.sort(b.box.size), atol=1e-4):
+            if a.is_box and b.is_box and np.allclose(np.sort(a.box.size), np.sort(b.box.size), atol=1e-4):
                 d = b.box.center - a.box.center
                 d[2] = 0.0
                 if np.linalg.norm(d) > 1e-3:

@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception import _open3d
-from cell.perception.align import sample_map
+from cell.perception.align import sample_map, sample_part_faces
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import orient_normals
 from cell.types import Cloud, WeldMap
@@ -85,8 +85,13 @@ def height_candidates(points_L: FloatArray, weldmap: WeldMap, table_z: float) ->
     # The map's height image about its origin: its parts' tops on a grid of half cells over their footprints.
     samples = []
     for part in weldmap.parts:
-        box = part.box
         h = float(transform_points(X0, part.vertices())[:, 2].max()) - table_z
+        if not part.is_box:  # any body: samples of its upward faces, half a cell apart
+            q, n = sample_part_faces(part.transformed(X0), cell / 2)
+            q = q[n[:, 2] > 0.5]
+            samples.append(np.column_stack([q[:, :2], np.full(len(q), h)]))
+            continue
+        box = part.box
         u = np.arange(-box.size[0] / 2, box.size[0] / 2 + 1e-9, cell / 2)
         w = np.arange(-box.size[1] / 2, box.size[1] / 2 + 1e-9, cell / 2)
         uu, ww = np.meshgrid(u, w, indexing="ij")

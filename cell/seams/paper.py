@@ -14,6 +14,7 @@ import numpy as np
 from cell.config.seams import PaperOptions
 from cell.geometry import FloatArray
 from cell.seams._features import cloud_features
+from cell.seams._support import mesh_part, not_supported
 from cell.seams.sigma import paper_sigma
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
@@ -142,6 +143,8 @@ class PaperLocator:
         """Find ``seam`` (the aligned map's seam, in R) in ``scene.cloud``; ``rng`` is unused
         (deterministic)."""
         del rng
+        if (part := mesh_part(scene, seam)) is not None:
+            return not_supported(seam, self.name, part, "the paper's method is axis-aligned by construction (boxes)")
         axes = self.axes(scene, seam)
         if isinstance(axes, str):
             return _not_found(seam, axes, Reason.NOT_SUPPORTED)

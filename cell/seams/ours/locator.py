@@ -11,6 +11,8 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
+from cell.seams._index import _BOX_KEY, _INDEX_KEY, dense_index
+from cell.seams._support import boxes_only, mesh_part, not_supported
 from cell.seams.ours._ends import find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line
@@ -50,9 +52,29 @@ class OursLocator:
         """:meth:`locate_with_errors` for every seam of ``seams``, in lock-step: each seam's steps run as they
         would alone, but the plane fits of a pass (and the tilt steps) are one batched fit for all the seams,
         so that numpy's cost per call is paid once per pass, not once per seam. Each seam draws from its own
-        generator spawned from ``rng``, in the order given."""
+        generator spawned from ``rng``, in the order given. A seam on a part that is not a box (a mesh) is
+        refused (``not_supported``, with the reason); the others go on."""
+        rngs = rng.spawn(len(seams))
+        refused = {s.id: part for s in seams if (part := mesh_part(scene, s)) is not None}
+        if not refused and all(p.is_box for p in scene.weldmap.parts):
+            return self._locate_all(scene, seams, rngs)
+        # A seam on a mesh part is refused; the others run on the map's boxes (the steps read part boxes).
+        dense_index(scene)  # built once, shared with the boxes-only scene
+        boxes = boxes_only(scene, keep_cache=(_INDEX_KEY, _BOX_KEY))
+        todo = [(s, r) for s, r in zip(seams, rngs, strict=True) if s.id not in refused]
+        done = iter(self._locate_all(boxes, [s for s, _ in todo], [r for _, r in todo]))
+        why = "the box-frame locator needs boxes"
+        return [
+            (not_supported(s, self.name, refused[s.id], why), NO_ERRORS) if s.id in refused else next(done)
+            for s in seams
+        ]
+
+    def _locate_all(
+        self, scene: SeamScene, seams: Sequence[MapSeam], rngs: Sequence[np.random.Generator]
+    ) -> list[tuple[SeamEstimate, SeamErrors]]:
+        """The lock-step loop of :meth:`locate_many_with_errors` over seams whose parts are all boxes."""
         o = self.options
-        runs = [self._run(scene, seam, r) for seam, r in zip(seams, rng.spawn(len(seams)), strict=True)]
+        runs = [self._run(scene, seam, r) for seam, r in zip(seams, rngs, strict=True)]
         out: list[tuple[SeamEstimate, SeamErrors] | None] = [None] * len(runs)
         pending: dict[int, FitRequest] = {}
 

@@ -4,8 +4,10 @@ Deviations are given per part in the part's own frame (size and offset in mm, ro
 centre): a box's frame B (its centre, axes along its edges); for a polyhedral body its principal frame P (the volume
 centroid, axes along the eigenvectors of its vertices' covariance as drawn, largest spread first; docs/bodies.md), in
 which a size change scales the body about the centroid along each axis so that its extent changes by ``size_mm``.
-After the deviations, every part is dropped (or lifted) so that its lowest vertex rests on the table: a part lies on
-the table, it does not float or sink into it. The result is the ground truth of the simulation.
+After the deviations, every part drawn on the table (its lowest vertex within ``ON_TABLE_M`` of the table top where
+the map really lies) is dropped (or lifted) so that its lowest vertex rests on the table: it does not float or sink
+into it. A part drawn above the table (a brace held between posts, on top of a rail) keeps its drawn height: it is
+held by the parts it is welded to, not by the table. The result is the ground truth of the simulation.
 
 The map's fixtures (clamps, stops, jigs) are placed where the part really lies, without deviations and without
 dropping (:func:`as_built_fixtures`).
@@ -22,6 +24,7 @@ from cell.types import Box, Part, Polyhedron, WeldMap
 
 # Which deviation keys each kind of body takes (the scenario's Deviation fields).
 VALID_KEYS = {"box": ("size_mm", "offset_mm", "rpy_deg"), "mesh": ("size_mm", "offset_mm", "rpy_deg")}
+ON_TABLE_M = 0.002  # [m] a part drawn this close to the table top rests on it
 _DISTINCT = 1e-6  # principal spreads closer than this (relative) do not define a size change's axes
 
 
@@ -40,19 +43,21 @@ def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
         dev = deviations.get(part.name)
         if dev is not None:
             _check_keys(part, dev)
+        on_table = float(transform_points(X_WM, part.vertices())[:, 2].min()) - table_top <= ON_TABLE_M
         if part.is_box:
             box_W = part.box.transformed(X_WM)
             if dev is not None:
                 box_W = _deviated_box(part.name, box_W, dev)
-            lowest = float(box_W.corners()[:, 2].min())
             X = box_W.X_AB.copy()
-            X[2, 3] += table_top - lowest  # rest on the table
+            if on_table:
+                X[2, 3] += table_top - float(box_W.corners()[:, 2].min())  # rest on the table
             parts.append(Part(part.name, Box(X, box_W.size), part.drawn_as))
             continue
         body = part.body
         assert isinstance(body, Polyhedron)
         v_W = transform_points(X_WM, _deviated_vertices(part.name, body, dev) if dev is not None else body.vertices)
-        v_W[:, 2] += table_top - float(v_W[:, 2].min())  # rest on the table
+        if on_table:
+            v_W[:, 2] += table_top - float(v_W[:, 2].min())  # rest on the table
         parts.append(Part(part.name, Polyhedron(v_W, body.faces, body.names), part.drawn_as))
     return tuple(parts)
 

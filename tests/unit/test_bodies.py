@@ -33,7 +33,7 @@ TINY = """
 name: tiny-bodies
 seed: 3
 simulation: {noise: none}
-map: {file: dummy.dxf}
+map: {file: dummy.dxf, X_WM: {xyz_m: [0.0, 0.0, 0.9], rpy_deg: [0.0, 0.0, 30.0]}}
 table: {center_m: [0.0, 0.0, 0.85], size_m: [1.2, 0.8, 0.1]}
 cameras:
   above:
@@ -216,6 +216,10 @@ def test_a_mesh_part_takes_offset_rotation_and_size_along_its_principal_axes(tmp
     np.testing.assert_allclose(shift, 0.005 * axis_W, atol=1e-9)
     spread = np.ptp(moved.vertices() @ axis_W)
     assert spread == pytest.approx(extent[0] + 0.010, abs=1e-12)
+    # a part drawn above the table (a brace on top of a rail) keeps its height; one drawn on it rests on it
+    up = WeldMap((Part("UP", w.body.transformed(make_pose(p=[0.0, 0.0, 0.05]))),), (), "m", "test")
+    (held,) = as_built_parts(up, base)
+    assert held.vertices()[:, 2].min() == pytest.approx(base.table.top_z + 0.05, abs=1e-12)
     cube = Part("CUBE", Box(make_pose(), np.array([0.1, 0.1, 0.1])).to_polyhedron())
     bad = {"CUBE": scn.Deviation(size_mm=(1.0, 0.0, 0.0))}
     with pytest.raises(ScenarioError, match=r"deviations\.CUBE\.size_mm: part CUBE .*valid for it: offset_mm"):

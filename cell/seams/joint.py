@@ -22,7 +22,7 @@ import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.types import Joint, MapSeam, Part, WeldMap
+from cell.types import Box, Joint, MapSeam, Part, WeldMap
 
 _ANTIPARALLEL_COS = float(np.cos(np.radians(5.0)))  # end face vs receiving face: within 5 deg of opposite
 MIN_DIHEDRAL_DEG = 30.0  # the weld faces' angle: sharper than this is no fillet
@@ -77,13 +77,12 @@ def _candidates(seam: MapSeam, parts: tuple[Part, ...], tol: float, max_gap: flo
 
 
 def _nearest_faces(seam: MapSeam, parts: tuple[Part, ...], n: int = 2) -> str:
-    """The ``n`` face planes nearest the seam (its ends' largest distance), for a message."""
+    """The ``n`` faces nearest the seam (the larger of its ends' distances to each face's polygon), for a message."""
     pts = np.stack([seam.p_start, seam.p_end])
     near = []
     for p in parts:
-        names, N, D = _planes(p)
-        dist = np.abs(pts @ N.T - D).max(axis=0)
-        near += [(float(d), f"{p.name}:{f}") for d, f in zip(dist, names, strict=True)]
+        body = p.body.to_polyhedron() if isinstance(p.body, Box) else p.body
+        near += [(float(body.face_distance(f, pts).max()), f"{p.name}:{f}") for f in p.face_names()]
     near.sort()
     return ", ".join(f"{f} ({d * 1000:.1f} mm)" for d, f in near[:n]) or "none"
 

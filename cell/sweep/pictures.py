@@ -47,9 +47,9 @@ def write_risk(path: Path, weldmap_M: WeldMap, summary: Mapping[str, Any]) -> Pa
     ids = [s.id for s in weldmap_M.seams if s.id in seams]
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(15, max(5.0, 0.32 * len(ids) + 1.5)), width_ratios=(1.6, 1.0))
     for part in weldmap_M.parts:
-        outline = _footprint(np.asarray(part.box.corners())) * _MM
+        outline = _footprint(np.asarray(part.vertices())) * _MM  # any body: the hull of its vertices from above
         ax.fill(outline[:, 0], outline[:, 1], facecolor="0.88", edgecolor="0.45", linewidth=0.8)
-        c = np.asarray(part.box.X_AB)[:2, 3] * _MM
+        c = np.asarray(part.center)[:2] * _MM
         ax.text(c[0], c[1], part.name, fontsize=7, color="0.35", ha="center", va="center")
 
     def risk(sid: str) -> float:

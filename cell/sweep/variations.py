@@ -111,10 +111,11 @@ def variation(
         rng = stream(scenario.seed, "tolerances", k)
         devs = {}
         for part in weldmap_M.parts:  # map order: a part's draws never depend on another's
-            size_mm = np.asarray(part.box.size) * 1000.0
+            # a body that is not a box keeps its drawn size (same draws, so the next parts' stay the same)
+            size_mm = np.asarray(part.box.size if part.is_box else np.ptp(part.vertices(), axis=0)) * 1000.0
             axis = int(np.argmax(size_mm))
             bounds = [(tol.length if i == axis else tol.width_height) * size_mm[i] for i in range(3)]
-            ds = [_bounded(rng, b, 1)[0] for b in bounds]
+            ds = [_bounded(rng, b, 1)[0] * part.is_box for b in bounds]
             do = _bounded(rng, tol.location * size_mm[axis], 3)
             do[2] = 0.0  # the part rests on the table whatever its drawn height offset (cell/asbuilt.py)
             devs[part.name] = (tuple(round(v, 6) for v in ds), tuple(round(v, 6) for v in do))

@@ -149,6 +149,14 @@ class Polyhedron:
         """(m, 3) the face's vertices in order (counter-clockwise seen from outside) [m]."""
         return np.array(self.vertices[list(self.faces[self._index(face)])])
 
+    def face_distance(self, face: str, p_A: npt.ArrayLike) -> FloatArray:
+        """Distances (n,) [m] from points (n, 3) to the face (its polygon, not its plane)."""
+        p = np.asarray(p_A, dtype=float).reshape(-1, 3)
+        f = self.faces[self._index(face)]
+        tri = self._tris[np.all(np.isin(self._tris, f), axis=1)]
+        v = self.vertices[tri]
+        return np.asarray(_point_triangle_distance(p, v[:, 0], v[:, 1], v[:, 2]).min(axis=1))
+
     def triangles(self) -> npt.NDArray[np.intp]:
         """(t, 3) vertex indices of a triangulation of the faces, outward winding (a fan for a convex face)."""
         return self._tris

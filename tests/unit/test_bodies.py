@@ -129,6 +129,10 @@ def test_the_checker_finds_the_arm_inside_a_mesh_part_and_clears_it_outside(robo
     assert far.check(HOME) is None
     assert far.torch_clear(robot.fk(HOME), HOME) is None
     assert cc.torch_clear(robot.fk(HOME), HOME) is not None
+    # a convex prism (more than four vertices: qhull keeps its triangulated facets) near the torch, then clear of it
+    bar = brace().transformed(make_pose(p=p - brace().center))
+    assert CollisionChecker(robot, (Part("BAR", bar),)).check(HOME) is not None
+    assert CollisionChecker(robot, (Part("BAR", bar.transformed(make_pose(p=[0, 0, 1.5]))),)).check(HOME) is None
 
 
 def test_a_sweep_through_a_concave_mesh_is_found(robot: RobotModel) -> None:

@@ -81,7 +81,7 @@ def obstacle_shape(part: Part, grow: float) -> tuple[object, FloatArray, Bound]:
         vec = coal.StdVec_Vec3s()
         for p in pts:
             vec.append(np.asarray(p, dtype=float))
-        shape: object = coal.Convex.convexHull(vec, True, "")
+        shape: object = coal.Convex.convexHull(vec, True, "Qt")  # keep its triangles: qhull triangulates facets
     else:
         pts, tris = grown_mesh(body, grow)
         bvh = coal.BVHModelOBBRSS()

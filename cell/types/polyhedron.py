@@ -157,6 +157,45 @@ class Polyhedron:
         v = self.vertices[tri]
         return np.asarray(_point_triangle_distance(p, v[:, 0], v[:, 1], v[:, 2]).min(axis=1))
 
+    @property
+    def is_convex(self) -> bool:
+        """Whether every vertex lies behind every face's plane (within 1 um)."""
+        return bool(np.all(self.vertices @ self._planes[:, :3].T - self._planes[:, 3] <= 1e-6))
+
+    def segments_hit(self, p0: npt.ArrayLike, p1: npt.ArrayLike, margin: float = 0.0) -> npt.NDArray[np.bool_]:
+        """(m,) whether each segment p0 (3,) -> p1 (m, 3) meets the body [m].
+
+        A convex body is clipped by its faces' half-spaces, each moved out by ``margin``; any other body is met
+        when a segment crosses one of its triangles or starts inside it (``margin`` then not applied).
+        """
+        a = np.asarray(p0, dtype=float).reshape(3)
+        b = np.asarray(p1, dtype=float).reshape(-1, 3)
+        if not self.is_convex:
+            d = b - a
+            tri = self.vertices[self._tris]
+            e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+            h = np.cross(d[:, None, :], e2[None])
+            det = np.einsum("mtk,tk->mt", h, e1)
+            ok = np.abs(det) > 1e-18
+            inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+            s = a - tri[:, 0]
+            u = np.einsum("tk,mtk->mt", s, h) * inv
+            q = np.cross(s, e1)
+            v = np.einsum("tk,mk->mt", q, d) * inv
+            t = np.einsum("tk,tk->t", q, e2)[None] * inv
+            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+            return np.asarray(hit.any(axis=1) | bool(self.contains(a[None])[0]))
+        n, off = self._planes[:, :3], self._planes[:, 3] + margin
+        f0 = n @ a - off  # (F,) > 0: the start is outside that face
+        f1 = b @ n.T - off  # (m, F)
+        den = f1 - f0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = -f0 / den
+        enter = np.where(den < 0, t, -np.inf).max(axis=1, initial=0.0)
+        leave = np.where(den > 0, t, np.inf).min(axis=1, initial=1.0)
+        parallel_out = np.any((den == 0) & (f0 > 0), axis=1)
+        return np.asarray((enter <= leave) & ~parallel_out)
+
     def triangles(self) -> npt.NDArray[np.intp]:
         """(t, 3) vertex indices of a triangulation of the faces, outward winding (a fan for a convex face)."""
         return self._tris

@@ -139,3 +139,18 @@ def test_bad_bodies_are_refused() -> None:
         Polyhedron(np.zeros((4, 3)), ((0, 1, 2), (0, 2, 3), (0, 3, 1), (1, 3, 2)))
     with pytest.raises(ValueError, match="vertex indices"):
         Polyhedron(np.eye(3), ((0, 1, 5), (0, 1, 2), (0, 2, 1), (1, 2, 0)))
+
+
+def test_segments_hit_convex_and_non_convex_bodies() -> None:
+    box = Box(make_pose(p=[0.0, 0.0, 0.0]), np.array([0.2, 0.2, 0.2]))
+    poly = box.to_polyhedron()
+    assert poly.is_convex and not L_SHAPE.is_convex
+    eye = np.array([0.0, 0.0, 1.0])
+    ends = np.array([[0.0, 0.0, -1.0], [0.5, 0.0, -1.0], [0.0, 0.0, 0.2]])  # through, past the side, short
+    assert poly.segments_hit(eye, ends).tolist() == [True, False, False]
+    grazing = np.array([[0.105, 0.0, -1.0]])  # straight down 5 mm beside the box
+    assert not poly.segments_hit([0.105, 0.0, 1.0], grazing).any()
+    assert poly.segments_hit([0.105, 0.0, 1.0], grazing, margin=0.01).all()
+    # through the L's notch: clear; through an arm: met
+    top = np.array([0.2, 0.2, 0.5])
+    assert L_SHAPE.segments_hit(top, np.array([[0.2, 0.2, -0.1], [0.05, 0.2, -0.1]])).tolist() == [False, True]

@@ -18,9 +18,9 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.seams._extent import EDGE_BLURS, EdgeFit, edge_fit
-from cell.seams._lines import line_box_span, plane_intersection
+from cell.seams._lines import extent_behind, line_box_span, plane_intersection
 from cell.seams._robust import histogram_mode, robust_offset
-from cell.types import BOX_FACES, Box
+from cell.types import BOX_FACES, Box, Part, Polyhedron
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
@@ -71,7 +71,7 @@ class EdgePlacement:
 def place_from_edge(
     n: FloatArray,
     d: float,
-    box: Box,
+    part: Part,
     face_name: str,
     skip: str,
     seam: tuple[FloatArray, FloatArray],
@@ -81,15 +81,15 @@ def place_from_edge(
     crop: Box,
     o: EdgeOptions,
 ) -> EdgePlacement | str:
-    """Place the unseen face ``face_name`` of ``box`` (plane n . p = d from the map, outward unit normal n (3,))
+    """Place the unseen face ``face_name`` of ``part`` (plane n . p = d from the map, outward unit normal n (3,))
     from the edge where an adjacent face of the same part, seen, ends across it: the stretch of that edge
     alongside ``seam`` (its start and end (3,)). ``skip``: a face not to read (the joint's end face); ``away``
     masks the points (n, 3) far enough from the joint's other part; ``points`` reads the cloud; ``crop``: where
     the cloud was cropped (an edge there is the crop's, not the part's). The adjacent faces are tried nearest
     first; each camera's edge on its own, combined by inverse variance. Returns the placement, or why none."""
-    k_f = "xyz".index(face_name[1])
     search = 2.0 * o.map_tolerance_m  # the edge may lie as far from the map as a fitted face may drift [m]
-    lo = max(-2.0 * search, -float(box.size[k_f]) + o.edge_band_m)  # the window along u, inside ...
+    depth = float(part.box.size["xyz".index(face_name[1])]) if part.is_box else extent_behind(part, n, d)
+    lo = max(-2.0 * search, -depth + o.edge_band_m)  # the window along u, inside ...
     hi = search + 3.0 * max(EDGE_BLURS) + o.edge_band_m  # ... and beyond the edge [m]
     gate = o.map_tolerance_m + 3.0 * o.sensor_sigma_m
     best: EdgePlacement | None = None
@@ -97,10 +97,10 @@ def place_from_edge(
     mid = 0.5 * (seam[0] + seam[1])
     tilt = np.tan(np.radians(o.tilt_prior_deg))
     edges = []
-    for g in BOX_FACES:
-        n_g, d_g = box.face_plane(g)
-        if "xyz".index(g[1]) == k_f or g == skip or on_table(n_g, d_g, table_z, o.map_tolerance_m):
-            continue  # not adjacent, the joint's end face, or never seen
+    for g in adjacent_faces(part, face_name):
+        n_g, d_g = part.face_plane(g)
+        if g == skip or on_table(n_g, d_g, table_z, o.map_tolerance_m):
+            continue  # the joint's end face, or never seen
         q0, e = plane_intersection(n, d, n_g, d_g, mid)
         reach = float(np.linalg.norm((mid - q0) - float(e @ (mid - q0)) * e))  # seam to edge line [m]
         edges.append((reach, g, n_g, d_g, q0, e))
@@ -109,14 +109,13 @@ def place_from_edge(
         # edge that far cannot place it better than the best one found.
         if best is not None and tilt * reach >= best.se:
             continue
-        k_g = "xyz".index(g[1])
         # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
         s_ends = sorted(float(e @ (p - q0)) for p in seam)
         e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
         P, cam, ok = points(q0 + e_lo * e, q0 + e_hi * e, float(np.hypot(max(-lo, hi), gate)))
         u = P @ n - d  # along the face's outward normal: the adjacent face's points end at u = 0
         r_g = P @ n_g - d_g
-        region = ok & away(P) & (u > lo) & (u < hi) & in_face(box, P, (k_f, k_g), o.edge_band_m)
+        region = ok & away(P) & (u > lo) & (u < hi) & along_edge(part, face_name, g, P, o.edge_band_m)
         sel = region & (np.abs(r_g) < gate)
         if np.count_nonzero(sel) < o.min_face_points:
             continue
@@ -195,15 +194,39 @@ def on_table(n: FloatArray, d: float, table_z: float, tol: float) -> bool:
     return float(n @ _Z) < -0.9 and abs(d + table_z) < tol
 
 
-def in_face(box: Box, P: FloatArray, free: tuple[int, ...], band: float) -> BoolArray:
-    """Points (n, 3) whose coordinates along every box axis but the ``free`` ones lie inside the box shrunk by
-    ``band`` [m]."""
-    q = (P - box.center) @ box.X_AB[:3, :3]
-    ok = np.ones(len(P), bool)
-    for j in range(3):
-        if j not in free:
-            ok &= np.abs(q[:, j]) <= 0.5 * float(box.size[j]) - band
-    return ok
+def adjacent_faces(part: Part, face: str) -> list[str]:
+    """The faces of ``part`` that share an edge with ``face`` (a box: the four not parallel to it, in
+    :data:`BOX_FACES` order; any other body: those whose polygons share two vertices with it, in face order)."""
+    if part.is_box:
+        k_f = "xyz".index(face[1])
+        return [g for g in BOX_FACES if "xyz".index(g[1]) != k_f]
+    body = part.body
+    assert isinstance(body, Polyhedron)
+    mine = set(body.faces[body.names.index(face)])
+    return [g for g, f in zip(body.names, body.faces, strict=True) if g != face and len(mine & set(f)) >= 2]
+
+
+def along_edge(part: Part, f: str, g: str, P: FloatArray, band: float) -> BoolArray:
+    """Points (n, 3) alongside the edge where faces ``f`` and ``g`` of ``part`` meet: their coordinate along the
+    edge inside its span shrunk by ``band`` [m] (a box: along its third axis, inside the box so shrunk)."""
+    if part.is_box:
+        box = part.box
+        free = ("xyz".index(f[1]), "xyz".index(g[1]))
+        q = (P - box.center) @ box.X_AB[:3, :3]
+        ok = np.ones(len(P), bool)
+        for j in range(3):
+            if j not in free:
+                ok &= np.abs(q[:, j]) <= 0.5 * float(box.size[j]) - band
+        return ok
+    body = part.body
+    assert isinstance(body, Polyhedron)
+    shared = sorted(set(body.faces[body.names.index(f)]) & set(body.faces[body.names.index(g)]))
+    ends = body.vertices[shared]
+    e = ends[-1] - ends[0]
+    e /= max(float(np.linalg.norm(e)), 1e-300)
+    s = ends @ e
+    along = P @ e
+    return np.asarray((along >= float(s.min()) + band) & (along <= float(s.max()) - band))
 
 
 def combine(estimates: list[tuple[float, float]]) -> tuple[float, float]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.types import Box
+from cell.types import Box, Part
 
 
 def plane_intersection(
@@ -58,3 +58,9 @@ def line_box_span(p0: FloatArray, t: FloatArray, box: Box) -> tuple[float, float
         a, b = (-h[k] - o[k]) / d[k], (h[k] - o[k]) / d[k]
         s_in, s_out = max(s_in, min(a, b)), min(s_out, max(a, b))
     return (float(s_in), float(s_out)) if s_in <= s_out else (float("inf"), float("-inf"))
+
+
+def extent_behind(part: Part, n: FloatArray, d: float) -> float:
+    """How far [m] a part's body reaches behind the plane n . p = d (one of its outward face planes): the largest
+    d - n . v over its vertices (a box's edge length across that face)."""
+    return float(np.max(d - part.vertices() @ n))

@@ -16,7 +16,7 @@ from cell.seams._edge import place_from_edge
 from cell.seams.ours._planes import Face, FitRequest, Fitted, Selection, Tilt, Tilted
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.options import OursOptions
-from cell.types import Box, Joint, MapSeam, SeamScene
+from cell.types import Joint, MapSeam, Part, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
@@ -105,7 +105,7 @@ def tilt(jobs: list[tuple[Selection, Fitted | None, Tilt, Points]], o: OursOptio
 def face_from_edge(
     scene: SeamScene,
     face: Face,
-    box: Box,
+    part: Part,
     face_name: str,
     skip: str,
     seam: MapSeam,
@@ -114,7 +114,7 @@ def face_from_edge(
     rng: np.random.Generator,
     o: OursOptions,
 ) -> Face | str:
-    """Place an unseen ``face`` of ``box`` from an edge (:func:`~cell.seams._edge.place_from_edge`, on
+    """Place an unseen ``face`` of ``part`` from an edge (:func:`~cell.seams._edge.place_from_edge`, on
     ``edge_sample_share`` of the cloud); ``away`` masks the points (n, 3) far enough from the joint's other
     part. Returns the face placed (its standard error from the edge's own data), else why not."""
 
@@ -125,7 +125,7 @@ def face_from_edge(
     placed = place_from_edge(
         face.n,
         face.d,
-        box,
+        part,
         face_name,
         skip,
         (seam.p_start, seam.p_end),
@@ -153,6 +153,6 @@ def away_from(face: Face, band: float) -> Callable[[FloatArray], BoolArray]:
     return lambda P: np.asarray(P @ face.n - face.d >= band)
 
 
-def outside(box: Box, band: float) -> Callable[[FloatArray], BoolArray]:
-    """A mask of points (n, 3) outside ``box`` grown by ``band`` [m]."""
-    return lambda P: ~box.contains(P, margin=band)
+def outside(part: Part, band: float) -> Callable[[FloatArray], BoolArray]:
+    """A mask of points (n, 3) outside ``part``'s body grown by ``band`` [m]."""
+    return lambda P: ~part.contains(P, margin=band)

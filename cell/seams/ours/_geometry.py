@@ -11,68 +11,106 @@ import numpy.typing as npt
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
-from cell.seams._lines import plane_intersection
+from cell.seams._lines import extent_behind, plane_intersection
+from cell.seams.ours._bodies import over_polygon, side_planes
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
-from cell.types import Box, Joint, MapSeam, SeamScene
+from cell.types import Joint, MapSeam, Part, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 _Z = np.array([0.0, 0.0, 1.0])
+_SIDE_REACH_M = 0.02  # a side face of a body ends the seam only this near the map's end [m]
 
 
 @dataclass(frozen=True)
 class JointGeometry:
-    """What the map says about the joint's boxes, for region tests (frame R)."""
+    """What the map says about the joint's bodies, for region tests (frame R): a box's from its axes, any other
+    body's from its vertices and face polygons (:mod:`cell.seams.ours._bodies`)."""
 
-    box_a: Box
-    box_b: Box
+    part_a: Part
+    part_b: Part
     depth_a: float  # A's thickness below its weld face [m]
     length_a: float  # A's length away from B (along its end face's normal) [m]
-    side_axis: int  # A's box axis across the seam's ends (-1: none: the seam is not across A's faces)
-    k_b: int  # B's box axis normal to the receiving face
+    planes: tuple[tuple[FloatArray, float], tuple[FloatArray, float]]  # (n, d) across the line at its two ends
+    has_sides: bool  # whether ``planes`` are A's side faces (else the seam crosses none: its ends are found)
+    face_b: str  # B's receiving face
     edge_band: float
 
     @staticmethod
-    def of(box_a: Box, box_b: Box, joint: Joint, t: FloatArray, edge_band: float) -> JointGeometry:
-        """The geometry of ``joint`` between A's ``box_a`` and B's ``box_b``, its seam along t (3,)."""
+    def of(
+        part_a: Part,
+        part_b: Part,
+        joint: Joint,
+        p0: FloatArray,
+        t: FloatArray,
+        s_map: tuple[float, float],
+        o_band: float,
+    ) -> JointGeometry:
+        """The geometry of ``joint`` between parts A and B, its seam on the line p0 + s t (3,), the map's ends at
+        ``s_map`` along it; ``o_band`` the edge band [m]."""
+        n_a, d_a = part_a.face_plane(joint.face_abutting)
+        n_e, d_e = part_a.face_plane(joint.end_face)
+        if not part_a.is_box:
+            sides = side_planes(part_a, (joint.face_abutting, joint.end_face), p0, t, s_map, _SIDE_REACH_M)
+            across = ((-t, float(-t @ p0) - s_map[0]), (t, float(t @ p0) + s_map[1]))  # never fitted
+            return JointGeometry(
+                part_a,
+                part_b,
+                extent_behind(part_a, n_a, d_a),
+                extent_behind(part_a, n_e, d_e),
+                across if sides is None else sides,
+                sides is not None,
+                joint.face_receiving,
+                o_band,
+            )
+        box_a = part_a.box
         k_a = "xyz".index(joint.face_abutting[1])
         k_e = "xyz".index(joint.end_face[1])
         R_A = box_a.X_AB[:3, :3]
         cand = [k for k in range(3) if k != k_a]
         k_t = max(cand, key=lambda k: abs(float(R_A[:, k] @ t)))
-        side_axis = k_t if abs(float(R_A[:, k_t] @ t)) > np.cos(np.radians(30.0)) else -1
-        k_b = "xyz".index(joint.face_receiving[1])
-        return JointGeometry(box_a, box_b, float(box_a.size[k_a]), float(box_a.size[k_e]), side_axis, k_b, edge_band)
-
-    @property
-    def has_sides(self) -> bool:
-        """Whether the seam runs across A's side faces (so that they end it)."""
-        return self.side_axis >= 0
+        has_sides = abs(float(R_A[:, k_t] @ t)) > np.cos(np.radians(30.0))
+        k = k_t if has_sides else 0
+        h = 0.5 * float(box_a.size[k])
+        axis = R_A[:, k] if float(R_A[:, k] @ t) >= 0.0 else -R_A[:, k]
+        c = box_a.center
+        planes = ((-axis, float(-axis @ c) + h), (axis, float(axis @ c) + h))
+        return JointGeometry(
+            part_a,
+            part_b,
+            float(box_a.size[k_a]),
+            float(box_a.size[k_e]),
+            planes,
+            has_sides,
+            joint.face_receiving,
+            o_band,
+        )
 
     def end_planes(self, t: FloatArray, s_map: list[float], table_z: float, tol: float) -> tuple[End, End]:
         """Planes of A's side faces at the start and the end of the seam (direction t; outward normals), the
-        table instead of a side face that rests on it; the ends where the map puts them (``s_map`` along t [m])."""
-        R_A = self.box_a.X_AB[:3, :3]
-        k = max(self.side_axis, 0)
-        h = 0.5 * float(self.box_a.size[k])
-        c = self.box_a.center
-        axis = R_A[:, k] if float(R_A[:, k] @ t) >= 0.0 else -R_A[:, k]
+        table instead of a side face that rests on it; the ends where the map puts them (``s_map`` along t [m]).
+        A seam that crosses no side faces keeps planes it never fits (its ends come from the extent of face A's
+        points)."""
         out = []
-        for sign, s in zip((-1.0, 1.0), s_map, strict=True):
-            n = sign * axis
-            d = float(n @ c) + h
+        for (n, d), s in zip(self.planes, s_map, strict=True):
             on_table = self.has_sides and _edge.on_table(n, d, table_z, tol)
             out.append(End(-_Z, -table_z, True, s) if on_table else End(n, d, False, s))
         return out[0], out[1]
 
     def in_face_b(self, pts: Points, slack: float) -> BoolArray:
         """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""
+        if not self.part_b.is_box:
+            n_b, _ = self.part_b.face_plane(self.face_b)
+            polygon = self.part_b.face_polygon(self.face_b)
+            return over_polygon(pts.P, polygon, n_b, self.edge_band + slack)
+        box_b = self.part_b.box
+        k_b = "xyz".index(self.face_b[1])
         ok = np.ones(len(pts.cam), bool)
-        R_B, c_B = self.box_b.X_AB[:3, :3], self.box_b.center
+        R_B, c_B = box_b.X_AB[:3, :3], box_b.center
         for j in range(3):
-            if j != self.k_b:
+            if j != k_b:
                 axis = R_B[:, j]
-                half = 0.5 * float(self.box_b.size[j]) - self.edge_band - slack
+                half = 0.5 * float(box_b.size[j]) - self.edge_band - slack
                 ok &= np.abs(pts.along(axis) - float(axis @ c_B)) <= half
         return ok
 

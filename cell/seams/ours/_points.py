@@ -82,6 +82,9 @@ def gather(
         part = scene.weldmap.parts[k]
         if part.name in (joint.abutting, joint.receiving):
             continue
+        if not part.is_box:
+            ok &= ~part.contains(xyz.T, margin=o.map_tolerance_m)
+            continue
         R, c = part.box.X_AB[:3, :3], part.box.center
         q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
         h = 0.5 * part.box.size + o.map_tolerance_m

@@ -11,8 +11,6 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams._index import _BOX_KEY, _INDEX_KEY, dense_index
-from cell.seams._support import boxes_only, mesh_part, not_supported
 from cell.seams.ours._ends import find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line
@@ -52,27 +50,14 @@ class OursLocator:
         """:meth:`locate_with_errors` for every seam of ``seams``, in lock-step: each seam's steps run as they
         would alone, but the plane fits of a pass (and the tilt steps) are one batched fit for all the seams,
         so that numpy's cost per call is paid once per pass, not once per seam. Each seam draws from its own
-        generator spawned from ``rng``, in the order given. A seam on a part that is not a box (a mesh) is
-        refused (``not_supported``, with the reason); the others go on."""
-        rngs = rng.spawn(len(seams))
-        refused = {s.id: part for s in seams if (part := mesh_part(scene, s)) is not None}
-        if not refused and all(p.is_box for p in scene.weldmap.parts):
-            return self._locate_all(scene, seams, rngs)
-        # A seam on a mesh part is refused; the others run on the map's boxes (the steps read part boxes).
-        dense_index(scene)  # built once, shared with the boxes-only scene
-        boxes = boxes_only(scene, keep_cache=(_INDEX_KEY, _BOX_KEY))
-        todo = [(s, r) for s, r in zip(seams, rngs, strict=True) if s.id not in refused]
-        done = iter(self._locate_all(boxes, [s for s, _ in todo], [r for _, r in todo]))
-        why = "the box-frame locator needs boxes"
-        return [
-            (not_supported(s, self.name, refused[s.id], why), NO_ERRORS) if s.id in refused else next(done)
-            for s in seams
-        ]
+        generator spawned from ``rng``, in the order given. Any closed planar-faced body works: a box answers from
+        its axes, a polyhedron from its vertices and face polygons (:mod:`cell.seams.ours._bodies`)."""
+        return self._locate_all(scene, seams, rng.spawn(len(seams)))
 
     def _locate_all(
         self, scene: SeamScene, seams: Sequence[MapSeam], rngs: Sequence[np.random.Generator]
     ) -> list[tuple[SeamEstimate, SeamErrors]]:
-        """The lock-step loop of :meth:`locate_many_with_errors` over seams whose parts are all boxes."""
+        """The lock-step loop of :meth:`locate_many_with_errors`."""
         o = self.options
         runs = [self._run(scene, seam, r) for seam, r in zip(seams, rngs, strict=True)]
         out: list[tuple[SeamEstimate, SeamErrors] | None] = [None] * len(runs)
@@ -108,10 +93,10 @@ class OursLocator:
         errors."""
         o = self.options
         joint = joint_of(scene, seam)
-        box_a = scene.weldmap.part(joint.abutting).box
-        box_b = scene.weldmap.part(joint.receiving).box
-        n_a, d_a = box_a.face_plane(joint.face_abutting)
-        n_b, d_b = box_b.face_plane(joint.face_receiving)
+        part_a = scene.weldmap.part(joint.abutting)
+        part_b = scene.weldmap.part(joint.receiving)
+        n_a, d_a = part_a.face_plane(joint.face_abutting)
+        n_b, d_b = part_b.face_plane(joint.face_receiving)
         mid = 0.5 * (seam.p_start + seam.p_end)
         try:
             p0, t = line(n_a, d_a, n_b, d_b, mid, seam.direction)
@@ -131,8 +116,8 @@ class OursLocator:
             density)."""
             return gather(scene, a, b, o.tube_radius_m, 0.0, joint, rng, o, o.edge_sample_share)
 
-        geo = JointGeometry.of(box_a, box_b, joint, t, o.edge_band_m)
         s_map = sorted((float(t @ (seam.p_start - p0)), float(t @ (seam.p_end - p0))))
+        geo = JointGeometry.of(part_a, part_b, joint, p0, t, (s_map[0], s_map[1]), o.edge_band_m)
         face_a = Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
         face_b = Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
         ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m)
@@ -155,9 +140,9 @@ class OursLocator:
                 & pts.ok
             )
             planes: list[Selection] = []
-            for key, face, r, region, box, face_name, skip in (
-                ("a", face_a, r_a, in_a, box_a, joint.face_abutting, joint.end_face),
-                ("b", face_b, r_b, in_b, box_b, joint.face_receiving, ""),
+            for key, face, r, region, part, face_name, skip in (
+                ("a", face_a, r_a, in_a, part_a, joint.face_abutting, joint.end_face),
+                ("b", face_b, r_b, in_b, part_b, joint.face_receiving, ""),
             ):
                 if face.source != "points":
                     continue  # placed from an edge in the first pass
@@ -169,8 +154,8 @@ class OursLocator:
                 why = "no edge of it is seen either: not seen or not there"
                 if first:
                     # Where an adjacent face of the same part may show this face's edge: away from the other part.
-                    away = away_from(face_b, band_b) if key == "a" else outside(box_a, band_a)
-                    placed = face_from_edge(scene, face, box, face_name, skip, seam, joint, away, rng, o)
+                    away = away_from(face_b, band_b) if key == "a" else outside(part_a, band_a)
+                    placed = face_from_edge(scene, face, part, face_name, skip, seam, joint, away, rng, o)
                     if isinstance(placed, Face):
                         face_a, face_b = (placed, face_b) if key == "a" else (face_a, placed)
                         continue

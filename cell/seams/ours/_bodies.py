@@ -1,0 +1,79 @@
+"""What our locator asks of a joint's bodies when they are not boxes (frame R, metres): how thick and how long the
+abutting part is, its side faces across the seam's ends, and which points lie over the receiving face's polygon.
+
+A box answers these from its axes (:class:`cell.seams.ours._geometry.JointGeometry`); any closed planar-faced body
+(:class:`cell.types.Polyhedron`) answers them from its vertices and face polygons here, the same quantities by
+their definitions: the depth of A is its extent behind its weld face, its length its extent away from B (behind
+its end face), a side face one of A's faces that crosses the seam line (its normal within :data:`SIDE_MAX_ANGLE_DEG`
+of the line) where the map puts an end of the seam.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import FloatArray
+from cell.types import Part
+
+BoolArray = npt.NDArray[np.bool_]
+SIDE_MAX_ANGLE_DEG = 60.0  # a face of A ends the seam when its normal is this close to the seam's direction
+_SIDE_COS = math.cos(math.radians(SIDE_MAX_ANGLE_DEG))
+
+
+def side_planes(
+    part_a: Part, skip: tuple[str, ...], p0: FloatArray, t: FloatArray, s_map: tuple[float, float], reach_m: float
+) -> tuple[tuple[FloatArray, float], tuple[FloatArray, float]] | None:
+    """A's faces that end the seam line p0 + s t at its start and its end: ((n, d) at the start, (n, d) at the
+    end), outward unit normals; None unless both ends have one.
+
+    A face ends the line at the start when its outward normal points back along t (n . t <= -cos 60 deg), at the
+    end when it points along t; of those, the one whose plane meets the line nearest the map's end ``s_map``, if
+    within ``reach_m``. ``skip``: A's faces that hold the seam (the weld face and the end face)."""
+    best: list[tuple[float, FloatArray, float] | None] = [None, None]
+    for name in part_a.face_names():
+        if name in skip:
+            continue
+        n, d = part_a.face_plane(name)
+        c = float(n @ t)
+        if abs(c) < _SIDE_COS:
+            continue
+        end = 1 if c > 0.0 else 0
+        s = (d - float(n @ p0)) / c
+        off = abs(s - s_map[end])
+        current = best[end]
+        if off <= reach_m and (current is None or off < current[0]):
+            best[end] = (off, n, d)
+    start, stop = best
+    if start is None or stop is None:
+        return None
+    return (start[1], start[2]), (stop[1], stop[2])
+
+
+def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:
+    """(k,) which points P (k, 3) project inside ``polygon`` (m, 3), a planar face of outward normal n, shrunk by
+    ``inset_m`` [m] (every point at least that far from each of its edges). Convex or not (even-odd rule)."""
+    u = polygon[1] - polygon[0]
+    u = u - (u @ n) * n
+    u /= max(float(np.linalg.norm(u)), 1e-300)
+    v = np.cross(n, u)
+    q = np.stack([P @ u, P @ v], axis=1)
+    c = np.stack([polygon @ u, polygon @ v], axis=1)
+    a, b = c, np.roll(c, -1, axis=0)
+    inside = np.zeros(len(q), dtype=bool)
+    for (ax, ay), (bx, by) in zip(a, b, strict=True):  # even-odd crossings of a ray along +u
+        crosses = (ay > q[:, 1]) != (by > q[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = ax + (q[:, 1] - ay) * (bx - ax) / (by - ay)
+        inside ^= crosses & (q[:, 0] < x)
+    if inset_m <= 0.0:
+        return inside
+    e = b - a
+    ll = np.maximum(np.einsum("ij,ij->i", e, e), 1e-300)
+    w = q[:, None, :] - a[None]
+    s = np.clip(np.einsum("nmk,mk->nm", w, e) / ll, 0.0, 1.0)
+    gap = w - s[..., None] * e[None]
+    nearest = np.sqrt(np.einsum("nmk,nmk->nm", gap, gap)).min(axis=1)
+    return inside & (nearest >= inset_m)

@@ -1,4 +1,5 @@
-"""Triangle meshes of what the 3D view draws as solids, numpy only: the robot's shapes, the table, camera frusta.
+"""Triangle meshes of what the 3D view draws as solids, numpy only: the robot's shapes, the table, any part's body
+(box or polyhedron), camera frusta.
 
 Input in the robot frame R [m]; meshes come out in millimetres (vertices (n, 3), triangles (m, 3) of vertex
 indices), ready for plotly's ``Mesh3d``.
@@ -12,7 +13,7 @@ import numpy as np
 
 from cell.geometry import FloatArray
 from cell.preview.views import MM
-from cell.types import Box, CameraView, RobotPose, Shape, ShapeKind
+from cell.types import Box, CameraView, Part, RobotPose, Shape, ShapeKind
 
 _SIDES = 16  # facets around a cylinder
 # corners indexed by bits (x, y, z) as Box.corners: 0 = ---, 1 = --+, 2 = -+-, 3 = -++, 4 = +--, ...
@@ -109,6 +110,13 @@ def link_colour(shapes: tuple[Shape, ...], link: str) -> str:
 def box_mesh(box: Box) -> Mesh:
     """The mesh [mm] of a box given in R."""
     return solid_mesh(ShapeKind.BOX, box.size, box.X_AB)
+
+
+def part_mesh(part: Part) -> Mesh:
+    """The mesh [mm] of any part given in R: a box's twelve triangles, a polyhedron's own triangulation of its
+    faces (outward winding)."""
+    vertices, triangles = part.triangles()
+    return Mesh(np.asarray(vertices, dtype=float) * MM, np.asarray(triangles, dtype=int))
 
 
 def frustum_segments(cam: CameraView) -> FloatArray:

@@ -249,3 +249,22 @@ def test_truth_files_hold_mesh_parts_beside_boxes(tmp_path: Path) -> None:
     path.write_text(json.dumps(data))
     with pytest.raises(CaptureError, match=r"parts\[0\] is not a closed body"):
         truth_parts(path)
+
+
+# -- pictures --------------------------------------------------------------------------------------------------
+
+
+def test_part_mesh_draws_any_body_in_millimetres() -> None:
+    from cell.preview.solids import box_mesh, part_mesh
+
+    w = Part("WEDGE", wedge())
+    mesh = part_mesh(w)
+    np.testing.assert_allclose(mesh.vertices, np.asarray(w.vertices()) * 1000.0)
+    assert mesh.triangles.shape == (8, 3)  # the two triangular ends, three rectangles of two triangles each
+    area = 0.0
+    for a, b, c in mesh.vertices[mesh.triangles]:
+        area += 0.5 * float(np.linalg.norm(np.cross(b - a, c - a)))
+    hyp = math.hypot(100.0, 50.0)
+    assert area == pytest.approx(2 * 0.5 * 100.0 * 50.0 + 200.0 * (100.0 + 50.0 + hyp), rel=1e-9)  # [mm^2]
+    box = RAIL.box
+    assert sorted(map(tuple, part_mesh(RAIL).vertices.round(9))) == sorted(map(tuple, box_mesh(box).vertices.round(9)))

@@ -14,7 +14,7 @@ from pinhole import deproject
 from tiny_cell import HOME, URDF
 
 from cell import scenario as scn
-from cell.asbuilt import as_built_parts, principal_frame
+from cell.asbuilt import as_built_fixtures, as_built_parts, principal_frame
 from cell.errors import CaptureError, ScenarioError
 from cell.geometry import make_pose, rot_x, transform_points
 from cell.motion.collision import CollisionChecker
@@ -224,6 +224,10 @@ def test_a_mesh_part_takes_offset_rotation_and_size_along_its_principal_axes(tmp
     up = WeldMap((Part("UP", w.body.transformed(make_pose(p=[0.0, 0.0, 0.05]))),), (), "m", "test")
     (held,) = as_built_parts(up, base)
     assert held.vertices()[:, 2].min() == pytest.approx(base.table.top_z + 0.05, abs=1e-12)
+    # fixtures lie where the map really lies: no deviation, no drop
+    clamp = Part("CLAMP", Box(make_pose(p=[0.3, 0.0, 0.1]), np.array([0.04, 0.04, 0.04])))
+    (placed,) = as_built_fixtures(WeldMap((w,), (), "m", "test", fixtures=(clamp,)), base)
+    np.testing.assert_allclose(placed.box.X_AB, base.X_WM @ base.simulation.placement_error.X @ clamp.box.X_AB)
     cube = Part("CUBE", Box(make_pose(), np.array([0.1, 0.1, 0.1])).to_polyhedron())
     bad = {"CUBE": scn.Deviation(size_mm=(1.0, 0.0, 0.0))}
     with pytest.raises(ScenarioError, match=r"deviations\.CUBE\.size_mm: part CUBE .*valid for it: offset_mm"):

@@ -79,12 +79,16 @@ def joint_type(weldmap_R: WeldMap, joint: Joint) -> str:
     va = a.vertices()
     if _extent(va, n_end) < _extent(va, n_a):
         return "lap"
-    opposite = ("-" if joint.face_abutting[0] == "+" else "+") + joint.face_abutting[1]
-    n_o, d_o = a.face_plane(opposite)
-    for face in ("+x", "-x", "+y", "-y", "+z", "-z"):
-        n_f, d_f = b.face_plane(face)
-        if float(n_f @ n_o) > math.cos(math.radians(5.0)) and abs(d_f - d_o) <= _COPLANAR_M:
-            return "corner"
+    # A's faces opposite its weld face (a box: the one; any body: every face turned away within 5 deg).
+    flush = math.cos(math.radians(5.0))
+    for opposite in a.face_names():
+        n_o, d_o = a.face_plane(opposite)
+        if float(n_o @ n_a) > -flush:
+            continue
+        for face in b.face_names():
+            n_f, d_f = b.face_plane(face)
+            if float(n_f @ n_o) > flush and abs(d_f - d_o) <= _COPLANAR_M:
+                return "corner"
     return "T"
 
 

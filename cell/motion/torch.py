@@ -9,7 +9,9 @@ part's face, outward normal n_b), seam direction d (unit, from the weld start to
 * work angle w: in the plane perpendicular to the seam, the torch axis leaves the joint at angle w from face B,
   turned towards face A: u = cos(w) t_b + sin(w) n_b, where t_b is the direction in face B pointing away from
   the corner (n_a with its n_b component removed). In a square fillet w = 45 deg gives u = (n_a + n_b) / sqrt 2,
-  the bisector.
+  the bisector. A fillet that opens by another angle theta (:func:`fillet_angle`: a mitred brace's acute or
+  obtuse corner) keeps the work angle's offset from its own bisector: the torch leaves face B at
+  w + theta / 2 - 45 deg, so that 45 deg is on the bisector of any dihedral.
 * travel angle a: the torch axis tilts along the seam, z = -cos(a) u + sin(a) d; a > 0 is a push angle (the wire
   points ahead, z . d > 0), a < 0 a drag angle.
 * spin psi: the free rotation about the torch axis. psi = 0 puts T's x axis along the part of d perpendicular to
@@ -109,6 +111,19 @@ def fillet_axes(d_R: npt.ArrayLike, n_a_R: npt.ArrayLike, n_b_R: npt.ArrayLike) 
     return np.asarray(t_b / np.linalg.norm(t_b)), n_b
 
 
+def fillet_angle(d_R: npt.ArrayLike, n_a_R: npt.ArrayLike, n_b_R: npt.ArrayLike) -> float:
+    """The fillet's opening angle [rad] between face B and face A about the seam d (3,): pi / 2 for a square T,
+    less in an acute corner (a 35 deg brace), more in an obtuse one. Exactly pi / 2 when the faces are square
+    within 1e-9 rad, so that a box's torch poses keep their last bits."""
+    d = _unit(d_R, "seam direction")
+    t_b, n_b = fillet_axes(d, n_a_R, n_b_R)
+    n_a = _unit(n_a_R, "normal of face A")
+    t_a = n_b - (n_b @ n_a) * n_a - ((n_b - (n_b @ n_a) * n_a) @ d) * d  # in face A away from the corner
+    t_a = t_a / max(float(np.linalg.norm(t_a)), 1e-300)
+    angle = math.atan2(float(t_a @ n_b), float(t_a @ t_b))
+    return 0.5 * math.pi if abs(angle - 0.5 * math.pi) < 1e-9 else angle
+
+
 def torch_rotation(
     d_R: npt.ArrayLike,
     n_a_R: npt.ArrayLike,
@@ -123,7 +138,8 @@ def torch_rotation(
     """
     d = _unit(d_R, "seam direction")
     t_b, n_b = fillet_axes(d, n_a_R, n_b_R)
-    u = math.cos(work_angle) * t_b + math.sin(work_angle) * n_b  # out of the joint, perpendicular to d
+    w = work_angle + 0.5 * fillet_angle(d, n_a_R, n_b_R) - 0.25 * math.pi  # about the actual bisector
+    u = math.cos(w) * t_b + math.sin(w) * n_b  # out of the joint, perpendicular to d
     z = -math.cos(travel_angle) * u + math.sin(travel_angle) * d
     x = d - (d @ z) * z
     x /= np.linalg.norm(x)
@@ -188,11 +204,12 @@ def line_poses(X_from: npt.ArrayLike, X_to: npt.ArrayLike, spacing: float = 0.00
 def measured_angles(
     X_RT: npt.ArrayLike, d_R: npt.ArrayLike, n_a_R: npt.ArrayLike, n_b_R: npt.ArrayLike
 ) -> tuple[float, float]:
-    """(work angle, travel angle) [rad] of a torch pose on a seam (the inverse of :func:`torch_rotation`)."""
+    """(work angle, travel angle) [rad] of a torch pose on a seam (the inverse of :func:`torch_rotation`: the work
+    angle as its argument, 45 deg on the bisector of whatever dihedral the faces make)."""
     z = np.asarray(X_RT, dtype=float)[:3, 2]
     d = _unit(d_R, "seam direction")
     t_b, n_b = fillet_axes(d, n_a_R, n_b_R)
     travel = math.asin(float(np.clip(z @ d, -1.0, 1.0)))
     u = -(z - (z @ d) * d)
-    work = math.atan2(float(u @ n_b), float(u @ t_b))
+    work = math.atan2(float(u @ n_b), float(u @ t_b)) - 0.5 * fillet_angle(d, n_a_R, n_b_R) + 0.25 * math.pi
     return work, travel

@@ -150,3 +150,26 @@ def test_fence1_joints_unchanged() -> None:
         r, face = rest.split(":")
         assert (joints[sid].abutting, joints[sid].receiving, joints[sid].face_abutting) == (a, r, face)
     assert set(parts) == {p.name for p in m.parts}
+
+
+@pytest.mark.parametrize("form", ["3DFACE", "POLYFACE", "3DSOLID"])
+def test_the_brace_drawn_as_3dfaces_a_polyface_or_a_solid(tmp_path: Path, form: str) -> None:
+    parts, seams = design("fence1")
+    doc = make_maps.build_map(parts, seams + make_maps.brace_seams(), solid="mesh")
+    mesh = make_maps.brace_mesh()
+    if form == "POLYFACE":
+        mesh.render_polyface(doc.modelspace(), dxfattribs={"layer": "BRACE"})
+    elif form == "3DSOLID":  # ACIS, as AutoCAD writes solids
+        make_maps._add_body(doc.modelspace(), mesh, "BRACE", "3dsolid")
+    else:  # each quad as two triangles, as mesh exporters write them
+        for f in mesh.faces:
+            a, b, c, d = (mesh.vertices[i] for i in f)
+            doc.modelspace().add_3dface([a, b, c], dxfattribs={"layer": "BRACE"})
+            doc.modelspace().add_3dface([a, c, d], dxfattribs={"layer": "BRACE"})
+    doc.saveas(tmp_path / "b.dxf")
+    m = read_map(tmp_path / "b.dxf")
+    part = m.part("BRACE")
+    assert part.drawn_as == form and not part.is_box and m.warnings == ()
+    assert sorted(len(part.face_polygon(f)) for f in part.face_names()) == [4] * 6  # triangles merged into quads
+    joints = find_joints(m)
+    assert sorted(round(math.degrees(dihedral(m, joints[s]))) for s in BRACE_SEAMS) == [55, 55, 125, 125]

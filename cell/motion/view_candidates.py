@@ -18,7 +18,7 @@ import numpy.typing as npt
 from cell.config.motion import ViewOptions
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, transform_points
 from cell.motion.robot import RobotModel
-from cell.types import CameraIntrinsics, Part
+from cell.types import Box, CameraIntrinsics, Part
 from cell.types.plan import SeamTask
 
 
@@ -115,7 +115,10 @@ def _face_labels(m: int) -> npt.NDArray[np.int_]:
 
 
 def segments_hit_box(p0: FloatArray, p1: FloatArray, part: Part, margin: float) -> npt.NDArray[np.bool_]:
-    """(m,) whether each segment p0 (3,) -> p1 (m, 3) crosses the part's box grown by ``margin`` (slab test)."""
+    """(m,) whether each segment p0 (3,) -> p1 (m, 3) crosses the part's box grown by ``margin`` (slab test); a part
+    that is not a box: :meth:`~cell.types.Polyhedron.segments_hit`."""
+    if not isinstance(part.body, Box):
+        return part.body.segments_hit(p0, p1, margin)
     X_BA = invert(part.box.X_AB)
     a = transform_points(X_BA, p0)
     b = transform_points(X_BA, p1)

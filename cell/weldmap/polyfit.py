@@ -170,6 +170,10 @@ def fit_polyhedron(vertices: FloatArray, faces: Sequence[Sequence[int]], name: s
     than this [m] are one, faces with an area of at most ``tol`` squared are dropped.
     """
     v = np.asarray(vertices, dtype=float)
+    if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
+        raise _fail(name, "has vertices that are not finite 3D points")
+    if any(len(f) and (min(f) < 0 or max(f) >= len(v)) for f in faces):
+        raise _fail(name, f"has a face naming a vertex it does not have (valid: 0 to {len(v) - 1})")
     key = np.round(v / max(tol, _WELD_REL)).astype(np.int64)
     _, first, ids = np.unique(key, axis=0, return_index=True, return_inverse=True)
     V = v[first]

@@ -173,3 +173,13 @@ def test_the_brace_drawn_as_3dfaces_a_polyface_or_a_solid(tmp_path: Path, form: 
     assert sorted(len(part.face_polygon(f)) for f in part.face_names()) == [4] * 6  # triangles merged into quads
     joints = find_joints(m)
     assert sorted(round(math.degrees(dihedral(m, joints[s]))) for s in BRACE_SEAMS) == [55, 55, 125, 125]
+
+
+def test_broken_meshes_are_one_line_errors() -> None:
+    v, f = _box_faces((0, 0, 0), (0.1, 0.2, 0.3))
+    with pytest.raises(MapError, match="part P has a face naming a vertex it does not have"):
+        fit_polyhedron(np.array(v), [*f[:-1], (1, 3, 7, 9)], "P", 1e-4)
+    bad = np.array(v, dtype=float)
+    bad[2, 1] = np.nan
+    with pytest.raises(MapError, match="not finite"):
+        fit_polyhedron(bad, f, "P", 1e-4)

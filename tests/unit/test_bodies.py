@@ -135,6 +135,22 @@ def test_the_checker_finds_the_arm_inside_a_mesh_part_and_clears_it_outside(robo
     assert CollisionChecker(robot, (Part("BAR", bar.transformed(make_pose(p=[0, 0, 1.5]))),)).check(HOME) is None
 
 
+def test_the_arm_wholly_inside_a_concave_mesh_is_a_contact(robot: RobotModel) -> None:
+    # a thick angle (L profile, walls 0.5 m) whose corner block holds the whole wrist and torch
+    p = robot.fk(HOME, "tool0")[:3, 3]
+    angle = l_prism(size=1.0, wall=0.5, length=0.6).transformed(make_pose(p=p - [0.25, 0.0, 0.25]))
+    assert not is_convex(angle) and bool(angle.contains(p[None])[0])
+    cc = CollisionChecker(robot, (Part("ANGLE", angle),))
+    hit = cc.check(HOME)  # the deepest: a link wholly inside (its distance to the surface, as a penetration)
+    assert hit is not None and hit.b == "ANGLE" and hit.depth < -0.15
+    assert cc.clearance(HOME)[0] == pytest.approx(hit.depth)
+    deep = cc.torch_clear(robot.fk(HOME), HOME)
+    assert deep is not None and deep.depth < -0.15
+    cc._solids = {}  # the surface alone: only the links that cross it, far less deep
+    surface = cc.check(HOME)
+    assert surface is not None and surface.depth > hit.depth + 0.05
+
+
 def test_a_sweep_through_a_concave_mesh_is_found(robot: RobotModel) -> None:
     q_a = HOME + np.radians([-20.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     q_b = HOME + np.radians([20.0, 0.0, 0.0, 0.0, 0.0, 0.0])

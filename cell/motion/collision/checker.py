@@ -35,7 +35,7 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
-from cell.motion.collision.shapes import Bound, Boxes, ToolShapes, obstacle_shape, torch_contacts
+from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts
 from cell.motion.contact import Contact, advance_along
 from cell.motion.robot import RobotModel
 from cell.types import Part
@@ -67,13 +67,9 @@ class CollisionChecker:
         self._trim_near_tcp(geom, tcp)
         self._n_robot = len(geom.geometryObjects)
         self.link_of: list[str] = [self._model.frames[o.parentFrame].name for o in geom.geometryObjects]
-        bounds: list[Bound] = []
-        for part in obstacles:
-            grow = opt.table_inflation if part.name == opt.table_name else opt.part_inflation
-            shape, X_RG, bound = obstacle_shape(part, grow)
-            geom.addGeometryObject(pin.GeometryObject(part.name, 0, 0, pin.SE3(X_RG), shape))
-            bounds.append(bound)
-            self.link_of.append(part.name)
+        # each obstacle's grown shape, its bound for the broad phase, the bodies whose shape is a surface only
+        bounds, self._solids = add_obstacles(geom, obstacles, opt)
+        self.link_of.extend(p.name for p in obstacles)
         self.obstacle_names = tuple(p.name for p in obstacles)
         self._pairs = _Pairs()
         parents = self._model.parents
@@ -229,7 +225,15 @@ class CollisionChecker:
     def _distances(self, q: FloatArray) -> FloatArray:
         """Signed distance [m] of every checked pair at configuration q (negative: penetration)."""
         pin.computeDistances(self._model, self._data, self._geom, self._gdata, np.asarray(q, dtype=float))
-        return np.fromiter((r.min_distance for r in self._gdata.distanceResults), float, len(self._geom.collisionPairs))
+        d = np.fromiter((r.min_distance for r in self._gdata.distanceResults), float, len(self._geom.collisionPairs))
+        n = self._n_robot
+        for k in np.flatnonzero(self._is_obstacle_pair & (d > 0.0)) if self._solids else ():
+            body = self._solids.get(int(self._pair_second[k]) - n)
+            if body is not None:  # a surface mesh: inside the body is a penetration
+                i = int(self._pair_first[k])
+                X = np.array(self._gdata.oMg[i].homogeneous)
+                d[k] = signed(float(d[k]), body, X[:3, :3] @ self._centre_arr[i] + X[:3, 3])
+        return d
 
     def _contact(self, k: int, d: float, q: FloatArray, index: int, t: float) -> Contact:
         pair = self._geom.collisionPairs[k]
@@ -262,7 +266,10 @@ class CollisionChecker:
         lower[slf] = np.linalg.norm(c[a[slf]] - c[b[slf]], axis=1) - self._radius_arr[a[slf]] - self._radius_arr[b[slf]]
         cut = np.where(obs, cut_obstacle, cut_self)
         for k in np.flatnonzero(lower <= cut):
-            lower[k] = pin.computeDistance(geom, gdata, int(k)).min_distance
+            d = pin.computeDistance(geom, gdata, int(k)).min_distance
+            if self._solids and obs[k]:  # a surface mesh: inside the body is a penetration
+                d = signed(d, self._solids.get(int(b[k]) - n), c[a[k]])
+            lower[k] = d
         return lower
 
     def check(self, q: npt.ArrayLike, index: int = 0, t: float = float("nan")) -> Contact | None:
@@ -326,4 +333,5 @@ class CollisionChecker:
             X_RT,
             q_ref,
             first,
+            self._solids,
         )

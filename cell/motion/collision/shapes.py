@@ -4,12 +4,14 @@ each grown by its margin: :mod:`cell.motion.collision.grow`) with their bounding
 contacts of many TCP poses against them in one broad-phase query (no IK: the poses are in R, so wherever a linear
 track puts the base). Part of the coal adapter with :mod:`cell.motion.collision.checker`.
 
-A triangle mesh answers the distance to its surface: a shape wholly inside a non-convex body is not seen by one
-query (docs/bodies.md); along a motion from a clear start, conservative advancement meets the surface first."""
+A triangle mesh answers the distance to its surface only: a shape wholly inside a non-convex body would read as
+clear. So where a query against such a body (a :data:`Solids` entry) says clear, the shape's centre is tested
+against the body (its winding number) and, inside, the distance is turned into a penetration of the same depth
+(docs/bodies.md)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -18,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
+from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
 from cell.motion.collision.grow import bounding_box, grown_convex, grown_mesh, is_convex
 from cell.motion.contact import Contact, sphere_box_distance
@@ -53,6 +56,21 @@ class ToolShapes:
             rad.append(float(np.linalg.norm(hi - lo)) / 2.0)
             shapes.append(g)
         return ToolShapes(np.array(X).reshape(-1, 4, 4), np.array(cen).reshape(-1, 3), np.array(rad), tuple(shapes))
+
+
+Solids = Mapping[int, Polyhedron]  # obstacle index -> a non-convex body whose coal shape is its surface only
+
+
+def surface_only(part: Part) -> bool:
+    """Whether the obstacle's coal shape is a triangle mesh (a body neither a box nor convex)."""
+    return not part.is_box and isinstance(part.body, Polyhedron) and not is_convex(part.body)
+
+
+def signed(distance: float, solid: Polyhedron | None, centre_R: FloatArray) -> float:
+    """A surface distance [m] made a penetration (negative) when the shape's centre (3,) lies inside ``solid``."""
+    if solid is None or distance <= 0.0 or not bool(solid.contains(centre_R.reshape(1, 3))[0]):
+        return distance
+    return -distance
 
 
 class Bound(NamedTuple):
@@ -93,6 +111,24 @@ def obstacle_shape(part: Part, grow: float) -> tuple[object, FloatArray, Bound]:
     return shape, np.eye(4), Bound(*bounding_box(pts))
 
 
+def add_obstacles(
+    geom: pin.GeometryModel, obstacles: Sequence[Part], options: CollisionOptions
+) -> tuple[list[Bound], dict[int, Polyhedron]]:
+    """Add every obstacle to ``geom`` (fixed to the universe, named by its part) as its coal shape grown by its margin
+    (``table_inflation`` for the part named ``table_name``, else ``part_inflation``). Returns one bound per obstacle
+    and the bodies whose shape is a surface only, by obstacle index (:data:`Solids`)."""
+    bounds: list[Bound] = []
+    solids: dict[int, Polyhedron] = {}
+    for i, part in enumerate(obstacles):
+        grow = options.table_inflation if part.name == options.table_name else options.part_inflation
+        shape, X_RG, bound = obstacle_shape(part, grow)
+        geom.addGeometryObject(pin.GeometryObject(part.name, 0, 0, pin.SE3(X_RG), shape))
+        bounds.append(bound)
+        if surface_only(part) and isinstance(part.body, Polyhedron):
+            solids[i] = part.body
+    return bounds, solids
+
+
 @dataclass(frozen=True)
 class Boxes:
     """The obstacles' bounding boxes as placed in R: rotation R_RB (k, 3, 3), centre (k, 3), half sizes (k, 3) [m]
@@ -129,10 +165,12 @@ def torch_contacts(
     X_RT: npt.ArrayLike,
     q_ref: npt.ArrayLike,
     first: bool = False,
+    solids: Solids | None = None,
 ) -> list[Contact | None]:
     """The deepest contact (or with ``first`` the first found) of the tool's shapes against the boxes for every
     TCP pose X_RT (m, 4, 4) [m], None where a pose is clear by ``min_clearance``. tool_ids / obstacle_ids: the
-    shapes' and boxes' indices in the checker's geometry model, link_of its names by index (for the contact)."""
+    shapes' and boxes' indices in the checker's geometry model, link_of its names by index (for the contact);
+    solids: the obstacles (by their index among the boxes) whose shape is a surface (see :func:`signed`)."""
     X_RT = np.asarray(X_RT, dtype=float).reshape(-1, 4, 4)
     X_RG = X_RT[:, None] @ tool.X_TG[None]  # (m, shapes, 4, 4)
     c_R = np.einsum("msij,sj->msi", X_RG[..., :3, :3], tool.centre_G) + X_RG[..., :3, 3]
@@ -148,6 +186,8 @@ def torch_contacts(
         Tg = coal.Transform3s(X_RG[p, a, :3, :3], X_RG[p, a, :3, 3])
         res = coal.DistanceResult()
         dist = coal.distance(tool.shapes[a], Tg, boxes.shapes[k], boxes.T[k], req, res)
+        if solids:
+            dist = signed(dist, solids.get(int(k)), c_R[p, a])
         b = best[p]
         if dist <= min_clearance and (b is None or dist < b.depth):
             pt = readonly(np.array(res.getNearestPoint1()))

@@ -13,7 +13,7 @@ from cell import pipeline
 from cell.geometry import make_pose
 from cell.seams._lines import extent_behind
 from cell.seams.ours import OursLocator
-from cell.seams.ours._bodies import over_polygon, side_planes
+from cell.seams.ours._bodies import coplanar_boundary, over_polygon, over_region, side_planes
 from cell.seams.ours._geometry import JointGeometry
 from cell.seams.ours._points import Points
 from cell.types import Box, Joint, Part, Polyhedron, SeamStatus
@@ -34,6 +34,38 @@ def test_over_polygon_convex_and_not_with_an_inset() -> None:
     Q = np.array([[0.75, 0.75, 0.0], [0.25, 0.75, 0.0], [0.75, 0.25, 0.0], [0.55, 0.45, 0.0]])
     assert over_polygon(Q, ell, n, 0.0).tolist() == [False, True, True, True]
     assert over_polygon(Q, ell, n, 0.1).tolist() == [False, True, True, False]  # 0.05 from the notch's corner
+
+
+def _plate_with_hole() -> Polyhedron:
+    """A 0.3 x 0.2 x 0.01 m plate with a 0.06 m square hole, drawn as a mesh exporter does: its top and bottom
+    each four quads around the hole."""
+    outer = [(0.0, 0.0), (0.3, 0.0), (0.3, 0.2), (0.0, 0.2)]
+    inner = [(0.12, 0.07), (0.18, 0.07), (0.18, 0.13), (0.12, 0.13)]
+    v = np.array([(x, y, z) for z in (0.0, 0.01) for x, y in outer + inner])
+    faces = []
+    for i in range(4):
+        j = (i + 1) % 4
+        o0, o1, i0, i1 = i, j, 4 + i, 4 + j
+        faces += [
+            (o0 + 8, o1 + 8, i1 + 8, i0 + 8),
+            (o0, i0, i1, o1),
+            (o0, o1, o1 + 8, o0 + 8),
+            (i0, i0 + 8, i1 + 8, i1),
+        ]
+    return Polyhedron(v, tuple(faces))
+
+
+def test_a_face_split_in_quads_around_a_hole_is_one_region() -> None:
+    plate = Part("BASE", _plate_with_hole())
+    top = plate.face_names()[0]
+    n, _ = plate.face_plane(top)
+    edges = coplanar_boundary(plate, top)
+    assert len(edges) == 8  # the outline and the hole; the four seams between the quads are inside
+    P = np.array([[0.05, 0.1, 0.01], [0.15, 0.1, 0.01], [0.25, 0.18, 0.01], [0.15, 0.065, 0.01], [0.35, 0.1, 0.0]])
+    assert over_region(P, edges, n, 0.0).tolist() == [True, False, True, True, False]
+    assert over_region(P, edges, n, 0.01).tolist() == [True, False, True, False, False]  # 5 mm from the hole
+    # One quad alone holds only the points over its own trapezoid.
+    assert over_polygon(P, plate.face_polygon(top), n, 0.0).sum() < 3
 
 
 def _wedge(angle_deg: float) -> Polyhedron:

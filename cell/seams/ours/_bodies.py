@@ -1,5 +1,6 @@
 """What our locator asks of a joint's bodies when they are not boxes (frame R, metres): how thick and how long the
-abutting part is, its side faces across the seam's ends, and which points lie over the receiving face's polygon.
+abutting part is, its side faces across the seam's ends, and which points lie over the receiving face (with the
+faces coplanar with it: one plane a drawing split into several faces).
 
 A box answers these from its axes (:class:`cell.seams.ours._geometry.JointGeometry`); any closed planar-faced body
 (:class:`cell.types.Polyhedron`) answers them from its vertices and face polygons here, the same quantities by
@@ -16,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.types import Part
+from cell.types import Part, Polyhedron
 
 BoolArray = npt.NDArray[np.bool_]
 SIDE_MAX_ANGLE_DEG = 60.0  # a face of A ends the seam when its normal is this close to the seam's direction
@@ -52,16 +53,36 @@ def side_planes(
     return (start[1], start[2]), (stop[1], stop[2])
 
 
-def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:
-    """(k,) which points P (k, 3) project inside ``polygon`` (m, 3), a planar face of outward normal n, shrunk by
-    ``inset_m`` [m] (every point at least that far from each of its edges). Convex or not (even-odd rule)."""
-    u = polygon[1] - polygon[0]
+def coplanar_boundary(part: Part, face: str, tol_m: float = 1e-6) -> FloatArray:
+    """(k, 2, 3) the boundary edges of the region ``face`` makes with every face of ``part`` in its plane (a
+    drawing may split a plane into several faces: a plate's top around its hole is four quads). Edges two of
+    those faces share lie inside the region and are left out; a hole's edges stay (its own loop)."""
+    body = part.body
+    assert isinstance(body, Polyhedron)
+    n, d = part.face_plane(face)
+    count: dict[tuple[int, int], int] = {}
+    for name, loop in zip(body.names, body.faces, strict=True):
+        n_f, d_f = body.face_plane(name)
+        if float(n_f @ n) < 1.0 - 1e-9 or abs(d_f - d) > tol_m:
+            continue
+        for a, b in zip(loop, loop[1:] + loop[:1], strict=True):
+            key = (min(a, b), max(a, b))
+            count[key] = count.get(key, 0) + 1
+    V = body.vertices
+    return np.array([[V[a], V[b]] for (a, b), k in count.items() if k == 1], dtype=float).reshape(-1, 2, 3)
+
+
+def over_region(P: FloatArray, edges: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:
+    """(k,) which points P (k, 3) project inside the planar region bounded by ``edges`` (m, 2, 3) (closed loops;
+    holes are loops too), of normal n, shrunk by ``inset_m`` [m] (every point at least that far from each edge).
+    Convex or not, with holes or not (even-odd rule)."""
+    u = edges[0, 1] - edges[0, 0]
     u = u - (u @ n) * n
     u /= max(float(np.linalg.norm(u)), 1e-300)
     v = np.cross(n, u)
     q = np.stack([P @ u, P @ v], axis=1)
-    c = np.stack([polygon @ u, polygon @ v], axis=1)
-    a, b = c, np.roll(c, -1, axis=0)
+    a = np.stack([edges[:, 0] @ u, edges[:, 0] @ v], axis=1)
+    b = np.stack([edges[:, 1] @ u, edges[:, 1] @ v], axis=1)
     inside = np.zeros(len(q), dtype=bool)
     for (ax, ay), (bx, by) in zip(a, b, strict=True):  # even-odd crossings of a ray along +u
         crosses = (ay > q[:, 1]) != (by > q[:, 1])
@@ -77,3 +98,9 @@ def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: flo
     gap = w - s[..., None] * e[None]
     nearest = np.sqrt(np.einsum("nmk,nmk->nm", gap, gap)).min(axis=1)
     return inside & (nearest >= inset_m)
+
+
+def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:
+    """(k,) which points P (k, 3) project inside ``polygon`` (m, 3), a planar face of outward normal n, shrunk by
+    ``inset_m`` [m] (:func:`over_region` of its edges)."""
+    return over_region(P, np.stack([polygon, np.roll(polygon, -1, axis=0)], axis=1), n, inset_m)

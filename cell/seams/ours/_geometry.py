@@ -12,7 +12,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
 from cell.seams._lines import extent_behind, plane_intersection
-from cell.seams.ours._bodies import over_polygon, side_planes
+from cell.seams.ours._bodies import coplanar_boundary, over_region, side_planes
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
 from cell.types import Joint, MapSeam, Part, SeamScene
@@ -101,8 +101,7 @@ class JointGeometry:
         """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""
         if not self.part_b.is_box:
             n_b, _ = self.part_b.face_plane(self.face_b)
-            polygon = self.part_b.face_polygon(self.face_b)
-            return over_polygon(pts.P, polygon, n_b, self.edge_band + slack)
+            return over_region(pts.P, coplanar_boundary(self.part_b, self.face_b), n_b, self.edge_band + slack)
         box_b = self.part_b.box
         k_b = "xyz".index(self.face_b[1])
         ok = np.ones(len(pts.cam), bool)

@@ -97,6 +97,7 @@ class Polyhedron:
     names: tuple[str, ...] = ()
     _planes: FloatArray = field(init=False, repr=False, compare=False)
     _tris: npt.NDArray[np.intp] = field(init=False, repr=False, compare=False)
+    _mass: tuple[float, FloatArray, float] = field(init=False, repr=False, compare=False)  # volume, centre, radius
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "vertices", readonly(self.vertices))
@@ -129,6 +130,8 @@ class Polyhedron:
             tris.extend((f[a], f[b], f[c]) for a, b, c in _ear_clip(uv))
         object.__setattr__(self, "_planes", readonly(planes))
         object.__setattr__(self, "_tris", readonly(np.array(tris, dtype=np.intp).reshape(-1, 3), np.intp))
+        vol, c = self._volume_centroid()
+        object.__setattr__(self, "_mass", (vol, readonly(c), float(np.max(np.linalg.norm(self.vertices - c, axis=1)))))
 
     def _index(self, face: str) -> int:
         try:
@@ -243,7 +246,7 @@ class Polyhedron:
     @property
     def volume(self) -> float:
         """The enclosed volume [m^3]."""
-        return self._volume_centroid()[0]
+        return self._mass[0]
 
     def _volume_centroid(self) -> tuple[float, FloatArray]:
         o = self.vertices.mean(axis=0)
@@ -258,12 +261,12 @@ class Polyhedron:
     @property
     def center(self) -> FloatArray:
         """(3,) the centroid of the body's volume [m]."""
-        return self._volume_centroid()[1]
+        return self._mass[1]
 
     @property
     def radius(self) -> float:
         """The radius [m] of a sphere about :attr:`center` that holds the whole body."""
-        return float(np.max(np.linalg.norm(self.vertices - self.center, axis=1)))
+        return self._mass[2]
 
     def edges(self) -> FloatArray:
         """(m, 2, 3) the body's feature edges (where two faces of different planes meet, or an open border) [m]."""

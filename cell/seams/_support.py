@@ -1,9 +1,7 @@
-"""Which seams a locator built for boxes can take: a seam whose joint holds a polyhedral part (a mesh) is refused
-with reason code ``not_supported`` and a one-line reason, while every other seam goes on."""
+"""Which seams a locator built for boxes can take (the paper's method): a seam whose joint holds a polyhedral part
+(a mesh) is refused with reason code ``not_supported`` and a one-line reason, while every other seam goes on."""
 
 from __future__ import annotations
-
-from dataclasses import replace
 
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
@@ -24,12 +22,3 @@ def not_supported(seam: MapSeam, method: str, part: str, why: str) -> SeamEstima
     return SeamEstimate(
         seam.id, SeamStatus.NOT_FOUND, f"{method}: part {part} is a mesh; {why}", code=Reason.NOT_SUPPORTED
     )
-
-
-def boxes_only(scene: SeamScene, keep_cache: tuple[str, ...] = ()) -> SeamScene:
-    """The scene with only the map's box parts (the same scene when every part is a box); ``keep_cache``: the
-    cache entries that do not depend on the parts and may be shared."""
-    if all(p.is_box for p in scene.weldmap.parts):
-        return scene
-    weldmap = replace(scene.weldmap, parts=tuple(p for p in scene.weldmap.parts if p.is_box))
-    return replace(scene, weldmap=weldmap, cache={k: v for k, v in scene.cache.items() if k in keep_cache})

@@ -136,9 +136,9 @@ def test_box_only_locators_refuse_a_mesh_seam(brace: WeldMap) -> None:
     scene = SeamScene(cloud=None, dense=None, weldmap=brace, joints=joints, table_z=0.0)  # type: ignore[arg-type]
     assert mesh_part(scene, brace.seam(BRACE_SEAMS[1])) == "BRACE"
     assert mesh_part(scene, brace.seam("POST_L>TOP_RAIL:+z")) is None
-    est = not_supported(brace.seam(BRACE_SEAMS[1]), "ours", "BRACE", "the box-frame locator needs boxes")
+    est = not_supported(brace.seam(BRACE_SEAMS[1]), "paper", "BRACE", "the method needs boxes")
     assert est.status is SeamStatus.NOT_FOUND and est.code is Reason.NOT_SUPPORTED
-    assert est.reason == "ours: part BRACE is a mesh; the box-frame locator needs boxes"
+    assert est.reason == "paper: part BRACE is a mesh; the method needs boxes"
 
 
 def test_fence1_joints_unchanged() -> None:

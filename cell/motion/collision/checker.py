@@ -34,8 +34,8 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
-from cell.geometry import FloatArray, invert, readonly
-from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts
+from cell.geometry import FloatArray, readonly
+from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts, trim_near_tcp
 from cell.motion.contact import Contact, advance_along
 from cell.motion.robot import RobotModel
 from cell.types import Part
@@ -64,7 +64,7 @@ class CollisionChecker:
         geom = pin.buildGeomFromUrdf(self._model, str(robot.source), pin.COLLISION)
         tcp = self._model.getFrameId(opt.tcp_frame)
         self._tcp_frame = tcp
-        self._trim_near_tcp(geom, tcp)
+        trim_near_tcp(self._model, geom, tcp, opt.tcp_clearance)
         self._n_robot = len(geom.geometryObjects)
         self.link_of: list[str] = [self._model.frames[o.parentFrame].name for o in geom.geometryObjects]
         # each obstacle's grown shape, its bound for the broad phase, the bodies whose shape is a surface only
@@ -115,35 +115,6 @@ class CollisionChecker:
         self.set_base(robot.base_offset_R)
 
     # -- set-up ------------------------------------------------------------------------------------------------
-
-    def _trim_near_tcp(self, geom: pin.GeometryModel, tcp: int) -> None:
-        """Cut torch cylinders coaxial with the wire back to ``tcp_clearance`` behind the wire tip."""
-        r_ex = self.options.tcp_clearance
-        frame = self._model.frames[tcp]
-        X_JT = np.array(frame.placement.homogeneous)  # TCP in its parent joint's frame
-        drop = []
-        for i, obj in enumerate(geom.geometryObjects):
-            if obj.parentJoint != frame.parentJoint or not isinstance(obj.geometry, coal.Cylinder):
-                continue
-            X_JG = np.array(obj.placement.homogeneous)
-            X_TG = invert(X_JT) @ X_JG  # the shape in the TCP frame: coaxial shapes lie on -z
-            axis, c = X_TG[:3, 2], X_TG[:3, 3]
-            if np.linalg.norm(c[:2]) > 1e-6 or abs(abs(axis[2]) - 1.0) > 1e-6:
-                continue
-            half = float(obj.geometry.halfLength)
-            front, back = -c[2] - half, -c[2] + half  # distances behind the tip [m]
-            if front >= r_ex:
-                continue
-            if back <= r_ex:
-                drop.append(i)
-                continue
-            new_half = (back - r_ex) / 2.0
-            X_TG_new = X_TG.copy()
-            X_TG_new[:3, 3] = [0.0, 0.0, -(r_ex + new_half)]
-            obj.geometry = coal.Cylinder(float(obj.geometry.radius), 2.0 * new_half)
-            obj.placement = pin.SE3(X_JT @ X_TG_new)
-        for i in reversed(drop):
-            geom.removeGeometryObject(geom.geometryObjects[i].name)
 
     def _joint_radii(self) -> FloatArray:
         """r_j (dof,): bound on the distance of any collision shape point from joint j's axis [m]."""

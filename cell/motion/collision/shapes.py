@@ -1,4 +1,5 @@
-"""The torch test's geometry: the tool-side collision shapes placed from the TCP, the obstacles' coal shapes (a box
+"""The torch test's geometry: the torch's cylinders cut back near the wire tip, the tool-side collision shapes
+placed from the TCP, the obstacles' coal shapes (a box
 as ``coal.Box``, a convex polyhedron as ``coal.Convex``, any other body as a ``coal.BVHModelOBBRSS`` triangle mesh,
 each grown by its margin: :mod:`cell.motion.collision.grow`) with their bounding boxes as placed in R, and the
 contacts of many TCP poses against them in one broad-phase query (no IK: the poses are in R, so wherever a linear
@@ -25,6 +26,36 @@ from cell.geometry import FloatArray, invert, readonly
 from cell.motion.collision.grow import bounding_box, grown_convex, grown_mesh, is_convex
 from cell.motion.contact import Contact, sphere_box_distance
 from cell.types import Part, Polyhedron
+
+
+def trim_near_tcp(model: pin.Model, geom: pin.GeometryModel, tcp: int, r_ex: float) -> None:
+    """Cut the torch cylinders coaxial with the wire (on the TCP frame ``tcp``'s joint) back to ``r_ex`` [m] (the
+    options' ``tcp_clearance``) behind the wire tip; a cylinder wholly within it is removed."""
+    frame = model.frames[tcp]
+    X_JT = np.array(frame.placement.homogeneous)  # TCP in its parent joint's frame
+    drop = []
+    for i, obj in enumerate(geom.geometryObjects):
+        if obj.parentJoint != frame.parentJoint or not isinstance(obj.geometry, coal.Cylinder):
+            continue
+        X_JG = np.array(obj.placement.homogeneous)
+        X_TG = invert(X_JT) @ X_JG  # the shape in the TCP frame: coaxial shapes lie on -z
+        axis, c = X_TG[:3, 2], X_TG[:3, 3]
+        if np.linalg.norm(c[:2]) > 1e-6 or abs(abs(axis[2]) - 1.0) > 1e-6:
+            continue
+        half = float(obj.geometry.halfLength)
+        front, back = -c[2] - half, -c[2] + half  # distances behind the tip [m]
+        if front >= r_ex:
+            continue
+        if back <= r_ex:
+            drop.append(i)
+            continue
+        new_half = (back - r_ex) / 2.0
+        X_TG_new = X_TG.copy()
+        X_TG_new[:3, 3] = [0.0, 0.0, -(r_ex + new_half)]
+        obj.geometry = coal.Cylinder(float(obj.geometry.radius), 2.0 * new_half)
+        obj.placement = pin.SE3(X_JT @ X_TG_new)
+    for i in reversed(drop):
+        geom.removeGeometryObject(geom.geometryObjects[i].name)
 
 
 @dataclass(frozen=True)

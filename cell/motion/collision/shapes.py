@@ -1,9 +1,9 @@
 """The torch test's geometry: the torch's cylinders cut back near the wire tip, the tool-side collision shapes
-placed from the TCP, the obstacles' coal shapes (a box
-as ``coal.Box``, a convex polyhedron as ``coal.Convex``, any other body as a ``coal.BVHModelOBBRSS`` triangle mesh,
-each grown by its margin: :mod:`cell.motion.collision.grow`) with their bounding boxes as placed in R, and the
-contacts of many TCP poses against them in one broad-phase query (no IK: the poses are in R, so wherever a linear
-track puts the base). Part of the coal adapter with :mod:`cell.motion.collision.checker`.
+placed from the TCP, the obstacles' coal shapes (a box as ``coal.Box``, a convex polyhedron as ``coal.Convex``, any
+other body as a ``coal.BVHModelOBBRSS`` triangle mesh, each grown by its margin: :mod:`cell.motion.collision.grow`)
+with their bounding boxes as placed in R, and the contacts of many TCP poses against them in one broad-phase query
+(no IK: the poses are in R, so wherever a linear track puts the base). Part of the coal adapter with
+:mod:`cell.motion.collision.checker`.
 
 A triangle mesh answers the distance to its surface only: a shape wholly inside a non-convex body would read as
 clear. So where a query against such a body (a :data:`Solids` entry) says clear, the shape's centre is tested

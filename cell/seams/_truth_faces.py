@@ -7,7 +7,8 @@ The seam lies on the line L where the planes of the two as-built weld faces meet
   B; a gap or a small rotation moves it off L, its extent along L stays), exactly. Where those faces share no
   edge, the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by
   the tolerance;
-* B's extent is the chord of L through B's face polygon (L lies in B's plane), grown by the tolerance.
+* B's extent is the chord of L through B's face polygon (L lies in B's plane), or through the region its faces in
+  that plane make together (a plate's top drawn as quads around a hole), grown by the tolerance.
 
 Start and end follow the map seam, carried onto the as-built A by the rigid motion that best maps A's designed
 vertices onto its as-built ones (any frame of the design works: the side of a part turned over too).
@@ -24,6 +25,7 @@ from cell.types import Joint, MapSeam, Part
 CLIP_TOL_M = 1e-4  # [m] how far past a face's polygon the seam may still reach (numerical slack)
 _SAME_POINT_M = 1e-9  # [m] two polygons' vertices closer than this are one vertex
 _MIN_SIN = 1e-6  # faces more nearly parallel than this meet in no line
+_SAME_PLANE_M = 1e-6  # [m] faces of one body whose planes lie this close (and parallel) are one plane
 
 
 def best_rigid(p_from: FloatArray, p_to: FloatArray) -> FloatArray:
@@ -97,6 +99,30 @@ def polygon_extent(poly: FloatArray, n: FloatArray, p0: FloatArray, u: FloatArra
     return float(near[:, 0].min()) - tol, float(near[:, 0].max()) + tol
 
 
+def plane_extent(part: Part, face: str, p0: FloatArray, u: FloatArray, tol: float) -> tuple[float, float]:
+    """(t0, t1) [m] along the line p0 + t u (in ``face``'s plane) of the region the body's faces in that plane
+    make together (a drawing may split one plane into several faces: a plate's top as four quads around its
+    hole): the hull of the chords of those the line crosses, each grown by ``tol``; the face's own
+    :func:`polygon_extent` when the line crosses none of them."""
+    n, d = part.face_plane(face)
+    w = np.cross(n, u)
+    lo, hi = np.inf, -np.inf
+    for other in part.face_names():
+        n_o, d_o = part.face_plane(other)
+        if float(n_o @ n) < 1.0 - 1e-9 or abs(d_o - d) > _SAME_PLANE_M:
+            continue
+        rel = part.face_polygon(other) - p0
+        uv = np.column_stack([rel @ u, rel @ w])
+        if uv[:, 1].min() > tol or uv[:, 1].max() < -tol:
+            continue  # the line passes by this one
+        chord = _clip(uv, -tol, tol)
+        if len(chord):
+            lo, hi = min(lo, float(chord[:, 0].min()) - tol), max(hi, float(chord[:, 0].max()) + tol)
+    if not np.isfinite(lo):
+        return polygon_extent(part.face_polygon(face), n, p0, u, tol)
+    return lo, hi
+
+
 def general_seam_W(
     seam: MapSeam, joint: Joint, design_a: Part, a: Part, b: Part, tol: float = CLIP_TOL_M
 ) -> tuple[FloatArray, FloatArray]:
@@ -118,7 +144,7 @@ def general_seam_W(
         ta = (float(t_edge.min()), float(t_edge.max()))
     else:
         ta = polygon_extent(a.face_polygon(joint.face_abutting), n_a, p0, u, tol)
-    tb = polygon_extent(b.face_polygon(joint.face_receiving), n_b, p0, u, tol)
+    tb = plane_extent(b, joint.face_receiving, p0, u, tol)
     t0, t1 = max(ta[0], tb[0]), min(ta[1], tb[1])
     if t1 <= t0:
         raise MapError(

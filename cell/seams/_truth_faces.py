@@ -4,9 +4,10 @@ The seam lies on the line L where the planes of the two as-built weld faces meet
 ``face_receiving``. It is clipped to the faces' common extent along L:
 
 * A's extent is the projection onto L of A's edge between ``face_abutting`` and ``end_face`` (the edge that meets
-  B; a gap or a small rotation moves it off L, its extent along L stays), exactly. Where those faces share no
-  edge, the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by
-  the tolerance;
+  B; a gap or a small rotation moves it off L, its extent along L stays), exactly: every vertex of A on both
+  faces' planes (so a face the drawing split in several keeps its whole edge). Where no two vertices lie on both,
+  the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by the
+  tolerance;
 * B's extent is the chord of L through B's face polygon (L lies in B's plane), or through the region its faces in
   that plane make together (a plate's top drawn as quads around a hole), grown by the tolerance.
 
@@ -23,7 +24,6 @@ from cell.geometry import FloatArray, transform_points
 from cell.types import Joint, MapSeam, Part
 
 CLIP_TOL_M = 1e-4  # [m] how far past a face's polygon the seam may still reach (numerical slack)
-_SAME_POINT_M = 1e-9  # [m] two polygons' vertices closer than this are one vertex
 _MIN_SIN = 1e-6  # faces more nearly parallel than this meet in no line
 _SAME_PLANE_M = 1e-6  # [m] faces of one body whose planes lie this close (and parallel) are one plane
 
@@ -53,15 +53,13 @@ def plane_line(
     return np.asarray(p), np.asarray(u)
 
 
-def shared_edge(poly_1: FloatArray, poly_2: FloatArray) -> FloatArray | None:
-    """(2, 3) the two farthest-apart vertices the polygons (m, 3) share, or None when they share fewer than two."""
-    d = np.linalg.norm(poly_1[:, None, :] - poly_2[None, :, :], axis=-1)
-    common = poly_1[np.any(d <= _SAME_POINT_M, axis=1)]
-    if len(common) < 2:
-        return None
-    gap = np.linalg.norm(common[:, None, :] - common[None, :, :], axis=-1)
-    i, j = np.unravel_index(int(np.argmax(gap)), gap.shape)
-    return np.stack([common[i], common[j]])
+def edge_vertices(part: Part, face_1: str, face_2: str) -> FloatArray:
+    """(m, 3) the part's vertices that lie on both faces' planes (within ``_SAME_PLANE_M``): the ends of the edge
+    where the two faces meet, and of its pieces when the drawing split a face in several."""
+    v = np.asarray(part.vertices(), dtype=float)
+    n_1, d_1 = part.face_plane(face_1)
+    n_2, d_2 = part.face_plane(face_2)
+    return v[(np.abs(v @ n_1 - d_1) <= _SAME_PLANE_M) & (np.abs(v @ n_2 - d_2) <= _SAME_PLANE_M)]
 
 
 def _clip(uv: FloatArray, lo: float, hi: float) -> FloatArray:
@@ -138,8 +136,8 @@ def general_seam_W(
     X = best_rigid(design_a.vertices(), a.vertices())  # the design of A onto A as built
     ends = transform_points(X, np.stack([seam.p_start, seam.p_end]))
     p0, u = plane_line(n_a, d_a, n_b, d_b, ends.mean(axis=0))
-    edge = shared_edge(a.face_polygon(joint.face_abutting), a.face_polygon(joint.end_face))
-    if edge is not None:
+    edge = edge_vertices(a, joint.face_abutting, joint.end_face)
+    if len(edge) >= 2:
         t_edge = (edge - p0) @ u  # exact: A's edge ends the seam where it is the shorter
         ta = (float(t_edge.min()), float(t_edge.max()))
     else:

@@ -197,6 +197,28 @@ def test_truth_of_a_35_degree_brace_is_the_line_where_its_faces_meet() -> None:
     np.testing.assert_allclose(truth["side"], [[FOOT, DEPTH / 2, 0.0], [0.0, DEPTH / 2, 0.0]], atol=1e-12)
 
 
+def test_truth_keeps_the_whole_edge_of_an_end_face_drawn_in_two() -> None:
+    # a block standing on the rail whose end face (z = 0) is drawn as two quads split at x = 0.05
+    d, h = 0.02, 0.05
+    bottom = [[0, -d, 0], [0.05, -d, 0], [0.1, -d, 0], [0.1, d, 0], [0.05, d, 0], [0, d, 0]]
+    v = np.array([*bottom, [0, -d, h], [0.1, -d, h], [0.1, d, h], [0, d, h]], dtype=float)
+    faces = (
+        (0, 5, 4, 1),  # f0: the end, first half (normal -z)
+        (1, 4, 3, 2),  # f1: the end, second half
+        (0, 1, 2, 7, 6),  # f2: -y (a pentagon: the split's vertex on its lower edge)
+        (3, 4, 5, 9, 8),  # f3: +y
+        (0, 6, 9, 5),  # f4: -x
+        (2, 3, 8, 7),  # f5: +x
+        (6, 7, 8, 9),  # f6: top
+    )
+    block = Polyhedron(v, faces)
+    assert block.volume == pytest.approx(0.1 * 2 * d * h) and block.face_plane("f0")[0][2] == pytest.approx(-1.0)
+    seam = MapSeam("front", np.array([0.0, -d, 0.0]), np.array([0.1, -d, 0.0]))
+    design = WeldMap((Part("BLOCK", block), RAIL), (seam,), "m", "test")
+    truth = true_seams(design, {"front": Joint("front", "BLOCK", "RAIL", "f2", "+z", "f0")}, design.parts, np.eye(4))
+    np.testing.assert_allclose(truth["front"], [[0.0, -d, 0.0], [0.1, -d, 0.0]], atol=1e-12)  # not only f0's half
+
+
 def test_general_truth_of_boxes_equals_the_box_truth_on_fence1() -> None:
     from cell.seams.joint import find_joints
     from cell.weldmap import read_map

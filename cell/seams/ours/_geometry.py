@@ -31,6 +31,7 @@ class JointGeometry:
     part_b: Part
     depth_a: float  # A's thickness below its weld face [m]
     length_a: float  # A's length away from B (along its end face's normal) [m]
+    depth_b: float  # B's thickness behind its receiving face [m]
     planes: tuple[tuple[FloatArray, float], tuple[FloatArray, float]]  # (n, d) across the line at its two ends
     has_sides: bool  # whether ``planes`` are A's side faces (else the seam crosses none: its ends are found)
     face_b: str  # B's receiving face
@@ -58,6 +59,7 @@ class JointGeometry:
                 part_b,
                 extent_behind(part_a, n_a, d_a),
                 extent_behind(part_a, n_e, d_e),
+                extent_behind(part_b, *part_b.face_plane(joint.face_receiving)),
                 across if sides is None else sides,
                 sides is not None,
                 joint.face_receiving,
@@ -80,6 +82,7 @@ class JointGeometry:
             part_b,
             float(box_a.size[k_a]),
             float(box_a.size[k_e]),
+            extent_behind(part_b, *part_b.face_plane(joint.face_receiving)),
             planes,
             has_sides,
             joint.face_receiving,

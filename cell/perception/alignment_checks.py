@@ -29,6 +29,8 @@ from cell.perception.align import Alignment, sample_map
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, WeldMap
 
+_CONTACT_M = 0.003  # [m] a part's top this close to another part is covered by it (the joints' gaps are 0-2 mm)
+
 
 @dataclass(frozen=True)
 class Alternative:
@@ -158,6 +160,9 @@ def part_coverage(
     """Part name -> share of its upward faces' samples (top, in R) with a cloud point within ``band_m`` [m].
 
     Upward faces are seen by every camera above the table; a part that is on the table covers most of its top.
+    Samples within :data:`_CONTACT_M` of another part are left out (covered by it: in contact, or under it). A part
+    with no upward face left to sample (a gusset's sloped top, a plate wholly under others) is not judged: it has
+    no entry.
     """
     spacing = max(spec.voxel_m / 2.0, 0.002)
     tree = None if not len(cloud) else cloud_tree_of(cloud) if cloud_tree is None else cloud_tree
@@ -169,8 +174,10 @@ def part_coverage(
         # Leave out where another part covers it (in contact) or stands over it.
         for other in weldmap_R.parts:
             if other is not part and len(top):
-                top = top[~other.contains(top, band_m)]
-        if tree is None or len(top) == 0:
+                top = top[~other.contains(top, _CONTACT_M)]
+        if len(top) == 0:
+            continue  # nothing of it faces up in the open: no top to judge by
+        if tree is None:
             out[part.name] = 0.0
             continue
         out[part.name] = float(np.mean(np.isfinite(tree.query(top, distance_upper_bound=band_m, workers=-1)[0])))

@@ -47,7 +47,7 @@ def plate_with_hole_mesh() -> MeshTransformer:
     inner = [(hx0, hy0), (hx1, hy0), (hx1, hy1), (hx0, hy1)]
     mesh = MeshTransformer()
     mesh.vertices = [DxfVec3(x, y, z) for z in (z0, z1) for x, y in outer + inner]
-    faces = []
+    faces: list[Sequence[int]] = []
     for i in range(4):
         j = (i + 1) % 4
         o0, o1, i0, i1 = i, j, 4 + i, 4 + j

@@ -2,8 +2,9 @@
 
 1. Candidates (:func:`cell.motion.torch_candidates.candidate_groups`: weld directions x spins x work/travel
    angles, nominal first).
-   A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK;
-   the rest get IK at the weld start, each held with the wrist equivalent (:mod:`cell.motion.wrist`: A4 and A6
+   A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK
+   (:mod:`cell.motion.placement`; when none of the nominal group can be placed, the other groups are swept in a
+   few broad-phase queries, and a seam none can be placed on is refused there); the rest get IK at the weld start, each held with the wrist equivalent (:mod:`cell.motion.wrist`: A4 and A6
    turned by whole turns, the flipped wrist) with A6 in the hose package's window, on home's side of the wrist
    (A5's sign) and nearest the reference wrist every seam shares. They are ranked: A6 in the window first, then
    those within ``_GOOD`` of the best start manipulability, nearest that reference first (so the free spin
@@ -21,21 +22,21 @@ Frames: everything in the robot base frame R [m]; joints [rad].
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from cell.errors import IKError, PlanError
-from cell.geometry import FloatArray, make_pose, readonly, rot_z
-from cell.motion.collision import CollisionChecker, Contact
+from cell.geometry import FloatArray
+from cell.motion.collision import CollisionChecker
 from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
 from cell.motion.ik import solve_ik
 from cell.motion.lines import solve_line
+from cell.motion.placement import Rotations, place, sweep, torch_tests, wording
 from cell.motion.plan_options import PlanOptions
 from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
-from cell.motion.torch import WeldProcess, back_off, line_poses, torch_rotation
+from cell.motion.torch import WeldProcess, back_off, line_poses
 from cell.motion.torch_candidates import Candidate, candidate_groups
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
 from cell.types.plan import PlanReason, SeamTask
@@ -102,7 +103,9 @@ class SeamSearch:
 
         With a reach model, a seam out of reach for every torch within the process's angles fails at once
         (BEYOND_REACH, no candidate built), and a candidate whose wrist centre is out of reach anywhere along the
-        seam is dropped before IK."""
+        seam is dropped before IK. When no candidate of the nominal group can be placed, the other groups are
+        swept for one that can (:func:`cell.motion.placement.sweep`, a few broad-phase queries): a seam none can
+        be placed on is refused there, with the failure the group-by-group search would keep."""
         pr, opt = self.process, self.opt
         if self.reach is not None:
             out = seam_reach(self.reach, task, pr)
@@ -110,17 +113,20 @@ class SeamSearch:
                 return out
         best_fail: SeamFailure | None = None
         q_ref = self._reference(q_seed)
-        rotations: dict[tuple[bool, float, float], FloatArray] = {}
-        for group in candidate_groups(pr, opt):
+        rotations: Rotations = {}
+        groups = candidate_groups(pr, opt)
+        for n_group, group in enumerate(groups):
             found: list[tuple[Candidate, FloatArray, FloatArray]] = []
             q_prev: FloatArray | None = None
-            for cand, (R, hit_start, hit_end) in zip(
-                group, self._torch_tests(task, group, rotations, q_seed, _wording(best_fail)), strict=True
+            any_placed = False
+            for cand, test in zip(
+                group, torch_tests(self, task, group, rotations, q_seed, wording(best_fail)), strict=True
             ):
-                placed = self._place(task, cand, R, hit_start, hit_end, best_fail)
+                placed = place(self, task, cand, test, best_fail)
                 if not isinstance(placed, np.ndarray):
                     best_fail = best_fail if placed is None else better(best_fail, placed)
                     continue
+                any_placed = True
                 X = placed
                 q0: FloatArray | None = None
                 if q_prev is not None:  # warm start from the neighbouring candidate
@@ -142,6 +148,11 @@ class SeamSearch:
                 if isinstance(res, SeamSolution):
                     return res
                 best_fail = better(best_fail, res)
+            if n_group == 0 and not any_placed:  # nothing placed at the nominal angles: can anything be?
+                some, fail = sweep(self, task, groups[1:], q_seed, best_fail, rotations)
+                if not some:
+                    best_fail = fail
+                    break
         if best_fail is None:  # cannot happen: there is always the nominal candidate, and it passes or fails
             raise PlanError(f"seam {task.id}: the torch search tried no candidate")
         return best_fail
@@ -149,107 +160,14 @@ class SeamSearch:
     def placeable(self, task: SeamTask, q_seed: FloatArray) -> SeamFailure | None:
         """None when some candidate's torch can be placed on the seam (the reach pre-check, clear of the obstacles
         at both weld ends, its wrist centre in reach all along: what :meth:`plan_seam` checks before any IK);
-        else the failure :meth:`plan_seam` would report, found without IK (tens of ms for a seam that fails)."""
-        pr = self.process
+        else the failure :meth:`plan_seam` would report, found without IK (:func:`cell.motion.placement.sweep`:
+        a few broad-phase queries for a seam that fails)."""
         if self.reach is not None:
-            out = seam_reach(self.reach, task, pr)
+            out = seam_reach(self.reach, task, self.process)
             if out is not None:
                 return out
-        best_fail: SeamFailure | None = None
-        rotations: dict[tuple[bool, float, float], FloatArray] = {}
-        for group in candidate_groups(pr, self.opt):
-            for cand, (R, hit_start, hit_end) in zip(
-                group, self._torch_tests(task, group, rotations, q_seed, _wording(best_fail)), strict=True
-            ):
-                placed = self._place(task, cand, R, hit_start, hit_end, best_fail)
-                if isinstance(placed, np.ndarray):
-                    return None
-                best_fail = best_fail if placed is None else better(best_fail, placed)
-        return best_fail
-
-    def _torch_tests(
-        self,
-        task: SeamTask,
-        group: list[Candidate],
-        rotations: dict[tuple[bool, float, float], FloatArray],
-        q_seed: FloatArray,
-        worded: bool = True,
-    ) -> list[tuple[FloatArray, Contact | None, Contact | None]]:
-        """Per candidate of a group: its torch rotation R_RT (3, 3) and the torch's contact with the obstacles at
-        the weld start and at the weld end (placed by pose alone; all the group's poses in one query).
-        rotations : the spin-free torch rotations so far, shared by a group's spins. worded : the deepest
-        contact of each pose (for the failure's words), else its first (a failure kept already ranks higher)."""
-        pr = self.process
-        Rs, tips_a, tips_b = [], [], []
-        for cand in group:
-            a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
-            key = (cand.reversed, cand.work_offset, cand.travel_offset)
-            if key not in rotations:
-                rotations[key] = torch_rotation(
-                    (b - a) / task.length,
-                    task.n_a,
-                    task.n_b,
-                    pr.work_angle + cand.work_offset,
-                    pr.travel_angle + cand.travel_offset,
-                )
-            Rs.append(rotations[key] @ rot_z(cand.spin))
-            tips_a.append(a)
-            tips_b.append(a + task.length * ((b - a) / task.length))  # as _poses places the last pose
-        # the two end poses of every candidate, as _poses places them (wire tip standoff back along z)
-        R_all = np.array(Rs)
-        back = pr.standoff * R_all[:, :, 2]
-        starts = np.zeros((len(group), 4, 4))
-        starts[:, :3, :3], starts[:, 3, 3] = R_all, 1.0
-        ends = starts.copy()
-        starts[:, :3, 3] = np.array(tips_a) - back
-        ends[:, :3, 3] = np.array(tips_b) - back
-        at_start = self.checker.torch_clear_many(starts, q_seed, first=not worded)
-        clear = [k for k, h in enumerate(at_start) if h is None]  # the end is tested only where the start is clear
-        at_end: list[Contact | None] = [None] * len(group)
-        if clear:
-            for k, h in zip(
-                clear,
-                self.checker.torch_clear_many(ends[clear], q_seed, not worded),
-                strict=True,
-            ):
-                at_end[k] = h
-        return [(Rs[k], at_start[k], at_end[k]) for k in range(len(group))]
-
-    def _place(
-        self,
-        task: SeamTask,
-        cand: Candidate,
-        R: FloatArray,
-        hit_start: Contact | None,
-        hit_end: Contact | None,
-        best_fail: SeamFailure | None,
-    ) -> FloatArray | SeamFailure | None:
-        """The candidate's weld poses X_RT (n, 4, 4) (torch rotation R (3, 3)) when its torch clears the
-        obstacles at both weld ends (``hit_start``, ``hit_end``: the contacts there) and its wrist centre is in
-        reach all along the seam; else why not (None: a torch collision that would not be kept over
-        ``best_fail``)."""
-        pr, opt = self.process, self.opt
-        a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
-        hit = hit_start or hit_end
-        if hit is not None:
-            if best_fail is not None and best_fail.progress >= -1e-3 - 1e-9:
-                return None  # the failure kept so far ranks at least as high: no need to word this one
-            end = "start" if hit_start is not None else "end"
-            where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
-            # ranks below an IK failure at the start: the pose was not even tried
-            return SeamFailure(PlanReason.COLLISION, where, hit.p_R, -1e-3)
-        X = _poses(a, b, R, pr.standoff, max(2, math.ceil(task.length / opt.spacing - 1e-9) + 1))
-        if self.reach is not None:
-            over = self.reach.pose_excess(X)
-            k = int(np.argmax(over))
-            if over[k] > 0.0:
-                s_k = k * task.length / (len(X) - 1)
-                where = (
-                    f"beyond reach: the wrist centre lies {over[k] * 1000:.0f} mm beyond the shoulder's "
-                    f"reach at {s_k * 1000:.1f} mm along the seam"
-                )
-                return SeamFailure(PlanReason.BEYOND_REACH, where, X[k][:3, 3].copy(), -0.5e-3)
-        return X
+        some, fail = sweep(self, task, candidate_groups(self.process, self.opt), q_seed)
+        return None if some else fail
 
     def _ik(self, X: FloatArray, seed: FloatArray, restarts: bool = False) -> FloatArray:
         return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None, options=self.opt.ik)
@@ -314,20 +232,3 @@ class SeamSearch:
                 float(s_path[k]),
             )
         return SeamSolution(task, cand, X, q_app, q_weld, q_dep, X_app, X_dep)
-
-
-def _poses(a: FloatArray, b: FloatArray, R: FloatArray, standoff: float, n: int) -> FloatArray:
-    """n torch poses (n, 4, 4) of orientation R_RT (3, 3) from seam point a to b (3,) [m], evenly spaced, the wire
-    tip ``standoff`` [m] back along the torch axis (as :func:`~cell.motion.torch.torch_poses` places them)."""
-    length = float(np.linalg.norm(b - a))
-    d = (b - a) / length
-    p = a + np.outer(np.linspace(0.0, length, n), d) - standoff * R[:, 2]
-    out = np.repeat(make_pose(R)[None], n, axis=0)
-    out[:, :3, 3] = p
-    return readonly(out)
-
-
-def _wording(best_fail: SeamFailure | None) -> bool:
-    """Whether a torch collision found now could become the seam's failure (else only whether it collides
-    matters): no failure kept yet, or one that ranks below a torch collision."""
-    return best_fail is None or best_fail.progress < -1e-3 - 1e-9

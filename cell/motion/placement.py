@@ -1,0 +1,206 @@
+"""Placing the torch on a seam without IK: the first steps of the torch search (:mod:`cell.motion.candidates`).
+
+A candidate (:class:`~cell.motion.torch_candidates.Candidate`) is *placed* when its torch, put at the weld start
+and at the weld end by pose alone, clears every obstacle (:func:`torch_tests`, the broad phase of many poses in one
+query) and its wrist centre is within the shoulder's reach all along the seam (:func:`place`). Only placed
+candidates cost IK.
+
+A seam no candidate can be placed on (the ladder's rung-to-rail side seams, in their 36 mm slots) is refused
+without IK. :func:`sweep` finds that out in a few broad-phase queries instead of one per candidate group: the
+groups go in chunks that double in size (1, 2, 4 ... groups per query), each pose asked only whether it collides.
+A seam that can be placed stops at the first chunk that holds a placed candidate, so at most about twice the poses
+the group-by-group search would have tested up to there are tested. The failure it returns is the one the
+group-by-group search keeps (the nearest-nominal candidate with the highest rank, ties to the earlier), and a torch
+collision that becomes the seam's failure is worded as there, from its deepest contact.
+
+Frames: the robot base R [m]; angles [rad].
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from cell.geometry import FloatArray, make_pose, readonly, rot_z
+from cell.motion.collision import Contact
+from cell.motion.failures import SeamFailure, better, mm
+from cell.motion.torch import fillet_axes
+from cell.motion.torch_candidates import Candidate
+from cell.types.plan import PlanReason, SeamTask
+
+if TYPE_CHECKING:
+    from cell.motion.candidates import SeamSearch
+
+PLACED = -1e-3  # a SeamFailure's progress when the torch hit an obstacle where it was placed (below an IK failure)
+BEYOND = -0.5e-3  # ... when the wrist centre is beyond reach somewhere along the seam (above a torch collision)
+
+Rotations = dict[tuple[bool, float, float], FloatArray]  # (reversed, work offset, travel offset) -> R_RT (3, 3)
+TorchTest = tuple[FloatArray, Contact | None, Contact | None]  # R_RT (3, 3), contact at the weld start, at its end
+
+
+def wording(best_fail: SeamFailure | None) -> bool:
+    """Whether a torch collision found now could become the seam's failure (else only whether it collides
+    matters): no failure kept yet, or one that ranks below a torch collision."""
+    return best_fail is None or best_fail.progress < PLACED - 1e-9
+
+
+def torch_tests(
+    search: SeamSearch,
+    task: SeamTask,
+    cands: Sequence[Candidate],
+    rotations: Rotations,
+    q_seed: FloatArray,
+    worded: bool = True,
+) -> list[TorchTest]:
+    """Per candidate: its torch rotation R_RT (3, 3) and the torch's contact with the obstacles at the weld start
+    and at the weld end (placed by pose alone; all the poses in one query, the ends only of those clear at the
+    start). rotations : the spin-free torch rotations so far (shared by spins and by calls). worded : the deepest
+    contact of each pose (for the failure's words), else its first (enough to know that it collides)."""
+    pr = search.process
+    length = task.length
+    Rs, tips_a, tips_b = [], [], []
+    spins: dict[float, FloatArray] = {}
+    for cand in cands:
+        a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
+        key = (cand.reversed, cand.work_offset, cand.travel_offset)
+        if key not in rotations:
+            rotations[key] = _rotation(
+                rotations,
+                (b - a) / length,
+                task,
+                cand.reversed,
+                pr.work_angle + cand.work_offset,
+                pr.travel_angle + cand.travel_offset,
+            )
+        if cand.spin not in spins:
+            spins[cand.spin] = rot_z(cand.spin)
+        Rs.append(rotations[key] @ spins[cand.spin])
+        tips_a.append(a)
+        tips_b.append(a + length * ((b - a) / length))  # as poses() places the last pose
+    # the two end poses of every candidate, as poses() places them (wire tip standoff back along z)
+    R_all = np.array(Rs)
+    back = pr.standoff * R_all[:, :, 2]
+    starts = np.zeros((len(cands), 4, 4))
+    starts[:, :3, :3], starts[:, 3, 3] = R_all, 1.0
+    ends = starts.copy()
+    starts[:, :3, 3] = np.array(tips_a) - back
+    ends[:, :3, 3] = np.array(tips_b) - back
+    at_start = search.checker.torch_clear_many(starts, q_seed, first=not worded)
+    clear = [k for k, h in enumerate(at_start) if h is None]  # the end is tested only where the start is clear
+    at_end: list[Contact | None] = [None] * len(cands)
+    if clear:
+        for k, h in zip(clear, search.checker.torch_clear_many(ends[clear], q_seed, not worded), strict=True):
+            at_end[k] = h
+    return [(Rs[k], at_start[k], at_end[k]) for k in range(len(cands))]
+
+
+def _rotation(
+    rotations: Rotations, v: FloatArray, task: SeamTask, reverse: bool, work_angle: float, travel_angle: float
+) -> FloatArray:
+    """R_RT (3, 3): :func:`~cell.motion.torch.torch_rotation` of the seam direction ``v`` (3,) with spin 0, the
+    same arithmetic, its fillet axes computed once per weld direction (kept in ``rotations`` under the key
+    ``(reverse, inf, inf)``: a seam's candidates share them)."""
+    axes = (reverse, math.inf, math.inf)
+    frame = rotations.get(axes)
+    if frame is None:
+        d = v / float(np.linalg.norm(v))
+        t_b, n_b = fillet_axes(d, task.n_a, task.n_b)
+        frame = rotations[axes] = np.stack([d, t_b, n_b])
+    d, t_b, n_b = frame
+    u = math.cos(work_angle) * t_b + math.sin(work_angle) * n_b  # out of the joint, perpendicular to d
+    z = -math.cos(travel_angle) * u + math.sin(travel_angle) * d
+    x = d - (d @ z) * z
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return np.column_stack([x, y, z]) @ _SPIN_0
+
+
+_SPIN_0 = rot_z(0.0)
+
+
+def place(
+    search: SeamSearch,
+    task: SeamTask,
+    cand: Candidate,
+    test: TorchTest,
+    best_fail: SeamFailure | None,
+) -> FloatArray | SeamFailure | None:
+    """The candidate's weld poses X_RT (n, 4, 4) when its torch clears the obstacles at both weld ends and its
+    wrist centre is in reach all along the seam (``test`` from :func:`torch_tests`); else why not (None: a torch
+    collision that would not be kept over ``best_fail``)."""
+    pr, opt = search.process, search.opt
+    R, hit_start, hit_end = test
+    a, b = (task.p_end, task.p_start) if cand.reversed else (task.p_start, task.p_end)
+    hit = hit_start or hit_end
+    if hit is not None:
+        if best_fail is not None and best_fail.progress >= PLACED - 1e-9:
+            return None  # the failure kept so far ranks at least as high: no need to word this one
+        end = "start" if hit_start is not None else "end"
+        where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
+        # ranks below an IK failure at the start: the pose was not even tried
+        return SeamFailure(PlanReason.COLLISION, where, hit.p_R, PLACED)
+    length = task.length
+    X = poses(a, b, R, pr.standoff, max(2, math.ceil(length / opt.spacing - 1e-9) + 1))
+    if search.reach is not None:
+        over = search.reach.pose_excess(X)
+        k = int(np.argmax(over))
+        if over[k] > 0.0:
+            s_k = k * length / (len(X) - 1)
+            where = (
+                f"beyond reach: the wrist centre lies {over[k] * 1000:.0f} mm beyond the shoulder's "
+                f"reach at {s_k * 1000:.1f} mm along the seam"
+            )
+            return SeamFailure(PlanReason.BEYOND_REACH, where, X[k][:3, 3].copy(), BEYOND)
+    return X
+
+
+def sweep(
+    search: SeamSearch,
+    task: SeamTask,
+    groups: Sequence[Sequence[Candidate]],
+    q_seed: FloatArray,
+    best_fail: SeamFailure | None = None,
+    rotations: Rotations | None = None,
+) -> tuple[bool, SeamFailure | None]:
+    """Whether some candidate of ``groups`` (in order) can be placed on ``task`` (module docstring) and, when none
+    can, the failure the group-by-group search keeps after them all, starting from ``best_fail`` (the kept failure
+    of the groups before). q_seed (dof,) [rad] is carried in the contacts. Chunks of 1, 2, 4 ... groups per
+    broad-phase query, each pose tested for a collision only; the torch collision that ends up kept is worded
+    from its deepest contact, as the group-by-group search words it."""
+    rotations = {} if rotations is None else rotations
+    kept: tuple[Candidate, SeamFailure] | None = None  # a torch collision kept, to word at the end
+    k, size = 0, 1
+    while k < len(groups):
+        chunk = [c for g in groups[k : k + size] for c in g]
+        k, size = k + size, 2 * size
+        if not chunk:
+            continue
+        for cand, test in zip(chunk, torch_tests(search, task, chunk, rotations, q_seed, worded=False), strict=True):
+            placed = place(search, task, cand, test, best_fail)
+            if isinstance(placed, np.ndarray):
+                return True, None
+            if placed is None:
+                continue
+            best_fail = better(best_fail, placed)
+            if best_fail is placed and placed.code is PlanReason.COLLISION:
+                kept = (cand, placed)
+    if kept is not None and best_fail is kept[1]:
+        cand = kept[0]
+        worded = place(search, task, cand, torch_tests(search, task, [cand], rotations, q_seed)[0], None)
+        if isinstance(worded, SeamFailure):
+            best_fail = worded
+    return False, best_fail
+
+
+def poses(a: FloatArray, b: FloatArray, R: FloatArray, standoff: float, n: int) -> FloatArray:
+    """n torch poses (n, 4, 4) of orientation R_RT (3, 3) from seam point a to b (3,) [m], evenly spaced, the wire
+    tip ``standoff`` [m] back along the torch axis (as :func:`~cell.motion.torch.torch_poses` places them)."""
+    length = float(np.linalg.norm(b - a))
+    d = (b - a) / length
+    p = a + np.outer(np.linspace(0.0, length, n), d) - standoff * R[:, 2]
+    out = np.repeat(make_pose(R)[None], n, axis=0)
+    out[:, :3, 3] = p
+    return readonly(out)

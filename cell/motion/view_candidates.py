@@ -9,7 +9,7 @@ direction u and the camera pose. Frames: R the robot base, C the camera's optica
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -140,19 +140,17 @@ def segments_hit_box(p0: FloatArray, p1: FloatArray, part: Part, margin: float) 
     return np.asarray((enter <= leave) & (leave >= 0.0) & (enter <= 1.0))
 
 
-def _geometry_ok(
+def _seen(
     X_RC: FloatArray,
     pts: FloatArray,
     normals: FloatArray,
     face: npt.NDArray[np.int_],
     K: CameraIntrinsics,
     torch_C: FloatArray,
-    parts: Sequence[Part],
     o: ViewOptions,
 ) -> tuple[bool, tuple[float, float]]:
-    """Whether every sample point is in the image, clear of the torch, seen at a good incidence and not occluded;
-    and the worst incidence on face A's and B's samples [deg]."""
-    eye = X_RC[:3, 3]
+    """Whether every sample point is in the image, clear of the torch and seen at a good incidence (the tests
+    before the line of sight); and the worst incidence on face A's and B's samples [deg]."""
     p_C = transform_points(invert(X_RC), pts)
     z = p_C[:, 2]
     if np.any(z <= 0.05):
@@ -170,19 +168,96 @@ def _geometry_ok(
         near = np.hypot(u[:, None] - tu[None, :], v[:, None] - tv[None, :]) < radius[None, :]
         if np.any(near & (ahead[None, :, 2] < z[:, None])):
             return False, (90.0, 90.0)
-    sight = eye - pts
+    sight = X_RC[:3, 3] - pts
     sight /= np.linalg.norm(sight, axis=1, keepdims=True)
     cos = np.einsum("ij,ij->i", sight, normals)
     inc = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
     inc_a = float(inc[face == 1].max(initial=0.0))
     inc_b = float(inc[face == 2].max(initial=0.0))
-    if float(inc.max()) > o.max_incidence_deg:
-        return False, (inc_a, inc_b)
-    ends = pts + 0.002 * normals  # just off the surfaces, so that their own part does not count
+    return float(inc.max()) <= o.max_incidence_deg, (inc_a, inc_b)
+
+
+def _occluded(eye: FloatArray, pts: FloatArray, normals: FloatArray, parts: Sequence[Part], margin: float) -> bool:
+    """Whether a part of ``parts`` (its box grown by ``margin`` [m]) stands on the line of sight from the eye (3,)
+    to a sample point (m, 3), taken just off its surface (so that its own part does not count). A part whose box
+    cannot meet the sight lines' bounding box is not tested."""
+    ends = pts + 0.002 * normals
+    lo = np.minimum(ends.min(axis=0), eye)
+    hi = np.maximum(ends.max(axis=0), eye)
     for part in parts:
-        if np.any(segments_hit_box(eye, ends, part, o.occlusion_margin_m)):
-            return False, (inc_a, inc_b)
-    return True, (inc_a, inc_b)
+        box = part.box
+        reach = np.abs(box.X_AB[:3, :3]) @ (box.size / 2.0 + margin)  # the grown box's axis-aligned half sizes
+        if np.any(box.center + reach < lo) or np.any(box.center - reach > hi):
+            continue
+        if np.any(segments_hit_box(eye, ends, part, margin)):
+            return True
+    return False
+
+
+def ranked_views(
+    target: ViewTarget,
+    intrinsics: CameraIntrinsics,
+    torch_C: FloatArray,
+    parts: Sequence[Part],
+    table_z: float,
+    options: ViewOptions | None = None,
+) -> Iterator[ViewCandidate]:
+    """:func:`view_candidates` one at a time, best score first: every grid pose gets the image, torch and
+    incidence tests and its score, and the line-of-sight test (the costly one: a slab test per part) is done
+    lazily, in the order of the score, on the candidates the caller asks for."""
+    o = options or ViewOptions()
+    b, t = target.bisector, target.direction
+    w = np.cross(t, b)
+    w /= np.linalg.norm(w)
+    pts, normals, face = _samples(target, table_z, o)
+    offset = np.radians(o.image_offset_deg)
+    seen: list[ViewCandidate] = []
+    for distance in o.distances_m:
+        for tilt in o.tilts_deg:
+            for slant in o.slants_deg:
+                ta, sl = np.radians(tilt), np.radians(slant)
+                u = np.cos(sl) * (np.cos(ta) * b + np.sin(ta) * w) + np.sin(sl) * t
+                if float((target.mid + distance * u)[2]) < table_z + 0.05:
+                    continue
+                for roll in o.rolls_deg:
+                    X_RC = _camera_pose(target, u, distance, np.radians(roll), offset)
+                    ok, inc = _seen(X_RC, pts, normals, face, intrinsics, torch_C, o)
+                    if ok:
+                        score = max(inc) + o.distance_weight_deg_per_m * abs(distance - o.preferred_distance_m)
+                        seen.append(ViewCandidate(X_RC, distance, tilt, slant, roll, inc, score))
+    seen.sort(key=lambda c: c.score)  # stable: ties keep the grid order (sorting before the last test keeps it)
+    for c in seen:
+        if not _occluded(c.X_RC[:3, 3], pts, normals, parts, o.occlusion_margin_m):
+            yield c
+
+
+def _samples(target: ViewTarget, table_z: float, o: ViewOptions) -> tuple[FloatArray, FloatArray, npt.NDArray[np.int_]]:
+    """The target's sample points (m, 3), their normals (m, 3) and surfaces (m,) (:meth:`ViewTarget.samples`),
+    those below the table top ``table_z`` [m] dropped."""
+    pts, normals = target.samples(o.face_strip_m, o.end_margin_m)
+    above = pts[:, 2] >= table_z + 0.001
+    return pts[above], normals[above], _face_labels(len(above))[above]
+
+
+def sees(
+    X_RC: FloatArray,
+    target: ViewTarget,
+    intrinsics: CameraIntrinsics,
+    torch_C: FloatArray,
+    parts: Sequence[Part],
+    table_z: float,
+    options: ViewOptions | None = None,
+) -> tuple[float, float] | None:
+    """The worst incidence on face A's and B's samples [deg] when a camera at X_RC (4, 4) in R sees ``target``
+    as well as a view candidate must (every test of :func:`view_candidates`: in the image with its margin, clear
+    of the torch, incidence, line of sight past ``parts``), else None. A close-up taken for one seam serves
+    every other seam it sees this way."""
+    o = options or ViewOptions()
+    pts, normals, face = _samples(target, table_z, o)
+    ok, inc = _seen(X_RC, pts, normals, face, intrinsics, torch_C, o)
+    if not ok or _occluded(X_RC[:3, 3], pts, normals, parts, o.occlusion_margin_m):
+        return None
+    return inc
 
 
 def view_candidates(
@@ -199,28 +274,6 @@ def view_candidates(
     parts : the map's parts in R that may stand in the line of sight (not the joint's own two: the incidence
     test keeps their faces turned to the camera, and the seam estimate may lie inside their drawn boxes);
     table_z : the table top in R [m] (the camera stays above it; samples below it are dropped).
+    All of :func:`ranked_views` (which the view planner reads lazily, as far as it needs).
     """
-    o = options or ViewOptions()
-    b, t = target.bisector, target.direction
-    w = np.cross(t, b)
-    w /= np.linalg.norm(w)
-    pts, normals = target.samples(o.face_strip_m, o.end_margin_m)
-    above = pts[:, 2] >= table_z + 0.001
-    pts, normals, face = pts[above], normals[above], _face_labels(len(above))[above]
-    offset = np.radians(o.image_offset_deg)
-    out: list[ViewCandidate] = []
-    for distance in o.distances_m:
-        for tilt in o.tilts_deg:
-            for slant in o.slants_deg:
-                ta, sl = np.radians(tilt), np.radians(slant)
-                u = np.cos(sl) * (np.cos(ta) * b + np.sin(ta) * w) + np.sin(sl) * t
-                if float((target.mid + distance * u)[2]) < table_z + 0.05:
-                    continue
-                for roll in o.rolls_deg:
-                    X_RC = _camera_pose(target, u, distance, np.radians(roll), offset)
-                    ok, inc = _geometry_ok(X_RC, pts, normals, face, intrinsics, torch_C, parts, o)
-                    if ok:
-                        score = max(inc) + o.distance_weight_deg_per_m * abs(distance - o.preferred_distance_m)
-                        out.append(ViewCandidate(X_RC, distance, tilt, slant, roll, inc, score))
-    out.sort(key=lambda c: c.score)  # stable: ties keep the grid order
-    return out
+    return list(ranked_views(target, intrinsics, torch_C, parts, table_z, options))

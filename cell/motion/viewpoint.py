@@ -27,8 +27,9 @@ each was rejected) when none does.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from enum import StrEnum
+from itertools import chain
 
 import numpy as np
 import numpy.typing as npt
@@ -43,6 +44,7 @@ from cell.motion.view_candidates import (
     ViewCandidate,
     ViewOptions,
     ViewTarget,
+    ranked_views,
     segments_hit_box,
     torch_axis_in_camera,
     view_candidates,
@@ -100,8 +102,9 @@ def plan_view(
     o = options or ViewOptions()
     q0 = np.asarray(q_from, dtype=float)
     torch_C = torch_axis_in_camera(model, o)
-    cands = view_candidates(target, intrinsics, torch_C, parts, table_z, o)
-    if not cands:
+    ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)  # lazily: the first that works ends it
+    best = next(ranked, None)
+    if best is None:
         raise NoViewError(
             f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "
             f"torch, incidence <= {o.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m",
@@ -110,9 +113,10 @@ def plan_view(
     why: dict[ViewRejection, int] = {}
     seeds = [q0] if q_via is None else [q0, np.asarray(q_via, dtype=float)]
     tried = 0
+    first = _Prefix(chain([best], ranked))
     # Pass 1: warm-started IK only (cheap), on the best max_candidates; pass 2: random restarts on the best few.
-    for pass_, top in ((1, cands[:max_candidates]), (2, cands[:restart_candidates])):
-        for c in top:
+    for pass_, top in ((1, max_candidates), (2, restart_candidates)):
+        for c in first.upto(top):
             tried += 1
             q = _ik(model, c.X_RC, seeds, o.camera_frame, rng if pass_ == 2 else None, o.ik)
             if q is None:
@@ -136,6 +140,25 @@ def plan_view(
         tried=tried,
         rejected=why,
     )
+
+
+class _Prefix:
+    """The candidates of an iterator read as far as asked and kept, so a second pass reads the same ones again."""
+
+    def __init__(self, source: Iterator[ViewCandidate]) -> None:
+        self._source, self._seen = source, list[ViewCandidate]()
+
+    def upto(self, n: int) -> Iterator[ViewCandidate]:
+        """The first ``n`` candidates (fewer when the source ends), read lazily."""
+        k = 0
+        while k < n:
+            if k == len(self._seen):
+                nxt = next(self._source, None)
+                if nxt is None:
+                    return
+                self._seen.append(nxt)
+            yield self._seen[k]
+            k += 1
 
 
 def _ik(

@@ -3,7 +3,9 @@ escalate.
 
 The values it needs (views, close-up scenes, fusion) come from :mod:`cell.rescan` and
 :mod:`cell.motion.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
-for it. Frames: R (robot base) for every estimate and pose; metres, radians, seconds.
+for it. One close-up serves every seam still to re-scan that it sees as well as a view of that seam's own must
+(:func:`shared_by`): the ladder's neighbouring seams share an image instead of costing one each. Frames: R (robot
+base) for every estimate and pose; metres, radians, seconds.
 """
 
 from __future__ import annotations
@@ -37,7 +39,8 @@ from cell.rescan import (
 )
 from cell.seams.base import SeamLocator
 from cell.station import Arm, Station
-from cell.types import SeamEstimate, SeamStatus
+from cell.types import DepthImage, SeamEstimate, SeamStatus
+from cell.types.rescan import Viewpoint
 
 if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker
@@ -70,8 +73,9 @@ class _Run:
         self.q = np.asarray(move.q[-1], dtype=float)
 
 
-def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan:
-    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan`)."""
+def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequence[str]) -> list[SeamRescan]:
+    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan`), and every seam of
+    ``pending`` the same close-up sees as well as a view of its own must (:func:`shared_by`): one image each."""
     from cell.motion.viewpoint import plan_view
 
     t0 = time.perf_counter()
@@ -94,14 +98,55 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan
         )
     except CellError as exc:
         reason = f"unreachable view: {exc.message}"
-        return SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)
+        return [SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)]
     run.play(vp.move)
     image = run.station.capture_eye_in_hand(run.camera)
+    out = [_closeup(run, seam_id, image, vp, vp.move.duration, t0)]
+    for other, seen in shared_by(run, vp, pending):
+        out.append(_closeup(run, other, image, seen, 0.0, time.perf_counter()))
+    return out
+
+
+def shared_by(run: _Run, vp: Viewpoint, pending: Sequence[str]) -> list[tuple[str, Viewpoint]]:
+    """The seams of ``pending`` (with a first estimate or the map's line) that the close-up from ``vp`` sees as
+    a view candidate of their own must (:func:`cell.motion.view_candidates.sees`: in the image with its margin,
+    clear of the torch, at the incidence allowed, no part in the way), each with the view as it is for that seam
+    (its distance and incidence; no move, tried 0). Only seams within ``_SHARE_RADIUS`` of the viewed one are
+    tested."""
+    from cell.motion.view_candidates import sees, torch_axis_in_camera
+
+    det, o = run.detection, run.options
+    base = _scene_of(det).seam_scene
+    by_id = {e.id: e for e in det.estimates}
+    K = run.station.intrinsics(run.camera)
+    torch_C = torch_axis_in_camera(run.arm.model, o.view)
+    here = view_target(base, base.weldmap.seam(vp.seam_id), by_id[vp.seam_id]).mid
+    out = []
+    for sid in pending:
+        target = view_target(base, base.weldmap.seam(sid), by_id[sid])
+        if float(np.linalg.norm(target.mid - here)) > _SHARE_RADIUS:
+            continue
+        inc = sees(vp.X_RC, target, K, torch_C, occluders(base, sid), base.table_z, o.view)
+        if inc is not None:
+            dist = float(np.linalg.norm(vp.X_RC[:3, 3] - target.mid))
+            out.append((sid, replace(vp, seam_id=sid, distance_m=dist, incidence_deg=inc, tried=0)))
+    return out
+
+
+_SHARE_RADIUS = 0.25  # [m] seams whose midpoints lie farther from the viewed seam's are not looked for in its image
+
+
+def _closeup(run: _Run, seam_id: str, image: DepthImage, vp: Viewpoint, motion_s: float, t0: float) -> SeamRescan:
+    """Locate ``seam_id`` in the close-up ``image`` taken from ``vp`` and fuse it with its first estimate."""
+    o, det = run.options, run.detection
+    base = _scene_of(det).seam_scene
+    first = next(e for e in det.estimates if e.id == seam_id)
+    seam = base.weldmap.seam(seam_id)
     scene = closeup_scene(image, det.scenario.X_WR, seam, base, o, det.scenario.perception.voxel_m)
     n = len(scene.dense)
     if n < o.min_points:
         reason = f"nothing seen: {n} points near the seam in the close-up (needs {o.min_points})"
-        return SeamRescan(seam_id, first, None, first, 0.0, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
+        return SeamRescan(seam_id, first, None, first, 0.0, vp, motion_s, time.perf_counter() - t0, reason, n)
     t = time.perf_counter()
     est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
     est = replace(est, time_s=time.perf_counter() - t)
@@ -109,7 +154,7 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator) -> SeamRescan
     est = closeup_sigma(est, X_RC[:3, 3], pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty()))
     fused, w = fuse(first, est, estimate_sigma(first), estimate_sigma(est), o.first_scale_m)
     reason = "" if w > 0.0 else f"close-up not used: {est.reason or est.status.value}"
-    return SeamRescan(seam_id, first, est, fused, w, vp, vp.move.duration, time.perf_counter() - t0, reason, n)
+    return SeamRescan(seam_id, first, est, fused, w, vp, motion_s, time.perf_counter() - t0, reason, n)
 
 
 def _scene_of(det: Detection) -> Scene:
@@ -127,7 +172,9 @@ def rescan_seams(
     motion: MotionScene | None = None,
     progress: Progress = quiet,
 ) -> Rescan:
-    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`).
+    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`). A
+    seam the close-up of an earlier one sees (:func:`shared_by`) is located in that image, with no view of its own
+    (its record's ``motion_s`` is 0); the result lists every seam in the order asked.
 
     station : the running cell the detection came from. Its arm moves from where it is to each view (arc off)
     and, with ``options.return_to_scan``, back to the scan configuration when that move is free; the result says
@@ -155,10 +202,17 @@ def rescan_seams(
     locator = make_locator(detection.method, closeup_scenario(sc, detection.method, o))
     run = _Run(station, arm, detection, o, camera, checker, locator, station.joint_state())
     rng = sc.rng("rescan/view")
-    results = []
+    done: dict[str, SeamRescan] = {}
     for k, sid in enumerate(seam_ids):
+        if sid in done:  # seen in an earlier seam's close-up
+            continue
+        pending = [i for i in seam_ids[k + 1 :] if i not in done]
         progress(f"re-scan {k + 1}/{len(seam_ids)}: {sid}")
-        results.append(_rescan_one(run, sid, rng))
+        got = _rescan_one(run, sid, rng, pending)
+        if len(got) > 1:
+            progress(f"the same close-up sees {', '.join(r.id for r in got[1:])}: located there too")
+        done.update((r.id, r) for r in got)
+    results = [done[sid] for sid in seam_ids]
     returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
     if o.return_to_scan and not returned:
         back = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)

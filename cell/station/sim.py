@@ -34,12 +34,13 @@ class SimStation:
     """
 
     def __init__(self, scenario: Scenario, weldmap: WeldMap, *, gui: bool = False, with_robot: bool = True) -> None:
-        from cell.asbuilt import as_built_parts
+        from cell.asbuilt import as_built_fixtures, as_built_parts
         from cell.sim import SimCell
 
         self.scenario = scenario
         self.parts_W: tuple[Part, ...] = as_built_parts(weldmap, scenario)
-        self.sim: SimCell = SimCell(scenario, self.parts_W, gui=gui)
+        # The clamps and stops the map draws are there for the cameras too (never parts, never aligned).
+        self.sim: SimCell = SimCell(scenario, self.parts_W, gui=gui, fixtures_W=as_built_fixtures(weldmap, scenario))
         self._arm: Arm | None = None
         self.X_W_turned: FloatArray | None = None  # the true motion of the last turn (ground truth)
         try:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import pybullet
 
 from cell import scenario as sc
 from cell.asbuilt import as_built_fixtures
@@ -23,6 +22,6 @@ def test_a_maps_fixture_is_a_body_of_the_station_at_its_as_built_place() -> None
     weldmap = dataclasses.replace(weldmap, fixtures=(clamp,))
     with SimStation(s, weldmap, with_robot=False) as station:
         body = station.sim.body_id(FIXTURE_PREFIX + "CLAMP")
-        p_W, _ = pybullet.getBasePositionAndOrientation(body, physicsClientId=station.sim.client)
+        p_W, _ = station.sim.client.getBasePositionAndOrientation(body)
     (expected,) = as_built_fixtures(weldmap, s)
     assert np.allclose(p_W, expected.center, atol=1e-6)

@@ -92,7 +92,15 @@ def _log_scene(rec: Any, rr: Any, run: WeldRun, max_points: int, moving: frozens
     if len(cloud):
         p = thin(cloud, max_points).astype(np.float32)
         rec.log("cell/cloud", rr.Points3D(p, colors=_height_colours(p), radii=0.001), static=True)
-    parts = det.weldmap_R.parts
+    parts = tuple(pt for pt in det.weldmap_R.parts if pt.is_box)
+    for pt in det.weldmap_R.parts:
+        if not pt.is_box:  # any other body: its own triangulation
+            vertices, triangles = pt.triangles()
+            rec.log(
+                f"cell/map/meshes/{pt.name}",
+                rr.Mesh3D(vertex_positions=np.asarray(vertices, np.float32), triangle_indices=triangles),
+                static=True,
+            )
     if parts:
         X = np.array([pt.box.X_AB for pt in parts])
         rec.log(

@@ -8,6 +8,8 @@ Run by :func:`cell.perception.perceive.perceive` before splicing:
 - :func:`disagreeing_cameras`: the cameras' clouds against each other in R (calibrated extrinsics). A camera
   knocked out of calibration sees the same part elsewhere: few of its points lie on the others' surfaces while
   the others agree with each other. With only two cameras nobody can tell which one is wrong: none is dropped.
+  A camera that sees only part of what another sees (an eye-in-hand camera close over a thin part) is judged on
+  the part it sees: the other camera's points count only where the first one has points at all (its footprint).
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ from cell.config.perception import HealthOptions
 from cell.geometry import FloatArray
 from cell.perception.preprocess import downsample
 from cell.types import Cloud, DepthImage
+
+FOOTPRINT_TOLS = 4.0  # a camera's footprint: the voxels of this many agreement tolerances its points occupy
 
 
 @dataclass(frozen=True)
@@ -96,6 +100,14 @@ def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None)
     Both grids share one anchoring, so when the tolerance covers a voxel's diagonal, a's grid point whose voxel
     b also occupies agrees without a search (the two centroids lie in one voxel); only the others are searched.
     """
+    return _shares(clouds, options)[0]
+
+
+def _shares(
+    clouds: Mapping[str, Cloud], options: HealthOptions | None = None
+) -> tuple[dict[tuple[str, str], float], dict[tuple[str, str], float]]:
+    """:func:`agreement`, and (a, b) -> the same share over only a's grid points inside b's footprint (the
+    voxels of ``FOOTPRINT_TOLS`` x ``agree_tol_m`` that b's points occupy; NaN when none is)."""
     o = options if options is not None else HealthOptions()
     names = [n for n, c in clouds.items() if len(c) > 0]
 
@@ -109,26 +121,39 @@ def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None)
     trees = {n: tree for n, (_, tree) in done.items()}
     shortcut = o.agree_voxel_m * math.sqrt(3.0) * (1.0 + 1e-6) <= o.agree_tol_m
     keys = {n: _voxel_keys(p, o.agree_voxel_m) for n, p in grids.items()} if shortcut else {}
+    coarse = {n: _voxel_keys(p, FOOTPRINT_TOLS * o.agree_tol_m) for n, p in grids.items()}
     out: dict[tuple[str, str], float] = {}
+    within: dict[tuple[str, str], float] = {}
     for a, pa in grids.items():
         for b, tree in trees.items():
             if a == b:
                 continue
             near = np.isin(keys[a], keys[b]) if shortcut else np.zeros(len(pa), dtype=bool)
+            agrees = near.copy()
             dist, _ = tree.query(pa[~near], distance_upper_bound=o.agree_tol_m, workers=-1)
-            out[(a, b)] = float((np.count_nonzero(near) + np.count_nonzero(np.isfinite(dist))) / len(pa))
-    return out
+            agrees[~near] = np.isfinite(dist)
+            out[(a, b)] = float(np.count_nonzero(agrees) / len(pa))
+            inside = np.isin(coarse[a], coarse[b])
+            n_in = np.count_nonzero(inside)
+            within[(a, b)] = float(np.count_nonzero(agrees & inside) / n_in) if n_in else float("nan")
+    return out, within
 
 
 def disagreeing_cameras(clouds: Mapping[str, Cloud], options: HealthOptions | None = None) -> dict[str, str]:
     """Cameras whose cloud agrees with no other camera while at least two others agree with each other:
     name -> reason. Empty when all agree, or when there is no agreeing majority to judge by."""
     o = options if options is not None else HealthOptions()
-    share = agreement(clouds, o)
+    share, within = _shares(clouds, o)
     names = sorted({a for a, _ in share})
 
-    def agree(a: str, b: str) -> bool:  # both ways: a shifted cloud can still cover the other's tops
-        return min(share[(a, b)], share[(b, a)]) >= o.min_agreement
+    def both(a: str, b: str) -> float:  # both ways: a shifted cloud can still cover the other's tops
+        return min(share[(a, b)], share[(b, a)])
+
+    def agree(a: str, b: str) -> bool:
+        """Both ways, each camera's points where the other has any (a camera that sees a part of what the other
+        sees is judged there), and one of them lies on the other's surfaces as a whole."""
+        inside = min(within[(a, b)], within[(b, a)])  # NaN (no common footprint) never agrees
+        return bool(inside >= o.min_agreement) and max(share[(a, b)], share[(b, a)]) >= o.min_agreement
 
     out = {}
     for c in names:
@@ -137,8 +162,8 @@ def disagreeing_cameras(clouds: Mapping[str, Cloud], options: HealthOptions | No
             continue
         if not any(agree(a, b) for i, a in enumerate(others) for b in others[i + 1 :]):
             continue  # no pair of the others agrees either: no majority to tell who is wrong
-        best = max(others, key=lambda n: min(share[(c, n)], share[(n, c)]))
-        worst = min(share[(c, best)], share[(best, c)])
+        best = max(others, key=lambda n: both(c, n))
+        worst = both(c, best)
         out[c] = (
             f"disagrees with the other cameras: at best {worst:.0%} of its points and {best}'s lie within "
             f"{o.agree_tol_m * 1000:.0f} mm of each other (needs {o.min_agreement:.0%}), while the others agree: "

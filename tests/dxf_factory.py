@@ -10,7 +10,8 @@ for _p in (REPO_ROOT, REPO_ROOT / "tools"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
-import make_maps  # noqa: E402  (after the path set-up above)
+import make_brace  # noqa: E402, F401  (after the path set-up above; the tests import it from here)
+import make_maps  # noqa: E402
 
 BoxSpec = make_maps.BoxSpec
 SeamSpec = make_maps.SeamSpec

@@ -1,8 +1,8 @@
-"""Generate the welding maps in ``maps/`` (fence1, fence2, ladder, tee, brace) and variants of them for tests.
+"""Generate the welding maps in ``maps/`` (fence1, fence2, ladder, tee) and variants of them for tests.
 
 Run from the repository root::
 
-    .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, fence2.dxf, ladder.dxf, tee.dxf, brace.dxf
+    .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, fence2.dxf, ladder.dxf, tee.dxf
     .venv/bin/python tools/make_maps.py --out DIR  # somewhere else
 
 Conventions of every map: drawing units mm (``$INSUNITS`` = 4), map frame M with its origin at the fence corner and
@@ -16,8 +16,8 @@ The output is byte-stable for a given ezdxf version: ezdxf's fixed-metadata opti
 GUIDs and marker, solids get GUIDs derived from their handles, the ACIS creation date is a fixed one, and
 the CLASS entries are sorted.
 
-``brace`` is fence1 drawn as MESH bodies plus a diagonal flat-bar brace between the posts (see
-:func:`build_brace_map`): a body that is not a box, inside a rotated block.
+``maps/brace.dxf`` (fence1 with a mitred flat-bar brace, a body that is not a box) is written by
+``tools/make_brace.py``, ``maps/bracket.dxf`` (plates) by ``tools/make_weldments.py``.
 """
 
 from __future__ import annotations
@@ -375,75 +375,6 @@ def _save_stable(doc: Drawing, path: Path) -> None:
     doc.saveas(path)
 
 
-# --- The brace map: fence1 with a mitred diagonal brace (a body that is not a box) --------------------------
-
-BRACE_DEG = 35.0  # the brace's axis to the rails (M's x) [deg]
-BRACE_WIDTH = 40.0  # across its axis, in the table's plane [mm]
-BRACE_Z = (61.0, 80.0)  # a flat bar 1 mm over the bottom rail, flush with the posts' tops [mm]
-BRACE_Y0 = 60.0  # y of its centre line at its left end [mm]
-BRACE_GAP = 1.0  # between each mitred end and a post's inner face [mm]
-
-
-def brace_outline() -> list[tuple[float, float]]:
-    """The brace's corners in the table's plane (x, y) [mm], counter-clockwise from above: a parallelogram whose
-    ends are cut square to the rails (mitred), so that they lie flat on the posts' inner faces across the gap."""
-    (_, (x_l, _, _)), ((x_r, _, _), _) = FENCE1_PARTS["POST_L"], FENCE1_PARTS["POST_R"]
-    x0, x1 = x_l + BRACE_GAP, x_r - BRACE_GAP
-    t, h = math.tan(math.radians(BRACE_DEG)), BRACE_WIDTH / 2.0 / math.cos(math.radians(BRACE_DEG))
-    y1 = BRACE_Y0 + (x1 - x0) * t
-    return [(x0, BRACE_Y0 - h), (x1, y1 - h), (x1, y1 + h), (x0, BRACE_Y0 + h)]
-
-
-def brace_mesh(M: Matrix44 | None = None) -> MeshTransformer:
-    """The brace as a closed MESH (8 vertices, 6 quads, outward normals) [mm], moved by ``M`` if given."""
-    mesh = MeshTransformer()
-    mesh.vertices = [ezdxf.math.Vec3(x, y, z) for z in BRACE_Z for x, y in brace_outline()]
-    mesh.faces = [(3, 2, 1, 0), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
-    if M is not None:
-        mesh.transform(M)
-    return mesh
-
-
-def brace_seams() -> list[SeamSpec]:
-    """The brace's four fillets: where its two long sides meet each post's inner face (vertical, z over the
-    brace's thickness), ids ``BRACE>POST_L:lower`` ... (lower/upper: the side of smaller/larger y)."""
-    (_, (x_l, _, _)), ((x_r, _, _), _) = FENCE1_PARTS["POST_L"], FENCE1_PARTS["POST_R"]
-    (x0, y_lo), _, _, (_, y_hi) = brace_outline()
-    t = math.tan(math.radians(BRACE_DEG))
-    seams: list[SeamSpec] = []
-    for post, x in (("POST_L", x_l), ("POST_R", x_r)):
-        for side, y0 in (("lower", y_lo), ("upper", y_hi)):
-            y = y0 + (x - x0) * t  # the side's plane at the post's face
-            seams.append((f"BRACE>{post}:{side}", (x, y, BRACE_Z[0]), (x, y, BRACE_Z[1])))
-    return seams
-
-
-def build_brace_map() -> Drawing:
-    """fence1's posts and rails as MESH bodies with their 16 seams, plus the brace as a MESH on layer 0 inside
-    block ``BRACE`` (drawn along its own axis, turned by the INSERT's ``BRACE_DEG`` rotation) and its 4 seams."""
-    doc = build_map(FENCE1_PARTS, all_seams(FENCE1_PARTS, FENCE1_JUNCTIONS), solid="mesh")
-    doc.layers.add("BRACE", color=PART_LAYER_COLOR)
-    (x0, y0), *_ = brace_outline()
-    block = doc.blocks.new("BRACE")
-    _add_body(block, brace_mesh(Matrix44.translate(-x0, -y0, 0.0) @ _rot_z(-BRACE_DEG)), "0", "mesh")
-    doc.modelspace().add_blockref("BRACE", (x0, y0, 0.0), dxfattribs={"layer": "BRACE", "rotation": BRACE_DEG})
-    for seam_id, p0, p1 in brace_seams():
-        _add_seam(doc.modelspace(), seam_id, p0, p1, "WELD_SEAMS", "explicit", None)
-    return doc
-
-
-def write_brace_map(path: str | Path) -> Path:
-    """Write the brace map (:func:`build_brace_map`) to ``path``, byte-stable; returns the path."""
-    path = Path(path)
-    fixed = ezdxf.options.write_fixed_meta_data_for_testing
-    ezdxf.options.write_fixed_meta_data_for_testing = True
-    try:
-        _save_stable(build_brace_map(), path)
-    finally:
-        ezdxf.options.write_fixed_meta_data_for_testing = fixed
-    return path
-
-
 def designs() -> dict[str, tuple[dict[str, BoxSpec], tuple[Junction, ...]]]:
     """The maps this tool writes: name -> (parts, junctions)."""
     return {
@@ -471,8 +402,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         seams = design_seams(name, parts, junctions)
         path = write_map(args.out / f"{name}.dxf", parts, seams)
         print(f"{path}: {len(parts)} parts, {len(junctions)} junctions, {len(seams)} seams")
-    path = write_brace_map(args.out / "brace.dxf")
-    print(f"{path}: {len(FENCE1_PARTS) + 1} parts (one a mesh), {16 + len(brace_seams())} seams")
     return 0
 
 

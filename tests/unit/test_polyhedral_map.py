@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from dxf_factory import REPO_ROOT, design, make_maps
+from dxf_factory import REPO_ROOT, design, make_brace, make_maps
 
 from cell.errors import MapError
 from cell.geometry import make_pose
@@ -32,13 +32,13 @@ def brace() -> WeldMap:
 
 
 def test_the_brace_reads_as_a_polyhedral_part(brace: WeldMap, tmp_path: Path) -> None:
-    assert make_maps.write_brace_map(tmp_path / "b.dxf").read_bytes() == (MAPS / "brace.dxf").read_bytes()
+    assert make_brace.write_brace_map(tmp_path / "b.dxf").read_bytes() == (MAPS / "brace.dxf").read_bytes()
     assert brace.warnings == () and len(brace.seams) == 20
     part = brace.part("BRACE")
     assert part.drawn_as == "MESH" and not part.is_box and len(part.face_names()) == 6
     assert [p.is_box for p in brace.parts] == [True] * 4 + [False]
     # the block's rotation undone: the drawn outline, 19 mm thick, a parallelogram 40 mm across its axis
-    (x0, _), (x1, _), _, _ = make_maps.brace_outline()
+    (x0, _), (x1, _), _, _ = make_brace.brace_outline()
     v = part.vertices()
     assert v[:, 0].min() == pytest.approx(x0 * 1e-3) and v[:, 0].max() == pytest.approx(x1 * 1e-3)
     assert np.ptp(v[:, 2]) == pytest.approx(0.019)
@@ -155,8 +155,8 @@ def test_fence1_joints_unchanged() -> None:
 @pytest.mark.parametrize("form", ["3DFACE", "POLYFACE", "3DSOLID"])
 def test_the_brace_drawn_as_3dfaces_a_polyface_or_a_solid(tmp_path: Path, form: str) -> None:
     parts, seams = design("fence1")
-    doc = make_maps.build_map(parts, seams + make_maps.brace_seams(), solid="mesh")
-    mesh = make_maps.brace_mesh()
+    doc = make_maps.build_map(parts, seams + make_brace.brace_seams(), solid="mesh")
+    mesh = make_brace.brace_mesh()
     if form == "POLYFACE":
         mesh.render_polyface(doc.modelspace(), dxfattribs={"layer": "BRACE"})
     elif form == "3DSOLID":  # ACIS, as AutoCAD writes solids

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from cell.asbuilt_realism import as_built_tacks, shapers
+from cell.asbuilt_shapes import principal_frame
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, invert, make_pose, rpy_to_matrix, transform_points
 from cell.scenario import Deviation, Scenario
@@ -38,6 +40,7 @@ def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
     deviations = _by_part(scenario.deviations, names)
     X_WM = _true_placement(scenario)
     table_top = scenario.table.top_z
+    shaped = shapers(weldmap_M, scenario, X_WM)
     parts = []
     for part in weldmap_M.parts:
         dev = deviations.get(part.name)
@@ -48,14 +51,20 @@ def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
             box_W = part.box.transformed(X_WM)
             if dev is not None:
                 box_W = _deviated_box(part.name, box_W, dev)
-            X = box_W.X_AB.copy()
-            if on_table:
-                X[2, 3] += table_top - float(box_W.corners()[:, 2].min())  # rest on the table
-            parts.append(Part(part.name, Box(X, box_W.size), part.drawn_as))
-            continue
-        body = part.body
-        assert isinstance(body, Polyhedron)
-        v_W = transform_points(X_WM, _deviated_vertices(part.name, body, dev) if dev is not None else body.vertices)
+            if part.name not in shaped:
+                X = box_W.X_AB.copy()
+                if on_table:
+                    X[2, 3] += table_top - float(box_W.corners()[:, 2].min())  # rest on the table
+                parts.append(Part(part.name, Box(X, box_W.size), part.drawn_as))
+                continue
+            v_W, body = box_W.corners(), box_W.to_polyhedron()
+        else:
+            assert isinstance(part.body, Polyhedron)
+            body = part.body
+            v_W = transform_points(X_WM, _deviated_vertices(part.name, body, dev) if dev is not None else body.vertices)
+        if part.name in shaped:  # bowed, or its ends cut out of square (docs/bodies.md section 7)
+            shaped_W = shaped[part.name](Polyhedron(v_W, body.faces, body.names))
+            v_W, body = np.array(shaped_W.vertices), shaped_W
         if on_table:
             v_W[:, 2] += table_top - float(v_W[:, 2].min())  # rest on the table
         parts.append(Part(part.name, Polyhedron(v_W, body.faces, body.names), part.drawn_as))
@@ -63,26 +72,14 @@ def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
 
 
 def as_built_fixtures(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
-    """The map's fixtures in W, where the part really lies (the scenario's placement with its error)."""
+    """The map's fixtures in W, where the part really lies (the scenario's placement with its error); with
+    ``simulation.tacks_present``, followed by the tack welds' beads (bodies named ``tack:<seam id>:start|end``,
+    :func:`cell.asbuilt_realism.as_built_tacks`: the simulator renders them and moves them with the part)."""
     X_WM = _true_placement(scenario)
-    return tuple(f.transformed(X_WM) for f in weldmap_M.fixtures)
-
-
-def principal_frame(body: Polyhedron) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """A polyhedron's principal frame in its own frame A: the pose X_AP (4, 4) (origin the volume centroid, axes
-    the eigenvectors of the vertices' covariance, largest spread first, each axis's largest component positive,
-    right-handed), the vertices' extents (3,) [m] along those axes, and the spreads (eigenvalues, (3,) [m^2])."""
-    c = np.asarray(body.center, dtype=float)
-    v = np.asarray(body.vertices, dtype=float) - c
-    spread, E = np.linalg.eigh(np.cov(v.T, bias=True))
-    order = np.argsort(spread)[::-1]
-    spread, E = spread[order], E[:, order]
-    for i in (0, 1):
-        if E[np.argmax(np.abs(E[:, i])), i] < 0:
-            E[:, i] = -E[:, i]
-    E[:, 2] = np.cross(E[:, 0], E[:, 1])
-    v_P = v @ E
-    return make_pose(E, c), v_P.max(axis=0) - v_P.min(axis=0), spread
+    fixtures = tuple(f.transformed(X_WM) for f in weldmap_M.fixtures)
+    if scenario.simulation.tacks_present is None:
+        return fixtures
+    return fixtures + as_built_tacks(weldmap_M, as_built_parts(weldmap_M, scenario), scenario.simulation.tacks_present)
 
 
 def _deviated_vertices(name: str, body: Polyhedron, dev: Deviation) -> FloatArray:

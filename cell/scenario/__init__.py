@@ -34,6 +34,7 @@ from cell.scenario.locator_specs import (
     spec_method,
 )
 from cell.scenario.model import Scenario
+from cell.scenario.realism_specs import BowSpec, GapsSpec, SpecularDropoutSpec, TacksPresentSpec
 from cell.scenario.run_specs import (
     CameraFaultSpec,
     ExportSpec,
@@ -51,6 +52,7 @@ __all__ = [
     "REPO_ROOT",
     "SCENARIO_DIR",
     "AnyLocatorSpec",
+    "BowSpec",
     "CalibrationSpec",
     "CameraFaultSpec",
     "CameraSpec",
@@ -58,6 +60,7 @@ __all__ = [
     "ExportSpec",
     "ExtrinsicErrorSpec",
     "FaultsSpec",
+    "GapsSpec",
     "LocatorSpec",
     "MapSpec",
     "MotionSpec",
@@ -73,7 +76,9 @@ __all__ = [
     "RobotSpec",
     "Scenario",
     "SimulationSpec",
+    "SpecularDropoutSpec",
     "TableSpec",
+    "TacksPresentSpec",
     "WorkspaceSpec",
     "available",
     "from_dict",

@@ -8,7 +8,7 @@ import difflib
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from cell.config import (
     CONFIDENCE_THRESHOLD,
@@ -28,6 +28,7 @@ from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import Deviation, PoseSpec, WorkspaceSpec
 from cell.scenario.flip_specs import FlipPlacementSpec
 from cell.scenario.locator_specs import LOCATOR_SPECS, spec_method
+from cell.scenario.realism_specs import BowSpec, GapsSpec, SpecularDropoutSpec, TacksPresentSpec
 
 
 class ProcessSpec(Model):
@@ -189,3 +190,21 @@ class SimulationSpec(Model):
     faults: FaultsSpec = FaultsSpec()
     bead: BeadStyle = BeadStyle()  # how the weld bead is drawn (no effect on any figure)
     flip_placement: FlipPlacementSpec = FlipPlacementSpec()  # the operator's error setting the turned part down
+    gaps: GapsSpec | None = None  # joint gaps varying along the seams (docs/bodies.md section 7); null: as drawn
+    tacks_present: TacksPresentSpec | None = None  # tack welds at both ends of every seam; null: none
+    bow: tuple[BowSpec, ...] = ()  # bowed parts: one {part, mm} or a list of them; empty: every part straight
+    specular_dropout: SpecularDropoutSpec | None = None  # shiny steel facing the cameras drops out; null: off
+
+    @field_validator("bow", mode="before")
+    @classmethod
+    def _one_bow(cls, v: object) -> object:
+        return (v,) if isinstance(v, dict) else v
+
+    @field_validator("bow")
+    @classmethod
+    def _bow_once(cls, v: tuple[BowSpec, ...]) -> tuple[BowSpec, ...]:
+        names = [b.part for b in v]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ValueError(f"simulation.bow: one bow per part; {', '.join(twice)} given more than once")
+        return v

@@ -53,6 +53,37 @@ def plane_line(
     return np.asarray(p), np.asarray(u)
 
 
+def resolve_face(part: Part, face: str, near: FloatArray) -> tuple[str, tuple[str, ...]]:
+    """The as-built face that stands for the drawn face ``face`` near the point ``near`` (3,) [m], and the faces of
+    its family: ``face`` itself when the body has it; else, for a body cut in segments (a bow,
+    :mod:`cell.asbuilt_shapes`: faces ``<face>@<k>``), the segment nearest to ``near`` (the one holding the seam's
+    middle), and all the segments. ValueError naming the valid faces when there is neither."""
+    names = part.face_names()
+    if face in names:
+        return face, (face,)
+    family = tuple(n for n in names if n.startswith(face + "@"))
+    if not family:
+        raise ValueError(f"unknown face {face!r}; valid: {', '.join(names)}")
+    p = np.asarray(near, dtype=float)
+
+    def gap(name: str) -> float:
+        poly = part.face_polygon(name)
+        n, d = part.face_plane(name)
+        rel = p - poly.mean(axis=0)
+        inplane = rel - (rel @ n) * n
+        return abs(float(p @ n) - d) + max(0.0, float(np.linalg.norm(inplane)) - _half_extent(poly, inplane))
+
+    return min(family, key=gap), family
+
+
+def _half_extent(poly: FloatArray, direction: FloatArray) -> float:
+    """How far a polygon (m, 3) reaches from its vertex mean along ``direction`` (3,) (any length)."""
+    norm = float(np.linalg.norm(direction))
+    if norm <= 0.0:
+        return 0.0
+    return float(np.max((poly - poly.mean(axis=0)) @ (direction / norm)))
+
+
 def edge_vertices(part: Part, face_1: str, face_2: str) -> FloatArray:
     """(m, 3) the part's vertices that lie on both faces' planes (within ``_SAME_PLANE_M``): the ends of the edge
     where the two faces meet, and of its pieces when the drawing split a face in several."""
@@ -97,17 +128,22 @@ def polygon_extent(poly: FloatArray, n: FloatArray, p0: FloatArray, u: FloatArra
     return float(near[:, 0].min()) - tol, float(near[:, 0].max()) + tol
 
 
-def plane_extent(part: Part, face: str, p0: FloatArray, u: FloatArray, tol: float) -> tuple[float, float]:
+def plane_extent(
+    part: Part, face: str, p0: FloatArray, u: FloatArray, tol: float, family: tuple[str, ...] = ()
+) -> tuple[float, float]:
     """(t0, t1) [m] along the line p0 + t u (in ``face``'s plane) of the region the body's faces in that plane
     make together (a drawing may split one plane into several faces: a plate's top as four quads around its
     hole): the hull of the chords of those the line crosses, each grown by ``tol``; the face's own
-    :func:`polygon_extent` when the line crosses none of them."""
+    :func:`polygon_extent` when the line crosses none of them. ``family``: the segments of a bowed face
+    (:func:`resolve_face`), which count with it when they come within ``tol`` of the line (a seam may cross from one
+    segment to the next)."""
     n, d = part.face_plane(face)
     w = np.cross(n, u)
     lo, hi = np.inf, -np.inf
     for other in part.face_names():
         n_o, d_o = part.face_plane(other)
-        if float(n_o @ n) < 1.0 - 1e-9 or abs(d_o - d) > _SAME_PLANE_M:
+        coplanar = float(n_o @ n) >= 1.0 - 1e-9 and abs(d_o - d) <= _SAME_PLANE_M
+        if not coplanar and other not in family:
             continue
         rel = part.face_polygon(other) - p0
         uv = np.column_stack([rel @ u, rel @ w])
@@ -126,23 +162,29 @@ def general_seam_W(
 ) -> tuple[FloatArray, FloatArray]:
     """The true seam (p_start_W, p_end_W) (3,) each [m] of ``joint`` between the as-built parts ``a`` (abutting) and
     ``b`` (receiving) in W; ``seam`` and ``design_a`` are the map's seam and part A in one frame (any)."""
-    n_a, d_a = a.face_plane(joint.face_abutting)
-    n_b, d_b = b.face_plane(joint.face_receiving)
+    drawn = design_a.vertices()
+    # The design of A onto A as built (a bowed A keeps its drawn vertices first, cut-in vertices after them).
+    X = best_rigid(drawn, a.vertices()[: len(drawn)])
+    ends = transform_points(X, np.stack([seam.p_start, seam.p_end]))
+    middle = ends.mean(axis=0)
+    face_a, _ = resolve_face(a, joint.face_abutting, middle)
+    end_a, _ = resolve_face(a, joint.end_face, middle)
+    face_b, family_b = resolve_face(b, joint.face_receiving, middle)
+    n_a, d_a = a.face_plane(face_a)
+    n_b, d_b = b.face_plane(face_b)
     if np.linalg.norm(np.cross(n_a, n_b)) < _MIN_SIN:
         raise MapError(
             f"seam {joint.seam_id!r}: faces {joint.abutting}.{joint.face_abutting} and "
             f"{joint.receiving}.{joint.face_receiving} are parallel as built; valid: weld faces that meet in a line"
         )
-    X = best_rigid(design_a.vertices(), a.vertices())  # the design of A onto A as built
-    ends = transform_points(X, np.stack([seam.p_start, seam.p_end]))
-    p0, u = plane_line(n_a, d_a, n_b, d_b, ends.mean(axis=0))
-    edge = edge_vertices(a, joint.face_abutting, joint.end_face)
+    p0, u = plane_line(n_a, d_a, n_b, d_b, middle)
+    edge = edge_vertices(a, face_a, end_a)
     if len(edge) >= 2:
         t_edge = (edge - p0) @ u  # exact: A's edge ends the seam where it is the shorter
         ta = (float(t_edge.min()), float(t_edge.max()))
     else:
-        ta = polygon_extent(a.face_polygon(joint.face_abutting), n_a, p0, u, tol)
-    tb = plane_extent(b, joint.face_receiving, p0, u, tol)
+        ta = polygon_extent(a.face_polygon(face_a), n_a, p0, u, tol)
+    tb = plane_extent(b, face_b, p0, u, tol, family_b if len(family_b) > 1 else ())
     t0, t1 = max(ta[0], tb[0]), min(ta[1], tb[1])
     if t1 <= t0:
         raise MapError(

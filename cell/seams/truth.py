@@ -20,7 +20,7 @@ import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray, invert, transform_points
-from cell.seams._truth_faces import general_seam_W
+from cell.seams._truth_faces import general_seam_W, resolve_face
 from cell.types import Box, Joint, Part, WeldMap
 
 
@@ -77,6 +77,13 @@ def true_seam_W(design: WeldMap, joint: Joint, parts_as_built_W: Sequence[Part])
         return np.asarray(p + ((d_b - n_b @ p) / denom) * n_e)
 
     return onto_b(start), onto_b(end)
+
+
+def weld_face_plane(part: Part, face: str, near: FloatArray) -> tuple[FloatArray, float]:
+    """The outward normal (3,) and offset [m] of the as-built face that stands for the drawn ``face`` near the point
+    ``near`` (3,): the face itself, or on a bowed part the segment nearest to it (docs/bodies.md section 7)."""
+    name, _ = resolve_face(part, face, near)
+    return part.face_plane(name)
 
 
 def true_seams(

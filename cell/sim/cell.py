@@ -28,7 +28,7 @@ from cell.scenario import CameraSpec, Scenario
 from cell.sim.bodies import add_box, add_part
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
-from cell.sim.noise import apply_noise, perturb_pose
+from cell.sim.noise import apply_noise, perturb_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
@@ -42,6 +42,8 @@ _PART_RGBA = (0.7, 0.72, 0.75, 1.0)
 _OCCLUDER_RGBA = (0.2, 0.3, 0.8, 1.0)
 _FIXTURE_RGBA = (0.45, 0.45, 0.47, 1.0)  # grey: clamps, stops and jigs
 FIXTURE_PREFIX = "fixture:"  # body names of the map's fixtures: ``fixture:<name>``
+TACK_PREFIX = "tack:"  # tack welds laid before the cell sees the part (``simulation.tacks_present``), not fixtures
+_TACK_RGBA = (0.3, 0.3, 0.32, 1.0)
 DEFAULT_BEAD = BeadStyle()
 EYE_IN_HAND_LINK = "camera_optical"  # the arm's optical frame of the eye-in-hand camera (z forward, y down)
 
@@ -54,6 +56,8 @@ class SimCell:
     gui : show PyBullet's GUI (needs a display); headless ``DIRECT`` by default.
     fixtures_W : the map's fixtures in W (``cell.asbuilt.as_built_fixtures``): clamps, stops, jigs, rendered grey as
         bodies ``fixture:<name>`` so the cameras see them as in the real cell; they stay put when the part is turned.
+        Entries named ``tack:...`` (``cell.asbuilt.as_built_fixtures`` with ``simulation.tacks_present``) are tack
+        welds' beads instead: bodies of that name, dark, on the part (they turn with it).
     The scenario's ``faults:`` (:mod:`cell.sim.faults`) are applied here: parts in ``missing_parts`` are not
     built (``parts_W`` still lists them: it is the design as built), occluders are added as bodies
     ``occluder:<name>``, and a faulty camera's images are corrupted after the noise model.
@@ -86,7 +90,12 @@ class SimCell:
         # Faults (scenario ``faults:``): parts not built are left out, objects the map does not know are added.
         for part in built_parts(self.parts_W, scenario.faults):
             self._bodies[part.name] = add_part(self.client, part, _PART_RGBA)
+        self._tacks: list[str] = []  # tack welds' beads (``tack:...``): on the part, they turn with it
         for fixture in fixtures_W:
+            if fixture.name.startswith(TACK_PREFIX):
+                self._bodies[fixture.name] = add_part(self.client, fixture, _TACK_RGBA)
+                self._tacks.append(fixture.name)
+                continue
             self._bodies[FIXTURE_PREFIX + fixture.name] = add_part(self.client, fixture, _FIXTURE_RGBA)
         for name, box in occluder_boxes(scenario.faults):
             self._add_box(name, box, _OCCLUDER_RGBA)
@@ -167,6 +176,10 @@ class SimCell:
         if self.scenario.noise == "realistic":
             rng = self._noise_rngs.setdefault(camera, self.scenario.rng(camera))
             noisy = apply_noise(depth, intr, spec.noise, rng)
+            shiny = self.scenario.simulation.specular_dropout
+            if shiny is not None:  # its own stream: the noise draws are the same with it on or off
+                srng = self._noise_rngs.setdefault(camera + "/specular", self.scenario.rng(camera + "/specular"))
+                noisy = specular_dropout(noisy, depth, intr, shiny, srng)
         else:
             noisy = depth.astype(np.float32)
         fault = self.scenario.faults.cameras.get(camera)
@@ -266,7 +279,7 @@ class SimCell:
         new ground truth); the table, the ground, the fixtures and the occluders stay where they are."""
         X = np.asarray(X_W_new_old, dtype=float)
         names = {p.name for p in self.parts_W}
-        bodies = [b for n, b in self._bodies.items() if n in names] + list(self._beads)
+        bodies = [b for n, b in self._bodies.items() if n in names or n in self._tacks] + list(self._beads)
         for body in bodies:
             pos, quat = self.client.getBasePositionAndOrientation(body)
             X_old = make_pose(Rotation.from_quat(quat).as_matrix(), np.asarray(pos, dtype=float))

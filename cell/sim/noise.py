@@ -17,7 +17,8 @@ What a real depth camera does to a perfect depth image, driven by a :class:`~cel
   sides of the jump), the rest 0.
 - ``none``: the image is returned unchanged (as float32).
 
-Lateral noise and specular dropout are not modelled.
+Specular dropout (``simulation.specular_dropout``, off by default): :func:`specular_dropout`, applied after the
+model. Lateral noise is not modelled.
 Depth images are (H, W) [m] along the optical axis, 0 = invalid.
 """
 
@@ -27,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, axis_angle_to_matrix, make_pose
-from cell.scenario import ExtrinsicErrorSpec, NoiseSpec
+from cell.scenario import ExtrinsicErrorSpec, NoiseSpec, SpecularDropoutSpec
 from cell.types import CameraIntrinsics
 
 # Kinect v1 axial noise (Nguyen, Izadi, Lovell, "Modeling Kinect sensor noise for improved 3D reconstruction
@@ -176,6 +177,30 @@ def apply_noise(
     flat[flying] = _quantise(z_own + t * (z_other - z_own), spec.depth_unit_m)
     noisy[~valid] = 0.0
     return noisy.astype(np.float32)
+
+
+def specular_dropout(
+    noisy_m: npt.ArrayLike,
+    true_depth_m: npt.ArrayLike,
+    intrinsics: CameraIntrinsics,
+    spec: SpecularDropoutSpec,
+    rng: np.random.Generator,
+) -> npt.NDArray[np.float32]:
+    """Shiny steel seen by an active-stereo camera: a copy (H, W) float32 [m] of ``noisy_m`` where each pixel whose
+    true surface (``true_depth_m``, its normal from :func:`incidence_angles`) faces the camera within
+    ``spec.within_deg`` is 0 with probability ``spec.fraction``.
+
+    The projector sits beside the camera (the stereo baseline, 55 mm at 1 m and more is under 3 degrees), so its
+    mirror direction on a surface is the viewing ray itself within that: a surface facing the camera reflects the
+    pattern straight back (saturated) or, polished, away from the other imager; either way the matcher has no
+    texture. One uniform draw per pixel from ``rng`` (the camera's ``/specular`` stream), invalid pixels stay 0.
+    """
+    out = np.array(noisy_m, dtype=np.float32)
+    theta = incidence_angles(true_depth_m, intrinsics)
+    facing = np.nan_to_num(theta, nan=np.pi) <= np.radians(spec.within_deg)
+    draw = rng.uniform(0.0, 1.0, size=out.shape)
+    out[facing & (draw < spec.fraction)] = 0.0
+    return out
 
 
 def perturb_pose(X_WC: FloatArray, spec: ExtrinsicErrorSpec, rng: np.random.Generator) -> FloatArray:

@@ -1,0 +1,116 @@
+"""The realism options of ``simulation:`` (docs/bodies.md section 7): varying gaps, tack welds, a bow, specular
+dropout. Small and direct: the as-built geometry of fence1's map, one synthetic depth image."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from cell.asbuilt import as_built_fixtures, as_built_parts
+from cell.asbuilt_shapes import bowed, principal_frame
+from cell.errors import ScenarioError
+from cell.scenario import Scenario, SpecularDropoutSpec, from_dict, load
+from cell.seams.joint import find_joints
+from cell.seams.truth import true_seams
+from cell.sim.camera import intrinsics_for
+from cell.sim.noise import specular_dropout
+from cell.types import Box, Part, WeldMap
+from cell.weldmap import read_map
+
+
+@pytest.fixture(scope="module")
+def fence1() -> tuple[Scenario, WeldMap]:
+    scenario = load("fence1")
+    return scenario, read_map(scenario.map_path)
+
+
+def _with(scenario: Scenario, **simulation: Any) -> Scenario:
+    data = scenario.model_dump()
+    data["simulation"].update(simulation)
+    return from_dict(data, base_dir=Path(scenario.base_dir))
+
+
+def _part(parts: tuple[Part, ...], name: str) -> Part:
+    return next(p for p in parts if p.name == name)
+
+
+def test_every_option_is_off_by_default(fence1: tuple[Scenario, WeldMap]) -> None:
+    scenario, weldmap = fence1
+    sim = scenario.simulation
+    assert sim.gaps is None and sim.tacks_present is None and sim.bow == () and sim.specular_dropout is None
+    assert all(p.is_box for p in as_built_parts(weldmap, scenario))
+    assert as_built_fixtures(weldmap, scenario) == ()
+
+
+def test_gap_opens_from_zero_to_max_along_the_seam(fence1: tuple[Scenario, WeldMap]) -> None:
+    scenario, weldmap = fence1
+    plain = as_built_parts(weldmap, scenario)
+    gapped = as_built_parts(weldmap, _with(scenario, gaps={"max_mm": 2.0}))
+    a0, a1 = _part(plain, "BOTTOM_RAIL"), _part(gapped, "BOTTOM_RAIL")
+    assert not a1.is_box and _part(gapped, "TOP_RAIL").is_box  # only abutting parts are cut
+    post = _part(plain, "POST_L").box
+    n, d = post.face_plane("+x")
+    on_end = a1.vertices() @ n < d + 0.01  # the rail's end at POST_L
+    gap0 = np.abs(a0.box.corners() @ n - d)[on_end]
+    gap1 = np.abs(a1.vertices() @ n - d)[on_end]
+    opened = (gap1 - gap0) * 1000.0
+    assert opened.min() == pytest.approx(0.0, abs=1e-6)
+    assert opened.max() == pytest.approx(2.0, abs=1e-6)
+    # Along the junction's horizontal seam (+z: along y) the opening grows linearly from one end to the other.
+    ys = a1.vertices()[on_end, 1]
+    order = np.argsort(ys)
+    assert abs(opened[order][0] - opened[order][-1]) == pytest.approx(2.0, abs=1e-6)
+
+
+def test_tacks_lie_in_the_corner_at_both_ends_of_every_seam(fence1: tuple[Scenario, WeldMap]) -> None:
+    scenario, weldmap = fence1
+    tacked = _with(scenario, tacks_present={"length_mm": 10.0, "leg_mm": 4.0})
+    tacks = as_built_fixtures(weldmap, tacked)
+    assert len(tacks) == 2 * len(weldmap.seams)
+    truth = true_seams(weldmap, find_joints(weldmap), as_built_parts(weldmap, tacked), np.eye(4))
+    seam_id = "POST_L>TOP_RAIL:+z"
+    start = next(t for t in tacks if t.name == f"tack:{seam_id}:start")
+    end = next(t for t in tacks if t.name == f"tack:{seam_id}:end")
+    assert start.volume == pytest.approx(0.5 * 0.004**2 * 0.010, rel=1e-6)
+    p0, p1 = truth[seam_id]
+    assert np.linalg.norm(start.vertices()[0] - p0) < 1e-9 and np.linalg.norm(end.vertices()[3] - p1) < 1e-9
+    # In the corner: above the rail's top... the bead's legs run along the rail's -y face and up the post's top.
+    legs = start.vertices()[1:3] - p0
+    assert sorted(np.round(np.abs(legs).max(axis=1) * 1000.0, 3)) == [4.0, 4.0]
+
+
+def test_bow_has_its_sagitta_and_moves_the_seams_on_the_bowed_face(fence1: tuple[Scenario, WeldMap]) -> None:
+    scenario, weldmap = fence1
+    box = Box(np.eye(4), np.array([1.4, 0.1, 0.1])).to_polyhedron()
+    X_AP, _, _ = principal_frame(box)
+    bent = bowed(box, X_AP, 0.0015, 1, 16)
+    assert len([n for n in bent.names if n.startswith("+y@")]) == 16
+    mid = np.abs(bent.vertices[:, 0]) < 1e-9
+    assert float(bent.vertices[mid, 1].max()) - 0.05 == pytest.approx(0.0015, abs=1e-9)
+    assert float(np.abs(bent.vertices[:8, 1]).max()) == pytest.approx(0.05, abs=1e-6)  # the ends stay put
+    bow = _with(scenario, bow={"part": "TOP_RAIL", "mm": 1.5})
+    joints = find_joints(weldmap)
+    t0 = true_seams(weldmap, joints, as_built_parts(weldmap, scenario), np.eye(4))
+    t1 = true_seams(weldmap, joints, as_built_parts(weldmap, bow), np.eye(4))
+    shift = t1["POST_L>TOP_RAIL:+x"][0] - t0["POST_L>TOP_RAIL:+x"][0]
+    # The rail (1420 mm as built) bulges away from the posts; the post's +x side is 420 mm from its middle:
+    # 1.5 mm x (1 - (2 x 420 / 1420)^2) = 0.975 mm, less the tilt of the rail's as-built turn.
+    assert shift[1] * 1000.0 == pytest.approx(0.95, abs=0.05)
+    assert np.linalg.norm(t1["BOTTOM_RAIL>POST_L:+z"][0] - t0["BOTTOM_RAIL>POST_L:+z"][0]) < 1e-9
+    with pytest.raises(ScenarioError, match="names no one part"):
+        as_built_parts(weldmap, _with(scenario, bow={"part": "NOPE", "mm": 1.0}))
+
+
+def test_specular_dropout_takes_the_fraction_of_pixels_facing_the_camera() -> None:
+    intr = intrinsics_for(64, 48, np.radians(10.0))  # every ray within 6 degrees of the axis
+    facing = np.full((48, 64), 1.0)
+    spec = SpecularDropoutSpec(within_deg=8.0, fraction=0.7)
+    out = specular_dropout(facing, facing, intr, spec, np.random.default_rng(3))
+    assert (out == 0).mean() == pytest.approx(0.7, abs=0.03)
+    v = np.arange(48)[:, None].repeat(64, axis=1)
+    tilted = 1.0 / (1.0 - (v - intr.cy) / intr.fy)  # the plane z = 1 + y: 45 degrees to the axis
+    kept = specular_dropout(tilted, tilted, intr, spec, np.random.default_rng(3))
+    assert (kept == 0).mean() == 0.0

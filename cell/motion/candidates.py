@@ -4,8 +4,10 @@
    angles, nominal first).
    A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK
    (:mod:`cell.motion.placement`; when none of the nominal group can be placed, the other groups are swept in a
-   few broad-phase queries, and a seam none can be placed on is refused there); the rest get IK at the weld start, each held with the wrist equivalent (:mod:`cell.motion.wrist`: A4 and A6
-   turned by whole turns, the flipped wrist) with A6 in the hose package's window, on home's side of the wrist
+   few broad-phase queries, and a seam none can be placed on is refused there, else the search goes on from the
+   first group that places one); the rest get IK at the weld start, each held with the wrist equivalent
+   (:mod:`cell.motion.wrist`: A4 and A6 turned by whole turns, the flipped wrist) with A6 in the hose package's
+   window, on home's side of the wrist
    (A5's sign) and nearest the reference wrist every seam shares. They are ranked: A6 in the window first, then
    those within ``_GOOD`` of the best start manipulability, nearest that reference first (so the free spin
    keeps A6 near the window's centre), then the rest by manipulability.
@@ -105,7 +107,8 @@ class SeamSearch:
         (BEYOND_REACH, no candidate built), and a candidate whose wrist centre is out of reach anywhere along the
         seam is dropped before IK. When no candidate of the nominal group can be placed, the other groups are
         swept for one that can (:func:`cell.motion.placement.sweep`, a few broad-phase queries): a seam none can
-        be placed on is refused there, with the failure the group-by-group search would keep."""
+        be placed on is refused there, with the failure the group-by-group search would keep; otherwise the search
+        goes on from the first group that places one (the groups before it only add their placement failures)."""
         pr, opt = self.process, self.opt
         if self.reach is not None:
             out = seam_reach(self.reach, task, pr)
@@ -115,7 +118,9 @@ class SeamSearch:
         q_ref = self._reference(q_seed)
         rotations: Rotations = {}
         groups = candidate_groups(pr, opt)
-        for n_group, group in enumerate(groups):
+        n_group = 0
+        while n_group < len(groups):
+            group = groups[n_group]
             found: list[tuple[Candidate, FloatArray, FloatArray]] = []
             q_prev: FloatArray | None = None
             any_placed = False
@@ -148,11 +153,12 @@ class SeamSearch:
                 if isinstance(res, SeamSolution):
                     return res
                 best_fail = better(best_fail, res)
-            if n_group == 0 and not any_placed:  # nothing placed at the nominal angles: can anything be?
-                some, fail = sweep(self, task, groups[1:], q_seed, best_fail, rotations)
-                if not some:
-                    best_fail = fail
+            n_group += 1
+            if n_group == 1 and not any_placed:  # nothing placed at the nominal angles: where can anything be?
+                at, best_fail = sweep(self, task, groups[1:], q_seed, best_fail, rotations)
+                if at is None:
                     break
+                n_group += at  # the groups before it place nothing: their failures are in best_fail
         if best_fail is None:  # cannot happen: there is always the nominal candidate, and it passes or fails
             raise PlanError(f"seam {task.id}: the torch search tried no candidate")
         return best_fail
@@ -166,8 +172,8 @@ class SeamSearch:
             out = seam_reach(self.reach, task, self.process)
             if out is not None:
                 return out
-        some, fail = sweep(self, task, candidate_groups(self.process, self.opt), q_seed)
-        return None if some else fail
+        at, fail = sweep(self, task, candidate_groups(self.process, self.opt), q_seed)
+        return None if at is not None else fail
 
     def _ik(self, X: FloatArray, seed: FloatArray, restarts: bool = False) -> FloatArray:
         return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None, options=self.opt.ik)

@@ -8,10 +8,11 @@ candidates cost IK.
 A seam no candidate can be placed on (the ladder's rung-to-rail side seams, in their 36 mm slots) is refused
 without IK. :func:`sweep` finds that out in a few broad-phase queries instead of one per candidate group: the
 groups go in chunks that double in size (1, 2, 4 ... groups per query), each pose asked only whether it collides.
-A seam that can be placed stops at the first chunk that holds a placed candidate, so at most about twice the poses
-the group-by-group search would have tested up to there are tested. The failure it returns is the one the
-group-by-group search keeps (the nearest-nominal candidate with the highest rank, ties to the earlier), and a torch
-collision that becomes the seam's failure is worded as there, from its deepest contact.
+A seam that can be placed stops at the first chunk that holds a placed candidate (at most about twice the poses the
+group-by-group search would have tested up to there), and the search goes on from that candidate's group. The
+failure it returns is the one the group-by-group search keeps (the nearest-nominal candidate with the highest rank,
+ties to the earlier), and a torch collision that becomes the seam's failure is worded as there, from its deepest
+contact.
 
 Frames: the robot base R [m]; angles [rad].
 """
@@ -164,35 +165,52 @@ def sweep(
     q_seed: FloatArray,
     best_fail: SeamFailure | None = None,
     rotations: Rotations | None = None,
-) -> tuple[bool, SeamFailure | None]:
-    """Whether some candidate of ``groups`` (in order) can be placed on ``task`` (module docstring) and, when none
-    can, the failure the group-by-group search keeps after them all, starting from ``best_fail`` (the kept failure
-    of the groups before). q_seed (dof,) [rad] is carried in the contacts. Chunks of 1, 2, 4 ... groups per
-    broad-phase query, each pose tested for a collision only; the torch collision that ends up kept is worded
-    from its deepest contact, as the group-by-group search words it."""
+) -> tuple[int | None, SeamFailure | None]:
+    """The index in ``groups`` of the first group with a candidate that can be placed on ``task`` (module
+    docstring), None when none can; and the failure the group-by-group search keeps before that group (after them
+    all when none), starting from ``best_fail`` (the kept failure of the groups before). q_seed (dof,) [rad] is
+    carried in the contacts. Chunks of 1, 2, 4 ... groups per broad-phase query, each pose tested for a collision
+    only; a torch collision kept is worded from its deepest contact, as the group-by-group search words it."""
     rotations = {} if rotations is None else rotations
     kept: tuple[Candidate, SeamFailure] | None = None  # a torch collision kept, to word at the end
     k, size = 0, 1
     while k < len(groups):
-        chunk = [c for g in groups[k : k + size] for c in g]
+        members = [(j, c) for j in range(k, min(k + size, len(groups))) for c in groups[j]]
         k, size = k + size, 2 * size
-        if not chunk:
+        if not members:
             continue
-        for cand, test in zip(chunk, torch_tests(search, task, chunk, rotations, q_seed, worded=False), strict=True):
+        chunk = [c for _, c in members]
+        at_group, current = members[0][0], best_fail  # the failure kept when each group starts
+        for (j, cand), test in zip(
+            members, torch_tests(search, task, chunk, rotations, q_seed, worded=False), strict=True
+        ):
+            if j != at_group:
+                at_group, current = j, best_fail
             placed = place(search, task, cand, test, best_fail)
             if isinstance(placed, np.ndarray):
-                return True, None
+                return j, _worded(search, task, current, kept, rotations, q_seed)
             if placed is None:
                 continue
             best_fail = better(best_fail, placed)
             if best_fail is placed and placed.code is PlanReason.COLLISION:
                 kept = (cand, placed)
-    if kept is not None and best_fail is kept[1]:
-        cand = kept[0]
-        worded = place(search, task, cand, torch_tests(search, task, [cand], rotations, q_seed)[0], None)
-        if isinstance(worded, SeamFailure):
-            best_fail = worded
-    return False, best_fail
+    return None, _worded(search, task, best_fail, kept, rotations, q_seed)
+
+
+def _worded(
+    search: SeamSearch,
+    task: SeamTask,
+    fail: SeamFailure | None,
+    kept: tuple[Candidate, SeamFailure] | None,
+    rotations: Rotations,
+    q_seed: FloatArray,
+) -> SeamFailure | None:
+    """``fail``, worded from its deepest contact when it is the torch collision ``kept`` (candidate, failure)."""
+    if kept is None or fail is not kept[1]:
+        return fail
+    cand = kept[0]
+    worded = place(search, task, cand, torch_tests(search, task, [cand], rotations, q_seed)[0], None)
+    return worded if isinstance(worded, SeamFailure) else fail
 
 
 def poses(a: FloatArray, b: FloatArray, R: FloatArray, standoff: float, n: int) -> FloatArray:

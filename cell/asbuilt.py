@@ -15,6 +15,8 @@ dropping (:func:`as_built_fixtures`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from cell.asbuilt_realism import as_built_tacks, shapers
@@ -22,7 +24,8 @@ from cell.asbuilt_shapes import principal_frame
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, invert, make_pose, rpy_to_matrix, transform_points
 from cell.scenario import Deviation, Scenario
-from cell.types import Box, Part, Polyhedron, WeldMap
+from cell.seams.joint import find_joints
+from cell.types import Box, Joint, Part, Polyhedron, WeldMap
 
 # Which deviation keys each kind of body takes (the scenario's Deviation fields).
 VALID_KEYS = {"box": ("size_mm", "offset_mm", "rpy_deg"), "mesh": ("size_mm", "offset_mm", "rpy_deg")}
@@ -30,17 +33,21 @@ ON_TABLE_M = 0.002  # [m] a part drawn this close to the table top rests on it
 _DISTINCT = 1e-6  # principal spreads closer than this (relative) do not define a size change's axes
 
 
-def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
+def as_built_parts(
+    weldmap_M: WeldMap, scenario: Scenario, joints: Mapping[str, Joint] | None = None
+) -> tuple[Part, ...]:
     """The as-built parts in the world frame W.
 
     weldmap_M : the designed map, frame ``"M"``.
+    joints : the map's joints (``cell.seams.joint.find_joints``), when the caller has them; found here only when
+        ``simulation.gaps`` needs them.
     Returns one :class:`Part` per designed part, same names, order and kind of body (box or polyhedron), in W.
     """
     names = {p.name for p in weldmap_M.parts}
     deviations = _by_part(scenario.deviations, names)
     X_WM = _true_placement(scenario)
     table_top = scenario.table.top_z
-    shaped = shapers(weldmap_M, scenario, X_WM)
+    shaped = shapers(weldmap_M, scenario, X_WM, joints)
     parts = []
     for part in weldmap_M.parts:
         dev = deviations.get(part.name)
@@ -71,7 +78,9 @@ def as_built_parts(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
     return tuple(parts)
 
 
-def as_built_fixtures(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...]:
+def as_built_fixtures(
+    weldmap_M: WeldMap, scenario: Scenario, joints: Mapping[str, Joint] | None = None
+) -> tuple[Part, ...]:
     """The map's fixtures in W, where the part really lies (the scenario's placement with its error); with
     ``simulation.tacks_present``, followed by the tack welds' beads (bodies named ``tack:<seam id>:start|end``,
     :func:`cell.asbuilt_realism.as_built_tacks`: the simulator renders them and moves them with the part)."""
@@ -79,7 +88,9 @@ def as_built_fixtures(weldmap_M: WeldMap, scenario: Scenario) -> tuple[Part, ...
     fixtures = tuple(f.transformed(X_WM) for f in weldmap_M.fixtures)
     if scenario.simulation.tacks_present is None:
         return fixtures
-    return fixtures + as_built_tacks(weldmap_M, as_built_parts(weldmap_M, scenario), scenario.simulation.tacks_present)
+    found = find_joints(weldmap_M) if joints is None else joints
+    parts_W = as_built_parts(weldmap_M, scenario, found)
+    return fixtures + as_built_tacks(weldmap_M, parts_W, scenario.simulation.tacks_present, found)
 
 
 def _deviated_vertices(name: str, body: Polyhedron, dev: Deviation) -> FloatArray:

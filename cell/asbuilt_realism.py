@@ -8,7 +8,7 @@ the true seams of the as-built parts. Nothing here runs when the options are off
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -24,8 +24,11 @@ Shaper = Callable[[Polyhedron], Polyhedron]
 TACK_PREFIX = "tack:"  # body names of the tack welds' beads: ``tack:<seam id>:start`` / ``:end``
 
 
-def shapers(weldmap_M: WeldMap, scenario: Scenario, X_WM: FloatArray) -> dict[str, Shaper]:
-    """Part name -> how its deviated body (in W) is shaped as built; empty when no bow and no gaps are asked."""
+def shapers(
+    weldmap_M: WeldMap, scenario: Scenario, X_WM: FloatArray, joints: Mapping[str, Joint] | None = None
+) -> dict[str, Shaper]:
+    """Part name -> how its deviated body (in W) is shaped as built; empty when no bow and no gaps are asked.
+    ``joints``: the map's (found here when gaps need them and none are given)."""
     sim = scenario.simulation
     names = {p.name for p in weldmap_M.parts}
     steps: dict[str, list[Shaper]] = {}
@@ -33,7 +36,8 @@ def shapers(weldmap_M: WeldMap, scenario: Scenario, X_WM: FloatArray) -> dict[st
         steps.setdefault(_part_named(bow.part, names), []).append(_bow_step(bow))
     if sim.gaps is not None:
         max_m = sim.gaps.max_mm / 1000.0
-        for (abutting, receiving, end_face), across_M in _junctions(weldmap_M).items():
+        found = find_joints(weldmap_M) if joints is None else joints
+        for (abutting, receiving, end_face), across_M in _junctions(weldmap_M, found).items():
             sign = 1.0 if scenario.rng(f"gaps/{abutting}>{receiving}").uniform() < 0.5 else -1.0
             across_W = sign * (np.asarray(X_WM, dtype=float)[:3, :3] @ across_M)
             steps.setdefault(abutting, []).append(_gap_step(end_face, across_W, max_m))
@@ -82,11 +86,10 @@ def _gap_step(end_face: str, across_W: FloatArray, max_m: float) -> Shaper:
     return step
 
 
-def _junctions(weldmap_M: WeldMap) -> dict[tuple[str, str, str], FloatArray]:
+def _junctions(weldmap_M: WeldMap, joints: Mapping[str, Joint]) -> dict[tuple[str, str, str], FloatArray]:
     """(abutting, receiving, one of A's end faces there) -> the unit direction (3,) in M of the junction's most
     horizontal seam (the one nearest to M's x-y plane; the first in map order on a tie): the direction the gap
     opens along. A junction is one end of A against one face plane of B."""
-    joints = find_joints(weldmap_M)
     out: dict[tuple[str, str, str], FloatArray] = {}
     seen: dict[tuple[str, str, tuple[float, ...]], tuple[str, float]] = {}
     for seam in weldmap_M.seams:
@@ -103,11 +106,12 @@ def _junctions(weldmap_M: WeldMap) -> dict[tuple[str, str, str], FloatArray]:
     return out
 
 
-def as_built_tacks(weldmap_M: WeldMap, parts_W: Sequence[Part], spec: TacksPresentSpec) -> tuple[Part, ...]:
+def as_built_tacks(
+    weldmap_M: WeldMap, parts_W: Sequence[Part], spec: TacksPresentSpec, joints: Mapping[str, Joint]
+) -> tuple[Part, ...]:
     """The tack welds' beads in W: at both ends of every seam of the map, a fillet bead ``spec.length_mm`` long (at
     most half the seam) with legs ``spec.leg_mm``, in the corner of the two as-built weld faces along the true
-    seam. Named ``tack:<seam id>:start`` and ``:end``, drawn as ``"tack"``."""
-    joints = find_joints(weldmap_M)
+    seam. Named ``tack:<seam id>:start`` and ``:end``, drawn as ``"tack"``. ``joints``: the map's."""
     leg = spec.leg_mm / 1000.0
     out: list[Part] = []
     by_name = {p.name: p for p in parts_W}

@@ -114,3 +114,36 @@ def test_specular_dropout_takes_the_fraction_of_pixels_facing_the_camera() -> No
     tilted = 1.0 / (1.0 - (v - intr.cy) / intr.fy)  # the plane z = 1 + y: 45 degrees to the axis
     kept = specular_dropout(tilted, tilted, intr, spec, np.random.default_rng(3))
     assert (kept == 0).mean() == 0.0
+
+
+def test_tacks_are_rendered_and_turn_with_the_part(fence1: tuple[Scenario, WeldMap]) -> None:
+    from cell.geometry import make_pose
+    from cell.sim import SimCell
+
+    scenario, weldmap = fence1
+    tacked = _with(scenario, tacks_present={"length_mm": 10.0, "leg_mm": 4.0}, noise="none")
+    tacks = as_built_fixtures(weldmap, tacked)
+    with SimCell(tacked, as_built_parts(weldmap, tacked), fixtures_W=tacks) as sim:
+        name = "tack:POST_L>TOP_RAIL:+z:start"
+        assert name in sim.bodies and not any(n.startswith("fixture:") for n in sim.bodies)
+        before = sim.client.getBasePositionAndOrientation(sim.body_id(name))[0]
+        sim.move_part(make_pose(p=(0.0, 0.0, 0.1)))
+        after = sim.client.getBasePositionAndOrientation(sim.body_id(name))[0]
+        assert after[2] - before[2] == pytest.approx(0.1, abs=1e-9)
+
+
+def test_the_rhs_map_reads_as_hollow_tubes_and_every_seam_has_a_truth() -> None:
+    scenario = load("rhs")
+    weldmap = read_map(scenario.map_path)
+    assert [p.kind for p in weldmap.parts] == ["mesh"] * 4 and len(weldmap.seams) == 12
+    top = weldmap.part("TOP_RAIL")
+    assert len(top.face_names()) == 80
+    # Open ends: the volume is the wall's (4 mm, corner radii 8 and 4 mm, 4 facets a quarter) times 1.4 m, not a box's.
+    assert 1.4 * 0.1 * 0.1 * 0.1 < top.volume < 1.4 * 0.1 * 0.1 * 0.2
+    joints = find_joints(weldmap)
+    parts = as_built_parts(weldmap, scenario, joints)
+    truth = true_seams(weldmap, joints, parts, scenario.X_WR)
+    assert len(truth) == 12
+    lengths = [float(np.linalg.norm(b - a)) * 1000.0 for a, b in truth.values()]
+    assert min(lengths) > 40.0 and max(lengths) < 70.0
+    assert len(as_built_fixtures(weldmap, scenario, joints)) == 24  # two tacks a seam

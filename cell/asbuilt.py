@@ -28,7 +28,10 @@ from cell.seams.joint import find_joints
 from cell.types import Box, Joint, Part, Polyhedron, WeldMap
 
 # Which deviation keys each kind of body takes (the scenario's Deviation fields).
-VALID_KEYS = {"box": ("size_mm", "offset_mm", "rpy_deg"), "mesh": ("size_mm", "offset_mm", "rpy_deg")}
+VALID_KEYS = {
+    "box": ("size_mm", "offset_mm", "rpy_deg", "bow_mm"),
+    "mesh": ("size_mm", "offset_mm", "rpy_deg", "bow_mm"),
+}
 ON_TABLE_M = 0.002  # [m] a part drawn this close to the table top rests on it
 _DISTINCT = 1e-6  # principal spreads closer than this (relative) do not define a size change's axes
 

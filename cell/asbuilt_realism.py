@@ -32,8 +32,15 @@ def shapers(
     sim = scenario.simulation
     names = {p.name for p in weldmap_M.parts}
     steps: dict[str, list[Shaper]] = {}
-    for bow in sim.bow:
-        steps.setdefault(_part_named(bow.part, names), []).append(_bow_step(bow))
+    bows = list(sim.bow)
+    for key, dev in sim.deviations.items():
+        if dev.bow_mm != 0.0:
+            bows.append(BowSpec(part=key, mm=dev.bow_mm))
+    for bow in bows:
+        name = _part_named(bow.part, names)
+        if name in steps:
+            raise ScenarioError(f"part {name} is bowed twice (simulation.bow and deviations.{name}.bow_mm); give one")
+        steps[name] = [_bow_step(bow)]
     if sim.gaps is not None:
         max_m = sim.gaps.max_mm / 1000.0
         found = find_joints(weldmap_M) if joints is None else joints

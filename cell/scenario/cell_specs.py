@@ -42,6 +42,8 @@ class Deviation(Model):
     size_mm: Vec3 = (0.0, 0.0, 0.0)
     offset_mm: Vec3 = (0.0, 0.0, 0.0)
     rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+    # Bent in an arc of this sagitta [mm] over its length, as ``simulation.bow: {part, mm}`` (docs/bodies.md section 7)
+    bow_mm: Annotated[float, Field(ge=-20.0, le=20.0)] = 0.0
 
 
 class TableSpec(Model):

@@ -100,6 +100,12 @@ def test_bow_has_its_sagitta_and_moves_the_seams_on_the_bowed_face(fence1: tuple
     # 1.5 mm x (1 - (2 x 420 / 1420)^2) = 0.975 mm, less the tilt of the rail's as-built turn.
     assert shift[1] * 1000.0 == pytest.approx(0.95, abs=0.05)
     assert np.linalg.norm(t1["BOTTOM_RAIL>POST_L:+z"][0] - t0["BOTTOM_RAIL>POST_L:+z"][0]) < 1e-9
+    dev = scenario.model_dump()["simulation"]["deviations"]
+    dev["TOP_RAIL"]["bow_mm"] = 1.5  # the same bow, given with the part's deviations
+    t2 = true_seams(weldmap, joints, as_built_parts(weldmap, _with(scenario, deviations=dev)), np.eye(4))
+    assert np.array_equal(t2["POST_L>TOP_RAIL:+x"][0], t1["POST_L>TOP_RAIL:+x"][0])
+    with pytest.raises(ScenarioError, match="bowed twice"):
+        as_built_parts(weldmap, _with(scenario, deviations=dev, bow={"part": "TOP_RAIL", "mm": 1.0}))
     with pytest.raises(ScenarioError, match="names no one part"):
         as_built_parts(weldmap, _with(scenario, bow={"part": "NOPE", "mm": 1.0}))
 

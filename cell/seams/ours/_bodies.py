@@ -104,3 +104,19 @@ def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: flo
     """(k,) which points P (k, 3) project inside ``polygon`` (m, 3), a planar face of outward normal n, shrunk by
     ``inset_m`` [m] (:func:`over_region` of its edges)."""
     return over_region(P, np.stack([polygon, np.roll(polygon, -1, axis=0)], axis=1), n, inset_m)
+
+
+TOUCH_M = 0.001  # a face lies on another body's face when their planes are this close [m] (opposite normals)
+
+
+def touches(part: Part, n: FloatArray, d: float, at: FloatArray) -> bool:
+    """Whether ``part`` has a face in the plane n . p = d (n outward of the other body, so the face's own normal is
+    -n) within :data:`TOUCH_M`, and the point ``at`` (3,) lies on the part (within 2 :data:`TOUCH_M`): the other
+    body's face lies on this part there (a rail's end on a post's face far from ``at`` does not count)."""
+    if not bool(part.contains(at[None, :], margin=2.0 * TOUCH_M)[0]):
+        return False
+    for name in part.face_names():
+        n_f, d_f = part.face_plane(name)
+        if float(n_f @ n) < -0.999 and abs(d_f + d) <= TOUCH_M:
+            return True
+    return False

@@ -11,7 +11,7 @@ import numpy as np
 from cell.geometry import FloatArray
 from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_ml
 from cell.seams._lines import line_plane_parameter
-from cell.seams.ours._geometry import JointGeometry
+from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
 from cell.seams.ours._points import Points
 from cell.seams.ours.options import OursOptions
@@ -32,22 +32,28 @@ def side_selections(
     to be fitted with the weld faces."""
     if not geo.has_sides:
         return []
-    band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
-    eb = o.edge_band_m + slack
-    side = (r_a < -eb) & (r_a > -(geo.depth_a - eb)) & (r_b >= band_b) & (r_b <= geo.length_a - eb) & pts.ok
+    # The bands across the side face, no wider than a share of a thin plate's extent (its depth, its height).
+    band_b = within(max(o.corner_band_m, 3.0 * face_b.scale) + slack, geo.length_a)
+    eb_d, eb_h = within(o.edge_band_m + slack, geo.depth_a), within(o.edge_band_m + slack, geo.length_a)
+    side = (r_a < -eb_d) & (r_a > -(geo.depth_a - eb_d)) & (r_b >= band_b) & (r_b <= geo.length_a - eb_h) & pts.ok
     # A side face seen at all shows a good part of the points its patch would hold seen well; a few
     # dozen flying pixels off an edge (a face seen at grazing incidence drops out) must not pass for it.
-    patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * o.edge_band_m) * (
-        min(geo.length_a, o.tube_radius_m) - band_b - o.edge_band_m
+    patch = (min(geo.depth_a, o.tube_radius_m) - 2.0 * within(o.edge_band_m, geo.depth_a)) * (
+        min(geo.length_a, o.tube_radius_m) - band_b - within(o.edge_band_m, geo.length_a)
     )
     need = max(o.min_end_points, int(o.min_end_fill * max(patch, 0.0) / pts.pitch**2))
+    # A side face against another part's face is hidden: that face's points beside A place it (in front of
+    # face A, as far from B as A's own side would be); they belong to another part, so ``pts.ok`` cannot hold them.
+    beside = (r_a > eb_d) & (r_a < o.tube_radius_m) & (r_b >= band_b) & (r_b <= geo.length_a - eb_h)
     out = []
     for key, end in zip(END_KEYS, ends, strict=True):
         if end.on_table:
             continue
         r_l = pts.along(end.n) - end.d
         gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
-        sel = np.flatnonzero(side & (np.abs(r_l) < gate))
+        near = np.abs(r_l) < gate
+        # On the other part's face, never as deep as its far side (an upright's other face, 12 mm behind).
+        sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching) if end.touching else side & near)
         if len(sel) >= need:
             out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
     return out
@@ -63,12 +69,14 @@ def find_ends(
     p0: FloatArray,
     t: FloatArray,
     s_map: list[float],
+    face_a_height: float,
     o: OursOptions,
 ) -> tuple[End, End]:
     """Both ends placed on the fitted line p0 + s t: the table where A rests on it, A's side face where it was
     fitted (``sides_se``: the standard error of each fitted side face's offset, by end index), else the extent of
     face A's support along the seam: the quantiles of its points in ``pts`` extrapolated, then refined as an edge
-    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last)."""
+    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last).
+    ``face_a_height``: face A's extent away from B [m] (a thin plate's side keeps a window above the corner band)."""
     placed = list(ends)
     known = [False, False]
     for k, end in enumerate(ends):
@@ -86,7 +94,7 @@ def find_ends(
         return placed[0], placed[1]
     # Face A's support along t; a known end's neighbourhood is cut away (A's side face shows up there),
     # which only shifts the CDF by a constant and leaves the other end's extrapolation unbiased.
-    band_b = max(o.corner_band_m, 3.0 * face_b.scale)
+    band_b = within(max(o.corner_band_m, 3.0 * face_b.scale), face_a_height)
     cut = o.edge_band_m + 3.0 * face_a.scale
     s_known = [end.s for end in placed]
 

@@ -12,7 +12,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
 from cell.seams._lines import extent_behind, plane_intersection
-from cell.seams.ours._bodies import coplanar_boundary, over_region, side_planes
+from cell.seams.ours._bodies import coplanar_boundary, over_region, side_planes, touches
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
 from cell.types import Joint, MapSeam, Part, SeamScene
@@ -20,6 +20,14 @@ from cell.types import Joint, MapSeam, Part, SeamScene
 BoolArray = npt.NDArray[np.bool_]
 _Z = np.array([0.0, 0.0, 1.0])
 _SIDE_REACH_M = 0.02  # a side face of a body ends the seam only this near the map's end [m]
+THIN_SHARE = 0.25  # a band cut off a face is at most this share of the face's extent (thin plates keep a window)
+
+
+def within(band: float, extent: float) -> float:
+    """``band`` [m], cut off a face whose extent across it is ``extent`` [m], no wider than :data:`THIN_SHARE` of
+    it: an 8 mm lap plate's side keeps a window between its corner and its edge bands. Faces 44 mm and taller
+    keep every band the locator uses (at most 11 mm) as it is."""
+    return min(band, THIN_SHARE * extent)
 
 
 @dataclass(frozen=True)
@@ -89,7 +97,15 @@ class JointGeometry:
             o_band,
         )
 
-    def end_planes(self, t: FloatArray, s_map: list[float], table_z: float, tol: float) -> tuple[End, End]:
+    def end_planes(
+        self,
+        t: FloatArray,
+        s_map: list[float],
+        table_z: float,
+        tol: float,
+        others: tuple[Part, ...] = (),
+        p0: FloatArray | None = None,
+    ) -> tuple[End, End]:
         """Planes of A's side faces at the start and the end of the seam (direction t; outward normals), the
         table instead of a side face that rests on it; the ends where the map puts them (``s_map`` along t [m]).
         A seam that crosses no side faces keeps planes it never fits (its ends come from the extent of face A's
@@ -97,7 +113,12 @@ class JointGeometry:
         out = []
         for (n, d), s in zip(self.planes, s_map, strict=True):
             on_table = self.has_sides and _edge.on_table(n, d, table_z, tol)
-            out.append(End(-_Z, -table_z, True, s) if on_table else End(n, d, False, s))
+            at = None if p0 is None else p0 + s * t
+            behind = [
+                extent_behind(p, -n, -d) for p in others if self.has_sides and at is not None and touches(p, n, d, at)
+            ]
+            touching = 0.0 if on_table or not behind else min(behind)
+            out.append(End(-_Z, -table_z, True, s) if on_table else End(n, d, False, s, touching=touching))
         return out[0], out[1]
 
     def in_face_b(self, pts: Points, slack: float) -> BoolArray:

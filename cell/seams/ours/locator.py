@@ -13,7 +13,7 @@ from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
 from cell.seams.ours._ends import find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
-from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line
+from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
@@ -120,7 +120,8 @@ class OursLocator:
         geo = JointGeometry.of(part_a, part_b, joint, p0, t, (s_map[0], s_map[1]), o.edge_band_m)
         face_a = Face(n_a, d_a, o.sensor_sigma_m, f"{joint.abutting} {joint.face_abutting}")
         face_b = Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
-        ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m)
+        others = tuple(p for p in scene.weldmap.parts if p.name != part_a.name)
+        ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m, others, p0)
 
         for it in range(o.passes):
             first, last = it == 0, it == o.passes - 1
@@ -133,7 +134,9 @@ class OursLocator:
             band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
             e0, e1 = ends[0].s, ends[1].s
             eb = o.edge_band_m + (slack if first else min(max(ends[0].se, ends[1].se), o.map_tolerance_m))
-            in_a = (r_b >= band_b) & (r_b <= geo.length_a - eb) & (s >= e0 + eb) & (s <= e1 - eb) & pts.ok
+            # Across face A (its height over B), the bands leave a thin plate's side a window.
+            lo_a, hi_a = within(band_b, geo.length_a), geo.length_a - within(eb, geo.length_a)
+            in_a = (r_b >= lo_a) & (r_b <= hi_a) & (s >= e0 + eb) & (s <= e1 - eb) & pts.ok
             in_b = (
                 geo.in_face_b(pts, slack)
                 & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
@@ -156,7 +159,7 @@ class OursLocator:
                 why = "no edge of it is seen either: not seen or not there"
                 if first:
                     # Where an adjacent face of the same part may show this face's edge: away from the other part.
-                    away = away_from(face_b, band_b) if key == "a" else outside(part_a, band_a)
+                    away = away_from(face_b, lo_a) if key == "a" else outside(part_a, band_a)
                     placed = face_from_edge(scene, face, part, face_name, skip, seam, joint, away, rng, o)
                     if isinstance(placed, Face):
                         face_a, face_b = (placed, face_b) if key == "a" else (face_a, placed)
@@ -188,7 +191,17 @@ class OursLocator:
                         f"(allowed {2000 * o.map_tolerance_m:.1f} mm): wrong surface or part moved",
                     )
             ends = find_ends(
-                fitting.ends, fitting.sides_se, pts, dense if last else None, face_a, face_b, p0, t, s_map, o
+                fitting.ends,
+                fitting.sides_se,
+                pts,
+                dense if last else None,
+                face_a,
+                face_b,
+                p0,
+                t,
+                s_map,
+                geo.length_a,
+                o,
             )
 
         length = ends[1].s - ends[0].s

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from cell.geometry import make_pose
-from cell.seams.ours._bodies import touches
+from cell.seams.ours._bodies import touch_gap
 from cell.seams.ours._geometry import THIN_SHARE, JointGeometry, within
 from cell.types import Box, Joint, Part
 
@@ -31,15 +31,22 @@ def _upright_and_gusset() -> tuple[Part, Part, Part]:
 def test_a_side_face_on_another_part_is_touching_where_the_seam_ends() -> None:
     base, upright, gusset = _upright_and_gusset()
     n_back, d_back = gusset.face_plane("+x")
-    assert touches(upright, n_back, d_back, np.array([0.2, 0.119, 0.012]))
-    assert not touches(upright, n_back, d_back, np.array([0.2, 0.119, 0.3]))  # the plane, but off the upright there
-    assert not touches(base, n_back, d_back, np.array([0.2, 0.119, 0.012]))  # no face of the base in that plane
+    assert touch_gap(upright, n_back, d_back, np.array([0.2, 0.119, 0.012])) == pytest.approx(0.0)
+    assert touch_gap(upright, n_back, d_back - 0.001, np.array([0.2, 0.119, 0.012])) == pytest.approx(
+        0.001
+    )  # drawn 1 mm off
+    assert (
+        touch_gap(upright, n_back, d_back, np.array([0.2, 0.119, 0.3])) is None
+    )  # the plane, but off the upright there
+    assert touch_gap(base, n_back, d_back, np.array([0.2, 0.119, 0.012])) is None  # no face of the base in that plane
     # The gusset-to-base seam along its -y face: from the upright (x = 0.2) to the toe (x = 0.1).
     joint = Joint("G", "GUSSET", "BASE", "-y", "+z", "-z")
     p0, t = np.array([0.2, 0.119, 0.012]), np.array([-1.0, 0.0, 0.0])
     geo = JointGeometry.of(gusset, base, joint, p0, t, (0.0, 0.1), 0.004)
     start, end = geo.end_planes(t, [0.0, 0.1], 0.0, 0.006, (base, upright), p0)
-    assert start.touching == pytest.approx(0.012)  # the upright, 12 mm thick behind its face
+    assert start.touching == pytest.approx(0.012) and start.gap == pytest.approx(
+        0.0, abs=1e-12
+    )  # the upright, 12 mm thick behind its face
     assert end.touching == 0.0  # the toe's face is free
     plain = geo.end_planes(t, [0.0, 0.1], 0.0, 0.006)  # no other parts given: nothing touches
     assert plain[0].touching == 0.0 and plain[1].touching == 0.0

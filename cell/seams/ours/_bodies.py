@@ -106,17 +106,43 @@ def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: flo
     return over_region(P, np.stack([polygon, np.roll(polygon, -1, axis=0)], axis=1), n, inset_m)
 
 
-TOUCH_M = 0.001  # a face lies on another body's face when their planes are this close [m] (opposite normals)
+TOUCH_M = 0.002  # a face lies on another body's face when their planes are this close [m] (opposite normals)
 
 
-def touches(part: Part, n: FloatArray, d: float, at: FloatArray) -> bool:
-    """Whether ``part`` has a face in the plane n . p = d (n outward of the other body, so the face's own normal is
-    -n) within :data:`TOUCH_M`, and the point ``at`` (3,) lies on the part (within 2 :data:`TOUCH_M`): the other
-    body's face lies on this part there (a rail's end on a post's face far from ``at`` does not count)."""
-    if not bool(part.contains(at[None, :], margin=2.0 * TOUCH_M)[0]):
-        return False
+def touch_gap(part: Part, n: FloatArray, d: float, at: FloatArray) -> float | None:
+    """How far [m] ``part``'s face lies beyond the plane n . p = d (n outward of the other body, so the face's own
+    normal is -n), when one does within :data:`TOUCH_M` and the point ``at`` (3,) lies on the part (within
+    :data:`TOUCH_M`): the other body's face lies on this part there, with this drawn gap (a brace drawn 1 mm over
+    a rail). None when no face of ``part`` touches the plane there (a rail's end on a post's face far from ``at``)."""
+    if not bool(part.contains(at[None, :], margin=TOUCH_M)[0]):
+        return None
+    gaps = []
     for name in part.face_names():
         n_f, d_f = part.face_plane(name)
         if float(n_f @ n) < -0.999 and abs(d_f + d) <= TOUCH_M:
-            return True
-    return False
+            gaps.append(-(d_f + d))
+    return min(gaps, key=abs) if gaps else None
+
+
+def fills_rectangle(part: Part, face: str, t: FloatArray, tol: float = 1e-3) -> bool:
+    """Whether the region ``face`` makes with ``part``'s faces in its plane is (within ``tol`` of its area) the
+    rectangle of its extents along ``t`` (the seam) and across it in the plane: then a face's extents bound it, as
+    a box's do (a gusset's triangle, a plate's top around its hole do not fill theirs)."""
+    body = part.body
+    assert isinstance(body, Polyhedron)
+    n, d = part.face_plane(face)
+    u = t - (t @ n) * n
+    u /= max(float(np.linalg.norm(u)), 1e-300)
+    v = np.cross(n, u)
+    area, pts = 0.0, []
+    for name in body.names:
+        n_f, d_f = body.face_plane(name)
+        if float(n_f @ n) < 1.0 - 1e-9 or abs(d_f - d) > 1e-6:
+            continue
+        poly = body.face_polygon(name)
+        q = np.stack([poly @ u, poly @ v], axis=1)
+        area += 0.5 * abs(float(np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1])))
+        pts.append(q)
+    q = np.concatenate(pts)
+    box = float(np.prod(q.max(axis=0) - q.min(axis=0)))
+    return area >= (1.0 - tol) * box

@@ -84,7 +84,7 @@ def find_ends(
             placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table")
             known[k] = True
         elif k in sides_se:
-            s = line_plane_parameter(p0, t, end.n, end.d)
+            s = line_plane_parameter(p0, t, end.n, end.d - end.gap)
             placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
             known[k] = True
     if all(known) or face_a.source != "points":

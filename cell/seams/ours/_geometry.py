@@ -12,7 +12,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
 from cell.seams._lines import extent_behind, plane_intersection
-from cell.seams.ours._bodies import coplanar_boundary, over_region, side_planes, touches
+from cell.seams.ours._bodies import coplanar_boundary, fills_rectangle, over_region, side_planes, touch_gap
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
 from cell.types import Joint, MapSeam, Part, SeamScene
@@ -44,6 +44,7 @@ class JointGeometry:
     has_sides: bool  # whether ``planes`` are A's side faces (else the seam crosses none: its ends are found)
     face_b: str  # B's receiving face
     edge_band: float
+    region_a: FloatArray | None = None  # A's weld face's boundary edges (k, 2, 3) when its extents do not bound it
 
     @staticmethod
     def of(
@@ -72,6 +73,9 @@ class JointGeometry:
                 sides is not None,
                 joint.face_receiving,
                 o_band,
+                None
+                if fills_rectangle(part_a, joint.face_abutting, t)
+                else coplanar_boundary(part_a, joint.face_abutting),
             )
         box_a = part_a.box
         k_a = "xyz".index(joint.face_abutting[1])
@@ -109,17 +113,31 @@ class JointGeometry:
         """Planes of A's side faces at the start and the end of the seam (direction t; outward normals), the
         table instead of a side face that rests on it; the ends where the map puts them (``s_map`` along t [m]).
         A seam that crosses no side faces keeps planes it never fits (its ends come from the extent of face A's
-        points)."""
+        points). A side face that lies on a face of one of ``others`` (the map's other parts: a gusset's back on an
+        upright, its foot on a base plate, a brace drawn 1 mm over a rail) where the map's end is (on the line
+        p0 + s t), within :data:`~cell.seams.ours._bodies.TOUCH_M`, is hidden: its End is that other face's plane
+        (``touching``: the other part's thickness behind it; ``gap``: the drawn gap the end lies short of it)."""
         out = []
         for (n, d), s in zip(self.planes, s_map, strict=True):
-            on_table = self.has_sides and _edge.on_table(n, d, table_z, tol)
-            at = None if p0 is None else p0 + s * t
-            behind = [
-                extent_behind(p, -n, -d) for p in others if self.has_sides and at is not None and touches(p, n, d, at)
-            ]
-            touching = 0.0 if on_table or not behind else min(behind)
-            out.append(End(-_Z, -table_z, True, s) if on_table else End(n, d, False, s, touching=touching))
+            if self.has_sides and _edge.on_table(n, d, table_z, tol):
+                out.append(End(-_Z, -table_z, True, s))
+                continue
+            at = None if p0 is None or not self.has_sides else p0 + s * t
+            found = [(g, p) for p in others if at is not None and (g := touch_gap(p, n, d, at)) is not None]
+            if not found:
+                out.append(End(n, d, False, s))
+                continue
+            gap, other = min(found, key=lambda x: abs(x[0]))
+            out.append(End(n, d + gap, False, s, touching=extent_behind(other, -n, -d - gap), gap=gap))
         return out[0], out[1]
+
+    def in_face_a(self, pts: Points, face_a: str, inset: float) -> BoolArray:
+        """Points whose projection lies inside A's weld face (with its coplanar faces) shrunk by ``inset`` [m] when
+        its extents do not bound it (a gusset's triangle); all points when they do (a box, a rectangle)."""
+        if self.region_a is None:
+            return np.ones(len(pts.cam), bool)
+        n_a, _ = self.part_a.face_plane(face_a)
+        return over_region(pts.P, self.region_a, n_a, inset)
 
     def in_face_b(self, pts: Points, slack: float) -> BoolArray:
         """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""

@@ -57,14 +57,17 @@ class End:
     # The side face lies against another part's face (hidden), that part this thick behind it [m] (0: it does not):
     # the other face's points place it.
     touching: float = 0.0
+    gap: float = 0.0  # ... and the drawn gap [m]: d is the other face's plane, the end lies this much short of it
 
     def moved(self, fit: Fitted) -> End:
         """The side face at this end moved by its offset fit."""
-        return End(self.n, self.d + fit.offset, self.on_table, self.s, self.se, fit.scale, self.source, self.touching)
+        return End(
+            self.n, self.d + fit.offset, self.on_table, self.s, self.se, fit.scale, self.source, self.touching, self.gap
+        )
 
     def at(self, s: float, se: float, source: str) -> End:
         """This end placed at ``s`` along the line [m], with its standard error [m] and where it came from."""
-        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching)
+        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching, self.gap)
 
 
 END_KEYS = ("start", "end")  # the keys of the selections of A's side faces at the seam's ends

@@ -136,7 +136,10 @@ class OursLocator:
             eb = o.edge_band_m + (slack if first else min(max(ends[0].se, ends[1].se), o.map_tolerance_m))
             # Across face A (its height over B), the bands leave a thin plate's side a window.
             lo_a, hi_a = within(band_b, geo.length_a), geo.length_a - within(eb, geo.length_a)
-            in_a = (r_b >= lo_a) & (r_b <= hi_a) & (s >= e0 + eb) & (s <= e1 - eb) & pts.ok
+            eb_s = within(eb, s_map[1] - s_map[0])  # a 19 mm seam keeps a window along it too
+            in_a = (r_b >= lo_a) & (r_b <= hi_a) & (s >= e0 + eb_s) & (s <= e1 - eb_s) & pts.ok
+            if geo.region_a is not None:  # a polyhedron's face need not fill its extents: only points over it
+                in_a &= geo.in_face_a(pts, joint.face_abutting, within(eb, geo.length_a))
             in_b = (
                 geo.in_face_b(pts, slack)
                 & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))

@@ -91,13 +91,15 @@ def over_region(P: FloatArray, edges: FloatArray, n: FloatArray, inset_m: float)
         inside ^= crosses & (q[:, 0] < x)
     if inset_m <= 0.0:
         return inside
+    idx = np.flatnonzero(inside)  # the distance to the edges only where it can matter
     e = b - a
     ll = np.maximum(np.einsum("ij,ij->i", e, e), 1e-300)
-    w = q[:, None, :] - a[None]
+    w = q[idx, None, :] - a[None]
     s = np.clip(np.einsum("nmk,mk->nm", w, e) / ll, 0.0, 1.0)
     gap = w - s[..., None] * e[None]
-    nearest = np.sqrt(np.einsum("nmk,nmk->nm", gap, gap)).min(axis=1)
-    return inside & (nearest >= inset_m)
+    nearest = np.einsum("nmk,nmk->nm", gap, gap).min(axis=1)
+    inside[idx] = nearest >= inset_m * inset_m
+    return inside
 
 
 def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:

@@ -18,6 +18,7 @@ from cell.types import Box, Joint, SeamScene
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
 _SPHERES_KEY = "cell.seams.ours.part_spheres"
+_SUPPORT_KEY = "cell.seams.ours.support_planes"
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,13 @@ def gather(
         if part.name in (joint.abutting, joint.receiving):
             continue
         if not part.is_box:
-            ok &= ~part.contains(xyz.T, margin=o.map_tolerance_m)
+            # Only points behind every supporting face plane (grown by the margin) can be near the body: the exact
+            # (costly) test on those alone.
+            N, D = _support_planes(scene, int(k))
+            m = o.map_tolerance_m
+            cand = np.flatnonzero(np.all(N @ xyz <= (D + m)[:, None], axis=0))
+            if len(cand):
+                ok[cand] &= ~part.contains(xyz[:, cand].T, margin=m)
             continue
         R, c = part.box.X_AB[:3, :3], part.box.center
         q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
@@ -107,3 +114,19 @@ def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
         radii = np.array([p.radius for p in parts])
         out = scene.cache[_SPHERES_KEY] = (centres, radii)
     return out
+
+
+def _support_planes(scene: SeamScene, k: int) -> tuple[FloatArray, FloatArray]:
+    """Normals (f, 3) and offsets (f,) [m] of part ``k``'s faces that have the whole body behind them (the faces on
+    its convex hull: a plate's top, bottom and outer walls, not its hole's), cached per scene."""
+    out = scene.cache.get(_SUPPORT_KEY)
+    if out is None:
+        out = []
+        for part in scene.weldmap.parts:
+            V = part.vertices()
+            planes = [part.face_plane(f) for f in part.face_names()]
+            kept = [(n, d) for n, d in planes if float(np.max(V @ n)) <= d + 1e-9]
+            out.append((np.array([n for n, _ in kept]).reshape(-1, 3), np.array([d for _, d in kept])))
+        scene.cache[_SUPPORT_KEY] = out
+    N, D = out[k]
+    return N, D

@@ -116,14 +116,14 @@ def touch_gap(part: Part, n: FloatArray, d: float, at: FloatArray) -> float | No
     normal is -n), when one does within :data:`TOUCH_M` and the point ``at`` (3,) lies on the part (within
     :data:`TOUCH_M`): the other body's face lies on this part there, with this drawn gap (a brace drawn 1 mm over
     a rail). None when no face of ``part`` touches the plane there (a rail's end on a post's face far from ``at``)."""
-    if not bool(part.contains(at[None, :], margin=TOUCH_M)[0]):
-        return None
     gaps = []
     for name in part.face_names():
         n_f, d_f = part.face_plane(name)
         if float(n_f @ n) < -0.999 and abs(d_f + d) <= TOUCH_M:
             gaps.append(-(d_f + d))
-    return min(gaps, key=abs) if gaps else None
+    if not gaps or not bool(part.contains(at[None, :], margin=TOUCH_M)[0]):
+        return None
+    return min(gaps, key=abs)
 
 
 def fills_rectangle(part: Part, face: str, t: FloatArray, tol: float = 1e-3) -> bool:

@@ -139,11 +139,18 @@ class JointGeometry:
         n_a, _ = self.part_a.face_plane(face_a)
         return over_region(pts.P, self.region_a, n_a, inset)
 
-    def in_face_b(self, pts: Points, slack: float) -> BoolArray:
-        """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``)."""
+    def in_face_b(self, pts: Points, slack: float, where: BoolArray | None = None) -> BoolArray:
+        """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``); a
+        polyhedron's region is tested only on the points ``where`` says (the others: False), a box's on all."""
         if not self.part_b.is_box:
             n_b, _ = self.part_b.face_plane(self.face_b)
-            return over_region(pts.P, coplanar_boundary(self.part_b, self.face_b), n_b, self.edge_band + slack)
+            edges = coplanar_boundary(self.part_b, self.face_b)
+            if where is None:
+                return over_region(pts.P, edges, n_b, self.edge_band + slack)
+            out = np.zeros(len(pts.cam), bool)
+            idx = np.flatnonzero(where)
+            out[idx] = over_region(pts.P[idx], edges, n_b, self.edge_band + slack)
+            return out
         box_b = self.part_b.box
         k_b = "xyz".index(self.face_b[1])
         ok = np.ones(len(pts.cam), bool)

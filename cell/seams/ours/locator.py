@@ -140,8 +140,10 @@ class OursLocator:
             in_a = (r_b >= lo_a) & (r_b <= hi_a) & (s >= e0 + eb_s) & (s <= e1 - eb_s) & pts.ok
             if geo.region_a is not None:  # a polyhedron's face need not fill its extents: only points over it
                 in_a &= geo.in_face_a(pts, joint.face_abutting, within(eb, geo.length_a))
+            # The widest gate B's points pass below (the region test on a polyhedron is costly: only on those).
+            gate_b = max(o.map_tolerance_m + 3.0 * o.sensor_sigma_m, o.gate_sigmas * face_b.scale)
             in_b = (
-                geo.in_face_b(pts, slack)
+                geo.in_face_b(pts, slack, pts.ok & (np.abs(r_b) < gate_b))
                 & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
                 & pts.ok
             )

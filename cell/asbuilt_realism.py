@@ -87,8 +87,10 @@ def _bow_step(bow: BowSpec) -> Shaper:
 
 def _gap_step(end_face: str, across_W: FloatArray, max_m: float) -> Shaper:
     def step(body: Polyhedron) -> Polyhedron:
-        face = end_face if end_face in body.names else next(n for n in body.names if n.startswith(end_face + "@"))
-        return cut_end(body, face, across_W, max_m)
+        faces = [n for n in body.names if n == end_face or n.startswith(end_face + "@")]
+        if not faces:  # pragma: no cover - the joint's faces come from the same body
+            raise ScenarioError(f"simulation.gaps: the as-built body has no end face {end_face}")
+        return cut_end(body, faces[0], across_W, max_m)
 
     return step
 

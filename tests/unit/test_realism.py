@@ -3,11 +3,13 @@ dropout. Small and direct: the as-built geometry of fence1's map, one synthetic 
 
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from dxf_factory import REPO_ROOT  # puts tools/ on the path
 
 from cell.asbuilt import as_built_fixtures, as_built_parts
 from cell.asbuilt_shapes import bowed, principal_frame
@@ -153,3 +155,8 @@ def test_the_rhs_map_reads_as_hollow_tubes_and_every_seam_has_a_truth() -> None:
     lengths = [float(np.linalg.norm(b - a)) * 1000.0 for a, b in truth.values()]
     assert min(lengths) > 40.0 and max(lengths) < 70.0
     assert len(as_built_fixtures(weldmap, scenario, joints)) == 24  # two tacks a seam
+
+
+def test_make_rhs_writes_the_shipped_map_byte_for_byte(tmp_path: Path) -> None:
+    make_rhs = importlib.import_module("make_rhs")  # tools/make_rhs.py (tools/ is on the path: dxf_factory)
+    assert make_rhs.write_rhs_map(tmp_path / "rhs.dxf").read_bytes() == (REPO_ROOT / "maps" / "rhs.dxf").read_bytes()

@@ -142,11 +142,8 @@ class OursLocator:
                 in_a &= geo.in_face_a(pts, joint.face_abutting, within(eb, geo.length_a))
             # The widest gate B's points pass below (the region test on a polyhedron is costly: only on those).
             gate_b = max(o.map_tolerance_m + 3.0 * o.sensor_sigma_m, o.gate_sigmas * face_b.scale)
-            in_b = (
-                geo.in_face_b(pts, slack, pts.ok & (np.abs(r_b) < gate_b))
-                & ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
-                & pts.ok
-            )
+            beside_a = ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
+            in_b = geo.in_face_b(pts, slack, pts.ok & beside_a & (np.abs(r_b) < gate_b)) & beside_a & pts.ok
             planes: list[Selection] = []
             for key, face, r, region, part, face_name, skip in (
                 ("a", face_a, r_a, in_a, part_a, joint.face_abutting, joint.end_face),

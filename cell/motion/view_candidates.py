@@ -178,16 +178,21 @@ def _seen(
 
 
 def _occluded(eye: FloatArray, pts: FloatArray, normals: FloatArray, parts: Sequence[Part], margin: float) -> bool:
-    """Whether a part of ``parts`` (its box grown by ``margin`` [m]) stands on the line of sight from the eye (3,)
-    to a sample point (m, 3), taken just off its surface (so that its own part does not count). A part whose box
+    """Whether a part of ``parts`` (its body grown by ``margin`` [m]) stands on the line of sight from the eye (3,)
+    to a sample point (m, 3), taken just off its surface (so that its own part does not count). A part whose bounds
     cannot meet the sight lines' bounding box is not tested."""
     ends = pts + 0.002 * normals
     lo = np.minimum(ends.min(axis=0), eye)
     hi = np.maximum(ends.max(axis=0), eye)
     for part in parts:
-        box = part.box
-        reach = np.abs(box.X_AB[:3, :3]) @ (box.size / 2.0 + margin)  # the grown box's axis-aligned half sizes
-        if np.any(box.center + reach < lo) or np.any(box.center - reach > hi):
+        if part.is_box:
+            box = part.box
+            centre = box.center
+            reach = np.abs(box.X_AB[:3, :3]) @ (box.size / 2.0 + margin)  # the grown box's axis-aligned half sizes
+        else:  # any other body: its vertices' axis-aligned bounds, grown
+            v = part.vertices()
+            centre, reach = 0.5 * (v.max(axis=0) + v.min(axis=0)), 0.5 * np.ptp(v, axis=0) + margin
+        if np.any(centre + reach < lo) or np.any(centre - reach > hi):
             continue
         if np.any(segments_hit_box(eye, ends, part, margin)):
             return True

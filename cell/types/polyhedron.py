@@ -212,17 +212,22 @@ class Polyhedron:
         p = np.asarray(p_A, dtype=float)
         single = p.ndim == 1
         p = p.reshape(-1, 3)
+        out = np.zeros(len(p), dtype=bool)
+        # Only points within the body's bounds (grown by the margin) can be inside: most that a stage asks are not.
+        grow = max(margin, 0.0)
+        near = np.flatnonzero(
+            np.all((p >= self.vertices.min(axis=0) - grow) & (p <= self.vertices.max(axis=0) + grow), axis=1)
+        )
         tri = self.vertices[self._tris]
         a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
-        out = np.zeros(len(p), dtype=bool)
         step = max(1, _CHUNK // max(1, len(tri)))
-        for s in range(0, len(p), step):
-            q = p[s : s + step]
+        for s in range(0, len(near), step):
+            q = p[near[s : s + step]]
             inside = self._winding(q, a, b, c) > 0.5
             if margin != 0.0:
                 d = _point_triangle_distance(q, a, b, c).min(axis=1)
                 inside = (inside | (d <= margin)) if margin > 0 else (inside & (d >= -margin))
-            out[s : s + step] = inside
+            out[near[s : s + step]] = inside
         return out[0] if single else out
 
     @staticmethod

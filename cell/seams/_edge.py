@@ -231,9 +231,12 @@ def along_edge(part: Part, f: str, g: str, P: FloatArray, band: float) -> BoolAr
 
 def combine(estimates: list[tuple[float, float]]) -> tuple[float, float]:
     """Inverse-variance mean of (value, standard error) pairs and its standard error, inflated by the Birge
-    ratio sqrt(chi^2 / (k - 1)) when the values scatter more than their errors say."""
+    ratio sqrt(chi^2 / (k - 1)) when the values scatter more than their errors say. Estimates whose errors are all
+    infinite carry no weight: (nan, inf)."""
     v = np.array([e[0] for e in estimates])
     w = 1.0 / np.square(np.maximum([e[1] for e in estimates], 1e-9))
+    if not w.sum() > 0.0:
+        return float("nan"), float("inf")
     mean = float(w @ v / w.sum())
     se = float(1.0 / np.sqrt(w.sum()))
     if len(v) > 1:

@@ -12,7 +12,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
 from cell.seams._lines import extent_behind, plane_intersection
-from cell.seams.ours._bodies import coplanar_boundary, fills_rectangle, over_region, side_planes, touch_gap
+from cell.seams.ours._bodies import TOUCH_M, coplanar_boundary, fills_rectangle, over_region, side_planes, touch_gap
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
 from cell.types import Joint, MapSeam, Part, SeamScene
@@ -123,7 +123,9 @@ class JointGeometry:
                 out.append(End(-_Z, -table_z, True, s))
                 continue
             at = None if p0 is None or not self.has_sides else p0 + s * t
-            found = [(g, p) for p in others if at is not None and (g := touch_gap(p, n, d, at)) is not None]
+            # Only a part whose bounding sphere reaches the end can hold it (most of the map's parts lie far off).
+            near = () if at is None else [p for p in others if np.linalg.norm(at - p.center) <= p.radius + TOUCH_M]
+            found = [(g, p) for p in near if at is not None and (g := touch_gap(p, n, d, at)) is not None]
             if not found:
                 out.append(End(n, d, False, s))
                 continue

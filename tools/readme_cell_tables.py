@@ -126,6 +126,28 @@ def _cycle_line(r: Row) -> str:
     )
 
 
+def weldments_table(rows: Sequence[Row]) -> str:
+    """One line per ``cell weld`` run of a part that is not all boxes (``weldments.json``): seams found, their mean
+    located errors, welded, the worst executed TCP RMS, our time per seam, and why the others were not welded."""
+    lines = [
+        "| scenario | found / visible | located: lateral / endpoint mean [mm] | welded / visible "
+        "| worst TCP RMS [mm] | ours, ms per seam (median) | not welded: why (seams) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        if r.get("error"):
+            lines.append(f"| {r['scenario']} | - | - | - | - | - | {r['error']['message']} |")
+            continue
+        rms = [s["tcp_rms_mm"] for s in r["seams"] if s["welded"] and s["tcp_rms_mm"] is not None]
+        why = ", ".join(f"{k.replace('_', ' ')}: {n}" for k, n in sorted(r["weld_reason_counts"].items()))
+        lines.append(
+            f"| {r['scenario']} | {r['found']}/{r['visible']} | {_f(r['lateral_mean_mm'], 2)} / "
+            f"{_f(r['endpoint_mean_mm'], 2)} | {r['welded']}/{r['visible']} | {_f(max(rms) if rms else None, 2)} "
+            f"| {_f(r['ms_per_seam_median'], 1)} | {why or '-'} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 def weld_table(r: Row) -> str:
     """One line per seam of a ``cell weld`` run (with its side when the part was turned), then its cycle-time
     line (and the turn's)."""

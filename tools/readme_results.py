@@ -163,6 +163,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "faults": lambda results: cell_tables.faults_table(_load(results, "faults.json")),
     "planning": lambda results: cell_tables.planning_table(_load_object(results, "planning.json")),
     "real-scans": lambda results: cell_tables.real_scans_table(_load_object(results, "real_scans.json")),
+    "weldments": lambda results: cell_tables.weldments_table(_load(results, "weldments.json")),
 }
 
 

@@ -33,7 +33,6 @@ from cell.errors import EXIT_INTERRUPTED, UsageError
 
 if TYPE_CHECKING:
     from cell.station import Station
-    from cell.types import WeldMap
 
 BENCH_SAVED = Path("benchmarks/results/latest.json")  # what --save writes (the README's Table 1 is made from it)
 
@@ -60,6 +59,7 @@ def map_info(
     ] = None,
 ) -> None:
     """Print the units, parts, fixtures and seams (with their joints) of a DXF welding map, and what it skipped."""
+    from cell.seams.joint import joint_notes
     from cell.weldmap import METRES_PER_UNIT, describe, read_map
 
     with cell_errors():
@@ -72,29 +72,7 @@ def map_info(
             spec = sc.load(scenario).map
             layers, units = spec.layers, units if units is not None else spec.units
         weldmap = read_map(path, units=units, layers=layers)  # its warnings print through cli.common's handler
-        out.print(describe(weldmap, _joints(weldmap)), soft_wrap=True, markup=False, highlight=False)
-
-
-def _joints(weldmap: WeldMap) -> dict[str, str]:
-    """Each seam's joint for ``map info``: type, dihedral, abutting > receiving part (seams no two faces hold: none)."""
-    import math
-    from dataclasses import replace
-
-    from cell.errors import MapError
-    from cell.motion.procedures import joint_type
-    from cell.seams.joint import find_joints
-
-    text = {}
-    for s in weldmap.seams:
-        try:
-            joint = find_joints(replace(weldmap, seams=(s,)))[s.id]
-        except MapError:
-            continue
-        a, b = weldmap.part(joint.abutting), weldmap.part(joint.receiving)
-        n_a, n_b = a.face_plane(joint.face_abutting)[0], b.face_plane(joint.face_receiving)[0]
-        dihedral = 180.0 - math.degrees(math.acos(max(-1.0, min(1.0, float(n_a @ n_b)))))
-        text[s.id] = f"{joint_type(weldmap, joint)} {dihedral:.0f} deg  {joint.abutting} > {joint.receiving}"
-    return text
+        out.print(describe(weldmap, joint_notes(weldmap)), soft_wrap=True, markup=False, highlight=False)
 
 
 @app.command()

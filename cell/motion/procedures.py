@@ -28,7 +28,6 @@ from cell.types.plan import SeamTask
 from cell.types.procedure import WeldProcedure
 
 VERTICAL_DEG = 30.0  # [deg] a seam this close to vertical is welded in its procedure's direction
-_COPLANAR_M = 0.003  # [m] how far two faces may lie apart and still be flush (a corner joint)
 UP_R = np.array([0.0, 0.0, 1.0])  # against gravity in R when the base stands upright
 
 
@@ -61,35 +60,12 @@ class NoProcedure:
     reason: str
 
 
-def _extent(vertices: FloatArray, n: FloatArray) -> float:
-    h = vertices @ n
-    return float(h.max() - h.min())
-
-
 def joint_type(weldmap_R: WeldMap, joint: Joint) -> str:
-    """``T``, ``corner`` or ``lap`` for one seam's joint (parts and faces in the same frame).
+    """``T``, ``corner`` or ``lap`` for one seam's joint (parts and faces in the same frame): the joint's kind as the
+    map reads it (:func:`cell.seams.joint.joint_kind`), the key a procedure row is chosen by."""
+    from cell.seams.joint import joint_kind  # the seams package stays out of the motion import chain
 
-    lap: the abutting part rests on the receiving face with a thin side (its extent across the receiving face is
-    smaller than along its seam face's normal); corner: the abutting part's face opposite the weld face is flush
-    with a face of the receiving part (the outside of an L); T otherwise.
-    """
-    a, b = weldmap_R.part(joint.abutting), weldmap_R.part(joint.receiving)
-    n_end, _ = a.face_plane(joint.end_face)
-    n_a, _ = a.face_plane(joint.face_abutting)
-    va = a.vertices()
-    if _extent(va, n_end) < _extent(va, n_a):
-        return "lap"
-    # A's faces opposite its weld face (a box: the one; any body: every face turned away within 5 deg).
-    flush = math.cos(math.radians(5.0))
-    for opposite in a.face_names():
-        n_o, d_o = a.face_plane(opposite)
-        if float(n_o @ n_a) > -flush:
-            continue
-        for face in b.face_names():
-            n_f, d_f = b.face_plane(face)
-            if float(n_f @ n_o) > flush and abs(d_f - d_o) <= _COPLANAR_M:
-                return "corner"
-    return "T"
+    return joint_kind(weldmap_R, joint)
 
 
 def is_vertical(d_R: npt.ArrayLike, up_R: npt.ArrayLike = UP_R) -> bool:

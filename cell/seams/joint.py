@@ -162,8 +162,9 @@ def joint_kind(weldmap: WeldMap, joint: Joint) -> str:
     """``T``, ``corner`` or ``lap`` for one seam's joint, for any bodies (parts and faces in the same frame).
 
     lap: the abutting part rests on the receiving face with a thin side (its extent along the end face's normal is
-    smaller than along its weld face's normal); corner: the abutting part's face most opposite its weld face is
-    flush with a face of the receiving part (the outside of an L); T otherwise.
+    smaller than along its weld face's normal); corner: a face of the abutting part opposite its weld face (within
+    5 deg; a hollow tube has its outer wall and its inner one) is flush with a face of the receiving part (the outside
+    of an L); T otherwise.
     """
     a, b = weldmap.part(joint.abutting), weldmap.part(joint.receiving)
     n_end, _ = a.face_plane(joint.end_face)
@@ -171,12 +172,13 @@ def joint_kind(weldmap: WeldMap, joint: Joint) -> str:
     h_end, h_a = a.vertices() @ n_end, a.vertices() @ n_a
     if np.ptp(h_end) < np.ptp(h_a):
         return "lap"
+    within = math.cos(math.radians(5.0))
     _, N_a, D_a = _planes(a)
-    k_o = int(np.argmin(N_a @ n_a))
-    n_o, d_o = N_a[k_o], D_a[k_o]
     _, N_b, D_b = _planes(b)
-    flush = (N_b @ n_o > math.cos(math.radians(5.0))) & (np.abs(D_b - d_o) <= _COPLANAR_M)
-    return "corner" if bool(np.any(flush)) else "T"
+    for n_o, d_o in zip(N_a[N_a @ n_a < -within], D_a[N_a @ n_a < -within], strict=True):
+        if bool(np.any((N_b @ n_o > within) & (np.abs(D_b - d_o) <= _COPLANAR_M))):
+            return "corner"
+    return "T"
 
 
 def joint_notes(weldmap: WeldMap) -> dict[str, str]:

@@ -27,9 +27,9 @@ from make_maps import (
     _add_body,
     _add_seam,
     _rot_z,
-    _save_stable,
     all_seams,
     build_map,
+    write_stable,
 )
 
 BRACE_DEG = 35.0  # the brace's axis to the rails (M's x) [deg]
@@ -89,14 +89,7 @@ def build_brace_map() -> Drawing:
 
 def write_brace_map(path: str | Path) -> Path:
     """Write the brace map (:func:`build_brace_map`) to ``path``, byte-stable; returns the path."""
-    path = Path(path)
-    fixed = ezdxf.options.write_fixed_meta_data_for_testing
-    ezdxf.options.write_fixed_meta_data_for_testing = True
-    try:
-        _save_stable(build_brace_map(), path)
-    finally:
-        ezdxf.options.write_fixed_meta_data_for_testing = fixed
-    return path
+    return write_stable(build_brace_map, path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

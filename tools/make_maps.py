@@ -27,7 +27,7 @@ import math
 import re
 import uuid
 from collections import OrderedDict
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Literal
 
@@ -346,11 +346,9 @@ def write_map(
     in_blocks : parts and seams inside block references (seams nested two deep), each INSERT turned by
         ``block_rotation_deg`` about z, so that the drawn geometry equals the design.
     """
-    path = Path(path)
-    fixed = ezdxf.options.write_fixed_meta_data_for_testing
-    ezdxf.options.write_fixed_meta_data_for_testing = True  # fixed dates, GUIDs, marker: byte-stable
-    try:
-        doc = build_map(
+
+    def build() -> Drawing:
+        return build_map(
             parts,
             seams,
             units=units,
@@ -361,7 +359,18 @@ def write_map(
             block_rotation_deg=block_rotation_deg,
             dxfversion=dxfversion,
         )
-        _save_stable(doc, path)
+
+    return write_stable(build, path)
+
+
+def write_stable(build: Callable[[], Drawing], path: str | Path) -> Path:
+    """Build a drawing with ezdxf's fixed metadata (dates, GUIDs, marker) and save it byte-stable (:func:`_save_stable`)
+    to ``path``; returns the path. Every map of ``maps/`` is written through here."""
+    path = Path(path)
+    fixed = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        _save_stable(build(), path)
     finally:
         ezdxf.options.write_fixed_meta_data_for_testing = fixed
     return path

@@ -37,8 +37,8 @@ from make_maps import (
     SEAM_LAYER_COLOR,
     SeamSpec,
     _add_seam,
-    _save_stable,
     all_seams,
+    write_stable,
 )
 
 WALL_MM = {"TOP_RAIL": 4.0, "POST_L": 3.0, "POST_R": 3.0, "BOTTOM_RAIL": 3.0}
@@ -129,14 +129,7 @@ def build_rhs_map() -> ezdxf.document.Drawing:
 
 def write_rhs_map(path: str | Path) -> Path:
     """Write the rhs map (:func:`build_rhs_map`) to ``path``, byte-stable; returns the path."""
-    path = Path(path)
-    fixed = ezdxf.options.write_fixed_meta_data_for_testing
-    ezdxf.options.write_fixed_meta_data_for_testing = True
-    try:
-        _save_stable(build_rhs_map(), path)
-    finally:
-        ezdxf.options.write_fixed_meta_data_for_testing = fixed
-    return path
+    return write_stable(build_rhs_map, path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

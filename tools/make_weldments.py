@@ -27,7 +27,7 @@ from pathlib import Path
 import ezdxf
 from ezdxf.math import Vec3 as DxfVec3
 from ezdxf.render import MeshTransformer
-from make_maps import APPID, PART_LAYER_COLOR, REPO_ROOT, SEAM_LAYER_COLOR, SeamSpec, _add_seam, _save_stable, box_mesh
+from make_maps import APPID, PART_LAYER_COLOR, REPO_ROOT, SEAM_LAYER_COLOR, SeamSpec, _add_seam, box_mesh, write_stable
 
 BASE = (0.0, 0.0, 0.0, 400.0, 250.0, 12.0)  # x0, y0, z0, x1, y1, z1 [mm]
 HOLE = (20.0, 95.0, 80.0, 155.0)  # x0, y0, x1, y1 of the base's square hole [mm]
@@ -111,14 +111,7 @@ def build_bracket_map() -> ezdxf.document.Drawing:
 
 def write_bracket_map(path: str | Path) -> Path:
     """Write the bracket map (:func:`build_bracket_map`) to ``path``, byte-stable; returns the path."""
-    path = Path(path)
-    fixed = ezdxf.options.write_fixed_meta_data_for_testing
-    ezdxf.options.write_fixed_meta_data_for_testing = True
-    try:
-        _save_stable(build_bracket_map(), path)
-    finally:
-        ezdxf.options.write_fixed_meta_data_for_testing = fixed
-    return path
+    return write_stable(build_bracket_map, path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

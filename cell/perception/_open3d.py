@@ -123,7 +123,14 @@ def icp(
         method = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=float(tukey_k_m)))
     X0 = np.eye(4) if init is None else _array(init)
     src, tgt = _legacy_cloud(source), _legacy_cloud(target, target_normals)
-    return _result(reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations)))
+    # On one thread: open3d sums the normal equations over its threads in an order that changes from run to run, so
+    # the same clouds gave poses up to 11 um apart (the bracket's thin plates); one thread gives one answer.
+    threads = _o3d().utility.get_max_threads()
+    _o3d().utility.set_max_threads(1)
+    try:
+        return _result(reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations)))
+    finally:
+        _o3d().utility.set_max_threads(threads)
 
 
 def estimate_normals(points: npt.ArrayLike, radius_m: float, max_neighbours: int) -> FloatArray:

@@ -19,6 +19,7 @@ import argparse
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -152,33 +153,42 @@ def run(seed: int) -> list[dict[str, object]]:
     return rows
 
 
-def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, object]]:
-    """Plan every visible designed seam of each scenario; times [s]."""
+def designed_cell(s: Any) -> tuple[RobotModel, list[Any], tuple[Any, ...]]:
+    """A scenario's cell as designed, in R, no perception: the arm, a task per visible seam, the obstacles."""
     from cell import scenario as sc
     from cell.geometry import invert
-    from cell.motion.collision import CollisionChecker
-    from cell.motion.gate import find_violations
-    from cell.motion.plan import SeamTask, cell_obstacles, plan_welds
-    from cell.motion.torch import WeldProcess
+    from cell.motion.plan import SeamTask, cell_obstacles
+    from cell.pipeline.detect import table_z_R
     from cell.seams.joint import find_joints, weld_faces
     from cell.seams.visibility import visibility
     from cell.weldmap import read_map
 
+    assert s.robot.urdf is not None and s.robot.home_deg is not None
+    robot = RobotModel.from_urdf(sc.REPO_ROOT / "robots" / s.robot.urdf)
+    wm = read_map(s.map_path, units=s.map.units, layers=s.map.layers).transformed(invert(s.X_WR) @ s.X_WM, "R")
+    joints = find_joints(wm)
+    table_z = table_z_R(s)
+    tasks = []
+    for seam in wm.seams:
+        if visibility(wm, joints[seam.id], table_z)[0]:
+            n_a, _, n_b, _ = weld_faces(wm, joints[seam.id])
+            tasks.append(SeamTask(seam.id, seam.p_start, seam.p_end, n_a, n_b))
+    return robot, tasks, cell_obstacles(wm, s.X_WR, s.table.center_m, s.table.size_m)
+
+
+def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, object]]:
+    """Plan every visible designed seam of each scenario; times [s]."""
+    from cell import scenario as sc
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.gate import find_violations
+    from cell.motion.plan import plan_welds
+    from cell.motion.torch import WeldProcess
+
     rows: list[dict[str, object]] = []
     for name in names:
         s = sc.load(name)
-        assert s.robot.urdf is not None and s.robot.home_deg is not None
-        robot = RobotModel.from_urdf(sc.REPO_ROOT / "robots" / s.robot.urdf)
-        X_RM = invert(s.X_WR) @ s.X_WM
-        wm = read_map(s.map_path, units=s.map.units).transformed(X_RM, "R")
-        joints = find_joints(wm)
-        table_z = float((invert(s.X_WR) @ [0.0, 0.0, s.table.top_z, 1.0])[2])
-        tasks = []
-        for seam in wm.seams:
-            if visibility(wm, joints[seam.id], table_z)[0]:
-                n_a, _, n_b, _ = weld_faces(wm, joints[seam.id])
-                tasks.append(SeamTask(seam.id, seam.p_start, seam.p_end, n_a, n_b))
-        obstacles = cell_obstacles(wm, s.X_WR, s.table.center_m, s.table.size_m)
+        robot, tasks, obstacles = designed_cell(s)
+        assert s.robot.home_deg is not None
         home = np.radians(s.robot.home_deg)
         process = WeldProcess.from_spec(s.process, s.robot.stickout_mm)
         plan = plan_welds(robot, tasks, home, process, obstacles, rng=s.rng("plan"))

@@ -14,18 +14,14 @@ import argparse
 import time
 
 import numpy as np
+from bench_motion import designed_cell
 
 from cell import scenario as sc
-from cell.geometry import invert
 from cell.motion.collision import CollisionChecker
 from cell.motion.gate import find_violations
-from cell.motion.plan import SeamTask, cell_obstacles, plan_welds
-from cell.motion.robot import RobotModel
+from cell.motion.plan import plan_welds
 from cell.motion.torch import WeldProcess
-from cell.seams.joint import find_joints, weld_faces
-from cell.seams.visibility import visibility
 from cell.types import Part
-from cell.weldmap import read_map
 
 
 def main() -> None:
@@ -35,17 +31,8 @@ def main() -> None:
     parser.add_argument("--meshes", action="store_true", help="every part as a polyhedron")
     args = parser.parse_args()
     s = sc.load(args.scenario)
-    assert s.robot.urdf is not None and s.robot.home_deg is not None
-    robot = RobotModel.from_urdf(sc.REPO_ROOT / "robots" / s.robot.urdf)
-    wm = read_map(s.map_path, units=s.map.units, layers=s.map.layers).transformed(invert(s.X_WR) @ s.X_WM, "R")
-    joints = find_joints(wm)
-    table_z = float((invert(s.X_WR) @ [0.0, 0.0, s.table.top_z, 1.0])[2])
-    tasks = []
-    for seam in wm.seams:
-        if visibility(wm, joints[seam.id], table_z)[0]:
-            n_a, _, n_b, _ = weld_faces(wm, joints[seam.id])
-            tasks.append(SeamTask(seam.id, seam.p_start, seam.p_end, n_a, n_b))
-    obstacles = cell_obstacles(wm, s.X_WR, s.table.center_m, s.table.size_m)
+    robot, tasks, obstacles = designed_cell(s)
+    assert s.robot.home_deg is not None
     if args.meshes:
         obstacles = tuple(
             p if not p.is_box or p.name == "TABLE" else Part(p.name, p.box.to_polyhedron()) for p in obstacles

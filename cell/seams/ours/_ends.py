@@ -1,6 +1,8 @@
 """The ends of a seam our locator finds (frame R, metres): where the fitted line meets A's side face across it
 (fitted with the weld faces), the table, or the extent of face A's points along it (an empirical CDF extrapolated,
-refined as a blurred edge, :mod:`cell.seams._extent`)."""
+refined as a blurred edge, :mod:`cell.seams._extent`). On a rounded tube the end lies short of the side face (or
+the table) by the map's inset, the corner radius; an end whose side is not seen lies the drawn width from the
+other (docs/bodies.md section 8)."""
 
 from __future__ import annotations
 
@@ -15,6 +17,10 @@ from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
 from cell.seams.ours._points import Points
 from cell.seams.ours.options import OursOptions
+
+# How far a hollow section's flat may be wider or narrower than drawn [m] (docs/reference.md: EN 10219-2's
+# outer-size tolerance, 1 % of a 60 mm side, at least 0.5 mm).
+SECTION_TOLERANCE_M = 5e-4
 
 
 def side_selections(
@@ -53,7 +59,12 @@ def side_selections(
         gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
         near = np.abs(r_l) < gate
         # On the other part's face, never as deep as its far side (an upright's other face, 12 mm behind).
-        sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching) if end.touching else side & near)
+        if end.touching:
+            sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching))
+        elif end.inset:  # a tube's side flat begins past its corner radius, below face A and above its far side
+            sel = np.flatnonzero(side & near & (r_a < -eb_d - end.inset) & (r_a > end.inset - (geo.depth_a - eb_d)))
+        else:
+            sel = np.flatnonzero(side & near)
         if len(sel) >= need:
             out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
     return out
@@ -81,11 +92,20 @@ def find_ends(
     known = [False, False]
     for k, end in enumerate(ends):
         if end.on_table:
-            placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table")
+            placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d - end.inset), 2e-4, "table")
             known[k] = True
         elif k in sides_se:
-            s = line_plane_parameter(p0, t, end.n, end.d - end.gap)
+            s = line_plane_parameter(p0, t, end.n, end.d - end.short_of)
             placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
+            known[k] = True
+    for k, end in enumerate(ends):
+        # A tube's flat ends into its radius, no edge to find: beside an end from A's own side face, the other end
+        # lies the drawn flat's width away (to within the section's size tolerance).
+        other = placed[1 - k]
+        if not known[k] and end.inset and known[1 - k] and other.source == "side face" and not other.touching:
+            width = s_map[1] - s_map[0]
+            s = other.s + (width if k == 1 else -width)
+            placed[k] = end.at(s, float(np.hypot(other.se, SECTION_TOLERANCE_M)), "width")
             known[k] = True
     if all(known) or face_a.source != "points":
         for k, end in enumerate(ends):

@@ -23,6 +23,40 @@ from cell.seams.ours.options import OursOptions
 SECTION_TOLERANCE_M = 5e-4
 
 
+TANGENT_WINDOW_M = 0.008  # points this far along the line about the extent's guess place a tangent end [m]
+_TANGENT_STEP_M = 5e-5  # the grid the tangent line is searched on [m]
+
+
+def tangent_end(s: FloatArray, r: FloatArray, guess: float, radius: float, scale: float) -> tuple[float, float]:
+    """Where a flat ends into a corner of ``radius`` [m] (the upper end along s; pass -s for a lower end):
+    (s0 [m], its standard error [m]; inf when the data do not define it), from points at s (n,) with offsets r
+    (n,) from the flat's plane (outward positive) [m], ``scale`` their noise [m].
+
+    Profile: r = 0 up to s0, then -(radius - sqrt(radius^2 - (s - s0)^2)) round the corner. s0 is searched within
+    ``[guess - radius, guess + radius / 2]`` (the extent of the points near the plane runs past the tangent line);
+    the points deeper than a third of the radius (the side beyond the corner) are left out, and each residual is
+    capped at 3 scales (strays, a tack). The standard error comes from the curvature of the profile likelihood."""
+    sigma = max(scale, 5e-5)
+    keep = (r > -radius / 3.0) & (s > guess - 2.0 * radius) & (s < guess + radius)
+    s, r = s[keep], r[keep]
+    if len(s) < 20:
+        return guess, float("inf")
+    grid = np.arange(guess - radius, guess + 0.5 * radius, _TANGENT_STEP_M)
+    h = np.clip(s[None, :] - grid[:, None], 0.0, radius)
+    model = -(radius - np.sqrt(radius * radius - h * h))
+    cost = np.minimum(np.square((r[None, :] - model) / sigma), 9.0).sum(axis=1)
+    i = int(np.argmin(cost))
+    if not 0 < i < len(grid) - 1:
+        return guess, float("inf")
+    c2 = 0.5 * (cost[i - 1] - 2.0 * cost[i] + cost[i + 1])  # -log-likelihood's second difference
+    if c2 <= 0.0:
+        return float(grid[i]), float("inf")
+    shift = 0.25 * (cost[i - 1] - cost[i + 1]) / c2
+    # The curvature understates it (the residuals are capped, the points not independent, a drawn radius is
+    # facets): no better than the points' noise, which is what a close-up's ends scatter by on rhs.
+    return float(grid[i] + shift * _TANGENT_STEP_M), float(max(_TANGENT_STEP_M / np.sqrt(c2), sigma))
+
+
 def side_selections(
     ends: tuple[End, End],
     pts: Points,
@@ -130,6 +164,15 @@ def find_ends(
             near_a &= s < s_known[1] - cut
         return s[near_a]
 
+    def profile_a(pts: Points) -> tuple[FloatArray, FloatArray]:
+        """Parameters along the line and offsets from face A of the points of A's flat and of the corner radius
+        it ends into (down to a third of the radius below the plane) among ``pts``."""
+        r_a = pts.along(face_a.n) - face_a.d
+        r_b = pts.along(face_b.n) - face_b.d
+        s = pts.along(t) - float(p0 @ t)
+        on = (r_a < 3.0 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
+        return s[on], r_a[on]
+
     s_a = along_a(pts)
     extent = cdf_extent(s_a) if len(s_a) >= pts.least(o.min_face_points) else None
     for k, end in enumerate(ends):
@@ -139,6 +182,14 @@ def find_ends(
             placed[k] = end.at(s_map[k], o.map_tolerance_m, "map")
         elif dense is None:
             placed[k] = end.at(extent[k], extent[2], "extent")
+        elif end.inset:
+            # A flat that ends into a corner radius has no edge: its points bend away from the plane past the tangent
+            # line, and the extent of those near the plane runs on into the radius. Fit the radius's profile.
+            sign = 1.0 if k == 1 else -1.0
+            d = dense(p0 + (extent[k] - TANGENT_WINDOW_M) * t, p0 + (extent[k] + TANGENT_WINDOW_M) * t)
+            s_d, r_d = profile_a(d)
+            s0, se = tangent_end(sign * s_d, r_d, sign * extent[k], end.inset, face_a.scale)
+            placed[k] = end.at(sign * s0, se, "tangent") if np.isfinite(se) else end.at(extent[k], extent[2], "extent")
         else:
             # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
             # point of the dense cloud within the likelihood's window about it.

@@ -2,7 +2,8 @@
 (fitted with the weld faces), the table, or the extent of face A's points along it (an empirical CDF extrapolated,
 refined as a blurred edge, :mod:`cell.seams._extent`). On a rounded tube the end lies short of the side face (or
 the table) by the map's inset, the corner radius; an end whose side is not seen lies the drawn width from the
-other (docs/bodies.md section 8)."""
+other, or, with no side seen, at the tangent line where face A's points bend away round the radius (docs/bodies.md
+section 8)."""
 
 from __future__ import annotations
 
@@ -120,7 +121,9 @@ def find_ends(
     """Both ends placed on the fitted line p0 + s t: the table where A rests on it, A's side face where it was
     fitted (``sides_se``: the standard error of each fitted side face's offset, by end index), else the extent of
     face A's support along the seam: the quantiles of its points in ``pts`` extrapolated, then refined as an edge
-    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last).
+    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last). An end
+    short of its plane by an inset (a rounded tube) and not seen lies the drawn width from an end on A's side face,
+    else at the tangent line fitted in the ``dense`` points (:func:`tangent_end`).
     ``face_a_height``: face A's extent away from B [m] (a thin plate's side keeps a window above the corner band)."""
     placed = list(ends)
     known = [False, False]

@@ -22,6 +22,7 @@ from cell.types import Part, Polyhedron
 BoolArray = npt.NDArray[np.bool_]
 SIDE_MAX_ANGLE_DEG = 60.0  # a face of A ends the seam when its normal is this close to the seam's direction
 _SIDE_COS = math.cos(math.radians(SIDE_MAX_ANGLE_DEG))
+_ACROSS_TIE = 1e-3  # faces whose normals' components along the line differ by less are as much across it
 
 
 def side_planes(
@@ -31,9 +32,12 @@ def side_planes(
     end), outward unit normals; None unless both ends have one.
 
     A face ends the line at the start when its outward normal points back along t (n . t <= -cos 60 deg), at the
-    end when it points along t; of those, the one whose plane meets the line nearest the map's end ``s_map``, if
-    within ``reach_m``. ``skip``: A's faces that hold the seam (the weld face and the end face)."""
-    best: list[tuple[float, FloatArray, float] | None] = [None, None]
+    end when it points along t; of those whose plane meets the line within ``reach_m`` of the map's end ``s_map``,
+    the one most across the line (a tube's side flat, not the facets of the corner radius before it: the seam
+    ends short of that flat, :meth:`~cell.seams.ours._geometry.JointGeometry.end_planes`), the nearest of those as
+    much across it (within :data:`_ACROSS_TIE`). ``skip``: A's faces that hold the seam (the weld face and the end
+    face)."""
+    best: list[tuple[float, float, FloatArray, float] | None] = [None, None]
     for name in part_a.face_names():
         if name in skip:
             continue
@@ -45,12 +49,18 @@ def side_planes(
         s = (d - float(n @ p0)) / c
         off = abs(s - s_map[end])
         current = best[end]
-        if off <= reach_m and (current is None or off < current[0]):
-            best[end] = (off, n, d)
+        if off > reach_m:
+            continue
+        if (
+            current is None
+            or abs(c) > current[0] + _ACROSS_TIE
+            or (abs(c) > current[0] - _ACROSS_TIE and off < current[1])
+        ):
+            best[end] = (abs(c), off, n, d)
     start, stop = best
     if start is None or stop is None:
         return None
-    return (start[1], start[2]), (stop[1], stop[2])
+    return (start[2], start[3]), (stop[2], stop[3])
 
 
 def coplanar_boundary(part: Part, face: str, tol_m: float = 1e-6) -> FloatArray:

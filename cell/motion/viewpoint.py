@@ -28,6 +28,7 @@ each was rejected) when none does.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import replace
 from enum import StrEnum
 from itertools import chain
 
@@ -51,6 +52,10 @@ from cell.motion.view_candidates import (
 )
 from cell.types import CameraIntrinsics, Part
 from cell.types.rescan import Viewpoint
+
+# The tilts tried when the grid's (``ViewOptions.tilts_deg``) give no geometric candidate at all: a seam between
+# tall parts is seen only from a narrow cone, which 15 deg steps can step over.
+FINE_TILTS_DEG = (-22.5, 22.5, -7.5, 7.5, -37.5, 37.5, -30.0, 30.0)
 
 _segments_hit_box = segments_hit_box  # the old private name (tests/test_rescan.py imports it from here)
 
@@ -104,6 +109,10 @@ def plan_view(
     torch_C = torch_axis_in_camera(model, o)
     ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)  # lazily: the first that works ends it
     best = next(ranked, None)
+    if best is None:  # between tall parts (a lap plate's side 67 mm from an upright) only a narrow cone sees it
+        o = replace(o, tilts_deg=FINE_TILTS_DEG, max_incidence_deg=80.0, face_strip_m=0.015)
+        ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)
+        best = next(ranked, None)
     if best is None:
         raise NoViewError(
             f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "

@@ -15,7 +15,9 @@ and checked in that order, cheapest first:
 
 1. geometry, without IK: the seam and a strip of each weld face (``face_strip_m``) inside the image with a
    margin, clear of the torch's image (the torch axis from the flange to the TCP, grown by ``torch_radius_m``),
-   seen at an incidence below ``max_incidence_deg``, with no part of the map on the line of sight;
+   seen at an incidence below ``max_incidence_deg``, with no part of the map on the line of sight (a face strip's
+   samples that another part covers need not be seen); when no grid pose passes, once more on the
+   ``fallback_*`` grid (finer tilts, a grazing incidence limit, a narrower strip);
 2. IK of the camera's optical frame on the full pose (warm-started from the current configuration, random
    restarts from the given generator);
 3. no collision at the view, and none along a jerk-limited point-to-point move from the current
@@ -52,10 +54,6 @@ from cell.motion.view_candidates import (
 )
 from cell.types import CameraIntrinsics, Part
 from cell.types.rescan import Viewpoint
-
-# The tilts tried when the grid's (``ViewOptions.tilts_deg``) give no geometric candidate at all: a seam between
-# tall parts is seen only from a narrow cone, which 15 deg steps can step over.
-FINE_TILTS_DEG = (-22.5, 22.5, -7.5, 7.5, -37.5, 37.5, -30.0, 30.0)
 
 _segments_hit_box = segments_hit_box  # the old private name (tests/test_rescan.py imports it from here)
 
@@ -109,14 +107,21 @@ def plan_view(
     torch_C = torch_axis_in_camera(model, o)
     ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)  # lazily: the first that works ends it
     best = next(ranked, None)
-    if best is None:  # between tall parts (a lap plate's side 67 mm from an upright) only a narrow cone sees it
-        o = replace(o, tilts_deg=FINE_TILTS_DEG, max_incidence_deg=80.0, face_strip_m=0.015)
+    grid = o
+    if best is None:  # between tall parts only a narrow, grazing cone sees it: the fallback grid (ViewOptions)
+        o = replace(
+            grid,
+            tilts_deg=o.fallback_tilts_deg,
+            max_incidence_deg=o.fallback_max_incidence_deg,
+            face_strip_m=o.fallback_face_strip_m,
+        )
         ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)
         best = next(ranked, None)
     if best is None:
         raise NoViewError(
             f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "
-            f"torch, incidence <= {o.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m",
+            f"torch, incidence <= {grid.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m, nor"
+            f" a grazing one (<= {o.max_incidence_deg:g} deg, {o.face_strip_m * 1000:g} mm strips)",
             seam_id=target.id,
         )
     why: dict[ViewRejection, int] = {}

@@ -31,14 +31,16 @@ def room_on_b(
         return reach
     e /= norm
     steps = np.arange(0.0, reach + _STEP_M, _STEP_M)
+    mids = np.asarray(mids, dtype=float).reshape(-1, 3)
+    probe = (mids + _OFF_M * n_b)[:, None, :] + steps[None, :, None] * e  # (k, steps, 3): one probe per point
+    flat = probe.reshape(-1, 3)
+    lo, hi = flat.min(axis=0), flat.max(axis=0)
     room = reach
-    for mid in np.asarray(mids, dtype=float).reshape(-1, 3):
-        probe = mid + _OFF_M * n_b + np.outer(steps, e)
-        lo, hi = probe.min(axis=0), probe.max(axis=0)
-        for part in others:
-            if np.any(part.center + part.radius + margin < lo) or np.any(part.center - part.radius - margin > hi):
-                continue  # its sphere cannot meet the probe
-            inside = np.flatnonzero(part.contains(probe, margin=margin))
-            if len(inside):
-                room = min(room, float(steps[inside[0]]))
+    for part in others:
+        if np.any(part.center + part.radius + margin < lo) or np.any(part.center - part.radius - margin > hi):
+            continue  # its sphere cannot meet the probes
+        inside = part.contains(flat, margin=margin).reshape(probe.shape[:2])
+        hit = inside.any(axis=1)
+        if np.any(hit):
+            room = min(room, float(steps[np.argmax(inside[hit], axis=1)].min()))
     return room

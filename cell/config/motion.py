@@ -109,7 +109,8 @@ class ViewOptions:
     max_incidence_deg: float = 72.0  # largest angle between a line of sight and a weld face's normal
     face_strip_m: float = 0.03  # width of each weld face next to the seam that must be in view
     # A seam no grid pose sees (a lap plate's side in a 67 mm channel beside a 168 mm upright) is tried once more
-    # on these tilts, with this incidence limit and this strip: a grazing close-up is better than none.
+    # on these tilts, with this incidence limit and this strip: a grazing close-up is better than none (the
+    # re-scan asks it only for a seam the fixed cameras did not find; empty: never).
     fallback_tilts_deg: tuple[float, ...] = (-22.5, 22.5, -7.5, 7.5, -37.5, 37.5, -30.0, 30.0)
     fallback_max_incidence_deg: float = 80.0  # the fallback grid's incidence limit
     fallback_face_strip_m: float = 0.015  # the fallback grid's face strip

@@ -107,8 +107,8 @@ def plan_view(
     torch_C = torch_axis_in_camera(model, o)
     ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)  # lazily: the first that works ends it
     best = next(ranked, None)
-    grid = o
-    if best is None:  # between tall parts only a narrow, grazing cone sees it: the fallback grid (ViewOptions)
+    grid, tried_fallback = o, best is None and bool(o.fallback_tilts_deg)
+    if tried_fallback:  # between tall parts only a narrow, grazing cone sees it: the fallback grid (ViewOptions)
         o = replace(
             grid,
             tilts_deg=o.fallback_tilts_deg,
@@ -118,10 +118,11 @@ def plan_view(
         ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)
         best = next(ranked, None)
     if best is None:
+        grazing = f", nor a grazing one (<= {o.max_incidence_deg:g} deg, {o.face_strip_m * 1000:g} mm strips)"
         raise NoViewError(
             f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "
-            f"torch, incidence <= {grid.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m, nor"
-            f" a grazing one (<= {o.max_incidence_deg:g} deg, {o.face_strip_m * 1000:g} mm strips)",
+            f"torch, incidence <= {grid.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m"
+            f"{grazing if tried_fallback else ''}",
             seam_id=target.id,
         )
     why: dict[ViewRejection, int] = {}

@@ -3,7 +3,7 @@ triangular gusset, an 8 mm lap plate): ``pipeline.detect`` once for the module, 
 truth (realistic noise). Measured (2026-12, scenarios/bracket.yaml): 6 of the 9 visible seams found, mean lateral
 0.15 mm, mean endpoint 0.68 mm (the gusset's ends at the upright: it stands 0.4 mm off it as built); the lap plate's
 +x, -x and +y sides are not (too few points on an 8 mm side face seen from 1.5 m, or no base plate beside it), each
-with its reason."""
+with its reason; a close-up finds the -x side (the last test, on the module's running station)."""
 
 from __future__ import annotations
 

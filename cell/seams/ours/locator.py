@@ -16,7 +16,6 @@ from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outsid
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
-from cell.seams.ours._room import room_on_b
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
 from cell.seams.sigma import ours_sigma
@@ -123,15 +122,6 @@ class OursLocator:
         face_b = Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
         others = tuple(p for p in scene.weldmap.parts if p.name != part_a.name)
         ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m, others, p0)
-        # Face B's strip beside A, where a third part covers B near the seam (a brace's end below a rail): when the
-        # first pass's band about A would leave it less than two corner bands, the band is no wider than a share
-        # of it, as a thin plate's (a strip under two corner bands keeps the band: no window there; the ladder's
-        # 30 mm slots keep theirs). Probed inside the seam, not at its ends.
-        inner = seam.p_start + np.outer((0.25, 0.5, 0.75), seam.p_end - seam.p_start)
-        third = tuple(p for p in others if p.name != part_b.name)
-        room_b = room_on_b(n_a, n_b, inner, third, o.tube_radius_m, o.map_tolerance_m)
-        band_first = max(o.corner_band_m, 3.0 * o.sensor_sigma_m) + o.map_tolerance_m
-        narrow_b = 2.0 * o.corner_band_m <= room_b < band_first + 2.0 * o.corner_band_m
 
         for it in range(o.passes):
             first, last = it == 0, it == o.passes - 1
@@ -152,8 +142,7 @@ class OursLocator:
                 in_a &= geo.in_face_a(pts, joint.face_abutting, within(eb, geo.length_a))
             # The widest gate B's points pass below (the region test on a polyhedron is costly: only on those).
             gate_b = max(o.map_tolerance_m + 3.0 * o.sensor_sigma_m, o.gate_sigmas * face_b.scale)
-            band_ab = within(band_a, room_b) if narrow_b else band_a
-            beside_a = ~((r_a < band_ab) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
+            beside_a = ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
             in_b = geo.in_face_b(pts, slack, pts.ok & beside_a & (np.abs(r_b) < gate_b)) & beside_a & pts.ok
             planes: list[Selection] = []
             for key, face, r, region, part, face_name, skip in (

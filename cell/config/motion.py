@@ -108,6 +108,12 @@ class ViewOptions:
     image_offset_deg: float = 11.0  # the seam's midpoint this far above the image centre (torch below)
     max_incidence_deg: float = 72.0  # largest angle between a line of sight and a weld face's normal
     face_strip_m: float = 0.03  # width of each weld face next to the seam that must be in view
+    # A seam no grid pose sees (a lap plate's side in a 67 mm channel beside a 168 mm upright) is tried once more
+    # on these tilts, with this incidence limit and this strip: a grazing close-up is better than none (the
+    # re-scan asks it only for a seam the fixed cameras did not find; empty: never).
+    fallback_tilts_deg: tuple[float, ...] = (-22.5, 22.5, -7.5, 7.5, -37.5, 37.5, -30.0, 30.0)
+    fallback_max_incidence_deg: float = 80.0  # the fallback grid's incidence limit
+    fallback_face_strip_m: float = 0.015  # the fallback grid's face strip
     end_margin_m: float = 0.01  # the seam's line beyond its ends that must be in view
     image_margin_px: float = 24.0  # kept free along the image border
     torch_radius_m: float = 0.03  # the torch's radius about its axis, with margin (URDF body: 22 mm)
@@ -125,3 +131,5 @@ class ViewOptions:
             raise ValueError(f"view distances_m must be positive, got {self.distances_m}")
         if not 0.0 < self.max_incidence_deg < 90.0:
             raise ValueError(f"max_incidence_deg must be in (0, 90), got {self.max_incidence_deg}")
+        if not 0.0 < self.fallback_max_incidence_deg < 90.0:
+            raise ValueError(f"fallback_max_incidence_deg must be in (0, 90), got {self.fallback_max_incidence_deg}")

@@ -214,7 +214,7 @@ def ranked_views(
     b, t = target.bisector, target.direction
     w = np.cross(t, b)
     w /= np.linalg.norm(w)
-    pts, normals, face = _samples(target, table_z, o)
+    pts, normals, face = _samples(target, table_z, o, parts)
     offset = np.radians(o.image_offset_deg)
     seen: list[ViewCandidate] = []
     for distance in o.distances_m:
@@ -236,12 +236,25 @@ def ranked_views(
             yield c
 
 
-def _samples(target: ViewTarget, table_z: float, o: ViewOptions) -> tuple[FloatArray, FloatArray, npt.NDArray[np.int_]]:
+_COVERED_M = 0.005  # a sample this near another part lies on a face that part covers or shades [m]
+
+
+def _samples(
+    target: ViewTarget, table_z: float, o: ViewOptions, parts: Sequence[Part] = ()
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.int_]]:
     """The target's sample points (m, 3), their normals (m, 3) and surfaces (m,) (:meth:`ViewTarget.samples`),
-    those below the table top ``table_z`` [m] dropped."""
+    those below the table top ``table_z`` [m] dropped, and the face strips' samples within :data:`_COVERED_M` of
+    one of ``parts``: a face strip that another part covers (a brace's end 21 mm below a rail leaves the post's
+    face a 21 mm strip) is seen where it is free, or no view could ever pass the line-of-sight test. The seam
+    line's samples are all kept (a seam running into another part still has no view)."""
     pts, normals = target.samples(o.face_strip_m, o.end_margin_m)
-    above = pts[:, 2] >= table_z + 0.001
-    return pts[above], normals[above], _face_labels(len(above))[above]
+    face = _face_labels(len(pts))
+    keep = pts[:, 2] >= table_z + 0.001
+    for part in parts:
+        near = (face > 0) & (np.linalg.norm(pts - part.center, axis=1) <= part.radius + _COVERED_M)
+        if np.any(near & keep):
+            keep[near] &= ~part.contains(pts[near], margin=_COVERED_M)
+    return pts[keep], normals[keep], face[keep]
 
 
 def sees(
@@ -258,7 +271,7 @@ def sees(
     of the torch, incidence, line of sight past ``parts``), else None. A close-up taken for one seam serves
     every other seam it sees this way."""
     o = options or ViewOptions()
-    pts, normals, face = _samples(target, table_z, o)
+    pts, normals, face = _samples(target, table_z, o, parts)
     ok, inc = _seen(X_RC, pts, normals, face, intrinsics, torch_C, o)
     if not ok or _occluded(X_RC[:3, 3], pts, normals, parts, o.occlusion_margin_m):
         return None

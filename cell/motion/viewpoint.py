@@ -15,7 +15,9 @@ and checked in that order, cheapest first:
 
 1. geometry, without IK: the seam and a strip of each weld face (``face_strip_m``) inside the image with a
    margin, clear of the torch's image (the torch axis from the flange to the TCP, grown by ``torch_radius_m``),
-   seen at an incidence below ``max_incidence_deg``, with no part of the map on the line of sight;
+   seen at an incidence below ``max_incidence_deg``, with no part of the map on the line of sight (a face strip's
+   samples that another part covers need not be seen); when no grid pose passes, once more on the
+   ``fallback_*`` grid (finer tilts, a grazing incidence limit, a narrower strip);
 2. IK of the camera's optical frame on the full pose (warm-started from the current configuration, random
    restarts from the given generator);
 3. no collision at the view, and none along a jerk-limited point-to-point move from the current
@@ -28,6 +30,7 @@ each was rejected) when none does.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import replace
 from enum import StrEnum
 from itertools import chain
 
@@ -104,10 +107,22 @@ def plan_view(
     torch_C = torch_axis_in_camera(model, o)
     ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)  # lazily: the first that works ends it
     best = next(ranked, None)
+    grid, tried_fallback = o, best is None and bool(o.fallback_tilts_deg)
+    if tried_fallback:  # between tall parts only a narrow, grazing cone sees it: the fallback grid (ViewOptions)
+        o = replace(
+            grid,
+            tilts_deg=o.fallback_tilts_deg,
+            max_incidence_deg=o.fallback_max_incidence_deg,
+            face_strip_m=o.fallback_face_strip_m,
+        )
+        ranked = ranked_views(target, intrinsics, torch_C, parts, table_z, o)
+        best = next(ranked, None)
     if best is None:
+        grazing = f", nor a grazing one (<= {o.max_incidence_deg:g} deg, {o.face_strip_m * 1000:g} mm strips)"
         raise NoViewError(
             f"seam {target.id}: no close-up view sees the seam and both faces (in the image, clear of the "
-            f"torch, incidence <= {o.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m",
+            f"torch, incidence <= {grid.max_incidence_deg:g} deg, unoccluded) at {list(o.distances_m)} m"
+            f"{grazing if tried_fallback else ''}",
             seam_id=target.id,
         )
     why: dict[ViewRejection, int] = {}

@@ -83,6 +83,8 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
     base = _scene_of(det).seam_scene
     first = next(e for e in det.estimates if e.id == seam_id)
     seam = base.weldmap.seam(seam_id)
+    # The grazing fallback grid only for a seam the fixed cameras did not find: a close-up is its only chance.
+    view = o.view if first.status is not SeamStatus.FOUND else replace(o.view, fallback_tilts_deg=())
     try:
         vp = plan_view(
             run.arm.model,
@@ -94,7 +96,7 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
             base.table_z,
             rng=rng,
             q_via=run.arm.q_scan,
-            options=o.view,
+            options=view,
         )
     except CellError as exc:
         reason = f"unreachable view: {exc.message}"

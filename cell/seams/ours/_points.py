@@ -88,7 +88,7 @@ def gather(
             # (costly) test on those alone.
             N, D = _support_planes(scene, int(k))
             m = o.map_tolerance_m
-            cand = np.flatnonzero(np.all(N @ xyz <= (D + m)[:, None], axis=0))
+            cand = np.flatnonzero(ok & np.all(N @ xyz <= (D + m)[:, None], axis=0))  # points still usable only
             if len(cand):
                 ok[cand] &= ~part.contains(xyz[:, cand].T, margin=m)
             continue

@@ -20,6 +20,7 @@ from cell.geometry import FloatArray
 from cell.types import Part, Polyhedron
 
 BoolArray = npt.NDArray[np.bool_]
+_PAIRS = 1_000_000  # point-edge pairs tested at once in over_region() (bounds the memory)
 SIDE_MAX_ANGLE_DEG = 60.0  # a face of A ends the seam when its normal is this close to the seam's direction
 _SIDE_COS = math.cos(math.radians(SIDE_MAX_ANGLE_DEG))
 
@@ -33,24 +34,38 @@ def side_planes(
     A face ends the line at the start when its outward normal points back along t (n . t <= -cos 60 deg), at the
     end when it points along t; of those, the one whose plane meets the line nearest the map's end ``s_map``, if
     within ``reach_m``. ``skip``: A's faces that hold the seam (the weld face and the end face)."""
-    best: list[tuple[float, FloatArray, float] | None] = [None, None]
-    for name in part_a.face_names():
-        if name in skip:
-            continue
-        n, d = part_a.face_plane(name)
-        c = float(n @ t)
-        if abs(c) < _SIDE_COS:
-            continue
-        end = 1 if c > 0.0 else 0
-        s = (d - float(n @ p0)) / c
-        off = abs(s - s_map[end])
-        current = best[end]
-        if off <= reach_m and (current is None or off < current[0]):
-            best[end] = (off, n, d)
-    start, stop = best
-    if start is None or stop is None:
-        return None
-    return (start[1], start[2]), (stop[1], stop[2])
+    N, D = face_planes(part_a)
+    c = N @ t
+    crossing = np.array([name not in skip for name in part_a.face_names()]) & (np.abs(c) >= _SIDE_COS)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (D - N @ p0) / c
+    out = []
+    for end, side in ((0, crossing & (c <= 0.0)), (1, crossing & (c > 0.0))):
+        off = np.abs(s - s_map[end])
+        idx = np.flatnonzero(side & (off <= reach_m))
+        if not len(idx):
+            return None
+        k = int(idx[np.argmin(off[idx])])  # the first of the nearest, in the faces' order
+        out.append((np.array(N[k]), float(D[k])))
+    return out[0], out[1]
+
+
+def face_planes(part: Part) -> tuple[FloatArray, FloatArray]:
+    """Outward unit normals (f, 3) and offsets (f,) [m] of every face of ``part``, in :meth:`Part.face_names`
+    order: a polyhedron's at once (no lookup by name per face), a box's six from its axes."""
+    body = part.body
+    if isinstance(body, Polyhedron):
+        planes = body.face_planes()
+        return planes[:, :3], planes[:, 3]
+    rows = [part.face_plane(name) for name in part.face_names()]
+    return np.array([n for n, _ in rows]).reshape(-1, 3), np.array([d for _, d in rows])
+
+
+def _coplanar(part: Part, face: str, tol_m: float) -> list[int]:
+    """Indices of ``part``'s faces in the plane of ``face`` (same outward normal, offsets within ``tol_m``)."""
+    N, D = face_planes(part)
+    n, d = part.face_plane(face)
+    return [int(i) for i in np.flatnonzero((N @ n >= 1.0 - 1e-9) & (np.abs(D - d) <= tol_m))]
 
 
 def coplanar_boundary(part: Part, face: str, tol_m: float = 1e-6) -> FloatArray:
@@ -59,12 +74,8 @@ def coplanar_boundary(part: Part, face: str, tol_m: float = 1e-6) -> FloatArray:
     those faces share lie inside the region and are left out; a hole's edges stay (its own loop)."""
     body = part.body
     assert isinstance(body, Polyhedron)
-    n, d = part.face_plane(face)
     count: dict[tuple[int, int], int] = {}
-    for name, loop in zip(body.names, body.faces, strict=True):
-        n_f, d_f = body.face_plane(name)
-        if float(n_f @ n) < 1.0 - 1e-9 or abs(d_f - d) > tol_m:
-            continue
+    for loop in (body.faces[i] for i in _coplanar(part, face, tol_m)):
         for a, b in zip(loop, loop[1:] + loop[:1], strict=True):
             key = (min(a, b), max(a, b))
             count[key] = count.get(key, 0) + 1
@@ -84,11 +95,13 @@ def over_region(P: FloatArray, edges: FloatArray, n: FloatArray, inset_m: float)
     a = np.stack([edges[:, 0] @ u, edges[:, 0] @ v], axis=1)
     b = np.stack([edges[:, 1] @ u, edges[:, 1] @ v], axis=1)
     inside = np.zeros(len(q), dtype=bool)
-    for (ax, ay), (bx, by) in zip(a, b, strict=True):  # even-odd crossings of a ray along +u
-        crosses = (ay > q[:, 1]) != (by > q[:, 1])
+    step = max(1, _PAIRS // max(1, len(a)))
+    for i in range(0, len(q), step):  # even-odd crossings of a ray along +u, every edge at once
+        qx, qy = q[i : i + step, 0, None], q[i : i + step, 1, None]
+        crosses = (a[None, :, 1] > qy) != (b[None, :, 1] > qy)
         with np.errstate(divide="ignore", invalid="ignore"):
-            x = ax + (q[:, 1] - ay) * (bx - ax) / (by - ay)
-        inside ^= crosses & (q[:, 0] < x)
+            x = a[None, :, 0] + (qy - a[None, :, 1]) * (b[:, 0] - a[:, 0])[None] / (b[:, 1] - a[:, 1])[None]
+        inside[i : i + step] = np.logical_xor.reduce(crosses & (qx < x), axis=1)
     if inset_m <= 0.0:
         return inside
     idx = np.flatnonzero(inside)  # the distance to the edges only where it can matter
@@ -116,14 +129,11 @@ def touch_gap(part: Part, n: FloatArray, d: float, at: FloatArray) -> float | No
     normal is -n), when one does within :data:`TOUCH_M` and the point ``at`` (3,) lies on the part (within
     :data:`TOUCH_M`): the other body's face lies on this part there, with this drawn gap (a brace drawn 1 mm over
     a rail). None when no face of ``part`` touches the plane there (a rail's end on a post's face far from ``at``)."""
-    gaps = []
-    for name in part.face_names():
-        n_f, d_f = part.face_plane(name)
-        if float(n_f @ n) < -0.999 and abs(d_f + d) <= TOUCH_M:
-            gaps.append(-(d_f + d))
-    if not gaps or not bool(part.contains(at[None, :], margin=TOUCH_M)[0]):
+    N, D = face_planes(part)
+    gaps = -(D[(N @ n < -0.999) & (np.abs(D + d) <= TOUCH_M)] + d)
+    if not len(gaps) or not bool(part.contains(at[None, :], margin=TOUCH_M)[0]):
         return None
-    return min(gaps, key=abs)
+    return float(gaps[np.argmin(np.abs(gaps))])  # the first of the nearest, in the faces' order
 
 
 def fills_rectangle(part: Part, face: str, t: FloatArray, tol: float = 1e-3) -> bool:
@@ -132,16 +142,13 @@ def fills_rectangle(part: Part, face: str, t: FloatArray, tol: float = 1e-3) -> 
     a box's do (a gusset's triangle, a plate's top around its hole do not fill theirs)."""
     body = part.body
     assert isinstance(body, Polyhedron)
-    n, d = part.face_plane(face)
+    n, _ = part.face_plane(face)
     u = t - (t @ n) * n
     u /= max(float(np.linalg.norm(u)), 1e-300)
     v = np.cross(n, u)
     area, pts = 0.0, []
-    for name in body.names:
-        n_f, d_f = body.face_plane(name)
-        if float(n_f @ n) < 1.0 - 1e-9 or abs(d_f - d) > 1e-6:
-            continue
-        poly = body.face_polygon(name)
+    for i in _coplanar(part, face, 1e-6):
+        poly = body.vertices[list(body.faces[i])]
         q = np.stack([poly @ u, poly @ v], axis=1)
         area += 0.5 * abs(float(np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1])))
         pts.append(q)

@@ -45,6 +45,7 @@ class JointGeometry:
     face_b: str  # B's receiving face
     edge_band: float
     region_a: FloatArray | None = None  # A's weld face's boundary edges (k, 2, 3) when its extents do not bound it
+    region_b: FloatArray | None = None  # a polyhedron B's receiving face's boundary edges (k, 2, 3) (coplanar too)
 
     @staticmethod
     def of(
@@ -60,6 +61,8 @@ class JointGeometry:
         ``s_map`` along it; ``o_band`` the edge band [m]."""
         n_a, d_a = part_a.face_plane(joint.face_abutting)
         n_e, d_e = part_a.face_plane(joint.end_face)
+        # Built once per seam, not in every pass's region test.
+        region_b = None if part_b.is_box else coplanar_boundary(part_b, joint.face_receiving)
         if not part_a.is_box:
             sides = side_planes(part_a, (joint.face_abutting, joint.end_face), p0, t, s_map, _SIDE_REACH_M)
             across = ((-t, float(-t @ p0) - s_map[0]), (t, float(t @ p0) + s_map[1]))  # never fitted
@@ -76,6 +79,7 @@ class JointGeometry:
                 None
                 if fills_rectangle(part_a, joint.face_abutting, t)
                 else coplanar_boundary(part_a, joint.face_abutting),
+                region_b,
             )
         box_a = part_a.box
         k_a = "xyz".index(joint.face_abutting[1])
@@ -99,6 +103,7 @@ class JointGeometry:
             has_sides,
             joint.face_receiving,
             o_band,
+            region_b=region_b,
         )
 
     def end_planes(
@@ -146,7 +151,7 @@ class JointGeometry:
         polyhedron's region is tested only on the points ``where`` says (the others: False), a box's on all."""
         if not self.part_b.is_box:
             n_b, _ = self.part_b.face_plane(self.face_b)
-            edges = coplanar_boundary(self.part_b, self.face_b)
+            edges = self.region_b if self.region_b is not None else coplanar_boundary(self.part_b, self.face_b)
             if where is None:
                 return over_region(pts.P, edges, n_b, self.edge_band + slack)
             out = np.zeros(len(pts.cam), bool)

@@ -87,6 +87,41 @@ def over_region(P: FloatArray, edges: FloatArray, n: FloatArray, inset_m: float)
     """(k,) which points P (k, 3) project inside the planar region bounded by ``edges`` (m, 2, 3) (closed loops;
     holes are loops too), of normal n, shrunk by ``inset_m`` [m] (every point at least that far from each edge).
     Convex or not, with holes or not (even-odd rule)."""
+    q, a, b = _projected(P, edges, n)
+    inside = _parity(q, a, b)
+    if inset_m <= 0.0:
+        return inside
+    idx = np.flatnonzero(inside)  # the distance to the edges only where it can matter
+    inside[idx] = _nearest2(q[idx], a, b) >= inset_m * inset_m
+    return inside
+
+
+class Region:
+    """:func:`over_region` of one set of points P (k, 3) and one region (``edges`` (m, 2, 3), normal n), asked
+    again and again (each pass of a seam, with another inset and other points): each point's side of the region
+    and its distance to the nearest edge are computed once, on first demand; an inset is then one comparison."""
+
+    def __init__(self, P: FloatArray, edges: FloatArray, n: FloatArray) -> None:
+        self._q, self._a, self._b = _projected(P, edges, n)
+        self._done = np.zeros(len(P), dtype=bool)
+        self._inside = np.zeros(len(P), dtype=bool)
+        self._near2 = np.full(len(P), np.inf)  # squared distance to the nearest edge [m^2] (of the points inside)
+
+    def over(self, inset_m: float, where: BoolArray | None = None) -> BoolArray:
+        """(k,) :func:`over_region` ``(P, edges, n, inset_m)``, on the points ``where`` says (the others: False)."""
+        todo = np.flatnonzero(~self._done if where is None else where & ~self._done)
+        if len(todo):
+            self._done[todo] = True
+            inside = _parity(self._q[todo], self._a, self._b)
+            self._inside[todo] = inside
+            mine = todo[inside]
+            self._near2[mine] = _nearest2(self._q[mine], self._a, self._b)
+        out = self._inside & (self._near2 >= inset_m * inset_m) if inset_m > 0.0 else self._inside.copy()
+        return out if where is None else out & where
+
+
+def _projected(P: FloatArray, edges: FloatArray, n: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Points P (k, 3) and the edges' ends (m, 2, 3) in the region's plane: q (k, 2), a (m, 2), b (m, 2) [m]."""
     u = edges[0, 1] - edges[0, 0]
     u = u - (u @ n) * n
     u /= max(float(np.linalg.norm(u)), 1e-300)
@@ -94,25 +129,34 @@ def over_region(P: FloatArray, edges: FloatArray, n: FloatArray, inset_m: float)
     q = np.stack([P @ u, P @ v], axis=1)
     a = np.stack([edges[:, 0] @ u, edges[:, 0] @ v], axis=1)
     b = np.stack([edges[:, 1] @ u, edges[:, 1] @ v], axis=1)
+    return q, a, b
+
+
+def _parity(q: FloatArray, a: FloatArray, b: FloatArray) -> BoolArray:
+    """(k,) whether a ray along +u from each point q (k, 2) crosses the edges a-b (m, 2) an odd number of times."""
     inside = np.zeros(len(q), dtype=bool)
     step = max(1, _PAIRS // max(1, len(a)))
-    for i in range(0, len(q), step):  # even-odd crossings of a ray along +u, every edge at once
+    for i in range(0, len(q), step):  # every edge at once, for a chunk of the points
         qx, qy = q[i : i + step, 0, None], q[i : i + step, 1, None]
         crosses = (a[None, :, 1] > qy) != (b[None, :, 1] > qy)
         with np.errstate(divide="ignore", invalid="ignore"):
             x = a[None, :, 0] + (qy - a[None, :, 1]) * (b[:, 0] - a[:, 0])[None] / (b[:, 1] - a[:, 1])[None]
         inside[i : i + step] = np.logical_xor.reduce(crosses & (qx < x), axis=1)
-    if inset_m <= 0.0:
-        return inside
-    idx = np.flatnonzero(inside)  # the distance to the edges only where it can matter
+    return inside
+
+
+def _nearest2(q: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """(k,) the squared distance [m^2] from each point q (k, 2) to the nearest of the segments a-b (m, 2)."""
     e = b - a
     ll = np.maximum(np.einsum("ij,ij->i", e, e), 1e-300)
-    w = q[idx, None, :] - a[None]
-    s = np.clip(np.einsum("nmk,mk->nm", w, e) / ll, 0.0, 1.0)
-    gap = w - s[..., None] * e[None]
-    nearest = np.einsum("nmk,nmk->nm", gap, gap).min(axis=1)
-    inside[idx] = nearest >= inset_m * inset_m
-    return inside
+    out = np.empty(len(q))
+    step = max(1, _PAIRS // max(1, len(a)))
+    for i in range(0, len(q), step):
+        w = q[i : i + step, None, :] - a[None]
+        s = np.clip(np.einsum("nmk,mk->nm", w, e) / ll, 0.0, 1.0)
+        gap = w - s[..., None] * e[None]
+        out[i : i + step] = np.einsum("nmk,nmk->nm", gap, gap).min(axis=1, initial=np.inf)
+    return out
 
 
 def over_polygon(P: FloatArray, polygon: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:

@@ -79,8 +79,8 @@ def coplanar_boundary(part: Part, face: str, tol_m: float = 1e-6) -> FloatArray:
         for a, b in zip(loop, loop[1:] + loop[:1], strict=True):
             key = (min(a, b), max(a, b))
             count[key] = count.get(key, 0) + 1
-    V = body.vertices
-    return np.array([[V[a], V[b]] for (a, b), k in count.items() if k == 1], dtype=float).reshape(-1, 2, 3)
+    ends = np.array([key for key, k in count.items() if k == 1], dtype=np.intp).reshape(-1, 2)
+    return np.array(body.vertices[ends], dtype=float).reshape(-1, 2, 3)
 
 
 def over_region(P: FloatArray, edges: FloatArray, n: FloatArray, inset_m: float) -> BoolArray:
@@ -146,16 +146,17 @@ def _parity(q: FloatArray, a: FloatArray, b: FloatArray) -> BoolArray:
 
 
 def _nearest2(q: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-    """(k,) the squared distance [m^2] from each point q (k, 2) to the nearest of the segments a-b (m, 2)."""
-    e = b - a
-    ll = np.maximum(np.einsum("ij,ij->i", e, e), 1e-300)
+    """(k,) the squared distance [m^2] from each point q (k, 2) to the nearest of the segments a-b (m, 2) (x and y
+    apart: several times faster than einsum over a last axis of two)."""
+    ex, ey = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    ll = np.maximum(ex * ex + ey * ey, 1e-300)
     out = np.empty(len(q))
     step = max(1, _PAIRS // max(1, len(a)))
     for i in range(0, len(q), step):
-        w = q[i : i + step, None, :] - a[None]
-        s = np.clip(np.einsum("nmk,mk->nm", w, e) / ll, 0.0, 1.0)
-        gap = w - s[..., None] * e[None]
-        out[i : i + step] = np.einsum("nmk,nmk->nm", gap, gap).min(axis=1, initial=np.inf)
+        wx, wy = q[i : i + step, 0, None] - a[None, :, 0], q[i : i + step, 1, None] - a[None, :, 1]
+        s = np.clip((wx * ex + wy * ey) / ll, 0.0, 1.0)
+        gx, gy = wx - s * ex, wy - s * ey
+        out[i : i + step] = (gx * gx + gy * gy).min(axis=1, initial=np.inf)
     return out
 
 

@@ -26,6 +26,7 @@ from cell.config.perception import CoverageOptions, SymmetryOptions
 from cell.errors import AlignmentError, AlignmentFailure
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception.align import Alignment, sample_map
+from cell.perception.sky import open_to_sky
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, WeldMap
 
@@ -159,10 +160,11 @@ def part_coverage(
 ) -> dict[str, float]:
     """Part name -> share of its upward faces' samples (top, in R) with a cloud point within ``band_m`` [m].
 
-    Upward faces are seen by every camera above the table; a part that is on the table covers most of its top.
-    Samples within :data:`_CONTACT_M` of another part are left out (covered by it: in contact, or under it). A part
-    with no upward face left to sample (a gusset's sloped top, a plate wholly under others) is not judged: it has
-    no entry.
+    Upward faces open to the sky are seen by every camera above the table; a part that is on the table covers most
+    of its top. Samples within :data:`_CONTACT_M` of another part are left out (covered by it: in contact, or under
+    it), and so are those under any part's surface (:func:`~cell.perception.sky.open_to_sky`: an open tube's inner
+    bottom wall, under its own top wall). A part with no upward face left to sample (a gusset's sloped top, a plate
+    wholly under others) is not judged: it has no entry.
     """
     spacing = max(spec.voxel_m / 2.0, 0.002)
     tree = None if not len(cloud) else cloud_tree_of(cloud) if cloud_tree is None else cloud_tree
@@ -175,6 +177,7 @@ def part_coverage(
         for other in weldmap_R.parts:
             if other is not part and len(top):
                 top = top[~other.contains(top, _CONTACT_M)]
+        top = top[open_to_sky(top, weldmap_R.parts)]
         if len(top) == 0:
             continue  # nothing of it faces up in the open: no top to judge by
         if tree is None:

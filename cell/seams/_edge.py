@@ -25,6 +25,8 @@ from cell.types import BOX_FACES, Box, Part, Polyhedron
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
 _Z = np.array([0.0, 0.0, 1.0])
+_ROUND_COS = np.cos(np.radians(30.0))  # an adjacent face this near the face's own plane is a corner radius's facet
+ROUND_BLUR_M = 1e-3  # a rounded edge seen blurred over this much is a silhouette, not the face's plane [m]
 
 # The points of the cloud within ``radius`` [m] of the segment a-b (3,): (n, 3) [m], camera (n,), and whether each
 # may support a plane (above the table, away from the map's other parts).
@@ -115,6 +117,9 @@ def place_from_edge(
         P, cam, ok = points(q0 + e_lo * e, q0 + e_hi * e, float(np.hypot(max(-lo, hi), gate)))
         u = P @ n - d  # along the face's outward normal: the adjacent face's points end at u = 0
         r_g = P @ n_g - d_g
+        # A facet of a corner radius (a tube's rounded edge): only a camera in front of the face sees the round out
+        # to the face's plane, sharply; one that sees it blurred looks from behind the face, at its silhouette.
+        rounded = abs(float(n_g @ n)) > _ROUND_COS
         region = ok & away(P) & (u > lo) & (u < hi) & along_edge(part, face_name, g, P, o.edge_band_m)
         sel = region & (np.abs(r_g) < gate)
         if np.count_nonzero(sel) < o.min_face_points:
@@ -139,6 +144,11 @@ def place_from_edge(
             edge = edge_fit(uu[mine], lo, hi, -search, search)
             b = edge.b if np.isfinite(edge.b) else 0.0
             fault = edge_fault(edge, g, search, at_cut(crop, q0 + b * n, n, edge.blur, o.edge_band_m), o)
+            if not fault and rounded and edge.blur >= ROUND_BLUR_M:
+                fault = (
+                    f"the edge of {g} turns into the face round a corner radius and is blurred over "
+                    f"{1000 * edge.blur:.1f} mm: seen from behind the face, its silhouette lies inside the round"
+                )
             if fault:
                 faults.append((int(n_c), fault))
                 continue

@@ -66,16 +66,21 @@ def test_the_kept_region_test_is_over_region_for_every_inset_and_subset() -> Non
 def test_vectorised_face_searches_are_the_loops_over_faces() -> None:
     bar = Part("BAR", _wedge(40.0))
     p0, t = np.array([0.0, 0.0, 0.04]), np.array([0.0, 1.0, 0.0])
-    # side_planes: of the faces crossing the line, the one nearest each map end.
+    # side_planes: of the faces crossing the line within reach of each map end, the one most across it, the nearest
+    # of those as much across it (the faces in order).
     best = []
     for end, s_end in enumerate((0.0, 0.2)):
-        cands = []
+        kept: tuple[float, float, str] | None = None
         for f in bar.face_names():
             nf, df = bar.face_plane(f)
             c = float(nf @ t)
-            if f not in ("top", "left") and abs(c) >= np.cos(np.radians(60.0)) and (c > 0.0) == (end == 1):
-                cands.append((abs((df - float(nf @ p0)) / c - s_end), f))
-        best.append(bar.face_plane(min(cands)[1]))
+            if f in ("top", "left") or abs(c) < np.cos(np.radians(60.0)) or (c > 0.0) != (end == 1):
+                continue
+            off = abs((df - float(nf @ p0)) / c - s_end)
+            if off <= 0.05 and (kept is None or abs(c) > kept[0] + 1e-3 or (abs(c) > kept[0] - 1e-3 and off < kept[1])):
+                kept = (abs(c), off, f)
+        assert kept is not None
+        best.append(bar.face_plane(kept[2]))
     sides = side_planes(bar, ("top", "left"), p0, t, (0.0, 0.2), 0.05)
     assert sides is not None
     for (n_got, d_got), (n_want, d_want) in zip(sides, best, strict=True):

@@ -23,6 +23,7 @@ BoolArray = npt.NDArray[np.bool_]
 _PAIRS = 1_000_000  # point-edge pairs tested at once in over_region() (bounds the memory)
 SIDE_MAX_ANGLE_DEG = 60.0  # a face of A ends the seam when its normal is this close to the seam's direction
 _SIDE_COS = math.cos(math.radians(SIDE_MAX_ANGLE_DEG))
+_ACROSS_TIE = 1e-3  # faces whose normals' components along the line differ by less are as much across it
 
 
 def side_planes(
@@ -32,22 +33,34 @@ def side_planes(
     end), outward unit normals; None unless both ends have one.
 
     A face ends the line at the start when its outward normal points back along t (n . t <= -cos 60 deg), at the
-    end when it points along t; of those, the one whose plane meets the line nearest the map's end ``s_map``, if
-    within ``reach_m``. ``skip``: A's faces that hold the seam (the weld face and the end face)."""
+    end when it points along t; of those whose plane meets the line within ``reach_m`` of the map's end ``s_map``,
+    the one most across the line (a tube's side flat, not the facets of the corner radius before it: the seam
+    ends short of that flat, :meth:`~cell.seams.ours._geometry.JointGeometry.end_planes`), the nearest of those as
+    much across it (within :data:`_ACROSS_TIE`). ``skip``: A's faces that hold the seam (the weld face and the end
+    face)."""
     N, D = face_planes(part_a)
-    c = N @ t
-    crossing = np.array([name not in skip for name in part_a.face_names()]) & (np.abs(c) >= _SIDE_COS)
+    c_all = N @ t
+    crossing = np.array([name not in skip for name in part_a.face_names()]) & (np.abs(c_all) >= _SIDE_COS)
     with np.errstate(divide="ignore", invalid="ignore"):
-        s = (D - N @ p0) / c
-    out = []
-    for end, side in ((0, crossing & (c <= 0.0)), (1, crossing & (c > 0.0))):
-        off = np.abs(s - s_map[end])
-        idx = np.flatnonzero(side & (off <= reach_m))
-        if not len(idx):
-            return None
-        k = int(idx[np.argmin(off[idx])])  # the first of the nearest, in the faces' order
-        out.append((np.array(N[k]), float(D[k])))
-    return out[0], out[1]
+        s_all = (D - N @ p0) / c_all
+    best: list[tuple[float, float, int] | None] = [None, None]
+    for i in np.flatnonzero(crossing):  # in the faces' order: the tie rule depends on it
+        c = float(c_all[i])
+        end = 1 if c > 0.0 else 0
+        off = abs(float(s_all[i]) - s_map[end])
+        current = best[end]
+        if off > reach_m:
+            continue
+        if (
+            current is None
+            or abs(c) > current[0] + _ACROSS_TIE
+            or (abs(c) > current[0] - _ACROSS_TIE and off < current[1])
+        ):
+            best[end] = (abs(c), off, int(i))
+    start, stop = best
+    if start is None or stop is None:
+        return None
+    return (np.array(N[start[2]]), float(D[start[2]])), (np.array(N[stop[2]]), float(D[stop[2]]))
 
 
 def face_planes(part: Part) -> tuple[FloatArray, FloatArray]:

@@ -1,6 +1,9 @@
 """The ends of a seam our locator finds (frame R, metres): where the fitted line meets A's side face across it
 (fitted with the weld faces), the table, or the extent of face A's points along it (an empirical CDF extrapolated,
-refined as a blurred edge, :mod:`cell.seams._extent`)."""
+refined as a blurred edge, :mod:`cell.seams._extent`). On a rounded tube the end lies short of the side face (or
+the table) by the map's inset, the corner radius; an end whose side is not seen lies the drawn width from the
+other, or, with no side seen, at the tangent line where face A's points bend away round the radius (docs/bodies.md
+section 8)."""
 
 from __future__ import annotations
 
@@ -15,6 +18,44 @@ from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
 from cell.seams.ours._points import Points
 from cell.seams.ours.options import OursOptions
+
+# How far a hollow section's flat may be wider or narrower than drawn [m] (docs/reference.md: EN 10219-2's
+# outer-size tolerance, 1 % of a 60 mm side, at least 0.5 mm).
+SECTION_TOLERANCE_M = 5e-4
+
+
+TANGENT_WINDOW_M = 0.008  # points this far along the line about the extent's guess place a tangent end [m]
+_TANGENT_STEP_M = 5e-5  # the grid the tangent line is searched on [m]
+
+
+def tangent_end(s: FloatArray, r: FloatArray, guess: float, radius: float, scale: float) -> tuple[float, float]:
+    """Where a flat ends into a corner of ``radius`` [m] (the upper end along s; pass -s for a lower end):
+    (s0 [m], its standard error [m]; inf when the data do not define it), from points at s (n,) with offsets r
+    (n,) from the flat's plane (outward positive) [m], ``scale`` their noise [m].
+
+    Profile: r = 0 up to s0, then -(radius - sqrt(radius^2 - (s - s0)^2)) round the corner. s0 is searched within
+    ``[guess - radius, guess + radius / 2]`` (the extent of the points near the plane runs past the tangent line);
+    the points deeper than a third of the radius (the side beyond the corner) are left out, and each residual is
+    capped at 3 scales (strays, a tack). The standard error comes from the curvature of the profile likelihood."""
+    sigma = max(scale, 5e-5)
+    keep = (r > -radius / 3.0) & (s > guess - 2.0 * radius) & (s < guess + radius)
+    s, r = s[keep], r[keep]
+    if len(s) < 20:
+        return guess, float("inf")
+    grid = np.arange(guess - radius, guess + 0.5 * radius, _TANGENT_STEP_M)
+    h = np.clip(s[None, :] - grid[:, None], 0.0, radius)
+    model = -(radius - np.sqrt(radius * radius - h * h))
+    cost = np.minimum(np.square((r[None, :] - model) / sigma), 9.0).sum(axis=1)
+    i = int(np.argmin(cost))
+    if not 0 < i < len(grid) - 1:
+        return guess, float("inf")
+    c2 = 0.5 * (cost[i - 1] - 2.0 * cost[i] + cost[i + 1])  # -log-likelihood's second difference
+    if c2 <= 0.0:
+        return float(grid[i]), float("inf")
+    shift = 0.25 * (cost[i - 1] - cost[i + 1]) / c2
+    # The curvature understates it (the residuals are capped, the points not independent, a drawn radius is
+    # facets): no better than the points' noise, which is what a close-up's ends scatter by on rhs.
+    return float(grid[i] + shift * _TANGENT_STEP_M), float(max(_TANGENT_STEP_M / np.sqrt(c2), sigma))
 
 
 def side_selections(
@@ -53,7 +94,12 @@ def side_selections(
         gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * end.scale
         near = np.abs(r_l) < gate
         # On the other part's face, never as deep as its far side (an upright's other face, 12 mm behind).
-        sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching) if end.touching else side & near)
+        if end.touching:
+            sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching))
+        elif end.inset:  # a tube's side flat begins past its corner radius, below face A and above its far side
+            sel = np.flatnonzero(side & near & (r_a < -eb_d - end.inset) & (r_a > end.inset - (geo.depth_a - eb_d)))
+        else:
+            sel = np.flatnonzero(side & near)
         if len(sel) >= need:
             out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
     return out
@@ -75,17 +121,28 @@ def find_ends(
     """Both ends placed on the fitted line p0 + s t: the table where A rests on it, A's side face where it was
     fitted (``sides_se``: the standard error of each fitted side face's offset, by end index), else the extent of
     face A's support along the seam: the quantiles of its points in ``pts`` extrapolated, then refined as an edge
-    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last).
+    in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last). An end
+    short of its plane by an inset (a rounded tube) and not seen lies the drawn width from an end on A's side face,
+    else at the tangent line fitted in the ``dense`` points (:func:`tangent_end`).
     ``face_a_height``: face A's extent away from B [m] (a thin plate's side keeps a window above the corner band)."""
     placed = list(ends)
     known = [False, False]
     for k, end in enumerate(ends):
         if end.on_table:
-            placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d), 2e-4, "table")
+            placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d - end.inset), 2e-4, "table")
             known[k] = True
         elif k in sides_se:
-            s = line_plane_parameter(p0, t, end.n, end.d - end.gap)
+            s = line_plane_parameter(p0, t, end.n, end.d - end.short_of)
             placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
+            known[k] = True
+    for k, end in enumerate(ends):
+        # A tube's flat ends into its radius, no edge to find: beside an end from A's own side face, the other end
+        # lies the drawn flat's width away (to within the section's size tolerance).
+        other = placed[1 - k]
+        if not known[k] and end.inset and known[1 - k] and other.source == "side face" and not other.touching:
+            width = s_map[1] - s_map[0]
+            s = other.s + (width if k == 1 else -width)
+            placed[k] = end.at(s, float(np.hypot(other.se, SECTION_TOLERANCE_M)), "width")
             known[k] = True
     if all(known) or face_a.source != "points":
         for k, end in enumerate(ends):
@@ -110,6 +167,15 @@ def find_ends(
             near_a &= s < s_known[1] - cut
         return s[near_a]
 
+    def profile_a(pts: Points) -> tuple[FloatArray, FloatArray]:
+        """Parameters along the line and offsets from face A of the points of A's flat and of the corner radius
+        it ends into (down to a third of the radius below the plane) among ``pts``."""
+        r_a = pts.along(face_a.n) - face_a.d
+        r_b = pts.along(face_b.n) - face_b.d
+        s = pts.along(t) - float(p0 @ t)
+        on = (r_a < 3.0 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
+        return s[on], r_a[on]
+
     s_a = along_a(pts)
     extent = cdf_extent(s_a) if len(s_a) >= pts.least(o.min_face_points) else None
     for k, end in enumerate(ends):
@@ -119,6 +185,14 @@ def find_ends(
             placed[k] = end.at(s_map[k], o.map_tolerance_m, "map")
         elif dense is None:
             placed[k] = end.at(extent[k], extent[2], "extent")
+        elif end.inset:
+            # A flat that ends into a corner radius has no edge: its points bend away from the plane past the tangent
+            # line, and the extent of those near the plane runs on into the radius. Fit the radius's profile.
+            sign = 1.0 if k == 1 else -1.0
+            d = dense(p0 + (extent[k] - TANGENT_WINDOW_M) * t, p0 + (extent[k] + TANGENT_WINDOW_M) * t)
+            s_d, r_d = profile_a(d)
+            s0, se = tangent_end(sign * s_d, r_d, sign * extent[k], end.inset, face_a.scale)
+            placed[k] = end.at(sign * s0, se, "tangent") if np.isfinite(se) else end.at(extent[k], extent[2], "extent")
         else:
             # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
             # point of the dense cloud within the likelihood's window about it.

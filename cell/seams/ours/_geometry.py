@@ -20,6 +20,7 @@ from cell.types import Joint, MapSeam, Part, SeamScene
 BoolArray = npt.NDArray[np.bool_]
 _Z = np.array([0.0, 0.0, 1.0])
 _SIDE_REACH_M = 0.02  # a side face of a body ends the seam only this near the map's end [m]
+_INSET_MIN_M = 1e-4  # a map's end nearer its side face than this lies on it [m]
 THIN_SHARE = 0.25  # a band cut off a face is at most this share of the face's extent (thin plates keep a window)
 
 
@@ -126,19 +127,28 @@ class JointGeometry:
         (``touching``: the other part's thickness behind it; ``gap``: the drawn gap the end lies short of it)."""
         out = []
         for (n, d), s in zip(self.planes, s_map, strict=True):
-            if self.has_sides and _edge.on_table(n, d, table_z, tol):
-                out.append(End(-_Z, -table_z, True, s))
-                continue
             at = None if p0 is None or not self.has_sides else p0 + s * t
+            if self.has_sides and _edge.on_table(n, d, table_z, tol):
+                out.append(End(-_Z, -table_z, True, s, inset=self._inset(-_Z, -table_z, at)))
+                continue
             # Only a part whose bounding sphere reaches the end can hold it (most of the map's parts lie far off).
             near = () if at is None else [p for p in others if np.linalg.norm(at - p.center) <= p.radius + TOUCH_M]
             found = [(g, p) for p in near if at is not None and (g := touch_gap(p, n, d, at)) is not None]
             if not found:
-                out.append(End(n, d, False, s))
+                out.append(End(n, d, False, s, inset=self._inset(n, d, at)))
                 continue
             gap, other = min(found, key=lambda x: abs(x[0]))
             out.append(End(n, d + gap, False, s, touching=extent_behind(other, -n, -d - gap), gap=gap))
         return out[0], out[1]
+
+    def _inset(self, n: FloatArray, d: float, at: FloatArray | None) -> float:
+        """How far [m] the map's end ``at`` (3,) lies short of the plane n . p = d: a tube's flat ends into its
+        corner radius (or the receiving tube's) before its side face (docs/bodies.md section 8). 0 for a box, and
+        for a body whose end lies on the side face (within :data:`_INSET_MIN_M`)."""
+        if at is None or self.part_a.is_box:
+            return 0.0
+        inset = d - float(n @ at)
+        return inset if inset > _INSET_MIN_M else 0.0
 
     def _region(self, key: str, pts: Points, edges: FloatArray, n: FloatArray) -> Region:
         """The region test of face ``key`` ("a" or "b": its boundary ``edges``, normal n) for ``pts``, kept."""

@@ -58,16 +58,33 @@ class End:
     # the other face's points place it.
     touching: float = 0.0
     gap: float = 0.0  # ... and the drawn gap [m]: d is the other face's plane, the end lies this much short of it
+    # A body's flat that ends into a corner radius: the seam ends this far short of the side face's plane [m]
+    # (the map's end to that plane; 0 for a box, whose faces meet at sharp edges). docs/bodies.md section 8.
+    inset: float = 0.0
 
     def moved(self, fit: Fitted) -> End:
         """The side face at this end moved by its offset fit."""
         return End(
-            self.n, self.d + fit.offset, self.on_table, self.s, self.se, fit.scale, self.source, self.touching, self.gap
+            self.n,
+            self.d + fit.offset,
+            self.on_table,
+            self.s,
+            self.se,
+            fit.scale,
+            self.source,
+            self.touching,
+            self.gap,
+            self.inset,
         )
 
     def at(self, s: float, se: float, source: str) -> End:
         """This end placed at ``s`` along the line [m], with its standard error [m] and where it came from."""
-        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching, self.gap)
+        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching, self.gap, self.inset)
+
+    @property
+    def short_of(self) -> float:
+        """How far [m] the seam's end lies short of this end's plane: the drawn gap and the radius's inset."""
+        return self.gap + self.inset
 
 
 END_KEYS = ("start", "end")  # the keys of the selections of A's side faces at the seam's ends

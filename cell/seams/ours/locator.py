@@ -214,7 +214,9 @@ class OursLocator:
             )
         crop = crop_box(scene, o)
         for k, end in enumerate(ends):
-            if end.source == "extent" and at_cut(crop, p0 + end.s * t, t if k == 1 else -t, 0.0, o.edge_band_m):
+            if end.source in ("extent", "tangent") and at_cut(
+                crop, p0 + end.s * t, t if k == 1 else -t, 0.0, o.edge_band_m
+            ):
                 return _not_found(
                     seam.id,
                     f"the seam's {('start', 'end')[k]} is not seen: face {face_a.name}'s points run to where the "

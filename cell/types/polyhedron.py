@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, readonly, transform_points
+from cell.types._near import within
 
 _CHUNK = 200_000  # point-triangle pairs evaluated at once in contains() (bounds the memory)
 
@@ -148,6 +149,11 @@ class Polyhedron:
         row = self._planes[self._index(face)]
         return np.array(row[:3]), float(row[3])
 
+    def face_planes(self) -> FloatArray:
+        """(f, 4) read-only: each face's outward unit normal and offset (n, d) in :attr:`names` order, the rows of
+        :meth:`face_plane` at once."""
+        return self._planes
+
     def face_polygon(self, face: str) -> FloatArray:
         """(m, 3) the face's vertices in order (counter-clockwise seen from outside) [m]."""
         return np.array(self.vertices[list(self.faces[self._index(face)])])
@@ -223,10 +229,17 @@ class Polyhedron:
         step = max(1, _CHUNK // max(1, len(tri)))
         for s in range(0, len(near), step):
             q = p[near[s : s + step]]
+            if margin > 0.0:
+                # Within the margin of a triangle: in, whatever the winding number says; the others' winding alone.
+                inside = within(q, a, b, c, margin)
+                rest = np.flatnonzero(~inside)
+                inside[rest] = self._winding(q[rest], a, b, c) > 0.5
+                out[near[s : s + step]] = inside
+                continue
             inside = self._winding(q, a, b, c) > 0.5
             if margin != 0.0:
                 d = _point_triangle_distance(q, a, b, c).min(axis=1)
-                inside = (inside | (d <= margin)) if margin > 0 else (inside & (d >= -margin))
+                inside = inside & (d >= -margin)
             out[near[s : s + step]] = inside
         return out[0] if single else out
 

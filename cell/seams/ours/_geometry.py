@@ -3,7 +3,7 @@ bound, the seam line where two planes meet, the side faces (or the table) at the
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -12,7 +12,7 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams import _edge
 from cell.seams._lines import extent_behind, plane_intersection
-from cell.seams.ours._bodies import TOUCH_M, coplanar_boundary, fills_rectangle, over_region, side_planes, touch_gap
+from cell.seams.ours._bodies import TOUCH_M, Region, coplanar_boundary, fills_rectangle, side_planes, touch_gap
 from cell.seams.ours._planes import End
 from cell.seams.ours._points import Points
 from cell.types import Joint, MapSeam, Part, SeamScene
@@ -46,6 +46,9 @@ class JointGeometry:
     face_b: str  # B's receiving face
     edge_band: float
     region_a: FloatArray | None = None  # A's weld face's boundary edges (k, 2, 3) when its extents do not bound it
+    region_b: FloatArray | None = None  # a polyhedron B's receiving face's boundary edges (k, 2, 3) (coplanar too)
+    # The region tests of this seam's points, computed once per point over the passes: "a" or "b" -> (points, test).
+    _regions: dict[str, tuple[Points, Region]] = field(default_factory=dict, compare=False, repr=False)
 
     @staticmethod
     def of(
@@ -61,6 +64,8 @@ class JointGeometry:
         ``s_map`` along it; ``o_band`` the edge band [m]."""
         n_a, d_a = part_a.face_plane(joint.face_abutting)
         n_e, d_e = part_a.face_plane(joint.end_face)
+        # Built once per seam, not in every pass's region test.
+        region_b = None if part_b.is_box else coplanar_boundary(part_b, joint.face_receiving)
         if not part_a.is_box:
             sides = side_planes(part_a, (joint.face_abutting, joint.end_face), p0, t, s_map, _SIDE_REACH_M)
             across = ((-t, float(-t @ p0) - s_map[0]), (t, float(t @ p0) + s_map[1]))  # never fitted
@@ -77,6 +82,7 @@ class JointGeometry:
                 None
                 if fills_rectangle(part_a, joint.face_abutting, t)
                 else coplanar_boundary(part_a, joint.face_abutting),
+                region_b,
             )
         box_a = part_a.box
         k_a = "xyz".index(joint.face_abutting[1])
@@ -100,6 +106,7 @@ class JointGeometry:
             has_sides,
             joint.face_receiving,
             o_band,
+            region_b=region_b,
         )
 
     def end_planes(
@@ -143,26 +150,27 @@ class JointGeometry:
         inset = d - float(n @ at)
         return inset if inset > _INSET_MIN_M else 0.0
 
+    def _region(self, key: str, pts: Points, edges: FloatArray, n: FloatArray) -> Region:
+        """The region test of face ``key`` ("a" or "b": its boundary ``edges``, normal n) for ``pts``, kept."""
+        kept = self._regions.get(key)
+        if kept is None or kept[0] is not pts:
+            kept = self._regions[key] = (pts, Region(pts.P, edges, n))
+        return kept[1]
+
     def in_face_a(self, pts: Points, face_a: str, inset: float) -> BoolArray:
         """Points whose projection lies inside A's weld face (with its coplanar faces) shrunk by ``inset`` [m] when
         its extents do not bound it (a gusset's triangle); all points when they do (a box, a rectangle)."""
         if self.region_a is None:
             return np.ones(len(pts.cam), bool)
-        n_a, _ = self.part_a.face_plane(face_a)
-        return over_region(pts.P, self.region_a, n_a, inset)
+        return self._region("a", pts, self.region_a, self.part_a.face_plane(face_a)[0]).over(inset)
 
     def in_face_b(self, pts: Points, slack: float, where: BoolArray | None = None) -> BoolArray:
         """Points whose projection lies inside B's receiving face shrunk by the edge band (and ``slack``); a
         polyhedron's region is tested only on the points ``where`` says (the others: False), a box's on all."""
         if not self.part_b.is_box:
-            n_b, _ = self.part_b.face_plane(self.face_b)
-            edges = coplanar_boundary(self.part_b, self.face_b)
-            if where is None:
-                return over_region(pts.P, edges, n_b, self.edge_band + slack)
-            out = np.zeros(len(pts.cam), bool)
-            idx = np.flatnonzero(where)
-            out[idx] = over_region(pts.P[idx], edges, n_b, self.edge_band + slack)
-            return out
+            edges = self.region_b if self.region_b is not None else coplanar_boundary(self.part_b, self.face_b)
+            region = self._region("b", pts, edges, self.part_b.face_plane(self.face_b)[0])
+            return region.over(self.edge_band + slack, where)
         box_b = self.part_b.box
         k_b = "xyz".index(self.face_b[1])
         ok = np.ones(len(pts.cam), bool)

@@ -12,6 +12,7 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.seams._index import cloud_box, dense_index
+from cell.seams.ours._bodies import face_planes
 from cell.seams.ours.options import OursOptions
 from cell.types import Box, Joint, SeamScene
 
@@ -84,11 +85,12 @@ def gather(
         if part.name in (joint.abutting, joint.receiving):
             continue
         if not part.is_box:
-            # Only points behind every supporting face plane (grown by the margin) can be near the body: the exact
-            # (costly) test on those alone.
-            N, D = _support_planes(scene, int(k))
+            # Only points within the body's bounds and behind every supporting face plane (both grown by the margin)
+            # can be near the body: the exact (costly) test on those alone, of the points still usable.
+            N, D, lo, hi = _support_planes(scene, int(k))
             m = o.map_tolerance_m
-            cand = np.flatnonzero(np.all(N @ xyz <= (D + m)[:, None], axis=0))
+            cand = np.flatnonzero(ok & _in_bounds(xyz, lo - m, hi + m))
+            cand = cand[np.all(N @ xyz[:, cand] <= (D + m)[:, None], axis=0)]
             if len(cand):
                 ok[cand] &= ~part.contains(xyz[:, cand].T, margin=m)
             continue
@@ -116,17 +118,26 @@ def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
     return out
 
 
-def _support_planes(scene: SeamScene, k: int) -> tuple[FloatArray, FloatArray]:
+def _support_planes(scene: SeamScene, k: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Normals (f, 3) and offsets (f,) [m] of part ``k``'s faces that have the whole body behind them (the faces on
-    its convex hull: a plate's top, bottom and outer walls, not its hole's), cached per scene."""
+    its convex hull: a plate's top, bottom and outer walls, not its hole's), and the body's bounds along the axes
+    of R (lowest and highest corner (3,) [m]), cached per scene."""
     out = scene.cache.get(_SUPPORT_KEY)
     if out is None:
         out = []
         for part in scene.weldmap.parts:
             V = part.vertices()
-            planes = [part.face_plane(f) for f in part.face_names()]
-            kept = [(n, d) for n, d in planes if float(np.max(V @ n)) <= d + 1e-9]
-            out.append((np.array([n for n, _ in kept]).reshape(-1, 3), np.array([d for _, d in kept])))
+            N, D = face_planes(part)
+            kept = (V @ N.T).max(axis=0) <= D + 1e-9
+            out.append((N[kept].reshape(-1, 3), D[kept], V.min(axis=0), V.max(axis=0)))
         scene.cache[_SUPPORT_KEY] = out
-    N, D = out[k]
-    return N, D
+    N, D, lo, hi = out[k]
+    return N, D, lo, hi
+
+
+def _in_bounds(xyz: FloatArray, lo: FloatArray, hi: FloatArray) -> BoolArray:
+    """(n,) which points xyz (3, n) lie within the axis-aligned bounds lo, hi (3,) [m]."""
+    inside = (xyz[0] >= lo[0]) & (xyz[0] <= hi[0])
+    for k in (1, 2):
+        inside &= (xyz[k] >= lo[k]) & (xyz[k] <= hi[k])
+    return inside

@@ -255,3 +255,21 @@ def read_pcd(path: Path) -> FloatArray:
     if "positions" not in pc.point:
         return np.zeros((0, 3))
     return np.asarray(pc.point.positions.numpy(), dtype=np.float64).reshape(-1, 3)
+
+
+def rays_hit(
+    vertices: npt.ArrayLike, triangles: npt.ArrayLike, origins: npt.ArrayLike, directions: npt.ArrayLike
+) -> npt.NDArray[np.bool_]:
+    """(n,) whether each ray (origins (n, 3) [m], directions (n, 3)) meets the triangle mesh ``vertices`` (v, 3)
+    [m], ``triangles`` (t, 3) vertex indices at a distance t >= 0 (open3d's ``RaycastingScene``, Embree; single
+    precision, so about 0.1 um at a metre)."""
+    o3d = _o3d()
+    o = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    tri = np.asarray(triangles, dtype=np.uint32).reshape(-1, 3)
+    if not len(o) or not len(tri):
+        return np.zeros(len(o), dtype=bool)
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(_array(vertices, np.float32)), o3d.core.Tensor(_array(tri, np.uint32)))
+    rays = np.hstack([o, np.asarray(directions, dtype=np.float64).reshape(-1, 3)])
+    t_hit = scene.cast_rays(o3d.core.Tensor(_array(rays, np.float32)))["t_hit"].numpy()
+    return np.asarray(np.isfinite(t_hit))

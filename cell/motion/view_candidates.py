@@ -150,7 +150,10 @@ def _seen(
     o: ViewOptions,
 ) -> tuple[bool, tuple[float, float]]:
     """Whether every sample point is in the image, clear of the torch and seen at a good incidence (the tests
-    before the line of sight); and the worst incidence on face A's and B's samples [deg]."""
+    before the line of sight); and the worst incidence on face A's and B's samples [deg]. No samples left (all
+    under the table or inside other parts: a seam estimate of a part that is not there) is nothing seen."""
+    if not len(pts):
+        return False, (90.0, 90.0)
     p_C = transform_points(invert(X_RC), pts)
     z = p_C[:, 2]
     if np.any(z <= 0.05):

@@ -71,3 +71,13 @@ def test_a_close_up_may_serve_a_neighbouring_seam_but_not_a_hidden_one(
     assert all(sees(c.X_RC, far, K, torch_C, (), 0.0) is None for c in views)  # out of the image
     hidden = [c for c in shared if sees(c.X_RC, NEXT, K, torch_C, (BLOCK,), 0.0) is None]
     assert hidden  # the block stands between some of those views and the second seam
+
+
+def test_a_seam_with_no_sample_above_the_table_is_seen_by_no_view(
+    torch_C: np.ndarray, free: list[ViewCandidate]
+) -> None:
+    """A seam estimate under the table top (a missing part's seam, faults/missing-part): nothing to see, no view (it
+    raised on an empty array when a close-up of another seam was tested for it)."""
+    low = ViewTarget("low", TOP.p_start - [0.0, 0.0, 0.5], TOP.p_end - [0.0, 0.0, 0.5], TOP.n_a, TOP.n_b)
+    assert sees(free[0].X_RC, low, K, torch_C, (), float(TOP.p_start[2])) is None
+    assert list(ranked_views(low, K, torch_C, (), float(TOP.p_start[2]))) == []

@@ -13,6 +13,7 @@ method (the voxel cloud, the voxel-ordered dense cloud) is in none of them.
 
 from __future__ import annotations
 
+import math
 import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -157,7 +158,12 @@ def markdown_table(rows: Sequence[dict[str, Any]]) -> str:
         ref = f"{paper[0]:.2f} / {paper[1]:.0f}" if paper else ""
         lines.append(
             f"| {r['scenario']} | {r['noise']} | {r['extrinsics']} | {r['method']} | {r['found']}/{r['visible']} | "
-            f"{r['paper_me_mean_mm']:.3f} | {r['paper_me_p95_mm']:.3f} | {r['lateral_mean_mm']:.3f} | "
-            f"{r['endpoint_mean_mm']:.3f} | {r['ms_per_seam_median']:.2f} | {r['ms_per_seam_amortised']:.2f} | {ref} |"
+            f"{_mm(r['paper_me_mean_mm'])} | {_mm(r['paper_me_p95_mm'])} | {_mm(r['lateral_mean_mm'])} | "
+            f"{_mm(r['endpoint_mean_mm'])} | {r['ms_per_seam_median']:.2f} | {r['ms_per_seam_amortised']:.2f} | {ref} |"
         )
     return head + "\n".join(lines) + "\n"
+
+
+def _mm(x: float) -> str:
+    """An error [mm] to three decimals; '-' when no seam was found to measure it on (NaN)."""
+    return "-" if math.isnan(x) else f"{x:.3f}"

@@ -131,7 +131,7 @@ def weldments_table(rows: Sequence[Row]) -> str:
     located errors, welded, the worst executed TCP RMS, our time per seam, and why the others were not welded."""
     lines = [
         "| scenario | found / visible | located: lateral / endpoint mean [mm] | welded / visible "
-        "| worst TCP RMS [mm] | ours, ms per seam (median) | not welded: why (seams) |",
+        "| worst TCP RMS [mm] | ours, ms per seam with its close-up (median) | not welded: why (seams) |",
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:

@@ -16,7 +16,10 @@ Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->``
 - ``rescan``, ``confidence``, ``weld``, ``motion``, ``faults``: the tables of the cell's own commands
   (``rescan.json``, ``weld.json``, ``faults.json`` by ``benchmarks/bench_cell.py``; ``confidence.json`` by
   ``benchmarks/bench_confidence.py``; ``motion.json`` by ``benchmarks/bench_motion.py``), rendered by
-  ``tools/readme_cell_tables.py``.
+  ``tools/readme_cell_tables.py``;
+- ``weldments``, ``weldments-bench``: the parts that are not boxes, welded whole (``weldments.json`` by
+  ``benchmarks/bench_cell.py weld --scenarios brace,bracket,rhs``) and their Table 1 rows (``weldments-bench.json``
+  by ``cell bench brace bracket rhs``).
 
 The Table 1 blocks are :func:`cell.bench.markdown_table` of the rows, the renderer that also writes
 ``benchmarks/results/*.md``; the scaling block is the README's one-line-per-scenario summary of
@@ -164,6 +167,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "planning": lambda results: cell_tables.planning_table(_load_object(results, "planning.json")),
     "real-scans": lambda results: cell_tables.real_scans_table(_load_object(results, "real_scans.json")),
     "weldments": lambda results: cell_tables.weldments_table(_load(results, "weldments.json")),
+    "weldments-bench": lambda results: markdown_table(_load(results, "weldments-bench.json")),
 }
 
 

@@ -10,9 +10,9 @@ import numpy.typing as npt
 from cell.geometry import FloatArray
 
 
-def _pair_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
-    """Distances (k,) from each point p (k, 3) to its own triangle a, b, c (k, 3) each: the pairs' entries of
-    :func:`cell.types.polyhedron._point_triangle_distance`, by the same steps."""
+def pair_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+    """Distances (k,) from each point p (k, 3) to its own triangle a, b, c (k, 3) each: the distance to its plane
+    where the point lies over the triangle, else to its nearest edge."""
     ab, ac = b - a, c - a
     n = np.cross(ab, ac)
     nn = np.maximum(np.einsum("ik,ik->i", n, n), 1e-300)
@@ -34,7 +34,7 @@ def _pair_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -
 
 def within(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray, margin: float) -> npt.NDArray[np.bool_]:
     """(n,) whether each point p (n, 3) lies within ``margin`` [m] of one of the triangles a, b, c (t, 3) each: the
-    test ``_point_triangle_distance(p, a, b, c).min(axis=1) <= margin``, with the distance computed only for the
+    test ``min over the triangles of pair_distance <= margin``, with the distance computed only for the
     pairs that can pass it (the point inside the triangle's bounds grown by the margin, and that near its plane)."""
     reach = margin * (1.0 + 1e-9) + 1e-12  # a pair culled here is farther than the margin by more than rounding
     lo = np.minimum(np.minimum(a, b), c) - reach
@@ -47,6 +47,6 @@ def within(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray, margin: f
     i, j = np.nonzero(near)
     out = np.zeros(len(p), dtype=bool)
     if len(i):
-        d = _pair_distance(p[i], a[j], b[j], c[j])
+        d = pair_distance(p[i], a[j], b[j], c[j])
         out[i[d <= margin]] = True
     return out

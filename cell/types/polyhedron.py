@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, readonly, transform_points
-from cell.types._near import within
+from cell.types._near import pair_distance, within
 
 _CHUNK = 200_000  # point-triangle pairs evaluated at once in contains() (bounds the memory)
 
@@ -63,25 +63,10 @@ def _any_in_triangle(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray)
 
 
 def _point_triangle_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
-    """Distances (n, t) from points p (n, 3) to triangles given by corners a, b, c (t, 3) each."""
-    ab, ac = b - a, c - a
-    n = np.cross(ab, ac)
-    nn = np.maximum(np.einsum("ij,ij->i", n, n), 1e-300)
-    ap = p[:, None, :] - a[None]
-    # inside the prism over the triangle: the distance to its plane
-    w = np.einsum("ntk,tk->nt", np.cross(ab[None], ap), n) / nn
-    v = np.einsum("ntk,tk->nt", np.cross(ap, ac[None]), n) / nn
-    inside = (v >= 0) & (w >= 0) & (v + w <= 1)
-    d_plane = np.abs(np.einsum("ntk,tk->nt", ap, n)) / np.sqrt(nn)
-    best = np.full(d_plane.shape, np.inf)
-    for s, e in ((a, b), (b, c), (c, a)):  # otherwise the nearest edge
-        se = e - s
-        ll = np.maximum(np.einsum("ij,ij->i", se, se), 1e-300)
-        sp = p[:, None, :] - s[None]
-        t = np.clip(np.einsum("ntk,tk->nt", sp, se) / ll, 0.0, 1.0)
-        q = sp - t[..., None] * se[None]
-        best = np.minimum(best, np.sqrt(np.einsum("ntk,ntk->nt", q, q)))
-    return np.asarray(np.where(inside, d_plane, best))
+    """Distances (n, t) from points p (n, 3) to triangles given by corners a, b, c (t, 3) each: every pair's
+    :func:`cell.types._near.pair_distance`."""
+    i, j = np.divmod(np.arange(len(p) * len(a)), max(len(a), 1))
+    return pair_distance(p[i], a[j], b[j], c[j]).reshape(len(p), len(a))
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,6 @@ Run from the repository root::
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -22,13 +21,13 @@ from make_maps import (
     FENCE1_JUNCTIONS,
     FENCE1_PARTS,
     PART_LAYER_COLOR,
-    REPO_ROOT,
     SeamSpec,
     _add_body,
     _add_seam,
     _rot_z,
     all_seams,
     build_map,
+    one_map_main,
     write_stable,
 )
 
@@ -93,13 +92,13 @@ def write_brace_map(path: str | Path) -> Path:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    parser.add_argument("--out", type=Path, default=REPO_ROOT / "maps", help="output folder (default: maps/)")
-    args = parser.parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
-    path = write_brace_map(args.out / "brace.dxf")
-    print(f"{path}: {len(FENCE1_PARTS) + 1} parts (one a mesh), {16 + len(brace_seams())} seams")
-    return 0
+    return one_map_main(
+        argv,
+        __doc__,
+        "brace.dxf",
+        write_brace_map,
+        lambda: f"{len(FENCE1_PARTS) + 1} parts (one a mesh), {16 + len(brace_seams())} seams",
+    )
 
 
 if __name__ == "__main__":

@@ -402,6 +402,25 @@ def design_seams(name: str, parts: Mapping[str, BoxSpec], junctions: Iterable[Ju
     return seams
 
 
+def one_map_main(
+    argv: Sequence[str] | None,
+    doc: str | None,
+    filename: str,
+    write: Callable[[Path], Path],
+    summary: Callable[[], str],
+) -> int:
+    """The command line of a tool that writes one map: ``--out DIR`` (default ``maps/``), then ``write(DIR /
+    filename)`` and one line, the path and ``summary()``. ``doc``: the tool's module docstring (its first line is
+    the help text)."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0] if doc else None)
+    parser.add_argument("--out", type=Path, default=REPO_ROOT / "maps", help="output folder (default: maps/)")
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = write(args.out / filename)
+    print(f"{path}: {summary()}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
     parser.add_argument("--out", type=Path, default=REPO_ROOT / "maps", help="output folder (default: maps/)")

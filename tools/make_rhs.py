@@ -20,7 +20,6 @@ carrying its id as XDATA (``WELDCELL``). The output is byte-stable (ezdxf's fixe
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -33,11 +32,11 @@ from make_maps import (
     FENCE1_JUNCTIONS,
     FENCE1_PARTS,
     PART_LAYER_COLOR,
-    REPO_ROOT,
     SEAM_LAYER_COLOR,
     SeamSpec,
     _add_seam,
     all_seams,
+    one_map_main,
     write_stable,
 )
 
@@ -133,13 +132,13 @@ def write_rhs_map(path: str | Path) -> Path:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    parser.add_argument("--out", type=Path, default=REPO_ROOT / "maps", help="output folder (default: maps/)")
-    args = parser.parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
-    path = write_rhs_map(args.out / "rhs.dxf")
-    print(f"{path}: {len(FENCE1_PARTS)} RHS tubes (MESH), {len(rhs_seams())} seams")
-    return 0
+    return one_map_main(
+        argv,
+        __doc__,
+        "rhs.dxf",
+        write_rhs_map,
+        lambda: f"{len(FENCE1_PARTS)} RHS tubes (MESH), {len(rhs_seams())} seams",
+    )
 
 
 if __name__ == "__main__":

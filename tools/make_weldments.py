@@ -20,14 +20,22 @@ byte-stable (ezdxf's fixed metadata, sorted classes).
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
 import ezdxf
 from ezdxf.math import Vec3 as DxfVec3
 from ezdxf.render import MeshTransformer
-from make_maps import APPID, PART_LAYER_COLOR, REPO_ROOT, SEAM_LAYER_COLOR, SeamSpec, _add_seam, box_mesh, write_stable
+from make_maps import (
+    APPID,
+    PART_LAYER_COLOR,
+    SEAM_LAYER_COLOR,
+    SeamSpec,
+    _add_seam,
+    box_mesh,
+    one_map_main,
+    write_stable,
+)
 
 BASE = (0.0, 0.0, 0.0, 400.0, 250.0, 12.0)  # x0, y0, z0, x1, y1, z1 [mm]
 HOLE = (20.0, 95.0, 80.0, 155.0)  # x0, y0, x1, y1 of the base's square hole [mm]
@@ -115,13 +123,9 @@ def write_bracket_map(path: str | Path) -> Path:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    parser.add_argument("--out", type=Path, default=REPO_ROOT / "maps", help="output folder (default: maps/)")
-    args = parser.parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
-    path = write_bracket_map(args.out / "bracket.dxf")
-    print(f"{path}: 4 parts (two meshes), {len(bracket_seams())} seams")
-    return 0
+    return one_map_main(
+        argv, __doc__, "bracket.dxf", write_bracket_map, lambda: f"4 parts (two meshes), {len(bracket_seams())} seams"
+    )
 
 
 if __name__ == "__main__":

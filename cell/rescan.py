@@ -152,7 +152,11 @@ def closeup_scene(
     p_R = p_R[crop_around(p_R, seam, options.crop_margin_m)]
     dense = Cloud(p_R, "R", np.zeros(len(p_R), np.int16), (image.camera,))
     return SeamScene(
-        cloud=downsample(dense, voxel_m), dense=dense, weldmap=base.weldmap, joints=base.joints, table_z=base.table_z
+        voxel=lambda: downsample(dense, voxel_m),
+        dense=dense,
+        weldmap=base.weldmap,
+        joints=base.joints,
+        table_z=base.table_z,
     )
 
 

@@ -9,6 +9,7 @@ with outliers).
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.types import Cloud
@@ -51,3 +52,26 @@ def voxel_corners(table: VoxelTable) -> FloatArray:
     i, rest = np.divmod(table.keys, ny * nz)
     j, k = np.divmod(rest, nz)
     return (np.stack([i, j, k], axis=1) + np.asarray(table.origin)) * table.voxel_m
+
+
+def in_box(table: VoxelTable, lo: FloatArray, hi: FloatArray) -> npt.NDArray[np.intp]:
+    """Indices into the voxel-ordered cloud of ``table`` of every point that may lie in the axis-aligned box
+    lo-hi (3,) [m]: the points of the occupied voxels the box touches, a superset of those inside it (a point
+    inside lies in a voxel between those of the corners: the floor is monotone), in cloud order."""
+    v = table.voxel_m
+    first = [max(int(np.floor(lo[k] / v)), table.origin[k]) for k in range(3)]
+    last = [min(int(np.floor(hi[k] / v)), table.origin[k] + table.dims[k] - 1) for k in range(3)]
+    if any(a > b for a, b in zip(first, last, strict=True)):
+        return np.zeros(0, np.intp)
+    i, j, k = (np.arange(a, b + 1) - o for a, b, o in zip(first, last, table.origin, strict=True))
+    _, ny, nz = table.dims
+    wanted = ((i[:, None, None] * ny + j[None, :, None]) * nz + k[None, None, :]).reshape(-1)
+    at = np.searchsorted(table.keys, wanted)
+    hit = at < len(table.keys)
+    hit[hit] = table.keys[at[hit]] == wanted[hit]
+    at = at[hit]
+    begin, end = table.starts[at], table.starts[at + 1]
+    counts = end - begin
+    # The runs begin..end concatenated: each run's offsets from its own start.
+    offsets = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts)
+    return np.asarray(np.repeat(begin, counts) + offsets, np.intp)

@@ -11,9 +11,9 @@ usable camera remains is it a :class:`SensorError`.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -33,36 +33,54 @@ from cell.voxels import voxel_order
 class Perceived:
     """What perception hands on, all in the robot frame R.
 
-    dense : spliced, Z-passthrough and outlier filtered, full resolution (per-point camera index).
-    downsampled : ``dense`` on the voxel grid of ``spec.voxel_m`` (what the paper's locator reads).
     clouds : camera name -> its own cropped cloud before splicing (empty for a lost camera).
-    spliced : the splice result (unfiltered dense cloud and the ICP diagnostics).
+    spliced : the splice result (the registered cloud, the ICP diagnostics, the merge when asked for).
     lost : cameras left out (their data cannot be trusted), in capture order; ``lost_reasons`` says why.
     lost_reasons : camera name -> one-line reason it was left out.
-    timings : step name -> wall time [s] (``clouds``, ``splice``, ``preprocess``: both clouds' filters, side by
-        side; ``downsample``: both voxel grids, side by side).
+    timings : step name -> wall time [s] (``clouds``, ``splice``, ``preprocess``: the registered cloud's filters,
+        ``downsample``: its voxel order; ``merge``: the paper's cloud, once it has been asked for).
     registered : every camera registered, Z-passthrough and outlier filtered, *not* merged (per-point camera
-        index), in voxel order: what a locator that weighs each camera by its own noise reads.
+        index), in voxel order: what the map alignment and a locator that weighs each camera by its own noise read.
     registered_voxels : where ``registered``'s voxels (``spec.voxel_m``) lie in it (what such a locator's tube
         queries read).
     origins_R : camera name -> (3,) its optical centre in R as calibrated (how far a seam is from it).
+    filter_merged : the paper's cloud made from ``spliced.dense`` (filtered as ``registered``, then on the voxel
+        grid): run once, on the first read of ``dense`` or ``downsampled``.
     """
 
-    dense: Cloud
-    downsampled: Cloud
     clouds: dict[str, Cloud]
     spliced: Spliced
+    registered: Cloud
+    registered_voxels: VoxelTable | None = None
     lost: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
     lost_reasons: dict[str, str] = field(default_factory=dict)
+    origins_R: dict[str, FloatArray] = field(default_factory=dict)
+    filter_merged: Callable[[], tuple[Cloud, Cloud]] | None = field(default=None, compare=False, repr=False)
+
+    @cached_property
+    def _merged(self) -> tuple[Cloud, Cloud]:
+        if self.filter_merged is None:
+            raise ValueError("perceived: no merged cloud (made without the splice's merge)")
+        t = time.perf_counter()
+        out = self.filter_merged()
+        self.timings["merge"] = time.perf_counter() - t
+        return out
+
+    @property
+    def dense(self) -> Cloud:
+        """The paper's cloud: spliced (the prioritised merge), Z-passthrough and outlier filtered, full resolution
+        (per-point camera index)."""
+        return self._merged[0]
+
+    @property
+    def downsampled(self) -> Cloud:
+        """``dense`` on the voxel grid of ``spec.voxel_m`` (what the paper's locator reads)."""
+        return self._merged[1]
 
     def lost_described(self) -> tuple[str, ...]:
         """``"name: reason"`` of every lost camera (for reports)."""
         return tuple(f"{n}: {self.lost_reasons.get(n, 'lost')}" for n in self.lost)
-
-    registered: Cloud = field(default_factory=lambda: Cloud(np.zeros((0, 3)), "R"))
-    registered_voxels: VoxelTable | None = None
-    origins_R: dict[str, FloatArray] = field(default_factory=dict)
 
     def splice_corrections(self) -> dict[str, dict[str, Any]]:
         """Per registered camera, what the splice did to its calibration (for reports): ``applied`` (bool),
@@ -117,34 +135,35 @@ def perceive(
     t = time.perf_counter()
     spliced = splice({n: c for n, c in clouds.items() if n not in lost}, images, X_WR, spec)
     timings["splice"] = time.perf_counter() - t
-    # The merged cloud and the registered one are filtered and gridded apart, each on its own core: numpy's sorts
-    # and arithmetic and scipy's searches let go of the interpreter lock, and each result is what it would be alone.
-    with ThreadPoolExecutor(max_workers=1) as beside:
-        t = time.perf_counter()
-        filtered = beside.submit(preprocess, spliced.registered, spec.workspace, X_WR, spec)
+    t = time.perf_counter()
+    registered = preprocess(spliced.registered, spec.workspace, X_WR, spec)
+    timings["preprocess"] = time.perf_counter() - t
+    if len(registered) == 0:
+        raise SensorError(
+            f"Z passthrough and outlier removal left no point of the {len(spliced.registered)} registered ones"
+        )
+    t = time.perf_counter()
+    registered, registered_voxels = voxel_order(registered, spec.voxel_m)
+    timings["downsample"] = time.perf_counter() - t
+    X_RW = invert(np.asarray(X_WR, dtype=float))
+    origins_R = {name: (X_RW @ np.asarray(image.X_WC, dtype=float))[:3, 3] for name, image in images.items()}
+
+    def filter_merged() -> tuple[Cloud, Cloud]:
         dense = preprocess(spliced.dense, spec.workspace, X_WR, spec)
-        registered = filtered.result()
-        timings["preprocess"] = time.perf_counter() - t
         if len(dense) == 0:
             raise SensorError(
                 f"Z passthrough and outlier removal left no point of the {len(spliced.dense)} spliced ones"
             )
-        t = time.perf_counter()
-        ordered = beside.submit(voxel_order, registered, spec.voxel_m)
-        downsampled = downsample(dense, spec.voxel_m)
-        registered, registered_voxels = ordered.result()
-        timings["downsample"] = time.perf_counter() - t
-    X_RW = invert(np.asarray(X_WR, dtype=float))
-    origins_R = {name: (X_RW @ np.asarray(image.X_WC, dtype=float))[:3, 3] for name, image in images.items()}
+        return dense, downsample(dense, spec.voxel_m)
+
     return Perceived(
-        dense,
-        downsampled,
         clouds,
         spliced,
+        registered,
+        registered_voxels,
         lost,
         timings,
         {n: why[n] for n in lost},
-        registered,
-        registered_voxels,
         origins_R,
+        filter_merged,
     )

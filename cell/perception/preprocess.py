@@ -36,13 +36,14 @@ def z_range_R(workspace: WorkspaceSpec, X_WR: FloatArray) -> tuple[float, float]
     return float(z.min()), float(z.max())
 
 
-def _cube_keys(points: FloatArray, edge_m: float) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
-    """(n,) one int64 per point naming its cube of edge ``edge_m`` [m], and the grid's dims (3,); the grid has
-    one empty layer of cubes around the points, so a neighbour key (+-1 along each axis) never wraps."""
-    ijk = np.floor(points / edge_m).astype(np.int64)
-    ijk -= ijk.min(axis=0) - 1
-    dims = ijk.max(axis=0) + 2
-    return (ijk[:, 0] * dims[1] + ijk[:, 1]) * dims[2] + ijk[:, 2], dims
+def _cube_keys(
+    ijk: tuple[npt.NDArray[np.int64], ...], lo: npt.NDArray[np.int64], hi: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+    """(n,) one int64 per point naming its cube (integer cube coordinates ``ijk``: three (n,) columns, between
+    ``lo`` and ``hi`` (3,)), and the grid's dims (3,); the grid has one empty layer of cubes around the points,
+    so a neighbour key (+-1 along each axis) never wraps."""
+    dims = hi - lo + 3
+    return ((ijk[0] - (lo[0] - 1)) * dims[1] + (ijk[1] - (lo[1] - 1))) * dims[2] + (ijk[2] - (lo[2] - 1)), dims
 
 
 def _block_shifts(dims: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
@@ -59,7 +60,7 @@ def radius_outlier_mask(points: FloatArray, radius_m: float, min_neighbours: int
     searched, in three tests of growing cost, each exact:
 
     1. cubes of edge radius / sqrt 3 (their diagonal is the radius): a point whose own cube holds enough points
-       is kept (95 % of a scene's points, one sort);
+       is kept (95 % of a scene's points, one sort); every grid here is one floor of the points, halved;
     2. for the others, cubes of edge radius / (2 sqrt 3): every point of the 3 x 3 x 3 cubes around a point's own
        cube lies within the radius of it, so a point with enough points in that block is kept (looked up for
        the doubtful cubes only);
@@ -70,12 +71,21 @@ def radius_outlier_mask(points: FloatArray, radius_m: float, min_neighbours: int
     if n == 0:
         return np.zeros(0, dtype=bool)
     shrink = 1.0 - 1e-9  # cubes a hair smaller than the bound: rounding never puts two points a radius apart
-    keys, _ = _cube_keys(points, radius_m / math.sqrt(3.0) * shrink)
+    # One floor for all three grids: the finest cubes (edge radius / (2 sqrt 3)), and by halving their integer
+    # coordinates cubes of twice and four times that edge (the first test's, and cubes wider than the radius).
+    scaled = np.floor(points.T * (2.0 * math.sqrt(3.0) / (radius_m * shrink)))
+    fine_ijk = tuple(np.asarray(column, dtype=np.int64) for column in scaled)
+    lo, hi = np.array([c.min() for c in fine_ijk]), np.array([c.max() for c in fine_ijk])
+
+    def grid(halvings: int) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        return _cube_keys(tuple(c >> halvings for c in fine_ijk), lo >> halvings, hi >> halvings)
+
+    keys, _ = grid(1)
     _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
     keep = counts[inverse.reshape(-1)] - 1 >= min_neighbours
     doubtful = np.flatnonzero(~keep)
     if len(doubtful):
-        fine, dims = _cube_keys(points, radius_m / (2.0 * math.sqrt(3.0)) * shrink)
+        fine, dims = grid(0)
         cells, cell_counts = np.unique(fine, return_counts=True)
         asked, asked_at = np.unique(fine[doubtful], return_inverse=True)
         block = np.zeros(len(asked), dtype=np.int64)
@@ -86,8 +96,9 @@ def radius_outlier_mask(points: FloatArray, radius_m: float, min_neighbours: int
         keep[doubtful[sure]] = True
         doubtful = doubtful[~sure]
     if len(doubtful):
-        # Only points within one radius-sized cube of a doubtful point's cube can be its neighbours.
-        coarse, cdims = _cube_keys(points, radius_m)
+        # Only points within one cube (edge 2 radius / sqrt 3, wider than the radius) of a doubtful point's cube
+        # can be its neighbours.
+        coarse, cdims = grid(2)
         near = np.unique(coarse[doubtful])
         wanted = np.unique((near[:, None] + _block_shifts(cdims)[None, :]).reshape(-1))
         candidates = points[np.isin(coarse, wanted)]

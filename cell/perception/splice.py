@@ -23,9 +23,9 @@ a miscalibration of 1 mm / 0.1 deg is taken out. ``Registration.refused`` says w
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
@@ -111,16 +111,32 @@ def refusal(info: Mapping[str, float]) -> str:
 class Spliced:
     """The spliced clouds and how they were made, all in R, before Z passthrough and downsampling.
 
-    dense : the paper's cloud: every camera registered, then the prioritised merge; ``camera`` tags each point.
     registered : every camera registered, nothing merged away (per-point ``camera`` index).
     registrations : the registrations in the order they were made.
-    kept : camera name -> number of its points that survived the prioritised merge.
+    merge : makes the paper's merged cloud and its per-camera counts from the registration's result (the
+        prioritised merge); run once, on the first read of ``dense`` or ``kept``. Only the paper's and RANSAC's
+        locators and the pictures read the merged cloud, so a detection with ours never pays for it.
     """
 
-    dense: Cloud
     registered: Cloud
     registrations: tuple[Registration, ...] = ()
-    kept: dict[str, int] = field(default_factory=dict)
+    merge: Callable[[], tuple[Cloud, dict[str, int]]] | None = field(default=None, compare=False, repr=False)
+
+    @cached_property
+    def _merged(self) -> tuple[Cloud, dict[str, int]]:
+        if self.merge is None:
+            return self.registered, {}
+        return self.merge()
+
+    @property
+    def dense(self) -> Cloud:
+        """The paper's cloud: every camera registered, then the prioritised merge; ``camera`` tags each point."""
+        return self._merged[0]
+
+    @property
+    def kept(self) -> dict[str, int]:
+        """Camera name -> number of its points that survived the prioritised merge."""
+        return self._merged[1]
 
 
 def splice_order(images: Mapping[str, DepthImage], names: tuple[str, ...]) -> tuple[str, ...]:
@@ -166,17 +182,19 @@ def splice(
     camera = np.concatenate([np.full(len(clouds[n]), index[n], np.int16) for n in order])
     bounds = np.cumsum([0] + [len(clouds[n]) for n in order])
     eyes = {i: X[:3, 3] for i, X in X_RC.items()}
-    with ThreadPoolExecutor(max_workers=1) as beside:
-        # Normals from plane fits twice the voxel wide (a voxel-wide fit of 2-3 mm noise is as noisy as the depth),
-        # of the points as calibrated (a copy: the registrations move them), fitted on a core of their own while
-        # the registrations run; only the merge reads them.
-        fitted = beside.submit(surface_normals, points.copy(), camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
-        registrations = _register_in_order(points, bounds, order, index, X_RC, spec)
-        normals = fitted.result()
+    # The merge's normals are plane fits twice the voxel wide (a voxel-wide fit of 2-3 mm noise is as noisy as the
+    # depth) of the points as calibrated: a copy, as the registrations move them.
+    calibrated = points.copy()
+    registrations = _register_in_order(points, bounds, order, index, X_RC, spec)
     registered = Cloud(points, "R", camera, cameras)
-    keep = prioritised_merge(points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
-    kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}
-    return Spliced(registered.select(keep), registered, tuple(registrations), kept)
+
+    def merge() -> tuple[Cloud, dict[str, int]]:
+        normals = surface_normals(calibrated, camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
+        keep = prioritised_merge(points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
+        kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}
+        return registered.select(keep), kept
+
+    return Spliced(registered, tuple(registrations), merge)
 
 
 def _register_in_order(

@@ -17,9 +17,11 @@ from cell.types.seams import SeamScene
 
 
 class SeamLocator(Protocol):
-    """A seam finder. ``name`` is what ``--method`` selects."""
+    """A seam finder. ``name`` is what ``--method`` selects; ``reads_voxel_cloud`` says whether it reads the
+    scene's voxel cloud (``SeamScene.cloud``: perception's merge, made on first read, before the locator is timed)."""
 
     name: str
+    reads_voxel_cloud: bool
 
     def locate(self, scene: SeamScene, seam: MapSeam, rng: np.random.Generator) -> SeamEstimate:
         """Find ``seam`` (given in R, from the aligned map) in ``scene``; time is filled in by the caller."""

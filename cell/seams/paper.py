@@ -134,6 +134,7 @@ class PaperLocator:
     """
 
     name = "paper"
+    reads_voxel_cloud = True
 
     def __init__(self, spec: PaperOptions | None = None, *, strict: bool = False) -> None:
         self.spec = spec if spec is not None else PaperOptions()

@@ -43,6 +43,7 @@ class RansacLocator:
     """RANSAC plane-intersection baseline (Takubo et al.), restricted to the map's seam region."""
 
     name: str = "ransac"
+    reads_voxel_cloud: bool = True
 
     def __init__(self, options: RansacOptions | None = None) -> None:
         self.options = options if options is not None else RansacOptions()

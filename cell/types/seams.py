@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -92,7 +93,9 @@ class Joint:
 class SeamScene:
     """Everything a locator may look at, all in the robot frame R.
 
-    cloud : the spliced, filtered, voxel-downsampled cloud (what the paper's method uses).
+    voxel : the spliced, filtered, voxel-downsampled cloud (what the paper's method uses), or what makes it on
+        first use (perception's merge, which a locator that never reads ``cloud`` never pays for); read it as
+        ``cloud``.
     dense : every camera's registered, filtered points, not merged and not downsampled (full resolution, per-point
         camera index): what our locator and the map alignment read.
     weldmap : the welding map aligned to the cloud (frame ``"R"``).
@@ -104,13 +107,18 @@ class SeamScene:
         it is the one mutable member, and only ever holds values derived from the fields above.
     """
 
-    cloud: Cloud
+    voxel: Cloud | Callable[[], Cloud]
     dense: Cloud
     weldmap: WeldMap
     joints: Mapping[str, Joint]
     table_z: float
     dense_voxels: VoxelTable | None = None
     cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    @cached_property
+    def cloud(self) -> Cloud:
+        """The voxel-downsampled cloud (``voxel``, made on first read when it is a function)."""
+        return self.voxel if isinstance(self.voxel, Cloud) else self.voxel()
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ import numpy as np
 
 from cell.seams import _batch, _index, _robust
 from cell.types import Cloud
-from cell.voxels import voxel_order
+from cell.voxels import in_box, voxel_order
 
 
 def test_fit_offsets_recovers_each_plane_despite_outliers_and_weighs_cameras_by_their_noise() -> None:
@@ -111,6 +111,25 @@ def test_voxel_order_groups_each_voxel_and_its_table_says_where() -> None:
     assert np.allclose(table.lo, P.min(axis=0)) and np.allclose(table.hi, P.max(axis=0))
     camera_of = {tuple(p): c for p, c in zip(P, cam, strict=True)}
     assert all(camera_of[tuple(p)] == c for p, c in zip(ordered.points[:500], ordered.camera[:500], strict=True))
+
+
+def test_in_box_gives_every_point_of_a_box_from_the_voxels_it_touches() -> None:
+    rng = np.random.default_rng(6)
+    P = rng.uniform([-0.2, 0.1, 0.0], [0.1, 0.3, 0.05], (30000, 3))
+    ordered, table = voxel_order(Cloud(P, "R"), 0.01)
+    Q = np.asarray(ordered.points)
+    for lo, hi in [
+        ([-0.05, 0.15, 0.01], [0.02, 0.2, 0.03]),
+        ([-0.3, 0.0, -0.1], [0.3, 0.4, 0.2]),  # around everything
+        ([0.0, 0.2, 0.02], [0.0, 0.2, 0.02]),  # a point-sized box
+        ([0.2, 0.5, 0.1], [0.3, 0.6, 0.2]),  # beside the cloud
+    ]:
+        at = in_box(table, np.array(lo), np.array(hi))
+        inside = np.flatnonzero(np.all((np.array(lo) <= Q) & (np.array(hi) >= Q), axis=1))
+        assert len(np.unique(at)) == len(at) and set(inside) <= set(at.tolist())
+        near = Q[at]  # and nothing farther than a voxel from the box
+        assert np.all(near >= np.array(lo) - 0.01) and np.all(near <= np.array(hi) + 0.01)
+    assert len(in_box(table, np.array([-0.3, 0.0, -0.1]), np.array([0.3, 0.4, 0.2]))) == len(P)
 
 
 def test_robust_offset_recovers_a_plane_despite_outliers_and_weighs_cameras_by_their_noise() -> None:

@@ -434,8 +434,11 @@ def test_perceive_end_to_end_and_lost_camera() -> None:
     images["cam_left"] = DepthImage("cam_left", np.ones((k.height, k.width), np.float32), k, away)
     result = perceive(images, X_WR, SPEC)
     assert result.lost == ("cam_left",)
-    assert len(result.clouds["cam_left"]) == 0 and len(result.dense) > 1000
+    # The paper's merged cloud is made only when it is read (ours reads the registered cloud alone).
     assert set(result.timings) == {"clouds", "splice", "preprocess", "downsample"}
+    assert len(result.clouds["cam_left"]) == 0 and len(result.dense) > 1000
+    assert set(result.timings) == {"clouds", "splice", "preprocess", "downsample", "merge"}
+    assert len(result.dense) < len(result.registered)  # the merge keeps one camera per region
     assert len(result.downsampled) < len(result.dense)
     assert set(result.dense.camera.tolist()) == {0, 2}  # cam_right and eye_in_hand
     # The downsampled cloud is good enough to align the map to.

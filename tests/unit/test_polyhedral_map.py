@@ -133,7 +133,7 @@ def _down_face(m: WeldMap) -> str:
 
 def test_box_only_locators_refuse_a_mesh_seam(brace: WeldMap) -> None:
     joints = find_joints(brace)
-    scene = SeamScene(cloud=None, dense=None, weldmap=brace, joints=joints, table_z=0.0)  # type: ignore[arg-type]
+    scene = SeamScene(voxel=None, dense=None, weldmap=brace, joints=joints, table_z=0.0)  # type: ignore[arg-type]
     assert mesh_part(scene, brace.seam(BRACE_SEAMS[1])) == "BRACE"
     assert mesh_part(scene, brace.seam("POST_L>TOP_RAIL:+z")) is None
     est = not_supported(brace.seam(BRACE_SEAMS[1]), "paper", "BRACE", "the method needs boxes")

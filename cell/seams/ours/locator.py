@@ -26,6 +26,7 @@ class OursLocator:
     """Map-guided plane-fit seam locator (the method: :mod:`cell.seams.ours`). Deterministic for a given ``rng``."""
 
     name: str = "ours"
+    reads_voxel_cloud: bool = False  # the dense, registered cloud only
 
     def __init__(self, options: OursOptions | None = None) -> None:
         self.options = options if options is not None else OursOptions()

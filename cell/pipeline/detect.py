@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from typing import Literal
 
@@ -74,6 +75,7 @@ def build_scene(
     X_RM_nominal : where the map is believed to lie (default: the scenario's ``map.X_WM``; the turned part's pose
     on its second side); seed : a search of the cloud near it for a start the ICP can converge from."""
     from cell.perception import align_map, check_alignment, perceive
+    from cell.perception.alignment_checks import cloud_tree_of
 
     sc = cap.scenario
     timings: dict[str, float] = {}
@@ -90,12 +92,17 @@ def build_scene(
     weldmap_nominal_R = cap.weldmap.transformed(X_RM_nominal, "R")
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
     # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud.
-    alignment = align_map(weldmap_nominal_R, perceived.registered, sc.perception)
-    X_RM = alignment.X_RR_corr @ X_RM_nominal
-    weldmap_R = cap.weldmap.transformed(X_RM, "R")
-    # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
-    # parts that are simply not there are named, and their seams are never searched.
-    missing = check_alignment(weldmap_R, perceived.registered, alignment, sc.perception)
+    cloud = perceived.registered
+    with ThreadPoolExecutor(max_workers=1) as beside:
+        # The checks' KD-tree of the cloud is built on the other core while the alignment's ICP runs on one (open3d's
+        # ICP and scipy's tree build both let go of the interpreter lock); it is the tree the checks would build.
+        tree = beside.submit(cloud_tree_of, cloud) if len(cloud) else None
+        alignment = align_map(weldmap_nominal_R, cloud, sc.perception)
+        X_RM = alignment.X_RR_corr @ X_RM_nominal
+        weldmap_R = cap.weldmap.transformed(X_RM, "R")
+        # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
+        # parts that are simply not there are named, and their seams are never searched.
+        missing = check_alignment(weldmap_R, cloud, alignment, sc.perception, tree.result() if tree else None)
     timings["align_s"] = time.perf_counter() - t
 
     seam_scene = SeamScene(

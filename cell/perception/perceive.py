@@ -51,17 +51,15 @@ class Perceived:
     clouds: dict[str, Cloud]
     spliced: Spliced
     registered: Cloud
+    filter_merged: Callable[[], tuple[Cloud, Cloud]] = field(compare=False, repr=False)
     registered_voxels: VoxelTable | None = None
     lost: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
     lost_reasons: dict[str, str] = field(default_factory=dict)
     origins_R: dict[str, FloatArray] = field(default_factory=dict)
-    filter_merged: Callable[[], tuple[Cloud, Cloud]] | None = field(default=None, compare=False, repr=False)
 
     @cached_property
     def _merged(self) -> tuple[Cloud, Cloud]:
-        if self.filter_merged is None:
-            raise ValueError("perceived: no merged cloud (made without the splice's merge)")
         t = time.perf_counter()
         out = self.filter_merged()
         self.timings["merge"] = time.perf_counter() - t
@@ -160,10 +158,10 @@ def perceive(
         clouds,
         spliced,
         registered,
+        filter_merged,
         registered_voxels,
         lost,
         timings,
         {n: why[n] for n in lost},
         origins_R,
-        filter_merged,
     )

@@ -119,13 +119,11 @@ class Spliced:
     """
 
     registered: Cloud
-    registrations: tuple[Registration, ...] = ()
-    merge: Callable[[], tuple[Cloud, dict[str, int]]] | None = field(default=None, compare=False, repr=False)
+    registrations: tuple[Registration, ...]
+    merge: Callable[[], tuple[Cloud, dict[str, int]]] = field(compare=False, repr=False)
 
     @cached_property
     def _merged(self) -> tuple[Cloud, dict[str, int]]:
-        if self.merge is None:
-            return self.registered, {}
         return self.merge()
 
     @property

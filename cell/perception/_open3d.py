@@ -9,6 +9,7 @@ this module.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -18,6 +19,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
+
+_ONE_THREAD = threading.Lock()  # held while an ICP runs open3d on one thread (icp)
 
 
 @cache
@@ -124,13 +127,16 @@ def icp(
     X0 = np.eye(4) if init is None else _array(init)
     src, tgt = _legacy_cloud(source), _legacy_cloud(target, target_normals)
     # On one thread: open3d sums the normal equations over its threads in an order that changes from run to run, so
-    # the same clouds gave poses up to 11 um apart (the bracket's thin plates); one thread gives one answer.
-    threads = _o3d().utility.get_max_threads()
-    _o3d().utility.set_max_threads(1)
-    try:
-        return _result(reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations)))
-    finally:
-        _o3d().utility.set_max_threads(threads)
+    # the same clouds gave poses up to 11 um apart (the bracket's thin plates); one thread gives one answer. The
+    # setting is open3d's, for every thread of the process: one ICP at a time sets and restores it.
+    with _ONE_THREAD:
+        threads = _o3d().utility.get_max_threads()
+        _o3d().utility.set_max_threads(1)
+        try:
+            X = reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations))
+        finally:
+            _o3d().utility.set_max_threads(threads)
+    return _result(X)
 
 
 def estimate_normals(points: npt.ArrayLike, radius_m: float, max_neighbours: int) -> FloatArray:

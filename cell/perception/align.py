@@ -14,6 +14,7 @@ minimum.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -177,8 +178,13 @@ def surface_fit(
     return float(inlier.sum() / len(points)), float(np.sqrt(np.mean(d[inlier] ** 2)))
 
 
-def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignment:
+def align_map(
+    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, proceed: Callable[[], None] | None = None
+) -> Alignment:
     """Fit the nominal map (already in R) to the cloud (in R); see the module docstring.
+
+    proceed : called before each ICP stage; it may raise to stop a fit nobody will read (a speculation,
+    :func:`cell.perception.perceive.perceive_then`).
 
     Pass the dense filtered cloud (``Perceived.dense``): 1 cm voxel centroids sit inside the parts at their
     edges and bias the fit by millimetres. Clouds over 30 000 points are first put on a grid of the finest
@@ -215,6 +221,8 @@ def align_map(weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec) -> Alignme
         limit = _COARSE_SOURCE[stage] if stage < min(len(_COARSE_SOURCE), len(thresholds) - 1) else len(points)
         source = points[:: max(1, math.ceil(len(points) / limit))]
         samples, normals = (target, target_normals) if last else coarse
+        if proceed is not None:
+            proceed()
         X_MC = _open3d.icp(source, samples, threshold, spec.align_iterations, X_MC, normals).X_TS
     band = thresholds[_FITNESS_STAGE]
     fitness, rmse = surface_fit(

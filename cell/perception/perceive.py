@@ -10,11 +10,13 @@ usable camera remains is it a :class:`SensorError`.
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, Generic, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -23,10 +25,12 @@ from cell.geometry import FloatArray, invert
 from cell.perception.camera_health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame
 from cell.perception.preprocess import downsample, preprocess
-from cell.perception.splice import Spliced, splice
+from cell.perception.splice import Spliced, splice, stacked
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage, VoxelTable
 from cell.voxels import voxel_order
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -107,10 +111,29 @@ def perceive(
     when None). Raises :class:`SensorError` when there is no image, when no usable camera remains (naming
     each camera and why it was left out), or when filtering leaves no point.
     """
+    return perceive_then(images, X_WR, spec, health, lambda cloud, proceed: None).perceived
+
+
+def perceive_then(
+    images: Mapping[str, DepthImage],
+    X_WR: FloatArray,
+    spec: PerceptionSpec,
+    health: HealthOptions | None,
+    then: Callable[[Cloud, Callable[[], None]], T],
+) -> PerceivedThen[T]:
+    """:func:`perceive`, and ``then`` of its registered cloud (the caller's next stage: the map alignment).
+
+    The registered cloud is the calibrated one, point for point, unless the splice applies a correction (in a
+    calibrated cell it applies none). So its filters and ``then`` start on the calibrated cloud beside the
+    splice's registrations, on the other core, and are kept when no correction is applied; after one, they run
+    again on the registered cloud (an answer never depends on the speculation, only the wall time does).
+    ``then(cloud, proceed)`` must not depend on anything the splice decides but its cloud; it calls
+    ``proceed()`` between its steps, which stops a speculation that a correction has made moot (by raising).
+    """
     if not images:
         raise SensorError("no depth images to perceive from (no camera delivered one)")
     timings: dict[str, float] = {}
-    t = time.perf_counter()
+    t0 = t = time.perf_counter()
     why: dict[str, str] = {}
     for name, image in images.items():
         verdict = image_health(image, health)
@@ -130,19 +153,49 @@ def perceive(
     timings["clouds"] = time.perf_counter() - t
     if len(lost) == len(clouds):
         raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in lost), lost=why)
-    t = time.perf_counter()
-    spliced = splice({n: c for n, c in clouds.items() if n not in lost}, images, X_WR, spec)
-    timings["splice"] = time.perf_counter() - t
-    t = time.perf_counter()
-    registered = preprocess(spliced.registered, spec.workspace, X_WR, spec)
-    timings["preprocess"] = time.perf_counter() - t
-    if len(registered) == 0:
-        raise SensorError(
-            f"Z passthrough and outlier removal left no point of the {len(spliced.registered)} registered ones"
-        )
-    t = time.perf_counter()
-    registered, registered_voxels = voxel_order(registered, spec.voxel_m)
-    timings["downsample"] = time.perf_counter() - t
+    usable = {n: c for n, c in clouds.items() if n not in lost}
+    calibrated = stacked(usable, images)
+    corrected = threading.Event()
+
+    def onward(cloud: Cloud) -> tuple[Cloud, VoxelTable, T, dict[str, float], dict[str, float]]:
+        """The registered cloud's filters and voxel order, then ``then`` (unless a correction made it moot)."""
+        timings: dict[str, float] = {}
+        stamps: dict[str, float] = {}
+        t = time.perf_counter()
+        filtered = preprocess(cloud, spec.workspace, X_WR, spec)
+        timings["preprocess"] = time.perf_counter() - t
+        if len(filtered) == 0:
+            raise SensorError(f"Z passthrough and outlier removal left no point of the {len(cloud)} registered ones")
+        t = time.perf_counter()
+        ordered, voxels = voxel_order(filtered, spec.voxel_m)
+        timings["downsample"] = time.perf_counter() - t
+        stamps["filtered"] = time.perf_counter()
+
+        def proceed() -> None:
+            if cloud is calibrated and corrected.is_set():
+                raise _SupersededError
+
+        proceed()
+        t = time.perf_counter()
+        answer = then(ordered, proceed)
+        stamps["answered"] = time.perf_counter()
+        stamps["then_s"] = stamps["answered"] - t
+        return ordered, voxels, answer, timings, stamps
+
+    beside = ThreadPoolExecutor(max_workers=1)
+    try:
+        ahead = beside.submit(onward, calibrated)
+        t = time.perf_counter()
+        spliced = splice(usable, images, X_WR, spec, calibrated, lambda name: corrected.set())
+        timings["splice"] = time.perf_counter() - t
+        spliced_at = time.perf_counter()
+        if spliced.registered is calibrated:
+            registered, registered_voxels, answer, onward_timings, stamps = ahead.result()
+        else:
+            registered, registered_voxels, answer, onward_timings, stamps = onward(spliced.registered)
+    finally:
+        beside.shutdown(wait=False, cancel_futures=True)  # a moot speculation is left to end on its own
+    timings |= onward_timings
     X_RW = invert(np.asarray(X_WR, dtype=float))
     origins_R = {name: (X_RW @ np.asarray(image.X_WC, dtype=float))[:3, 3] for name, image in images.items()}
 
@@ -154,7 +207,7 @@ def perceive(
             )
         return dense, downsample(dense, spec.voxel_m)
 
-    return Perceived(
+    perceived = Perceived(
         clouds,
         spliced,
         registered,
@@ -165,3 +218,26 @@ def perceive(
         {n: why[n] for n in lost},
         origins_R,
     )
+    cloud_s = max(spliced_at, stamps["filtered"]) - t0
+    return PerceivedThen(perceived, answer, cloud_s, max(spliced_at, stamps["answered"]) - t0, stamps["then_s"])
+
+
+class PerceivedThen(NamedTuple, Generic[T]):
+    """What :func:`perceive_then` returns: the perception, ``then``'s answer, and when each was ready.
+
+    cloud_s : wall time [s] from the call until the registered cloud was ready (spliced and filtered).
+    answer_s : wall time [s] from the call until ``then``'s answer was ready and known to be of the registered
+        cloud (the splice done); it may have started beside the splice, so ``answer_s - cloud_s`` is what it
+        added to the wall, not its own time.
+    then_s : ``then``'s own wall time [s].
+    """
+
+    perceived: Perceived
+    answer: T
+    cloud_s: float
+    answer_s: float
+    then_s: float
+
+
+class _SupersededError(Exception):
+    """A speculation on the calibrated cloud after the splice applied a correction (nobody reads its answer)."""

@@ -152,43 +152,66 @@ def splice_order(images: Mapping[str, DepthImage], names: tuple[str, ...]) -> tu
     return (*moving, *fixed)
 
 
-def splice(
-    clouds: Mapping[str, Cloud], images: Mapping[str, DepthImage], X_WR: FloatArray, spec: PerceptionSpec
-) -> Spliced:
-    """Splice per-camera clouds (frame R, from :func:`clouds_in_robot_frame`) into one in R (module docstring).
-
-    images : the captures the clouds came from (their mounts and calibrated poses X_WC, intrinsics fx).
-    Empty clouds are skipped; :class:`SensorError` if every cloud is empty.
-    """
+def _stack_order(
+    clouds: Mapping[str, Cloud], images: Mapping[str, DepthImage]
+) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(the non-empty clouds' names in the splice order, the camera tuple their points are indexed by): the
+    clouds' shared tuple when they have one (indices stay valid), else the names. :class:`SensorError` if every
+    cloud is empty."""
     names = tuple(n for n in clouds if len(clouds[n]) > 0)
     if not names:
         raise SensorError(f"nothing to splice: every camera cloud is empty ({', '.join(clouds) or 'none given'})")
     for n in names:
         if clouds[n].frame != "R":
             raise ValueError(f"splice: cloud of {n!r} is in frame {clouds[n].frame!r}; expected 'R'")
-    order = splice_order(images, names)
-    # Keep the clouds' shared camera tuple when they have one (indices stay valid), else index by name order.
     shared = {clouds[n].cameras for n in names}
     cameras = shared.pop() if len(shared) == 1 else names
-    if not set(names) <= set(cameras):
-        cameras = names
-    index = {n: cameras.index(n) for n in names}
+    return splice_order(images, names), cameras if set(names) <= set(cameras) else names
+
+
+def stacked(clouds: Mapping[str, Cloud], images: Mapping[str, DepthImage]) -> Cloud:
+    """Every non-empty camera cloud (frame R) concatenated in the splice order (:func:`splice_order`), as
+    calibrated: the cloud :func:`splice` registers, and its ``registered`` cloud when no correction is applied
+    (the same object then). :class:`SensorError` if every cloud is empty."""
+    order, cameras = _stack_order(clouds, images)
+    points = np.concatenate([np.asarray(clouds[n].points) for n in order])
+    camera = np.concatenate([np.full(len(clouds[n]), cameras.index(n), np.int16) for n in order])
+    return Cloud(points, "R", camera, cameras)
+
+
+def splice(
+    clouds: Mapping[str, Cloud],
+    images: Mapping[str, DepthImage],
+    X_WR: FloatArray,
+    spec: PerceptionSpec,
+    calibrated: Cloud | None = None,
+    on_correction: Callable[[str], None] | None = None,
+) -> Spliced:
+    """Splice per-camera clouds (frame R, from :func:`clouds_in_robot_frame`) into one in R (module docstring).
+
+    images : the captures the clouds came from (their mounts and calibrated poses X_WC, intrinsics fx).
+    calibrated : :func:`stacked` of the same clouds when the caller has it (made here otherwise).
+    on_correction : called with a camera's name as soon as its correction is applied (the registered cloud will
+    differ from ``calibrated``). Empty clouds are skipped; :class:`SensorError` if every cloud is empty.
+    """
+    order, cameras = _stack_order(clouds, images)
+    calibrated = stacked(clouds, images) if calibrated is None else calibrated
+    index = {n: cameras.index(n) for n in order}
     X_RW = invert(np.asarray(X_WR, dtype=np.float64))
     X_RC = {index[n]: X_RW @ images[n].X_WC for n in order}
     fx = {index[n]: images[n].intrinsics.fx for n in order}
-    points = np.concatenate([np.asarray(clouds[n].points) for n in order])
-    camera = np.concatenate([np.full(len(clouds[n]), index[n], np.int16) for n in order])
+    camera = calibrated.camera
     bounds = np.cumsum([0] + [len(clouds[n]) for n in order])
     eyes = {i: X[:3, 3] for i, X in X_RC.items()}
-    # The merge's normals are plane fits twice the voxel wide (a voxel-wide fit of 2-3 mm noise is as noisy as the
-    # depth) of the points as calibrated: a copy, as the registrations move them.
-    calibrated = points.copy()
-    registrations = _register_in_order(points, bounds, order, index, X_RC, spec)
-    registered = Cloud(points, "R", camera, cameras)
+    # The registrations move a copy; the merge's normals are plane fits twice the voxel wide (a voxel-wide fit of
+    # 2-3 mm noise is as noisy as the depth) of the points as calibrated.
+    points = np.array(calibrated.points)
+    registrations = _register_in_order(points, bounds, order, index, X_RC, spec, on_correction)
+    registered = Cloud(points, "R", camera, cameras) if any(r.accepted for r in registrations) else calibrated
 
     def merge() -> tuple[Cloud, dict[str, int]]:
-        normals = surface_normals(calibrated, camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
-        keep = prioritised_merge(points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
+        normals = surface_normals(calibrated.points, camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
+        keep = prioritised_merge(registered.points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
         kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}
         return registered.select(keep), kept
 
@@ -202,9 +225,11 @@ def _register_in_order(
     index: Mapping[str, int],
     X_RC: dict[int, FloatArray],
     spec: PerceptionSpec,
+    on_correction: Callable[[str], None] | None = None,
 ) -> list[Registration]:
     """Register each camera's points (``points[bounds[k]:bounds[k + 1]]``, cameras in ``order``) onto those of the
-    cameras before it; an accepted correction moves its points and its pose in ``X_RC`` (both in place)."""
+    cameras before it; an accepted correction moves its points and its pose in ``X_RC`` (both in place) and is
+    announced to ``on_correction``."""
     registrations = []
     for k, name in enumerate(order[1:], start=1):
         part = slice(bounds[k], bounds[k + 1])
@@ -232,6 +257,8 @@ def _register_in_order(
             )
         )
         if accepted:
+            if on_correction is not None:
+                on_correction(name)
             points[part] = transform_points(X_corr, points[part])
             X_RC[index[name]] = X_corr @ X_RC[index[name]]
     return registrations

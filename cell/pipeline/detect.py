@@ -11,6 +11,7 @@ from typing import Literal
 
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
+from cell.perception.align import Alignment
 from cell.perception.calibration import PoseUncertainty, with_calibration
 from cell.pipeline.evaluation import evaluate
 from cell.pipeline.progress import Progress, quiet
@@ -74,36 +75,39 @@ def build_scene(
 
     X_RM_nominal : where the map is believed to lie (default: the scenario's ``map.X_WM``; the turned part's pose
     on its second side); seed : a search of the cloud near it for a start the ICP can converge from."""
-    from cell.perception import align_map, check_alignment, perceive
+    from cell.perception import align_map, check_alignment
     from cell.perception.alignment_checks import cloud_tree_of
+    from cell.perception.perceive import perceive_then
 
     sc = cap.scenario
-    timings: dict[str, float] = {}
-    t = time.perf_counter()
-    progress("splicing point clouds")
-    perceived = perceive(cap.images, sc.X_WR, sc.perception, sc.perception.health)
-    timings["perceive_s"] = time.perf_counter() - t
+    X_RM_believed = invert(sc.X_WR) @ sc.X_WM if X_RM_nominal is None else X_RM_nominal
 
-    t = time.perf_counter()
-    progress("aligning the welding map to the cloud")
-    X_RM_nominal = invert(sc.X_WR) @ sc.X_WM if X_RM_nominal is None else X_RM_nominal
-    if seed is not None:
-        X_RM_nominal = seed(perceived.registered, X_RM_nominal)
-    weldmap_nominal_R = cap.weldmap.transformed(X_RM_nominal, "R")
+    def aligned(cloud: Cloud, proceed: Callable[[], None]) -> tuple[Alignment, FloatArray, WeldMap, dict[str, str]]:
+        """The map aligned to the registered cloud, and the checks of that fit (the stage after perception);
+        ``proceed()`` between the steps (it stops a moot speculation)."""
+        X_RM_start = X_RM_believed if seed is None else seed(cloud, X_RM_believed)
+        weldmap_nominal_R = cap.weldmap.transformed(X_RM_start, "R")
+        with ThreadPoolExecutor(max_workers=1) as beside:
+            # The checks' KD-tree of the cloud is built on the other core while the alignment's ICP runs on one
+            # (open3d's ICP and scipy's tree build both let go of the interpreter lock); it is the tree the checks
+            # would build.
+            tree = beside.submit(cloud_tree_of, cloud) if len(cloud) else None
+            alignment = align_map(weldmap_nominal_R, cloud, sc.perception, proceed)
+            proceed()
+            X_RM = alignment.X_RR_corr @ X_RM_start
+            weldmap_R = cap.weldmap.transformed(X_RM, "R")
+            # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is
+            # refused; parts that are simply not there are named, and their seams are never searched.
+            missing = check_alignment(weldmap_R, cloud, alignment, sc.perception, tree.result() if tree else None)
+        return alignment, X_RM, weldmap_R, missing
+
+    progress("splicing point clouds and aligning the welding map to them")
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
-    # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud.
-    cloud = perceived.registered
-    with ThreadPoolExecutor(max_workers=1) as beside:
-        # The checks' KD-tree of the cloud is built on the other core while the alignment's ICP runs on one (open3d's
-        # ICP and scipy's tree build both let go of the interpreter lock); it is the tree the checks would build.
-        tree = beside.submit(cloud_tree_of, cloud) if len(cloud) else None
-        alignment = align_map(weldmap_nominal_R, cloud, sc.perception)
-        X_RM = alignment.X_RR_corr @ X_RM_nominal
-        weldmap_R = cap.weldmap.transformed(X_RM, "R")
-        # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is refused;
-        # parts that are simply not there are named, and their seams are never searched.
-        missing = check_alignment(weldmap_R, cloud, alignment, sc.perception, tree.result() if tree else None)
-    timings["align_s"] = time.perf_counter() - t
+    # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud. The
+    # alignment starts beside the splice (perceive_then); the stage times split the wall where the cloud was ready.
+    done = perceive_then(cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned)
+    perceived, (alignment, X_RM, weldmap_R, missing) = done.perceived, done.answer
+    timings = {"perceive_s": done.cloud_s, "align_s": done.answer_s - done.cloud_s, "align_own_s": done.then_s}
 
     seam_scene = SeamScene(
         voxel=lambda: perceived.downsampled,  # the paper's merged cloud, made when a locator reads it

@@ -36,9 +36,10 @@ from cell.perception import (
     splice,
 )
 from cell.perception.merge import predicted_noise, prioritised_merge
+from cell.perception.perceive import perceive_then
 from cell.perception.preprocess import radius_outlier_mask, z_range_R
 from cell.perception.registration import register, registration_settings, significance
-from cell.perception.splice import MIN_SHIFT_M, REFUSALS, refusal, splice_order
+from cell.perception.splice import MIN_SHIFT_M, REFUSALS, refusal, splice_order, stacked
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
 
@@ -314,6 +315,34 @@ def test_splice_takes_out_a_real_miscalibration_and_applies_no_noise(mode: str) 
     before = np.linalg.norm(transform_points(ideal, p) - p, axis=1).mean()
     after = np.linalg.norm(transform_points(ideal, p) - transform_points(reg.X_corr, p), axis=1).mean()
     assert before > 0.0015 and after < (0.2 if mode == "robust" else 0.8) * before
+
+
+def test_perceive_then_answers_from_the_registered_cloud_with_or_without_a_correction() -> None:
+    """The next stage starts beside the splice on the cloud as calibrated; its answer is kept only when the
+    splice applies no correction, else it is made again from the corrected cloud (never from stale points)."""
+    images = _noisy_images((640, 480), 5)
+    seen: list[np.ndarray] = []
+
+    def then(cloud: Cloud, proceed: object) -> np.ndarray:
+        seen.append(np.array(cloud.points))
+        return np.array(cloud.points)
+
+    exact = perceive_then(images, X_WR, SPEC, None, then)
+    assert not any(r.accepted for r in exact.perceived.spliced.registrations)
+    assert len(seen) == 1  # the speculation was kept
+    np.testing.assert_array_equal(exact.answer, exact.perceived.registered.points)
+    assert 0.0 < exact.then_s <= exact.answer_s and 0.0 < exact.cloud_s <= exact.answer_s
+    X_err = make_pose(axis_angle_to_matrix([0.3, -1.0, 0.5], math.radians(0.1)), [0.0012, -0.0006, 0.0006])
+    left = images["cam_left"]
+    images["cam_left"] = DepthImage("cam_left", left.depth, left.intrinsics, left.X_WC @ X_err, left.mount)
+    seen.clear()
+    off = perceive_then(images, X_WR, SPEC, None, then)
+    assert any(r.accepted for r in off.perceived.spliced.registrations)
+    np.testing.assert_array_equal(off.answer, off.perceived.registered.points)
+    np.testing.assert_array_equal(off.perceived.registered.points, perceive(images, X_WR, SPEC).registered.points)
+    calibrated = stacked(clouds_in_robot_frame(images, X_WR, WORKSPACE), images)
+    assert len(off.answer) != len(calibrated) or not np.array_equal(off.answer, calibrated.points)
+    assert 1 <= len(seen) <= 2  # a speculation that had started before the correction was stopped or ignored
 
 
 # ----------------------------------------------------------------------------------------------- 3.4

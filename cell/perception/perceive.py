@@ -123,12 +123,12 @@ def perceive_then(
 ) -> PerceivedThen[T]:
     """:func:`perceive`, and ``then`` of its registered cloud (the caller's next stage: the map alignment).
 
-    The registered cloud is the calibrated one, point for point, unless the splice applies a correction (in a
-    calibrated cell it applies none). So its filters and ``then`` start on the calibrated cloud beside the
-    splice's registrations, on the other core, and are kept when no correction is applied; after one, they run
-    again on the registered cloud (an answer never depends on the speculation, only the wall time does).
-    ``then(cloud, proceed)`` must not depend on anything the splice decides but its cloud; it calls
-    ``proceed()`` between its steps, which stops a speculation that a correction has made moot (by raising).
+    The registered cloud is the calibrated cloud of the healthy cameras, point for point, unless a camera
+    disagrees with the others or the splice applies a correction (in a calibrated cell neither happens). So its
+    filters and ``then`` start on that guess, on the other core, beside the agreement check and the splice's
+    registrations, and are kept when the guess holds; else they run again on the registered cloud (an answer
+    never depends on the speculation, only the wall time does). ``then(cloud, proceed)`` must not depend on
+    anything but its cloud; it calls ``proceed()`` between its steps, which stops a moot speculation (by raising).
     """
     if not images:
         raise SensorError("no depth images to perceive from (no camera delivered one)")
@@ -146,19 +146,15 @@ def perceive_then(
         elif len(cloud) == 0:
             ws = spec.workspace
             why[name] = f"no point inside the workspace {ws.min_m}..{ws.max_m} m (looking elsewhere, or covered)"
-    why.update(disagreeing_cameras({n: c for n, c in clouds.items() if n not in why}, health))
-    for name in why:
-        clouds[name] = clouds[name].select(np.zeros(len(clouds[name]), dtype=bool))
-    lost = tuple(name for name in clouds if name in why)
-    timings["clouds"] = time.perf_counter() - t
-    if len(lost) == len(clouds):
-        raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in lost), lost=why)
-    usable = {n: c for n, c in clouds.items() if n not in lost}
-    calibrated = stacked(usable, images)
-    corrected = threading.Event()
+    if len(why) == len(clouds):
+        raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in clouds), lost=why)
+    # The guess: no camera disagrees with the others (the check below runs beside the work that starts on it).
+    guessed = tuple(n for n in clouds if n not in why)
+    guess = stacked({n: clouds[n] for n in guessed}, images)
+    moot = threading.Event()  # set when the guess cannot be the registered cloud
 
     def onward(cloud: Cloud) -> tuple[Cloud, VoxelTable, T, dict[str, float], dict[str, float]]:
-        """The registered cloud's filters and voxel order, then ``then`` (unless a correction made it moot)."""
+        """The registered cloud's filters and voxel order, then ``then`` (unless the guess turned out moot)."""
         timings: dict[str, float] = {}
         stamps: dict[str, float] = {}
         t = time.perf_counter()
@@ -172,7 +168,7 @@ def perceive_then(
         stamps["filtered"] = time.perf_counter()
 
         def proceed() -> None:
-            if cloud is calibrated and corrected.is_set():
+            if cloud is guess and moot.is_set():
                 raise _SupersededError
 
         proceed()
@@ -184,12 +180,23 @@ def perceive_then(
 
     beside = ThreadPoolExecutor(max_workers=1)
     try:
-        ahead = beside.submit(onward, calibrated)
+        ahead = beside.submit(onward, guess)
+        why.update(disagreeing_cameras({n: c for n, c in clouds.items() if n not in why}, health))
+        for name in why:
+            clouds[name] = clouds[name].select(np.zeros(len(clouds[name]), dtype=bool))
+        lost = tuple(name for name in clouds if name in why)
+        timings["clouds"] = time.perf_counter() - t
+        if len(lost) == len(clouds):
+            raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in lost), lost=why)
+        usable = {n: c for n, c in clouds.items() if n not in lost}
+        calibrated = guess if set(usable) == set(guessed) else stacked(usable, images)
+        if calibrated is not guess:
+            moot.set()
         t = time.perf_counter()
-        spliced = splice(usable, images, X_WR, spec, calibrated, lambda name: corrected.set())
+        spliced = splice(usable, images, X_WR, spec, calibrated, lambda name: moot.set())
         timings["splice"] = time.perf_counter() - t
         spliced_at = time.perf_counter()
-        if spliced.registered is calibrated:
+        if spliced.registered is guess:
             registered, registered_voxels, answer, onward_timings, stamps = ahead.result()
         else:
             registered, registered_voxels, answer, onward_timings, stamps = onward(spliced.registered)

@@ -107,7 +107,7 @@ def build_scene(
     # alignment starts beside the splice (perceive_then); the stage times split the wall where the cloud was ready.
     done = perceive_then(cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned)
     perceived, (alignment, X_RM, weldmap_R, missing) = done.perceived, done.answer
-    timings = {"perceive_s": done.cloud_s, "align_s": done.answer_s - done.cloud_s, "align_own_s": done.then_s}
+    timings = {"perceive_s": done.cloud_s, "align_s": done.answer_s - done.cloud_s}
 
     seam_scene = SeamScene(
         voxel=lambda: perceived.downsampled,  # the paper's merged cloud, made when a locator reads it

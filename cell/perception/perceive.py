@@ -134,18 +134,7 @@ def perceive_then(
         raise SensorError("no depth images to perceive from (no camera delivered one)")
     timings: dict[str, float] = {}
     t0 = t = time.perf_counter()
-    why: dict[str, str] = {}
-    for name, image in images.items():
-        verdict = image_health(image, health)
-        if not verdict.ok:
-            why[name] = verdict.reason
-    clouds = clouds_in_robot_frame(images, X_WR, spec.workspace)
-    for name, cloud in clouds.items():
-        if name in why:
-            clouds[name] = cloud.select(np.zeros(len(cloud), dtype=bool))
-        elif len(cloud) == 0:
-            ws = spec.workspace
-            why[name] = f"no point inside the workspace {ws.min_m}..{ws.max_m} m (looking elsewhere, or covered)"
+    clouds, why = _camera_clouds(images, X_WR, spec, health)
     if len(why) == len(clouds):
         raise SensorError("no usable camera: " + "; ".join(f"{n}: {why[n]}" for n in clouds), lost=why)
     # The guess: no camera disagrees with the others (the check below runs beside the work that starts on it).
@@ -227,6 +216,26 @@ def perceive_then(
     )
     cloud_s = max(spliced_at, stamps["filtered"]) - t0
     return PerceivedThen(perceived, answer, cloud_s, max(spliced_at, stamps["answered"]) - t0, stamps["then_s"])
+
+
+def _camera_clouds(
+    images: Mapping[str, DepthImage], X_WR: FloatArray, spec: PerceptionSpec, health: HealthOptions | None
+) -> tuple[dict[str, Cloud], dict[str, str]]:
+    """Each camera's cropped cloud in R, and the cameras lost so far (name -> reason): an implausible image, or
+    no point inside the workspace. A lost camera's cloud is empty."""
+    why: dict[str, str] = {}
+    for name, image in images.items():
+        verdict = image_health(image, health)
+        if not verdict.ok:
+            why[name] = verdict.reason
+    clouds = clouds_in_robot_frame(images, X_WR, spec.workspace)
+    for name, cloud in clouds.items():
+        if name in why:
+            clouds[name] = cloud.select(np.zeros(len(cloud), dtype=bool))
+        elif len(cloud) == 0:
+            ws = spec.workspace
+            why[name] = f"no point inside the workspace {ws.min_m}..{ws.max_m} m (looking elsewhere, or covered)"
+    return clouds, why
 
 
 class PerceivedThen(NamedTuple, Generic[T]):

@@ -190,7 +190,8 @@ def perceive_then(
         else:
             registered, registered_voxels, answer, onward_timings, stamps = onward(spliced.registered)
     finally:
-        beside.shutdown(wait=False, cancel_futures=True)  # a moot speculation is left to end on its own
+        moot.set()  # whatever the speculation still does, nobody reads it now (an error, or it is done)
+        beside.shutdown(wait=False, cancel_futures=True)  # it stops at its next step or ends on its own
     timings |= onward_timings
     X_RW = invert(np.asarray(X_WR, dtype=float))
     origins_R = {name: (X_RW @ np.asarray(image.X_WC, dtype=float))[:3, 3] for name, image in images.items()}
@@ -256,4 +257,4 @@ class PerceivedThen(NamedTuple, Generic[T]):
 
 
 class _SupersededError(Exception):
-    """A speculation on the calibrated cloud after the splice applied a correction (nobody reads its answer)."""
+    """A speculation on the guess after a camera was lost or a correction applied (nobody reads its answer)."""

@@ -42,6 +42,7 @@ from cell.perception.registration import register, registration_settings, signif
 from cell.perception.splice import MIN_SHIFT_M, REFUSALS, refusal, splice_order, stacked
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
+from cell.voxels import voxel_order
 
 TABLE_Z = 0.90  # table top in W [m]
 X_WR = make_pose(p=[0.15, -1.1, 1.9])  # the paper's robot base (eq. 3)
@@ -340,8 +341,10 @@ def test_perceive_then_answers_from_the_registered_cloud_with_or_without_a_corre
     assert any(r.accepted for r in off.perceived.spliced.registrations)
     np.testing.assert_array_equal(off.answer, off.perceived.registered.points)
     np.testing.assert_array_equal(off.perceived.registered.points, perceive(images, X_WR, SPEC).registered.points)
-    calibrated = stacked(clouds_in_robot_frame(images, X_WR, WORKSPACE), images)
-    assert len(off.answer) != len(calibrated) or not np.array_equal(off.answer, calibrated.points)
+    # ... and not the guess's answer: the calibrated cloud, filtered and ordered as the speculation had it.
+    guess = preprocess(stacked(clouds_in_robot_frame(images, X_WR, WORKSPACE), images), WORKSPACE, X_WR, SPEC)
+    stale = voxel_order(guess, SPEC.voxel_m)[0].points
+    assert off.answer.shape != stale.shape or not np.array_equal(off.answer, stale)
     assert 1 <= len(seen) <= 2  # a speculation that had started before the correction was stopped or ignored
 
 

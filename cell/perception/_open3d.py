@@ -5,11 +5,20 @@ module, and without the package's ``__init__`` (which pulls in its visualization
 --help`` and the numpy-only stages stay instant, and the first ICP pays 0.3 s, not 0.9 s. Every function takes
 and returns plain numpy arrays (points ``(n, 3)`` float64 [m], poses ``(4, 4)``); open3d objects never leave
 this module.
+
+open3d's thread count is one setting for the whole process (``utility.set_max_threads``), read by each of its
+parallel loops as it starts. An ICP must run on one thread (:func:`icp`); the other calls here give the same
+answer on any number of threads. So the setting stays at one from the load on, and a call whose answer does not
+depend on it runs on every core while no ICP is in flight (:func:`_every_core`). Two ICPs on two threads of the
+cell (the map alignment beside the splice, :func:`cell.perception.perceive.perceive_then`) then run side by side;
+they used to take turns on a lock around the setting.
 """
 
 from __future__ import annotations
 
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -20,7 +29,8 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 
-_ONE_THREAD = threading.Lock()  # held while an ICP runs open3d on one thread (icp)
+_SETTING = threading.Lock()  # guards open3d's thread setting and the count of ICPs in flight
+_in_flight = {"icps": 0}  # ICPs running now (each on one thread)
 
 
 @cache
@@ -59,7 +69,40 @@ def _o3d() -> Any:
                 raise
     # open3d prints warnings on stdout; the cell reports through returned values instead.
     core.utility.set_verbosity_level(core.utility.VerbosityLevel.Error)
+    _cores.append(core.utility.get_max_threads())  # open3d's default: every core
+    core.utility.set_max_threads(1)  # see the module docstring
     return core
+
+
+_cores: list[int] = []  # open3d's default thread count, read once at the load
+
+
+@contextmanager
+def _one_thread() -> Iterator[None]:
+    """Held around an ICP: open3d stays on one thread until it ends (other ICPs may run meanwhile)."""
+    with _SETTING:
+        _in_flight["icps"] += 1
+    try:
+        yield
+    finally:
+        with _SETTING:
+            _in_flight["icps"] -= 1
+
+
+@contextmanager
+def _every_core() -> Iterator[None]:
+    """Held around a call whose answer does not depend on the thread count: every core while no ICP is in flight
+    (an ICP asked for meanwhile waits until the call ends), else one thread, as the ICP needs."""
+    o3d = _o3d()
+    with _SETTING:
+        if _in_flight["icps"] == 0:
+            o3d.utility.set_max_threads(_cores[0])
+            try:
+                yield
+            finally:
+                o3d.utility.set_max_threads(1)
+            return
+    yield
 
 
 def _array(a: npt.ArrayLike, dtype: type = np.float64) -> npt.NDArray:
@@ -127,15 +170,9 @@ def icp(
     X0 = np.eye(4) if init is None else _array(init)
     src, tgt = _legacy_cloud(source), _legacy_cloud(target, target_normals)
     # On one thread: open3d sums the normal equations over its threads in an order that changes from run to run, so
-    # the same clouds gave poses up to 11 um apart (the bracket's thin plates); one thread gives one answer. The
-    # setting is open3d's, for every thread of the process: one ICP at a time sets and restores it.
-    with _ONE_THREAD:
-        threads = _o3d().utility.get_max_threads()
-        _o3d().utility.set_max_threads(1)
-        try:
-            X = reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations))
-        finally:
-            _o3d().utility.set_max_threads(threads)
+    # the same clouds gave poses up to 11 um apart (the bracket's thin plates); one thread gives one answer.
+    with _one_thread():
+        X = reg.registration_icp(src, tgt, float(max_correspondence_m), X0, method, _criteria(iterations))
     return _result(X)
 
 
@@ -144,7 +181,9 @@ def estimate_normals(points: npt.ArrayLike, radius_m: float, max_neighbours: int
     most the ``max_neighbours`` nearest): open3d's ``estimate_normals`` with a hybrid KD-tree search."""
     o3d = _o3d()
     pc = _legacy_cloud(points)
-    pc.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=float(radius_m), max_nn=int(max_neighbours)))
+    # open3d holds the interpreter lock throughout (the cell's other threads wait): on every core it is over soonest.
+    with _every_core():
+        pc.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=float(radius_m), max_nn=int(max_neighbours)))
     return np.asarray(pc.normals, dtype=np.float64).reshape(-1, 3)
 
 
@@ -155,9 +194,9 @@ def correspondences(
     the source points that have one within ``max_correspondence_m`` [m] (open3d's ``evaluate_registration``)."""
     o3d = _o3d()
     X = np.eye(4) if X_TS is None else _array(X_TS)
-    r = o3d.pipelines.registration.evaluate_registration(
-        _legacy_cloud(source), _legacy_cloud(target), float(max_correspondence_m), X
-    )
+    src, tgt = _legacy_cloud(source), _legacy_cloud(target)
+    with _every_core():
+        r = o3d.pipelines.registration.evaluate_registration(src, tgt, float(max_correspondence_m), X)
     return np.asarray(r.correspondence_set, dtype=np.intp).reshape(-1, 2)
 
 
@@ -167,9 +206,9 @@ def evaluate(
     """(fitness, inlier RMSE [m]) of ``source`` moved by X_TS against ``target``, point-to-point."""
     o3d = _o3d()
     X = np.eye(4) if X_TS is None else _array(X_TS)
-    r = o3d.pipelines.registration.evaluate_registration(
-        _legacy_cloud(source), _legacy_cloud(target), float(max_correspondence_m), X
-    )
+    src, tgt = _legacy_cloud(source), _legacy_cloud(target)
+    with _every_core():
+        r = o3d.pipelines.registration.evaluate_registration(src, tgt, float(max_correspondence_m), X)
     return float(r.fitness), float(r.inlier_rmse)
 
 
@@ -180,7 +219,9 @@ def radius_outlier_mask(points: npt.ArrayLike, radius_m: float, min_neighbours: 
     if len(pts) == 0:
         return keep
     # open3d keeps a point when its neighbour count *including itself* exceeds nb_points.
-    _, index = _legacy_cloud(pts).remove_radius_outlier(nb_points=int(min_neighbours), radius=float(radius_m))
+    cloud = _legacy_cloud(pts)
+    with _every_core():
+        _, index = cloud.remove_radius_outlier(nb_points=int(min_neighbours), radius=float(radius_m))
     keep[np.asarray(index, dtype=np.intp)] = True
     return keep
 
@@ -189,8 +230,9 @@ def neighbour_counts(points: npt.ArrayLike, queries: npt.ArrayLike, radius_m: fl
     """(q,) number of ``points`` (n, 3) within ``radius_m`` of each of ``queries`` (q, 3), itself included."""
     o3d = _o3d()
     nns = o3d.core.nns.NearestNeighborSearch(o3d.core.Tensor(_array(points)))
-    nns.fixed_radius_index(float(radius_m))
-    _, _, splits = nns.fixed_radius_search(o3d.core.Tensor(_array(queries)), float(radius_m))
+    with _every_core():
+        nns.fixed_radius_index(float(radius_m))
+        _, _, splits = nns.fixed_radius_search(o3d.core.Tensor(_array(queries)), float(radius_m))
     return np.diff(splits.numpy()).astype(np.int64)
 
 
@@ -236,21 +278,22 @@ def fpfh_ransac(
     o3d.utility.random.seed(int(seed))
     src, tgt = _legacy_cloud(source, source_normals), _legacy_cloud(target, target_normals)
     search = o3d.geometry.KDTreeSearchParamHybrid(radius=5.0 * float(voxel_m), max_nn=100)
-    f_src = reg.compute_fpfh_feature(src, search)
-    f_tgt = reg.compute_fpfh_feature(tgt, search)
     distance = 1.5 * float(voxel_m)
-    result = reg.registration_ransac_based_on_feature_matching(
-        src,
-        tgt,
-        f_src,
-        f_tgt,
-        True,
-        distance,
-        reg.TransformationEstimationPointToPoint(False),
-        3,
-        [reg.CorrespondenceCheckerBasedOnEdgeLength(0.9), reg.CorrespondenceCheckerBasedOnDistance(distance)],
-        reg.RANSACConvergenceCriteria(int(iterations), 0.999),
-    )
+    with _every_core():
+        f_src = reg.compute_fpfh_feature(src, search)
+        f_tgt = reg.compute_fpfh_feature(tgt, search)
+        result = reg.registration_ransac_based_on_feature_matching(
+            src,
+            tgt,
+            f_src,
+            f_tgt,
+            True,
+            distance,
+            reg.TransformationEstimationPointToPoint(False),
+            3,
+            [reg.CorrespondenceCheckerBasedOnEdgeLength(0.9), reg.CorrespondenceCheckerBasedOnDistance(distance)],
+            reg.RANSACConvergenceCriteria(int(iterations), 0.999),
+        )
     return np.array(result.transformation)
 
 

@@ -8,10 +8,11 @@ this module.
 
 open3d's thread count is one setting for the whole process (``utility.set_max_threads``), read by each of its
 parallel loops as it starts. An ICP must run on one thread (:func:`icp`); the other calls here give the same
-answer on any number of threads. So the setting stays at one from the load on, and a call whose answer does not
-depend on it runs on every core while no ICP is in flight (:func:`_every_core`). Two ICPs on two threads of the
-cell (the map alignment beside the splice, :func:`cell.perception.perceive.perceive_then`) then run side by side;
-they used to take turns on a lock around the setting.
+answer on any number of threads (RANSAC's varies with the threads' timing on any number of them). So the setting
+stays at one from the load on, and a call whose answer does not depend on it runs on every core while no ICP is in
+flight (:func:`_every_core`). Two ICPs on two threads of the cell (the map alignment beside the splice,
+:func:`cell.perception.perceive.perceive_then`) then run side by side; they used to take turns on a lock around
+the setting.
 """
 
 from __future__ import annotations
@@ -185,31 +186,6 @@ def estimate_normals(points: npt.ArrayLike, radius_m: float, max_neighbours: int
     with _every_core():
         pc.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=float(radius_m), max_nn=int(max_neighbours)))
     return np.asarray(pc.normals, dtype=np.float64).reshape(-1, 3)
-
-
-def correspondences(
-    source: npt.ArrayLike, target: npt.ArrayLike, max_correspondence_m: float, X_TS: FloatArray | None = None
-) -> npt.NDArray[np.intp]:
-    """(k, 2) index pairs (source, target): each source point moved by X_TS with its nearest target point, for
-    the source points that have one within ``max_correspondence_m`` [m] (open3d's ``evaluate_registration``)."""
-    o3d = _o3d()
-    X = np.eye(4) if X_TS is None else _array(X_TS)
-    src, tgt = _legacy_cloud(source), _legacy_cloud(target)
-    with _every_core():
-        r = o3d.pipelines.registration.evaluate_registration(src, tgt, float(max_correspondence_m), X)
-    return np.asarray(r.correspondence_set, dtype=np.intp).reshape(-1, 2)
-
-
-def evaluate(
-    source: npt.ArrayLike, target: npt.ArrayLike, max_correspondence_m: float, X_TS: FloatArray | None = None
-) -> tuple[float, float]:
-    """(fitness, inlier RMSE [m]) of ``source`` moved by X_TS against ``target``, point-to-point."""
-    o3d = _o3d()
-    X = np.eye(4) if X_TS is None else _array(X_TS)
-    src, tgt = _legacy_cloud(source), _legacy_cloud(target)
-    with _every_core():
-        r = o3d.pipelines.registration.evaluate_registration(src, tgt, float(max_correspondence_m), X)
-    return float(r.fitness), float(r.inlier_rmse)
 
 
 def radius_outlier_mask(points: npt.ArrayLike, radius_m: float, min_neighbours: int) -> npt.NDArray[np.bool_]:

@@ -30,8 +30,18 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 
-_SETTING = threading.Lock()  # guards open3d's thread setting and the count of ICPs in flight
-_in_flight = {"icps": 0}  # ICPs running now (each on one thread)
+
+class _ThreadSetting:
+    """open3d's thread setting as the cell uses it (module docstring): ``lock`` guards the setting and ``icps``, the
+    ICPs in flight; ``cores`` is open3d's default count (every core), read at the load."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.icps = 0
+        self.cores = 1
+
+
+_THREADS = _ThreadSetting()
 
 
 @cache
@@ -70,24 +80,21 @@ def _o3d() -> Any:
                 raise
     # open3d prints warnings on stdout; the cell reports through returned values instead.
     core.utility.set_verbosity_level(core.utility.VerbosityLevel.Error)
-    _cores.append(core.utility.get_max_threads())  # open3d's default: every core
+    _THREADS.cores = core.utility.get_max_threads()
     core.utility.set_max_threads(1)  # see the module docstring
     return core
-
-
-_cores: list[int] = []  # open3d's default thread count, read once at the load
 
 
 @contextmanager
 def _one_thread() -> Iterator[None]:
     """Held around an ICP: open3d stays on one thread until it ends (other ICPs may run meanwhile)."""
-    with _SETTING:
-        _in_flight["icps"] += 1
+    with _THREADS.lock:
+        _THREADS.icps += 1
     try:
         yield
     finally:
-        with _SETTING:
-            _in_flight["icps"] -= 1
+        with _THREADS.lock:
+            _THREADS.icps -= 1
 
 
 @contextmanager
@@ -95,9 +102,9 @@ def _every_core() -> Iterator[None]:
     """Held around a call whose answer does not depend on the thread count: every core while no ICP is in flight
     (an ICP asked for meanwhile waits until the call ends), else one thread, as the ICP needs."""
     o3d = _o3d()
-    with _SETTING:
-        if _in_flight["icps"] == 0:
-            o3d.utility.set_max_threads(_cores[0])
+    with _THREADS.lock:
+        if _THREADS.icps == 0:
+            o3d.utility.set_max_threads(_THREADS.cores)
             try:
                 yield
             finally:

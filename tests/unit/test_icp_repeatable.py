@@ -39,7 +39,7 @@ def test_open3d_stays_on_one_thread_while_an_icp_is_in_flight_and_uses_every_cor
     o3d = _open3d._o3d()
     assert o3d.utility.get_max_threads() == 1  # from the load on
     with _open3d._every_core():
-        assert o3d.utility.get_max_threads() == _open3d._cores[0]
+        assert o3d.utility.get_max_threads() == _open3d._THREADS.cores
     assert o3d.utility.get_max_threads() == 1
     with _open3d._one_thread(), _open3d._every_core():  # an ICP in flight on another of the cell's threads
         assert o3d.utility.get_max_threads() == 1
@@ -56,4 +56,4 @@ def test_icps_and_normals_on_two_threads_give_the_poses_they_give_alone() -> Non
         fits = [pool.submit(_open3d.estimate_normals, source, 0.02, 50) for _ in range(4)]
         assert all(np.array_equal(f.result().X_TS, alone) for f in icps)
         assert all(np.array_equal(f.result(), normals_alone) for f in fits)
-    assert _open3d._o3d().utility.get_max_threads() == 1 and _open3d._in_flight["icps"] == 0
+    assert _open3d._o3d().utility.get_max_threads() == 1 and _open3d._THREADS.icps == 0

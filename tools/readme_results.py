@@ -19,7 +19,9 @@ Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->``
   ``tools/readme_cell_tables.py``;
 - ``weldments``, ``weldments-bench``: the parts that are not boxes, welded whole (``weldments.json`` by
   ``benchmarks/bench_cell.py weld --scenarios brace,bracket,rhs``) and their Table 1 rows (``weldments-bench.json``
-  by ``cell bench brace bracket rhs``).
+  by ``cell bench brace bracket rhs``);
+- ``trust``: the trust benchmark on random cells, one row per stage (``trust.json`` by
+  ``benchmarks/bench_trust.py``), each stage's command under the table.
 
 The Table 1 blocks are :func:`cell.bench.markdown_table` of the rows, the renderer that also writes
 ``benchmarks/results/*.md``; the scaling block is the README's one-line-per-scenario summary of
@@ -153,6 +155,58 @@ def weld(results: Path) -> str:
     return cell_tables.weld_table(_load(results, "weld.json")[0])
 
 
+def _pct(v: float | None) -> str:
+    return "-" if v is None else f"{v:.0%}"
+
+
+def _num(v: float | int | None, fmt: str = ".2f") -> str:
+    return "-" if v is None else format(v, fmt)
+
+
+def _dist(d: Mapping[str, Any]) -> str:
+    return f"{_num(d['p95'])} / {_num(d['max'])}"
+
+
+def trust_table(data: Mapping[str, Any]) -> str:
+    """One row per stage of ``trust.json`` (docs/trust.md, "The trust benchmark"), a dash where the report had no
+    such figure; under the table, each stage's command, commit and time."""
+    lines = [
+        "| stage | cells (failed) | visible seams | located | re-scanned | refused: reasons "
+        "| lateral p95 / max [mm] | ends p95 / max [mm] | within 2 sigma across | ends within 2 end sigmas "
+        "| splice corrections, exact cameras | welded | worst welded TCP max [mm] | beads > 1 mm off a joint's end |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    notes = []
+    for stage in ("detect", "weld"):
+        b = data.get(stage)
+        if b is None:
+            continue
+        reasons = ", ".join(f"{k} {v}" for k, v in b["refused_reasons"].items())
+        lines.append(
+            f"| {stage} | {b['cells']} ({b['cells_failed']}) | {b['seams_visible']} | {_pct(b['located_share'])} "
+            f"| {_pct(b.get('rescanned_share'))} | {_pct(b['refused_share'])}{': ' + reasons if reasons else ''} "
+            f"| {_dist(b['lateral_mm'])} | {_dist(b['end_mm'])} | {_pct(b['coverage_2sigma_across'])} "
+            f"| {_pct(b['coverage_2sigma_ends'])} | {_num(b['splice_corrections_exact'], 'd')} "
+            f"in {b['cells_exact']} cells | {_pct(b.get('welded_share'))} "
+            f"| {_num(b.get('worst_welded_tcp_max_mm'))} | {_num(b.get('beads_past_end'), 'd')} |"
+        )
+        w = b["cell_wall_s"]
+        notes.append(
+            f"- {stage}: `{b['command']}` (commit {b['commit'][:12]}; {b['cells_run_now']} of the {b['cells']} "
+            f"cells run in the last sitting, {b['wall_s'] / 60.0:.1f} min on {b['workers']} workers; per cell "
+            f"{_num(w['median'], '.1f')} s median, {_num(w['max'], '.1f')} s max)"
+        )
+    if not notes:
+        return "Not run yet: `.venv/bin/python benchmarks/bench_trust.py --cells 200 --seed 0 --stage detect`.\n"
+    return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n"
+
+
+def trust(results: Path) -> str:
+    """The trust benchmark's table (``trust.json``; not run yet when the file is missing)."""
+    path = results / "trust.json"
+    return trust_table(_load_object(results, "trust.json") if path.exists() else {})
+
+
 BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "table1": table1,
     "table1-noise-none": table1_noise_none,
@@ -168,6 +222,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "real-scans": lambda results: cell_tables.real_scans_table(_load_object(results, "real_scans.json")),
     "weldments": lambda results: cell_tables.weldments_table(_load(results, "weldments.json")),
     "weldments-bench": lambda results: markdown_table(_load(results, "weldments-bench.json")),
+    "trust": trust,
 }
 
 

@@ -167,3 +167,17 @@ def test_a_rerun_runs_only_the_cells_not_yet_stored(
     # the same store for other cells is refused (the option named), not mixed
     with pytest.raises(UsageError, match="--store"):
         bench.open_cells(store, bench.store_params("detect", 4, "random", ["fence1"], None), False)
+
+
+def test_the_readme_table_shows_a_dash_where_the_report_had_no_figure(tm: ModuleType) -> None:
+    from tools_loader import load_tool
+
+    blk = tm.block(
+        [{**tm.cell_record(_report([_seam()]), "detect"), "cell": 0, "error": None, "wall_s": 2.0}], "detect"
+    )
+    blk.update(command="bench_trust.py --cells 1 --stage detect", commit="0" * 40, cells_run_now=1, wall_s=2.0)
+    blk["workers"] = 1
+    text = load_tool("readme_results").trust_table({"detect": blk})
+    row = text.splitlines()[2].split(" | ")
+    assert row[0] == "| detect" and row[8] == "100%" and row[9] == "-"  # across covered; no end sigma: a dash
+    assert "`bench_trust.py --cells 1 --stage detect`" in text and "weld |" not in text

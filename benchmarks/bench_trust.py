@@ -37,7 +37,7 @@ import trust_metrics as tm  # noqa: E402
 
 from cell.errors import UsageError  # noqa: E402
 from cell.export.report import write_json  # noqa: E402
-from cell.provenance import git_commit, sha256_file  # noqa: E402
+from cell.provenance import git_commit  # noqa: E402
 from cell.sweep.store import RunStore, open_store, params_key  # noqa: E402
 
 RESULTS = BENCH / "results"
@@ -64,7 +64,7 @@ def store_params(stage: str, seed: int, kind: str, scenarios: Sequence[str], met
         "kind": kind,
         "scenarios": list(scenarios),
         "method": method,
-        "generator_sha256": None if scenarios else sha256_file(tc.generator_path()),
+        "generator_sha256": None if scenarios else tc.generator_sha256(),
     }
 
 

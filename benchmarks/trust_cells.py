@@ -11,6 +11,7 @@ lies. Every figure is read from that report (:mod:`trust_metrics`). A cell never
 
 from __future__ import annotations
 
+import hashlib
 import json
 import sys
 import time
@@ -55,8 +56,12 @@ def generator() -> Any:
     return random_cells
 
 
-def generator_path() -> Path:
-    return TOOLS / "random_cells.py"
+def generator_sha256() -> str:
+    """One digest of the generator's files (``tools/random_cell*.py``): another digest, other cells."""
+    h = hashlib.sha256()
+    for path in sorted(TOOLS.glob("random_cell*.py")):
+        h.update(path.name.encode() + b"\0" + path.read_bytes())
+    return h.hexdigest()
 
 
 def _scenario(job: CellJob) -> tuple[Any, str]:

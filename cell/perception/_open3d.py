@@ -42,11 +42,19 @@ class _ThreadSetting:
 
 
 _THREADS = _ThreadSetting()
+_LOADING = threading.Lock()  # the first load, once: a second thread waits for the whole core, never half of it
+
+
+def _o3d() -> Any:
+    """open3d's compiled core (``open3d.pybind``: geometry, pipelines, core, io, utility, t), loaded on first use;
+    threads that ask for it at once get it when it is whole (:func:`_load`)."""
+    with _LOADING:
+        return _load()
 
 
 @cache
-def _o3d() -> Any:
-    """open3d's compiled core (``open3d.pybind``: geometry, pipelines, core, io, utility, t), loaded on first use.
+def _load() -> Any:
+    """Load open3d's compiled core (called under ``_LOADING``).
 
     ``import open3d`` runs the package's ``__init__``, which imports ``open3d.visualization`` and through it
     dash and plotly: 0.9 s on the 2-core bench machine, of which the compiled core is 0.3 s. The core is one

@@ -2,16 +2,16 @@
 hold (docs/trust.md, "The trust benchmark")?
 
     .venv/bin/python benchmarks/bench_trust.py --cells N --seed S --stage detect|weld [--workers K] [--out PATH]
-        [--fresh] [--store DIR] [--kind random] [--scenarios fence1,brace,...] [--method NAME]
+        [--fresh] [--retry-failed] [--store DIR] [--kind random] [--scenarios fence1,brace,...] [--method NAME]
 
 Cell k is made by ``tools/random_cells.py`` from its own seed (:func:`trust_cells.cell_seed` of S and k), or, with
 ``--scenarios``, is the k-th of those public scenarios in turn, run with that seed. ``detect`` runs what ``cell
 detect --json`` runs on it, ``weld`` what ``cell weld --sides first --json`` runs, and every figure is read from
 that report (:mod:`trust_metrics`). Cells run on a pool of K processes (default 2); each finished cell is stored
 at once (``--store``, default ``runs/trust/<stage>-seed<S>-<key>/``, one line per cell: :mod:`cell.sweep.store`),
-so a rerun runs only the cells not yet done (``--fresh``: all again). The figures over the cells 0 .. N-1 go to
-``--out`` (default ``benchmarks/results/trust.json``) as the block of the stage, beside the other stage's block;
-``tools/readme_results.py`` renders the README's table from it.
+so a rerun runs only the cells not yet done (``--fresh``: all again; ``--retry-failed``: also those that failed).
+The figures over the cells 0 .. N-1 go to ``--out`` (default ``benchmarks/results/trust.json``) as the block of
+the stage, beside the other stage's block; ``tools/readme_results.py`` renders the README's table from it.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ import trust_metrics as tm  # noqa: E402
 from cell.errors import UsageError  # noqa: E402
 from cell.export.report import write_json  # noqa: E402
 from cell.provenance import git_commit  # noqa: E402
-from cell.sweep.store import RunStore, open_store, params_key  # noqa: E402
+from cell.sweep.store import RUNS, RunStore, dumps, open_store, params_key  # noqa: E402
 
 RESULTS = BENCH / "results"
 STORE = tc.REPO / "runs" / "trust"  # git ignores runs/
@@ -75,6 +75,16 @@ def open_cells(store_dir: Path | None, params: dict[str, Any], fresh: bool) -> R
         return open_store(out, params, fresh=fresh, warn=_say)
     except UsageError as e:
         raise UsageError(e.message.replace("--out", "--store")) from None
+
+
+def drop_failed(store: RunStore) -> list[int]:
+    """Forget the stored cells that failed (their lines cut from the store's file), so they run again."""
+    failed = sorted(k for k, ln in store.lines.items() if ln.get("error") is not None)
+    for k in failed:
+        del store.lines[k]
+    if failed:
+        (store.out / RUNS).write_text("".join(dumps(ln) + "\n" for ln in store.lines.values()), encoding="utf-8")
+    return failed
 
 
 def _alone(job: tc.CellJob) -> Result:
@@ -178,6 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=2, help="cells run at once, one process each")
     ap.add_argument("--out", type=Path, default=RESULTS / "trust.json", help="the results file")
     ap.add_argument("--fresh", action="store_true", help="run every cell again (the store emptied)")
+    ap.add_argument("--retry-failed", action="store_true", help="run the stored cells that failed again")
     ap.add_argument("--store", type=Path, default=None, help="the folder of the cells' lines and files")
     ap.add_argument("--kind", default="random", help="the generator's kind of cell")
     ap.add_argument("--scenarios", default="", help="comma-separated public scenarios instead of random cells")
@@ -192,6 +203,8 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as e:
         print(f"error: {e.message}", file=sys.stderr)
         return e.exit_code
+    if args.retry_failed and (again := drop_failed(store)):
+        _say(f"cells {', '.join(map(str, again))} failed before: run again")
     todo = [k for k in range(args.cells) if k not in store.lines]
     _say(f"{store.out}: {args.cells - len(todo)} of {args.cells} cells done, {len(todo)} to run")
     jobs = [

@@ -139,10 +139,12 @@ def test_splice_corrections_are_counted_apart_for_exact_and_perturbed_cameras(tm
     assert [r["splice_applied"] for r in blk["rows"]] == [1, 1, 0, None]
 
 
-def _fake_run_cell(calls: list[int], tm: ModuleType) -> Any:
+def _fake_run_cell(calls: list[int], tm: ModuleType, fail: int | None = None) -> Any:
     def run_cell(job: Any) -> dict[str, Any]:
         calls.append(job.k)
         line = {"run": job.k, "cell": job.k, "cell_seed": job.cell_seed, "scenario": job.scenario, "error": None}
+        if job.k == fail and calls.count(job.k) == 1:  # fails the first time only
+            return {"line": {**line, "error": {"type": "RuntimeError", "message": "x", "exit_code": 1}}}
         return {"line": {**line, **tm.cell_record(_report([_seam()]), job.stage), "wall_s": 1.0}, "timings": {}}
 
     return run_cell
@@ -152,7 +154,7 @@ def test_a_rerun_runs_only_the_cells_not_yet_stored(
     bench: ModuleType, tm: ModuleType, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls: list[int] = []
-    monkeypatch.setattr(bench.tc, "run_cell", _fake_run_cell(calls, tm))
+    monkeypatch.setattr(bench.tc, "run_cell", _fake_run_cell(calls, tm, fail=1))
     out, store = tmp_path / "trust.json", tmp_path / "store"
     common = ["--seed", "3", "--stage", "detect", "--scenarios", "fence1", "--workers", "1"]
     common += ["--store", str(store), "--out", str(out)]
@@ -160,8 +162,13 @@ def test_a_rerun_runs_only_the_cells_not_yet_stored(
     assert bench.main(["--cells", "3", *common]) == 0 and calls == [0, 1, 2]
     data = json.loads(out.read_text(encoding="utf-8"))
     assert data["detect"]["cells"] == 3 and data["detect"]["cells_run_now"] == 1 and "weld" not in data
-    assert [r["cell"] for r in data["detect"]["rows"]] == [0, 1, 2]
-    assert bench.main(["--cells", "2", *common, "--fresh"]) == 0 and calls == [0, 1, 2, 0, 1]
+    assert [r["cell"] for r in data["detect"]["rows"]] == [0, 1, 2] and data["detect"]["cells_failed"] == 1
+    assert data["detect"]["rows"][1]["error"] == "RuntimeError" and data["detect"]["seams_visible"] == 2
+    assert bench.main(["--cells", "3", *common, "--retry-failed"]) == 0 and calls == [0, 1, 2, 1]
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["detect"]["cells_failed"] == 0 and data["detect"]["seams_visible"] == 3
+    assert bench.main(["--cells", "3", *common]) == 0 and calls == [0, 1, 2, 1]  # the retried line was kept
+    assert bench.main(["--cells", "2", *common, "--fresh"]) == 0 and calls == [0, 1, 2, 1, 0, 1]
     # a cell's seed depends on the benchmark's seed and its index only
     assert data["detect"]["rows"][2]["cell_seed"] == bench.tc.cell_seed(3, 2) != bench.tc.cell_seed(3, 1)
     # the same store for other cells is refused (the option named), not mixed

@@ -18,12 +18,15 @@ from random_cell_parts import Body, Circle, Seam, prism, vec
 
 @dataclass(frozen=True)
 class Design:
-    """A weldment: its bodies (parts and fixtures), seams, curved seams, and what its truth records."""
+    """A weldment: its bodies (parts and fixtures), seams, curved seams, what its truth records, and which parts
+    the build deviations must keep in place (``held``, ``ending``)."""
 
     bodies: tuple[Body, ...]
     seams: tuple[Seam, ...]
     circles: tuple[Circle, ...] = ()
     facts: dict[str, float] = field(default_factory=dict)
+    held: tuple[str, ...] = ()  # parts another member's end rests against: they must not move as built
+    ending: tuple[tuple[str, str], ...] = ()  # (member, part): the member's -x end rests against the part's face
 
 
 def _box(name: str, kind: str, lo: tuple[float, float, float], hi: tuple[float, float, float]) -> Body:

@@ -2,9 +2,10 @@
 
 A member stands (or lies) on the top face of a receiving part at height ``z_top`` across a drawn gap, at a centre
 (x, y) and a yaw about z; its own frame has x along its length. Each builder returns the :class:`Body`, its seams
-(named ``<member>><receiving>:<face>``, the member's face in its own frame) and its footprint on the receiving face
-as a circle (centre (x, y), radius) for placing the next member clear of it. A seam runs along the member's edge
-between the weld face and the end face, carried across the gap onto the receiving face, as the cell's truth does.
+(named ``<member>><receiving>:<face>``, the member's face in its own frame) and its footprint on the receiving
+face (a capsule: a segment and a radius that hold it) for placing the next member clear of it. A seam runs along
+the member's edge between the weld face and the end face, carried across the gap onto the receiving face, as the
+cell's truth does.
 """
 
 from __future__ import annotations
@@ -34,11 +35,20 @@ DIHEDRAL_RANGE_DEG = (35.0, 145.0)  # a welder's fillet (the reader's joint find
 
 @dataclass(frozen=True)
 class Member:
-    """A body, its seams and its footprint circle (centre (x, y), radius) [mm]."""
+    """A body, its seams and its footprint: a capsule (x0, y0, x1, y1, radius) that holds it [mm]."""
 
     body: Body
     seams: tuple[Seam, ...]
-    footprint: tuple[float, float, float]
+    footprint: tuple[float, float, float, float, float]
+
+
+def capsule(X: np.ndarray, a: float, b: float) -> tuple[float, float, float, float, float]:
+    """The capsule holding an a x b rectangle about the origin of the pose X (4, 4): a segment along its longer
+    side and the radius that takes in its corners."""
+    long_x = a >= b
+    half = (abs(a - b) / 2, 0.0) if long_x else (0.0, abs(a - b) / 2)
+    p0, p1 = moved(X, (-half[0], -half[1], 0.0)), moved(X, (half[0], half[1], 0.0))
+    return (float(p0[0]), float(p0[1]), float(p1[0]), float(p1[1]), min(a, b) / math.sqrt(2.0))
 
 
 def _sides(
@@ -79,7 +89,7 @@ def standing(
     seams = foot_seams(body, base, z_top, _sides(a, b, X, faces))
     joint = "lap" if kind == "flat" else "T"
     seams = [Seam(s.id, s.p0, s.p1, s.abutting, s.receiving, s.dihedral_deg, joint) for s in seams]
-    return Member(body, tuple(seams), (xy[0], xy[1], math.hypot(a, b) / 2))
+    return Member(body, tuple(seams), capsule(X, a, b))
 
 
 def rhs(
@@ -101,7 +111,7 @@ def rhs(
     body = Body(name, "rhs", v, f, vec(X[:3, 3]), (0.0, 0.0, yaw), size, extra={"wall_mm": wall, "radius_mm": 2 * wall})
     X0 = pose(rot_z(yaw), (xy[0], xy[1], 0.0))
     seams = foot_seams(body, base, z_top, _sides(a, b, X0, ("+x", "-x", "+y", "-y"), inset=2 * wall))
-    return Member(body, tuple(seams), (xy[0], xy[1], math.hypot(a, b) / 2))
+    return Member(body, tuple(seams), capsule(X, a, b))
 
 
 def round_tube(
@@ -116,7 +126,7 @@ def round_tube(
     v, f = hollow(polygon(ro, segments, phase), polygon(ri, segments, phase), -height / 2, height / 2, X)
     extra = {"outer_d_mm": outer_d, "wall_mm": wall, "segments": float(segments)}
     body = Body(name, kind, v, f, vec(X[:3, 3]), (0.0, 0.0, 0.0), (outer_d, outer_d, height), extra=extra)
-    return Member(body, (), (xy[0], xy[1], ro))
+    return Member(body, (), (xy[0], xy[1], xy[0], xy[1], ro))
 
 
 def _in_range(deg: float) -> bool:
@@ -179,6 +189,33 @@ def brace(
         p0, p1_ = vec(moved(X, a)), vec(moved(X, b))
         if _in_range(deg) and math.dist(p0, p1_) >= MIN_SEAM_MM:
             seams.append(Seam(f"{name}>{recv}:{face}", p0, p1_, name, recv, deg))
-    reach = p2[0] / 2
-    foot = moved(X, (reach, 0.0, 0.0))
-    return Member(body, tuple(seams), (float(foot[0]), float(foot[1]), math.hypot(reach, w)))
+    footprint = capsule(pose(np.column_stack([n, R[:, 2], up]), moved(X, (p2[0] / 2, 0.0, 0.0))), p2[0], width)
+    return Member(body, tuple(seams), footprint)
+
+
+def ending_plate(
+    name: str,
+    size: tuple[float, float, float],
+    F: np.ndarray,
+    n: np.ndarray,
+    base: str,
+    z_top: float,
+    gaps: tuple[float, float],
+    host: str | None,
+) -> Member:
+    """A plate standing on ``base`` whose end lies flat against a vertical face of a third part across ``gaps[1]``
+    (F (3,): the face's point at z_top where the plate's middle meets it; n (3,): its horizontal outward normal):
+    its fillets on the base run up to that part's wall. With ``host`` named (a face wide enough), also the two
+    vertical fillets of the plate's end on that face."""
+    a, b, h = size
+    yaw = math.degrees(math.atan2(n[1], n[0]))
+    centre = F + n * (gaps[1] + a / 2)
+    m = standing(name, "plate", size, (float(centre[0]), float(centre[1])), yaw, base, z_top, gaps[0], ("+y", "-y"))
+    seams = list(m.seams)
+    if host is not None:
+        side = rot_z(yaw)[:, 1]
+        for face, sign in (("+y", 1.0), ("-y", -1.0)):
+            p = F + side * sign * b / 2
+            p0, p1 = vec((p[0], p[1], z_top + gaps[0])), vec((p[0], p[1], z_top + gaps[0] + h))
+            seams.append(Seam(f"{name}>{host}:{face}", p0, p1, name, host, 90.0))
+    return Member(m.body, tuple(seams), m.footprint)

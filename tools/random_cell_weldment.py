@@ -1,48 +1,63 @@
-"""A random weldment (``kind = "random"`` of ``tools/random_cells.py``) and what the simulation does to it: the
-realism options and the build deviations, all drawn from the caller's generator [mm, frame M, z = 0 on the table].
+"""A random weldment (``kind = "random"`` of ``tools/random_cells.py``) drawn from the caller's generator [mm, frame
+M, z = 0 on the table].
 
-The weldment is a base plate lying on the table with 2-4 members on its top, each across a drawn gap of 0-2 mm: a
-plate standing on its edge (fillets on both sides), a box post or an RHS with corner radii (a fillet on each side,
-an RHS's on its flats), a flat bar lying flat (lap fillets all round); a standing plate or post may carry a mitred
-brace (a flat bar from the base up to its face at 20-70 degrees); 1-2 round tubes or pipes stand among them (MESH or
-3DFACE; half of them with a red CIRCLE at the foot, which the cell lists as unsupported); 0-2 stops on a fixture
-layer sit near a seam. Members keep 50 mm apart (room for the torch) and inside the plate's edge.
+A base plate lying on the table with 2-4 members on its top, each across a drawn gap of 0-2 mm: a plate standing on
+its edge (fillets on both sides), a box post or an RHS with corner radii (a fillet on each side, an RHS's on its
+flats), a flat bar lying flat (lap fillets all round). A standing plate or post may carry a mitred brace (a flat bar
+from the base up to its face at 20-70 degrees). 1-2 round tubes or pipes stand among them (MESH or 3DFACE; half of
+them with a red CIRCLE at the foot, which the cell lists as unsupported). A post, tube or pipe may have a plate
+standing against it, its end flat on the post's face or a facet of the tube (its fillets on the base end at that
+wall; on a post also the two vertical fillets of its end). 0-2 stop blocks on a fixture layer sit near a seam.
+Members keep 50 mm apart (room for the torch) and inside the plate's edge beyond its build deviation.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
+from random_cell_build import TOL_LENGTH
 from random_cell_layouts import Design
-from random_cell_members import Member, brace, rhs, round_tube, standing
+from random_cell_members import Member, brace, ending_plate, rhs, round_tube, standing
 from random_cell_parts import Body, Circle, Seam, box_body, prism, rectangle, rot_z, vec
-from random_cell_scene import Placement, r6
-
-from cell.asbuilt_shapes import principal_frame
-from cell.geometry import matrix_to_rpy
-from cell.types import Polyhedron, WeldMap
 
 CLEAR_MM = 50.0  # between members' footprints
 EDGE_MM = 20.0  # members inside the base plate's edge, beyond its build deviation
 RHS_SIZES = ((40, 40), (50, 30), (60, 40), (60, 60), (80, 40), (80, 80), (100, 50))  # [mm]
-# The paper's industrial tolerances (docs/trust.md): width and height 1 %, length 5 %, location 1 %.
-TOL_SECTION, TOL_LENGTH, TOL_LOCATION = 0.01, 0.05, 0.01
-YAW_DEG = 0.3  # a member's turn about the vertical as built [deg]
 
 
-def _fits(
-    c: tuple[float, float, float], placed: list[tuple[float, float, float]], L: float, W: float, clear: float = CLEAR_MM
-) -> bool:
-    """Whether a footprint circle (x, y, r) [mm] lies inside the base plate (beyond its build deviation) and
-    ``clear`` from every one placed."""
-    x, y, r = c
-    edge = EDGE_MM + TOL_LENGTH * max(L, W) / 2
-    if not (edge + r <= x <= L - edge - r and edge + r <= y <= W - edge - r):
-        return False
-    return all(math.hypot(x - px, y - py) >= r + pr + clear for px, py, pr in placed)
+Capsule = tuple[float, float, float, float, float]  # a footprint: a segment (x0, y0, x1, y1) and a radius [mm]
+
+
+def _gap(c: Capsule, d: Capsule) -> float:
+    """The clearance [mm] between two capsules (negative: they overlap)."""
+    a0, a1, b0, b1 = np.array(c[:2]), np.array(c[2:4]), np.array(d[:2]), np.array(d[2:4])
+
+    def to_seg(p: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> float:
+        v = q1 - q0
+        t = 0.0 if v @ v < 1e-12 else float(np.clip((p - q0) @ v / (v @ v), 0.0, 1.0))
+        return float(np.linalg.norm(p - q0 - t * v))
+
+    da, db = a1 - a0, b1 - b0
+    den = da[0] * db[1] - da[1] * db[0]
+    if abs(den) > 1e-12:  # crossing segments
+        w = b0 - a0
+        s, t = (w[0] * db[1] - w[1] * db[0]) / den, (w[0] * da[1] - w[1] * da[0]) / den
+        if 0.0 <= s <= 1.0 and 0.0 <= t <= 1.0:
+            return -c[4] - d[4]
+    dist = min(to_seg(a0, b0, b1), to_seg(a1, b0, b1), to_seg(b0, a0, a1), to_seg(b1, a0, a1))
+    return dist - c[4] - d[4]
+
+
+def _fits(c: Capsule, placed: dict[str, Capsule], L: float, W: float, clear: float = CLEAR_MM, skip: str = "") -> bool:
+    """Whether a footprint lies inside the base plate (beyond its build deviation) and ``clear`` from every one
+    placed but ``skip``."""
+    edge = EDGE_MM + TOL_LENGTH * max(L, W) / 2 + c[4]
+    for x, y in (c[:2], c[2:4]):
+        if not (edge <= x <= L - edge and edge <= y <= W - edge):
+            return False
+    return all(_gap(c, d) >= clear for k, d in placed.items() if k != skip)
 
 
 def _member(rng: np.random.Generator, kind: str, name: str, xy: tuple[float, float], t: float) -> Member:
@@ -92,6 +107,32 @@ def _fixture(rng: np.random.Generator, name: str, seam: Seam, away: np.ndarray, 
     return box_body(name, "fixture", size, (centre[0], centre[1], t + size[2] / 2), yaw)
 
 
+def _ending(rng: np.random.Generator, name: str, host: Body, t: float) -> tuple[Member | None, str]:
+    """A plate standing on the base with its end flat against the host (a post's face, a tube's facet), and the
+    post's face it stands against (its own fillet on the base is then not drawn: the plate's end sits on it)."""
+    face = ""
+    if host.kind == "box":
+        a, b, h = host.size_mm
+        R = rot_z(host.rpy_deg[2])
+        k = int(rng.integers(4))
+        n, face = R[:, k // 2] * (1.0 if k % 2 == 0 else -1.0), ("+x", "-x", "+y", "-y")[k]
+        half, width, along = (a / 2, b, R[:, 1]) if k < 2 else (b / 2, a, R[:, 0])
+    else:
+        segments = int(host.extra["segments"])
+        ang = 2 * math.pi * int(rng.integers(segments)) / segments  # facet middles at k 360/segments degrees
+        n, half, along = np.array([math.cos(ang), math.sin(ang), 0.0]), host.size_mm[0] / 2, np.zeros(3)
+        width, h = 2 * half * math.tan(math.pi / segments), host.size_mm[2]
+    thick = float(rng.choice([8, 10, 12]))
+    if h * (1 - TOL_LENGTH) - 15 < 50:
+        return None, face
+    size = (rng.uniform(60, 180), thick, rng.uniform(50, h * (1 - TOL_LENGTH) - 15))
+    room = max(0.0, width / 2 - thick / 2 - 5)
+    F = np.array([host.centre_mm[0], host.centre_mm[1], t]) + half * n + along * rng.uniform(-room, room)
+    gaps = (round(float(rng.uniform(0, 2)), 1), round(float(rng.uniform(0, 1.5)), 1))
+    named_host = host.name if host.kind == "box" and width >= thick + 10 else None
+    return ending_plate(name, size, F, n, "BASE", t, gaps, named_host), face
+
+
 def random_design(rng: np.random.Generator) -> tuple[Design, float]:
     """A random weldment (module docstring) and the yaw it is drawn at (0: the cell turns it on the table)."""
     L, W, t = rng.uniform(350, 650), rng.uniform(250, 450), float(rng.choice([8, 10, 12, 15, 20]))
@@ -100,13 +141,15 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
         "BASE", "plate", v + np.array([L / 2, W / 2, 0.0]), f, vec((L / 2, W / 2, t / 2)), (0.0, 0.0, 0.0), (L, W, t)
     )
     bodies, seams, circles = [base], [], []
-    placed: list[tuple[float, float, float]] = []
+    placed: dict[str, Capsule] = {}
     count: dict[str, int] = {}
+    held: list[str] = []
+    ending: list[tuple[str, str]] = []
 
     def add(m: Member) -> None:
         bodies.append(m.body)
         seams.extend(m.seams)
-        placed.append(m.footprint)
+        placed[m.body.name] = m.footprint
 
     def label(kind: str) -> str:
         count[kind] = count.get(kind, 0) + 1
@@ -130,9 +173,8 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
             add(m)
             if br is not None:
                 label("brace")
-                bodies.append(br.body)
-                seams.extend(br.seams)
-                placed.append(br.footprint)
+                add(br)
+                held.append(m.body.name)
             break
     for _ in range(int(rng.integers(1, 3))):
         pipe = bool(rng.random() < 0.5)
@@ -156,10 +198,26 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
             label(kind)
             body = m.body if rng.random() < 0.5 else replace(m.body, drawn_as="3dface")
             bodies.append(body)
-            placed.append(m.footprint)
+            placed[body.name] = m.footprint
             if rng.random() < 0.5:
                 circles.append(Circle(f"{body.name}>BASE:foot", vec((xy[0], xy[1], t)), d / 2))
             break
+    for host in [b for b in bodies if b.kind in ("box", "tube", "pipe") and b.name not in held]:
+        if rng.random() >= 0.5 or (host.kind != "box" and host.size_mm[0] < 50):
+            continue
+        name = f"PLATE_{count.get('plate', 0) + 1}"
+        for _try in range(8):  # a face (facet) and length whose plate fits
+            plate, face = _ending(rng, name, host, t)
+            if plate is not None and _fits(plate.footprint, placed, L, W, skip=host.name):
+                break
+        else:
+            continue
+        assert plate is not None
+        seams[:] = [s for s in seams if s.id != f"{host.name}>BASE:{face}"]
+        label("plate")
+        add(plate)
+        held.append(host.name)
+        ending.append((name, host.name))
     on_base = [s for s in seams if s.receiving == "BASE"]
     for k in range(int(rng.integers(0, 3)) if on_base else 0):
         s = on_base[int(rng.integers(len(on_base)))]
@@ -174,78 +232,9 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
             continue
         fx = _fixture(rng, f"FIXTURE_{k + 1}", s, away / np.linalg.norm(away), t)
         r = math.hypot(fx.size_mm[0], fx.size_mm[1]) / 2
-        if _fits((fx.centre_mm[0], fx.centre_mm[1], r), placed, L, W, clear=10.0):
+        foot = (fx.centre_mm[0], fx.centre_mm[1], fx.centre_mm[0], fx.centre_mm[1], r)
+        if _fits(foot, placed, L, W, clear=10.0):
             bodies.append(fx)
-            placed.append((fx.centre_mm[0], fx.centre_mm[1], r))
-    return Design(
-        tuple(bodies), tuple(seams), tuple(circles), facts={"base_mm_x": L, "base_mm_y": W, "base_mm_z": t}
-    ), 0.0
-
-
-def realism(rng: np.random.Generator, design: Design, weldmap: WeldMap, placement: Placement) -> dict[str, Any]:
-    """The ``simulation`` keys of a random cell but its deviations: noise realistic (4 in 5) or none, the operator's
-    placement error (up to 5 mm, 0.5 deg), and each of the realism options half the time (gaps varying to 0.5-2 mm,
-    tacks at the seam ends, specular dropout on shiny faces)."""
-    sim: dict[str, Any] = {"noise": "realistic" if rng.random() < 0.8 else "none"}
-    sim["placement_error"] = {
-        "xyz_m": [r6(rng.uniform(-0.005, 0.005)), r6(rng.uniform(-0.005, 0.005)), 0.0],
-        "rpy_deg": [0.0, 0.0, r6(rng.uniform(-0.5, 0.5))],
-    }
-    if rng.random() < 0.5:
-        sim["gaps"] = {"max_mm": r6(rng.uniform(0.5, 2.0))}
-    if rng.random() < 0.5:
-        sim["tacks_present"] = {"length_mm": r6(rng.uniform(6, 12)), "leg_mm": r6(rng.uniform(3, 5))}
-    if rng.random() < 0.3:
-        sim["specular_dropout"] = {"within_deg": r6(rng.uniform(5, 10)), "fraction": r6(rng.uniform(0.3, 0.8))}
-    return sim
-
-
-def _frame(weldmap: WeldMap, name: str) -> np.ndarray:
-    """(3, 3) the axes of a part's deviation frame in M: a box's own, a polyhedron's principal frame."""
-    part = weldmap.part(name)
-    if part.is_box:
-        return np.asarray(part.box.X_AB[:3, :3])
-    assert isinstance(part.body, Polyhedron)
-    return np.asarray(principal_frame(part.body)[0][:3, :3])
-
-
-def deviations(rng: np.random.Generator, design: Design, weldmap: WeldMap) -> dict[str, Any]:
-    """Each part as built minus drawn, within the tolerances (module constants), in its deviation frame: boxes
-    change size (the longest edge by up to 5 %, the others 1 %; a part's foot stays on what it stands on), members
-    move by up to 1 % of their length and turn by up to 0.3 deg about the vertical; a brace only slides along its
-    width, a brace's host only changes length; RHS, tubes and pipes only move."""
-    hosts = {s.receiving for s in design.seams if s.abutting.startswith("BRACE") and s.receiving != "BASE"}
-    out: dict[str, Any] = {}
-    for b in design.bodies:
-        if b.kind == "fixture":
-            continue
-        R_m = rot_z(b.rpy_deg[2])  # the member's own axes in M (x along its length, z up)
-        dims = np.array(b.size_mm)
-        size_m, offset_M, yaw = np.zeros(3), np.zeros(3), 0.0
-        if b.kind in ("plate", "box", "flat") and b.name not in hosts:
-            tol = np.where(dims == dims.max(), TOL_LENGTH, TOL_SECTION)
-            size_m = rng.uniform(-1, 1, 3) * tol * dims
-            if b.name == "BASE" or b.kind == "flat":
-                size_m[2] = -abs(size_m[2])  # thinner only: it never grows into what lies on it
-        elif b.name in hosts:
-            size_m[0] = rng.uniform(-1, 1) * TOL_LENGTH * dims[0]
-        if b.kind == "brace":
-            offset_M = R_m[:, 1] * rng.uniform(-0.5, 0.5)
-        elif b.name not in hosts:
-            ang = rng.uniform(0, 2 * math.pi)
-            reach = min(TOL_LOCATION * dims.max(), 1.0 if b.kind in ("tube", "pipe") else 2.0)
-            offset_M = np.array([math.cos(ang), math.sin(ang), 0.0]) * rng.uniform(0, reach)
-            yaw = 0.0 if b.kind in ("tube", "pipe") else rng.uniform(-YAW_DEG, YAW_DEG)
-        offset_M = offset_M + np.array([0.0, 0.0, size_m[2] / 2]) * (b.name != "BASE")  # the foot stays
-        R_P = _frame(weldmap, b.name)
-        entry: dict[str, Any] = {}
-        if np.any(size_m != 0):
-            match = np.argmax(np.abs(R_P.T @ R_m), axis=1)  # the member axis along each frame axis
-            entry["size_mm"] = [r6(round(size_m[j], 4)) for j in match]
-        if np.any(offset_M != 0):
-            entry["offset_mm"] = [r6(round(v, 4)) for v in R_P.T @ offset_M]
-        if yaw:
-            entry["rpy_deg"] = [r6(round(math.degrees(v), 4)) for v in matrix_to_rpy(R_P.T @ rot_z(yaw) @ R_P)]
-        if entry:
-            out[b.name] = entry
-    return out
+            placed[fx.name] = foot
+    facts = {"base_mm_x": L, "base_mm_y": W, "base_mm_z": t}
+    return Design(tuple(bodies), tuple(seams), tuple(circles), facts, tuple(held), tuple(ending)), 0.0

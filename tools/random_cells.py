@@ -31,10 +31,11 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # the sibling modules below, also when loaded by path
 
+from random_cell_build import deviations, realism
 from random_cell_layouts import Design, named
 from random_cell_parts import write_map
 from random_cell_scene import Camera, Placement, fixed_cameras, init_cameras, place, r6, scan_pose, scenario_dict, t3
-from random_cell_weldment import deviations, random_design, realism
+from random_cell_weldment import random_design
 
 from cell.errors import CellError
 from cell.types import WeldMap
@@ -213,6 +214,7 @@ def truth(
         "parts": [b for b in bodies if b["kind"] != "fixture"],
         "fixtures": [b for b in bodies if b["kind"] == "fixture"],
         "seams": seams,
+        "ends_against": [{"part": m, "against": host} for m, host in design.ending],
         "curved_seams": [
             {"id": c.id, "centre_mm": list(t3(c.centre)), "radius_mm": r6(c.radius)} for c in design.circles
         ],

@@ -251,7 +251,7 @@ def weld_figures(visible: Sequence[Row]) -> Row:
     }
 
 
-def _splice_count(lines: Sequence[Row], exact: bool) -> int | None:
+def _splice_count(lines: Sequence[Mapping[str, Any]], exact: bool) -> int | None:
     """Splice corrections applied over the cells whose extrinsics are exact (or not); None when no such cell's
     report says which were applied."""
     known = [ln["splice_applied"] for ln in lines if ln["exact"] is exact and ln["splice_applied"] is not None]

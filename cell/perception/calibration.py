@@ -29,31 +29,25 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 from cell.geometry import FloatArray
+from cell.perception.pose_prior import PoseUncertainty
 from cell.perception.splice import Registration
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
+__all__ = [
+    "PoseUncertainty",
+    "calibration_sigma",
+    "closeup_sigma",
+    "reference_of",
+    "support_shares",
+    "with_calibration",
+]
+
 SUPPORT_RADIUS_M = 0.015  # points within this of the located segment are the seam's support (both faces' strips)
-
-
-@dataclass(frozen=True)
-class PoseUncertainty:
-    """How well one camera's pose is known: RMS translation [m] and rotation [rad] of its calibration residual."""
-
-    translation_m: float = 0.0
-    rotation_rad: float = 0.0
-
-    def sigma_at(self, range_m: float) -> float:
-        """Per-axis standard deviation [m] of a point at ``range_m`` from the camera (module docstring)."""
-        return math.hypot(self.translation_m, range_m * self.rotation_rad) / math.sqrt(3.0)
-
-    @property
-    def zero(self) -> bool:
-        return self.translation_m == 0.0 and self.rotation_rad == 0.0
 
 
 def reference_of(registrations: Sequence[Registration]) -> dict[str, str]:

@@ -4,8 +4,9 @@ deproject + crop + robot frame (section 3.2) -> splice (3.3) -> Z passthrough an
 voxel grid (3.4). A camera whose data cannot be trusted is *lost*, with the reason, before it can poison the
 splice (:mod:`cell.perception.camera_health`): no valid pixel (dead, blinded), an implausible image (one value
 everywhere, random depths, heavy interference), no point inside the workspace, or a cloud that agrees with no
-other camera while the others agree (knocked out of calibration). The others go on without it; only when no
-usable camera remains is it a :class:`SensorError`.
+other camera while the others agree (knocked out of calibration), or, in the splice, data that disagree with
+the camera's stated calibration beyond three of its sigmas (:mod:`cell.perception.splice`). The others go on
+without it; only when no usable camera remains is it a :class:`SensorError`.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from cell.errors import SensorError
 from cell.geometry import FloatArray, invert
 from cell.perception.camera_health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame
+from cell.perception.pose_prior import PoseUncertainty
 from cell.perception.preprocess import downsample, preprocess
 from cell.perception.splice import Spliced, splice, stacked
 from cell.scenario import PerceptionSpec
@@ -86,16 +88,19 @@ class Perceived:
 
     def splice_corrections(self) -> dict[str, dict[str, Any]]:
         """Per registered camera, what the splice did to its calibration (for reports): ``applied`` (bool),
-        ``applied_mm`` and ``estimated_mm`` (RMS displacement of the overlap by the applied / the estimated
-        correction), ``directions`` (kept / constrained of the six), ``refused`` (``""`` or the test that refused
-        it, :data:`cell.perception.splice.REFUSALS`), onto which cameras (``target``)."""
+        ``applied_mm`` and ``estimated_mm`` (RMS displacement of the overlap by the applied MAP correction / by
+        the data's estimate along the informed directions), ``directions`` (informed of the six),
+        ``disagreement_sigmas`` (the data against the stated calibration, in its sigmas), ``refused`` (``""`` or
+        why not, :data:`cell.perception.splice.REFUSALS`; ``beyond_prior``: the camera was dropped), onto which
+        cameras (``target``)."""
         return {
             r.source: {
                 "target": list(r.target),
                 "applied": r.accepted,
                 "applied_mm": round(r.applied_shift_m * 1e3, 4),
                 "estimated_mm": round(r.shift_m * 1e3, 4),
-                "directions": f"{r.constrained}/{r.directions_constrained}",
+                "directions": f"{r.informed}/6",
+                "disagreement_sigmas": round(r.disagreement_sigmas, 2),
                 "refused": r.refused,
             }
             for r in self.spliced.registrations
@@ -103,15 +108,20 @@ class Perceived:
 
 
 def perceive(
-    images: Mapping[str, DepthImage], X_WR: FloatArray, spec: PerceptionSpec, health: HealthOptions | None = None
+    images: Mapping[str, DepthImage],
+    X_WR: FloatArray,
+    spec: PerceptionSpec,
+    health: HealthOptions | None = None,
+    priors: Mapping[str, PoseUncertainty] | None = None,
 ) -> Perceived:
     """Run the perception stage on one depth image per camera (see the module docstring).
 
     X_WR : (4, 4) pose of the robot base R in the world. health : thresholds of the camera checks (defaults
-    when None). Raises :class:`SensorError` when there is no image, when no usable camera remains (naming
+    when None). priors : camera name -> its stated calibration (the splice's prior; a camera not named is stated
+    exact). Raises :class:`SensorError` when there is no image, when no usable camera remains (naming
     each camera and why it was left out), or when filtering leaves no point.
     """
-    return perceive_then(images, X_WR, spec, health, lambda cloud, proceed: None).perceived
+    return perceive_then(images, X_WR, spec, health, lambda cloud, proceed: None, priors).perceived
 
 
 def perceive_then(
@@ -120,15 +130,18 @@ def perceive_then(
     spec: PerceptionSpec,
     health: HealthOptions | None,
     then: Callable[[Cloud, Callable[[], None]], T],
+    priors: Mapping[str, PoseUncertainty] | None = None,
 ) -> PerceivedThen[T]:
     """:func:`perceive`, and ``then`` of its registered cloud (the caller's next stage: the map alignment).
 
     The registered cloud is the calibrated cloud of the healthy cameras, point for point, unless a camera
-    disagrees with the others or the splice applies a correction (in a calibrated cell neither happens). So its
+    disagrees with the others or the splice applies a correction or drops a camera (in a calibrated cell none of
+    these happens). So its
     filters and ``then`` start on that guess, on the other core, beside the agreement check and the splice's
     registrations, and are kept when the guess holds; else they run again on the registered cloud (an answer
     never depends on the speculation, only the wall time does). ``then(cloud, proceed)`` must not depend on
     anything but its cloud; it calls ``proceed()`` between its steps, which stops a moot speculation (by raising).
+    priors : as :func:`perceive`.
     """
     if not images:
         raise SensorError("no depth images to perceive from (no camera delivered one)")
@@ -182,8 +195,12 @@ def perceive_then(
         if calibrated is not guess:
             moot.set()
         t = time.perf_counter()
-        spliced = splice(usable, images, X_WR, spec, calibrated, lambda name: moot.set())
+        spliced = splice(usable, images, X_WR, spec, calibrated, lambda name: moot.set(), priors)
         timings["splice"] = time.perf_counter() - t
+        why.update(spliced.faults)  # data beyond the camera's stated calibration: dropped as a disagreeing camera
+        for name in spliced.faults:
+            clouds[name] = clouds[name].select(np.zeros(len(clouds[name]), dtype=bool))
+        lost = tuple(name for name in clouds if name in why)
         spliced_at = time.perf_counter()
         if spliced.registered is guess:
             registered, registered_voxels, answer, onward_timings, stamps = ahead.result()

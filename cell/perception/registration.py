@@ -1,5 +1,5 @@
-"""Registering one camera's cloud onto others for the splice (:mod:`cell.perception.splice`), and the test of
-what the registration found.
+"""Registering one camera's cloud onto others for the splice (:mod:`cell.perception.splice`), and the estimate of
+its correction with the camera's calibration as the prior.
 
 :func:`register` is open3d's ICP, through :mod:`cell.perception._open3d`, chosen by ``PerceptionSpec.splice_icp``:
 
@@ -12,25 +12,22 @@ what the registration found.
   (:func:`registration_settings`) from the voxel size and the noise measured in the overlap; source and
   target are thinned to an even stride of at most :data:`_PROBE_POINTS` / :data:`_TARGET_POINTS` points.
 
-A correction's motion along a direction the overlap does not constrain (a view of top faces alone says nothing
-about a shift along them) is dropped: that direction stays as calibrated. So is its motion along a constrained
-direction that the data do not support on its own: in the eigenvectors of the information matrix of the
-point-to-plane problem, a direction is kept only if its part of the motion lowers the patch misfit by
-:data:`MIN_DIRECTION_DROP` of the misfit at the calibration (removing it alone from the correction raises the
-misfit that much), unless the whole correction lowers the misfit by :data:`CLEAR_DROP` (a real calibration
-error). The sensor's errors are not independent from patch to patch (flying pixels at the edges each camera sees,
-faces one camera sees head-on and the other at grazing incidence), so with exact extrinsics a long part seen
-along its length gives an estimate of 0.5-3 mm along it with a chi-square in the hundreds and a misfit gain of
-0-3 %: the misfit, not the chi-square, tells a calibration error from that. (Without the flying pixels the
-largest such estimate fell from 3.1 to 0.7 mm; one direction of 1.2-1.8 mm that lowers the misfit by 1-3 % can
-remain, and the splice's overall misfit test refuses it.) :func:`significance` measures how much the data
-support what is left (shift, patch-robust chi-square and the smallest per-direction z score, patch misfit before
-and after); the splice decides from those whether to apply it.
+What the registration found is not applied as it is. :func:`evidence` measures what the overlap says about it:
+the correction's coordinates (the rotation vector scaled to metres at the overlap's RMS radius ``lever`` about
+its centroid, then the centroid's displacement) and their information, the inverse of a sandwich (patch-robust)
+covariance of the point-to-plane estimate: the sensor's errors are not independent from point to point (flying
+pixels at the edges each camera sees, faces one camera sees head-on and the other at grazing incidence), so each
+patch of ``merge_cell_m`` and surface direction counts as one measurement. A direction the overlap does not
+constrain (a shift along a flat face, a slide along or a turn about a round body's axis) carries no
+information whatever ICP did along it. :func:`register` then weighs that against the camera's stated
+calibration (:func:`cell.perception.pose_prior.posterior`): the MAP correction along the directions where the
+data outweigh the prior, and how far the data disagree with the prior there.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,21 +35,20 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from cell.geometry import FloatArray, invert, make_pose, transform_points
+from cell.geometry import FloatArray, make_pose, readonly, transform_points
 from cell.perception import _open3d
+from cell.perception.pose_prior import posterior
 from cell.scenario import PerceptionSpec
 
 _PROBE_POINTS = 20_000  # source points a registration uses (an even stride)
 _TARGET_POINTS = 60_000  # target points a registration searches (an even stride)
-_MIN_OVERLAP = 200  # fewer source points in the overlap: no registration, the calibrated extrinsics stand
-_WEAK_DIRECTION = 0.005  # a direction holding less than this share of the constraint is left as calibrated
+MIN_OVERLAP = 200  # fewer source points in the overlap: no registration, the calibrated extrinsics stand
+_SCORE_RCOND = 1e-10  # patch-score covariance eigenvalues below this share of the largest carry no information
 _TUKEY_C = 4.685  # biweight cut-off [robust scales] (95 % efficiency on Gaussian residuals)
 _MAD_TO_SIGMA = 1.4826  # median absolute deviation -> standard deviation (Gaussian)
 _NORMAL_RADIUS_VOXELS = 2.0  # target normals from neighbours within this many voxels
 _NORMAL_NEIGHBOURS = 50  # ... at most this many (the nearest)
 _MIN_NOISE_M = 1e-4  # [m] floor of the measured noise (noise-free synthetic clouds)
-MIN_DIRECTION_DROP = 0.001  # a constrained direction is kept only if its motion lowers the patch misfit by this
-CLEAR_DROP = 0.15  # ... unless the whole correction lowers the patch misfit by this share (a calibration error)
 
 
 @dataclass(frozen=True)
@@ -129,162 +125,169 @@ def _patch_misfit(r: FloatArray, w: FloatArray, patch: npt.NDArray[np.intp]) -> 
     return float(np.sqrt(np.sum(sw[used] * mean**2) / np.sum(sw[used]))) if used.any() else math.inf
 
 
-def _constrained(p: FloatArray, n: FloatArray, w: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, float]:
-    """The point-to-plane least-squares problem of points p (k, 3) on planes of normals n (k, 3), weights w (k,).
-
-    Coordinates: rotation vector scaled to metres at the points' RMS radius ``lever`` about their centroid,
-    then shift. Returns (J (k, 6), the constrained directions D (6, d) (eigenvectors of the weighted normal
-    matrix holding at least :data:`_WEAK_DIRECTION` of its trace), centroid (3,), lever [m]).
-    """
-    centre = p.mean(axis=0)
-    lever = max(float(np.sqrt(np.mean(np.sum((p - centre) ** 2, axis=1)))), 1e-9)
-    J = _jacobian(p, n, centre, lever)
-    vals, vecs = np.linalg.eigh((J.T * w) @ J)
-    return J, vecs[:, vals >= _WEAK_DIRECTION * max(float(vals.sum()), 1e-300)], centre, lever
-
-
 def _jacobian(p: FloatArray, n: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
     """(k, 6) point-to-plane Jacobian of points p (k, 3) on planes n (k, 3) in the coordinates of
-    :func:`_constrained` about ``centre`` (3,) with ``lever`` [m]."""
+    :func:`coordinates` about ``centre`` (3,) with ``lever`` [m]."""
     return np.hstack([np.cross(p - centre, n) / lever, n])
 
 
-def _restricted(X: FloatArray, D: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
-    """X (4, 4), a motion that puts points at ``centre`` (3,), keeping only its part along the directions D (6, d)
-    (coordinates of :func:`_constrained`): a motion along a direction the overlap does not see is arbitrary."""
-    c0 = transform_points(invert(X), centre[None])[0]  # X moves c0 to the centre: X p = R (p - c0) + centre
-    est = np.concatenate([Rotation.from_matrix(X[:3, :3]).as_rotvec() * lever, centre - c0])
-    kept = D @ (D.T @ est)
-    R = Rotation.from_rotvec(kept[:3] / lever).as_matrix()
-    return make_pose(R, c0 + kept[3:] - R @ c0)
+def coordinates(X: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
+    """(6,) [m] coordinates of the motion X (4, 4): its rotation vector times ``lever``, then how far it moves
+    ``centre`` (3,). :func:`pose_of` is the inverse."""
+    moved = transform_points(X, np.asarray(centre)[None])[0]
+    return np.concatenate([Rotation.from_matrix(X[:3, :3]).as_rotvec() * lever, moved - centre])
 
 
-def significance(
-    probe: FloatArray,
-    target: FloatArray,
-    normals: FloatArray,
-    X_icp: FloatArray,
-    settings: RegistrationSettings,
-    patch_m: float,
-    tree: cKDTree | None = None,
-    calibrated: tuple[FloatArray, FloatArray, FloatArray] | None = None,
-) -> tuple[FloatArray, dict[str, float]]:
-    """The part of the correction X_icp (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3))
-    that the overlap constrains, and how much the data support it (all in R).
+def pose_of(x: FloatArray, centre: FloatArray, lever: float) -> FloatArray:
+    """(4, 4) motion of coordinates x (6,) (:func:`coordinates`): the rotation ``x[:3] / lever`` about ``centre``
+    (3,), then the shift ``x[3:]``."""
+    R = Rotation.from_rotvec(np.asarray(x[:3]) / lever).as_matrix()
+    return make_pose(R, centre + x[3:] - R @ centre)
 
-    Returns (X (4, 4): X_icp without its motion along directions the overlap does not constrain or the data do
-    not support (:func:`_supported`); diagnostics directions_constrained, constrained (the directions kept),
-    shift_m, chi2, z_min, misfit_before_m, misfit_m of X, see :class:`cell.perception.splice.Registration`).
-    The chi-square is a sandwich (patch-robust) covariance of a point-to-plane least-squares estimate at X:
-    Tukey-weighted residuals, one score per patch of ``patch_m`` and surface direction, in the constrained
-    directions. ``tree`` : the KD-tree of ``target`` when the caller has one (built here otherwise);
-    ``calibrated`` : :func:`_plane_residuals` of ``probe`` at the identity when the caller has them (with that tree).
+
+@dataclass(frozen=True)
+class Evidence:
+    """What an overlap says about a correction, in the coordinates of :func:`coordinates`.
+
+    centre_R : (3,) centroid of the overlap (the probe points paired at the calibration) [m]; lever_m : their RMS
+    radius about it [m]. x_data : (6,) the registration's estimate [m]. information : (6, 6) its information
+    [1/m^2], the inverse of the patch-robust covariance (zero along a direction the overlap does not constrain).
     """
-    reach, k = settings.reach_m, settings.tukey_k_m
-    tree = cKDTree(target, balanced_tree=False, compact_nodes=False) if tree is None else tree
-    info = {"constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0, "chi2": 0.0, "z_min": 0.0}
-    info |= {"misfit_before_m": math.inf, "misfit_m": math.inf}
-    if calibrated is None:
-        calibrated = _plane_residuals(probe, tree, target, normals, reach, np.eye(4))
-    p0, n0, r0 = calibrated
-    p, n, r = _plane_residuals(probe, tree, target, normals, reach, X_icp)
-    if len(r0) < _MIN_OVERLAP or len(r) < _MIN_OVERLAP:
-        return np.eye(4), info
-    info["misfit_before_m"] = _patch_misfit(r0, _tukey(r0, k), _patch_keys(p0, n0, patch_m))
-    _, D, centre, lever = _constrained(p, n, _tukey(r, k))
-    info["directions_constrained"] = float(D.shape[1])
-    D = _supported(probe, tree, target, normals, X_icp, D, centre, lever, settings, patch_m, info["misfit_before_m"])
-    if D.shape[1] == 0:
-        return np.eye(4), info
-    X = _restricted(X_icp, D, centre, lever)
-    p, n, r = _plane_residuals(probe, tree, target, normals, reach, X)
-    if len(r) < _MIN_OVERLAP:
-        return np.eye(4), info
-    w = _tukey(r, k)
-    patch = _patch_keys(p, n, patch_m)
-    info["misfit_m"] = _patch_misfit(r, w, patch)
-    info["shift_m"] = float(np.sqrt(np.mean(np.sum((transform_points(X, probe) - probe) ** 2, axis=1))))
-    Jd = _jacobian(p, n, centre, lever) @ D  # the kept directions, as they were chosen
-    score = np.stack([np.bincount(patch, w * r * Jd[:, j], int(patch.max()) + 1) for j in range(D.shape[1])], 1)
-    c0 = transform_points(invert(X), centre[None])[0]
-    est = D.T @ np.concatenate([Rotation.from_matrix(X[:3, :3]).as_rotvec() * lever, centre - c0])
-    try:
-        H_inv = np.linalg.inv((Jd.T * w) @ Jd)
-        cov = H_inv @ (score.T @ score) @ H_inv
-        chi2 = float(est @ np.linalg.solve(cov, est))
-        z_min = float(np.min(np.abs(est) / np.sqrt(np.maximum(np.diag(cov), 1e-300))))
-    except np.linalg.LinAlgError:
-        chi2, z_min = 0.0, 0.0
-    info |= {"constrained": float(D.shape[1]), "chi2": chi2, "z_min": z_min}
-    return X, info
+
+    centre_R: FloatArray
+    lever_m: float
+    x_data: FloatArray
+    information: FloatArray
+
+    def __post_init__(self) -> None:
+        for name in ("centre_R", "x_data", "information"):
+            object.__setattr__(self, name, readonly(getattr(self, name)))
 
 
-def _supported(
+def evidence(
     probe: FloatArray,
     tree: cKDTree,
     target: FloatArray,
     normals: FloatArray,
-    X_icp: FloatArray,
-    D: FloatArray,
-    centre: FloatArray,
-    lever: float,
+    X: FloatArray,
     settings: RegistrationSettings,
     patch_m: float,
-    misfit_before_m: float,
-) -> FloatArray:
-    """The columns of D (6, d) (eigenvectors of the information matrix, coordinates of :func:`_constrained`)
-    along which X_icp's motion lowers the patch misfit on its own: removing that direction's part from the
-    correction raises the misfit by at least :data:`MIN_DIRECTION_DROP` x ``misfit_before_m``; all of them when
-    the whole correction lowers the misfit by :data:`CLEAR_DROP` or more (a miscalibration of 1 mm / 0.1 deg
-    lowers it by 20-40 %, what the sensor's edges fake by 0-10 %: a real error's small components along weak
-    directions do not lower the misfit on their own, yet they matter far from the overlap). Returns (6, d')."""
-    c0 = transform_points(invert(X_icp), centre[None])[0]
-    e = D.T @ np.concatenate([Rotation.from_matrix(X_icp[:3, :3]).as_rotvec() * lever, centre - c0])
+    calibrated: tuple[FloatArray, FloatArray, FloatArray],
+) -> Evidence | None:
+    """The estimate X (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3), its KD-tree
+    ``tree``) as :class:`Evidence`; None when fewer than :data:`MIN_OVERLAP` points pair at X.
 
-    def misfit(keep: npt.NDArray[np.bool_]) -> float:
-        kept = D[:, keep] @ e[keep]
-        R = Rotation.from_rotvec(kept[:3] / lever).as_matrix()
-        p, n, r = _plane_residuals(probe, tree, target, normals, settings.reach_m, make_pose(R, c0 + kept[3:] - R @ c0))
-        return _patch_misfit(r, _tukey(r, settings.tukey_k_m), _patch_keys(p, n, patch_m)) if len(r) else math.inf
-
-    every = np.ones(D.shape[1], dtype=bool)
-    full = misfit(every)
-    if full <= (1.0 - CLEAR_DROP) * misfit_before_m:  # a calibration error explains the misfit: every direction
-        return D
-    gain = np.array([misfit(every & (np.arange(len(every)) != j)) - full for j in range(len(every))])
-    return D[:, gain >= MIN_DIRECTION_DROP * misfit_before_m]
-
-
-def register(source: FloatArray, target: FloatArray, spec: PerceptionSpec) -> tuple[FloatArray, dict[str, float]]:
-    """Open3D ICP of ``source`` (n, 3) [m] in R onto ``target`` (m, 3) in R, as ``spec.splice_icp`` says.
-
-    Returns the estimated correction X (4, 4) in R (p' = X p) and diagnostics: overlap, noise_m and those of
-    :func:`significance` (X is restricted to the constrained directions there). X is the identity when the
-    overlap is too small. Runs ``spec.icp_iterations`` iterations at most; distances from
-    :func:`registration_settings`. The paper's ICP runs on every point, the robust one and the test on an
-    even stride of the points.
+    calibrated : :func:`_plane_residuals` of ``probe`` at the identity (its paired points fix the centre). The
+    information is ``H S^+ H``: H the Tukey-weighted normal matrix of the point-to-plane residuals at X, S the
+    covariance of their scores summed per patch of ``patch_m`` and surface direction.
     """
+    p0 = calibrated[0]
+    centre = p0.mean(axis=0)
+    lever = max(float(np.sqrt(np.mean(np.sum((p0 - centre) ** 2, axis=1)))), 1e-9)
+    p, n, r = _plane_residuals(probe, tree, target, normals, settings.reach_m, X)
+    if len(r) < MIN_OVERLAP:
+        return None
+    w = _tukey(r, settings.tukey_k_m)
+    J = _jacobian(p, n, transform_points(X, centre[None])[0], lever)
+    H = (J.T * w) @ J
+    patch = _patch_keys(p, n, patch_m)
+    score = np.stack([np.bincount(patch, w * r * J[:, j], int(patch.max()) + 1) for j in range(6)], axis=1)
+    S_pinv = np.linalg.pinv(score.T @ score, rcond=_SCORE_RCOND, hermitian=True)
+    information = H @ S_pinv @ H
+    return Evidence(centre, lever, coordinates(X, centre, lever), 0.5 * (information + information.T))
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """One registration's estimate of a camera's correction in R (p' = X p), with its prior.
+
+    X_icp : (4, 4) open3d's ICP result, every direction as ICP left it.
+    X_estimated : (4, 4) the data's estimate along the informed directions only (identity when none is).
+    X_map : (4, 4) the MAP correction (:func:`cell.perception.pose_prior.posterior`): what may be applied.
+    overlap : probe points with a target point within reach at the calibration; noise_m : robust standard
+        deviation of their point-to-plane residuals [m].
+    informed : directions (of six) where the data outweigh the prior; disagreement_sigmas : the data's largest
+        disagreement with the prior along one of them [prior sigmas] (beyond 3: a camera fault).
+    shift_m, map_shift_m : RMS displacement of the overlap by ``X_estimated`` / ``X_map`` [m].
+    misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibration and
+        after ``X_map``.
+    """
+
+    X_icp: FloatArray
+    X_estimated: FloatArray
+    X_map: FloatArray
+    overlap: int = 0
+    noise_m: float = 0.0
+    informed: int = 0
+    disagreement_sigmas: float = 0.0
+    shift_m: float = 0.0
+    map_shift_m: float = 0.0
+    misfit_before_m: float = math.inf
+    misfit_m: float = math.inf
+
+    def __post_init__(self) -> None:
+        for name in ("X_icp", "X_estimated", "X_map"):
+            object.__setattr__(self, name, readonly(getattr(self, name)))
+
+
+def register(
+    source: FloatArray,
+    target: FloatArray,
+    spec: PerceptionSpec,
+    prior: Callable[[FloatArray, float], FloatArray],
+) -> Estimate:
+    """Open3D ICP of ``source`` (n, 3) [m] in R onto ``target`` (m, 3) in R, as ``spec.splice_icp`` says, and the
+    correction it supports against ``prior``: (overlap centroid (3,), lever [m]) -> (6, 6) prior covariance of the
+    disagreement in the coordinates of :func:`coordinates` (:func:`cell.perception.pose_prior.relative_covariance`).
+
+    Every estimate is the identity when the overlap is too small. Runs ``spec.icp_iterations`` iterations at
+    most; distances from :func:`registration_settings`. The paper's ICP runs on every point, the robust one and
+    the evidence on an even stride of the points.
+    """
+    eye = np.eye(4)
     probe = np.asarray(source, dtype=np.float64)[:: max(1, math.ceil(len(source) / _PROBE_POINTS))]
     sub = np.asarray(target, dtype=np.float64)[:: max(1, math.ceil(len(target) / _TARGET_POINTS))]
-    info = {"overlap": 0.0, "noise_m": 0.0, "constrained": 0.0, "directions_constrained": 0.0, "shift_m": 0.0}
-    info |= {"chi2": 0.0, "z_min": 0.0, "misfit_before_m": math.inf, "misfit_m": math.inf}
-    if len(probe) < _MIN_OVERLAP or len(sub) < _MIN_OVERLAP:
-        return np.eye(4), info
+    if len(probe) < MIN_OVERLAP or len(sub) < MIN_OVERLAP:
+        return Estimate(eye, eye, eye)
     settings = registration_settings(spec, 0.0)
     normals = _open3d.estimate_normals(sub, settings.normal_radius_m, _NORMAL_NEIGHBOURS)
     tree = cKDTree(sub, balanced_tree=False, compact_nodes=False)  # built in half the time, same answers
-    calibrated = _plane_residuals(probe, tree, sub, normals, settings.reach_m, np.eye(4))
-    r0 = calibrated[2]
-    info["overlap"] = float(len(r0))
-    if len(r0) < _MIN_OVERLAP:
-        return np.eye(4), info
+    calibrated = _plane_residuals(probe, tree, sub, normals, settings.reach_m, eye)
+    p0, n0, r0 = calibrated
+    if len(r0) < MIN_OVERLAP:
+        return Estimate(eye, eye, eye, overlap=len(r0))
     noise = _MAD_TO_SIGMA * float(np.median(np.abs(r0)))  # about 0, not the median: an offset widens it
     settings = registration_settings(spec, noise)
-    info["noise_m"] = noise
     corr = settings.max_correspondence_m
     if spec.splice_icp == "paper":  # as the paper ran it: every point, no subsampling
-        X = _open3d.icp(source, target, corr, spec.icp_iterations).X_TS
+        X_icp = _open3d.icp(source, target, corr, spec.icp_iterations).X_TS
     else:
-        X = _open3d.icp(probe, sub, corr, spec.icp_iterations, None, normals, settings.tukey_k_m).X_TS
-    X, stats = significance(probe, sub, normals, X, settings, spec.merge_cell_m, tree, calibrated)
-    return X, info | stats
+        X_icp = _open3d.icp(probe, sub, corr, spec.icp_iterations, None, normals, settings.tukey_k_m).X_TS
+    before = _patch_misfit(r0, _tukey(r0, settings.tukey_k_m), _patch_keys(p0, n0, spec.merge_cell_m))
+    found = evidence(probe, tree, sub, normals, X_icp, settings, spec.merge_cell_m, calibrated)
+    if found is None:
+        return Estimate(X_icp, eye, eye, len(r0), noise, misfit_before_m=before, misfit_m=before)
+    post = posterior(found.x_data, found.information, prior(found.centre_R, found.lever_m))
+    X_estimated = pose_of(post.x_informed, found.centre_R, found.lever_m)
+    X_map = pose_of(post.x_map, found.centre_R, found.lever_m)
+    p, n, r = _plane_residuals(probe, tree, sub, normals, settings.reach_m, X_map)
+    after = math.inf
+    if len(r):
+        after = _patch_misfit(r, _tukey(r, settings.tukey_k_m), _patch_keys(p, n, spec.merge_cell_m))
+
+    def rms(X: FloatArray) -> float:
+        return float(np.sqrt(np.mean(np.sum((transform_points(X, probe) - probe) ** 2, axis=1))))
+
+    return Estimate(
+        X_icp,
+        X_estimated,
+        X_map,
+        len(r0),
+        noise,
+        post.informed,
+        post.disagreement_sigmas,
+        rms(X_estimated),
+        rms(X_map),
+        before,
+        after,
+    )

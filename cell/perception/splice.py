@@ -9,20 +9,28 @@ cloud of all cameras registered but *not* merged is kept as well (``Spliced.regi
 weighs each camera by its own noise loses nothing to the merge.
 
 Each camera is registered onto the cameras before it by :func:`cell.perception.registration.register` (open3d's
-ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says); its motion along directions the
-overlap does not constrain is dropped there. Whichever ICP, the correction is *applied* only when it is
-significant (a test, not a solver): at least one direction lowers the misfit on its own (the registration keeps
-only those), its displacement of the overlap exceeds :data:`MIN_SHIFT_M`, its chi-square against a covariance
-that treats every patch of ``merge_cell_m`` as one independent measurement (edges, flying pixels and shadows
-bias whole patches, not single points) exceeds :data:`SIGNIFICANCE_CHI2`, and the patch misfit (point-to-plane)
-drops by at least :data:`MIN_MISFIT_DROP`. (A z score per kept direction, ``Registration.z_min``, is reported but
-not tested: a real miscalibration can have a component near zero along one direction.) With
-exact extrinsics nothing is applied, also for long parts seen along their length (``scenarios/long-*.yaml``);
-a miscalibration of 1 mm / 0.1 deg is taken out. ``Registration.refused`` says which test refused a correction.
+ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says), and what it found is an estimate with
+the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`cell.perception.pose_prior`):
+the correction is applied only along directions where the overlap's information outweighs the prior, as the MAP
+estimate, and only if it explains the data: it must lower the misfit of the overlap's patches (RMS of each
+patch's mean point-to-plane residual) by :data:`MIN_MISFIT_DROP`. That test stays because the information counts
+each patch of ``merge_cell_m`` as independent, and the sensor's biases are not: edges and flying pixels seen from
+one side bias whole faces, so exact cameras stated at 1 mm / 0.1 deg get estimates of 0.1-2.5 mm that look
+informed yet lower the misfit by 8 % at most (often not at all), while a real error of that size lowers it by
+10-50 %. A refused real correction is not unsafe (the camera's seams keep its calibration in their sigma); an
+applied false one is.
+
+A camera stated exact (the default) is not registered at all and never moves (``calibration_exact``); a gross
+error of such a camera is left to the agreement check (:mod:`cell.perception.camera_health`). A camera whose data
+disagree with the prior by more than three prior sigmas along an informed direction is a *fault*
+(``beyond_prior``), not a correction: its points leave the registered cloud and the targets of the cameras after
+it, and perception drops it with the reason (``Spliced.faults``), as a camera that disagrees with the others.
+``Registration.refused`` says why nothing was applied (:data:`REFUSALS`).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -33,36 +41,36 @@ import numpy.typing as npt
 from cell.errors import SensorError
 from cell.geometry import FloatArray, invert, readonly, transform_points
 from cell.perception.merge import prioritised_merge, surface_normals
-from cell.perception.registration import register
+from cell.perception.pose_prior import FAULT_SIGMAS, PoseUncertainty, relative_covariance
+from cell.perception.registration import MIN_OVERLAP, Estimate, register
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage
 
 MOUNTS = ("fixed", "eye_in_hand")
-MIN_SHIFT_M = 0.0001  # [m] a correction moving the overlap by less than this (RMS) is not applied
-SIGNIFICANCE_CHI2 = 50.0  # a correction is applied only above this chi-square (patch-robust covariance)
-MIN_MISFIT_DROP = 0.05  # ... and only if it lowers the patch misfit by at least this fraction
-REFUSALS = ("no_overlap", "no_supported_direction", "too_small", "not_significant", "no_misfit_gain")
+MIN_SHIFT_M = 0.0001  # [m] a MAP correction moving the overlap by less than this (RMS) is not applied
+MIN_MISFIT_DROP = 0.10  # ... nor one that lowers the patch misfit by less than this fraction (nor is it a fault)
+REFUSALS = ("calibration_exact", "no_overlap", "not_informed", "too_small", "no_misfit_gain", "beyond_prior")
+FAULT = "beyond_prior"  # the refusal that makes the camera a fault (dropped), not merely left as calibrated
 
 
 @dataclass(frozen=True)
 class Registration:
     """One splice registration: the cloud of ``source`` onto the registered cloud of the ``target`` cameras.
 
-    X_corr : (4, 4) correction applied to the source cloud in R (p_R' = X_corr p_R); identity if not accepted.
-    X_estimated : (4, 4) the correction the registration found, applied or not: open3d's ICP result without
-        its motion along directions the overlap does not constrain.
-    overlap : source probe points with a target point within reach (``voxel_m``) at the calibrated extrinsics.
-    constrained : number of the six rigid degrees of freedom the overlap constrains (the chi-square's).
-    shift_m : RMS displacement of the overlap by ``X_estimated`` [m].
-    chi2 : its chi-square against the patch-robust covariance.
+    X_corr : (4, 4) correction applied to the source cloud in R (p_R' = X_corr p_R): the MAP estimate when
+        accepted, else the identity.
+    X_estimated : (4, 4) the data's estimate along the informed directions (identity along the others).
+    overlap : source probe points with a target point within reach (``voxel_m``) at the calibrated extrinsics
+        (0: not registered).
+    informed : directions (of six) where the overlap's information outweighs the prior.
+    shift_m, map_shift_m : RMS displacement of the overlap by ``X_estimated`` / by the MAP estimate [m].
     misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibrated
-        extrinsics and after ``X_estimated``.
-    accepted : whether the correction was applied (see the module docstring).
+        extrinsics and after the MAP estimate.
+    accepted : whether the correction was applied.
     noise_m : robust standard deviation of the point-to-plane residuals in the overlap [m] (calibrated).
-    directions_constrained : directions the overlap constrains, of which ``constrained`` lower the misfit on
-        their own and are kept in ``X_estimated`` (the others stay as calibrated).
-    z_min : the smallest z score of ``X_estimated``'s motion along a kept direction (patch-robust).
-    refused : ``""`` when applied, else the first test that refused it (one of :data:`REFUSALS`).
+    disagreement_sigmas : the data's largest disagreement with the prior along an informed direction, in prior
+        sigmas (beyond :data:`cell.perception.pose_prior.FAULT_SIGMAS`: a camera fault).
+    refused : ``""`` when applied, else why not (one of :data:`REFUSALS`; :data:`FAULT` drops the camera).
     """
 
     source: str
@@ -70,15 +78,14 @@ class Registration:
     X_corr: FloatArray
     X_estimated: FloatArray
     overlap: int
-    constrained: int
+    informed: int
     shift_m: float
-    chi2: float
+    map_shift_m: float
     misfit_before_m: float
     misfit_m: float
     accepted: bool
     noise_m: float = 0.0
-    directions_constrained: int = 0
-    z_min: float = 0.0
+    disagreement_sigmas: float = 0.0
     refused: str = ""
 
     def __post_init__(self) -> None:
@@ -88,22 +95,30 @@ class Registration:
     @property
     def applied_shift_m(self) -> float:
         """RMS displacement of the overlap by the applied correction [m] (0 when refused)."""
-        return self.shift_m if self.accepted else 0.0
+        return self.map_shift_m if self.accepted else 0.0
+
+    @property
+    def fault(self) -> bool:
+        """The camera disagrees with its targets beyond its stated calibration (dropped from the splice)."""
+        return self.refused == FAULT
 
 
-def refusal(info: Mapping[str, float]) -> str:
-    """``""`` if a registration's diagnostics (:func:`cell.perception.registration.register`) pass every test of
-    the module docstring, else the first that fails (one of :data:`REFUSALS`)."""
-    if info["overlap"] <= 0.0 or info["directions_constrained"] <= 0.0:
+def refusal(est: Estimate) -> str:
+    """``""`` if a registration's estimate (:func:`cell.perception.registration.register`) may be applied, else
+    why not (one of :data:`REFUSALS`, in this order): too few points overlap, no direction is informed, the
+    MAP correction moves the overlap by less than :data:`MIN_SHIFT_M` or lowers the patch misfit by less than
+    :data:`MIN_MISFIT_DROP` (it explains nothing), or the data disagree with the prior beyond
+    :data:`cell.perception.pose_prior.FAULT_SIGMAS` (a fault)."""
+    if est.overlap < MIN_OVERLAP:
         return "no_overlap"
-    if info["constrained"] <= 0.0:
-        return "no_supported_direction"
-    if info["shift_m"] < MIN_SHIFT_M:
+    if est.informed == 0:
+        return "not_informed"
+    if est.map_shift_m < MIN_SHIFT_M:
         return "too_small"
-    if info["chi2"] < SIGNIFICANCE_CHI2:
-        return "not_significant"
-    if not info["misfit_m"] <= (1.0 - MIN_MISFIT_DROP) * info["misfit_before_m"]:
+    if not est.misfit_m <= (1.0 - MIN_MISFIT_DROP) * est.misfit_before_m:
         return "no_misfit_gain"
+    if est.disagreement_sigmas > FAULT_SIGMAS:
+        return FAULT
     return ""
 
 
@@ -111,8 +126,9 @@ def refusal(info: Mapping[str, float]) -> str:
 class Spliced:
     """The spliced clouds and how they were made, all in R, before Z passthrough and downsampling.
 
-    registered : every camera registered, nothing merged away (per-point ``camera`` index).
+    registered : every camera registered, nothing merged away (per-point ``camera`` index), less the faults.
     registrations : the registrations in the order they were made.
+    faults : camera name -> why it was dropped (its data disagree with the prior, :data:`FAULT`).
     merge : makes the paper's merged cloud and its per-camera counts from the registration's result (the
         prioritised merge); run once, on the first read of ``dense`` or ``kept``. Only the paper's and RANSAC's
         locators and the pictures read the merged cloud, so a detection with ours never pays for it.
@@ -121,6 +137,7 @@ class Spliced:
     registered: Cloud
     registrations: tuple[Registration, ...]
     merge: Callable[[], tuple[Cloud, dict[str, int]]] = field(compare=False, repr=False)
+    faults: Mapping[str, str] = field(default_factory=dict)
 
     @cached_property
     def _merged(self) -> tuple[Cloud, dict[str, int]]:
@@ -186,13 +203,16 @@ def splice(
     spec: PerceptionSpec,
     calibrated: Cloud | None = None,
     on_correction: Callable[[str], None] | None = None,
+    priors: Mapping[str, PoseUncertainty] | None = None,
 ) -> Spliced:
     """Splice per-camera clouds (frame R, from :func:`clouds_in_robot_frame`) into one in R (module docstring).
 
     images : the captures the clouds came from (their mounts and calibrated poses X_WC, intrinsics fx).
     calibrated : :func:`stacked` of the same clouds when the caller has it (made here otherwise).
-    on_correction : called with a camera's name as soon as its correction is applied (the registered cloud will
-    differ from ``calibrated``). Empty clouds are skipped; :class:`SensorError` if every cloud is empty.
+    on_correction : called with a camera's name as soon as the registered cloud will differ from ``calibrated``
+        (its correction applied, or the camera dropped as a fault).
+    priors : camera name -> its stated calibration (the prior on its pose); a camera not named is stated exact.
+    Empty clouds are skipped; :class:`SensorError` if every cloud is empty.
     """
     order, cameras = _stack_order(clouds, images)
     calibrated = stacked(clouds, images) if calibrated is None else calibrated
@@ -206,59 +226,104 @@ def splice(
     # The registrations move a copy; the merge's normals are plane fits twice the voxel wide (a voxel-wide fit of
     # 2-3 mm noise is as noisy as the depth) of the points as calibrated.
     points = np.array(calibrated.points)
-    registrations = _register_in_order(points, bounds, order, index, X_RC, spec, on_correction)
+    steps = _Steps(points, bounds, order, index, X_RC, dict(priors or {}))
+    registrations = steps.run(spec, on_correction)
+    faults = {r.source: _fault_reason(r) for r in registrations if r.fault}
+    keep = ~np.isin(camera, [index[n] for n in faults]) if faults else None
     registered = Cloud(points, "R", camera, cameras) if any(r.accepted for r in registrations) else calibrated
+    if keep is not None:
+        registered, calibrated = registered.select(keep), calibrated.select(keep)
+    X_RC_kept = {i: X for i, X in X_RC.items() if cameras[i] not in faults}
 
     def merge() -> tuple[Cloud, dict[str, int]]:
-        normals = surface_normals(calibrated.points, camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
-        keep = prioritised_merge(registered.points, camera, X_RC, fx, spec.merge_cell_m, spec.voxel_m, normals)
-        kept = {n: int(np.count_nonzero(keep[bounds[k] : bounds[k + 1]])) for k, n in enumerate(order)}
-        return registered.select(keep), kept
-
-    return Spliced(registered, tuple(registrations), merge)
-
-
-def _register_in_order(
-    points: FloatArray,
-    bounds: npt.NDArray[np.intp],
-    order: tuple[str, ...],
-    index: Mapping[str, int],
-    X_RC: dict[int, FloatArray],
-    spec: PerceptionSpec,
-    on_correction: Callable[[str], None] | None = None,
-) -> list[Registration]:
-    """Register each camera's points (``points[bounds[k]:bounds[k + 1]]``, cameras in ``order``) onto those of the
-    cameras before it; an accepted correction moves its points and its pose in ``X_RC`` (both in place) and is
-    announced to ``on_correction``."""
-    registrations = []
-    for k, name in enumerate(order[1:], start=1):
-        part = slice(bounds[k], bounds[k + 1])
-        X, info = register(points[part], points[: bounds[k]], spec)
-        refused = refusal(info)
-        accepted = not refused
-        X_corr = X if accepted else np.eye(4)
-        registrations.append(
-            Registration(
-                name,
-                order[:k],
-                X_corr,
-                X,
-                int(info["overlap"]),
-                int(info["constrained"]),
-                info["shift_m"],
-                info["chi2"],
-                info["misfit_before_m"],
-                info["misfit_m"],
-                accepted,
-                info["noise_m"],
-                int(info["directions_constrained"]),
-                info["z_min"],
-                refused,
-            )
+        normals = surface_normals(calibrated.points, calibrated.camera, eyes, 2.0 * spec.voxel_m, spec.merge_cell_m)
+        kept_mask = prioritised_merge(
+            registered.points, registered.camera, X_RC_kept, fx, spec.merge_cell_m, spec.voxel_m, normals
         )
-        if accepted:
-            if on_correction is not None:
+        tags = registered.camera[kept_mask]
+        kept = {n: int(np.count_nonzero(tags == index[n])) for n in order}
+        return registered.select(kept_mask), kept
+
+    return Spliced(registered, tuple(registrations), merge, faults)
+
+
+def _fault_reason(r: Registration) -> str:
+    """One line: why a camera whose data disagree with its stated calibration was dropped."""
+    return (
+        f"disagrees with {', '.join(r.target)} by {r.disagreement_sigmas:.1f} sigmas of its stated calibration along "
+        f"a direction their overlap fixes (at most {FAULT_SIGMAS:.0f}): knocked out of calibration?"
+    )
+
+
+@dataclass
+class _Steps:
+    """The registrations in the splice order, each camera (``points[bounds[k]:bounds[k + 1]]``, cameras in
+    ``order``) onto the cameras before it that are not faults. An accepted correction moves the camera's points
+    and its pose in ``X_RC`` (both in place); ``tied`` follows which camera's calibration a corrected camera now
+    rests on (its first target's)."""
+
+    points: FloatArray
+    bounds: npt.NDArray[np.intp]
+    order: tuple[str, ...]
+    index: Mapping[str, int]
+    X_RC: dict[int, FloatArray]
+    priors: dict[str, PoseUncertainty]
+    tied: dict[str, str] = field(default_factory=dict)
+
+    def run(self, spec: PerceptionSpec, on_correction: Callable[[str], None] | None) -> list[Registration]:
+        out: list[Registration] = []
+        faults: set[str] = set()
+        for k, name in enumerate(self.order[1:], start=1):
+            targets = tuple(n for n in self.order[:k] if n not in faults)
+            r = self.one(k, name, targets, spec)
+            out.append(r)
+            if r.fault:
+                faults.add(name)
+            elif r.accepted:
+                part = slice(self.bounds[k], self.bounds[k + 1])
+                self.points[part] = transform_points(r.X_corr, self.points[part])
+                i = self.index[name]
+                self.X_RC[i] = r.X_corr @ self.X_RC[i]
+                self.tied[name] = self.tied.get(targets[0], targets[0])
+            if (r.fault or r.accepted) and on_correction is not None:
                 on_correction(name)
-            points[part] = transform_points(X_corr, points[part])
-            X_RC[index[name]] = X_corr @ X_RC[index[name]]
-    return registrations
+        return out
+
+    def one(self, k: int, name: str, targets: tuple[str, ...], spec: PerceptionSpec) -> Registration:
+        """Camera ``order[k]`` registered onto ``targets`` with its prior (or not at all when stated exact)."""
+        eye = np.eye(4)
+        u = self.priors.get(name, PoseUncertainty())
+        if u.zero or not targets:
+            refused = "calibration_exact" if u.zero else "no_overlap"
+            return Registration(name, targets, eye, eye, 0, 0, 0.0, 0.0, math.inf, math.inf, False, refused=refused)
+        parts = [slice(self.bounds[j], self.bounds[j + 1]) for j, n in enumerate(self.order[:k]) if n in targets]
+        counts = [p.stop - p.start for p in parts]
+        shares: dict[str, float] = {}  # each target's share, summed per calibration it rests on
+        for n, c in zip(targets, counts, strict=True):
+            src = self.tied.get(n, n)
+            shares[src] = shares.get(src, 0.0) + c / max(sum(counts), 1)
+        origin = {n: self.X_RC[self.index[n]][:3, 3] for n in (name, *shares)}
+
+        def prior(centre_R: FloatArray, lever_m: float) -> FloatArray:
+            rest = [(self.priors.get(n, PoseUncertainty()), origin[n], w) for n, w in shares.items()]
+            return relative_covariance((u, origin[name]), rest, centre_R, lever_m)
+
+        target_points = np.concatenate([self.points[p] for p in parts])
+        est = register(self.points[self.bounds[k] : self.bounds[k + 1]], target_points, spec, prior)
+        refused = refusal(est)
+        return Registration(
+            name,
+            targets,
+            est.X_map if not refused else eye,
+            est.X_estimated,
+            est.overlap,
+            est.informed,
+            est.shift_m,
+            est.map_shift_m,
+            est.misfit_before_m,
+            est.misfit_m,
+            not refused,
+            est.noise_m,
+            est.disagreement_sigmas,
+            refused,
+        )

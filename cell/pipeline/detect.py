@@ -105,7 +105,7 @@ def build_scene(
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
     # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud. The
     # alignment starts beside the splice (perceive_then); the stage times split the wall where the cloud was ready.
-    done = perceive_then(cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned)
+    done = perceive_then(cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned, pose_uncertainties(sc))
     perceived, (alignment, X_RM, weldmap_R, missing) = done.perceived, done.answer
     timings = {"perceive_s": done.cloud_s, "align_s": done.answer_s - done.cloud_s}
 

@@ -1,0 +1,133 @@
+"""A camera's stated calibration as the prior on its pose, and the splice's estimate that weighs the data against it.
+
+The scenario states how well each camera's pose is known (``cameras.<name>.calibration``: the RMS translation
+``t`` and rotation ``theta`` of its calibration residual, :class:`PoseUncertainty`). A pose error moves the
+camera's points rigidly: a rotation ``w`` about the camera's optical centre ``o`` and a shift ``s``. The splice
+registers a camera onto the cameras before it in the coordinates of :mod:`cell.perception.registration`: the
+rotation vector scaled by the overlap's RMS radius ``lever`` about its centroid ``c``, then the displacement of
+``c``. In those coordinates the camera's error is ``x = A [w; s]`` with ``A = [[lever I, 0], [-[c - o]x, I]]``
+(a rotation about the camera moves the overlap by ``w x (c - o)``), so its prior covariance is
+
+    P_cam = A diag(theta^2 / 3 I, t^2 / 3 I) A^T
+
+(each RMS spread evenly over three axes), and the prior of the disagreement between the camera and its targets is
+the sum of the camera's and its targets' (each target camera's weighted by the square of its share of the target).
+
+:func:`posterior` combines that prior with what the overlap says: the registration's estimate ``x_d`` and its
+information ``I_d`` (the inverse of the patch-robust covariance of the point-to-plane estimate). In the prior's
+whitened coordinates (``x = L y``, ``P = L L^T``) the information's eigenvectors ``u_i`` are the directions,
+their eigenvalues ``mu_i`` the ratio of prior to data variance along each. A direction is *informed* when
+``mu_i >= INFORMED_RATIO`` (the data's variance at most a tenth of the prior's); only those move. Along each,
+``a_i = u_i . y_d`` is the data's disagreement in prior sigmas: beyond :data:`FAULT_SIGMAS` the camera is not
+miscalibrated within what its calibration states but knocked (a fault, never a correction); else the MAP
+estimate, one Gauss-Newton step of the prior-augmented problem from the data's optimum, is
+``b_i = mu_i / (1 + mu_i) a_i``. Directions a round or flat overlap leaves free carry no information and stay
+as calibrated; a camera whose calibration is stated exact (``P = 0``) never moves.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from cell.geometry import FloatArray, readonly
+
+INFORMED_RATIO = 10.0  # a direction moves only where the prior's variance is this many times the data's
+FAULT_SIGMAS = 3.0  # a disagreement beyond this many prior sigmas along an informed direction is a camera fault
+_RELATIVE_EPS = 1e-12  # prior eigenvalues below this share of the largest are exact (the direction is fixed)
+
+
+@dataclass(frozen=True)
+class PoseUncertainty:
+    """How well one camera's pose is known: RMS translation [m] and rotation [rad] of its calibration residual."""
+
+    translation_m: float = 0.0
+    rotation_rad: float = 0.0
+
+    def sigma_at(self, range_m: float) -> float:
+        """Per-axis standard deviation [m] of a point at ``range_m`` from the camera (an RMS over three axes)."""
+        return math.hypot(self.translation_m, range_m * self.rotation_rad) / math.sqrt(3.0)
+
+    @property
+    def zero(self) -> bool:
+        return self.translation_m == 0.0 and self.rotation_rad == 0.0
+
+
+def camera_covariance(u: PoseUncertainty, origin_R: FloatArray, centre_R: FloatArray, lever_m: float) -> FloatArray:
+    """(6, 6) prior covariance [m^2] of a camera's pose error in the registration's coordinates about the
+    overlap's centroid ``centre_R`` (3,) with ``lever_m``; the camera's optical centre is ``origin_R`` (3,)."""
+    d = np.asarray(centre_R, dtype=float) - np.asarray(origin_R, dtype=float)
+    skew = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
+    A = np.zeros((6, 6))
+    A[:3, :3] = lever_m * np.eye(3)
+    A[3:, :3] = -skew
+    A[3:, 3:] = np.eye(3)
+    spread = np.repeat([u.rotation_rad**2 / 3.0, u.translation_m**2 / 3.0], 3)
+    return np.asarray((A * spread) @ A.T)
+
+
+def relative_covariance(
+    source: tuple[PoseUncertainty, FloatArray],
+    targets: Sequence[tuple[PoseUncertainty, FloatArray, float]],
+    centre_R: FloatArray,
+    lever_m: float,
+) -> FloatArray:
+    """(6, 6) prior covariance of the disagreement between the ``source`` camera (uncertainty, origin) and the
+    cloud of ``targets`` (uncertainty, origin, share of the target's points), in the coordinates of
+    :func:`camera_covariance`: independent errors add, a target camera's weighted by the square of its share."""
+    P = camera_covariance(source[0], source[1], centre_R, lever_m)
+    for u, origin, share in targets:
+        P = P + share**2 * camera_covariance(u, origin, centre_R, lever_m)
+    return P
+
+
+@dataclass(frozen=True)
+class Posterior:
+    """The splice's estimate of one camera's correction, in the registration's coordinates (6,) [m].
+
+    x_map : the MAP correction along the informed directions (zero along the others): what may be applied.
+    x_informed : the data's estimate along the informed directions, unshrunk (what the overlap says there).
+    informed : number of informed directions (0-6).
+    disagreement_sigmas : the largest disagreement along an informed direction, in prior sigmas.
+    """
+
+    x_map: FloatArray
+    x_informed: FloatArray
+    informed: int
+    disagreement_sigmas: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x_map", readonly(self.x_map))
+        object.__setattr__(self, "x_informed", readonly(self.x_informed))
+
+    @property
+    def fault(self) -> bool:
+        """The data disagree with the prior beyond :data:`FAULT_SIGMAS` along an informed direction."""
+        return self.disagreement_sigmas > FAULT_SIGMAS
+
+
+def posterior(x_data: FloatArray, information: FloatArray, prior: FloatArray) -> Posterior:
+    """The MAP correction from the data's estimate ``x_data`` (6,), its information (6, 6) [1/m^2] and the prior
+    covariance (6, 6) [m^2] (module docstring). A prior of zero gives zero and no informed direction."""
+    x_data = np.asarray(x_data, dtype=float)
+    zero = np.zeros(6)
+    vals, vecs = np.linalg.eigh(0.5 * (prior + prior.T))
+    top = float(vals.max()) if vals.size else 0.0
+    free = vals > _RELATIVE_EPS * top if top > 0.0 else np.zeros(6, dtype=bool)
+    if not free.any():
+        return Posterior(zero, zero, 0, 0.0)
+    L = vecs[:, free] * np.sqrt(vals[free])  # (6, k): x = L y, y ~ N(0, I) under the prior
+    L_pinv = (vecs[:, free] / np.sqrt(vals[free])).T  # (k, 6)
+    info_w = L.T @ (0.5 * (information + information.T)) @ L  # whitened information: prior / data variance
+    mu, U = np.linalg.eigh(info_w)
+    informed = mu >= INFORMED_RATIO
+    if not informed.any():
+        return Posterior(zero, zero, 0, 0.0)
+    a = U[:, informed].T @ (L_pinv @ x_data)  # the data's estimate along each informed direction [prior sigmas]
+    b = mu[informed] / (1.0 + mu[informed]) * a
+    x_informed = L @ (U[:, informed] @ a)
+    x_map = L @ (U[:, informed] @ b)
+    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))))

@@ -38,6 +38,8 @@ from cell.rescan import (
     view_target,
 )
 from cell.seams.base import SeamLocator
+from cell.seams.ends import check_ends
+from cell.seams.registry import part_tolerance_m
 from cell.station import Arm, Station
 from cell.types import DepthImage, SeamEstimate, SeamStatus
 from cell.types.rescan import Viewpoint
@@ -152,6 +154,7 @@ def _closeup(run: _Run, seam_id: str, image: DepthImage, vp: Viewpoint, motion_s
     t = time.perf_counter()
     est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
     est = replace(est, time_s=time.perf_counter() - t)
+    est = check_ends(scene.weldmap, scene.joints, [est], part_tolerance_m(det.scenario, det.method))[0]
     X_RC = invert(det.scenario.X_WR) @ image.X_WC
     est = closeup_sigma(est, X_RC[:3, 3], pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty()))
     fused, w = fuse(first, est, estimate_sigma(first), estimate_sigma(est), o.first_scale_m)

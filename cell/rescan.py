@@ -119,20 +119,35 @@ def fuse_along(x1: float, s1: float, x2: float, s2: float) -> tuple[float, float
 
 
 def seams_to_rescan(
-    estimates: Sequence[SeamEstimate], threshold: float = CONFIDENCE_THRESHOLD, max_sigma_m: float = math.inf
+    estimates: Sequence[SeamEstimate],
+    threshold: float = CONFIDENCE_THRESHOLD,
+    max_sigma_m: float = math.inf,
+    max_end_sigma_m: float = math.inf,
 ) -> list[str]:
-    """Ids of the seams worth a close look: found with confidence below ``threshold`` or a sigma over
-    ``max_sigma_m`` [m] (too uncertain to weld, :func:`within_tolerance`), or visible but not found.
+    """Ids of the seams worth a close look: found with confidence below ``threshold``, a sigma over
+    ``max_sigma_m`` [m] (too uncertain to weld, :func:`within_tolerance`) or an end's sigma over
+    ``max_end_sigma_m`` [m] (:func:`ends_within_tolerance`), or visible but not found.
 
     ``threshold=math.inf`` selects every visible seam. Seams no camera can see (against the table) are left out.
     """
     out = []
     for e in estimates:
         if e.status is SeamStatus.NOT_FOUND or (
-            e.status is SeamStatus.FOUND and (e.confidence < threshold or not within_tolerance(e, max_sigma_m))
+            e.status is SeamStatus.FOUND
+            and (
+                e.confidence < threshold
+                or not within_tolerance(e, max_sigma_m)
+                or not ends_within_tolerance(e, max_end_sigma_m)
+            )
         ):
             out.append(e.id)
     return out
+
+
+def ends_within_tolerance(estimate: SeamEstimate, max_end_sigma_m: float) -> bool:
+    """Whether a found estimate's ends are certain enough to weld: each end's sigma along the seam at most
+    ``max_end_sigma_m`` [m] (the end tolerance over the bound's factor, ``RescanSpec.max_end_sigma_m``)."""
+    return estimate.status is SeamStatus.FOUND and max(estimate.end_sigma_m) <= max_end_sigma_m
 
 
 def within_tolerance(estimate: SeamEstimate, max_sigma_m: float) -> bool:
@@ -228,6 +243,7 @@ __all__ = [
     "closeup_scenario",
     "closeup_scene",
     "crop_around",
+    "ends_within_tolerance",
     "estimate_sigma",
     "eye_in_hand_camera",
     "fuse",

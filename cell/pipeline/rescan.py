@@ -257,7 +257,8 @@ def rescan_detection(
     estimates: the one re-scan path of ``cell weld`` and ``cell rescan``.
 
     mode : ``low``: the seams below ``rescan.confidence_threshold``, those whose bound (``rescan.bound_sigmas``
-    sigma) exceeds ``rescan.weld_tolerance_mm``, and those not found; ``all``: every visible seam.
+    sigma) exceeds ``rescan.weld_tolerance_mm`` or whose end bound exceeds ``rescan.end_tolerance_mm``, and those
+    not found; ``all``: every visible seam.
     seam_ids : these seams instead of the mode's choice (``cell rescan --seams``).
     Escalation (unless ``all``): a close-up that moves its seam by more than ``rescan.escalate_mm`` shows the fixed
     cameras cannot be trusted here (calibration off, a bumped camera): every other visible seam is re-scanned too.
@@ -267,7 +268,7 @@ def rescan_detection(
         ids = list(seam_ids)
     else:
         threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
-        ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
+        ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m, sc.rescan.max_end_sigma_m)
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
     rs = rescan_seams(station, det, ids, motion=motion, progress=progress)
     after = rescanned(det, rs)

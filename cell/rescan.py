@@ -12,8 +12,9 @@ moves the arm for it; this module holds the values it computes):
    and run the same locator on a local :class:`SeamScene` (this close cloud, the same aligned map and joints);
 4. fuse the close-up estimate with the first by inverse variance (:func:`fuse`): each estimate's standard
    deviation is its locator's calibrated sigma (``SeamEstimate.sigma_m``, :mod:`cell.seams.sigma`; the close-up's
-   its own, with the close-up's floor). A failed close-up keeps the first estimate; an uncertain one gets a small
-   weight. The fused estimate carries the fused sigma, which the weld gate reads.
+   its own, with the close-up's floor); each end along the seam by its end sigmas (``SeamEstimate.end_sigma_m``,
+   :func:`fuse_along`). A failed close-up keeps the first estimate; an uncertain one gets a small weight. The fused
+   estimate carries the fused sigmas, which the weld gate reads.
 
 Finally the arm goes back to its scan configuration (when that move is free). Frames: R (robot base) for every
 estimate and pose, W for the simulator; metres, radians, seconds.
@@ -59,44 +60,94 @@ def fuse(
         conf = 1.0 / (1.0 + (sigma_closeup / scale_m) ** 2)
         return replace(closeup, confidence=conf, reason=f"close-up only; {closeup.reason}"), 1.0
     a, b = closeup.p_start, closeup.p_end
+    ends_closeup, sources_closeup = closeup.end_sigma_m, closeup.end_source
     if np.linalg.norm(a - first.p_end) + np.linalg.norm(b - first.p_start) < np.linalg.norm(
         a - first.p_start
     ) + np.linalg.norm(b - first.p_end):
         a, b = b, a
+        ends_closeup, sources_closeup = ends_closeup[::-1], sources_closeup[::-1]
     v1, v2 = sigma_first**2, sigma_closeup**2
     w = v1 / (v1 + v2) if v1 + v2 > 0.0 else 0.5
     sigma = math.sqrt(v1 * v2 / (v1 + v2)) if v1 + v2 > 0.0 else 0.0
+    p_start, p_end = (1.0 - w) * first.p_start + w * a, (1.0 - w) * first.p_end + w * b
+    # Along the fused line each end is fused on its own, by its end sigmas (the line across stays as fused above).
+    u = (p_end - p_start) / max(float(np.linalg.norm(p_end - p_start)), 1e-12)
+    ends, sigmas, sources = [], [], []
+    for p, q1, q2, s1, s2, k1, k2 in zip(
+        (p_start, p_end),
+        (first.p_start, first.p_end),
+        (a, b),
+        first.end_sigma_m,
+        ends_closeup,
+        first.end_source,
+        sources_closeup,
+        strict=True,
+    ):
+        along, s_end = fuse_along(float((q1 - p) @ u), s1, float((q2 - p) @ u), s2)
+        ends.append(p + along * u)
+        sigmas.append(s_end)
+        sources.append(k2 if s2 <= s1 else k1)
     fused = SeamEstimate(
         id=first.id,
         status=SeamStatus.FOUND,
         reason=f"fused, close-up weight {w:.2f}; close-up {closeup.reason}",
-        p_start=(1.0 - w) * first.p_start + w * a,
-        p_end=(1.0 - w) * first.p_end + w * b,
+        p_start=ends[0],
+        p_end=ends[1],
         confidence=1.0 / (1.0 + (sigma / scale_m) ** 2),
         time_s=first.time_s + closeup.time_s,
         sigma_m=sigma,
+        end_sigma_m=(sigmas[0], sigmas[1]),
+        end_source=(sources[0], sources[1]),
     )
     return fused, float(w)
+
+
+def fuse_along(x1: float, s1: float, x2: float, s2: float) -> tuple[float, float]:
+    """Inverse-variance fusion of two positions x1, x2 [m] along a seam with standard deviations s1, s2 [m]:
+    (fused position, its standard deviation); an infinite sigma has no weight (both infinite: x1, inf)."""
+    if not math.isfinite(s2):
+        return x1, s1
+    if not math.isfinite(s1):
+        return x2, s2
+    v1, v2 = s1 * s1, s2 * s2
+    if v1 + v2 <= 0.0:
+        return 0.5 * (x1 + x2), 0.0
+    return (x1 * v2 + x2 * v1) / (v1 + v2), math.sqrt(v1 * v2 / (v1 + v2))
 
 
 # -- which seams ---------------------------------------------------------------------------------------------
 
 
 def seams_to_rescan(
-    estimates: Sequence[SeamEstimate], threshold: float = CONFIDENCE_THRESHOLD, max_sigma_m: float = math.inf
+    estimates: Sequence[SeamEstimate],
+    threshold: float = CONFIDENCE_THRESHOLD,
+    max_sigma_m: float = math.inf,
+    max_end_sigma_m: float = math.inf,
 ) -> list[str]:
-    """Ids of the seams worth a close look: found with confidence below ``threshold`` or a sigma over
-    ``max_sigma_m`` [m] (too uncertain to weld, :func:`within_tolerance`), or visible but not found.
+    """Ids of the seams worth a close look: found with confidence below ``threshold``, a sigma over
+    ``max_sigma_m`` [m] (too uncertain to weld, :func:`within_tolerance`) or an end's sigma over
+    ``max_end_sigma_m`` [m] (:func:`ends_within_tolerance`), or visible but not found.
 
     ``threshold=math.inf`` selects every visible seam. Seams no camera can see (against the table) are left out.
     """
     out = []
     for e in estimates:
         if e.status is SeamStatus.NOT_FOUND or (
-            e.status is SeamStatus.FOUND and (e.confidence < threshold or not within_tolerance(e, max_sigma_m))
+            e.status is SeamStatus.FOUND
+            and (
+                e.confidence < threshold
+                or not within_tolerance(e, max_sigma_m)
+                or not ends_within_tolerance(e, max_end_sigma_m)
+            )
         ):
             out.append(e.id)
     return out
+
+
+def ends_within_tolerance(estimate: SeamEstimate, max_end_sigma_m: float) -> bool:
+    """Whether a found estimate's ends are certain enough to weld: each end's sigma along the seam at most
+    ``max_end_sigma_m`` [m] (the end tolerance over the bound's factor, ``RescanSpec.max_end_sigma_m``)."""
+    return estimate.status is SeamStatus.FOUND and max(estimate.end_sigma_m) <= max_end_sigma_m
 
 
 def within_tolerance(estimate: SeamEstimate, max_sigma_m: float) -> bool:
@@ -192,9 +243,11 @@ __all__ = [
     "closeup_scenario",
     "closeup_scene",
     "crop_around",
+    "ends_within_tolerance",
     "estimate_sigma",
     "eye_in_hand_camera",
     "fuse",
+    "fuse_along",
     "occluders",
     "seams_to_rescan",
     "view_target",

@@ -12,7 +12,14 @@ from cell.config.export import KrlOptions
 from cell.config.motion import STICKOUT_MM, CollisionOptions, GateOptions, IKOptions, PlanOptions, ViewOptions
 from cell.config.perception import CoverageOptions, HealthOptions, ScreenOptions, SymmetryOptions
 from cell.config.rescan import CLOSEUP_OURS_OPTIONS, CLOSEUP_TARGET_SE_M, CONFIDENCE_THRESHOLD, RescanOptions
-from cell.config.seams import INDEX_SHARES, OursSettings, PaperOptions, RansacOptions, RansacThresholds
+from cell.config.seams import (
+    INDEX_SHARES,
+    PART_TOLERANCE_M,
+    OursSettings,
+    PaperOptions,
+    RansacOptions,
+    RansacThresholds,
+)
 from cell.config.sim import BeadStyle
 
 __all__ = [
@@ -20,6 +27,7 @@ __all__ = [
     "CLOSEUP_TARGET_SE_M",
     "CONFIDENCE_THRESHOLD",
     "INDEX_SHARES",
+    "PART_TOLERANCE_M",
     "STICKOUT_MM",
     "BeadStyle",
     "Bounds",

@@ -23,6 +23,11 @@ CLOSEUP_TARGET_SE_M = 0.00002
 WELD_TOLERANCE_MM = 0.5
 BOUND_SIGMAS = 3.0
 
+# The ends' gate: a bead more than 1 mm past or short of its joint's end is a defect (past: metal on the bare face
+# beyond the joint, or into another part; short: joint left open), so a seam is welded only when BOUND_SIGMAS times
+# each end's sigma along the seam is within END_TOLERANCE_MM (``rescan.end_tolerance_mm``).
+END_TOLERANCE_MM = 1.0
+
 # Ours' sigma floor up close [m]: the arm's pose accuracy and hand-eye calibration on a real cell (exact kinematics
 # in the simulator); the close-ups of fence1, fence1-exact and fence2 end 0.006-0.017 mm off on average (README,
 # the re-scan table), and the fixed cameras' calibration, which the first pass's floor stands for, does not apply.

@@ -12,6 +12,11 @@ from typing import Annotated
 from cell.config.bounds import Bounds, check_bounds
 from cell.errors import ScenarioError
 
+# How far an as-built part's faces and ends may lie from the aligned map [m]: the paper's industrial tolerances
+# (docs/reference.md: 1 % of a part's width and location, 5 % of its length) on the public parts' members, a few mm.
+# The one source of the part tolerance: our locator's ``map_tolerance_m`` default, and the sigma of an end that only
+# the drawn length places (cell/seams/sigma.py).
+PART_TOLERANCE_M = 0.006
 INDEX_SHARES = (0.25, 0.5, 1.0)  # shares of the dense cloud a query may ask for (1 / k: every k-th point)
 Positive = Bounds(gt=0.0)
 
@@ -84,7 +89,7 @@ class OursSettings:
     extend_m: float = 0.02  # ... and this far past the map's ends
     corner_band_m: float = 0.005  # least band excluded next to the other weld face (gap, shadow, corner noise)
     edge_band_m: float = 0.004  # band excluded along convex edges (flying pixels, side faces)
-    map_tolerance_m: float = 0.006  # how far the as-built faces and ends may lie from the aligned map
+    map_tolerance_m: float = PART_TOLERANCE_M  # how far the as-built faces and ends may lie from the aligned map
     sensor_sigma_m: float = 0.003  # depth noise assumed before it is measured
     gate_sigmas: float = 3.5  # half-width of the gate around a plane, in measured noise scales
     passes: int = 2  # fits: the first from the map with wide gates, the others with measured noise and ends

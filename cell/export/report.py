@@ -31,8 +31,13 @@ def _pt(p: np.ndarray) -> list[float | None]:
     return [_r(float(x), 7) for x in p]
 
 
-def _errors(m: SeamMetrics) -> dict[str, float | None]:
-    return {"paper_me": _r(m.paper_me_mm, 4), "endpoint": _r(m.endpoint_mm, 4), "lateral": _r(m.lateral_mm, 4)}
+def _errors(m: SeamMetrics) -> dict[str, Any]:
+    return {
+        "paper_me": _r(m.paper_me_mm, 4),
+        "endpoint": _r(m.endpoint_mm, 4),
+        "lateral": _r(m.lateral_mm, 4),
+        "end_along": [_r(v, 4) for v in m.end_along_mm],
+    }
 
 
 def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
@@ -48,6 +53,8 @@ def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
         entry["detected"] = {"start": _pt(est.p_start), "end": _pt(est.p_end)}
         entry["confidence"] = _r(est.confidence, 4)
         entry["sigma_mm"] = _r(est.sigma_m * 1000.0, 4)
+        entry["end_sigma_mm"] = [_r(v * 1000.0, 4) for v in est.end_sigma_m]
+        entry["end_source"] = [k.value for k in est.end_source]
     if rec.truth is not None:  # none when the station knows no truth (real data)
         entry["truth"] = {"start": _pt(rec.truth[0]), "end": _pt(rec.truth[1])}
     if rec.metrics is not None:

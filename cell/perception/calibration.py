@@ -17,8 +17,9 @@ source with the summed share. Independent sources add in quadrature,
     sigma_cal = sqrt(sum_g (W_g * sigma_g)^2),
 
 so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
-cameras about 1 / sqrt(2) of it. The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``. With every
-calibration at 0 (the default) nothing changes and nothing is computed.
+cameras about 1 / sqrt(2) of it. The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``, and so does each
+end's sigma along it (``end_sigma_m``: the same rigid error moves the ends too). With every calibration at 0 (the
+default) nothing changes and nothing is computed.
 
 The close-up of a re-scan (:func:`closeup_sigma`) is seen by the arm's camera alone, at its close range. (Its
 fusion with the first estimate treats the two as independent; when both rest on the same camera's calibration the
@@ -125,8 +126,19 @@ def with_calibration(
         shares = support_shares(registered, est.p_start, est.p_end)
         mid = 0.5 * (est.p_start + est.p_end)
         cal = calibration_sigma(shares, mid, origins_R, uncertainty, tied)
-        out.append(replace(est, sigma_m=math.hypot(est.sigma_m, cal)) if cal > 0.0 else est)
+        out.append(with_term(est, cal) if cal > 0.0 else est)
     return tuple(out)
+
+
+def with_term(est: SeamEstimate, sigma_cal: float) -> SeamEstimate:
+    """``est`` with a calibration term ``sigma_cal`` [m] in quadrature, across the seam and at each end along it
+    (a camera's pose error moves its points rigidly, along the seam as much as across it)."""
+    ends = est.end_sigma_m
+    return replace(
+        est,
+        sigma_m=math.hypot(est.sigma_m, sigma_cal),
+        end_sigma_m=(math.hypot(ends[0], sigma_cal), math.hypot(ends[1], sigma_cal)),
+    )
 
 
 def closeup_sigma(est: SeamEstimate, origin_R: FloatArray, uncertainty: PoseUncertainty) -> SeamEstimate:
@@ -135,4 +147,4 @@ def closeup_sigma(est: SeamEstimate, origin_R: FloatArray, uncertainty: PoseUnce
         return est
     mid = 0.5 * (est.p_start + est.p_end)
     cal = uncertainty.sigma_at(float(np.linalg.norm(mid - np.asarray(origin_R))))
-    return replace(est, sigma_m=math.hypot(est.sigma_m, cal))
+    return with_term(est, cal)

@@ -20,8 +20,9 @@ def locate_seams(
     """Every seam of ``ss``'s map (frame L) located by ``method`` (ours with the scenario's options, cut at
     ``workspace_L``), the underside ones NOT_VISIBLE, then screened (missing parts, occluders, doubt)."""
     from cell.seams.base import BatchSeamLocator, SeamLocator
+    from cell.seams.ends import check_ends
     from cell.seams.ours import OursLocator, OursOptions
-    from cell.seams.registry import locator_spec, make_locator
+    from cell.seams.registry import locator_spec, make_locator, part_tolerance_m
 
     if method == "ours":
         opts = locator_spec(scenario, "ours").options
@@ -46,6 +47,7 @@ def locate_seams(
             t = time.perf_counter()
             out[seam.id] = replace(locator.locate(ss, seam, rng), time_s=time.perf_counter() - t)
     estimates = tuple(unseen_reason(out[s.id]) for s in ss.weldmap.seams)
+    estimates = check_ends(ss.weldmap, ss.joints, estimates, part_tolerance_m(scenario, method))
     return screen(ss, estimates, missing, scenario.perception.screen)
 
 

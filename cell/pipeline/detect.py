@@ -124,7 +124,8 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
     from cell.perception import screen
     from cell.seams.base import BatchSeamLocator
-    from cell.seams.registry import make_locator
+    from cell.seams.ends import check_ends
+    from cell.seams.registry import make_locator, part_tolerance_m
     from cell.seams.visibility import visibility
 
     ss = scene.seam_scene
@@ -152,6 +153,8 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
             est = locator.locate(ss, seam, rng)
             timed[seam.id] = replace(est, time_s=time.perf_counter() - t)
     out = tuple(hidden[seam.id] if seam.id in hidden else timed[seam.id] for seam in ss.weldmap.seams)
+    # Ends inside another body, off their joint's faces or making a length the map does not draw: cut or replaced.
+    out = check_ends(ss.weldmap, ss.joints, out, part_tolerance_m(scenario, method))
     # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
     out = screen(ss, out, scene.missing, scenario.perception.screen)
     # A seam resting on one camera carries that camera's calibration error (the locator's sigma cannot see it).

@@ -10,7 +10,7 @@ import numpy as np
 
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.records import Detection
-from cell.rescan import within_tolerance
+from cell.rescan import ends_within_tolerance, within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station
 from cell.types import SeamEstimate, SeamStatus
@@ -23,15 +23,26 @@ if TYPE_CHECKING:
 
 def doubt(est: SeamEstimate, sc: Scenario) -> str:
     """Why a found seam is too uncertain to weld ("" when it may be welded): its bound (``rescan.bound_sigmas``
-    times its calibrated sigma) over ``rescan.weld_tolerance_mm``, or its confidence under
-    ``rescan.weld_min_confidence``."""
+    times its calibrated sigma) over ``rescan.weld_tolerance_mm``, its confidence under
+    ``rescan.weld_min_confidence``, or an end's bound over ``rescan.end_tolerance_mm`` (:func:`end_doubt`)."""
     r = sc.rescan
     if not within_tolerance(est, r.max_sigma_m):
         bound_mm = r.bound_sigmas * est.sigma_m * 1000.0
         return f"bound {r.bound_sigmas:g} sigma = {bound_mm:.2f} mm > weld tolerance {r.weld_tolerance_mm:g} mm"
     if est.confidence < r.weld_min_confidence:
         return f"confidence {est.confidence:.2f} < {r.weld_min_confidence:.2f}"
-    return ""
+    return end_doubt(est, sc)
+
+
+def end_doubt(est: SeamEstimate, sc: Scenario) -> str:
+    """Why a found seam's ends are too uncertain to weld ("" when they are not): an end's bound along the seam
+    (``rescan.bound_sigmas`` times its sigma) over ``rescan.end_tolerance_mm``."""
+    r = sc.rescan
+    if ends_within_tolerance(est, r.max_end_sigma_m):
+        return ""
+    bounds = ", ".join(f"{r.bound_sigmas * s * 1000.0:.2f}" for s in est.end_sigma_m)
+    where = "/".join(str(k) for k in est.end_source)
+    return f"end bound {r.bound_sigmas:g} sigma = {bounds} mm ({where}) > end tolerance {r.end_tolerance_mm:g} mm"
 
 
 def seam_welds(
@@ -65,7 +76,8 @@ def seam_welds(
             continue
         doubtful = doubt(est, sc)
         if doubtful and gated and est.id not in unplaceable:
-            out.append(SeamWeld(est.id, False, False, f"low_confidence: {doubtful}", code=WeldReason.LOW_CONFIDENCE))
+            code = WeldReason.END_UNCERTAIN if doubtful == end_doubt(est, sc) else WeldReason.LOW_CONFIDENCE
+            out.append(SeamWeld(est.id, False, False, f"{code.value}: {doubtful}", code=code))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
         if outcome is None or not outcome.feasible:

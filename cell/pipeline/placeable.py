@@ -78,7 +78,7 @@ def rescan_weldable(
     if arm is None:  # rescan_detection says so
         return (*rescan_detection(station, det, mode, motion=motion, progress=progress), {})
     threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
-    chosen = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
+    chosen = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m, sc.rescan.max_end_sigma_m)
     hopeless = _hopeless(arm, det, chosen, motion, progress)
     ids = [i for i in chosen if i not in hopeless]
     if mode == "all" or not hopeless:  # nothing left out: the re-scan as it always was

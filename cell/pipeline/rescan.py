@@ -38,6 +38,8 @@ from cell.rescan import (
     view_target,
 )
 from cell.seams.base import SeamLocator
+from cell.seams.ends import check_ends
+from cell.seams.registry import part_tolerance_m
 from cell.station import Arm, Station
 from cell.types import DepthImage, SeamEstimate, SeamStatus
 from cell.types.rescan import Viewpoint
@@ -152,6 +154,7 @@ def _closeup(run: _Run, seam_id: str, image: DepthImage, vp: Viewpoint, motion_s
     t = time.perf_counter()
     est = run.locator.locate(scene, seam, det.scenario.rng(f"rescan/{det.method}/{seam_id}"))
     est = replace(est, time_s=time.perf_counter() - t)
+    est = check_ends(scene.weldmap, scene.joints, [est], part_tolerance_m(det.scenario, det.method))[0]
     X_RC = invert(det.scenario.X_WR) @ image.X_WC
     est = closeup_sigma(est, X_RC[:3, 3], pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty()))
     fused, w = fuse(first, est, estimate_sigma(first), estimate_sigma(est), o.first_scale_m)
@@ -254,7 +257,8 @@ def rescan_detection(
     estimates: the one re-scan path of ``cell weld`` and ``cell rescan``.
 
     mode : ``low``: the seams below ``rescan.confidence_threshold``, those whose bound (``rescan.bound_sigmas``
-    sigma) exceeds ``rescan.weld_tolerance_mm``, and those not found; ``all``: every visible seam.
+    sigma) exceeds ``rescan.weld_tolerance_mm`` or whose end bound exceeds ``rescan.end_tolerance_mm``, and those
+    not found; ``all``: every visible seam.
     seam_ids : these seams instead of the mode's choice (``cell rescan --seams``).
     Escalation (unless ``all``): a close-up that moves its seam by more than ``rescan.escalate_mm`` shows the fixed
     cameras cannot be trusted here (calibration off, a bumped camera): every other visible seam is re-scanned too.
@@ -264,7 +268,7 @@ def rescan_detection(
         ids = list(seam_ids)
     else:
         threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
-        ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m)
+        ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m, sc.rescan.max_end_sigma_m)
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
     rs = rescan_seams(station, det, ids, motion=motion, progress=progress)
     after = rescanned(det, rs)

@@ -177,7 +177,9 @@ def weld(
     A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
     every seam's reason, so the report can still be written. A seam whose confidence stays below
     ``rescan.weld_min_confidence``, or whose bound (``rescan.bound_sigmas`` times its calibrated sigma) stays over
-    ``rescan.weld_tolerance_mm``, after the re-scan is not welded (``low_confidence``).
+    ``rescan.weld_tolerance_mm``, after the re-scan is not welded (``low_confidence``); nor is one whose end bound
+    (``rescan.bound_sigmas`` times an end's sigma along the seam) stays over ``rescan.end_tolerance_mm``
+    (``end_uncertain``).
 
     station : a running cell to weld on (left open; built and closed here when None). detect_options : keywords
     for :func:`detect` (a turned part's ``X_RM_nominal`` and ``seed``). only : the seam ids this run is about

@@ -22,7 +22,7 @@ from cell.config import (
     ScreenOptions,
     SymmetryOptions,
 )
-from cell.config.rescan import BOUND_SIGMAS, WELD_TOLERANCE_MM
+from cell.config.rescan import BOUND_SIGMAS, END_TOLERANCE_MM, WELD_TOLERANCE_MM
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import Deviation, PoseSpec, WorkspaceSpec
@@ -82,6 +82,9 @@ class RescanSpec(Model):
         seam, ``none`` nothing.
     weld_tolerance_mm, bound_sigmas : after the re-scan, a seam whose locator's sigma (calibrated,
         cell/seams/sigma.py) times ``bound_sigmas`` exceeds ``weld_tolerance_mm`` is not welded (``low_confidence``).
+    end_tolerance_mm : a seam whose end bound (``bound_sigmas`` times an end's sigma along the seam,
+        ``SeamEstimate.end_sigma_m``) exceeds this is re-scanned in ``low`` mode and, still over after the re-scan, not
+        welded (``end_uncertain``): a bead more than this past or short of its joint's end is a defect.
     weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
     escalate_mm : in ``low`` mode, a close-up that disagrees with the first estimate by more than this [mm]
         triggers a re-scan of every visible seam.
@@ -94,6 +97,7 @@ class RescanSpec(Model):
     weld_min_confidence: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
     weld_tolerance_mm: Annotated[float, Field(gt=0.0)] = WELD_TOLERANCE_MM
     bound_sigmas: Annotated[float, Field(gt=0.0)] = BOUND_SIGMAS
+    end_tolerance_mm: Annotated[float, Field(gt=0.0)] = END_TOLERANCE_MM
     # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
     # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.
     escalate_mm: Annotated[float, Field(gt=0.0)] = 0.5
@@ -103,6 +107,12 @@ class RescanSpec(Model):
     def max_sigma_m(self) -> float:
         """The largest sigma [m] a seam may have and be welded: ``weld_tolerance_mm`` / ``bound_sigmas``."""
         return self.weld_tolerance_mm / 1000.0 / self.bound_sigmas
+
+    @property
+    def max_end_sigma_m(self) -> float:
+        """The largest sigma [m] of an end along the seam for the seam to be welded: ``end_tolerance_mm`` /
+        ``bound_sigmas``."""
+        return self.end_tolerance_mm / 1000.0 / self.bound_sigmas
 
     @model_validator(mode="after")
     def _closeup_locator_options(self) -> RescanSpec:

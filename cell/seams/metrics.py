@@ -4,7 +4,8 @@
 per seam, the mean over its two end points of |dx| + |dy| in the robot frame. ``endpoint_mm`` is the mean 3D
 distance of the end points, ``lateral_mm`` the largest distance of the detected segment from the true seam
 line (what the torch feels). Detected ends are matched to true ends first (swapped when the locator reports
-the seam reversed).
+the seam reversed). ``end_along_mm`` is each end's signed error along the true seam (start, end): positive past the
+true end (the located seam longer there), negative short of it.
 """
 
 from __future__ import annotations
@@ -39,15 +40,31 @@ def segment_errors(
     return paper * _MM, endpoint * _MM, lateral * _MM, swapped
 
 
+def end_errors_along(
+    p_start: FloatArray, p_end: FloatArray, t_start: FloatArray, t_end: FloatArray
+) -> tuple[float, float]:
+    """Signed error [mm] of each end of a detected segment along the true seam t_start -> t_end (all (3,), R [m]),
+    in the true seam's order (a reversed detection matched first): positive past the true end (outwards, the
+    located seam longer), negative short of it."""
+    det = np.stack([np.asarray(p_start, float), np.asarray(p_end, float)])
+    tru = np.stack([np.asarray(t_start, float), np.asarray(t_end, float)])
+    if np.linalg.norm(det[::-1] - tru, axis=1).sum() < np.linalg.norm(det - tru, axis=1).sum():
+        det = det[::-1]
+    axis = tru[1] - tru[0]
+    u = axis / max(float(np.linalg.norm(axis)), 1e-12)
+    return float(-(det[0] - tru[0]) @ u) * _MM, float((det[1] - tru[1]) @ u) * _MM
+
+
 def seam_metrics(estimate: SeamEstimate, t_start: FloatArray, t_end: FloatArray) -> SeamMetrics:
     """Errors of one locator answer against its true seam (t_start_R, t_end_R) (3,) [m]; NaN when not
     found."""
     time_ms = estimate.time_s * _MM
     if estimate.status is not SeamStatus.FOUND:
         nan = float("nan")
-        return SeamMetrics(estimate.id, estimate.status, nan, nan, nan, time_ms)
+        return SeamMetrics(estimate.id, estimate.status, nan, nan, nan, time_ms, end_along_mm=(nan, nan))
     paper, endpoint, lateral, swapped = segment_errors(estimate.p_start, estimate.p_end, t_start, t_end)
-    return SeamMetrics(estimate.id, estimate.status, paper, endpoint, lateral, time_ms, swapped)
+    along = end_errors_along(estimate.p_start, estimate.p_end, t_start, t_end)
+    return SeamMetrics(estimate.id, estimate.status, paper, endpoint, lateral, time_ms, swapped, along)
 
 
 def evaluate(

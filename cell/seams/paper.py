@@ -15,8 +15,8 @@ from cell.config.seams import PaperOptions
 from cell.geometry import FloatArray
 from cell.seams._features import cloud_features
 from cell.seams._support import mesh_part, not_supported
-from cell.seams.sigma import paper_sigma
-from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
+from cell.seams.sigma import paper_end_sigmas, paper_sigma
+from cell.types import EndSource, MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 AXIS_TOLERANCE_DEG = 10.0  # a seam within this of x, y or z counts as "along" it
 MIN_MASK_POINTS = 8  # fewer cloud points than this in the outer mask: nothing to measure
@@ -192,7 +192,17 @@ class PaperLocator:
         start[c], start[a] = across, along
         # Step 5: the end from the map's seam vector.
         end = start + (np.asarray(seam.p_end) - s0)
-        return SeamEstimate(seam.id, SeamStatus.FOUND, "", start, end, confidence, sigma_m=paper_sigma(confidence))
+        return SeamEstimate(
+            seam.id,
+            SeamStatus.FOUND,
+            "",
+            start,
+            end,
+            confidence,
+            sigma_m=paper_sigma(confidence),
+            end_sigma_m=paper_end_sigmas(confidence, seam.length),
+            end_source=(EndSource.FACE_END, EndSource.DRAWN),
+        )
 
     def _along_from_far_face(
         self,

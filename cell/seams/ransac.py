@@ -28,8 +28,8 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._index import dense_index
 from cell.seams._lines import plane_intersection
-from cell.seams.sigma import ransac_sigma
-from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
+from cell.seams.sigma import RANSAC_END_SIGMA_M, ransac_sigma
+from cell.types import EndSource, MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
 @dataclass(frozen=True)
@@ -86,6 +86,8 @@ class RansacLocator:
             p_end=med[1],
             confidence=conf,
             sigma_m=ransac_sigma(),
+            end_sigma_m=(RANSAC_END_SIGMA_M, RANSAC_END_SIGMA_M),
+            end_source=(EndSource.FACE_END, EndSource.FACE_END),
         )
 
     def _map_normals(self, scene: SeamScene, seam: MapSeam) -> tuple[FloatArray, FloatArray]:

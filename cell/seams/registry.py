@@ -14,6 +14,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from cell.config.seams import PART_TOLERANCE_M
 from cell.errors import ScenarioError
 from cell.geometry import invert, make_pose
 from cell.scenario import (
@@ -102,6 +103,13 @@ def with_options(scenario: Scenario, method: str, overrides: Mapping[str, Any]) 
     except (TypeError, ValueError) as e:
         raise ScenarioError(f"locator.options of {method}: {e}") from None
     return scenario.model_copy(update={"locator": spec.model_copy(update={"options": options})})
+
+
+def part_tolerance_m(scenario: Scenario, method: str | None = None) -> float:
+    """How far [m] an as-built end may lie from the aligned map's, for ``method``'s seams: our locator's
+    ``map_tolerance_m`` when it runs, else the project's part tolerance (``PART_TOLERANCE_M``)."""
+    options = locator_spec(scenario, method).options
+    return float(getattr(options, "map_tolerance_m", PART_TOLERANCE_M))
 
 
 def make_locator(method: str, scenario: Scenario) -> SeamLocator:

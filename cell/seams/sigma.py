@@ -20,22 +20,81 @@ here were chosen from its rows:
 
 The weld gate (:mod:`cell.pipeline.weld`) welds a seam only when ``rescan.bound_sigmas`` sigma is within
 ``rescan.weld_tolerance_mm``.
+
+Each end has a sigma of its own ALONG the seam (``SeamEstimate.end_sigma_m``), from how it was placed
+(:class:`~cell.types.EndSource`); calibrated the same way (about 95 % of located ends within 2 end sigmas) by
+``benchmarks/bench_ends.py`` on fence1, fence2, brace, bracket, rhs and fence1's faults (seed 0, realistic noise;
+``benchmarks/results/ends.json``, figures in docs/locate.md):
+
+- an end that only the drawn length places (``drawn``) has the part tolerance as its sigma
+  (:func:`drawn_end_sigma`, from ``PART_TOLERANCE_M`` and :data:`LENGTH_SHARE`: the one place it is derived);
+- ours: its statistical standard error of the end (the side face's offset fit, the edge's likelihood, the
+  extent's order statistics) with a floor per source in quadrature (:data:`OURS_END_FLOOR_M`): what the fit cannot
+  see (a blurred edge's bias, flying pixels along it, a tack or a bead near the end);
+- the paper's method reads its start on 1 cm voxel faces (:data:`PAPER_START_SIGMA_M`) and takes its end from the
+  map's vector: that end carries the start's error and the drawn length's (``drawn``);
+- RANSAC's ends are the extent of its planes' inliers on a 1 cm voxel cloud: fixed and wide
+  (:data:`RANSAC_END_SIGMA_M`).
 """
 
 from __future__ import annotations
 
 import math
 
+from cell.config.seams import PART_TOLERANCE_M
+from cell.types import EndSource
+
 PAPER_SIGMA_M = 0.0009  # both faces of the start read (confidence >= PAPER_FACES_CONFIDENCE)
 PAPER_SIGMA_UNSEEN_M = 0.010  # a face of the start not seen: the paper's raw boundary value
 PAPER_FACES_CONFIDENCE = 0.9  # the paper locator's confidence when at least its faces were read
 RANSAC_SIGMA_M = 0.0016
+
+# Our locator's floor per end source [m], in quadrature with its standard error of the end.
+OURS_END_FLOOR_M = {
+    EndSource.EDGE: 0.0001,
+    EndSource.FACE_END: 0.0001,
+    EndSource.OTHER_PART: 0.0001,
+    EndSource.DRAWN: 0.0,
+}
+PAPER_START_SIGMA_M = 0.002  # the paper's start along the seam, read on 1 cm voxel faces
+RANSAC_END_SIGMA_M = 0.014  # RANSAC's ends: the extent of its inliers along the line on a 1 cm voxel cloud
 
 
 def ours_sigma(se_m: float, floor_m: float) -> float:
     """Our locator's sigma [m]: its statistical standard error ``se_m`` of the line across itself [m] and the
     ``floor_m`` [m] for what it cannot see, in quadrature (inf stays inf)."""
     return math.hypot(se_m, floor_m)
+
+
+# An as-built part may be up to this share of its length longer or shorter than drawn (docs/reference.md, the
+# paper's industrial tolerance), so a seam along it too.
+LENGTH_SHARE = 0.05
+
+
+def length_tolerance_m(tolerance_m: float, length_m: float) -> float:
+    """How far [m] an as-built seam of drawn length ``length_m`` [m] may be longer or shorter than drawn: the part
+    tolerance ``tolerance_m`` [m] and :data:`LENGTH_SHARE` of its length."""
+    return tolerance_m + LENGTH_SHARE * length_m
+
+
+def drawn_end_sigma(tolerance_m: float = PART_TOLERANCE_M, length_m: float = 0.0) -> float:
+    """The sigma [m] of an end only the drawn length places, on a seam of drawn length ``length_m`` [m]: the part
+    tolerance ``tolerance_m`` [m], and the length's share of it (:data:`LENGTH_SHARE`) spread over both ends."""
+    return math.hypot(tolerance_m, 0.5 * LENGTH_SHARE * length_m)
+
+
+def ours_end_sigma(se_m: float, source: EndSource) -> float:
+    """Our locator's sigma [m] of one end along the seam: its standard error ``se_m`` [m] and the floor of its
+    ``source`` in quadrature (:data:`OURS_END_FLOOR_M`; an end the map alone places takes :func:`drawn_end_sigma`)."""
+    return math.hypot(se_m, OURS_END_FLOOR_M[source])
+
+
+def paper_end_sigmas(confidence: float, length_m: float) -> tuple[float, float]:
+    """The paper locator's end sigmas [m] (start, end) on a seam drawn ``length_m`` [m] long: its start read on the
+    faces (wider when it read none, as across the seam), its end the start plus the map's vector (the drawn
+    length's tolerance too)."""
+    start = PAPER_START_SIGMA_M if confidence >= PAPER_FACES_CONFIDENCE - 1e-9 else PAPER_SIGMA_UNSEEN_M
+    return start, math.hypot(start, drawn_end_sigma(PART_TOLERANCE_M, length_m))
 
 
 def paper_sigma(confidence: float) -> float:
@@ -49,11 +108,19 @@ def ransac_sigma() -> float:
 
 
 __all__ = [
+    "LENGTH_SHARE",
+    "OURS_END_FLOOR_M",
     "PAPER_FACES_CONFIDENCE",
     "PAPER_SIGMA_M",
     "PAPER_SIGMA_UNSEEN_M",
+    "PAPER_START_SIGMA_M",
+    "RANSAC_END_SIGMA_M",
     "RANSAC_SIGMA_M",
+    "drawn_end_sigma",
+    "length_tolerance_m",
+    "ours_end_sigma",
     "ours_sigma",
+    "paper_end_sigmas",
     "paper_sigma",
     "ransac_sigma",
 ]

@@ -14,7 +14,16 @@ from cell.types.procedure import Weave, WeldPass, WeldProcedure
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 from cell.types.robot import JointLimits, Kinematics
 from cell.types.run import SeamRecord, SeamWeld, WeldReason
-from cell.types.seams import Joint, MetricsSummary, Reason, SeamEstimate, SeamMetrics, SeamScene, SeamStatus
+from cell.types.seams import (
+    EndSource,
+    Joint,
+    MetricsSummary,
+    Reason,
+    SeamEstimate,
+    SeamMetrics,
+    SeamScene,
+    SeamStatus,
+)
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
 from cell.types.trajectory import PathProfile, Trajectory
 from cell.types.view import CameraView, CellView, RobotPose, Shape, ShapeKind
@@ -27,6 +36,7 @@ __all__ = [
     "CellView",
     "Cloud",
     "DepthImage",
+    "EndSource",
     "Event",
     "Execution",
     "Joint",

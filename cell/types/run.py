@@ -25,6 +25,7 @@ class WeldReason(enum.StrEnum):
     NOT_VISIBLE = "not_visible"  # no camera can see it on this side (against the table)
     NOT_LOCATED = "not_located"  # visible, but not found (its estimate says why)
     LOW_CONFIDENCE = "low_confidence"  # found, but still too uncertain after the re-scan
+    END_UNCERTAIN = "end_uncertain"  # found, but an end's bound along the seam still over the end tolerance
     NOT_PLANNED = "not_planned"  # the planner could not weld it (its outcome's code says why)
     NOT_EXECUTED = "not_executed"  # planned, but the run stopped before the arm moved (the run's error says why)
     PREVIEW = "preview"  # planned in a dry run: nothing moves

@@ -38,6 +38,16 @@ class Reason(enum.StrEnum):
     LOW_CONFIDENCE = "low_confidence"  # found, but too weakly to be reported
     NO_SUPPORT = "no_support"  # the data does not hold the seam's faces or ends
     NOT_SUPPORTED = "not_supported"  # the locator cannot handle this seam's geometry
+    LENGTH_MISMATCH = "length_mismatch"  # the located length disagrees with the drawn one beyond the part tolerance
+
+
+class EndSource(enum.StrEnum):
+    """How a locator placed one end of a seam along it (its sigma follows from it: ``cell/seams/sigma.py``)."""
+
+    EDGE = "edge"  # an edge seen: face A's own side face fitted where it meets the weld face, or a face's sharp edge
+    FACE_END = "face_end"  # a face seen ending: the extent of face A's points along the seam
+    OTHER_PART = "other_part"  # another part's face (a part it ends against, the table)
+    DRAWN = "drawn"  # only the drawn length from the aligned map (the part tolerance is its sigma)
 
 
 @dataclass(frozen=True)
@@ -50,6 +60,9 @@ class SeamEstimate:
     sigma_m : the locator's calibrated standard deviation of the seam line across it [m] (``cell/seams/sigma.py``;
         inf when it gives none).
     time_s : wall time the locator spent on this seam [s].
+    end_sigma_m : (start, end) the calibrated standard deviation of each end ALONG the seam [m] (inf when not
+        given).
+    end_source : (start, end) how each end was placed (:class:`EndSource`).
     """
 
     id: str
@@ -61,6 +74,8 @@ class SeamEstimate:
     time_s: float = 0.0
     sigma_m: float = math.inf
     code: Reason | None = None
+    end_sigma_m: tuple[float, float] = (math.inf, math.inf)
+    end_source: tuple[EndSource, EndSource] = (EndSource.DRAWN, EndSource.DRAWN)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "p_start", readonly(self.p_start))
@@ -123,7 +138,11 @@ class SeamScene:
 
 @dataclass(frozen=True)
 class SeamMetrics:
-    """One seam's errors [mm] (NaN when the seam was not found) and the locator's time [ms]."""
+    """One seam's errors [mm] (NaN when the seam was not found) and the locator's time [ms].
+
+    end_along_mm : each end's signed error along the true seam (start, end) [mm]: positive past the true end,
+        negative short of it (``cell/seams/metrics.py``).
+    """
 
     id: str
     status: SeamStatus
@@ -132,6 +151,7 @@ class SeamMetrics:
     lateral_mm: float
     time_ms: float
     swapped: bool = False
+    end_along_mm: tuple[float, float] = (math.nan, math.nan)
 
     @property
     def found(self) -> bool:

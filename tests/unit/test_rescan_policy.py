@@ -19,15 +19,23 @@ from cell.pipeline import Detection, evaluate, rescan_detection
 from cell.types import SeamEstimate, SeamStatus, WeldMap
 
 
-def _found(seam_id: str, confidence: float, y: float = 0.0) -> SeamEstimate:
+def _found(seam_id: str, confidence: float, y: float = 0.0, end_sigma_m: float = 1e-4) -> SeamEstimate:
     p0, p1 = np.array([0.0, y, 0.0]), np.array([0.1, y, 0.0])
-    return SeamEstimate(seam_id, SeamStatus.FOUND, "", p0, p1, confidence, sigma_m=1e-4)  # within 0.5 mm at 3 sigma
+    # within 0.5 mm at 3 sigma across; the ends within 1 mm at 3 sigma unless end_sigma_m says otherwise
+    ends = (1e-4, end_sigma_m)
+    return SeamEstimate(seam_id, SeamStatus.FOUND, "", p0, p1, confidence, sigma_m=1e-4, end_sigma_m=ends)
 
 
-def _detection(confidences: dict[str, float]) -> Any:
-    estimates = (*(_found(k, c) for k, c in confidences.items()), SeamEstimate("under", SeamStatus.NOT_VISIBLE))
+def _detection(confidences: dict[str, float], end_sigmas_m: dict[str, float] | None = None) -> Any:
+    ends = end_sigmas_m or {}
+    estimates = (
+        *(_found(k, c, end_sigma_m=ends.get(k, 1e-4)) for k, c in confidences.items()),
+        SeamEstimate("under", SeamStatus.NOT_VISIBLE),
+    )
     scenario: Any = SimpleNamespace(
-        rescan=SimpleNamespace(confidence_threshold=0.55, escalate_mm=0.5, max_sigma_m=0.5e-3 / 3.0)
+        rescan=SimpleNamespace(
+            confidence_threshold=0.55, escalate_mm=0.5, max_sigma_m=0.5e-3 / 3.0, max_end_sigma_m=1e-3 / 3.0
+        )
     )
     _, summary = evaluate(estimates, {})
     return Detection(scenario, "ours", WeldMap((), (), "mm", "inline"), estimates, {}, {}, summary)
@@ -40,6 +48,16 @@ def test_low_mode_rescans_the_doubtful_seams_and_escalates_when_a_closeup_disagr
     assert fake.calls == [["b"], ["a", "c"]]  # the doubtful one, then every other visible seam
     assert rs.escalated_mm == pytest.approx(2.0) and [r.id for r in rs.seams] == ["b", "a", "c"]
     assert [e.id for e in after.estimates] == ["a", "b", "c", "under"]
+
+
+def test_low_mode_rescans_a_seam_whose_end_bound_is_over_the_end_tolerance(monkeypatch: Any) -> None:
+    fake = FakeLoop({})
+    monkeypatch.setattr(loop, "rescan_seams", fake)
+    # "b" is sure across and confident, but its end's 3 sigma (1.2 mm) is over the 1 mm end tolerance; "a"'s 0.9 mm
+    # is not.
+    det = _detection({"a": 0.9, "b": 0.9}, {"a": 0.3e-3, "b": 0.4e-3})
+    rescan_detection(None, det, "low")  # type: ignore[arg-type]
+    assert fake.calls == [["b"]]
 
 
 def test_no_escalation_when_the_closeups_agree_or_every_seam_was_asked_for(monkeypatch: Any) -> None:

@@ -18,10 +18,32 @@ from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
 from cell.seams.ours._points import Points
 from cell.seams.ours.options import OursOptions
+from cell.types import EndSource
 
 # How far a hollow section's flat may be wider or narrower than drawn [m] (docs/reference.md: EN 10219-2's
 # outer-size tolerance, 1 % of a 60 mm side, at least 0.5 mm).
 SECTION_TOLERANCE_M = 5e-4
+
+
+# How each way find_ends places an end is reported (End.source -> EndSource): A's side face fitted where it meets
+# face A is an edge seen; face A's points ending (their extent, an edge's likelihood, the tangent line into a
+# radius) a face seen ending; the table, or another part's face a hidden side face lies on, another part; the map's
+# end, or the drawn width from the other end, the drawn length.
+_SOURCES = {
+    "side face": EndSource.EDGE,
+    "extent": EndSource.FACE_END,
+    "tangent": EndSource.FACE_END,
+    "table": EndSource.OTHER_PART,
+    "width": EndSource.DRAWN,
+    "map": EndSource.DRAWN,
+}
+
+
+def end_source(end: End) -> EndSource:
+    """How ``end`` was placed, as an :class:`EndSource` (a side face against another part's face: that part)."""
+    if end.source == "side face" and end.touching:
+        return EndSource.OTHER_PART
+    return _SOURCES[end.source]
 
 
 TANGENT_WINDOW_M = 0.008  # points this far along the line about the extent's guess place a tangent end [m]

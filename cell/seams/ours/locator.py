@@ -11,14 +11,14 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams.ours._ends import find_ends, side_selections
+from cell.seams.ours._ends import end_source, find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
-from cell.seams.sigma import ours_sigma
+from cell.seams.sigma import drawn_end_sigma, ours_end_sigma, ours_sigma
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
@@ -226,6 +226,11 @@ class OursLocator:
         errors = errors_of(face_a, face_b, ends)
         conf = confidence(face_a, face_b, errors, pts.pitch, o)
         via = [f"face {f.name} from the {f.source} ({f.note})" for f in (face_a, face_b) if f.source != "points"]
+        sources = (end_source(ends[0]), end_source(ends[1]))
+        drawn = drawn_end_sigma(o.map_tolerance_m, s_map[1] - s_map[0])
+        end_sigmas = [
+            drawn if e.source == "map" else ours_end_sigma(e.se, k) for e, k in zip(ends, sources, strict=True)
+        ]
         estimate = SeamEstimate(
             id=seam.id,
             status=SeamStatus.FOUND,
@@ -234,6 +239,8 @@ class OursLocator:
             p_end=p0 + ends[1].s * t,
             confidence=conf,
             sigma_m=ours_sigma(errors.lateral_m, o.sigma_floor_m),
+            end_sigma_m=(end_sigmas[0], end_sigmas[1]),
+            end_source=sources,
         )
         return estimate, errors
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from cell.errors import CellError
 from cell.export.atomic import write_atomic
-from cell.export.procedure_report import procedure_entry
+from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus
 
@@ -173,8 +173,9 @@ def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
 
 def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The ``cell weld`` / ``cell preview`` report: the detection report plus, per seam, ``welded``, ``reason``,
-    ``tcp_error_mm`` {rms, max} of the executed tool path against the true seam and ``weld_time_s``; at the top,
-    ``cycle_time_s``, ``events``, the gate's ``violations`` and the ``error`` that stopped the run (or null)."""
+    ``tcp_error_mm`` {rms, max, short_start, short_end, past_start, past_end} of the executed tool path against the
+    true seam and ``weld_time_s``; at the top, ``cycle_time_s``, ``events``, the gate's ``violations`` and the
+    ``error`` that stopped the run (or null)."""
     records = run.records()
     rep = detection_report(run.detection, records, provenance=provenance)
     plan = run.plan
@@ -203,7 +204,7 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
                 entry["failing_point"] = _pt(o.p_fail)
         if w.quality is not None:
             q = w.quality
-            entry["tcp_error_mm"] = {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)}
+            entry["tcp_error_mm"] = tcp_error_entry(q)
             entry["weld_time_s"] = _r(q.weld_time_s, 3)
             entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
         entry.update(procedure_entry(w))  # the weld procedure it got and the bead per pass

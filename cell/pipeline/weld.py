@@ -109,7 +109,16 @@ def plan_for(
             on_seam=seam_counter(progress) if not dropped else None,
         )
         progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
-        found = find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)
+        found = find_violations(
+            arm.model,
+            plan,
+            arm.q_home,
+            checker=checker,
+            options=sc.motion.gate,
+            bodies=ss.weldmap.parts,  # no TCP or wire inside a part's body (the aligned map's)
+            wire_m=process.stickout,
+            joint_parts={sid: (j.abutting, j.receiving) for sid, j in ss.joints.items()},
+        )
         blamed = blamed_seams(plan, found)
         if blamed is None:  # none, or one that concerns the whole plan
             break

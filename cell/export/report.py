@@ -189,6 +189,15 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
             # The detection's reason says why a seam was not found; the weld's why it was not welded.
             entry["weld_reason"] = w.reason
             entry["weld_reason_code"] = w.code.value if w.code is not None else None
+            if w.check is not None:  # the last check before the arc: which test, by how much
+                c = w.check
+                entry["last_check"] = {
+                    "code": c.code.value,
+                    "end": c.end,
+                    "part": c.part,
+                    "value_mm": _r(c.value_m * 1000.0, 3),
+                    "limit_mm": _r(c.limit_m * 1000.0, 3),
+                }
         o = rec.outcome
         if o is not None and o.feasible:
             entry["torch"] = {

@@ -109,7 +109,10 @@ def plan_for(
             procedures=procs | tack_procedures(procs, kept_tacks),
             on_seam=seam_counter(progress) if not dropped else None,
         )
-        progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
+        progress(
+            "safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops, the wire"
+            " clear of every part's body"
+        )
         found = find_violations(
             arm.model,
             plan,

@@ -140,3 +140,31 @@ def test_a_seams_own_parts_are_left_out_along_its_weld_but_not_on_a_transfer() -
     move = Segment("move", "A>B", tr, 0.0, np.eye(4))
     assert [p.name for p in seam_bodies(parts, weld, joints)] == ["TUBE"]
     assert [p.name for p in seam_bodies(parts, move, joints)] == ["A", "B", "TUBE"]
+
+
+def test_the_gate_refuses_a_planned_weld_that_runs_into_a_third_part_and_blames_its_seam() -> None:
+    """The tiny cell's post-on-rail seams, planned for real: clear of every body (the TCP in its own joint's corner);
+    with a third part standing over one end of the top seam, that seam alone is dropped as ``enters_body``."""
+    from tiny_cell import HOME, OBSTACLES, POST, RAIL, SIDE_SEAM, TOP_SEAM, URDF
+
+    from cell import scenario as sc
+    from cell.motion.gate import ViolationKind, find_violations
+    from cell.motion.gate.blame import blamed_seams
+    from cell.motion.plan import PlanReason, SeamTask, plan_welds
+    from cell.motion.torch import WeldProcess
+
+    robot = RobotModel.from_urdf(URDF)
+    process = WeldProcess.from_spec(sc.ProcessSpec())
+    plan = plan_welds(robot, [SeamTask(*TOP_SEAM), SeamTask(*SIDE_SEAM)], HOME, process, OBSTACLES)
+    assert set(plan.order) == {"top", "side"}
+    joints = {"top": ("POST", "RAIL"), "side": ("POST", "RAIL")}
+    clear = find_violations(robot, plan, HOME, bodies=(RAIL, POST), wire_m=process.stickout, joint_parts=joints)
+    assert clear == []
+    tube = _box("TUBE", [-0.036, 0.864, 0.054], [-0.024, 0.876, 0.066])  # 6 mm about the top seam's x = -30 mm end
+    found = find_violations(robot, plan, HOME, bodies=(RAIL, POST, tube), wire_m=process.stickout, joint_parts=joints)
+    assert found and all(v.kind is ViolationKind.BODY for v in found)
+    assert {v.seam_id for v in found} == {"top"} and {v.body for v in found} == {"TUBE"}
+    assert found[0].excess >= 0.005  # the arc-off (or -on) point 6 mm inside it
+    blamed = blamed_seams(plan, found)
+    assert blamed is not None and set(blamed) == {"top"}
+    assert blamed["top"].code is PlanReason.ENTERS_BODY and "TUBE" in blamed["top"].reason

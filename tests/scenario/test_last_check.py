@@ -13,6 +13,7 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
+from cell.export.report import weld_report
 from cell.types import LastCheck, SeamStatus, WeldReason
 
 weld_stage = importlib.import_module("cell.pipeline.weld")  # the module (``cell.pipeline.weld`` is also the function)
@@ -45,3 +46,6 @@ def test_a_corrupted_seam_is_rescanned_then_refused_not_welded(monkeypatch: pyte
     assert run.rescan is not None and BAD in {r.id for r in run.rescan.seams}  # re-scanned before it was refused
     assert run.plan is not None and BAD not in run.plan.order  # nothing planned along it
     assert by_id[GOOD].welded and by_id[GOOD].check is None  # the other seam passes and is welded
+    entry = next(s for s in weld_report(run)["seams"] if s["id"] == BAD)
+    assert entry["weld_reason_code"] == "last_check" and entry["last_check"]["code"] == "length"
+    assert entry["last_check"]["value_mm"] > entry["last_check"]["limit_mm"] > 6.0  # the build tolerance and more

@@ -84,6 +84,9 @@ class GateOptions:
     rest_tol : joint speed [rad/s] (and acceleration [rad/s^2]) below which an exact stop is at rest.
     min_manipulability : below this a configuration counts as singular [m^3].
     lin_step : TCP travel between singularity checks on LIN segments [m].
+    body_depth : how deep [m] the TCP or the wire may lie inside a part's body before the path counts as entering
+        it (the TCP sits in the joint's corner, on both parts' faces, within the seam's position error).
+    body_step : TCP travel between the samples of that check [m].
     """
 
     rate_hz: float = 1000.0
@@ -92,6 +95,8 @@ class GateOptions:
     rest_tol: float = 1e-6
     min_manipulability: float = 0.01
     lin_step: float = 0.002
+    body_depth: float = 0.001
+    body_step: float = 0.0005
 
 
 @dataclass(frozen=True)

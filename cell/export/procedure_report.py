@@ -46,12 +46,26 @@ def procedure_dict(p: WeldProcedure) -> dict[str, Any]:
     }
 
 
+def tcp_error_entry(q: WeldQuality) -> dict[str, float]:
+    """A weld's ``tcp_error_mm`` [mm]: ``rms`` and ``max`` of the TCP's distance from the true seam, and at each
+    end how much of the joint the bead left unwelded (``short_start``, ``short_end``) and how far it ran past it
+    (``past_start``, ``past_end``), the ends being the true seam's start and end."""
+    return {
+        "rms": _r(q.tcp_rms_mm, 4),
+        "max": _r(q.tcp_max_mm, 4),
+        "short_start": _r(q.short_start_mm, 3),
+        "short_end": _r(q.short_end_mm, 3),
+        "past_start": _r(q.past_start_mm, 3),
+        "past_end": _r(q.past_end_mm, 3),
+    }
+
+
 def _bead(q: WeldQuality) -> dict[str, Any]:
     return {
         "length_mm": _r(q.length_mm, 2),
         "weld_time_s": _r(q.weld_time_s, 3),
         "travel_speed_mm_s": _r(q.speed_mm_s, 3),
-        "tcp_error_mm": {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)},
+        "tcp_error_mm": tcp_error_entry(q),
     }
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from cell.errors import CellError
 from cell.export.atomic import write_atomic
-from cell.export.procedure_report import procedure_entry
+from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus
 
@@ -180,8 +180,9 @@ def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
 
 def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The ``cell weld`` / ``cell preview`` report: the detection report plus, per seam, ``welded``, ``reason``,
-    ``tcp_error_mm`` {rms, max} of the executed tool path against the true seam and ``weld_time_s``; at the top,
-    ``cycle_time_s``, ``events``, the gate's ``violations`` and the ``error`` that stopped the run (or null)."""
+    ``tcp_error_mm`` {rms, max, short_start, short_end, past_start, past_end} of the executed tool path against the
+    true seam and ``weld_time_s``; at the top, ``cycle_time_s``, ``events``, the gate's ``violations`` and the
+    ``error`` that stopped the run (or null)."""
     records = run.records()
     rep = detection_report(run.detection, records, provenance=provenance)
     plan = run.plan
@@ -195,6 +196,15 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
             # The detection's reason says why a seam was not found; the weld's why it was not welded.
             entry["weld_reason"] = w.reason
             entry["weld_reason_code"] = w.code.value if w.code is not None else None
+            if w.check is not None:  # the last check before the arc: which test, by how much
+                c = w.check
+                entry["last_check"] = {
+                    "code": c.code.value,
+                    "end": c.end,
+                    "part": c.part,
+                    "value_mm": _r(c.value_m * 1000.0, 3),
+                    "limit_mm": _r(c.limit_m * 1000.0, 3),
+                }
         o = rec.outcome
         if o is not None and o.feasible:
             entry["torch"] = {
@@ -210,7 +220,7 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
                 entry["failing_point"] = _pt(o.p_fail)
         if w.quality is not None:
             q = w.quality
-            entry["tcp_error_mm"] = {"rms": _r(q.tcp_rms_mm, 4), "max": _r(q.tcp_max_mm, 4)}
+            entry["tcp_error_mm"] = tcp_error_entry(q)
             entry["weld_time_s"] = _r(q.weld_time_s, 3)
             entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
         entry.update(procedure_entry(w))  # the weld procedure it got and the bead per pass

@@ -28,6 +28,7 @@ _WORD = {
     PlanReason.TIMING: "timing",
     PlanReason.NO_PROCEDURE: "no procedure",
     PlanReason.HOSE_WINDOW: "hose window",
+    PlanReason.ENTERS_BODY: "enters a body",
 }
 
 

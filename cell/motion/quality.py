@@ -1,4 +1,5 @@
-"""How well a seam was welded: the executed tool path against the true seam, and the travel speed along it."""
+"""How well a seam was welded: the executed tool path against the true seam (how far it strays from the joint, and
+how much of the joint it leaves unwelded or overruns at each end), and the travel speed along it."""
 
 from __future__ import annotations
 
@@ -22,6 +23,22 @@ def distance_to_segment(p: npt.ArrayLike, a: npt.ArrayLike, b: npt.ArrayLike) ->
     return np.asarray(np.linalg.norm(p - (a + t[:, None] * ab), axis=1))
 
 
+def end_coverage(p: npt.ArrayLike, a: npt.ArrayLike, b: npt.ArrayLike) -> tuple[float, float, float, float]:
+    """How a bead along points p (n, 3) covers the joint a-b (3,) [m]: (short_start, short_end, past_start,
+    past_end) [m], each >= 0.
+
+    The points are projected on the joint's line (whatever way the bead ran): short is how much of the joint at
+    that end the bead leaves unwelded, past how far it runs beyond that end (one of the two is 0 at each end).
+    """
+    p = np.asarray(p, dtype=float).reshape(-1, 3)
+    a = np.asarray(a, dtype=float)
+    ab = np.asarray(b, dtype=float) - a
+    length = float(np.linalg.norm(ab))
+    s = (p - a) @ (ab / length)
+    lo, hi = float(s.min()), float(s.max())
+    return max(lo, 0.0), max(length - hi, 0.0), max(-lo, 0.0), max(hi - length, 0.0)
+
+
 def weld_quality(
     times: npt.ArrayLike,
     tcp_R: npt.ArrayLike,
@@ -36,6 +53,9 @@ def weld_quality(
         :func:`cell.motion.weave.intended_offsets`); the TCP error and the travel speed are measured on the
         records minus these (against the seam plus the intended weave and offset), the length on the path as
         driven. None: on the seam line.
+
+    The TCP error is each record's distance to the true segment (a record beyond an end counts its distance to
+    that end); the ends' coverage (:func:`end_coverage`) is of the records minus the offsets too.
     """
     t = np.asarray(times, dtype=float)
     raw = np.asarray(tcp_R, dtype=float)
@@ -43,6 +63,7 @@ def weld_quality(
     if len(t) < 2:
         raise ValueError("a weld needs at least two tool records")
     d = distance_to_segment(p, truth_start, truth_end) * _MM
+    short_start, short_end, past_start, past_end = end_coverage(p, truth_start, truth_end)
     step = np.linalg.norm(np.diff(p, axis=0), axis=1)
     driven = np.linalg.norm(np.diff(raw, axis=0), axis=1)
     dt = np.diff(t)
@@ -55,12 +76,17 @@ def weld_quality(
         length_mm=float(driven.sum() * _MM),
         speed_mm_s=float(np.median(cruise)) if cruise.size else 0.0,
         samples=len(t),
+        short_start_mm=short_start * _MM,
+        short_end_mm=short_end * _MM,
+        past_start_mm=past_start * _MM,
+        past_end_mm=past_end * _MM,
     )
 
 
 def combined(passes: Sequence[WeldQuality]) -> WeldQuality:
     """All passes of one seam as one figure: the TCP error over every record (RMS weighted by samples, the
-    largest), the arc time and driven length summed, the first pass's travel speed."""
+    largest), the arc time and driven length summed, the first pass's travel speed, and at each end the worst
+    pass's shortfall and overrun."""
     if not passes:
         raise ValueError("a weld needs at least one pass")
     n = sum(q.samples for q in passes)
@@ -71,4 +97,8 @@ def combined(passes: Sequence[WeldQuality]) -> WeldQuality:
         length_mm=sum(q.length_mm for q in passes),
         speed_mm_s=passes[0].speed_mm_s,
         samples=n,
+        short_start_mm=max(q.short_start_mm for q in passes),
+        short_end_mm=max(q.short_end_mm for q in passes),
+        past_start_mm=max(q.past_start_mm for q in passes),
+        past_end_mm=max(q.past_end_mm for q in passes),
     )

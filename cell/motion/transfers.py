@@ -3,11 +3,12 @@
 A transfer is a Ruckig point-to-point move (KRL PTP) where the direct move is free. Where it collides, the next
 strategy is tried, in order (:data:`DEFAULT_STRATEGIES`): straight up (a LIN, as a depart) to ``transfer_lift``
 above the highest obstacle, across (PTP) and straight down (a LIN, as an approach); the same one
-``transfer_lift`` higher; PTP via home. A strategy whose motions take A6 further out of the hose package's window
-(:class:`~cell.motion.wrist.HoseWindow`) than its two ends are fails too (a PTP between ends inside the window
-stays inside: it is a straight joint line; a vertical line's IK may turn A6). When every strategy collides or
-fails, the last one's contact (or error) is the :class:`TransferFail`; the planner then re-orders the seams, or
-drops the seam.
+``transfer_lift`` higher; PTP via home. A strategy fails too where the wire tip or the wire (which the collision
+model leaves out) enters an obstacle's body (:func:`cell.motion.gate.bodies.body_entry`), or where its motions
+take A6 further out of the hose package's window (:class:`~cell.motion.wrist.HoseWindow`) than its two ends are
+(a PTP between ends inside the window stays inside: it is a straight joint line; a vertical line's IK may turn
+A6). When every strategy collides or fails, the last one's contact (or error) is the :class:`TransferFail`; the
+planner then re-orders the seams, or drops the seam.
 
 Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 """
@@ -20,10 +21,12 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
+from cell.config.motion import GateOptions
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.failures import LineError
+from cell.motion.gate.bodies import Entry, body_entry
 from cell.motion.lines import line_trajectory, solve_line
 from cell.motion.plan_options import PlanOptions
 from cell.motion.robot import RobotModel
@@ -110,6 +113,8 @@ class ViaHome:
         ]
 
 
+_BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
+
 DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (Direct(), Lift(), Lift("lift_high", extra=1), ViaHome())
 
 
@@ -134,6 +139,8 @@ class Transfers:
         self.q_home = q_home
         self.strategies = tuple(strategies)
         self.window = HoseWindow(options.a6_center, options.a6_window)
+        self.obstacles = tuple(obstacles)
+        self._gate = GateOptions()
         tops = [float(np.max(o.vertices()[:, 2])) for o in obstacles]
         self.lift_z = (max(tops) if tops else 0.0) + options.transfer_lift
         # Each move searched once: the planner re-assembles its order after a failing transfer and asks again
@@ -170,9 +177,29 @@ class Transfers:
                 None,
             )
             if hit is None:
-                return [pc for pc in pieces if pc.trajectory.duration > 0.0]
+                entry = self._entry(pieces)
+                if entry is None:
+                    return [pc for pc in pieces if pc.trajectory.duration > 0.0]
+                fail = TransferFail(f"{strategy.name}: {entry.describe()}", entry.p_R)
+                continue
             fail = TransferFail(hit.describe(), hit.p_R)
         return fail
+
+    def _entry(self, pieces: list[Piece]) -> Entry | None:
+        """Where the wire tip or the wire, which the collision model leaves out, first enters an obstacle's body
+        along the motions (the safety gate's test, :mod:`cell.motion.gate.bodies`); None: nowhere."""
+        for pc in pieces:
+            hit = body_entry(
+                self.robot,
+                pc.trajectory,
+                self.obstacles,
+                wire_m=self.process.stickout,
+                depth=self._gate.body_depth,
+                step=_BODY_STEP,
+            )
+            if hit is not None:
+                return hit
+        return None
 
     def _wound(self, pieces: list[Piece], q_a: FloatArray, q_b: FloatArray) -> TransferFail | None:
         """Why the motions take A6 further out of the hose window than their ends q_a, q_b are (None: they do

@@ -3,7 +3,7 @@ found seam is too uncertain to weld; the planned torch paths for pictures and re
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -13,7 +13,7 @@ from cell.pipeline.records import Detection
 from cell.rescan import ends_within_tolerance, within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station
-from cell.types import SeamEstimate, SeamStatus
+from cell.types import CheckFail, SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
@@ -54,10 +54,12 @@ def seam_welds(
     sc: Scenario,
     gated: bool,
     unplaceable: Collection[str] = (),
+    checked: Mapping[str, CheckFail] | None = None,
 ) -> tuple[SeamWeld, ...]:
     """Per seam: welded (with its quality against the true seam) or the reason it was not. gated : the weld gate
     applied (not a preview): a found seam too uncertain to weld is ``low_confidence``, but one no torch can be
-    placed on (``unplaceable``: planned anyway) gets the planner's reason."""
+    placed on (``unplaceable``: planned anyway) gets the planner's reason. checked : the seams that failed the
+    last check before the arc (``last_check``, with the test)."""
     from cell.motion.plan import seam_tasks
     from cell.motion.quality import combined, weld_quality
 
@@ -78,6 +80,11 @@ def seam_welds(
         if doubtful and gated and est.id not in unplaceable:
             code = WeldReason.END_UNCERTAIN if doubtful == end_doubt(est, sc) else WeldReason.LOW_CONFIDENCE
             out.append(SeamWeld(est.id, False, False, f"{code.value}: {doubtful}", code=code))
+            continue
+        fail = (checked or {}).get(est.id)
+        if fail is not None:
+            why = f"last_check: {fail.describe()}"
+            out.append(SeamWeld(est.id, False, False, why, code=WeldReason.LAST_CHECK, check=fail))
             continue
         outcome = next((o for o in plan.seams if o.seam_id == est.id), None) if plan is not None else None
         if outcome is None or not outcome.feasible:

@@ -15,6 +15,7 @@ from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
 from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
+from cell.pipeline.last_check import joined, last_checked
 from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
 from cell.pipeline.records import Detection, WeldRun
@@ -22,7 +23,7 @@ from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import SeamStatus
+from cell.types import CheckFail, SeamStatus
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
@@ -108,8 +109,20 @@ def plan_for(
             procedures=procs | tack_procedures(procs, kept_tacks),
             on_seam=seam_counter(progress) if not dropped else None,
         )
-        progress("safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops")
-        found = find_violations(arm.model, plan, arm.q_home, checker=checker, options=sc.motion.gate)
+        progress(
+            "safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops, the wire"
+            " clear of every part's body"
+        )
+        found = find_violations(
+            arm.model,
+            plan,
+            arm.q_home,
+            checker=checker,
+            options=sc.motion.gate,
+            bodies=ss.weldmap.parts,  # no TCP or wire inside a part's body (the aligned map's)
+            wire_m=process.stickout,
+            joint_parts={sid: (j.abutting, j.receiving) for sid, j in ss.joints.items()},
+        )
         blamed = blamed_seams(plan, found)
         if blamed is None:  # none, or one that concerns the whole plan
             break
@@ -201,6 +214,7 @@ def weld(
         violations: tuple[str, ...] = ()
         error: CellError | None = None
         hopeless: dict[str, str] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
+        checked: dict[str, CheckFail] = {}  # seams that failed the last check before the arc, re-scanned or not
         try:
             if det.error is not None:
                 raise det.error
@@ -216,6 +230,11 @@ def weld(
                     hopeless = {i: why for i, why in hopeless.items() if "beyond reach" not in why}
                 if rs is not None:
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
+            if execute_plan:  # the last check before the arc: re-scanned, then refused (cell/pipeline/last_check.py)
+                det, more, checked = last_checked(station, det, skip=hopeless, motion=motion, progress=progress)
+                rs = joined(rs, more)
+                if rs is not None:
+                    timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             # A preview moves nothing, so it cannot re-scan: it plans doubtful seams too and says so. A seam no
             # torch can be placed on is planned too: the planner refuses it with its own reason.
             low = {
@@ -229,7 +248,13 @@ def weld(
                 progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)")
             else:
                 plan, pre, violations = plan_for(
-                    station, det, skip=low, q_start=q_start, motion=motion, progress=progress, tacks=tacks
+                    station,
+                    det,
+                    skip=low | set(checked),
+                    q_start=q_start,
+                    motion=motion,
+                    progress=progress,
+                    tacks=tacks,
                 )
                 timings["plan_s"] = setup_s + time.perf_counter() - t
                 if violations:
@@ -242,7 +267,7 @@ def weld(
             error = e
         refused = f"not executed: {error.message}" if error is not None else ""
         pre_s = pre.duration if pre is not None else 0.0
-        seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless)
+        seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)

@@ -13,7 +13,7 @@ from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentK
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 from cell.types.robot import JointLimits, Kinematics
-from cell.types.run import SeamRecord, SeamWeld, WeldReason
+from cell.types.run import CheckFail, LastCheck, SeamRecord, SeamWeld, WeldReason
 from cell.types.seams import (
     EndSource,
     Joint,
@@ -34,6 +34,7 @@ __all__ = [
     "CameraIntrinsics",
     "CameraView",
     "CellView",
+    "CheckFail",
     "Cloud",
     "DepthImage",
     "EndSource",
@@ -42,6 +43,7 @@ __all__ = [
     "Joint",
     "JointLimits",
     "Kinematics",
+    "LastCheck",
     "MapSeam",
     "MetricsSummary",
     "Part",

@@ -74,10 +74,14 @@ class Execution:
 class WeldQuality:
     """One seam's weld as executed.
 
-    tcp_rms_mm, tcp_max_mm : distance of the tool centre point from the true seam segment while the arc burned.
+    tcp_rms_mm, tcp_max_mm : distance of the tool centre point from the true seam segment while the arc burned (a
+        point beyond an end counts its distance to that end).
     weld_time_s : arc time [s]; length_mm : length of the executed arc-on path.
     speed_mm_s : median TCP speed while the arc burned, ramps excluded (the constant-speed part).
     samples : number of recorded tool positions behind the figures.
+    short_start_mm, short_end_mm : how much of the true joint the bead leaves unwelded at its start and its end
+        (the true seam's ``p_start``, ``p_end``; >= 0), the arc-on records projected on the joint's line.
+    past_start_mm, past_end_mm : how far the bead runs beyond the joint's start and end (>= 0).
     """
 
     tcp_rms_mm: float
@@ -86,3 +90,12 @@ class WeldQuality:
     length_mm: float
     speed_mm_s: float
     samples: int
+    short_start_mm: float = 0.0
+    short_end_mm: float = 0.0
+    past_start_mm: float = 0.0
+    past_end_mm: float = 0.0
+
+    @property
+    def ends_mm(self) -> float:
+        """The worst of the four end figures [mm]: how far the bead misses either end of the joint, either way."""
+        return max(self.short_start_mm, self.short_end_mm, self.past_start_mm, self.past_end_mm)

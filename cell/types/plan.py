@@ -87,6 +87,7 @@ class PlanReason(StrEnum):
     TIMING = "timing"  # a line cannot be timed within the joint limits (e.g. the weld at the travel speed)
     NO_PROCEDURE = "no_procedure"  # no row of the WPS table fits the seam (joint type, position, leg)
     HOSE_WINDOW = "hose_window"  # A6 would leave the hose package's window of cable travel
+    ENTERS_BODY = "enters_body"  # the TCP or the wire would enter a part's body (the safety gate)
 
 
 @dataclass(frozen=True)

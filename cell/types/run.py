@@ -29,6 +29,36 @@ class WeldReason(enum.StrEnum):
     NOT_PLANNED = "not_planned"  # the planner could not weld it (its outcome's code says why)
     NOT_EXECUTED = "not_executed"  # planned, but the run stopped before the arm moved (the run's error says why)
     PREVIEW = "preview"  # planned in a dry run: nothing moves
+    LAST_CHECK = "last_check"  # found, but against the aligned map and the other parts it cannot be there
+    #   (re-scanned, then refused: its ``check`` says which test and by how much)
+
+
+class LastCheck(enum.StrEnum):
+    """Which test of the last check before the arc a located seam failed (:mod:`cell.seams.last_check`)."""
+
+    ACROSS = "across"  # its line lies further across the drawn seam than the build, placement and calibration allow
+    LENGTH = "length"  # its length differs from the drawn length by more than the parts' tolerance
+    END_IN_BODY = "end_in_body"  # an end lies inside another part's body
+    END_OFF_FACE = "end_off_face"  # an end lies off a face its joint joins (a bead running on past the joint)
+
+
+@dataclass(frozen=True)
+class CheckFail:
+    """A failed last check: which test (``code``), the measured ``value_m`` and its ``limit_m`` [m], which end
+    (``"start"``, ``"end"``; ``""`` for the whole line) and the part concerned (the body an end lies in, the part
+    whose face it is off; ``""`` otherwise)."""
+
+    code: LastCheck
+    value_m: float
+    limit_m: float
+    end: str = ""
+    part: str = ""
+
+    def describe(self) -> str:
+        """One line for people: what, where, by how much against what."""
+        where = f" at its {self.end}" if self.end else ""
+        of = f" ({self.part})" if self.part else ""
+        return f"{self.code}{where}{of}: {self.value_m * 1000.0:.2f} mm > {self.limit_m * 1000.0:.2f} mm"
 
 
 @dataclass(frozen=True)
@@ -36,7 +66,7 @@ class SeamWeld:
     """What became of one seam in ``cell weld``: planned and welded, or why not (``code`` and the detail
     ``reason``); how well (the executed TCP against the true seam, when the truth is known: all passes together
     in ``quality``, each pass's bead in ``passes``, in pass order); the weld ``procedure`` it got (None: the
-    plan used none)."""
+    plan used none); the last check it failed (``check``, with the code ``last_check``)."""
 
     id: str
     planned: bool
@@ -46,6 +76,7 @@ class SeamWeld:
     code: WeldReason | None = None
     procedure: WeldProcedure | None = None
     passes: tuple[WeldQuality, ...] = ()
+    check: CheckFail | None = None
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,9 @@ def test_every_visible_seam_is_welded_within_a_millimetre(fence1_run: pipeline.W
         # Executed tool path against the TRUE seam (perception, alignment, IK and playback errors all included).
         assert w.quality.tcp_rms_mm <= 1.0, w.id  # the acceptance figure
         assert w.quality.tcp_max_mm < 0.4, w.id  # measured up to 0.20 mm (rms up to 0.08 mm)
+        # The weld measured whole: no end of the joint left unwelded or overrun by more than 0.4 mm (measured
+        # up to 0.22 mm past an end, 0.12 mm short).
+        assert w.quality.ends_mm < 0.4, (w.id, w.quality)
         assert abs(w.quality.speed_mm_s - speed) <= 0.001 * speed, w.id  # measured within 0.001 mm/s
 
 
@@ -102,6 +105,9 @@ def test_weld_cli_writes_report_and_robot_program(
     for s in data["seams"]:
         if s["welded"]:
             assert s["tcp_error_mm"]["rms"] <= 1.0 and s["weld_time_s"] > 0
+            ends = [s["tcp_error_mm"][k] for k in ("short_start", "short_end", "past_start", "past_end")]
+            assert min(ends) >= 0.0 and max(ends) < 0.4, s["id"]
+            assert s["passes"][0]["bead"]["tcp_error_mm"].keys() == s["tcp_error_mm"].keys()
     assert (krl / "WELD_FENCE1.src").is_file() and (krl / "WELD_FENCE1.dat").is_file()
     assert json.loads((krl / "trajectory.json").read_text())["joint_names"][0] == "joint_a1"
 

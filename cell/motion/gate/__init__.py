@@ -18,7 +18,10 @@ each saying what, where (time, joint) and by how much; :func:`check_plan` raises
 * :class:`ArcSwitching` (``arc``): arc on only during weld segments, switched on and off at exact stops
   (run with the singularity check, segment by segment);
 * :class:`Collisions` (``collisions``): robot against the obstacles and itself along every segment
-  (conservative advancement, see :mod:`cell.motion.collision`), when a checker is given.
+  (conservative advancement, see :mod:`cell.motion.collision`), when a checker is given;
+* :class:`BodyEntry` (``bodies``): the TCP and the wire behind it never inside a part's body by more than
+  ``body_depth`` along any segment, when the bodies are given (what the collision model's cut-back torch leaves
+  out: a weld running on through a tube's wall).
 
 A new check: a frozen dataclass with ``violations(gate: GateInput) -> list[Violation]`` in a module of its own,
 added to the ``checks`` passed to :func:`find_violations` (or to :data:`DEFAULT_CHECKS`).
@@ -37,6 +40,7 @@ from cell.motion.gate.base import (
     ViolationKind,
     resample_times,
 )
+from cell.motion.gate.bodies import BodyEntry
 from cell.motion.gate.collisions import Collisions
 from cell.motion.gate.continuity import SampleJumps, SegmentJoins
 from cell.motion.gate.gate import DEFAULT_CHECKS, GateRefusedError, check_plan, find_violations
@@ -49,6 +53,7 @@ __all__ = [
     "DEFAULT_CHECKS",
     "AccelerationLimit",
     "ArcSwitching",
+    "BodyEntry",
     "Check",
     "Collisions",
     "GateInput",

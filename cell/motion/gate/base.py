@@ -7,7 +7,8 @@ Units: SI (rad, rad/s, rad/s^2, rad/s^3, m, s) in the fields; degrees and mm in 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from enum import StrEnum
 from functools import cached_property
 from typing import Protocol
@@ -18,6 +19,7 @@ from cell.config.motion import GateOptions
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.types import Part
 from cell.types.plan import Segment, WeldPlan
 from cell.types.trajectory import Trajectory
 
@@ -36,19 +38,23 @@ class ViolationKind(StrEnum):
     SINGULARITY = "singularity"
     ARC = "arc"
     COLLISION = "collision"
+    BODY = "body"  # the TCP or the wire inside a part's body
 
 
 @dataclass(frozen=True)
 class Violation:
     """One problem: kind (start_state | position | velocity | acceleration | jerk | jump | singularity | arc |
-    collision), a one-line description, where (time t [s], joint name or ""), and by how much (``excess`` in
-    the kind's SI unit: rad, rad/s, rad/s^2, rad/s^3, m^3 for manipulability, m for collision depth)."""
+    collision | body), a one-line description, where (time t [s], joint name or ""), and by how much (``excess`` in
+    the kind's SI unit: rad, rad/s, rad/s^2, rad/s^3, m^3 for manipulability, m for collision and body depth).
+    seam_id, body : the seam whose motion it is and the part it enters ("" when the check does not say)."""
 
     kind: ViolationKind
     what: str
     t: float
     joint: str = ""
     excess: float = 0.0
+    seam_id: str = ""
+    body: str = ""
 
     def __str__(self) -> str:
         j = f" {self.joint}" if self.joint else ""
@@ -81,14 +87,19 @@ class Resampled:
 @dataclass(frozen=True)
 class GateInput:
     """What every check sees: the arm, the plan (with at least one segment), the arm's current state q_current
-    (dof,) [rad], the collision checker (None: collisions are not checked) and the options. The joined trajectory
-    and its re-sampling are computed once, on first use."""
+    (dof,) [rad], the collision checker (None: collisions are not checked) and the options; the parts' bodies in R
+    no TCP or wire may enter (the aligned map's; empty: not checked), the wire's stick-out ``wire_m`` [m] behind
+    the TCP, and per seam id the names of its joint's two parts (left out of that check along its own weld). The
+    joined trajectory and its re-sampling are computed once, on first use."""
 
     robot: RobotModel
     plan: WeldPlan
     q_current: FloatArray
     checker: CollisionChecker | None
     options: GateOptions
+    bodies: tuple[Part, ...] = ()
+    wire_m: float = 0.0
+    joint_parts: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     @cached_property
     def trajectory(self) -> Trajectory:

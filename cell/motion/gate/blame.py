@@ -20,6 +20,7 @@ from cell.types.plan import PlanReason, SeamOutcome, Segment, WeldPlan
 _CODE = {
     ViolationKind.COLLISION: PlanReason.COLLISION,
     ViolationKind.SINGULARITY: PlanReason.SINGULAR,
+    ViolationKind.BODY: PlanReason.ENTERS_BODY,
 }
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -11,6 +11,7 @@ from cell.errors import PlanError
 from cell.motion.collision import CollisionChecker
 from cell.motion.gate.arc import ArcSwitching
 from cell.motion.gate.base import Check, GateInput, GateOptions, PerSegment, Violation
+from cell.motion.gate.bodies import BodyEntry
 from cell.motion.gate.collisions import Collisions
 from cell.motion.gate.continuity import SampleJumps, SegmentJoins
 from cell.motion.gate.position import PositionLimits
@@ -18,6 +19,7 @@ from cell.motion.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
 from cell.motion.gate.singularity import Singularity
 from cell.motion.gate.start import StartState
 from cell.motion.robot import RobotModel
+from cell.types import Part
 from cell.types.plan import WeldPlan
 
 # The gate's checks, in the order their violations are listed.
@@ -31,6 +33,7 @@ DEFAULT_CHECKS: tuple[Check, ...] = (
     JerkLimit(),
     PerSegment((Singularity(), ArcSwitching())),
     Collisions(),
+    BodyEntry(),
 )
 
 
@@ -50,14 +53,22 @@ def find_violations(
     checker: CollisionChecker | None = None,
     options: GateOptions | None = None,
     checks: Sequence[Check] = DEFAULT_CHECKS,
+    bodies: Sequence[Part] = (),
+    wire_m: float = 0.0,
+    joint_parts: Mapping[str, tuple[str, ...]] | None = None,
 ) -> list[Violation]:
     """Every violation of the gate's checks (see :mod:`cell.motion.gate`); an empty list means go.
 
     q_current : (dof,) [rad] where the arm is now. checker : collisions are checked only when one is given.
+    bodies : the parts (the aligned map's, in R) no TCP or wire may enter, checked only when given; wire_m : the
+    wire's stick-out behind the TCP [m]; joint_parts : per seam id its joint's two parts, left out along its own
+    approach, weld and depart (:mod:`cell.motion.gate.bodies`).
     """
     if not plan.segments:
         return []
-    gate = GateInput(robot, plan, np.asarray(q_current, dtype=float), checker, options or GateOptions())
+    opts = options or GateOptions()
+    q = np.asarray(q_current, dtype=float)
+    gate = GateInput(robot, plan, q, checker, opts, tuple(bodies), wire_m, dict(joint_parts or {}))
     return [v for check in checks for v in check.violations(gate)]
 
 
@@ -68,10 +79,15 @@ def check_plan(
     *,
     checker: CollisionChecker | None = None,
     options: GateOptions | None = None,
+    bodies: Sequence[Part] = (),
+    wire_m: float = 0.0,
+    joint_parts: Mapping[str, tuple[str, ...]] | None = None,
 ) -> None:
     """Raise GateRefusedError (a PlanError) naming the violations (the first five and a count) unless the plan
-    passes the gate."""
-    found = find_violations(robot, plan, q_current, checker=checker, options=options)
+    passes the gate (:func:`find_violations`)."""
+    found = find_violations(
+        robot, plan, q_current, checker=checker, options=options, bodies=bodies, wire_m=wire_m, joint_parts=joint_parts
+    )
     if found:
         shown = "; ".join(str(v) for v in found[:5])
         more = f" (+{len(found) - 5} more)" if len(found) > 5 else ""

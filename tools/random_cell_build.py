@@ -65,9 +65,11 @@ def _member_deviation(rng: np.random.Generator, b: Body, design: Design) -> tupl
     if b.name in design.held and b.kind in ("plate", "box"):  # its faces stay: only its height changes
         size[2] = rng.uniform(-1, 1) * (TOL_LENGTH if dims[2] == dims.max() else TOL_SECTION) * dims[2]
     move = min(TOL_LOCATION * dims.max(), MOVE_MM)
-    if b.kind == "brace" or b.name in {m for m, _ in design.ending}:  # slides along its width only
-        offset = R_m[:, 1] * rng.uniform(-1, 1) * min(move, 0.5)
-        offset += R_m[:, 0] * size[0] / 2  # an ending plate's end stays on the face it meets
+    if b.kind == "brace":  # slides along the faces it meets
+        slide = math.radians(b.extra["slide_deg"])
+        offset = np.array([math.cos(slide), math.sin(slide), 0.0]) * rng.uniform(-0.5, 0.5)
+    elif b.name in {m for m, _ in design.ending}:  # slides sideways; its end stays on the face it meets
+        offset = R_m[:, 1] * rng.uniform(-0.5, 0.5) + R_m[:, 0] * size[0] / 2
     elif b.name not in design.held:
         ang = rng.uniform(0, 2 * math.pi)
         offset = np.array([math.cos(ang), math.sin(ang), 0.0]) * rng.uniform(

@@ -171,7 +171,8 @@ def brace(
     centre = moved(X, (np.mean([p1[0], p2[0], p3[0], p4[0]]), np.mean([p1[1], p2[1], p3[1], p4[1]]), 0.0))
     yaw = math.degrees(math.atan2(n[1], n[0]))
     length = math.hypot(p2[0] - p3[0], p2[1] - p3[1])
-    extra = {"angle_to_base_deg": theta, "angle_to_face_deg": 90.0 - theta}
+    slide = math.degrees(math.atan2(R[1, 2], R[0, 2]))  # along the face, parallel to the base
+    extra = {"angle_to_base_deg": theta, "angle_to_face_deg": 90.0 - theta, "slide_deg": slide}
     body = Body(name, "brace", v, f, vec(centre), (0.0, -theta, yaw), (length, width, thick), extra=extra)
     w = width / 2
     cands = [  # (receiving, face of the brace, start (s, z, w), end, dihedral)

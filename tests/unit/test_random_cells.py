@@ -15,6 +15,7 @@ from tools_loader import load_tool
 from cell import scenario as sc
 from cell.scenario.init import check_layout
 from cell.seams.joint import dihedral, find_joints
+from cell.station import load_arm
 from cell.types import Polyhedron
 from cell.weldmap import read_map
 
@@ -42,13 +43,14 @@ def test_different_seeds_give_different_cells(rc: ModuleType, tmp_path: Path) ->
 
 
 def test_twenty_random_cells_load_and_are_laid_out_for_the_cell(rc: ModuleType, tmp_path: Path) -> None:
-    kinds, noises, exact, perturbed = set(), set(), 0, 0
+    kinds, noises, exact, perturbed, features = set(), set(), 0, 0, set()
     for seed in range(20):
         cell = rc.make_cell(seed, tmp_path / f"cell-{seed}")
         truth = _truth(cell)
         scn = sc.load(cell.scenario)
         weldmap = read_map(scn.map_path)
         assert check_layout(scn, weldmap) == [], seed
+        load_arm(scn)  # the arm reaches the scan pose (IKError otherwise)
         joints = find_joints(weldmap)  # every drawn seam has its joint, as the truth says
         assert sorted(joints) == sorted(s["id"] for s in truth["seams"])
         for s in truth["seams"]:
@@ -73,10 +75,15 @@ def test_twenty_random_cells_load_and_are_laid_out_for_the_cell(rc: ModuleType, 
                 assert 0.3 <= cam.extrinsic_error.translation_mm <= 1.0
                 assert 0.03 <= cam.extrinsic_error.rotation_deg <= 0.1
         kinds |= {p["kind"] for p in truth["parts"]}
+        features |= {k for p in truth["parts"] for k in ("angle_to_base_deg", "angle_to_plates_deg") if k in p}
+        features |= {"ends_against"} if truth["ends_against"] else set()
+        features |= {"fixture"} if truth["fixtures"] else set()
+        features |= {"curved"} if truth["curved_seams"] else set()
         noises.add(scn.noise)
         assert truth["seed"] == seed and truth["kind"] == "random" and truth["redraws"] >= 0
     assert kinds >= {"plate", "box", "rhs", "flat", "brace"} and kinds & {"tube", "pipe"}
     assert noises == {"none", "realistic"} and exact and perturbed
+    assert features == {"angle_to_base_deg", "angle_to_plates_deg", "ends_against", "fixture", "curved"}
 
 
 def test_post_pipes_has_a_square_post_among_two_pipes(rc: ModuleType, tmp_path: Path) -> None:

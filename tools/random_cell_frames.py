@@ -55,11 +55,11 @@ def braced_pair(
     seams = []
     for plate, y, n_b in ((names[0], -clear / 2, R[:, 1]), (names[1], clear / 2, -R[:, 1])):
         ye = yl if plate == names[0] else yr
-        lo, hi = x_at(ye, -1), x_at(ye, 1)
+        lo, hi = x_at(ye, -1), x_at(ye, 1)  # the end's edge; a cheek's plane meets the face at x_at(y)
         for face, a, b, n_a in (
             ("top", (lo, y, z0 + bar), (hi, y, z0 + bar), np.array([0.0, 0.0, 1.0])),
-            ("cheek-", (lo, y, z0), (lo, y, z0 + bar), -m_W),
-            ("cheek+", (hi, y, z0), (hi, y, z0 + bar), m_W),
+            ("cheek-", (x_at(y, -1), y, z0), (x_at(y, -1), y, z0 + bar), -m_W),
+            ("cheek+", (x_at(y, 1), y, z0), (x_at(y, 1), y, z0 + bar), m_W),
         ):
             deg = 180.0 - math.degrees(math.acos(max(-1.0, min(1.0, float(n_a @ n_b)))))
             p0, p1 = vec(moved(X, a)), vec(moved(X, b))

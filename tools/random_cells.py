@@ -93,10 +93,11 @@ def _check_scenario(path: Path, weldmap: WeldMap) -> None:
 
 def _cameras(kind: str, placement: Placement, rng: np.random.Generator) -> list[Camera]:
     """The fixed cameras and the arm camera. Named layouts: exact extrinsics stated 0, realistic stereo noise
-    (``web_tube`` with cell init's pair, the others three around the part); random: 2-4 anywhere in range, each
-    structured light or active stereo, extrinsics exact or perturbed with the matching stated calibration."""
+    (``web_tube`` and ``mitred_ladder`` with cell init's pair, ``post_pipes`` three around the part); random: 2-4
+    anywhere in range, each structured light or active stereo, extrinsics exact or perturbed with the matching
+    stated calibration."""
     name = kind.partition(":")[0]
-    if name == "web_tube":
+    if name in ("web_tube", "mitred_ladder"):
         pairs, up = init_cameras(placement), (0.0, 1.0, 0.0)
         names = ["cam_left", "cam_right"]
     else:
@@ -136,7 +137,7 @@ def _draw(seed: int, kind: str, rng: np.random.Generator, out: Path) -> dict[str
     cameras = _cameras(kind, placement, rng)
     simulation: dict[str, Any] = {"noise": "realistic"}
     if kind == "random":
-        simulation = realism(rng, design, weldmap, placement)
+        simulation = realism(rng)
         simulation["deviations"] = deviations(rng, design, weldmap)
     name = f"{kind.replace(':', '-')}-{seed}"
     text = scenario_dict(

@@ -227,6 +227,13 @@ def truth(
     }
 
 
+def _without_folder(message: str, folder: Path) -> str:
+    """A rejection's reason without the output folder in it (the truth is the same wherever it is written)."""
+    for prefix in dict.fromkeys((str(folder.resolve()), str(folder))):
+        message = message.replace(prefix + "/", "")
+    return message
+
+
 def make_cell(seed: int, out_dir: Path, kind: str = "random") -> RandomCell:
     """Generate the cell of ``seed`` and ``kind`` into the folder ``out_dir`` (made if needed; its ``map.dxf``,
     ``scenario.yaml`` and ``truth.json`` are overwritten). The same seed and kind give byte-identical files.
@@ -241,7 +248,7 @@ def make_cell(seed: int, out_dir: Path, kind: str = "random") -> RandomCell:
         try:
             fields = _draw(seed, kind, rng, out_dir)
         except RejectedDrawError as err:
-            why.append(str(err))
+            why.append(_without_folder(str(err), out_dir))
             continue
         record = {
             "format": "weld-cell-random-truth",

@@ -170,7 +170,7 @@ def brace(
     R = np.column_stack([n, up, np.cross(n, up)])  # outline in (s, z), extruded across the width
     X = pose(R, F)
     v, f = prism([p1, p2, p3, p4], -width / 2, width / 2, X)
-    centre = moved(X, (np.mean([p1[0], p2[0], p3[0], p4[0]]), np.mean([p1[1], p2[1], p3[1], p4[1]]), 0.0))
+    centre = moved(X, [*np.mean([p1, p2, p3, p4], axis=0), 0.0])
     yaw = math.degrees(math.atan2(n[1], n[0]))
     length = math.hypot(p2[0] - p3[0], p2[1] - p3[1])
     slide = math.degrees(math.atan2(R[1, 2], R[0, 2]))  # along the face, parallel to the base

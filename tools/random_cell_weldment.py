@@ -143,7 +143,9 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
     base = Body(
         "BASE", "plate", v + np.array([L / 2, W / 2, 0.0]), f, vec((L / 2, W / 2, t / 2)), (0.0, 0.0, 0.0), (L, W, t)
     )
-    bodies, seams, circles = [base], [], []
+    bodies: list[Body] = [base]
+    seams: list[Seam] = []
+    circles: list[Circle] = []
     placed: dict[str, Capsule] = {}
     count: dict[str, int] = {}
     held: list[str] = []

@@ -227,6 +227,11 @@ def truth(
     }
 
 
+def cell_folder(root: Path, seed: int) -> Path:
+    """Where the command line writes the cell of ``seed`` under ``root``: ``root/cell-<seed>``."""
+    return Path(root) / f"cell-{seed}"
+
+
 def _without_folder(message: str, folder: Path) -> str:
     """A rejection's reason without the output folder in it (the truth is the same wherever it is written)."""
     for prefix in dict.fromkeys((str(folder.resolve()), str(folder))):
@@ -272,7 +277,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--kind", default="random", help="random, post_pipes, web_tube[:YAW], mitred_ladder[:ANGLE]")
     args = parser.parse_args(argv)
     for seed in range(args.seed, args.seed + args.count):
-        cell = make_cell(seed, args.out / f"cell-{seed}", args.kind)
+        cell = make_cell(seed, cell_folder(args.out, seed), args.kind)
         t = json.loads(cell.truth.read_text(encoding="utf-8"))
         fixed = sum(c["mount"] == "fixed" for c in t["cameras"])
         print(

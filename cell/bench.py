@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from cell import pipeline
-from cell.scenario import ExtrinsicErrorSpec, Scenario
+from cell.scenario import CalibrationSpec, ExtrinsicErrorSpec, Scenario
 from cell.types import SeamEstimate
 
 # The paper's Table 1 (ms and mm per seam, 8 seams each): scenario -> method -> (ME mm, ms).
@@ -59,12 +59,14 @@ class Extrinsics:
 
 
 def with_extrinsics(scenario: Scenario, ext: Extrinsics) -> Scenario:
-    """The scenario with every fixed camera's calibration off by ``ext`` (directions from the scenario seed)."""
+    """The scenario with every fixed camera's calibration off by ``ext`` (directions from the scenario seed), and
+    stated so (``calibration``, as a calibration report would: the splice's prior and the seams' sigma)."""
     if ext.label == "exact":
         return scenario
     spec = ExtrinsicErrorSpec(translation_mm=ext.translation_mm, rotation_deg=ext.rotation_deg)
+    stated = CalibrationSpec(translation_mm=ext.translation_mm, rotation_deg=ext.rotation_deg)
     cams = {
-        name: cam.model_copy(update={"extrinsic_error": spec}) if cam.mount == "fixed" else cam
+        name: cam.model_copy(update={"extrinsic_error": spec, "calibration": stated}) if cam.mount == "fixed" else cam
         for name, cam in scenario.cameras.items()
     }
     return scenario.model_copy(update={"cameras": cams})

@@ -10,6 +10,7 @@ built or placed off its drawing.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import ezdxf
@@ -34,7 +35,7 @@ def cylinder_mesh(radius_mm: float, length_mm: float, segments: int, M: Matrix44
     verts += [(0.0, 0.0, 0.0), (0.0, 0.0, length_mm)]
     mesh.vertices = [ezdxf.math.Vec3(v) for v in verts]
     n, cb, ct = segments, 2 * segments, 2 * segments + 1
-    faces = [(i, (i + 1) % n, n + (i + 1) % n, n + i) for i in range(n)]
+    faces: list[Sequence[int]] = [(i, (i + 1) % n, n + (i + 1) % n, n + i) for i in range(n)]
     faces += [(cb, (i + 1) % n, i) for i in range(n)] + [(ct, n + i, n + (i + 1) % n) for i in range(n)]
     mesh.faces = faces
     mesh.transform(M)

@@ -21,8 +21,10 @@ their eigenvalues ``mu_i`` the ratio of prior to data variance along each. A dir
 ``a_i = u_i . y_d`` is the data's disagreement in prior sigmas: beyond :data:`FAULT_SIGMAS` the camera is not
 miscalibrated within what its calibration states but knocked (a fault, never a correction); else the MAP
 estimate, one Gauss-Newton step of the prior-augmented problem from the data's optimum, is
-``b_i = mu_i / (1 + mu_i) a_i``. Directions a round or flat overlap leaves free carry no information and stay
-as calibrated; a camera whose calibration is stated exact (``P = 0``) never moves.
+``b_i = mu_i / (1 + mu_i) a_i``. The prior couples directions (a turn about the camera shifts the overlap), so
+the MAP move is then kept only along the directions of the registration's own coordinates that the data inform
+on their own (:func:`_seen`). Directions a round or flat overlap leaves free carry no information and stay as
+calibrated; a camera whose calibration is stated exact (``P = 0``) never moves.
 """
 
 from __future__ import annotations
@@ -128,6 +130,19 @@ def posterior(x_data: FloatArray, information: FloatArray, prior: FloatArray) ->
         return Posterior(zero, zero, 0, 0.0)
     a = U[:, informed].T @ (L_pinv @ x_data)  # the data's estimate along each informed direction [prior sigmas]
     b = mu[informed] / (1.0 + mu[informed]) * a
-    x_informed = L @ (U[:, informed] @ a)
-    x_map = L @ (U[:, informed] @ b)
+    seen = _seen(information, prior)
+    x_informed = seen @ (L @ (U[:, informed] @ a))
+    x_map = seen @ (L @ (U[:, informed] @ b))
     return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))))
+
+
+def _seen(information: FloatArray, prior: FloatArray) -> FloatArray:
+    """(6, 6) projector onto the directions of the registration's own coordinates that the data inform on their
+    own: eigenvectors v of the information whose data variance ``1 / (v^T I v)`` is at most the prior's
+    ``v^T P v`` over :data:`INFORMED_RATIO`. The prior couples a camera's turn with a shift of the overlap (the
+    turn is about the camera, metres away), so a MAP move along a direction the data inform would carry a shift
+    the data never saw (a tilt of a pipe's axis dragging a slide along it): that part is left as calibrated."""
+    lam, V = np.linalg.eigh(0.5 * (information + information.T))
+    prior_var = np.einsum("ij,jk,ki->i", V.T, prior, V)
+    keep = lam * prior_var >= INFORMED_RATIO
+    return np.asarray(V[:, keep] @ V[:, keep].T)

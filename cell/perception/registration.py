@@ -92,12 +92,29 @@ def _plane_residuals(
     tree : the KD-tree of ``target``, built once per registration (a registration asks 10-12 times). Returns
     (moved probe points (k, 3), their target normals (k, 3), signed residuals (k,) [m]).
     """
+    moved, at = _pairs(probe, tree, reach_m, X)
+    n = normals[at]
+    return moved, n, np.einsum("ij,ij->i", moved - target[at], n)
+
+
+def _pairs(probe: FloatArray, tree: cKDTree, reach_m: float, X: FloatArray) -> tuple[FloatArray, npt.NDArray[np.intp]]:
+    """(the probe points moved by X that have a target point within ``reach_m`` (k, 3), that point's index (k,))."""
     moved = transform_points(X, probe)
     dist, nearest = tree.query(moved, distance_upper_bound=reach_m, workers=-1)  # every core: same answers
     paired = np.isfinite(dist)
-    moved, at = moved[paired], nearest[paired]
-    n = normals[at]
-    return moved, n, np.einsum("ij,ij->i", moved - target[at], n)
+    return moved[paired], np.asarray(nearest[paired], np.intp)
+
+
+def _split_normals(target: FloatArray, normals: FloatArray, radius_m: float) -> tuple[FloatArray, FloatArray]:
+    """Two estimates of every target point's normal (each (m, 3), oriented as ``normals``), independent of each
+    other: each from one half of the points (even / odd), taken at the point's nearest neighbour in that half."""
+    out = []
+    for half in (target[0::2], target[1::2]):
+        n_half = _open3d.estimate_normals(half, radius_m, _NORMAL_NEIGHBOURS)
+        _, nearest = cKDTree(half, balanced_tree=False, compact_nodes=False).query(target, workers=-1)
+        n = n_half[nearest]
+        out.append(np.where((np.einsum("ij,ij->i", n, normals) < 0.0)[:, None], -n, n))
+    return out[0], out[1]
 
 
 def _patch_keys(points: FloatArray, normals: FloatArray, patch_m: float) -> npt.NDArray[np.intp]:
@@ -152,15 +169,17 @@ class Evidence:
     centre_R : (3,) centroid of the overlap (the probe points paired at the calibration) [m]; lever_m : their RMS
     radius about it [m]. x_data : (6,) the registration's estimate [m]. information : (6, 6) its information
     [1/m^2], the inverse of the patch-robust covariance (zero along a direction the overlap does not constrain).
+    hessian : (6, 6) the Tukey-weighted normal matrix J^T W J at the estimate (unitless: the cost's curvature).
     """
 
     centre_R: FloatArray
     lever_m: float
     x_data: FloatArray
     information: FloatArray
+    hessian: FloatArray
 
     def __post_init__(self) -> None:
-        for name in ("centre_R", "x_data", "information"):
+        for name in ("centre_R", "x_data", "information", "hessian"):
             object.__setattr__(self, name, readonly(getattr(self, name)))
 
 
@@ -173,28 +192,37 @@ def evidence(
     settings: RegistrationSettings,
     patch_m: float,
     calibrated: tuple[FloatArray, FloatArray, FloatArray],
+    split: tuple[FloatArray, FloatArray],
 ) -> Evidence | None:
     """The estimate X (4, 4) of ``probe`` (n, 3) onto ``target`` (m, 3) (unit normals (m, 3), its KD-tree
     ``tree``) as :class:`Evidence`; None when fewer than :data:`MIN_OVERLAP` points pair at X.
 
-    calibrated : :func:`_plane_residuals` of ``probe`` at the identity (its paired points fix the centre). The
-    information is ``H S^+ H``: H the Tukey-weighted normal matrix of the point-to-plane residuals at X, S the
-    covariance of their scores summed per patch of ``patch_m`` and surface direction.
+    calibrated : :func:`_plane_residuals` of ``probe`` at the identity (its paired points fix the centre).
+    split : :func:`_split_normals` of the target. The information is ``H S^+ H``: H the Tukey-weighted normal
+    matrix of the point-to-plane residuals at X, S the covariance of their scores summed per patch of ``patch_m``
+    and surface direction. The estimated normals are noisy, and ``J^T W J`` of one estimate counts their tilt as
+    information (a plane's or a round body's axis' slide looks constrained, about by the number of points over
+    the normals' neighbourhood, whatever the depth noise); H is made of the two independent estimates instead,
+    ``(J_a^T W J_b + J_b^T W J_a) / 2``, whose tilts do not correlate (instrumental variables).
     """
     p0 = calibrated[0]
     centre = p0.mean(axis=0)
     lever = max(float(np.sqrt(np.mean(np.sum((p0 - centre) ** 2, axis=1)))), 1e-9)
-    p, n, r = _plane_residuals(probe, tree, target, normals, settings.reach_m, X)
-    if len(r) < MIN_OVERLAP:
+    p, at = _pairs(probe, tree, settings.reach_m, X)
+    if len(at) < MIN_OVERLAP:
         return None
+    n = normals[at]
+    r = np.einsum("ij,ij->i", p - target[at], n)
     w = _tukey(r, settings.tukey_k_m)
-    J = _jacobian(p, n, transform_points(X, centre[None])[0], lever)
-    H = (J.T * w) @ J
+    moved_centre = transform_points(X, centre[None])[0]
+    J_a, J_b = (_jacobian(p, half[at], moved_centre, lever) for half in split)
+    H = 0.5 * ((J_a.T * w) @ J_b + (J_b.T * w) @ J_a)
+    J = 0.5 * (J_a + J_b)
     patch = _patch_keys(p, n, patch_m)
     score = np.stack([np.bincount(patch, w * r * J[:, j], int(patch.max()) + 1) for j in range(6)], axis=1)
     S_pinv = np.linalg.pinv(score.T @ score, rcond=_SCORE_RCOND, hermitian=True)
     information = H @ S_pinv @ H
-    return Evidence(centre, lever, coordinates(X, centre, lever), 0.5 * (information + information.T))
+    return Evidence(centre, lever, coordinates(X, centre, lever), 0.5 * (information + information.T), H)
 
 
 @dataclass(frozen=True)
@@ -264,7 +292,8 @@ def register(
     else:
         X_icp = _open3d.icp(probe, sub, corr, spec.icp_iterations, None, normals, settings.tukey_k_m).X_TS
     before = _patch_misfit(r0, _tukey(r0, settings.tukey_k_m), _patch_keys(p0, n0, spec.merge_cell_m))
-    found = evidence(probe, tree, sub, normals, X_icp, settings, spec.merge_cell_m, calibrated)
+    split = _split_normals(sub, normals, settings.normal_radius_m)
+    found = evidence(probe, tree, sub, normals, X_icp, settings, spec.merge_cell_m, calibrated, split)
     if found is None:
         return Estimate(X_icp, eye, eye, len(r0), noise, misfit_before_m=before, misfit_m=before)
     post = posterior(found.x_data, found.information, prior(found.centre_R, found.lever_m))

@@ -153,7 +153,9 @@ def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end:
             in_u = half
         else:
             out_u = half
-    return out_u, part.name
+    # The walk found where it is deeper than the margin: the face lies the margin before that.
+    back = INSIDE_MARGIN_M if end > mid else -INSIDE_MARGIN_M
+    return out_u - back, part.name
 
 
 __all__ = ["INSIDE_MARGIN_M", "check_ends", "check_seam_ends"]

@@ -52,7 +52,7 @@ RANSAC_SIGMA_M = 0.0016
 # Our locator's floor per end source [m], in quadrature with its standard error of the end.
 OURS_END_FLOOR_M = {
     EndSource.EDGE: 0.0001,
-    EndSource.FACE_END: 0.0001,
+    EndSource.FACE_END: 0.0002,
     EndSource.OTHER_PART: 0.0001,
     EndSource.DRAWN: 0.0,
 }

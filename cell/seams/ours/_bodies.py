@@ -21,7 +21,9 @@ from cell.types import Part, Polyhedron
 
 BoolArray = npt.NDArray[np.bool_]
 _PAIRS = 1_000_000  # point-edge pairs tested at once in over_region() (bounds the memory)
-SIDE_MAX_ANGLE_DEG = 60.0  # a face of A ends the seam when its normal is this close to the seam's direction
+SIDE_MAX_ANGLE_DEG = (
+    75.0  # a face of A ends the seam when its normal is this close to the seam's direction (a brace at 15 deg)
+)
 _SIDE_COS = math.cos(math.radians(SIDE_MAX_ANGLE_DEG))
 _ACROSS_TIE = 1e-3  # faces whose normals' components along the line differ by less are as much across it
 

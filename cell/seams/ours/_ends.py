@@ -8,6 +8,7 @@ section 8)."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,6 +45,58 @@ def end_source(end: End) -> EndSource:
     if end.source == "side face" and end.touching:
         return EndSource.OTHER_PART
     return _SOURCES[end.source]
+
+
+# A side face this far off square to the seam (tan of the angle) shears face A's support: below it (a box, whose
+# fitted faces tilt a little off the map's) the window along the seam stays square.
+_SHEAR_MIN = float(np.tan(np.radians(1.0)))
+
+
+@dataclass(frozen=True)
+class Shear:
+    """How A's side faces at the seam's ends run across face A (a mitred brace's, at an angle to the seam).
+
+    w : (3,) the unit direction in face A across the seam, away from face B; h0 : where along w A's edge on its end
+        face lies [m] (the drawn gap over the angle between the end face and w; 0 without one); c : a side face
+        meets that edge at ``s(h0) - c (h - h0)`` along the seam at a height h along w, so that ``s + c (h - h0)``
+        of a point of face A is where the side line through it meets A's edge at the end face: the end's place as
+        the truth has it (the edge projected on the seam). 0 for ends square to the seam (a box: all as before).
+    """
+
+    w: FloatArray
+    c: float
+    h0: float
+
+    def s(self, pts: Points, p0: FloatArray, t: FloatArray) -> FloatArray:
+        """The points' parameters along the seam p0 + s t, each carried along its side line to A's end edge."""
+        s = pts.along(t) - float(p0 @ t)
+        if not self.c:
+            return s
+        return s + self.c * (pts.along(self.w) - float(p0 @ self.w) - self.h0)
+
+
+def end_shear(
+    ends: tuple[End, End],
+    n_a: FloatArray,
+    n_b: FloatArray,
+    t: FloatArray,
+    p0: FloatArray,
+    end_face: tuple[FloatArray, float],
+) -> Shear:
+    """The :class:`Shear` of the ends' planes (the table or another part's face included: what A's side lies on;
+    their mean slope), face A (normal ``n_a``) meeting face B (``n_b``) on the line p0 + s t, A's end face the
+    plane ``end_face`` (n, d)."""
+    w = np.cross(n_a, t)
+    w = w / max(float(np.linalg.norm(w)), 1e-12)
+    if float(w @ n_b) < 0.0:
+        w = -w
+    slopes = [float(e.n @ w) / float(e.n @ t) for e in ends if abs(float(e.n @ t)) > 0.2]
+    c = float(np.mean(slopes)) if slopes else 0.0
+    if abs(c) < _SHEAR_MIN:
+        return Shear(w, 0.0, 0.0)
+    n_e, d_e = end_face
+    h0 = (d_e - float(n_e @ p0)) / float(n_e @ w) if abs(float(n_e @ w)) > 0.3 else 0.0
+    return Shear(w, c, max(h0, 0.0))
 
 
 TANGENT_WINDOW_M = 0.008  # points this far along the line about the extent's guess place a tangent end [m]
@@ -139,6 +192,7 @@ def find_ends(
     s_map: list[float],
     face_a_height: float,
     o: OursOptions,
+    end_face: tuple[FloatArray, float],
 ) -> tuple[End, End]:
     """Both ends placed on the fitted line p0 + s t: the table where A rests on it, A's side face where it was
     fitted (``sides_se``: the standard error of each fitted side face's offset, by end index), else the extent of
@@ -146,15 +200,20 @@ def find_ends(
     in the ``dense`` points of a short tube about it (None: not refined, as in a pass before the last). An end
     short of its plane by an inset (a rounded tube) and not seen lies the drawn width from an end on A's side face,
     else at the tangent line fitted in the ``dense`` points (:func:`tangent_end`).
-    ``face_a_height``: face A's extent away from B [m] (a thin plate's side keeps a window above the corner band)."""
+    ``face_a_height``: face A's extent away from B [m] (a thin plate's side keeps a window above the corner band);
+    ``end_face``: A's end face's plane (n, d) from the aligned map (where a skewed side line ends, :class:`Shear`)."""
     placed = list(ends)
     known = [False, False]
+    shear = end_shear(ends, face_a.n, face_b.n, t, p0, end_face)
+    # A side face at an angle meets the seam's line past A's edge on its end face (by the gap seen across it): the
+    # end is where it meets the line through that edge (the edge projected on the seam), as for a square one.
+    at_edge = p0 + shear.h0 * shear.w if shear.c else p0
     for k, end in enumerate(ends):
         if end.on_table:
-            placed[k] = end.at(line_plane_parameter(p0, t, end.n, end.d - end.inset), 2e-4, "table")
+            placed[k] = end.at(line_plane_parameter(at_edge, t, end.n, end.d - end.inset), 2e-4, "table")
             known[k] = True
         elif k in sides_se:
-            s = line_plane_parameter(p0, t, end.n, end.d - end.short_of)
+            s = line_plane_parameter(at_edge, t, end.n, end.d - end.short_of)
             placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
             known[k] = True
     for k, end in enumerate(ends):
@@ -176,12 +235,13 @@ def find_ends(
     band_b = within(max(o.corner_band_m, 3.0 * face_b.scale), face_a_height)
     cut = o.edge_band_m + 3.0 * face_a.scale
     s_known = [end.s for end in placed]
+    c = shear.c
 
     def along_a(pts: Points) -> FloatArray:
         """The parameters along the line of the points of face A's support among ``pts``."""
         r_a = pts.along(face_a.n) - face_a.d
         r_b = pts.along(face_b.n) - face_b.d
-        s = pts.along(t) - float(p0 @ t)
+        s = shear.s(pts, p0, t)
         near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         if known[0]:
             near_a &= s > s_known[0] + cut
@@ -194,7 +254,7 @@ def find_ends(
         it ends into (down to a third of the radius below the plane) among ``pts``."""
         r_a = pts.along(face_a.n) - face_a.d
         r_b = pts.along(face_b.n) - face_b.d
-        s = pts.along(t) - float(p0 @ t)
+        s = shear.s(pts, p0, t)
         on = (r_a < 3.0 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         return s[on], r_a[on]
 
@@ -211,7 +271,8 @@ def find_ends(
             # A flat that ends into a corner radius has no edge: its points bend away from the plane past the tangent
             # line, and the extent of those near the plane runs on into the radius. Fit the radius's profile.
             sign = 1.0 if k == 1 else -1.0
-            d = dense(p0 + (extent[k] - TANGENT_WINDOW_M) * t, p0 + (extent[k] + TANGENT_WINDOW_M) * t)
+            wide = TANGENT_WINDOW_M + abs(c) * o.tube_radius_m
+            d = dense(p0 + (extent[k] - wide) * t, p0 + (extent[k] + wide) * t)
             s_d, r_d = profile_a(d)
             s0, se = tangent_end(sign * s_d, r_d, sign * extent[k], end.inset, face_a.scale)
             placed[k] = end.at(sign * s0, se, "tangent") if np.isfinite(se) else end.at(extent[k], extent[2], "extent")
@@ -219,7 +280,7 @@ def find_ends(
             # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
             # point of the dense cloud within the likelihood's window about it.
             sign = 1.0 if k == 1 else -1.0
-            reach = EDGE_WINDOW_M + o.edge_band_m
+            reach = EDGE_WINDOW_M + o.edge_band_m + abs(c) * o.tube_radius_m  # the whole side line's points
             s_d = along_a(dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t))
             edge, se = edge_ml(sign * s_d, sign * extent[k])
             if np.isfinite(se):

@@ -47,6 +47,9 @@ class JointGeometry:
     edge_band: float
     region_a: FloatArray | None = None  # A's weld face's boundary edges (k, 2, 3) when its extents do not bound it
     region_b: FloatArray | None = None  # a polyhedron B's receiving face's boundary edges (k, 2, 3) (coplanar too)
+    # From the seam line to A's edge on its end face, in face A across the seam [m] (a polyhedron's: the drawn gap
+    # seen across face A): where a side face's inset is measured (a skewed side face meets the line past that edge).
+    to_end_edge: FloatArray | None = None
     # The region tests of this seam's points, computed once per point over the passes: "a" or "b" -> (points, test).
     _regions: dict[str, tuple[Points, Region]] = field(default_factory=dict, compare=False, repr=False)
 
@@ -68,6 +71,11 @@ class JointGeometry:
         region_b = None if part_b.is_box else coplanar_boundary(part_b, joint.face_receiving)
         if not part_a.is_box:
             sides = side_planes(part_a, (joint.face_abutting, joint.end_face), p0, t, s_map, _SIDE_REACH_M)
+            w = np.cross(n_a, t)
+            w = w / max(float(np.linalg.norm(w)), 1e-12)
+            if float(w @ part_b.face_plane(joint.face_receiving)[0]) < 0.0:
+                w = -w
+            h0 = (d_e - float(n_e @ p0)) / float(n_e @ w) if abs(float(n_e @ w)) > 0.3 else 0.0
             across = ((-t, float(-t @ p0) - s_map[0]), (t, float(t @ p0) + s_map[1]))  # never fitted
             return JointGeometry(
                 part_a,
@@ -83,6 +91,7 @@ class JointGeometry:
                 if fills_rectangle(part_a, joint.face_abutting, t)
                 else coplanar_boundary(part_a, joint.face_abutting),
                 region_b,
+                max(h0, 0.0) * w,
             )
         box_a = part_a.box
         k_a = "xyz".index(joint.face_abutting[1])
@@ -147,6 +156,8 @@ class JointGeometry:
         for a body whose end lies on the side face (within :data:`_INSET_MIN_M`)."""
         if at is None or self.part_a.is_box:
             return 0.0
+        if self.to_end_edge is not None:
+            at = at + self.to_end_edge
         inset = d - float(n @ at)
         return inset if inset > _INSET_MIN_M else 0.0
 

@@ -11,7 +11,7 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams.ours._ends import end_source, find_ends, side_selections
+from cell.seams.ours._ends import end_shear, end_source, find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
@@ -110,8 +110,6 @@ class OursLocator:
             reason = "the seam lies against the table"
             return SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason, code=Reason.UNDERSIDE), NO_ERRORS
 
-        pts = gather(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m, joint, rng, o)
-
         def dense(a: FloatArray, b: FloatArray) -> Points:
             """The tube about a-b (3,) from ``edge_sample_share`` of the cloud (an end found as an edge needs
             density)."""
@@ -123,13 +121,18 @@ class OursLocator:
         face_b = Face(n_b, d_b, o.sensor_sigma_m, f"{joint.receiving} {joint.face_receiving}")
         others = tuple(p for p in scene.weldmap.parts if p.name != part_a.name)
         ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m, others, p0)
+        # A side face at an angle to the seam (a mitred brace's) ends face A's points that far further along it.
+        end_face = part_a.face_plane(joint.end_face)
+        skew = abs(end_shear(ends, n_a, n_b, t, p0, end_face).c) * o.tube_radius_m
+        pts = gather(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m + skew, joint, rng, o)
 
         for it in range(o.passes):
             first, last = it == 0, it == o.passes - 1
             p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
             r_a = pts.along(face_a.n) - face_a.d
             r_b = pts.along(face_b.n) - face_b.d
-            s = pts.along(t) - float(p0 @ t)
+            # Along the seam as A's side faces run across face A (square for a box; a mitred brace's at an angle).
+            s = end_shear(ends, face_a.n, face_b.n, t, p0, end_face).s(pts, p0, t)
             slack = o.map_tolerance_m if first else 0.0
             band_a = max(o.corner_band_m, 3.0 * face_a.scale) + slack
             band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
@@ -205,6 +208,7 @@ class OursLocator:
                 s_map,
                 geo.length_a,
                 o,
+                end_face,
             )
 
         length = ends[1].s - ends[0].s

@@ -72,6 +72,10 @@ def _seam_row(s: Row) -> Row:
         "weld_reason_code": s.get("weld_reason_code"),
         "tcp_rms_mm": tcp.get("rms"),
         "tcp_max_mm": tcp.get("max"),
+        # the weld measured whole: the most of the joint left unwelded or overrun at either end
+        "ends_mm": max(
+            (tcp[k] for k in ("short_start", "short_end", "past_start", "past_end") if k in tcp), default=None
+        ),
         "travel_speed_mm_s": s.get("travel_speed_mm_s"),
         "weld_time_s": s.get("weld_time_s"),
     }
@@ -120,6 +124,7 @@ def report_row(rep: Row, code: int) -> Row:
     seams = [_seam_row(s) for s in rep["seams"]]
     rescan = rep["rescan"]
     tcp_max = [s["tcp_max_mm"] for s in seams if s["welded"] and s["tcp_max_mm"] is not None]
+    ends = [s["ends_mm"] for s in seams if s["welded"] and s["ends_mm"] is not None]
     return {
         "scenario": rep["scenario"],
         "method": rep["method"],
@@ -135,6 +140,7 @@ def report_row(rep: Row, code: int) -> Row:
         "status_counts": dict(Counter(s["status"] for s in seams)),
         "weld_reason_counts": dict(Counter(s["weld_reason_code"] for s in seams if not s["welded"])),
         "tcp_max_mm": max(tcp_max) if tcp_max else None,
+        "ends_max_mm": max(ends) if ends else None,
         "cycle_time_s": rep["cycle_time_s"],
         "arc_time_s": rep["arc_time_s"],
         "rescan": rescan,

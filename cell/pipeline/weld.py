@@ -23,7 +23,7 @@ from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import CheckFail, SeamStatus
+from cell.types import CheckFail, Joint, SeamStatus
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
@@ -121,7 +121,7 @@ def plan_for(
             options=sc.motion.gate,
             bodies=ss.weldmap.parts,  # no TCP or wire inside a part's body (the aligned map's)
             wire_m=process.stickout,
-            joint_parts={sid: (j.abutting, j.receiving) for sid, j in ss.joints.items()},
+            joint_parts=_joint_parts(ss.joints, [t.id for t in (*kept, *kept_tacks)]),
         )
         blamed = blamed_seams(plan, found)
         if blamed is None:  # none, or one that concerns the whole plan
@@ -136,6 +136,19 @@ def plan_for(
 
 
 _GATE_ROUNDS = 4  # plans tried: after the third round of drops the gate's word is final
+
+
+def _joint_parts(joints: Mapping[str, Joint], task_ids: Sequence[str]) -> dict[str, tuple[str, ...]]:
+    """Per task id (a seam's, or a tack's: its seam's), the two parts of its joint: the safety gate leaves them out
+    of its body test along that task's own weld."""
+    from cell.pipeline.tacks import TACK_MARK
+
+    out = {}
+    for tid in task_ids:
+        j = joints.get(tid.split(TACK_MARK)[0])
+        if j is not None:
+            out[tid] = (j.abutting, j.receiving)
+    return out
 
 
 def seam_counter(progress: Progress) -> Callable[[int, int], None]:

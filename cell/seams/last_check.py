@@ -99,10 +99,10 @@ def last_check(
     by_name = {p.name: p for p in parts}
     for name, p in zip(names, (est.p_start, est.p_end), strict=True):
         for part_name in (joint.abutting, joint.receiving):
-            part = by_name.get(part_name)
-            if part is not None and not bool(part.contains(p, margin=limits.face_m)):
+            joined = by_name.get(part_name)
+            if joined is not None and not bool(joined.contains(p, margin=limits.face_m)):
                 return CheckFail(
-                    LastCheck.END_OFF_FACE, _outside(part, p, limits.face_m), limits.face_m, name, part_name
+                    LastCheck.END_OFF_FACE, _outside(joined, p, limits.face_m), limits.face_m, name, part_name
                 )
     return None
 

@@ -39,6 +39,7 @@ def test_weave_and_two_passes_welded_with_a_bead_per_pass(
     for w in (weave, two):
         for q in w.passes:
             assert q.tcp_rms_mm < 0.2, w.id  # against the seam plus the intended weave and offset (up to 0.08)
+            assert q.ends_mm < 0.4, w.id  # each pass covers the joint end to end: measured up to 0.22 mm either way
     # The procedure's travel speed along the seam: a triangle weave ends at its last centre crossing, up to half a
     # wavelength before the seam's end, so the mean over the pass is a little off it (measured 3.017 mm/s).
     assert abs(weave.passes[0].speed_mm_s - 3.0) < 0.03

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from random_cell_layouts import Design
 from random_cell_parts import Body, rot_z
-from random_cell_scene import Placement, r6
+from random_cell_scene import r6
 
 from cell.asbuilt_shapes import principal_frame
 from cell.geometry import matrix_to_rpy
@@ -24,10 +24,10 @@ YAW_DEG = 0.3  # a member's turn about the vertical as built [deg]
 MOVE_MM = 2.0  # the most a member moves as built [mm]
 
 
-def realism(rng: np.random.Generator, design: Design, weldmap: WeldMap, placement: Placement) -> dict[str, Any]:
+def realism(rng: np.random.Generator) -> dict[str, Any]:
     """The ``simulation`` keys of a random cell but its deviations: noise realistic (4 in 5) or none, the operator's
-    placement error (up to 5 mm, 0.5 deg), and each of the realism options half the time (gaps varying to 0.5-2 mm,
-    tacks at the seam ends, specular dropout on shiny faces)."""
+    placement error (up to 5 mm, 0.5 deg), gaps varying to 0.5-2 mm and tacks at the seam ends half the time each,
+    specular dropout on shiny faces three times in ten."""
     sim: dict[str, Any] = {"noise": "realistic" if rng.random() < 0.8 else "none"}
     sim["placement_error"] = {
         "xyz_m": [r6(rng.uniform(-0.005, 0.005)), r6(rng.uniform(-0.005, 0.005)), 0.0],
@@ -65,9 +65,11 @@ def _member_deviation(rng: np.random.Generator, b: Body, design: Design) -> tupl
     if b.name in design.held and b.kind in ("plate", "box"):  # its faces stay: only its height changes
         size[2] = rng.uniform(-1, 1) * (TOL_LENGTH if dims[2] == dims.max() else TOL_SECTION) * dims[2]
     move = min(TOL_LOCATION * dims.max(), MOVE_MM)
-    if b.kind == "brace" or b.name in {m for m, _ in design.ending}:  # slides along its width only
-        offset = R_m[:, 1] * rng.uniform(-1, 1) * min(move, 0.5)
-        offset += R_m[:, 0] * size[0] / 2  # an ending plate's end stays on the face it meets
+    if b.kind == "brace":  # slides along the faces it meets
+        slide = math.radians(b.extra["slide_deg"])
+        offset = np.array([math.cos(slide), math.sin(slide), 0.0]) * rng.uniform(-0.5, 0.5)
+    elif b.name in {m for m, _ in design.ending}:  # slides sideways; its end stays on the face it meets
+        offset = R_m[:, 1] * rng.uniform(-0.5, 0.5) + R_m[:, 0] * size[0] / 2
     elif b.name not in design.held:
         ang = rng.uniform(0, 2 * math.pi)
         offset = np.array([math.cos(ang), math.sin(ang), 0.0]) * rng.uniform(

@@ -114,8 +114,8 @@ def mitred_ladder(angle_deg: float = 44.0) -> Design:
         for face, p0, p1, n_a in (
             ("top", (x, lo, h), (x, hi, h), np.array([0.0, 0.0, 1.0])),
             ("bottom", (x, lo, 0.0), (x, hi, 0.0), np.array([0.0, 0.0, -1.0])),
-            ("lower", (x, lo, 0.0), (x, lo, h), m),
-            ("upper", (x, hi, 0.0), (x, hi, h), -m),
+            ("lower", (x, y_at(x, 1), 0.0), (x, y_at(x, 1), h), m),  # a cheek's plane meets the face at y_at(x)
+            ("upper", (x, y_at(x, -1), 0.0), (x, y_at(x, -1), h), -m),
         ):
             deg = _dihedral(n_a, n_b)
             if 35.0 <= deg <= 145.0:

@@ -153,7 +153,9 @@ def brace(
 
     Fillets: its two cheeks on the base and on the face (90 degrees), and its underside and overside on each
     (theta and 180 - theta on the base, 90 - theta and 90 + theta on the face) where a welder's torch fits
-    (:data:`DIHEDRAL_RANGE_DEG`), each at least :data:`MIN_SEAM_MM` long.
+    (:data:`DIHEDRAL_RANGE_DEG`), each at least :data:`MIN_SEAM_MM` long. Each lies where the planes of its two
+    weld faces meet (across a gap, a skewed face's plane meets the other beyond the edge), over the extent of the
+    bar's edge at that end (the cell's truth: docs/bodies.md section 3).
     """
     g1, g2 = gaps
     st, ct = math.sin(math.radians(theta)), math.cos(math.radians(theta))
@@ -168,21 +170,22 @@ def brace(
     R = np.column_stack([n, up, np.cross(n, up)])  # outline in (s, z), extruded across the width
     X = pose(R, F)
     v, f = prism([p1, p2, p3, p4], -width / 2, width / 2, X)
-    centre = moved(X, (np.mean([p1[0], p2[0], p3[0], p4[0]]), np.mean([p1[1], p2[1], p3[1], p4[1]]), 0.0))
+    centre = moved(X, [*np.mean([p1, p2, p3, p4], axis=0), 0.0])
     yaw = math.degrees(math.atan2(n[1], n[0]))
     length = math.hypot(p2[0] - p3[0], p2[1] - p3[1])
-    extra = {"angle_to_base_deg": theta, "angle_to_face_deg": 90.0 - theta}
+    slide = math.degrees(math.atan2(R[1, 2], R[0, 2]))  # along the face, parallel to the base
+    extra = {"angle_to_base_deg": theta, "angle_to_face_deg": 90.0 - theta, "slide_deg": slide}
     body = Body(name, "brace", v, f, vec(centre), (0.0, -theta, yaw), (length, width, thick), extra=extra)
     w = width / 2
     cands = [  # (receiving, face of the brace, start (s, z, w), end, dihedral)
         (base, "cheek+", (p1[0], 0.0, w), (p2[0], 0.0, w), 90.0),
         (base, "cheek-", (p1[0], 0.0, -w), (p2[0], 0.0, -w), 90.0),
-        (base, "under", (p1[0], 0.0, -w), (p1[0], 0.0, w), theta),
-        (base, "over", (p2[0], 0.0, -w), (p2[0], 0.0, w), 180.0 - theta),
+        (base, "under", (c / st, 0.0, -w), (c / st, 0.0, w), theta),
+        (base, "over", ((c + thick) / st, 0.0, -w), ((c + thick) / st, 0.0, w), 180.0 - theta),
         (host, "cheek+", (0.0, p4[1], w), (0.0, p3[1], w), 90.0),
         (host, "cheek-", (0.0, p4[1], -w), (0.0, p3[1], -w), 90.0),
-        (host, "under", (0.0, p4[1], -w), (0.0, p4[1], w), 90.0 - theta),
-        (host, "over", (0.0, p3[1], -w), (0.0, p3[1], w), 90.0 + theta),
+        (host, "under", (0.0, c / ct, -w), (0.0, c / ct, w), 90.0 - theta),
+        (host, "over", (0.0, (c + thick) / ct, -w), (0.0, (c + thick) / ct, w), 90.0 + theta),
     ]
     seams = []
     for recv, face, a, b, deg in cands:

@@ -3,12 +3,14 @@ M, z = 0 on the table].
 
 A base plate lying on the table with 2-4 members on its top, each across a drawn gap of 0-2 mm: a plate standing on
 its edge (fillets on both sides), a box post or an RHS with corner radii (a fillet on each side, an RHS's on its
-flats), a flat bar lying flat (lap fillets all round). A standing plate or post may carry a mitred brace (a flat bar
-from the base up to its face at 20-70 degrees). 1-2 round tubes or pipes stand among them (MESH or 3DFACE; half of
-them with a red CIRCLE at the foot, which the cell lists as unsupported). A post, tube or pipe may have a plate
-standing against it, its end flat on the post's face or a facet of the tube (its fillets on the base end at that
-wall; on a post also the two vertical fillets of its end). 0-2 stop blocks on a fixture layer sit near a seam.
-Members keep 50 mm apart (room for the torch) and inside the plate's edge beyond its build deviation.
+flats), a flat bar lying flat (lap fillets all round), or a braced pair (two parallel plates with a flat bar lying
+between them at 20-70 degrees, its ends mitred onto their faces: ``tools/random_cell_frames.py``). A standing plate
+or post may carry a mitred brace (a flat bar from the base up to its face at 20-70 degrees). 1-2 round tubes or
+pipes stand among them (MESH or 3DFACE; half of them with a red CIRCLE at the foot, which the cell lists as
+unsupported). A post, tube or pipe may have a plate standing against it, its end flat on the post's face or a
+facet of the tube (its fillets on the base end at that wall; on a post also the two vertical fillets of its end).
+0-2 stop blocks on a fixture layer sit near a seam. Members keep 50 mm apart (room for the torch) and inside the
+plate's edge beyond its build deviation.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from dataclasses import replace
 
 import numpy as np
 from random_cell_build import TOL_LENGTH
+from random_cell_frames import braced_pair
 from random_cell_layouts import Design
 from random_cell_members import Member, brace, ending_plate, rhs, round_tube, standing
 from random_cell_parts import Body, Circle, Seam, box_body, prism, rectangle, rot_z, vec
@@ -140,7 +143,9 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
     base = Body(
         "BASE", "plate", v + np.array([L / 2, W / 2, 0.0]), f, vec((L / 2, W / 2, t / 2)), (0.0, 0.0, 0.0), (L, W, t)
     )
-    bodies, seams, circles = [base], [], []
+    bodies: list[Body] = [base]
+    seams: list[Seam] = []
+    circles: list[Circle] = []
     placed: dict[str, Capsule] = {}
     count: dict[str, int] = {}
     held: list[str] = []
@@ -156,9 +161,22 @@ def random_design(rng: np.random.Generator) -> tuple[Design, float]:
         return f"{kind.upper()}_{count[kind]}"
 
     for _ in range(int(rng.integers(2, 5))):
-        kind = str(rng.choice(["plate", "box", "rhs", "flat"], p=[0.3, 0.25, 0.25, 0.2]))
+        kind = str(rng.choice(["plate", "box", "rhs", "flat", "pair"], p=[0.25, 0.2, 0.2, 0.15, 0.2]))
         for _try in range(30):
             xy = (float(rng.uniform(0, L)), float(rng.uniform(0, W)))
+            if kind == "pair":
+                n1, n2 = count.get("plate", 0) + 1, count.get("brace", 0) + 1
+                names = (f"PLATE_{n1}", f"PLATE_{n1 + 1}", f"BRACE_{n2}")
+                pair = braced_pair(rng, names, xy, float(rng.uniform(0.0, 180.0)), t)
+                if pair is None or not _fits(pair[1], placed, L, W):
+                    continue
+                for m in pair[0]:
+                    label(m.body.kind)
+                    bodies.append(m.body)
+                    seams.extend(m.seams)
+                placed[names[2]] = pair[1]
+                held.extend(names[:2])
+                break
             m = _member(rng, kind, f"{kind.upper()}_{count.get(kind, 0) + 1}", xy, t)
             if not _fits(m.footprint, placed, L, W):
                 continue

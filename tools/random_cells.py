@@ -93,10 +93,11 @@ def _check_scenario(path: Path, weldmap: WeldMap) -> None:
 
 def _cameras(kind: str, placement: Placement, rng: np.random.Generator) -> list[Camera]:
     """The fixed cameras and the arm camera. Named layouts: exact extrinsics stated 0, realistic stereo noise
-    (``web_tube`` with cell init's pair, the others three around the part); random: 2-4 anywhere in range, each
-    structured light or active stereo, extrinsics exact or perturbed with the matching stated calibration."""
+    (``web_tube`` and ``mitred_ladder`` with cell init's pair, ``post_pipes`` three around the part); random: 2-4
+    anywhere in range, each structured light or active stereo, extrinsics exact or perturbed with the matching
+    stated calibration."""
     name = kind.partition(":")[0]
-    if name == "web_tube":
+    if name in ("web_tube", "mitred_ladder"):
         pairs, up = init_cameras(placement), (0.0, 1.0, 0.0)
         names = ["cam_left", "cam_right"]
     else:
@@ -136,7 +137,7 @@ def _draw(seed: int, kind: str, rng: np.random.Generator, out: Path) -> dict[str
     cameras = _cameras(kind, placement, rng)
     simulation: dict[str, Any] = {"noise": "realistic"}
     if kind == "random":
-        simulation = realism(rng, design, weldmap, placement)
+        simulation = realism(rng)
         simulation["deviations"] = deviations(rng, design, weldmap)
     name = f"{kind.replace(':', '-')}-{seed}"
     text = scenario_dict(
@@ -226,6 +227,18 @@ def truth(
     }
 
 
+def cell_folder(root: Path, seed: int) -> Path:
+    """Where the command line writes the cell of ``seed`` under ``root``: ``root/cell-<seed>``."""
+    return Path(root) / f"cell-{seed}"
+
+
+def _without_folder(message: str, folder: Path) -> str:
+    """A rejection's reason without the output folder in it (the truth is the same wherever it is written)."""
+    for prefix in dict.fromkeys((str(folder.resolve()), str(folder))):
+        message = message.replace(prefix + "/", "")
+    return message
+
+
 def make_cell(seed: int, out_dir: Path, kind: str = "random") -> RandomCell:
     """Generate the cell of ``seed`` and ``kind`` into the folder ``out_dir`` (made if needed; its ``map.dxf``,
     ``scenario.yaml`` and ``truth.json`` are overwritten). The same seed and kind give byte-identical files.
@@ -240,7 +253,7 @@ def make_cell(seed: int, out_dir: Path, kind: str = "random") -> RandomCell:
         try:
             fields = _draw(seed, kind, rng, out_dir)
         except RejectedDrawError as err:
-            why.append(str(err))
+            why.append(_without_folder(str(err), out_dir))
             continue
         record = {
             "format": "weld-cell-random-truth",
@@ -264,7 +277,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--kind", default="random", help="random, post_pipes, web_tube[:YAW], mitred_ladder[:ANGLE]")
     args = parser.parse_args(argv)
     for seed in range(args.seed, args.seed + args.count):
-        cell = make_cell(seed, args.out / f"cell-{seed}", args.kind)
+        cell = make_cell(seed, cell_folder(args.out, seed), args.kind)
         t = json.loads(cell.truth.read_text(encoding="utf-8"))
         fixed = sum(c["mount"] == "fixed" for c in t["cameras"])
         print(

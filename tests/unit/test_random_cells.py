@@ -15,7 +15,9 @@ from tools_loader import load_tool
 from cell import scenario as sc
 from cell.scenario.init import check_layout
 from cell.seams.joint import dihedral, find_joints
-from cell.types import Polyhedron
+from cell.seams.truth import true_seams
+from cell.station import load_arm
+from cell.types import Polyhedron, WeldMap
 from cell.weldmap import read_map
 
 
@@ -28,9 +30,18 @@ def _truth(cell: object) -> dict:
     return json.loads(cell.truth.read_text(encoding="utf-8"))  # type: ignore[attr-defined]
 
 
+def _drawn_where_the_truth_lies(weldmap: WeldMap) -> None:
+    """Every drawn seam is the cell's true seam of the parts as drawn (docs/bodies.md section 3), within 1 um."""
+    truth = true_seams(weldmap, find_joints(weldmap), weldmap.parts, np.eye(4))
+    for seam in weldmap.seams:
+        p0, p1 = truth[seam.id]
+        assert np.linalg.norm(p0 - seam.p_start) < 1e-6 and np.linalg.norm(p1 - seam.p_end) < 1e-6, seam.id
+
+
 def test_same_seed_gives_byte_identical_files(rc: ModuleType, tmp_path: Path) -> None:
-    for kind in ("random", "mitred_ladder:33"):
-        a, b = rc.make_cell(11, tmp_path / "a", kind), rc.make_cell(11, tmp_path / "b", kind)
+    for seed, kind in ((11, "random"), (1001, "random"), (11, "mitred_ladder:33")):
+        a, b = rc.make_cell(seed, tmp_path / "a", kind), rc.make_cell(seed, tmp_path / "b", kind)
+        assert seed != 1001 or _truth(a)["redraws"] >= 1  # a draw rejected and drawn again: the same again
         for name in rc.FILES:
             assert (a.scenario.parent / name).read_bytes() == (b.scenario.parent / name).read_bytes(), (kind, name)
 
@@ -42,15 +53,17 @@ def test_different_seeds_give_different_cells(rc: ModuleType, tmp_path: Path) ->
 
 
 def test_twenty_random_cells_load_and_are_laid_out_for_the_cell(rc: ModuleType, tmp_path: Path) -> None:
-    kinds, noises, exact, perturbed = set(), set(), 0, 0
+    kinds, noises, exact, perturbed, features = set(), set(), 0, 0, set()
     for seed in range(20):
         cell = rc.make_cell(seed, tmp_path / f"cell-{seed}")
         truth = _truth(cell)
         scn = sc.load(cell.scenario)
         weldmap = read_map(scn.map_path)
         assert check_layout(scn, weldmap) == [], seed
+        load_arm(scn)  # the arm reaches the scan pose (IKError otherwise)
         joints = find_joints(weldmap)  # every drawn seam has its joint, as the truth says
         assert sorted(joints) == sorted(s["id"] for s in truth["seams"])
+        _drawn_where_the_truth_lies(weldmap)
         for s in truth["seams"]:
             j = joints[s["id"]]
             assert (j.abutting, j.receiving) == (s["abutting"], s["receiving"])
@@ -73,10 +86,15 @@ def test_twenty_random_cells_load_and_are_laid_out_for_the_cell(rc: ModuleType, 
                 assert 0.3 <= cam.extrinsic_error.translation_mm <= 1.0
                 assert 0.03 <= cam.extrinsic_error.rotation_deg <= 0.1
         kinds |= {p["kind"] for p in truth["parts"]}
+        features |= {k for p in truth["parts"] for k in ("angle_to_base_deg", "angle_to_plates_deg") if k in p}
+        features |= {"ends_against"} if truth["ends_against"] else set()
+        features |= {"fixture"} if truth["fixtures"] else set()
+        features |= {"curved"} if truth["curved_seams"] else set()
         noises.add(scn.noise)
         assert truth["seed"] == seed and truth["kind"] == "random" and truth["redraws"] >= 0
     assert kinds >= {"plate", "box", "rhs", "flat", "brace"} and kinds & {"tube", "pipe"}
     assert noises == {"none", "realistic"} and exact and perturbed
+    assert features == {"angle_to_base_deg", "angle_to_plates_deg", "ends_against", "fixture", "curved"}
 
 
 def test_post_pipes_has_a_square_post_among_two_pipes(rc: ModuleType, tmp_path: Path) -> None:
@@ -84,6 +102,7 @@ def test_post_pipes_has_a_square_post_among_two_pipes(rc: ModuleType, tmp_path: 
     truth, scn = _truth(cell), sc.load(cell.scenario)
     kinds = {p["name"]: p["kind"] for p in truth["parts"]}
     assert kinds == {"PLATE": "plate", "POST": "box", "PIPE_1": "pipe", "PIPE_2": "pipe"}
+    _drawn_where_the_truth_lies(read_map(cell.map))
     post = read_map(cell.map).part("POST")
     assert post.is_box and sorted(np.round(post.box.size * 1000, 6))[:2] == [40.0, 40.0]
     assert sorted(s["id"] for s in truth["seams"]) == sorted(f"POST>PLATE:{f}" for f in ("+x", "-x", "+y", "-y"))
@@ -95,6 +114,7 @@ def test_post_pipes_has_a_square_post_among_two_pipes(rc: ModuleType, tmp_path: 
 def test_web_tube_fillets_end_at_the_tube_wall(rc: ModuleType, tmp_path: Path) -> None:
     cell = rc.make_cell(3, tmp_path, "web_tube")
     weldmap = read_map(cell.map)
+    _drawn_where_the_truth_lies(weldmap)
     assert {p.name: p.drawn_as for p in weldmap.parts} == {"PLATE": "MESH", "WEB": "MESH", "TUBE": "MESH"}
     tube = weldmap.part("TUBE").body
     assert isinstance(tube, Polyhedron)
@@ -109,6 +129,7 @@ def test_web_tube_fillets_end_at_the_tube_wall(rc: ModuleType, tmp_path: Path) -
 def test_mitred_ladder_brace_at_the_angle_asked(rc: ModuleType, tmp_path: Path, angle: float) -> None:
     cell = rc.make_cell(5, tmp_path, f"mitred_ladder:{angle:g}")
     weldmap = read_map(cell.map)
+    _drawn_where_the_truth_lies(weldmap)
     top = [s.id for s in weldmap.seams if s.id.startswith("BRACE>") and s.id.endswith(":top")]
     assert sorted(top) == ["BRACE>RUNG_1:top", "BRACE>RUNG_2:top"]
     rung = weldmap.part("RUNG_1").box

@@ -22,9 +22,10 @@ import os
 import shlex
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -87,9 +88,24 @@ def drop_failed(store: RunStore) -> list[int]:
     return failed
 
 
+@contextmanager
+def _pool(workers: int) -> Iterator[ProcessPoolExecutor]:
+    """A pool of ``workers`` fresh processes. Its workers ignore Ctrl-C: the driver takes it and stops them at once
+    (their cells are lost, and run by the next run); on a normal exit it waits for them."""
+    pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn"), initializer=tc.ignore_interrupt)
+    try:
+        yield pool
+    except BaseException:
+        for proc in list((pool._processes or {}).values()):  # no public way to stop them before Python 3.14
+            proc.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
 def _alone(job: tc.CellJob) -> Result:
     """Run one cell in a process of its own; a cell that kills its process is a failed cell."""
-    with ProcessPoolExecutor(1, mp_context=mp.get_context("spawn")) as pool:
+    with _pool(1) as pool:
         try:
             return pool.submit(tc.run_cell, job).result()
         except BrokenProcessPool:
@@ -110,7 +126,7 @@ def run_cells(jobs: Sequence[tc.CellJob], workers: int, on_result: Callable[[Res
     queue = list(jobs)
     while queue:
         suspects: list[tc.CellJob] = []
-        with ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn")) as pool:
+        with _pool(workers) as pool:
             pending: dict[Any, tc.CellJob] = {}
             try:
                 while queue or pending:
@@ -228,6 +244,9 @@ def main(argv: list[str] | None = None) -> int:
     t = time.perf_counter()
     try:
         run_cells(jobs, args.workers, on_result)
+    except KeyboardInterrupt:
+        _say(f"interrupted: {len(store.lines)} cells stored in {store.out}; the same command runs the rest")
+        return 130
     finally:
         store.close()
     blk = results_block(argv, args, store, time.perf_counter() - t, len(todo))

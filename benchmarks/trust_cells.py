@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import signal
 import sys
 import time
 import traceback
@@ -45,6 +46,11 @@ def cell_seed(seed: int, k: int) -> int:
     """Cell ``k``'s own seed, drawn from the benchmark's ``seed`` and ``k`` alone (cell k is the same cell
     whatever the number of cells): a 32-bit integer."""
     return int(np.random.SeedSequence([seed, k]).generate_state(1)[0])
+
+
+def ignore_interrupt() -> None:
+    """A pool worker's start: Ctrl-C is the driver's to handle (it stops the workers), never a worker's."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def generator() -> Any:

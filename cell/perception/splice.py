@@ -13,12 +13,11 @@ ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says), and wh
 the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`cell.perception.pose_prior`):
 the correction is applied only along directions where the overlap's information outweighs the prior, as the MAP
 estimate, and only if it explains the data: it must lower the misfit of the overlap's patches (RMS of each
-patch's mean point-to-plane residual) by :data:`MIN_MISFIT_DROP`. That test stays because the information counts
-each patch of ``merge_cell_m`` as independent, and the sensor's biases are not: edges and flying pixels seen from
-one side bias whole faces, so exact cameras stated at 1 mm / 0.1 deg get estimates of 0.1-2.5 mm that look
-informed yet lower the misfit by 8 % at most (often not at all), while a real error of that size lowers it by
-10-50 %. A refused real correction is not unsafe (the camera's seams keep its calibration in their sigma); an
-applied false one is.
+patch's mean point-to-plane residual) by :data:`MIN_MISFIT_DROP`. The information alone is not enough: it counts
+each patch of ``merge_cell_m`` as independent and the sensor's biases are not (edges and flying pixels seen from
+one side bias whole faces): exact cameras get estimates within their prior that look informed yet explain
+nothing, while a real error explains a good part of the misfit (figures in ``docs/perception.md``). A refused
+real correction is not unsafe (the camera's seams keep its calibration in their sigma); an applied false one is.
 
 A camera stated exact (the default) is not registered at all and never moves (``calibration_exact``); a gross
 error of such a camera is left to the agreement check (:mod:`cell.perception.camera_health`). A camera whose data

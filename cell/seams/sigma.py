@@ -30,7 +30,8 @@ Each end has a sigma of its own ALONG the seam (``SeamEstimate.end_sigma_m``), f
   (:func:`drawn_end_sigma`, from ``PART_TOLERANCE_M`` and :data:`LENGTH_SHARE`: the one place it is derived);
 - ours: its statistical standard error of the end (the side face's offset fit, the edge's likelihood, the
   extent's order statistics) with a floor per source in quadrature (:data:`OURS_END_FLOOR_M`): what the fit cannot
-  see (a blurred edge's bias, flying pixels along it, a tack or a bead near the end);
+  see (a blurred edge's bias, flying pixels along it, a tack or a bead near the end); an end placed on another
+  part's face the drawn gap short of it also carries the as-built gap's uncertainty (:data:`GAP_SIGMA_M`);
 - the paper's method reads its start on 1 cm voxel faces (:data:`PAPER_START_SIGMA_M`) and takes its end from the
   map's vector: that end carries the start's error and the drawn length's (``drawn``);
 - RANSAC's ends are the extent of its planes' inliers on a 1 cm voxel cloud: fixed and wide
@@ -56,6 +57,9 @@ OURS_END_FLOOR_M = {
     EndSource.OTHER_PART: 0.0001,
     EndSource.DRAWN: 0.0,
 }
+# How far an as-built gap between two parts may differ from the drawn one [m]: parts placed to about 1 mm (bracket:
+# the gusset 0.4 mm and the upright 0.5 mm off, its back 0.9-1.1 mm from the upright where the map draws it on it).
+GAP_SIGMA_M = 0.0005
 PAPER_START_SIGMA_M = 0.002  # the paper's start along the seam, read on 1 cm voxel faces
 RANSAC_END_SIGMA_M = 0.014  # RANSAC's ends: the extent of its inliers along the line on a 1 cm voxel cloud
 
@@ -83,10 +87,13 @@ def drawn_end_sigma(tolerance_m: float = PART_TOLERANCE_M, length_m: float = 0.0
     return math.hypot(tolerance_m, 0.5 * LENGTH_SHARE * length_m)
 
 
-def ours_end_sigma(se_m: float, source: EndSource) -> float:
+def ours_end_sigma(se_m: float, source: EndSource, against_part: bool = False) -> float:
     """Our locator's sigma [m] of one end along the seam: its standard error ``se_m`` [m] and the floor of its
-    ``source`` in quadrature (:data:`OURS_END_FLOOR_M`; an end the map alone places takes :func:`drawn_end_sigma`)."""
-    return math.hypot(se_m, OURS_END_FLOOR_M[source])
+    ``source`` in quadrature (:data:`OURS_END_FLOOR_M`; an end the map alone places takes :func:`drawn_end_sigma`);
+    an end ``against_part`` (A's hidden side on another part's face, the drawn gap short of it) also the as-built
+    gap's uncertainty (:data:`GAP_SIGMA_M`)."""
+    sigma = math.hypot(se_m, OURS_END_FLOOR_M[source])
+    return math.hypot(sigma, GAP_SIGMA_M) if against_part else sigma
 
 
 def paper_end_sigmas(confidence: float, length_m: float) -> tuple[float, float]:

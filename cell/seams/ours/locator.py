@@ -233,7 +233,8 @@ class OursLocator:
         sources = (end_source(ends[0]), end_source(ends[1]))
         drawn = drawn_end_sigma(o.map_tolerance_m, s_map[1] - s_map[0])
         end_sigmas = [
-            drawn if e.source == "map" else ours_end_sigma(e.se, k) for e, k in zip(ends, sources, strict=True)
+            drawn if e.source == "map" else ours_end_sigma(e.se, k, bool(e.touching) and e.source == "side face")
+            for e, k in zip(ends, sources, strict=True)
         ]
         estimate = SeamEstimate(
             id=seam.id,

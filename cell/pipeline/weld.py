@@ -143,7 +143,7 @@ def _joint_parts(joints: Mapping[str, Joint], task_ids: Sequence[str]) -> dict[s
     of its body test along that task's own weld."""
     from cell.pipeline.tacks import TACK_MARK
 
-    out = {}
+    out: dict[str, tuple[str, ...]] = {}
     for tid in task_ids:
         j = joints.get(tid.split(TACK_MARK)[0])
         if j is not None:

@@ -1,6 +1,8 @@
-"""The last check before the arc, through the real pipeline: a seam whose estimate is corrupted after the re-scan
-(its end run on 30 mm along the receiving face, with a tiny sigma: confidently wrong) is re-scanned up close, still
-cannot be where it is said to be, and is refused with its own reason; nothing is welded along it."""
+"""The last check before the arc and the gate's body test, through the real pipeline: a seam whose estimate is
+corrupted after the re-scan (its end run on 30 mm along the receiving face, with a tiny sigma: confidently wrong)
+is re-scanned up close, still cannot be where it is said to be, and is refused with its own reason; a seam whose
+end a third part overlaps by less than the last check allows is dropped by the safety gate. Nothing is welded
+along either."""
 
 from __future__ import annotations
 
@@ -14,12 +16,14 @@ import pytest
 from cell import pipeline
 from cell import scenario as sc
 from cell.export.report import weld_report
-from cell.types import LastCheck, SeamStatus, WeldReason
+from cell.geometry import make_pose
+from cell.types import Box, LastCheck, Part, PlanReason, SeamStatus, WeldReason
 
 weld_stage = importlib.import_module("cell.pipeline.weld")  # the module (``cell.pipeline.weld`` is also the function)
 
 BAD = "POST_R>TOP_RAIL:+x"
 GOOD = "POST_R>TOP_RAIL:+z"
+FAR = "POST_L>TOP_RAIL:+x"  # the other post's: nowhere near the first's top corner
 
 
 def test_a_corrupted_seam_is_rescanned_then_refused_not_welded(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -49,3 +53,34 @@ def test_a_corrupted_seam_is_rescanned_then_refused_not_welded(monkeypatch: pyte
     entry = next(s for s in weld_report(run)["seams"] if s["id"] == BAD)
     assert entry["weld_reason_code"] == "last_check" and entry["last_check"]["code"] == "length"
     assert entry["last_check"]["value_mm"] > entry["last_check"]["limit_mm"] > 6.0  # the build tolerance and more
+
+
+def test_a_third_part_over_a_seams_end_passes_the_last_check_but_not_the_gate(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A small part stands over the end of a seam in the aligned map, the end 2 mm inside it: within what the
+        last check allows an end (half the build tolerance), but the wire tip would burn 2 mm into it. The safety gate
+        drops that seam alone (``enters_body``), with the part's name; a seam of the other post is welded (the top seam
+    of the same corner would pass through the part too: with both at fault the whole plan is refused)."""
+    original = weld_stage.rescan_weldable
+    placed: list[Part] = []
+
+    def with_a_block(*args: Any, **kw: Any) -> Any:
+        rs, det, hopeless = original(*args, **kw)
+        e = next(e for e in det.estimates if e.id == BAD)
+        d = (e.p_end - e.p_start) / np.linalg.norm(e.p_end - e.p_start)
+        block = Part("BLOCK", Box(make_pose(p=e.p_end + 0.002 * d), np.full(3, 0.008)))
+        placed.append(block)
+        ss = det.scene.seam_scene
+        scene = replace(
+            det.scene, seam_scene=replace(ss, weldmap=replace(ss.weldmap, parts=(*ss.weldmap.parts, block)))
+        )
+        return rs, replace(det, scene=scene), hopeless
+
+    monkeypatch.setattr(weld_stage, "rescan_weldable", with_a_block)
+    run = pipeline.weld(sc.load("fence1"), only={BAD, FAR})
+    assert placed
+    by_id = {w.id: w for w in run.seams}
+    bad = by_id[BAD]
+    assert not bad.welded and bad.check is None  # the last check let it through ...
+    assert bad.code is WeldReason.NOT_PLANNED and "BLOCK" in bad.reason  # ... the gate did not
+    assert run.plan is not None and run.plan.outcome(BAD).code is PlanReason.ENTERS_BODY
+    assert by_id[FAR].welded

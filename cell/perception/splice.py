@@ -47,7 +47,7 @@ from cell.types import Cloud, DepthImage
 
 MOUNTS = ("fixed", "eye_in_hand")
 MIN_SHIFT_M = 0.0001  # [m] a MAP correction moving the overlap by less than this (RMS) is not applied
-MIN_MISFIT_DROP = 0.07  # ... nor one that lowers the patch misfit by less than this fraction (nor is it a fault)
+MIN_MISFIT_DROP = 0.10  # ... nor one that lowers the patch misfit by less than this fraction (nor is it a fault)
 REFUSALS = ("calibration_exact", "no_overlap", "not_informed", "too_small", "no_misfit_gain", "beyond_prior")
 FAULT = "beyond_prior"  # the refusal that makes the camera a fault (dropped), not merely left as calibrated
 

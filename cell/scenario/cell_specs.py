@@ -93,8 +93,10 @@ class ExtrinsicErrorSpec(Model):
 class CalibrationSpec(Model):
     """How well a camera's pose is known: the residual of its calibration as a calibration report states it (RMS of
     the whole error, translation and rotation). What the cell is told, not what the simulation draws
-    (``extrinsic_error``). A seam seen by this camera alone carries it in its sigma (:mod:`cell.perception.
-    calibration`); 0 (the default) says the calibration is within the locator's own floor."""
+    (``extrinsic_error``). It is the prior on the camera's pose when the splice registers it (:mod:`cell.perception.
+    pose_prior`: a correction only where the data outweigh it, a disagreement beyond three of its sigmas drops the
+    camera), and a seam seen by this camera alone carries it in its sigma (:mod:`cell.perception.calibration`);
+    0 (the default) says the calibration is within the locator's own floor: the camera is never moved."""
 
     translation_mm: NonNeg = 0.0
     rotation_deg: NonNeg = 0.0

@@ -41,7 +41,7 @@ from cell.seams.base import SeamLocator
 from cell.seams.ends import check_ends
 from cell.seams.registry import part_tolerance_m
 from cell.station import Arm, Station
-from cell.types import DepthImage, SeamEstimate, SeamStatus
+from cell.types import DepthImage, EndSource, SeamEstimate, SeamStatus
 from cell.types.rescan import Viewpoint
 
 if TYPE_CHECKING:
@@ -300,9 +300,19 @@ def escalated(first: Rescan, more: Rescan, shift_mm: float) -> Rescan:
 
 
 def end_shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
-    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing)."""
+    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing);
+    an end of ``before`` that only the drawn length placed (``drawn``) counts only across the seam: the close-up
+    finding where it really is says nothing of the fixed cameras."""
     if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
         return 0.0
     a = np.stack([before.p_start, before.p_end])
+    t = (a[1] - a[0]) / max(float(np.linalg.norm(a[1] - a[0])), 1e-12)
+    drawn = np.array([k is EndSource.DRAWN for k in before.end_source])
+
+    def worst(b: FloatArray) -> float:
+        d = b - a
+        d[drawn] -= np.outer(d[drawn] @ t, t)  # a drawn end: across the seam only
+        return float(np.linalg.norm(d, axis=1).max())
+
     b = np.stack([closeup.p_start, closeup.p_end])
-    return float(min(np.linalg.norm(a - b, axis=1).max(), np.linalg.norm(a - b[::-1], axis=1).max()))
+    return min(worst(b), worst(b[::-1]))

@@ -261,3 +261,24 @@ def test_the_gate_refuses_a_seam_whose_end_bound_stays_over_the_end_tolerance() 
     welds = {w.id: w for w in seam_welds(det, None, None, 0.0, "", sc, True)}
     assert welds["drawn"].code is WeldReason.END_UNCERTAIN and not welds["drawn"].welded
     assert welds["sure"].code is not WeldReason.END_UNCERTAIN
+
+
+def test_a_closeup_that_finds_where_a_drawn_end_really_is_does_not_escalate() -> None:
+    from cell.pipeline.rescan import end_shift_m
+
+    a, b = np.zeros(3), np.array([0.1, 0.0, 0.0])
+    seen = SeamEstimate(
+        "s",
+        SeamStatus.FOUND,
+        "",
+        a,
+        b,
+        0.9,
+        sigma_m=1e-4,
+        end_sigma_m=(1e-4, 1e-4),
+        end_source=(EndSource.EDGE, EndSource.EDGE),
+    )
+    drawn = replace(seen, end_source=(EndSource.EDGE, EndSource.DRAWN), end_sigma_m=(1e-4, PART_TOLERANCE_M))
+    close = replace(seen, p_end=b + np.array([-0.004, 0.0002, 0.0]))  # the end 4 mm in, 0.2 mm across
+    assert end_shift_m(seen, close) == pytest.approx(math.hypot(0.004, 0.0002))  # the cameras were 4 mm off
+    assert end_shift_m(drawn, close) == pytest.approx(0.0002)  # the map's end was: only across counts

@@ -75,6 +75,18 @@ class Shear:
         return s + self.c * (pts.along(self.w) - float(p0 @ self.w) - self.h0)
 
 
+def end_slopes(ends: tuple[End, End], n_a: FloatArray, n_b: FloatArray, t: FloatArray) -> tuple[float, float]:
+    """Each end plane's slope across face A (see :class:`Shear`): how far along the seam [m] its end moves per metre
+    that A's edge on its end face lies further from face B than drawn (an as-built gap); 0 for a plane square to the
+    seam or one that does not cross it."""
+    w = np.cross(n_a, t)
+    w = w / max(float(np.linalg.norm(w)), 1e-12)
+    if float(w @ n_b) < 0.0:
+        w = -w
+    out = [float(e.n @ w) / float(e.n @ t) if abs(float(e.n @ t)) > 0.2 else 0.0 for e in ends]
+    return out[0], out[1]
+
+
 def end_shear(
     ends: tuple[End, End],
     n_a: FloatArray,

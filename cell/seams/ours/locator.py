@@ -11,7 +11,7 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams.ours._ends import end_shear, end_source, find_ends, side_selections
+from cell.seams.ours._ends import end_shear, end_slopes, end_source, find_ends, side_selections
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
@@ -232,9 +232,13 @@ class OursLocator:
         via = [f"face {f.name} from the {f.source} ({f.note})" for f in (face_a, face_b) if f.source != "points"]
         sources = (end_source(ends[0]), end_source(ends[1]))
         drawn = drawn_end_sigma(o.map_tolerance_m, s_map[1] - s_map[0])
+        # A side face at an angle to the seam moves its end along it by the as-built gap's error times its slope.
+        slopes = end_slopes(ends, face_a.n, face_b.n, t)
         end_sigmas = [
-            drawn if e.source == "map" else ours_end_sigma(e.se, k, bool(e.touching) and e.source == "side face")
-            for e, k in zip(ends, sources, strict=True)
+            drawn
+            if e.source == "map"
+            else ours_end_sigma(e.se, k, bool(e.touching) and e.source == "side face", abs(slope))
+            for e, k, slope in zip(ends, sources, slopes, strict=True)
         ]
         estimate = SeamEstimate(
             id=seam.id,

@@ -33,6 +33,11 @@ END_TOLERANCE_MM = 1.0
 # the re-scan table), and the fixed cameras' calibration, which the first pass's floor stands for, does not apply.
 CLOSEUP_SIGMA_FLOOR_M = 0.00002
 
+# Ours' floors of the ends' sigmas up close, as a share of the fixed cameras' (cell/seams/sigma.py): the close-ups of
+# fence1's faults/two-cameras-dead and of bracket end 0.00-0.03 mm off where an edge is seen and 0.02-0.16 mm where a
+# face is seen ending; the fixed cameras' floors (0.1 / 0.2 mm) made a close-up weigh less than the first estimate.
+CLOSEUP_END_FLOOR_SCALE = 0.25
+
 # Options of the "ours" locator for a close-up cloud (~0.2 mm noise and ~0.35 mm pixels at 0.35 m instead of
 # ~4 mm and ~1.6 mm at 1.6 m): the standard error that earns full confidence and the bands cut along edges and
 # corners shrink with the sensor. The noise assumed before it is measured (sensor_sigma_m) stays: it also sets
@@ -42,6 +47,7 @@ CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
     "edge_band_m": 0.002,
     "corner_band_m": 0.003,
     "sigma_floor_m": CLOSEUP_SIGMA_FLOOR_M,
+    "end_floor_scale": CLOSEUP_END_FLOOR_SCALE,
 }
 
 

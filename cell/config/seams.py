@@ -106,6 +106,9 @@ class OursSettings:
     # Added in quadrature to the standard error for the reported sigma: what the fit cannot see (calibration, tilt);
     # 0.05 mm puts 96 % of the scenarios' seams within 2 sigma (benchmarks/bench_coverage.py, cell/seams/sigma.py).
     sigma_floor_m: float = 0.00005
+    # Scales each end source's floor of the ends' sigmas along the seam (cell/seams/sigma.py, OURS_END_FLOOR_M): 1 for
+    # the fixed cameras; up close the close-up's own (the re-scan sets it, CLOSEUP_OURS_OPTIONS).
+    end_floor_scale: float = 1.0
     min_edge_points: int = 20  # fewer points just inside an edge: it does not place an unseen face
     max_edge_strays: float = 0.3  # more density beyond an edge (share of that inside): it places nothing
     edge_pitch_factor: float = 0.15  # an edge's sampling error, in point pitches on its face [-] (0.29: aligned grid)

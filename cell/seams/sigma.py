@@ -87,14 +87,16 @@ def drawn_end_sigma(tolerance_m: float = PART_TOLERANCE_M, length_m: float = 0.0
     return math.hypot(tolerance_m, 0.5 * LENGTH_SHARE * length_m)
 
 
-def ours_end_sigma(se_m: float, source: EndSource, against_part: bool = False, slope: float = 0.0) -> float:
+def ours_end_sigma(
+    se_m: float, source: EndSource, against_part: bool = False, slope: float = 0.0, floor_scale: float = 1.0
+) -> float:
     """Our locator's sigma [m] of one end along the seam: its standard error ``se_m`` [m] and the floor of its
     ``source`` in quadrature (:data:`OURS_END_FLOOR_M`; an end the map alone places takes :func:`drawn_end_sigma`);
     an end ``against_part`` (A's hidden side on another part's face, the drawn gap short of it) also the as-built
     gap's uncertainty (:data:`GAP_SIGMA_M`), and an end on a side face at an angle to the seam that gap's
     uncertainty times the face's ``slope`` across face A (a mitred brace's, a gusset's sloped side: the end moves
-    along the seam by the slope times the gap's error)."""
-    sigma = math.hypot(se_m, OURS_END_FLOOR_M[source], slope * GAP_SIGMA_M)
+    along the seam by the slope times the gap's error). ``floor_scale``: the floor's share (a close-up's own)."""
+    sigma = math.hypot(se_m, floor_scale * OURS_END_FLOOR_M[source], slope * GAP_SIGMA_M)
     return math.hypot(sigma, GAP_SIGMA_M) if against_part else sigma
 
 

@@ -116,6 +116,7 @@ def build_scene(
         joints=cap.joints,
         table_z=table_z_R(sc),
         dense_voxels=perceived.registered_voxels,
+        eyes_R=perceived.origins_R,
     )
     return Scene(seam_scene, perceived, alignment, X_RM, timings, missing)
 

@@ -32,6 +32,7 @@ class Points:
     pitch: float  # point pitch of these points on a well-seen surface [m] (the sample's, thinned)
     share: float  # the share of the dense cloud's points these are
     n_cams: int  # camera indices run 0 .. n_cams - 1
+    eyes: FloatArray | None = None  # (n_cams, 3) each camera's optical centre [m] (NaN: not known); None: none known
     _along: dict[bytes, FloatArray] = field(default_factory=dict, compare=False, repr=False)  # memo of along()
 
     def least(self, dense_points: int) -> int:
@@ -45,6 +46,15 @@ class Points:
         if out is None:
             out = self._along[key] = n @ self.xyz
         return out
+
+    def facing(self, n: FloatArray, d: float) -> BoolArray:
+        """(n,) which points may lie on a face in the plane n . p = d (outward unit normal ``n`` (3,), [m]): those
+        whose camera lies in front of it (a camera sees a face only from its front: the inside of a hollow tube's
+        wall, seen down its bore, faces the other way); every point whose camera's centre is not known."""
+        if self.eyes is None:
+            return np.ones(len(self.cam), bool)
+        h = self.eyes @ np.asarray(n, float) - d  # (n_cams,) each camera's height over the plane
+        return np.asarray(~(h <= 0.0))[self.cam]  # NaN (unknown) passes
 
     @property
     def P(self) -> FloatArray:
@@ -98,7 +108,8 @@ def gather(
         q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
         h = 0.5 * part.box.size + o.map_tolerance_m
         ok &= (np.abs(q[0]) > h[0]) | (np.abs(q[1]) > h[1]) | (np.abs(q[2]) > h[2])
-    return Points(xyz, cam, ok, index.pitch(share * kept), share * kept, int(cam.max(initial=0)) + 1)
+    n_cams = int(cam.max(initial=0)) + 1
+    return Points(xyz, cam, ok, index.pitch(share * kept), share * kept, n_cams, _eyes(scene, n_cams))
 
 
 def crop_box(scene: SeamScene, o: OursOptions) -> Box:
@@ -141,3 +152,15 @@ def _in_bounds(xyz: FloatArray, lo: FloatArray, hi: FloatArray) -> BoolArray:
     for k in (1, 2):
         inside &= (xyz[k] >= lo[k]) & (xyz[k] <= hi[k])
     return inside
+
+
+def _eyes(scene: SeamScene, n_cams: int) -> FloatArray | None:
+    """(n_cams, 3) the optical centre [m] of each camera index of the dense cloud (NaN where not known: a mixed or
+    unknown capture), or None when the scene knows no camera's centre."""
+    if not scene.eyes_R:
+        return None
+    eyes = np.full((max(n_cams, len(scene.dense.cameras)), 3), np.nan)
+    for k, name in enumerate(scene.dense.cameras):
+        if name in scene.eyes_R:
+            eyes[k] = np.asarray(scene.eyes_R[name], float)
+    return eyes

@@ -158,7 +158,8 @@ class OursLocator:
                 gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
                 # Never past half the part's thickness behind the face: a thin plate's far side is not this face.
                 behind = 0.5 * (geo.depth_a if key == "a" else geo.depth_b)
-                sel = np.flatnonzero(region & (np.abs(r) < gate) & (r > -behind))
+                # Only points whose camera looks at the face's front (a tube's inner wall, seen down its bore, is not).
+                sel = np.flatnonzero(region & (np.abs(r) < gate) & (r > -behind) & pts.facing(face.n, face.d))
                 if len(sel) >= pts.least(o.min_face_points):
                     planes.append(Selection(key, face, r, sel, thin(sel, o.max_fit_points)))
                     continue

@@ -12,9 +12,13 @@ A pose error moves every point the camera sees rigidly: at range ``r`` from the 
 (per-point camera index) within :data:`SUPPORT_RADIUS_M` of the located segment; camera ``c`` holds the share
 ``w_c`` of those points. A camera the splice registered and *corrected* (``Registration.accepted``) now sits where
 its reference camera puts it, so it inherits the reference's error: cameras tied to one reference make one error
-source with the summed share. Independent sources add in quadrature,
+source with the summed share. It also keeps what the correction did not fix: the splice's posterior of the
+disagreement left (``Registration.residual``, :class:`~cell.perception.pose_prior.PoseResidual`: its prior along
+every direction the overlap did not inform, the posterior's along those it did), an error of its own at the
+seam ``sigma_res``, counted as an independent source with the camera's share (conservative: the reference's
+error is counted in both). Independent sources add in quadrature,
 
-    sigma_cal = sqrt(sum_g (W_g * sigma_g)^2),
+    sigma_cal = sqrt(sum_g (W_g * sigma_g)^2 + sum_c (w_c * sigma_res_c)^2),
 
 so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
 cameras about 1 / sqrt(2) of it. The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``, and so does each
@@ -35,7 +39,7 @@ from dataclasses import replace
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.perception.pose_prior import PoseUncertainty
+from cell.perception.pose_prior import PoseResidual, PoseUncertainty
 from cell.perception.splice import Registration
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
@@ -44,6 +48,7 @@ __all__ = [
     "calibration_sigma",
     "closeup_sigma",
     "reference_of",
+    "residuals_of",
     "support_shares",
     "with_calibration",
 ]
@@ -62,20 +67,35 @@ def reference_of(registrations: Sequence[Registration]) -> dict[str, str]:
     return tied
 
 
+def residuals_of(registrations: Sequence[Registration]) -> dict[str, tuple[PoseResidual, ...]]:
+    """Camera name -> what its applied correction left unknown (the splice's posterior), for every corrected
+    camera whose registration computed one, followed by its corrected targets' (a camera registered onto a corrected
+    one carries that one's residual too: counted whole, conservatively, whatever its share of the target)."""
+    out: dict[str, tuple[PoseResidual, ...]] = {}
+    for r in registrations:  # in the splice's order: a target's residuals are known before its sources'
+        if r.accepted and r.residual is not None:
+            out[r.source] = (r.residual, *(x for t in r.target for x in out.get(t, ())))
+    return out
+
+
 def calibration_sigma(
     shares: Mapping[str, float],
     mid_R: FloatArray,
     origins_R: Mapping[str, FloatArray],
     uncertainty: Mapping[str, PoseUncertainty],
     tied: Mapping[str, str],
+    residuals: Mapping[str, Sequence[PoseResidual]] | None = None,
 ) -> float:
     """sigma_cal [m] of a seam at ``mid_R`` whose support is split ``shares`` (camera -> fraction) between cameras
-    (module docstring). A camera with no stated uncertainty or no known origin contributes nothing."""
+    (module docstring); ``residuals``: a corrected camera's posterior (:func:`residuals_of`). A camera with no
+    stated uncertainty or no known origin contributes nothing."""
     groups: dict[str, float] = {}
+    total = 0.0
     for camera, w in shares.items():
         source = tied.get(camera, camera)
         groups[source] = groups.get(source, 0.0) + w
-    total = 0.0
+        for left in (residuals or {}).get(camera, ()) if source != camera else ():
+            total += (w * left.sigma_at(mid_R)) ** 2
     for source, w in groups.items():
         u = uncertainty.get(source)
         origin = origins_R.get(source)
@@ -118,6 +138,7 @@ def with_calibration(
     if all(u.zero for u in uncertainty.values()):
         return tuple(estimates)
     tied = reference_of(registrations)
+    left = residuals_of(registrations)
     out = []
     for est in estimates:
         if est.status is not SeamStatus.FOUND or not math.isfinite(est.sigma_m):
@@ -125,7 +146,7 @@ def with_calibration(
             continue
         shares = support_shares(registered, est.p_start, est.p_end)
         mid = 0.5 * (est.p_start + est.p_end)
-        cal = calibration_sigma(shares, mid, origins_R, uncertainty, tied)
+        cal = calibration_sigma(shares, mid, origins_R, uncertainty, tied, left)
         out.append(with_term(est, cal) if cal > 0.0 else est)
     return tuple(out)
 

@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation
 
 from cell.geometry import FloatArray, make_pose, readonly, transform_points
 from cell.perception import _open3d
-from cell.perception.pose_prior import posterior
+from cell.perception.pose_prior import PoseResidual, posterior
 from cell.scenario import PerceptionSpec
 
 _PROBE_POINTS = 20_000  # source points a registration uses (an even stride)
@@ -239,6 +239,7 @@ class Estimate:
     shift_m, map_shift_m : RMS displacement of the overlap by ``X_estimated`` / ``X_map`` [m].
     misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibration and
         after ``X_map``.
+    residual : what is left unknown of the disagreement once ``X_map`` is applied (None: no estimate was made).
     """
 
     X_icp: FloatArray
@@ -252,6 +253,7 @@ class Estimate:
     map_shift_m: float = 0.0
     misfit_before_m: float = math.inf
     misfit_m: float = math.inf
+    residual: PoseResidual | None = None
 
     def __post_init__(self) -> None:
         for name in ("X_icp", "X_estimated", "X_map"):
@@ -319,4 +321,5 @@ def register(
         rms(X_map),
         before,
         after,
+        PoseResidual(post.covariance, found.centre_R, found.lever_m, after),
     )

@@ -1,8 +1,10 @@
 """Our locator on generated cells nobody tuned it for: with exact data (no noise, exact extrinsics, built as drawn)
-every seam it locates lies where the truth puts it, whatever the body (a hollow RHS turned on the base too)."""
+every seam it locates lies where the truth puts it, whatever the body (a hollow RHS turned on the base too); the
+map's own fixtures near a seam are no unknown occluders."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from types import ModuleType
 
@@ -12,9 +14,11 @@ import yaml
 from tools_loader import load_tool
 
 from cell import scenario as sc
+from cell.config.perception import ScreenOptions
+from cell.perception.seam_screen import foreign_points
 from cell.pipeline.detect import detect
 from cell.seams.ours._points import Points
-from cell.types import SeamStatus
+from cell.types import Box, Cloud, Part, SeamStatus, WeldMap
 
 
 @pytest.fixture(scope="module")
@@ -56,3 +60,24 @@ def test_a_turned_hollow_rhs_is_located_on_its_outer_faces(rc: ModuleType, tmp_p
         # Seen directly: within 0.01 mm; a face placed from its edge: within its own sigma.
         assert m.lateral_mm <= max(0.01, 1000 * est.sigma_m), seam_id
         assert max(abs(a) for a in m.end_along_mm) <= 0.05, seam_id
+
+
+def _box(name: str, centre: tuple[float, float, float], size: tuple[float, float, float]) -> Part:
+    X = np.eye(4)
+    X[:3, 3] = centre
+    return Part(name, Box(X, np.array(size)))
+
+
+def test_a_fixture_the_map_draws_is_no_occluder() -> None:
+    # A clamp block drawn on the map's fixture layer, 30 mm beside a seam on a plate: its points are explained.
+    plate = _box("BASE", (0.0, 0.0, 0.005), (0.4, 0.4, 0.01))
+    clamp = _box("CLAMP", (0.0, 0.04, 0.03), (0.03, 0.03, 0.04))
+    rng = np.random.default_rng(0)
+    on_clamp = np.column_stack(
+        [rng.uniform(-0.015, 0.015, 200), rng.uniform(0.025, 0.055, 200), np.full(200, 0.05)]
+    )  # its top face
+    cloud = Cloud(on_clamp, "R")
+    a, b = np.array([-0.05, 0.0, 0.01]), np.array([0.05, 0.0, 0.01])
+    without = WeldMap((plate,), (), "mm", "test", "R")
+    assert foreign_points(without, cloud, a, b, 0.0) >= ScreenOptions().min_foreign  # occluded, once
+    assert foreign_points(replace(without, fixtures=(clamp,)), cloud, a, b, 0.0) == 0

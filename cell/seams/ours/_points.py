@@ -14,7 +14,7 @@ from cell.geometry import FloatArray
 from cell.seams._index import cloud_box, dense_index
 from cell.seams.ours._bodies import face_planes
 from cell.seams.ours.options import OursOptions
-from cell.types import Box, Joint, SeamScene
+from cell.types import Box, Joint, Part, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
@@ -90,8 +90,9 @@ def gather(
     reach = radius + extend + 0.5 * float(np.linalg.norm(b - a)) + o.map_tolerance_m
     centres, radii = _part_spheres(scene)
     near = np.linalg.norm(centres - 0.5 * (a + b), axis=1) <= reach + radii
+    bodies = _bodies(scene)
     for k in np.flatnonzero(near):
-        part = scene.weldmap.parts[k]
+        part = bodies[k]
         if part.name in (joint.abutting, joint.receiving):
             continue
         if not part.is_box:
@@ -118,11 +119,16 @@ def crop_box(scene: SeamScene, o: OursOptions) -> Box:
     return ws if ws is not None else cloud_box(scene)
 
 
+def _bodies(scene: SeamScene) -> tuple[Part, ...]:
+    """The map's parts, then its fixtures (a clamp near a seam is no face of it either), as the caches index them."""
+    return (*scene.weldmap.parts, *scene.weldmap.fixtures)
+
+
 def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
-    """Centres (P, 3) and radii (P,) of the spheres around the map's parts [m], cached per scene."""
+    """Centres (P, 3) and radii (P,) of the spheres around the map's parts and fixtures [m], cached per scene."""
     out = scene.cache.get(_SPHERES_KEY)
     if out is None:
-        parts = scene.weldmap.parts
+        parts = _bodies(scene)
         centres = np.array([p.center for p in parts]).reshape(-1, 3)
         radii = np.array([p.radius for p in parts])
         out = scene.cache[_SPHERES_KEY] = (centres, radii)
@@ -136,7 +142,7 @@ def _support_planes(scene: SeamScene, k: int) -> tuple[FloatArray, FloatArray, F
     out = scene.cache.get(_SUPPORT_KEY)
     if out is None:
         out = []
-        for part in scene.weldmap.parts:
+        for part in _bodies(scene):
             V = part.vertices()
             N, D = face_planes(part)
             kept = (V @ N.T).max(axis=0) <= D + 1e-9

@@ -162,6 +162,9 @@ class TiltFit:
 
     c0, a, b : (J,) offset [m] and slopes [-]; uc, vc : (J,) weighted centroids [m].
     se0 : (J,) standard error of the plane's value at u = 0, v = vc [m] (sandwich).
+    bias0 : (J,) how far [m] the plane the prior holds lies, at u = 0 and the points' far ends along v, from the
+        plane the points alone fit, beyond twice that difference's own standard error: a face tilted more than the
+        prior lets it (an as-built part tilted by its neighbour), whose line the offset's error does not cover.
     """
 
     c0: FloatArray
@@ -170,6 +173,7 @@ class TiltFit:
     uc: FloatArray
     vc: FloatArray
     se0: FloatArray
+    bias0: FloatArray
 
 
 def tilt_fits(
@@ -204,4 +208,21 @@ def tilt_fits(
     cov = H_inv @ outer_sums(m, m) @ H_inv * (n / np.maximum(n - 3.0, 1.0))[:, None, None]
     J = np.stack([np.ones(n_planes), -uc, np.zeros(n_planes)], axis=1)
     se0 = np.sqrt(np.maximum(np.einsum("ji,jik,jk->j", J, cov, J), 0.0))
-    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0)
+    # The points alone (no prior on the slopes), and how far that plane lies from the prior's at the ends.
+    H_free = outer_sums(wX, X)
+    bias0 = np.zeros(n_planes)
+    ok = np.abs(np.linalg.det(H_free)) > 1e-30
+    if ok.any():
+        H_free_inv = np.zeros_like(H_free)
+        H_free_inv[ok] = np.linalg.inv(H_free[ok])
+        coef_free = np.einsum("jik,kj->ji", H_free_inv, np.add.reduceat(wX * r, starts, axis=1))
+        m_free = X * (w * (r - np.einsum("in,ni->n", X, coef_free[label])))
+        cov_free = H_free_inv @ outer_sums(m_free, m_free) @ H_free_inv * (n / np.maximum(n - 3.0, 1.0))[:, None, None]
+        v_lo, v_hi = np.minimum.reduceat(v, starts), np.maximum.reduceat(v, starts)
+        for v_end in (v_lo, v_hi):
+            J_end = np.stack([np.ones(n_planes), -uc, v_end - vc], axis=1)
+            gap = np.einsum("ji,ji->j", J_end, coef_free - coef)
+            var = np.einsum("ji,jik,jk->j", J_end, cov_free, J_end)
+            bias0 = np.maximum(bias0, np.sqrt(np.maximum(gap**2 - 4.0 * var, 0.0)))
+        bias0[~ok] = 0.0
+    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0, bias0)

@@ -17,6 +17,7 @@ from cell import scenario as sc
 from cell.config.perception import ScreenOptions
 from cell.perception.seam_screen import foreign_points
 from cell.pipeline.detect import detect
+from cell.seams._batch import tilt_fits
 from cell.seams.ours._points import Points
 from cell.types import Box, Cloud, Part, SeamStatus, WeldMap
 
@@ -81,3 +82,16 @@ def test_a_fixture_the_map_draws_is_no_occluder() -> None:
     without = WeldMap((plate,), (), "mm", "test", "R")
     assert foreign_points(without, cloud, a, b, 0.0) >= ScreenOptions().min_foreign  # occluded, once
     assert foreign_points(replace(without, fixtures=(clamp,)), cloud, a, b, 0.0) == 0
+
+
+def test_a_face_tilted_past_the_prior_says_so_at_the_seam_ends() -> None:
+    # A face seen over 60 x 40 mm, 0.05 mm of noise: tilted 1 deg along the seam (the prior holds 0.05 deg), the
+    # line the prior keeps lies ~0.5 mm off the points' own plane at the ends; level, it lies on it.
+    rng = np.random.default_rng(0)
+    u, v = rng.uniform(0.005, 0.045, 2000), rng.uniform(-0.03, 0.03, 2000)
+    w = np.ones(2000)
+    prior = float(np.tan(np.radians(0.05)))
+    for slope, lo, hi in ((np.tan(np.radians(1.0)), 3e-4, 7e-4), (0.0, 0.0, 2e-5)):
+        r = slope * v + rng.normal(0.0, 5e-5, 2000)
+        fit = tilt_fits(r, u, v, w, [2000], prior)
+        assert lo <= float(fit.bias0[0]) <= hi

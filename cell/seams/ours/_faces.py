@@ -98,7 +98,10 @@ def tilt(jobs: list[tuple[Selection, Fitted | None, Tilt, Points]], o: OursOptio
         norm = float(np.linalg.norm(m))
         d_fitted = face.d + fitted.offset
         d = (d_fitted + c0 - a * (float(fit.uc[j]) + float(e_u @ p0)) - b * (float(fit.vc[j]) + float(t @ p0))) / norm
-        out[i] = Tilted(m / norm, d, float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel)))
+        # The offset's error (the fit's stride stands for all the support), and the tilt the prior did not let the
+        # face follow (it moves the line by that much at the seam's ends, whatever the number of points).
+        se = float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel))
+        out[i] = Tilted(m / norm, d, float(np.hypot(se, fit.bias0[j])))
     return out
 
 
@@ -118,9 +121,9 @@ def face_from_edge(
     ``edge_sample_share`` of the cloud); ``away`` masks the points (n, 3) far enough from the joint's other
     part. Returns the face placed (its standard error from the edge's own data), else why not."""
 
-    def points(a: FloatArray, b: FloatArray, radius: float) -> tuple[FloatArray, IntArray, BoolArray]:
+    def points(a: FloatArray, b: FloatArray, radius: float) -> tuple[FloatArray, IntArray, BoolArray, BoolArray]:
         pts = gather(scene, a, b, radius, 0.0, joint, rng, o, o.edge_sample_share)
-        return pts.P, pts.cam, pts.ok
+        return pts.P, pts.cam, pts.ok, pts.facing(face.n, face.d)
 
     placed = place_from_edge(
         face.n,

@@ -165,6 +165,9 @@ class TiltFit:
     bias0 : (J,) how far [m] the plane the prior holds lies, at u = 0 and the points' far ends along v, from the
         plane the points alone fit, beyond twice that difference's own standard error: a face tilted more than the
         prior lets it (an as-built part tilted by its neighbour), whose line the offset's error does not cover.
+    tilt0 : (J,) the standard deviation [m] of the plane's value at u = 0 and the points' far ends along v from
+        the slopes alone, as far as the points leave them unknown: each slope's posterior from the points and
+        the parts' angular tolerance (``tolerance_sd``), carried from the centroid.
     """
 
     c0: FloatArray
@@ -174,16 +177,24 @@ class TiltFit:
     vc: FloatArray
     se0: FloatArray
     bias0: FloatArray
+    tilt0: FloatArray
 
 
 def tilt_fits(
-    r: FloatArray, u: FloatArray, v: FloatArray, w: FloatArray, lengths: list[int], prior_sd: float
+    r: FloatArray,
+    u: FloatArray,
+    v: FloatArray,
+    w: FloatArray,
+    lengths: list[int],
+    prior_sd: float,
+    tolerance_sd: float = 0.0,
 ) -> TiltFit:
     """Weighted least squares of the residuals r (n,) [m] of J planes (one segment of ``lengths[j] >= 4``
     points per plane, in order) as r = c0 + a (u - uc) + b (v - vc) in each plane's coordinates u, v (n,) [m]
     with weights w (n,), the slopes held near 0 by a Gaussian prior of ``prior_sd``; about each plane's
     weighted centroid (uc, vc), so that the offset and the slopes are uncorrelated. The covariance is the
-    sandwich (robust to weights that are not inverse variances), scaled by n / (n - 3)."""
+    sandwich (robust to weights that are not inverse variances), scaled by n / (n - 3). ``tolerance_sd``: the
+    standard deviation of the slopes as built [-] (0: not counted), for :attr:`TiltFit.tilt0`."""
     n_planes = len(lengths)
     starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
     label = np.repeat(np.arange(n_planes), lengths)
@@ -210,7 +221,7 @@ def tilt_fits(
     se0 = np.sqrt(np.maximum(np.einsum("ji,jik,jk->j", J, cov, J), 0.0))
     # The points alone (no prior on the slopes), and how far that plane lies from the prior's at the ends.
     H_free = outer_sums(wX, X)
-    bias0 = np.zeros(n_planes)
+    bias0, tilt0 = np.zeros(n_planes), np.zeros(n_planes)
     ok = np.abs(np.linalg.det(H_free)) > 1e-30
     if ok.any():
         H_free_inv = np.zeros_like(H_free)
@@ -224,5 +235,10 @@ def tilt_fits(
             gap = np.einsum("ji,ji->j", J_end, coef_free - coef)
             var = np.einsum("ji,jik,jk->j", J_end, cov_free, J_end)
             bias0 = np.maximum(bias0, np.sqrt(np.maximum(gap**2 - 4.0 * var, 0.0)))
+            if tolerance_sd > 0.0:
+                # Each slope as the points and the tolerance know it together (the points' information added).
+                slopes = 1.0 / (tolerance_sd**-2 + 1.0 / np.maximum(cov_free[:, (1, 2), (1, 2)], 1e-30))
+                tilt0 = np.maximum(tilt0, np.sqrt(slopes[:, 0] * uc**2 + slopes[:, 1] * (v_end - vc) ** 2))
         bias0[~ok] = 0.0
-    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0, bias0)
+        tilt0[~ok] = 0.0
+    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0, bias0, tilt0)

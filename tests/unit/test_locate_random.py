@@ -95,3 +95,17 @@ def test_a_face_tilted_past_the_prior_says_so_at_the_seam_ends() -> None:
         r = slope * v + rng.normal(0.0, 5e-5, 2000)
         fit = tilt_fits(r, u, v, w, [2000], prior)
         assert lo <= float(fit.bias0[0]) <= hi
+
+
+def test_a_tilt_the_points_cannot_pin_stays_in_the_sigma() -> None:
+    # The same face, noisy (1 mm) and with few points: its slopes are barely seen, so the line at the seam's ends
+    # keeps about the tolerance's tilt times the lever; 0.05 mm of noise pins them and leaves far less.
+    rng = np.random.default_rng(1)
+    u, v = rng.uniform(0.005, 0.045, 200), rng.uniform(-0.03, 0.03, 200)
+    prior, tol = float(np.tan(np.radians(0.05))), float(np.radians(10.0 / 60.0))
+    noisy = tilt_fits(rng.normal(0.0, 1e-3, 200), u, v, np.ones(200), [200], prior, tol)
+    sharp = tilt_fits(rng.normal(0.0, 5e-5, 200), u, v, np.ones(200), [200], prior, tol)
+    lever = float(np.hypot(noisy.uc[0], 0.03))
+    assert 0.5 * tol * lever < float(noisy.tilt0[0]) <= 1.05 * tol * lever
+    assert float(sharp.tilt0[0]) < 0.3 * float(noisy.tilt0[0])
+    assert float(tilt_fits(rng.normal(0.0, 1e-3, 200), u, v, np.ones(200), [200], prior).tilt0[0]) == 0.0

@@ -243,7 +243,7 @@ class OursLocator:
             p_start=p0 + ends[0].s * t,
             p_end=p0 + ends[1].s * t,
             confidence=conf,
-            sigma_m=ours_sigma(errors.lateral_m, o.sigma_floor_m),
+            sigma_m=ours_sigma(float(np.hypot(errors.lateral_m, errors.tilt_m)), o.sigma_floor_m),
             end_sigma_m=(end_sigmas[0], end_sigmas[1]),
             end_source=sources,
         )

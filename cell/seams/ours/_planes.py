@@ -43,7 +43,9 @@ class Face:
 
     def with_area(self, area: float) -> Face:
         """The face with the area of its support region [m^2]."""
-        return Face(self.n, self.d, self.scale, self.name, self.se, self.count, self.source, area, self.note, self.tilt_se)
+        return Face(
+            self.n, self.d, self.scale, self.name, self.se, self.count, self.source, area, self.note, self.tilt_se
+        )
 
 
 @dataclass(frozen=True)

@@ -109,3 +109,12 @@ def test_a_tilt_the_points_cannot_pin_stays_in_the_sigma() -> None:
     assert 0.5 * tol * lever < float(noisy.tilt0[0]) <= 1.05 * tol * lever
     assert float(sharp.tilt0[0]) < 0.3 * float(noisy.tilt0[0])
     assert float(tilt_fits(rng.normal(0.0, 1e-3, 200), u, v, np.ones(200), [200], prior).tilt0[0]) == 0.0
+
+
+def test_a_noisy_thin_plate_face_is_not_dragged_out_by_a_one_sided_gate(rc: ModuleType, tmp_path: Path) -> None:
+    # Seed 1247478191: an 8 mm plate on the base seen by far cameras (2.6 mm of depth noise on its face); its points
+    # cut 4 mm behind the face (its far side) but 9 mm in front put the face, and the seam, 0.8 mm out.
+    cell = rc.make_cell(1247478191, tmp_path)
+    found = detect(sc.load(cell.scenario), "ours")
+    m = found.metrics["PLATE_1>BASE:-y"]
+    assert m.status is SeamStatus.FOUND and m.lateral_mm <= 0.3

@@ -21,7 +21,11 @@ error is counted in both). Independent sources add in quadrature,
     sigma_cal = sqrt(sum_g (W_g * sigma_g)^2 + sum_c (w_c * sigma_res_c)^2),
 
 so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
-cameras about 1 / sqrt(2) of it. The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``, and so does each
+cameras about 1 / sqrt(2) of it. Given the seam's weld faces (:func:`seam_calibration_sigma`), that sum is taken
+over each face's strip on its own and the two add in quadrature over the sine of the angle between the faces:
+the line moves with each face, so a face seen by one camera alone brings all of that camera's error whatever
+camera sees the other (a fillet's floor from one camera and its wall from another: sqrt 2 of one camera's error,
+not 1 / sqrt 2). The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``, and so does each
 end's sigma along it (``end_sigma_m``: the same rigid error moves the ends too). With every calibration at 0 (the
 default) nothing changes and nothing is computed.
 
@@ -37,6 +41,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.perception.pose_prior import PoseResidual, PoseUncertainty
@@ -49,6 +54,7 @@ __all__ = [
     "closeup_sigma",
     "reference_of",
     "residuals_of",
+    "seam_calibration_sigma",
     "support_shares",
     "with_calibration",
 ]
@@ -109,6 +115,21 @@ def support_shares(
     cloud: Cloud, p0: FloatArray, p1: FloatArray, radius_m: float = SUPPORT_RADIUS_M
 ) -> dict[str, float]:
     """Camera name -> share of ``cloud``'s points within ``radius_m`` of the segment p0-p1 (empty: none near)."""
+    _, cams = _support(cloud, p0, p1, radius_m)
+    return _shares(cloud, cams)
+
+
+def _shares(cloud: Cloud, cams: npt.NDArray[np.int16]) -> dict[str, float]:
+    """Camera name -> share of the camera indices ``cams`` (unknown ones left out; empty: none)."""
+    cams = cams[cams >= 0]
+    if cams.size == 0:
+        return {}
+    idx, counts = np.unique(cams, return_counts=True)
+    return {cloud.cameras[int(i)]: float(c) / float(cams.size) for i, c in zip(idx, counts, strict=True)}
+
+
+def _support(cloud: Cloud, p0: FloatArray, p1: FloatArray, radius_m: float) -> tuple[FloatArray, npt.NDArray[np.int16]]:
+    """The points (k, 3) of ``cloud`` within ``radius_m`` of the segment p0-p1 and their camera indices (k,)."""
     lo = np.minimum(p0, p1) - radius_m
     hi = np.maximum(p0, p1) + radius_m
     pts = cloud.points
@@ -118,12 +139,33 @@ def support_shares(
     length2 = float(t @ t)
     s = np.clip(((near - p0) @ t) / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros(len(near))
     d = np.linalg.norm(near - (p0 + s[:, None] * t), axis=1)
-    cams = cams[d <= radius_m]
-    cams = cams[cams >= 0]
-    if cams.size == 0:
-        return {}
-    idx, counts = np.unique(cams, return_counts=True)
-    return {cloud.cameras[int(i)]: float(c) / float(cams.size) for i, c in zip(idx, counts, strict=True)}
+    return near[d <= radius_m], cams[d <= radius_m]
+
+
+def seam_calibration_sigma(
+    cloud: Cloud,
+    est: SeamEstimate,
+    faces: tuple[FloatArray, float, FloatArray, float] | None,
+    origins_R: Mapping[str, FloatArray],
+    uncertainty: Mapping[str, PoseUncertainty],
+    tied: Mapping[str, str],
+    residuals: Mapping[str, Sequence[PoseResidual]],
+) -> float:
+    """sigma_cal [m] of one found seam. Without its weld faces' planes (``faces``: n_a, d_a, n_b, d_b), from
+    its whole support (module docstring). With them, each face's strip on its own: the line moves with each face,
+    over the sine of the angle between them, so a face seen by one camera carries all of that camera's error into
+    the line however many cameras see the other (conservative by up to sqrt 2 when one camera sees both)."""
+    P, cams = _support(cloud, est.p_start, est.p_end, SUPPORT_RADIUS_M)
+    mid = 0.5 * (est.p_start + est.p_end)
+    if faces is None or len(P) == 0:
+        return calibration_sigma(_shares(cloud, cams), mid, origins_R, uncertainty, tied, residuals)
+    n_a, d_a, n_b, d_b = faces
+    on_a = np.abs(P @ n_a - d_a) < np.abs(P @ n_b - d_b)
+    sig = [
+        calibration_sigma(_shares(cloud, cams[m]), mid, origins_R, uncertainty, tied, residuals) for m in (on_a, ~on_a)
+    ]
+    sin_ab = float(np.linalg.norm(np.cross(n_a, n_b)))
+    return math.hypot(sig[0], sig[1]) / max(sin_ab, 0.1)
 
 
 def with_calibration(
@@ -132,9 +174,11 @@ def with_calibration(
     origins_R: Mapping[str, FloatArray],
     uncertainty: Mapping[str, PoseUncertainty],
     registrations: Sequence[Registration],
+    faces: Mapping[str, tuple[FloatArray, float, FloatArray, float]] | None = None,
 ) -> tuple[SeamEstimate, ...]:
     """Every found seam's sigma with its cameras' calibration in quadrature (module docstring); the estimates
-    unchanged when no camera states an uncertainty."""
+    unchanged when no camera states an uncertainty. ``faces``: seam id -> its weld faces' planes (n_a, d_a, n_b,
+    d_b) in R, for the term per face (:func:`seam_calibration_sigma`)."""
     if all(u.zero for u in uncertainty.values()):
         return tuple(estimates)
     tied = reference_of(registrations)
@@ -144,9 +188,7 @@ def with_calibration(
         if est.status is not SeamStatus.FOUND or not math.isfinite(est.sigma_m):
             out.append(est)
             continue
-        shares = support_shares(registered, est.p_start, est.p_end)
-        mid = 0.5 * (est.p_start + est.p_end)
-        cal = calibration_sigma(shares, mid, origins_R, uncertainty, tied, left)
+        cal = seam_calibration_sigma(registered, est, (faces or {}).get(est.id), origins_R, uncertainty, tied, left)
         out.append(with_term(est, cal) if cal > 0.0 else est)
     return tuple(out)
 

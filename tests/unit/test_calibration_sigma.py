@@ -128,3 +128,29 @@ def test_the_posterior_covariance_is_what_a_correction_leaves() -> None:
     # Along a direction nothing informs, the prior stays whole.
     none = posterior(np.ones(6) * 1e-3, np.zeros((6, 6)), prior)
     assert np.allclose(none.covariance, prior)
+
+
+def test_a_correction_that_leaves_half_the_misfit_leaves_half_the_prior() -> None:
+    from cell.perception.registration import _left
+
+    prior, posterior_cov = np.eye(6) * 1e-6, np.eye(6) * 1e-10
+    assert np.allclose(_left(posterior_cov, prior, 1.0e-3, 0.5e-3), posterior_cov + 0.25 * prior)
+    assert np.allclose(_left(posterior_cov, prior, 1.0e-3, 2.0e-3), posterior_cov + prior)  # worse: the prior whole
+    assert np.allclose(_left(posterior_cov, prior, math.inf, 1e-3), posterior_cov + prior)  # no misfit measured
+
+
+def test_a_face_seen_by_one_camera_carries_its_error_whole_into_the_line() -> None:
+    # A fillet between a face in z = 0 (seen by "a" alone) and one in y = 0 (seen by "b" alone): by shares each
+    # camera would count half; the line moves with each face whole.
+    rng = np.random.default_rng(2)
+    floor = np.column_stack([rng.uniform(0.0, 0.1, 300), rng.uniform(0.001, 0.012, 300), np.zeros(300)])
+    wall = np.column_stack([rng.uniform(0.0, 0.1, 300), np.zeros(300), rng.uniform(0.001, 0.012, 300)])
+    cloud = Cloud(np.vstack([floor, wall]), "R", np.repeat(np.array([0, 1], np.int16), 300), ("a", "b"))
+    found = SeamEstimate("s", SeamStatus.FOUND, "", np.zeros(3), np.array([0.1, 0.0, 0.0]), 0.9, sigma_m=0.0)
+    u = {"a": PoseUncertainty(1.0 * MM, 0.0), "b": PoseUncertainty(1.0 * MM, 0.0)}
+    faces = {"s": (np.array([0.0, 0.0, 1.0]), 0.0, np.array([0.0, 1.0, 0.0]), 0.0)}
+    by_shares = with_calibration([found], cloud, ORIGINS, u, [])[0].sigma_m
+    by_faces = with_calibration([found], cloud, ORIGINS, u, [], faces)[0].sigma_m
+    one = u["a"].sigma_at(0.0)
+    assert math.isclose(by_shares, one / math.sqrt(2.0), rel_tol=0.05)
+    assert math.isclose(by_faces, one * math.sqrt(2.0), rel_tol=0.05)

@@ -21,13 +21,12 @@ error is counted in both). Independent sources add in quadrature,
     sigma_cal = sqrt(sum_g (W_g * sigma_g)^2 + sum_c (w_c * sigma_res_c)^2),
 
 so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
-cameras about 1 / sqrt(2) of it. Given the seam's weld faces (:func:`seam_calibration_sigma`), that sum is taken
-over each face's strip on its own and the two add in quadrature over the sine of the angle between the faces:
-the line moves with each face, so a face seen by one camera alone brings all of that camera's error whatever
-camera sees the other (a fillet's floor from one camera and its wall from another: sqrt 2 of one camera's error,
-not 1 / sqrt 2). The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``, and so does each
-end's sigma along it (``end_sigma_m``: the same rigid error moves the ends too). With every calibration at 0 (the
-default) nothing changes and nothing is computed.
+cameras about 1 / sqrt(2) of it. Given the seam's weld faces (:func:`seam_calibration_sigma`), the shares are
+taken per face strip and carried to the line where the two faces meet: the line moves with each face, so a face
+seen by one camera alone brings all of that camera's error whatever camera sees the other (a fillet's floor from
+one camera and its wall from another: one camera's sigma, not 1 / sqrt 2 of it). The seam's sigma becomes
+``hypot(sigma_locator, sigma_cal)``, and so does each end's sigma along it (``end_sigma_m``: the same rigid
+error moves the ends too). With every calibration at 0 (the default) nothing changes and nothing is computed.
 
 The close-up of a re-scan (:func:`closeup_sigma`) is seen by the arm's camera alone, at its close range. (Its
 fusion with the first estimate treats the two as independent; when both rest on the same camera's calibration the
@@ -152,20 +151,36 @@ def seam_calibration_sigma(
     residuals: Mapping[str, Sequence[PoseResidual]],
 ) -> float:
     """sigma_cal [m] of one found seam. Without its weld faces' planes (``faces``: n_a, d_a, n_b, d_b), from
-    its whole support (module docstring). With them, each face's strip on its own: the line moves with each face,
-    over the sine of the angle between them, so a face seen by one camera carries all of that camera's error into
-    the line however many cameras see the other (conservative by up to sqrt 2 when one camera sees both)."""
+    its whole support (module docstring). With them, through each face: an error source ``s`` (a camera group,
+    or a corrected camera's residual) of per-axis sigma ``sigma_s`` that holds the shares ``a_s``, ``b_s`` of the
+    two faces' strips moves their offsets by ``(a_s n_a . e, b_s n_b . e)``, and the line, where the two planes
+    meet, by ``x`` with ``|x|^2 = delta^T G^-1 delta`` (``G`` the faces' normals' Gram matrix). The sigma is the
+    per-axis RMS of ``x`` across the seam, ``sqrt(tr(G^-1 C) / 2)``, ``C`` the offsets' covariance: one camera
+    seeing both faces moves the line rigidly (its own sigma), one camera per face moves each face alone (its
+    own sigma too, where the shares would have said 1 / sqrt 2), and a sharp dihedral amplifies both."""
     P, cams = _support(cloud, est.p_start, est.p_end, SUPPORT_RADIUS_M)
     mid = 0.5 * (est.p_start + est.p_end)
     if faces is None or len(P) == 0:
         return calibration_sigma(_shares(cloud, cams), mid, origins_R, uncertainty, tied, residuals)
     n_a, d_a, n_b, d_b = faces
     on_a = np.abs(P @ n_a - d_a) < np.abs(P @ n_b - d_b)
-    sig = [
-        calibration_sigma(_shares(cloud, cams[m]), mid, origins_R, uncertainty, tied, residuals) for m in (on_a, ~on_a)
-    ]
-    sin_ab = float(np.linalg.norm(np.cross(n_a, n_b)))
-    return math.hypot(sig[0], sig[1]) / max(sin_ab, 0.1)
+    strips = (_shares(cloud, cams[on_a]), _shares(cloud, cams[~on_a]))
+    sources: dict[tuple[str, int], list[float]] = {}  # (source, k) -> [sigma, share of A, share of B]
+    for side, shares in enumerate(strips):
+        for camera, w in shares.items():
+            group = tied.get(camera, camera)
+            u, origin = uncertainty.get(group), origins_R.get(group)
+            if u is not None and not u.zero and origin is not None:
+                src = sources.setdefault((group, -1), [u.sigma_at(float(np.linalg.norm(mid - origin))), 0.0, 0.0])
+                src[1 + side] += w
+            for k, left in enumerate(residuals.get(camera, ()) if group != camera else ()):
+                sources.setdefault((camera, k), [left.sigma_at(mid), 0.0, 0.0])[1 + side] += w
+    c = float(np.clip(n_a @ n_b, -0.995, 0.995))
+    C = np.zeros((2, 2))
+    for sigma, a, b in sources.values():
+        C += sigma**2 * np.array([[a * a, a * b * c], [a * b * c, b * b]])
+    G_inv = np.linalg.inv(np.array([[1.0, c], [c, 1.0]]))
+    return math.sqrt(max(float(np.trace(G_inv @ C)), 0.0) / 2.0)
 
 
 def with_calibration(

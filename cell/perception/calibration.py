@@ -154,10 +154,12 @@ def seam_calibration_sigma(
     its whole support (module docstring). With them, through each face: an error source ``s`` (a camera group,
     or a corrected camera's residual) of per-axis sigma ``sigma_s`` that holds the shares ``a_s``, ``b_s`` of the
     two faces' strips moves their offsets by ``(a_s n_a . e, b_s n_b . e)``, and the line, where the two planes
-    meet, by ``x`` with ``|x|^2 = delta^T G^-1 delta`` (``G`` the faces' normals' Gram matrix). The sigma is the
-    per-axis RMS of ``x`` across the seam, ``sqrt(tr(G^-1 C) / 2)``, ``C`` the offsets' covariance: one camera
-    seeing both faces moves the line rigidly (its own sigma), one camera per face moves each face alone (its
-    own sigma too, where the shares would have said 1 / sqrt 2), and a sharp dihedral amplifies both."""
+    meet, by ``x`` with ``|x|^2 = delta^T G^-1 delta`` (``G`` the faces' normals' Gram matrix). With ``C`` the
+    offsets' covariance, ``x``'s per-axis RMS across the seam is ``sqrt(tr(G^-1 C) / 2)``: one camera seeing both
+    faces moves the line rigidly (its own sigma), one camera per face moves each face alone (its own sigma too,
+    where the shares would have said 1 / sqrt 2), and a sharp dihedral amplifies both. The lateral error is the
+    distance ``|x|`` over both axes, so the sigma returned is that RMS times sqrt(-2 ln 0.05) / 2 (1.22): two
+    of it hold 95 % of such a distance."""
     P, cams = _support(cloud, est.p_start, est.p_end, SUPPORT_RADIUS_M)
     mid = 0.5 * (est.p_start + est.p_end)
     if faces is None or len(P) == 0:
@@ -180,7 +182,9 @@ def seam_calibration_sigma(
     for sigma, a, b in sources.values():
         C += sigma**2 * np.array([[a * a, a * b * c], [a * b * c, b * b]])
     G_inv = np.linalg.inv(np.array([[1.0, c], [c, 1.0]]))
-    return math.sqrt(max(float(np.trace(G_inv @ C)), 0.0) / 2.0)
+    # |x| is a distance over two axes: 95 % of it lies within sqrt(-2 ln 0.05) per-axis RMS (chi-square, two
+    # degrees), and the sigma is read as 95 % within two of it.
+    return math.sqrt(max(float(np.trace(G_inv @ C)), 0.0) / 2.0 * -2.0 * math.log(0.05) / 4.0)
 
 
 def with_calibration(

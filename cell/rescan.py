@@ -40,6 +40,9 @@ if TYPE_CHECKING:
     from cell.scenario import Scenario
 
 
+CONSISTENT_SIGMAS = 3.0  # two ends further apart than this many combined sigmas disagree (:func:`fuse_along`)
+
+
 # -- uncertainty and fusion --------------------------------------------------------------------------------
 
 
@@ -103,13 +106,22 @@ def fuse(
 
 
 def fuse_along(x1: float, s1: float, x2: float, s2: float) -> tuple[float, float]:
-    """Inverse-variance fusion of two positions x1, x2 [m] along a seam with standard deviations s1, s2 [m]:
-    (fused position, its standard deviation); an infinite sigma has no weight (both infinite: x1, inf)."""
+    """Fusion of a first position x1 and a close-up's x2 [m] along a seam, with standard deviations s1, s2 [m]:
+    (fused position, its standard deviation). An infinite sigma has no weight (both infinite: x1, inf).
+
+    Two positions within :data:`CONSISTENT_SIGMAS` of their combined sigma are fused by inverse variance. Two that
+    disagree by more cannot both be right, and nothing says which is wrong: the close-up's position is kept (the
+    nearer, finer view) with a sigma of at least half the disagreement, so that an end a confidently wrong
+    estimate pulled away is re-scanned or refused (``end_uncertain``), never averaged into a small sigma.
+    """
     if not math.isfinite(s2):
         return x1, s1
     if not math.isfinite(s1):
         return x2, s2
     v1, v2 = s1 * s1, s2 * s2
+    gap = abs(x1 - x2)
+    if gap > CONSISTENT_SIGMAS * math.sqrt(v1 + v2):
+        return x2, max(s2, 0.5 * gap)
     if v1 + v2 <= 0.0:
         return 0.5 * (x1 + x2), 0.0
     return (x1 * v2 + x2 * v1) / (v1 + v2), math.sqrt(v1 * v2 / (v1 + v2))

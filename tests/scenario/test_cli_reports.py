@@ -41,7 +41,7 @@ def test_detect_writes_the_report_contract(tmp_path: Path) -> None:
         assert {"id", "status", "reason", "truth", "time_ms"} <= set(s)
         if s["status"] == "found":
             assert len(s["detected"]["start"]) == 3
-            assert set(s["error_mm"]) == {"paper_me", "endpoint", "lateral"}
+            assert set(s["error_mm"]) == {"paper_me", "endpoint", "lateral", "end_along"}
         else:
             assert "detected" not in s and s["reason"]
     summary = data["summary"]

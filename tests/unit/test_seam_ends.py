@@ -192,6 +192,18 @@ def test_each_end_fuses_by_its_own_sigma_and_the_line_across_by_its_own() -> Non
     assert fused.end_source == (EndSource.FACE_END, EndSource.EDGE)  # each from the surer estimate
 
 
+def test_ends_that_disagree_are_not_averaged_into_a_small_sigma() -> None:
+    # within 3 combined sigmas: inverse variance, the fused sigma smaller than either
+    x, s = fuse_along(0.0, 2e-4, 3e-4, 2e-4)
+    assert x == pytest.approx(1.5e-4) and s == pytest.approx(2e-4 / math.sqrt(2.0))
+    # a first end confidently 30 mm out against a close-up: the close-up's place, as uncertain as half the gap
+    x, s = fuse_along(0.030, 1e-4, 0.0, 2e-4)
+    assert x == 0.0 and s == pytest.approx(0.015)
+    # a small disagreement just past the test: the sigma covers it, the place is the close-up's
+    x, s = fuse_along(0.0, 1e-4, 1e-3, 1e-4)
+    assert x == pytest.approx(1e-3) and s == pytest.approx(5e-4)
+
+
 def test_the_calibration_term_widens_the_ends_too() -> None:
     est = SeamEstimate(
         "s", SeamStatus.FOUND, "", np.zeros(3), np.array([0.1, 0.0, 0.0]), 0.9, sigma_m=1e-4, end_sigma_m=(1e-4, 2e-4)

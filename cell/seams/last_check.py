@@ -6,7 +6,7 @@ So before a seam is welded its estimate is held against the aligned map (:func:`
 
 * across: both ends lie within ``Budget.across_m`` of the drawn seam's line (the build's tolerance, the cameras'
   stated calibration and the estimate's own uncertainty: :func:`budget`);
-* length: the located length lies within ``Budget.length_m`` of the drawn length;
+* length: the located length lies within ``Budget.length_m`` of the drawn length (its ends' sigmas in it);
 * ends in a body: neither end lies inside another part's body (any but the joint's two) by more than
   ``Budget.body_m``;
 * ends on the faces: each end lies within ``Budget.face_m`` of both bodies its joint joins (on the faces it joins,
@@ -41,18 +41,28 @@ class Budget:
     face_m: float
 
 
-def budget(map_tolerance_m: float, calibration_m: float, sigma_m: float) -> Budget:
+def budget(
+    map_tolerance_m: float, calibration_m: float, sigma_m: float, end_sigma_m: tuple[float, float] = (0.0, 0.0)
+) -> Budget:
     """The budget of one estimate [m]: the as-built faces and ends may lie ``map_tolerance_m`` from the aligned map
     (the build's deviations and the placement the alignment leaves; a whole part's offset moves its seams by up
     to twice that, as the locators' search allows), a camera's stated calibration ``calibration_m`` moves what it
-    saw, and the estimate carries its own ``sigma_m`` (``CHECK_SIGMAS`` of it)."""
-    own = calibration_m + CHECK_SIGMAS * (sigma_m if math.isfinite(sigma_m) else 0.0)
+    saw, and the estimate carries its own ``sigma_m`` across the seam and ``end_sigma_m`` (start, end) along it
+    (``CHECK_SIGMAS`` of each: the length adds its ends' sigmas in quadrature, an end off its faces the larger;
+    a sigma not given, inf, adds nothing)."""
+    own = calibration_m + CHECK_SIGMAS * _finite(sigma_m)
+    ends = [_finite(s) for s in end_sigma_m]
     return Budget(
         across_m=2.0 * map_tolerance_m + own,
-        length_m=map_tolerance_m + own,
+        length_m=map_tolerance_m + own + CHECK_SIGMAS * math.hypot(*ends),
         body_m=0.5 * map_tolerance_m + own,
-        face_m=2.0 * map_tolerance_m + own,
+        face_m=2.0 * map_tolerance_m + own + CHECK_SIGMAS * max(ends),
     )
+
+
+def _finite(sigma_m: float) -> float:
+    """A sigma [m], 0 when it is not given (inf or nan)."""
+    return float(sigma_m) if math.isfinite(sigma_m) else 0.0
 
 
 def _outside(part: Part, p: FloatArray, at_least: float) -> float:

@@ -41,6 +41,16 @@ def test_the_budget_is_the_build_tolerance_the_calibration_and_the_estimates_sig
     assert budget(0.006, 0.0, float("inf")).across_m == pytest.approx(0.012)  # no sigma: nothing added
 
 
+def test_the_ends_sigmas_widen_the_length_and_the_faces_not_the_line() -> None:
+    """An end placed only within a few mm (its sigma along the seam) is not failed for lying where its sigma says
+    it may; the line across the seam keeps its budget."""
+    b0, b = budget(0.006, 0.0, 0.0002), budget(0.006, 0.0, 0.0002, (0.0003, 0.0004))
+    assert b.length_m == pytest.approx(b0.length_m + CHECK_SIGMAS * 0.0005)  # both ends in quadrature
+    assert b.face_m == pytest.approx(b0.face_m + CHECK_SIGMAS * 0.0004)  # the larger end's
+    assert (b.across_m, b.body_m) == (b0.across_m, b0.body_m)
+    assert budget(0.006, 0.0, 0.0002, (float("inf"), float("inf"))) == b0  # none given: nothing added
+
+
 def test_a_seam_where_the_map_draws_it_within_the_tolerance_passes() -> None:
     est = _est([0.004, -0.0495, 0.0003], [0.004, 0.0497, -0.0002])  # the upright built 4 mm off
     assert last_check(est, DRAWN, JOINT, PARTS, LIMITS) is None

@@ -130,15 +130,19 @@ def _square_tube(center: np.ndarray, outer: float, wall: float, height: float) -
     return Polyhedron(np.array(v, float), tuple(faces))
 
 
-@pytest.mark.parametrize("kind", ["box", "tube"])
+@pytest.mark.parametrize("kind", ["box", "tube", "tube_on_face"])
 def test_an_end_never_lies_inside_a_third_body(kind: str) -> None:
     # A third part stands where the seam ends: a rail across it, or a tube whose bore the located end ran into
-    # (through its 2.6 mm wall). The end is cut at its face, and said to come from another part.
+    # (through its 2.6 mm wall). The end is cut at its face, and said to come from another part. ``tube_on_face``:
+    # the tube stands on B's face, level with the seam's line (which only grazes its wall): the bead's walk, lifted
+    # out of the fillet corner, enters it (the line's alone left the end in the bore).
     if kind == "box":
         # its face at x = 0.04, set 1 mm into B's face (the seam's line lies on that face)
         third = Box(make_pose(p=(0.07, -0.029, 0.08)), np.array([0.06, 0.06, 0.04]))
-    else:
+    elif kind == "tube":
         third = _square_tube(np.array([0.07, -0.029, 0.0]), 0.06, 0.0026, 0.12)  # its outer wall at x = 0.04
+    else:
+        third = _square_tube(np.array([0.07, -0.030, 0.0]), 0.06, 0.0026, 0.12)  # its wall ends on B's face
     weldmap, seam = _map(Part("THIRD", third))
     est = _found(seam.p_start, seam.p_end + np.array([0.0088 + 0.0026, 0.0, 0.0]))  # 8.8 mm into the bore
     out = check_ends(weldmap, JOINTS, [est], PART_TOLERANCE_M)[0]

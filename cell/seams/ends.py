@@ -27,9 +27,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.seams.joint import fillet_bisector
 from cell.seams.sigma import drawn_end_sigma, length_tolerance_m
 from cell.types import EndSource, Joint, Part, Reason, SeamEstimate, SeamStatus, WeldMap
 
@@ -74,18 +72,14 @@ def check_seam_ends(weldmap: WeldMap, joint: Joint | None, est: SeamEstimate, to
     sig = [float(x) for x in est.end_sigma_m]
     src = list(est.end_source)
     notes: list[str] = []
-    own = (joint.abutting, joint.receiving) if joint is not None else ()
-    others = [p for p in weldmap.parts if p.name not in own]
     drawn = drawn_end_sigma(tolerance_m, seam.length)
     allowed = length_tolerance_m(tolerance_m, seam.length)
-    origins = [a, *_lifted(weldmap, joint, a)]
 
     def cut(k: int) -> None:
         """End k cut where the seam or its bead enters another body, walking out from the middle."""
-        hits = [h for o in origins if (h := _entry(others, o, t, 0.5 * (s[0] + s[1]), s[k])) is not None]
-        if not hits:
+        hit = bead_entry(weldmap.parts, joint, a, t, 0.5 * (s[0] + s[1]), s[k])
+        if hit is None:
             return
-        hit = min(hits, key=lambda h: abs(h[0] - 0.5 * (s[0] + s[1])))
         u, part = hit
         moved = abs(s[k] - u)
         s[k] = u
@@ -130,15 +124,30 @@ def check_seam_ends(weldmap: WeldMap, joint: Joint | None, est: SeamEstimate, to
     )
 
 
-def _lifted(weldmap: WeldMap, joint: Joint | None, a: FloatArray) -> list[FloatArray]:
-    """Point a (3,) [m] lifted :data:`BEAD_LIFT_M` out of the joint's fillet corner (along its bisector), or none
-    (no joint, or faces with no corner between them)."""
-    if joint is None:
+def bead_entry(
+    parts: Sequence[Part], joint: Joint | None, a: FloatArray, t: FloatArray, mid: float, end: float
+) -> tuple[float, str] | None:
+    """Where the seam a + u t (a, t (3,), frame of ``parts``) or the bead along it (the line lifted
+    :data:`BEAD_LIFT_M` out of the joint's fillet corner, along its bisector), walked from u = ``mid`` to u = ``end``
+    [m], first enters a part other than the joint's two (deeper than :data:`INSIDE_MARGIN_M`): (u [m] at that
+    part's face, its name), or None. ``joint`` None: the line alone, every part counting as another."""
+    own = (joint.abutting, joint.receiving) if joint is not None else ()
+    others = [p for p in parts if p.name not in own]
+    hits = [h for o in (a, *_lifted(parts, joint, a)) if (h := _entry(others, o, t, mid, end)) is not None]
+    return min(hits, key=lambda h: abs(h[0] - mid)) if hits else None
+
+
+def _lifted(parts: Sequence[Part], joint: Joint | None, a: FloatArray) -> list[FloatArray]:
+    """Point a (3,) [m] lifted :data:`BEAD_LIFT_M` out of the joint's fillet corner (along the bisector of its two
+    faces' outward normals), or none (no joint, a part not in ``parts``, or faces with no corner between them)."""
+    by_name = {p.name: p for p in parts}
+    if joint is None or joint.abutting not in by_name or joint.receiving not in by_name:
         return []
-    try:
-        return [a + BEAD_LIFT_M * fillet_bisector(weldmap, joint)]
-    except (MapError, KeyError):
-        return []
+    n = by_name[joint.abutting].face_plane(joint.face_abutting)[0] + by_name[joint.receiving].face_plane(
+        joint.face_receiving
+    )[0]
+    norm = float(np.linalg.norm(n))
+    return [a + BEAD_LIFT_M * n / norm] if norm > 1e-9 else []
 
 
 def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end: float) -> tuple[float, str] | None:
@@ -177,4 +186,4 @@ def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end:
     return out_u - back, part.name
 
 
-__all__ = ["BEAD_LIFT_M", "INSIDE_MARGIN_M", "check_ends", "check_seam_ends"]
+__all__ = ["BEAD_LIFT_M", "INSIDE_MARGIN_M", "bead_entry", "check_ends", "check_seam_ends"]

@@ -8,7 +8,8 @@ So before a seam is welded its estimate is held against the aligned map (:func:`
   stated calibration and the estimate's own uncertainty: :func:`budget`);
 * length: the located length lies within ``Budget.length_m`` of the drawn length (its ends' sigmas in it);
 * ends in a body: neither end lies inside another part's body (any but the joint's two) by more than
-  ``Budget.body_m``;
+  ``Budget.body_m``, nor beyond a face the seam or its bead enters on the way from the seam's middle (a tube's
+  wall, its bore behind it: :func:`cell.seams.ends.bead_entry`) by more than that;
 * ends on the faces: each end lies within ``Budget.face_m`` of both bodies its joint joins (on the faces it joins,
   the line being across-checked already): an end that runs on along the receiving face past the abutting part, or
   off the receiving part's edge, is off a face.
@@ -26,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray
+from cell.seams.ends import bead_entry
 from cell.types import CheckFail, Joint, LastCheck, MapSeam, Part, SeamEstimate, SeamStatus
 
 CHECK_SIGMAS = 3.0  # the estimate's own sigma counts this many times in the across budget
@@ -104,6 +106,12 @@ def last_check(
         for part in parts:
             if part.name not in own and bool(part.contains(p, margin=-limits.body_m)):
                 return CheckFail(LastCheck.END_IN_BODY, _depth(part, p, limits.body_m), limits.body_m, name, part.name)
+    if length > 0.0 and joint is not None:
+        t = (est.p_end - est.p_start) / length
+        for name, u_end in zip(names, (0.0, length), strict=True):
+            hit = bead_entry(parts, joint, est.p_start, t, 0.5 * length, u_end)
+            if hit is not None and abs(u_end - hit[0]) > limits.body_m:
+                return CheckFail(LastCheck.END_IN_BODY, abs(u_end - hit[0]), limits.body_m, name, hit[1])
     if joint is None:
         return None
     by_name = {p.name: p for p in parts}

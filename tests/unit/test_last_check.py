@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from synthetic_joint import square_tube
 
 from cell.geometry import make_pose
 from cell.seams.last_check import CHECK_SIGMAS, budget, last_check
@@ -91,3 +92,18 @@ def test_a_seam_not_found_or_without_a_joint() -> None:
     assert last_check(missing, DRAWN, JOINT, PARTS, LIMITS) is None
     # Without its joint every part is another: the ends on the upright's edge lie in no body deeper than 3 mm.
     assert last_check(_est([0.0, -0.05, 0.0], [0.0, 0.05, 0.0]), DRAWN, None, (BASE, UPRIGHT), LIMITS) is None
+
+
+def test_an_end_run_on_into_a_tubes_bore_fails_in_a_body() -> None:
+    """A tube standing on the base (its bottom level with the seam's line) against the upright's end: a seam
+    located 5 mm on past the end (within the length budget), its end in the tube's bore. Neither end is inside
+    the tube's body, but the bead along the seam passes its 2.6 mm wall: the end lies 5 mm beyond the face it
+    enters."""
+    tube = Part("TUBE", square_tube(np.array([0.0, 0.08, 0.0]), 0.06, 0.0026, 0.1))  # its outer wall at y = 0.05
+    parts = (BASE, UPRIGHT, tube)
+    est = _est([0.0, -0.05, 0.0], [0.0, 0.055, 0.0])
+    assert not tube.contains(est.p_end[None])[0]  # in the bore, not in the wall
+    fail = last_check(est, DRAWN, JOINT, parts, LIMITS)
+    assert fail is not None and fail.code is LastCheck.END_IN_BODY
+    assert fail.part == "TUBE" and fail.end == "end" and fail.value_m == pytest.approx(0.005, abs=4e-4)
+    assert last_check(_est([0.0, -0.05, 0.0], [0.0, 0.0495, 0.0]), DRAWN, JOINT, parts, LIMITS) is None

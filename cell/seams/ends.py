@@ -143,9 +143,10 @@ def _lifted(parts: Sequence[Part], joint: Joint | None, a: FloatArray) -> list[F
     by_name = {p.name: p for p in parts}
     if joint is None or joint.abutting not in by_name or joint.receiving not in by_name:
         return []
-    n = by_name[joint.abutting].face_plane(joint.face_abutting)[0] + by_name[joint.receiving].face_plane(
-        joint.face_receiving
-    )[0]
+    n = (
+        by_name[joint.abutting].face_plane(joint.face_abutting)[0]
+        + by_name[joint.receiving].face_plane(joint.face_receiving)[0]
+    )
     norm = float(np.linalg.norm(n))
     return [a + BEAD_LIFT_M * n / norm] if norm > 1e-9 else []
 

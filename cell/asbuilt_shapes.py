@@ -172,22 +172,27 @@ def cut_end(body: Polyhedron, end_face: str, across: FloatArray, max_m: float) -
 
 
 def _slide(body: Polyhedron, on: npt.NDArray[np.bool_], n: FloatArray) -> FloatArray:
-    """(m, 3) for each vertex ``on`` the end face (outward normal n), the direction it moves back by: along the one
-    edge that leaves the end face there, scaled so that it moves 1 along -n; -n where that edge is square to the
-    face, or where the vertex has none or several such edges."""
+    """(m, 3) for each vertex ``on`` the end face (outward normal n), the direction it moves back by: along the
+    edge that leaves the end face there, scaled so that it moves 1 along -n, when every end vertex has one such edge
+    and they are all parallel (a prism: a brace, a box); else (a triangulated mesh's diagonals), or where those
+    edges are square to the face or too flat to slide along, -n for all."""
     v = np.asarray(body.vertices, dtype=float)
-    out = []
+    edges = []
     for i in np.flatnonzero(on):
         away = set()
         for f in body.faces:
             if i in f:
                 k = list(f).index(i)
                 away |= {j for j in (f[k - 1], f[(k + 1) % len(f)]) if not on[j]}
-        e = v[next(iter(away))] - v[i] if len(away) == 1 else -n
-        e = e / np.linalg.norm(e)
-        square = float(e @ n) <= -1.0 + 1e-9 or float(e @ n) >= -0.2  # along -n, or too flat to slide along
-        out.append(-n if square else e / -float(e @ n))
-    return np.array(out).reshape(-1, 3)
+        if len(away) != 1:
+            return np.tile(-n, (int(np.count_nonzero(on)), 1))
+        e = v[away.pop()] - v[i]
+        edges.append(e / np.linalg.norm(e))
+    e = edges[0]
+    parallel = all(float(x @ e) >= 1.0 - 1e-9 for x in edges)
+    if not parallel or float(e @ n) <= -1.0 + 1e-9 or float(e @ n) >= -0.2:
+        return np.tile(-n, (len(edges), 1))
+    return np.tile(e / -float(e @ n), (len(edges), 1))
 
 
 def tack_bead(p0: FloatArray, p1: FloatArray, n_a: FloatArray, n_b: FloatArray, leg_m: float) -> Polyhedron:

@@ -178,8 +178,8 @@ def _slide(body: Polyhedron, on: npt.NDArray[np.bool_], n: FloatArray) -> FloatA
     edges are square to the face or too flat to slide along, -n for all."""
     v = np.asarray(body.vertices, dtype=float)
     edges = []
-    for i in np.flatnonzero(on):
-        away = set()
+    for i in (int(k) for k in np.flatnonzero(on)):
+        away: set[int] = set()
         for f in body.faces:
             if i in f:
                 k = list(f).index(i)

@@ -7,6 +7,7 @@ Every function takes and returns bodies in one frame (any; W in :mod:`cell.asbui
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, make_pose
@@ -152,10 +153,12 @@ def bowed(body: Polyhedron, X_AP: FloatArray, sagitta_m: float, toward: int, seg
 
 
 def cut_end(body: Polyhedron, end_face: str, across: FloatArray, max_m: float) -> Polyhedron:
-    """The body with its end face ``end_face`` (every vertex in that face's plane) moved back along the face's
-    normal by 0 at its edge farthest along ``-across`` to ``max_m`` [m] at its edge farthest along ``+across``
+    """The body with its end face ``end_face`` (every vertex in that face's plane) moved back by 0 at its edge
+    farthest along ``-across`` to ``max_m`` [m] (along the face's normal) at its edge farthest along ``+across``
     (unit, in the face's plane), linearly: the end cut out of square, so the gap to what it meets opens from 0 to
-    ``max_m``. The end's vertices stay in one plane and on the side faces' planes (they move along the normal)."""
+    ``max_m``. Each end vertex slides along the body's edge that leaves the end face there (:func:`_slide`), so
+    the side faces keep their planes, also where they meet the end at an angle (a mitred brace's broad faces);
+    square to the end (a box) that is the face's normal. The end's vertices stay in one plane."""
     n, d = body.face_plane(end_face)
     v = np.array(body.vertices, dtype=float)
     on = np.abs(v @ n - d) <= 1e-6
@@ -163,8 +166,33 @@ def cut_end(body: Polyhedron, end_face: str, across: FloatArray, max_m: float) -
     span = float(t.max() - t.min())
     if span <= 0.0:  # pragma: no cover - a face has an extent in its own plane
         return body
-    v[on] -= np.outer(max_m * (t - t.min()) / span, n)
+    back = max_m * (t - t.min()) / span
+    v[on] += back[:, None] * _slide(body, on, n)
     return Polyhedron(v, body.faces, body.names)
+
+
+def _slide(body: Polyhedron, on: npt.NDArray[np.bool_], n: FloatArray) -> FloatArray:
+    """(m, 3) for each vertex ``on`` the end face (outward normal n), the direction it moves back by: along the
+    edge that leaves the end face there, scaled so that it moves 1 along -n, when every end vertex has one such edge
+    and they are all parallel (a prism: a brace, a box); else (a triangulated mesh's diagonals), or where those
+    edges are square to the face or too flat to slide along, -n for all."""
+    v = np.asarray(body.vertices, dtype=float)
+    edges = []
+    for i in (int(k) for k in np.flatnonzero(on)):
+        away: set[int] = set()
+        for f in body.faces:
+            if i in f:
+                k = list(f).index(i)
+                away |= {j for j in (f[k - 1], f[(k + 1) % len(f)]) if not on[j]}
+        if len(away) != 1:
+            return np.tile(-n, (int(np.count_nonzero(on)), 1))
+        e = v[away.pop()] - v[i]
+        edges.append(e / np.linalg.norm(e))
+    e = edges[0]
+    parallel = all(float(x @ e) >= 1.0 - 1e-9 for x in edges)
+    if not parallel or float(e @ n) <= -1.0 + 1e-9 or float(e @ n) >= -0.2:
+        return np.tile(-n, (len(edges), 1))
+    return np.tile(e / -float(e @ n), (len(edges), 1))
 
 
 def tack_bead(p0: FloatArray, p1: FloatArray, n_a: FloatArray, n_b: FloatArray, leg_m: float) -> Polyhedron:

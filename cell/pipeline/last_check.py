@@ -30,7 +30,8 @@ MAP_TOLERANCE_M = 0.006  # how far the as-built faces and ends may lie from the 
 def check_budget(sc: Scenario, est: SeamEstimate) -> Budget:
     """The last check's budget of one found estimate, from the scenario alone: the build tolerance the locator
     is told (``locator.options.map_tolerance_m``), the largest stated calibration of a fixed camera at its range to
-    the seam (``cameras.<name>.calibration``: translation plus rotation times range), and the estimate's sigma."""
+    the seam (``cameras.<name>.calibration``: translation plus rotation times range), and the estimate's sigma
+    across the seam and its ends' along it."""
     tol = float(getattr(sc.locator.options, "map_tolerance_m", MAP_TOLERANCE_M))
     mid_W = transform_points(sc.X_WR, 0.5 * (est.p_start + est.p_end))
     calibration = max(
@@ -42,7 +43,7 @@ def check_budget(sc: Scenario, est: SeamEstimate) -> Budget:
         ),
         default=0.0,
     )
-    return budget(tol, calibration, est.sigma_m)
+    return budget(tol, calibration, est.sigma_m, est.end_sigma_m)
 
 
 def failing(det: Detection, ids: Collection[str] | None = None) -> dict[str, CheckFail]:

@@ -4,8 +4,11 @@ A locator places each end from what it saw (:class:`~cell.types.EndSource`); wha
 not be. :func:`check_ends` holds every found estimate to two things the aligned map knows:
 
 1. an end never lies inside another part's body: walking from the seam's middle towards each end, where the line
-   enters any other part of the map (a tube the seam ends against, a rail across it) the end is cut to its face
-   (``other_part``; an end moved further than two of its sigmas keeps only the drawn end's sigma);
+   or the bead along it (the line lifted :data:`BEAD_LIFT_M` out of the fillet corner, along its bisector) enters
+   any other part of the map (a tube the seam ends against, a rail across it) the end is cut to its face
+   (``other_part``; an end moved further than two of its sigmas keeps only the drawn end's sigma). The bead's walk
+   sees a part standing on the same face as the seam: a tube on the plate, whose bottom lies level with the seam's
+   line, so that the line alone only grazes it;
 2. the located length agrees with the drawn one to within the part tolerance on a seam of that length
    (:func:`~cell.seams.sigma.length_tolerance_m`) plus two sigmas of the two ends together (an end run along the
    receiving face past the abutting part's end, a mitred brace's, does not); otherwise the end that deviates
@@ -32,6 +35,7 @@ INSIDE_MARGIN_M = 3e-4  # an end deeper than this inside another body is in it (
 _STEP_M = 2.5e-4  # the walk along the seam that finds where it enters another body [m] (a 2 mm wall is 8 steps)
 _BISECT = 10  # halvings of a step where the seam enters a body (0.25 mm / 2^10)
 _NAMES = ("start", "end")
+BEAD_LIFT_M = 1.5e-3  # how far out of the fillet corner the bead's walk runs [m]: inside a 4 mm leg's bead
 
 
 def check_ends(
@@ -68,14 +72,12 @@ def check_seam_ends(weldmap: WeldMap, joint: Joint | None, est: SeamEstimate, to
     sig = [float(x) for x in est.end_sigma_m]
     src = list(est.end_source)
     notes: list[str] = []
-    own = (joint.abutting, joint.receiving) if joint is not None else ()
-    others = [p for p in weldmap.parts if p.name not in own]
     drawn = drawn_end_sigma(tolerance_m, seam.length)
     allowed = length_tolerance_m(tolerance_m, seam.length)
 
     def cut(k: int) -> None:
-        """End k cut where the seam enters another body, walking out from the middle."""
-        hit = _entry(others, a, t, 0.5 * (s[0] + s[1]), s[k])
+        """End k cut where the seam or its bead enters another body, walking out from the middle."""
+        hit = bead_entry(weldmap.parts, joint, a, t, 0.5 * (s[0] + s[1]), s[k])
         if hit is None:
             return
         u, part = hit
@@ -122,6 +124,33 @@ def check_seam_ends(weldmap: WeldMap, joint: Joint | None, est: SeamEstimate, to
     )
 
 
+def bead_entry(
+    parts: Sequence[Part], joint: Joint | None, a: FloatArray, t: FloatArray, mid: float, end: float
+) -> tuple[float, str] | None:
+    """Where the seam a + u t (a, t (3,), frame of ``parts``) or the bead along it (the line lifted
+    :data:`BEAD_LIFT_M` out of the joint's fillet corner, along its bisector), walked from u = ``mid`` to u = ``end``
+    [m], first enters a part other than the joint's two (deeper than :data:`INSIDE_MARGIN_M`): (u [m] at that
+    part's face, its name), or None. ``joint`` None: the line alone, every part counting as another."""
+    own = (joint.abutting, joint.receiving) if joint is not None else ()
+    others = [p for p in parts if p.name not in own]
+    hits = [h for o in (a, *_lifted(parts, joint, a)) if (h := _entry(others, o, t, mid, end)) is not None]
+    return min(hits, key=lambda h: abs(h[0] - mid)) if hits else None
+
+
+def _lifted(parts: Sequence[Part], joint: Joint | None, a: FloatArray) -> list[FloatArray]:
+    """Point a (3,) [m] lifted :data:`BEAD_LIFT_M` out of the joint's fillet corner (along the bisector of its two
+    faces' outward normals), or none (no joint, a part not in ``parts``, or faces with no corner between them)."""
+    by_name = {p.name: p for p in parts}
+    if joint is None or joint.abutting not in by_name or joint.receiving not in by_name:
+        return []
+    n = (
+        by_name[joint.abutting].face_plane(joint.face_abutting)[0]
+        + by_name[joint.receiving].face_plane(joint.face_receiving)[0]
+    )
+    norm = float(np.linalg.norm(n))
+    return [a + BEAD_LIFT_M * n / norm] if norm > 1e-9 else []
+
+
 def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end: float) -> tuple[float, str] | None:
     """Where the line a + u t (a, t (3,)), walked from u = ``mid`` to u = ``end`` [m], first enters one of ``parts``
     (deeper than :data:`INSIDE_MARGIN_M`): (u [m], that part's name), or None. A part the middle lies in is not
@@ -158,4 +187,4 @@ def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end:
     return out_u - back, part.name
 
 
-__all__ = ["INSIDE_MARGIN_M", "check_ends", "check_seam_ends"]
+__all__ = ["BEAD_LIFT_M", "INSIDE_MARGIN_M", "bead_entry", "check_ends", "check_seam_ends"]

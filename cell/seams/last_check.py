@@ -6,9 +6,10 @@ So before a seam is welded its estimate is held against the aligned map (:func:`
 
 * across: both ends lie within ``Budget.across_m`` of the drawn seam's line (the build's tolerance, the cameras'
   stated calibration and the estimate's own uncertainty: :func:`budget`);
-* length: the located length lies within ``Budget.length_m`` of the drawn length;
+* length: the located length lies within ``Budget.length_m`` of the drawn length (its ends' sigmas in it);
 * ends in a body: neither end lies inside another part's body (any but the joint's two) by more than
-  ``Budget.body_m``;
+  ``Budget.body_m``, nor beyond a face the seam or its bead enters on the way from the seam's middle (a tube's
+  wall, its bore behind it: :func:`cell.seams.ends.bead_entry`) by more than that;
 * ends on the faces: each end lies within ``Budget.face_m`` of both bodies its joint joins (on the faces it joins,
   the line being across-checked already): an end that runs on along the receiving face past the abutting part, or
   off the receiving part's edge, is off a face.
@@ -26,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray
+from cell.seams.ends import bead_entry
 from cell.types import CheckFail, Joint, LastCheck, MapSeam, Part, SeamEstimate, SeamStatus
 
 CHECK_SIGMAS = 3.0  # the estimate's own sigma counts this many times in the across budget
@@ -41,18 +43,28 @@ class Budget:
     face_m: float
 
 
-def budget(map_tolerance_m: float, calibration_m: float, sigma_m: float) -> Budget:
+def budget(
+    map_tolerance_m: float, calibration_m: float, sigma_m: float, end_sigma_m: tuple[float, float] = (0.0, 0.0)
+) -> Budget:
     """The budget of one estimate [m]: the as-built faces and ends may lie ``map_tolerance_m`` from the aligned map
     (the build's deviations and the placement the alignment leaves; a whole part's offset moves its seams by up
     to twice that, as the locators' search allows), a camera's stated calibration ``calibration_m`` moves what it
-    saw, and the estimate carries its own ``sigma_m`` (``CHECK_SIGMAS`` of it)."""
-    own = calibration_m + CHECK_SIGMAS * (sigma_m if math.isfinite(sigma_m) else 0.0)
+    saw, and the estimate carries its own ``sigma_m`` across the seam and ``end_sigma_m`` (start, end) along it
+    (``CHECK_SIGMAS`` of each: the length adds its ends' sigmas in quadrature, an end off its faces the larger;
+    a sigma not given, inf, adds nothing)."""
+    own = calibration_m + CHECK_SIGMAS * _finite(sigma_m)
+    ends = [_finite(s) for s in end_sigma_m]
     return Budget(
         across_m=2.0 * map_tolerance_m + own,
-        length_m=map_tolerance_m + own,
+        length_m=map_tolerance_m + own + CHECK_SIGMAS * math.hypot(*ends),
         body_m=0.5 * map_tolerance_m + own,
-        face_m=2.0 * map_tolerance_m + own,
+        face_m=2.0 * map_tolerance_m + own + CHECK_SIGMAS * max(ends),
     )
+
+
+def _finite(sigma_m: float) -> float:
+    """A sigma [m], 0 when it is not given (inf or nan)."""
+    return float(sigma_m) if math.isfinite(sigma_m) else 0.0
 
 
 def _outside(part: Part, p: FloatArray, at_least: float) -> float:
@@ -94,6 +106,12 @@ def last_check(
         for part in parts:
             if part.name not in own and bool(part.contains(p, margin=-limits.body_m)):
                 return CheckFail(LastCheck.END_IN_BODY, _depth(part, p, limits.body_m), limits.body_m, name, part.name)
+    if length > 0.0 and joint is not None:
+        t = (est.p_end - est.p_start) / length
+        for name, u_end in zip(names, (0.0, length), strict=True):
+            hit = bead_entry(parts, joint, est.p_start, t, 0.5 * length, u_end)
+            if hit is not None and abs(u_end - hit[0]) > limits.body_m:
+                return CheckFail(LastCheck.END_IN_BODY, abs(u_end - hit[0]), limits.body_m, name, hit[1])
     if joint is None:
         return None
     by_name = {p.name: p for p in parts}

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray, invert, look_at, make_pose, rot_x, rot_z, transform_points
-from cell.types import Box, Cloud, Joint, MapSeam, Part, SeamScene, WeldMap
+from cell.types import Box, Cloud, Joint, MapSeam, Part, Polyhedron, SeamScene, WeldMap
 
 TOP = "A>B:+z"  # along x, on A's top
 SIDE = "A>B:+x"  # along z, on A's +x side
@@ -210,3 +210,21 @@ def voxel_cloud(cloud: Cloud, voxel: float) -> Cloud:
     inverse = inverse.reshape(-1)
     sums = np.stack([np.bincount(inverse, cloud.points[:, i]) for i in range(3)], axis=1)
     return Cloud(sums / counts[:, None], cloud.frame)
+
+
+def square_tube(center: np.ndarray, outer: float, wall: float, height: float) -> Polyhedron:
+    """A vertical square tube (its bore open top and bottom) as a closed polyhedron [m]."""
+    o, i = outer / 2.0, outer / 2.0 - wall
+    square = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
+    v = [
+        (center[0] + h * x, center[1] + h * y, center[2] + z) for z in (0.0, height) for h in (o, i) for x, y in square
+    ]
+    # 0-3 outer bottom, 4-7 inner bottom, 8-11 outer top, 12-15 inner top
+    faces = []
+    for k in range(4):
+        j = (k + 1) % 4
+        faces.append((k, j, 8 + j, 8 + k))  # outer wall, outward
+        faces.append((4 + j, 4 + k, 12 + k, 12 + j))  # inner wall, facing the bore
+        faces.append((j, k, 4 + k, 4 + j))  # bottom ring, facing down
+        faces.append((8 + k, 8 + j, 12 + j, 12 + k))  # top ring, facing up
+    return Polyhedron(np.array(v, float), tuple(faces))

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from synthetic_joint import square_tube
 
 from cell.geometry import make_pose
 from cell.seams.last_check import CHECK_SIGMAS, budget, last_check
@@ -39,6 +40,16 @@ def test_the_budget_is_the_build_tolerance_the_calibration_and_the_estimates_sig
     assert b.body_m == pytest.approx(0.003 + own)
     assert b.face_m == pytest.approx(0.012 + own)
     assert budget(0.006, 0.0, float("inf")).across_m == pytest.approx(0.012)  # no sigma: nothing added
+
+
+def test_the_ends_sigmas_widen_the_length_and_the_faces_not_the_line() -> None:
+    """An end placed only within a few mm (its sigma along the seam) is not failed for lying where its sigma says
+    it may; the line across the seam keeps its budget."""
+    b0, b = budget(0.006, 0.0, 0.0002), budget(0.006, 0.0, 0.0002, (0.0003, 0.0004))
+    assert b.length_m == pytest.approx(b0.length_m + CHECK_SIGMAS * 0.0005)  # both ends in quadrature
+    assert b.face_m == pytest.approx(b0.face_m + CHECK_SIGMAS * 0.0004)  # the larger end's
+    assert (b.across_m, b.body_m) == (b0.across_m, b0.body_m)
+    assert budget(0.006, 0.0, 0.0002, (float("inf"), float("inf"))) == b0  # none given: nothing added
 
 
 def test_a_seam_where_the_map_draws_it_within_the_tolerance_passes() -> None:
@@ -81,3 +92,18 @@ def test_a_seam_not_found_or_without_a_joint() -> None:
     assert last_check(missing, DRAWN, JOINT, PARTS, LIMITS) is None
     # Without its joint every part is another: the ends on the upright's edge lie in no body deeper than 3 mm.
     assert last_check(_est([0.0, -0.05, 0.0], [0.0, 0.05, 0.0]), DRAWN, None, (BASE, UPRIGHT), LIMITS) is None
+
+
+def test_an_end_run_on_into_a_tubes_bore_fails_in_a_body() -> None:
+    """A tube standing on the base (its bottom level with the seam's line) against the upright's end: a seam
+    located 5 mm on past the end (within the length budget), its end in the tube's bore. Neither end is inside
+    the tube's body, but the bead along the seam passes its 2.6 mm wall: the end lies 5 mm beyond the face it
+    enters."""
+    tube = Part("TUBE", square_tube(np.array([0.0, 0.08, 0.0]), 0.06, 0.0026, 0.1))  # its outer wall at y = 0.05
+    parts = (BASE, UPRIGHT, tube)
+    est = _est([0.0, -0.05, 0.0], [0.0, 0.055, 0.0])
+    assert not tube.contains(est.p_end[None])[0]  # in the bore, not in the wall
+    fail = last_check(est, DRAWN, JOINT, parts, LIMITS)
+    assert fail is not None and fail.code is LastCheck.END_IN_BODY
+    assert fail.part == "TUBE" and fail.end == "end" and fail.value_m == pytest.approx(0.005, abs=4e-4)
+    assert last_check(_est([0.0, -0.05, 0.0], [0.0, 0.0495, 0.0]), DRAWN, JOINT, parts, LIMITS) is None

@@ -12,14 +12,14 @@ import pytest
 from dxf_factory import REPO_ROOT  # puts tools/ on the path
 
 from cell.asbuilt import as_built_fixtures, as_built_parts
-from cell.asbuilt_shapes import bowed, principal_frame
+from cell.asbuilt_shapes import bowed, cut_end, principal_frame
 from cell.errors import ScenarioError
 from cell.scenario import Scenario, SpecularDropoutSpec, from_dict, load
 from cell.seams.joint import find_joints
 from cell.seams.truth import true_seams
 from cell.sim.camera import intrinsics_for
 from cell.sim.noise import specular_dropout
-from cell.types import Box, Part, WeldMap
+from cell.types import Box, Part, Polyhedron, WeldMap
 from cell.weldmap import read_map
 
 
@@ -160,3 +160,23 @@ def test_the_rhs_map_reads_as_hollow_tubes_and_every_seam_has_a_truth() -> None:
 def test_make_rhs_writes_the_shipped_map_byte_for_byte(tmp_path: Path) -> None:
     make_rhs = importlib.import_module("make_rhs")  # tools/make_rhs.py (tools/ is on the path: dxf_factory)
     assert make_rhs.write_rhs_map(tmp_path / "rhs.dxf").read_bytes() == (REPO_ROOT / "maps" / "rhs.dxf").read_bytes()
+
+
+def test_an_end_cut_out_of_square_keeps_a_mitred_bodys_faces_plane() -> None:
+    """A brace leaning at 35 deg, its end mitred to lie flat: the end cut out of square slides each end vertex along
+    the brace's edge, so its broad faces stay planes (moved along the end's normal, they were warped by the gap's
+    share and the true seam along them was lost) and the gap still opens from 0 to its maximum."""
+    a, length, w, t = np.radians(35.0), 0.1, 0.04, 0.006
+    base = np.array([[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, t, 0.0], [0.0, t, 0.0]])
+    axis = np.array([0.0, np.cos(a), np.sin(a)])
+    v = np.vstack([base, base + length * axis])
+    faces = ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
+    body = Polyhedron(v, faces)
+    end = body.names[0]  # the bottom, flat on what it meets
+    cut = cut_end(body, end, np.array([1.0, 0.0, 0.0]), 0.002)
+    for name, face in zip(cut.names, cut.faces, strict=True):
+        n, d = cut.face_plane(name)
+        assert np.max(np.abs(cut.vertices[list(face)] @ n - d)) < 1e-12, name
+    rise = cut.vertices[:4, 2]  # how far each end vertex moved back off the plane it lay on
+    np.testing.assert_allclose(rise, [0.0, 0.002, 0.002, 0.0], atol=1e-12)
+    np.testing.assert_allclose(cut.vertices[4:], v[4:])  # the other end untouched

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from skewed_joint import scene as skewed_scene
-from synthetic_joint import CASES, JOINTS, NOMINAL, TOP, make_scene
+from synthetic_joint import CASES, JOINTS, NOMINAL, TOP, make_scene, square_tube
 
 from cell.config.seams import PART_TOLERANCE_M
 from cell.geometry import make_pose
@@ -29,7 +29,7 @@ from cell.seams.sigma import (
     ours_end_sigma,
     paper_end_sigmas,
 )
-from cell.types import Box, EndSource, MapSeam, Part, Polyhedron, Reason, SeamEstimate, SeamStatus, WeldMap
+from cell.types import Box, EndSource, MapSeam, Part, Reason, SeamEstimate, SeamStatus, WeldMap
 
 # -- each end source's sigma ----------------------------------------------------------------------------------
 
@@ -112,33 +112,19 @@ def test_a_seam_far_from_its_drawn_length_is_not_this_joint() -> None:
     assert out.status is SeamStatus.NOT_FOUND and out.code is Reason.LENGTH_MISMATCH
 
 
-def _square_tube(center: np.ndarray, outer: float, wall: float, height: float) -> Polyhedron:
-    """A vertical square tube (its bore open top and bottom) as a closed polyhedron [m]."""
-    o, i = outer / 2.0, outer / 2.0 - wall
-    square = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
-    v = [
-        (center[0] + h * x, center[1] + h * y, center[2] + z) for z in (0.0, height) for h in (o, i) for x, y in square
-    ]
-    # 0-3 outer bottom, 4-7 inner bottom, 8-11 outer top, 12-15 inner top
-    faces = []
-    for k in range(4):
-        j = (k + 1) % 4
-        faces.append((k, j, 8 + j, 8 + k))  # outer wall, outward
-        faces.append((4 + j, 4 + k, 12 + k, 12 + j))  # inner wall, facing the bore
-        faces.append((j, k, 4 + k, 4 + j))  # bottom ring, facing down
-        faces.append((8 + k, 8 + j, 12 + j, 12 + k))  # top ring, facing up
-    return Polyhedron(np.array(v, float), tuple(faces))
-
-
-@pytest.mark.parametrize("kind", ["box", "tube"])
+@pytest.mark.parametrize("kind", ["box", "tube", "tube_on_face"])
 def test_an_end_never_lies_inside_a_third_body(kind: str) -> None:
     # A third part stands where the seam ends: a rail across it, or a tube whose bore the located end ran into
-    # (through its 2.6 mm wall). The end is cut at its face, and said to come from another part.
+    # (through its 2.6 mm wall). The end is cut at its face, and said to come from another part. ``tube_on_face``:
+    # the tube stands on B's face, level with the seam's line (which only grazes its wall): the bead's walk, lifted
+    # out of the fillet corner, enters it (the line's alone left the end in the bore).
     if kind == "box":
         # its face at x = 0.04, set 1 mm into B's face (the seam's line lies on that face)
         third = Box(make_pose(p=(0.07, -0.029, 0.08)), np.array([0.06, 0.06, 0.04]))
+    elif kind == "tube":
+        third = square_tube(np.array([0.07, -0.029, 0.0]), 0.06, 0.0026, 0.12)  # its outer wall at x = 0.04
     else:
-        third = _square_tube(np.array([0.07, -0.029, 0.0]), 0.06, 0.0026, 0.12)  # its outer wall at x = 0.04
+        third = square_tube(np.array([0.07, -0.030, 0.0]), 0.06, 0.0026, 0.12)  # its wall ends on B's face
     weldmap, seam = _map(Part("THIRD", third))
     est = _found(seam.p_start, seam.p_end + np.array([0.0088 + 0.0026, 0.0, 0.0]))  # 8.8 mm into the bore
     out = check_ends(weldmap, JOINTS, [est], PART_TOLERANCE_M)[0]

@@ -86,6 +86,13 @@ EDGE_BLURS = (2e-4, 5e-4, 1e-3, 1.5e-3, 2.5e-3)  # [m]
 EDGE_WINDOW_M = 0.01  # half-width of the window about a guess that :func:`edge_ml` reads [m]
 
 
+def _log_normaliser(b: FloatArray, lo: float, hi: float, stray: float, n: int) -> FloatArray:
+    """n times the log of the edge model's normalisation for edges at b (k,) [m] in the window [lo, hi]: +inf for an
+    edge so far below the window that nothing of the model is left in it (its likelihood is then -inf, never NaN)."""
+    mass = (b - lo) + stray * (hi - lo)
+    return np.where(mass > 0.0, n * np.log(np.maximum(mass, 1e-300)), np.inf)
+
+
 def edge_fit(
     s: FloatArray,
     lo: float,
@@ -129,13 +136,13 @@ def edge_fit(
     sig_c = sig[::2]
     z = (coarse[None, :, None] - at[None, None, :]) / sig_c[:, None, None]
     ll_c = (np.log(ndtr(z) + stray) * bins[filled]).sum(axis=2)  # the normalisation is the same for every blur
-    ll_c -= len(x) * np.log((coarse - lo) + stray * (hi - lo))
+    ll_c -= _log_normaliser(coarse, lo, hi, stray, len(x))
     centre = float(coarse[int(np.argmax(ll_c.max(axis=0)))])
     b = np.asarray(centre + step * np.arange(-6, 7), np.float64)  # (13,)
     # Points more than 6 blurs inside (outside) every b add log(1 + stray) (log(stray)) whatever b, to within
     # 1e-7: only those nearer are evaluated, for each blur (x is sorted).
     ll = np.empty((len(sig), len(b)))
-    norm = len(x) * np.log((b - lo) + stray * (hi - lo))
+    norm = _log_normaliser(b, lo, hi, stray, len(x))
     for j, sj in enumerate(blurs):
         i0, i1 = np.searchsorted(x, (b[0] - 6.0 * sj, b[-1] + 6.0 * sj))
         z = (b[:, None] - x[None, i0:i1]) / sj

@@ -153,7 +153,7 @@ def edge_fit(
     pos, se = float(b[i]), float("inf")
     if 0 < i < len(b) - 1:
         c2 = best[i - 1] - 2.0 * best[i] + best[i + 1]
-        if c2 < 0.0:
+        if np.isfinite(c2) and c2 < 0.0:  # a neighbour below the window (-inf) leaves the grid's step as it is
             pos += float(0.5 * (best[i - 1] - best[i + 1]) / c2) * step
             se = float(step / np.sqrt(-c2))
     blur = float(sig[int(np.argmax(ll[:, i]))])

@@ -47,8 +47,18 @@ from cell.types import Cloud, DepthImage
 
 MOUNTS = ("fixed", "eye_in_hand")
 MIN_SHIFT_M = 0.0001  # [m] a MAP correction moving the overlap by less than this (RMS) is not applied
+MIN_SHIFT_NOISE = 0.5  # ... nor by less than this many times the overlap's noise (what its biases reach)
 MIN_MISFIT_DROP = 0.10  # ... nor one that lowers the patch misfit by less than this fraction (nor is it a fault)
-REFUSALS = ("calibration_exact", "no_overlap", "not_informed", "too_small", "no_misfit_gain", "beyond_prior")
+FAULT_MISFIT_DROP = 0.80  # a partly informed overlap shows a fault only if the move explains this much of the misfit
+REFUSALS = (
+    "calibration_exact",
+    "no_overlap",
+    "not_informed",
+    "partly_informed",
+    "too_small",
+    "no_misfit_gain",
+    "beyond_prior",
+)
 FAULT = "beyond_prior"  # the refusal that makes the camera a fault (dropped), not merely left as calibrated
 
 
@@ -104,15 +114,20 @@ class Registration:
 
 def refusal(est: Estimate) -> str:
     """``""`` if a registration's estimate (:func:`cell.perception.registration.register`) may be applied, else
-    why not (one of :data:`REFUSALS`, in this order): too few points overlap, no direction is informed, the
-    MAP correction moves the overlap by less than :data:`MIN_SHIFT_M` or lowers the patch misfit by less than
-    :data:`MIN_MISFIT_DROP` (it explains nothing), or the data disagree with the prior beyond
-    :data:`cell.perception.pose_prior.FAULT_SIGMAS` (a fault)."""
+    why not (one of :data:`REFUSALS`, in this order): too few points overlap, no direction is informed, not all
+    six are (the overlap does not fix the whole pose: no correction, and a fault only if the move also lowers the
+    patch misfit by :data:`FAULT_MISFIT_DROP`), the MAP correction
+    moves the overlap by less than :data:`MIN_SHIFT_M` or :data:`MIN_SHIFT_NOISE` times its noise, or lowers
+    the patch misfit by less than :data:`MIN_MISFIT_DROP` (it explains nothing), or the data disagree with the
+    prior beyond :data:`cell.perception.pose_prior.FAULT_SIGMAS` (a fault)."""
     if est.overlap < MIN_OVERLAP:
         return "no_overlap"
     if est.informed == 0:
         return "not_informed"
-    if est.map_shift_m < MIN_SHIFT_M:
+    if est.informed < 6:
+        gross = est.misfit_m <= (1.0 - FAULT_MISFIT_DROP) * est.misfit_before_m
+        return FAULT if est.disagreement_sigmas > FAULT_SIGMAS and gross else "partly_informed"
+    if est.map_shift_m < max(MIN_SHIFT_M, MIN_SHIFT_NOISE * est.noise_m):
         return "too_small"
     if not est.misfit_m <= (1.0 - MIN_MISFIT_DROP) * est.misfit_before_m:
         return "no_misfit_gain"

@@ -137,7 +137,7 @@ def rows_of(s: Scenario, images: dict[str, Any], tags: dict[str, Any]) -> list[d
         before_mm = _rms(o, true_o) * 1e3
         after_mm = _rms(after, true_o) * 1e3
         row |= {
-            "overlap": int(len(o)),
+            "overlap": len(o),
             "prior_mm": round(math.sqrt(3.0) * u.sigma_at(rng_m) * 1e3, 3),
             "true_mm": round(before_mm, 3),
             "relative_mm": round(_rms(o - true_o, tgt_disp) * 1e3, 3),
@@ -186,7 +186,9 @@ def main() -> None:
     ap.add_argument("--exact-stated", default="0.7/0.07")
     ap.add_argument("--cache", type=Path, default=Path("/tmp/splice_truth"))
     ap.add_argument("--json", type=Path, default=None)
-    ap.add_argument("--noise", default=None, help="every cell's noise: realistic, none, or KEY=VALUE of the cameras' noise models")
+    ap.add_argument(
+        "--noise", default=None, help="every cell's noise: realistic, none, or KEY=VALUE of the cameras' noise models"
+    )
     a = ap.parse_args()
     t_mm, r_deg = (float(v) for v in a.exact_stated.split("/"))
     rows: list[dict[str, Any]] = []
@@ -202,7 +204,9 @@ def main() -> None:
     s = summary(rows)
     print(s)
     if a.json is not None:
-        write_json(a.json, {"seed": a.seed, "cells": a.cells, "exact_stated": a.exact_stated, "summary": s, "rows": rows})
+        write_json(
+            a.json, {"seed": a.seed, "cells": a.cells, "exact_stated": a.exact_stated, "summary": s, "rows": rows}
+        )
 
 
 if __name__ == "__main__":

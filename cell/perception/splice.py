@@ -11,8 +11,9 @@ weighs each camera by its own noise loses nothing to the merge.
 Each camera is registered onto the cameras before it by :func:`cell.perception.registration.register` (open3d's
 ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says), and what it found is an estimate with
 the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`cell.perception.pose_prior`):
-the correction is applied only along directions where the overlap's information outweighs the prior, as the MAP
-estimate, and only if it explains the data: it must lower the misfit of the overlap's patches (RMS of each
+the correction is applied only where the overlap informs all six directions (a partly informed overlap's estimate
+is biased by the sensor's noise at edges: 1-9 mm on random cells, ``docs/perception.md``), as the MAP estimate,
+only if it moves the overlap by more than half its noise, and only if it explains the data: it must lower the misfit of the overlap's patches (RMS of each
 patch's mean point-to-plane residual) by :data:`MIN_MISFIT_DROP`. The information alone is not enough: it counts
 each patch of ``merge_cell_m`` as independent and the sensor's biases are not (edges and flying pixels seen from
 one side bias whole faces): exact cameras get estimates within their prior that look informed yet explain

@@ -47,15 +47,23 @@ from cell.export.report import write_json  # noqa: E402
 from cell.geometry import FloatArray, invert, transform_points  # noqa: E402
 from cell.perception import perceive  # noqa: E402
 from cell.perception.deproject import clouds_in_robot_frame  # noqa: E402
+from cell.perception.splice import FAULT  # noqa: E402
 from cell.pipeline.detect import pose_uncertainties  # noqa: E402
-from cell.scenario import CalibrationSpec, Scenario  # noqa: E402
+from cell.scenario import CalibrationSpec, ExtrinsicErrorSpec, Scenario  # noqa: E402
+
+KNOCKED = "cam_1"  # the camera ``--knock`` moves beyond its statement
 
 
 def _scenario(
-    seed: int, k: int, folder: Path, exact_stated: tuple[float, float], noise: str | None = None
+    seed: int,
+    k: int,
+    folder: Path,
+    exact_stated: tuple[float, float],
+    noise: str | None = None,
+    knock: tuple[float, float] | None = None,
 ) -> tuple[Scenario, bool]:
-    """Cell k's scenario (exact cells with their fixed cameras stated ``exact_stated``), and whether it is
-    perturbed."""
+    """Cell k's scenario (exact cells with their fixed cameras stated ``exact_stated``; ``knock``: cam_1's true
+    error made that, its statement kept), and whether it is perturbed."""
     made = random_cells.make_cell(tc.cell_seed(seed, k), folder)
     s = sc.load(made.scenario)
     if noise is not None and "=" in noise:  # one key of every camera's noise model changed
@@ -72,6 +80,10 @@ def _scenario(
         cal = CalibrationSpec(translation_mm=exact_stated[0], rotation_deg=exact_stated[1])
         cams = {n: c.model_copy(update={"calibration": cal}) if c.mount == "fixed" else c for n, c in s.cameras.items()}
         s = s.model_copy(update={"cameras": cams})
+    if knock is not None:
+        err = ExtrinsicErrorSpec(translation_mm=knock[0], rotation_deg=knock[1])
+        cams = {n: c.model_copy(update={"extrinsic_error": err}) if n == KNOCKED else c for n, c in s.cameras.items()}
+        s = s.model_copy(update={"cameras": cams})
     return s, perturbed
 
 
@@ -80,13 +92,19 @@ def _rms(a: FloatArray, b: FloatArray) -> float:
 
 
 def rows_of_cell(
-    seed: int, k: int, cache: Path, exact_stated: tuple[float, float], noise: str | None = None
+    seed: int,
+    k: int,
+    cache: Path,
+    exact_stated: tuple[float, float],
+    noise: str | None = None,
+    knock: tuple[float, float] | None = None,
 ) -> list[dict[str, Any]]:
     """One row per registration of cell k of the benchmark seed ``seed`` (``noise``: the cell's noise model
-    replaced)."""
+    replaced; ``knock``: :data:`KNOCKED` knocked by (mm, deg))."""
     folder = cache / f"seed{seed}" / str(k)
-    s, perturbed = _scenario(seed, k, folder, exact_stated, noise)
+    s, perturbed = _scenario(seed, k, folder, exact_stated, noise, knock)
     folder = folder / noise if noise is not None else folder
+    folder = folder / f"knock{knock[0]}_{knock[1]}" if knock is not None else folder
     folder.mkdir(parents=True, exist_ok=True)
     pickled = folder / "images.pkl"
     if pickled.exists():
@@ -94,7 +112,8 @@ def rows_of_cell(
     else:
         images = pipeline.capture(s).images
         pickled.write_bytes(pickle.dumps(images))
-    return rows_of(s, images, {"seed": seed, "cell": k, "perturbed": perturbed})
+    rows = rows_of(s, images, {"seed": seed, "cell": k, "perturbed": perturbed})
+    return [r | {"knocked": knock is not None and r["camera"] == KNOCKED} for r in rows]
 
 
 def rows_of(s: Scenario, images: dict[str, Any], tags: dict[str, Any]) -> list[dict[str, Any]]:
@@ -164,8 +183,11 @@ def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     """The acceptance's counts: applied corrections (better / worse by more than the prior's 1 sigma) and faults
     on cameras within their stated calibration, for perturbed and exact-but-stated cells."""
     out: dict[str, Any] = {}
+    knocked = [r for r in rows if r.get("knocked") and r.get("overlap")]
+    if knocked:
+        out["knocked"] = {"registrations": len(knocked), "beyond_prior": sum(r["refused"] == FAULT for r in knocked)}
     for label, pert in (("perturbed", True), ("exact_stated", False)):
-        rs = [r for r in rows if r["perturbed"] == pert and r.get("overlap")]
+        rs = [r for r in rows if r["perturbed"] == pert and r.get("overlap") and not r.get("knocked")]
         applied = [r for r in rs if r["refused"] == ""]
         out[label] = {
             "registrations": len(rs),
@@ -186,15 +208,17 @@ def main() -> None:
     ap.add_argument("--exact-stated", default="0.7/0.07")
     ap.add_argument("--cache", type=Path, default=Path("/tmp/splice_truth"))
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--knock", default=None, help=f"T/R: {KNOCKED} truly off by T mm / R deg (its statement kept)")
     ap.add_argument(
         "--noise", default=None, help="every cell's noise: realistic, none, or KEY=VALUE of the cameras' noise models"
     )
     a = ap.parse_args()
     t_mm, r_deg = (float(v) for v in a.exact_stated.split("/"))
+    knock = tuple(float(v) for v in a.knock.split("/")) if a.knock else None
     rows: list[dict[str, Any]] = []
     for k in range(a.first, a.first + a.cells):
         try:
-            got = rows_of_cell(a.seed, k, a.cache, (t_mm, r_deg), a.noise)
+            got = rows_of_cell(a.seed, k, a.cache, (t_mm, r_deg), a.noise, knock)  # type: ignore[arg-type]
         except Exception as err:  # a cell that fails to perceive is reported, not fatal
             print(f"cell {k}: {type(err).__name__}: {err}", flush=True)
             continue

@@ -39,6 +39,7 @@ from cell.geometry import FloatArray, readonly
 
 INFORMED_RATIO = 10.0  # a direction moves only where the prior's variance is this many times the data's
 FAULT_SIGMAS = 3.0  # a disagreement beyond this many prior sigmas along an informed direction is a camera fault
+STRONG_RATIO = 100.0  # a direction the data inform this many times better than the prior is strongly informed
 _RELATIVE_EPS = 1e-12  # prior eigenvalues below this share of the largest are exact (the direction is fixed)
 
 
@@ -94,12 +95,14 @@ class Posterior:
     x_informed : the data's estimate along the informed directions, unshrunk (what the overlap says there).
     informed : number of informed directions (0-6).
     disagreement_sigmas : the largest disagreement along an informed direction, in prior sigmas.
+    strong_sigmas : the same along the strongly informed directions only (:data:`STRONG_RATIO`; 0 when none).
     """
 
     x_map: FloatArray
     x_informed: FloatArray
     informed: int
     disagreement_sigmas: float
+    strong_sigmas: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "x_map", readonly(self.x_map))
@@ -133,7 +136,8 @@ def posterior(x_data: FloatArray, information: FloatArray, prior: FloatArray) ->
     seen = _seen(information, prior)
     x_informed = seen @ (L @ (U[:, informed] @ a))
     x_map = seen @ (L @ (U[:, informed] @ b))
-    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))))
+    strong = float(np.max(np.abs(a[mu[informed] >= STRONG_RATIO]), initial=0.0))
+    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))), strong)
 
 
 def _seen(information: FloatArray, prior: FloatArray) -> FloatArray:

@@ -239,6 +239,8 @@ class Estimate:
     shift_m, map_shift_m : RMS displacement of the overlap by ``X_estimated`` / ``X_map`` [m].
     misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibration and
         after ``X_map``.
+    strong_sigmas : the largest disagreement along a strongly informed direction [prior sigmas]
+        (:data:`cell.perception.pose_prior.STRONG_RATIO`).
     """
 
     X_icp: FloatArray
@@ -252,6 +254,7 @@ class Estimate:
     map_shift_m: float = 0.0
     misfit_before_m: float = math.inf
     misfit_m: float = math.inf
+    strong_sigmas: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("X_icp", "X_estimated", "X_map"):
@@ -319,4 +322,5 @@ def register(
         rms(X_map),
         before,
         after,
+        post.strong_sigmas,
     )

@@ -39,6 +39,7 @@ from cell.geometry import FloatArray, readonly
 
 INFORMED_RATIO = 10.0  # a direction moves only where the prior's variance is this many times the data's
 FAULT_SIGMAS = 3.0  # a disagreement beyond this many prior sigmas along an informed direction is a camera fault
+STRONG_RATIO = 100.0  # a direction the data inform this many times better than the prior is strongly informed
 _RELATIVE_EPS = 1e-12  # prior eigenvalues below this share of the largest are exact (the direction is fixed)
 
 
@@ -124,6 +125,7 @@ class Posterior:
     disagreement_sigmas : the largest disagreement along an informed direction, in prior sigmas.
     covariance : (6, 6) [m^2] of the disagreement left once ``x_map`` is applied (:func:`residual_covariance`):
         the prior's along every direction that was not moved, less along those the data fixed.
+    strong_sigmas : the same along the strongly informed directions only (:data:`STRONG_RATIO`; 0 when none).
     """
 
     x_map: FloatArray
@@ -131,6 +133,7 @@ class Posterior:
     informed: int
     disagreement_sigmas: float
     covariance: FloatArray = field(default_factory=lambda: np.zeros((6, 6)))
+    strong_sigmas: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "x_map", readonly(self.x_map))
@@ -166,7 +169,8 @@ def posterior(x_data: FloatArray, information: FloatArray, prior: FloatArray) ->
     x_informed = seen @ (L @ (U[:, informed] @ a))
     x_map = seen @ (L @ (U[:, informed] @ b))
     covariance = residual_covariance(L, U[:, informed], mu[informed], seen)
-    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))), covariance)
+    strong = float(np.max(np.abs(a[mu[informed] >= STRONG_RATIO]), initial=0.0))
+    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))), covariance, strong)
 
 
 def residual_covariance(L: FloatArray, U_in: FloatArray, mu_in: FloatArray, seen: FloatArray) -> FloatArray:

@@ -240,6 +240,8 @@ class Estimate:
     misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibration and
         after ``X_map``.
     residual : what is left unknown of the disagreement once ``X_map`` is applied (None: no estimate was made).
+    strong_sigmas : the largest disagreement along a strongly informed direction [prior sigmas]
+        (:data:`cell.perception.pose_prior.STRONG_RATIO`).
     """
 
     X_icp: FloatArray
@@ -254,6 +256,7 @@ class Estimate:
     misfit_before_m: float = math.inf
     misfit_m: float = math.inf
     residual: PoseResidual | None = None
+    strong_sigmas: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("X_icp", "X_estimated", "X_map"):
@@ -323,6 +326,7 @@ def register(
         before,
         after,
         PoseResidual(_left(post.covariance, P_prior, before, after), found.centre_R, found.lever_m, after),
+        post.strong_sigmas,
     )
 
 

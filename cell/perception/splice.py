@@ -11,19 +11,18 @@ weighs each camera by its own noise loses nothing to the merge.
 Each camera is registered onto the cameras before it by :func:`cell.perception.registration.register` (open3d's
 ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says), and what it found is an estimate with
 the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`cell.perception.pose_prior`):
-the correction is applied only along directions where the overlap's information outweighs the prior, as the MAP
-estimate, and only if it explains the data: it must lower the misfit of the overlap's patches (RMS of each
-patch's mean point-to-plane residual) by :data:`MIN_MISFIT_DROP`. The information alone is not enough: it counts
-each patch of ``merge_cell_m`` as independent and the sensor's biases are not (edges and flying pixels seen from
-one side bias whole faces): exact cameras get estimates within their prior that look informed yet explain
-nothing, while a real error explains a good part of the misfit (figures in ``docs/perception.md``). A refused
-real correction is not unsafe (the camera's seams keep its calibration in their sigma); an applied false one is.
+the correction is applied only where the overlap informs all six directions (a partly informed overlap's estimate
+is biased by the sensor's noise at edges: 1-9 mm on random cells, ``docs/perception.md``), as the MAP estimate,
+only if it moves the overlap by more than half its noise, and only if it lowers the misfit of the overlap's patches
+(RMS of each patch's mean point-to-plane residual) by :data:`MIN_MISFIT_DROP`. A refused real correction is not
+unsafe (the camera's seams keep its calibration in their sigma); an applied false one is.
 
 A camera stated exact (the default) is not registered at all and never moves (``calibration_exact``); a gross
 error of such a camera is left to the agreement check (:mod:`cell.perception.camera_health`). A camera whose data
-disagree with the prior by more than three prior sigmas along an informed direction is a *fault*
-(``beyond_prior``), not a correction: its points leave the registered cloud and the targets of the cameras after
-it, and perception drops it with the reason (``Spliced.faults``), as a camera that disagrees with the others.
+disagree with the prior by more than three prior sigmas along an informed direction (a partly informed overlap:
+along a strongly informed one, or with the move explaining most of the misfit) is a *fault* (``beyond_prior``),
+not a correction: its points leave the registered cloud and the targets of the cameras after it, and perception
+drops it with the reason (``Spliced.faults``), as a camera that disagrees with the others.
 ``Registration.refused`` says why nothing was applied (:data:`REFUSALS`).
 """
 
@@ -47,8 +46,18 @@ from cell.types import Cloud, DepthImage
 
 MOUNTS = ("fixed", "eye_in_hand")
 MIN_SHIFT_M = 0.0001  # [m] a MAP correction moving the overlap by less than this (RMS) is not applied
+MIN_SHIFT_NOISE = 0.5  # ... nor by less than this many times the overlap's noise (what its biases reach)
 MIN_MISFIT_DROP = 0.10  # ... nor one that lowers the patch misfit by less than this fraction (nor is it a fault)
-REFUSALS = ("calibration_exact", "no_overlap", "not_informed", "too_small", "no_misfit_gain", "beyond_prior")
+FAULT_MISFIT_DROP = 0.80  # a partly informed overlap shows a fault only if the move explains this much of the misfit
+REFUSALS = (
+    "calibration_exact",
+    "no_overlap",
+    "not_informed",
+    "partly_informed",
+    "too_small",
+    "no_misfit_gain",
+    "beyond_prior",
+)
 FAULT = "beyond_prior"  # the refusal that makes the camera a fault (dropped), not merely left as calibrated
 
 
@@ -107,15 +116,23 @@ class Registration:
 
 def refusal(est: Estimate) -> str:
     """``""`` if a registration's estimate (:func:`cell.perception.registration.register`) may be applied, else
-    why not (one of :data:`REFUSALS`, in this order): too few points overlap, no direction is informed, the
-    MAP correction moves the overlap by less than :data:`MIN_SHIFT_M` or lowers the patch misfit by less than
-    :data:`MIN_MISFIT_DROP` (it explains nothing), or the data disagree with the prior beyond
-    :data:`cell.perception.pose_prior.FAULT_SIGMAS` (a fault)."""
+    why not (one of :data:`REFUSALS`, in this order): too few points overlap, no direction is informed, not all
+    six are (the overlap does not fix the whole pose: no correction, and a fault only if the move also lowers the
+    patch misfit by :data:`FAULT_MISFIT_DROP`, or by :data:`MIN_MISFIT_DROP` with the disagreement along a
+    strongly informed direction), the MAP correction
+    moves the overlap by less than :data:`MIN_SHIFT_M` or :data:`MIN_SHIFT_NOISE` times its noise, or lowers
+    the patch misfit by less than :data:`MIN_MISFIT_DROP` (it explains nothing), or the data disagree with the
+    prior beyond :data:`cell.perception.pose_prior.FAULT_SIGMAS` (a fault)."""
     if est.overlap < MIN_OVERLAP:
         return "no_overlap"
     if est.informed == 0:
         return "not_informed"
-    if est.map_shift_m < MIN_SHIFT_M:
+    if est.informed < 6:
+        gross = est.misfit_m <= (1.0 - FAULT_MISFIT_DROP) * est.misfit_before_m
+        gain = est.misfit_m <= (1.0 - MIN_MISFIT_DROP) * est.misfit_before_m
+        strong = est.strong_sigmas > FAULT_SIGMAS and gain
+        return FAULT if (est.disagreement_sigmas > FAULT_SIGMAS and gross) or strong else "partly_informed"
+    if est.map_shift_m < max(MIN_SHIFT_M, MIN_SHIFT_NOISE * est.noise_m):
         return "too_small"
     if not est.misfit_m <= (1.0 - MIN_MISFIT_DROP) * est.misfit_before_m:
         return "no_misfit_gain"

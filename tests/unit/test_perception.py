@@ -503,6 +503,12 @@ def test_refusal_names_the_first_failing_test() -> None:
     assert refusal(ok) == ""
     assert refusal(replace(ok, overlap=MIN_OVERLAP - 1)) == "no_overlap"
     assert refusal(replace(ok, informed=0)) == "not_informed"
+    assert refusal(replace(ok, informed=5)) == "partly_informed"  # the overlap does not fix the whole pose
+    gross = replace(ok, informed=5, disagreement_sigmas=3.5, misfit_m=0.0001)  # the move explains 5/6 of the misfit
+    assert refusal(gross) == "beyond_prior" and refusal(replace(gross, misfit_m=0.0003)) == "partly_informed"
+    strong = replace(ok, informed=5, disagreement_sigmas=3.5, strong_sigmas=3.2)  # along a strongly informed one
+    assert refusal(strong) == "beyond_prior" and refusal(replace(strong, misfit_m=0.00058)) == "partly_informed"
+    assert refusal(replace(ok, map_shift_m=0.0004)) == "too_small"  # under half the overlap's 1 mm of noise
     assert refusal(replace(ok, map_shift_m=MIN_SHIFT_M / 2)) == "too_small"
     assert refusal(replace(ok, misfit_m=0.00058)) == "no_misfit_gain"  # 3 % lower: explains nothing
     assert refusal(replace(ok, disagreement_sigmas=3.5)) == "beyond_prior"  # a fault, not a correction

@@ -114,13 +114,15 @@ def test_prior_of_a_camera_rotation_reaches_the_overlap_by_its_range() -> None:
 
 def test_a_small_miscalibration_is_recovered_along_informed_directions() -> None:
     """cam_b 1 mm / 0.1 deg off (its stated calibration): every direction informed by the box on its plane, the
-    MAP correction takes out nearly all of it and lowers the misfit; within the prior, so no fault."""
+    MAP correction takes out nearly all of it and lowers the misfit; within the prior, so no fault (applied only
+    when all six directions are informed)."""
     rng = np.random.default_rng(1)
     target = _noisy(*_box_on_plane(rng), rng)
     X_off = _off(EYES["cam_b"], [0.3, -1.0, 0.5], 0.1, [0.0006, -0.0005, 0.0006])
     source = transform_points(X_off, _noisy(*_box_on_plane(rng), rng))  # other samples: another camera
     est = register(source, target, SPEC, _prior())
-    assert est.informed >= 5 and est.disagreement_sigmas < FAULT_SIGMAS and refusal(est) == ""
+    assert est.informed >= 5 and est.disagreement_sigmas < FAULT_SIGMAS
+    assert refusal(est) == ("" if est.informed == 6 else "partly_informed")
     probe = source[::20]
     before = np.linalg.norm(transform_points(invert(X_off), probe) - probe, axis=1).mean()
     after = np.linalg.norm(transform_points(invert(X_off), probe) - transform_points(est.X_map, probe), axis=1).mean()
@@ -130,13 +132,14 @@ def test_a_small_miscalibration_is_recovered_along_informed_directions() -> None
 
 def test_a_flat_overlap_moves_nothing_along_it() -> None:
     """A plane fixes its height and its tilt: a shift of 3 mm along it and a turn about its normal are not
-    followed, whatever ICP made of them; the 0.8 mm of height is taken out."""
+    followed, whatever ICP made of them; the MAP takes out the 0.8 mm of height, yet nothing is applied: the
+    overlap does not fix the whole pose, and on random cells such estimates are biased by the sensor."""
     rng = np.random.default_rng(2)
     target = _noisy(*_plane(rng), rng)
     X_off = make_pose(axis_angle_to_matrix([0, 0, 1], math.radians(0.3)), [0.003, -0.002, 0.0008])
     source = transform_points(X_off, _noisy(*_plane(rng), rng))
     est = register(source, target, SPEC, _prior())
-    assert est.informed == 3 and refusal(est) == ""
+    assert est.informed == 3 and refusal(est) == "partly_informed"
     moved = transform_points(est.X_map, source) - source
     assert np.abs(moved[:, :2]).max() < 5e-5  # nothing along the plane (20 um at most at its edge)
     assert abs(moved[:, 2].mean() + 0.0008) < 5e-5  # its height recovered
@@ -144,13 +147,14 @@ def test_a_flat_overlap_moves_nothing_along_it() -> None:
 
 def test_a_round_overlap_moves_nothing_along_or_about_its_axis() -> None:
     """A pipe seen from above fixes its axis' place and direction, not a slide along it nor a turn about it: a
-    cloud 4 mm along and 1 deg about the axis off, and 0.6 mm across, is moved only across."""
+    cloud 4 mm along and 1 deg about the axis off, and 0.6 mm across, is moved only across by the MAP (which is
+    not applied: the overlap does not fix the whole pose)."""
     rng = np.random.default_rng(3)
     target = _noisy(*_pipe(rng), rng, 0.0015)
     X_off = make_pose(axis_angle_to_matrix([1, 0, 0], math.radians(1.0)), [0.004, 0.0006, 0.0])
     source = transform_points(X_off, _noisy(*_pipe(rng), rng, 0.0015))
     est = register(source, target, SPEC, _prior())
-    assert est.informed == 4 and refusal(est) == ""
+    assert est.informed == 4 and refusal(est) == "partly_informed"
     moved = transform_points(est.X_map, source) - source
     assert np.abs(moved[:, 0]).max() < 5e-5  # no slide along the axis (measured 1 um; 1.6 mm without the prior)
     assert abs(moved[:, 1].mean() + 0.0006) < 5e-5  # the 0.6 mm across recovered

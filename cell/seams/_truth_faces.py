@@ -86,11 +86,20 @@ def _half_extent(poly: FloatArray, direction: FloatArray) -> float:
 
 def edge_vertices(part: Part, face_1: str, face_2: str) -> FloatArray:
     """(m, 3) the part's vertices that lie on both faces' planes (within ``_SAME_PLANE_M``): the ends of the edge
-    where the two faces meet, and of its pieces when the drawing split a face in several."""
+    where the two faces meet, and of its pieces when the drawing split a face in several; and the corners both
+    faces' polygons share (a face warped as built, its corners off its fitted plane: a brace's end face moved to
+    open a gap twists the faces beside it)."""
     v = np.asarray(part.vertices(), dtype=float)
     n_1, d_1 = part.face_plane(face_1)
     n_2, d_2 = part.face_plane(face_2)
-    return v[(np.abs(v @ n_1 - d_1) <= _SAME_PLANE_M) & (np.abs(v @ n_2 - d_2) <= _SAME_PLANE_M)]
+    on_both = (np.abs(v @ n_1 - d_1) <= _SAME_PLANE_M) & (np.abs(v @ n_2 - d_2) <= _SAME_PLANE_M)
+    p_1, p_2 = part.face_polygon(face_1), part.face_polygon(face_2)
+    shared = np.all(p_1[:, None, :] == p_2[None, :, :], axis=2).any(axis=1)
+    corners = p_1[shared]
+    if not len(corners):
+        return v[on_both]
+    new = ~np.all(corners[:, None, :] == v[on_both][None, :, :], axis=2).any(axis=1)
+    return np.concatenate([v[on_both], corners[new]])
 
 
 def _clip(uv: FloatArray, lo: float, hi: float) -> FloatArray:

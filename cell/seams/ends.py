@@ -5,10 +5,7 @@ not be. :func:`check_ends` holds every found estimate to two things the aligned 
 
 1. an end never lies inside another part's body: walking from the seam's middle towards each end, where the line
    enters any other part of the map (a tube the seam ends against, a rail across it) the end is cut to its face
-   (``other_part``; an end moved further than two of its sigmas keeps only the drawn end's sigma). The line walked
-   lies :data:`FILLET_OFFSET_M` off both weld faces, in the fillet the bead fills: a part standing on the receiving
-   face (a pipe on the base plate a web ends against) has its foot in that face's plane, where the seam's own line
-   never enters it deeper than the surface noise;
+   (``other_part``; an end moved further than two of its sigmas keeps only the drawn end's sigma);
 2. the located length agrees with the drawn one to within the part tolerance on a seam of that length
    (:func:`~cell.seams.sigma.length_tolerance_m`) plus two sigmas of the two ends together (an end run along the
    receiving face past the abutting part's end, a mitred brace's, does not); otherwise the end that deviates
@@ -32,9 +29,6 @@ from cell.seams.sigma import drawn_end_sigma, length_tolerance_m
 from cell.types import EndSource, Joint, Part, Reason, SeamEstimate, SeamStatus, WeldMap
 
 INSIDE_MARGIN_M = 3e-4  # an end deeper than this inside another body is in it (surface noise apart) [m]
-# How far off each weld face [m] the walked line lies: in the bead (a fillet's leg is 3 mm and more), and past the
-# margin, so that a body standing on a weld face is entered there.
-FILLET_OFFSET_M = 1e-3
 _STEP_M = 2.5e-4  # the walk along the seam that finds where it enters another body [m] (a 2 mm wall is 8 steps)
 _BISECT = 10  # halvings of a step where the seam enters a body (0.25 mm / 2^10)
 _NAMES = ("start", "end")
@@ -79,11 +73,9 @@ def check_seam_ends(weldmap: WeldMap, joint: Joint | None, est: SeamEstimate, to
     drawn = drawn_end_sigma(tolerance_m, seam.length)
     allowed = length_tolerance_m(tolerance_m, seam.length)
 
-    lifted = a + _fillet_offset(weldmap, joint, t)
-
     def cut(k: int) -> None:
-        """End k cut where the seam's fillet enters another body, walking out from the middle."""
-        hit = _entry(others, lifted, t, 0.5 * (s[0] + s[1]), s[k])
+        """End k cut where the seam enters another body, walking out from the middle."""
+        hit = _entry(others, a, t, 0.5 * (s[0] + s[1]), s[k])
         if hit is None:
             return
         u, part = hit
@@ -130,22 +122,6 @@ def check_seam_ends(weldmap: WeldMap, joint: Joint | None, est: SeamEstimate, to
     )
 
 
-def _fillet_offset(weldmap: WeldMap, joint: Joint | None, t: FloatArray) -> FloatArray:
-    """(3,) [m] from the seam's line into its fillet: :data:`FILLET_OFFSET_M` off each weld face (outward normals
-    n_a, n_b, made square to the seam's direction ``t``); zero without a joint."""
-    if joint is None:
-        return np.zeros(3)
-    n_a = weldmap.part(joint.abutting).face_plane(joint.face_abutting)[0]
-    n_b = weldmap.part(joint.receiving).face_plane(joint.face_receiving)[0]
-    n_a, n_b = n_a - (n_a @ t) * t, n_b - (n_b @ t) * t
-    # The point off both faces by the offset: n_a . x = n_b . x = offset, x square to t.
-    G = np.array([[n_a @ n_a, n_a @ n_b], [n_a @ n_b, n_b @ n_b]])
-    if abs(float(np.linalg.det(G))) < 1e-9:
-        return np.zeros(3)
-    c = np.linalg.solve(G, [FILLET_OFFSET_M, FILLET_OFFSET_M])
-    return np.asarray(c[0] * n_a + c[1] * n_b, float)
-
-
 def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end: float) -> tuple[float, str] | None:
     """Where the line a + u t (a, t (3,)), walked from u = ``mid`` to u = ``end`` [m], first enters one of ``parts``
     (deeper than :data:`INSIDE_MARGIN_M`): (u [m], that part's name), or None. A part the middle lies in is not
@@ -182,4 +158,4 @@ def _entry(parts: Sequence[Part], a: FloatArray, t: FloatArray, mid: float, end:
     return out_u - back, part.name
 
 
-__all__ = ["FILLET_OFFSET_M", "INSIDE_MARGIN_M", "check_ends", "check_seam_ends"]
+__all__ = ["INSIDE_MARGIN_M", "check_ends", "check_seam_ends"]

@@ -208,6 +208,7 @@ def closeup_scene(
         weldmap=base.weldmap,
         joints=base.joints,
         table_z=base.table_z,
+        eyes_R={image.camera: np.asarray(in_R.X_WC, dtype=float)[:3, 3]},
     )
 
 

@@ -12,14 +12,21 @@ A pose error moves every point the camera sees rigidly: at range ``r`` from the 
 (per-point camera index) within :data:`SUPPORT_RADIUS_M` of the located segment; camera ``c`` holds the share
 ``w_c`` of those points. A camera the splice registered and *corrected* (``Registration.accepted``) now sits where
 its reference camera puts it, so it inherits the reference's error: cameras tied to one reference make one error
-source with the summed share. Independent sources add in quadrature,
+source with the summed share. It also keeps what the correction did not fix: the splice's posterior of the
+disagreement left (``Registration.residual``, :class:`~cell.perception.pose_prior.PoseResidual`: its prior along
+every direction the overlap did not inform, the posterior's along those it did), an error of its own at the
+seam ``sigma_res``, counted as an independent source with the camera's share (conservative: the reference's
+error is counted in both). Independent sources add in quadrature,
 
-    sigma_cal = sqrt(sum_g (W_g * sigma_g)^2),
+    sigma_cal = sqrt(sum_g (W_g * sigma_g)^2 + sum_c (w_c * sigma_res_c)^2),
 
 so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
-cameras about 1 / sqrt(2) of it. The seam's sigma becomes ``hypot(sigma_locator, sigma_cal)``, and so does each
-end's sigma along it (``end_sigma_m``: the same rigid error moves the ends too). With every calibration at 0 (the
-default) nothing changes and nothing is computed.
+cameras about 1 / sqrt(2) of it. Given the seam's weld faces (:func:`seam_calibration_sigma`), the shares are
+taken per face strip and carried to the line where the two faces meet: the line moves with each face, so a face
+seen by one camera alone brings all of that camera's error whatever camera sees the other (a fillet's floor from
+one camera and its wall from another: one camera's sigma, not 1 / sqrt 2 of it). The seam's sigma becomes
+``hypot(sigma_locator, sigma_cal)``, and so does each end's sigma along it (``end_sigma_m``: the same rigid
+error moves the ends too). With every calibration at 0 (the default) nothing changes and nothing is computed.
 
 The close-up of a re-scan (:func:`closeup_sigma`) is seen by the arm's camera alone, at its close range. (Its
 fusion with the first estimate treats the two as independent; when both rest on the same camera's calibration the
@@ -33,9 +40,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.perception.pose_prior import PoseUncertainty
+from cell.perception.pose_prior import PoseResidual, PoseUncertainty
 from cell.perception.splice import Registration
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
@@ -44,6 +52,8 @@ __all__ = [
     "calibration_sigma",
     "closeup_sigma",
     "reference_of",
+    "residuals_of",
+    "seam_calibration_sigma",
     "support_shares",
     "with_calibration",
 ]
@@ -62,20 +72,35 @@ def reference_of(registrations: Sequence[Registration]) -> dict[str, str]:
     return tied
 
 
+def residuals_of(registrations: Sequence[Registration]) -> dict[str, tuple[PoseResidual, ...]]:
+    """Camera name -> what its applied correction left unknown (the splice's posterior), for every corrected
+    camera whose registration computed one, followed by its corrected targets' (a camera registered onto a corrected
+    one carries that one's residual too: counted whole, conservatively, whatever its share of the target)."""
+    out: dict[str, tuple[PoseResidual, ...]] = {}
+    for r in registrations:  # in the splice's order: a target's residuals are known before its sources'
+        if r.accepted and r.residual is not None:
+            out[r.source] = (r.residual, *(x for t in r.target for x in out.get(t, ())))
+    return out
+
+
 def calibration_sigma(
     shares: Mapping[str, float],
     mid_R: FloatArray,
     origins_R: Mapping[str, FloatArray],
     uncertainty: Mapping[str, PoseUncertainty],
     tied: Mapping[str, str],
+    residuals: Mapping[str, Sequence[PoseResidual]] | None = None,
 ) -> float:
     """sigma_cal [m] of a seam at ``mid_R`` whose support is split ``shares`` (camera -> fraction) between cameras
-    (module docstring). A camera with no stated uncertainty or no known origin contributes nothing."""
+    (module docstring); ``residuals``: a corrected camera's posterior (:func:`residuals_of`). A camera with no
+    stated uncertainty or no known origin contributes nothing."""
     groups: dict[str, float] = {}
+    total = 0.0
     for camera, w in shares.items():
         source = tied.get(camera, camera)
         groups[source] = groups.get(source, 0.0) + w
-    total = 0.0
+        for left in (residuals or {}).get(camera, ()) if source != camera else ():
+            total += (w * left.sigma_at(mid_R)) ** 2
     for source, w in groups.items():
         u = uncertainty.get(source)
         origin = origins_R.get(source)
@@ -89,6 +114,21 @@ def support_shares(
     cloud: Cloud, p0: FloatArray, p1: FloatArray, radius_m: float = SUPPORT_RADIUS_M
 ) -> dict[str, float]:
     """Camera name -> share of ``cloud``'s points within ``radius_m`` of the segment p0-p1 (empty: none near)."""
+    _, cams = _support(cloud, p0, p1, radius_m)
+    return _shares(cloud, cams)
+
+
+def _shares(cloud: Cloud, cams: npt.NDArray[np.int16]) -> dict[str, float]:
+    """Camera name -> share of the camera indices ``cams`` (unknown ones left out; empty: none)."""
+    cams = cams[cams >= 0]
+    if cams.size == 0:
+        return {}
+    idx, counts = np.unique(cams, return_counts=True)
+    return {cloud.cameras[int(i)]: float(c) / float(cams.size) for i, c in zip(idx, counts, strict=True)}
+
+
+def _support(cloud: Cloud, p0: FloatArray, p1: FloatArray, radius_m: float) -> tuple[FloatArray, npt.NDArray[np.int16]]:
+    """The points (k, 3) of ``cloud`` within ``radius_m`` of the segment p0-p1 and their camera indices (k,)."""
     lo = np.minimum(p0, p1) - radius_m
     hi = np.maximum(p0, p1) + radius_m
     pts = cloud.points
@@ -98,12 +138,53 @@ def support_shares(
     length2 = float(t @ t)
     s = np.clip(((near - p0) @ t) / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros(len(near))
     d = np.linalg.norm(near - (p0 + s[:, None] * t), axis=1)
-    cams = cams[d <= radius_m]
-    cams = cams[cams >= 0]
-    if cams.size == 0:
-        return {}
-    idx, counts = np.unique(cams, return_counts=True)
-    return {cloud.cameras[int(i)]: float(c) / float(cams.size) for i, c in zip(idx, counts, strict=True)}
+    return near[d <= radius_m], cams[d <= radius_m]
+
+
+def seam_calibration_sigma(
+    cloud: Cloud,
+    est: SeamEstimate,
+    faces: tuple[FloatArray, float, FloatArray, float] | None,
+    origins_R: Mapping[str, FloatArray],
+    uncertainty: Mapping[str, PoseUncertainty],
+    tied: Mapping[str, str],
+    residuals: Mapping[str, Sequence[PoseResidual]],
+) -> float:
+    """sigma_cal [m] of one found seam. Without its weld faces' planes (``faces``: n_a, d_a, n_b, d_b), from
+    its whole support (module docstring). With them, through each face: an error source ``s`` (a camera group,
+    or a corrected camera's residual) of per-axis sigma ``sigma_s`` that holds the shares ``a_s``, ``b_s`` of the
+    two faces' strips moves their offsets by ``(a_s n_a . e, b_s n_b . e)``, and the line, where the two planes
+    meet, by ``x`` with ``|x|^2 = delta^T G^-1 delta`` (``G`` the faces' normals' Gram matrix). With ``C`` the
+    offsets' covariance, ``x``'s per-axis RMS across the seam is ``sqrt(tr(G^-1 C) / 2)``: one camera seeing both
+    faces moves the line rigidly (its own sigma), one camera per face moves each face alone (its own sigma too,
+    where the shares would have said 1 / sqrt 2), and a sharp dihedral amplifies both. The lateral error is the
+    distance ``|x|`` over both axes, so the sigma returned is that RMS times sqrt(-2 ln 0.05) / 2 (1.22): two
+    of it hold 95 % of such a distance."""
+    P, cams = _support(cloud, est.p_start, est.p_end, SUPPORT_RADIUS_M)
+    mid = 0.5 * (est.p_start + est.p_end)
+    if faces is None or len(P) == 0:
+        return calibration_sigma(_shares(cloud, cams), mid, origins_R, uncertainty, tied, residuals)
+    n_a, d_a, n_b, d_b = faces
+    on_a = np.abs(P @ n_a - d_a) < np.abs(P @ n_b - d_b)
+    strips = (_shares(cloud, cams[on_a]), _shares(cloud, cams[~on_a]))
+    sources: dict[tuple[str, int], list[float]] = {}  # (source, k) -> [sigma, share of A, share of B]
+    for side, shares in enumerate(strips):
+        for camera, w in shares.items():
+            group = tied.get(camera, camera)
+            u, origin = uncertainty.get(group), origins_R.get(group)
+            if u is not None and not u.zero and origin is not None:
+                src = sources.setdefault((group, -1), [u.sigma_at(float(np.linalg.norm(mid - origin))), 0.0, 0.0])
+                src[1 + side] += w
+            for k, left in enumerate(residuals.get(camera, ()) if group != camera else ()):
+                sources.setdefault((camera, k), [left.sigma_at(mid), 0.0, 0.0])[1 + side] += w
+    c = float(np.clip(n_a @ n_b, -0.995, 0.995))
+    C = np.zeros((2, 2))
+    for sigma, a, b in sources.values():
+        C += sigma**2 * np.array([[a * a, a * b * c], [a * b * c, b * b]])
+    G_inv = np.linalg.inv(np.array([[1.0, c], [c, 1.0]]))
+    # |x| is a distance over two axes: 95 % of it lies within sqrt(-2 ln 0.05) per-axis RMS (chi-square, two
+    # degrees), and the sigma is read as 95 % within two of it.
+    return math.sqrt(max(float(np.trace(G_inv @ C)), 0.0) / 2.0 * -2.0 * math.log(0.05) / 4.0)
 
 
 def with_calibration(
@@ -112,20 +193,21 @@ def with_calibration(
     origins_R: Mapping[str, FloatArray],
     uncertainty: Mapping[str, PoseUncertainty],
     registrations: Sequence[Registration],
+    faces: Mapping[str, tuple[FloatArray, float, FloatArray, float]] | None = None,
 ) -> tuple[SeamEstimate, ...]:
     """Every found seam's sigma with its cameras' calibration in quadrature (module docstring); the estimates
-    unchanged when no camera states an uncertainty."""
+    unchanged when no camera states an uncertainty. ``faces``: seam id -> its weld faces' planes (n_a, d_a, n_b,
+    d_b) in R, for the term per face (:func:`seam_calibration_sigma`)."""
     if all(u.zero for u in uncertainty.values()):
         return tuple(estimates)
     tied = reference_of(registrations)
+    left = residuals_of(registrations)
     out = []
     for est in estimates:
         if est.status is not SeamStatus.FOUND or not math.isfinite(est.sigma_m):
             out.append(est)
             continue
-        shares = support_shares(registered, est.p_start, est.p_end)
-        mid = 0.5 * (est.p_start + est.p_end)
-        cal = calibration_sigma(shares, mid, origins_R, uncertainty, tied)
+        cal = seam_calibration_sigma(registered, est, (faces or {}).get(est.id), origins_R, uncertainty, tied, left)
         out.append(with_term(est, cal) if cal > 0.0 else est)
     return tuple(out)
 

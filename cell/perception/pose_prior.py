@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -56,6 +56,34 @@ class PoseUncertainty:
     @property
     def zero(self) -> bool:
         return self.translation_m == 0.0 and self.rotation_rad == 0.0
+
+
+@dataclass(frozen=True)
+class PoseResidual:
+    """What is left unknown of a camera's pose once the splice applied its correction: the covariance (6, 6)
+    [m^2] of the disagreement left (:attr:`Posterior.covariance`) in the registration's coordinates about the
+    overlap's centroid ``centre_R`` (3,) [m] with ``lever_m`` [m] (:mod:`cell.perception.registration`)."""
+
+    covariance: FloatArray
+    centre_R: FloatArray
+    lever_m: float
+    misfit_m: float = 0.0  # RMS over patches of the overlap's mean point-to-plane residual after the correction [m]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "covariance", readonly(self.covariance))
+        object.__setattr__(self, "centre_R", readonly(self.centre_R))
+
+    def sigma_at(self, p_R: FloatArray) -> float:
+        """Per-axis standard deviation [m] of a point at ``p_R`` (3,) moved by that error (an RMS over three axes,
+        as :meth:`PoseUncertainty.sigma_at`): a rotation ``w`` (the first three coordinates over the lever) about
+        the centroid and a shift ``s`` move it by ``s + w x (p - centre)``; never less than the misfit the overlap
+        still shows after the correction (the surfaces of the camera and of its targets still that far apart: what
+        the data's information, which assumes the model right, cannot see)."""
+        d = np.asarray(p_R, dtype=float) - self.centre_R
+        skew = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
+        J = np.hstack([-skew / self.lever_m, np.eye(3)])
+        spread = math.sqrt(max(float(np.trace(J @ self.covariance @ J.T)), 0.0) / 3.0)
+        return math.hypot(spread, self.misfit_m if math.isfinite(self.misfit_m) else 0.0)
 
 
 def camera_covariance(u: PoseUncertainty, origin_R: FloatArray, centre_R: FloatArray, lever_m: float) -> FloatArray:
@@ -94,16 +122,20 @@ class Posterior:
     x_informed : the data's estimate along the informed directions, unshrunk (what the overlap says there).
     informed : number of informed directions (0-6).
     disagreement_sigmas : the largest disagreement along an informed direction, in prior sigmas.
+    covariance : (6, 6) [m^2] of the disagreement left once ``x_map`` is applied (:func:`residual_covariance`):
+        the prior's along every direction that was not moved, less along those the data fixed.
     """
 
     x_map: FloatArray
     x_informed: FloatArray
     informed: int
     disagreement_sigmas: float
+    covariance: FloatArray = field(default_factory=lambda: np.zeros((6, 6)))
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "x_map", readonly(self.x_map))
         object.__setattr__(self, "x_informed", readonly(self.x_informed))
+        object.__setattr__(self, "covariance", readonly(self.covariance))
 
     @property
     def fault(self) -> bool:
@@ -120,20 +152,38 @@ def posterior(x_data: FloatArray, information: FloatArray, prior: FloatArray) ->
     top = float(vals.max()) if vals.size else 0.0
     free = vals > _RELATIVE_EPS * top if top > 0.0 else np.zeros(6, dtype=bool)
     if not free.any():
-        return Posterior(zero, zero, 0, 0.0)
+        return Posterior(zero, zero, 0, 0.0, np.zeros((6, 6)))
     L = vecs[:, free] * np.sqrt(vals[free])  # (6, k): x = L y, y ~ N(0, I) under the prior
     L_pinv = (vecs[:, free] / np.sqrt(vals[free])).T  # (k, 6)
     info_w = L.T @ (0.5 * (information + information.T)) @ L  # whitened information: prior / data variance
     mu, U = np.linalg.eigh(info_w)
     informed = mu >= INFORMED_RATIO
     if not informed.any():
-        return Posterior(zero, zero, 0, 0.0)
+        return Posterior(zero, zero, 0, 0.0, L @ L.T)
     a = U[:, informed].T @ (L_pinv @ x_data)  # the data's estimate along each informed direction [prior sigmas]
     b = mu[informed] / (1.0 + mu[informed]) * a
     seen = _seen(information, prior)
     x_informed = seen @ (L @ (U[:, informed] @ a))
     x_map = seen @ (L @ (U[:, informed] @ b))
-    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))))
+    covariance = residual_covariance(L, U[:, informed], mu[informed], seen)
+    return Posterior(x_map, x_informed, int(informed.sum()), float(np.max(np.abs(a))), covariance)
+
+
+def residual_covariance(L: FloatArray, U_in: FloatArray, mu_in: FloatArray, seen: FloatArray) -> FloatArray:
+    """(6, 6) [m^2] covariance of the disagreement e left after the correction of :func:`posterior` is applied.
+
+    In the prior's whitened coordinates (``e = L y``, ``y ~ N(0, I)``) the data read ``y + v`` with ``v`` of
+    covariance ``U diag(1 / mu) U^T``; the correction is ``x = S L K (y + v)`` with ``K = U_in diag(mu / (1 + mu))
+    U_in^T`` (the informed directions ``U_in`` (k, m), their ratios ``mu_in`` (m,)) and ``S`` the projector
+    ``seen`` (6, 6). What is left, ``e - x = (L - S L K) y - S L K v``, has the covariance
+
+        (L - S L K)(L - S L K)^T + S L U_in diag(mu / (1 + mu)^2) U_in^T L^T S^T
+
+    (the prior itself along every direction not moved, the posterior's along those the data fixed)."""
+    K = (U_in * (mu_in / (1.0 + mu_in))) @ U_in.T
+    M = L - seen @ L @ K
+    N = seen @ L @ U_in * np.sqrt(mu_in) / (1.0 + mu_in)
+    return np.asarray(M @ M.T + N @ N.T)
 
 
 def _seen(information: FloatArray, prior: FloatArray) -> FloatArray:

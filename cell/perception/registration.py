@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation
 
 from cell.geometry import FloatArray, make_pose, readonly, transform_points
 from cell.perception import _open3d
-from cell.perception.pose_prior import posterior
+from cell.perception.pose_prior import PoseResidual, posterior
 from cell.scenario import PerceptionSpec
 
 _PROBE_POINTS = 20_000  # source points a registration uses (an even stride)
@@ -239,6 +239,7 @@ class Estimate:
     shift_m, map_shift_m : RMS displacement of the overlap by ``X_estimated`` / ``X_map`` [m].
     misfit_before_m, misfit_m : RMS over patches of the mean point-to-plane residual [m], at the calibration and
         after ``X_map``.
+    residual : what is left unknown of the disagreement once ``X_map`` is applied (None: no estimate was made).
     """
 
     X_icp: FloatArray
@@ -252,6 +253,7 @@ class Estimate:
     map_shift_m: float = 0.0
     misfit_before_m: float = math.inf
     misfit_m: float = math.inf
+    residual: PoseResidual | None = None
 
     def __post_init__(self) -> None:
         for name in ("X_icp", "X_estimated", "X_map"):
@@ -296,7 +298,8 @@ def register(
     found = evidence(probe, tree, sub, normals, X_icp, settings, spec.merge_cell_m, calibrated, split)
     if found is None:
         return Estimate(X_icp, eye, eye, len(r0), noise, misfit_before_m=before, misfit_m=before)
-    post = posterior(found.x_data, found.information, prior(found.centre_R, found.lever_m))
+    P_prior = prior(found.centre_R, found.lever_m)
+    post = posterior(found.x_data, found.information, P_prior)
     X_estimated = pose_of(post.x_informed, found.centre_R, found.lever_m)
     X_map = pose_of(post.x_map, found.centre_R, found.lever_m)
     p, n, r = _plane_residuals(probe, tree, sub, normals, settings.reach_m, X_map)
@@ -319,4 +322,14 @@ def register(
         rms(X_map),
         before,
         after,
+        PoseResidual(_left(post.covariance, P_prior, before, after), found.centre_R, found.lever_m, after),
     )
+
+
+def _left(posterior_cov: FloatArray, prior_cov: FloatArray, misfit_before_m: float, misfit_m: float) -> FloatArray:
+    """(6, 6) [m^2] what a correction leaves unknown: the posterior's covariance, and at least the share of the
+    prior that the overlap's patch misfit still shows after the correction (``misfit_m / misfit_before_m``, squared).
+    The information takes the patches as independent and the sensor's biases are not (exact cameras stated at
+    1 mm / 0.1 deg get informed estimates of up to 2.5 mm, docs/perception.md): the posterior alone is too sure."""
+    share = misfit_m / misfit_before_m if 0.0 < misfit_before_m < math.inf and math.isfinite(misfit_m) else 1.0
+    return np.asarray(posterior_cov + min(share, 1.0) ** 2 * prior_cov)

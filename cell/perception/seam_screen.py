@@ -27,7 +27,7 @@ def foreign_points(
     voxels: VoxelTable | None = None,
 ) -> int:
     """How many points of ``dense`` (R) within ``radius_m`` of the segment p_start-p_end (3,) [m] lie further
-    than ``margin_m`` from every part of the map and above the table: an object the map does not know.
+    than ``margin_m`` from every part and fixture of the map and above the table: an object the map does not know.
 
     voxels : where the voxels of ``dense`` lie in it when it is in voxel order: only the points of the voxels
     about the segment are looked at (the same count, without a pass over the whole cloud)."""
@@ -41,7 +41,7 @@ def foreign_points(
     t = np.clip((Q - a) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0)
     near = np.linalg.norm(Q - (a + t[:, None] * ab), axis=1) <= o.radius_m
     Q = Q[near & (Q[:, 2] > table_z + o.margin_m)]
-    for part in weldmap_R.parts:
+    for part in (*weldmap_R.parts, *weldmap_R.fixtures):  # the map's fixtures are known too: not occluders
         Q = Q[~part.contains(Q, o.margin_m)]
     return len(Q)
 

@@ -40,7 +40,7 @@ import numpy.typing as npt
 from cell.errors import SensorError
 from cell.geometry import FloatArray, invert, readonly, transform_points
 from cell.perception.merge import prioritised_merge, surface_normals
-from cell.perception.pose_prior import FAULT_SIGMAS, PoseUncertainty, relative_covariance
+from cell.perception.pose_prior import FAULT_SIGMAS, PoseResidual, PoseUncertainty, relative_covariance
 from cell.perception.registration import MIN_OVERLAP, Estimate, register
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage
@@ -70,6 +70,8 @@ class Registration:
     disagreement_sigmas : the data's largest disagreement with the prior along an informed direction, in prior
         sigmas (beyond :data:`cell.perception.pose_prior.FAULT_SIGMAS`: a camera fault).
     refused : ``""`` when applied, else why not (one of :data:`REFUSALS`; :data:`FAULT` drops the camera).
+    residual : what is left unknown of the camera's pose relative to its targets once the correction is applied
+        (the posterior; None when nothing was estimated).
     """
 
     source: str
@@ -86,6 +88,7 @@ class Registration:
     noise_m: float = 0.0
     disagreement_sigmas: float = 0.0
     refused: str = ""
+    residual: PoseResidual | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "X_corr", readonly(self.X_corr))
@@ -325,4 +328,5 @@ class _Steps:
             est.noise_m,
             est.disagreement_sigmas,
             refused,
+            est.residual,
         )

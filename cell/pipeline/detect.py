@@ -116,6 +116,7 @@ def build_scene(
         joints=cap.joints,
         table_z=table_z_R(sc),
         dense_voxels=perceived.registered_voxels,
+        eyes_R=perceived.origins_R,
     )
     return Scene(seam_scene, perceived, alignment, X_RM, timings, missing)
 
@@ -125,6 +126,7 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     from cell.perception import screen
     from cell.seams.base import BatchSeamLocator
     from cell.seams.ends import check_ends
+    from cell.seams.joint import weld_faces
     from cell.seams.registry import make_locator, part_tolerance_m
     from cell.seams.visibility import visibility
 
@@ -159,7 +161,10 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     out = screen(ss, out, scene.missing, scenario.perception.screen)
     # A seam resting on one camera carries that camera's calibration error (the locator's sigma cannot see it).
     p = scene.perceived
-    return with_calibration(out, p.registered, p.origins_R, pose_uncertainties(scenario), p.spliced.registrations)
+    faces = {s.id: weld_faces(ss.weldmap, ss.joints[s.id]) for s in seams if s.id in ss.joints}
+    return with_calibration(
+        out, p.registered, p.origins_R, pose_uncertainties(scenario), p.spliced.registrations, faces
+    )
 
 
 def pose_uncertainties(scenario: Scenario) -> dict[str, PoseUncertainty]:

@@ -162,6 +162,12 @@ class TiltFit:
 
     c0, a, b : (J,) offset [m] and slopes [-]; uc, vc : (J,) weighted centroids [m].
     se0 : (J,) standard error of the plane's value at u = 0, v = vc [m] (sandwich).
+    bias0 : (J,) how far [m] the plane the prior holds lies, at u = 0 and the points' far ends along v, from the
+        plane the points alone fit, beyond twice that difference's own standard error: a face tilted more than the
+        prior lets it (an as-built part tilted by its neighbour), whose line the offset's error does not cover.
+    tilt0 : (J,) the standard deviation [m] of the plane's value at u = 0 and the points' far ends along v from
+        the slopes alone, as far as the points leave them unknown: each slope's posterior from the points and
+        the parts' angular tolerance (``tolerance_sd``), carried from the centroid.
     """
 
     c0: FloatArray
@@ -170,16 +176,25 @@ class TiltFit:
     uc: FloatArray
     vc: FloatArray
     se0: FloatArray
+    bias0: FloatArray
+    tilt0: FloatArray
 
 
 def tilt_fits(
-    r: FloatArray, u: FloatArray, v: FloatArray, w: FloatArray, lengths: list[int], prior_sd: float
+    r: FloatArray,
+    u: FloatArray,
+    v: FloatArray,
+    w: FloatArray,
+    lengths: list[int],
+    prior_sd: float,
+    tolerance_sd: float = 0.0,
 ) -> TiltFit:
     """Weighted least squares of the residuals r (n,) [m] of J planes (one segment of ``lengths[j] >= 4``
     points per plane, in order) as r = c0 + a (u - uc) + b (v - vc) in each plane's coordinates u, v (n,) [m]
     with weights w (n,), the slopes held near 0 by a Gaussian prior of ``prior_sd``; about each plane's
     weighted centroid (uc, vc), so that the offset and the slopes are uncorrelated. The covariance is the
-    sandwich (robust to weights that are not inverse variances), scaled by n / (n - 3)."""
+    sandwich (robust to weights that are not inverse variances), scaled by n / (n - 3). ``tolerance_sd``: the
+    standard deviation of the slopes as built [-] (0: not counted), for :attr:`TiltFit.tilt0`."""
     n_planes = len(lengths)
     starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
     label = np.repeat(np.arange(n_planes), lengths)
@@ -204,4 +219,26 @@ def tilt_fits(
     cov = H_inv @ outer_sums(m, m) @ H_inv * (n / np.maximum(n - 3.0, 1.0))[:, None, None]
     J = np.stack([np.ones(n_planes), -uc, np.zeros(n_planes)], axis=1)
     se0 = np.sqrt(np.maximum(np.einsum("ji,jik,jk->j", J, cov, J), 0.0))
-    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0)
+    # The points alone (no prior on the slopes), and how far that plane lies from the prior's at the ends.
+    H_free = outer_sums(wX, X)
+    bias0, tilt0 = np.zeros(n_planes), np.zeros(n_planes)
+    ok = np.abs(np.linalg.det(H_free)) > 1e-30
+    if ok.any():
+        H_free_inv = np.zeros_like(H_free)
+        H_free_inv[ok] = np.linalg.inv(H_free[ok])
+        coef_free = np.einsum("jik,kj->ji", H_free_inv, np.add.reduceat(wX * r, starts, axis=1))
+        m_free = X * (w * (r - np.einsum("in,ni->n", X, coef_free[label])))
+        cov_free = H_free_inv @ outer_sums(m_free, m_free) @ H_free_inv * (n / np.maximum(n - 3.0, 1.0))[:, None, None]
+        v_lo, v_hi = np.minimum.reduceat(v, starts), np.maximum.reduceat(v, starts)
+        for v_end in (v_lo, v_hi):
+            J_end = np.stack([np.ones(n_planes), -uc, v_end - vc], axis=1)
+            gap = np.einsum("ji,ji->j", J_end, coef_free - coef)
+            var = np.einsum("ji,jik,jk->j", J_end, cov_free, J_end)
+            bias0 = np.maximum(bias0, np.sqrt(np.maximum(gap**2 - 4.0 * var, 0.0)))
+            if tolerance_sd > 0.0:
+                # Each slope as the points and the tolerance know it together (the points' information added).
+                slopes = 1.0 / (tolerance_sd**-2 + 1.0 / np.maximum(cov_free[:, (1, 2), (1, 2)], 1e-30))
+                tilt0 = np.maximum(tilt0, np.sqrt(slopes[:, 0] * uc**2 + slopes[:, 1] * (v_end - vc) ** 2))
+        bias0[~ok] = 0.0
+        tilt0[~ok] = 0.0
+    return TiltFit(coef[:, 0], coef[:, 1], coef[:, 2], uc, vc, se0, bias0, tilt0)

@@ -28,9 +28,10 @@ _Z = np.array([0.0, 0.0, 1.0])
 _ROUND_COS = np.cos(np.radians(30.0))  # an adjacent face this near the face's own plane is a corner radius's facet
 ROUND_BLUR_M = 1e-3  # a rounded edge seen blurred over this much is a silhouette, not the face's plane [m]
 
-# The points of the cloud within ``radius`` [m] of the segment a-b (3,): (n, 3) [m], camera (n,), and whether each
-# may support a plane (above the table, away from the map's other parts).
-Points = Callable[[FloatArray, FloatArray, float], tuple[FloatArray, IntArray, BoolArray]]
+# The points of the cloud within ``radius`` [m] of the segment a-b (3,): (n, 3) [m], camera (n,), whether each
+# may support a plane (above the table, away from the map's other parts), and whether its camera lies in front of
+# the face being placed (all True where the cameras' centres are not known).
+Points = Callable[[FloatArray, FloatArray, float], tuple[FloatArray, IntArray, BoolArray, BoolArray]]
 
 
 class EdgeOptions(Protocol):
@@ -114,13 +115,17 @@ def place_from_edge(
         # Points near the edge line, alongside the seam (its ends projected on the edge, +- the tube radius).
         s_ends = sorted(float(e @ (p - q0)) for p in seam)
         e_lo, e_hi = s_ends[0] - o.tube_radius_m, s_ends[1] + o.tube_radius_m
-        P, cam, ok = points(q0 + e_lo * e, q0 + e_hi * e, float(np.hypot(max(-lo, hi), gate)))
+        P, cam, ok, front = points(q0 + e_lo * e, q0 + e_hi * e, float(np.hypot(max(-lo, hi), gate)))
         u = P @ n - d  # along the face's outward normal: the adjacent face's points end at u = 0
         r_g = P @ n_g - d_g
         # A facet of a corner radius (a tube's rounded edge): only a camera in front of the face sees the round out
         # to the face's plane, sharply; one that sees it blurred looks from behind the face, at its silhouette.
+        # A camera behind the face sees the round's silhouette, wherever the round meets the face: only the cameras
+        # in front of it read a facet's edge (where their centres are known; else the blur below tells).
         rounded = abs(float(n_g @ n)) > _ROUND_COS
         region = ok & away(P) & (u > lo) & (u < hi) & along_edge(part, face_name, g, P, o.edge_band_m)
+        if rounded:
+            region &= front
         sel = region & (np.abs(r_g) < gate)
         if np.count_nonzero(sel) < o.min_face_points:
             continue

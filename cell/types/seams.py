@@ -118,6 +118,8 @@ class SeamScene:
     table_z : height of the table top in R [m] (seams against it cannot be seen).
     dense_voxels : where the voxels of ``dense`` lie in it, when perception handed it on in voxel order (None:
         a locator that needs it orders ``dense`` itself).
+    eyes_R : camera name (of ``dense.cameras``) -> its optical centre (3,) in R [m], where known: a camera sees a
+        face only from in front of it (a hollow tube's inner wall, seen down its bore, is not its outer face).
     cache : per-scene scratch space a locator may fill once and reuse for every seam (e.g. a KD-tree);
         it is the one mutable member, and only ever holds values derived from the fields above.
     """
@@ -128,6 +130,7 @@ class SeamScene:
     joints: Mapping[str, Joint]
     table_z: float
     dense_voxels: VoxelTable | None = None
+    eyes_R: Mapping[str, FloatArray] = field(default_factory=dict)
     cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     @cached_property

@@ -119,11 +119,13 @@ def test_calibration_error_of_1mm_and_0_1deg_is_the_accuracy_limit(detected: Det
     # 1.5 m).
     assert max(o.errors_mm.values()) < 2.5
     # The cell is told so (cameras.<name>.calibration): every seam's sigma carries it, so the error it cannot see
-    # is within 2 sigma of every seam (measured lateral 0.58-1.52 mm, sigma 1.36-1.56 mm): the weld gate's bound
+    # is within 2 sigma of every seam (measured lateral 0.48-1.38 mm, sigma 1.75-2.51 mm: the two corrected cameras
+    # keep what their corrections left unknown beside the reference's error, counted twice: conservative): the
+    # weld gate's bound
     # (rescan.bound_sigmas sigma) is then far over the weld tolerance, as it should be.
     for i, m in o.detection.metrics.items():
         sigma_mm = 1000.0 * o.estimates[i].sigma_m
-        assert 1.2 < sigma_mm < 1.8 and m.lateral_mm < 2.0 * sigma_mm, (i, sigma_mm, m.lateral_mm)
+        assert 1.2 < sigma_mm < 3.0 and m.lateral_mm < 2.0 * sigma_mm, (i, sigma_mm, m.lateral_mm)
 
 
 def test_occluded_seams_are_reported_never_invented(detected: Detected) -> None:

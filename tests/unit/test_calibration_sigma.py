@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -11,9 +12,11 @@ from cell.perception.calibration import (
     calibration_sigma,
     closeup_sigma,
     reference_of,
+    residuals_of,
     support_shares,
     with_calibration,
 )
+from cell.perception.pose_prior import PoseResidual, posterior
 from cell.perception.splice import Registration
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
@@ -90,3 +93,68 @@ def test_found_seams_gain_the_term_in_quadrature_others_are_untouched() -> None:
     assert nothing[0] is found  # no stated uncertainty: not even computed
     close = closeup_sigma(found, np.array([0.05, 0.0, 0.3]), u["a"])
     assert math.isclose(close.sigma_m, math.hypot(0.05 * MM, u["a"].sigma_at(0.3)))
+
+
+def test_a_corrected_camera_keeps_what_its_correction_left_unknown() -> None:
+    # The overlap informed every direction but a slide along x: the posterior keeps the prior's 1 mm there, and the
+    # overlap still disagrees by 0.2 mm after the correction; a seam seen by that camera alone carries both.
+    cov = np.diag([1e-12, 1e-12, 1e-12, (1.0 * MM) ** 2, 1e-12, 1e-12])
+    left = PoseResidual(cov, np.zeros(3), 0.2, 0.2 * MM)
+    reg = replace(_registration("a", "ref", accepted=True), residual=left)
+    u = {"a": PoseUncertainty(1.0 * MM, 0.1 * DEG), "ref": PoseUncertainty()}
+    residuals = residuals_of([reg])
+    sigma = calibration_sigma({"a": 1.0}, np.zeros(3), ORIGINS, u, reference_of([reg]), residuals)
+    assert math.isclose(sigma, math.hypot(1.0 * MM / math.sqrt(3.0), 0.2 * MM), rel_tol=1e-3)
+    # A camera registered onto it carries its residual too; a refused correction keeps the camera's own prior.
+    chained = replace(_registration("b", "a", accepted=True), residual=PoseResidual(np.zeros((6, 6)), np.zeros(3), 0.2))
+    assert len(residuals_of([reg, chained])["b"]) == 2
+    assert residuals_of([replace(reg, accepted=False)]) == {}
+
+
+def test_the_posterior_covariance_is_what_a_correction_leaves() -> None:
+    # Monte Carlo of the splice's estimate: the spread of (true error - applied correction) is the covariance stated.
+    rng = np.random.default_rng(3)
+    A, B = rng.normal(size=(6, 6)), rng.normal(size=(6, 6))
+    prior = A @ A.T * 1e-6
+    information = B @ np.diag([1e8, 1e7, 3e6, 1e5, 1e4, 1e3]) @ B.T
+    L_p, L_d = np.linalg.cholesky(prior), np.linalg.cholesky(np.linalg.inv(information))
+    left = []
+    for _ in range(3000):
+        e = L_p @ rng.normal(size=6)
+        post = posterior(e + L_d @ rng.normal(size=6), information, prior)
+        left.append(e - post.x_map)
+    ratio = np.diag(np.cov(np.array(left).T)) / np.diag(post.covariance)
+    assert post.informed >= 2 and np.all((ratio > 0.85) & (ratio < 1.15))
+    # Along a direction nothing informs, the prior stays whole.
+    none = posterior(np.ones(6) * 1e-3, np.zeros((6, 6)), prior)
+    assert np.allclose(none.covariance, prior)
+
+
+def test_a_correction_that_leaves_half_the_misfit_leaves_half_the_prior() -> None:
+    from cell.perception.registration import _left
+
+    prior, posterior_cov = np.eye(6) * 1e-6, np.eye(6) * 1e-10
+    assert np.allclose(_left(posterior_cov, prior, 1.0e-3, 0.5e-3), posterior_cov + 0.25 * prior)
+    assert np.allclose(_left(posterior_cov, prior, 1.0e-3, 2.0e-3), posterior_cov + prior)  # worse: the prior whole
+    assert np.allclose(_left(posterior_cov, prior, math.inf, 1e-3), posterior_cov + prior)  # no misfit measured
+
+
+def test_a_face_seen_by_one_camera_carries_its_error_whole_into_the_line() -> None:
+    # A fillet between a face in z = 0 (seen by "a" alone) and one in y = 0 (seen by "b" alone): by shares each
+    # camera would count half; the line moves with each face whole.
+    rng = np.random.default_rng(2)
+    floor = np.column_stack([rng.uniform(0.0, 0.1, 300), rng.uniform(0.001, 0.012, 300), np.zeros(300)])
+    wall = np.column_stack([rng.uniform(0.0, 0.1, 300), np.zeros(300), rng.uniform(0.001, 0.012, 300)])
+    cloud = Cloud(np.vstack([floor, wall]), "R", np.repeat(np.array([0, 1], np.int16), 300), ("a", "b"))
+    found = SeamEstimate("s", SeamStatus.FOUND, "", np.zeros(3), np.array([0.1, 0.0, 0.0]), 0.9, sigma_m=0.0)
+    u = {"a": PoseUncertainty(1.0 * MM, 0.0), "b": PoseUncertainty(1.0 * MM, 0.0)}
+    faces = {"s": (np.array([0.0, 0.0, 1.0]), 0.0, np.array([0.0, 1.0, 0.0]), 0.0)}
+    by_shares = with_calibration([found], cloud, ORIGINS, u, [])[0].sigma_m
+    by_faces = with_calibration([found], cloud, ORIGINS, u, [], faces)[0].sigma_m
+    one = u["a"].sigma_at(0.0)
+    k95 = math.sqrt(-2.0 * math.log(0.05)) / 2.0  # the lateral error is a distance over two axes
+    assert math.isclose(by_shares, one / math.sqrt(2.0), rel_tol=0.05)
+    assert math.isclose(by_faces, k95 * one, rel_tol=0.05)
+    # One camera seeing both faces moves the line rigidly: its own sigma, by faces as by shares.
+    both = Cloud(cloud.points, "R", np.zeros(600, np.int16), ("a", "b"))
+    assert math.isclose(with_calibration([found], both, ORIGINS, u, [], faces)[0].sigma_m, k95 * one, rel_tol=0.05)

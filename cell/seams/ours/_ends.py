@@ -183,7 +183,11 @@ def side_selections(
         # On the other part's face, never as deep as its far side (an upright's other face, 12 mm behind).
         if end.touching:
             sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching))
-        elif end.inset:  # a tube's side flat begins past its corner radius, below face A and above its far side
+            if len(sel) >= need:
+                out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
+            continue
+        near &= pts.facing(end.n, end.d)  # seen from in front: a hollow tube's inner wall is not its side face
+        if end.inset:  # a tube's side flat begins past its corner radius, below face A and above its far side
             sel = np.flatnonzero(side & near & (r_a < -eb_d - end.inset) & (r_a > end.inset - (geo.depth_a - eb_d)))
         else:
             sel = np.flatnonzero(side & near)
@@ -255,6 +259,7 @@ def find_ends(
         r_b = pts.along(face_b.n) - face_b.d
         s = shear.s(pts, p0, t)
         near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
+        near_a &= pts.facing(face_a.n, face_a.d)
         if known[0]:
             near_a &= s > s_known[0] + cut
         if known[1]:

@@ -16,6 +16,7 @@ from cell.seams._edge import place_from_edge
 from cell.seams.ours._planes import Face, FitRequest, Fitted, Selection, Tilt, Tilted
 from cell.seams.ours._points import Points, crop_box, gather
 from cell.seams.ours.options import OursOptions
+from cell.seams.sigma import TILT_TOLERANCE_RAD
 from cell.types import Joint, MapSeam, Part, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
@@ -90,6 +91,7 @@ def tilt(jobs: list[tuple[Selection, Fitted | None, Tilt, Points]], o: OursOptio
         np.concatenate(w),
         [len(ri) for ri in r],
         float(np.tan(np.radians(o.tilt_prior_deg))),
+        TILT_TOLERANCE_RAD,
     )
     for j, (i, x, face, fitted, e_u, p0, t) in enumerate(todo):
         # The plane r = c0 + a (u - uc) + b (v - vc) in the face's normal and offset (as its offset fit moved it).
@@ -98,7 +100,11 @@ def tilt(jobs: list[tuple[Selection, Fitted | None, Tilt, Points]], o: OursOptio
         norm = float(np.linalg.norm(m))
         d_fitted = face.d + fitted.offset
         d = (d_fitted + c0 - a * (float(fit.uc[j]) + float(e_u @ p0)) - b * (float(fit.vc[j]) + float(t @ p0))) / norm
-        out[i] = Tilted(m / norm, d, float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel)))
+        # The offset's error (the fit's stride stands for all the support) and the tilt the prior did not let the
+        # face follow (it moves the line by that much at the seam's ends, whatever the number of points); apart,
+        # the tilt the points cannot pin within the parts' angular tolerance (for the sigma).
+        se = float(fit.se0[j]) * np.sqrt(len(x.fit) / len(x.sel))
+        out[i] = Tilted(m / norm, d, float(np.hypot(se, fit.bias0[j])), float(fit.tilt0[j]))
     return out
 
 
@@ -118,9 +124,9 @@ def face_from_edge(
     ``edge_sample_share`` of the cloud); ``away`` masks the points (n, 3) far enough from the joint's other
     part. Returns the face placed (its standard error from the edge's own data), else why not."""
 
-    def points(a: FloatArray, b: FloatArray, radius: float) -> tuple[FloatArray, IntArray, BoolArray]:
+    def points(a: FloatArray, b: FloatArray, radius: float) -> tuple[FloatArray, IntArray, BoolArray, BoolArray]:
         pts = gather(scene, a, b, radius, 0.0, joint, rng, o, o.edge_sample_share)
-        return pts.P, pts.cam, pts.ok
+        return pts.P, pts.cam, pts.ok, pts.facing(face.n, face.d)
 
     placed = place_from_edge(
         face.n,

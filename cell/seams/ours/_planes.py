@@ -28,6 +28,7 @@ class Face:
     source: str = "points"  # or "edge of <face>" (an adjacent face of the same part)
     area: float = 0.0  # area of its support region [m^2] (what a head-on view would fill with points)
     note: str = ""  # how well an edge placed it (for the reason)
+    tilt_se: float = 0.0  # the offset's spread at the seam's ends from a tilt the points leave within tolerance [m]
 
     # The constructor, not dataclasses.replace, in the per-pass updates: a third of the cost.
     def moved(self, fit: Fitted, count: int) -> Face:
@@ -36,11 +37,15 @@ class Face:
 
     def tilted(self, tilt: Tilted) -> Face:
         """The face tilted off the map's normal by its tilt step."""
-        return Face(tilt.n, tilt.d, self.scale, self.name, tilt.se, self.count, self.source, self.area, self.note)
+        return Face(
+            tilt.n, tilt.d, self.scale, self.name, tilt.se, self.count, self.source, self.area, self.note, tilt.tilt_se
+        )
 
     def with_area(self, area: float) -> Face:
         """The face with the area of its support region [m^2]."""
-        return Face(self.n, self.d, self.scale, self.name, self.se, self.count, self.source, area, self.note)
+        return Face(
+            self.n, self.d, self.scale, self.name, self.se, self.count, self.source, area, self.note, self.tilt_se
+        )
 
 
 @dataclass(frozen=True)
@@ -134,6 +139,7 @@ class Tilted:
     n: FloatArray
     d: float
     se: float
+    tilt_se: float = 0.0  # the offset's spread at the seam's ends from a tilt the points leave within tolerance [m]
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from cell.geometry import FloatArray
 from cell.seams._index import cloud_box, dense_index
 from cell.seams.ours._bodies import face_planes
 from cell.seams.ours.options import OursOptions
-from cell.types import Box, Joint, SeamScene
+from cell.types import Box, Joint, Part, SeamScene
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.intp]
@@ -32,6 +32,7 @@ class Points:
     pitch: float  # point pitch of these points on a well-seen surface [m] (the sample's, thinned)
     share: float  # the share of the dense cloud's points these are
     n_cams: int  # camera indices run 0 .. n_cams - 1
+    eyes: FloatArray | None = None  # (n_cams, 3) each camera's optical centre [m] (NaN: not known); None: none known
     _along: dict[bytes, FloatArray] = field(default_factory=dict, compare=False, repr=False)  # memo of along()
 
     def least(self, dense_points: int) -> int:
@@ -45,6 +46,15 @@ class Points:
         if out is None:
             out = self._along[key] = n @ self.xyz
         return out
+
+    def facing(self, n: FloatArray, d: float) -> BoolArray:
+        """(n,) which points may lie on a face in the plane n . p = d (outward unit normal ``n`` (3,), [m]): those
+        whose camera lies in front of it (a camera sees a face only from its front: the inside of a hollow tube's
+        wall, seen down its bore, faces the other way); every point whose camera's centre is not known."""
+        if self.eyes is None:
+            return np.ones(len(self.cam), bool)
+        h = self.eyes @ np.asarray(n, float) - d  # (n_cams,) each camera's height over the plane
+        return np.asarray(~(h <= 0.0))[self.cam]  # NaN (unknown) passes
 
     @property
     def P(self) -> FloatArray:
@@ -80,8 +90,9 @@ def gather(
     reach = radius + extend + 0.5 * float(np.linalg.norm(b - a)) + o.map_tolerance_m
     centres, radii = _part_spheres(scene)
     near = np.linalg.norm(centres - 0.5 * (a + b), axis=1) <= reach + radii
+    bodies = _bodies(scene)
     for k in np.flatnonzero(near):
-        part = scene.weldmap.parts[k]
+        part = bodies[k]
         if part.name in (joint.abutting, joint.receiving):
             continue
         if not part.is_box:
@@ -98,7 +109,8 @@ def gather(
         q = R.T @ xyz - (R.T @ c)[:, None]  # in the part's frame
         h = 0.5 * part.box.size + o.map_tolerance_m
         ok &= (np.abs(q[0]) > h[0]) | (np.abs(q[1]) > h[1]) | (np.abs(q[2]) > h[2])
-    return Points(xyz, cam, ok, index.pitch(share * kept), share * kept, int(cam.max(initial=0)) + 1)
+    n_cams = int(cam.max(initial=0)) + 1
+    return Points(xyz, cam, ok, index.pitch(share * kept), share * kept, n_cams, _eyes(scene, n_cams))
 
 
 def crop_box(scene: SeamScene, o: OursOptions) -> Box:
@@ -107,11 +119,16 @@ def crop_box(scene: SeamScene, o: OursOptions) -> Box:
     return ws if ws is not None else cloud_box(scene)
 
 
+def _bodies(scene: SeamScene) -> tuple[Part, ...]:
+    """The map's parts, then its fixtures (a clamp near a seam is no face of it either), as the caches index them."""
+    return (*scene.weldmap.parts, *scene.weldmap.fixtures)
+
+
 def _part_spheres(scene: SeamScene) -> tuple[FloatArray, FloatArray]:
-    """Centres (P, 3) and radii (P,) of the spheres around the map's parts [m], cached per scene."""
+    """Centres (P, 3) and radii (P,) of the spheres around the map's parts and fixtures [m], cached per scene."""
     out = scene.cache.get(_SPHERES_KEY)
     if out is None:
-        parts = scene.weldmap.parts
+        parts = _bodies(scene)
         centres = np.array([p.center for p in parts]).reshape(-1, 3)
         radii = np.array([p.radius for p in parts])
         out = scene.cache[_SPHERES_KEY] = (centres, radii)
@@ -125,7 +142,7 @@ def _support_planes(scene: SeamScene, k: int) -> tuple[FloatArray, FloatArray, F
     out = scene.cache.get(_SUPPORT_KEY)
     if out is None:
         out = []
-        for part in scene.weldmap.parts:
+        for part in _bodies(scene):
             V = part.vertices()
             N, D = face_planes(part)
             kept = (V @ N.T).max(axis=0) <= D + 1e-9
@@ -141,3 +158,15 @@ def _in_bounds(xyz: FloatArray, lo: FloatArray, hi: FloatArray) -> BoolArray:
     for k in (1, 2):
         inside &= (xyz[k] >= lo[k]) & (xyz[k] <= hi[k])
     return inside
+
+
+def _eyes(scene: SeamScene, n_cams: int) -> FloatArray | None:
+    """(n_cams, 3) the optical centre [m] of each camera index of the dense cloud (NaN where not known: a mixed or
+    unknown capture), or None when the scene knows no camera's centre."""
+    if not scene.eyes_R:
+        return None
+    eyes = np.full((max(n_cams, len(scene.dense.cameras)), 3), np.nan)
+    for k, name in enumerate(scene.dense.cameras):
+        if name in scene.eyes_R:
+            eyes[k] = np.asarray(scene.eyes_R[name], float)
+    return eyes

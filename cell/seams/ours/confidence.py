@@ -21,6 +21,8 @@ class SeamErrors:
     lateral_m : of the seam line across itself (from the two faces' offsets).
     start_m, end_m : of the ends along the line.
     face_a_m, face_b_m : of the offsets of A's and B's weld faces (an edge-placed face: its edge's).
+    tilt_m : of the seam line across itself at its ends from the faces' tilts that the points leave within the
+        parts' angular tolerance (in the sigma, not in the confidence: every seam carries some).
     """
 
     lateral_m: float
@@ -28,6 +30,7 @@ class SeamErrors:
     end_m: float
     face_a_m: float
     face_b_m: float
+    tilt_m: float = 0.0
 
 
 NO_ERRORS = SeamErrors(*(5 * (float("inf"),)))  # a seam not found
@@ -38,7 +41,8 @@ def errors_of(face_a: Face, face_b: Face, ends: tuple[End, End]) -> SeamErrors:
     over the sine of the angle between them)."""
     sin_ab = float(np.linalg.norm(np.cross(face_a.n, face_b.n)))
     lateral = float(np.hypot(face_a.se, face_b.se)) / max(sin_ab, 0.1)
-    return SeamErrors(lateral, ends[0].se, ends[1].se, face_a.se, face_b.se)
+    tilt = float(np.hypot(face_a.tilt_se, face_b.tilt_se)) / max(sin_ab, 0.1)
+    return SeamErrors(lateral, ends[0].se, ends[1].se, face_a.se, face_b.se, tilt)
 
 
 def confidence(face_a: Face, face_b: Face, errors: SeamErrors, spacing: float, o: OursOptions) -> float:

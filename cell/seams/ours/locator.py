@@ -156,9 +156,11 @@ class OursLocator:
                 if face.source != "points":
                     continue  # placed from an edge in the first pass
                 gate = (o.map_tolerance_m + 3.0 * o.sensor_sigma_m) if first else o.gate_sigmas * face.scale
-                # Never past half the part's thickness behind the face: a thin plate's far side is not this face.
+                # Never past half the part's thickness behind the face: a thin plate's far side is not this face;
+                # and as far in front (a gate cut on one side only drags a noisy face out: 0.8 mm on an 8 mm plate).
                 behind = 0.5 * (geo.depth_a if key == "a" else geo.depth_b)
-                sel = np.flatnonzero(region & (np.abs(r) < gate) & (r > -behind))
+                # Only points whose camera looks at the face's front (a tube's inner wall, seen down its bore, is not).
+                sel = np.flatnonzero(region & (np.abs(r) < min(gate, behind)) & pts.facing(face.n, face.d))
                 if len(sel) >= pts.least(o.min_face_points):
                     planes.append(Selection(key, face, r, sel, thin(sel, o.max_fit_points)))
                     continue
@@ -247,7 +249,7 @@ class OursLocator:
             p_start=p0 + ends[0].s * t,
             p_end=p0 + ends[1].s * t,
             confidence=conf,
-            sigma_m=ours_sigma(errors.lateral_m, o.sigma_floor_m),
+            sigma_m=ours_sigma(float(np.hypot(errors.lateral_m, errors.tilt_m)), o.sigma_floor_m),
             end_sigma_m=(end_sigmas[0], end_sigmas[1]),
             end_source=sources,
         )

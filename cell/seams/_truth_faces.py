@@ -5,7 +5,8 @@ The seam lies on the line L where the planes of the two as-built weld faces meet
 
 * A's extent is the projection onto L of A's edge between ``face_abutting`` and ``end_face`` (the edge that meets
   B; a gap or a small rotation moves it off L, its extent along L stays), exactly: every vertex of A on both
-  faces' planes (so a face the drawing split in several keeps its whole edge). Where no two vertices lie on both,
+  faces' planes (so a face the drawing split in several keeps its whole edge), and the corners the two faces'
+  polygons share (a face warped as built, its corners off its fitted plane). Where no two vertices lie on both,
   the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by the
   tolerance;
 * B's extent is the chord of L through B's face polygon (L lies in B's plane), or through the region its faces in

@@ -5,7 +5,8 @@ The seam lies on the line L where the planes of the two as-built weld faces meet
 
 * A's extent is the projection onto L of A's edge between ``face_abutting`` and ``end_face`` (the edge that meets
   B; a gap or a small rotation moves it off L, its extent along L stays), exactly: every vertex of A on both
-  faces' planes (so a face the drawing split in several keeps its whole edge). Where no two vertices lie on both,
+  faces' planes (so a face the drawing split in several keeps its whole edge), and the corners the two faces'
+  polygons share (a face warped as built, its corners off its fitted plane). Where no two vertices lie on both,
   the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by the
   tolerance;
 * B's extent is the chord of L through B's face polygon (L lies in B's plane), or through the region its faces in
@@ -86,11 +87,20 @@ def _half_extent(poly: FloatArray, direction: FloatArray) -> float:
 
 def edge_vertices(part: Part, face_1: str, face_2: str) -> FloatArray:
     """(m, 3) the part's vertices that lie on both faces' planes (within ``_SAME_PLANE_M``): the ends of the edge
-    where the two faces meet, and of its pieces when the drawing split a face in several."""
+    where the two faces meet, and of its pieces when the drawing split a face in several; and the corners both
+    faces' polygons share (a face warped as built, its corners off its fitted plane: a brace's end face moved to
+    open a gap twists the faces beside it)."""
     v = np.asarray(part.vertices(), dtype=float)
     n_1, d_1 = part.face_plane(face_1)
     n_2, d_2 = part.face_plane(face_2)
-    return v[(np.abs(v @ n_1 - d_1) <= _SAME_PLANE_M) & (np.abs(v @ n_2 - d_2) <= _SAME_PLANE_M)]
+    on_both = (np.abs(v @ n_1 - d_1) <= _SAME_PLANE_M) & (np.abs(v @ n_2 - d_2) <= _SAME_PLANE_M)
+    p_1, p_2 = part.face_polygon(face_1), part.face_polygon(face_2)
+    shared = np.all(p_1[:, None, :] == p_2[None, :, :], axis=2).any(axis=1)
+    corners = p_1[shared]
+    if not len(corners):
+        return v[on_both]
+    new = ~np.all(corners[:, None, :] == v[on_both][None, :, :], axis=2).any(axis=1)
+    return np.concatenate([v[on_both], corners[new]])
 
 
 def _clip(uv: FloatArray, lo: float, hi: float) -> FloatArray:

@@ -197,6 +197,19 @@ def test_truth_of_a_35_degree_brace_is_the_line_where_its_faces_meet() -> None:
     np.testing.assert_allclose(truth["side"], [[FOOT, DEPTH / 2, 0.0], [0.0, DEPTH / 2, 0.0]], atol=1e-12)
 
 
+def test_truth_keeps_the_whole_edge_of_a_face_warped_as_built() -> None:
+    # A gap opened unevenly under the brace's foot (one corner of its cut end 0.8 mm up) twists the faces beside it:
+    # no corner lies on both fitted planes any more, and the true seam is still the whole edge, not a sliver of it.
+    body = brace(depth=DEPTH)
+    v = np.array(body.vertices, dtype=float)
+    corner = int(np.argmin(np.linalg.norm(v - [FOOT, DEPTH / 2, 0.0], axis=1)))
+    v[corner, 2] += 0.0008
+    warped = Part("BRACE", Polyhedron(v, body.faces))
+    design, joints = _brace_map(Part("BRACE", body))
+    start, end = true_seams(design, joints, (warped, RAIL), np.eye(4))["acute"]
+    assert float(np.linalg.norm(end - start)) == pytest.approx(DEPTH, abs=1e-3)
+
+
 def test_truth_keeps_the_whole_edge_of_an_end_face_drawn_in_two() -> None:
     # a block standing on the rail whose end face (z = 0) is drawn as two quads split at x = 0.05
     d, h = 0.02, 0.05

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_ml
+from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_fit
 from cell.seams._lines import line_plane_parameter
 from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
@@ -111,6 +111,7 @@ def end_shear(
     return Shear(w, c, max(h0, 0.0))
 
 
+EDGE_SEARCH_M = 0.003  # how far from the extent's guess an end's edge is searched [m] (as edge_ml's)
 TANGENT_WINDOW_M = 0.008  # points this far along the line about the extent's guess place a tangent end [m]
 _TANGENT_STEP_M = 5e-5  # the grid the tangent line is searched on [m]
 
@@ -143,6 +144,15 @@ def tangent_end(s: FloatArray, r: FloatArray, guess: float, radius: float, scale
     # The curvature understates it (the residuals are capped, the points not independent, a drawn radius is
     # facets): no better than the points' noise, which is what a close-up's ends scatter by on rhs.
     return float(grid[i] + shift * _TANGENT_STEP_M), float(max(_TANGENT_STEP_M / np.sqrt(c2), sigma))
+
+
+def extent_sigma(se: float, pitch: float, scale: float) -> float:
+    """The sigma [m] of an end read where face A's points stop: the edge likelihood's standard error ``se`` [m], what a
+    sampled edge cannot resolve (it lies anywhere within a ``pitch`` [m] of the last sample: pitch / sqrt 12, one
+    camera's rows sharing their phase) and the edge's blur ``scale`` [m] (the points' noise, or the blur fitted
+    across the edge when wider: a blurred edge's bias, the end face's points within face A's gate, a face seen at
+    grazing incidence smeared along it, points thinning out towards a corner), in quadrature."""
+    return float(np.sqrt(se * se + pitch * pitch / 12.0 + scale * scale))
 
 
 def side_selections(
@@ -298,13 +308,17 @@ def find_ends(
             # point of the dense cloud within the likelihood's window about it.
             sign = 1.0 if k == 1 else -1.0
             reach = EDGE_WINDOW_M + o.edge_band_m + abs(c) * o.tube_radius_m  # the whole side line's points
-            s_d = along_a(dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t))
-            edge, se = edge_ml(sign * s_d, sign * extent[k])
-            if np.isfinite(se):
-                # The curvature understates the scatter of a blurred edge: no better than 3 spacings.
+            d = dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t)
+            s_d = along_a(d)
+            g = sign * extent[k]
+            fit = edge_fit(sign * s_d, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
+            if np.isfinite(fit.b) and np.isfinite(fit.se):
+                # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
+                # 3 spacings; the end's sigma adds what the sample cannot resolve (extent_sigma).
                 inside = np.count_nonzero(np.abs(s_d - extent[k]) < EDGE_WINDOW_M)
                 density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
-                placed[k] = end.at(sign * edge, max(se, 3.0 / max(density, 1.0)), "extent")
+                sigma = extent_sigma(fit.se, d.pitch, max(face_a.scale, fit.blur))
+                placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", sigma)
             else:
                 placed[k] = end.at(extent[k], extent[2], "extent")
     return placed[0], placed[1]

@@ -66,6 +66,14 @@ class End:
     # A body's flat that ends into a corner radius: the seam ends this far short of the side face's plane [m]
     # (the map's end to that plane; 0 for a box, whose faces meet at sharp edges). docs/bodies.md section 8.
     inset: float = 0.0
+    # What the end's place may be off by [m] when more than ``se`` says (the confidence reads ``se``, the end's
+    # sigma this): an edge read where a face's points stop also carries its blur and its sampling. None: ``se``.
+    sigma: float | None = None
+
+    @property
+    def spread(self) -> float:
+        """The end's standard deviation along the seam [m] before the floors: ``sigma``, else ``se``."""
+        return self.se if self.sigma is None else self.sigma
 
     def moved(self, fit: Fitted) -> End:
         """The side face at this end moved by its offset fit."""
@@ -82,9 +90,10 @@ class End:
             self.inset,
         )
 
-    def at(self, s: float, se: float, source: str) -> End:
-        """This end placed at ``s`` along the line [m], with its standard error [m] and where it came from."""
-        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching, self.gap, self.inset)
+    def at(self, s: float, se: float, source: str, sigma: float | None = None) -> End:
+        """This end placed at ``s`` along the line [m], with its standard error [m], where it came from and, when
+        wider than the standard error, its sigma [m] (:attr:`spread`)."""
+        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching, self.gap, self.inset, sigma)
 
     @property
     def short_of(self) -> float:

@@ -239,7 +239,9 @@ class OursLocator:
         end_sigmas = [
             drawn
             if e.source == "map"
-            else ours_end_sigma(e.se, k, bool(e.touching) and e.source == "side face", abs(slope), o.end_floor_scale)
+            else ours_end_sigma(
+                e.spread, k, bool(e.touching) and e.source == "side face", abs(slope), o.end_floor_scale
+            )
             for e, k, slope in zip(ends, sources, slopes, strict=True)
         ]
         estimate = SeamEstimate(

@@ -36,8 +36,10 @@ def bracket(bracket_cell: tuple[Station, pipeline.Detection]) -> pipeline.Detect
 def test_every_camera_kept_and_the_thin_plates_found(bracket: pipeline.Detection) -> None:
     assert bracket.lost_cameras == ()  # the eye-in-hand camera sees part of the scene: kept, not "disagreeing"
     found = {e.id for e in bracket.estimates if e.status is SeamStatus.FOUND}
-    assert {"UPRIGHT>BASE:+x", "LAP>BASE:-y", *GUSSET} <= found
-    assert bracket.summary.visible == 9 and bracket.summary.found >= 6
+    # The lap plate's seams lie on an 8 mm face the fixed cameras see at grazing incidence: with the tilt the points
+    # leave unknown in their sigma they are too uncertain here (confidence <= 0.04) and left to the close-up.
+    assert {"UPRIGHT>BASE:+x", *GUSSET} <= found
+    assert bracket.summary.visible == 9 and bracket.summary.found >= 5
     for e in bracket.estimates:  # the others refused with their one-line reason
         assert e.status is SeamStatus.FOUND or (e.code is not None and e.reason and "\n" not in e.reason), e
 

@@ -47,7 +47,8 @@ from cell.types import EndSource
 
 # A member's angle as built [rad], one standard deviation: ISO 13920 class A's angular tolerance for the welded
 # constructions' shorter leg up to 400 mm (+-20 arcmin) taken as two sigma. What our locator's tilt prior
-# (``OursSettings.tilt_prior_deg``, tighter) holds a face to, the points may not pin: its line carries the rest.
+# (``OursSettings.tilt_prior_deg``, tighter) holds a face to, the points may not pin: its line carries the rest
+# (docs/reference.md section 4).
 TILT_TOLERANCE_RAD = math.radians(10.0 / 60.0)
 PAPER_SIGMA_M = 0.0009  # both faces of the start read (confidence >= PAPER_FACES_CONFIDENCE)
 PAPER_SIGMA_UNSEEN_M = 0.010  # a face of the start not seen: the paper's raw boundary value

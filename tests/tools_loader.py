@@ -1,4 +1,5 @@
-"""The scripts of ``tools/`` as modules, for the tests that check what they generate (tools/ is not a package)."""
+"""The scripts of ``tools/`` and ``benchmarks/`` as modules, for the tests that check what they generate or count
+(neither folder is a package)."""
 
 from __future__ import annotations
 
@@ -20,5 +21,18 @@ def load_tool(name: str) -> ModuleType:
         raise ImportError(f"no tool {name!r} in {REPO / 'tools'}")
     module = importlib.util.module_from_spec(spec)
     sys.modules[key] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def load_bench(name: str) -> ModuleType:
+    """``benchmarks/NAME.py`` imported as the module ``NAME`` (once per session)."""
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, REPO / "benchmarks" / f"{name}.py")
+    if spec is None or spec.loader is None:
+        raise ImportError(f"no benchmark {name!r} in {REPO / 'benchmarks'}")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
     spec.loader.exec_module(module)
     return module

@@ -3,26 +3,20 @@ the calibration the sigma models cite (cell/seams/sigma.py): about 95 % of the s
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import pytest
+from tools_loader import load_bench
 
 REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
 def bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_coverage", REPO / "benchmarks" / "bench_coverage.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_bench("bench_coverage")
 
 
 def _row(method: str, group: str, sigma_mm: float, lateral_mm: float, endpoint_mm: float) -> dict[str, Any]:

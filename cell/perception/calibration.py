@@ -44,7 +44,7 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.perception.pose_prior import PoseResidual, PoseUncertainty
-from cell.perception.splice import Registration
+from cell.perception.splice_decision import Registration
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
 __all__ = [

@@ -91,7 +91,7 @@ class Perceived:
         ``applied_mm`` and ``estimated_mm`` (RMS displacement of the overlap by the applied MAP correction / by
         the data's estimate along the informed directions), ``directions`` (informed of the six),
         ``disagreement_sigmas`` (the data against the stated calibration, in its sigmas), ``refused`` (``""`` or
-        why not, :data:`cell.perception.splice.REFUSALS`; ``beyond_prior``: the camera was dropped), onto which
+        why not, :data:`cell.perception.splice_decision.REFUSALS`; ``beyond_prior``: the camera was dropped), onto which
         cameras (``target``)."""
         return {
             r.source: {

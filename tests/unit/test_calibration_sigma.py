@@ -17,7 +17,7 @@ from cell.perception.calibration import (
     with_calibration,
 )
 from cell.perception.pose_prior import PoseResidual, posterior
-from cell.perception.splice import Registration
+from cell.perception.splice_decision import Registration
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
 MM, DEG = 1e-3, math.radians(1.0)

@@ -23,7 +23,8 @@ from cell.perception.pose_prior import (
     relative_covariance,
 )
 from cell.perception.registration import register
-from cell.perception.splice import FAULT, refusal, splice
+from cell.perception.splice import splice
+from cell.perception.splice_decision import FAULT, refusal
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import CameraIntrinsics, Cloud, DepthImage
 

@@ -1,4 +1,4 @@
-"""``cell weld`` / ``cell preview`` of a whole part (issue 13, docs/flip.md): the two-sided report, its table and
+"""``cell weld`` / ``cell preview`` of a whole part (docs/flip.md): the two-sided report, its table and
 the robot programs of both sides with the main program that stops for the operator's turn."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 
 def parse_sides(sides: str) -> str:
-    """``--sides``: ``first`` (side A only, as before issue 13) or ``all`` (turn the part for the rest)."""
+    """``--sides``: ``first`` (side A only, the part as it lies) or ``all`` (turn the part for the rest)."""
     if sides not in ("first", "all"):
         raise UsageError(f"--sides {sides!r} is unknown; valid: first, all")
     return sides
@@ -81,7 +81,7 @@ def sides_line(rep: Mapping[str, Any]) -> str:
 def write_programs(run: TwoSidedRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
     """The robot programs into ``krl``, each side's weld points in its own aligned map's base.
 
-    One side welded: its program ``WELD_<SCENARIO>`` (as before issue 13) and ``trajectory.json``/``.csv``. Two:
+    One side welded: its program ``WELD_<SCENARIO>`` and ``trajectory.json``/``.csv``. Two:
     one program per side (``WELD_<SCENARIO>_A``, ``_B``), the main program ``WELD_<SCENARIO>`` that runs A, stops
     for the operator's turn and runs B (:func:`cell.export.two_sided.write_two_sided`), and each side's
     trajectory (``trajectory_A.json`` ...)."""

@@ -1,4 +1,4 @@
-"""The report of a whole part welded on two sides (issue 13, docs/flip.md): the single-sided report's keys, each
+"""The report of a whole part welded on two sides (docs/flip.md): the single-sided report's keys, each
 seam from the side that searched it, the turn and what the second alignment measured."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from cell.pipeline.two_sided import TwoSidedRun
 
 
 def two_sided_report(run: TwoSidedRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """The report of a whole part (issue 13): side A's :func:`weld_report` with every key kept, each seam's entry
+    """The report of a whole part: side A's :func:`weld_report` with every key kept, each seam's entry
     taken from the side that searched it and given its ``side`` (``"A"``/``"B"``), a ``flip`` block (the turn
     planned, the placement error the second alignment measured, its fitness, the seams left with why), ``sides``
     (per side: welded, cycle time, the side's summary and error) and ``job_time_s`` (both sides' robot time, side

@@ -1,4 +1,4 @@
-"""The whole part welded (issue 13, docs/flip.md): side A as ``cell weld`` does it, then, when seams are left
+"""The whole part welded (docs/flip.md): side A as ``cell weld`` does it, then, when seams are left
 against the table, the turn planned from the aligned map (before anything moves), the part turned over by the
 operator, and side B: capture again, align the map from its nominal turned pose (a search of the cloud near it
 first: the operator's placement error is not known), locate, re-scan, plan, gate and weld the seams the turn

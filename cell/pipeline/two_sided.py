@@ -1,4 +1,4 @@
-"""The record of a two-sided job (issue 13): side A's weld run, the turn planned before anything moved, side B's
+"""The record of a two-sided job: side A's weld run, the turn planned before anything moved, side B's
 run after the operator turned the part, and what the second alignment measured. Values only."""
 
 from __future__ import annotations

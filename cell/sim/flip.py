@@ -1,4 +1,4 @@
-"""The operator turns the part over (issue 13): where the as-built part, with the beads already on it, comes to
+"""The operator turns the part over: where the as-built part, with the beads already on it, comes to
 rest after the nominal turn, and how far off the operator sets it down (``simulation.flip_placement``).
 
 Ground truth only: nothing here is handed to perception.

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bench_coverage import FAULTS  # the same fault scenarios as the sigma across the seam is measured on
 
 from cell import pipeline
 from cell import scenario as sc
@@ -33,19 +34,6 @@ from cell.seams.metrics import end_errors_along
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SCENARIOS = ("fence1", "fence2", "brace", "bracket", "rhs")
-FAULTS = (
-    "faults/camera-bumped",
-    "faults/camera-dead",
-    "faults/camera-frozen",
-    "faults/camera-random",
-    "faults/camera-salt",
-    "faults/displaced",
-    "faults/extrinsics-fixed-off",
-    "faults/extrinsics-off",
-    "faults/missing-part",
-    "faults/occluded",
-    "faults/two-cameras-dead",
-)
 
 
 def rows_of(names: Sequence[str], group: str, methods: Sequence[str]) -> list[dict[str, Any]]:

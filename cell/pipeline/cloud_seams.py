@@ -20,7 +20,7 @@ def locate_seams(
     """Every seam of ``ss``'s map (frame L) located by ``method`` (ours with the scenario's options, cut at
     ``workspace_L``), the underside ones NOT_VISIBLE, then screened (missing parts, occluders, doubt)."""
     from cell.seams.base import BatchSeamLocator, SeamLocator
-    from cell.seams.ends import check_ends
+    from cell.seams.checks import check_ends
     from cell.seams.ours import OursLocator, OursOptions
     from cell.seams.registry import locator_spec, make_locator, part_tolerance_m
 

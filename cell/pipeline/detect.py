@@ -125,7 +125,7 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
     from cell.perception import screen
     from cell.seams.base import BatchSeamLocator
-    from cell.seams.ends import check_ends
+    from cell.seams.checks import check_ends
     from cell.seams.joint import weld_faces
     from cell.seams.registry import make_locator, part_tolerance_m
     from cell.seams.visibility import visibility

@@ -1,5 +1,5 @@
 """The last check before the arc, in the run: every found seam about to be welded is held against the aligned map
-(:func:`cell.seams.last_check.last_check`, with its budget derived here from the scenario, :func:`check_budget`);
+(:func:`cell.seams.checks.last_check.last_check`, with its budget derived here from the scenario, :func:`check_budget`);
 a seam that fails is re-scanned up close (the re-scan loop of :mod:`cell.pipeline.rescan`) and checked again, and
 one that still fails is not welded (``last_check``, with the test it failed)."""
 
@@ -18,7 +18,7 @@ from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
 from cell.pipeline.rescan import rescan_seams, rescanned
 from cell.scenario import Scenario
-from cell.seams.last_check import Budget, budget, last_check
+from cell.seams.checks import Budget, budget, last_check
 from cell.station import Station
 from cell.types import CheckFail, SeamEstimate, SeamStatus
 from cell.types.rescan import Rescan

@@ -38,7 +38,7 @@ from cell.rescan import (
     view_target,
 )
 from cell.seams.base import SeamLocator
-from cell.seams.ends import check_ends
+from cell.seams.checks import check_ends
 from cell.seams.registry import part_tolerance_m
 from cell.station import Arm, Station
 from cell.types import DepthImage, EndSource, SeamEstimate, SeamStatus

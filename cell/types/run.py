@@ -34,7 +34,7 @@ class WeldReason(enum.StrEnum):
 
 
 class LastCheck(enum.StrEnum):
-    """Which test of the last check before the arc a located seam failed (:mod:`cell.seams.last_check`)."""
+    """Which test of the last check before the arc a located seam failed (:mod:`cell.seams.checks.last_check`)."""
 
     ACROSS = "across"  # its line lies further across the drawn seam than the build, placement and calibration allow
     LENGTH = "length"  # its length differs from the drawn length by more than the parts' tolerance

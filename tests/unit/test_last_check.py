@@ -9,7 +9,7 @@ import pytest
 from synthetic_joint import square_tube
 
 from cell.geometry import make_pose
-from cell.seams.last_check import CHECK_SIGMAS, budget, last_check
+from cell.seams.checks import CHECK_SIGMAS, budget, last_check
 from cell.types import Box, Joint, LastCheck, MapSeam, Part, SeamEstimate, SeamStatus
 
 

@@ -16,7 +16,7 @@ from cell.config.seams import PART_TOLERANCE_M
 from cell.geometry import make_pose
 from cell.perception.calibration import PoseUncertainty, closeup_sigma
 from cell.rescan import fuse, fuse_along
-from cell.seams.ends import check_ends
+from cell.seams.checks import check_ends
 from cell.seams.metrics import end_errors_along
 from cell.seams.ours import OursLocator
 from cell.seams.sigma import (

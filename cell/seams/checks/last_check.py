@@ -9,7 +9,7 @@ So before a seam is welded its estimate is held against the aligned map (:func:`
 * length: the located length lies within ``Budget.length_m`` of the drawn length (its ends' sigmas in it);
 * ends in a body: neither end lies inside another part's body (any but the joint's two) by more than
   ``Budget.body_m``, nor beyond a face the seam or its bead enters on the way from the seam's middle (a tube's
-  wall, its bore behind it: :func:`cell.seams.ends.bead_entry`) by more than that;
+  wall, its bore behind it: :func:`cell.seams.checks.ends.bead_entry`) by more than that;
 * ends on the faces: each end lies within ``Budget.face_m`` of both bodies its joint joins (on the faces it joins,
   the line being across-checked already): an end that runs on along the receiving face past the abutting part, or
   off the receiving part's edge, is off a face.
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.seams.ends import bead_entry
+from cell.seams.checks.ends import bead_entry
 from cell.types import CheckFail, Joint, LastCheck, MapSeam, Part, SeamEstimate, SeamStatus
 
 CHECK_SIGMAS = 3.0  # the estimate's own sigma counts this many times in the across budget

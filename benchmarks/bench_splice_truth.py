@@ -47,7 +47,7 @@ from cell.export.report import write_json  # noqa: E402
 from cell.geometry import FloatArray, invert, transform_points  # noqa: E402
 from cell.perception import perceive  # noqa: E402
 from cell.perception.deproject import clouds_in_robot_frame  # noqa: E402
-from cell.perception.splice_decision import FAULT  # noqa: E402
+from cell.perception.splicing.decision import FAULT  # noqa: E402
 from cell.pipeline.detect import pose_uncertainties  # noqa: E402
 from cell.scenario import CalibrationSpec, ExtrinsicErrorSpec, Scenario  # noqa: E402
 

@@ -20,8 +20,8 @@ from cell.perception.perceive import Perceived, perceive
 from cell.perception.ply import load_ply, save_ply
 from cell.perception.preprocess import downsample, preprocess
 from cell.perception.seam_screen import ScreenOptions, foreign_points, screen
-from cell.perception.splice import Spliced, splice
-from cell.perception.splice_decision import Registration
+from cell.perception.splicing.decision import Registration
+from cell.perception.splicing.splice import Spliced, splice
 
 __all__ = [
     "Alignment",

@@ -13,7 +13,7 @@ A pose error moves every point the camera sees rigidly: at range ``r`` from the 
 ``w_c`` of those points. A camera the splice registered and *corrected* (``Registration.accepted``) now sits where
 its reference camera puts it, so it inherits the reference's error: cameras tied to one reference make one error
 source with the summed share. It also keeps what the correction did not fix: the splice's posterior of the
-disagreement left (``Registration.residual``, :class:`~cell.perception.pose_prior.PoseResidual`: its prior along
+disagreement left (``Registration.residual``, :class:`~cell.perception.splicing.PoseResidual`: its prior along
 every direction the overlap did not inform, the posterior's along those it did), an error of its own at the
 seam ``sigma_res``, counted as an independent source with the camera's share (conservative: the reference's
 error is counted in both). Independent sources add in quadrature,
@@ -43,8 +43,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.perception.pose_prior import PoseResidual, PoseUncertainty
-from cell.perception.splice_decision import Registration
+from cell.perception.splicing.decision import Registration
+from cell.perception.splicing.pose_prior import PoseResidual, PoseUncertainty
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
 __all__ = [

@@ -5,7 +5,7 @@ voxel grid (3.4). A camera whose data cannot be trusted is *lost*, with the reas
 splice (:mod:`cell.perception.camera_health`): no valid pixel (dead, blinded), an implausible image (one value
 everywhere, random depths, heavy interference), no point inside the workspace, or a cloud that agrees with no
 other camera while the others agree (knocked out of calibration), or, in the splice, data that disagree with
-the camera's stated calibration beyond three of its sigmas (:mod:`cell.perception.splice`). The others go on
+the camera's stated calibration beyond three of its sigmas (:mod:`cell.perception.splicing.splice`). The others go on
 without it; only when no usable camera remains is it a :class:`SensorError`.
 """
 
@@ -25,9 +25,9 @@ from cell.errors import SensorError
 from cell.geometry import FloatArray, invert
 from cell.perception.camera_health import HealthOptions, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame
-from cell.perception.pose_prior import PoseUncertainty
 from cell.perception.preprocess import downsample, preprocess
-from cell.perception.splice import Spliced, splice, stacked
+from cell.perception.splicing.pose_prior import PoseUncertainty
+from cell.perception.splicing.splice import Spliced, splice, stacked
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage, VoxelTable
 from cell.voxels import voxel_order
@@ -91,7 +91,7 @@ class Perceived:
         ``applied_mm`` and ``estimated_mm`` (RMS displacement of the overlap by the applied MAP correction / by
         the data's estimate along the informed directions), ``directions`` (informed of the six),
         ``disagreement_sigmas`` (the data against the stated calibration, in its sigmas), ``refused`` (``""`` or
-        why not, :data:`cell.perception.splice_decision.REFUSALS`; ``beyond_prior``: the camera was dropped), onto which
+        why not, :data:`cell.perception.splicing.REFUSALS`; ``beyond_prior``: the camera was dropped), onto which
         cameras (``target``)."""
         return {
             r.source: {

@@ -21,7 +21,7 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export import detection_report
 from cell.perception import perceive
-from cell.perception.splice_decision import FAULT, REFUSALS
+from cell.perception.splicing.decision import FAULT, REFUSALS
 from cell.pipeline.detect import pose_uncertainties
 from cell.scenario import CalibrationSpec, ExtrinsicErrorSpec
 

@@ -16,8 +16,8 @@ from cell.perception.calibration import (
     support_shares,
     with_calibration,
 )
-from cell.perception.pose_prior import PoseResidual, posterior
-from cell.perception.splice_decision import Registration
+from cell.perception.splicing.decision import Registration
+from cell.perception.splicing.pose_prior import PoseResidual, posterior
 from cell.types import Cloud, SeamEstimate, SeamStatus
 
 MM, DEG = 1e-3, math.radians(1.0)
@@ -131,7 +131,7 @@ def test_the_posterior_covariance_is_what_a_correction_leaves() -> None:
 
 
 def test_a_correction_that_leaves_half_the_misfit_leaves_half_the_prior() -> None:
-    from cell.perception.registration import _left
+    from cell.perception.splicing.registration import _left
 
     prior, posterior_cov = np.eye(6) * 1e-6, np.eye(6) * 1e-10
     assert np.allclose(_left(posterior_cov, prior, 1.0e-3, 0.5e-3), posterior_cov + 0.25 * prior)

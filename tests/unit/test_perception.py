@@ -38,11 +38,11 @@ from cell.perception import (
 )
 from cell.perception.merge import predicted_noise, prioritised_merge
 from cell.perception.perceive import perceive_then
-from cell.perception.pose_prior import PoseUncertainty, camera_covariance
 from cell.perception.preprocess import radius_outlier_mask, z_range_R
-from cell.perception.registration import MIN_OVERLAP, Estimate, register, registration_settings
-from cell.perception.splice import splice_order, stacked
-from cell.perception.splice_decision import MIN_MISFIT_DROP, MIN_SHIFT_M, REFUSALS, refusal
+from cell.perception.splicing.decision import MIN_MISFIT_DROP, MIN_SHIFT_M, REFUSALS, refusal
+from cell.perception.splicing.pose_prior import PoseUncertainty, camera_covariance
+from cell.perception.splicing.registration import MIN_OVERLAP, Estimate, register, registration_settings
+from cell.perception.splicing.splice import splice_order, stacked
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, CameraIntrinsics, Cloud, DepthImage, Part, WeldMap
 from cell.voxels import voxel_order

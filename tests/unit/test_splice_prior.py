@@ -14,7 +14,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, look_at, make_pose, transform_points
-from cell.perception.pose_prior import (
+from cell.perception.splicing.decision import FAULT, refusal
+from cell.perception.splicing.pose_prior import (
     FAULT_SIGMAS,
     INFORMED_RATIO,
     PoseUncertainty,
@@ -22,9 +23,8 @@ from cell.perception.pose_prior import (
     posterior,
     relative_covariance,
 )
-from cell.perception.registration import register
-from cell.perception.splice import splice
-from cell.perception.splice_decision import FAULT, refusal
+from cell.perception.splicing.registration import register
+from cell.perception.splicing.splice import splice
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import CameraIntrinsics, Cloud, DepthImage
 

@@ -1,4 +1,4 @@
-"""Registering one camera's cloud onto others for the splice (:mod:`cell.perception.splice`), and the estimate of
+"""Registering one camera's cloud onto others for the splice (:mod:`.splice`), and the estimate of
 its correction with the camera's calibration as the prior.
 
 :func:`register` is open3d's ICP, through :mod:`cell.perception._open3d`, chosen by ``PerceptionSpec.splice_icp``:
@@ -20,7 +20,7 @@ pixels at the edges each camera sees, faces one camera sees head-on and the othe
 patch of ``merge_cell_m`` and surface direction counts as one measurement. A direction the overlap does not
 constrain (a shift along a flat face, a slide along or a turn about a round body's axis) carries no
 information whatever ICP did along it. :func:`register` then weighs that against the camera's stated
-calibration (:func:`cell.perception.pose_prior.posterior`): the MAP correction along the directions where the
+calibration (:func:`cell.perception.splicing.pose_prior.posterior`): the MAP correction along the directions where the
 data outweigh the prior, and how far the data disagree with the prior there.
 """
 
@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation
 
 from cell.geometry import FloatArray, make_pose, readonly, transform_points
 from cell.perception import _open3d
-from cell.perception.pose_prior import PoseResidual, posterior
+from cell.perception.splicing.pose_prior import PoseResidual, posterior
 from cell.scenario import PerceptionSpec
 
 _PROBE_POINTS = 20_000  # source points a registration uses (an even stride)
@@ -231,7 +231,7 @@ class Estimate:
 
     X_icp : (4, 4) open3d's ICP result, every direction as ICP left it.
     X_estimated : (4, 4) the data's estimate along the informed directions only (identity when none is).
-    X_map : (4, 4) the MAP correction (:func:`cell.perception.pose_prior.posterior`): what may be applied.
+    X_map : (4, 4) the MAP correction (:func:`cell.perception.splicing.pose_prior.posterior`): what may be applied.
     overlap : probe points with a target point within reach at the calibration; noise_m : robust standard
         deviation of their point-to-plane residuals [m].
     informed : directions (of six) where the data outweigh the prior; disagreement_sigmas : the data's largest
@@ -241,7 +241,7 @@ class Estimate:
         after ``X_map``.
     residual : what is left unknown of the disagreement once ``X_map`` is applied (None: no estimate was made).
     strong_sigmas : the largest disagreement along a strongly informed direction [prior sigmas]
-        (:data:`cell.perception.pose_prior.STRONG_RATIO`).
+        (:data:`cell.perception.splicing.pose_prior.STRONG_RATIO`).
     """
 
     X_icp: FloatArray
@@ -271,7 +271,7 @@ def register(
 ) -> Estimate:
     """Open3D ICP of ``source`` (n, 3) [m] in R onto ``target`` (m, 3) in R, as ``spec.splice_icp`` says, and the
     correction it supports against ``prior``: (overlap centroid (3,), lever [m]) -> (6, 6) prior covariance of the
-    disagreement in the coordinates of :func:`coordinates` (:func:`cell.perception.pose_prior.relative_covariance`).
+    disagreement in the coordinates of :func:`coordinates` (:func:`.pose_prior.relative_covariance`).
 
     Every estimate is the identity when the overlap is too small. Runs ``spec.icp_iterations`` iterations at
     most; distances from :func:`registration_settings`. The paper's ICP runs on every point, the robust one and

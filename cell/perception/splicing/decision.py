@@ -1,6 +1,6 @@
 """What one splice registration decides: the correction applied, or why not, or a camera fault.
 
-A registration's estimate (:class:`cell.perception.registration.Estimate`) is applied only where the overlap fixes
+A registration's estimate (:class:`.registration.Estimate`) is applied only where the overlap fixes
 the whole pose and the data beat the camera's stated calibration (:func:`refusal`, in the order of its tests);
 :class:`Registration` is the record the splice keeps of each, which the report and the seams' calibration term
 read (docs/perception.md, the splice).
@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from cell.geometry import FloatArray, readonly
-from cell.perception.pose_prior import FAULT_SIGMAS, PoseResidual
-from cell.perception.registration import MIN_OVERLAP, Estimate
+from cell.perception.splicing.pose_prior import FAULT_SIGMAS, PoseResidual
+from cell.perception.splicing.registration import MIN_OVERLAP, Estimate
 
 MIN_SHIFT_M = 0.0001  # [m] a MAP correction moving the overlap by less than this (RMS) is not applied
 MIN_SHIFT_NOISE = 0.5  # ... nor by less than this many times the overlap's noise (what its biases reach)
@@ -46,7 +46,7 @@ class Registration:
     accepted : whether the correction was applied.
     noise_m : robust standard deviation of the point-to-plane residuals in the overlap [m] (calibrated).
     disagreement_sigmas : the data's largest disagreement with the prior along an informed direction, in prior
-        sigmas (beyond :data:`cell.perception.pose_prior.FAULT_SIGMAS`: a camera fault).
+        sigmas (beyond :data:`cell.perception.splicing.pose_prior.FAULT_SIGMAS`: a camera fault).
     refused : ``""`` when applied, else why not (one of :data:`REFUSALS`; :data:`FAULT` drops the camera).
     residual : what is left unknown of the camera's pose relative to its targets once the correction is applied
         (the posterior; None when nothing was estimated).
@@ -84,14 +84,14 @@ class Registration:
 
 
 def refusal(est: Estimate) -> str:
-    """``""`` if a registration's estimate (:func:`cell.perception.registration.register`) may be applied, else
+    """``""`` if a registration's estimate (:func:`cell.perception.splicing.registration.register`) may be applied, else
     why not (one of :data:`REFUSALS`, in this order): too few points overlap, no direction is informed, not all
     six are (the overlap does not fix the whole pose: no correction, and a fault only if the move also lowers the
     patch misfit by :data:`FAULT_MISFIT_DROP`, or by :data:`MIN_MISFIT_DROP` with the disagreement along a
     strongly informed direction), the MAP correction
     moves the overlap by less than :data:`MIN_SHIFT_M` or :data:`MIN_SHIFT_NOISE` times its noise, or lowers
     the patch misfit by less than :data:`MIN_MISFIT_DROP` (it explains nothing), or the data disagree with the
-    prior beyond :data:`cell.perception.pose_prior.FAULT_SIGMAS` (a fault)."""
+    prior beyond :data:`cell.perception.splicing.pose_prior.FAULT_SIGMAS` (a fault)."""
     if est.overlap < MIN_OVERLAP:
         return "no_overlap"
     if est.informed == 0:

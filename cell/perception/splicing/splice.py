@@ -8,13 +8,13 @@ merge (:func:`cell.perception.merge.prioritised_merge`) then makes the paper's c
 cloud of all cameras registered but *not* merged is kept as well (``Spliced.registered``): a locator that
 weighs each camera by its own noise loses nothing to the merge.
 
-Each camera is registered onto the cameras before it by :func:`cell.perception.registration.register` (open3d's
+Each camera is registered onto the cameras before it by :func:`cell.perception.splicing.registration.register` (open3d's
 ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says), and what it found is an estimate with
-the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`cell.perception.pose_prior`):
+the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`.pose_prior`):
 the correction is applied only where the overlap informs all six directions (a partly informed overlap's estimate
 is biased by the sensor's noise at edges: 1-9 mm on random cells, ``docs/perception.md``), as the MAP estimate,
 only if it moves the overlap by more than half its noise, and only if it lowers the misfit of the overlap's
-patches (RMS of each patch's mean point-to-plane residual) enough (:mod:`cell.perception.splice_decision`). A
+patches (RMS of each patch's mean point-to-plane residual) enough (:mod:`cell.perception.splicing.decision`). A
 refused real correction is not unsafe (the camera's seams keep its calibration in their sigma); an applied false
 one is.
 
@@ -24,7 +24,7 @@ disagree with the prior by more than three prior sigmas along an informed direct
 along a strongly informed one, or with the move explaining most of the misfit) is a *fault* (``beyond_prior``),
 not a correction: its points leave the registered cloud and the targets of the cameras after it, and perception
 drops it with the reason (``Spliced.faults``), as a camera that disagrees with the others.
-``Registration.refused`` says why nothing was applied (:data:`cell.perception.splice_decision.REFUSALS`).
+``Registration.refused`` says why nothing was applied (:data:`cell.perception.splicing.decision.REFUSALS`).
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ import numpy.typing as npt
 from cell.errors import SensorError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.perception.merge import prioritised_merge, surface_normals
-from cell.perception.pose_prior import FAULT_SIGMAS, PoseUncertainty, relative_covariance
-from cell.perception.registration import register
-from cell.perception.splice_decision import Registration, refusal
+from cell.perception.splicing.decision import Registration, refusal
+from cell.perception.splicing.pose_prior import FAULT_SIGMAS, PoseUncertainty, relative_covariance
+from cell.perception.splicing.registration import register
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage
 
@@ -56,7 +56,7 @@ class Spliced:
     registered : every camera registered, nothing merged away (per-point ``camera`` index), less the faults.
     registrations : the registrations in the order they were made.
     faults : camera name -> why it was dropped (its data disagree with the prior,
-        :data:`cell.perception.splice_decision.FAULT`).
+        :data:`cell.perception.splicing.decision.FAULT`).
     merge : makes the paper's merged cloud and its per-camera counts from the registration's result (the
         prioritised merge); run once, on the first read of ``dense`` or ``kept``. Only the paper's and RANSAC's
         locators and the pictures read the merged cloud, so a detection with ours never pays for it.

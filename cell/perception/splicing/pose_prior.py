@@ -3,7 +3,7 @@
 The scenario states how well each camera's pose is known (``cameras.<name>.calibration``: the RMS translation
 ``t`` and rotation ``theta`` of its calibration residual, :class:`PoseUncertainty`). A pose error moves the
 camera's points rigidly: a rotation ``w`` about the camera's optical centre ``o`` and a shift ``s``. The splice
-registers a camera onto the cameras before it in the coordinates of :mod:`cell.perception.registration`: the
+registers a camera onto the cameras before it in the coordinates of :mod:`cell.perception.splicing.registration`: the
 rotation vector scaled by the overlap's RMS radius ``lever`` about its centroid ``c``, then the displacement of
 ``c``. In those coordinates the camera's error is ``x = A [w; s]`` with ``A = [[lever I, 0], [-[c - o]x, I]]``
 (a rotation about the camera moves the overlap by ``w x (c - o)``), so its prior covariance is
@@ -63,7 +63,7 @@ class PoseUncertainty:
 class PoseResidual:
     """What is left unknown of a camera's pose once the splice applied its correction: the covariance (6, 6)
     [m^2] of the disagreement left (:attr:`Posterior.covariance`) in the registration's coordinates about the
-    overlap's centroid ``centre_R`` (3,) [m] with ``lever_m`` [m] (:mod:`cell.perception.registration`)."""
+    overlap's centroid ``centre_R`` (3,) [m] with ``lever_m`` [m] (:mod:`cell.perception.splicing.registration`)."""
 
     covariance: FloatArray
     centre_R: FloatArray

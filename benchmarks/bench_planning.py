@@ -35,9 +35,9 @@ from cell.station import open_station
 def bench(name: str) -> dict[str, Any]:
     """One row: the scenario's seams, what the planner made of them and what it cost."""
     from cell.motion.plan import reach_model, seam_process, seam_tasks
-    from cell.motion.procedures import SeamProcedure
+    from cell.motion.process.procedures import SeamProcedure
+    from cell.motion.process.torch import WeldProcess
     from cell.motion.reach import seam_reach
-    from cell.motion.torch import WeldProcess
     from cell.pipeline.placeable import seam_procedures
 
     s = sc.load(name)

@@ -20,7 +20,7 @@ from cell import scenario as sc
 from cell.motion.collision import CollisionChecker
 from cell.motion.gate import find_violations
 from cell.motion.plan import plan_welds
-from cell.motion.torch import WeldProcess
+from cell.motion.process.torch import WeldProcess
 from cell.types import Part
 
 

@@ -18,19 +18,15 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker, CollisionOptions, Contact
+    from cell.motion.collision.scene import cell_obstacles
     from cell.motion.gate import GateOptions, GateRefusedError, Violation, ViolationKind, check_plan, find_violations
     from cell.motion.ik import IKOptions, IKSolveError, solve_ik, solve_path
     from cell.motion.limits import JointLimits, load_limits
     from cell.motion.lines import line_trajectory
     from cell.motion.plan import plan_welds
     from cell.motion.plan_options import PlanOptions
-    from cell.motion.quality import WeldQuality, weld_quality
-    from cell.motion.robot import RobotModel
-    from cell.motion.scan import scan_configuration
-    from cell.motion.scene import cell_obstacles
-    from cell.motion.tasks import seam_tasks
-    from cell.motion.timing import DEFAULT_DT, path_profile, ptp, ptp_duration
-    from cell.motion.torch import (
+    from cell.motion.process.quality import WeldQuality, weld_quality
+    from cell.motion.process.torch import (
         WeldProcess,
         back_off,
         fillet_axes,
@@ -39,7 +35,11 @@ if TYPE_CHECKING:
         torch_poses,
         torch_rotation,
     )
-    from cell.motion.viewpoint import (
+    from cell.motion.robot import RobotModel
+    from cell.motion.tasks import seam_tasks
+    from cell.motion.timing import DEFAULT_DT, path_profile, ptp, ptp_duration
+    from cell.motion.views.scan import scan_configuration
+    from cell.motion.views.viewpoint import (
         ViewOptions,
         Viewpoint,
         ViewTarget,
@@ -77,31 +77,31 @@ _WHERE = {
     "WeldPlan": "cell.types.plan",
     "seam_tasks": "cell.motion.tasks",
     "WeldQuality": "cell.types.execution",
-    "weld_quality": "cell.motion.quality",
+    "weld_quality": "cell.motion.process.quality",
     "RobotModel": "cell.motion.robot",
-    "scan_configuration": "cell.motion.scan",
-    "cell_obstacles": "cell.motion.scene",
+    "scan_configuration": "cell.motion.views.scan",
+    "cell_obstacles": "cell.motion.collision.scene",
     "DEFAULT_DT": "cell.motion.timing",
     "PathProfile": "cell.types.trajectory",
     "Trajectory": "cell.types.trajectory",
     "path_profile": "cell.motion.timing",
     "ptp": "cell.motion.timing",
     "ptp_duration": "cell.motion.timing",
-    "WeldProcess": "cell.motion.torch",
-    "back_off": "cell.motion.torch",
-    "fillet_axes": "cell.motion.torch",
-    "line_poses": "cell.motion.torch",
-    "measured_angles": "cell.motion.torch",
-    "torch_poses": "cell.motion.torch",
-    "torch_rotation": "cell.motion.torch",
-    "NoViewError": "cell.motion.viewpoint",
-    "ViewOptions": "cell.motion.viewpoint",
-    "ViewRejection": "cell.motion.viewpoint",
-    "ViewTarget": "cell.motion.viewpoint",
-    "Viewpoint": "cell.motion.viewpoint",
-    "plan_view": "cell.motion.viewpoint",
-    "torch_axis_in_camera": "cell.motion.viewpoint",
-    "view_candidates": "cell.motion.viewpoint",
+    "WeldProcess": "cell.motion.process.torch",
+    "back_off": "cell.motion.process.torch",
+    "fillet_axes": "cell.motion.process.torch",
+    "line_poses": "cell.motion.process.torch",
+    "measured_angles": "cell.motion.process.torch",
+    "torch_poses": "cell.motion.process.torch",
+    "torch_rotation": "cell.motion.process.torch",
+    "NoViewError": "cell.motion.views.viewpoint",
+    "ViewOptions": "cell.motion.views.viewpoint",
+    "ViewRejection": "cell.motion.views.viewpoint",
+    "ViewTarget": "cell.motion.views.viewpoint",
+    "Viewpoint": "cell.motion.views.viewpoint",
+    "plan_view": "cell.motion.views.viewpoint",
+    "torch_axis_in_camera": "cell.motion.views.viewpoint",
+    "view_candidates": "cell.motion.views.viewpoint",
 }
 
 __all__ = [

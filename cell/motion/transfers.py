@@ -29,9 +29,9 @@ from cell.motion.failures import LineError
 from cell.motion.gate.bodies import Entry, body_entry
 from cell.motion.lines import line_trajectory, solve_line
 from cell.motion.plan_options import PlanOptions
+from cell.motion.process.torch import WeldProcess, line_poses
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
-from cell.motion.torch import WeldProcess, line_poses
 from cell.motion.wrist import HoseWindow
 from cell.types import Part
 from cell.types.plan import SegmentKind

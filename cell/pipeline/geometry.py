@@ -29,7 +29,7 @@ class MotionScene:
 def motion_scene(arm: Arm, det: Detection) -> MotionScene:
     """The obstacles of a detection's aligned map (its nominal placement when alignment failed) and the table."""
     from cell.motion.collision import CollisionChecker
-    from cell.motion.scene import cell_obstacles
+    from cell.motion.collision.scene import cell_obstacles
 
     sc = det.scenario
     obstacles = cell_obstacles(det.weldmap_R, sc.X_WR, sc.table.center_m, sc.table.size_m)

@@ -2,7 +2,7 @@
 escalate.
 
 The values it needs (views, close-up scenes, fusion) come from :mod:`cell.rescan` and
-:mod:`cell.motion.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
+:mod:`cell.motion.views.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
 for it. One close-up serves every seam still to re-scan that it sees as well as a view of that seam's own must
 (:func:`shared_by`): the ladder's neighbouring seams share an image instead of costing one each. Frames: R (robot
 base) for every estimate and pose; metres, radians, seconds.
@@ -78,7 +78,7 @@ class _Run:
 def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequence[str]) -> list[SeamRescan]:
     """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan`), and every seam of
     ``pending`` the same close-up sees as well as a view of its own must (:func:`shared_by`): one image each."""
-    from cell.motion.viewpoint import plan_view
+    from cell.motion.views.viewpoint import plan_view
 
     t0 = time.perf_counter()
     o, det = run.options, run.detection
@@ -113,11 +113,11 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
 
 def shared_by(run: _Run, vp: Viewpoint, pending: Sequence[str]) -> list[tuple[str, Viewpoint]]:
     """The seams of ``pending`` (with a first estimate or the map's line) that the close-up from ``vp`` sees as
-    a view candidate of their own must (:func:`cell.motion.view_candidates.sees`: in the image with its margin,
+    a view candidate of their own must (:func:`cell.motion.views.view_candidates.sees`: in the image with its margin,
     clear of the torch, at the incidence allowed, no part in the way), each with the view as it is for that seam
     (its distance and incidence; no move, tried 0). Only seams within ``_SHARE_RADIUS`` of the viewed one are
     tested."""
-    from cell.motion.view_candidates import sees, torch_axis_in_camera
+    from cell.motion.views.view_candidates import sees, torch_axis_in_camera
 
     det, o = run.detection, run.options
     base = _scene_of(det).seam_scene

@@ -57,8 +57,8 @@ def plan_for(
     from cell.motion.gate import find_violations
     from cell.motion.gate.blame import blamed_seams
     from cell.motion.plan import plan_welds, seam_tasks
+    from cell.motion.process.torch import WeldProcess
     from cell.motion.timing import ptp
-    from cell.motion.torch import WeldProcess
     from cell.motion.track import plan_on_track
     from cell.motion.transfers import TransferFail, Transfers, joined
     from cell.pipeline.tacks import tack_procedures

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from cell import pipeline
-from cell.motion.view_candidates import ranked_views, sees, torch_axis_in_camera
+from cell.motion.views.view_candidates import ranked_views, sees, torch_axis_in_camera
 from cell.pipeline.rescan import _SHARE_RADIUS, _Run, shared_by
 from cell.rescan import eye_in_hand_camera, occluders, view_target
 from cell.station.sim import SimStation

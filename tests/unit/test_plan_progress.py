@@ -14,8 +14,8 @@ from cell import scenario as sc
 from cell.cli import bar as bar_module
 from cell.cli.bar import Bar
 from cell.motion.plan import SeamTask, plan_welds
+from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
-from cell.motion.torch import WeldProcess
 from cell.pipeline.weld import seam_counter
 
 FAR = [

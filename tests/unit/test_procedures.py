@@ -12,8 +12,8 @@ from tiny_cell import SIDE_SEAM, TOP_SEAM
 
 from cell import scenario as sc
 from cell.errors import ScenarioError
-from cell.motion.procedures import NoProcedure, SeamProcedure, joint_type, position, select_procedure
-from cell.motion.weave import cross_section, intended_offsets, pass_offsets, weave_lateral
+from cell.motion.process.procedures import NoProcedure, SeamProcedure, joint_type, position, select_procedure
+from cell.motion.process.weave import cross_section, intended_offsets, pass_offsets, weave_lateral
 from cell.pipeline.detect import read_weldmap
 from cell.seams.joint import find_joints
 from cell.types.plan import SeamTask

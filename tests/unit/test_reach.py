@@ -16,9 +16,9 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.gate.base import Violation, ViolationKind
 from cell.motion.gate.blame import blamed_seams, seam_of
 from cell.motion.plan import PlanOptions, PlanReason, SeamTask, reach_model
+from cell.motion.process.torch import WeldProcess
 from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
-from cell.motion.torch import WeldProcess
 from cell.types import Box, Part
 from cell.types.plan import Segment, WeldPlan
 from cell.types.trajectory import Trajectory

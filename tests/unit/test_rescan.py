@@ -14,7 +14,7 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 from cell.geometry import invert, make_pose, transform_points
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.motion.viewpoint import (
+from cell.motion.views.viewpoint import (
     ViewOptions,
     ViewTarget,
     _segments_hit_box,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cell.motion.order import seam_order
-from cell.motion.procedures import NoProcedure, SeamProcedure
+from cell.motion.process.procedures import NoProcedure, SeamProcedure
 from cell.motion.robot import RobotModel
 from cell.pipeline.tacks import choose_tacks, tack_procedures, tack_records
 from cell.types.plan import SeamOutcome, SeamTask, WeldPlan

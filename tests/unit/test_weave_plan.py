@@ -17,11 +17,11 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.gate import find_violations
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds
 from cell.motion.plan_options import PlanOptions
-from cell.motion.procedures import NoProcedure, select_procedures
+from cell.motion.process.procedures import NoProcedure, select_procedures
+from cell.motion.process.torch import WeldProcess
+from cell.motion.process.torch_candidates import candidate_groups
+from cell.motion.process.weave import cross_section, intended_offsets
 from cell.motion.robot import RobotModel
-from cell.motion.torch import WeldProcess
-from cell.motion.torch_candidates import candidate_groups
-from cell.motion.weave import cross_section, intended_offsets
 from cell.types.plan import PlanReason
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 

@@ -3,6 +3,6 @@ torch test's shapes and boxes in :mod:`.shapes`. The only package that imports c
 
 from cell.config.motion import CollisionOptions
 from cell.motion.collision.checker import CollisionChecker
-from cell.motion.contact import Contact
+from cell.motion.collision.contact import Contact
 
 __all__ = ["CollisionChecker", "CollisionOptions", "Contact"]

@@ -35,8 +35,8 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, readonly
+from cell.motion.collision.contact import Contact, advance_along
 from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts, trim_near_tcp
-from cell.motion.contact import Contact, advance_along
 from cell.motion.robot import RobotModel
 from cell.types import Part
 from cell.types.track import LinearTrack

@@ -23,8 +23,8 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, invert, readonly
+from cell.motion.collision.contact import Contact, sphere_box_distance
 from cell.motion.collision.grow import bounding_box, grown_convex, grown_mesh, is_convex
-from cell.motion.contact import Contact, sphere_box_distance
 from cell.types import Part, Polyhedron
 
 
@@ -182,7 +182,7 @@ class Boxes:
         return Boxes(R, c, half, tuple(o.geometry for o in objs), T)
 
     def sphere_distance(self, c_R: FloatArray, radius: FloatArray) -> FloatArray:
-        """(m, k) [m]: :func:`cell.motion.contact.sphere_box_distance` to each of these boxes."""
+        """(m, k) [m]: :func:`cell.motion.collision.contact.sphere_box_distance` to each of these boxes."""
         return sphere_box_distance(self.R_RB, self.centre, self.half, c_R, radius)
 
 

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass
 
 from cell.motion.plan_options import PlanOptions
-from cell.motion.torch import WeldProcess
+from cell.motion.process.torch import WeldProcess
 
 
 @dataclass(frozen=True)

@@ -43,10 +43,9 @@ def _o3d() -> Any:
 def _load() -> Any:
     """Load open3d's compiled core (called under ``_LOADING``).
 
-    ``import open3d`` runs the package's ``__init__``, which imports ``open3d.visualization`` and through it
-    dash and plotly: 0.9 s on the 2-core bench machine, of which the compiled core is 0.3 s. The core is one
-    extension module next to that ``__init__``; it is loaded from its file without running the package (when
-    open3d is already imported, its own is taken). Everything this module uses lives in it.
+    The core is one extension module next to the package's ``__init__`` (which imports the visualization, dash
+    and plotly: docs/perception.md); it is loaded from its file without running the package (when open3d is already
+    imported, its own is taken). Everything this module uses lives in it.
     """
     import importlib.machinery
     import importlib.util

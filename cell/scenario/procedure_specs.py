@@ -3,8 +3,8 @@ the scenario) validated row by row and converted to :class:`cell.types.WeldProce
 
 Units as a WPS states them: millimetres, degrees, seconds, amperes, volts, metres per minute. The planner picks
 the first row whose joint type, position and leg range fit a seam (:mod:`cell.motion.process.procedures`); with no
-table, one row made from ``process:`` (:func:`default_procedure`) applies to every seam, so a scenario without
-procedures plans as before, except that vertical seams are welded upwards.
+table, one row made from ``process:`` (:func:`default_procedure`) applies to every seam (vertical seams welded
+upwards).
 """
 
 from __future__ import annotations

@@ -1,11 +1,7 @@
-"""One exception tree for the whole cell; the CLI maps each class to a documented exit code.
-
-Every error carries a one-line message that names what was wrong and what is valid. Classes also inherit the
-matching builtin (as ezdxf does with ``DXFValueError(DXFError, ValueError)``) so generic callers can catch them.
-
-The exit codes, one table for the whole cell: docs/architecture.md section 4 (held against this module by
-tests/unit/test_errors.py).
-"""
+"""One exception tree for the whole cell; the CLI maps each class to a documented exit code. Every error carries a
+one-line message that names what was wrong and what is valid; each class also inherits the matching builtin (as
+ezdxf's ``DXFValueError(DXFError, ValueError)``). The exit codes, one table for the whole cell: docs/architecture.md
+section 4 (held against this module by tests/unit/test_errors.py)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
 """Obstacle bodies grown by a safety margin, numpy and scipy only (the coal shapes are built in
-:mod:`cell.motion.collision.shapes`; docs/bodies.md).
-
-A box or a convex polyhedron grows each face out by the margin (a box: ``coal.Box`` of the size plus twice the
-margin); a body that is not convex grows along its vertex normals, each face at least the margin out (docs/bodies.md
-section 2).
-"""
+:mod:`cell.motion.collision.shapes`): a box or a convex polyhedron grows each face out by the margin, a body that is
+not convex grows along its vertex normals, each face at least the margin out (docs/bodies.md section 2)."""
 
 from __future__ import annotations
 

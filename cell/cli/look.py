@@ -186,7 +186,7 @@ def bench(
         Path | None, typer.Option("--json", help="Also write the rows (and their .md table) to this file.")
     ] = None,
     save: Annotated[
-        bool, typer.Option("--save", help=f"Also write the rows to {BENCH_SAVED} (the source of Table 1 in docs/results.md).")
+        bool, typer.Option("--save", help=f"Also write the rows to {BENCH_SAVED} (Table 1 of docs/results.md).")
     ] = False,
 ) -> None:
     """Table 1 of the paper, reproduced and extended: every locator on the same clouds in one run.

@@ -125,7 +125,7 @@ def interrupted_report(
     scenario: Scenario, method: str | None, stage: str, provenance: Mapping[str, Any] | None
 ) -> dict[str, Any]:
     """The report of a run stopped by Ctrl-C before its stages returned: what ran, where it stopped, no seam
-    results (docs/report.md: ``interrupted``, ``error`` with exit code 130)."""
+    results (docs/cli.md: ``interrupted``, ``error`` with exit code 130)."""
     return stopped_report(
         scenario.name,
         method or scenario.locator.method,

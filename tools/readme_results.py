@@ -208,10 +208,10 @@ def headline(results: Path) -> str:
         "|---|---|---|",
         f"| [fence1, realistic depth noise]({link}table-1-reproduced-and-beaten): a seam located, paper ME / lateral, "
         f"mean | {ours['paper_me_mean_mm']:.3f} / {ours['lateral_mean_mm']:.3f} mm | the paper's method here "
-        f"{paper['paper_me_mean_mm']:.3f} / {paper['lateral_mean_mm']:.3f} mm; the paper's Table 1 {me_paper} mm, "
-        "noise-free |",
+        f"{paper['paper_me_mean_mm']:.3f} / {paper['lateral_mean_mm']:.3f} mm; the paper's own, noise-free, "
+        f"{me_paper} mm |",
         f"| time to locate a seam, median | {ours['ms_per_seam_median']:.2f} ms | the paper's method here "
-        f"{paper['ms_per_seam_median']:.2f} ms; the paper's Table 1 {ms_paper:.0f} ms |",
+        f"{paper['ms_per_seam_median']:.2f} ms; the paper's own {ms_paper:.0f} ms |",
         f"| [`cell weld fence1`]({link}welding-fence1), both sides: welded, worst executed TCP max against the "
         f"true seam | {w['welded']}/{w['visible']}, {w['tcp_max_mm']:.2f} mm | job time {w['job_time_s']:.0f} s "
         f"with the operator's turn |",

@@ -8,7 +8,7 @@ section 8)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -19,7 +19,6 @@ from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
 from cell.seams.ours._points import BoolArray, IntArray, Points
 from cell.seams.ours.options import OursOptions
-from cell.seams.sigma import TILT_TOLERANCE_RAD
 from cell.types import EndSource
 
 # How far a hollow section's flat may be wider or narrower than drawn [m] (docs/reference.md: EN 10219-2's
@@ -147,13 +146,13 @@ def tangent_end(s: FloatArray, r: FloatArray, guess: float, radius: float, scale
     return float(grid[i] + shift * _TANGENT_STEP_M), float(max(_TANGENT_STEP_M / np.sqrt(c2), sigma))
 
 
-def extent_sigma(se: float, pitch: float, scale: float) -> float:
-    """The sigma [m] of an end read where face A's points stop: the edge likelihood's standard error ``se`` [m], what a
-    sampled edge cannot resolve (it lies anywhere within a ``pitch`` [m] of the last sample: pitch / sqrt 12, one
-    camera's rows sharing their phase) and the edge's blur ``scale`` [m] (the points' noise, or the blur fitted
-    across the edge when wider: a blurred edge's bias, the end face's points within face A's gate, a face seen at
-    grazing incidence smeared along it, points thinning out towards a corner), in quadrature."""
-    return float(np.sqrt(se * se + pitch * pitch / 12.0 + scale * scale))
+def edge_bias(pitch: float, scale: float) -> float:
+    """What an end read where face A's points stop may be off by that no fit sees [m]: what a sampled edge cannot
+    resolve (it lies anywhere within a ``pitch`` [m] of the last sample: pitch / sqrt 12, one camera's rows sharing
+    their phase) and the edge's blur ``scale`` [m] (the points' noise, or the blur fitted across the edge when
+    wider: a blurred edge's bias, the end face's points within face A's gate, a face seen at grazing incidence
+    smeared along it, points thinning out towards a corner), in quadrature."""
+    return float(np.sqrt(pitch * pitch / 12.0 + scale * scale))
 
 
 # A side face's points scattering about their fitted plane more than this many times the sensor's noise are not one
@@ -207,7 +206,7 @@ def side_selections(
             sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching) & pts.facing(-end.n, -end.d))
             sel = sel[on_face(end, pts, sel, r_l, n_a, o.edge_band_m)]
             if len(sel) >= need:
-                out.append(Selection(key, _levered(end, r_a, sel), r_l, sel, thin(sel, o.max_fit_points), need))
+                out.append(_side(key, end, r_l, sel, need, r_a, r_b, o))
             continue
         near &= pts.facing(end.n, end.d)  # seen from in front: a hollow tube's inner wall is not its side face
         if end.inset:  # a tube's side flat begins past its corner radius, below face A and above its far side
@@ -215,13 +214,17 @@ def side_selections(
         else:
             sel = np.flatnonzero(side & near)
         if len(sel) >= need:
-            out.append(Selection(key, _levered(end, r_a, sel), r_l, sel, thin(sel, o.max_fit_points), need))
+            out.append(_side(key, end, r_l, sel, need, r_a, r_b, o))
     return out
 
 
-def _levered(end: End, r_a: FloatArray, sel: IntArray) -> End:
-    """``end`` with the lever of its side face's points ``sel`` (``r_a``: heights over face A [m])."""
-    return replace(end, lever=float(np.median(np.abs(r_a[sel]))))
+def _side(
+    key: str, end: End, r_l: FloatArray, sel: IntArray, need: int, r_a: FloatArray, r_b: FloatArray, o: OursOptions
+) -> Selection:
+    """The selection of a side face's points ``sel`` (heights ``r_l`` over its plane), with where its fitted points
+    lie over faces A and B (``r_a``, ``r_b`` [m]): the plane's turn is read from them (:class:`Selection`)."""
+    fit = thin(sel, o.max_fit_points)
+    return Selection(key, end, r_l, sel, fit, need, np.stack([r_a[fit], r_b[fit]]))
 
 
 def on_face(end: End, pts: Points, sel: IntArray, r_l: FloatArray, n_a: FloatArray, band: float) -> BoolArray:
@@ -270,10 +273,7 @@ def find_ends(
             known[k] = True
         elif k in sides_se and end.scale <= SIDE_SCATTER_LIMIT * o.sensor_sigma_m:
             s = line_plane_parameter(at_edge, t, end.n, end.d - end.short_of)
-            cos = max(abs(float(end.n @ t)), 1e-3)
-            # The fit holds the side face's offset where its points are, the end lies at face A's edge: a part
-            # turned within its angular tolerance moves it by the lever between them.
-            placed[k] = end.at(s, sides_se[k] / cos, "side face", bias=TILT_TOLERANCE_RAD * end.lever / cos)
+            placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
             known[k] = True
     for k, end in enumerate(ends):
         # A tube's flat ends into its radius, no edge to find: beside an end from A's own side face, the other end
@@ -354,11 +354,12 @@ def find_ends(
             fit = edge_fit(sign * s_d, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
             if np.isfinite(fit.b) and np.isfinite(fit.se):
                 # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
-                # 3 spacings; the end's sigma adds what the sample cannot resolve (extent_sigma).
+                # 3 spacings; the end's sigma is the likelihood's standard error and what the sample cannot resolve
+                # (edge_bias).
                 inside = np.count_nonzero(np.abs(s_d - extent[k]) < EDGE_WINDOW_M)
                 density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
-                sigma = extent_sigma(fit.se, d.pitch, max(face_a.scale, fit.blur))
-                placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", sigma)
+                bias = edge_bias(d.pitch, max(face_a.scale, fit.blur))
+                placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", fit.se, bias)
             else:
                 placed[k] = end.at(extent[k], extent[2], "extent")
     return placed[0], placed[1]

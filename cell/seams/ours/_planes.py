@@ -11,6 +11,7 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.seams.ours._points import Points
+from cell.seams.sigma import TILT_TOLERANCE_RAD
 from cell.types import Part
 
 IntArray = npt.NDArray[np.intp]
@@ -67,22 +68,21 @@ class End:
     # A body's flat that ends into a corner radius: the seam ends this far short of the side face's plane [m]
     # (the map's end to that plane; 0 for a box, whose faces meet at sharp edges). docs/bodies.md section 8.
     inset: float = 0.0
-    # What the end's place may be off by [m] when more than ``se`` says (the confidence reads ``se``, the end's
-    # sigma this): an edge read where a face's points stop also carries its blur and its sampling. None: ``se``.
+    # The statistical standard error of the end's place [m] where the confidence reads another (``se``: an edge's
+    # likelihood no better than three point spacings, for the confidence; the likelihood's own for the sigma).
+    # None: ``se``.
     sigma: float | None = None
     # The other part whose face a hidden side face lies on (``touching``): only points on that face, inside its
     # outline, place the end (that part's other faces beside A are not it). None: no other part.
     against: Part | None = None
-    # How far from face A's plane the side face's fitted points lie, at the median [m]: a part turned within its
-    # angular tolerance moves the side face at the seam (face A's edge) by this lever times the turn.
-    lever: float = 0.0
-    # What may move the placed end that no fit sees, one standard deviation [m]: the part's turn over the lever, a
-    # section's size tolerance (an end a drawn width from the other); added to the sigma, not widened with it.
+    # What may move the placed end that no fit sees, one standard deviation [m]: an edge's blur and sampling where
+    # a face's points stop, a section's size tolerance (an end a drawn width from the other); added to the sigma,
+    # not widened with the statistical part.
     bias: float = 0.0
 
     @property
     def spread(self) -> float:
-        """The end's standard deviation along the seam [m] before the floors: ``sigma``, else ``se``."""
+        """The end's statistical standard deviation along the seam [m]: ``sigma``, else ``se``."""
         return self.se if self.sigma is None else self.sigma
 
     def moved(self, fit: Fitted) -> End:
@@ -116,6 +116,9 @@ class Selection:
     sel: IntArray
     fit: IntArray
     need: int = 0
+    # A side face's fitted points' heights over faces A and B (2, len(fit)) [m]: the seam's end lies at (0, 0),
+    # away from its points, where the part's turn moves the plane by that lever (:func:`at_seam`). None: a weld face.
+    across: FloatArray | None = None
 
 
 @dataclass(frozen=True)
@@ -127,6 +130,18 @@ class Fitted:
     se: float
     scale: float
     weights: FloatArray
+
+
+def at_seam(x: Selection, fit: Fitted) -> float:
+    """The standard error [m] of a side face's plane where it meets the seam: the fit holds its offset at its
+    points' weighted centre, the seam's end lies at (0, 0) over faces A and B, and a part turned or leaning within
+    its angular tolerance (:data:`~cell.seams.sigma.TILT_TOLERANCE_RAD`) moves the plane there by that lever."""
+    assert x.across is not None
+    w = np.asarray(fit.weights, dtype=float)
+    if len(w) != x.across.shape[1] or w.sum() <= 0.0:
+        return fit.se
+    centre = x.across @ w / w.sum()  # (2,) [m]
+    return float(np.hypot(fit.se, TILT_TOLERANCE_RAD * float(np.linalg.norm(centre))))
 
 
 @dataclass(frozen=True)
@@ -173,6 +188,7 @@ class PassFit:
         """The weld faces and the ends after this fit of ``request`` (and its tilt steps)."""
         faces = {"a": face_a, "b": face_b}
         moved = list(ends)
+        side_se: dict[int, float] = {}
         for x, fit in zip(request.selections, self.fits, strict=True):
             if fit is None:
                 continue
@@ -180,18 +196,13 @@ class PassFit:
                 faces[x.key] = faces[x.key].moved(fit, len(x.sel))
             else:
                 k = END_KEYS.index(x.key)
-                lever = x.plane.lever if isinstance(x.plane, End) else 0.0
-                moved[k] = replace(moved[k].moved(fit), lever=lever)
+                moved[k] = moved[k].moved(fit)
+                side_se[k] = fit.se if x.across is None else at_seam(x, fit)
         for j, tilted in self.tilted.items():
             key = request.selections[j].key
             if tilted is not None:
                 faces[key] = faces[key].tilted(tilted)
-        sides_se = {
-            END_KEYS.index(x.key): fit.se
-            for x, fit in zip(request.selections, self.fits, strict=True)
-            if fit is not None and x.key in END_KEYS
-        }
-        return Fitting(faces["a"], faces["b"], (moved[0], moved[1]), sides_se)
+        return Fitting(faces["a"], faces["b"], (moved[0], moved[1]), side_se)
 
 
 @dataclass(frozen=True)

@@ -179,8 +179,8 @@ def designed_cell(s: Any) -> tuple[RobotModel, list[Any], tuple[Any, ...]]:
 def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, object]]:
     """Plan every visible designed seam of each scenario; times [s]."""
     from cell import scenario as sc
+    from cell.gate import find_violations
     from cell.motion.collision import CollisionChecker
-    from cell.motion.gate import find_violations
     from cell.motion.plan import plan_welds
     from cell.motion.process.torch import WeldProcess
 

@@ -5,7 +5,7 @@ Modules of one concept each: the plan is made by :mod:`~cell.motion.plan` from t
 (:mod:`~cell.motion.candidates`), straight lines (:mod:`~cell.motion.lines`), the order
 (:mod:`~cell.motion.order`), transfers (:mod:`~cell.motion.transfers`) and the assembly
 (:mod:`~cell.motion.assembly`); its values live in :mod:`~cell.types.plan`; the gate is the package
-:mod:`cell.motion.gate`, one check per module.
+:mod:`cell.gate`, one check per module.
 
 ``from cell.motion import X`` imports X's module when X is first asked for, so that a light name (say
 ``JointLimits``) does not pull in Pinocchio, coal and Ruckig.
@@ -17,9 +17,9 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from cell.gate import GateOptions, GateRefusedError, Violation, ViolationKind, check_plan, find_violations
     from cell.motion.collision import CollisionChecker, CollisionOptions, Contact
     from cell.motion.collision.scene import cell_obstacles
-    from cell.motion.gate import GateOptions, GateRefusedError, Violation, ViolationKind, check_plan, find_violations
     from cell.motion.ik import IKOptions, IKSolveError, solve_ik, solve_path
     from cell.motion.limits import JointLimits, load_limits
     from cell.motion.lines import line_trajectory
@@ -54,12 +54,12 @@ _WHERE = {
     "CollisionChecker": "cell.motion.collision",
     "CollisionOptions": "cell.motion.collision",
     "Contact": "cell.motion.collision",
-    "GateOptions": "cell.motion.gate",
-    "GateRefusedError": "cell.motion.gate",
-    "Violation": "cell.motion.gate",
-    "ViolationKind": "cell.motion.gate",
-    "check_plan": "cell.motion.gate",
-    "find_violations": "cell.motion.gate",
+    "GateOptions": "cell.gate",
+    "GateRefusedError": "cell.gate",
+    "Violation": "cell.gate",
+    "ViolationKind": "cell.gate",
+    "check_plan": "cell.gate",
+    "find_violations": "cell.gate",
     "IKOptions": "cell.motion.ik",
     "IKSolveError": "cell.motion.ik",
     "solve_ik": "cell.motion.ik",

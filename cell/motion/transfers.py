@@ -4,7 +4,7 @@ A transfer is a Ruckig point-to-point move (KRL PTP) where the direct move is fr
 strategy is tried, in order (:data:`DEFAULT_STRATEGIES`): straight up (a LIN, as a depart) to ``transfer_lift``
 above the highest obstacle, across (PTP) and straight down (a LIN, as an approach); the same one
 ``transfer_lift`` higher; PTP via home. A strategy fails too where the wire tip or the wire (which the collision
-model leaves out) enters an obstacle's body (:func:`cell.motion.gate.bodies.body_entry`), or where its motions
+model leaves out) enters an obstacle's body (:func:`cell.motion.collision.wire.body_entry`), or where its motions
 take A6 further out of the hose package's window (:class:`~cell.motion.wrist.HoseWindow`) than its two ends are
 (a PTP between ends inside the window stays inside: it is a straight joint line; a vertical line's IK may turn
 A6). When every strategy collides or fails, the last one's contact (or error) is the :class:`TransferFail`; the
@@ -25,8 +25,8 @@ from cell.config.motion import GateOptions
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
+from cell.motion.collision.wire import Entry, body_entry
 from cell.motion.failures import LineError
-from cell.motion.gate.bodies import Entry, body_entry
 from cell.motion.lines import line_trajectory, solve_line
 from cell.motion.plan_options import PlanOptions
 from cell.motion.process.torch import WeldProcess, line_poses
@@ -187,7 +187,7 @@ class Transfers:
 
     def _entry(self, pieces: list[Piece]) -> Entry | None:
         """Where the wire tip or the wire, which the collision model leaves out, first enters an obstacle's body
-        along the motions (the safety gate's test, :mod:`cell.motion.gate.bodies`); None: nowhere."""
+        along the motions (the safety gate's test, :mod:`cell.gate.bodies`); None: nowhere."""
         for pc in pieces:
             hit = body_entry(
                 self.robot,

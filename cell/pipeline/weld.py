@@ -54,8 +54,8 @@ def plan_for(
         seam, each with its seam's procedure; the plan's outcomes list them after the seams (an arm on a track
         lays none).
     """
-    from cell.motion.gate import find_violations
-    from cell.motion.gate.blame import blamed_seams
+    from cell.gate import find_violations
+    from cell.gate.blame import blamed_seams
     from cell.motion.plan import plan_welds, seam_tasks
     from cell.motion.process.torch import WeldProcess
     from cell.motion.timing import ptp

@@ -13,9 +13,7 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TABLE, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.errors import PlanError
-from cell.geometry import make_pose, point_line_distance
-from cell.motion.collision import CollisionChecker
-from cell.motion.gate import (
+from cell.gate import (
     DEFAULT_CHECKS,
     Check,
     GateInput,
@@ -25,6 +23,8 @@ from cell.motion.gate import (
     check_plan,
     find_violations,
 )
+from cell.geometry import make_pose, point_line_distance
+from cell.motion.collision import CollisionChecker
 from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
 from cell.motion.process.torch import WeldProcess, torch_poses
 from cell.motion.robot import RobotModel

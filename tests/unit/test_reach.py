@@ -9,12 +9,12 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, TOP_SEAM, URDF
 
 from cell import scenario as sc
+from cell.gate.base import Violation, ViolationKind
+from cell.gate.blame import blamed_seams, seam_of
 from cell.geometry import make_pose
 from cell.motion import candidates
 from cell.motion.candidates import SeamSearch
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate.base import Violation, ViolationKind
-from cell.motion.gate.blame import blamed_seams, seam_of
 from cell.motion.plan import PlanOptions, PlanReason, SeamTask, reach_model
 from cell.motion.process.torch import WeldProcess
 from cell.motion.reach import ReachModel, seam_reach

@@ -15,9 +15,9 @@ from cell.errors import IKError, ScenarioError
 from cell.export.krl import krl_program
 from cell.export.program import ProgramJob
 from cell.export.rapid import rapid_text
+from cell.gate import find_violations
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
 from cell.motion.ik import solve_ik
 from cell.motion.plan import plan_welds, reach_model
 from cell.motion.process.torch import WeldProcess

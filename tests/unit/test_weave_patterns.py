@@ -12,8 +12,8 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, URDF
 
 from cell import scenario as sc
 from cell.errors import ScenarioError
+from cell.gate import find_violations
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
 from cell.motion.plan import SeamTask, plan_welds
 from cell.motion.process.procedures import select_procedures
 from cell.motion.process.torch import WeldProcess

@@ -12,9 +12,9 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
+from cell.gate import find_violations
 from cell.geometry import point_line_distance
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds
 from cell.motion.plan_options import PlanOptions
 from cell.motion.process.procedures import NoProcedure, select_procedures

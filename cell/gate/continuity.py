@@ -8,7 +8,7 @@ from itertools import pairwise
 
 import numpy as np
 
-from cell.motion.gate.base import DEG, GateInput, Violation, ViolationKind
+from cell.gate.base import DEG, GateInput, Violation, ViolationKind
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from cell.motion.gate.base import GateInput, Violation, ViolationKind
+from cell.gate.base import GateInput, Violation, ViolationKind
 
 
 @dataclass(frozen=True)

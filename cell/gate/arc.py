@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cell.motion.gate.base import DEG, GateInput, Violation, ViolationKind
+from cell.gate.base import DEG, GateInput, Violation, ViolationKind
 from cell.types.plan import Segment
 
 

@@ -28,8 +28,8 @@ added to the ``checks`` passed to :func:`find_violations` (or to :data:`DEFAULT_
 Units: SI (rad, rad/s, rad/s^2, rad/s^3, m, s) in the fields; degrees and mm in the messages.
 """
 
-from cell.motion.gate.arc import ArcSwitching
-from cell.motion.gate.base import (
+from cell.gate.arc import ArcSwitching
+from cell.gate.base import (
     Check,
     GateInput,
     GateOptions,
@@ -40,14 +40,14 @@ from cell.motion.gate.base import (
     ViolationKind,
     resample_times,
 )
-from cell.motion.gate.bodies import BodyEntry
-from cell.motion.gate.collisions import Collisions
-from cell.motion.gate.continuity import SampleJumps, SegmentJoins
-from cell.motion.gate.gate import DEFAULT_CHECKS, GateRefusedError, check_plan, find_violations
-from cell.motion.gate.position import PositionLimits
-from cell.motion.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
-from cell.motion.gate.singularity import Singularity
-from cell.motion.gate.start import StartState
+from cell.gate.bodies import BodyEntry
+from cell.gate.collisions import Collisions
+from cell.gate.continuity import SampleJumps, SegmentJoins
+from cell.gate.gate import DEFAULT_CHECKS, GateRefusedError, check_plan, find_violations
+from cell.gate.position import PositionLimits
+from cell.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
+from cell.gate.singularity import Singularity
+from cell.gate.start import StartState
 
 __all__ = [
     "DEFAULT_CHECKS",

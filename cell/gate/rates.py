@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cell.gate.base import DEG, GateInput, Violation, ViolationKind
 from cell.geometry import FloatArray
-from cell.motion.gate.base import DEG, GateInput, Violation, ViolationKind
 
 
 def _worst(

@@ -1,29 +1,21 @@
-"""Bodies: no motion takes the torch's wire tip (the TCP) or its wire into a part's body.
-
-The collision model cuts the torch away near the wire tip so that it can reach into a fillet
-(:mod:`cell.motion.collision`): this check covers what that leaves out. Along a motion the TCP is sampled every
-``body_step`` of its travel or closer, with the wire behind it (``wire_m`` back along the torch axis, -z of the
-tool frame, to the contact tip), and each point is tested against the bodies (:func:`body_entry`): one that lies
-inside a body by more than ``body_depth`` is a violation. During a seam's approach, weld and depart the two parts
-of its own joint are left out: the TCP sits in their corner, and the part as built may stand a few mm off the
-drawing there (the seam's estimate follows the part as built, the aligned map the drawing); every other part's
-body is tested (a bead that runs on through a tube's wall into its bore). Transfers test every part. Frames: R;
-metres.
+"""Where a motion's torch wire tip (the TCP) or its wire first enters a part's body: what the collision model,
+which cuts the torch away near the wire tip so that it can reach into a fillet (:mod:`cell.motion.collision`),
+leaves out. Along a motion the TCP is sampled every ``step`` of its travel or closer, with the wire behind it
+(``wire_m`` back along the torch axis, -z of the tool frame, to the contact tip), and each point is tested against
+the bodies (:func:`body_entry`). Frames: R; metres.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.motion.gate.base import GateInput, Violation, ViolationKind
 from cell.motion.robot import RobotModel
 from cell.types import Part
-from cell.types.plan import Segment
 from cell.types.trajectory import Trajectory
 
 _COARSE = 33  # samples of a motion's TCP path that measure its length before the fine sampling
@@ -132,51 +124,3 @@ def body_entry(
             i, j = divmod(int(inside[0]), k)
             return Entry(float(t[poses[i]]), part.name, deep, pts[inside[0]].copy(), float(s[j]))
     return None
-
-
-def seam_bodies(bodies: Sequence[Part], seg: Segment, joint_parts: Mapping[str, Sequence[str]]) -> list[Part]:
-    """The bodies a segment is tested against: every one for a transfer, all but its seam's joint's two parts for
-    its approach, weld and depart."""
-    own = set(joint_parts.get(seg.seam_id, ())) if seg.kind != "move" else set()
-    return [b for b in bodies if b.name not in own]
-
-
-@dataclass(frozen=True)
-class BodyEntry:
-    """Per segment, the first body its TCP or wire enters deeper than ``body_depth`` (:func:`body_entry`), one
-    violation per segment; none without bodies."""
-
-    def violations(self, gate: GateInput) -> list[Violation]:
-        if not gate.bodies:
-            return []
-        out: list[Violation] = []
-        for seg in gate.plan.segments:
-            v = self.segment_violation(gate, seg)
-            if v is not None:
-                out.append(v)
-        return out
-
-    def segment_violation(self, gate: GateInput, seg: Segment) -> Violation | None:
-        opt, tr, track = gate.options, seg.trajectory, gate.plan.track
-        offset = None
-        if track is not None:
-
-            def offset(t: FloatArray) -> FloatArray:
-                return np.stack([track.offset_R(float(e)) for e in tr.e1_at(t)])
-
-        bodies = seam_bodies(gate.bodies, seg, gate.joint_parts)
-        hit = body_entry(
-            gate.robot, tr, bodies, wire_m=gate.wire_m, depth=opt.body_depth, step=opt.body_step, offset=offset
-        )
-        if hit is None:
-            return None
-        seam = f" of {seg.seam_id}" if seg.seam_id else ""
-        return Violation(
-            ViolationKind.BODY,
-            f"{hit.describe()} during the {seg.kind}{seam}",
-            seg.t0 + hit.t,
-            "",
-            hit.depth,
-            seam_id=seg.seam_id,
-            body=hit.body,
-        )

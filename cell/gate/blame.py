@@ -12,9 +12,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from cell.gate.base import Violation, ViolationKind
 from cell.geometry import readonly
 from cell.motion.failures import reason_text
-from cell.motion.gate.base import Violation, ViolationKind
 from cell.types.plan import PlanReason, SeamOutcome, Segment, WeldPlan
 
 _CODE = {

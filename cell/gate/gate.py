@@ -8,16 +8,16 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.errors import PlanError
+from cell.gate.arc import ArcSwitching
+from cell.gate.base import Check, GateInput, GateOptions, PerSegment, Violation
+from cell.gate.bodies import BodyEntry
+from cell.gate.collisions import Collisions
+from cell.gate.continuity import SampleJumps, SegmentJoins
+from cell.gate.position import PositionLimits
+from cell.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
+from cell.gate.singularity import Singularity
+from cell.gate.start import StartState
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate.arc import ArcSwitching
-from cell.motion.gate.base import Check, GateInput, GateOptions, PerSegment, Violation
-from cell.motion.gate.bodies import BodyEntry
-from cell.motion.gate.collisions import Collisions
-from cell.motion.gate.continuity import SampleJumps, SegmentJoins
-from cell.motion.gate.position import PositionLimits
-from cell.motion.gate.rates import AccelerationLimit, JerkLimit, VelocityLimit
-from cell.motion.gate.singularity import Singularity
-from cell.motion.gate.start import StartState
 from cell.motion.robot import RobotModel
 from cell.types import Part
 from cell.types.plan import WeldPlan
@@ -57,12 +57,12 @@ def find_violations(
     wire_m: float = 0.0,
     joint_parts: Mapping[str, tuple[str, ...]] | None = None,
 ) -> list[Violation]:
-    """Every violation of the gate's checks (see :mod:`cell.motion.gate`); an empty list means go.
+    """Every violation of the gate's checks (see :mod:`cell.gate`); an empty list means go.
 
     q_current : (dof,) [rad] where the arm is now. checker : collisions are checked only when one is given.
     bodies : the parts (the aligned map's, in R) no TCP or wire may enter, checked only when given; wire_m : the
     wire's stick-out behind the TCP [m]; joint_parts : per seam id its joint's two parts, left out along its own
-    approach, weld and depart (:mod:`cell.motion.gate.bodies`).
+    approach, weld and depart (:mod:`cell.gate.bodies`).
     """
     if not plan.segments:
         return []

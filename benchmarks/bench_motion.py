@@ -182,7 +182,7 @@ def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, o
     from cell.gate import find_violations
     from cell.motion.collision import CollisionChecker
     from cell.motion.plan import plan_welds
-    from cell.motion.process.torch import WeldProcess
+    from cell.process.torch import WeldProcess
 
     rows: list[dict[str, object]] = []
     for name in names:

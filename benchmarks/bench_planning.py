@@ -35,10 +35,10 @@ from cell.station import open_station
 def bench(name: str) -> dict[str, Any]:
     """One row: the scenario's seams, what the planner made of them and what it cost."""
     from cell.motion.plan import reach_model, seam_process, seam_tasks
-    from cell.motion.process.procedures import SeamProcedure
-    from cell.motion.process.torch import WeldProcess
     from cell.motion.reach import seam_reach
     from cell.pipeline.placeable import seam_procedures
+    from cell.process.procedures import SeamProcedure
+    from cell.process.torch import WeldProcess
 
     s = sc.load(name)
     weldmap = read_weldmap(s)

@@ -20,7 +20,7 @@ from cell import scenario as sc
 from cell.gate import find_violations
 from cell.motion.collision import CollisionChecker
 from cell.motion.plan import plan_welds
-from cell.motion.process.torch import WeldProcess
+from cell.process.torch import WeldProcess
 from cell.types import Part
 
 

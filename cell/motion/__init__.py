@@ -17,6 +17,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from cell.config.motion import PlanOptions
     from cell.gate import GateOptions, GateRefusedError, Violation, ViolationKind, check_plan, find_violations
     from cell.motion.collision import CollisionChecker, CollisionOptions, Contact
     from cell.motion.collision.scene import cell_obstacles
@@ -24,17 +25,6 @@ if TYPE_CHECKING:
     from cell.motion.limits import JointLimits, load_limits
     from cell.motion.lines import line_trajectory
     from cell.motion.plan import plan_welds
-    from cell.motion.plan_options import PlanOptions
-    from cell.motion.process.quality import WeldQuality, weld_quality
-    from cell.motion.process.torch import (
-        WeldProcess,
-        back_off,
-        fillet_axes,
-        line_poses,
-        measured_angles,
-        torch_poses,
-        torch_rotation,
-    )
     from cell.motion.robot import RobotModel
     from cell.motion.tasks import seam_tasks
     from cell.motion.timing import DEFAULT_DT, path_profile, ptp, ptp_duration
@@ -46,6 +36,16 @@ if TYPE_CHECKING:
         plan_view,
         torch_axis_in_camera,
         view_candidates,
+    )
+    from cell.process.quality import WeldQuality, weld_quality
+    from cell.process.torch import (
+        WeldProcess,
+        back_off,
+        fillet_axes,
+        line_poses,
+        measured_angles,
+        torch_poses,
+        torch_rotation,
     )
     from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
     from cell.types.trajectory import PathProfile, Trajectory
@@ -68,7 +68,6 @@ _WHERE = {
     "load_limits": "cell.motion.limits",
     "line_trajectory": "cell.motion.lines",
     "plan_welds": "cell.motion.plan",
-    "PlanOptions": "cell.motion.plan_options",
     "PlanReason": "cell.types.plan",
     "SeamOutcome": "cell.types.plan",
     "SeamTask": "cell.types.plan",
@@ -77,7 +76,7 @@ _WHERE = {
     "WeldPlan": "cell.types.plan",
     "seam_tasks": "cell.motion.tasks",
     "WeldQuality": "cell.types.execution",
-    "weld_quality": "cell.motion.process.quality",
+    "weld_quality": "cell.process.quality",
     "RobotModel": "cell.motion.robot",
     "scan_configuration": "cell.motion.views.scan",
     "cell_obstacles": "cell.motion.collision.scene",
@@ -87,13 +86,13 @@ _WHERE = {
     "path_profile": "cell.motion.timing",
     "ptp": "cell.motion.timing",
     "ptp_duration": "cell.motion.timing",
-    "WeldProcess": "cell.motion.process.torch",
-    "back_off": "cell.motion.process.torch",
-    "fillet_axes": "cell.motion.process.torch",
-    "line_poses": "cell.motion.process.torch",
-    "measured_angles": "cell.motion.process.torch",
-    "torch_poses": "cell.motion.process.torch",
-    "torch_rotation": "cell.motion.process.torch",
+    "WeldProcess": "cell.process.torch",
+    "back_off": "cell.process.torch",
+    "fillet_axes": "cell.process.torch",
+    "line_poses": "cell.process.torch",
+    "measured_angles": "cell.process.torch",
+    "torch_poses": "cell.process.torch",
+    "torch_rotation": "cell.process.torch",
     "NoViewError": "cell.motion.views.viewpoint",
     "ViewOptions": "cell.motion.views.viewpoint",
     "ViewRejection": "cell.motion.views.viewpoint",

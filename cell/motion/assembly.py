@@ -12,13 +12,13 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from cell.config.motion import PlanOptions
 from cell.geometry import FloatArray, readonly
 from cell.motion.candidates import SeamSolution
 from cell.motion.lines import line_trajectory
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
 from cell.motion.transfers import Piece, TransferFail, Transfers
+from cell.process.torch import WeldProcess
 from cell.types.plan import Segment
 from cell.types.procedure import WeldProcedure
 

@@ -1,6 +1,6 @@
 """The torch search for one seam (step 1 and 2 of :func:`cell.motion.plan.plan_welds`).
 
-1. Candidates (:func:`cell.motion.process.torch_candidates.candidate_groups`: weld directions x spins x work/travel
+1. Candidates (:func:`cell.process.torch_orientations.candidate_groups`: weld directions x spins x work/travel
    angles, nominal first).
    A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK
    (:mod:`cell.motion.placement`; when none of the nominal group can be placed, the other groups are swept in a
@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cell.config.motion import PlanOptions
 from cell.errors import IKError, PlanError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
@@ -35,12 +36,11 @@ from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable
 from cell.motion.ik import solve_ik
 from cell.motion.lines import solve_line
 from cell.motion.placement import Rotations, place, sweep, torch_tests, wording
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.torch import WeldProcess, back_off, line_poses
-from cell.motion.process.torch_candidates import Candidate, candidate_groups
 from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
+from cell.process.torch import WeldProcess, back_off, line_poses
+from cell.process.torch_orientations import Candidate, candidate_groups
 from cell.types.plan import PlanReason, SeamTask
 
 _GOOD = 0.6  # candidates within this share of the best start manipulability are ranked by their wrist

@@ -3,7 +3,7 @@ weaves) solved along the seam like the weld line, and their motions in order (va
 
 The torch search (:mod:`cell.motion.candidates`) picks how to hold the torch on the seam line (direction, spin,
 angles). :func:`solve_passes` keeps that candidate and solves every pass with it: the torch poses of the seam at
-knots fine enough for the weave (:func:`cell.motion.process.weave.knot_spacing`), moved by the pass's offsets and weave,
+knots fine enough for the weave (:func:`cell.process.weave.knot_spacing`), moved by the pass's offsets and weave,
 then IK, approach, depart, singularity and collision checks exactly as for the seam line
 (:meth:`SeamSearch.solve_candidate`). A procedure of one pass at the root without a weave is the seam line
 itself: its solution is returned unchanged. :func:`pass_pieces` times the passes (each weld at its pass's travel
@@ -24,16 +24,16 @@ from dataclasses import replace
 
 import numpy as np
 
+from cell.config.motion import PlanOptions
 from cell.errors import IKError
 from cell.motion.assembly import seam_pieces
 from cell.motion.candidates import SeamSearch, SeamSolution
 from cell.motion.failures import SeamFailure, unreachable
 from cell.motion.ik import solve_ik
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.torch import WeldProcess, torch_poses
-from cell.motion.process.weave import cross_section, knot_spacing, offset_poses, pass_speed
 from cell.motion.robot import RobotModel
 from cell.motion.transfers import Piece, TransferFail, Transfers
+from cell.process.torch import WeldProcess, torch_poses
+from cell.process.weave import cross_section, knot_spacing, offset_poses, pass_speed
 from cell.types.procedure import WeldProcedure
 from cell.types.trajectory import Trajectory
 

@@ -1,6 +1,6 @@
 """Placing the torch on a seam without IK: the first steps of the torch search (:mod:`cell.motion.candidates`).
 
-A candidate (:class:`~cell.motion.process.torch_candidates.Candidate`) is *placed* when its torch, put at the weld start
+A candidate (:class:`~cell.process.torch_orientations.Candidate`) is *placed* when its torch, put at the weld start
 and at the weld end by pose alone, clears every obstacle (:func:`torch_tests`, the broad phase of many poses in one
 query) and its wrist centre is within the shoulder's reach all along the seam (:func:`place`). Only placed
 candidates cost IK.
@@ -28,8 +28,8 @@ import numpy as np
 from cell.geometry import FloatArray, make_pose, readonly, rot_z
 from cell.motion.collision import Contact
 from cell.motion.failures import SeamFailure, better, mm
-from cell.motion.process.torch import fillet_axes
-from cell.motion.process.torch_candidates import Candidate
+from cell.process.torch import fillet_axes
+from cell.process.torch_orientations import Candidate
 from cell.types.plan import PlanReason, SeamTask
 
 if TYPE_CHECKING:
@@ -101,7 +101,7 @@ def torch_tests(
 def _rotation(
     rotations: Rotations, v: FloatArray, task: SeamTask, reverse: bool, work_angle: float, travel_angle: float
 ) -> FloatArray:
-    """R_RT (3, 3): :func:`~cell.motion.process.torch.torch_rotation` of the seam direction ``v`` (3,) with spin 0, the
+    """R_RT (3, 3): :func:`~cell.process.torch.torch_rotation` of the seam direction ``v`` (3,) with spin 0, the
     same arithmetic, its fillet axes computed once per weld direction (kept in ``rotations`` under the key
     ``(reverse, inf, inf)``: a seam's candidates share them)."""
     axes = (reverse, math.inf, math.inf)
@@ -215,7 +215,7 @@ def _worded(
 
 def poses(a: FloatArray, b: FloatArray, R: FloatArray, standoff: float, n: int) -> FloatArray:
     """n torch poses (n, 4, 4) of orientation R_RT (3, 3) from seam point a to b (3,) [m], evenly spaced, the wire
-    tip ``standoff`` [m] back along the torch axis (as :func:`~cell.motion.process.torch.torch_poses` places them)."""
+    tip ``standoff`` [m] back along the torch axis (as :func:`~cell.process.torch.torch_poses` places them)."""
     length = float(np.linalg.norm(b - a))
     d = (b - a) / length
     p = a + np.outer(np.linspace(0.0, length, n), d) - standoff * R[:, 2]

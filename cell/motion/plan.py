@@ -39,6 +39,7 @@ from dataclasses import replace
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.motion import PlanOptions
 from cell.errors import MotionError, PlanError, TimingError
 from cell.geometry import readonly
 from cell.motion.assembly import assemble
@@ -49,15 +50,14 @@ from cell.motion.failures import SeamFailure, reason_text
 from cell.motion.lines import line_trajectory
 from cell.motion.order import seam_order
 from cell.motion.passes import pass_pieces, solve_passes
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.procedures import NoProcedure, SeamProcedure
-from cell.motion.process.torch import WeldProcess
 from cell.motion.reach import ReachModel
 from cell.motion.robot import RobotModel
 from cell.motion.stand_off import blocked_by_table, stand_off, table_top
 from cell.motion.tasks import seam_tasks
 from cell.motion.transfers import Piece, TransferFail, Transfers
 from cell.motion.views.scan import scan_configuration
+from cell.process.procedures import NoProcedure, SeamProcedure
+from cell.process.torch import WeldProcess
 from cell.types import Part
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 
@@ -81,7 +81,7 @@ def plan_welds(
     tasks : the seams, in R (underside seams are not passed in: the caller marks them "needs a flip").
     q_home : (dof,) [rad] where the program starts and ends. obstacles : parts and table, boxes in R.
     rng : for IK restarts (deterministic for a seeded generator; default seed 0).
-    procedures : seam id -> the weld procedure it got (:mod:`cell.motion.process.procedures`): its travel speed and
+    procedures : seam id -> the weld procedure it got (:mod:`cell.process.procedures`): its travel speed and
         torch angles drive the search, its direction fixes a vertical seam's, its passes and weave become one
         weld segment per pass; a NoProcedure is the seam's reason (no_procedure). A seam not in it is welded
         with ``process`` alone, one pass on the seam line.

@@ -23,8 +23,8 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.motion.failures import SeamFailure
-from cell.motion.process.torch import WeldProcess, fillet_axes
 from cell.motion.robot import RobotModel
+from cell.process.torch import WeldProcess, fillet_axes
 from cell.types.plan import PlanReason, SeamTask
 
 _PAD_M = 1e-3  # [m] added to d_max: rounding of the fitted elbow law and of the FK, never a real reach

@@ -31,16 +31,16 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.motion import PlanOptions
 from cell.errors import PlanError
 from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.plan import plan_welds, reach_model, seam_process
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.procedures import NoProcedure, SeamProcedure
-from cell.motion.process.torch import WeldProcess, fillet_axes
 from cell.motion.reach import ReachModel, cone_excess
 from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
+from cell.process.procedures import NoProcedure, SeamProcedure
+from cell.process.torch import WeldProcess, fillet_axes
 from cell.types import Part
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, WeldPlan
 from cell.types.track import LinearTrack

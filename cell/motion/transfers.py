@@ -21,18 +21,17 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
-from cell.config.motion import GateOptions
+from cell.config.motion import GateOptions, PlanOptions
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import Entry, body_entry
 from cell.motion.failures import LineError
 from cell.motion.lines import line_trajectory, solve_line
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.torch import WeldProcess, line_poses
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.wrist import HoseWindow
+from cell.process.torch import WeldProcess, line_poses
 from cell.types import Part
 from cell.types.plan import SegmentKind
 

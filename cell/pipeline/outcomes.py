@@ -61,7 +61,7 @@ def seam_welds(
     placed on (``unplaceable``: planned anyway) gets the planner's reason. checked : the seams that failed the
     last check before the arc (``last_check``, with the test)."""
     from cell.motion.plan import seam_tasks
-    from cell.motion.process.quality import combined, weld_quality
+    from cell.process.quality import combined, weld_quality
 
     X_RW = invert(det.scenario.X_WR)
     ss = det.scene.seam_scene if det.scene is not None else None
@@ -118,7 +118,7 @@ def seam_welds(
 def _intended(task: SeamTask | None, reversed_: bool, seg: Segment, tcp_R: FloatArray) -> FloatArray | None:
     """Where the plan meant each TCP record of a weld segment to lie off the seam (its pass's offset and the
     weave), from the planned seam (None without a procedure or a task: on the seam line)."""
-    from cell.motion.process.weave import cross_section, intended_offsets
+    from cell.process.weave import cross_section, intended_offsets
 
     if seg.procedure is None or task is None:
         return None

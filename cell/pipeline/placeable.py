@@ -20,7 +20,7 @@ from cell.scenario import Scenario
 from cell.station import Arm, Station
 
 if TYPE_CHECKING:
-    from cell.motion.process.procedures import NoProcedure, SeamProcedure
+    from cell.process.procedures import NoProcedure, SeamProcedure
     from cell.types.plan import SeamTask
     from cell.types.rescan import Rescan
 
@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, str]:
     """Seam id -> the planner's reason, for those of ``seam_ids`` (found seams only) no torch can be placed on."""
     from cell.motion.plan import seam_tasks, unplaceable
-    from cell.motion.process.torch import WeldProcess
+    from cell.process.torch import WeldProcess
 
     if det.scene is None:
         return {}
@@ -53,7 +53,7 @@ def seam_procedures(sc: Scenario, det: Detection, tasks: Sequence[SeamTask]) -> 
     """The weld procedure of every task (the scenario's WPS table, or its one row from ``process:``): by the
     joint type the aligned map gives, the position against gravity in R, the leg ``process.leg_mm`` (or
     ``process.seam_leg_mm`` of the seam)."""
-    from cell.motion.process.procedures import joint_type, select_procedures
+    from cell.process.procedures import joint_type, select_procedures
 
     ss = det.scene.seam_scene if det.scene is not None else None
     kinds = {t.id: joint_type(ss.weldmap, ss.joints[t.id]) for t in tasks if ss and t.id in ss.joints}

@@ -15,7 +15,7 @@ from cell.types.plan import SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass
 
 if TYPE_CHECKING:  # the records are read by the reports, which import no stage: the planner's types only here
-    from cell.motion.process.procedures import NoProcedure, SeamProcedure
+    from cell.process.procedures import NoProcedure, SeamProcedure
 
 TACK_MARK = "~tack"  # a tack's task id: <seam id>~tack<k>
 End = Literal["start", "end"]

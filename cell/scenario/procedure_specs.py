@@ -2,7 +2,7 @@
 the scenario) validated row by row and converted to :class:`cell.types.WeldProcedure` values.
 
 Units as a WPS states them: millimetres, degrees, seconds, amperes, volts, metres per minute. The planner picks
-the first row whose joint type, position and leg range fit a seam (:mod:`cell.motion.process.procedures`); with no
+the first row whose joint type, position and leg range fit a seam (:mod:`cell.process.procedures`); with no
 table, one row made from ``process:`` (:func:`default_procedure`) applies to every seam, so a scenario without
 procedures plans as before, except that vertical seams are welded upwards.
 """
@@ -21,7 +21,7 @@ from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 
 class WeaveSpec(Model):
-    """Oscillation of the torch while it travels on along the seam (:mod:`cell.motion.process.weave`): ``zigzag``
+    """Oscillation of the torch while it travels on along the seam (:mod:`cell.process.weave`): ``zigzag``
     side to side across the bisector with smooth turns, fading in and out over the first and last wavelength;
     ``triangle`` side to side on straight legs with sharp turns, at full width from the start (ArcTech's
     #Triangle); ``circle`` round a circle of the width's diameter in the joint's cross-section, from the pass line

@@ -152,7 +152,7 @@ def test_the_gate_refuses_a_planned_weld_that_runs_into_a_third_part_and_blames_
     from cell.gate import ViolationKind, find_violations
     from cell.gate.blame import blamed_seams
     from cell.motion.plan import PlanReason, SeamTask, plan_welds
-    from cell.motion.process.torch import WeldProcess
+    from cell.process.torch import WeldProcess
 
     robot = RobotModel.from_urdf(URDF)
     process = WeldProcess.from_spec(sc.ProcessSpec())

@@ -18,8 +18,8 @@ from cell.export.status_turn import status_turn
 from cell.export.trajectory import write_csv, write_json
 from cell.geometry import make_pose, rot_z, rpy_to_matrix
 from cell.motion.plan import SeamTask, WeldPlan, plan_welds
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
+from cell.process.torch import WeldProcess
 from cell.types import Box, Part
 
 URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"

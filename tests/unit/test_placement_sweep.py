@@ -15,9 +15,9 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.failures import SeamFailure, better
 from cell.motion.placement import Rotations, place, torch_tests, wording
 from cell.motion.plan import PlanOptions, PlanReason, SeamTask, reach_model
-from cell.motion.process.torch import WeldProcess
-from cell.motion.process.torch_candidates import candidate_groups
 from cell.motion.robot import RobotModel
+from cell.process.torch import WeldProcess
+from cell.process.torch_orientations import candidate_groups
 from cell.types import Box, Part
 
 STIFF = WeldProcess.from_spec(sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0))

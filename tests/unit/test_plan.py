@@ -26,8 +26,8 @@ from cell.gate import (
 from cell.geometry import make_pose, point_line_distance
 from cell.motion.collision import CollisionChecker
 from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
-from cell.motion.process.torch import WeldProcess, torch_poses
 from cell.motion.robot import RobotModel
+from cell.process.torch import WeldProcess, torch_poses
 from cell.types import Box, Part
 from cell.types.trajectory import Trajectory
 

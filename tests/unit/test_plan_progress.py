@@ -14,9 +14,9 @@ from cell import scenario as sc
 from cell.cli import bar as bar_module
 from cell.cli.bar import Bar
 from cell.motion.plan import SeamTask, plan_welds
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
 from cell.pipeline.weld import seam_counter
+from cell.process.torch import WeldProcess
 
 FAR = [
     SeamTask(

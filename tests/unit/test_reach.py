@@ -16,9 +16,9 @@ from cell.motion import candidates
 from cell.motion.candidates import SeamSearch
 from cell.motion.collision import CollisionChecker
 from cell.motion.plan import PlanOptions, PlanReason, SeamTask, reach_model
-from cell.motion.process.torch import WeldProcess
 from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
+from cell.process.torch import WeldProcess
 from cell.types import Box, Part
 from cell.types.plan import Segment, WeldPlan
 from cell.types.trajectory import Trajectory

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from cell.motion.order import seam_order
-from cell.motion.process.procedures import NoProcedure, SeamProcedure
 from cell.motion.robot import RobotModel
 from cell.pipeline.tacks import choose_tacks, tack_procedures, tack_records
+from cell.process.procedures import NoProcedure, SeamProcedure
 from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.torch import WeldProcess
+from cell.config.motion import PlanOptions
+from cell.process.torch import WeldProcess
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,7 @@ def weld_quality(
 
     times : (n,) record times [s]; tcp_R : (n, 3) tool positions in R [m] (n >= 2); truth : the true seam in R [m].
     offsets_R : (n, 3) [m] where the plan meant each record to lie off the seam (the pass's offset and the weave,
-        :func:`cell.motion.process.weave.intended_offsets`); the TCP error and the travel speed are measured on the
+        :func:`cell.process.weave.intended_offsets`); the TCP error and the travel speed are measured on the
         records minus these (against the seam plus the intended weave and offset), the length on the path as
         driven. None: on the seam line.
 

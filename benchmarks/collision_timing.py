@@ -19,7 +19,7 @@ from bench_motion import designed_cell
 from cell import scenario as sc
 from cell.gate import find_violations
 from cell.motion.collision import CollisionChecker
-from cell.motion.plan import plan_welds
+from cell.planning.plan import plan_welds
 from cell.process.torch import WeldProcess
 from cell.types import Part
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from cell.gate.base import Violation, ViolationKind
 from cell.geometry import readonly
-from cell.motion.failures import reason_text
+from cell.planning.failures import reason_text
 from cell.types.plan import PlanReason, SeamOutcome, Segment, WeldPlan
 
 _CODE = {

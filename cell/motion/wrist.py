@@ -1,5 +1,5 @@
 """The wrist of a six-axis arm: its equivalent configurations, the hose package's A6 window and how far a
-configuration is from the wrist the cell prefers (used by the torch search, :mod:`cell.motion.candidates`).
+configuration is from the wrist the cell prefers (used by the torch search, :mod:`cell.planning.seam_search`).
 
 A spherical wrist reaches one flange pose in several ways (docs/reference.md section 3): A4 and A6 may each
 turn a whole revolution within their +-350 deg ranges, and the wrist may flip (A4 + 180 deg, -A5, A6 + 180 deg).

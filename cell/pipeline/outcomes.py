@@ -10,7 +10,7 @@ import numpy as np
 
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.records import Detection
-from cell.rescan import ends_within_tolerance, within_tolerance
+from cell.rescan.fusion import ends_within_tolerance, within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station
 from cell.types import CheckFail, SeamEstimate, SeamStatus
@@ -60,7 +60,7 @@ def seam_welds(
     applied (not a preview): a found seam too uncertain to weld is ``low_confidence``, but one no torch can be
     placed on (``unplaceable``: planned anyway) gets the planner's reason. checked : the seams that failed the
     last check before the arc (``last_check``, with the test)."""
-    from cell.motion.plan import seam_tasks
+    from cell.planning.tasks import seam_tasks
     from cell.process.quality import combined, weld_quality
 
     X_RW = invert(det.scenario.X_WR)

@@ -15,7 +15,7 @@ from cell.pipeline.detect import Progress, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
 from cell.pipeline.rescan import RescanMode, end_shift_m, escalated, rescan_detection
-from cell.rescan import seams_to_rescan
+from cell.rescan.fusion import seams_to_rescan
 from cell.scenario import Scenario
 from cell.station import Arm, Station
 
@@ -27,7 +27,8 @@ if TYPE_CHECKING:
 
 def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, str]:
     """Seam id -> the planner's reason, for those of ``seam_ids`` (found seams only) no torch can be placed on."""
-    from cell.motion.plan import seam_tasks, unplaceable
+    from cell.planning.plan import unplaceable
+    from cell.planning.tasks import seam_tasks
     from cell.process.torch import WeldProcess
 
     if det.scene is None:

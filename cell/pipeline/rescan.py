@@ -1,8 +1,8 @@
 """The close-up re-scan loop, once for ``cell weld`` and ``cell rescan``: plan a view, move, capture, locate, fuse,
 escalate.
 
-The values it needs (views, close-up scenes, fusion) come from :mod:`cell.rescan` and
-:mod:`cell.motion.views.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
+The values it needs (views, close-up scenes, fusion) come from :mod:`cell.rescan.fusion` and
+:mod:`cell.rescan.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
 for it. One close-up serves every seam still to re-scan that it sees as well as a view of that seam's own must
 (:func:`shared_by`): the ladder's neighbouring seams share an image instead of costing one each. Frames: R (robot
 base) for every estimate and pose; metres, radians, seconds.
@@ -18,16 +18,14 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from cell.config.rescan import RescanOptions
 from cell.errors import CellError, ScenarioError
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty, closeup_sigma
 from cell.pipeline.detect import Progress, evaluate, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, Scene
-from cell.rescan import (
-    Rescan,
-    RescanOptions,
-    SeamRescan,
+from cell.rescan.fusion import (
     closeup_scenario,
     closeup_scene,
     estimate_sigma,
@@ -42,7 +40,7 @@ from cell.seams.checks import check_ends
 from cell.seams.registry import part_tolerance_m
 from cell.station import Arm, Station
 from cell.types import DepthImage, EndSource, SeamEstimate, SeamStatus
-from cell.types.rescan import Viewpoint
+from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 
 if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker
@@ -76,9 +74,9 @@ class _Run:
 
 
 def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequence[str]) -> list[SeamRescan]:
-    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan`), and every seam of
+    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan.fusion`), and every seam of
     ``pending`` the same close-up sees as well as a view of its own must (:func:`shared_by`): one image each."""
-    from cell.motion.views.viewpoint import plan_view
+    from cell.rescan.viewpoint import plan_view
 
     t0 = time.perf_counter()
     o, det = run.options, run.detection
@@ -113,11 +111,11 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
 
 def shared_by(run: _Run, vp: Viewpoint, pending: Sequence[str]) -> list[tuple[str, Viewpoint]]:
     """The seams of ``pending`` (with a first estimate or the map's line) that the close-up from ``vp`` sees as
-    a view candidate of their own must (:func:`cell.motion.views.view_candidates.sees`: in the image with its margin,
+    a view candidate of their own must (:func:`cell.rescan.view_grid.sees`: in the image with its margin,
     clear of the torch, at the incidence allowed, no part in the way), each with the view as it is for that seam
     (its distance and incidence; no move, tried 0). Only seams within ``_SHARE_RADIUS`` of the viewed one are
     tested."""
-    from cell.motion.views.view_candidates import sees, torch_axis_in_camera
+    from cell.rescan.view_grid import sees, torch_axis_in_camera
 
     det, o = run.detection, run.options
     base = _scene_of(det).seam_scene
@@ -177,7 +175,7 @@ def rescan_seams(
     motion: MotionScene | None = None,
     progress: Progress = quiet,
 ) -> Rescan:
-    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`). A
+    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan.fusion`). A
     seam the close-up of an earlier one sees (:func:`shared_by`) is located in that image, with no view of its own
     (its record's ``motion_s`` is 0); the result lists every seam in the order asked.
 

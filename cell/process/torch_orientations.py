@@ -1,5 +1,5 @@
 """Which torch orientations the torch search tries for a seam, in which order (step 1 of
-:mod:`cell.motion.candidates`): both weld directions (one if not ``process.reversible``) x spins about the torch
+:mod:`cell.planning.seam_search`): both weld directions (one if not ``process.reversible``) x spins about the torch
 axis (``spin_step`` apart, within the process's spin tolerance) x work/travel angle offsets (nominal first, then
 widened in ``angle_step`` steps within their tolerances, docs/reference.md section 7). Values only: no IK here.
 """

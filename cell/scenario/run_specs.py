@@ -75,7 +75,7 @@ class PerceptionSpec(Model):
 
 
 class RescanSpec(Model):
-    """Close-up re-scan before welding and the weld gate (cell.rescan; calibration in its docstring).
+    """Close-up re-scan before welding and the weld gate (cell.rescan.fusion; calibration in its docstring).
 
     mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` or whose bound
         (``bound_sigmas`` sigma) exceeds ``weld_tolerance_mm`` (and visible seams not found), ``all`` every visible

@@ -1,8 +1,8 @@
 """The welding program as values: seams to weld (:class:`SeamTask`) and the timed, checked plan (:class:`WeldPlan`)
 with its segments and per-seam outcomes (:class:`SeamOutcome`, :class:`PlanReason`). Values only: no planning.
 
-Tasks are made from located seams by :func:`cell.motion.tasks.seam_tasks`; the plan by
-:func:`cell.motion.plan.plan_welds`, read by the safety gate, the exporters, the simulator playback and
+Tasks are made from located seams by :func:`cell.planning.tasks.seam_tasks`; the plan by
+:func:`cell.planning.plan.plan_welds`, read by the safety gate, the exporters, the simulator playback and
 the pictures. Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 """
 
@@ -97,7 +97,7 @@ class SeamOutcome:
     For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]. code: why it
     could not be planned (None when feasible); reason: the same in words, with where and by how much.
     trimmed : the length [m] not welded at the seam's table end (the torch's stand-off above the table,
-    :mod:`cell.motion.stand_off`); 0 for a seam welded whole."""
+    :mod:`cell.planning.stand_off`); 0 for a seam welded whole."""
 
     seam_id: str
     feasible: bool

@@ -20,10 +20,10 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export.flip_report import two_sided_report
 from cell.export.krl import krl_program
-from cell.motion.plan import seam_tasks
 from cell.pipeline.sides import tack_rule, weld_part
 from cell.pipeline.tacks import Tack, is_tack
 from cell.pipeline.weld import plan_for
+from cell.planning.tasks import seam_tasks
 from cell.station import open_station
 from cell.types.plan import SeamTask, WeldPlan
 

@@ -151,8 +151,9 @@ def test_the_gate_refuses_a_planned_weld_that_runs_into_a_third_part_and_blames_
     from cell import scenario as sc
     from cell.gate import ViolationKind, find_violations
     from cell.gate.blame import blamed_seams
-    from cell.motion.plan import PlanReason, SeamTask, plan_welds
+    from cell.planning.plan import plan_welds
     from cell.process.torch import WeldProcess
+    from cell.types.plan import PlanReason, SeamTask
 
     robot = RobotModel.from_urdf(URDF)
     process = WeldProcess.from_spec(sc.ProcessSpec())

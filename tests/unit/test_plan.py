@@ -25,10 +25,12 @@ from cell.gate import (
 )
 from cell.geometry import make_pose, point_line_distance
 from cell.motion.collision import CollisionChecker
-from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
 from cell.motion.robot import RobotModel
+from cell.motion.scan import scan_configuration
+from cell.planning.plan import plan_welds
 from cell.process.torch import WeldProcess, torch_poses
 from cell.types import Box, Part
+from cell.types.plan import PlanReason, SeamTask, WeldPlan
 from cell.types.trajectory import Trajectory
 
 TOP = SeamTask(*TOP_SEAM)

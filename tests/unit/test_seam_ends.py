@@ -15,7 +15,7 @@ from synthetic_joint import CASES, JOINTS, NOMINAL, TOP, make_scene, square_tube
 from cell.config.seams import PART_TOLERANCE_M
 from cell.geometry import make_pose
 from cell.perception.calibration import PoseUncertainty, closeup_sigma
-from cell.rescan import fuse, fuse_along
+from cell.rescan.fusion import fuse, fuse_along
 from cell.seams.checks import check_ends
 from cell.seams.metrics import end_errors_along
 from cell.seams.ours import OursLocator

@@ -13,9 +13,9 @@ from cell.config.motion import PlanOptions
 from cell.errors import TimingError
 from cell.geometry import FloatArray, make_pose
 from cell.motion.collision import CollisionChecker
-from cell.motion.failures import SeamFailure, better, reason_text
 from cell.motion.robot import RobotModel
-from cell.motion.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
+from cell.planning.failures import SeamFailure, better, reason_text
+from cell.planning.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
 from cell.process.torch import WeldProcess
 from cell.types import Box, Part
 from cell.types.plan import PlanReason

@@ -22,8 +22,9 @@ from cell.export.program import ProgramJob
 from cell.export.rapid import RapidPost
 from cell.export.two_sided import two_sided_program, write_two_sided
 from cell.geometry import make_pose, rot_x
-from cell.motion.plan import WeldPlan, plan_welds
 from cell.motion.robot import RobotModel
+from cell.planning.plan import plan_welds
+from cell.types.plan import WeldPlan
 
 MESSAGE = "Turn the part over about its x axis, set it against the stops, then confirm"
 X_RB_B = make_pose(rot_x(np.pi), [0.0, 0.0, 0.12])  # side B: the part turned about x (a base only, same motion)

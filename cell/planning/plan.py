@@ -2,25 +2,25 @@
 
 Per seam (:func:`plan_welds`):
 
-0. The reach pre-check (:mod:`cell.motion.reach`, no IK, about a hundred microseconds a seam): a seam whose
+0. The reach pre-check (:mod:`cell.planning.reach`, no IK, about a hundred microseconds a seam): a seam whose
    wrist centre would lie beyond the shoulder's reach for every torch within the process's angles is refused at
    once (``unreachable: beyond reach: ...``, code BEYOND_REACH); the same test per candidate skips IK for the
    candidates out of reach.
-1. and 2. The torch search (:mod:`cell.motion.candidates`): candidate directions, spins and angles; IK at the
+1. and 2. The torch search (:mod:`cell.planning.seam_search`): candidate directions, spins and angles; IK at the
    weld start, then along the seam, the approach and the depart; singularity and collision checks. The first
    candidate that passes is kept; otherwise the seam is reported with the reason that got furthest, e.g.
    ``unreachable: IK did not converge at 35.0 mm along the seam``, and its code
    (:class:`~cell.types.plan.PlanReason`). A seam that ends on the table and is refused because the torch meets
    the table there for every candidate is searched again shortened at that end by the least stand-off that
-   clears the table (:mod:`cell.motion.stand_off`, at most ``table_stand_off_max``); its outcome's ``trimmed``.
-3. Timing (:mod:`cell.motion.lines`, :mod:`cell.motion.assembly`): approach, weld and depart are straight TCP
+   clears the table (:mod:`cell.planning.stand_off`, at most ``table_stand_off_max``); its outcome's ``trimmed``.
+3. Timing (:mod:`cell.planning.lines`, :mod:`cell.planning.assembly`): approach, weld and depart are straight TCP
    lines (KRL LIN): a one-axis Ruckig profile of the path length s(t) mapped through a C2 spline of the IK knots
    q(s); the weld runs at exactly the travel speed between its rest-to-rest ramps. Transfers between seams and
-   from/to home (:mod:`cell.motion.transfers`) are Ruckig point-to-point moves (KRL PTP), lifted over the parts
+   from/to home (:mod:`cell.planning.transfers`) are Ruckig point-to-point moves (KRL PTP), lifted over the parts
    or taken via home where the direct move collides. A transfer that finds no free way is first avoided by
    re-ordering; if it cannot be, the seam is reported as a collision and skipped.
-4. Order (:mod:`cell.motion.order`): greedy nearest neighbour then 2-opt on the point-to-point durations, home
-   at both ends. Each transfer is searched once (:class:`~cell.motion.transfers.Transfers` remembers them), so a
+4. Order (:mod:`cell.planning.order`): greedy nearest neighbour then 2-opt on the point-to-point durations, home
+   at both ends. Each transfer is searched once (:class:`~cell.planning.transfers.Transfers` remembers them), so a
    re-ordering after a failing transfer costs only its new transfers.
 
 What grows with the part is kept near the work: the collision checks query only the obstacle pairs that could
@@ -42,24 +42,20 @@ import numpy.typing as npt
 from cell.config.motion import PlanOptions
 from cell.errors import MotionError, PlanError, TimingError
 from cell.geometry import readonly
-from cell.motion.assembly import assemble
-from cell.motion.candidates import SeamSearch, SeamSolution
 from cell.motion.collision import CollisionChecker
-from cell.motion.collision.scene import cell_obstacles
-from cell.motion.failures import SeamFailure, reason_text
-from cell.motion.lines import line_trajectory
-from cell.motion.order import seam_order
-from cell.motion.passes import pass_pieces, solve_passes
-from cell.motion.reach import ReachModel
 from cell.motion.robot import RobotModel
-from cell.motion.stand_off import blocked_by_table, stand_off, table_top
-from cell.motion.tasks import seam_tasks
-from cell.motion.transfers import Piece, TransferFail, Transfers
-from cell.motion.views.scan import scan_configuration
+from cell.planning.assembly import assemble
+from cell.planning.failures import SeamFailure, reason_text
+from cell.planning.order import seam_order
+from cell.planning.passes import pass_pieces, solve_passes
+from cell.planning.reach import ReachModel
+from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.stand_off import blocked_by_table, stand_off, table_top
+from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.procedures import NoProcedure, SeamProcedure
 from cell.process.torch import WeldProcess
 from cell.types import Part
-from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
+from cell.types.plan import PlanReason, SeamOutcome, SeamTask, WeldPlan
 
 
 def plan_welds(
@@ -221,7 +217,7 @@ def unplaceable(
 
 
 def reach_model(robot: RobotModel) -> ReachModel | None:
-    """The arm's reach pre-check (:mod:`cell.motion.reach`, about 10 ms to build), None for an arm it does not
+    """The arm's reach pre-check (:mod:`cell.planning.reach`, about 10 ms to build), None for an arm it does not
     fit (no spherical wrist, other frame names): the search then goes straight to IK."""
     try:
         return ReachModel.from_robot(robot)
@@ -261,7 +257,7 @@ def _table_stand_off(
     sel: SeamProcedure | None,
     q0: npt.NDArray[np.float64],
 ) -> tuple[SeamSolution, float] | None:
-    """The seam planned shortened at its table end (:mod:`cell.motion.stand_off`) and by how much [m], when its
+    """The seam planned shortened at its table end (:mod:`cell.planning.stand_off`) and by how much [m], when its
     failure is the torch against the table where it is placed; None otherwise or when the shortened seam does
     not plan either (the seam keeps its failure)."""
     if not blocked_by_table(fail, opt.collision.table_name):
@@ -282,18 +278,4 @@ def _failed(seam_id: str, code: PlanReason, detail: str, p_R: npt.ArrayLike) -> 
     return SeamOutcome(seam_id, False, reason_text(code, detail), readonly(p_R), code=code)
 
 
-# Old import paths (cell.motion.plan.X) of names that live in their own modules now.
-__all__ = [
-    "PlanOptions",
-    "PlanReason",
-    "SeamOutcome",
-    "SeamTask",
-    "Segment",
-    "SegmentKind",
-    "WeldPlan",
-    "cell_obstacles",
-    "line_trajectory",
-    "plan_welds",
-    "scan_configuration",
-    "seam_tasks",
-]
+__all__ = ["plan_welds", "reach_model", "seam_process", "unplaceable"]

@@ -3,7 +3,7 @@ group, the arm planned per group with its base there, the track moved between gr
 
 1. Reach along the track (:func:`reach_curves`, no IK): for every seam and every E1 on a grid over the track's
    limits, how much room the arm has: the nominal torch's wrist centre against the longest shoulder-to-wrist
-   distance the elbow allows (the model of :mod:`cell.motion.reach`, with the base moved by E1: the seam's
+   distance the elbow allows (the model of :mod:`cell.planning.reach`, with the base moved by E1: the seam's
    points moved by -E1 along the axis). Negative is inside the band, by that much.
 2. Groups (:func:`group_seams`): each seam's usable E1 are those where it has at least ``margin`` of room (or,
    for a seam that never does, within 5 mm of its best). Those usable at E1 = 0 stay there (the arm plans them as
@@ -11,7 +11,7 @@ group, the arm planned per group with its base there, the track moved between gr
    without one are chosen greedily (sort by the end of each seam's interval, stab), each the grid value that
    leaves its group's worst seam the most room. A seam out of reach at every E1 joins the group nearest its best
    E1, where the planner refuses it with its reason.
-3. Per group (:func:`plan_on_track`): :func:`~cell.motion.plan.plan_welds` with the arm's base moved
+3. Per group (:func:`plan_on_track`): :func:`~cell.planning.plan.plan_welds` with the arm's base moved
    (:meth:`RobotModel.shifted`) and the collision checker's base moved (:meth:`CollisionChecker.set_base`: the
    obstacles are not rebuilt), from home to home. Between groups the track moves from one E1 to the next with the
    arm at home, a jerk-limited one-axis Ruckig profile (:func:`cell.motion.timing.path_profile`) within the
@@ -35,10 +35,10 @@ from cell.config.motion import PlanOptions
 from cell.errors import PlanError
 from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker
-from cell.motion.plan import plan_welds, reach_model, seam_process
-from cell.motion.reach import ReachModel, cone_excess
 from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
+from cell.planning.plan import plan_welds, reach_model, seam_process
+from cell.planning.reach import ReachModel, cone_excess
 from cell.process.procedures import NoProcedure, SeamProcedure
 from cell.process.torch import WeldProcess, fillet_axes
 from cell.types import Part
@@ -80,7 +80,7 @@ def reach_curves(
     included) of how far the nominal torch's wrist centre (the process's work angle, no travel angle, on the torch
     axis) lies beyond the longest shoulder-to-wrist distance d_max (negative: inside, by that much room). With
     ``cone``: the reach pre-check's excess of every torch within the process's angles instead
-    (:func:`cell.motion.reach.cone_excess`, > 0: out of reach for sure). The base moved by E1 is the same as the
+    (:func:`cell.planning.reach.cone_excess`, > 0: out of reach for sure). The base moved by E1 is the same as the
     seam moved by -E1 along the axis."""
     out = np.empty((len(tasks), len(grid)))
     shift = grid[:, None, None] * track.axis_R  # (G, 1, 3)
@@ -175,7 +175,7 @@ def plan_on_track(
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
     on_seam: Callable[[int, int], None] | None = None,
 ) -> WeldPlan:
-    """:func:`~cell.motion.plan.plan_welds` for an arm on ``track`` (module docstring): the same arguments and the
+    """:func:`~cell.planning.plan.plan_welds` for an arm on ``track`` (module docstring): the same arguments and the
     same plan, whose segments carry E1 and whose ``track`` is set. ``robot`` is the arm with its base at R
     (E1 = 0). Raises PlanError when home is outside the limits or collides at E1 = 0; a group whose home collides
     at its E1 has its seams refused (collision) with that reason."""

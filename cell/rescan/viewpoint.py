@@ -43,7 +43,7 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.ik import IKOptions, solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
-from cell.motion.views.view_candidates import (
+from cell.rescan.view_grid import (
     ViewCandidate,
     ViewOptions,
     ViewTarget,

@@ -22,8 +22,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.motion.failures import SeamFailure
 from cell.motion.robot import RobotModel
+from cell.planning.failures import SeamFailure
 from cell.process.torch import WeldProcess, fillet_axes
 from cell.types.plan import PlanReason, SeamTask
 

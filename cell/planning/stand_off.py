@@ -2,9 +2,9 @@
 
 Where two parts meet on the table, a seam climbing from the table top starts in the corner of the table and both
 parts: the gas nozzle meets the table there for every torch orientation the process allows, and the torch search
-(:mod:`cell.motion.candidates`) refuses the seam (``collision: torch vs TABLE at the weld start``). A welding cell
+(:mod:`cell.planning.seam_search`) refuses the seam (``collision: torch vs TABLE at the weld start``). A welding cell
 welds it from a stand-off instead: the seam shortened at its table end by the least multiple of ``_STEP`` at which
-some torch clears the table (tested without IK, :meth:`~cell.motion.candidates.SeamSearch.placeable`), at most
+some torch clears the table (tested without IK, :meth:`~cell.planning.seam_search.SeamSearch.placeable`), at most
 ``PlanOptions.table_stand_off_max`` and never more than a third of the seam. Nothing changes for a seam that
 plans as it is, or one whose failure is anything but the torch against the table where it is placed.
 
@@ -18,8 +18,8 @@ from typing import Literal
 
 import numpy as np
 
-from cell.motion.candidates import SeamSearch
-from cell.motion.failures import SeamFailure
+from cell.planning.failures import SeamFailure
+from cell.planning.seam_search import SeamSearch
 from cell.types import Part
 from cell.types.plan import PlanReason, SeamTask
 

@@ -1,4 +1,4 @@
-"""Transfers between seams and from/to home (step 3 of :func:`cell.motion.plan.plan_welds`).
+"""Transfers between seams and from/to home (step 3 of :func:`cell.planning.plan.plan_welds`).
 
 A transfer is a Ruckig point-to-point move (KRL PTP) where the direct move is free. Where it collides, the next
 strategy is tried, in order (:data:`DEFAULT_STRATEGIES`): straight up (a LIN, as a depart) to ``transfer_lift``
@@ -26,11 +26,11 @@ from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import Entry, body_entry
-from cell.motion.failures import LineError
-from cell.motion.lines import line_trajectory, solve_line
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.wrist import HoseWindow
+from cell.planning.failures import LineError
+from cell.planning.lines import line_trajectory, solve_line
 from cell.process.torch import WeldProcess, line_poses
 from cell.types import Part
 from cell.types.plan import SegmentKind

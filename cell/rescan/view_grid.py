@@ -3,7 +3,7 @@
 The view grid and thresholds (:class:`ViewOptions`), what is looked at (:class:`ViewTarget`: a seam task with a
 fillet), and the candidates that pass the geometric tests (:func:`view_candidates`): the seam and a strip of each
 weld face inside the image with a margin, clear of the torch's image, seen at an incidence below
-``max_incidence_deg``, with no part of the map on the line of sight. See :mod:`cell.motion.views.viewpoint` for the view
+``max_incidence_deg``, with no part of the map on the line of sight. See :mod:`cell.rescan.viewpoint` for the view
 direction u and the camera pose. Frames: R the robot base, C the camera's optical frame; lengths [m].
 """
 

@@ -14,10 +14,10 @@ import numpy as np
 
 from cell.config.motion import PlanOptions
 from cell.geometry import FloatArray, readonly
-from cell.motion.candidates import SeamSolution
-from cell.motion.lines import line_trajectory
 from cell.motion.robot import RobotModel
-from cell.motion.transfers import Piece, TransferFail, Transfers
+from cell.planning.lines import line_trajectory
+from cell.planning.seam_search import SeamSolution
+from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess
 from cell.types.plan import Segment
 from cell.types.procedure import WeldProcedure

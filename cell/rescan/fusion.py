@@ -6,7 +6,7 @@ with ~0.2 mm depth noise and a ~0.35 mm footprint, and its pose comes from the r
 fixed cameras' calibration. Per seam (the loop is :func:`cell.pipeline.rescan.rescan_seams`, the only code that
 moves the arm for it; this module holds the values it computes):
 
-1. plan a view (:func:`cell.motion.views.viewpoint.plan_view`) from where the arm is;
+1. plan a view (:func:`cell.rescan.viewpoint.plan_view`) from where the arm is;
 2. move the simulated arm there (arc off) and take one image from the camera on the arm;
 3. deproject it with the image's believed pose, keep the points in a box around the seam (``crop_margin_m``),
    and run the same locator on a local :class:`SeamScene` (this close cloud, the same aligned map and joints);
@@ -32,7 +32,7 @@ import numpy as np
 from cell.config.rescan import CONFIDENCE_THRESHOLD, RescanOptions
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, invert
-from cell.motion.views.viewpoint import ViewTarget
+from cell.rescan.viewpoint import ViewTarget
 from cell.types import Cloud, DepthImage, MapSeam, Part, SeamEstimate, SeamScene, SeamStatus
 from cell.types.rescan import Rescan, SeamRescan
 

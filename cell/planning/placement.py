@@ -1,4 +1,4 @@
-"""Placing the torch on a seam without IK: the first steps of the torch search (:mod:`cell.motion.candidates`).
+"""Placing the torch on a seam without IK: the first steps of the torch search (:mod:`cell.planning.seam_search`).
 
 A candidate (:class:`~cell.process.torch_orientations.Candidate`) is *placed* when its torch, put at the weld start
 and at the weld end by pose alone, clears every obstacle (:func:`torch_tests`, the broad phase of many poses in one
@@ -27,13 +27,13 @@ import numpy as np
 
 from cell.geometry import FloatArray, make_pose, readonly, rot_z
 from cell.motion.collision import Contact
-from cell.motion.failures import SeamFailure, better, mm
+from cell.planning.failures import SeamFailure, better, mm
 from cell.process.torch import fillet_axes
 from cell.process.torch_orientations import Candidate
 from cell.types.plan import PlanReason, SeamTask
 
 if TYPE_CHECKING:
-    from cell.motion.candidates import SeamSearch
+    from cell.planning.seam_search import SeamSearch
 
 PLACED = -1e-3  # a SeamFailure's progress when the torch hit an obstacle where it was placed (below an IK failure)
 BEYOND = -0.5e-3  # ... when the wrist centre is beyond reach somewhere along the seam (above a torch collision)

@@ -1,7 +1,7 @@
 """A seam's weld procedure executed: its passes (each at its offset in the cross-section, weaving if the procedure
 weaves) solved along the seam like the weld line, and their motions in order (values in, values out).
 
-The torch search (:mod:`cell.motion.candidates`) picks how to hold the torch on the seam line (direction, spin,
+The torch search (:mod:`cell.planning.seam_search`) picks how to hold the torch on the seam line (direction, spin,
 angles). :func:`solve_passes` keeps that candidate and solves every pass with it: the torch poses of the seam at
 knots fine enough for the weave (:func:`cell.process.weave.knot_spacing`), moved by the pass's offsets and weave,
 then IK, approach, depart, singularity and collision checks exactly as for the seam line
@@ -26,12 +26,12 @@ import numpy as np
 
 from cell.config.motion import PlanOptions
 from cell.errors import IKError
-from cell.motion.assembly import seam_pieces
-from cell.motion.candidates import SeamSearch, SeamSolution
-from cell.motion.failures import SeamFailure, unreachable
 from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
-from cell.motion.transfers import Piece, TransferFail, Transfers
+from cell.planning.assembly import seam_pieces
+from cell.planning.failures import SeamFailure, unreachable
+from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess, torch_poses
 from cell.process.weave import cross_section, knot_spacing, offset_poses, pass_speed
 from cell.types.procedure import WeldProcedure

@@ -14,10 +14,10 @@ from scipy.interpolate import CubicSpline
 
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
-from cell.motion.failures import LineError, SeamFailure, unreachable
 from cell.motion.ik import IKOptions, solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile
+from cell.planning.failures import LineError, SeamFailure, unreachable
 from cell.types.plan import PlanReason
 
 

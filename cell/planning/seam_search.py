@@ -1,9 +1,9 @@
-"""The torch search for one seam (step 1 and 2 of :func:`cell.motion.plan.plan_welds`).
+"""The torch search for one seam (step 1 and 2 of :func:`cell.planning.plan.plan_welds`).
 
 1. Candidates (:func:`cell.process.torch_orientations.candidate_groups`: weld directions x spins x work/travel
    angles, nominal first).
    A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK
-   (:mod:`cell.motion.placement`; when none of the nominal group can be placed, the other groups are swept in a
+   (:mod:`cell.planning.placement`; when none of the nominal group can be placed, the other groups are swept in a
    few broad-phase queries, and a seam none can be placed on is refused there, else the search goes on from the
    first group that places one); the rest get IK at the weld start, each held with the wrist equivalent
    (:mod:`cell.motion.wrist`: A4 and A6 turned by whole turns, the flipped wrist) with A6 in the hose package's
@@ -16,7 +16,7 @@
    depart line, checked against singularities and for collisions (conservative advancement between knots).
    A candidate whose A6 leaves the hose window anywhere on approach, seam or depart fails.
    The first candidate that passes is kept (:class:`SeamSolution`); otherwise the failure that got furthest
-   (:class:`~cell.motion.failures.SeamFailure`), e.g. ``unreachable: IK did not converge at 35.0 mm along the
+   (:class:`~cell.planning.failures.SeamFailure`), e.g. ``unreachable: IK did not converge at 35.0 mm along the
    seam``.
 
 Frames: everything in the robot base frame R [m]; joints [rad].
@@ -32,13 +32,13 @@ from cell.config.motion import PlanOptions
 from cell.errors import IKError, PlanError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
-from cell.motion.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
 from cell.motion.ik import solve_ik
-from cell.motion.lines import solve_line
-from cell.motion.placement import Rotations, place, sweep, torch_tests, wording
-from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
+from cell.planning.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
+from cell.planning.lines import solve_line
+from cell.planning.placement import Rotations, place, sweep, torch_tests, wording
+from cell.planning.reach import ReachModel, seam_reach
 from cell.process.torch import WeldProcess, back_off, line_poses
 from cell.process.torch_orientations import Candidate, candidate_groups
 from cell.types.plan import PlanReason, SeamTask
@@ -106,7 +106,7 @@ class SeamSearch:
         With a reach model, a seam out of reach for every torch within the process's angles fails at once
         (BEYOND_REACH, no candidate built), and a candidate whose wrist centre is out of reach anywhere along the
         seam is dropped before IK. When no candidate of the nominal group can be placed, the other groups are
-        swept for one that can (:func:`cell.motion.placement.sweep`, a few broad-phase queries): a seam none can
+        swept for one that can (:func:`cell.planning.placement.sweep`, a few broad-phase queries): a seam none can
         be placed on is refused there, with the failure the group-by-group search would keep; otherwise the search
         goes on from the first group that places one (the groups before it only add their placement failures)."""
         pr, opt = self.process, self.opt
@@ -166,7 +166,7 @@ class SeamSearch:
     def placeable(self, task: SeamTask, q_seed: FloatArray) -> SeamFailure | None:
         """None when some candidate's torch can be placed on the seam (the reach pre-check, clear of the obstacles
         at both weld ends, its wrist centre in reach all along: what :meth:`plan_seam` checks before any IK);
-        else the failure :meth:`plan_seam` would report, found without IK (:func:`cell.motion.placement.sweep`:
+        else the failure :meth:`plan_seam` would report, found without IK (:func:`cell.planning.placement.sweep`:
         a few broad-phase queries for a seam that fails)."""
         if self.reach is not None:
             out = seam_reach(self.reach, task, self.process)
@@ -179,7 +179,7 @@ class SeamSearch:
         return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None, options=self.opt.ik)
 
     def solve_line(self, X: FloatArray, q0: FloatArray, what: str, offset: float, step: float) -> FloatArray:
-        """:func:`~cell.motion.lines.solve_line` with this search's arm and joint step bound."""
+        """:func:`~cell.planning.lines.solve_line` with this search's arm and joint step bound."""
         return solve_line(self.robot, X, q0, what, offset, step, self.opt.max_joint_step, ik=self.opt.ik)
 
     def solve_candidate(

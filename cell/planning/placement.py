@@ -21,22 +21,39 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
+from cell.config.motion import PlanOptions
 from cell.geometry import FloatArray, make_pose, readonly, rot_z
-from cell.motion.collision import Contact
+from cell.motion.collision import CollisionChecker, Contact
 from cell.planning.failures import SeamFailure, better, mm
-from cell.process.torch import fillet_axes
+from cell.planning.reach import ReachModel
+from cell.process.torch import WeldProcess, fillet_axes
 from cell.process.torch_orientations import Candidate
 from cell.types.plan import PlanReason, SeamTask
 
-if TYPE_CHECKING:
-    from cell.planning.seam_search import SeamSearch
-
 PLACED = -1e-3  # a SeamFailure's progress when the torch hit an obstacle where it was placed (below an IK failure)
 BEYOND = -0.5e-3  # ... when the wrist centre is beyond reach somewhere along the seam (above a torch collision)
+
+
+class TorchSearch(Protocol):
+    """What placing a torch asks of the torch search (:class:`cell.planning.seam_search.SeamSearch`): its weld
+    process, collision checker, options and reach model (None: no reach pre-check)."""
+
+    @property
+    def process(self) -> WeldProcess: ...
+
+    @property
+    def checker(self) -> CollisionChecker: ...
+
+    @property
+    def opt(self) -> PlanOptions: ...
+
+    @property
+    def reach(self) -> ReachModel | None: ...
+
 
 Rotations = dict[tuple[bool, float, float], FloatArray]  # (reversed, work offset, travel offset) -> R_RT (3, 3)
 TorchTest = tuple[FloatArray, Contact | None, Contact | None]  # R_RT (3, 3), contact at the weld start, at its end
@@ -49,7 +66,7 @@ def wording(best_fail: SeamFailure | None) -> bool:
 
 
 def torch_tests(
-    search: SeamSearch,
+    search: TorchSearch,
     task: SeamTask,
     cands: Sequence[Candidate],
     rotations: Rotations,
@@ -123,7 +140,7 @@ _SPIN_0 = rot_z(0.0)
 
 
 def place(
-    search: SeamSearch,
+    search: TorchSearch,
     task: SeamTask,
     cand: Candidate,
     test: TorchTest,
@@ -159,7 +176,7 @@ def place(
 
 
 def sweep(
-    search: SeamSearch,
+    search: TorchSearch,
     task: SeamTask,
     groups: Sequence[Sequence[Candidate]],
     q_seed: FloatArray,
@@ -198,7 +215,7 @@ def sweep(
 
 
 def _worded(
-    search: SeamSearch,
+    search: TorchSearch,
     task: SeamTask,
     fail: SeamFailure | None,
     kept: tuple[Candidate, SeamFailure] | None,

@@ -6,6 +6,7 @@
 - :mod:`cell.sim.execution`: :class:`Execution`, what playing back a trajectory recorded (numpy only).
 - :mod:`cell.sim.robot`: :class:`SimRobot`, the arm in the PyBullet client, and the weld bead.
 - :mod:`cell.sim.cell`: :class:`SimCell`, which owns a PyBullet client, builds the cell and renders cameras.
+- :mod:`cell.sim.asbuilt`: the part as really built, the simulation's ground truth (numpy only).
 
 ``from cell.sim import SimCell`` (or ``SimRobot``, ``BeadStyle``) imports pybullet only when the name is first
 asked for; the numpy-only names are imported with the package.

@@ -29,13 +29,14 @@ if TYPE_CHECKING:
 class SimStation:
     """A running simulated cell built from a scenario and its welding map (as drawn, frame M).
 
-    The as-built parts are the map's parts with the scenario's deviations (:func:`cell.asbuilt.as_built_parts`).
+    The as-built parts are the map's parts with the scenario's deviations
+    (:func:`cell.sim.asbuilt.parts.as_built_parts`).
     Use as a context manager; the simulator's client is released on exit.
     """
 
     def __init__(self, scenario: Scenario, weldmap: WeldMap, *, gui: bool = False, with_robot: bool = True) -> None:
-        from cell.asbuilt import as_built_fixtures, as_built_parts
         from cell.sim import SimCell
+        from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts
 
         self.scenario = scenario
         self.parts_W: tuple[Part, ...] = as_built_parts(weldmap, scenario)

@@ -14,7 +14,6 @@ from pinhole import deproject
 from tiny_cell import HOME, URDF
 
 from cell import scenario as scn
-from cell.asbuilt import as_built_fixtures, as_built_parts, principal_frame
 from cell.errors import CaptureError, ScenarioError
 from cell.geometry import make_pose, rot_x, transform_points
 from cell.motion.collision import CollisionChecker
@@ -24,6 +23,7 @@ from cell.recorded._fields import truth_json, truth_parts
 from cell.scenario.flip_specs import FlipPlacementSpec
 from cell.seams.truth import true_seams
 from cell.sim import SimCell
+from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts, principal_frame
 from cell.sim.cell import FIXTURE_PREFIX
 from cell.sim.flip import body_volume, turned_pose
 from cell.types import Box, Joint, MapSeam, Part, Polyhedron, WeldMap

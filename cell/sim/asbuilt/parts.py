@@ -19,12 +19,12 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from cell.asbuilt_realism import as_built_tacks, shapers
-from cell.asbuilt_shapes import principal_frame
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray, invert, make_pose, rpy_to_matrix, transform_points
 from cell.scenario import Deviation, Scenario
 from cell.seams.joint import find_joints
+from cell.sim.asbuilt.realism import as_built_tacks, shapers
+from cell.sim.asbuilt.shapes import principal_frame
 from cell.types import Box, Joint, Part, Polyhedron, WeldMap
 
 # Which deviation keys each kind of body takes (the scenario's Deviation fields).
@@ -86,7 +86,7 @@ def as_built_fixtures(
 ) -> tuple[Part, ...]:
     """The map's fixtures in W, where the part really lies (the scenario's placement with its error); with
     ``simulation.tacks_present``, followed by the tack welds' beads (bodies named ``tack:<seam id>:start|end``,
-    :func:`cell.asbuilt_realism.as_built_tacks`: the simulator renders them and moves them with the part)."""
+    :func:`cell.sim.asbuilt.realism.as_built_tacks`: the simulator renders them and moves them with the part)."""
     X_WM = _true_placement(scenario)
     fixtures = tuple(f.transformed(X_WM) for f in weldmap_M.fixtures)
     if scenario.simulation.tacks_present is None:

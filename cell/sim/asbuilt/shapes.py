@@ -1,7 +1,7 @@
 """The shapes of the realism options (docs/bodies.md section 7), numpy only: a body bent in an arc (a bow), an
 abutting part's end cut out of square (a gap that varies along its seams), and a tack weld's bead.
 
-Every function takes and returns bodies in one frame (any; W in :mod:`cell.asbuilt`), metres.
+Every function takes and returns bodies in one frame (any; W in :mod:`cell.sim.asbuilt.parts`), metres.
 """
 
 from __future__ import annotations

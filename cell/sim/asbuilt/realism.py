@@ -12,12 +12,12 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from cell.asbuilt_shapes import bowed, cut_end, principal_frame, tack_bead
 from cell.errors import ScenarioError
 from cell.geometry import FloatArray
 from cell.scenario import BowSpec, Scenario, TacksPresentSpec
 from cell.seams.joint import find_joints
 from cell.seams.truth import true_seam_W, weld_face_plane
+from cell.sim.asbuilt.shapes import bowed, cut_end, principal_frame, tack_bead
 from cell.types import Joint, Part, Polyhedron, WeldMap
 
 Shaper = Callable[[Polyhedron], Polyhedron]

@@ -13,7 +13,7 @@ what a depth camera's intrinsics and viewing direction give for free.
   ``viewpoint`` when one is given; else towards +z for faces within about 70 degrees of horizontal and, for steep
   faces, away from the centroid of the points (outwards on a convex part).
 
-Where the map lies with no usable placement: :mod:`cell.perception.global_placement`.
+Where the map lies with no usable placement: :mod:`cell.perception.align.placement`.
 
 All in one frame (the cloud's, or the levelled one), metres.
 """

@@ -13,7 +13,7 @@ The cloud is unorganised (no intrinsics, no view direction), in metres, in its o
    :data:`cell.pipeline.cloud_setup.MARGIN_M` (and, above the table, by its noise);
 4. the map aligned by the usual staged ICP and its checks (fitness, tilt, ambiguity, parts seen); with no nominal
    placement, or one whose fit is poor (:data:`POOR_FITNESS`), a global registration first
-   (:mod:`cell.perception.global_placement`: a height-image search over turns and shifts on the table, then FPFH +
+   (:mod:`cell.perception.align.placement`: a height-image search over turns and shifts on the table, then FPFH +
    RANSAC if that fits poorly), each candidate aligned and the one explaining the most points kept;
 5. every seam of the aligned map located (our locator by default), screened (occluders, missing parts, doubt), and
    carried back into F. A seam no data supports is NOT_FOUND or NOT_VISIBLE with the reason, never invented.
@@ -32,9 +32,9 @@ import numpy as np
 
 from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
 from cell.geometry import FloatArray, invert, make_pose, transform_points
-from cell.perception.align import Alignment, align_map, sample_map, surface_fit
-from cell.perception.alignment_checks import check_alignment_unique, check_parts_seen
-from cell.perception.global_placement import DISTINCT_DEG, DISTINCT_M, fpfh_candidates, height_candidates, on_table
+from cell.perception.align.checks import check_alignment_unique, check_parts_seen
+from cell.perception.align.fit import Alignment, align_map, sample_map, surface_fit
+from cell.perception.align.placement import DISTINCT_DEG, DISTINCT_M, fpfh_candidates, height_candidates, on_table
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
@@ -228,7 +228,7 @@ def _global(
     rng: np.random.Generator,
     spec: PerceptionSpec,
 ) -> tuple[FloatArray, Alignment, float] | None:
-    """The best global candidate (:mod:`cell.perception.global_placement`) as aligned by the staged ICP: the one
+    """The best global candidate (:mod:`cell.perception.align.placement`) as aligned by the staged ICP: the one
     that explains the most points of the cloud (:func:`_aligned`); None when none aligns. The height-image search
     first; FPFH + RANSAC only when none of its candidates fits well (on the real scans FPFH proposed the part
     turned by 180 degrees and took 5 s; the height image 0.3 s, right every time)."""

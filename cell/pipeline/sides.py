@@ -69,11 +69,11 @@ def _turn_for(det: Detection) -> FlipPlan | None:
 
 def near_seed(weldmap_M: WeldMap, table_z: float) -> Seed:
     """A :data:`cell.pipeline.detect.Seed`: the height-image search of the cloud (turns and shifts on the table,
-    :func:`cell.perception.global_placement.height_candidates`) for the turned map, its candidates within
+    :func:`cell.perception.align.placement.height_candidates`) for the turned map, its candidates within
     SEARCH_TURN_RAD and SEARCH_SHIFT_M of the nominal pose, the best by the share of the cloud on the map's
     surfaces, the nominal pose itself among them."""
-    from cell.perception.align import sample_map, surface_fit
-    from cell.perception.global_placement import height_candidates
+    from cell.perception.align.fit import sample_map, surface_fit
+    from cell.perception.align.placement import height_candidates
 
     def seed(cloud: Cloud, X_RM: FloatArray) -> FloatArray:
         nominal = weldmap_M.transformed(X_RM, "R")

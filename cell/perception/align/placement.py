@@ -1,5 +1,5 @@
 """Where the welding map lies in an unorganised cloud when no usable placement is given: candidates for the map's
-pose on the table, each to be refined by the usual staged ICP (:func:`cell.perception.align.align_map`) and the
+pose on the table, each to be refined by the usual staged ICP (:func:`cell.perception.align.fit.align_map`) and the
 best kept by its fitness.
 
 A part rests on the table, so in the levelled frame L (the table's normal +z, its top at one height) its pose is a
@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception import _open3d
-from cell.perception.align import sample_map, sample_part_faces
+from cell.perception.align.fit import sample_map, sample_part_faces
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import orient_normals
 from cell.types import Cloud, WeldMap

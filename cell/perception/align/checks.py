@@ -1,6 +1,6 @@
 """Is the map fitted to the cloud where the part is? Checks that turn a wrong map fit into a reason.
 
-For the pipeline, after :func:`cell.perception.align.align_map`:
+For the pipeline, after :func:`cell.perception.align.fit.align_map`:
 
 - :func:`check_alignment_unique`: the map's near-symmetries (a ladder shifted by one rung pitch, a part turned
   by 180 degrees) fit the cloud almost as well as the true placement. Compare the chosen fit with each
@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 from cell.config.perception import CoverageOptions, SymmetryOptions
 from cell.errors import AlignmentError, AlignmentFailure
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
-from cell.perception.align import Alignment, sample_map
+from cell.perception.align.fit import Alignment, sample_map
 from cell.perception.sky import open_to_sky
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, WeldMap

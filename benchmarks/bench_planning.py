@@ -38,8 +38,8 @@ def bench(name: str) -> dict[str, Any]:
     from cell.planning.plan import reach_model, seam_process
     from cell.planning.reach import seam_reach
     from cell.planning.tasks import seam_tasks
-    from cell.process.procedures import SeamProcedure
     from cell.process.torch import WeldProcess
+    from cell.types.plan import SeamProcedure
 
     s = sc.load(name)
     weldmap = read_weldmap(s)

@@ -20,8 +20,7 @@ from cell.scenario import Scenario
 from cell.station import Arm, Station
 
 if TYPE_CHECKING:
-    from cell.process.procedures import NoProcedure, SeamProcedure
-    from cell.types.plan import SeamTask
+    from cell.types.plan import NoProcedure, SeamProcedure, SeamTask
     from cell.types.rescan import Rescan
 
 

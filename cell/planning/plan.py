@@ -52,10 +52,9 @@ from cell.planning.reach import ReachModel
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.planning.stand_off import blocked_by_table, stand_off, table_top
 from cell.planning.transfers import Piece, TransferFail, Transfers
-from cell.process.procedures import NoProcedure, SeamProcedure
 from cell.process.torch import WeldProcess
 from cell.types import Part
-from cell.types.plan import PlanReason, SeamOutcome, SeamTask, WeldPlan
+from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
 
 
 def plan_welds(

@@ -39,10 +39,9 @@ from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
 from cell.planning.plan import plan_welds, reach_model, seam_process
 from cell.planning.reach import ReachModel, cone_excess
-from cell.process.procedures import NoProcedure, SeamProcedure
 from cell.process.torch import WeldProcess, fillet_axes
 from cell.types import Part
-from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, WeldPlan
+from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, Segment, WeldPlan
 from cell.types.track import LinearTrack
 from cell.types.trajectory import Trajectory
 

@@ -17,47 +17,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.types import Joint, WeldMap
-from cell.types.plan import SeamTask
+from cell.types.plan import NoProcedure, SeamProcedure, SeamTask
 from cell.types.procedure import WeldProcedure
 
 VERTICAL_DEG = 30.0  # [deg] a seam this close to vertical is welded in its procedure's direction
 UP_R = np.array([0.0, 0.0, 1.0])  # against gravity in R when the base stands upright
-
-
-@dataclass(frozen=True)
-class SeamProcedure:
-    """The procedure a seam got: the row, the seam's joint type and position, whether its ends are swapped
-    (``reverse``: welded from p_end to p_start, to weld a vertical seam upwards) and whether the direction is
-    fixed (a vertical seam: the planner tries only that one)."""
-
-    seam_id: str
-    procedure: WeldProcedure
-    joint: str
-    position: str
-    leg_mm: float
-    reverse: bool = False
-    fixed_direction: bool = False
-
-    def oriented(self, task: SeamTask) -> SeamTask:
-        """The task with its ends swapped when the procedure welds it the other way."""
-        if not self.reverse:
-            return task
-        return SeamTask(task.id, task.p_end, task.p_start, task.n_a, task.n_b)
-
-
-@dataclass(frozen=True)
-class NoProcedure:
-    """No row of the WPS table fits the seam: why (joint, position, leg it asked for)."""
-
-    seam_id: str
-    reason: str
 
 
 def joint_type(weldmap_R: WeldMap, joint: Joint) -> str:

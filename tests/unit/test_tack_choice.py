@@ -11,8 +11,7 @@ import pytest
 from cell.motion.robot import RobotModel
 from cell.pipeline.tacks import choose_tacks, tack_procedures, tack_records
 from cell.planning.order import seam_order
-from cell.process.procedures import NoProcedure, SeamProcedure
-from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
+from cell.types.plan import NoProcedure, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"

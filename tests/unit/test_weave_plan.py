@@ -18,11 +18,11 @@ from cell.geometry import point_line_distance
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.plan import plan_welds
-from cell.process.procedures import NoProcedure, select_procedures
+from cell.process.procedures import select_procedures
 from cell.process.torch import WeldProcess
 from cell.process.torch_orientations import candidate_groups
 from cell.process.weave import cross_section, intended_offsets
-from cell.types.plan import PlanReason, SeamTask, WeldPlan
+from cell.types.plan import NoProcedure, PlanReason, SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 TOP = SeamTask(*TOP_SEAM)

@@ -262,7 +262,7 @@ def test_the_gate_refuses_a_seam_whose_end_bound_stays_over_the_end_tolerance() 
 
 
 def test_a_closeup_that_finds_where_a_drawn_end_really_is_does_not_escalate() -> None:
-    from cell.pipeline.rescan import end_shift_m
+    from cell.rescan.escalation import end_shift_m
 
     a, b = np.zeros(3), np.array([0.1, 0.0, 0.0])
     seen = SeamEstimate(

@@ -73,7 +73,7 @@ def plan_welds(
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
-    tasks : the seams, in R (underside seams are not passed in: the caller marks them "needs a flip").
+    tasks : the seams, in R (underside seams are not passed in: the caller marks them for the turnover).
     q_home : (dof,) [rad] where the program starts and ends. obstacles : parts and table, boxes in R.
     rng : for IK restarts (deterministic for a seeded generator; default seed 0).
     procedures : seam id -> the weld procedure it got (:mod:`cell.process.procedures`): its travel speed and

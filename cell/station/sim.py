@@ -97,7 +97,7 @@ class SimStation:
         """The operator turns the part over: the as-built part (its beads on it) moves by the nominal turn
         X_W_turn (4, 4) in W, settles on its own hull and is set down with ``simulation.flip_placement``'s error
         (drawn from ``Scenario.rng("flip")``); :meth:`truth` moves with it."""
-        from cell.sim.flip import turned_pose
+        from cell.sim.turnover import turned_pose
 
         sim = self.scenario.simulation
         X = turned_pose(

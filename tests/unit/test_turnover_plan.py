@@ -1,4 +1,4 @@
-"""Which turn exposes the seams side A leaves against the table (cell.seams.flip, cell.resting): fence1's half
+"""Which turn exposes the seams side A leaves against the table (cell.planning.turnover, cell.resting): fence1's half
 turn about its long axis, a flat pair of bars that turns without leaning, a part that cannot rest after any turn,
 a forbidden turn; the operator's placement error drawn from the seed."""
 
@@ -12,14 +12,14 @@ import pytest
 from cell import scenario as sc
 from cell.geometry import invert, make_pose
 from cell.pipeline.detect import read_weldmap, table_z_R
+from cell.planning.turnover import pivot, plan_turnover
 from cell.resting import axis_rotation, set_down
-from cell.scenario.flip_specs import FlipPlacementSpec
-from cell.seams.flip import pivot, plan_flip
+from cell.scenario.turnover_specs import TurnoverPlacementSpec
 from cell.seams.joint import fillet_bisector, find_joints
 from cell.seams.visibility import visibility
-from cell.sim.flip import operator_error
+from cell.sim.turnover import operator_error
 from cell.types import Box, MapSeam, Part, WeldMap
-from cell.types.flip import FlipPlan
+from cell.types.turnover import TurnoverPlan
 
 
 def _underside(w: WeldMap, joints: dict, table_z: float) -> list[str]:
@@ -38,7 +38,7 @@ def test_fence1_turns_half_about_its_long_axis_and_exposes_its_four_underside_se
     w, joints, tz, X_RM = fence1
     left = _underside(w, joints, tz)
     assert len(left) == 4 and all(s.endswith(":-z") for s in left)
-    plan = plan_flip(w, joints, tz, left, X_RM)
+    plan = plan_turnover(w, joints, tz, left, X_RM)
     assert plan.go and plan.axis == "x" and plan.angle_rad == pytest.approx(math.pi)
     assert set(plan.exposed) == set(left) and not plan.left
     # The rails are 100 and 60 mm tall, the posts 80: upside down it rests on the top rail's face and the posts'
@@ -56,8 +56,8 @@ def test_fence1_turns_half_about_its_long_axis_and_exposes_its_four_underside_se
 
 def test_the_same_map_gives_the_same_plan(fence1: tuple) -> None:
     w, joints, tz, X_RM = fence1
-    a = plan_flip(w, joints, tz, _underside(w, joints, tz), X_RM)
-    b = plan_flip(w, joints, tz, _underside(w, joints, tz), X_RM)
+    a = plan_turnover(w, joints, tz, _underside(w, joints, tz), X_RM)
+    b = plan_turnover(w, joints, tz, _underside(w, joints, tz), X_RM)
     assert a.exposed == b.exposed and np.array_equal(a.X_RM_after, b.X_RM_after)
 
 
@@ -80,7 +80,7 @@ def test_bars_of_one_height_turn_without_leaning() -> None:
     joints = find_joints(w)
     left = _underside(w, joints, 0.0)
     assert left == ["B:-z"]
-    plan = plan_flip(w, joints, 0.0, left, np.eye(4))
+    plan = plan_turnover(w, joints, 0.0, left, np.eye(4))
     assert plan.go and plan.exposed == ("B:-z",)
     assert plan.tilt_rad == pytest.approx(0.0, abs=1e-9)
 
@@ -88,7 +88,7 @@ def test_bars_of_one_height_turn_without_leaning() -> None:
 def test_a_part_that_cannot_rest_after_any_turn_lists_every_seam_with_why(fence1: tuple) -> None:
     w, joints, tz, X_RM = fence1
     left = _underside(w, joints, tz)
-    plan = plan_flip(w, joints, tz, left, X_RM, max_tilt_rad=math.radians(1.0))
+    plan = plan_turnover(w, joints, tz, left, X_RM, max_tilt_rad=math.radians(1.0))
     assert not plan.go and not plan.stable and plan.exposed == ()
     assert set(plan.left) == set(left)
     assert all("lean" in why and "at most 1.0" in why for why in plan.left.values())
@@ -97,15 +97,15 @@ def test_a_part_that_cannot_rest_after_any_turn_lists_every_seam_with_why(fence1
 def test_a_forbidden_turn_keeps_the_seams_with_the_reason(fence1: tuple) -> None:
     w, joints, tz, X_RM = fence1
     left = _underside(w, joints, tz)
-    plan = plan_flip(w, joints, tz, left, X_RM, allowed=False)
-    assert isinstance(plan, FlipPlan) and not plan.go and not plan.allowed
+    plan = plan_turnover(w, joints, tz, left, X_RM, allowed=False)
+    assert isinstance(plan, TurnoverPlan) and not plan.go and not plan.allowed
     assert set(plan.left) == set(left) and all("flip.allowed" in why for why in plan.left.values())
     assert "forbids" in plan.reason
 
 
 def test_nothing_left_means_no_turn(fence1: tuple) -> None:
     w, joints, tz, X_RM = fence1
-    plan = plan_flip(w, joints, tz, [], X_RM)
+    plan = plan_turnover(w, joints, tz, [], X_RM)
     assert not plan.go and plan.reason
 
 
@@ -120,7 +120,7 @@ def test_a_cube_turned_upside_down_rests_level_and_stable() -> None:
 
 
 def test_the_operators_error_has_the_asked_size_and_comes_from_the_seed() -> None:
-    spec = FlipPlacementSpec(offset_mm=30.0, rotation_deg=5.0)
+    spec = TurnoverPlacementSpec(offset_mm=30.0, rotation_deg=5.0)
     centre = np.array([0.1, 1.0, 0.05])
     scn = sc.load("fence1")
     a = operator_error(spec, scn.rng("flip"), centre)

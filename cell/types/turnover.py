@@ -15,7 +15,7 @@ from cell.geometry import FloatArray, invert, readonly
 
 
 @dataclass(frozen=True)
-class FlipPlan:
+class TurnoverPlan:
     """How the part is turned over so that the seams left after side A face up.
 
     axis : the part's principal axis turned about (``"x"``, ``"y"`` or ``"z"`` of the map's box frame P), with
@@ -60,7 +60,7 @@ class FlipPlan:
 
 
 @dataclass(frozen=True)
-class FlipResult:
+class TurnoverResult:
     """What the second alignment found: where the part really lies after the turn, against its nominal pose.
 
     offset_m : horizontal distance [m] of the aligned map's centre from its nominal place after the turn.

@@ -18,7 +18,7 @@ class TackSpec(Model):
     length_mm: Annotated[float, Field(gt=0.0, le=100.0)] = 10.0  # each tack's length
 
 
-class FlipSpec(Model):
+class TurnoverSpec(Model):
     """Whether and how the part may be turned over for the seams its first side leaves against the table.
 
     allowed : false for a part too heavy (or too awkward) to turn: the seams left keep their reason.
@@ -35,7 +35,7 @@ class FlipSpec(Model):
     max_tilt_deg: Annotated[float, Field(ge=0.0, le=20.0)] = 5.0
 
 
-class FlipPlacementSpec(Model):
+class TurnoverPlacementSpec(Model):
     """How far off its nominal turned pose the operator sets the part down (ground truth only): a horizontal
     offset of ``offset_mm`` in a direction and a turn of ``rotation_deg`` about the vertical of a sign, both drawn
     from ``Scenario.rng("flip")``."""

@@ -20,7 +20,7 @@ from cell.export.krl_calls import check_all, read_target
 from cell.export.post import write_program
 from cell.export.program import ProgramJob
 from cell.export.rapid import RapidPost
-from cell.export.two_sided import two_sided_program, write_two_sided
+from cell.export.turnover_program import turnover_program, write_turnover_program
 from cell.geometry import make_pose, rot_x
 from cell.motion.robot import RobotModel
 from cell.planning.plan import plan_welds
@@ -59,7 +59,7 @@ def _check(target: Path, robot: RobotModel) -> list[tuple[str, str]]:
 
 
 def test_krl_main_runs_side_a_stops_for_the_operator_then_runs_side_b(sides: list[ProgramJob]) -> None:
-    texts = two_sided_program("krl", sides, main_name="weld_t", flip_message=MESSAGE)
+    texts = turnover_program("krl", sides, main_name="weld_t", turnover_message=MESSAGE)
     assert list(texts) == [f"{n}.{e}" for n in ("WELD_T", "WELD_T_A", "WELD_T_B") for e in ("src", "dat")]
     src, dat = _lines(texts["WELD_T.src"]), texts["WELD_T.dat"]
     assert src[2] == "DEF WELD_T( )" and dat.startswith("DEFDAT WELD_T PUBLIC")
@@ -81,16 +81,16 @@ def test_krl_main_runs_side_a_stops_for_the_operator_then_runs_side_b(sides: lis
 
 
 def test_krl_halt_stop_and_one_side_only(sides: list[ProgramJob]) -> None:
-    texts = two_sided_program("krl", sides, main_name="WELD_T", flip_message="Turn the part", stop="halt")
+    texts = turnover_program("krl", sides, main_name="WELD_T", turnover_message="Turn the part", stop="halt")
     src = _lines(texts["WELD_T.src"])
     a, b = _index(src, r"^WELD_T_A\( \)$"), _index(src, r"^WELD_T_B\( \)$")
     assert [ln for ln in src[a:b] if ln.startswith("HALT")] == ["HALT ; Turn the part"]
     assert "Set_KrlMsg" not in texts["WELD_T.src"] and "FLIP_MSG" not in texts["WELD_T.dat"]
-    assert two_sided_program("krl", sides[:1], main_name="WELD_T", flip_message=MESSAGE) == KrlPost().texts(sides[0])
+    assert turnover_program("krl", sides[:1], main_name="WELD_T", turnover_message=MESSAGE) == KrlPost().texts(sides[0])
 
 
 def test_rapid_main_module_calls_both_sides_and_waits_for_the_operator(sides: list[ProgramJob]) -> None:
-    texts = two_sided_program("rapid", sides, main_name="WELD_T", flip_message=MESSAGE)
+    texts = turnover_program("rapid", sides, main_name="WELD_T", turnover_message=MESSAGE)
     assert list(texts) == ["WELD_T.mod", "WELD_T_A.mod", "WELD_T_B.mod"]
     main = _lines(texts["WELD_T.mod"])
     a, b = _index(main, r"^WELD_T_A_RUN;$"), _index(main, r"^WELD_T_B_RUN;$")
@@ -108,7 +108,9 @@ def test_rapid_main_module_calls_both_sides_and_waits_for_the_operator(sides: li
         # nothing else changed from the post's own module
         own = side.replace("  LOCAL ", "  ").replace(f"PROC {name}_RUN()", "PROC main()")
         assert own == RapidPost().texts(job)[f"{name}.mod"]
-    halt = _lines(two_sided_program("rapid", sides, main_name="WELD_T", flip_message="Turn", stop="halt")["WELD_T.mod"])
+    halt = _lines(
+        turnover_program("rapid", sides, main_name="WELD_T", turnover_message="Turn", stop="halt")["WELD_T.mod"]
+    )
     s = _index(halt, r'^TPWrite "Turn";$')
     assert halt[s + 1] == "Stop;" and "TPReadFK" not in " ".join(halt)
 
@@ -123,7 +125,7 @@ def test_rapid_main_module_calls_both_sides_and_waits_for_the_operator(sides: li
         ("krl", "WELD_T", ("A", "B"), "x" * 81, "at most 80 printable ASCII"),
         ("krl", "WELD_T", ("A", "B"), 'say "turned"', "without a double quote or backslash"),
         ("rapid", "WELD_T", ("A", "B"), "C:\\part", "without a double quote or backslash"),
-        ("krl", "WELD_T", ("A", "B"), "  ", "the flip message is empty"),
+        ("krl", "WELD_T", ("A", "B"), "  ", "the turnover message is empty"),
         ("fanuc", "WELD_T", ("A", "B"), MESSAGE, "controller 'fanuc' is unknown; valid: krl, rapid"),
     ],
 )
@@ -132,22 +134,22 @@ def test_bad_names_and_messages_are_one_line_value_errors(
 ) -> None:
     jobs = [replace(j, name=n.upper()) for j, n in zip(sides, names, strict=True)]
     with pytest.raises(ValueError, match=re.escape(needle)) as e:
-        two_sided_program(controller, jobs, main_name=main, flip_message=message)
+        turnover_program(controller, jobs, main_name=main, turnover_message=message)
     assert "\n" not in str(e.value)
 
 
 def test_sides_that_plan_different_homes_or_no_side_are_refused(sides: list[ProgramJob]) -> None:
     other = replace(sides[1].plan, q_home=sides[1].plan.q_home + np.radians([0, 0, 0, 0, 0, 1.0]))
     with pytest.raises(ValueError, match=r"WELD_T_B's home differs from WELD_T_A's by 1.00 deg"):
-        two_sided_program("krl", [sides[0], replace(sides[1], plan=other)], main_name="W", flip_message=MESSAGE)
+        turnover_program("krl", [sides[0], replace(sides[1], plan=other)], main_name="W", turnover_message=MESSAGE)
     with pytest.raises(ValueError, match="at least one job"):
-        two_sided_program("krl", [], main_name="W", flip_message=MESSAGE)
+        turnover_program("krl", [], main_name="W", turnover_message=MESSAGE)
 
 
 def test_checker_passes_the_written_folder_and_the_main_file(
     sides: list[ProgramJob], robot: RobotModel, tmp_path: Path
 ) -> None:
-    paths = write_two_sided("krl", sides, "weld_t", MESSAGE, tmp_path)
+    paths = write_turnover_program("krl", sides, "weld_t", MESSAGE, tmp_path)
     assert [p.name for p in paths][:2] == ["WELD_T.src", "WELD_T.dat"]
     assert b"\r\n" in paths[0].read_bytes()
     assert _check(tmp_path, robot) == []
@@ -156,7 +158,7 @@ def test_checker_passes_the_written_folder_and_the_main_file(
     assert not any(p.src.problems or p.dat.problems for p in programs)
     assert _check(tmp_path / "WELD_T.src", robot) == []
     halt = tmp_path / "halt"
-    write_two_sided("krl", sides, "WELD_T", MESSAGE, halt, stop="halt")
+    write_turnover_program("krl", sides, "WELD_T", MESSAGE, halt, stop="halt")
     assert _check(halt, robot) == []
 
 
@@ -169,13 +171,13 @@ def _edit(path: Path, old: str, new: str) -> None:
 def test_checker_finds_a_missing_side_an_unknown_call_a_missing_stop_and_a_shared_base(
     sides: list[ProgramJob], robot: RobotModel, tmp_path: Path
 ) -> None:
-    write_two_sided("krl", sides, "WELD_T", MESSAGE, tmp_path)
+    write_turnover_program("krl", sides, "WELD_T", MESSAGE, tmp_path)
     main = tmp_path / "WELD_T.src"
     (tmp_path / "WELD_T_B.src").unlink()
     (tmp_path / "WELD_T_B.dat").unlink()
     found = _check(main, robot)
     assert found == [("call", "WELD_T_B( ) is neither a program in the folder nor a KSS routine this checker knows")]
-    write_two_sided("krl", sides, "WELD_T", MESSAGE, tmp_path)
+    write_turnover_program("krl", sides, "WELD_T", MESSAGE, tmp_path)
     text = main.read_text()
     start, end = text.index(";FOLD OPERATOR STOP"), text.index(";ENDFOLD", text.index("ENDWHILE"))
     main.write_text(text[:start] + "CLEAN_TORCH( )" + text[end + len(";ENDFOLD") :])
@@ -189,7 +191,7 @@ def test_checker_finds_a_missing_side_an_unknown_call_a_missing_stop_and_a_share
     _edit(main, "PTP XHOME ; back home", "")
     assert [c for c, _ in _check(main, robot)] == ["operator_stop"]
     # the message shown must be declared, with a text that fits Msg_Txt[] (CHAR[80])
-    write_two_sided("krl", sides, "WELD_T", MESSAGE, tmp_path)
+    write_turnover_program("krl", sides, "WELD_T", MESSAGE, tmp_path)
     dat = tmp_path / "WELD_T.dat"
     _edit(dat, f'"{MESSAGE}"', f'"{MESSAGE}{"!" * (81 - len(MESSAGE))}"')
     assert _check(main, robot) == [("operator_stop", "FLIP_MSG's text has 81 characters, over the 80 of Msg_Txt[]")]
@@ -205,7 +207,7 @@ def test_checker_finds_a_missing_side_an_unknown_call_a_missing_stop_and_a_share
 
 
 def test_cli_checks_a_main_file_and_its_sides(sides: list[ProgramJob], tmp_path: Path) -> None:
-    write_two_sided("krl", sides, "WELD_T", MESSAGE, tmp_path)
+    write_turnover_program("krl", sides, "WELD_T", MESSAGE, tmp_path)
     runner = CliRunner()
     ok = runner.invoke(app, ["krl", "check", str(tmp_path / "WELD_T.src")])
     assert ok.exit_code == 0 and "WELD_T, WELD_T_A, WELD_T_B: passed" in ok.stderr

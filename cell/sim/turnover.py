@@ -13,7 +13,7 @@ import numpy as np
 
 from cell.geometry import FloatArray, make_pose, transform_points
 from cell.resting import axis_rotation, set_down
-from cell.scenario.flip_specs import FlipPlacementSpec
+from cell.scenario.turnover_specs import TurnoverPlacementSpec
 from cell.types import Part
 
 
@@ -35,7 +35,7 @@ def body_volume(part: Part) -> float:
     return float(np.prod(part.box.size)) if part.is_box else float(part.volume)
 
 
-def operator_error(spec: FlipPlacementSpec, rng: np.random.Generator, centre_W: FloatArray) -> FloatArray:
+def operator_error(spec: TurnoverPlacementSpec, rng: np.random.Generator, centre_W: FloatArray) -> FloatArray:
     """(4, 4) the operator's placement error in W: a turn of ``rotation_deg`` (its sign drawn) about the vertical
     through ``centre_W`` (3,), then a horizontal shift of ``offset_mm`` in a drawn direction."""
     direction = float(rng.uniform(0.0, 2.0 * math.pi))
@@ -52,7 +52,7 @@ def turned_pose(
     bead_radius_m: float,
     X_W_turn: FloatArray,
     table_top_z: float,
-    spec: FlipPlacementSpec,
+    spec: TurnoverPlacementSpec,
     rng: np.random.Generator,
 ) -> FloatArray:
     """(4, 4) X_W_new_old: the as-built part moved by the nominal turn X_W_turn (4, 4), settled on its own hull

@@ -15,8 +15,8 @@ from cell.cli.tables import print_weld
 from cell.errors import UsageError
 
 if TYPE_CHECKING:
-    from cell.pipeline.two_sided import TwoSidedRun
-    from cell.types.flip import FlipPlan
+    from cell.pipeline.turnover_run import TurnoverRun
+    from cell.types.turnover import TurnoverPlan
 
 
 def parse_sides(sides: str) -> str:
@@ -26,13 +26,13 @@ def parse_sides(sides: str) -> str:
     return sides
 
 
-def flip_message(plan: FlipPlan) -> str:
+def turnover_message(plan: TurnoverPlan) -> str:
     """The operator's message between the sides (at most 80 characters)."""
     return f"Turn the part {math.degrees(plan.angle_rad):+.0f} deg about its {plan.axis} axis, then confirm"
 
 
-def finish_two_sided(
-    run: TwoSidedRun,
+def finish_turnover(
+    run: TurnoverRun,
     json_path: Path | None,
     krl: Path | None,
     *,
@@ -44,9 +44,9 @@ def finish_two_sided(
 ) -> str | None:
     """Write the report first, then the programs; print the table and one line per side; the exit's explanation
     when the job is partial (None when complete)."""
-    from cell.export.flip_report import two_sided_report
+    from cell.export.turnover_report import turnover_report
 
-    rep = two_sided_report(run, provenance=provenance)
+    rep = turnover_report(run, provenance=provenance)
     writer.report(json_path, rep)
     if krl is not None:
         written = writer.attempt(lambda: write_programs(run, krl, provenance, controller))
@@ -78,19 +78,19 @@ def sides_line(rep: Mapping[str, Any]) -> str:
     return " · ".join(parts)
 
 
-def write_programs(run: TwoSidedRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
+def write_programs(run: TurnoverRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
     """The robot programs into ``krl``, each side's weld points in its own aligned map's base.
 
     One side welded: its program ``WELD_<SCENARIO>`` and ``trajectory.json``/``.csv``. Two:
     one program per side (``WELD_<SCENARIO>_A``, ``_B``), the main program ``WELD_<SCENARIO>`` that runs A, stops
-    for the operator's turn and runs B (:func:`cell.export.two_sided.write_two_sided`), and each side's
+    for the operator's turn and runs B (:func:`cell.export.turnover_program.write_turnover_program`), and each side's
     trajectory (``trajectory_A.json`` ...)."""
     import numpy as np
 
     from cell.export.post import write_program
     from cell.export.program import ProgramJob
     from cell.export.trajectory import write_csv, write_json
-    from cell.export.two_sided import write_two_sided
+    from cell.export.turnover_program import write_turnover_program
 
     sc = run.side_a.detection.scenario
     base = ("WELD_" + "".join(ch if ch.isalnum() else "_" for ch in sc.name).upper())[:22]
@@ -108,7 +108,7 @@ def write_programs(run: TwoSidedRun, krl: Path, provenance: Mapping[str, Any], c
         written = write_program(controller, jobs[0], krl)
     else:
         assert run.plan is not None
-        written = write_two_sided(controller, jobs, base, flip_message(run.plan), krl)
+        written = write_turnover_program(controller, jobs, base, turnover_message(run.plan), krl)
     for side, wr in runs:  # after the programs: they make the folder
         assert wr.plan is not None
         stem = "trajectory" if len(runs) == 1 else f"trajectory_{side}"

@@ -16,7 +16,7 @@ from cell.types import WeldMap
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from cell.pipeline.two_sided import TwoSidedRun
+    from cell.pipeline.turnover_run import TurnoverRun
 
 SIDE_COLOURS = {"A": "tab:blue", "B": "tab:orange", "left": "0.55"}
 
@@ -37,7 +37,7 @@ def _draw(ax: Axes, weldmap: WeldMap, colour_of: dict[str, str], axes: tuple[int
     ax.set_ylabel(f"{'xyz'[j]}_R [m]")
 
 
-def write_flip(run: TwoSidedRun, out_dir: Path) -> list[Path]:
+def write_turnover(run: TurnoverRun, out_dir: Path) -> list[Path]:
     """``flip.png`` in ``out_dir``: side A's part and seams, the turn and side B's seams at the nominal turned
     pose; nothing when no turn was planned."""
     plan, turned = run.plan, run.turned_map

@@ -10,12 +10,12 @@ from cell.errors import CellError
 from cell.pipeline.records import WeldRun
 from cell.pipeline.tacks import TackRecord
 from cell.types import SeamStatus, WeldMap
-from cell.types.flip import FlipPlan, FlipResult
 from cell.types.run import SeamRecord
+from cell.types.turnover import TurnoverPlan, TurnoverResult
 
 
 @dataclass(frozen=True)
-class TwoSidedRun:
+class TurnoverRun:
     """A whole part welded: side A, then (when seams were left against the table and the turn was made) side B.
 
     plan : the turn (None when nothing was left for a second side, or ``--sides first``). side_b : side B's run
@@ -27,9 +27,9 @@ class TwoSidedRun:
     """
 
     side_a: WeldRun
-    plan: FlipPlan | None = None
+    plan: TurnoverPlan | None = None
     side_b: WeldRun | None = None
-    result: FlipResult | None = None
+    result: TurnoverResult | None = None
     operator_s: float = 0.0
     tacks_s: float = 0.0
     error: CellError | None = None

@@ -22,7 +22,7 @@ from cell.resting import axis_rotation, set_down
 from cell.seams.joint import fillet_bisector
 from cell.seams.visibility import visibility
 from cell.types import Joint, WeldMap
-from cell.types.flip import FlipPlan
+from cell.types.turnover import TurnoverPlan
 
 _FACING_DOWN_Z = -0.2  # a fillet whose bisector points further down than this cannot be reached from above
 _TURNS = (math.pi, math.pi / 2.0, -math.pi / 2.0)  # half turn first, then onto a side
@@ -76,7 +76,7 @@ def _why_left(turned: WeldMap, joint: Joint, table_z: float, table_xy: tuple[Flo
     return ""
 
 
-def plan_flip(
+def plan_turnover(
     weldmap_R: WeldMap,
     joints: Mapping[str, Joint],
     table_z: float,
@@ -86,20 +86,20 @@ def plan_flip(
     allowed: bool = True,
     max_tilt_rad: float = math.radians(5.0),
     table_xy: tuple[FloatArray, FloatArray] | None = None,
-) -> FlipPlan:
+) -> TurnoverPlan:
     """The turn that exposes the seams ``remaining`` (ids left against the table after side A).
 
     weldmap_R : the aligned map in R (+z up); joints : seam id -> joint; table_z : the table top in R [m].
     X_RM : (4, 4) the aligned map's pose now. table_xy : the table's (min, max) corners (3,) in R, if the part
-    must stay on it. Returns the :class:`FlipPlan` (``go`` False, with its ``reason``, when no turn is made).
+    must stay on it. Returns the :class:`TurnoverPlan` (``go`` False, with its ``reason``, when no turn is made).
     """
     remaining = [s.id for s in weldmap_R.seams if s.id in set(remaining)]
     axes = principal_axes(weldmap_R)
     if not remaining:
-        return FlipPlan("x", axes[:, 0], 0.0, 0.0, X_RM, X_RM, (), {}, reason="no seam is left for a second side")
+        return TurnoverPlan("x", axes[:, 0], 0.0, 0.0, X_RM, X_RM, (), {}, reason="no seam is left for a second side")
     if not allowed:
         why = "flip.allowed is false: the part may not be turned (too heavy to turn); the seam stays underside"
-        return FlipPlan(
+        return TurnoverPlan(
             "x",
             axes[:, 0],
             0.0,
@@ -113,7 +113,7 @@ def plan_flip(
         )
     pts = np.concatenate([p.vertices() for p in weldmap_R.parts])
     com, c = centre_of_mass(weldmap_R), pivot(weldmap_R)
-    best: tuple[tuple[int, int], FlipPlan] | None = None
+    best: tuple[tuple[int, int], TurnoverPlan] | None = None
     rank = 0
     for k, name in enumerate("xyz"[:2]):  # about the longest axis, then the middle one: a turn over, not a spin
         for angle in _TURNS:
@@ -134,7 +134,9 @@ def plan_flip(
                     f"mass {margin * 1000:+.0f} mm inside its support, {height * 1000:.0f} mm up (tips over at "
                     f"{math.degrees(tip):.0f} deg, needs {math.degrees(MIN_TIP_RAD):.0f})"
                 )
-            plan = FlipPlan(name, axes[:, k], angle, tilt, X @ X_RM, X_RM, exposed, left, stable=stable, reason=reason)
+            plan = TurnoverPlan(
+                name, axes[:, k], angle, tilt, X @ X_RM, X_RM, exposed, left, stable=stable, reason=reason
+            )
             score = (len(exposed) if stable else -1, -rank)
             if best is None or score > best[0]:
                 best = (score, plan)

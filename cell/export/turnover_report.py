@@ -8,10 +8,10 @@ from collections.abc import Mapping
 from typing import Any
 
 from cell.export.report import _error, _pt, _r, weld_report
-from cell.pipeline.two_sided import TwoSidedRun
+from cell.pipeline.turnover_run import TurnoverRun
 
 
-def two_sided_report(run: TwoSidedRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
+def turnover_report(run: TurnoverRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The report of a whole part: side A's :func:`weld_report` with every key kept, each seam's entry
     taken from the side that searched it and given its ``side`` (``"A"``/``"B"``), a ``flip`` block (the turn
     planned, the placement error the second alignment measured, its fitness, the seams left with why), ``sides``
@@ -43,7 +43,7 @@ def two_sided_report(run: TwoSidedRun, *, provenance: Mapping[str, Any] | None =
     rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
     rep["job_time_s"] = _r(run.job_time_s, 3)
     rep["sides"] = sides
-    rep["flip"] = _flip_entry(run)
+    rep["flip"] = _turnover_entry(run)
     if rep["error"] is None and run.side_b is not None and run.side_b.error is not None:
         rep["error"] = _error(run.side_b.error)
     if rep["error"] is None and run.error is not None:
@@ -63,7 +63,7 @@ def _side_entry(rep: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
-def _flip_entry(run: TwoSidedRun) -> dict[str, Any] | None:
+def _turnover_entry(run: TurnoverRun) -> dict[str, Any] | None:
     """The turn: planned (axis, angle, lean, nominal pose after), made or why not, and what was measured."""
     p = run.plan
     if p is None:

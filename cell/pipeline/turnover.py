@@ -19,13 +19,13 @@ from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.detect import Progress, Seed, quiet, read_weldmap, table_z_R
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.tacks import Tack, choose_tacks, tack_records, tacks_time_s
-from cell.pipeline.two_sided import TwoSidedRun
+from cell.pipeline.turnover_run import TurnoverRun
 from cell.pipeline.weld import weld
 from cell.scenario import Scenario
 from cell.station import Station, open_station
 from cell.types import Cloud, SeamStatus, WeldMap
-from cell.types.flip import FlipPlan, FlipResult
 from cell.types.plan import SeamTask
+from cell.types.turnover import TurnoverPlan, TurnoverResult
 
 Sides = Literal["first", "all"]
 SEARCH_TURN_RAD = math.radians(15.0)  # how far off its nominal turned pose the second alignment looks for the part
@@ -41,21 +41,21 @@ def table_box_R(sc: Scenario) -> tuple[FloatArray, FloatArray]:
     return p.min(axis=0), p.max(axis=0)
 
 
-def plan_turn(run: WeldRun) -> FlipPlan | None:
+def plan_turn(run: WeldRun) -> TurnoverPlan | None:
     """The turn for the seams side A left against the table (None when none is left), from side A's aligned map."""
     return _turn_for(run.detection)
 
 
-def _turn_for(det: Detection) -> FlipPlan | None:
+def _turn_for(det: Detection) -> TurnoverPlan | None:
     """:func:`plan_turn` from side A's detection (before its welds are planned: the tacks depend on it)."""
-    from cell.seams.flip import plan_flip
+    from cell.planning.turnover import plan_turnover
 
     left = [e.id for e in det.estimates if e.status is SeamStatus.NOT_VISIBLE]
     if not left:
         return None
     sc = det.scenario
     X_RM = det.scene.X_RM if det.scene is not None else invert(sc.X_WR) @ sc.X_WM
-    return plan_flip(
+    return plan_turnover(
         det.weldmap_R,
         det.joints,
         table_z_R(sc),
@@ -96,13 +96,13 @@ def near_seed(weldmap_M: WeldMap, table_z: float) -> Seed:
     return seed
 
 
-def flip_result(plan: FlipPlan, run: WeldRun, weldmap_M: WeldMap) -> FlipResult | None:
+def turnover_result(plan: TurnoverPlan, run: WeldRun, weldmap_M: WeldMap) -> TurnoverResult | None:
     """The placement the second alignment measured against the plan's nominal turned pose: the shift of the
     part's centre and the turn about the vertical (None: no alignment)."""
     scene = run.detection.scene
     if scene is None:
         return None
-    from cell.seams.flip import pivot
+    from cell.planning.turnover import pivot
 
     # The part's centre (the middle of its extent, the turn's pivot) at its nominal turned place and where found.
     nominal_c = pivot(weldmap_M.transformed(plan.X_RM_after, "R"))
@@ -110,7 +110,7 @@ def flip_result(plan: FlipPlan, run: WeldRun, weldmap_M: WeldMap) -> FlipResult 
     found_c = transform_points(D, nominal_c)
     rotation = math.atan2(float(D[1, 0]), float(D[0, 0]))
     offset = float(np.linalg.norm((found_c - nominal_c)[:2]))
-    return FlipResult(offset, rotation, scene.alignment.fitness, scene.X_RM)
+    return TurnoverResult(offset, rotation, scene.alignment.fitness, scene.X_RM)
 
 
 def weld_part(
@@ -123,7 +123,7 @@ def weld_part(
     progress: Progress = quiet,
     gui: bool = False,
     sides: Sides = "all",
-) -> TwoSidedRun:
+) -> TurnoverRun:
     """The whole part: side A (:func:`cell.pipeline.weld.weld`), then with ``sides="all"`` the turn and side B.
 
     A preview (``execute_plan`` False) moves nothing: it plans side A and the turn, and shows side B's seams at
@@ -150,9 +150,9 @@ def weld_part(
         )
         plan = plan_turn(a) if sides == "all" else None
         if plan is None:
-            return TwoSidedRun(a, timings={"total_s": time.perf_counter() - t_all})
+            return TurnoverRun(a, timings={"total_s": time.perf_counter() - t_all})
         refused = f"not executed: {a.error.message}" if a.error is not None else ""
-        base = TwoSidedRun(
+        base = TurnoverRun(
             a,
             plan,
             operator_s=sc.flip.operator_s,
@@ -161,7 +161,7 @@ def weld_part(
             tacks=tack_records(chosen, a.plan, a.execution is not None, refused),
         )
 
-        def done(**fields: Any) -> TwoSidedRun:
+        def done(**fields: Any) -> TurnoverRun:
             return replace(base, timings={"total_s": time.perf_counter() - t_all}, **fields)
 
         if not plan.go:
@@ -173,7 +173,7 @@ def weld_part(
             b = _side_b(station, sc, method, rescan, plan, weldmap, progress)
         except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
             return done(error=e)
-        return done(side_b=b, result=flip_result(plan, b, weldmap))
+        return done(side_b=b, result=turnover_result(plan, b, weldmap))
 
 
 def tack_rule(
@@ -199,7 +199,7 @@ def _side_b(
     sc: Scenario,
     method: str | None,
     rescan: Literal["none", "low", "all"] | None,
-    plan: FlipPlan,
+    plan: TurnoverPlan,
     weldmap: WeldMap,
     progress: Progress,
 ) -> WeldRun:

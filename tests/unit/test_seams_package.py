@@ -10,9 +10,11 @@ import sys
 
 
 def _loaded(code: str) -> list[str]:
-    code += "; print(sorted(m for m in sys.modules if m.startswith('cell.seams')))"
-    out = subprocess.run([sys.executable, "-c", "import sys; " + code], capture_output=True, text=True, check=True)
-    return eval(out.stdout)
+    code += "; print(json.dumps(sorted(m for m in sys.modules if m.startswith('cell.seams'))))"
+    out = subprocess.run(
+        [sys.executable, "-c", "import json, sys; " + code], capture_output=True, text=True, check=True
+    )
+    return list(json.loads(out.stdout))
 
 
 def test_importing_the_package_loads_no_module() -> None:

@@ -1,10 +1,5 @@
-"""The cell around the part as values for pictures: the table, the robot's URDF shapes at its poses, the cameras.
-
-Computed once per run (:func:`cell_view`) so that the preview reads values only: link poses from the arm's
-forward kinematics at the scan pose and along the plan, link shapes from the URDF's visual geometry (boxes,
-cylinders, spheres; meshes are skipped), the cameras' optical frames and intrinsics from the scenario. Frame
-``R`` (robot base), metres.
-"""
+"""The cell around the part as values for pictures, computed once per run so that the preview reads values only: the
+table, the robot's URDF shapes and link poses at the scan pose and along the plan, the cameras. Frame R, metres."""
 
 from __future__ import annotations
 

@@ -1,9 +1,6 @@
-"""Where a motion's torch wire tip (the TCP) or its wire first enters a part's body: what the collision model,
-which cuts the torch away near the wire tip so that it can reach into a fillet (:mod:`cell.motion.collision`),
-leaves out. Along a motion the TCP is sampled every ``step`` of its travel or closer, with the wire behind it
-(``wire_m`` back along the torch axis, -z of the tool frame, to the contact tip), and each point is tested against
-the bodies (:func:`body_entry`). Frames: R; metres.
-"""
+"""Where a motion's torch wire tip (the TCP) or its wire first enters a part's body: what the collision model's
+cut-back torch leaves out, sampled along the TCP's travel and along the wire behind it (:func:`body_entry`; the
+safety gate's check is :mod:`cell.gate.bodies`, docs/planning.md section 6). Frames: R; metres."""
 
 from __future__ import annotations
 

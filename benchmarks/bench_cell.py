@@ -5,8 +5,8 @@
         [--json PATH]
     .venv/bin/python benchmarks/bench_cell.py faults [--scenarios faults/NAME,...] [--json PATH]
 
-``weld`` runs what ``cell weld SCENARIO`` runs, the whole part (:func:`cell.pipeline.sides.weld_part`: side A, the
-turn, side B; its report :func:`cell.export.flip_report.two_sided_report`) and keeps per seam its side, the located
+``weld`` runs what ``cell weld SCENARIO`` runs, the whole part (:func:`cell.pipeline.turnover.weld_part`: side A, the
+turn, side B; its report :func:`cell.export.turnover_report.turnover_report`) and keeps per seam its side, the located
 error, welded or why not, the executed TCP against the true seam, the travel speed and the weld time; per run the
 cycle, arc and re-scan robot times, the job time, the turn and what side B's alignment measured, and the wall time
 of each stage (default ``benchmarks/results/weld.json``). ``faults`` welds side A only (``cell weld --sides first``):
@@ -93,8 +93,8 @@ def weld_row(name: str) -> Row:
 
 def part_row(name: str) -> Row:
     """``cell weld NAME`` (both sides): the whole part's figures from its report, with the turn's."""
-    from cell.export.flip_report import two_sided_report
-    from cell.pipeline.sides import weld_part
+    from cell.export.turnover_report import turnover_report
+    from cell.pipeline.turnover import weld_part
 
     _say(f"cell weld {name}")
     t = time.perf_counter()
@@ -103,7 +103,7 @@ def part_row(name: str) -> Row:
     except CellError as e:
         return {"scenario": name, "exit_code": e.exit_code, "error": {"type": type(e).__name__, "message": e.message}}
     wall_s = time.perf_counter() - t
-    rep = two_sided_report(run)
+    rep = turnover_report(run)
     row = report_row(rep, EXIT_OK if run.complete else EXIT_PARTIAL)
     for seam, entry in zip(row["seams"], rep["seams"], strict=True):
         seam["side"] = entry.get("side", "A")

@@ -7,7 +7,7 @@ Each scenario is captured with seeds 0 .. N-1 (realistic noise; a new seed draws
 scenario has them, new as-built deviations), perceived, and located with ``ours``. Per threshold: how many seams
 fall below it (re-scanned by ``cell weld``) and how many of the seams with a lateral error over ``--big-mm`` it
 catches; and the Spearman rank correlation of confidence with the lateral error. The re-scan threshold lives in
-``cell.rescan.CONFIDENCE_THRESHOLD``. The table's figures and the per-seam rows go to ``--json`` (default
+``cell.config.rescan.CONFIDENCE_THRESHOLD``. The table's figures and the per-seam rows go to ``--json`` (default
 ``benchmarks/results/confidence.json``), which ``tools/readme_results.py`` renders into docs/results.md.
 """
 
@@ -22,8 +22,8 @@ from scipy.stats import spearmanr
 
 from cell import pipeline
 from cell import scenario as sc
+from cell.config.rescan import CONFIDENCE_THRESHOLD
 from cell.export.report import write_json
-from cell.rescan import CONFIDENCE_THRESHOLD
 
 RESULTS = Path(__file__).resolve().parent / "results"
 THRESHOLDS = (0.45, 0.5, CONFIDENCE_THRESHOLD, 0.6, 0.65)

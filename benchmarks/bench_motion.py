@@ -157,10 +157,11 @@ def designed_cell(s: Any) -> tuple[RobotModel, list[Any], tuple[Any, ...]]:
     """A scenario's cell as designed, in R, no perception: the arm, a task per visible seam, the obstacles."""
     from cell import scenario as sc
     from cell.geometry import invert
-    from cell.motion.plan import SeamTask, cell_obstacles
+    from cell.motion.collision.scene import cell_obstacles
     from cell.pipeline.detect import table_z_R
     from cell.seams.joint import find_joints, weld_faces
     from cell.seams.visibility import visibility
+    from cell.types.plan import SeamTask
     from cell.weldmap import read_map
 
     assert s.robot.urdf is not None and s.robot.home_deg is not None
@@ -179,10 +180,10 @@ def designed_cell(s: Any) -> tuple[RobotModel, list[Any], tuple[Any, ...]]:
 def run_plans(names: tuple[str, ...] = ("fence1", "fence2")) -> list[dict[str, object]]:
     """Plan every visible designed seam of each scenario; times [s]."""
     from cell import scenario as sc
+    from cell.gate import find_violations
     from cell.motion.collision import CollisionChecker
-    from cell.motion.gate import find_violations
-    from cell.motion.plan import plan_welds
-    from cell.motion.process.torch import WeldProcess
+    from cell.planning.plan import plan_welds
+    from cell.process.torch import WeldProcess
 
     rows: list[dict[str, object]] = []
     for name in names:

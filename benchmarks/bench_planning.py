@@ -7,7 +7,7 @@ Per scenario the cell is captured and perceived once (``pipeline.detect``, no cl
 seams are planned and gated as ``cell weld`` does (``pipeline.weld.plan_for``: torch search, IK, timing, order,
 transfers, the safety gate). Reported: seams asked for, planned, refused per reason code, the plan's cycle time,
 planning CPU time (``time.process_time``: the machine is shared, wall time is given too) in all, per planned seam
-and per seam asked for, and the reach pre-check's time per seam (``cell.motion.reach.seam_reach`` on every task,
+and per seam asked for, and the reach pre-check's time per seam (``cell.planning.reach.seam_reach`` on every task,
 the median of five runs). The figure to watch: ladder planning CPU per planned seam against fence1's (the goal: at
 most 1.5 x). With ``--weld NAME`` the whole ``cell weld NAME`` (capture, perception, re-scan, plan, gate, execute) is
 run too: its wall time per stage and how many seams it welded.
@@ -34,11 +34,12 @@ from cell.station import open_station
 
 def bench(name: str) -> dict[str, Any]:
     """One row: the scenario's seams, what the planner made of them and what it cost."""
-    from cell.motion.plan import reach_model, seam_process, seam_tasks
-    from cell.motion.process.procedures import SeamProcedure
-    from cell.motion.process.torch import WeldProcess
-    from cell.motion.reach import seam_reach
     from cell.pipeline.placeable import seam_procedures
+    from cell.planning.plan import reach_model, seam_process
+    from cell.planning.reach import seam_reach
+    from cell.planning.tasks import seam_tasks
+    from cell.process.torch import WeldProcess
+    from cell.types.plan import SeamProcedure
 
     s = sc.load(name)
     weldmap = read_weldmap(s)

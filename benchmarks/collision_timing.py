@@ -17,10 +17,10 @@ import numpy as np
 from bench_motion import designed_cell
 
 from cell import scenario as sc
+from cell.gate import find_violations
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
-from cell.motion.plan import plan_welds
-from cell.motion.process.torch import WeldProcess
+from cell.planning.plan import plan_welds
+from cell.process.torch import WeldProcess
 from cell.types import Part
 
 

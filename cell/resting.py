@@ -1,6 +1,6 @@
 """How a rigid body comes to rest on a level table: on the facet of its convex hull under its centre of mass.
 
-Used both to plan the turn of a part (on the drawn boxes: :mod:`cell.seams.flip`) and by the simulator to set the
+Used both to plan the turn of a part (on the drawn boxes: :mod:`cell.planning.turnover`) and by the simulator to set the
 turned as-built part down (its boxes and the beads on it). Pure geometry: numpy and scipy; metres, radians; any
 frame whose +z is up.
 """

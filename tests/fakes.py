@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from cell.rescan import Rescan, SeamRescan
+from cell.types.rescan import Rescan, SeamRescan
 
 
 class FakeLoop:

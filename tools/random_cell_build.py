@@ -15,8 +15,8 @@ from random_cell_layouts import Design
 from random_cell_parts import Body, rot_z
 from random_cell_scene import r6
 
-from cell.asbuilt_shapes import principal_frame
 from cell.geometry import matrix_to_rpy
+from cell.sim.asbuilt.shapes import principal_frame
 from cell.types import Polyhedron, WeldMap
 
 TOL_SECTION, TOL_LENGTH, TOL_LOCATION = 0.01, 0.05, 0.01

@@ -79,8 +79,8 @@ def _check_scenario(path: Path, weldmap: WeldMap) -> None:
     """The scenario loads, ``cell scenario check`` has nothing to say, the as-built parts can be made, and the arm
     reaches the scan pose."""
     from cell import scenario as sc
-    from cell.asbuilt import as_built_parts
     from cell.scenario.init import check_layout
+    from cell.sim.asbuilt.parts import as_built_parts
     from cell.station import load_arm
 
     scn = sc.load(path)

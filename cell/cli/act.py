@@ -92,9 +92,9 @@ def weld(
     """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation;
     then turn the part over for the seams against the table and weld its other side (``--sides all``)."""
     from cell import pipeline
-    from cell.cli.sides import finish_two_sided, parse_sides
-    from cell.pipeline.sides import weld_part
-    from cell.pipeline.two_sided import TwoSidedRun
+    from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.pipeline.turnover import weld_part
+    from cell.pipeline.turnover_run import TurnoverRun
 
     with cell_errors():
         table = parse_format(fmt)
@@ -113,11 +113,11 @@ def weld(
         try:
             if side_opt == "first":  # side A alone, as the part lies
                 run = pipeline.weld(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
-                job = TwoSidedRun(run)
+                job = TurnoverRun(run)
             else:
                 job = weld_part(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
                 run = job.side_a  # the page and the recording show side A
-            partial = finish_two_sided(
+            partial = finish_turnover(
                 job, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
             )
             if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
@@ -194,11 +194,11 @@ def preview(
     """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots, and of
     the planned turn with side B's seams at their nominal turned place (``--sides all``)."""
     from cell import pipeline
-    from cell.cli.sides import finish_two_sided, parse_sides
-    from cell.pipeline.sides import weld_part
-    from cell.pipeline.two_sided import TwoSidedRun
+    from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.pipeline.turnover import weld_part
+    from cell.pipeline.turnover_run import TurnoverRun
     from cell.preview import write_run
-    from cell.preview.flip import write_flip
+    from cell.preview.turnover import write_turnover
 
     with cell_errors():
         table = parse_format(fmt)
@@ -212,16 +212,16 @@ def preview(
         try:
             if side_opt == "first":
                 run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
-                job = TwoSidedRun(run)
+                job = TurnoverRun(run)
             else:
                 job = weld_part(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
                 run = job.side_a
-            partial = finish_two_sided(job, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
+            partial = finish_turnover(job, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
             _write_rerun(run, rerun_path, writer)  # before the pictures: it needs no cloud, they do
             stage(f"drawing pictures into {out_dir}/")
             done = run
             paths = writer.attempt(lambda: write_run(done, out_dir)) or []
-            paths += writer.attempt(lambda: write_flip(job, out_dir)) or []
+            paths += writer.attempt(lambda: write_turnover(job, out_dir)) or []
             for p in paths:
                 say(str(p))
         except (KeyboardInterrupt, ImportError) as e:

@@ -35,7 +35,7 @@ from cell.errors import EXIT_INTERRUPTED, UsageError
 from cell.geometry import FloatArray
 
 if TYPE_CHECKING:
-    from cell.pipeline import Detection
+    from cell.pipeline.records import Detection
     from cell.types import Cloud
 
 TRUTH_UNITS = "mm"  # a truth file's coordinates (docs/locate.md)

@@ -16,7 +16,7 @@ from rich.table import Table
 from cell.cli.common import TableFormat, out
 
 if TYPE_CHECKING:
-    from cell.pipeline import Detection
+    from cell.pipeline.records import Detection
 
 
 def print_rescan(rep: dict) -> None:

@@ -77,7 +77,7 @@ class PlanOptions:
 
 @dataclass(frozen=True)
 class GateOptions:
-    """Thresholds of the safety gate (:func:`~cell.motion.gate.find_violations`).
+    """Thresholds of the safety gate (:func:`~cell.gate.find_violations`).
 
     rate_hz : re-sampling rate [Hz]. rel_tol : relative slack on the velocity/acceleration/jerk limits.
     start_tol : how far the plan may start from the arm's configuration [rad].

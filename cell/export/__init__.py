@@ -1,6 +1,6 @@
 """What the cell writes: the JSON report (:mod:`cell.export.report`), the robot program through a post-processor
 (:mod:`cell.export.program`, :mod:`cell.export.post`: KUKA KRL in :mod:`cell.export.krl`, ABB RAPID in
-:mod:`cell.export.rapid`; a part turned over between sides in :mod:`cell.export.two_sided`;
+:mod:`cell.export.rapid`; a part turned over between sides in :mod:`cell.export.turnover_program`;
 :mod:`cell.export.krl_check` re-reads a KRL program) and the joint trajectory as JSON and CSV
 (:mod:`cell.export.trajectory`); reports and programs are written whole (:mod:`cell.export.atomic`). Values in,
 files out: these modules read the vocabulary and the run records, never a stage (an import-linter contract)."""
@@ -12,13 +12,13 @@ from cell.export.program import ProgramJob
 from cell.export.report import detection_report, rescan_report, weld_report, write_json
 from cell.export.trajectory import write_csv
 from cell.export.trajectory import write_json as write_trajectory_json
-from cell.export.two_sided import two_sided_program, write_two_sided
+from cell.export.turnover_program import turnover_program, write_turnover_program
 
 __all__ = [
     "ProgramJob",
     "detection_report",
     "rescan_report",
-    "two_sided_program",
+    "turnover_program",
     "weld_report",
     "write_atomic",
     "write_csv",
@@ -26,5 +26,5 @@ __all__ = [
     "write_krl",
     "write_program",
     "write_trajectory_json",
-    "write_two_sided",
+    "write_turnover_program",
 ]

@@ -3,8 +3,7 @@
 The only part of the cell that uses open3d, and only through :mod:`cell.perception._open3d` (imported lazily).
 """
 
-from cell.perception.align import Alignment, align_map, sample_map
-from cell.perception.alignment_checks import (
+from cell.perception.align.checks import (
     Alternative,
     SymmetryOptions,
     alignment_alternatives,
@@ -14,6 +13,7 @@ from cell.perception.alignment_checks import (
     missing_parts,
     part_coverage,
 )
+from cell.perception.align.fit import Alignment, align_map, sample_map
 from cell.perception.camera_health import HealthOptions, ImageHealth, agreement, disagreeing_cameras, image_health
 from cell.perception.deproject import clouds_in_robot_frame, crop, deproject
 from cell.perception.perceive import Perceived, perceive

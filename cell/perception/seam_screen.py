@@ -1,7 +1,7 @@
 """Which found seams must not be welded? The screen after the locator, turning seams into reasons.
 
 For the pipeline, after the locator: :func:`screen` turns a found seam into NOT_FOUND / OCCLUDED, with the
-reason, when its part is missing (:func:`cell.perception.alignment_checks.check_parts_seen`), when an object the
+reason, when its part is missing (:func:`cell.perception.align.checks.check_parts_seen`), when an object the
 map does not know lies over it (:func:`foreign_points`), or when the locator itself had almost no confidence in it.
 """
 
@@ -54,7 +54,7 @@ def screen(
 ) -> tuple[SeamEstimate, ...]:
     """The locator's estimates with the seams that must not be welded taken out, each with its reason.
 
-    missing : part name -> reason (from :func:`~cell.perception.alignment_checks.check_parts_seen`): every seam
+    missing : part name -> reason (from :func:`~cell.perception.align.checks.check_parts_seen`): every seam
     of such a part is NOT_FOUND, whatever the locator or the visibility check said. A seam (found or not) with at
     least ``min_foreign`` foreign points near it (map seam when not found) is OCCLUDED. A found seam with
     confidence below ``min_confidence`` is NOT_FOUND.

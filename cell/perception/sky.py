@@ -1,5 +1,5 @@
 """Which points of the map's surfaces are open to the sky: nothing of the map's parts lies straight above them
-(frame R, z up, metres). The parts-seen check (:func:`cell.perception.alignment_checks.part_coverage`) judges a
+(frame R, z up, metres). The parts-seen check (:func:`cell.perception.align.checks.part_coverage`) judges a
 part only by the samples of its top a camera above the table can see: an open tube's inner bottom wall faces up
 but lies under the tube's own top wall."""
 

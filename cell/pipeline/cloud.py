@@ -13,9 +13,9 @@ import numpy as np
 
 from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
 from cell.geometry import FloatArray, invert, make_pose, transform_points
-from cell.perception.align import Alignment, align_map, sample_map, surface_fit
-from cell.perception.alignment_checks import check_alignment_unique, check_parts_seen
-from cell.perception.global_placement import DISTINCT_DEG, DISTINCT_M, fpfh_candidates, height_candidates, on_table
+from cell.perception.align.checks import check_alignment_unique, check_parts_seen
+from cell.perception.align.fit import Alignment, align_map, sample_map, surface_fit
+from cell.perception.align.placement import DISTINCT_DEG, DISTINCT_M, fpfh_candidates, height_candidates, on_table
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
@@ -209,7 +209,7 @@ def _global(
     rng: np.random.Generator,
     spec: PerceptionSpec,
 ) -> tuple[FloatArray, Alignment, float] | None:
-    """The best global candidate (:mod:`cell.perception.global_placement`) as aligned by the staged ICP: the one
+    """The best global candidate (:mod:`cell.perception.align.placement`) as aligned by the staged ICP: the one
     that explains the most points of the cloud (:func:`_aligned`); None when none aligns. The height-image search
     first; FPFH + RANSAC only when none of its candidates fits well (on the real scans FPFH proposed the part
     turned by 180 degrees and took 5 s; the height image 0.3 s, right every time)."""

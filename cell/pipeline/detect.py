@@ -11,7 +11,7 @@ from typing import Literal
 
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
-from cell.perception.align import Alignment
+from cell.perception.align.fit import Alignment
 from cell.perception.calibration import PoseUncertainty, with_calibration
 from cell.pipeline.evaluation import evaluate
 from cell.pipeline.progress import Progress, quiet
@@ -76,7 +76,7 @@ def build_scene(
     X_RM_nominal : where the map is believed to lie (default: the scenario's ``map.X_WM``; the turned part's pose
     on its second side); seed : a search of the cloud near it for a start the ICP can converge from."""
     from cell.perception import align_map, check_alignment
-    from cell.perception.alignment_checks import cloud_tree_of
+    from cell.perception.align.checks import cloud_tree_of
     from cell.perception.perceive import perceive_then
 
     sc = cap.scenario

@@ -10,7 +10,7 @@ import numpy as np
 
 from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.records import Detection
-from cell.rescan import ends_within_tolerance, within_tolerance
+from cell.rescan.fusion import ends_within_tolerance, within_tolerance
 from cell.scenario import Scenario
 from cell.station import Station
 from cell.types import CheckFail, SeamEstimate, SeamStatus
@@ -60,8 +60,8 @@ def seam_welds(
     applied (not a preview): a found seam too uncertain to weld is ``low_confidence``, but one no torch can be
     placed on (``unplaceable``: planned anyway) gets the planner's reason. checked : the seams that failed the
     last check before the arc (``last_check``, with the test)."""
-    from cell.motion.plan import seam_tasks
-    from cell.motion.process.quality import combined, weld_quality
+    from cell.planning.tasks import seam_tasks
+    from cell.process.quality import combined, weld_quality
 
     X_RW = invert(det.scenario.X_WR)
     ss = det.scene.seam_scene if det.scene is not None else None
@@ -118,7 +118,7 @@ def seam_welds(
 def _intended(task: SeamTask | None, reversed_: bool, seg: Segment, tcp_R: FloatArray) -> FloatArray | None:
     """Where the plan meant each TCP record of a weld segment to lie off the seam (its pass's offset and the
     weave), from the planned seam (None without a procedure or a task: on the seam line)."""
-    from cell.motion.process.weave import cross_section, intended_offsets
+    from cell.process.weave import cross_section, intended_offsets
 
     if seg.procedure is None or task is None:
         return None

@@ -28,9 +28,9 @@ from cell.types.run import SeamRecord, SeamWeld
 
 if TYPE_CHECKING:
     from cell.perception import Alignment, Perceived
-    from cell.rescan import Rescan
     from cell.types.execution import Execution
     from cell.types.plan import WeldPlan
+    from cell.types.rescan import Rescan
     from cell.types.trajectory import Trajectory
     from cell.types.view import CellView
 

@@ -6,22 +6,21 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from cell.config.rescan import RescanOptions
 from cell.errors import CellError, ScenarioError
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty, closeup_sigma
 from cell.pipeline.detect import Progress, evaluate, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, Scene
-from cell.rescan import (
-    Rescan,
-    RescanOptions,
-    SeamRescan,
+from cell.rescan.escalation import escalated, largest_shift_mm
+from cell.rescan.fusion import (
     closeup_scenario,
     closeup_scene,
     estimate_sigma,
@@ -35,8 +34,8 @@ from cell.seams.base import SeamLocator
 from cell.seams.checks import check_ends
 from cell.seams.registry import part_tolerance_m
 from cell.station import Arm, Station
-from cell.types import DepthImage, EndSource, SeamEstimate, SeamStatus
-from cell.types.rescan import Viewpoint
+from cell.types import DepthImage, SeamStatus
+from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 
 if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker
@@ -70,9 +69,9 @@ class _Run:
 
 
 def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequence[str]) -> list[SeamRescan]:
-    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan`), and every seam of
+    """Plan the view, move, capture, locate and fuse one seam (see :mod:`cell.rescan.fusion`), and every seam of
     ``pending`` the same close-up sees as well as a view of its own must (:func:`shared_by`): one image each."""
-    from cell.motion.views.viewpoint import plan_view
+    from cell.rescan.viewpoint import plan_view
 
     t0 = time.perf_counter()
     o, det = run.options, run.detection
@@ -107,11 +106,11 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
 
 def shared_by(run: _Run, vp: Viewpoint, pending: Sequence[str]) -> list[tuple[str, Viewpoint]]:
     """The seams of ``pending`` (with a first estimate or the map's line) that the close-up from ``vp`` sees as
-    a view candidate of their own must (:func:`cell.motion.views.view_candidates.sees`: in the image with its margin,
+    a view candidate of their own must (:func:`cell.rescan.view_grid.sees`: in the image with its margin,
     clear of the torch, at the incidence allowed, no part in the way), each with the view as it is for that seam
     (its distance and incidence; no move, tried 0). Only seams within ``_SHARE_RADIUS`` of the viewed one are
     tested."""
-    from cell.motion.views.view_candidates import sees, torch_axis_in_camera
+    from cell.rescan.view_grid import sees, torch_axis_in_camera
 
     det, o = run.detection, run.options
     base = _scene_of(det).seam_scene
@@ -171,7 +170,7 @@ def rescan_seams(
     motion: MotionScene | None = None,
     progress: Progress = quiet,
 ) -> Rescan:
-    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan`). A
+    """Re-scan ``seam_ids`` up close with the eye-in-hand camera, in that order, and fuse (:mod:`cell.rescan.fusion`). A
     seam the close-up of an earlier one sees (:func:`shared_by`) is located in that image, with no view of its own
     (its record's ``motion_s`` is 0); the result lists every seam in the order asked.
 
@@ -248,14 +247,39 @@ def rescan_detection(
     progress: Progress = quiet,
 ) -> tuple[Rescan, Detection]:
     """Re-scan the seams worth a closer look with the eye-in-hand camera and return the detection with the fused
-    estimates: the one re-scan path of ``cell weld`` and ``cell rescan``.
+    estimates (:func:`rescan_chosen` leaving no seam out): ``cell rescan``'s re-scan.
 
     mode : ``low``: the seams below ``rescan.confidence_threshold``, those whose bound (``rescan.bound_sigmas``
     sigma) exceeds ``rescan.weld_tolerance_mm`` or whose end bound exceeds ``rescan.end_tolerance_mm``, and those
-    not found; ``all``: every visible seam.
+    not found, escalated (:mod:`cell.rescan.escalation`); ``all``: every visible seam.
     seam_ids : these seams instead of the mode's choice (``cell rescan --seams``).
-    Escalation (unless ``all``): a close-up that moves its seam by more than ``rescan.escalate_mm`` shows the fixed
-    cameras cannot be trusted here (calibration off, a bumped camera): every other visible seam is re-scanned too.
+    """
+    rs, after, _ = rescan_chosen(station, det, mode, seam_ids=seam_ids, motion=motion, progress=progress)
+    assert rs is not None  # None only when a seam was left out
+    return rs, after
+
+
+LeaveOut = Callable[[Detection, Sequence[str]], dict[str, str]]  # of these seams, those not to re-scan -> why
+
+
+def rescan_chosen(
+    station: Station,
+    det: Detection,
+    mode: RescanMode,
+    *,
+    seam_ids: Sequence[str] | None = None,
+    leave_out: LeaveOut | None = None,
+    motion: MotionScene | None = None,
+    progress: Progress = quiet,
+) -> tuple[Rescan | None, Detection, dict[str, str]]:
+    """The one re-scan path of ``cell weld`` and ``cell rescan``: the mode's seams (or ``seam_ids``) but those
+    ``leave_out`` names, re-scanned up close; then, in mode ``low``, the escalation: a close-up that moved its seam
+    by more than ``rescan.escalate_mm`` (:func:`cell.rescan.escalation.largest_shift_mm`) re-scans every other
+    visible seam too, but those left out (when any seam was left out of the choice, ``leave_out`` is asked about
+    the others as well).
+
+    Returns the re-scan (None when ``low`` chose only seams left out), the detection after it and the seams left
+    out (id -> why). mode, seam_ids: as :func:`rescan_detection`.
     """
     sc = det.scenario
     if seam_ids is not None:
@@ -263,50 +287,25 @@ def rescan_detection(
     else:
         threshold = math.inf if mode == "all" else sc.rescan.confidence_threshold
         ids = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m, sc.rescan.max_end_sigma_m)
+    left = leave_out(det, ids) if leave_out is not None else {}
+    ids = [i for i in ids if i not in left]
+    if left and not ids and mode != "all":
+        return None, det, left
     progress(f"re-scanning {len(ids)} seams up close with the eye-in-hand camera")
     rs = rescan_seams(station, det, ids, motion=motion, progress=progress)
     after = rescanned(det, rs)
-    shift_mm = max((end_shift_m(r.before, r.closeup) * 1000.0 for r in rs.seams if r.used), default=0.0)
-    rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids]
-    if mode == "low" and shift_mm > sc.rescan.escalate_mm and rest:
-        progress(
-            f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
-            f" {len(rest)} seams too"
-        )
-        more = rescan_seams(station, after, rest, motion=motion, progress=progress)
-        after = rescanned(after, more)
-        rs = escalated(rs, more, shift_mm)
-    return rs, after
-
-
-def escalated(first: Rescan, more: Rescan, shift_mm: float) -> Rescan:
-    """One re-scan of ``first``'s seams and then ``more``'s, escalated because a close-up of ``first`` moved its
-    seam by ``shift_mm`` [mm]."""
-    return replace(
-        more,
-        seams=first.seams + more.seams,
-        moves=first.moves + more.moves,
-        executions=first.executions + more.executions,
-        note=f"escalated: a close-up disagreed by {shift_mm:.2f} mm; {more.note}".rstrip("; "),
-        timings={k: first.timings.get(k, 0.0) + more.timings.get(k, 0.0) for k in {*first.timings, *more.timings}},
-        escalated_mm=shift_mm,
+    shift_mm = largest_shift_mm(rs)
+    rest = [i for i in seams_to_rescan(after.estimates, math.inf) if i not in ids and i not in left]
+    if mode == "all" or shift_mm <= sc.rescan.escalate_mm or not rest:
+        return rs, after, left
+    if left and leave_out is not None:
+        left = {**left, **leave_out(after, rest)}
+        rest = [i for i in rest if i not in left]
+        if not rest:
+            return rs, after, left
+    progress(
+        f"a close-up moved its seam {shift_mm:.2f} mm from the fixed cameras' estimate: re-scanning the other"
+        f" {len(rest)} seams too"
     )
-
-
-def end_shift_m(before: SeamEstimate, closeup: SeamEstimate | None) -> float:
-    """Largest distance [m] between matching ends of two found estimates of one seam (0 when either is missing);
-    an end of ``before`` that only the drawn length placed (``drawn``) counts only across the seam: the close-up
-    finding where it really is says nothing of the fixed cameras."""
-    if closeup is None or before.status is not SeamStatus.FOUND or closeup.status is not SeamStatus.FOUND:
-        return 0.0
-    a = np.stack([before.p_start, before.p_end])
-    t = (a[1] - a[0]) / max(float(np.linalg.norm(a[1] - a[0])), 1e-12)
-    drawn = np.array([k is EndSource.DRAWN for k in before.end_source])
-
-    def worst(b: FloatArray) -> float:
-        d = b - a
-        d[drawn] -= np.outer(d[drawn] @ t, t)  # a drawn end: across the seam only
-        return float(np.linalg.norm(d, axis=1).max())
-
-    b = np.stack([closeup.p_start, closeup.p_end])
-    return min(worst(b), worst(b[::-1]))
+    more = rescan_seams(station, after, rest, motion=motion, progress=progress)
+    return escalated(rs, more, shift_mm), rescanned(after, more), left

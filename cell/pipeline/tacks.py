@@ -7,15 +7,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 import numpy as np
 
-from cell.types.plan import SeamTask, WeldPlan
+from cell.types.plan import NoProcedure, SeamProcedure, SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass
-
-if TYPE_CHECKING:  # the records are read by the reports, which import no stage: the planner's types only here
-    from cell.motion.process.procedures import NoProcedure, SeamProcedure
 
 TACK_MARK = "~tack"  # a tack's task id: <seam id>~tack<k>
 End = Literal["start", "end"]
@@ -97,9 +94,10 @@ def tack_procedures(
         sel = procedures.get(t.id.split(TACK_MARK)[0])
         if sel is None:
             continue
-        proc = getattr(sel, "procedure", None)  # a SeamProcedure (no import of the planner here: the reports')
-        if proc is not None:
-            out[t.id] = replace(sel, seam_id=t.id, procedure=replace(proc, weave=Weave(), passes=(WeldPass(),)))
+        if isinstance(sel, SeamProcedure):
+            out[t.id] = replace(
+                sel, seam_id=t.id, procedure=replace(sel.procedure, weave=Weave(), passes=(WeldPass(),))
+            )
         else:
             out[t.id] = replace(sel, seam_id=t.id)
     return out

@@ -54,14 +54,15 @@ def plan_for(
         seam, each with its seam's procedure; the plan's outcomes list them after the seams (an arm on a track
         lays none).
     """
-    from cell.motion.gate import find_violations
-    from cell.motion.gate.blame import blamed_seams
-    from cell.motion.plan import plan_welds, seam_tasks
-    from cell.motion.process.torch import WeldProcess
+    from cell.gate import find_violations
+    from cell.gate.blame import blamed_seams
     from cell.motion.timing import ptp
-    from cell.motion.track import plan_on_track
-    from cell.motion.transfers import TransferFail, Transfers, joined
     from cell.pipeline.tacks import tack_procedures
+    from cell.planning.plan import plan_welds
+    from cell.planning.tasks import seam_tasks
+    from cell.planning.track import plan_on_track
+    from cell.planning.transfers import TransferFail, Transfers, joined
+    from cell.process.torch import WeldProcess
 
     sc = det.scenario
     arm = station.arm

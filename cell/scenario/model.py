@@ -12,7 +12,6 @@ from pydantic import Field, field_validator, model_validator
 from cell.geometry import FloatArray
 from cell.scenario.base import Model
 from cell.scenario.cell_specs import CameraSpec, Deviation, MapSpec, RobotSpec, TableSpec
-from cell.scenario.flip_specs import FlipSpec
 from cell.scenario.locator_specs import LocatorSpec, OursLocatorSpec
 from cell.scenario.procedure_specs import ProcedureSpec, default_procedure
 from cell.scenario.run_specs import (
@@ -24,6 +23,7 @@ from cell.scenario.run_specs import (
     RescanSpec,
     SimulationSpec,
 )
+from cell.scenario.turnover_specs import TurnoverSpec
 from cell.types.procedure import WeldProcedure
 
 MAP_DIR = Path(__file__).resolve().parents[2] / "maps"  # the repository's welding maps
@@ -49,7 +49,7 @@ class Scenario(Model):
     motion: MotionSpec = MotionSpec()
     export: ExportSpec = ExportSpec()
     simulation: SimulationSpec = SimulationSpec()
-    flip: FlipSpec = FlipSpec()  # turning the part over for its second side (docs/flip.md)
+    flip: TurnoverSpec = TurnoverSpec()  # turning the part over for its second side (docs/flip.md)
     # Set by the loader: the folder the file lives in (paths inside are relative to it).
     base_dir: str = Field(default=".", exclude=True)
 

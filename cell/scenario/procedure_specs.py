@@ -16,7 +16,7 @@ from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 
 class WeaveSpec(Model):
-    """Oscillation of the torch while it travels on along the seam (:mod:`cell.motion.process.weave`): ``zigzag``
+    """Oscillation of the torch while it travels on along the seam (:mod:`cell.process.weave`): ``zigzag``
     side to side across the bisector with smooth turns, fading in and out over the first and last wavelength;
     ``triangle`` side to side on straight legs with sharp turns, at full width from the start (ArcTech's
     #Triangle); ``circle`` round a circle of the width's diameter in the joint's cross-section, from the pass line

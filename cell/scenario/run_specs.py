@@ -26,9 +26,9 @@ from cell.config.rescan import BOUND_SIGMAS, END_TOLERANCE_MM, WELD_TOLERANCE_MM
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import Deviation, PoseSpec, WorkspaceSpec
-from cell.scenario.flip_specs import FlipPlacementSpec
 from cell.scenario.locator_specs import LOCATOR_SPECS, spec_method
 from cell.scenario.realism_specs import BowSpec, GapsSpec, SpecularDropoutSpec, TacksPresentSpec
+from cell.scenario.turnover_specs import TurnoverPlacementSpec
 
 
 class ProcessSpec(Model):
@@ -75,7 +75,7 @@ class PerceptionSpec(Model):
 
 
 class RescanSpec(Model):
-    """Close-up re-scan before welding and the weld gate (cell.rescan; calibration in its docstring).
+    """Close-up re-scan before welding and the weld gate (cell.rescan.fusion; calibration in its docstring).
 
     mode : ``low`` re-scans the seams whose confidence is below ``confidence_threshold`` or whose bound
         (``bound_sigmas`` sigma) exceeds ``weld_tolerance_mm`` (and visible seams not found), ``all`` every visible
@@ -199,7 +199,7 @@ class SimulationSpec(Model):
     placement_error: PoseSpec = PoseSpec()  # where the part really lies, relative to map.X_WM (ground truth only)
     faults: FaultsSpec = FaultsSpec()
     bead: BeadStyle = BeadStyle()  # how the weld bead is drawn (no effect on any figure)
-    flip_placement: FlipPlacementSpec = FlipPlacementSpec()  # the operator's error setting the turned part down
+    flip_placement: TurnoverPlacementSpec = TurnoverPlacementSpec()  # the operator's error setting the turned part down
     gaps: GapsSpec | None = None  # joint gaps varying along the seams (docs/bodies.md section 7); null: as drawn
     tacks_present: TacksPresentSpec | None = None  # tack welds at both ends of every seam; null: none
     bow: tuple[BowSpec, ...] = ()  # bowed parts: one {part, mm} or a list of them; empty: every part straight

@@ -42,7 +42,7 @@ def plane_line(
 def resolve_face(part: Part, face: str, near: FloatArray) -> tuple[str, tuple[str, ...]]:
     """The as-built face that stands for the drawn face ``face`` near the point ``near`` (3,) [m], and the faces of
     its family: ``face`` itself when the body has it; else, for a body cut in segments (a bow,
-    :mod:`cell.asbuilt_shapes`: faces ``<face>@<k>``), the segment nearest to ``near`` (the one holding the seam's
+    :mod:`cell.sim.asbuilt.shapes`: faces ``<face>@<k>``), the segment nearest to ``near`` (the one holding the seam's
     middle), and all the segments. ValueError naming the valid faces when there is neither."""
     names = part.face_names()
     if face in names:

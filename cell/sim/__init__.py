@@ -1,6 +1,7 @@
 """The simulated cell, the only package that imports pybullet: the sensor model, cameras, faults and execution records
-(numpy only), the arm and the cell. ``from cell.sim import SimCell`` imports pybullet only when the name is first
-asked for."""
+(numpy only), the arm and the cell, the part turned over (:mod:`~cell.sim.turnover`) and the simulation's ground
+truth (:mod:`cell.sim.asbuilt`, numpy only). ``from cell.sim import SimCell`` imports pybullet only when the name is
+first asked for."""
 
 from __future__ import annotations
 

@@ -42,11 +42,11 @@ class SimCell:
     """The as-built cell in PyBullet.
 
     scenario : the cell (table, cameras, noise, seed).
-    parts_W : the as-built parts in W (``cell.asbuilt.as_built_parts``), boxes or polyhedra; names must be unique.
+    parts_W : the as-built parts in W (``asbuilt.parts.as_built_parts``), boxes or polyhedra; names must be unique.
     gui : show PyBullet's GUI (needs a display); headless ``DIRECT`` by default.
-    fixtures_W : the map's fixtures in W (``cell.asbuilt.as_built_fixtures``): clamps, stops, jigs, rendered grey as
+    fixtures_W : the map's fixtures in W (``asbuilt.parts.as_built_fixtures``): clamps, stops, jigs, rendered grey as
         bodies ``fixture:<name>`` so the cameras see them as in the real cell; they stay put when the part is turned.
-        Entries named ``tack:...`` (``cell.asbuilt.as_built_fixtures`` with ``simulation.tacks_present``) are tack
+        Entries named ``tack:...`` (``asbuilt.parts.as_built_fixtures`` with ``simulation.tacks_present``) are tack
         welds' beads instead: bodies of that name, dark, on the part (they turn with it).
     The scenario's ``faults:`` (:mod:`cell.sim.faults`) are applied here: parts in ``missing_parts`` are not
     built (``parts_W`` still lists them: it is the design as built), occluders are added as bodies

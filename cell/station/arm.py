@@ -31,8 +31,8 @@ def robot_urdf(scenario: Scenario) -> Path:
 def load_arm(scenario: Scenario) -> Arm:
     """The robot model, its home (``robot.home_deg``) and the scan configuration that holds the eye-in-hand camera
     at its scenario viewpoint (IK on the camera's optical frame, rotation about the optical axis free)."""
-    from cell.motion.plan import scan_configuration
     from cell.motion.robot import RobotModel
+    from cell.motion.scan import scan_configuration
 
     model = RobotModel.from_urdf(robot_urdf(scenario))
     home_deg = scenario.robot.home_deg

@@ -29,13 +29,14 @@ if TYPE_CHECKING:
 class SimStation:
     """A running simulated cell built from a scenario and its welding map (as drawn, frame M).
 
-    The as-built parts are the map's parts with the scenario's deviations (:func:`cell.asbuilt.as_built_parts`).
+    The as-built parts are the map's parts with the scenario's deviations
+    (:func:`cell.sim.asbuilt.parts.as_built_parts`).
     Use as a context manager; the simulator's client is released on exit.
     """
 
     def __init__(self, scenario: Scenario, weldmap: WeldMap, *, gui: bool = False, with_robot: bool = True) -> None:
-        from cell.asbuilt import as_built_fixtures, as_built_parts
         from cell.sim import SimCell
+        from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts
 
         self.scenario = scenario
         self.parts_W: tuple[Part, ...] = as_built_parts(weldmap, scenario)
@@ -96,7 +97,7 @@ class SimStation:
         """The operator turns the part over: the as-built part (its beads on it) moves by the nominal turn
         X_W_turn (4, 4) in W, settles on its own hull and is set down with ``simulation.flip_placement``'s error
         (drawn from ``Scenario.rng("flip")``); :meth:`truth` moves with it."""
-        from cell.sim.flip import turned_pose
+        from cell.sim.turnover import turned_pose
 
         sim = self.scenario.simulation
         X = turned_pose(

@@ -118,7 +118,7 @@ def weld_seams(run: WeldRun, sc: Scenario, stage: Stage) -> dict[str, dict[str, 
 def _planned_tcp_rms(run: WeldRun, every: int = 20) -> dict[str, float]:
     """Per planned seam: RMS distance [mm] of the planned TCP (every ``every``-th 1 kHz sample of its root pass)
     from the true seam segment. Seams whose procedure weaves are left out (the weave is meant to leave the line)."""
-    from cell.motion.process.quality import distance_to_segment
+    from cell.process.quality import distance_to_segment
 
     if run.plan is None or run.arm is None:
         return {}

@@ -108,7 +108,7 @@ def variation(
             bounds = [(tol.length if i == axis else tol.width_height) * size_mm[i] for i in range(3)]
             ds = [_bounded(rng, b, 1)[0] * part.is_box for b in bounds]
             do = _bounded(rng, tol.location * size_mm[axis], 3)
-            do[2] = 0.0  # the part rests on the table whatever its drawn height offset (cell/asbuilt.py)
+            do[2] = 0.0  # the part rests on the table whatever its drawn height offset (cell/sim/asbuilt/parts.py)
             devs[part.name] = (tuple(round(v, 6) for v in ds), tuple(round(v, 6) for v in do))
     if "placement" in vary:
         rng = stream(scenario.seed, "placement", k)

@@ -93,7 +93,7 @@ class SeamOutcome:
     For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]. code: why it
     could not be planned (None when feasible); reason: the same in words, with where and by how much.
     trimmed : the length [m] not welded at the seam's table end (the torch's stand-off above the table,
-    :mod:`cell.motion.stand_off`); 0 for a seam welded whole."""
+    :mod:`cell.planning.stand_off`); 0 for a seam welded whole."""
 
     seam_id: str
     feasible: bool
@@ -199,3 +199,32 @@ class WeldPlan:
             e1,
         )
         return traj, self.arc_at(traj.times)
+
+
+@dataclass(frozen=True)
+class SeamProcedure:
+    """The procedure a seam got: the row, the seam's joint type and position, whether its ends are swapped
+    (``reverse``: welded from p_end to p_start, to weld a vertical seam upwards) and whether the direction is
+    fixed (a vertical seam: the planner tries only that one)."""
+
+    seam_id: str
+    procedure: WeldProcedure
+    joint: str
+    position: str
+    leg_mm: float
+    reverse: bool = False
+    fixed_direction: bool = False
+
+    def oriented(self, task: SeamTask) -> SeamTask:
+        """The task with its ends swapped when the procedure welds it the other way."""
+        if not self.reverse:
+            return task
+        return SeamTask(task.id, task.p_end, task.p_start, task.n_a, task.n_b)
+
+
+@dataclass(frozen=True)
+class NoProcedure:
+    """No row of the WPS table fits the seam: why (joint, position, leg it asked for)."""
+
+    seam_id: str
+    reason: str

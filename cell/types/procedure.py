@@ -17,7 +17,7 @@ Position = Literal["PA", "PB", "PF", "PG", "any"]
 class Weave:
     """Oscillation of the torch while it travels along the seam: ``pattern`` (none: a straight bead; zigzag:
     across the seam with smooth turns, fading in and out; triangle: across on straight legs with sharp turns;
-    circle: round a circle in the joint's cross-section; :mod:`cell.motion.process.weave`), full ``width_mm`` (peak to
+    circle: round a circle in the joint's cross-section; :mod:`cell.process.weave`), full ``width_mm`` (peak to
     peak; the circle's diameter), ``frequency_hz``, dwell at each side ``dwell_s`` (left, right)."""
 
     pattern: WeavePattern = "none"

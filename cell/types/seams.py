@@ -23,7 +23,7 @@ class SeamStatus(enum.StrEnum):
     """What became of a seam."""
 
     FOUND = "found"
-    NOT_VISIBLE = "not_visible"  # no camera can see it by design (against the table): flip the part
+    NOT_VISIBLE = "not_visible"  # no camera can see it by design (against the table): turn the part over
     NOT_FOUND = "not_found"  # visible, but the data does not support a seam there
     OCCLUDED = "occluded"  # visible by design, but something the map does not know is in the way: clear it
 

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from cell import pipeline
+from cell.config.rescan import RescanOptions
 from cell.pipeline import rescan_seams, rescanned
-from cell.rescan import RescanOptions
 from cell.seams.metrics import segment_errors
 from cell.station import SimStation, open_station
 from cell.types import SeamStatus

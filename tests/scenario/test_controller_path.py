@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from cell import pipeline
-from cell.motion.gate import GateInput, GateOptions
+from cell.gate import GateInput, GateOptions
 from cell.motion.timing import ptp_line_deviation
 
 MAX_PTP_DEVIATION = np.radians(0.01)  # [rad] the acceptance bound (measured: 0 up to rounding, < 1e-12 deg)

@@ -10,7 +10,8 @@ import pytest
 from cell import pipeline
 from cell.errors import AlignmentError
 from cell.geometry import invert, make_pose
-from cell.perception import align, align_map, check_alignment, check_alignment_unique, check_parts_seen
+from cell.perception import align_map, check_alignment, check_alignment_unique, check_parts_seen
+from cell.perception.align import fit
 from cell.types import WeldMap
 
 
@@ -57,7 +58,7 @@ def test_coarse_stages_on_sparser_samples_reach_the_fine_fit(
     cloud = det.scene.perceived.registered
     coarse = align_map(nominal, cloud, s.perception)
     np.testing.assert_allclose(coarse.X_RR_corr, det.scene.alignment.X_RR_corr, atol=1e-12)  # the pipeline's own
-    monkeypatch.setattr(align, "_COARSE_SPACING", 1.0)  # every stage on the fine samples
+    monkeypatch.setattr(fit, "_COARSE_SPACING", 1.0)  # every stage on the fine samples
     fine = align_map(nominal, cloud, s.perception)
     step = invert(fine.X_RR_corr) @ coarse.X_RR_corr
     assert np.linalg.norm(step[:3, 3]) < 10e-6  # [m] measured 0 (fence2: 4 um)

@@ -19,8 +19,8 @@ import cell.pipeline.rescan as loop
 from cell import pipeline
 from cell import scenario as sc
 from cell.cli import app
-from cell.rescan import Rescan
 from cell.types import SeamStatus
+from cell.types.rescan import Rescan
 
 WELD_MODULE = importlib.import_module("cell.pipeline.weld")  # the module (``cell.pipeline.weld`` is its function)
 

@@ -50,7 +50,7 @@ def test_a_gate_option_reaches_the_safety_gate(
     plan: the session's detection of fence1 stands in for the weld's own (handed on with the scenario it was given)."""
     from cell.errors import PlanError
     from cell.export.report import weld_report
-    from cell.motion.gate import ViolationKind
+    from cell.gate import ViolationKind
 
     scn = load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}"))
     asked: list[sc.Scenario] = []

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from cell import pipeline
-from cell.motion.views.view_candidates import ranked_views, sees, torch_axis_in_camera
 from cell.pipeline.rescan import _SHARE_RADIUS, _Run, shared_by
-from cell.rescan import eye_in_hand_camera, occluders, view_target
+from cell.rescan.fusion import eye_in_hand_camera, occluders, view_target
+from cell.rescan.view_grid import ranked_views, sees, torch_axis_in_camera
 from cell.station.sim import SimStation
 from cell.types import SeamStatus
 from cell.types.rescan import Viewpoint

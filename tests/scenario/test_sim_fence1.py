@@ -16,7 +16,7 @@ def test_fence1_exact_cameras_see_the_parts() -> None:
     map_path = scn.SCENARIO_DIR.parent / "maps" / "fence1.dxf"
     if not map_path.is_file():
         pytest.skip("maps/fence1.dxf not generated yet")
-    from cell.asbuilt import as_built_parts
+    from cell.sim.asbuilt.parts import as_built_parts
     from cell.weldmap import read_map
 
     scenario = scn.load("fence1-exact").with_noise("none")

@@ -18,12 +18,12 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.export.flip_report import two_sided_report
 from cell.export.krl import krl_program
-from cell.motion.plan import seam_tasks
-from cell.pipeline.sides import tack_rule, weld_part
+from cell.export.turnover_report import turnover_report
 from cell.pipeline.tacks import Tack, is_tack
+from cell.pipeline.turnover import tack_rule, weld_part
 from cell.pipeline.weld import plan_for
+from cell.planning.tasks import seam_tasks
 from cell.station import open_station
 from cell.types.plan import SeamTask, WeldPlan
 
@@ -136,6 +136,6 @@ def test_weld_part_records_the_tacks_side_a_laid(
     ]
     arc = sum(g.trajectory.duration for g in tacked.plan.segments if g.arc_on and is_tack(g.seam_id))
     assert arc < run.tacks_s < arc + 4 * 10.0  # their arc time and their own moves
-    rep = two_sided_report(run)
+    rep = turnover_report(run)
     assert [t["id"] for t in rep["flip"]["tacks"]] == [t.task.id for t in tacked.tacks]
     assert all(t["welded"] and t["reason"] == "" for t in rep["flip"]["tacks"])

@@ -11,9 +11,10 @@ import pytest
 from cell import pipeline
 from cell import scenario as sc
 from cell.export.krl import krl_program
-from cell.motion.plan import reach_model, seam_tasks
-from cell.motion.process.torch import WeldProcess
-from cell.motion.track import reach_curves
+from cell.planning.plan import reach_model
+from cell.planning.tasks import seam_tasks
+from cell.planning.track import reach_curves
+from cell.process.torch import WeldProcess
 
 BASE_X = -0.55  # [m] the base's x in W (fence1's is 0.15): the fence's right post is beyond the fixed reach
 

@@ -14,18 +14,18 @@ from pinhole import deproject
 from tiny_cell import HOME, URDF
 
 from cell import scenario as scn
-from cell.asbuilt import as_built_fixtures, as_built_parts, principal_frame
 from cell.errors import CaptureError, ScenarioError
 from cell.geometry import make_pose, rot_x, transform_points
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.grow import grown_convex, grown_mesh, is_convex
 from cell.motion.robot import RobotModel
 from cell.recorded._fields import truth_json, truth_parts
-from cell.scenario.flip_specs import FlipPlacementSpec
+from cell.scenario.turnover_specs import TurnoverPlacementSpec
 from cell.seams.truth import true_seams
 from cell.sim import SimCell
+from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts, principal_frame
 from cell.sim.cell import FIXTURE_PREFIX
-from cell.sim.flip import body_volume, turned_pose
+from cell.sim.turnover import body_volume, turned_pose
 from cell.types import Box, Joint, MapSeam, Part, Polyhedron, WeldMap
 
 TABLE_TOP = 0.9  # [m]
@@ -91,7 +91,9 @@ def test_the_turn_of_a_mesh_part_rests_it_on_a_face_by_its_mesh_volume() -> None
     box = Part("BOX", Box(make_pose(p=[0.0, 0.0, 1.0]), np.array([0.1, 0.2, 0.3])))
     assert body_volume(box) == 0.1 * 0.2 * 0.3  # a box exactly as before
     X_turn = make_pose(rot_x(math.pi), [0.0, 0.0, 2.0 * TABLE_TOP])  # upside down about x
-    X = turned_pose([part], np.zeros((0, 2, 3)), 0.0, X_turn, TABLE_TOP, FlipPlacementSpec(), np.random.default_rng(0))
+    X = turned_pose(
+        [part], np.zeros((0, 2, 3)), 0.0, X_turn, TABLE_TOP, TurnoverPlacementSpec(), np.random.default_rng(0)
+    )
     v = transform_points(X, w.vertices)
     assert v[:, 2].min() == pytest.approx(TABLE_TOP, abs=1e-9)
     assert np.sum(np.abs(v[:, 2] - TABLE_TOP) < 1e-9) >= 3  # lies on a face, not on an edge

@@ -1,6 +1,6 @@
 """Close-up views ranked lazily (the line-of-sight test only on the candidates asked for) are the same views in
 the same order, and a close-up taken for one seam is tested for another seam with every test a view of its own
-must pass (cell.motion.views.view_candidates.sees), so one image can serve several seams."""
+must pass (cell.rescan.view_grid.sees), so one image can serve several seams."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from tiny_cell import TOP_SEAM, URDF
 
 from cell.geometry import make_pose
 from cell.motion.robot import RobotModel
-from cell.motion.views.view_candidates import (
+from cell.rescan.view_grid import (
     ViewCandidate,
     ViewTarget,
     ranked_views,

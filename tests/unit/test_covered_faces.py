@@ -12,7 +12,7 @@ from dxf_factory import REPO_ROOT
 from tiny_cell import URDF
 
 from cell.motion.robot import RobotModel
-from cell.motion.views.view_candidates import ViewTarget, ranked_views, torch_axis_in_camera
+from cell.rescan.view_grid import ViewTarget, ranked_views, torch_axis_in_camera
 from cell.seams.joint import find_joints, weld_faces
 from cell.sim.camera import intrinsics_for
 from cell.types import Joint, Part, WeldMap

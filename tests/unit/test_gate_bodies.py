@@ -10,8 +10,9 @@ import numpy.typing as npt
 import pytest
 from bodies_fixtures import wedge
 
+from cell.gate.bodies import seam_bodies
 from cell.geometry import FloatArray, make_pose
-from cell.motion.gate.bodies import body_entry, seam_bodies
+from cell.motion.collision.wire import body_entry
 from cell.motion.robot import RobotModel
 from cell.types import Box, Part, Polyhedron
 from cell.types.plan import Segment
@@ -148,10 +149,11 @@ def test_the_gate_refuses_a_planned_weld_that_runs_into_a_third_part_and_blames_
     from tiny_cell import HOME, OBSTACLES, POST, RAIL, SIDE_SEAM, TOP_SEAM, URDF
 
     from cell import scenario as sc
-    from cell.motion.gate import ViolationKind, find_violations
-    from cell.motion.gate.blame import blamed_seams
-    from cell.motion.plan import PlanReason, SeamTask, plan_welds
-    from cell.motion.process.torch import WeldProcess
+    from cell.gate import ViolationKind, find_violations
+    from cell.gate.blame import blamed_seams
+    from cell.planning.plan import plan_welds
+    from cell.process.torch import WeldProcess
+    from cell.types.plan import PlanReason, SeamTask
 
     robot = RobotModel.from_urdf(URDF)
     process = WeldProcess.from_spec(sc.ProcessSpec())

@@ -17,10 +17,11 @@ from cell.export.krl import KrlOptions, krl_program, write_krl
 from cell.export.status_turn import status_turn
 from cell.export.trajectory import write_csv, write_json
 from cell.geometry import make_pose, rot_z, rpy_to_matrix
-from cell.motion.plan import SeamTask, WeldPlan, plan_welds
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
+from cell.planning.plan import plan_welds
+from cell.process.torch import WeldProcess
 from cell.types import Box, Part
+from cell.types.plan import SeamTask, WeldPlan
 
 URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"
 HOME = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])

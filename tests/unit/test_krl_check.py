@@ -15,9 +15,10 @@ from cell.export.krl import KrlOptions, write_krl
 from cell.export.krl_check import check_program, read_programs
 from cell.export.krl_kin import check_kinematics
 from cell.export.krl_read import parse_value, read_krl
-from cell.motion.plan import WeldPlan, plan_welds
 from cell.motion.robot import RobotModel
+from cell.planning.plan import plan_welds
 from cell.types import Trajectory, Weave, WeldPass, WeldProcedure
+from cell.types.plan import WeldPlan
 
 
 @pytest.fixture(scope="module")

@@ -19,8 +19,8 @@ from cell.export.krl_kin import check_kinematics
 from cell.export.post import write_program
 from cell.export.program import ProgramJob
 from cell.geometry import make_pose, rot_z
-from cell.motion.plan import plan_welds
 from cell.motion.robot import RobotModel
+from cell.planning.plan import plan_welds
 
 TRACK = (
     ";- Linear track E1 (KL-style, mathematically coupled): axis [1.0000, 0.0000, 0.0000] in $ROBROOT at E1 = 0;"

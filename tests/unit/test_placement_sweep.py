@@ -1,4 +1,4 @@
-"""Refusing a seam no torch can be placed on in a few broad-phase queries (cell.motion.placement.sweep) gives the
+"""Refusing a seam no torch can be placed on in a few broad-phase queries (cell.planning.placement.sweep) gives the
 failure the group-by-group torch search gives, and a seam some torch can be placed on is still placed."""
 
 from __future__ import annotations
@@ -10,15 +10,17 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
-from cell.motion.candidates import SeamSearch
+from cell.config.motion import PlanOptions
 from cell.motion.collision import CollisionChecker
-from cell.motion.failures import SeamFailure, better
-from cell.motion.placement import Rotations, place, torch_tests, wording
-from cell.motion.plan import PlanOptions, PlanReason, SeamTask, reach_model
-from cell.motion.process.torch import WeldProcess
-from cell.motion.process.torch_candidates import candidate_groups
 from cell.motion.robot import RobotModel
+from cell.planning.failures import SeamFailure, better
+from cell.planning.placement import Rotations, place, torch_tests, wording
+from cell.planning.plan import reach_model
+from cell.planning.seam_search import SeamSearch
+from cell.process.torch import WeldProcess
+from cell.process.torch_orientations import candidate_groups
 from cell.types import Box, Part
+from cell.types.plan import PlanReason, SeamTask
 
 STIFF = WeldProcess.from_spec(sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0))
 WIDE = WeldProcess.from_spec(sc.ProcessSpec())

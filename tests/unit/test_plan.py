@@ -13,9 +13,7 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TABLE, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.errors import PlanError
-from cell.geometry import make_pose, point_line_distance
-from cell.motion.collision import CollisionChecker
-from cell.motion.gate import (
+from cell.gate import (
     DEFAULT_CHECKS,
     Check,
     GateInput,
@@ -25,10 +23,14 @@ from cell.motion.gate import (
     check_plan,
     find_violations,
 )
-from cell.motion.plan import PlanReason, SeamTask, WeldPlan, plan_welds, scan_configuration
-from cell.motion.process.torch import WeldProcess, torch_poses
+from cell.geometry import make_pose, point_line_distance
+from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.motion.scan import scan_configuration
+from cell.planning.plan import plan_welds
+from cell.process.torch import WeldProcess, torch_poses
 from cell.types import Box, Part
+from cell.types.plan import PlanReason, SeamTask, WeldPlan
 from cell.types.trajectory import Trajectory
 
 TOP = SeamTask(*TOP_SEAM)

@@ -13,10 +13,11 @@ from tiny_cell import HOME, OBSTACLES, URDF
 from cell import scenario as sc
 from cell.cli import bar as bar_module
 from cell.cli.bar import Bar
-from cell.motion.plan import SeamTask, plan_welds
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
 from cell.pipeline.weld import seam_counter
+from cell.planning.plan import plan_welds
+from cell.process.torch import WeldProcess
+from cell.types.plan import SeamTask
 
 FAR = [
     SeamTask(

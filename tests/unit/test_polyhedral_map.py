@@ -14,7 +14,7 @@ from dxf_factory import REPO_ROOT, design, make_brace, make_maps
 
 from cell.errors import MapError
 from cell.geometry import make_pose
-from cell.motion.process.procedures import joint_type
+from cell.process.procedures import joint_type
 from cell.seams._support import mesh_part, not_supported
 from cell.seams.joint import dihedral, find_joints, joint_kind, joint_notes, weld_geometry
 from cell.seams.visibility import UNDERSIDE_REASON, visibility

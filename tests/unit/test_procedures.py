@@ -12,11 +12,11 @@ from tiny_cell import SIDE_SEAM, TOP_SEAM
 
 from cell import scenario as sc
 from cell.errors import ScenarioError
-from cell.motion.process.procedures import NoProcedure, SeamProcedure, joint_type, position, select_procedure
-from cell.motion.process.weave import cross_section, intended_offsets, pass_offsets, weave_lateral
 from cell.pipeline.detect import read_weldmap
+from cell.process.procedures import joint_type, position, select_procedure
+from cell.process.weave import cross_section, intended_offsets, pass_offsets, weave_lateral
 from cell.seams.joint import find_joints
-from cell.types.plan import SeamTask
+from cell.types.plan import NoProcedure, SeamProcedure, SeamTask
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 FENCE1 = (sc.SCENARIO_DIR / "fence1.yaml").read_text()

@@ -1,4 +1,4 @@
-"""The reach pre-check (cell.motion.reach) on the KR 5 arc: its bounds hold for every reachable pose, a seam beyond
+"""The reach pre-check (cell.planning.reach) on the KR 5 arc: its bounds hold for every reachable pose, a seam beyond
 reach is refused before any IK with "beyond reach", a seam inside passes on to IK; the torch test's broad phase
 finds the same contacts as querying every box; a gate violation is blamed on the seam whose motion it is in."""
 
@@ -9,18 +9,19 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, TOP_SEAM, URDF
 
 from cell import scenario as sc
+from cell.config.motion import PlanOptions
+from cell.gate.base import Violation, ViolationKind
+from cell.gate.blame import blamed_seams, seam_of
 from cell.geometry import make_pose
-from cell.motion import candidates
-from cell.motion.candidates import SeamSearch
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate.base import Violation, ViolationKind
-from cell.motion.gate.blame import blamed_seams, seam_of
-from cell.motion.plan import PlanOptions, PlanReason, SeamTask, reach_model
-from cell.motion.process.torch import WeldProcess
-from cell.motion.reach import ReachModel, seam_reach
 from cell.motion.robot import RobotModel
+from cell.planning import seam_search
+from cell.planning.plan import reach_model
+from cell.planning.reach import ReachModel, seam_reach
+from cell.planning.seam_search import SeamSearch
+from cell.process.torch import WeldProcess
 from cell.types import Box, Part
-from cell.types.plan import Segment, WeldPlan
+from cell.types.plan import PlanReason, SeamTask, Segment, WeldPlan
 from cell.types.trajectory import Trajectory
 
 PROCESS = WeldProcess.from_spec(sc.ProcessSpec())
@@ -93,7 +94,7 @@ def test_a_seam_beyond_reach_is_refused_before_ik(
     def no_ik(*args: object, **kwargs: object) -> None:
         raise AssertionError("IK was tried")
 
-    monkeypatch.setattr(candidates, "solve_ik", no_ik)
+    monkeypatch.setattr(seam_search, "solve_ik", no_ik)
     checker = CollisionChecker(robot, OBSTACLES)
     search = SeamSearch(robot, PROCESS, checker, PlanOptions(), np.random.default_rng(0), reach)
     for task, at_mm in ((FAR, 0.0), (EDGE, 0.0)):
@@ -101,7 +102,7 @@ def test_a_seam_beyond_reach_is_refused_before_ik(
         assert fail is not None and fail.code is PlanReason.BEYOND_REACH
         assert fail.where.startswith(f"beyond reach: at {at_mm:.1f} mm along the seam")
         out = search.plan_seam(task, HOME)  # no IK, no candidate: the pre-check's failure itself
-        assert not isinstance(out, candidates.SeamSolution)
+        assert not isinstance(out, seam_search.SeamSolution)
         assert (out.code, out.where) == (fail.code, fail.where)
 
 
@@ -112,7 +113,7 @@ def test_a_seam_inside_passes_on_to_ik(robot: RobotModel, reach: ReachModel) -> 
     assert seam_reach(reach, near, PROCESS) is None
     checker = CollisionChecker(robot, OBSTACLES[:1])
     search = SeamSearch(robot, PROCESS, checker, PlanOptions(), np.random.default_rng(0), reach)
-    assert isinstance(search.plan_seam(near, HOME), candidates.SeamSolution)
+    assert isinstance(search.plan_seam(near, HOME), seam_search.SeamSolution)
 
 
 def test_the_torch_tests_broad_phase_finds_what_every_box_finds(robot: RobotModel) -> None:

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from dxf_factory import REPO_ROOT  # puts tools/ on the path
 
-from cell.asbuilt import as_built_fixtures, as_built_parts
-from cell.asbuilt_shapes import bowed, cut_end, principal_frame
 from cell.errors import ScenarioError
 from cell.scenario import Scenario, SpecularDropoutSpec, from_dict, load
 from cell.seams.joint import find_joints
 from cell.seams.truth import true_seams
+from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts
+from cell.sim.asbuilt.shapes import bowed, cut_end, principal_frame
 from cell.sim.camera import intrinsics_for
 from cell.sim.noise import specular_dropout
 from cell.types import Box, Part, Polyhedron, WeldMap

@@ -14,18 +14,18 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 from cell.geometry import invert, make_pose, transform_points
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.motion.views.viewpoint import (
+from cell.rescan.fusion import (
+    estimate_sigma,
+    fuse,
+    seams_to_rescan,
+    within_tolerance,
+)
+from cell.rescan.viewpoint import (
     ViewOptions,
     ViewTarget,
     _segments_hit_box,
     plan_view,
     torch_axis_in_camera,
-)
-from cell.rescan import (
-    estimate_sigma,
-    fuse,
-    seams_to_rescan,
-    within_tolerance,
 )
 from cell.seams.sigma import PAPER_SIGMA_M, PAPER_SIGMA_UNSEEN_M, SE_INFLATION, ours_sigma, paper_sigma
 from cell.sim.camera import intrinsics_for

@@ -203,7 +203,7 @@ def test_the_method_names_come_from_one_registry() -> None:
 
 
 def test_the_closeup_merges_its_options_into_the_scenarios_locator() -> None:
-    from cell.rescan import closeup_scenario
+    from cell.rescan.fusion import closeup_scenario
 
     s = load_text(with_keys("locator: {method: ours, options: {tube_radius_m: 0.05}}"))
     close = closeup_scenario(s, "ours", s.rescan.closeup).locator.options

@@ -15,7 +15,7 @@ from synthetic_joint import CASES, JOINTS, NOMINAL, TOP, make_scene, square_tube
 from cell.config.seams import PART_TOLERANCE_M
 from cell.geometry import make_pose
 from cell.perception.calibration import PoseUncertainty, closeup_sigma
-from cell.rescan import fuse, fuse_along
+from cell.rescan.fusion import fuse, fuse_along
 from cell.seams.checks import check_ends
 from cell.seams.metrics import end_errors_along
 from cell.seams.ours import OursLocator
@@ -266,7 +266,7 @@ def test_the_gate_refuses_a_seam_whose_end_bound_stays_over_the_end_tolerance() 
 
 
 def test_a_closeup_that_finds_where_a_drawn_end_really_is_does_not_escalate() -> None:
-    from cell.pipeline.rescan import end_shift_m
+    from cell.rescan.escalation import end_shift_m
 
     a, b = np.zeros(3), np.array([0.1, 0.0, 0.0])
     seen = SeamEstimate(

@@ -7,9 +7,9 @@ import dataclasses
 import numpy as np
 
 from cell import scenario as sc
-from cell.asbuilt import as_built_fixtures
 from cell.geometry import make_pose
 from cell.pipeline import read_weldmap
+from cell.sim.asbuilt.parts import as_built_fixtures
 from cell.sim.cell import FIXTURE_PREFIX
 from cell.station.sim import SimStation
 from cell.types import Box, Part

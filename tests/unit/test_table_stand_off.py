@@ -9,11 +9,13 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
+from cell.config.motion import PlanOptions
 from cell.motion.collision import CollisionChecker
-from cell.motion.plan import PlanOptions, PlanReason, SeamTask, WeldPlan, plan_welds, unplaceable
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
-from cell.motion.stand_off import shortened, table_end, table_top
+from cell.planning.plan import plan_welds, unplaceable
+from cell.planning.stand_off import shortened, table_end, table_top
+from cell.process.torch import WeldProcess
+from cell.types.plan import PlanReason, SeamTask, WeldPlan
 
 # No travel or work angle freedom: the nozzle cannot tilt away from the table at the side seam's foot.
 STIFF = WeldProcess.from_spec(sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0))

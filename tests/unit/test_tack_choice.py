@@ -1,5 +1,5 @@
 """The tacks' choice, procedure and record (:mod:`cell.pipeline.tacks`) and the order that welds them first
-(:func:`cell.motion.order.seam_order`'s ``first``), on small made-up seams."""
+(:func:`cell.planning.order.seam_order`'s ``first``), on small made-up seams."""
 
 from __future__ import annotations
 
@@ -8,11 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cell.motion.order import seam_order
-from cell.motion.process.procedures import NoProcedure, SeamProcedure
 from cell.motion.robot import RobotModel
 from cell.pipeline.tacks import choose_tacks, tack_procedures, tack_records
-from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
+from cell.planning.order import seam_order
+from cell.types.plan import NoProcedure, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 URDF = Path(__file__).resolve().parents[2] / "robots" / "kr5_arc.urdf"

@@ -10,7 +10,7 @@ import pytest
 from cell import scenario as sc
 from cell.errors import PlanError, ScenarioError
 from cell.geometry import point_line_distance
-from cell.motion.process.torch import WeldProcess, back_off, measured_angles, torch_poses, torch_rotation
+from cell.process.torch import WeldProcess, back_off, measured_angles, torch_poses, torch_rotation
 
 # A square fillet along +x: face A is the top of the abutting part (+z), face B the wall it meets (+y normal).
 D = np.array([1.0, 0.0, 0.0])

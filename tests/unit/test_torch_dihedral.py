@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from cell.motion.process.torch import fillet_angle, measured_angles, torch_rotation
+from cell.process.torch import fillet_angle, measured_angles, torch_rotation
 
 
 def _corner(theta_deg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

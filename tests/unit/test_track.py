@@ -15,15 +15,15 @@ from cell.errors import IKError, ScenarioError
 from cell.export.krl import krl_program
 from cell.export.program import ProgramJob
 from cell.export.rapid import rapid_text
+from cell.gate import find_violations
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
 from cell.motion.ik import solve_ik
-from cell.motion.plan import plan_welds, reach_model
-from cell.motion.process.torch import WeldProcess
-from cell.motion.reach import seam_reach
 from cell.motion.robot import RobotModel
-from cell.motion.track import MARGIN, e1_grid, group_seams, plan_on_track, reach_curves, track_move
+from cell.planning.plan import plan_welds, reach_model
+from cell.planning.reach import seam_reach
+from cell.planning.track import MARGIN, e1_grid, group_seams, plan_on_track, reach_curves, track_move
+from cell.process.torch import WeldProcess
 from cell.types import Box, Part
 from cell.types.plan import PlanReason, SeamTask
 from cell.types.track import LinearTrack

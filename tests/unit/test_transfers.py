@@ -9,14 +9,14 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, URDF
 
 from cell import scenario as sc
+from cell.config.motion import PlanOptions
 from cell.errors import TimingError
 from cell.geometry import FloatArray, make_pose
 from cell.motion.collision import CollisionChecker
-from cell.motion.failures import SeamFailure, better, reason_text
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.torch import WeldProcess
 from cell.motion.robot import RobotModel
-from cell.motion.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
+from cell.planning.failures import SeamFailure, better, reason_text
+from cell.planning.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
+from cell.process.torch import WeldProcess
 from cell.types import Box, Part
 from cell.types.plan import PlanReason
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
-from cell.perception.align import sample_box_faces
+from cell.perception.align.fit import sample_box_faces
 from cell.perception.unorganised import find_table, levelling, orient_normals, sampling
 from cell.pipeline import locate_cloud
 from cell.types import Cloud, SeamStatus, WeldMap

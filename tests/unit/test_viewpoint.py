@@ -12,7 +12,7 @@ from cell.errors import PlanError
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.motion.views.viewpoint import NoViewError, ViewRejection, ViewTarget, plan_view
+from cell.rescan.viewpoint import NoViewError, ViewRejection, ViewTarget, plan_view
 from cell.sim.camera import intrinsics_for
 from cell.types import Box, Part
 

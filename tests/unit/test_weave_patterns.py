@@ -12,13 +12,14 @@ from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, URDF
 
 from cell import scenario as sc
 from cell.errors import ScenarioError
+from cell.gate import find_violations
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
-from cell.motion.plan import SeamTask, plan_welds
-from cell.motion.process.procedures import select_procedures
-from cell.motion.process.torch import WeldProcess
-from cell.motion.process.weave import cross_section, intended_offsets, knot_spacing, weave_offsets
 from cell.motion.robot import RobotModel
+from cell.planning.plan import plan_welds
+from cell.process.procedures import select_procedures
+from cell.process.torch import WeldProcess
+from cell.process.weave import cross_section, intended_offsets, knot_spacing, weave_offsets
+from cell.types.plan import SeamTask
 from cell.types.procedure import Weave, WeldProcedure
 
 V, LENGTH = 0.004, 0.0615  # [m/s], [m]: 15.375 wavelengths of 4 mm at 1 Hz

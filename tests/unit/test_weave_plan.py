@@ -12,17 +12,17 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
+from cell.config.motion import PlanOptions
+from cell.gate import find_violations
 from cell.geometry import point_line_distance
 from cell.motion.collision import CollisionChecker
-from cell.motion.gate import find_violations
-from cell.motion.plan import SeamTask, WeldPlan, plan_welds
-from cell.motion.plan_options import PlanOptions
-from cell.motion.process.procedures import NoProcedure, select_procedures
-from cell.motion.process.torch import WeldProcess
-from cell.motion.process.torch_candidates import candidate_groups
-from cell.motion.process.weave import cross_section, intended_offsets
 from cell.motion.robot import RobotModel
-from cell.types.plan import PlanReason
+from cell.planning.plan import plan_welds
+from cell.process.procedures import select_procedures
+from cell.process.torch import WeldProcess
+from cell.process.torch_orientations import candidate_groups
+from cell.process.weave import cross_section, intended_offsets
+from cell.types.plan import NoProcedure, PlanReason, SeamTask, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 TOP = SeamTask(*TOP_SEAM)

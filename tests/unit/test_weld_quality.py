@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.motion.process.quality import combined, distance_to_segment, end_coverage, weld_quality
+from cell.process.quality import combined, distance_to_segment, end_coverage, weld_quality
 from cell.types.execution import WeldQuality
 
 A = np.array([0.1, 0.2, 0.0])

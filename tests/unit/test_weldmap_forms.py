@@ -262,8 +262,8 @@ def test_deviation_keys_match_part_names_ignoring_case_unless_ambiguous() -> Non
     from dataclasses import replace
 
     from cell import scenario as sc
-    from cell.asbuilt import as_built_parts
     from cell.errors import ScenarioError
+    from cell.sim.asbuilt.parts import as_built_parts
     from cell.types import Part, WeldMap
 
     base = sc.load("fence1-exact")

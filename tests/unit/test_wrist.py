@@ -10,10 +10,12 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
-from cell.motion.plan import PlanOptions, PlanReason, SeamTask, plan_welds
-from cell.motion.process.torch import WeldProcess
+from cell.config.motion import PlanOptions
 from cell.motion.robot import RobotModel
 from cell.motion.wrist import HoseWindow, flip_wrist, flipped, nearest_wrist, wrist_cost, wrist_equivalents
+from cell.planning.plan import plan_welds
+from cell.process.torch import WeldProcess
+from cell.types.plan import PlanReason, SeamTask
 
 PROCESS = WeldProcess.from_spec(sc.ProcessSpec())
 

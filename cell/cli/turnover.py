@@ -1,0 +1,116 @@
+"""``cell weld`` / ``cell preview`` of a whole part (docs/flip.md): the two-sided report, its table and
+the robot programs of both sides with the main program that stops for the operator's turn."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from cell.cli.common import TableFormat, fail_line, say
+from cell.cli.explain import weld_exit
+from cell.cli.outputs import Writer
+from cell.cli.tables import print_weld
+from cell.errors import UsageError
+
+if TYPE_CHECKING:
+    from cell.pipeline.turnover_run import TurnoverRun
+    from cell.types.turnover import TurnoverPlan
+
+
+def parse_sides(sides: str) -> str:
+    """``--sides``: ``first`` (side A only, the part as it lies) or ``all`` (turn the part for the rest)."""
+    if sides not in ("first", "all"):
+        raise UsageError(f"--sides {sides!r} is unknown; valid: first, all")
+    return sides
+
+
+def turnover_message(plan: TurnoverPlan) -> str:
+    """The operator's message between the sides (at most 80 characters)."""
+    return f"Turn the part {math.degrees(plan.angle_rad):+.0f} deg about its {plan.axis} axis, then confirm"
+
+
+def finish_turnover(
+    run: TurnoverRun,
+    json_path: Path | None,
+    krl: Path | None,
+    *,
+    title: str,
+    provenance: Mapping[str, Any],
+    writer: Writer,
+    fmt: TableFormat,
+    controller: str = "krl",
+) -> str | None:
+    """Write the report first, then the programs; print the table and one line per side; the exit's explanation
+    when the job is partial (None when complete)."""
+    from cell.export.turnover_report import turnover_report
+
+    rep = turnover_report(run, provenance=provenance)
+    writer.report(json_path, rep)
+    if krl is not None:
+        written = writer.attempt(lambda: write_programs(run, krl, provenance, controller))
+        if written:
+            say(f"robot programs: {', '.join(map(str, written))}")
+    print_weld(rep, title, fmt)
+    if fmt == "table":
+        say(sides_line(rep))
+    for err in (run.side_a.error, run.side_b.error if run.side_b is not None else None, run.error):
+        if err is not None:
+            fail_line(f"error: {err.message}")
+    return None if run.complete else weld_exit(rep)
+
+
+def sides_line(rep: Mapping[str, Any]) -> str:
+    """One line: what each side welded, the turn and what the second alignment measured, the job's time."""
+    parts = [f"side {k}: welded {v['welded']} in {v['cycle_time_s'] or 0:.1f} s" for k, v in rep["sides"].items()]
+    f = rep.get("flip")
+    if f is not None and f["made"]:
+        parts.append(
+            f"turned {f['rotation_deg']:+.0f} deg about {f['axis']} (lean {f['tilt_deg']:.1f} deg), placement "
+            f"measured {f['placement_error_mm']:.1f} mm / {f['placement_rotation_deg']:+.2f} deg, fitness "
+            f"{f['fitness']:.3f}"
+        )
+    elif f is not None:
+        parts.append(f"no turn: {f['reason']}")
+    if f is not None and f["made"]:
+        parts.append(f"job {rep['job_time_s']:.1f} s with the operator's turn")
+    return " · ".join(parts)
+
+
+def write_programs(run: TurnoverRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
+    """The robot programs into ``krl``, each side's weld points in its own aligned map's base.
+
+    One side welded: its program ``WELD_<SCENARIO>`` and ``trajectory.json``/``.csv``. Two:
+    one program per side (``WELD_<SCENARIO>_A``, ``_B``), the main program ``WELD_<SCENARIO>`` that runs A, stops
+    for the operator's turn and runs B (:func:`cell.export.turnover_program.write_turnover_program`), and each side's
+    trajectory (``trajectory_A.json`` ...)."""
+    import numpy as np
+
+    from cell.export.post import write_program
+    from cell.export.program import ProgramJob
+    from cell.export.trajectory import write_csv, write_json
+    from cell.export.turnover_program import write_turnover_program
+
+    sc = run.side_a.detection.scenario
+    base = ("WELD_" + "".join(ch if ch.isalnum() else "_" for ch in sc.name).upper())[:22]
+    runs = [(k, wr) for k, wr in (("A", run.side_a), ("B", run.side_b)) if wr is not None]
+    runs = [(k, wr) for k, wr in runs if wr.plan is not None and wr.plan.segments and wr.arm is not None]
+    if not runs:
+        raise ValueError("no plan to write")
+    jobs = []
+    for side, wr in runs:
+        assert wr.plan is not None and wr.arm is not None
+        X_RB = wr.detection.scene.X_RM if wr.detection.scene is not None else np.eye(4)
+        name = base if len(runs) == 1 else f"{base}_{side}"
+        jobs.append(ProgramJob(wr.plan, wr.arm.model, name, X_RB, sc.X_WR, sc.export.krl, provenance))
+    if len(jobs) == 1:
+        written = write_program(controller, jobs[0], krl)
+    else:
+        assert run.plan is not None
+        written = write_turnover_program(controller, jobs, base, turnover_message(run.plan), krl)
+    for side, wr in runs:  # after the programs: they make the folder
+        assert wr.plan is not None
+        stem = "trajectory" if len(runs) == 1 else f"trajectory_{side}"
+        written += [write_json(wr.plan, krl / f"{stem}.json"), write_csv(wr.plan, krl / f"{stem}.csv")]
+    return list(written)

@@ -1,0 +1,59 @@
+"""Which seam a gate violation belongs to, so that a plan drops that seam and welds the rest: a violation during a
+seam's approach, weld, depart or the transfer to it is that seam's, the last move home the last seam's; a
+start-state violation, or one that blames every seam, concerns the whole plan."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from cell.gate.base import Violation, ViolationKind
+from cell.geometry import readonly
+from cell.planning.failures import reason_text
+from cell.types.plan import PlanReason, SeamOutcome, Segment, WeldPlan
+
+_CODE = {
+    ViolationKind.COLLISION: PlanReason.COLLISION,
+    ViolationKind.SINGULARITY: PlanReason.SINGULAR,
+    ViolationKind.BODY: PlanReason.ENTERS_BODY,
+}
+
+
+def seam_of(plan: WeldPlan, v: Violation) -> str:
+    """The seam whose motion violation ``v`` happens in ("" when it concerns the whole plan: the start state, or
+    a time outside every segment)."""
+    if v.kind is ViolationKind.START_STATE or not plan.segments:
+        return ""
+    seg = _segment_at(plan, v.t)
+    if seg.seam_id:
+        return seg.seam_id
+    return plan.order[-1] if plan.order else ""  # the move home: the transfer from the last seam
+
+
+def blamed_seams(plan: WeldPlan, violations: Sequence[Violation]) -> dict[str, SeamOutcome] | None:
+    """Per seam to drop, its outcome with the first violation as the reason; None when some violation concerns
+    the whole plan (then the plan is refused), when every seam of the plan is at fault (nothing would be left:
+    the reason is the whole's, e.g. a gate threshold no pose meets), or there is none."""
+    out: dict[str, SeamOutcome] = {}
+    for v in violations:
+        sid = seam_of(plan, v)
+        if not sid:
+            return None
+        if sid in out:
+            continue
+        seg = next(s for s in plan.segments if s.seam_id == sid)
+        transfer = v.kind is ViolationKind.COLLISION and _segment_at(plan, v.t).kind == "move"
+        code = PlanReason.TRANSFER_COLLISION if transfer else _CODE.get(v.kind, PlanReason.TIMING)
+        detail = f"the safety gate: {v}"
+        out[sid] = SeamOutcome(sid, False, reason_text(code, detail), readonly(seg.X_end[:3, 3].copy()), code=code)
+    if set(out) >= set(plan.order):  # every seam at fault: a reason that concerns the whole (e.g. a gate setting)
+        return None
+    return out or None
+
+
+def _segment_at(plan: WeldPlan, t: float) -> Segment:
+    """The segment running at plan time t [s] (the earlier one at a join)."""
+    t0 = np.array([s.t0 for s in plan.segments])
+    k = int(np.clip(np.searchsorted(t0, t, side="left") - 1, 0, len(t0) - 1))
+    return plan.segments[k]

@@ -1,0 +1,71 @@
+"""The welding order (step 4 of :func:`cell.planning.plan.plan_welds`): greedy nearest neighbour then 2-opt on the
+point-to-point durations between seams, home at both ends. Joints [rad]; durations [s]."""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Sequence
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.motion.robot import RobotModel
+from cell.motion.timing import ptp_duration
+
+_PENALTY_S = 1e6  # [s] added to a transfer known to collide: used only when no order avoids it
+_AFTER_S = 1e9  # [s] added to every step that puts a seam of ``first`` after another seam (never chosen)
+
+
+def seam_order(
+    ids: Sequence[str],
+    entries: Sequence[FloatArray],
+    exits: Sequence[FloatArray],
+    q_home: FloatArray,
+    robot: RobotModel,
+    forbidden: Collection[tuple[str, str]] = (),
+    first: Collection[str] = (),
+) -> list[int]:
+    """Seam order (indices into ``ids``) by point-to-point duration: greedy nearest from home, then 2-opt (home
+    fixed at both ends).
+
+    entries, exits : (dof,) [rad] per seam, where its approach starts and its depart ends; q_home (dof,) [rad].
+    forbidden : (from id, to id) transfers known to collide ("" = home); they cost a penalty, so they are used
+    only when no order avoids them.
+    first : ids welded before every other (tack welds): the order runs through them, then through the rest.
+    """
+    n = len(entries)
+    if n <= 1:
+        return list(range(n))
+    lim = robot.limits
+
+    def dur(a: FloatArray, b: FloatArray, edge: tuple[str, str]) -> float:
+        return ptp_duration(a, b, lim) + (_PENALTY_S if edge in forbidden else 0.0)
+
+    C = np.array([[dur(exits[i], entries[k], (ids[i], ids[k])) if i != k else 0.0 for k in range(n)] for i in range(n)])
+    from_home = np.array([dur(q_home, e, ("", ids[k])) for k, e in enumerate(entries)])
+    to_home = np.array([dur(x, q_home, (ids[k], "")) for k, x in enumerate(exits)])
+    lead = np.array([i in first for i in ids], dtype=bool)
+    if lead.any() and not lead.all():  # a seam of first after another one costs more than any valid order
+        C = C + _AFTER_S * (~lead[:, None] & lead[None, :])
+        from_home = from_home + _AFTER_S * ~lead
+        to_home = to_home + _AFTER_S * lead
+
+    def cost(p: list[int]) -> float:
+        return float(from_home[p[0]] + sum(C[p[i], p[i + 1]] for i in range(n - 1)) + to_home[p[-1]])
+
+    left, tour = set(range(n)), [int(np.argmin(from_home))]
+    left.remove(tour[0])
+    while left:
+        ahead = [k for k in left if lead[k]] or left
+        nxt = min(ahead, key=lambda k: C[tour[-1], k])
+        tour.append(nxt)
+        left.remove(nxt)
+    best, improved = cost(tour), True
+    while improved:
+        improved = False
+        for i in range(n - 1):
+            for k in range(i + 1, n):
+                cand = tour[:i] + tour[i : k + 1][::-1] + tour[k + 1 :]
+                c = cost(cand)
+                if c < best - 1e-9:
+                    tour, best, improved = cand, c, True
+    return tour

@@ -1,0 +1,254 @@
+"""Detected seams -> an executable welding plan for the arm (values in, a frozen :class:`WeldPlan` out): per seam the
+reach pre-check, the torch search, timing, then the order of the seams (docs/planning.md section 1).
+
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Collection, Mapping, Sequence
+from dataclasses import replace
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.config.motion import PlanOptions
+from cell.errors import MotionError, PlanError, TimingError
+from cell.geometry import readonly
+from cell.motion.collision import CollisionChecker
+from cell.motion.robot import RobotModel
+from cell.planning.assembly import assemble
+from cell.planning.failures import SeamFailure, reason_text
+from cell.planning.order import seam_order
+from cell.planning.passes import pass_pieces, solve_passes
+from cell.planning.reach import ReachModel
+from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.stand_off import blocked_by_table, stand_off, table_top
+from cell.planning.transfers import Piece, TransferFail, Transfers
+from cell.process.torch import WeldProcess
+from cell.types import Part
+from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
+
+
+def plan_welds(
+    robot: RobotModel,
+    tasks: Sequence[SeamTask],
+    q_home: npt.ArrayLike,
+    process: WeldProcess,
+    obstacles: Sequence[Part] = (),
+    *,
+    options: PlanOptions | None = None,
+    rng: np.random.Generator | None = None,
+    checker: CollisionChecker | None = None,
+    procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
+    on_seam: Callable[[int, int], None] | None = None,
+    first: Collection[str] = (),
+) -> WeldPlan:
+    """Plan every seam that can be welded, skip and report the others (see the module docstring).
+
+    tasks : the seams, in R (underside seams are not passed in: the caller marks them for the turnover).
+    q_home : (dof,) [rad] where the program starts and ends. obstacles : parts and table, boxes in R.
+    rng : for IK restarts (deterministic for a seeded generator; default seed 0).
+    procedures : seam id -> the weld procedure it got (:mod:`cell.process.procedures`): its travel speed and
+        torch angles drive the search, its direction fixes a vertical seam's, its passes and weave become one
+        weld segment per pass; a NoProcedure is the seam's reason (no_procedure). A seam not in it is welded
+        with ``process`` alone, one pass on the seam line.
+    on_seam : called with (seams searched, seams in all) after each seam's torch search (a progress bar).
+    first : task ids welded before all the others (tack welds, :mod:`cell.pipeline.tacks`).
+    Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
+    SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
+    """
+    t_start = time.perf_counter()
+    opt = options or PlanOptions()
+    q0 = np.asarray(q_home, dtype=float)
+    if q0.shape != (robot.dof,) or not robot.limits.contains(q0):
+        raise PlanError(f"home configuration {np.round(np.degrees(q0), 2).tolist()} deg is outside the joint limits")
+    checker = checker or CollisionChecker(robot, obstacles, opt.collision)
+    hit = checker.check(q0)
+    if hit is not None:
+        raise PlanError(f"home configuration is in collision: {hit.describe()}")
+    rng = rng or np.random.default_rng(0)
+    chosen = procedures or {}
+    outcomes: dict[str, SeamOutcome] = {}
+    solved: dict[str, tuple[SeamSolution, ...]] = {}  # per pass
+    searches: dict[str, SeamSearch] = {}
+    reach = reach_model(robot)
+    table_z = table_top(obstacles, opt.collision.table_name)
+    trims: dict[str, float] = {}  # seam id -> the stand-off [m] it is welded from at its table end
+    for n_done, task in enumerate(tasks, 1):
+        if on_seam is not None and n_done > 1:
+            on_seam(n_done - 1, len(tasks))
+        sel = chosen.get(task.id)
+        if isinstance(sel, NoProcedure):
+            outcomes[task.id] = _failed(task.id, PlanReason.NO_PROCEDURE, sel.reason, task.p_start)
+            continue
+        search = searches[task.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
+        found = search.plan_seam(sel.oriented(task) if sel else task, q0)
+        if isinstance(found, SeamFailure) and table_z is not None:
+            short = _table_stand_off(search, task, found, table_z, opt, sel, q0)
+            if short is not None:
+                found, trims[task.id] = short
+        res = found if isinstance(found, SeamFailure) or sel is None else solve_passes(search, found, sel.procedure)
+        if isinstance(res, SeamFailure):
+            outcomes[task.id] = _failed(task.id, res.code, res.where, res.p_R)
+        else:
+            solved[task.id] = res if isinstance(res, tuple) else (res,)
+    if on_seam is not None and tasks:
+        on_seam(len(tasks), len(tasks))
+
+    transfers = Transfers(robot, process, checker, opt, obstacles, q0)
+    seam_parts: dict[str, list[Piece]] = {}
+    for sid in list(solved):
+        sel = chosen.get(sid)
+        proc = sel.procedure if isinstance(sel, SeamProcedure) else None
+        try:
+            parts = pass_pieces(robot, searches[sid].process, opt, transfers, solved[sid], proc)
+        except TimingError as exc:
+            sols = solved.pop(sid)
+            outcomes[sid] = _failed(sid, PlanReason.TIMING, exc.message, sols[0].X_weld[0][:3, 3])
+            continue
+        if isinstance(parts, TransferFail):
+            solved.pop(sid)
+            detail = f"no free move between two passes: {parts.reason}"
+            outcomes[sid] = _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
+            continue
+        seam_parts[sid] = parts
+    ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
+    seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
+    forbidden: set[tuple[str, str]] = set()
+    while True:
+        ids = list(solved)
+        order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)
+        ordered = [ids[k] for k in order]
+        segments, failed = assemble(transfers, ordered, ends, seam_parts, q0, seam_procs)
+        if failed is None:
+            break
+        a, b, why = failed
+        if (a, b) not in forbidden and len(ids) > 1:
+            forbidden.add((a, b))  # try an order without this transfer first
+            continue
+        drop = b or a  # the seam this transfer leads to (or, on the way home, comes from)
+        solved.pop(drop)
+        direction = "to" if b else "from"
+        detail = f"no free transfer move {direction} the seam: {why.reason}"
+        outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
+    for sid, sols in solved.items():
+        c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
+        swapped = isinstance(sel, SeamProcedure) and sel.reverse  # the search saw the task's ends swapped
+        outcomes[sid] = SeamOutcome(
+            sid,
+            True,
+            "",
+            np.zeros(0),
+            c.reversed != swapped,
+            c.spin,
+            pr.work_angle + c.work_offset,
+            pr.travel_angle + c.travel_offset,
+            trimmed=trims.get(sid, 0.0),
+        )
+    return WeldPlan(
+        joint_names=robot.joint_names,
+        q_home=readonly(q0),
+        segments=tuple(segments),
+        seams=tuple(outcomes[t.id] for t in tasks),
+        order=tuple(ordered),
+        planning_s=time.perf_counter() - t_start,
+    )
+
+
+def unplaceable(
+    robot: RobotModel,
+    tasks: Sequence[SeamTask],
+    q_home: npt.ArrayLike,
+    process: WeldProcess,
+    checker: CollisionChecker,
+    *,
+    options: PlanOptions | None = None,
+    procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
+    table_z: float | None = None,
+) -> dict[str, str]:
+    """Seam id -> the reason :func:`plan_welds` would give, for the seams no torch can be placed on (out of
+    reach, or the torch against a part or the table at a weld end for every candidate): found without IK, the
+    same search's first steps with the same process per seam. A seam with no procedure is not judged here."""
+    reach, opt, chosen = reach_model(robot), options or PlanOptions(), procedures or {}
+    q0 = np.asarray(q_home, dtype=float)
+    out: dict[str, str] = {}
+    for task in tasks:
+        sel = chosen.get(task.id)
+        if isinstance(sel, NoProcedure):
+            continue
+        search = SeamSearch(robot, seam_process(process, sel), checker, opt, np.random.default_rng(0), reach)
+        fail = search.placeable(sel.oriented(task) if sel else task, q0)
+        if fail is not None and table_z is not None and blocked_by_table(fail, opt.collision.table_name):
+            orient = sel.oriented if sel else _as_is
+            if stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0) is not None:
+                fail = None  # placed from the table stand-off, as plan_welds would
+        if fail is not None:
+            out[task.id] = fail.reason()
+    return out
+
+
+def reach_model(robot: RobotModel) -> ReachModel | None:
+    """The arm's reach pre-check (:mod:`cell.planning.reach`, about 10 ms to build), None for an arm it does not
+    fit (no spherical wrist, other frame names): the search then goes straight to IK."""
+    try:
+        return ReachModel.from_robot(robot)
+    except (ValueError, MotionError):
+        return None
+
+
+def seam_process(process: WeldProcess, sel: SeamProcedure | None) -> WeldProcess:
+    """The process a seam is searched and welded with: ``process`` with its procedure's travel speed and torch
+    angles, and one direction only where the procedure fixes it (a vertical seam).
+
+    A fixed direction takes away the other direction's torch tilts: the travel-angle tolerance then grows by twice
+    the nominal angle, so the search may drag as far as it could have pushed the other way (the same torch
+    orientations: a vertical-up weld that starts at the table holds the torch as a downhill one ended there,
+    20 deg down). Nominal angles are still tried first."""
+    if sel is None:
+        return process
+    p = sel.procedure
+    travel = math.radians(p.travel_angle_deg)
+    tol = process.travel_angle_tol + (2.0 * abs(travel) if sel.fixed_direction else 0.0)
+    return replace(
+        process,
+        travel_speed=p.travel_speed_mm_s / 1000.0,
+        work_angle=math.radians(p.work_angle_deg),
+        travel_angle=travel,
+        travel_angle_tol=tol,
+        reversible=not sel.fixed_direction,
+    )
+
+
+def _table_stand_off(
+    search: SeamSearch,
+    task: SeamTask,
+    fail: SeamFailure,
+    table_z: float,
+    opt: PlanOptions,
+    sel: SeamProcedure | None,
+    q0: npt.NDArray[np.float64],
+) -> tuple[SeamSolution, float] | None:
+    """The seam planned shortened at its table end (:mod:`cell.planning.stand_off`) and by how much [m], when its
+    failure is the torch against the table where it is placed; None otherwise or when the shortened seam does
+    not plan either (the seam keeps its failure)."""
+    if not blocked_by_table(fail, opt.collision.table_name):
+        return None
+    orient = sel.oriented if sel else _as_is
+    short = stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0)
+    if short is None:
+        return None
+    again = search.plan_seam(orient(short[0]), q0)
+    return None if isinstance(again, SeamFailure) else (again, short[1])
+
+
+def _as_is(task: SeamTask) -> SeamTask:
+    return task
+
+
+def _failed(seam_id: str, code: PlanReason, detail: str, p_R: npt.ArrayLike) -> SeamOutcome:
+    return SeamOutcome(seam_id, False, reason_text(code, detail), readonly(p_R), code=code)
+
+
+__all__ = ["plan_welds", "reach_model", "seam_process", "unplaceable"]

@@ -1,0 +1,255 @@
+"""Transfers between seams and from/to home: a point-to-point move where the direct one is free, else lifted over the
+obstacles or taken via home, each strategy also kept out of the bodies and the hose window (docs/planning.md
+section 1). Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+from cell.config.motion import GateOptions, PlanOptions
+from cell.errors import IKError, TimingError
+from cell.geometry import FloatArray
+from cell.motion.collision import CollisionChecker
+from cell.motion.collision.wire import Entry, body_entry
+from cell.motion.robot import RobotModel
+from cell.motion.timing import Trajectory, ptp
+from cell.motion.wrist import HoseWindow
+from cell.planning.failures import LineError
+from cell.planning.lines import line_trajectory, solve_line
+from cell.process.torch import WeldProcess, line_poses
+from cell.types import Part
+from cell.types.plan import SegmentKind
+
+
+class Piece(NamedTuple):
+    """One timed motion before it gets its place in the plan: kind, trajectory, TCP speed [m/s] (0: PTP) and
+    the TCP pose X_end (4, 4) in R at its end."""
+
+    kind: SegmentKind
+    trajectory: Trajectory
+    speed: float
+    X_end: FloatArray
+
+
+@dataclass(frozen=True)
+class TransferFail:
+    """No free way: why (the last strategy's contact or error) and the contact point p_R (3,) [m] in R."""
+
+    reason: str
+    p_R: FloatArray
+
+
+class TransferStrategy(Protocol):
+    """One way to move between two configurations; ``name`` is how failure messages call it."""
+
+    @property
+    def name(self) -> str: ...
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        """The motions q_a -> q_b (dof,) [rad]; raises IKError, TimingError or LineError when it cannot time
+        them. Collisions are not checked here."""
+        ...
+
+
+@dataclass(frozen=True)
+class Direct:
+    """One PTP move."""
+
+    name: str = "direct"
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot = mover.robot
+        return [Piece("move", ptp(q_a, q_b, robot.limits, dt=mover.opt.dt), 0.0, robot.fk(q_b))]
+
+
+@dataclass(frozen=True)
+class Lift:
+    """Straight up to the lift height (plus ``extra`` times ``transfer_lift``), PTP across, straight down."""
+
+    name: str = "lift"
+    extra: int = 0
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot, opt = mover.robot, mover.opt
+        h = mover.lift_z + opt.transfer_lift * self.extra
+        up = mover.vertical(q_a, h, up=True)
+        down = mover.vertical(q_b, h, up=False)
+        top_a = up.trajectory.q[-1] if up is not None else q_a
+        top_b = down.trajectory.q[0] if down is not None else q_b
+        pieces = [up] if up is not None else []
+        pieces.append(Piece("move", ptp(top_a, top_b, robot.limits, dt=opt.dt), 0.0, robot.fk(top_b)))
+        if down is not None:
+            pieces.append(down)
+        return pieces
+
+
+@dataclass(frozen=True)
+class ViaHome:
+    """PTP to home, PTP on."""
+
+    name: str = "home"
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot, lim, dt, home = mover.robot, mover.robot.limits, mover.opt.dt, mover.q_home
+        return [
+            Piece("move", ptp(q_a, home, lim, dt=dt), 0.0, robot.fk(home)),
+            Piece("move", ptp(home, q_b, lim, dt=dt), 0.0, robot.fk(q_b)),
+        ]
+
+
+_BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
+
+DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (Direct(), Lift(), Lift("lift_high", extra=1), ViaHome())
+
+
+class Transfers:
+    """Collision-free transfers for one arm, process and scene (see the module docstring).
+
+    obstacles : the parts and the table in R (the lift height is ``transfer_lift`` above the highest of them);
+    q_home (dof,) [rad].
+    """
+
+    def __init__(
+        self,
+        robot: RobotModel,
+        process: WeldProcess,
+        checker: CollisionChecker,
+        options: PlanOptions,
+        obstacles: Sequence[Part],
+        q_home: FloatArray,
+        strategies: Sequence[TransferStrategy] = DEFAULT_STRATEGIES,
+    ) -> None:
+        self.robot, self.process, self.checker, self.opt = robot, process, checker, options
+        self.q_home = q_home
+        self.strategies = tuple(strategies)
+        self.window = HoseWindow(options.a6_center, options.a6_window)
+        self.obstacles = tuple(obstacles)
+        self._gate = GateOptions()
+        tops = [float(np.max(o.vertices()[:, 2])) for o in obstacles]
+        self.lift_z = (max(tops) if tops else 0.0) + options.transfer_lift
+        # Each move searched once: the planner re-assembles its order after a failing transfer and asks again
+        # for every transfer it kept (without this, n re-orderings cost n times the whole plan's transfers).
+        self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
+
+    def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
+        """:meth:`search`, remembered per (q_a, q_b)."""
+        key = (np.asarray(q_a, dtype=float).tobytes(), np.asarray(q_b, dtype=float).tobytes())
+        if key not in self._memo:
+            self._memo[key] = self.search(q_a, q_b)
+        return self._memo[key]
+
+    def search(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
+        """The first strategy's motions q_a -> q_b that collide with nothing (zero-length ones left out); the
+        last contact, or error, when every way collides."""
+        fail = TransferFail("no collision-free way found", np.zeros(3))
+        for strategy in self.strategies:
+            try:
+                pieces = strategy.pieces(self, q_a, q_b)
+            except (IKError, TimingError, LineError) as exc:
+                fail = TransferFail(f"{strategy.name}: {exc}", fail.p_R)
+                continue
+            wound = self._wound(pieces, q_a, q_b)
+            if wound is not None:
+                fail = TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
+                continue
+            hit = next(
+                (
+                    h
+                    for pc in pieces
+                    if (h := self.checker.check_path(pc.trajectory.q, pc.trajectory.times)) is not None
+                ),
+                None,
+            )
+            if hit is None:
+                entry = self._entry(pieces)
+                if entry is None:
+                    return [pc for pc in pieces if pc.trajectory.duration > 0.0]
+                fail = TransferFail(f"{strategy.name}: {entry.describe()}", entry.p_R)
+                continue
+            fail = TransferFail(hit.describe(), hit.p_R)
+        return fail
+
+    def _entry(self, pieces: list[Piece]) -> Entry | None:
+        """Where the wire tip or the wire, which the collision model leaves out, first enters an obstacle's body
+        along the motions (the safety gate's test, :mod:`cell.gate.bodies`); None: nowhere."""
+        for pc in pieces:
+            hit = body_entry(
+                self.robot,
+                pc.trajectory,
+                self.obstacles,
+                wire_m=self.process.stickout,
+                depth=self._gate.body_depth,
+                step=_BODY_STEP,
+            )
+            if hit is not None:
+                return hit
+        return None
+
+    def _wound(self, pieces: list[Piece], q_a: FloatArray, q_b: FloatArray) -> TransferFail | None:
+        """Why the motions take A6 further out of the hose window than their ends q_a, q_b are (None: they do
+        not), with the TCP p_R (3,) [m] where it is furthest out."""
+        allowed = max(self.window.excess(q_a), self.window.excess(q_b)) + 1e-9
+        q = np.concatenate([pc.trajectory.q for pc in pieces])
+        over = np.abs(q[:, -1] - self.window.center) - self.window.half_width
+        k = int(np.argmax(over))
+        if over[k] <= allowed:
+            return None
+        w = self.window
+        why = (
+            f"A6 leaves the hose package window ({np.degrees(w.center):.0f} +- {np.degrees(w.half_width):.0f} deg)"
+            f" by {np.degrees(over[k]):.1f} deg"
+        )
+        return TransferFail(why, self.robot.fk(q[k])[:3, 3].copy())
+
+    def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
+        """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is
+        already that high): up from q (a depart) or down to q (an approach)."""
+        robot, pr, opt = self.robot, self.process, self.opt
+        X = robot.fk(q)
+        rise = height - float(X[2, 3])
+        if rise < 1e-3:
+            return None
+        X_top = X.copy()
+        X_top[2, 3] = height
+        poses = line_poses(X, X_top, opt.line_spacing)
+        knots = solve_line(robot, poses, q, "lift", 0.0, rise / (len(poses) - 1), opt.max_joint_step, ik=opt.ik)
+        if up:
+            tr, v = line_trajectory(
+                robot,
+                knots,
+                rise,
+                np.array([0.0, 0.0, 1.0]),
+                pr.approach_speed,
+                opt.line_accel,
+                opt.line_jerk,
+                dt=opt.dt,
+            )
+            return Piece("depart", tr, v, X_top)
+        tr, v = line_trajectory(
+            robot,
+            knots[::-1],
+            rise,
+            np.array([0.0, 0.0, -1.0]),
+            pr.approach_speed,
+            opt.line_accel,
+            opt.line_jerk,
+            dt=opt.dt,
+        )
+        return Piece("approach", tr, v, X)
+
+
+def joined(pieces: Sequence[Piece]) -> Trajectory:
+    """One trajectory of timed motions put back to back (each starts where the last ended, at rest)."""
+    times, q, qd, qdd, t0 = [], [], [], [], 0.0
+    for k, pc in enumerate(pieces):
+        tr, skip = pc.trajectory, int(k > 0)  # a piece's first sample is the last one's final sample
+        times.append(tr.times[skip:] + t0)
+        q.append(tr.q[skip:])
+        qd.append(tr.qd[skip:])
+        qdd.append(tr.qdd[skip:])
+        t0 += tr.duration
+    return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))

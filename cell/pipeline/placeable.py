@@ -20,13 +20,15 @@ from cell.scenario import Scenario
 from cell.station import Arm, Station
 
 if TYPE_CHECKING:
+    from cell.motion.failures import SeamFailure
     from cell.motion.process.procedures import NoProcedure, SeamProcedure
     from cell.types.plan import SeamTask
     from cell.types.rescan import Rescan
 
 
-def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, str]:
-    """Seam id -> the planner's reason, for those of ``seam_ids`` (found seams only) no torch can be placed on."""
+def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, SeamFailure]:
+    """Seam id -> the planner's failure (its code, where), for those of ``seam_ids`` (found seams only) no torch
+    can be placed on."""
     from cell.motion.plan import seam_tasks, unplaceable
     from cell.motion.process.torch import WeldProcess
 
@@ -69,10 +71,10 @@ def rescan_weldable(
     *,
     motion: MotionScene,
     progress: Progress = quiet,
-) -> tuple[Rescan | None, Detection, dict[str, str]]:
+) -> tuple[Rescan | None, Detection, dict[str, SeamFailure]]:
     """:func:`~cell.pipeline.rescan.rescan_detection` without the seams no torch can be placed on: neither the
     mode's choice nor an escalation re-scans them. Returns the re-scan (None when nothing was left to re-scan),
-    the detection after it, and those seams (id -> the planner's reason)."""
+    the detection after it, and those seams (id -> the planner's failure)."""
     sc = det.scenario
     arm = station.arm
     if arm is None:  # rescan_detection says so
@@ -105,7 +107,9 @@ def rescan_weldable(
     return escalated(rs, more, shift_mm), after, hopeless
 
 
-def _hopeless(arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene, progress: Progress) -> dict[str, str]:
+def _hopeless(
+    arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene, progress: Progress
+) -> dict[str, SeamFailure]:
     """:func:`unweldable` of ``ids``, said on ``progress`` when there are any."""
     found = unweldable(arm, det, ids, motion)
     if found:

@@ -22,6 +22,7 @@ from cell.types import (
     SeamMetrics,
     SeamScene,
     SeamStatus,
+    Violation,
     WeldMap,
 )
 from cell.types.run import SeamRecord, SeamWeld
@@ -114,7 +115,7 @@ class WeldRun:
     plan: WeldPlan | None = None
     pre_move: Trajectory | None = None
     execution: Execution | None = None
-    violations: tuple[str, ...] = ()
+    violations: tuple[Violation, ...] = ()  # the safety gate's, in its order (the plan was refused)
     error: CellError | None = None
     timings: dict[str, float] = field(default_factory=dict)
     torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT

@@ -23,11 +23,13 @@ from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import CheckFail, Joint, SeamStatus
+from cell.types import CheckFail, Joint, SeamStatus, Violation, ViolationKind
+from cell.types.plan import PlanReason
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
 if TYPE_CHECKING:
+    from cell.motion.failures import SeamFailure
     from cell.types.execution import Execution
     from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
     from cell.types.trajectory import Trajectory
@@ -42,7 +44,7 @@ def plan_for(
     motion: MotionScene | None = None,
     progress: Progress = quiet,
     tacks: TackRule | None = None,
-) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
+) -> tuple[WeldPlan, Trajectory, tuple[Violation, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
     section 7).
 
@@ -80,14 +82,15 @@ def plan_for(
     )
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     q_now = arm.q_scan if q_start is None else q_start
-    problems = []
+    problems: list[Violation] = []
     # The move home takes the transfers' ways (direct, lifted over the parts): a close-up view can leave the
     # torch low between parts, where the direct move collides. When no way is free, nothing can move: the whole
     # plan is refused (the start state, not a seam).
     way = Transfers(arm.model, process, checker, sc.motion.plan, obstacles, arm.q_home).move(q_now, arm.q_home)
     if isinstance(way, TransferFail):
         pre = ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
-        problems.append(f"move from the arm's position to home collides whichever way: {way.reason}")
+        why = f"move from the arm's position to home collides whichever way: {way.reason}"
+        problems.append(Violation(ViolationKind.COLLISION, why, 0.0))
     else:
         pre = joined(way) if way else ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
     dropped: dict[str, SeamOutcome] = {}
@@ -131,7 +134,7 @@ def plan_for(
         dropped.update(blamed)
     outcomes = {o.seam_id: o for o in plan.seams} | dropped
     plan = replace(plan, seams=tuple(outcomes[t.id] for t in (*tasks, *tack_tasks) if t.id in outcomes))
-    problems += [str(v) for v in found]
+    problems += found
     return plan, pre, tuple(problems)
 
 
@@ -224,9 +227,9 @@ def weld(
         first, rs = det, None
         timings = dict(det.timings)
         plan = pre = ex = None
-        violations: tuple[str, ...] = ()
+        violations: tuple[Violation, ...] = ()
         error: CellError | None = None
-        hopeless: dict[str, str] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
+        hopeless: dict[str, SeamFailure] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
         checked: dict[str, CheckFail] = {}  # seams that failed the last check before the arc, re-scanned or not
         try:
             if det.error is not None:
@@ -240,7 +243,7 @@ def weld(
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
                 if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
-                    hopeless = {i: why for i, why in hopeless.items() if "beyond reach" not in why}
+                    hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             if execute_plan:  # the last check before the arc: re-scanned, then refused (cell/pipeline/last_check.py)
@@ -253,7 +256,7 @@ def weld(
             low = {
                 e.id
                 for e in det.estimates
-                if e.status is SeamStatus.FOUND and doubt(e, sc) and execute_plan and e.id not in hopeless
+                if e.status is SeamStatus.FOUND and doubt(e, sc) is not None and execute_plan and e.id not in hopeless
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
@@ -271,7 +274,10 @@ def weld(
                 )
                 timings["plan_s"] = setup_s + time.perf_counter() - t
                 if violations:
-                    raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
+                    from cell.motion.gate import GateRefusedError
+
+                    why = f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)"
+                    raise GateRefusedError(why, violations=violations)
                 if execute_plan:
                     t = time.perf_counter()
                     ex = execute(station, plan, pre, progress=progress)

@@ -18,6 +18,7 @@ import numpy as np
 from cell.errors import CellError
 from cell.scenario import Scenario
 from cell.sweep.variations import Variation, varied
+from cell.types.run import WeldReason
 
 if TYPE_CHECKING:
     from cell.pipeline import Detection, WeldRun
@@ -107,15 +108,16 @@ def weld_seams(run: WeldRun, sc: Scenario, stage: Stage) -> dict[str, dict[str, 
         rec = out.setdefault(w.id, {"found": False, "reasons": []})
         code = w.code.value if w.code is not None else None
         if stage == "plan":
-            rec["planned"] = bool(w.planned and code == "preview")
+            rec["planned"] = bool(w.planned and w.code is WeldReason.PREVIEW)
             rec["plan_tcp_rms_mm"] = _mm(planned_tcp.get(w.id))
         else:
             rec["planned"] = bool(w.planned)
             rec["welded"] = bool(w.welded)
             rec["weld_rms_mm"] = _mm(w.quality.tcp_rms_mm) if w.quality is not None else None
         rec["code"] = code
-        # a preview's words say nothing, and "not located: <the estimate's reason>" says it twice
-        if w.reason and code != "preview" and not any(r in w.reason for r in rec["reasons"]):
+        # a preview's words say nothing, and an unseen or unlocated seam's repeat the estimate's reason
+        repeats = w.code in (WeldReason.NOT_VISIBLE, WeldReason.NOT_LOCATED) and rec["reasons"]
+        if w.reason and w.code is not WeldReason.PREVIEW and not repeats:
             rec["reasons"] = [*rec["reasons"], w.reason]
     return out
 

@@ -8,6 +8,7 @@ Every stage imports its values from here and nothing here imports a stage (an im
 """
 
 from cell.types.execution import Event, Execution, WeldQuality
+from cell.types.gate import Violation, ViolationKind
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, UnsupportedSeam, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
@@ -69,6 +70,8 @@ __all__ = [
     "Trajectory",
     "UnsupportedSeam",
     "Viewpoint",
+    "Violation",
+    "ViolationKind",
     "VoxelTable",
     "Weave",
     "WeldMap",

@@ -8,17 +8,30 @@ code that talks to the station's ports (:mod:`cell.station`). The CLI is a thin 
 """
 
 from cell.pipeline.cloud import locate_cloud
-from cell.pipeline.detect import build_scene, capture, detect, evaluate, locate, read_weldmap, table_z_R, truths
+from cell.pipeline.detect import (
+    AlignStart,
+    build_scene,
+    capture,
+    detect,
+    evaluate,
+    locate,
+    read_weldmap,
+    table_z_R,
+    truths,
+)
+from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun
 from cell.pipeline.rescan import RescanMode, rescan_detection, rescan_seams, rescanned
 from cell.pipeline.weld import execute, plan_for, torch_paths, weld
 
 __all__ = [
+    "AlignStart",
     "Capture",
     "Detection",
     "RescanMode",
     "Scene",
     "SeamWeld",
+    "WeldJob",
     "WeldRun",
     "build_scene",
     "capture",

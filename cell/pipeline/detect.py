@@ -6,7 +6,7 @@ import math
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Literal
 
 from cell.errors import AlignmentError, CellError, SensorError
@@ -22,7 +22,28 @@ from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldM
 
 Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
 
-__all__ = ["Progress", "build_scene", "capture", "detect", "evaluate", "locate", "quiet", "read_weldmap", "truths"]
+
+@dataclass(frozen=True)
+class AlignStart:
+    """Where the map's alignment starts when the part is not where the scenario places it (a turned part): its
+    believed pose X_RM (4, 4) and a search of the cloud near it (:data:`Seed`; None: from X_RM itself)."""
+
+    X_RM: FloatArray
+    seed: Seed | None = None
+
+
+__all__ = [
+    "AlignStart",
+    "Progress",
+    "build_scene",
+    "capture",
+    "detect",
+    "evaluate",
+    "locate",
+    "quiet",
+    "read_weldmap",
+    "truths",
+]
 
 
 def read_weldmap(scenario: Scenario) -> WeldMap:

@@ -101,9 +101,9 @@ class Detection:
         return not self.lost_cameras and all(e.status not in undone for e in self.estimates)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class WeldRun:
-    """The outcome of ``cell weld`` / ``cell preview``.
+    """The outcome of ``cell weld`` / ``cell preview`` (built by keyword).
 
     plan : the checked welding plan (None when planning failed as a whole: see ``error``).
     execution : what the simulated arm did (None for a preview or when the gate refused the plan).

@@ -7,14 +7,15 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from contextlib import nullcontext
 from dataclasses import replace
 from functools import partial
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
-from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
+from cell.pipeline.detect import AlignStart, Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene
+from cell.pipeline.job import WeldJob
 from cell.pipeline.last_check import joined, last_checked
 from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
@@ -188,20 +189,17 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
 
 def weld(
     scenario: Scenario,
-    method: str | None = None,
+    job: WeldJob | None = None,
     *,
-    noise: Literal["none", "realistic"] | None = None,
-    rescan: Literal["none", "low", "all"] | None = None,
-    execute_plan: bool = True,
     progress: Progress = quiet,
-    gui: bool = False,
     station: Station | None = None,
-    detect_options: Mapping[str, Any] | None = None,
+    start: AlignStart | None = None,
     only: Collection[str] | None = None,
     tacks: TackRule | None = None,
 ) -> WeldRun:
-    """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a
-    preview) weld. ``rescan`` overrides the scenario's ``rescan.mode``.
+    """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``job.execute`` is False: a
+    preview) weld. ``job`` (:class:`~cell.pipeline.job.WeldJob`; None: as the scenario says) overrides the
+    scenario's locator, noise and ``rescan.mode``; its ``sides`` is :func:`cell.pipeline.sides.weld_part`'s.
 
     A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
     every seam's reason, so the report can still be written. A seam whose confidence stays below
@@ -210,18 +208,21 @@ def weld(
     (``rescan.bound_sigmas`` times an end's sigma along the seam) stays over ``rescan.end_tolerance_mm``
     (``end_uncertain``).
 
-    station : a running cell to weld on (left open; built and closed here when None). detect_options : keywords
-    for :func:`detect` (a turned part's ``X_RM_nominal`` and ``seed``). only : the seam ids this run is about
+    station : a running cell to weld on (left open; built and closed here when None). start : where the map's
+    alignment starts (a turned part's nominal pose and a search near it). only : the seam ids this run is about
     (a second side's: the others are neither re-scanned, planned nor reported). tacks : tack welds laid before
     the seams (:func:`plan_for`).
     """
     t_all = time.perf_counter()
-    sc = scenario.with_noise(noise) if noise else scenario
-    if rescan is not None:  # the override is what ran: the report's configuration says so
-        sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": rescan})})
+    job = job or WeldJob()
+    sc = scenario.with_noise(job.noise) if job.noise else scenario
+    if job.rescan is not None:  # the override is what ran: the report's configuration says so
+        sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": job.rescan})})
+    execute_plan = job.execute
     weldmap = read_weldmap(sc)
-    with open_station(sc, weldmap, gui=gui) if station is None else nullcontext(station) as station:
-        det = detect(sc, method, progress=progress, station=station, weldmap=weldmap, **(detect_options or {}))
+    with open_station(sc, weldmap, gui=job.gui) if station is None else nullcontext(station) as station:
+        X_RM, seed = (start.X_RM, start.seed) if start is not None else (None, None)
+        det = detect(sc, job.method, progress=progress, station=station, weldmap=weldmap, X_RM_nominal=X_RM, seed=seed)
         if only is not None:
             det = restricted(det, only)
         first, rs = det, None
@@ -290,4 +291,18 @@ def weld(
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan)
-        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs, view)
+        return WeldRun(
+            detection=det,
+            seams=seams,
+            plan=plan,
+            pre_move=pre,
+            execution=ex,
+            violations=violations,
+            error=error,
+            timings=timings,
+            torch_paths=paths,
+            arm=station.arm,
+            first_detection=first,
+            rescan=rs,
+            view=view,
+        )

@@ -54,9 +54,9 @@ def run_task(scenario: Scenario, v: Variation, stage: Stage, method: str | None 
             if det.error is not None:
                 line["error"] = error_json(det.error)
         else:
-            from cell.pipeline import weld
+            from cell.pipeline import WeldJob, weld
 
-            run = weld(sc, method, execute_plan=stage == "weld")
+            run = weld(sc, WeldJob(method, execute=stage == "weld"))
             line["seams"] = weld_seams(run, sc, stage)
             timings = dict(run.timings)
             if run.error is not None:

@@ -142,7 +142,7 @@ def test_a_large_placement_error_and_a_camera_lost_at_the_turn_still_weld_every_
     assert det.error is None and det.scene is not None
     assert det.lost_cameras and "cam_left" in det.lost_cameras[0]
     wm = read_weldmap(det.scenario)
-    res = flip_result(plan, WeldRun(det, ()), wm)
+    res = flip_result(plan, WeldRun(detection=det, seams=()), wm)
     assert res is not None
     # The operator's 30 mm plus the as-built part's own offset from its drawing, mirrored by the turn (its
     # deviations are a few mm): measured 32.4 mm.

@@ -61,7 +61,7 @@ def test_a_gate_option_reaches_the_safety_gate(
 
     monkeypatch.setattr(importlib.import_module("cell.pipeline.weld"), "detect", detect)
     assert scn.model_copy(update={"motion": fence1_detection.scenario.motion}) == fence1_detection.scenario
-    run = pipeline.weld(scn, execute_plan=False)
+    run = pipeline.weld(scn, pipeline.WeldJob(execute=False))
     assert asked == [scn]
     assert isinstance(run.error, GateRefusedError) and run.error.exit_code == PlanError.exit_code
     assert run.violations and run.error.violations == run.violations

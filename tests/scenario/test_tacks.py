@@ -9,6 +9,7 @@ One module fixture plans side A with the tacks (and once without) on a fence1 ce
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any
@@ -128,8 +129,8 @@ def test_weld_part_records_the_tacks_side_a_laid(
         asked.append(len(got))
         return replace(fence1_run, plan=tacked.plan)
 
-    monkeypatch.setattr(pipeline, "weld", side_a)
-    run = weld_part(sc.load("fence1-tacked"), execute_plan=False)
+    monkeypatch.setattr(importlib.import_module("cell.pipeline.sides"), "weld", side_a)
+    run = weld_part(sc.load("fence1-tacked"), pipeline.WeldJob(execute=False))
     assert asked == [4] and run.plan is not None and run.side_b is None
     assert [(t.seam_id, t.end, t.length_mm, t.welded) for t in run.tacks] == [
         (t.seam_id, t.end, 15.0, True) for t in tacked.tacks

@@ -85,10 +85,10 @@ def test_weld_cli_writes_report_and_robot_program(
 ) -> None:
     """``cell weld fence1`` hands the scenario to ``pipeline.weld`` and writes what it returns: the session's run
     stands in for a second one (the CLI's arguments are checked as it passes them)."""
-    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+    asked: list[tuple[sc.Scenario, pipeline.WeldJob | None, dict[str, object]]] = []
 
-    def weld(scenario: sc.Scenario, method: str | None = None, **kw: object) -> pipeline.WeldRun:
-        asked.append((scenario, method, kw))
+    def weld(scenario: sc.Scenario, job: pipeline.WeldJob | None = None, **kw: object) -> pipeline.WeldRun:
+        asked.append((scenario, job, kw))
         return fence1_run
 
     monkeypatch.setattr(pipeline, "weld", weld)
@@ -96,9 +96,9 @@ def test_weld_cli_writes_report_and_robot_program(
     report, krl = tmp_path / "r.json", tmp_path / "krl"
     result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--krl", str(krl)])
     assert result.exit_code == 0, result.stderr
-    ((scenario, method, kw),) = asked
-    assert scenario == sc.load("fence1") and method is None
-    assert kw["noise"] is None and kw["rescan"] is None and kw["gui"] is False
+    ((scenario, job, kw),) = asked
+    assert scenario == sc.load("fence1") and set(kw) == {"progress"}
+    assert job == pipeline.WeldJob(method=None, noise=None, rescan=None, execute=True, gui=False, sides="first")
     data = json.loads(report.read_text())
     assert data["welded"] == 12 and data["error"] is None
     assert data["cycle_time_s"] > 0 and data["events"]

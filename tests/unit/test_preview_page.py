@@ -137,7 +137,7 @@ def tiny_run() -> WeldRun:
     table = Box(make_pose(p=[0.0, 0.0, -1.07]), np.array([1.0, 0.6, 0.1]))
     view = CellView(table=table, cameras=cameras_R(SCENARIO))
     X = torch_along(front)
-    return WeldRun(det, welds, torch_paths={"S_front": X}, view=view)
+    return WeldRun(detection=det, seams=welds, torch_paths={"S_front": X}, view=view)
 
 
 def test_page_has_results_table_and_cell_figure(tmp_path: Path) -> None:

@@ -3,6 +3,7 @@ rerun-sdk is missing; and the recording's small numerical helpers (quaternions, 
 
 from __future__ import annotations
 
+import importlib
 import re
 import sys
 from pathlib import Path
@@ -29,6 +30,7 @@ def no_run(monkeypatch: pytest.MonkeyPatch) -> None:
         raise AssertionError("the pipeline ran")
 
     monkeypatch.setattr(pipeline, "weld", refuse)
+    monkeypatch.setattr(importlib.import_module("cell.pipeline.sides"), "weld", refuse)  # weld_part's side A
 
 
 def _one_error_line(argv: list[str], *needles: str) -> None:

@@ -16,7 +16,8 @@ import numpy as np
 
 from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
-from cell.pipeline.detect import AlignStart, Progress, Seed, quiet, read_weldmap, table_z_R
+from cell.perception.near_pose import near_seed
+from cell.pipeline.detect import AlignStart, Progress, quiet, read_weldmap, table_z_R
 from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.tacks import Tack, choose_tacks, tack_records, tacks_time_s
@@ -24,13 +25,9 @@ from cell.pipeline.two_sided import TwoSidedRun
 from cell.pipeline.weld import weld
 from cell.scenario import Scenario
 from cell.station import Station, open_station
-from cell.types import Cloud, SeamStatus, WeldMap
+from cell.types import SeamStatus, WeldMap
 from cell.types.flip import FlipPlan, FlipResult
 from cell.types.plan import SeamTask
-
-SEARCH_TURN_RAD = math.radians(15.0)  # how far off its nominal turned pose the second alignment looks for the part
-SEARCH_SHIFT_M = 0.15
-_SCORE_BAND_M = 0.01  # the band a start pose is scored in (cloud points near the map's surfaces)
 
 
 def table_box_R(sc: Scenario) -> tuple[FloatArray, FloatArray]:
@@ -65,35 +62,6 @@ def _turn_for(det: Detection) -> FlipPlan | None:
         max_tilt_rad=math.radians(sc.flip.max_tilt_deg),
         table_xy=table_box_R(sc),
     )
-
-
-def near_seed(weldmap_M: WeldMap, table_z: float) -> Seed:
-    """A :data:`cell.pipeline.detect.Seed`: the height-image search of the cloud (turns and shifts on the table,
-    :func:`cell.perception.global_placement.height_candidates`) for the turned map, its candidates within
-    SEARCH_TURN_RAD and SEARCH_SHIFT_M of the nominal pose, the best by the share of the cloud on the map's
-    surfaces, the nominal pose itself among them."""
-    from cell.perception.align import sample_map, surface_fit
-    from cell.perception.global_placement import height_candidates
-
-    def seed(cloud: Cloud, X_RM: FloatArray) -> FloatArray:
-        nominal = weldmap_M.transformed(X_RM, "R")
-        centre = np.mean([p.center for p in nominal.parts], axis=0)
-        points = np.asarray(cloud.points)
-        starts = [np.eye(4)]
-        for X in height_candidates(points, nominal, table_z):
-            turn = abs(math.atan2(float(X[1, 0]), float(X[0, 0])))
-            shift = float(np.linalg.norm((X[:3, :3] @ centre + X[:3, 3] - centre)[:2]))
-            if turn <= SEARCH_TURN_RAD and shift <= SEARCH_SHIFT_M:
-                starts.append(X)
-
-        def score(X: FloatArray) -> float:
-            samples, normals = sample_map(nominal.transformed(X, "R"), _SCORE_BAND_M / 2, _SCORE_BAND_M / 2)
-            return surface_fit(points, samples, normals, _SCORE_BAND_M, _SCORE_BAND_M / 2)[0]
-
-        best = max(starts, key=lambda X: round(score(X), 9))  # near-ties to the first start, in every process
-        return np.asarray(best @ X_RM)
-
-    return seed
 
 
 def flip_result(plan: FlipPlan, run: WeldRun, weldmap_M: WeldMap) -> FlipResult | None:

@@ -21,11 +21,12 @@ from cell.cli.sides import write_programs
 from cell.errors import AlignmentError, AlignmentFailure
 from cell.export.flip_report import two_sided_report
 from cell.geometry import invert
+from cell.perception.near_pose import near_seed
 from cell.pipeline import Detection
 from cell.pipeline.detect import detect, read_weldmap, table_z_R
 from cell.pipeline.records import WeldRun
 from cell.pipeline.restrict import restricted
-from cell.pipeline.sides import flip_result, near_seed, plan_turn, weld_part
+from cell.pipeline.sides import flip_result, plan_turn, weld_part
 from cell.pipeline.two_sided import TwoSidedRun
 from cell.pipeline.weld import plan_for
 from cell.scenario.cell_specs import PoseSpec

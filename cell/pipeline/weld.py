@@ -290,7 +290,7 @@ def weld(
         seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
-        view = cell_view(sc, station.arm, plan)
+        view = cell_view(sc, station.arm, plan, pre, ex)
         return WeldRun(
             detection=det,
             seams=seams,

@@ -27,10 +27,11 @@ from cell.types.seams import (
 )
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
 from cell.types.trajectory import PathProfile, Trajectory
-from cell.types.view import CameraView, CellView, RobotPose, Shape, ShapeKind
+from cell.types.view import ArmMotion, CameraView, CellView, RobotPose, Shape, ShapeKind
 
 __all__ = [
     "BOX_FACES",
+    "ArmMotion",
     "Box",
     "CameraIntrinsics",
     "CameraView",

@@ -75,6 +75,7 @@ def test_cell_view_poses_are_the_arms_forward_kinematics(arm: Arm) -> None:
     assert len(view.poses) == 1 and view.poses[0].label == "scan pose"
     assert np.allclose(view.poses[0].X_RL["torch"], arm.model.fk(arm.q_scan, "torch"))
     assert set(view.poses[0].X_RL) == set(view.links)
+    assert view.motion is None and view.limits == arm.model.limits  # no plan, no motion; the limits as values
 
 
 def test_3d_view_draws_the_cell_and_frames_the_part(arm: Arm) -> None:

@@ -16,8 +16,9 @@ from cell import pipeline
 from cell.cli import app
 from cell.errors import UsageError
 from cell.geometry import rpy_to_matrix
+from cell.pipeline.scene_view import subsample
 from cell.preview.rerun import require_rerun
-from cell.preview.timeline import quaternions_xyzw, subsample
+from cell.preview.timeline import quaternions_xyzw
 
 runner = CliRunner()
 

@@ -149,7 +149,7 @@ def rescan_cmd(
     """
     from cell import pipeline
     from cell.export.report import detection_report, rescan_report
-    from cell.station import open_station
+    from cell.pipeline.geometry import open_cell
 
     with cell_errors():
         check_file(json_path, "--json")
@@ -164,7 +164,7 @@ def rescan_cmd(
         stage, writer = Stage(), Writer()
         det: pipeline.Detection | None = None
         try:
-            with open_station(scn, weldmap) as station:
+            with open_cell(scn, weldmap) as station:
                 det = pipeline.detect(scn, method, progress=stage, station=station, weldmap=weldmap)
                 if det.error is not None:
                     writer.report(json_path, detection_report(det, provenance=prov))

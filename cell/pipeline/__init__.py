@@ -19,6 +19,7 @@ from cell.pipeline.detect import (
     table_z_R,
     truths,
 )
+from cell.pipeline.geometry import open_cell, robot_arm
 from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun
 from cell.pipeline.rescan import RescanMode, rescan_detection, rescan_seams, rescanned
@@ -40,11 +41,13 @@ __all__ = [
     "execute",
     "locate",
     "locate_cloud",
+    "open_cell",
     "plan_for",
     "read_weldmap",
     "rescan_detection",
     "rescan_seams",
     "rescanned",
+    "robot_arm",
     "table_z_R",
     "torch_paths",
     "truths",

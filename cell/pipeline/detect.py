@@ -14,10 +14,11 @@ from cell.geometry import FloatArray, invert
 from cell.perception.align import Alignment
 from cell.perception.calibration import PoseUncertainty, with_calibration
 from cell.pipeline.evaluation import evaluate
+from cell.pipeline.geometry import open_cell
 from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
-from cell.station import Station, open_station
+from cell.station import Station
 from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
 
 Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
@@ -72,7 +73,7 @@ def capture(
     weldmap = weldmap if weldmap is not None else read_weldmap(scenario)
     if station is None:
         progress(f"building the cell of {scenario.name}")
-        with open_station(scenario, weldmap, gui=gui) as st:
+        with open_cell(scenario, weldmap, gui=gui) as st:
             return capture(scenario, progress=progress, station=st, weldmap=weldmap)
     if station.source == "simulation":
         progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")

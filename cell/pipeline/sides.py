@@ -18,13 +18,14 @@ from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.perception.near_pose import near_seed
 from cell.pipeline.detect import AlignStart, Progress, quiet, read_weldmap, table_z_R
+from cell.pipeline.geometry import open_cell
 from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.tacks import Tack, choose_tacks, tack_records, tacks_time_s
 from cell.pipeline.two_sided import TwoSidedRun
 from cell.pipeline.weld import weld
 from cell.scenario import Scenario
-from cell.station import Station, open_station
+from cell.station import Station
 from cell.types import SeamStatus, WeldMap
 from cell.types.flip import FlipPlan, FlipResult
 from cell.types.plan import SeamTask
@@ -99,7 +100,7 @@ def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progr
     chosen: list[Tack] = []
     spec = sc.flip.tacks
     both = job.sides == "all"
-    with open_station(sc, weldmap, gui=job.gui) as station:
+    with open_cell(sc, weldmap, gui=job.gui) as station:
         # Tacks only when asked for and the part will be turned.
         rule = tack_rule(spec.count, spec.length_mm / 1000.0, chosen) if spec.count and both else None
         a = weld(sc, side_a, progress=progress, station=station, tacks=rule)

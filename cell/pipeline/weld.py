@@ -14,7 +14,7 @@ import numpy as np
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
 from cell.pipeline.detect import AlignStart, Progress, detect, quiet, read_weldmap
-from cell.pipeline.geometry import MotionScene, motion_scene
+from cell.pipeline.geometry import MotionScene, motion_scene, open_cell
 from cell.pipeline.job import WeldJob
 from cell.pipeline.last_check import joined, last_checked
 from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
@@ -23,7 +23,7 @@ from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
-from cell.station import Station, open_station
+from cell.station import Station
 from cell.types import CheckFail, Joint, SeamStatus, Violation, ViolationKind
 from cell.types.plan import PlanReason
 
@@ -220,7 +220,7 @@ def weld(
         sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": job.rescan})})
     execute_plan = job.execute
     weldmap = read_weldmap(sc)
-    with open_station(sc, weldmap, gui=job.gui) if station is None else nullcontext(station) as station:
+    with open_cell(sc, weldmap, gui=job.gui) if station is None else nullcontext(station) as station:
         X_RM, seed = (start.X_RM, start.seed) if start is not None else (None, None)
         det = detect(sc, job.method, progress=progress, station=station, weldmap=weldmap, X_RM_nominal=X_RM, seed=seed)
         if only is not None:

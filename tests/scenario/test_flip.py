@@ -24,6 +24,7 @@ from cell.geometry import invert
 from cell.perception.near_pose import near_seed
 from cell.pipeline import Detection
 from cell.pipeline.detect import detect, read_weldmap, table_z_R
+from cell.pipeline.geometry import robot_arm
 from cell.pipeline.records import WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.sides import flip_result, plan_turn, weld_part
@@ -130,7 +131,7 @@ def large_error() -> Iterator[tuple[FlipPlan, Detection, SimStation]]:
     w, joints, tz = wm.transformed(X_RM, "R"), find_joints(wm), table_z_R(scn)
     left = [s.id for s in w.seams if not visibility(w, joints[s.id], tz)[0]]
     plan = plan_flip(w, joints, tz, left, X_RM)
-    with SimStation(scn, wm) as station:
+    with SimStation(scn, wm, arm=robot_arm(scn)) as station:
         station.turn_part(scn.X_WR @ plan.X_R_turn @ invert(scn.X_WR))
         det = detect(scn, station=station, weldmap=wm, X_RM_nominal=plan.X_RM_after, seed=near_seed(wm, tz))
         yield plan, restricted(det, plan.exposed), station

@@ -22,10 +22,10 @@ from cell import scenario as sc
 from cell.export.flip_report import two_sided_report
 from cell.export.krl import krl_program
 from cell.motion.plan import seam_tasks
+from cell.pipeline.geometry import open_cell
 from cell.pipeline.sides import tack_rule, weld_part
 from cell.pipeline.tacks import Tack, is_tack
 from cell.pipeline.weld import plan_for
-from cell.station import open_station
 from cell.types.plan import SeamTask, WeldPlan
 
 LENGTH_M = 0.015
@@ -45,7 +45,7 @@ class Tacked:
 def tacked(fence1_run: pipeline.WeldRun) -> Iterator[Tacked]:
     det = fence1_run.detection
     scn = det.scenario
-    with open_station(scn, pipeline.read_weldmap(scn)) as station:
+    with open_cell(scn, pipeline.read_weldmap(scn)) as station:
         assert station.arm is not None
         chosen: list[Tack] = []
         plan, _, violations = plan_for(station, det, tacks=tack_rule(4, LENGTH_M, chosen))

@@ -197,9 +197,9 @@ def test_overview_legend_lists_only_what_is_drawn(tmp_path: Path) -> None:
 
 
 def test_scan_pose_holds_the_eye_in_hand_camera_where_its_frustum_starts() -> None:
-    from cell.station.arm import load_arm
+    from cell.pipeline.geometry import robot_arm
 
-    arm = load_arm(SCENARIO)  # q_scan by IK on the camera's viewpoint
+    arm = robot_arm(SCENARIO)  # q_scan by IK on the camera's viewpoint
     view = cell_view(SCENARIO, arm, None)
     (cam,) = (c for c in view.cameras if c.mount == "eye_in_hand")
     X_R_link = view.poses[0].X_RL["camera_link"]  # the drawn camera body at the scan pose

@@ -119,7 +119,7 @@ class WeldRun:
     error: CellError | None = None
     timings: dict[str, float] = field(default_factory=dict)
     torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT
-    arm: Arm | None = None
+    arm: Arm | None = None  # the robot that ran (the program post-processor needs its model; pictures read view)
     first_detection: Detection | None = None  # before the re-scan (the same as detection when none ran)
     rescan: Rescan | None = None
     view: CellView | None = None  # the table, the robot's shapes at its poses and the cameras, for pictures

@@ -1,4 +1,4 @@
-"""The cell's own commands as benchmarks: what the README's welding, re-scan and fault tables show.
+"""The cell's own commands as benchmarks: what the welding, re-scan and fault tables of docs/results.md show.
 
     .venv/bin/python benchmarks/bench_cell.py weld [--scenarios fence1] [--json PATH]
     .venv/bin/python benchmarks/bench_cell.py rescan [--scenarios fence1-exact,fence1,fence2,faults/extrinsics-off]
@@ -14,7 +14,7 @@ a fault's table is about what the fault does to the part as it lies. ``rescan`` 
 ``cell rescan SCENARIO --all`` runs (detect, :func:`cell.pipeline.rescan_detection` on every visible seam, its report
 :func:`cell.export.report.rescan_report`): the mean lateral and end point error before and after, the robot time
 (``rescan.json``). ``faults`` runs ``cell weld`` on every scenario of ``scenarios/faults/`` and keeps what the
-README's fault table quotes: welded count, the worst executed TCP error, the exit code the CLI gives, the lost
+fault table of docs/results.md quotes: welded count, the worst executed TCP error, the exit code the CLI gives, the lost
 cameras with their reason, the seams re-scanned (and whether a close-up escalated to every seam), the seams not
 found or occluded with their reasons, and the error of a refusal (``faults.json``). Every figure is taken from
 the command's own JSON report, so these rows and ``cell ... --json`` agree. Headless; one run per scenario.

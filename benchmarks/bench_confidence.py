@@ -8,7 +8,7 @@ scenario has them, new as-built deviations), perceived, and located with ``ours`
 fall below it (re-scanned by ``cell weld``) and how many of the seams with a lateral error over ``--big-mm`` it
 catches; and the Spearman rank correlation of confidence with the lateral error. The re-scan threshold lives in
 ``cell.rescan.CONFIDENCE_THRESHOLD``. The table's figures and the per-seam rows go to ``--json`` (default
-``benchmarks/results/confidence.json``), which ``tools/readme_results.py`` renders into the README.
+``benchmarks/results/confidence.json``), which ``tools/readme_results.py`` renders into docs/results.md.
 """
 
 from __future__ import annotations

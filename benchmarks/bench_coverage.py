@@ -10,7 +10,7 @@ group (the three scenarios, the faults): the found seams, the share whose latera
 3 sigma, the share whose endpoint error is within 2 sigma, the median sigma and the largest error. A sigma that
 is calibrated covers about 95 % at 2 sigma. The sigma models' constants (``cell/seams/sigma.py``) cite this
 benchmark. The figures and the per-seam rows go to ``--json`` (default ``benchmarks/results/coverage.json``),
-which ``tools/readme_results.py`` renders into the README.
+which ``tools/readme_results.py`` renders into docs/results.md.
 """
 
 from __future__ import annotations

@@ -3,9 +3,9 @@
     .venv/bin/python benchmarks/bench_motion.py [--json PATH] [--seed N]
 
 The rows go to ``--json`` (default ``benchmarks/results/motion.json``: ``primitives``, one row per case with a
-stable ``key``, and ``plans``, one row per scenario), which ``tools/readme_results.py`` renders into the README.
+stable ``key``, and ``plans``, one row per scenario), which ``tools/readme_results.py`` renders into docs/results.md.
 
-Goals (issue "Motion"): warm-started IK median <= 0.5 ms per pose; ptp computation <= 100 us.
+Goals: warm-started IK median <= 0.5 ms per pose; ptp computation <= 100 us.
 Times are wall-clock per call on this machine (single thread); the table gives median, 90th percentile, max.
 
 Second section, welding plans: every visible seam of each paper scenario's welding map (the designed seams in

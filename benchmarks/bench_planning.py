@@ -8,8 +8,8 @@ seams are planned and gated as ``cell weld`` does (``pipeline.weld.plan_for``: t
 transfers, the safety gate). Reported: seams asked for, planned, refused per reason code, the plan's cycle time,
 planning CPU time (``time.process_time``: the machine is shared, wall time is given too) in all, per planned seam
 and per seam asked for, and the reach pre-check's time per seam (``cell.motion.reach.seam_reach`` on every task,
-the median of five runs). The issue's figure: ladder planning CPU per planned seam against fence1's (at most
-1.5 x). With ``--weld NAME`` the whole ``cell weld NAME`` (capture, perception, re-scan, plan, gate, execute) is
+the median of five runs). The figure to watch: ladder planning CPU per planned seam against fence1's (the goal: at
+most 1.5 x). With ``--weld NAME`` the whole ``cell weld NAME`` (capture, perception, re-scan, plan, gate, execute) is
 run too: its wall time per stage and how many seams it welded.
 """
 
@@ -118,7 +118,7 @@ def main() -> None:
     ratio = None
     if "ladder" in by and "fence1" in by:
         ratio = by["ladder"]["cpu_s_per_planned_seam"] / by["fence1"]["cpu_s_per_planned_seam"]
-        print(f"ladder / fence1 planning CPU per planned seam: {ratio:.2f} (issue 16: at most 1.5)")
+        print(f"ladder / fence1 planning CPU per planned seam: {ratio:.2f} (the goal: at most 1.5)")
     welds = [weld_run(n) for n in args.weld.split(",") if n]
     for w in welds:
         print(f"cell weld {w['scenario']}: {w['wall_s']} s wall, welded {w['welded']}/{w['visible']}, {w['timings_s']}")

@@ -19,10 +19,10 @@ and CPU seconds; the CPU of open3d's threads counts too): ``perceive``'s own ste
 and the camera checks; ``splice``; ``preprocess``: Z passthrough and the isolated-point filter; ``downsample``),
 the map alignment (``align_map``) and its two checks (``check_unique``, ``check_parts_seen``; side by side as the
 pipeline runs them, ``check_alignment``), and loading
-open3d's core (``open3d_import_s``, once per process: the first scenario's). ``detect_vs_capture`` is issue 16's
-acceptance figure from the first (cold) run: perceive + align + locate (ours) against capture, where locate is
-the wall time of ``pipeline.locate`` as ``cell detect`` runs it (the locator and the screen after it, which the
-per-seam times leave out; ``locate_wall_s``, also per method: the fastest run).
+open3d's core (``open3d_import_s``, once per process: the first scenario's). ``detect_vs_capture`` says whether
+perception keeps up with the capture, from the first (cold) run: perceive + align + locate (ours) against capture,
+where locate is the wall time of ``pipeline.locate`` as ``cell detect`` runs it (the locator and the screen after
+it, which the per-seam times leave out; ``locate_wall_s``, also per method: the fastest run).
 
 Planning (``row["planning"]``): the seams ours found are planned and gated as ``cell weld`` does
 (``pipeline.weld.plan_for`` on the same station: torch search, IK, timing, order, transfers, the safety gate), once;

@@ -11,7 +11,7 @@ that report (:mod:`trust_metrics`). Cells run on a pool of K processes (default 
 at once (``--store``, default ``runs/trust/<stage>-seed<S>-<key>/``, one line per cell: :mod:`cell.sweep.store`),
 so a rerun runs only the cells not yet done (``--fresh``: all again; ``--retry-failed``: also those that failed).
 The figures over the cells 0 .. N-1 go to ``--out`` (default ``benchmarks/results/trust.json``) as the block of
-the stage, beside the other stage's block; ``tools/readme_results.py`` renders the README's table from it.
+the stage, beside the other stage's block; ``tools/readme_results.py`` renders docs/results.md's table from it.
 """
 
 from __future__ import annotations

@@ -1,17 +1,6 @@
-"""The part as it was really built: the map's designed parts with the scenario's deviations, placed in the world.
-
-Deviations are given per part in the part's own frame (size and offset in mm, rotation in degrees about the part
-centre): a box's frame B (its centre, axes along its edges); for a polyhedral body its principal frame P (the volume
-centroid, axes along the eigenvectors of its vertices' covariance as drawn, largest spread first; docs/bodies.md), in
-which a size change scales the body about the centroid along each axis so that its extent changes by ``size_mm``.
-After the deviations, every part drawn on the table (its lowest vertex within ``ON_TABLE_M`` of the table top where
-the map really lies) is dropped (or lifted) so that its lowest vertex rests on the table: it does not float or sink
-into it. A part drawn above the table (a brace held between posts, on top of a rail) keeps its drawn height: it is
-held by the parts it is welded to, not by the table. The result is the ground truth of the simulation.
-
-The map's fixtures (clamps, stops, jigs) are placed where the part really lies, without deviations and without
-dropping (:func:`as_built_fixtures`).
-"""
+"""The part as it was really built: the map's designed parts with the scenario's deviations (in each part's own
+frame), set down on the table when drawn on it, and the map's fixtures where the part really lies: the simulation's
+ground truth (docs/bodies.md section 4)."""
 
 from __future__ import annotations
 

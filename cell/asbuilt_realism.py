@@ -1,10 +1,6 @@
-"""Which realism options shape which as-built part, and the tack welds' beads (docs/bodies.md section 7).
-
-:func:`shapers` reads ``simulation.bow`` and ``simulation.gaps`` against the designed map and returns, per part
-they touch, the function that turns that part's deviated body (a polyhedron in W) into its shape as built: bent in
-an arc, its ends cut out of square. :func:`as_built_tacks` lays the tack welds of ``simulation.tacks_present`` on
-the true seams of the as-built parts. Nothing here runs when the options are off.
-"""
+"""Which realism options shape which as-built part (``simulation.bow``, ``simulation.gaps``: bent in an arc, ends cut
+out of square) and the tack welds' beads of ``simulation.tacks_present`` (docs/bodies.md section 7). Nothing here
+runs when the options are off."""
 
 from __future__ import annotations
 

@@ -1,15 +1,6 @@
-"""``cell bench``: the paper's Table 1, every locator on the same captured clouds in the same run.
-
-One row per scenario x noise x extrinsic-error setting x method. Each setting is captured and perceived once; every
-method then runs on that same scene, so the comparison is fair. Rows are plain dicts (the JSON contract in the
-README); :func:`markdown_table` renders them next to the paper's figures.
-
-Times are wall clock per visible seam, from :func:`cell.pipeline.locate`: every run starts from a cold scene cache
-(each method's once-per-scene work is in every run), the methods take turns within each repeat, each seam keeps
-its fastest run, and a locator that finds a scene's seams together (ours) charges each seam an equal share of the
-batch. What perception makes for a
-method (the voxel cloud, the voxel-ordered dense cloud) is in none of them.
-"""
+"""``cell bench``: the paper's Table 1, every locator on the same captured clouds in the same run, one row per
+scenario x noise x extrinsic-error setting x method; :func:`markdown_table` renders the rows next to the paper's
+figures. How the times are taken: docs/results.md, "Table 1, reproduced and beaten"."""
 
 from __future__ import annotations
 

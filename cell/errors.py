@@ -1,30 +1,7 @@
-"""One exception tree for the whole cell; the CLI maps each class to a documented exit code.
-
-Every error carries a one-line message that names what was wrong and what is valid. Classes also inherit the
-matching builtin (as ezdxf does with ``DXFValueError(DXFError, ValueError)``) so generic callers can catch them.
-
-Exit codes (also in the README):
-
-====  =========================================================================
-code  meaning
-====  =========================================================================
-0     everything asked for was done
-1     internal error (a bug: please report it with the traceback)
-2     command-line usage error (typer/click, or a bad value checked before any work), or an output path that
-      cannot be written (checked before the run; a write that fails late still writes every other output),
-      or a brought point cloud file that cannot be used (``CloudFileError``: read before any work)
-3     partial result: the report is written; some seams were not found/welded, or a stage failed after capture
-10    scenario file invalid (unknown key, value out of range, missing file)
-11    welding map (DXF) unreadable or invalid
-12    welding map has no known units
-13    camera/sensor failure (no image, no points)
-14    map-to-cloud alignment failed
-15    motion: IK, timing or plan failed as a whole
-16    recorded capture folder unreadable or invalid (a file missing, an image not a 16-bit PNG, sizes that
-      disagree with its CameraInfo, an unknown format version)
-130   interrupted (Ctrl-C): the partial report of the stage reached is written where --json asked
-====  =========================================================================
-"""
+"""One exception tree for the whole cell; the CLI maps each class to a documented exit code. Every error carries a
+one-line message that names what was wrong and what is valid; each class also inherits the matching builtin (as
+ezdxf's ``DXFValueError(DXFError, ValueError)``). The exit codes, one table for the whole cell: docs/architecture.md
+section 4 (held against this module by tests/unit/test_errors.py)."""
 
 from __future__ import annotations
 

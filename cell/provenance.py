@@ -1,4 +1,4 @@
-"""What made an output: the one record every report and robot program carries (README "Report", ``provenance``).
+"""What made an output: the one record every report and robot program carries (docs/report.md, ``provenance``).
 
 :func:`provenance` builds it once per command; the JSON reports store it under ``provenance`` and the KRL
 program writes it as comment lines in its header (:func:`header_lines`), so a file found later says which code,

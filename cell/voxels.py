@@ -1,10 +1,6 @@
-"""A cloud grouped by voxel: the points in voxel order and a table of where each voxel's points start.
-
-One sort of the voxel keys serves every consumer of a cloud: the voxel-grid filter takes each voxel's centroid
-(``np.add.reduceat`` over the runs), a seam locator gathers the points of a tube from a few runs of contiguous
-memory, without a search of its own. The grid is anchored at the origin of the cloud's frame (it does not move
-with outliers).
-"""
+"""A cloud grouped by voxel: the points in voxel order and a table of where each voxel's points start. One sort serves
+every consumer (the voxel-grid filter's centroids, a locator's tube from a few contiguous runs); the grid is
+anchored at the origin of the cloud's frame."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""The README's tables of the cell's own commands, rendered from ``benchmarks/results/`` (used by
-``tools/readme_results.py``, which puts them between the README's markers).
+"""The result tables of the cell's own commands, rendered from ``benchmarks/results/`` (used by
+``tools/readme_results.py``, which puts them between the markers of docs/results.md).
 
 - ``rescan``: the close-up re-scan, before -> after (``rescan.json``, ``benchmarks/bench_cell.py rescan``);
 - ``confidence``: the confidence thresholds (``confidence.json``, ``benchmarks/bench_confidence.py``);
@@ -8,8 +8,8 @@
 - ``faults``: every fault scenario (``faults.json``, ``bench_cell.py faults``).
 
 Every figure comes from the JSON. What the JSON cannot hold is written here by hand, kept apart in the mappings
-below: how the README names a scenario (the fault each one injects) and a short note where the README says more
-than the data can (the "what the cell does" column is otherwise one sentence template per kind of outcome).
+below: how the tables name a scenario (the fault each one injects) and a short note where docs/results.md says
+more than the data can (the "what the cell does" column is otherwise one sentence template per kind of outcome).
 """
 
 from __future__ import annotations
@@ -21,11 +21,11 @@ Row = Mapping[str, Any]
 
 # ---- written by hand: what the results cannot say ---------------------------------------------------------------
 
-# The re-scan table's scenario column, where the README says what the scenario is.
+# The re-scan table's scenario column, where the table says what the scenario is.
 RESCAN_LABELS: Mapping[str, str] = {
     "faults/extrinsics-off": "faults/extrinsics-off (every camera, the arm's included, off by 1 mm / 0.1 deg)",
 }
-# The fault table's rows, in the README's order: the scenario and the fault it injects.
+# The fault table's rows, in their order: the scenario and the fault it injects.
 FAULT_LABELS: Mapping[str, str] = {
     "faults/camera-dead": "camera-dead (cam_left)",
     "faults/camera-frozen": "camera-frozen (cam_left)",
@@ -41,13 +41,13 @@ FAULT_LABELS: Mapping[str, str] = {
     "faults/displaced-far": "displaced-far (120 mm)",
     "faults/ladder-shifted": "ladder-shifted (one rung pitch)",
 }
-# A note after the generated sentence, where the README says what the figures mean.
+# A note after the generated sentence, where the table says what the figures mean.
 FAULT_NOTES: Mapping[str, str] = {
     "faults/two-cameras-dead": "the eye-in-hand camera carries the cell",
     "faults/camera-salt": "the eye-in-hand camera, dropped from the scan, still serves up close",
     "faults/displaced": "the alignment re-finds the part",
 }
-# The motion table's rows: the case's key in motion.json, the README's name for it, whether it shows the goal.
+# The motion table's rows: the case's key in motion.json, the table's name for it, whether it shows the goal.
 MOTION_ROWS: Sequence[tuple[str, str, bool]] = (
     ("ik_warm", "IK, warm-started along seams, full pose", True),
     ("ik_warm_free_axis", "IK, warm-started, torch axis free", True),
@@ -195,7 +195,7 @@ def _turn_line(r: Row) -> str:
 
 
 def _time(us: float) -> str:
-    """A call's time as the README writes it: whole microseconds below 0.5 ms, else milliseconds, 3 digits."""
+    """A call's time as the tables write it: whole microseconds below 0.5 ms, else milliseconds, 3 digits."""
     return f"{us:.0f} us" if us < 500.0 else f"{us / 1000.0:.3g} ms"
 
 
@@ -262,7 +262,8 @@ def _lost(described: Sequence[str]) -> str:
 
 
 def faults_table(rows: Sequence[Row]) -> str:
-    """One line per fault scenario (the README's order first): what the cell does, welded, worst TCP error, exit."""
+    """One line per fault scenario (in :data:`FAULT_LABELS`'s order first): what the cell does, welded, worst TCP
+    error, exit."""
     order = {name: k for k, name in enumerate(FAULT_LABELS)}
     lines = [
         "| scenario (`scenarios/faults/`) | what the cell does | welded | worst executed TCP error [mm] | exit |",

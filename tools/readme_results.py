@@ -1,31 +1,14 @@
-"""Render the README's result tables from ``benchmarks/results/`` and put them between the README's markers.
+"""Render the result tables from ``benchmarks/results/`` and put them between the markers of docs/results.md (every
+table) and README.md (the headline figures).
 
 Run from the repository root::
 
-    .venv/bin/python tools/readme_results.py           # rewrite the marked blocks of README.md
-    .venv/bin/python tools/readme_results.py --check   # exit 1 when README.md differs from the results
+    .venv/bin/python tools/readme_results.py           # rewrite the marked blocks of docs/results.md and README.md
+    .venv/bin/python tools/readme_results.py --check   # exit 1 when either differs from the results
 
-Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->`` in README.md:
-
-- ``table1``: Table 1 with realistic noise and exact calibration (``latest.json``, the ``exact`` rows);
-- ``table1-noise-none``: the same with noise-free depth (``noise-none.json``);
-- ``calibration``: our locator under calibration error (``latest.json``, ``ours``, every other extrinsics row);
-- ``coverage``: each locator's sigma against its true errors (``coverage.json``, by ``benchmarks/bench_coverage.py``);
-- ``scaling``: fence1 against the ladder (``scaling.json``, written by ``benchmarks/bench_scaling.py``): size,
-  capture, perception, alignment, issue 16's perceive + align + locate against capture, the locators, planning;
-- ``rescan``, ``confidence``, ``weld``, ``motion``, ``faults``: the tables of the cell's own commands
-  (``rescan.json``, ``weld.json``, ``faults.json`` by ``benchmarks/bench_cell.py``; ``confidence.json`` by
-  ``benchmarks/bench_confidence.py``; ``motion.json`` by ``benchmarks/bench_motion.py``), rendered by
-  ``tools/readme_cell_tables.py``;
-- ``weldments``, ``weldments-bench``: the parts that are not boxes, welded whole (``weldments.json`` by
-  ``benchmarks/bench_cell.py weld --scenarios brace,bracket,rhs``) and their Table 1 rows (``weldments-bench.json``
-  by ``cell bench brace bracket rhs``);
-- ``trust``: the trust benchmark on random cells, one row per stage (``trust.json`` by
-  ``benchmarks/bench_trust.py``), each stage's command under the table.
-
-The Table 1 blocks are :func:`cell.bench.markdown_table` of the rows, the renderer that also writes
-``benchmarks/results/*.md``; the scaling block is the README's one-line-per-scenario summary of
-``scaling.json``. The JSON is the truth: re-run a benchmark with ``--json`` and then this script.
+Each block sits between ``<!-- results:NAME -->`` and ``<!-- /results:NAME -->``; :data:`BLOCKS` names the result
+file each block of docs/results.md is made from, :data:`README_BLOCKS` the README's. The JSON is the truth: re-run a
+benchmark with ``--json`` and then this script.
 """
 
 from __future__ import annotations
@@ -46,15 +29,16 @@ for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the
 
 import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
 
-from cell.bench import markdown_table  # noqa: E402
+from cell.bench import PAPER_TABLE1, markdown_table  # noqa: E402
 
 README = REPO / "README.md"
+RESULTS_MD = REPO / "docs" / "results.md"
 RESULTS = REPO / "benchmarks" / "results"
 COMMAND = ".venv/bin/python tools/readme_results.py"
 
 Rows = list[dict[str, Any]]
 
-# How the README names a scenario in the scaling table (the JSON holds the name only).
+# How the scaling table names a scenario (the JSON holds the name only).
 SCALING_LABELS: Mapping[str, str] = {"ladder": "ladder (26 rungs)"}
 # The methods of the scaling table, in its column order, and what each column shows.
 SCALING_METHODS = ("ours", "paper", "ransac")
@@ -100,7 +84,7 @@ def _planning_cells(p: Mapping[str, Any] | None) -> str:
 
 def scaling_table(rows: Sequence[Mapping[str, Any]]) -> str:
     """One line per scenario: size, capture, perception and alignment [s], perceive + align + locate against
-    capture (issue 16's figure, the first run), per method found and ms per seam, and planning per seam."""
+    capture (the first run), per method found and ms per seam, and planning per seam."""
     head = (
         "| scenario | seams / visible | points dense / 1 cm | capture s | perceive s | align s | "
         "perceive + align + locate / capture | ours: found, ms/seam median, lateral mm | paper: found, ms/seam | "
@@ -207,6 +191,43 @@ def trust(results: Path) -> str:
     return trust_table(_load_object(results, "trust.json") if path.exists() else {})
 
 
+def headline(results: Path) -> str:
+    """The README's one table: fence1 located against the paper, the time per seam, fence1 welded, the faults and
+    the random cells, each row linking to its section of docs/results.md."""
+    rows = [r for r in _load(results, "latest.json") if r["scenario"] == "fence1" and r["extrinsics"] == "exact"]
+    ours, paper = (next(r for r in rows if r["method"] == m) for m in ("ours", "paper"))
+    me_paper, ms_paper = PAPER_TABLE1["fence1"]["paper"]
+    w = _load(results, "weld.json")[0]
+    faults = _load(results, "faults.json")
+    tcp = [r["tcp_max_mm"] for r in faults if r["tcp_max_mm"] is not None]
+    refused = sum(r["welded"] == 0 for r in faults)
+    trust = _load_object(results, "trust.json").get("weld") if (results / "trust.json").exists() else None
+    link = "docs/results.md#"
+    lines = [
+        "| what | ours | beside it |",
+        "|---|---|---|",
+        f"| [fence1, realistic depth noise]({link}table-1-reproduced-and-beaten): a seam located, paper ME / lateral, "
+        f"mean | {ours['paper_me_mean_mm']:.3f} / {ours['lateral_mean_mm']:.3f} mm | the paper's method here "
+        f"{paper['paper_me_mean_mm']:.3f} / {paper['lateral_mean_mm']:.3f} mm; the paper's own, noise-free, "
+        f"{me_paper} mm |",
+        f"| time to locate a seam, median | {ours['ms_per_seam_median']:.2f} ms | the paper's method here "
+        f"{paper['ms_per_seam_median']:.2f} ms; the paper's own {ms_paper:.0f} ms |",
+        f"| [`cell weld fence1`]({link}welding-fence1), both sides: welded, worst executed TCP max against the "
+        f"true seam | {w['welded']}/{w['visible']}, {w['tcp_max_mm']:.2f} mm | job time {w['job_time_s']:.0f} s "
+        f"with the operator's turn |",
+        f"| [{len(faults)} fault scenarios]({link}faults): worst executed TCP error of a welded seam "
+        f"| {max(tcp):.2f} mm | {refused} refuse to weld anything, each with its reason |",
+    ]
+    if trust:
+        lines.append(
+            f"| [{trust['cells']} random cells nobody tuned for]({link}trust-on-cells-nobody-tuned-for): welded, "
+            f"worst TCP max, beads > 1 mm off a joint's end | {_pct(trust['welded_share'])}, "
+            f"{_num(trust.get('worst_welded_tcp_max_mm'))} mm, {_num(trust.get('beads_past_end'), 'd')} "
+            f"| of {trust['seams_visible']} visible seams; the rest refused, each with its reason |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "table1": table1,
     "table1-noise-none": table1_noise_none,
@@ -226,12 +247,15 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
 }
 
 
+README_BLOCKS: Mapping[str, Callable[[Path], str]] = {"headline": headline}
+
+
 def _pattern(name: str) -> re.Pattern[str]:
     return re.compile(rf"(<!-- results:{re.escape(name)} -->\n)(.*?)(<!-- /results:{re.escape(name)} -->)", re.DOTALL)
 
 
-def _block(readme: str, name: str) -> str:
-    found = _pattern(name).search(readme)
+def _block(text: str, name: str) -> str:
+    found = _pattern(name).search(text)
     return found.group(2) if found else ""
 
 
@@ -240,44 +264,51 @@ def _replacement(table: str) -> Callable[[re.Match[str]], str]:
     return lambda m: m.group(1) + table + m.group(3)
 
 
-def render(readme: str, results: Path = RESULTS) -> str:
-    """``readme`` with every marked block replaced by the table the results give (ValueError: a marker missing)."""
-    out = readme
-    for name, make in BLOCKS.items():
+def render(text: str, results: Path = RESULTS, blocks: Mapping[str, Callable[[Path], str]] = BLOCKS) -> str:
+    """``text`` with every block of ``blocks`` replaced by the table the results give (ValueError: a marker
+    missing)."""
+    out = text
+    for name, make in blocks.items():
         pattern = _pattern(name)
         if len(pattern.findall(out)) != 1:
-            raise ValueError(f"README needs exactly one <!-- results:{name} --> ... <!-- /results:{name} --> block")
-        table = make(results)
-        out = pattern.sub(_replacement(table), out)
+            raise ValueError(f"needs exactly one <!-- results:{name} --> ... <!-- /results:{name} --> block")
+        out = pattern.sub(_replacement(make(results)), out)
     return out
+
+
+def _update(path: Path, blocks: Mapping[str, Callable[[Path], str]], results: Path, check: bool) -> int:
+    """Check or rewrite the marked blocks of one file; 1 when it is stale (``check``) or a marker is missing."""
+    current = path.read_text(encoding="utf-8")
+    try:
+        text = render(current, results, blocks)
+    except ValueError as e:
+        print(f"error: {path}: {e}", file=sys.stderr)
+        return 1
+    if text == current:
+        if not check:
+            print(f"{path} already matches {results}")
+        return 0
+    if check:
+        stale = [n for n in blocks if _block(text, n) != _block(current, n)]
+        print(f"{path}: blocks {', '.join(stale)} differ from {results}; run {COMMAND}", file=sys.stderr)
+        return 1
+    path.write_text(text, encoding="utf-8")
+    print(f"rewrote the result blocks of {path}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--check", action="store_true", help="exit 1 when README.md differs from the results")
-    ap.add_argument("--readme", type=Path, default=README)
+    ap.add_argument("--check", action="store_true", help="exit 1 when a file differs from the results")
+    ap.add_argument("--doc", type=Path, default=RESULTS_MD, help="the results page (every table)")
+    ap.add_argument("--readme", type=Path, default=README, help="the README (the headline table)")
     ap.add_argument("--results", type=Path, default=RESULTS)
     args = ap.parse_args(argv)
-    current = args.readme.read_text(encoding="utf-8")
-    try:
-        text = render(current, args.results)
-    except ValueError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 1
-    if args.check:
-        if text != current:
-            stale = [n for n in BLOCKS if _block(text, n) != _block(current, n)]
-            print(
-                f"{args.readme}: blocks {', '.join(stale)} differ from {args.results}; run {COMMAND}", file=sys.stderr
-            )
-            return 1
-        return 0
-    if text != current:
-        args.readme.write_text(text, encoding="utf-8")
-        print(f"rewrote the result blocks of {args.readme}")
-    else:
-        print(f"{args.readme} already matches {args.results}")
-    return 0
+    codes = [
+        _update(args.doc, BLOCKS, args.results, args.check),
+        _update(args.readme, README_BLOCKS, args.results, args.check),
+    ]
+    return max(codes)
 
 
 if __name__ == "__main__":

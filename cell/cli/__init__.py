@@ -1,14 +1,5 @@
-"""The ``cell`` command: a thin typer layer over :mod:`cell.pipeline`.
-
-- :mod:`cell.cli.common`: the apps, consoles, global settings, error handling and option parsing every command
-  shares; :mod:`cell.cli.root`: the global options and the entry point;
-- :mod:`cell.cli.outputs`: output paths checked before the run, written whatever happens, Ctrl-C's partial report;
-- :mod:`cell.cli.look`: ``scenarios``, ``map info``, ``detect``, ``bench``;
-- :mod:`cell.cli.act`: ``weld``, ``preview``, ``rescan``;
-- :mod:`cell.cli.locate`: ``locate`` (seams in a point cloud someone brings);
-- :mod:`cell.cli.capture`: ``capture`` (a capture folder) and the replay of ``detect --capture``;
-- :mod:`cell.cli.tables`: what they print.
-"""
+"""The ``cell`` command: a thin typer layer over :mod:`cell.pipeline`, one module per group of commands
+(docs/cli.md; the modules: docs/architecture.md section 2)."""
 
 from __future__ import annotations
 

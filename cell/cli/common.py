@@ -1,10 +1,7 @@
-"""What every command shares: the typer apps, the consoles, the global options, error handling, option parsing.
-
-Heavy packages (pybullet, open3d, pinocchio) are imported inside the commands so ``cell --help`` is instant.
-Progress goes to stderr (and to ``--log-file``), results to stdout. Every :class:`~cell.errors.CellError` becomes
-a one-line message and its documented exit code (see :mod:`cell.errors`); nothing else is caught, so a bug still
-shows its traceback.
-"""
+"""What every command shares: the typer apps, the consoles, the global options, error handling, option parsing. Heavy
+packages are imported inside the commands so ``cell --help`` is instant; progress goes to stderr, results to stdout;
+every :class:`~cell.errors.CellError` becomes one line and its exit code, and nothing else is caught (a bug shows its
+traceback)."""
 
 from __future__ import annotations
 

@@ -1,11 +1,6 @@
-"""``cell krl check FOLDER_OR_FILE``: re-read KRL programs and list what is wrong with them.
-
-A folder: every program in it. A file (``NAME.src`` or ``NAME.dat``): that program and, when it is a main program
-calling others (a part turned over between sides, docs/programs.md), every program it calls from its folder.
-
-Exit codes: 0 when every program passes; :data:`EXIT_CHECK_FAILED` (4) with one line per finding
-(``FILE:LINE: code: detail``, on stdout) when not; 2 when the path holds no program (or does not exist).
-"""
+"""``cell krl check FOLDER_OR_FILE``: re-read KRL programs (a folder's, or one program and those it calls) and list
+what is wrong with them, one ``FILE:LINE: code: detail`` line per finding (docs/programs.md); exit
+:data:`EXIT_CHECK_FAILED` when there is any."""
 
 from __future__ import annotations
 

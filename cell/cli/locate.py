@@ -1,10 +1,6 @@
-"""``cell locate CLOUD --map MAP.dxf``: the map's seams located in a point cloud someone brings (docs/locate.md).
-
-The cloud (PLY or PCD, :func:`cell.perception.cloud_files.read_cloud`) is in its own frame F (``--frame``); the
-report's points are in F, in metres, and carry no truth or error fields unless ``--truth FILE.json`` gives the
-true seams (millimetres, in F). Everything that can be checked is checked before any work (exit 2): the outputs,
-the options, the map's existence, the cloud file, the truth file. Nothing here imports the simulator.
-"""
+"""``cell locate CLOUD --map MAP.dxf``: the map's seams located in a point cloud someone brings, in the cloud's own
+frame (docs/locate.md). Everything that can be checked is checked before any work (exit 2); nothing here imports
+the simulator."""
 
 from __future__ import annotations
 

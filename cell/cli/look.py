@@ -34,7 +34,7 @@ from cell.errors import EXIT_INTERRUPTED, UsageError
 if TYPE_CHECKING:
     from cell.station import Station
 
-BENCH_SAVED = Path("benchmarks/results/latest.json")  # what --save writes (the README's Table 1 is made from it)
+BENCH_SAVED = Path("benchmarks/results/latest.json")  # what --save writes (Table 1 of docs/results.md is made from it)
 
 
 @app.command()
@@ -186,7 +186,7 @@ def bench(
         Path | None, typer.Option("--json", help="Also write the rows (and their .md table) to this file.")
     ] = None,
     save: Annotated[
-        bool, typer.Option("--save", help=f"Also write the rows to {BENCH_SAVED} (the README's Table 1 source).")
+        bool, typer.Option("--save", help=f"Also write the rows to {BENCH_SAVED} (Table 1 of docs/results.md).")
     ] = False,
 ) -> None:
     """Table 1 of the paper, reproduced and extended: every locator on the same clouds in one run.

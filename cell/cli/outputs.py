@@ -1,12 +1,6 @@
-"""Outputs checked before the run and written whatever happens.
-
-- :func:`check_file` / :func:`check_folder`: before any capture, an output that cannot be written is one line and
-  exit 2 (a probe file is created and removed where the output will go: permission bits alone do not say, e.g.
-  for root or on a read-only file system);
-- :class:`Writer`: each output written on its own, so a failure late in the run (a disk filled, a folder
-  removed) loses that output only; the failures are reported at the end, exit 2;
-- :class:`Stage` and :func:`interrupted_report`: what a Ctrl-C writes when the run had not finished.
-"""
+"""Outputs checked before the run and written whatever happens: a path that cannot be written is one line and exit 2
+before any capture (a probe file, since permission bits alone do not say), each output written on its own so a late
+failure loses only that one, and what Ctrl-C writes when the run had not finished (docs/cli.md)."""
 
 from __future__ import annotations
 
@@ -131,7 +125,7 @@ def interrupted_report(
     scenario: Scenario, method: str | None, stage: str, provenance: Mapping[str, Any] | None
 ) -> dict[str, Any]:
     """The report of a run stopped by Ctrl-C before its stages returned: what ran, where it stopped, no seam
-    results (README "Report": ``interrupted``, ``error`` with exit code 130)."""
+    results (docs/cli.md: ``interrupted``, ``error`` with exit code 130)."""
     return stopped_report(
         scenario.name,
         method or scenario.locator.method,

@@ -1,10 +1,5 @@
-"""``cell sweep``: a tolerance study on Ray (docs/sweep.md).
-
-N varied builds of a scenario, one Ray task each (a local Ray by default, ``--address`` for a cluster), streamed
-into ``--out`` as they finish (runs.jsonl), the summary and pictures rewritten at intervals and at the end; a
-re-run with the same folder resumes. Everything it can check (the words of ``--vary``, the stage, the folder and
-whether it holds this sweep) is checked before Ray starts.
-"""
+"""``cell sweep``: a tolerance study on Ray (docs/sweep.md): N varied builds, one task each, streamed into ``--out`` as
+they finish and resumable; everything it can check is checked before Ray starts."""
 
 from __future__ import annotations
 

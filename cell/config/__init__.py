@@ -1,11 +1,6 @@
-"""Options of every stage, as small frozen dataclasses with their defaults: what a scenario can set.
-
-One module per stage (``perception``, ``motion``, ``seams``, ``rescan``, ``export``, ``sim``); stdlib and numpy
-only, nothing of the project but :mod:`cell.errors` (an import-linter contract), so :mod:`cell.scenario` composes
-them into the scenario's model and every stage imports its options from here without an import cycle. The
-scenario loader validates them (unknown keys, types, the ranges of :class:`~cell.config.bounds.Bounds`) and
-the report records them as resolved. Run-time values a stage also needs (ours' workspace crop) are not options.
-"""
+"""Options of every stage, as small frozen dataclasses with their defaults: what a scenario can set. One module per
+stage; stdlib and numpy only, nothing of the project but :mod:`cell.errors` (an import-linter contract), so the
+scenario composes them and every stage imports its options from here without a cycle."""
 
 from cell.config.bounds import Bounds, check_bounds
 from cell.config.export import KrlOptions

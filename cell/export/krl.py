@@ -1,26 +1,6 @@
-"""KUKA KRL export of a welding plan (docs/reference.md section 5): ``NAME.src`` and ``NAME.dat``.
-
-The program, in order: a header (what made it: scenario, version, commit, date), a setup block with the values
-to enter before the first run (TOOL_DATA / LOAD_DATA / BASE_DATA [n], XHOME in $config.dat, each weld's
-procedure), the standard INI fold (the stop-message interrupt, ``BAS(#INITMOV, 0)``), ``BAS(#TOOL, n)`` and
-``BAS(#BASE, n)``, a guard that $config.dat's XHOME is the planned home, ``$H_POS = XHOME`` and ``PTP XHOME``
-(the first motion: fully defined, block coincidence); with a linear track, its axis and limits in a comment and
-E1 [mm] in every point (docs/track.md); then per seam (its id in a comment at its block): PTP
-transfer(s) to E6AXIS points, the LIN approach ending at an exact stop at the weld start, the LIN weld(s), the LIN
-depart; finally ``PTP XHOME``. No motion is approximated: every point is an exact stop.
-
-The arc (``KrlOptions.arc``): ``arctech`` writes KUKA.ArcTech's inline forms: ARC_ON on the approach (ignition
-at its end), ARC_SWI on every weld motion followed by another one of the same burning arc (its data set holds
-the next motion's procedure: a pass or data change), ARC_OFF on the last weld motion (crater at its end), each
-with its weld data set (``WDATn``, :mod:`cell.export.krl_data`). ``signals`` switches a power source without
-ArcTech: ``$OUT[n]`` on, ``WAIT FOR $IN[m]`` (arc established) with a timeout and an error branch that switches
-the arc off and halts, the crater as a wait, ``$OUT[n]`` off.
-
-Points: every LIN point is an E6POS of the tool in the part's base (BASE_DATA[n] = the aligned map's pose, so a
-touch-up of that one base moves every seam), with S and T from the planned joint configuration
-(:mod:`cell.export.status_turn`); every PTP point an E6AXIS. The tool frame follows KUKA's default tool direction
-#X: its x axis is the wire (the ``torch_tcp`` z axis).
-"""
+"""KUKA KRL export of a welding plan: ``NAME.src`` and ``NAME.dat``, every point an exact stop, the arc by KUKA.ArcTech
+inline forms or plain signals. What the program holds, in order: docs/programs.md; the KRL facts it relies on:
+docs/reference.md section 5."""
 
 from __future__ import annotations
 

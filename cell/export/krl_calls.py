@@ -1,23 +1,5 @@
-"""``cell krl check`` across programs: a main program calling others (docs/programs.md), and what programs that run
-on one controller must agree on.
-
-Checks, each a :class:`~cell.export.krl_check.Finding` code:
-- ``call``: a call ``NAME( )`` to a routine that is neither a program read (in the folder) nor a KSS routine this
-  checker knows (:data:`KSS_ROUTINES`); a program that calls itself;
-- ``operator_stop``: two welding programs called one after the other with no operator stop between them. A stop is
-  a ``HALT`` outside any IF or loop, a ``WAIT FOR`` an input (an operator's button), an acknowledgement message
-  (``Set_KrlMsg(#QUIT, ...)``) or a dialog (``Set_KrlDlg``) followed by a loop waiting on ``Exists_KrlMsg`` /
-  ``Exists_KrlDlg``, or KSS's message-library routines ``MsgQuit`` / ``MsgDialog`` (they return once answered);
-  the message such a call shows is not declared (``KrlMsg_T``) or its text is over 80 characters;
-- ``home``: a main program that does not start or end at home (``PTP XHOME`` before its first call, or a first
-  called program that starts there; the same after its last call);
-- ``setup``: two programs giving the same TOOL_DATA[n] or BASE_DATA[n] different values in their setup blocks (the
-  controller holds one value per index: a turned part's side needs its own base index).
-
-:func:`read_target` reads a folder (every program) or one file (that program and, from its folder, every program it
-calls, in turn); :func:`check_all` runs every check of :mod:`cell.export.krl_check`, :mod:`cell.export.krl_kin` and
-this module on what was read.
-"""
+"""``cell krl check`` across programs: a main program calling others, and what programs that run on one controller
+must agree on (the checks ``call``, ``operator_stop``, ``home``, ``setup``: docs/programs.md)."""
 
 from __future__ import annotations
 

@@ -1,27 +1,5 @@
-"""``cell krl check``: re-read a KRL program (:mod:`cell.export.krl_read`) and list what would stop it or weld wrong.
-
-Checks, each a :class:`Finding` code:
-- ``files``: a .src without its .dat; the DEF / DEFDAT name differs from the file name;
-- ``syntax``: a line the reader cannot read; ``structure``: no END / ENDDAT (a truncated file), unbalanced FOLDs;
-- ``init``: the stop-message interrupt (``GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )``,
-  ``INTERRUPT ON 3``) and ``BAS(#INITMOV, 0)`` before the first motion, which must be a PTP to an axis point;
-- ``undeclared``: a motion to a point the .dat does not declare (``XHOME`` is $config.dat's), or an inline
-  form's LDAT / FDAT / PDAT or ArcTech data the .dat does not declare;
-- ``arc``: every ArcTech ARC_ON is followed by ARC_SWI ... ARC_OFF before any other ARC_ON or a PTP, each holding
-  one motion and a declared ``stArcDat_T`` weld data set of the right parts (Strike / Weld / Crater); in the
-  plain-signal mode every ``$OUT[n] = TRUE`` is followed by a ``WAIT FOR $IN[m]`` and switched off again; the
-  program ends with the arc off;
-- ``status_turn``: an E6POS without S or T; with the arm's kinematics (:func:`check_kinematics`), S and T that
-  are not the configuration the arm reaches the point in, tracked from the axis point before it;
-- ``kinematics``: a point the arm cannot reach, or no setup values (TOOL_DATA / BASE_DATA) to check against.
-- ``track``: the linear track's external axis E1 [mm] (docs/track.md). A program states its track in a header
-  comment (``;- Linear track E1 ... limits MIN .. MAX mm``) or the check is given the limits: then every E6POS and
-  E6AXIS must carry E1, within the limits (the given ones win over the stated ones); a program that states no
-  track and is given none must leave every E1 at 0 (a cell without the axis cannot reach such a point).
-
-A main program calling others (a part turned over between sides) is checked across programs in
-:mod:`cell.export.krl_calls`.
-"""
+"""``cell krl check``: re-read a KRL program (:mod:`cell.export.krl_read`) and list what would stop it or weld wrong,
+one :class:`Finding` per problem (its checks: docs/programs.md)."""
 
 from __future__ import annotations
 

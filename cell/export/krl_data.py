@@ -1,12 +1,5 @@
-"""The KRL texts of values: frames, E6POS / E6AXIS points, and KUKA.ArcTech's data (docs/reference.md section 5).
-
-Units mm and degrees; A, B, C are rotations about Z, Y, X (``R = Rz(A) Ry(B) Rx(C)``). ArcTech's weld data
-(``stArcDat_T``, ArcTech Basic 3.x) in the .dat: an ARC_ON set holds ``Strike`` (ignition: start time at rest,
-gas pre-flow), ``Weld`` (path velocity in m/s and the power source's channels) and ``Weave``; an ARC_SWI set
-``Weld`` and ``Weave`` of the part after it; an ARC_OFF set ``Crater`` (fill time, post-flow, burn-back). The
-channels are the power source's, as configured in WorkVisual; this cell writes Channel1 = wire feed [m/min],
-Channel2 = voltage [V], Channel3 = current [A]. The setup fold (values to enter before the first run) is here too.
-"""
+"""The KRL texts of values: frames, E6POS / E6AXIS points, KUKA.ArcTech's weld data sets and the setup fold, in mm and
+degrees (A, B, C about Z, Y, X); the data sets' parts and the power source's channels: docs/reference.md section 5."""
 
 from __future__ import annotations
 

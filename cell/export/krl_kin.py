@@ -1,12 +1,6 @@
-"""The kinematic part of ``cell krl check``: every E6POS's S and T against the configuration the arm reaches it in.
-
-The controller drives a LIN from the configuration it is in and keeps that configuration along the line; so the
-check starts at each axis point (a PTP's E6AXIS, or XHOME as the .dat's ``XHOME_PLAN``), follows every LIN after
-it by small steps of IK on the arm's forward kinematics (:class:`~cell.types.robot.Kinematics`: the flange
-``tool0``), and compares the configuration reached at each E6POS with the S and T written there
-(:func:`cell.export.status_turn.status_turn`). The point's flange pose is BASE_DATA[n] * point * TOOL_DATA[n]^-1,
-with the values of the program's setup block and the indices of its ``BAS(#TOOL, n)`` / ``BAS(#BASE, n)``.
-"""
+"""The kinematic part of ``cell krl check``: every E6POS's S and T against the configuration the arm reaches it in,
+followed from each axis point along every LIN by small IK steps on the arm's kinematics, the flange pose from the
+program's own setup values (docs/reference.md section 5, "Status and Turn")."""
 
 from __future__ import annotations
 

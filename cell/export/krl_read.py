@@ -1,13 +1,6 @@
-"""The project's own KRL reader: the subset the exporter writes plus what a KRL programmer adds around it.
-
-It reads ``&`` header lines, ``DEF name( )`` / ``END``, ``DEFDAT name [PUBLIC]`` / ``ENDDAT``, declarations
-(``DECL [GLOBAL] TYPE NAME[=value]``, values as nested ``{Key value, ...}`` structures of numbers, strings,
-``#enums`` and booleans), ``;FOLD`` / ``;ENDFOLD`` comments (kept as fold markers, their header text with them),
-the setup block's ``;- NAME[n] = {...}`` lines, and one statement a line (motions ``PTP``/``LIN``/``CIRC``/
-``SPTP``/``SLIN`` with their point, ``ArcMainNG(...)``, ``TRIGGER``, ``WAIT``, ``IF``/``ENDIF``, ``HALT``,
-the loops (``WHILE``, ``REPEAT``/``UNTIL``, ``LOOP``, ``FOR``), assignments, calls: another program's
-``NAME( )``). Lines it cannot read become :class:`Problem` values, never exceptions.
-"""
+"""The project's own KRL reader: the subset the exporter writes plus what a KRL programmer adds around it (header
+lines, DEF/DEFDAT, declarations, folds, the setup block, motions, ArcTech calls, control flow, calls). Lines it
+cannot read become :class:`Problem` values, never exceptions."""
 
 from __future__ import annotations
 

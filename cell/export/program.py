@@ -1,13 +1,6 @@
-"""What a post-processor is given and what it must do: the robot-program export behind one interface.
-
-A :class:`ProgramJob` holds everything a controller's program needs (the checked plan, the arm, the part's base,
-the program name, options, provenance); a :class:`PostProcessor` turns it into named texts (``texts``) that
-:func:`write_texts` writes. The KUKA KRL (:mod:`cell.export.krl`) and ABB RAPID (:mod:`cell.export.rapid`)
-posts implement it; :mod:`cell.export.post` lists them by name.
-
-Weld procedures: a weld segment without one (``Segment.procedure`` None) runs :func:`procedure_of`'s default,
-the WeldProcedure defaults at the segment's own travel speed.
-"""
+"""What a post-processor is given and what it must do: a :class:`ProgramJob` (the checked plan, the arm, the part's
+base, the name, options, provenance) that a :class:`PostProcessor` (KUKA KRL, ABB RAPID) turns into named texts. A
+weld segment without a procedure runs :func:`procedure_of`'s default at its own travel speed."""
 
 from __future__ import annotations
 

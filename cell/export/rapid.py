@@ -1,22 +1,5 @@
-"""ABB RAPID export of a welding plan (docs/reference.md section 5): one module ``NAME.mod`` (RobotWare Arc).
-
-The module: a header (what made it), ``tooldata`` (the torch TCP in the flange, z along the wire: ABB's tool
-direction), ``wobjdata`` (the part's base: the aligned map, in the user frame, so one frame moves every seam),
-``speeddata`` of the plan's speeds, per weld procedure ``seamdata`` (pre-flow, ignition, crater fill,
-burn-back, post-flow), ``welddata`` (weld speed and the main arc: voltage, wire feed, current) and
-``weavedata``, every point declared (``jointtarget`` home, ``robtarget`` with ``confdata``), and ``PROC main``:
-``MoveAbsJ`` home, per seam ``MoveJ`` transfers, ``ArcLStart`` on the approach (ignition at the weld start),
-``ArcL`` on every weld motion followed by another of the same arc, ``ArcLEnd`` on the last, ``MoveL`` departs,
-``MoveAbsJ`` home. With a linear track (docs/track.md) its position is every point's ``eax_a`` [mm]. Every point is
-an exact stop (``fine``); ``ConfJ \\On`` / ``ConfL \\On`` make the controller
-refuse a configuration other than the one written.
-
-confdata [cf1, cf4, cf6, cfx]: the quarter turns of axes 1, 4 and 6 (floor of the angle / 90 deg) and the
-configuration cfx = 4 (wrist centre behind axis 1) + 2 (behind the lower arm's line) + 1 (axis 5 negative),
-from the plan's joint values on its arm (the same geometry as KUKA's Status, :mod:`cell.export.status_turn`).
-The data types' component lists follow RobotWare Arc's ``arcdata`` [sched, mode, voltage, wirefeed, control,
-current, voltage2, wirefeed2, control2]; the components a power source uses depend on its configuration.
-"""
+"""ABB RAPID export of a welding plan: one module ``NAME.mod`` for RobotWare Arc (what it holds: docs/programs.md; the
+RAPID facts it relies on: docs/reference.md section 5)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""JSON reports: the contract other tools read (README "Report"). Metres inside, millimetres only where named _mm."""
+"""JSON reports: the contract other tools read (docs/report.md). Metres inside, millimetres only where named _mm."""
 
 from __future__ import annotations
 
@@ -66,7 +66,7 @@ def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
 def detection_report(
     det: Detection, records: Sequence[SeamRecord] | None = None, *, provenance: Mapping[str, Any] | None = None
 ) -> dict[str, Any]:
-    """The ``cell detect`` report as a JSON-ready dict (schema in the README), one entry per seam record.
+    """The ``cell detect`` report as a JSON-ready dict (schema in docs/report.md), one entry per seam record.
 
     provenance : what made it (:func:`cell.provenance.provenance`), stored under ``provenance`` (null if None).
 

@@ -1,17 +1,5 @@
-"""KUKA's Status and Turn of a joint configuration (docs/reference.md section 5), from the arm's kinematics.
-
-Status S (bits):
-- bit 0: the wrist point (where A4, A5 and A6 meet) lies at negative x in the A1 coordinate system (the frame that
-  is $ROBROOT at A1 = 0 and turns with A1): the overhead area. 0: the basic area.
-- bit 1: A3 >= phi, the arm's elbow-up side. phi is the A3 angle at which the wrist point lies on the extension
-  of the line from A2 to A3 (the stretched arm); 0 for an arm whose A3 and A4 axes meet, about +11 deg for the
-  KR 5 arc's 120 mm offset between them.
-- bit 2: A5 < 0 (within -180..0 deg; A5 >= 180 counts as negative too, A5 < -180 as positive).
-Turn T: bit i is 1 when axis A(i+1) is negative (A1 = bit 0 ... A6 = bit 5).
-
-The arm is read through :class:`~cell.types.robot.Kinematics` only (frames ``link_1``: the A1 frame, ``link_2``,
-``link_3``: origins on the A2 and A3 axes, ``link_5``: the wrist point), so phi follows the model.
-"""
+"""KUKA's Status and Turn of a joint configuration, from the arm's kinematics (the bits: docs/reference.md section
+5). The arm is read through :class:`~cell.types.robot.Kinematics` only, so the elbow's angle phi follows the model."""
 
 from __future__ import annotations
 

@@ -1,14 +1,5 @@
-"""Joint trajectory export: JSON shaped like ROS ``trajectory_msgs/JointTrajectory`` and CSV.
-
-JSON: ``{"header": {"stamp": {"sec", "nanosec"}, "frame_id"}, "joint_names": [...], "points": [{"positions",
-"velocities", "accelerations", "effort": [], "time_from_start": {"sec", "nanosec"}}]}`` in rad, rad/s, rad/s^2
-(the message's fields and units; the arc state has no field there: it is in the CSV and the KRL program).
-CSV: a header line ``t_s,q1_rad,...,qN_rad,arc_on`` then one row per sample (arc_on 1 while the arc burns from
-that sample to the next, else 0).
-
-Both are re-sampled from the plan every ``dt`` [s] (default 4 ms) plus every segment boundary (so the arc
-switches exactly at a row) and the end; ``dt=None`` writes the plan's own samples.
-"""
+"""Joint trajectory export: JSON shaped like ROS ``trajectory_msgs/JointTrajectory`` and CSV, re-sampled from the plan
+every ``dt`` plus every segment boundary (the format: docs/programs.md, "The joint trajectory")."""
 
 from __future__ import annotations
 

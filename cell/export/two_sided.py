@@ -1,26 +1,5 @@
-"""A job of several sides (the part turned over between them) as one robot program (docs/programs.md).
-
-Each side is an ordinary :class:`~cell.export.program.ProgramJob` written by its controller's post
-(``WELD_FENCE1_A``, ``WELD_FENCE1_B``); a main program (``WELD_FENCE1``) starts at home, calls the sides in order
-and between two sides stops the robot at home with an operator message and waits for the operator to confirm that
-the part was turned, then ends at home.
-
-KUKA KRL: the main program is a .src/.dat pair with the INI fold, the home guard and ``PTP XHOME`` of a side
-program. The stop (``stop="message"``, the default) is KSS 8.x's acknowledgement message: ``Set_KrlMsg(#QUIT,
-...)`` shows the text with an OK button and a ``WHILE Exists_KrlMsg(handle)`` loop holds the program until the
-operator acknowledges it; the message's option ``VL_Stop`` stops the advance run, so the message appears only
-once side A has really ended at home, and ``Clear_P_Reset`` removes it when the program is reset. ``stop="halt"``
-writes a plain ``HALT`` with the message as its comment (any KSS; the operator restarts with the Start key). Side
-B runs only when side A's call returned: a program stopped or reset inside side A never reaches it. Two sides that
-share a BASE_DATA index but not a base pose get consecutive indices (side k: the first side's index + k), since the
-controller holds one value per index.
-
-ABB RAPID: one module per side with its data ``LOCAL`` (each side has its own work object, points and data of the
-same names) and its routine renamed ``NAME_RUN``; the main module's ``PROC main()`` moves home, calls the sides and
-between them writes the message on the FlexPendant (``TPWrite``) and waits for a function key (``TPReadFK``):
-``Turned`` goes on, ``Abort`` ends the program (``EXIT``) before the next side. ``stop="halt"``: ``TPWrite`` and
-``Stop``.
-"""
+"""A job of several sides (the part turned over between them) as one robot program: each side's program and a main
+program that calls them with an operator stop between (KRL and RAPID; docs/programs.md)."""
 
 from __future__ import annotations
 

@@ -1,15 +1,6 @@
-"""Motion: the arm's model and IK (Pinocchio), torch poses, timing (Ruckig), collisions (coal), the welding plan,
-the safety gate and the eye-in-hand camera's close-up views.
-
-Modules of one concept each: the plan is made by :mod:`~cell.motion.plan` from the torch search
-(:mod:`~cell.motion.candidates`), straight lines (:mod:`~cell.motion.lines`), the order
-(:mod:`~cell.motion.order`), transfers (:mod:`~cell.motion.transfers`) and the assembly
-(:mod:`~cell.motion.assembly`); its values live in :mod:`~cell.types.plan`; the gate is the package
-:mod:`cell.motion.gate`, one check per module.
-
-``from cell.motion import X`` imports X's module when X is first asked for, so that a light name (say
-``JointLimits``) does not pull in Pinocchio, coal and Ruckig.
-"""
+"""Motion: the arm's model and IK (Pinocchio), torch poses, timing (Ruckig), collisions (coal), the welding plan, the
+safety gate and the eye-in-hand camera's close-up views (docs/planning.md). ``from cell.motion import X`` imports
+X's module when X is first asked for, so a light name does not pull in Pinocchio, coal and Ruckig."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""A plan's segments: each seam's approach, weld and depart timed as lines (:func:`seam_pieces`), and every
-motion of the program put back to back in welding order, with the transfers between them (:func:`assemble`).
-
-The weld runs at exactly the travel speed between its rest-to-rest ramps (arc on at an exact stop at the start,
-arc off at the exact stop at the end, before the depart), the approach and depart at most at the reduced speed.
-Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
-"""
+"""A plan's segments: each seam's approach, weld and depart timed as lines (the weld at exactly the travel speed, arc
+on and off at exact stops), and every motion of the program put back to back in welding order with the transfers
+between them. Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 

@@ -1,26 +1,8 @@
-"""The torch search for one seam (step 1 and 2 of :func:`cell.motion.plan.plan_welds`).
+"""The torch search for one seam: candidates placed without IK, IK at the weld start, ranked, then solved along the
+seam, the approach and the depart; the first that passes is kept, else the failure that got furthest
+(docs/planning.md section 2).
 
-1. Candidates (:func:`cell.motion.process.torch_candidates.candidate_groups`: weld directions x spins x work/travel
-   angles, nominal first).
-   A candidate whose torch (placed by pose alone) hits a part or the table at a seam end is dropped without IK
-   (:mod:`cell.motion.placement`; when none of the nominal group can be placed, the other groups are swept in a
-   few broad-phase queries, and a seam none can be placed on is refused there, else the search goes on from the
-   first group that places one); the rest get IK at the weld start, each held with the wrist equivalent
-   (:mod:`cell.motion.wrist`: A4 and A6 turned by whole turns, the flipped wrist) with A6 in the hose package's
-   window, on home's side of the wrist
-   (A5's sign) and nearest the reference wrist every seam shares. They are ranked: A6 in the window first, then
-   those within ``_GOOD`` of the best start manipulability, nearest that reference first (so the free spin
-   keeps A6 near the window's centre), then the rest by manipulability.
-2. The best candidates are solved along the seam (warm-started IK every ``spacing``, no joint jump beyond
-   ``max_joint_step``), along the approach line (back along the torch axis to ``process.approach``) and the
-   depart line, checked against singularities and for collisions (conservative advancement between knots).
-   A candidate whose A6 leaves the hose window anywhere on approach, seam or depart fails.
-   The first candidate that passes is kept (:class:`SeamSolution`); otherwise the failure that got furthest
-   (:class:`~cell.motion.failures.SeamFailure`), e.g. ``unreachable: IK did not converge at 35.0 mm along the
-   seam``.
-
-Frames: everything in the robot base frame R [m]; joints [rad].
-"""
+Frames: everything in the robot base frame R [m]; joints [rad]."""
 
 from __future__ import annotations
 

@@ -1,14 +1,6 @@
-"""Inverse kinematics: damped least squares on the 6D pose error (log6), joint limits kept by clamping.
-
-Frames: targets are ``X_RT``, poses of the target T in the robot base frame R [m]; the solved frame F
-(default ``torch_tcp``) is brought onto T. With ``free_axis=True`` only F's origin and z axis (the torch
-axis) must match T's: the rotation about the torch axis is left to the solver (a 5-DoF task, docs/reference.md
-section 7).
-
-A solution is returned only when it reaches the tolerance (default 0.01 mm and 0.01 deg) within the joint
-limits; otherwise :class:`IKSolveError` (an :class:`~cell.errors.IKError`) says which target, the best error reached
-and why, in words and in its fields (``target``, ``residual_m``, ``residual_rad``, ``beyond_reach``).
-"""
+"""Inverse kinematics: damped least squares on the 6D pose error (log6), joint limits kept by clamping; a solution only
+within the tolerance and the limits, else :class:`IKSolveError` with its fields (docs/planning.md section 1).
+Frames: targets ``X_RT`` in the robot base frame R [m]; the solved frame (default ``torch_tcp``) is brought onto T."""
 
 from __future__ import annotations
 

@@ -1,22 +1,8 @@
 """A seam's weld procedure executed: its passes (each at its offset in the cross-section, weaving if the procedure
-weaves) solved along the seam like the weld line, and their motions in order (values in, values out).
+weaves, craters held at rest) solved along the seam like the weld line, and their motions in order
+(docs/planning.md section 4).
 
-The torch search (:mod:`cell.motion.candidates`) picks how to hold the torch on the seam line (direction, spin,
-angles). :func:`solve_passes` keeps that candidate and solves every pass with it: the torch poses of the seam at
-knots fine enough for the weave (:func:`cell.motion.process.weave.knot_spacing`), moved by the pass's offsets and weave,
-then IK, approach, depart, singularity and collision checks exactly as for the seam line
-(:meth:`SeamSearch.solve_candidate`). A procedure of one pass at the root without a weave is the seam line
-itself: its solution is returned unchanged. :func:`pass_pieces` times the passes (each weld at its pass's travel
-speed, rest to rest: its own arc on and off) with a transfer between one pass's depart and the next's approach.
-
-The craters are part of each pass's weld segment (arc on): the torch holds at rest at the weld start for the
-procedure's ``crater_start_s`` (hot start) before it travels, and at the weld end for ``crater_end_s`` (crater
-fill) before the arc goes off (:func:`with_craters`). The segment stays one motion (one LIN in a program, whose
-controller holds the craters itself from the weld data); its duration, the cycle time and the arc time include
-the holds.
-
-Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
-"""
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 

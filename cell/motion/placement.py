@@ -1,21 +1,7 @@
-"""Placing the torch on a seam without IK: the first steps of the torch search (:mod:`cell.motion.candidates`).
+"""Placing the torch on a seam without IK, the first steps of the torch search: a candidate is placed when its torch
+clears every obstacle at the weld's ends and its wrist centre stays within reach (docs/planning.md section 2).
 
-A candidate (:class:`~cell.motion.process.torch_candidates.Candidate`) is *placed* when its torch, put at the weld start
-and at the weld end by pose alone, clears every obstacle (:func:`torch_tests`, the broad phase of many poses in one
-query) and its wrist centre is within the shoulder's reach all along the seam (:func:`place`). Only placed
-candidates cost IK.
-
-A seam no candidate can be placed on (the ladder's rung-to-rail side seams, in their 36 mm slots) is refused
-without IK. :func:`sweep` finds that out in a few broad-phase queries instead of one per candidate group: the
-groups go in chunks that double in size (1, 2, 4 ... groups per query), each pose asked only whether it collides.
-A seam that can be placed stops at the first chunk that holds a placed candidate (at most about twice the poses the
-group-by-group search would have tested up to there), and the search goes on from that candidate's group. The
-failure it returns is the one the group-by-group search keeps (the nearest-nominal candidate with the highest rank,
-ties to the earlier), and a torch collision that becomes the seam's failure is worded as there, from its deepest
-contact.
-
-Frames: the robot base R [m]; angles [rad].
-"""
+Frames: the robot base R [m]; angles [rad]."""
 
 from __future__ import annotations
 

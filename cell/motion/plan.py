@@ -1,33 +1,7 @@
-"""Detected seams -> an executable welding plan for the arm (values in, a frozen :class:`WeldPlan` out).
+"""Detected seams -> an executable welding plan for the arm (values in, a frozen :class:`WeldPlan` out): per seam the
+reach pre-check, the torch search, timing, then the order of the seams (docs/planning.md section 1).
 
-Per seam (:func:`plan_welds`):
-
-0. The reach pre-check (:mod:`cell.motion.reach`, no IK, about a hundred microseconds a seam): a seam whose
-   wrist centre would lie beyond the shoulder's reach for every torch within the process's angles is refused at
-   once (``unreachable: beyond reach: ...``, code BEYOND_REACH); the same test per candidate skips IK for the
-   candidates out of reach.
-1. and 2. The torch search (:mod:`cell.motion.candidates`): candidate directions, spins and angles; IK at the
-   weld start, then along the seam, the approach and the depart; singularity and collision checks. The first
-   candidate that passes is kept; otherwise the seam is reported with the reason that got furthest, e.g.
-   ``unreachable: IK did not converge at 35.0 mm along the seam``, and its code
-   (:class:`~cell.types.plan.PlanReason`). A seam that ends on the table and is refused because the torch meets
-   the table there for every candidate is searched again shortened at that end by the least stand-off that
-   clears the table (:mod:`cell.motion.stand_off`, at most ``table_stand_off_max``); its outcome's ``trimmed``.
-3. Timing (:mod:`cell.motion.lines`, :mod:`cell.motion.assembly`): approach, weld and depart are straight TCP
-   lines (KRL LIN): a one-axis Ruckig profile of the path length s(t) mapped through a C2 spline of the IK knots
-   q(s); the weld runs at exactly the travel speed between its rest-to-rest ramps. Transfers between seams and
-   from/to home (:mod:`cell.motion.transfers`) are Ruckig point-to-point moves (KRL PTP), lifted over the parts
-   or taken via home where the direct move collides. A transfer that finds no free way is first avoided by
-   re-ordering; if it cannot be, the seam is reported as a collision and skipped.
-4. Order (:mod:`cell.motion.order`): greedy nearest neighbour then 2-opt on the point-to-point durations, home
-   at both ends. Each transfer is searched once (:class:`~cell.motion.transfers.Transfers` remembers them), so a
-   re-ordering after a failing transfer costs only its new transfers.
-
-What grows with the part is kept near the work: the collision checks query only the obstacle pairs that could
-change their answer (:mod:`cell.motion.collision`'s broad phase), so fifty parts cost a check about what five do.
-
-Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
-"""
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 

@@ -1,18 +1,6 @@
-"""The reach pre-check: IK-free necessary conditions for a torch pose, to refuse an unreachable seam (or a
-candidate) in microseconds with its reason before any IK is tried.
-
-Geometry (a 6-axis arm with a spherical wrist, as the KR 5 arc): the wrist centre W (the origin of ``wrist``,
-where the A4, A5 and A6 axes meet) is rigid with the tool, so a TCP pose X_RT fixes it: p_RW = X_RT p_TW. The
-shoulder S (the origin of ``shoulder``, on A2's axis) turns with A1 on a circle about A1's axis; the distance
-|S W| depends on A3 alone (A1 and A2 turn S and W together, A4 turns about an axis through W) and lies within
-[d_min, d_max] over A3's limits. So a pose whose wrist centre is farther than d_max from every point of the
-shoulder circle is beyond reach (whatever A1, A2, the wrist): the pose test. A seam is beyond reach whatever the
-torch orientation when its points are farther than d_max + |p_TW| from that circle: the seam test (no torch pose
-needed). Both are necessary conditions only: a pose that passes may still fail IK (joint limits of A1, A2, the
-wrist), and then IK says why.
-
-Frames: R the robot base; T the TCP frame. Units: metres.
-"""
+"""The reach pre-check: IK-free necessary conditions for a torch pose, to refuse an unreachable seam (or a candidate)
+in microseconds with its reason before any IK is tried: the wrist centre against the shoulder's reach
+(docs/planning.md section 1). Frames: R the robot base; T the TCP frame. Units: metres."""
 
 from __future__ import annotations
 

@@ -1,11 +1,6 @@
-"""The arm's kinematic model: the only module that imports Pinocchio.
-
-Frames: ``R`` is the robot base frame (URDF root ``base_link`` = KUKA $ROBROOT); every pose returned here is
-``X_RF``, the 4x4 pose of frame F in R [m]. Joint values are the controller's A1..A6 [rad].
-
-A :class:`RobotModel` holds a fixed Pinocchio ``Model`` and one scratch ``Data``: it is cheap to call but
-not thread-safe (build one model per thread).
-"""
+"""The arm's kinematic model, the only module that imports Pinocchio. Frames: ``R`` the robot base (URDF root
+``base_link`` = KUKA $ROBROOT); every pose returned is ``X_RF`` [m]; joints are the controller's A1..A6 [rad]. A
+:class:`RobotModel` keeps one scratch ``Data``: cheap to call, not thread-safe (one model per thread)."""
 
 from __future__ import annotations
 

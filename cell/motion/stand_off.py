@@ -1,15 +1,6 @@
-"""The table stand-off: a seam that ends on the table is welded from the torch's clearance above it.
-
-Where two parts meet on the table, a seam climbing from the table top starts in the corner of the table and both
-parts: the gas nozzle meets the table there for every torch orientation the process allows, and the torch search
-(:mod:`cell.motion.candidates`) refuses the seam (``collision: torch vs TABLE at the weld start``). A welding cell
-welds it from a stand-off instead: the seam shortened at its table end by the least multiple of ``_STEP`` at which
-some torch clears the table (tested without IK, :meth:`~cell.motion.candidates.SeamSearch.placeable`), at most
-``PlanOptions.table_stand_off_max`` and never more than a third of the seam. Nothing changes for a seam that
-plans as it is, or one whose failure is anything but the torch against the table where it is placed.
-
-Frames: R [m].
-"""
+"""The table stand-off: a seam that ends on the table, refused because the torch meets the table there, is welded
+shortened at that end by the least stand-off at which some torch clears it (docs/track.md, "The table stand-off").
+Frames: R [m]."""
 
 from __future__ import annotations
 

@@ -1,17 +1,7 @@
-"""Jerk-limited timing with Ruckig: the only module that imports ruckig.
-
-Only state-to-state motions are used (docs/reference.md section 9): Ruckig's intermediate waypoints call a
-remote service. A point-to-point move from rest to rest is timed as a KRC4 drives a PTP (docs/reference.md
-section 9): a straight line in joint space, q(t) = q0 + u(t) (q1 - q0), every axis starting and stopping
-together, u(t) one jerk-limited profile from 0 to 1 whose limits are the tightest of the axes' limits scaled
-by their share of the move (the leading axis at its limit, the others proportionally slower). A move with
-boundary velocities (not a KRC PTP) is one Ruckig solve over all joints, phase-synchronised where the
-velocities allow it. A weld along a seam is timed by a one-axis profile of the path length s(t)
-(:func:`path_profile`) that the planner maps through IK. Every Ruckig result is checked: anything but
-Working/Finished raises :class:`~cell.errors.TimingError` with the result's name.
-
-Units: joints [rad], [rad/s], [rad/s^2], [rad/s^3]; path length [m], [m/s], [m/s^2], [m/s^3]; time [s].
-"""
+"""Jerk-limited timing with Ruckig, the only module that imports ruckig: state-to-state motions only, a rest-to-rest
+PTP timed as a KRC4 drives it, a weld as a one-axis profile of the path length; any result but Working/Finished
+raises :class:`~cell.errors.TimingError` (docs/reference.md section 9).
+Units: joints [rad], [rad/s], [rad/s^2], [rad/s^3]; path length [m], [m/s], [m/s^2], [m/s^3]; time [s]."""
 
 from __future__ import annotations
 

@@ -1,26 +1,8 @@
 """Planning with a linear track under the base (an external axis E1): seams grouped along the track, one E1 per
-group, the arm planned per group with its base there, the track moved between groups with the arm at home.
+group, the arm planned per group with its base there, the track moved between groups with the arm at home
+(docs/track.md, "Planning").
 
-1. Reach along the track (:func:`reach_curves`, no IK): for every seam and every E1 on a grid over the track's
-   limits, how much room the arm has: the nominal torch's wrist centre against the longest shoulder-to-wrist
-   distance the elbow allows (the model of :mod:`cell.motion.reach`, with the base moved by E1: the seam's
-   points moved by -E1 along the axis). Negative is inside the band, by that much.
-2. Groups (:func:`group_seams`): each seam's usable E1 are those where it has at least ``margin`` of room (or,
-   for a seam that never does, within 5 mm of its best). Those usable at E1 = 0 stay there (the arm plans them as
-   without a track: a part within reach plans as it always did); for the others the fewest E1 that leave none
-   without one are chosen greedily (sort by the end of each seam's interval, stab), each the grid value that
-   leaves its group's worst seam the most room. A seam out of reach at every E1 joins the group nearest its best
-   E1, where the planner refuses it with its reason.
-3. Per group (:func:`plan_on_track`): :func:`~cell.motion.plan.plan_welds` with the arm's base moved
-   (:meth:`RobotModel.shifted`) and the collision checker's base moved (:meth:`CollisionChecker.set_base`: the
-   obstacles are not rebuilt), from home to home. Between groups the track moves from one E1 to the next with the
-   arm at home, a jerk-limited one-axis Ruckig profile (:func:`cell.motion.timing.path_profile`) within the
-   track's speed, acceleration and jerk limits; the program starts and ends at E1 = 0.
-
-Frames (docs/track.md): R is the base at E1 = 0; the base at E1 = e is X_R_Re = translation(e * axis_R); every
-pose of the plan (X_end, torch paths) stays in R; each segment's trajectory carries its E1 (``Trajectory.e1``).
-Units: metres, radians, seconds.
-"""
+Frames: R is the base at E1 = 0; every pose of the plan stays in R. Units: metres, radians, seconds."""
 
 from __future__ import annotations
 

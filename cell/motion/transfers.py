@@ -1,17 +1,6 @@
-"""Transfers between seams and from/to home (step 3 of :func:`cell.motion.plan.plan_welds`).
-
-A transfer is a Ruckig point-to-point move (KRL PTP) where the direct move is free. Where it collides, the next
-strategy is tried, in order (:data:`DEFAULT_STRATEGIES`): straight up (a LIN, as a depart) to ``transfer_lift``
-above the highest obstacle, across (PTP) and straight down (a LIN, as an approach); the same one
-``transfer_lift`` higher; PTP via home. A strategy fails too where the wire tip or the wire (which the collision
-model leaves out) enters an obstacle's body (:func:`cell.motion.gate.bodies.body_entry`), or where its motions
-take A6 further out of the hose package's window (:class:`~cell.motion.wrist.HoseWindow`) than its two ends are
-(a PTP between ends inside the window stays inside: it is a straight joint line; a vertical line's IK may turn
-A6). When every strategy collides or fails, the last one's contact (or error) is the :class:`TransferFail`; the
-planner then re-orders the seams, or drops the seam.
-
-Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
-"""
+"""Transfers between seams and from/to home: a point-to-point move where the direct one is free, else lifted over the
+obstacles or taken via home, each strategy also kept out of the bodies and the hose window (docs/planning.md
+section 1). Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 

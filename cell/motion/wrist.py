@@ -1,17 +1,6 @@
-"""The wrist of a six-axis arm: its equivalent configurations, the hose package's A6 window and how far a
-configuration is from the wrist the cell prefers (used by the torch search, :mod:`cell.motion.candidates`).
-
-A spherical wrist reaches one flange pose in several ways (docs/reference.md section 3): A4 and A6 may each
-turn a whole revolution within their +-350 deg ranges, and the wrist may flip (A4 + 180 deg, -A5, A6 + 180 deg).
-They hold the torch alike, but not the hose package: the dress pack winds round A6, so A6 must stay within a
-window of cable travel around its reference (``PlanOptions.a6_window`` either side of ``a6_center``), and a
-flip between neighbouring seams (A5 changing sign, KUKA's status bit 2) swings A4 by half a turn. The torch
-search therefore holds every seam's torch with A6 in the window, the wrist on the reference's side (A5 of the
-home configuration's sign) and, among those, the equivalent nearest one reference wrist shared by all seams
-(A4 of the home configuration, A6 at the window's centre), so seams are near each other whatever their order.
-
-Joints [rad]; the wrist is the last three joints (A4, A5, A6).
-"""
+"""The wrist of a six-axis arm: its equivalent configurations, the hose package's A6 window and how far a configuration
+is from the wrist the cell prefers, for the torch search (docs/reference.md section 3, "The wrist and the hose
+package"). Joints [rad]; the wrist is the last three joints (A4, A5, A6)."""
 
 from __future__ import annotations
 

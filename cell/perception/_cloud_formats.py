@@ -1,15 +1,6 @@
-"""PLY and PCD parsed with numpy, for :mod:`cell.perception.cloud_files`: the header checked against the body.
-
-Only what a point cloud needs is read: the ``vertex`` element's x, y, z of a PLY file (other properties and
-elements skipped), the x, y, z fields of a PCD file (other fields skipped). A body shorter than its header says,
-a value that is not a number, or a header without x, y, z is a :class:`~cell.errors.CloudFileError`; so is a
-variant not read here (a list property inside PLY's vertex element). PCD ``binary_compressed`` is checked here
-(the sizes of its LZF block) and decoded by open3d (:attr:`Body.compressed`).
-
-PLY: Greg Turk's format (``ply`` / ``format ascii|binary_little_endian|binary_big_endian 1.0`` / ``element`` /
-``property`` / ``end_header``). PCD: the Point Cloud Library's v0.7 header (``FIELDS SIZE TYPE COUNT WIDTH HEIGHT
-VIEWPOINT POINTS DATA``), binary bodies row by row in little-endian order.
-"""
+"""PLY and PCD parsed with numpy for :mod:`cell.perception.cloud_files`: the header checked against the body, only x,
+y, z read; a body shorter than its header, a value that is not a number or a variant not read here is a
+:class:`~cell.errors.CloudFileError` (the formats read: docs/locate.md, "What it reads")."""
 
 from __future__ import annotations
 

@@ -1,19 +1,6 @@
-"""The only module of the cell that imports open3d: numpy in, numpy out.
-
-open3d's compiled core is loaded on first use (inside the functions, :func:`_o3d`), never at import time of this
-module, and without the package's ``__init__`` (which pulls in its visualization, dash and plotly): ``cell
---help`` and the numpy-only stages stay instant, and the first ICP pays 0.3 s, not 0.9 s. Every function takes
-and returns plain numpy arrays (points ``(n, 3)`` float64 [m], poses ``(4, 4)``); open3d objects never leave
-this module.
-
-open3d's thread count is one setting for the whole process (``utility.set_max_threads``), read by each of its
-parallel loops as it starts. An ICP must run on one thread (:func:`icp`); the other calls here give the same
-answer on any number of threads (RANSAC's varies with the threads' timing on any number of them). So the setting
-stays at one from the load on, and a call whose answer does not depend on it runs on every core while no ICP is in
-flight (:func:`_every_core`). Two ICPs on two threads of the cell (the map alignment beside the splice,
-:func:`cell.perception.perceive.perceive_then`) then run side by side; they used to take turns on a lock around
-the setting.
-"""
+"""The only module of the cell that imports open3d: numpy in, numpy out. Open3D's core is loaded on first use, and
+its threads are one setting for the process: one for every ICP, every core for the calls whose answer does not
+depend on it while no ICP is in flight (docs/perception.md, "One thread for the ICP")."""
 
 from __future__ import annotations
 
@@ -56,10 +43,9 @@ def _o3d() -> Any:
 def _load() -> Any:
     """Load open3d's compiled core (called under ``_LOADING``).
 
-    ``import open3d`` runs the package's ``__init__``, which imports ``open3d.visualization`` and through it
-    dash and plotly: 0.9 s on the 2-core bench machine, of which the compiled core is 0.3 s. The core is one
-    extension module next to that ``__init__``; it is loaded from its file without running the package (when
-    open3d is already imported, its own is taken). Everything this module uses lives in it.
+    The core is one extension module next to the package's ``__init__`` (which imports the visualization, dash
+    and plotly: docs/perception.md); it is loaded from its file without running the package (when open3d is already
+    imported, its own is taken). Everything this module uses lives in it.
     """
     import importlib.machinery
     import importlib.util

@@ -1,15 +1,6 @@
-"""Aligning the welding map to the point cloud (paper section 3.5).
-
-The map's parts (boxes or any polyhedral body) are sampled into surface points with normals (faces pointing
-down into the table and face areas in contact with another part are left out: no camera can see them). ICP then
-runs with the *cloud as source and the map samples as target*, point-to-plane with the faces' exact normals, coarse
-to fine, from the nominal placement (identity). The inverse of the ICP transform is the correction that moves the
-map onto the cloud.
-
-A part lies on the table, so the correction may turn it about the vertical only: a fit that tilts it by more
-than :data:`MAX_TILT_RAD` in roll or pitch is refused, as is a fit whose fitness stays below the scenario's
-minimum.
-"""
+"""Aligning the welding map to the point cloud (paper section 3.5): the map's visible faces sampled, a staged
+point-to-plane ICP of the cloud onto them from the nominal placement, its inverse the map's correction; a fit that
+tilts the part off the table or fits too little is refused."""
 
 from __future__ import annotations
 

@@ -1,16 +1,6 @@
-"""Is the map fitted to the cloud where the part is? Checks that turn a wrong map fit into a reason.
-
-For the pipeline, after :func:`cell.perception.align.align_map`:
-
-- :func:`check_alignment_unique`: the map's near-symmetries (a ladder shifted by one rung pitch, a part turned
-  by 180 degrees) fit the cloud almost as well as the true placement. Compare the chosen fit with each
-  alternative on the only surfaces that tell them apart; refuse (AlignmentError) when the cloud does not
-  clearly prefer the chosen one.
-- :func:`check_parts_seen` (:func:`part_coverage`, :func:`missing_parts`): how much of each part's top the
-  cloud covers; a part with almost none while the others are well covered is not on the table (its seams are
-  NOT_FOUND, never invented); parts half covered mean the map lies in the wrong place (AlignmentError).
-- :func:`check_alignment`: both, side by side.
-"""
+"""Is the map fitted to the cloud where the part is? Checks after the alignment that turn a wrong fit into a reason:
+a near-symmetric fit the cloud does not clearly reject (a ladder one rung off, a part turned by 180 degrees), and
+parts the cloud does not cover (missing parts, or the map in the wrong place)."""
 
 from __future__ import annotations
 

@@ -1,37 +1,6 @@
-"""The cameras' calibration in each seam's sigma: a seam seen by one camera only carries that camera's error.
-
-A locator's sigma (:mod:`cell.seams.sigma`) is calibrated on cells whose cameras are placed exactly; what it
-cannot see is how well each camera's pose is known. The scenario says that per camera
-(``cameras.<name>.calibration``: the RMS residual of its calibration, translation ``t`` and rotation ``theta``).
-A pose error moves every point the camera sees rigidly: at range ``r`` from the camera by ``t`` plus
-``r * theta``, in a direction nobody knows, so along any one axis (across the seam) by
-
-    sigma_cam = sqrt(t^2 + (r * theta)^2) / sqrt(3)
-
-(an RMS error spread evenly over three axes). Which cameras a seam rests on is counted from the registered cloud
-(per-point camera index) within :data:`SUPPORT_RADIUS_M` of the located segment; camera ``c`` holds the share
-``w_c`` of those points. A camera the splice registered and *corrected* (``Registration.accepted``) now sits where
-its reference camera puts it, so it inherits the reference's error: cameras tied to one reference make one error
-source with the summed share. It also keeps what the correction did not fix: the splice's posterior of the
-disagreement left (``Registration.residual``, :class:`~cell.perception.splicing.PoseResidual`: its prior along
-every direction the overlap did not inform, the posterior's along those it did), an error of its own at the
-seam ``sigma_res``, counted as an independent source with the camera's share (conservative: the reference's
-error is counted in both). Independent sources add in quadrature,
-
-    sigma_cal = sqrt(sum_g (W_g * sigma_g)^2 + sum_c (w_c * sigma_res_c)^2),
-
-so a seam on one uncorrected camera carries all of that camera's error, and one seen evenly by two independent
-cameras about 1 / sqrt(2) of it. Given the seam's weld faces (:func:`seam_calibration_sigma`), the shares are
-taken per face strip and carried to the line where the two faces meet: the line moves with each face, so a face
-seen by one camera alone brings all of that camera's error whatever camera sees the other (a fillet's floor from
-one camera and its wall from another: one camera's sigma, not 1 / sqrt 2 of it). The seam's sigma becomes
-``hypot(sigma_locator, sigma_cal)``, and so does each end's sigma along it (``end_sigma_m``: the same rigid
-error moves the ends too). With every calibration at 0 (the default) nothing changes and nothing is computed.
-
-The close-up of a re-scan (:func:`closeup_sigma`) is seen by the arm's camera alone, at its close range. (Its
-fusion with the first estimate treats the two as independent; when both rest on the same camera's calibration the
-fused sigma is optimistic by at most that camera's term, which the close-up's own range keeps small.)
-"""
+"""The cameras' calibration in each seam's sigma: a seam carries the stated pose error of the cameras its points come
+from, at their range and in proportion to their share (the model: docs/perception.md, "The cameras' calibration in
+each seam's sigma")."""
 
 from __future__ import annotations
 

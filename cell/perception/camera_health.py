@@ -1,16 +1,6 @@
-"""Is a camera's data fit to splice? Checks that turn a broken camera into a reason before it poisons the splice.
-
-Run by :func:`cell.perception.perceive.perceive` before splicing:
-
-- :func:`image_health`: one depth image on its own. A dead camera has (almost) no valid pixel; a stuck one reads
-  one value everywhere; a garbage stream (random depths, heavy interference) is rough everywhere, while a real
-  scene is piecewise smooth: only the pixels along depth edges jump between neighbours (a few per cent).
-- :func:`disagreeing_cameras`: the cameras' clouds against each other in R (calibrated extrinsics). A camera
-  knocked out of calibration sees the same part elsewhere: few of its points lie on the others' surfaces while
-  the others agree with each other. With only two cameras nobody can tell which one is wrong: none is dropped.
-  A camera that sees only part of what another sees (an eye-in-hand camera close over a thin part) is judged on
-  the part it sees: the other camera's points count only where the first one has points at all (its footprint).
-"""
+"""Is a camera's data fit to splice? Checks before the splice that turn a broken camera into a reason: one image on its
+own (dead, stuck, garbage), and the cameras' clouds against each other (a camera knocked out of calibration, judged
+on its footprint; with two cameras none can be blamed)."""
 
 from __future__ import annotations
 

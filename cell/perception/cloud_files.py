@@ -1,18 +1,6 @@
-"""Point cloud files people bring (``cell locate CLOUD``): PLY or PCD, ASCII or binary, read into a :class:`Cloud`.
-
-:func:`read_cloud` knows the format by the file's content, not its name: a PLY file starts with the line ``ply``,
-a PCD file with its header (``#`` comments, then ``VERSION``/``FIELDS``/... up to ``DATA``). Both are parsed here
-with numpy: open3d's PLY reader returns uninitialised memory for a truncated file or an ``inf`` token (and prints
-to stderr), which a brought file must never turn into points. Only PCD's ``binary_compressed`` body (LZF) is
-decoded by open3d, after its sizes are checked here. CRLF line ends are tolerated; fields other than x, y, z
-(intensity, normals, colour, padding) are ignored.
-
-Units: the file's numbers are read in ``units`` (``m`` by default) and scaled to metres. A cloud reaching beyond
-:data:`PLAUSIBLE_M` (20 m) from its frame's origin, or spanning more than that, is refused (a 260 mm part written in
-millimetres and read as metres is 260 m long); so is one spanning less than :data:`SMALLEST_M` (1 mm). Rows with a
-NaN or infinite coordinate are dropped, with a warning, when finite rows remain; a file with none is refused.
-Every refusal is a one-line :class:`~cell.errors.CloudFileError` with its :class:`~cell.errors.CloudFault`.
-"""
+"""Point cloud files people bring (``cell locate CLOUD``): PLY or PCD, ASCII or binary, known by content, read into a
+:class:`Cloud` in metres; implausible sizes and unusable files refused with a :class:`~cell.errors.CloudFileError`
+(docs/locate.md, "What it reads")."""
 
 from __future__ import annotations
 

@@ -1,23 +1,6 @@
-"""Where the welding map lies in an unorganised cloud when no usable placement is given: candidates for the map's
-pose on the table, each to be refined by the usual staged ICP (:func:`cell.perception.align.align_map`) and the
-best kept by its fitness.
-
-A part rests on the table, so in the levelled frame L (the table's normal +z, its top at one height) its pose is a
-turn about z and a shift in x, y: three unknowns. Two searches propose them:
-
-- :func:`height_candidates`: the cloud seen from above as a height image (the highest point above the table in
-  each cell, clipped at the map's height) correlated (FFT) with the map's own height image at every turn of
-  :data:`YAW_STEP_DEG`; each turn's best shift, the best first, those near a better one left out (the staged ICP
-  absorbs the rest). Robust to clutter lower than the
-  part (clamps, the table's holes): they add to every placement alike.
-- :func:`fpfh_candidates`: FPFH features and RANSAC (Open3D's feature matching through
-  :mod:`cell.perception._open3d`) between the map's surface samples and the cloud, a few seeded tries, each
-  flattened to a turn about z and refined by point-to-point ICP. On the tee (the real scans and a synthetic scan
-  of it) its candidates came out turned by about 180 degrees or 5-10 cm off: it is asked only when the height
-  image's candidates fit poorly, and whatever it proposes must still win the staged ICP's fit.
-
-Each candidate is put flat on the table (:func:`on_table`).
-"""
+"""Where the welding map lies in an unorganised cloud when no usable placement is given: candidate poses on the table
+(a height-image search over turns and shifts, then FPFH + RANSAC if those fit poorly), each to be refined by the
+staged ICP and the best kept by its fitness (docs/locate.md, "From the cloud to the seams")."""
 
 from __future__ import annotations
 

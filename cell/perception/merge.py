@@ -1,27 +1,6 @@
-"""The paper's prioritised merge (section 3.3), generalised to any number of cameras and surface directions.
-
-The paper takes "the left side of the fence from the left camera and the right side from the right camera",
-because a camera far from a region measures it with several millimetres of noise. Here space is cut into cubic
-cells of ``cell_m`` and every cell takes its points only from the camera with the lowest *predicted* noise
-there.
-
-A cell may hold two surfaces that different cameras see (the top of a tube and its side, which only one camera
-sees). So the unit of the merge is a cell *and* a surface direction: each camera's points get a normal from a
-local plane fit (per camera, per sub-cell of ``normal_cell_m``), the normal is snapped to one of the six axis
-directions of R, and cameras compete only for the same (cell, direction). A surface seen by one camera alone
-is always kept.
-
-Predicted noise (:func:`predicted_noise`, a ranking score, not metres) follows the active-stereo sensor of the
-cell (RealSense D4xx, docs/reference.md section 2): the error is in depth along the optical axis, sigma_z ~ z^2 /
-(f B) (the baseline B is unknown here and taken equal for all cameras), so a point moves along its *ray*. What
-a surface's position suffers from is the spread across the surface, sigma_z cos(theta) / cos(alpha) (theta the
-incidence, alpha the ray's angle off the optical axis), averaged over the points the camera puts on a unit of
-area, f^2 cos(theta) / (z^2 cos(alpha)). Their ratio, the standard error of the surface per unit area, is
-z^3 sqrt(cos(theta) / cos(alpha)) / f^2: range ranks a camera worse, an oblique view slightly *better* (its
-points are fewer but spread less across the face). Incidence is capped at :data:`MAX_INCIDENCE_DEG`, past which
-stereo matching drops pixels.
-
-"""
+"""The paper's prioritised merge (section 3.3), generalised to any number of cameras and surface directions: each
+cube of space and surface direction takes its points from the camera with the lowest predicted noise there
+(docs/perception.md, "The splice's order, its ICP and the prioritised merge")."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""Depth images to the clouds the seam locators read, in one call: the perception stage of the pipeline.
-
-deproject + crop + robot frame (section 3.2) -> splice (3.3) -> Z passthrough and outlier removal (3.4) ->
-voxel grid (3.4). A camera whose data cannot be trusted is *lost*, with the reason, before it can poison the
-splice (:mod:`cell.perception.camera_health`): no valid pixel (dead, blinded), an implausible image (one value
-everywhere, random depths, heavy interference), no point inside the workspace, or a cloud that agrees with no
-other camera while the others agree (knocked out of calibration), or, in the splice, data that disagree with
-the camera's stated calibration beyond three of its sigmas (:mod:`cell.perception.splicing.splice`). The others go on
-without it; only when no usable camera remains is it a :class:`SensorError`.
-"""
+"""Depth images to the clouds the seam locators read, in one call: deproject, crop and robot frame (paper section 3.2),
+splice (3.3), Z passthrough and outlier removal, voxel grid (3.4). A camera that cannot be trusted is lost with its
+reason before it poisons the splice, and the others go on; no usable camera left is a :class:`SensorError`."""
 
 from __future__ import annotations
 

@@ -1,10 +1,5 @@
-"""PLY files in and out, so clouds from real cameras (or other tools) enter the same pipeline.
-
-:func:`save_ply` writes binary PLY with double x, y, z and an int ``camera`` vertex property, and records the
-capture names and the frame in header comments (``comment cell-cameras a,b,c`` and ``comment cell-frame R``).
-:func:`load_ply` reads any PLY open3d can read (ascii or binary, float or double, extra properties ignored);
-it restores the camera indices and names when the file has them.
-"""
+"""PLY files in and out, so clouds from real cameras (or other tools) enter the same pipeline: binary PLY with the
+camera index per point and the capture names and frame in header comments, read back with them."""
 
 from __future__ import annotations
 

@@ -1,22 +1,7 @@
-"""Unorganised point clouds from any sensor (a swept laser line, a lidar, a stitched scan): the steps that replace
-what a depth camera's intrinsics and viewing direction give for free.
-
-- :func:`find_table`: the table plane from the data (RANSAC over the points whose local normal is near vertical,
-  then a least-squares refit of its inliers), with the data's noise measured on it (a robust scale of the inliers'
-  residuals). A real table is tilted by a degree and is not at z = 0; its holes and whatever stands on it are
-  outliers of the plane, not of the fit.
-- :func:`levelling`: the rotation that turns the table's normal onto +z (about the frame's origin), so that the
-  stages that take "up" to be +z and the table to be one height (visibility, the locators' table band) hold.
-- :func:`sampling`: the cloud's point spacing on the table (along a scan line, and between lines, from the
-  nearest-neighbour distance and the density), which bounds what a fit of the cloud can resolve.
-- :func:`orient_normals`: unit normals turned by a stated heuristic, since no view direction is known: towards
-  ``viewpoint`` when one is given; else towards +z for faces within about 70 degrees of horizontal and, for steep
-  faces, away from the centroid of the points (outwards on a convex part).
-
-Where the map lies with no usable placement: :mod:`cell.perception.global_placement`.
-
-All in one frame (the cloud's, or the levelled one), metres.
-"""
+"""Unorganised point clouds from any sensor (a swept laser line, a lidar, a stitched scan): the steps that replace what
+a depth camera's intrinsics and viewing direction give for free: the table plane and the noise on it, levelling, the
+point spacing, normals oriented by a stated heuristic (docs/locate.md, "From the cloud to the seams").
+All in one frame (the cloud's, or the levelled one), metres."""
 
 from __future__ import annotations
 

@@ -1,11 +1,6 @@
-"""The only place that knows the order of the stages: capture -> perceive -> align map -> locate -> re-scan ->
-plan -> gate -> execute.
-
-Each stage is a function taking values and returning values; this package wires them, times them, and is the only
-code that talks to the station's ports (:mod:`cell.station`). The CLI is a thin layer over :func:`detect`,
-:func:`weld` and :func:`rescan_detection` (and, for the bench, over :func:`capture`, :func:`build_scene` and
-:func:`locate`).
-"""
+"""The only place that knows the order of the stages: capture -> perceive -> align map -> locate -> re-scan -> plan ->
+gate -> execute. Each stage takes and returns values; this package wires them, times them, and is the only code
+that talks to the station's ports. The CLI is a thin layer over it."""
 
 from cell.pipeline.cloud import locate_cloud
 from cell.pipeline.detect import (

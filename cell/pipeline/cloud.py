@@ -1,26 +1,6 @@
-"""Locate a welding map's seams in a point cloud someone brings (a laser scan, a lidar sweep, any sensor's cloud):
-the same stages as :func:`cell.pipeline.detect` from the map alignment on, without a station or a simulator.
-
-The cloud is unorganised (no intrinsics, no view direction), in metres, in its own frame F. The steps:
-
-1. the table plane from the data and the cloud's noise on it (:func:`cell.perception.unorganised.find_table`); the
-   cloud is levelled (frame L: the table's normal is +z, the table at one height) so that "up" and "the table's
-   height" mean what the stages take them to mean; the point spacing along and between scan lines;
-2. the options from the data (:mod:`cell.pipeline.cloud_setup`): the ICP's correspondences and our locator's
-   noise and sigma floor from the measured noise and spacing;
-3. the nominal placement ``X_FM_nominal`` put flat on the found table (a part rests on it: its roll and pitch in L
-   are zero, its underside at the table's height); the cloud cropped to the placed map's bounds grown by
-   :data:`cell.perception.cloud_placement.MARGIN_M` (and, above the table, by its noise);
-4. the map aligned by the usual staged ICP (:func:`cell.perception.cloud_placement.place_map`) and its checks
-   (fitness, tilt, ambiguity, parts seen); with no nominal placement, or one whose fit is poor
-   (:data:`~cell.perception.cloud_placement.POOR_FITNESS`), a global registration first
-   (:mod:`cell.perception.global_placement`: a height-image search over turns and shifts on the table, then FPFH +
-   RANSAC if that fits poorly), each candidate aligned and the one explaining the most points kept;
-5. every seam of the aligned map located (our locator by default), screened (occluders, missing parts, doubt), and
-   carried back into F. A seam no data supports is NOT_FOUND or NOT_VISIBLE with the reason, never invented.
-
-Nothing here imports the simulator.
-"""
+"""Locate a welding map's seams in a point cloud someone brings (a laser scan, a lidar sweep, any sensor's cloud): the
+same stages as :func:`cell.pipeline.detect` from the map alignment on, without a station or a simulator (the steps:
+docs/locate.md, "From the cloud to the seams"). Nothing here imports the simulator."""
 
 from __future__ import annotations
 

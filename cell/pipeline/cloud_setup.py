@@ -1,22 +1,6 @@
-"""What :func:`cell.pipeline.cloud.locate_cloud` derives from a brought cloud before it looks for seams: the
-options that fit the data (its noise and density, not the D415's constants) and the scenario that stands for the
-cell the cloud came from (so that the usual report describes the run).
-
-Options from the data (the table's noise sigma and the point spacing between scan lines, both measured on the
-table by :mod:`cell.perception.unorganised`):
-
-- the map-to-cloud ICP's largest correspondence: 20 mm, or 20 noise sigma when that is more, so its three stages
-  (1, 1/4, 1/10 of it) keep the finest above 2 noise sigma and the fitness band (the middle stage) above 5;
-- our locator: told the measured noise (``sensor_sigma_m``); looks at a tube about the seam that holds
-  :data:`TUBE_LINES` scan lines across; reads every point (``sample_share`` 1: a line
-  scanner's cloud is sparse); a face is seen with the points of 30 mm^2 of it at the cloud's density
-  (:func:`min_face_points`); a weld face must be seen (``min_edge_points`` out of reach: placing an unseen face
-  from an edge needs a depth camera's per-pixel density, and a shadowed face is not a face); the sigma floor is
-  :func:`sigma_floor` (what a fit of such a cloud cannot see), and the standard error that still earns full
-  confidence is that floor too (the D415's 0.2 mm would mark every seam of a 1 mm-noise cloud as doubtful: a
-  statistical error below what the sensor resolves at all is as good as it gets);
-- the parts-seen check: a part's top counts as seen from :data:`MIN_SEEN` of it covered (open tubes).
-"""
+"""What :func:`cell.pipeline.cloud.locate_cloud` derives from a brought cloud before it looks for seams: the options
+that fit the data (its noise and density, not the D415's constants) and the scenario that stands for the cell the
+cloud came from, so that the usual report describes the run (docs/locate.md, "From the cloud to the seams")."""
 
 from __future__ import annotations
 

@@ -83,7 +83,7 @@ def rescan_weldable(
     chosen = seams_to_rescan(det.estimates, threshold, sc.rescan.max_sigma_m, sc.rescan.max_end_sigma_m)
     hopeless = _hopeless(arm, det, chosen, motion, progress)
     ids = [i for i in chosen if i not in hopeless]
-    if mode == "all" or not hopeless:  # nothing left out: the re-scan as it always was
+    if mode == "all" or not hopeless:  # nothing left out: rescan_detection's own selection and escalation
         rs, after = rescan_detection(station, det, mode, seam_ids=ids, motion=motion, progress=progress)
         return rs, after, hopeless
     if not ids:

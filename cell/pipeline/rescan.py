@@ -1,12 +1,6 @@
 """The close-up re-scan loop, once for ``cell weld`` and ``cell rescan``: plan a view, move, capture, locate, fuse,
-escalate.
-
-The values it needs (views, close-up scenes, fusion) come from :mod:`cell.rescan` and
-:mod:`cell.motion.views.viewpoint`; this module is the only place that drives the station's arm and eye-in-hand camera
-for it. One close-up serves every seam still to re-scan that it sees as well as a view of that seam's own must
-(:func:`shared_by`): the ladder's neighbouring seams share an image instead of costing one each. Frames: R (robot
-base) for every estimate and pose; metres, radians, seconds.
-"""
+escalate; the only place that drives the arm and its camera for it. One close-up serves every seam still waiting
+that it sees as well as a view of its own would. Frames: R for every estimate and pose; metres, radians, seconds."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""The cell around the part as values for pictures: the table, the robot's URDF shapes at its poses, the cameras.
-
-Computed once per run (:func:`cell_view`) so that the preview reads values only: link poses from the arm's
-forward kinematics at the scan pose, along the plan and along the motion (:func:`arm_motion`), link shapes from
-the URDF's visual geometry (boxes, cylinders, spheres; meshes are skipped), the joint limits, the cameras' optical
-frames and intrinsics from the scenario. Frame ``R`` (robot base), metres.
-"""
+"""The cell around the part as values for pictures, computed once per run so that the preview reads values only: the
+table, the robot's URDF shapes and link poses at the scan pose, along the plan and along the motion, its joint
+limits, the cameras. Frame R, metres."""
 
 from __future__ import annotations
 

@@ -1,29 +1,7 @@
-"""A Rerun recording of a run (``cell weld --rerun FILE.rrd``, ``cell preview --rerun FILE.rrd``).
-
-The only module that imports ``rerun`` (the optional extra ``rerun``: ``pip install 'weld-cell[rerun]'``), and
-only inside its functions. It writes, from the values the HTML page draws (the run's records and its
-:class:`~cell.types.CellView`), everything in the robot frame R [m] under ``cell/``:
-
-- ``cell/cloud``: the dense cloud (coloured by height); ``cell/table``; ``cell/map/parts``: the aligned map's
-  parts as boxes; ``cell/seams/<status>``: the estimated seams (where nothing was found: the map's) as lines
-  coloured like the page (:data:`~cell.preview.views.STATUS_COLOURS`), ``cell/seams/truth`` the true seams;
-- ``cell/cameras/<name>``: each camera's pinhole and pose X_RC (a fixed camera's static; the eye-in-hand camera's
-  on the timeline, from the arm's ``camera_optical`` frame, when the arm moves);
-- ``cell/robot/<link>``: the link's URDF shapes, posed along the motion on the ``time`` timeline; ``cell/tcp``:
-  the tool path (arc-on stretches one strip per weld) and the TCP now; ``plots/arc`` (0/1) and
-  ``plots/joints/<joint>`` [deg]; ``log``: the motion's marks (moves, arc on and off with their seam);
-- a default layout (the 3D cell beside the joints, the arc and the log).
-
-Time ``time`` [s] is the execution's: 0 where the move home starts (the scan pose, or where the re-scan left the
-arm), then the welding program. A weld run shows what the arm did (the execution's record), a preview the plan;
-without a plan the robot stands at its scan pose at 0. The motion, subsampled to ``MOTION_HZ`` (plus every arc
-switch), the link poses at those instants, the tool path and the marks are the run view's
-(:class:`~cell.types.view.ArmMotion`, computed once by :func:`cell.pipeline.scene_view.arm_motion`): nothing here
-knows the robot's model.
-
-The file is written in one piece (:func:`cell.export.atomic.write_atomic`); the recording id is derived from the
-run (scenario, method, whether it moved), so two recordings of the same run open as the same recording.
-"""
+"""A Rerun recording of a run (``cell weld --rerun FILE.rrd``, ``cell preview --rerun FILE.rrd``): the cell, the seams,
+the cameras and the robot along the motion on one timeline (what it holds: docs/cli.md, "Pictures and
+recordings"), from the run's values only (the motion: its view's :class:`~cell.types.view.ArmMotion`). The only
+module that imports ``rerun`` (an optional extra), and only inside its functions."""
 
 from __future__ import annotations
 

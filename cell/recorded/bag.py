@@ -1,21 +1,5 @@
-"""ROS 2 bags to a capture folder: depth images, their CameraInfo and their poses from tf (the only rosbags importer).
-
-What a bag gives (:func:`read_bag`): every depth camera's ``sensor_msgs/msg/Image`` topic (encoding ``16UC1``,
-millimetres, the ROS convention, or ``32FC1``, metres; 0, NaN and infinite pixels are invalid), the
-``sensor_msgs/msg/CameraInfo`` beside it (the topic ``camera_info`` in the image topic's namespace), and the pose
-of the image's ``header.frame_id`` (its optical frame, z forward) in the robot's base frame, chained through
-``tf_static`` and ``tf`` (``tf2_msgs/msg/TFMessage``) at the image's stamp (:mod:`cell.recorded.tf_tree`: each
-moving transform taken at its sample nearest the stamp). One image per camera: the first, or the one recorded
-nearest ``time`` [s from the bag's start]. A camera whose optical frame hangs below a moving link is an
-eye-in-hand camera with its pose at its stamp.
-
-CameraInfo's pixel convention is the project's (integer pixel coordinates at pixel centres), so K's
-(fx, fy, cx, cy) are used as they are. A distorted image (a non-zero D) is refused rather than used as if it were
-a pinhole: record the rectified depth (``image_rect_raw``), whose D is zero.
-
-:func:`capture_from_bag` writes what it read as a capture folder (docs/capture.md) with the robot base as the world
-(X_WR identity). Bad input is a one-line :class:`~cell.errors.CaptureError` naming the bag, never a traceback.
-"""
+"""ROS 2 bags to a capture folder: depth images, their CameraInfo and their poses from tf (the only rosbags importer;
+what is read and how: docs/bags.md). Bad input is a one-line :class:`~cell.errors.CaptureError` naming the bag."""
 
 from __future__ import annotations
 

@@ -1,12 +1,6 @@
-"""The cell a capture was taken in: ``cell.yaml`` written from a scenario, and the scenario a replay runs.
-
-- :func:`cell_yaml`: the scenario as YAML without its ``simulation:`` section (what a real cell is told; keys at
-  their defaults left out, as a hand-written scenario would), its ``map.file`` the bare name of the map copied
-  beside it, so the folder needs nothing else.
-- :func:`replay_scenario`: the scenario of a capture folder: its ``cell.yaml`` (the map and its placement
-  overridable), or, for a capture with none (one converted from a bag), a cell synthesised around the map placed
-  where it is told to be, with the capture's cameras. Frames: W the capture's world, R its robot base, M the map.
-"""
+"""The cell a capture was taken in: ``cell.yaml`` written from a scenario (without ``simulation:``, the map copied
+beside it), and the scenario a replay runs (that file, or a cell synthesised around the map for a capture with
+none). Frames: W the capture's world, R its robot base, M the map."""
 
 from __future__ import annotations
 

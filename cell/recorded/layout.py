@@ -1,17 +1,5 @@
-"""The capture folder (docs/capture.md): what the cameras of a cell saw, written so a real cell could write it too.
-
-One folder per capture::
-
-    capture.json            the index: format and version, provenance, X_WR, one entry per camera
-    <camera>.depth.png      16-bit depth units (0 = invalid), ``depth_scale_m`` metres per unit
-    cell.yaml               the cell it was taken in (the scenario without ``simulation:``), when known
-    <map>.dxf               the welding map ``cell.yaml`` names, copied beside it
-    truth.json              the as-built parts (frame W), when the station knows them; never read by perception
-
-Per camera the index holds its ROS ``CameraInfo`` fields, its pose ``X_RC`` in the robot frame R (and ``X_WC``, so
-a replay hands perception the very floats the capture had), its mount and, for an eye-in-hand camera, the flange
-pose ``X_RF`` when it took the image. Poses are 4 x 4 row-major [m].
-"""
+"""The capture folder: what the cameras of a cell saw (16-bit depth PNGs, their CameraInfo and poses, the cell it was
+taken in, the truth apart), written so a real cell could write it too (docs/capture.md)."""
 
 from __future__ import annotations
 

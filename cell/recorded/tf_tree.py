@@ -1,14 +1,6 @@
-"""A tf tree as a recording holds it: static and timed transforms between named frames, chained on demand.
-
-What ROS's tf2 keeps, reduced to what a capture needs (numpy only; the bag reader fills it): every frame has at
-most one parent; a static edge has one transform, a dynamic edge a series of stamped samples. :meth:`TfTree.lookup`
-chains the edges from a base frame to a target frame through their common ancestor, each dynamic edge taken at
-its sample *nearest* the asked stamp (no interpolation: a camera's image is matched to the arm's pose recorded
-closest to it, and the gap is reported so the caller can judge it).
-
-Frames are names without a leading ``/`` (tf2's convention; ROS 1 bags often carry one). Poses ``X_PC`` (4, 4):
-child C in parent P [m]; stamps are integer nanoseconds.
-"""
+"""A tf tree as a recording holds it: static and timed transforms between named frames, chained on demand, each
+moving edge taken at its sample nearest the asked stamp (docs/bags.md, "Poses from tf"). Numpy only; frames are
+names without a leading ``/``, poses ``X_PC`` (4, 4) [m], stamps integer nanoseconds."""
 
 from __future__ import annotations
 

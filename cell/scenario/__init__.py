@@ -3,8 +3,7 @@
 Everything about a cell lives in a scenario file under ``scenarios/``, never in code. An unknown or misspelled key,
 a value out of range or a missing file is a :class:`~cell.errors.ScenarioError` with a one-line message naming the
 key and what is valid. Lengths in the file are metres (keys end in ``_m``) or millimetres (``_mm``), angles degrees
-(``_deg``); :class:`Scenario` converts nothing implicitly: accessors named ``*_rad`` / ``X_*`` do it in one place.
-"""
+(``_deg``); :class:`Scenario` converts nothing implicitly: accessors named ``*_rad`` / ``X_*`` do it in one place."""
 
 # cell_specs: what the cell is (map, part as built, table, robot, cameras, sensor model); run_specs: how it works
 # (process, perception, re-scan, motion, export, simulation, simulated faults); locator_specs: which locator and its

@@ -1,21 +1,6 @@
-"""A scenario for any welding map (``cell init``): the cell laid out around the part's bounds, as YAML with a
-comment on every key.
-
-The layout is the one the shipped fence scenarios use (``scenarios/fence1.yaml``, ``fence2.yaml``), expressed
-relative to the part so that it carries over to another drawing:
-
-- the part lies flat on the table top (z = 0.90 m) with its centre at (0.15, 0.0) in the world, unrotated;
-- the table is the part's footprint grown by 0.2 m on each side, at least the shipped 2.0 x 1.2 m;
-- the KR 5 arc stands 0.45 m in front of the table's near edge (-y), at table-top height, facing +y, at the
-  part's centre in x (fence1's farthest seams, 1.44 m from the base horizontally, are still welded);
-- fixed cameras 1.0 m above the part's top, 0.85 m to either side of the point they look at (the part's centre;
-  a part longer than 1.6 m is cut into sections along x, each with its own pair), mounted portrait;
-- the eye-in-hand camera's scan pose 1.05 m above the part's top and 0.45 m in front of its centre;
-- the workspace is the part's bounds grown by 0.15 m in x and y (rounded out to 5 cm), from 5 mm above the table
-  top (the table itself is cropped away) to 0.2 m above the part.
-
-Nothing here simulates a fault: no deviations, no placement error, exact calibration, the default sensor noise.
-"""
+"""A scenario for any welding map (``cell init``): the cell laid out around the part's bounds as the shipped fence
+scenarios are around theirs, as YAML with a comment on every key; an exact build, no faults (the layout rules:
+docs/cell.md, "Your own part")."""
 
 from __future__ import annotations
 

@@ -28,7 +28,7 @@ class RansacLocatorSpec(Model):
 
 class OursLocatorSpec(Model):
     """Our map-guided locator: the two weld faces fitted near the map's seam, intersected, the ends found; it beats
-    both others (README, ``cell bench``)."""
+    both others (docs/results.md, ``cell bench``)."""
 
     method: Literal["ours"] = "ours"
     options: OursSettings = OursSettings()

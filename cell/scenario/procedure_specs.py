@@ -1,11 +1,6 @@
-"""Weld procedures in a scenario: the WPS table (``procedures:``, or ``procedures_file:`` naming a YAML file beside
-the scenario) validated row by row and converted to :class:`cell.types.WeldProcedure` values.
-
-Units as a WPS states them: millimetres, degrees, seconds, amperes, volts, metres per minute. The planner picks
-the first row whose joint type, position and leg range fit a seam (:mod:`cell.motion.process.procedures`); with no
-table, one row made from ``process:`` (:func:`default_procedure`) applies to every seam, so a scenario without
-procedures plans as before, except that vertical seams are welded upwards.
-"""
+"""Weld procedures in a scenario: the WPS table (``procedures:``, or ``procedures_file:`` beside the scenario)
+validated row by row into :class:`cell.types.WeldProcedure` values, in a WPS's units; with no table, one row made
+from ``process:`` (:func:`default_procedure`) applies to every seam."""
 
 from __future__ import annotations
 

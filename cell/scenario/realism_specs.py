@@ -1,7 +1,8 @@
 """``simulation:`` options that make the simulated part and sensors more like real ones (docs/bodies.md section 7).
 
-Every option is off (None or empty) by default, so a scenario without them gives the same numbers as before, bit
-for bit. All are seeded from the scenario's seed (``Scenario.rng``). Lengths in millimetres, angles in degrees.
+Every option is off (None or empty) by default: a scenario without them simulates the part as drawn with the
+scenario's deviations, and the sensors by their noise model alone. All are seeded from the scenario's seed
+(``Scenario.rng``). Lengths in millimetres, angles in degrees.
 """
 
 from __future__ import annotations

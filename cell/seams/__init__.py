@@ -1,12 +1,6 @@
-"""Seams: pair each map seam with its joint, tell whether a camera can see it, locate it, and score it.
-
-The public names are listed in ``__all__`` and load on first use (``from cell.seams import OursLocator`` imports
-only the ours locator's modules, as :func:`make_locator` does): the locators and their options, the registry
-(:data:`METHODS`, :func:`make_locator`), joints, truth and metrics; the values they read and return (the scene,
-joints, estimates, metrics) are in :mod:`cell.types`. Visibility is the module :mod:`cell.seams.visibility` (its
-function ``visibility`` shares the module's name, so the package does not re-export it). The modules with a
-leading underscore are this package's own; nothing outside it imports them.
-"""
+"""Seams: pair each map seam with its joint, tell whether a camera can see it, locate it, and score it. The public
+names load on first use (``from cell.seams import OursLocator`` imports only that locator's modules); the values
+they read and return are in :mod:`cell.types`; modules with a leading underscore are this package's own."""
 
 from __future__ import annotations
 

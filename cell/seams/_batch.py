@@ -1,15 +1,6 @@
-"""Robust offsets of several planes at once: one vectorised fit for every face a seam locator measures.
-
-A seam needs the offsets of up to four planes (two weld faces and the side faces at its ends), each from a few
-hundred to a few thousand points, each camera with its own noise; a scene's seams, dozens of planes. Fitted one by
-one, the per-call overhead of numpy dominates; here the planes' residuals are concatenated, one segment per plane,
-and every step (histogram mode, per-camera robust scale, Tukey-biweight IRLS, sandwich standard error) runs once
-for all of them, with ``np.add.reduceat`` doing the per-plane sums. The weld faces' tilt steps
-(:func:`tilt_fits`) are batched the same way.
-
-Residuals ``r`` are signed distances [m] of points from each plane's reference (its current estimate); the fit
-returns how far each plane moves along its normal.
-"""
+"""Robust offsets of several planes at once: one vectorised fit (histogram mode, per-camera robust scale,
+Tukey-biweight IRLS, sandwich standard error) for every face the seams of a scene measure, and the weld faces'
+tilt steps batched the same way. Residuals are signed distances [m] from each plane's current estimate."""
 
 from __future__ import annotations
 

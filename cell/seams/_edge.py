@@ -1,11 +1,6 @@
-"""Placing a face no camera sees from the edge where an adjacent face of the same part ends (our locator's step
-4, :mod:`cell.seams.ours`).
-
-A weld face can be hidden from every camera (too oblique, occluded) while an adjacent face of the same part is
-seen: that face's points end where the hidden face begins. The extent of those points across the edge, measured
-per camera with a blurred-step likelihood (:func:`cell.seams._extent.edge_fit`), places the hidden face, with a
-standard error from the edge's own data. Everything is in the robot frame R, metres.
-"""
+"""Placing a face no camera sees from the edge where an adjacent face of the same part ends (our locator's step 4):
+the extent of that face's points across the edge, per camera by a blurred-step likelihood, with a standard error
+from the edge's own data. Everything in the robot frame R, metres."""
 
 from __future__ import annotations
 

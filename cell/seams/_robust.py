@@ -1,12 +1,6 @@
 """A robust offset of one plane: the scalar IRLS (Tukey biweight, per-camera noise) that places a face from an
-adjacent face's edge (:mod:`cell.seams._edge`).
-
-It is not :func:`cell.seams._batch.fit_offsets` for a batch of one: it starts from the median of the densest
-window, measures each camera's scale on a subsample and pools the others' as one MAD, runs up to 10 iterations and
-reports the MAD of its inliers. The batched fit differs in each: as a batch of one here, it moved fence1's two
-edge-placed seams by up to 31 um (and one's confidence from 0.28 to 0.34), so both stay.
-Residuals ``r`` are signed distances [m] of points from the plane's reference (its map estimate).
-"""
+adjacent face's edge, kept apart from the batched fit (docs/bodies.md section 8, "A face placed from an edge").
+Residuals ``r`` are signed distances [m] of points from the plane's reference (its map estimate)."""
 
 from __future__ import annotations
 

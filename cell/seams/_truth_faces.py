@@ -1,20 +1,5 @@
-"""The true seam of a joint between any two bodies (boxes or polyhedra; docs/bodies.md), numpy only.
-
-The seam lies on the line L where the planes of the two as-built weld faces meet: A's ``face_abutting`` and B's
-``face_receiving``. It is clipped to the faces' common extent along L:
-
-* A's extent is the projection onto L of A's edge between ``face_abutting`` and ``end_face`` (the edge that meets
-  B; a gap or a small rotation moves it off L, its extent along L stays), exactly: every vertex of A on both
-  faces' planes (so a face the drawing split in several keeps its whole edge), and the corners the two faces'
-  polygons share (a face warped as built, its corners off its fitted plane). Where no two vertices lie on both,
-  the part of A's face polygon nearest to L is taken (within the tolerance of its nearest point), grown by the
-  tolerance;
-* B's extent is the chord of L through B's face polygon (L lies in B's plane), or through the region its faces in
-  that plane make together (a plate's top drawn as quads around a hole), grown by the tolerance.
-
-Start and end follow the map seam, carried onto the as-built A by the rigid motion that best maps A's designed
-vertices onto its as-built ones (any frame of the design works: the side of a part turned over too).
-"""
+"""The true seam of a joint between any two bodies (boxes or polyhedra), numpy only: the line where the planes of the
+two as-built weld faces meet, clipped to the faces' common extent along it (docs/bodies.md section 3)."""
 
 from __future__ import annotations
 

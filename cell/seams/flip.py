@@ -1,13 +1,6 @@
-"""Which turn of the part exposes the seams its first side leaves against the table (docs/flip.md).
-
-Values only, from the aligned map: the part (all its parts one rigid body) is turned about one of its principal
-axes through its centre, settles on the facet of its convex hull under its centre of mass
-(:func:`cell.resting.set_down`) and is set down at the same place. A turn is kept when the part rests stably (its
-centre of mass over its support, leaning at most ``max_tilt_rad``) and inside the table; among those, the one that
-exposes the most seams left (each must be visible after the turn, :func:`cell.seams.visibility.visibility`, and
-face up) wins, a half turn about the longest axis first. Seams no turn exposes are named with the reason, before
-anything moves.
-"""
+"""Which turn of the part exposes the seams its first side leaves against the table: values only, from the aligned
+map; the turns that rest stably on the table ranked by the seams they expose, the seams no turn exposes named with
+the reason (docs/flip.md)."""
 
 from __future__ import annotations
 

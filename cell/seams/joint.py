@@ -1,16 +1,6 @@
-"""How each seam of a welding map is made, from the geometry alone: which part abuts, which receives, which
-faces.
-
-A seam of a T, corner or lap fillet lies on a face of the receiving part B, where that face meets the plane of
-one of the side faces of the abutting part A, whose end face lies flat against B across a small gap (antiparallel
-to B's face: a mitred brace's end lies on the post). The two weld faces meet at any dihedral between
-``MIN_DIHEDRAL_DEG`` and ``MAX_DIHEDRAL_DEG`` (90 degrees for boxes). Faces are any of a part's
-:meth:`~cell.types.Part.face_names` (a box's ``"+x"``..., a polyhedron's ``"f0"``...). :func:`find_joints`
-recovers that :class:`~cell.types.Joint` for every seam without reading the seam id; :func:`weld_faces`,
-:func:`fillet_bisector`, :func:`dihedral` and :func:`weld_geometry` give the two faces' planes, the direction out
-of the fillet corner and the angle between the faces (for the torch and the locators); :func:`joint_kind` says T,
-corner or lap. All geometry is in the map's own frame (whatever ``weldmap.frame`` is), metres and radians.
-"""
+"""How each seam of a welding map is made, from the geometry alone: which part abuts, which receives, which faces
+(T, corner or lap fillets at any dihedral in range), and the faces' planes, bisector and angle for the torch and the
+locators. All in the map's own frame, metres and radians."""
 
 from __future__ import annotations
 

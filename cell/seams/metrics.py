@@ -1,12 +1,5 @@
-"""Seam accuracy against ground truth: metres in (frame R), millimetres out.
-
-``paper_me_mm`` is the paper's measure (Table 1, "ME is the summation of ME values along the x and y-axes"):
-per seam, the mean over its two end points of |dx| + |dy| in the robot frame. ``endpoint_mm`` is the mean 3D
-distance of the end points, ``lateral_mm`` the largest distance of the detected segment from the true seam
-line (what the torch feels). Detected ends are matched to true ends first (swapped when the locator reports
-the seam reversed). ``end_along_mm`` is each end's signed error along the true seam (start, end): positive past the
-true end (the located seam longer there), negative short of it.
-"""
+"""Seam accuracy against ground truth, metres in (frame R), millimetres out: the paper's ME, the end points' error,
+the lateral error and each end's signed error along the true seam (their definitions: docs/report.md)."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""The paper's seam locator (section 3.6): masks around the map seam, boundary points, extremes and
-frequencies.
-
-Everything is in the robot frame R, metres. The features of a mask's points (KD-tree, point spacing, normals,
-boundary points: :mod:`cell.seams._features`) are computed with numpy/scipy for each mask, as the paper's step 2
-does ("from the masked point cloud, extract boundary points"); every threshold derives from the cloud's own point
-spacing (the voxel size of a voxel-downsampled cloud) or from :class:`~cell.config.seams.PaperOptions`.
-"""
+"""The paper's seam locator (section 3.6): masks around the map seam, boundary points, extremes and frequencies, every
+threshold from the cloud's own point spacing (docs/locate.md, "The two baselines"). Everything in R, metres."""
 
 from __future__ import annotations
 

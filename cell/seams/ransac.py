@@ -1,19 +1,5 @@
-"""The baseline: Takubo et al. as the paper ran it (RANSAC planes, weld line = their intersection).
-
-As in the paper (section 4, Table 1), by default on the 1 cm voxel-downsampled cloud (``scene.cloud``), three
-independent runs per seam. In a region around the map's seam (the paper's "slight enhancement": search only
-near the seam), planes are segmented one after the other with RANSAC (vectorised numpy, hypotheses drawn from
-the given ``rng``, so a run is deterministic for a given seed) and refitted to their inliers by least squares.
-The joint's two planes are the largest ones whose normals match the map's two weld faces and that pass near
-the map's seam; a run that finds no such pair finds nothing (the method has no other way to tell which planes
-make the joint). The weld line is their intersection, clipped to the extent along it of both planes' inliers
-near the line (less a band along the corner, where both planes' points mix, and a small quantile at each
-end). The median of the runs that found the pair is reported, its confidence from their agreement.
-
-Thresholds that depend on the point spacing (inlier distance, the least plane, the clipping radius and band)
-are derived in one place, :meth:`RansacOptions.thresholds`, from the spacing measured in the region, so the
-same options serve the voxel cloud and the dense one (``cloud="dense"``).
-"""
+"""The baseline: Takubo et al. as the paper ran it (RANSAC planes, the weld line their intersection), three seeded runs
+per seam on the 1 cm cloud by default (docs/locate.md, "The two baselines")."""
 
 from __future__ import annotations
 

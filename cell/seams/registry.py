@@ -1,10 +1,5 @@
-"""Locators by name: the one registry that knows which ``--method`` builds which locator from which spec.
-
-:data:`LOCATORS` maps a method name to its spec class (the scenario's ``locator`` when ``locator.method`` is that
-name: :mod:`cell.scenario.locator_specs`) and the factory that builds the locator from the spec and the scenario;
-:data:`METHODS` and every list of method names (the CLI's ``--method``, ``cell bench``) derive from it. A method
-other than the scenario's runs with its spec's defaults (:func:`locator_spec`).
-"""
+"""Locators by name: the one registry that knows which ``--method`` builds which locator from which spec; every list
+of method names derives from it, and a method other than the scenario's runs with its spec's defaults."""
 
 from __future__ import annotations
 

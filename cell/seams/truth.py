@@ -1,16 +1,5 @@
-"""Ground truth of the seams of the part as it was really built (simulation only; exact, no noise).
-
-Two boxes (the fast path, unchanged): the true seam of a joint is the edge of the abutting part A where its weld
-face ``face_abutting`` meets its ``end_face`` (the edge nearest to the receiving part B), carried across the gap
-along A's end-face normal onto the plane of B's ``face_receiving``. Carrying it along A's own axis keeps the seam
-on both weld-face planes (the fillet corner); when A's end face is parallel to B's face it is the same as the
-orthogonal projection.
-
-Any other pair of bodies (:func:`cell.seams._truth_faces.general_seam_W`, docs/bodies.md): the true seam lies on the
-line where the planes of the two as-built weld faces meet, clipped to their common extent along it: A's extent is
-that of its edge between ``face_abutting`` and ``end_face`` (the edge that meets B, across any gap), B's the chord
-of the line through B's face polygon, each grown by a small tolerance.
-"""
+"""Ground truth of the seams of the part as it was really built (simulation only; exact, no noise): two boxes by
+their edge carried across the gap, any other pair by their as-built weld faces (docs/bodies.md section 3)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,5 @@
-"""Which seams a camera above the table can see: a seam against the table cannot be seen (nor welded) as it
-lies.
-
-No axis names are assumed for the parts (boxes or polyhedra alike): a weld face is "on the table" when its
-actual outward normal points down (against the robot frame's +z, the direction in which ``table_z`` is
-measured) and every vertex of its polygon lies at the table top.
-"""
+"""Which seams a camera above the table can see: a seam against the table (a weld face whose outward normal points
+down, every vertex at the table top) cannot be seen nor welded as it lies. No axis names are assumed for the parts."""
 
 from __future__ import annotations
 

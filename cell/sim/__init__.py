@@ -1,15 +1,6 @@
-"""The simulated cell: the only package that imports pybullet.
-
-- :mod:`cell.sim.noise`: depth-sensor error model (numpy only).
-- :mod:`cell.sim.camera`: pinhole intrinsics <-> OpenGL matrices, depth-buffer linearisation (numpy only).
-- :mod:`cell.sim.faults`: broken cameras, objects the map does not know, parts not built (numpy only).
-- :mod:`cell.sim.execution`: :class:`Execution`, what playing back a trajectory recorded (numpy only).
-- :mod:`cell.sim.robot`: :class:`SimRobot`, the arm in the PyBullet client, and the weld bead.
-- :mod:`cell.sim.cell`: :class:`SimCell`, which owns a PyBullet client, builds the cell and renders cameras.
-
-``from cell.sim import SimCell`` (or ``SimRobot``, ``BeadStyle``) imports pybullet only when the name is first
-asked for; the numpy-only names are imported with the package.
-"""
+"""The simulated cell, the only package that imports pybullet: the sensor model, cameras, faults and execution records
+(numpy only), the arm and the cell. ``from cell.sim import SimCell`` imports pybullet only when the name is first
+asked for."""
 
 from __future__ import annotations
 

@@ -1,12 +1,5 @@
-"""Static bodies of the simulated cell: a box as PyBullet's box, any other closed body from its mesh (docs/bodies.md).
-
-A polyhedral part is rendered from its triangles (``createVisualShape`` with ``GEOM_MESH``, vertices and indices, so
-the depth cameras see exactly its faces) and collided as a concave triangle mesh (``GEOM_FORCE_CONCAVE_TRIMESH``:
-allowed for static bodies, nothing here moves by physics). The mesh's vertices are given about the body's centroid
-and the body is placed there, so moving a body later (the part turned over) moves its base like a box's.
-
-Every body is static (mass 0); poses and vertices in the world W [m].
-"""
+"""Static bodies of the simulated cell: a box as PyBullet's box, any other closed body rendered and collided from its
+mesh about its centroid (docs/bodies.md section 1). Every body is static; poses and vertices in the world W [m]."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""Pinhole camera <-> OpenGL matrices for PyBullet's renderer, numpy only.
-
-Intrinsics follow the usual computer-vision convention: pixel (column u, row v) has its centre at
-integer (u, v), ``u = fx x/z + cx``, ``v = fy y/z + cy`` in the optical frame C (z forward, x right, y down).
-
-PyBullet's TinyRenderer fills pixel (u, v) with what it sees at OpenGL window coordinates (u, H - 1 - v)
-(pixel corners, not centres, and rows flipped), which we measured by deprojecting renders of tilted planes (a
-half-pixel error shows as ~0.4 mm on a 45-degree plane at 1.4 m). The projection matrix below includes that
-offset, so that the intrinsics we report are exact for the rendered image.
-"""
+"""Pinhole camera <-> OpenGL matrices for PyBullet's renderer, numpy only: pixel centres at integer (u, v) in the
+optical frame C (z forward, x right, y down), the renderer's half-pixel offset built into the projection so the
+reported intrinsics are exact for the rendered image (docs/reference.md section 2)."""
 
 from __future__ import annotations
 

@@ -1,16 +1,6 @@
-"""The simulated cell: one object owns its PyBullet client, builds the as-built cell, renders depth cameras.
-
-The world frame W has z up; the ground is the plane z = 0. Bodies are static, found by name (``"ground"``,
-``"table"``, each part's name and ``fixture:<name>`` for the map's fixtures), never by index: boxes as boxes, any
-other body from its mesh (:mod:`cell.sim.bodies`, docs/bodies.md). Cameras render with PyBullet's TinyRenderer
-(headless, CPU), also when a GUI is shown, because its sampling is the one :mod:`cell.sim.camera` models
-exactly.
-
-An arm can be added with :meth:`SimCell.load_robot` (see :mod:`cell.sim.robot`): it is then posed by joint
-values, plays back timed joint trajectories (:meth:`SimCell.execute`), draws the weld bead where the arc is on,
-and carries the eye-in-hand camera. Its links render in every camera, as a real arm would: put it in a scan
-pose out of the fixed cameras' way before capturing.
-"""
+"""The simulated cell: one object owns its PyBullet client, builds the as-built cell (bodies found by name, never by
+index) and renders depth cameras with the TinyRenderer (headless, the sampling :mod:`cell.sim.camera` models); an
+arm added to it plays back trajectories, draws the bead and carries the eye-in-hand camera. World frame W, z up."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""What the simulated arm did while playing back a joint trajectory: the record, numpy only.
-
-:meth:`SimRobot.play <cell.sim.robot.SimRobot.play>` checks the trajectory (:func:`_check_trajectory`),
-samples it at the record times (:func:`_record_times`, :func:`_interp_rows`), reads the tool pose there from
-PyBullet and logs the arc switches (:func:`_events`) into an :class:`Execution`.
-
-Frames: ``W`` world. Units: metres, radians, seconds.
-"""
+"""What the simulated arm did while playing back a joint trajectory, as a record (numpy only): the trajectory checked,
+sampled at the record times, the tool pose read there and the arc switches logged. Frame W; metres, radians, seconds."""
 
 from __future__ import annotations
 

@@ -1,17 +1,6 @@
-"""Simulated faults of the cell, numpy only: broken cameras, objects the map does not know, parts not built.
-
-Driven by the scenario's ``faults:`` section (:class:`~cell.scenario.FaultsSpec`) and applied by
-:class:`~cell.sim.cell.SimCell`; perception never sees this module, only what a faulty cell delivers:
-
-- a camera ``dead`` returns no valid pixel (0 everywhere: unplugged, blinded, projector off);
-- ``random`` returns a depth drawn uniformly between its near and far planes for every pixel (a corrupted
-  stream); ``constant`` returns one value everywhere (a stuck sensor); ``salt`` replaces ``fraction`` of the
-  pixels by random depths (interference from another projector, a failing emitter);
-- an occluder is a box in the world (a clamp on the part, a cable across it), rendered like any body;
-- a missing part is not put on the table (its body is not built; the map still draws it).
-
-Depth images are (H, W) [m] along the optical axis, 0 = invalid.
-"""
+"""Simulated faults of the cell, numpy only: broken cameras, objects the map does not know, parts not built, applied
+by the simulated cell from the scenario's ``faults:`` (docs/cell.md, "Faults the simulator plays").
+Depth images are (H, W) [m] along the optical axis, 0 = invalid."""
 
 from __future__ import annotations
 

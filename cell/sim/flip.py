@@ -29,7 +29,7 @@ def body_points(parts_W: Sequence[Part], beads_W: FloatArray, bead_radius_m: flo
 
 
 def body_volume(part: Part) -> float:
-    """The volume [m^3] of a part's body: a box's edge lengths multiplied (exactly as before meshes), a polyhedron's
+    """The volume [m^3] of a part's body: a box's edge lengths multiplied, a polyhedron's
     from its closed surface (signed tetrahedra from its triangles: :attr:`cell.types.Polyhedron.volume`, whose centre
     of mass :attr:`cell.types.Part.center` is the same sum's centroid)."""
     return float(np.prod(part.box.size)) if part.is_box else float(part.volume)

@@ -1,26 +1,7 @@
-"""A depth-sensor error model, numpy only (docs/reference.md section 2).
-
-What a real depth camera does to a perfect depth image, driven by a :class:`~cell.scenario.NoiseSpec` and an
-``np.random.Generator`` (never a global RNG):
-
-- ``active_stereo`` (Intel RealSense D4xx): the error lives in disparity ``d = fx * B / z`` [px]. Gaussian
-  subpixel noise (RMS ``subpixel_px``) is added to ``d``, ``d`` is quantised to ``disparity_step_px`` and
-  turned back into depth, which gives ``sigma_z = z^2 * s / (fx * B)`` (Intel, "Tuning depth cameras for best
-  performance"); the depth is then quantised to ``depth_unit_m``.
-- ``structured_light`` (Kinect v1): Gaussian noise in depth with the axial model of Nguyen, Izadi and Lovell
-  (2012), ``sigma_z = 0.0012 + 0.0019 (z - 0.4)^2 + 0.0001 / sqrt(z) * theta^2 / (pi/2 - theta)^2`` [m], theta
-  the incidence angle; then quantised to ``depth_unit_m``. (Baseline, subpixel and disparity step are not used
-  by this model.)
-- both: pixels seen at grazing incidence beyond ``grazing_dropout_deg`` drop out (0), and at depth
-  discontinuities (a 4-neighbour more than ``edge_jump_m`` nearer or farther) ``edge_invalid_fraction`` of the
-  edge pixels come back wrong: ``edge_flying_fraction`` of those as "flying pixels" (a depth between the two
-  sides of the jump), the rest 0.
-- ``none``: the image is returned unchanged (as float32).
-
-Specular dropout (``simulation.specular_dropout``, off by default): :func:`specular_dropout`, applied after the
-model. Lateral noise is not modelled.
-Depth images are (H, W) [m] along the optical axis, 0 = invalid.
-"""
+"""A depth-sensor error model, numpy only (docs/reference.md section 2): active stereo (D4xx) or structured light
+(Kinect v1) noise, quantisation, grazing dropout and invalid or flying pixels at depth edges, driven by a
+:class:`~cell.scenario.NoiseSpec` and a generator (never a global RNG); specular dropout on request.
+Depth images are (H, W) [m] along the optical axis, 0 = invalid."""
 
 from __future__ import annotations
 

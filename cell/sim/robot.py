@@ -1,17 +1,6 @@
-"""The arm inside the simulated cell: load a URDF, pose it by joint name, play back timed joint trajectories.
-
-A :class:`SimRobot` lives in the PyBullet client of a :class:`~cell.sim.cell.SimCell` (which creates it through
-``SimCell.load_robot``). Joints and links are found by name, never by index. Poses come from PyBullet's own
-forward kinematics (``getLinkState``), so a recorded tool path is an independent check of the Pinocchio model
-in :mod:`cell.motion.robot`.
-
-Playback is kinematic (``resetJointStatesMultiDof`` at each record time, no dynamics): deterministic and about
-10 us per sample, so minutes of robot time replay in well under a second. While the arc is on, the torch's
-path is drawn as a weld bead: visual-only capsules (no collision shape) that show up in rendered images. What
-a playback records (:class:`~cell.sim.execution.Execution`) is numpy only, in :mod:`cell.sim.execution`.
-
-Frames: ``W`` world, ``R`` robot base (URDF root link, KUKA $ROBROOT). Units: metres, radians, seconds.
-"""
+"""The arm inside the simulated cell: a URDF posed by joint name, timed joint trajectories played back kinematically
+(deterministic, no dynamics), poses from PyBullet's own forward kinematics (an independent check of the Pinocchio
+model), and the weld bead drawn where the arc is on. Frames: W world, R robot base. Units: metres, radians, seconds."""
 
 from __future__ import annotations
 

@@ -1,19 +1,6 @@
-"""The station's ports: what the pipeline may ask of a running cell, whatever drives it.
-
-A station is the boundary between the stages (values in, values out) and the world: the simulator today
-(:class:`cell.station.sim.SimStation`), a recorded capture or the real cell later. Only the pipeline talks to a
-station; no stage receives one. The ports are those a real cell offers (cf. Drake's ``MakeHardwareStation``: the
-same ports for simulation and hardware):
-
-- :meth:`Station.capture`: one image from every camera, the arm holding the eye-in-hand camera at its scan pose;
-- :meth:`Station.capture_eye_in_hand`: one image from a camera on the arm, wherever the arm is now;
-- :meth:`Station.execute`: drive the arm along a timed joint trajectory (arc on where asked) and record it;
-- :meth:`Station.joint_state`: where the arm is;
-- :meth:`Station.turn_part`: the part turned over for its second side (an operator's job on a real cell);
-- :meth:`Station.truth`: the as-built parts, when the station knows them (a simulation does; a real cell does not).
-
-Frames: W world, R robot base; metres, radians, seconds.
-"""
+"""The station's ports: what the pipeline may ask of a running cell, whatever drives it (the simulator, a recording,
+a real cell), as Drake's hardware station offers the same ports for simulation and hardware: capture, a close-up
+capture, execute, joint state, the turn, the truth (docs/architecture.md, "A station"). Frames: W, R; SI units."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""A station served from a recorded capture folder (docs/capture.md): the cameras' images as they were taken.
-
-It implements the ports of :mod:`cell.station.ports` without the simulator (an import-linter contract keeps
-pybullet and ``cell.sim`` out of it): :meth:`RecordedStation.capture` hands back the recorded images, bit for bit,
-:meth:`RecordedStation.truth` the recorded as-built parts (or None), and anything that would move the arm or take a
-new image is refused: a recording cannot be asked for what it did not record. The arm is None: no port that
-needs it can be served.
-"""
+"""A station served from a recorded capture folder (docs/capture.md): the recorded images bit for bit and the
+recorded truth, without the simulator; anything that would move the arm or take a new image is refused."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""A sweep's pictures (matplotlib, headless): per-seam risk on the part's top view, and error histograms.
-
-- ``risk.png``: the map's parts seen from above (frame M, as drawn, millimetres) with each seam drawn in the colour
-  of its probability within the weld tolerance (red: never, green: always; the riskiest drawn last, on top), and
-  beside it per seam the probabilities found, within tolerance and planned / welded as bars;
-- ``errors.png``: per seam found at least once, the histogram of its lateral error [mm] with the tolerance marked.
-"""
+"""A sweep's pictures (matplotlib, headless): ``risk.png``, each seam on the part's top view in the colour of its
+probability within the weld tolerance with its probabilities as bars, and ``errors.png``, per seam the histogram of
+its lateral error (docs/sweep.md)."""
 
 from __future__ import annotations
 

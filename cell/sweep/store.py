@@ -1,11 +1,6 @@
-"""A sweep's output folder: what the sweep is (``sweep.json``), one line per finished run (``runs.jsonl``,
-appended and flushed as each finishes), the runs' timings apart (``timings.jsonl``).
-
-Resume: a folder written by the same sweep (the same parameters: scenario content, map, vary, stage, method) keeps
-its finished runs and the sweep runs the rest; one written by a different sweep is a UsageError (exit 2) unless
-``fresh``. A line that cannot be read (the last one, torn by a kill mid-write) is dropped with a warning and the
-file cut back to its last whole line, so the next append starts on a line of its own.
-"""
+"""A sweep's output folder: what the sweep is (``sweep.json``), one line per finished run (``runs.jsonl``) and the
+runs' timings apart; resumed by the same sweep, refused to another unless ``fresh``, a torn last line dropped
+(docs/sweep.md, "The output folder")."""
 
 from __future__ import annotations
 

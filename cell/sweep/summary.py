@@ -1,10 +1,5 @@
-"""A sweep's summary: per seam, how often it was found, within the weld tolerance, planned and welded, and the
-percentiles of its errors, from the runs' lines (runs.jsonl); ``summary.json``.
-
-A failed run (its task raised or its worker died: no seam figures) counts in ``failed`` and in no seam's
-probability: it says nothing about the seams. A run whose detection failed (e.g. the map could not be aligned)
-is not failed: its seams count as not found.
-"""
+"""A sweep's summary (``summary.json``): per seam how often it was found, within the weld tolerance, planned and
+welded, and its errors' percentiles, from the runs' lines; a failed run counts in no seam's probability."""
 
 from __future__ import annotations
 

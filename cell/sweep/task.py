@@ -1,11 +1,6 @@
-"""One run of a sweep: build the varied scenario, run the pipeline to the sweep's stage, and say per seam what
-became of it, as plain JSON values.
-
-Stages (docs/sweep.md): ``detect`` (capture, perceive, align, locate), ``plan`` (detect, then plan and run the
-safety gate: nothing moves, no close-up re-scan), ``weld`` (the whole of ``cell weld``: re-scan, plan, gate,
-execute). A run never raises: a failure comes back as the run's ``error`` (its type, message and exit code).
-Millimetres in every figure; floats rounded so a run's line is the same bytes wherever it ran.
-"""
+"""One run of a sweep: build the varied scenario, run the pipeline to the sweep's stage and say per seam what became
+of it, as plain JSON values in millimetres, rounded so a run's line is the same bytes wherever it ran. A run never
+raises: a failure is its ``error``."""
 
 from __future__ import annotations
 

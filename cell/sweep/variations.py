@@ -1,15 +1,6 @@
-"""N varied builds of one scenario: part tolerances, placement error, camera extrinsic error and seed.
-
-Run k of a sweep is a value (:class:`Variation`) drawn from the scenario's seed and k alone: each kind of
-variation has its own ``numpy.random.Generator`` keyed by (scenario seed, a CRC-32 of the kind's name, k), so
-run k is the same whatever N is, whichever runs finished before, and whichever other kinds are varied
-(docs/sweep.md). There is no global RNG.
-
-Part tolerances: the paper's industrial figures (docs/reference.md section 1; docs/sweep.md): width and height of a
-part up to 1 % of their value, length (the part's longest edge) up to 5 %, location up to 1 % (of the part's
-length, per axis). A tolerance is read as a 3-sigma bound: each deviation is normal with sigma = tolerance / 3,
-clipped at the tolerance.
-"""
+"""N varied builds of one scenario (part tolerances, placement error, camera extrinsic error and seed): run k is drawn
+from the scenario's seed and k alone, each kind from its own generator, each tolerance read as a 3-sigma bound
+(docs/sweep.md, "What varies"). There is no global RNG."""
 
 from __future__ import annotations
 

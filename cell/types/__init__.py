@@ -1,11 +1,6 @@
-"""The vocabulary of the cell: frozen dataclasses with read-only arrays, numpy only.
-
-Frames: ``W`` world, ``R`` robot base (KUKA $ROBROOT), ``M`` welding map (DXF drawing), ``C`` camera optical frame
-(z forward, x right, y down), ``B`` a box part's own frame (axes along its edges, origin at its centre).
-Units: metres and radians everywhere inside; millimetres and degrees only at the edges (DXF, reports, KRL).
-
-Every stage imports its values from here and nothing here imports a stage (an import-linter contract).
-"""
+"""The vocabulary of the cell: frozen dataclasses with read-only arrays, numpy only; every stage imports its values
+from here and nothing here imports a stage. Frames: ``W`` world, ``R`` robot base, ``M`` welding map, ``C`` camera
+optical frame, ``B`` a box part's own frame. Metres and radians inside; millimetres and degrees only at the edges."""
 
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.gate import Violation, ViolationKind

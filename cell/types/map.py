@@ -1,11 +1,6 @@
-"""The welding map's vocabulary: boxes, parts, seams and the map that holds them.
-
-Frames: ``M`` welding map (DXF drawing), ``R`` robot base, ``W`` world, ``B`` a box part's own frame (axes along its
-edges, origin at its centre). Metres and radians.
-
-A part's body is a :class:`Box` (the fast special case) or a :class:`Polyhedron` (any closed planar-faced body); both
-answer the same methods (``face_names``, ``face_plane``, ``face_polygon``, ``triangles``, ``contains``, ...).
-"""
+"""The welding map's vocabulary: boxes, parts, seams and the map that holds them. A part's body is a :class:`Box` (the
+fast special case) or a :class:`Polyhedron` (any closed planar-faced body), both with the same methods.
+Frames: ``M`` welding map, ``R`` robot base, ``W`` world, ``B`` a box's own frame. Metres and radians."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
 """The welding program as values: seams to weld (:class:`SeamTask`) and the timed, checked plan (:class:`WeldPlan`)
 with its segments and per-seam outcomes (:class:`SeamOutcome`, :class:`PlanReason`). Values only: no planning.
-
-Tasks are made from located seams by :func:`cell.motion.tasks.seam_tasks`; the plan by
-:func:`cell.motion.plan.plan_welds`, read by the safety gate, the exporters, the simulator playback and
-the pictures. Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
-"""
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 

@@ -1,11 +1,6 @@
-"""Weld procedures (a WPS row): what the arc does along a seam, as values. Selected per seam by the planner
-(joint type, leg size, position), carried by each weld segment of the plan, written by the exporters (weld data
-sets), executed by the simulator (weave, passes) and reported per seam.
-
-Units: millimetres, degrees, seconds, amperes, volts and metres per minute, as a WPS states them (these values
-come from and go to people and controllers; the planner converts to metres where it builds paths).
-Position (ISO 6947): ``PA`` flat, ``PB`` horizontal-vertical fillet, ``PF`` vertical up, ``PG`` vertical down.
-"""
+"""Weld procedures (a WPS row): what the arc does along a seam, as values, selected per seam by the planner and
+carried to the exporters, the simulator and the report. Units as a WPS states them (mm, deg, s, A, V, m/min); the
+planner converts to metres where it builds paths."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""A linear track under the robot base (an external axis E1, a KUKA KL-style unit), as a value: numpy only.
-
-Frames: R is the robot base at E1 = 0 (the scenario's X_WR: where the arm stands for capture and re-scan, and the
-frame of every cloud, seam and torch pose); Re is the base at E1 = e. The carriage only translates, so
-X_R_Re = translation(e * axis_R) and a pose of the arm's own chain X_Re_F becomes X_RF = X_R_Re @ X_Re_F.
-Units: E1 [m], [m/s], [m/s^2], [m/s^3] inside; the KRL field E1 is in mm.
-"""
+"""A linear track under the robot base (an external axis E1), as a value, numpy only. Frames: R is the base at E1 = 0,
+Re the base at E1 = e, X_R_Re = translation(e * axis_R) (docs/track.md, "Frames"). Units: E1 [m], [m/s], [m/s^2],
+[m/s^3] inside; the KRL field E1 is in mm."""
 
 from __future__ import annotations
 

@@ -1,10 +1,5 @@
-"""Closed polyhedral bodies from drawn meshes (a body that is not a box): checks, then coplanar faces merged.
-
-A mesh becomes a :class:`~cell.types.Polyhedron` when it is closed (every edge on exactly two faces), consistently
-oriented (fixed where the drawing flips a face), not self-intersecting (no edge crosses a face it does not touch)
-and encloses a volume. Neighbouring triangles within ``MERGE_DEG`` of one plane merge into one face when their
-outline is one simple loop; a merged region with a hole keeps its drawn faces. No ezdxf here.
-"""
+"""Closed polyhedral bodies from drawn meshes (a body that is not a box): closed, consistently oriented, not
+self-intersecting, enclosing a volume; coplanar neighbouring triangles merged into faces (docs/maps.md). No ezdxf."""
 
 from __future__ import annotations
 

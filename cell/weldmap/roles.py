@@ -1,10 +1,5 @@
-"""Which layers hold what: parts, fixtures (obstacles, never welded) and seams, by name patterns (no ezdxf here).
-
-A body's name is its layer's, or its block's when it sits on layer ``0`` inside a block; a body is a fixture when
-its name or its layer matches a fixture pattern, else a part when there are no part patterns or one matches, else
-it is ignored with a warning. A LINE or polyline is a seam when it is red, or when it lies on a seam layer.
-Patterns are shell-style (``CLAMP*``) and, like DXF layer names, ignore case.
-"""
+"""Which layers hold what: parts, fixtures (obstacles, never welded) and seams, by shell-style name patterns that,
+like DXF layer names, ignore case (docs/maps.md section 3). No ezdxf here."""
 
 from __future__ import annotations
 

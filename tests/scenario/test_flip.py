@@ -1,4 +1,4 @@
-"""The whole part welded (issue 13): fence1 on both sides, the turn planned and measured, a forbidden turn, and a
+"""The whole part welded (docs/flip.md): fence1 on both sides, the turn planned and measured, a forbidden turn, and a
 large placement error by the operator (30 mm, 5 deg) that side B's alignment still takes.
 
 One module fixture runs the two-sided fence1 job (side A, the turn, side B) and every assertion on it reads that

@@ -1,4 +1,4 @@
-"""The speed-ups of perception give the answers of the plain computations they replace (issue 16, item 3), on
+"""The speed-ups of perception give the answers of the plain computations they replace (docs/perception.md), on
 fence1's own detection: the aligned map's two checks side by side, the alignment's coarse stages on sparser map
 samples."""
 

@@ -1,4 +1,4 @@
-"""Tack welds before the turn (issue 13 item 2, docs/flip.md): fence1's side A planned with 4 tacks of 15 mm from
+"""Tack welds before the turn (docs/flip.md): fence1's side A planned with 4 tacks of 15 mm from
 the session's weld (its detection after the re-scan, no new capture): the tacks come first, each on its seam line
 at the chosen end, of the asked length, arc on; the 12 seams are still planned; the KRL program welds them; with
 no tacks the plan is the one ``cell weld fence1`` ran. Then ``weld_part`` of fence1-tacked with side A stubbed

@@ -1,5 +1,6 @@
-"""The generated docs are what their sources give now: docs/scenarios.md from the scenario models, the README's
-result tables from benchmarks/results/. A model or a result changed without regenerating fails here."""
+"""The generated docs are what their sources give now: docs/scenarios.md from the scenario models, the result
+tables of docs/results.md and the README's headline table from benchmarks/results/. A model or a result changed
+without regenerating fails here. The README stays a front page with the two commands CI and a new machine run."""
 
 from __future__ import annotations
 
@@ -51,23 +52,63 @@ def test_scenario_docs_check_mode(scenario_docs: ModuleType, tmp_path: Path) -> 
     assert scenario_docs.main(["--check", "--out", str(stale)]) == 0
 
 
-def test_readme_tables_are_generated_from_the_results(readme_results: ModuleType) -> None:
+def test_result_tables_are_generated_from_the_results(readme_results: ModuleType) -> None:
     assert readme_results.main(["--check"]) == 0, (
-        f"README.md's result tables differ from benchmarks/results/: regenerate them with {readme_results.COMMAND}"
+        f"docs/results.md's or the README's result tables differ from benchmarks/results/: regenerate them with "
+        f"{readme_results.COMMAND}"
     )
 
 
-def test_readme_check_fails_on_a_changed_result(readme_results: ModuleType, tmp_path: Path) -> None:
+def _copies(tmp_path: Path) -> tuple[Path, Path, Path]:
+    """Copies of the results folder, docs/results.md and the README to change without touching the repository."""
     results = tmp_path / "results"
     shutil.copytree(REPO / "benchmarks" / "results", results)
+    doc, readme = tmp_path / "results.md", tmp_path / "README.md"
+    shutil.copy(REPO / "docs" / "results.md", doc)
+    shutil.copy(REPO / "README.md", readme)
+    return results, doc, readme
+
+
+def test_results_check_fails_on_a_changed_result(readme_results: ModuleType, tmp_path: Path) -> None:
+    results, doc, readme = _copies(tmp_path)
     rows = json.loads((results / "scaling.json").read_text(encoding="utf-8"))
     rows[0]["align_s"] += 1.0
     (results / "scaling.json").write_text(json.dumps(rows), encoding="utf-8")
-    readme = tmp_path / "README.md"
-    shutil.copy(REPO / "README.md", readme)
-    assert readme_results.main(["--check", "--readme", str(readme), "--results", str(results)]) == 1
-    assert readme_results.main(["--readme", str(readme), "--results", str(results)]) == 0
-    assert readme_results.main(["--check", "--readme", str(readme), "--results", str(results)]) == 0
+    args = ["--doc", str(doc), "--readme", str(readme), "--results", str(results)]
+    assert readme_results.main(["--check", *args]) == 1
+    assert readme_results.main(args) == 0
+    assert readme_results.main(["--check", *args]) == 0
+    assert readme.read_text(encoding="utf-8") == (REPO / "README.md").read_text(encoding="utf-8")  # not a headline
+
+
+def test_the_headline_table_follows_the_weld_result(readme_results: ModuleType, tmp_path: Path) -> None:
+    results, doc, readme = _copies(tmp_path)
+    runs = json.loads((results / "weld.json").read_text(encoding="utf-8"))
+    runs[0]["welded"] = 15
+    (results / "weld.json").write_text(json.dumps(runs), encoding="utf-8")
+    args = ["--doc", str(doc), "--readme", str(readme), "--results", str(results)]
+    assert readme_results.main(["--check", *args]) == 1
+    assert readme_results.main(args) == 0
+    assert "| 15/16, " in readme.read_text(encoding="utf-8")
+
+
+def test_a_missing_marker_is_an_error(readme_results: ModuleType, tmp_path: Path) -> None:
+    results, doc, readme = _copies(tmp_path)
+    readme.write_text("# no headline block\n", encoding="utf-8")
+    assert readme_results.main(["--doc", str(doc), "--readme", str(readme), "--results", str(results)]) == 1
+
+
+def test_the_readme_is_a_front_page_with_the_two_commands() -> None:
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) < 260
+    lines = text.splitlines()
+    # The two commands on a fresh machine; CI (.ci/run) runs the second as it is written here.
+    assert any(line.startswith("./scripts/weld fence1 ") for line in lines)
+    assert any(line.startswith("./scripts/test ") for line in lines)
+    assert "./scripts/test" in (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    linked = set(re.findall(r"\]\((docs/[\w.-]+\.(?:md|png))", text))
+    missing = sorted(p for p in linked if not (REPO / p).exists())
+    assert not missing, f"the README links to files the repository does not have: {missing}"
 
 
 REFERENCE_SECTIONS = {
@@ -113,10 +154,19 @@ def test_no_citation_of_the_design_notes_is_left() -> None:
     assert fix_citations.main(["--check"]) == 0, "run .venv/bin/python tools/fix_citations.py"
 
 
-@pytest.mark.parametrize("doc", ["architecture.md", "reference.md"])
+def _named_path_exists(named: str) -> bool:
+    """A path a doc names: a file or folder, a glob (``maps/*.dxf``) or a module's member (``cell/x/y.name``)."""
+    path = named.rstrip("/")
+    if (REPO / path).exists() or ("*" in path and any(REPO.glob(path))):
+        return True
+    module, _, member = path.rpartition(".")
+    return bool(member) and (REPO / f"{module}.py").exists()
+
+
+@pytest.mark.parametrize("doc", sorted(p.name for p in (REPO / "docs").glob("*.md")))
 def test_paths_the_docs_name_exist(doc: str) -> None:
     # The layout moves; a doc that names a file or package the repository no longer has is out of date.
     text = (REPO / "docs" / doc).read_text(encoding="utf-8")
     named = set(re.findall(r"`((?:cell|tools|benchmarks|robots|scenarios|maps|tests|docs|scripts)/[^`\s]*)`", text))
-    missing = sorted(p for p in named if not (REPO / p.rstrip("/")).exists())
+    missing = sorted(p for p in named if not _named_path_exists(p))
     assert not missing, f"docs/{doc} names paths that do not exist (update the doc): {missing}"

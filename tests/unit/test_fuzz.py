@@ -137,7 +137,7 @@ def test_dxf_with_duplicated_spans_and_extreme_numbers(data: bytes) -> None:
 
 @pytest.mark.parametrize("value", ["nan", "-inf", "1e12"])
 def test_an_extreme_coordinate_is_refused_or_harmless(value: str) -> None:
-    # Bug (issue 12): NaN, infinite and 1e12-metre coordinates were accepted into the map.
+    # NaN, infinite and 1e12-metre coordinates must never enter the map.
     for i in COORD_LINES[:: max(1, len(COORD_LINES) // 3)]:
         lines = list(DXF_LINES)
         lines[i] = value + "\n"

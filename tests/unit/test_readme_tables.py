@@ -1,6 +1,6 @@
-"""The README's tables of the cell's commands (tools/readme_cell_tables.py) say what their rows say: the sentence
-templates of the fault table, the README's time format, why a seam was not welded; and a changed result file
-makes the README check fail until the tables are rendered again."""
+"""The result tables of the cell's commands (tools/readme_cell_tables.py, in docs/results.md) say what their rows
+say: the sentence templates of the fault table, the time format, why a seam was not welded; and a changed result
+file makes the check of docs/results.md fail until the tables are rendered again."""
 
 from __future__ import annotations
 
@@ -80,7 +80,7 @@ def test_seams_not_found_quote_their_one_reason(tables: ModuleType) -> None:
     assert tables.fault_sentence(row) == '8 seams `not_found` ("part P is not in the cloud"), never welded'
 
 
-def test_the_fault_table_keeps_the_readme_order(tables: ModuleType) -> None:
+def test_the_fault_table_keeps_its_order(tables: ModuleType) -> None:
     rows = [_fault(scenario=s) for s in ("faults/zzz-new", "faults/ladder-shifted", "faults/camera-dead")]
     names = [line.split(" | ")[0].removeprefix("| ") for line in tables.faults_table(rows).splitlines()[2:]]
     assert names == ["camera-dead (cam_left)", "ladder-shifted (one rung pitch)", "zzz-new"]
@@ -89,7 +89,7 @@ def test_the_fault_table_keeps_the_readme_order(tables: ModuleType) -> None:
 @pytest.mark.parametrize(
     ("us", "text"), [(78.4, "78 us"), (100.0, "100 us"), (500.0, "0.5 ms"), (510.0, "0.51 ms"), (10_412.0, "10.4 ms")]
 )
-def test_times_as_the_readme_writes_them(tables: ModuleType, us: float, text: str) -> None:
+def test_times_as_the_tables_write_them(tables: ModuleType, us: float, text: str) -> None:
     assert tables._time(us) == text
 
 
@@ -111,19 +111,20 @@ def test_a_seam_not_welded_says_why_by_its_code(tables: ModuleType) -> None:
     assert "no close-up re-scan" in lines[-1]
 
 
-def test_readme_check_fails_on_a_changed_fault_result(tmp_path: Path) -> None:
+def test_results_check_fails_on_a_changed_fault_result(tmp_path: Path) -> None:
     readme_results = load_tool("readme_results")
     results = tmp_path / "results"
     shutil.copytree(REPO / "benchmarks" / "results", results)
     rows = json.loads((results / "faults.json").read_text(encoding="utf-8"))
     rows[0]["exit_code"] = 99
     (results / "faults.json").write_text(json.dumps(rows), encoding="utf-8")
-    readme = tmp_path / "README.md"
+    doc, readme = tmp_path / "results.md", tmp_path / "README.md"
+    shutil.copy(REPO / "docs" / "results.md", doc)
     shutil.copy(REPO / "README.md", readme)
-    args = ["--readme", str(readme), "--results", str(results)]
+    args = ["--doc", str(doc), "--readme", str(readme), "--results", str(results)]
     assert readme_results.main(["--check", *args]) == 1
     assert readme_results.main(args) == 0
-    assert "| 99 |" in readme.read_text(encoding="utf-8")
+    assert "| 99 |" in doc.read_text(encoding="utf-8")
     assert readme_results.main(["--check", *args]) == 0
 
 

@@ -27,7 +27,7 @@ from cell.rescan import (
     seams_to_rescan,
     within_tolerance,
 )
-from cell.seams.sigma import PAPER_SIGMA_M, PAPER_SIGMA_UNSEEN_M, ours_sigma, paper_sigma
+from cell.seams.sigma import PAPER_SIGMA_M, PAPER_SIGMA_UNSEEN_M, SE_INFLATION, ours_sigma, paper_sigma
 from cell.sim.camera import intrinsics_for
 from cell.types import Box, Part, SeamEstimate, SeamStatus
 
@@ -107,7 +107,7 @@ def _est(
 def test_sigma_models_and_the_fusion_reads_the_locators_sigma() -> None:
     s = [ours_sigma(se, 5e-5) for se in (0.0, 1e-5, 1e-4, 1e-3)]
     assert all(a < b for a, b in itertools.pairwise(s))
-    assert s[0] == pytest.approx(5e-5) and s[-1] == pytest.approx(math.hypot(1e-3, 5e-5))
+    assert s[0] == pytest.approx(5e-5) and s[-1] == pytest.approx(math.hypot(SE_INFLATION * 1e-3, 5e-5))
     assert math.isinf(ours_sigma(math.inf, 5e-5))
     assert paper_sigma(1.0) == paper_sigma(0.9) == PAPER_SIGMA_M
     assert paper_sigma(0.75) == paper_sigma(0.5) == PAPER_SIGMA_UNSEEN_M

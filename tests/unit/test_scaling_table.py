@@ -1,5 +1,6 @@
-"""The README's scaling table (tools/readme_results.py) shows issue 16's figure and planning per seam from
-``scaling.json``'s rows, and dashes where a row has none (a scenario without an arm, rows measured before)."""
+"""The scaling table of docs/results.md (tools/readme_results.py) shows perceive + align + locate against capture
+and planning per seam from ``scaling.json``'s rows, and dashes where a row has none (a scenario without an arm,
+rows measured before)."""
 
 from __future__ import annotations
 

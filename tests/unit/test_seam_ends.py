@@ -24,6 +24,7 @@ from cell.seams.sigma import (
     PAPER_SIGMA_UNSEEN_M,
     PAPER_START_SIGMA_M,
     RANSAC_END_SIGMA_M,
+    SE_INFLATION,
     drawn_end_sigma,
     length_tolerance_m,
     ours_end_sigma,
@@ -35,10 +36,13 @@ from cell.types import Box, EndSource, MapSeam, Part, Reason, SeamEstimate, Seam
 
 
 def test_each_end_source_has_its_sigma() -> None:
-    # ours: its standard error with the floor of its source in quadrature; the drawn end the part tolerance.
+    # ours: its standard error (widened) with the floor of its source in quadrature, a bias no fit sees added, not
+    # widened; the drawn end the part tolerance.
     for source in (EndSource.EDGE, EndSource.FACE_END, EndSource.OTHER_PART):
-        assert ours_end_sigma(0.0, source) == pytest.approx(OURS_END_FLOOR_M[source])
-        assert ours_end_sigma(3e-4, source) == pytest.approx(math.hypot(3e-4, OURS_END_FLOOR_M[source]))
+        floor = OURS_END_FLOOR_M[source]
+        assert ours_end_sigma(0.0, source) == pytest.approx(floor)
+        assert ours_end_sigma(3e-4, source) == pytest.approx(math.hypot(SE_INFLATION * 3e-4, floor))
+        assert ours_end_sigma(3e-4, source, bias_m=2e-4) == pytest.approx(math.hypot(SE_INFLATION * 3e-4, floor, 2e-4))
     assert drawn_end_sigma() == pytest.approx(PART_TOLERANCE_M)
     assert drawn_end_sigma(PART_TOLERANCE_M, 0.5) > drawn_end_sigma(PART_TOLERANCE_M, 0.05) > PART_TOLERANCE_M
     assert length_tolerance_m(PART_TOLERANCE_M, 0.4) == pytest.approx(PART_TOLERANCE_M + 0.02)

@@ -1,4 +1,4 @@
-"""The two-sided robot program (issue 13): each side's own program and a main program that runs them in order with
+"""The two-sided robot program: each side's own program and a main program that runs them in order with
 the operator's stop to turn the part between them (KRL and RAPID), its errors, and ``cell krl check`` on a main
 program (its calls, the stop, home, the sides' bases). One small plan of the tiny cell serves both sides: side B is
 the same motion with the part's base elsewhere."""

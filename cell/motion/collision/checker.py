@@ -1,27 +1,6 @@
-"""Collision checking with coal (through Pinocchio's GeometryModel): the checker (this module) and the torch's
-shapes and the obstacle boxes for the torch test (:mod:`cell.motion.collision.shapes`) are the only coal importers.
-
-What is checked, all in the robot base frame R [m]:
-
-* the arm's URDF collision shapes against obstacles: the as-perceived parts (the aligned welding map's bodies,
-  boxes or polyhedra: :func:`cell.motion.collision.shapes.obstacle_shape`, grown by ``part_inflation``), its
-  fixtures (grown alike) and the table (known exactly: grown by ``table_inflation``);
-* the arm against itself, except pairs on the same or on adjacent links (``parentJoint`` equal, or one the
-  parent of the other: their shapes touch at the joint by construction).
-
-The torch tip must reach into the fillet, a few mm from both faces. The wire is not modelled, and every torch
-shape within ``tcp_clearance`` (25 mm) of the wire tip is cut away: the gas nozzle cylinder, which ends 15 mm
-behind the tip, is shortened to start 25 mm behind it. In a square fillet at 45 deg the nozzle's rim then stays
-about 9 mm off both faces (2.5 mm with the full nozzle), which leaves room for the seam's position error;
-everything else of the torch (the rest of the nozzle, the neck, the body) and the whole arm must stay clear.
-
-Along a motion, checks use conservative advancement: at a configuration with clearance c (the smallest signed
-distance over the checked pairs), no point of the arm can touch anything before it has moved c; a joint-space
-step dq moves no arm point more than sum_j |dq_j| r_j (r_j: the farthest any collision shape can be from joint
-j's axis), so the next check is where that bound reaches c, and never more than ``max_step`` [m] of motion
-later (subdividing between trajectory samples when needed). A collision found this way is certain; a path
-declared free is free up to the clearance threshold (``min_clearance``).
-"""
+"""Collision checking with coal (through Pinocchio's GeometryModel): the arm against the cell's obstacles and
+itself, at a configuration and along a motion by conservative advancement (docs/planning.md section 5). With
+:mod:`cell.motion.collision.shapes`, the only coal importer. Everything in the robot base frame R [m]."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
 """Obstacle bodies grown by a safety margin, numpy and scipy only (the coal shapes are built in
-:mod:`cell.motion.collision.shapes`; docs/bodies.md).
-
-A box grows exactly as before: each face moved out by the margin (``coal.Box`` of the size plus twice the margin).
-A convex polyhedron grows the same way: the intersection of its faces' half-spaces each moved out by the margin
-(which holds every point within the margin of the body, as for the box). A body that is not convex is grown along
-its vertex normals: each vertex moves out along the mean of its faces' normals far enough that every face through it
-moves out by at least the margin; its triangles then lie at least the margin outside their own planes (a
-conservative equivalent on every face; at a concave edge the grown faces overlap, which only adds material).
-"""
+:mod:`cell.motion.collision.shapes`): a box or a convex polyhedron grows each face out by the margin, a body that is
+not convex grows along its vertex normals, each face at least the margin out (docs/bodies.md section 2)."""
 
 from __future__ import annotations
 

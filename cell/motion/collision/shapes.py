@@ -1,14 +1,6 @@
-"""The torch test's geometry: the torch's cylinders cut back near the wire tip, the tool-side collision shapes
-placed from the TCP, the obstacles' coal shapes (a box as ``coal.Box``, a convex polyhedron as ``coal.Convex``, any
-other body as a ``coal.BVHModelOBBRSS`` triangle mesh, each grown by its margin: :mod:`cell.motion.collision.grow`)
-with their bounding boxes as placed in R, and the contacts of many TCP poses against them in one broad-phase query
-(no IK: the poses are in R, so wherever a linear track puts the base). Part of the coal adapter with
-:mod:`cell.motion.collision.checker`.
-
-A triangle mesh answers the distance to its surface only: a shape wholly inside a non-convex body would read as
-clear. So where a query against such a body (a :data:`Solids` entry) says clear, the shape's centre is tested
-against the body (its winding number) and, inside, the distance is turned into a penetration of the same depth
-(docs/bodies.md)."""
+"""The torch test's geometry, part of the coal adapter: the torch's shapes cut back near the wire tip, the obstacles'
+coal shapes (box, convex polyhedron or triangle mesh, each grown by its margin) and the contacts of many TCP poses
+in one broad-phase query, with a point-in-body test where a mesh reads clear (docs/bodies.md section 2)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""Which seam a gate violation belongs to, so that a plan drops that seam and welds the rest instead of being
-refused as a whole (:func:`blamed_seams`).
-
-A violation during a seam's approach, weld, depart or the transfer that leads to it is that seam's; one during
-the last move home is the last seam's (the transfer from it). A start-state violation concerns the whole plan:
-it has no seam; so do violations that blame every seam of the plan.
-"""
+"""Which seam a gate violation belongs to, so that a plan drops that seam and welds the rest: a violation during a
+seam's approach, weld, depart or the transfer to it is that seam's, the last move home the last seam's; a
+start-state violation, or one that blames every seam, concerns the whole plan."""
 
 from __future__ import annotations
 

@@ -1,15 +1,6 @@
-"""Bodies: no motion takes the torch's wire tip (the TCP) or its wire into a part's body.
-
-The collision model cuts the torch away near the wire tip so that it can reach into a fillet
-(:mod:`cell.motion.collision`): this check covers what that leaves out. Along a motion the TCP is sampled every
-``body_step`` of its travel or closer, with the wire behind it (``wire_m`` back along the torch axis, -z of the
-tool frame, to the contact tip), and each point is tested against the bodies (:func:`body_entry`): one that lies
-inside a body by more than ``body_depth`` is a violation. During a seam's approach, weld and depart the two parts
-of its own joint are left out: the TCP sits in their corner, and the part as built may stand a few mm off the
-drawing there (the seam's estimate follows the part as built, the aligned map the drawing); every other part's
-body is tested (a bead that runs on through a tube's wall into its bore). Transfers test every part. Frames: R;
-metres.
-"""
+"""Bodies: no motion takes the torch's wire tip (the TCP) or its wire into a part's body, what the collision model's
+cut-back torch leaves out; a seam's own two parts are left out along its approach, weld and depart
+(docs/reference.md section 7, docs/planning.md section 6). Frames: R; metres."""
 
 from __future__ import annotations
 

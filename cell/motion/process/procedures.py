@@ -1,17 +1,6 @@
-"""Which weld procedure welds each seam, and in which direction (values in, values out).
-
-A seam's joint type comes from the map (:func:`joint_type`: T, corner or lap from the two parts' boxes), its
-welding position from the seam direction and the faces' normals against gravity in R (:func:`position`, ISO
-6947: ``PA`` flat, ``PB`` horizontal-vertical, ``PD`` overhead horizontal-vertical, ``PE`` overhead, ``PF``
-vertical up, ``PG`` vertical down), its leg from the scenario. The first row of the WPS table whose joint,
-position and leg range fit welds it (:func:`select_procedure`); a seam no row fits gets a reason, never a crash.
-
-A seam within ``VERTICAL_DEG`` of vertical is welded in the row's ``direction``: ``up`` (the default) from its
-lower end to its upper, ``down`` the other way, ``as_drawn`` from the map's start to its end; the planner then
-tries only that direction. Any other seam may be welded either way (the planner's choice, as before).
-
-Frames: R the robot base [m]; ``up_R`` the unit vector against gravity in R.
-"""
+"""Which weld procedure welds each seam, and in which direction (values in, values out): the first row whose joint
+type, welding position (ISO 6947) and leg fit; a seam near vertical in the row's direction (docs/planning.md
+section 1). Frames: R the robot base [m]; ``up_R`` the unit vector against gravity in R."""
 
 from __future__ import annotations
 

@@ -1,28 +1,8 @@
-"""Torch poses along a fillet seam, from the joint geometry alone (values in, poses out).
+"""Torch poses along a fillet seam, from the joint geometry alone (values in, poses out): work and travel angles,
+spin and contact-tip-to-work distance (the geometry: docs/planning.md section 3).
 
-Frames: ``R`` robot base; ``T`` the torch tool frame ``torch_tcp`` of the URDF: origin at the wire tip, z along
-the wire, out of the torch (so z points INTO the joint). Units: metres and radians.
-
-Geometry of a fillet between face A (the abutting part's face, outward normal n_a) and face B (the receiving
-part's face, outward normal n_b), seam direction d (unit, from the weld start to its end):
-
-* work angle w: in the plane perpendicular to the seam, the torch axis leaves the joint at angle w from face B,
-  turned towards face A: u = cos(w) t_b + sin(w) n_b, where t_b is the direction in face B pointing away from
-  the corner (n_a with its n_b component removed). In a square fillet w = 45 deg gives u = (n_a + n_b) / sqrt 2,
-  the bisector. A fillet that opens by another angle theta (:func:`fillet_angle`: a mitred brace's acute or
-  obtuse corner) keeps the work angle's offset from its own bisector: the torch leaves face B at
-  w + theta / 2 - 45 deg, so that 45 deg is on the bisector of any dihedral.
-* travel angle a: the torch axis tilts along the seam, z = -cos(a) u + sin(a) d; a > 0 is a push angle (the wire
-  points ahead, z . d > 0), a < 0 a drag angle.
-* spin psi: the free rotation about the torch axis. psi = 0 puts T's x axis along the part of d perpendicular to
-  z (ahead); psi turns x and y about z.
-
-Contact-tip-to-work distance (CTWD): ``torch_tcp`` sits at the wire tip, ``stickout`` beyond the contact tip
-(15 mm in robots/build_kr5_arc.py). The wire tip is put on the seam line when CTWD equals that stick-out (the
-default); a longer CTWD stands the whole torch back along its axis by ``ctwd - stickout`` (the wire tip then
-ends that far short of the seam: the arc length grows, as when a welder holds the torch higher), a shorter one
-pushes it in. The seam line is the fillet's root: the torch aims at the corner.
-"""
+Frames: ``R`` robot base; ``T`` the torch tool frame ``torch_tcp`` (origin at the wire tip, z along the wire into
+the joint). Units: metres and radians."""
 
 from __future__ import annotations
 

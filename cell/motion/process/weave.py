@@ -1,33 +1,8 @@
 """The path a weld pass's TCP follows: the seam line, shifted to the pass's place in the joint's cross-section,
-plus the weave across it (values in, arrays out; no IK here).
+plus the weave across it (``zigzag``, ``triangle``, ``circle``; docs/planning.md section 4). Values in, arrays
+out; no IK here.
 
-The cross-section of a fillet along d (unit, the weld direction) with faces of outward normals n_a, n_b has two
-axes (:func:`cross_section`): the bisector ``b`` (out of the root, between the faces) and ``e`` across it,
-perpendicular to d and b, towards face A (``e`` points where face A rises from the root). A pass lies at
-``lateral`` along e and ``lift`` along b; the weave adds to it (:func:`weave_offsets`), its phase a function of
-the time s / v at the distance s along the seam at the travel speed v, one period 1/f, the first dwell
-(``dwell_s[0]``) on the face A side (+e), the second (``dwell_s[1]``) on the other:
-
-* ``zigzag``: along e between -width/2 and +width/2: a dwell at +width/2, a crossing, a dwell at -width/2, a
-  crossing back. The crossings follow a quintic smootherstep (zero velocity and acceleration at the dwells: the
-  path is C2, so the arm's joint accelerations stay bounded), and the width fades in and out over the first and
-  last wavelength (v/f, at most a quarter of the seam), so the pass starts and ends on its line at rest.
-* ``triangle``: what ArcTech's ``#Triangle`` drives (the program's weave data: pattern, wavelength v/f,
-  amplitude width/2, the side delays; no fade, so none here): from the pass line straight out to +width/2, a
-  dwell, straight across to -width/2, a dwell, straight back to the line; straight legs at constant lateral
-  speed, sharp turns.
-* ``circle``: a circle of the width's diameter in the cross-section plane (e, b) through the pass line, its
-  centre width/2 out of the root along b (so the wire never dips into the root): from the line round to +width/2,
-  over the top (width out of the root), to -width/2, back down to the line, one turn a period at a constant
-  angular speed, no dwells; the first turn eases in from rest and the last eases out to rest (where the TCP
-  joins the line at the travel speed a sharp start or stop of the circle would jerk the arm beyond its limits).
-
-The triangle and the circle start on the pass line at full width and end on it: past the last time the pattern
-crosses the line (at most half a wavelength before the weld end for the triangle, one for the circle) the TCP
-travels on the line, so the weld's end point (the program's LIN point) lies on the pass line.
-
-Frames: R the robot base; lengths [m], time [s]; the procedure's millimetres converted here.
-"""
+Frames: R the robot base; lengths [m], time [s]; the procedure's millimetres converted here."""
 
 from __future__ import annotations
 

@@ -1,11 +1,6 @@
-"""Where the eye-in-hand camera may look at a seam from, without IK (step 1 of :func:`.viewpoint.plan_view`).
-
-The view grid and thresholds (:class:`ViewOptions`), what is looked at (:class:`ViewTarget`: a seam task with a
-fillet), and the candidates that pass the geometric tests (:func:`view_candidates`): the seam and a strip of each
-weld face inside the image with a margin, clear of the torch's image, seen at an incidence below
-``max_incidence_deg``, with no part of the map on the line of sight. See :mod:`cell.motion.views.viewpoint` for the view
-direction u and the camera pose. Frames: R the robot base, C the camera's optical frame; lengths [m].
-"""
+"""Where the eye-in-hand camera may look at a seam from, without IK: the view grid and thresholds, what is looked at,
+and the candidates that pass the geometric tests (docs/planning.md section 7). Frames: R the robot base, C the
+camera's optical frame; lengths [m]."""
 
 from __future__ import annotations
 

@@ -1,31 +1,6 @@
-"""Close-up views of a seam for the eye-in-hand camera: where to put the camera, and the arm's move there.
-
-A view looks into the fillet of a seam (end points p_start, p_end and weld-face normals n_a, n_b, all in the
-robot frame R) from ``distance`` [m] along a direction u out of the joint:
-
-    u = cos(slant) (cos(tilt) b + sin(tilt) w) + sin(slant) t
-
-with b the fillet bisector (n_a + n_b normalised), t the seam direction and w = t x b. ``tilt`` turns the
-view about the seam towards one weld face, ``slant`` along the seam (which also shows one of A's side faces,
-where the seam ends). The optical axis points back along -u, turned by ``image_offset`` so that the seam lies
-above the image centre, with the image x axis along the seam: the torch rides on the camera's optical axis
-(its tip 0.3 m ahead of the camera on the KR 5 arc) and hides the middle and lower part of every eye-in-hand
-image. Candidates are ranked by a score (worst incidence on the two faces, distance from the preferred one)
-and checked in that order, cheapest first:
-
-1. geometry, without IK: the seam and a strip of each weld face (``face_strip_m``) inside the image with a
-   margin, clear of the torch's image (the torch axis from the flange to the TCP, grown by ``torch_radius_m``),
-   seen at an incidence below ``max_incidence_deg``, with no part of the map on the line of sight (a face strip's
-   samples that another part covers need not be seen); when no grid pose passes, once more on the
-   ``fallback_*`` grid (finer tilts, a grazing incidence limit, a narrower strip);
-2. IK of the camera's optical frame on the full pose (warm-started from the current configuration, random
-   restarts from the given generator);
-3. no collision at the view, and none along a jerk-limited point-to-point move from the current
-   configuration (directly, else through ``q_via``, e.g. the scan configuration).
-
-The first candidate that passes is the view; :class:`NoViewError` (a PlanError: seam, how many were tried and why
-each was rejected) when none does.
-"""
+"""Close-up views of a seam for the eye-in-hand camera: where to put the camera, and the arm's move there; candidate
+views ranked, then checked cheapest first (geometry, IK, collisions); :class:`NoViewError` when none passes
+(docs/planning.md section 7). Everything in the robot frame R [m]."""
 
 from __future__ import annotations
 
@@ -55,7 +30,7 @@ from cell.motion.views.view_candidates import (
 from cell.types import CameraIntrinsics, Part
 from cell.types.rescan import Viewpoint
 
-_segments_hit_box = segments_hit_box  # the old private name (tests/test_rescan.py imports it from here)
+_segments_hit_box = segments_hit_box  # the name tests/unit/test_rescan.py imports from here
 
 
 class ViewRejection(StrEnum):

@@ -1,10 +1,6 @@
-"""What one splice registration decides: the correction applied, or why not, or a camera fault.
-
-A registration's estimate (:class:`.registration.Estimate`) is applied only where the overlap fixes
-the whole pose and the data beat the camera's stated calibration (:func:`refusal`, in the order of its tests);
-:class:`Registration` is the record the splice keeps of each, which the report and the seams' calibration term
-read (docs/perception.md, the splice).
-"""
+"""What one splice registration decides: the correction applied, or why not, or a camera fault (:func:`refusal`, in
+the order of its tests), and the :class:`Registration` record the report and the seams' calibration term read
+(docs/perception.md, the splice)."""
 
 from __future__ import annotations
 

@@ -1,31 +1,6 @@
-"""A camera's stated calibration as the prior on its pose, and the splice's estimate that weighs the data against it.
-
-The scenario states how well each camera's pose is known (``cameras.<name>.calibration``: the RMS translation
-``t`` and rotation ``theta`` of its calibration residual, :class:`PoseUncertainty`). A pose error moves the
-camera's points rigidly: a rotation ``w`` about the camera's optical centre ``o`` and a shift ``s``. The splice
-registers a camera onto the cameras before it in the coordinates of :mod:`cell.perception.splicing.registration`: the
-rotation vector scaled by the overlap's RMS radius ``lever`` about its centroid ``c``, then the displacement of
-``c``. In those coordinates the camera's error is ``x = A [w; s]`` with ``A = [[lever I, 0], [-[c - o]x, I]]``
-(a rotation about the camera moves the overlap by ``w x (c - o)``), so its prior covariance is
-
-    P_cam = A diag(theta^2 / 3 I, t^2 / 3 I) A^T
-
-(each RMS spread evenly over three axes), and the prior of the disagreement between the camera and its targets is
-the sum of the camera's and its targets' (each target camera's weighted by the square of its share of the target).
-
-:func:`posterior` combines that prior with what the overlap says: the registration's estimate ``x_d`` and its
-information ``I_d`` (the inverse of the patch-robust covariance of the point-to-plane estimate). In the prior's
-whitened coordinates (``x = L y``, ``P = L L^T``) the information's eigenvectors ``u_i`` are the directions,
-their eigenvalues ``mu_i`` the ratio of prior to data variance along each. A direction is *informed* when
-``mu_i >= INFORMED_RATIO`` (the data's variance at most a tenth of the prior's); only those move. Along each,
-``a_i = u_i . y_d`` is the data's disagreement in prior sigmas: beyond :data:`FAULT_SIGMAS` the camera is not
-miscalibrated within what its calibration states but knocked (a fault, never a correction); else the MAP
-estimate, one Gauss-Newton step of the prior-augmented problem from the data's optimum, is
-``b_i = mu_i / (1 + mu_i) a_i``. The prior couples directions (a turn about the camera shifts the overlap), so
-the MAP move is then kept only along the directions of the registration's own coordinates that the data inform
-on their own (:func:`_seen`). Directions a round or flat overlap leaves free carry no information and stay as
-calibrated; a camera whose calibration is stated exact (``P = 0``) never moves.
-"""
+"""A camera's stated calibration as the prior on its pose, and the splice's MAP estimate that weighs the overlap's
+data against it along the directions the data inform (docs/perception.md, "The splice: an estimate with the stated
+calibration as its prior")."""
 
 from __future__ import annotations
 

@@ -1,28 +1,6 @@
-"""Registering one camera's cloud onto others for the splice (:mod:`.splice`), and the estimate of
-its correction with the camera's calibration as the prior.
-
-:func:`register` is open3d's ICP, through :mod:`cell.perception._open3d`, chosen by ``PerceptionSpec.splice_icp``:
-
-- ``"paper"``: the paper's point-to-point ICP on every point, max correspondence ``icp_max_correspondence_m``
-  (1 mm), ``icp_iterations`` (50). On clouds with 1-3 mm of depth noise and 1.5-4 mm point spacing it latches onto
-  chance near-coincidences: it "corrects" exact extrinsics by tenths of a millimetre and removes only part of
-  a real calibration error.
-- ``"robust"`` (default): point-to-plane ICP with a Tukey kernel, target normals estimated by open3d; the
-  kernel width, correspondence distance and normal radius are derived in one place
-  (:func:`registration_settings`) from the voxel size and the noise measured in the overlap; source and
-  target are thinned to an even stride of at most :data:`_PROBE_POINTS` / :data:`_TARGET_POINTS` points.
-
-What the registration found is not applied as it is. :func:`evidence` measures what the overlap says about it:
-the correction's coordinates (the rotation vector scaled to metres at the overlap's RMS radius ``lever`` about
-its centroid, then the centroid's displacement) and their information, the inverse of a sandwich (patch-robust)
-covariance of the point-to-plane estimate: the sensor's errors are not independent from point to point (flying
-pixels at the edges each camera sees, faces one camera sees head-on and the other at grazing incidence), so each
-patch of ``merge_cell_m`` and surface direction counts as one measurement. A direction the overlap does not
-constrain (a shift along a flat face, a slide along or a turn about a round body's axis) carries no
-information whatever ICP did along it. :func:`register` then weighs that against the camera's stated
-calibration (:func:`cell.perception.splicing.pose_prior.posterior`): the MAP correction along the directions where the
-data outweigh the prior, and how far the data disagree with the prior there.
-"""
+"""Registering one camera's cloud onto others for the splice (Open3D's ICP, the paper's or a robust one), and the
+evidence the overlap gives about the correction: its coordinates and their patch-robust information
+(docs/perception.md, "The splice's order, its ICP and the prioritised merge")."""
 
 from __future__ import annotations
 

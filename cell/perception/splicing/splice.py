@@ -1,31 +1,7 @@
-"""Splicing the camera clouds into one (paper section 3.3), generalised to 1, 2 or more cameras.
-
-The paper: (1) ICP of camera 1's cloud onto camera 2's, (2) merge the two with priority (each side from the
-camera nearer to it), (3) ICP of the eye-in-hand cloud onto that, (4) merge again. Here: the eye-in-hand camera
-(calibrated to the robot) is the reference when there is one, else the second fixed camera; then the fixed
-cameras in the paper's order are each registered onto all the cameras registered before them; the prioritised
-merge (:func:`cell.perception.merge.prioritised_merge`) then makes the paper's cloud, ``Spliced.dense``. The
-cloud of all cameras registered but *not* merged is kept as well (``Spliced.registered``): a locator that
-weighs each camera by its own noise loses nothing to the merge.
-
-Each camera is registered onto the cameras before it by :func:`cell.perception.splicing.registration.register` (open3d's
-ICP, the paper's or a robust one, as ``PerceptionSpec.splice_icp`` says), and what it found is an estimate with
-the camera's stated calibration (``cameras.<name>.calibration``) as the prior (:mod:`.pose_prior`):
-the correction is applied only where the overlap informs all six directions (a partly informed overlap's estimate
-is biased by the sensor's noise at edges: 1-9 mm on random cells, ``docs/perception.md``), as the MAP estimate,
-only if it moves the overlap by more than half its noise, and only if it lowers the misfit of the overlap's
-patches (RMS of each patch's mean point-to-plane residual) enough (:mod:`cell.perception.splicing.decision`). A
-refused real correction is not unsafe (the camera's seams keep its calibration in their sigma); an applied false
-one is.
-
-A camera stated exact (the default) is not registered at all and never moves (``calibration_exact``); a gross
-error of such a camera is left to the agreement check (:mod:`cell.perception.camera_health`). A camera whose data
-disagree with the prior by more than three prior sigmas along an informed direction (a partly informed overlap:
-along a strongly informed one, or with the move explaining most of the misfit) is a *fault* (``beyond_prior``),
-not a correction: its points leave the registered cloud and the targets of the cameras after it, and perception
-drops it with the reason (``Spliced.faults``), as a camera that disagrees with the others.
-``Registration.refused`` says why nothing was applied (:data:`cell.perception.splicing.decision.REFUSALS`).
-"""
+"""Splicing the camera clouds into one (paper section 3.3), for 1, 2 or more cameras: each camera registered onto
+the cameras before it, a correction applied only where the overlap fixes the whole pose and lowers the misfit, a
+camera beyond its stated calibration dropped as a fault, then the prioritised merge (docs/perception.md, "The
+splice's order" and "The splice: an estimate with the stated calibration as its prior")."""
 
 from __future__ import annotations
 

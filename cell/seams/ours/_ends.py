@@ -8,7 +8,7 @@ section 8)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -17,8 +17,9 @@ from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_fit
 from cell.seams._lines import line_plane_parameter
 from cell.seams.ours._geometry import JointGeometry, within
 from cell.seams.ours._planes import END_KEYS, End, Face, Selection, thin
-from cell.seams.ours._points import Points
+from cell.seams.ours._points import BoolArray, IntArray, Points
 from cell.seams.ours.options import OursOptions
+from cell.seams.sigma import TILT_TOLERANCE_RAD
 from cell.types import EndSource
 
 # How far a hollow section's flat may be wider or narrower than drawn [m] (docs/reference.md: EN 10219-2's
@@ -155,6 +156,16 @@ def extent_sigma(se: float, pitch: float, scale: float) -> float:
     return float(np.sqrt(se * se + pitch * pitch / 12.0 + scale * scale))
 
 
+# A side face's points scattering about their fitted plane more than this many times the sensor's noise are not one
+# face: a 6 mm brace's side, a strip narrower than the noise seen from 1.5 m, mixes its neighbours' points and read
+# its end 7-12 mm off (random cells; well-seen side faces scatter 0.5-1 times the noise). Its end comes from the
+# extent of face A's points instead.
+SIDE_SCATTER_LIMIT = 1.5
+
+# How far into another part a point on its face is taken to test that it lies on that face, not beside it [m].
+_INTO_M = 0.001
+
+
 def side_selections(
     ends: tuple[End, End],
     pts: Points,
@@ -165,9 +176,10 @@ def side_selections(
     first: bool,
     slack: float,
     o: OursOptions,
+    n_a: FloatArray,
 ) -> list[Selection]:
     """The points on A's side faces at the seam's ends (where they are seen well enough to place an end),
-    to be fitted with the weld faces."""
+    to be fitted with the weld faces (``n_a``: face A's unit normal (3,))."""
     if not geo.has_sides:
         return []
     # The bands across the side face, no wider than a share of a thin plate's extent (its depth, its height).
@@ -192,9 +204,10 @@ def side_selections(
         near = np.abs(r_l) < gate
         # On the other part's face, never as deep as its far side (an upright's other face, 12 mm behind).
         if end.touching:
-            sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching))
+            sel = np.flatnonzero(beside & near & (r_l < 0.5 * end.touching) & pts.facing(-end.n, -end.d))
+            sel = sel[on_face(end, pts, sel, r_l, n_a, o.edge_band_m)]
             if len(sel) >= need:
-                out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
+                out.append(Selection(key, _levered(end, r_a, sel), r_l, sel, thin(sel, o.max_fit_points), need))
             continue
         near &= pts.facing(end.n, end.d)  # seen from in front: a hollow tube's inner wall is not its side face
         if end.inset:  # a tube's side flat begins past its corner radius, below face A and above its far side
@@ -202,8 +215,25 @@ def side_selections(
         else:
             sel = np.flatnonzero(side & near)
         if len(sel) >= need:
-            out.append(Selection(key, end, r_l, sel, thin(sel, o.max_fit_points), need))
+            out.append(Selection(key, _levered(end, r_a, sel), r_l, sel, thin(sel, o.max_fit_points), need))
     return out
+
+
+def _levered(end: End, r_a: FloatArray, sel: IntArray) -> End:
+    """``end`` with the lever of its side face's points ``sel`` (``r_a``: heights over face A [m])."""
+    return replace(end, lever=float(np.median(np.abs(r_a[sel]))))
+
+
+def on_face(end: End, pts: Points, sel: IntArray, r_l: FloatArray, n_a: FloatArray, band: float) -> BoolArray:
+    """(len(sel),) which of the points ``sel`` (``r_l``: their height over the end's plane [m]) lie on the face of
+    the part a hidden side face is against, not on that part's faces at an angle to it seen beside A (a box's side,
+    which runs back from the face at the distance it reaches in front of A): each point taken onto the plane and
+    just into the part must lie inside it there and still ``band`` [m] further from A (``n_a``: face A's unit
+    normal (3,)). A hollow part (a tube) counts only where its wall is."""
+    if end.against is None or not len(sel):
+        return np.ones(len(sel), bool)
+    q = pts.xyz[:, sel].T + np.outer(min(0.5 * end.touching, _INTO_M) - r_l[sel], end.n)
+    return np.asarray(end.against.contains(q) & end.against.contains(q + band * np.asarray(n_a)), bool)
 
 
 def find_ends(
@@ -238,9 +268,12 @@ def find_ends(
         if end.on_table:
             placed[k] = end.at(line_plane_parameter(at_edge, t, end.n, end.d - end.inset), 2e-4, "table")
             known[k] = True
-        elif k in sides_se:
+        elif k in sides_se and end.scale <= SIDE_SCATTER_LIMIT * o.sensor_sigma_m:
             s = line_plane_parameter(at_edge, t, end.n, end.d - end.short_of)
-            placed[k] = end.at(s, sides_se[k] / max(abs(float(end.n @ t)), 1e-3), "side face")
+            cos = max(abs(float(end.n @ t)), 1e-3)
+            # The fit holds the side face's offset where its points are, the end lies at face A's edge: a part
+            # turned within its angular tolerance moves it by the lever between them.
+            placed[k] = end.at(s, sides_se[k] / cos, "side face", bias=TILT_TOLERANCE_RAD * end.lever / cos)
             known[k] = True
     for k, end in enumerate(ends):
         # A tube's flat ends into its radius, no edge to find: beside an end from A's own side face, the other end
@@ -249,7 +282,14 @@ def find_ends(
         if not known[k] and end.inset and known[1 - k] and other.source == "side face" and not other.touching:
             width = s_map[1] - s_map[0]
             s = other.s + (width if k == 1 else -width)
-            placed[k] = end.at(s, float(np.hypot(other.se, SECTION_TOLERANCE_M)), "width")
+            placed[k] = end.at(s, other.se, "width", other.sigma, float(np.hypot(other.bias, SECTION_TOLERANCE_M)))
+            known[k] = True
+    for k, end in enumerate(ends):
+        # A hidden side face whose other part's face was not seen: face A's points stop short of that part (points
+        # near another part are not used), so where they stop is no end: the map's, the tolerance its sigma (the
+        # seam is found across, its end waits for a close-up: the confidence reads only what the points placed).
+        if not known[k] and end.touching:
+            placed[k] = end.at(s_map[k], 0.0, "map", sigma=o.map_tolerance_m)
             known[k] = True
     if all(known) or face_a.source != "points":
         for k, end in enumerate(ends):

@@ -147,7 +147,7 @@ class JointGeometry:
                 out.append(End(n, d, False, s, inset=self._inset(n, d, at)))
                 continue
             gap, other = min(found, key=lambda x: abs(x[0]))
-            out.append(End(n, d + gap, False, s, touching=extent_behind(other, -n, -d - gap), gap=gap))
+            out.append(End(n, d + gap, False, s, touching=extent_behind(other, -n, -d - gap), gap=gap, against=other))
         return out[0], out[1]
 
     def _inset(self, n: FloatArray, d: float, at: FloatArray | None) -> float:

@@ -4,13 +4,14 @@ values: a fit makes new faces and ends, it does not change them."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.seams.ours._points import Points
+from cell.types import Part
 
 IntArray = npt.NDArray[np.intp]
 
@@ -69,6 +70,15 @@ class End:
     # What the end's place may be off by [m] when more than ``se`` says (the confidence reads ``se``, the end's
     # sigma this): an edge read where a face's points stop also carries its blur and its sampling. None: ``se``.
     sigma: float | None = None
+    # The other part whose face a hidden side face lies on (``touching``): only points on that face, inside its
+    # outline, place the end (that part's other faces beside A are not it). None: no other part.
+    against: Part | None = None
+    # How far from face A's plane the side face's fitted points lie, at the median [m]: a part turned within its
+    # angular tolerance moves the side face at the seam (face A's edge) by this lever times the turn.
+    lever: float = 0.0
+    # What may move the placed end that no fit sees, one standard deviation [m]: the part's turn over the lever, a
+    # section's size tolerance (an end a drawn width from the other); added to the sigma, not widened with it.
+    bias: float = 0.0
 
     @property
     def spread(self) -> float:
@@ -77,23 +87,12 @@ class End:
 
     def moved(self, fit: Fitted) -> End:
         """The side face at this end moved by its offset fit."""
-        return End(
-            self.n,
-            self.d + fit.offset,
-            self.on_table,
-            self.s,
-            self.se,
-            fit.scale,
-            self.source,
-            self.touching,
-            self.gap,
-            self.inset,
-        )
+        return replace(self, d=self.d + fit.offset, scale=fit.scale, sigma=None, bias=0.0)
 
-    def at(self, s: float, se: float, source: str, sigma: float | None = None) -> End:
-        """This end placed at ``s`` along the line [m], with its standard error [m], where it came from and, when
-        wider than the standard error, its sigma [m] (:attr:`spread`)."""
-        return End(self.n, self.d, self.on_table, s, se, self.scale, source, self.touching, self.gap, self.inset, sigma)
+    def at(self, s: float, se: float, source: str, sigma: float | None = None, bias: float = 0.0) -> End:
+        """This end placed at ``s`` along the line [m], with its standard error [m], where it came from, when
+        wider than the standard error its sigma [m] (:attr:`spread`), and its :attr:`bias` [m]."""
+        return replace(self, s=s, se=se, source=source, sigma=sigma, bias=bias)
 
     @property
     def short_of(self) -> float:
@@ -181,7 +180,8 @@ class PassFit:
                 faces[x.key] = faces[x.key].moved(fit, len(x.sel))
             else:
                 k = END_KEYS.index(x.key)
-                moved[k] = moved[k].moved(fit)
+                lever = x.plane.lever if isinstance(x.plane, End) else 0.0
+                moved[k] = replace(moved[k].moved(fit), lever=lever)
         for j, tilted in self.tilted.items():
             key = request.selections[j].key
             if tilted is not None:

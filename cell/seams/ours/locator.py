@@ -178,7 +178,7 @@ class OursLocator:
                     f"face {face.name} is seen by no usable camera ({len(sel)} points near the seam in a "
                     f"{pts.share:.0%} sample, needs {pts.least(o.min_face_points)}) and {why}",
                 )
-            sides = side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack, o)
+            sides = side_selections(ends, pts, r_a, r_b, face_b, geo, first, slack, o, face_a.n)
             tilts = []
             if last and o.refine_normals:
                 for j, x in enumerate(planes):
@@ -240,7 +240,7 @@ class OursLocator:
             drawn
             if e.source == "map"
             else ours_end_sigma(
-                e.spread, k, bool(e.touching) and e.source == "side face", abs(slope), o.end_floor_scale
+                e.spread, k, bool(e.touching) and e.source == "side face", abs(slope), o.end_floor_scale, e.bias
             )
             for e, k, slope in zip(ends, sources, slopes, strict=True)
         ]

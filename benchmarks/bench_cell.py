@@ -34,7 +34,7 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.errors import EXIT_OK, EXIT_PARTIAL, CellError
 from cell.export.report import rescan_report, weld_report, write_json
-from cell.station import open_station
+from cell.pipeline.geometry import open_cell
 
 RESULTS = Path(__file__).resolve().parent / "results"
 RESCAN_SCENARIOS = ("fence1-exact", "fence1", "fence2", "faults/extrinsics-off")
@@ -165,7 +165,7 @@ def rescan_row(name: str) -> Row:
     _say(f"cell rescan {name} --all")
     scn = sc.load(name)
     weldmap = pipeline.read_weldmap(scn)
-    with open_station(scn, weldmap) as station:
+    with open_cell(scn, weldmap) as station:
         det = pipeline.detect(scn, None, station=station, weldmap=weldmap)
         if det.error is not None:
             raise det.error

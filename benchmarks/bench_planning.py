@@ -27,9 +27,8 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export.report import write_json
 from cell.pipeline.detect import read_weldmap
-from cell.pipeline.geometry import motion_scene
+from cell.pipeline.geometry import motion_scene, open_cell
 from cell.pipeline.weld import plan_for
-from cell.station import open_station
 
 
 def bench(name: str) -> dict[str, Any]:
@@ -43,7 +42,7 @@ def bench(name: str) -> dict[str, Any]:
 
     s = sc.load(name)
     weldmap = read_weldmap(s)
-    with open_station(s, weldmap) as station:
+    with open_cell(s, weldmap) as station:
         det = pipeline.detect(s, station=station, weldmap=weldmap)
         arm = station.arm
         assert arm is not None

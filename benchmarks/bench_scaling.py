@@ -49,12 +49,12 @@ from cell.geometry import invert
 from cell.perception import align_map, check_alignment, check_alignment_unique, check_parts_seen, perceive
 from cell.perception.preprocess import downsample
 from cell.pipeline.detect import read_weldmap
-from cell.pipeline.geometry import motion_scene
+from cell.pipeline.geometry import motion_scene, open_cell
 from cell.pipeline.weld import plan_for
 from cell.scenario import Scenario
 from cell.seams.base import BatchSeamLocator
 from cell.seams.registry import make_locator
-from cell.station import Station, open_station
+from cell.station import Station
 from cell.types import SeamEstimate, SeamStatus, WeldMap
 from cell.voxels import voxel_order
 
@@ -144,7 +144,7 @@ def bench(name: str, methods: list[str], noise: str, repeat: int) -> dict[str, A
     """One row: the scenario's size, its stage times [s], per method ms per seam and accuracy, and planning."""
     s = sc.load(name).with_noise("none" if noise == "none" else "realistic")
     weldmap = read_weldmap(s)
-    with open_station(s, weldmap) as station:
+    with open_cell(s, weldmap) as station:
         return _bench(name, station, s, weldmap, methods, repeat)
 
 

@@ -90,7 +90,7 @@ def report_of(job: CellJob, scenario: Any) -> dict[str, Any]:
 
     if job.stage == "detect":
         return detection_report(pipeline.detect(scenario, job.method))
-    return weld_report(pipeline.weld(scenario, job.method))
+    return weld_report(pipeline.weld(scenario, pipeline.WeldJob(job.method)))
 
 
 def run_cell(job: CellJob) -> dict[str, Any]:

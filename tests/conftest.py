@@ -78,10 +78,10 @@ def fence1_station(fence1_detection: pipeline.Detection) -> Iterator[SimStation]
     """A running fence1 cell of the test's own, as the session's detection left its station: the arm at its scan
     configuration and every camera one image on (a close-up draws the same noise as it does in ``cell weld``)."""
     from cell import pipeline
-    from cell.station import open_station
+    from cell.pipeline.geometry import open_cell
 
     scn = fence1_detection.scenario
-    with open_station(scn, pipeline.read_weldmap(scn)) as station:
+    with open_cell(scn, pipeline.read_weldmap(scn)) as station:
         station.capture()
         yield station
 

@@ -79,16 +79,16 @@ def _check_scenario(path: Path, weldmap: WeldMap) -> None:
     """The scenario loads, ``cell scenario check`` has nothing to say, the as-built parts can be made, and the arm
     reaches the scan pose."""
     from cell import scenario as sc
+    from cell.pipeline.geometry import robot_arm
     from cell.scenario.init import check_layout
     from cell.sim.asbuilt.parts import as_built_parts
-    from cell.station import load_arm
 
     scn = sc.load(path)
     problems = check_layout(scn, weldmap)
     if problems:
         raise RejectedDrawError(problems[0])
     as_built_parts(weldmap, scn)
-    load_arm(scn)
+    robot_arm(scn)
 
 
 def _cameras(kind: str, placement: Placement, rng: np.random.Generator) -> list[Camera]:

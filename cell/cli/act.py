@@ -93,6 +93,7 @@ def weld(
     then turn the part over for the seams against the table and weld its other side (``--sides all``)."""
     from cell import pipeline
     from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.pipeline.job import WeldJob
     from cell.pipeline.turnover import weld_part
     from cell.pipeline.turnover_run import TurnoverRun
 
@@ -111,11 +112,12 @@ def weld(
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
         try:
+            asked = WeldJob(method, noise=parse_noise(noise), rescan=mode, gui=gui, sides=side_opt)
             if side_opt == "first":  # side A alone, as the part lies
-                run = pipeline.weld(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
+                run = pipeline.weld(scn, asked, progress=stage)
                 job = TurnoverRun(run)
             else:
-                job = weld_part(scn, method, noise=parse_noise(noise), rescan=mode, progress=stage, gui=gui)
+                job = weld_part(scn, asked, progress=stage)
                 run = job.side_a  # the page and the recording show side A
             partial = finish_turnover(
                 job, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
@@ -147,7 +149,7 @@ def rescan_cmd(
     """
     from cell import pipeline
     from cell.export.report import detection_report, rescan_report
-    from cell.station import open_station
+    from cell.pipeline.geometry import open_cell
 
     with cell_errors():
         check_file(json_path, "--json")
@@ -162,7 +164,7 @@ def rescan_cmd(
         stage, writer = Stage(), Writer()
         det: pipeline.Detection | None = None
         try:
-            with open_station(scn, weldmap) as station:
+            with open_cell(scn, weldmap) as station:
                 det = pipeline.detect(scn, method, progress=stage, station=station, weldmap=weldmap)
                 if det.error is not None:
                     writer.report(json_path, detection_report(det, provenance=prov))
@@ -195,6 +197,7 @@ def preview(
     the planned turn with side B's seams at their nominal turned place (``--sides all``)."""
     from cell import pipeline
     from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.pipeline.job import WeldJob
     from cell.pipeline.turnover import weld_part
     from cell.pipeline.turnover_run import TurnoverRun
     from cell.preview import write_run
@@ -210,11 +213,12 @@ def preview(
         run: WeldRun | None = None
         json_path = out_dir / "report.json"
         try:
+            asked = WeldJob(method, noise=parse_noise(noise), execute=False, sides=side_opt)
             if side_opt == "first":
-                run = pipeline.weld(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
+                run = pipeline.weld(scn, asked, progress=stage)
                 job = TurnoverRun(run)
             else:
-                job = weld_part(scn, method, noise=parse_noise(noise), execute_plan=False, progress=stage)
+                job = weld_part(scn, asked, progress=stage)
                 run = job.side_a
             partial = finish_turnover(job, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
             _write_rerun(run, rerun_path, writer)  # before the pictures: it needs no cloud, they do

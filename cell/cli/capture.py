@@ -105,11 +105,11 @@ def write_simulated(
     """Simulate the scenario's cell, capture with every camera (the arm at its scan pose: the eye-in-hand camera's
     flange pose is recorded) and write the capture folder with its cell.yaml, map and truth; returns the folder."""
     from cell import pipeline
-    from cell.station import open_station
+    from cell.pipeline.geometry import open_cell
 
     weldmap = pipeline.read_weldmap(scn)
     say(f"building the cell of {scn.name}")
-    with open_station(scn, weldmap) as station:
+    with open_cell(scn, weldmap) as station:
         cap = pipeline.capture(scn, station=station, weldmap=weldmap, progress=say)
         flange = {}
         if station.arm is not None:  # the arm holds the eye-in-hand cameras where it is now (its scan pose)

@@ -13,17 +13,20 @@ from cell.cli.explain import weld_exit
 from cell.cli.outputs import Writer
 from cell.cli.tables import print_weld
 from cell.errors import UsageError
+from cell.pipeline.job import Sides
 
 if TYPE_CHECKING:
     from cell.pipeline.turnover_run import TurnoverRun
     from cell.types.turnover import TurnoverPlan
 
 
-def parse_sides(sides: str) -> str:
+def parse_sides(sides: str) -> Sides:
     """``--sides``: ``first`` (side A only, the part as it lies) or ``all`` (turn the part for the rest)."""
-    if sides not in ("first", "all"):
-        raise UsageError(f"--sides {sides!r} is unknown; valid: first, all")
-    return sides
+    if sides == "first":
+        return "first"
+    if sides == "all":
+        return "all"
+    raise UsageError(f"--sides {sides!r} is unknown; valid: first, all")
 
 
 def turnover_message(plan: TurnoverPlan) -> str:

@@ -17,7 +17,7 @@ from cell.errors import CellError
 from cell.export.atomic import write_atomic
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection, WeldRun
-from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus
+from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, Violation
 
 REPORT_VERSION = 1
 
@@ -178,6 +178,20 @@ def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
     return write_atomic(path, text.encode("utf-8"), what="report")
 
 
+def violation_entry(v: Violation) -> dict[str, Any]:
+    """One violation of the safety gate: its ``code`` (the kind), the ``detail`` line, where (``t_s``, ``joint``,
+    ``seam``, ``body``: "" when the check does not say) and by how much (``excess``, in the kind's SI unit)."""
+    return {
+        "code": v.kind.value,
+        "detail": str(v),
+        "t_s": _r(v.t, 4),
+        "joint": v.joint,
+        "seam": v.seam_id,
+        "body": v.body,
+        "excess": _r(v.excess, 6),
+    }
+
+
 def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The ``cell weld`` / ``cell preview`` report: the detection report plus, per seam, ``welded``, ``reason``,
     ``tcp_error_mm`` {rms, max, short_start, short_end, past_start, past_end} of the executed tool path against the
@@ -240,7 +254,7 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
         else None
     )
     rep["events"] = [{"t_s": _r(e.t, 4), "kind": e.kind, "detail": e.detail} for e in ex.events] if ex else []
-    rep["violations"] = list(run.violations)
+    rep["violations"] = [violation_entry(v) for v in run.violations]
     rep["error"] = _error(run.error)
     rep["timings_s"] = {k: _r(v, 4) for k, v in run.timings.items()}
     return rep

@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from enum import StrEnum
 from functools import cached_property
 from typing import Protocol
 
@@ -20,45 +19,12 @@ from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.types import Part
+from cell.types.gate import Violation as Violation  # the gate's vocabulary, kept in cell.types for the records
+from cell.types.gate import ViolationKind as ViolationKind
 from cell.types.plan import Segment, WeldPlan
 from cell.types.trajectory import Trajectory
 
 DEG = 180.0 / math.pi  # [deg/rad] for messages
-
-
-class ViolationKind(StrEnum):
-    """What a violation is about (the first word of its text)."""
-
-    START_STATE = "start_state"
-    POSITION = "position"
-    VELOCITY = "velocity"
-    ACCELERATION = "acceleration"
-    JERK = "jerk"
-    JUMP = "jump"
-    SINGULARITY = "singularity"
-    ARC = "arc"
-    COLLISION = "collision"
-    BODY = "body"  # the TCP or the wire inside a part's body
-
-
-@dataclass(frozen=True)
-class Violation:
-    """One problem: kind (start_state | position | velocity | acceleration | jerk | jump | singularity | arc |
-    collision | body), a one-line description, where (time t [s], joint name or ""), and by how much (``excess`` in
-    the kind's SI unit: rad, rad/s, rad/s^2, rad/s^3, m^3 for manipulability, m for collision and body depth).
-    seam_id, body : the seam whose motion it is and the part it enters ("" when the check does not say)."""
-
-    kind: ViolationKind
-    what: str
-    t: float
-    joint: str = ""
-    excess: float = 0.0
-    seam_id: str = ""
-    body: str = ""
-
-    def __str__(self) -> str:
-        j = f" {self.joint}" if self.joint else ""
-        return f"{self.kind}{j} at t = {self.t:.3f} s: {self.what}"
 
 
 def resample_times(times: FloatArray, rate_hz: float) -> FloatArray:

@@ -3,17 +3,31 @@ gate -> execute. Each stage takes and returns values; this package wires them, t
 that talks to the station's ports. The CLI is a thin layer over it."""
 
 from cell.pipeline.cloud import locate_cloud
-from cell.pipeline.detect import build_scene, capture, detect, evaluate, locate, read_weldmap, table_z_R, truths
+from cell.pipeline.detect import (
+    AlignStart,
+    build_scene,
+    capture,
+    detect,
+    evaluate,
+    locate,
+    read_weldmap,
+    table_z_R,
+    truths,
+)
+from cell.pipeline.geometry import open_cell, robot_arm
+from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun
 from cell.pipeline.rescan import RescanMode, rescan_detection, rescan_seams, rescanned
 from cell.pipeline.weld import execute, plan_for, torch_paths, weld
 
 __all__ = [
+    "AlignStart",
     "Capture",
     "Detection",
     "RescanMode",
     "Scene",
     "SeamWeld",
+    "WeldJob",
     "WeldRun",
     "build_scene",
     "capture",
@@ -22,11 +36,13 @@ __all__ = [
     "execute",
     "locate",
     "locate_cloud",
+    "open_cell",
     "plan_for",
     "read_weldmap",
     "rescan_detection",
     "rescan_seams",
     "rescanned",
+    "robot_arm",
     "table_z_R",
     "torch_paths",
     "truths",

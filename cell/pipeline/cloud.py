@@ -11,21 +11,21 @@ from dataclasses import replace
 
 import numpy as np
 
-from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
+from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert, make_pose, transform_points
 from cell.perception.align.checks import check_alignment_unique, check_parts_seen
-from cell.perception.align.fit import Alignment, align_map, sample_map, surface_fit
-from cell.perception.align.placement import DISTINCT_DEG, DISTINCT_M, fpfh_candidates, height_candidates, on_table
+from cell.perception.align.cloud import FRAME as _FRAME
+from cell.perception.align.cloud import POOR_FITNESS, crop_mask, place_map
+from cell.perception.align.placement import on_table
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, find_table, levelling
 from cell.perception.unorganised import sampling as spacing_of
 from cell.pipeline.cloud_seams import locate_seams
-from cell.pipeline.cloud_setup import FRAME as _FRAME
-from cell.pipeline.cloud_setup import crop_mask, scenario_for
+from cell.pipeline.cloud_setup import scenario_for
 from cell.pipeline.evaluation import evaluate
 from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Detection
-from cell.scenario import PerceptionSpec, Scenario
+from cell.scenario import Scenario
 from cell.seams.joint import find_joints
 from cell.seams.visibility import visibility
 from cell.types import (
@@ -40,9 +40,6 @@ from cell.types import (
 )
 from cell.voxels import voxel_order
 
-POOR_FITNESS = 0.6  # a fit from the nominal placement below this fitness is retried from a global registration
-CHALLENGE_MARGIN = 1.05  # a fit elsewhere must explain this many times the placement's fit's points to replace it
-PRESCORE, PRESCORE_BAND_M = 0.7, 0.01  # ... and before its ICP this share of them, within this band
 MIN_POINTS = 200  # fewer points than this: no cloud to locate anything in
 
 
@@ -102,35 +99,8 @@ def locate_cloud(
         name, weldmap, X_FL, X_LM0, P_L, above, table, viewpoint_L, (noise, along, between), method
     )
     spec = spec_scenario.perception
-    alignment: Alignment | None = None
-    error: CellError | None = None
-    count = 0.0
-    if X_LM0 is not None:
-        crop = crop_mask(P_L, above, weldmap.transformed(X_LM0, _FRAME))
-        try:
-            alignment = align_map(weldmap.transformed(X_LM0, _FRAME), Cloud(P_L[crop], _FRAME), spec)
-            count = alignment.fitness * int(crop.sum())
-        except AlignmentError as e:
-            error = e
-    if alignment is not None and X_LM0 is not None and alignment.fitness >= POOR_FITNESS:
-        # A placement turned far off settles on a wrong fit that the checks pass (the tee turned by 180 degrees
-        # fits 0.78 of its points): the height image's best pose unlike it must not explain clearly more points.
-        other = _challenger(P_L, above, weldmap, table_z, spec, alignment.X_RR_corr @ X_LM0)
-        if other is not None and other[2] > CHALLENGE_MARGIN * count:
-            progress(
-                f"the placement was far off: a fit elsewhere explains {other[2] / max(count, 1.0):.0%} of its points"
-            )
-            X_LM0, alignment = other[0], other[1]
-    elif alignment is None or alignment.fitness < POOR_FITNESS:
-        progress("global registration of the map (height image, FPFH + RANSAC)")
-        best = _global(P_L, above, weldmap, table_z, viewpoint_L, rng, spec)
-        if best is not None and (alignment is None or best[2] > count):
-            X_LM0, alignment, error = best[0], best[1], None
-        elif alignment is None and error is None:
-            error = AlignmentError(
-                "no placement of the map fits the cloud (global registration: no candidate aligned)",
-                code=AlignmentFailure.LOW_FITNESS,
-            )
+    placed = place_map(P_L, above, weldmap, table_z, X_LM0, spec, viewpoint_L, rng, progress)
+    X_LM0, alignment, error = placed.X_LM0, placed.alignment, placed.error
     timings["align_s"] = time.perf_counter() - t
 
     scenario = spec_scenario
@@ -185,78 +155,6 @@ def _placement_error(X_FM_nominal: FloatArray, X_FM: FloatArray) -> str:
 def _levelled(table: TablePlane, X_LF: FloatArray) -> TablePlane:
     """The table plane expressed in L."""
     return replace(table, normal=X_LF[:3, :3] @ table.normal)
-
-
-def _aligned(
-    P_L: FloatArray, above: np.ndarray, weldmap: WeldMap, X0: FloatArray, spec: PerceptionSpec
-) -> tuple[FloatArray, Alignment, float] | None:
-    """(X0, its alignment, the points it explains: fitness times the points of its crop), or None when the staged
-    ICP from X0 fails."""
-    crop = crop_mask(P_L, above, weldmap.transformed(X0, _FRAME))
-    try:
-        fit = align_map(weldmap.transformed(X0, _FRAME), Cloud(P_L[crop], _FRAME), spec)
-    except AlignmentError:
-        return None
-    return X0, fit, fit.fitness * int(crop.sum())
-
-
-def _global(
-    P_L: FloatArray,
-    above: np.ndarray,
-    weldmap: WeldMap,
-    table_z: float,
-    viewpoint_L: FloatArray | None,
-    rng: np.random.Generator,
-    spec: PerceptionSpec,
-) -> tuple[FloatArray, Alignment, float] | None:
-    """The best global candidate (:mod:`cell.perception.align.placement`) as aligned by the staged ICP: the one
-    that explains the most points of the cloud (:func:`_aligned`); None when none aligns. The height-image search
-    first; FPFH + RANSAC only when none of its candidates fits well (on the real scans FPFH proposed the part
-    turned by 180 degrees and took 5 s; the height image 0.3 s, right every time)."""
-    best: tuple[FloatArray, Alignment, float] | None = None
-    searches = (
-        lambda: height_candidates(P_L[above], weldmap, table_z),
-        lambda: fpfh_candidates(P_L[above], weldmap, table_z, viewpoint_L, rng),
-    )
-    for search in searches:
-        for X0 in search():
-            fit = _aligned(P_L, above, weldmap, X0, spec)
-            if fit is not None and (best is None or fit[2] > best[2]):
-                best = fit
-        if best is not None and best[1].fitness >= POOR_FITNESS:
-            break  # the height image's fit is good: FPFH is not asked
-    return best
-
-
-def _challenger(
-    P_L: FloatArray, above: np.ndarray, weldmap: WeldMap, table_z: float, spec: PerceptionSpec, X_LM: FloatArray
-) -> tuple[FloatArray, Alignment, float] | None:
-    """The height image's best candidate unlike the fit ``X_LM`` (turned by more than DISTINCT_DEG or its parts'
-    centre moved by more than DISTINCT_M), aligned; None when there is none or it does not align."""
-    centre_M = np.mean([p.center for p in weldmap.parts], axis=0)
-
-    def where(X: FloatArray) -> tuple[float, FloatArray]:
-        return float(np.arctan2(X[1, 0], X[0, 0])), X[:3, :3] @ centre_M + X[:3, 3]
-
-    yaw, c = where(X_LM)
-    for X0 in height_candidates(P_L[above], weldmap, table_z):
-        yaw0, c0 = where(X0)
-        turn = abs((yaw0 - yaw + np.pi) % (2.0 * np.pi) - np.pi)
-        if turn > np.radians(DISTINCT_DEG) or float(np.linalg.norm((c0 - c)[:2])) > DISTINCT_M:
-            # Only a candidate that already explains a fair share of what the fit does is worth an ICP.
-            if _explained(P_L, above, weldmap, X0) < PRESCORE * _explained(P_L, above, weldmap, X_LM):
-                return None
-            return _aligned(P_L, above, weldmap, X0, spec)
-    return None
-
-
-def _explained(P_L: FloatArray, above: np.ndarray, weldmap: WeldMap, X: FloatArray) -> float:
-    """How many points of the crop about the map at X lie within PRESCORE_BAND_M of its surfaces."""
-    map_L = weldmap.transformed(X, _FRAME)
-    crop = crop_mask(P_L, above, map_L)
-    samples, normals = sample_map(map_L, PRESCORE_BAND_M / 2.0, PRESCORE_BAND_M / 2.0)
-    fit, _ = surface_fit(P_L[crop], samples, normals, PRESCORE_BAND_M, PRESCORE_BAND_M / 2.0)
-    return fit * int(crop.sum())
 
 
 def _workspace_L(P_L: FloatArray, crop: np.ndarray) -> Box:

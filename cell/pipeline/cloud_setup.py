@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from cell.geometry import FloatArray, make_pose, matrix_to_rpy, transform_points
+from cell.perception.align.cloud import FRAME, crop_bounds
 from cell.perception.unorganised import TablePlane
 from cell.scenario import Scenario
 from cell.types import WeldMap
@@ -23,8 +24,6 @@ FLOOR_SPACING_SHARE = 1.0 / math.sqrt(12.0)  # RMS of a uniform position within 
 # A part's top half covered is a map placed half off the cloud for a depth camera over solid boxes; a real tube is
 # open at its ends, and its top shows only its rim (the scans' vertical tube: 37-46 % of its top within 1 cm).
 MIN_SEEN = 0.3
-MARGIN_M = 0.1  # the crop around the placed map's bounds, horizontally and above [m]
-FRAME = "R"  # the stages' name for the frame they work in (for a brought cloud, the levelled frame L)
 NO_EDGES = 10**9  # min_edge_points that no edge reaches: a weld face must be seen
 # The locator's tube about the seam holds this many scan lines across (within 60..150 mm): 60 mm (the default, for
 # a depth camera's 1-2 mm pitch) held 14-30 points of the scans' grazing wall (x0y24), its seam found or refused by a
@@ -115,18 +114,6 @@ def cloud_scenario(
         "base_dir": str(Path(source).parent) if source else ".",
     }
     return Scenario.model_validate(data)
-
-
-def crop_bounds(map_L: WeldMap) -> tuple[FloatArray, FloatArray]:
-    """(lo, hi) (3,) [m]: the placed map's bounds grown by MARGIN_M (its frame)."""
-    v = np.vstack([p.vertices() for p in map_L.parts])
-    return v.min(axis=0) - MARGIN_M, v.max(axis=0) + MARGIN_M
-
-
-def crop_mask(P_L: FloatArray, above: np.ndarray, map_L: WeldMap) -> np.ndarray:
-    """Points above the table within :func:`crop_bounds` (not below: the table is cut)."""
-    lo, hi = crop_bounds(map_L)
-    return above & np.all((lo <= P_L) & (hi >= P_L), axis=1)
 
 
 def scenario_for(

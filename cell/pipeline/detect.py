@@ -6,7 +6,7 @@ import math
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Literal
 
 from cell.errors import AlignmentError, CellError, SensorError
@@ -14,15 +14,37 @@ from cell.geometry import FloatArray, invert
 from cell.perception.align.fit import Alignment
 from cell.perception.calibration import PoseUncertainty, with_calibration
 from cell.pipeline.evaluation import evaluate
+from cell.pipeline.geometry import open_cell
 from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
-from cell.station import Station, open_station
+from cell.station import Station
 from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
 
 Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
 
-__all__ = ["Progress", "build_scene", "capture", "detect", "evaluate", "locate", "quiet", "read_weldmap", "truths"]
+
+@dataclass(frozen=True)
+class AlignStart:
+    """Where the map's alignment starts when the part is not where the scenario places it (a turned part): its
+    believed pose X_RM (4, 4) and a search of the cloud near it (:data:`Seed`; None: from X_RM itself)."""
+
+    X_RM: FloatArray
+    seed: Seed | None = None
+
+
+__all__ = [
+    "AlignStart",
+    "Progress",
+    "build_scene",
+    "capture",
+    "detect",
+    "evaluate",
+    "locate",
+    "quiet",
+    "read_weldmap",
+    "truths",
+]
 
 
 def read_weldmap(scenario: Scenario) -> WeldMap:
@@ -51,7 +73,7 @@ def capture(
     weldmap = weldmap if weldmap is not None else read_weldmap(scenario)
     if station is None:
         progress(f"building the cell of {scenario.name}")
-        with open_station(scenario, weldmap, gui=gui) as st:
+        with open_cell(scenario, weldmap, gui=gui) as st:
             return capture(scenario, progress=progress, station=st, weldmap=weldmap)
     if station.source == "simulation":
         progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")

@@ -4,6 +4,7 @@ found seam is too uncertain to weld; the planned torch paths for pictures and re
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -21,28 +22,40 @@ if TYPE_CHECKING:
     from cell.types.plan import SeamTask, Segment, WeldPlan
 
 
-def doubt(est: SeamEstimate, sc: Scenario) -> str:
-    """Why a found seam is too uncertain to weld ("" when it may be welded): its bound (``rescan.bound_sigmas``
+@dataclass(frozen=True)
+class Doubt:
+    """Why a found seam is too uncertain to weld: ``code`` (``low_confidence`` or ``end_uncertain``) and the
+    ``detail`` for people (which bound, by how much against what)."""
+
+    code: WeldReason
+    detail: str
+
+
+def doubt(est: SeamEstimate, sc: Scenario) -> Doubt | None:
+    """Why a found seam is too uncertain to weld (None when it may be welded): its bound (``rescan.bound_sigmas``
     times its calibrated sigma) over ``rescan.weld_tolerance_mm``, its confidence under
-    ``rescan.weld_min_confidence``, or an end's bound over ``rescan.end_tolerance_mm`` (:func:`end_doubt`)."""
+    ``rescan.weld_min_confidence`` (both ``low_confidence``), or an end's bound over ``rescan.end_tolerance_mm``
+    (:func:`end_doubt`)."""
     r = sc.rescan
     if not within_tolerance(est, r.max_sigma_m):
         bound_mm = r.bound_sigmas * est.sigma_m * 1000.0
-        return f"bound {r.bound_sigmas:g} sigma = {bound_mm:.2f} mm > weld tolerance {r.weld_tolerance_mm:g} mm"
+        why = f"bound {r.bound_sigmas:g} sigma = {bound_mm:.2f} mm > weld tolerance {r.weld_tolerance_mm:g} mm"
+        return Doubt(WeldReason.LOW_CONFIDENCE, why)
     if est.confidence < r.weld_min_confidence:
-        return f"confidence {est.confidence:.2f} < {r.weld_min_confidence:.2f}"
+        return Doubt(WeldReason.LOW_CONFIDENCE, f"confidence {est.confidence:.2f} < {r.weld_min_confidence:.2f}")
     return end_doubt(est, sc)
 
 
-def end_doubt(est: SeamEstimate, sc: Scenario) -> str:
-    """Why a found seam's ends are too uncertain to weld ("" when they are not): an end's bound along the seam
-    (``rescan.bound_sigmas`` times its sigma) over ``rescan.end_tolerance_mm``."""
+def end_doubt(est: SeamEstimate, sc: Scenario) -> Doubt | None:
+    """Why a found seam's ends are too uncertain to weld (``end_uncertain``; None when they are not): an end's
+    bound along the seam (``rescan.bound_sigmas`` times its sigma) over ``rescan.end_tolerance_mm``."""
     r = sc.rescan
     if ends_within_tolerance(est, r.max_end_sigma_m):
-        return ""
+        return None
     bounds = ", ".join(f"{r.bound_sigmas * s * 1000.0:.2f}" for s in est.end_sigma_m)
     where = "/".join(str(k) for k in est.end_source)
-    return f"end bound {r.bound_sigmas:g} sigma = {bounds} mm ({where}) > end tolerance {r.end_tolerance_mm:g} mm"
+    why = f"end bound {r.bound_sigmas:g} sigma = {bounds} mm ({where}) > end tolerance {r.end_tolerance_mm:g} mm"
+    return Doubt(WeldReason.END_UNCERTAIN, why)
 
 
 def seam_welds(
@@ -77,9 +90,9 @@ def seam_welds(
             out.append(SeamWeld(est.id, False, False, why, code=WeldReason.NOT_LOCATED))
             continue
         doubtful = doubt(est, sc)
-        if doubtful and gated and est.id not in unplaceable:
-            code = WeldReason.END_UNCERTAIN if doubtful == end_doubt(est, sc) else WeldReason.LOW_CONFIDENCE
-            out.append(SeamWeld(est.id, False, False, f"{code.value}: {doubtful}", code=code))
+        if doubtful is not None and gated and est.id not in unplaceable:
+            why = f"{doubtful.code.value}: {doubtful.detail}"
+            out.append(SeamWeld(est.id, False, False, why, code=doubtful.code))
             continue
         fail = (checked or {}).get(est.id)
         if fail is not None:
@@ -94,7 +107,7 @@ def seam_welds(
             continue
         welds = [g for g in plan.segments if g.arc_on and g.seam_id == est.id] if plan is not None else []
         if ex is None or plan is None:
-            note = f"; {doubtful}: would be re-scanned before welding" if doubtful else ""
+            note = f"; {doubtful.detail}: would be re-scanned before welding" if doubtful is not None else ""
             code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
             why = (refused or "planned, not executed (preview)") + note
             proc = welds[0].procedure if welds else None

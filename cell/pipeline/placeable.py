@@ -18,12 +18,14 @@ from cell.scenario import Scenario
 from cell.station import Arm, Station
 
 if TYPE_CHECKING:
+    from cell.planning.failures import SeamFailure
     from cell.types.plan import NoProcedure, SeamProcedure, SeamTask
     from cell.types.rescan import Rescan
 
 
-def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, str]:
-    """Seam id -> the planner's reason, for those of ``seam_ids`` (found seams only) no torch can be placed on."""
+def unweldable(arm: Arm, det: Detection, seam_ids: Collection[str], motion: MotionScene) -> dict[str, SeamFailure]:
+    """Seam id -> the planner's failure (its code, where), for those of ``seam_ids`` (found seams only) no torch
+    can be placed on."""
     from cell.planning.plan import unplaceable
     from cell.planning.tasks import seam_tasks
     from cell.process.torch import WeldProcess
@@ -67,21 +69,23 @@ def rescan_weldable(
     *,
     motion: MotionScene,
     progress: Progress = quiet,
-) -> tuple[Rescan | None, Detection, dict[str, str]]:
+) -> tuple[Rescan | None, Detection, dict[str, SeamFailure]]:
     """:func:`~cell.pipeline.rescan.rescan_chosen` leaving out the seams no torch can be placed on: neither the
     mode's choice nor an escalation re-scans them. Returns the re-scan (None when nothing was left to re-scan),
-    the detection after it, and those seams (id -> the planner's reason)."""
+    the detection after it, and those seams (id -> the planner's failure)."""
     arm = station.arm
     if arm is None:  # rescan_seams says so
         return rescan_chosen(station, det, mode, motion=motion, progress=progress)
 
-    def leave_out(d: Detection, ids: Sequence[str]) -> dict[str, str]:
+    def leave_out(d: Detection, ids: Sequence[str]) -> dict[str, SeamFailure]:
         return _hopeless(arm, d, ids, motion, progress)
 
     return rescan_chosen(station, det, mode, leave_out=leave_out, motion=motion, progress=progress)
 
 
-def _hopeless(arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene, progress: Progress) -> dict[str, str]:
+def _hopeless(
+    arm: Arm, det: Detection, ids: Sequence[str], motion: MotionScene, progress: Progress
+) -> dict[str, SeamFailure]:
     """:func:`unweldable` of ``ids``, said on ``progress`` when there are any."""
     found = unweldable(arm, det, ids, motion)
     if found:

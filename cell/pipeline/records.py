@@ -22,6 +22,7 @@ from cell.types import (
     SeamMetrics,
     SeamScene,
     SeamStatus,
+    Violation,
     WeldMap,
 )
 from cell.types.run import SeamRecord, SeamWeld
@@ -100,9 +101,9 @@ class Detection:
         return not self.lost_cameras and all(e.status not in undone for e in self.estimates)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class WeldRun:
-    """The outcome of ``cell weld`` / ``cell preview``.
+    """The outcome of ``cell weld`` / ``cell preview`` (built by keyword).
 
     plan : the checked welding plan (None when planning failed as a whole: see ``error``).
     execution : what the simulated arm did (None for a preview or when the gate refused the plan).
@@ -114,11 +115,11 @@ class WeldRun:
     plan: WeldPlan | None = None
     pre_move: Trajectory | None = None
     execution: Execution | None = None
-    violations: tuple[str, ...] = ()
+    violations: tuple[Violation, ...] = ()  # the safety gate's, in its order (the plan was refused)
     error: CellError | None = None
     timings: dict[str, float] = field(default_factory=dict)
     torch_paths: Mapping[str, FloatArray] = field(default_factory=dict)  # seam id -> (n, 4, 4) planned X_RT
-    arm: Arm | None = None
+    arm: Arm | None = None  # the robot that ran (the program post-processor needs its model; pictures read view)
     first_detection: Detection | None = None  # before the re-scan (the same as detection when none ran)
     rescan: Rescan | None = None
     view: CellView | None = None  # the table, the robot's shapes at its poses and the cameras, for pictures

@@ -39,6 +39,7 @@ from cell.types.rescan import Rescan, SeamRescan, Viewpoint
 
 if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker
+    from cell.planning.failures import SeamFailure
     from cell.types.execution import Execution
     from cell.types.trajectory import Trajectory
 
@@ -259,7 +260,7 @@ def rescan_detection(
     return rs, after
 
 
-LeaveOut = Callable[[Detection, Sequence[str]], dict[str, str]]  # of these seams, those not to re-scan -> why
+LeaveOut = Callable[[Detection, Sequence[str]], "dict[str, SeamFailure]"]  # of these seams, those not to re-scan -> why
 
 
 def rescan_chosen(
@@ -271,7 +272,7 @@ def rescan_chosen(
     leave_out: LeaveOut | None = None,
     motion: MotionScene | None = None,
     progress: Progress = quiet,
-) -> tuple[Rescan | None, Detection, dict[str, str]]:
+) -> tuple[Rescan | None, Detection, dict[str, SeamFailure]]:
     """The one re-scan path of ``cell weld`` and ``cell rescan``: the mode's seams (or ``seam_ids``) but those
     ``leave_out`` names, re-scanned up close; then, in mode ``low``, the escalation: a close-up that moved its seam
     by more than ``rescan.escalate_mm`` (:func:`cell.rescan.escalation.largest_shift_mm`) re-scans every other

@@ -1,22 +1,30 @@
 """The cell around the part as values for pictures, computed once per run so that the preview reads values only: the
-table, the robot's URDF shapes and link poses at the scan pose and along the plan, the cameras. Frame R, metres."""
+table, the robot's URDF shapes and link poses at the scan pose, along the plan and along the motion, its joint
+limits, the cameras. Frame R, metres."""
 
 from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.errors import ScenarioError
-from cell.geometry import FloatArray, invert, make_pose, pose_from_xyz_rpy
+from cell.geometry import FloatArray, invert, make_pose, pose_from_xyz_rpy, transform_points
 from cell.scenario import Scenario
 from cell.station.ports import Arm
 from cell.types import Box, CameraIntrinsics, WeldPlan
-from cell.types.view import CameraView, CellView, RobotPose, Shape, ShapeKind
+from cell.types.view import EYE, MOTION_HZ, TCP, ArmMotion, CameraView, CellView, RobotPose, Shape, ShapeKind
+
+if TYPE_CHECKING:
+    from cell.types.execution import Execution
+    from cell.types.trajectory import Trajectory
 
 PATH_POSES = 48  # robot poses drawn along the plan (evenly in time, plus every weld's start and end)
+TOOL_HZ = 50.0  # planned tool path samples per second (a preview's: nothing was executed)
 _GREY = (0.6, 0.6, 0.6, 1.0)
 
 
@@ -117,13 +125,92 @@ def cameras_R(scenario: Scenario) -> tuple[CameraView, ...]:
     return tuple(out)
 
 
-def cell_view(scenario: Scenario, arm: Arm | None, plan: WeldPlan | None) -> CellView:
-    """The cell around the part in R (module docstring): the table, the robot's shapes and poses, the cameras."""
+def subsample(times: FloatArray, arc: npt.NDArray[np.bool_], rate_hz: float) -> npt.NDArray[np.intp]:
+    """Indices of the samples kept: the first at or after every 1/rate_hz, every arc switch (both sides), the last."""
+    grid = np.arange(times[0], times[-1], 1.0 / rate_hz)
+    idx = np.searchsorted(times, grid - 1e-9)
+    switch = np.flatnonzero(np.diff(arc.astype(np.int8)) != 0)
+    return np.unique(np.clip(np.r_[idx, switch, switch + 1, len(times) - 1], 0, len(times) - 1))
+
+
+def _event_text(plan: WeldPlan, pre: Trajectory | None, t: float, kind: str, detail: str) -> str:
+    """An execution event as a line of the log: a move mark as it is, an arc switch with its seam's id."""
+    if kind == "move":
+        return detail
+    off = pre.duration if pre is not None else 0.0
+    welds = [s for s in plan.segments if s.arc_on]
+    seam = next((s.seam_id for s in welds if min(abs(off + s.t0 - t), abs(off + s.t1 - t)) < 0.02), "")
+    return f"{kind} {seam} ({detail})" if seam else f"{kind} ({detail})"
+
+
+def _timeline(
+    plan: WeldPlan, pre: Trajectory | None, ex: Execution | None
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_], tuple[tuple[float, str], ...]]:
+    """The motion's times (n,) [s], q (n, dof) [rad], arc (n,) and marks: what the arm did when it moved, else the
+    plan's (the move from the scan pose home, then the program)."""
+    if ex is not None:
+        done = tuple((float(e.t), _event_text(plan, pre, e.t, e.kind, e.detail)) for e in ex.events)
+        return np.asarray(ex.times, dtype=float), np.asarray(ex.q, dtype=float), np.asarray(ex.arc_on), done
+    traj, arc = plan.joint_trajectory()
+    t0 = pre.duration if pre is not None else 0.0
+    times, q = traj.times + t0, np.asarray(traj.q)
+    on = np.asarray(arc)
+    if pre is not None:
+        times = np.concatenate([pre.times, times[1:]])
+        q = np.concatenate([pre.q, q[1:]])
+        on = np.concatenate([np.zeros(len(pre.times), bool), on[1:]])
+    marks: list[tuple[float, str]] = [(0.0, "move scan -> home")] if pre is not None else []
+    for s in plan.segments:
+        marks.append((t0 + s.t0, f"{s.kind} {s.seam_id}".strip()))
+        if s.arc_on:
+            marks += [(t0 + s.t0, f"arc_on {s.seam_id}"), (t0 + s.t1, f"arc_off {s.seam_id}")]
+    return times, q, on, tuple(sorted(marks))
+
+
+def arm_motion(
+    arm: Arm,
+    links: tuple[str, ...],
+    plan: WeldPlan | None,
+    pre: Trajectory | None = None,
+    ex: Execution | None = None,
+    X_RW: FloatArray | None = None,
+) -> ArmMotion | None:
+    """The arm's motion for pictures (:class:`~cell.types.view.ArmMotion`): ``links`` (with the TCP and the
+    eye-in-hand camera's frame, those the arm has) posed by its forward kinematics every 1/MOTION_HZ and at every
+    arc switch; the tool path executed (``ex``'s TCP, carried into R by ``X_RW``), else planned (every 1/TOOL_HZ).
+    None without a plan."""
+    if plan is None or not plan.segments:
+        return None
+    times, q, arc, marks = _timeline(plan, pre, ex)
+    idx = subsample(times, arc, MOTION_HZ)
+    frames = tuple(f for f in dict.fromkeys((*links, TCP, EYE)) if f in arm.model.frame_names)
+    poses = [arm.model.fk_frames(q[i], frames) for i in idx]
+    X_RL = {f: np.array([p[f] for p in poses]) for f in frames}
+    if ex is not None:
+        tool_R, tool_arc = transform_points(X_RW if X_RW is not None else np.eye(4), ex.tcp_W), arc
+    elif TCP in frames:
+        keep = subsample(times, arc, TOOL_HZ)
+        tool_R, tool_arc = np.array([arm.model.fk_frames(q[i], (TCP,))[TCP][:3, 3] for i in keep]), arc[keep]
+    else:
+        tool_R, tool_arc = np.zeros((0, 3)), np.zeros(0, bool)
+    return ArmMotion(times[idx], q[idx], arc[idx], X_RL, tool_R, tool_arc, marks, MOTION_HZ)
+
+
+def cell_view(
+    scenario: Scenario,
+    arm: Arm | None,
+    plan: WeldPlan | None,
+    pre: Trajectory | None = None,
+    execution: Execution | None = None,
+) -> CellView:
+    """The cell around the part in R (module docstring): the table, the robot's shapes and poses, the cameras; the
+    arm's motion (the move home ``pre`` and the plan, or what the arm did: ``execution``) and its joint limits."""
     X_RW = invert(scenario.X_WR)
     table = Box(X_RW @ make_pose(p=scenario.table.center_m), np.asarray(scenario.table.size_m, dtype=float))
-    shapes: tuple[Shape, ...] = ()
-    poses: tuple[RobotPose, ...] = ()
-    if arm is not None:
-        shapes = tuple(s for s in urdf_shapes(arm.model.source) if s.link in arm.model.frame_names)
-        poses = robot_poses(arm, tuple(dict.fromkeys(s.link for s in shapes)), plan)
-    return CellView(table, shapes, poses, cameras_R(scenario))
+    if arm is None:
+        return CellView(table, (), (), cameras_R(scenario))
+    shapes = tuple(s for s in urdf_shapes(arm.model.source) if s.link in arm.model.frame_names)
+    links = tuple(dict.fromkeys(s.link for s in shapes))
+    poses = robot_poses(arm, links, plan)
+    motion = arm_motion(arm, links, plan, pre, execution, X_RW)
+    return CellView(table, shapes, poses, cameras_R(scenario), motion, arm.model.limits)

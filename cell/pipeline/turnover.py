@@ -10,27 +10,25 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
-from cell.pipeline.detect import Progress, Seed, quiet, read_weldmap, table_z_R
+from cell.perception.align.near_pose import near_seed
+from cell.pipeline.detect import AlignStart, Progress, quiet, read_weldmap, table_z_R
+from cell.pipeline.geometry import open_cell
+from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.tacks import Tack, choose_tacks, tack_records, tacks_time_s
 from cell.pipeline.turnover_run import TurnoverRun
 from cell.pipeline.weld import weld
 from cell.scenario import Scenario
-from cell.station import Station, open_station
-from cell.types import Cloud, SeamStatus, WeldMap
-from cell.types.plan import SeamTask
+from cell.station import Station
+from cell.types import SeamStatus, WeldMap
 from cell.types.turnover import TurnoverPlan, TurnoverResult
-
-Sides = Literal["first", "all"]
-SEARCH_TURN_RAD = math.radians(15.0)  # how far off its nominal turned pose the second alignment looks for the part
-SEARCH_SHIFT_M = 0.15
-_SCORE_BAND_M = 0.01  # the band a start pose is scored in (cloud points near the map's surfaces)
+from cell.types.plan import SeamTask
 
 
 def table_box_R(sc: Scenario) -> tuple[FloatArray, FloatArray]:
@@ -67,35 +65,6 @@ def _turn_for(det: Detection) -> TurnoverPlan | None:
     )
 
 
-def near_seed(weldmap_M: WeldMap, table_z: float) -> Seed:
-    """A :data:`cell.pipeline.detect.Seed`: the height-image search of the cloud (turns and shifts on the table,
-    :func:`cell.perception.align.placement.height_candidates`) for the turned map, its candidates within
-    SEARCH_TURN_RAD and SEARCH_SHIFT_M of the nominal pose, the best by the share of the cloud on the map's
-    surfaces, the nominal pose itself among them."""
-    from cell.perception.align.fit import sample_map, surface_fit
-    from cell.perception.align.placement import height_candidates
-
-    def seed(cloud: Cloud, X_RM: FloatArray) -> FloatArray:
-        nominal = weldmap_M.transformed(X_RM, "R")
-        centre = np.mean([p.center for p in nominal.parts], axis=0)
-        points = np.asarray(cloud.points)
-        starts = [np.eye(4)]
-        for X in height_candidates(points, nominal, table_z):
-            turn = abs(math.atan2(float(X[1, 0]), float(X[0, 0])))
-            shift = float(np.linalg.norm((X[:3, :3] @ centre + X[:3, 3] - centre)[:2]))
-            if turn <= SEARCH_TURN_RAD and shift <= SEARCH_SHIFT_M:
-                starts.append(X)
-
-        def score(X: FloatArray) -> float:
-            samples, normals = sample_map(nominal.transformed(X, "R"), _SCORE_BAND_M / 2, _SCORE_BAND_M / 2)
-            return surface_fit(points, samples, normals, _SCORE_BAND_M, _SCORE_BAND_M / 2)[0]
-
-        best = max(starts, key=lambda X: round(score(X), 9))  # near-ties to the first start, in every process
-        return np.asarray(best @ X_RM)
-
-    return seed
-
-
 def turnover_result(plan: TurnoverPlan, run: WeldRun, weldmap_M: WeldMap) -> TurnoverResult | None:
     """The placement the second alignment measured against the plan's nominal turned pose: the shift of the
     part's centre and the turn about the vertical (None: no alignment)."""
@@ -113,42 +82,29 @@ def turnover_result(plan: TurnoverPlan, run: WeldRun, weldmap_M: WeldMap) -> Tur
     return TurnoverResult(offset, rotation, scene.alignment.fitness, scene.X_RM)
 
 
-def weld_part(
-    scenario: Scenario,
-    method: str | None = None,
-    *,
-    noise: Literal["none", "realistic"] | None = None,
-    rescan: Literal["none", "low", "all"] | None = None,
-    execute_plan: bool = True,
-    progress: Progress = quiet,
-    gui: bool = False,
-    sides: Sides = "all",
-) -> TurnoverRun:
-    """The whole part: side A (:func:`cell.pipeline.weld.weld`), then with ``sides="all"`` the turn and side B.
+def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progress = quiet) -> TurnoverRun:
+    """The whole part: side A (:func:`cell.pipeline.weld.weld`), then with ``job.sides == "all"`` the turn and
+    side B (``job``: :class:`~cell.pipeline.job.WeldJob`; None: as the scenario says).
 
-    A preview (``execute_plan`` False) moves nothing: it plans side A and the turn, and shows side B's seams at
+    A preview (``job.execute`` False) moves nothing: it plans side A and the turn, and shows side B's seams at
     their nominal turned place. The turn is not made when side A stopped with an error, when the scenario forbids
     it (``flip.allowed``), or when no stable turn exposes a seam left: the seams keep their reason. A failure on
     side B (an ambiguous second alignment, the gate) is side B's ``error``: nothing of side B is welded, the
     report is still written.
     """
-    from cell import pipeline
-
     t_all = time.perf_counter()
-    sc = scenario.with_noise(noise) if noise else scenario
+    job = job or WeldJob()
+    sc = scenario.with_noise(job.noise) if job.noise else scenario
+    side_a = replace(job, noise=None)  # the noise is in the scenario now
     weldmap = read_weldmap(sc)
     chosen: list[Tack] = []
     spec = sc.flip.tacks
-    with open_station(sc, weldmap, gui=gui) as station:
-        # Through the package's name: what stands in for cell.pipeline.weld (a test's stub) stands in for side A.
-        # Tacks only when asked for and the part will be turned: their keyword only then (a stub need not know it).
-        extra: dict[str, Any] = (
-            {"tacks": tack_rule(spec.count, spec.length_mm / 1000.0, chosen)} if spec.count and sides == "all" else {}
-        )
-        a = pipeline.weld(
-            sc, method, rescan=rescan, execute_plan=execute_plan, progress=progress, station=station, **extra
-        )
-        plan = plan_turn(a) if sides == "all" else None
+    both = job.sides == "all"
+    with open_cell(sc, weldmap, gui=job.gui) as station:
+        # Tacks only when asked for and the part will be turned.
+        rule = tack_rule(spec.count, spec.length_mm / 1000.0, chosen) if spec.count and both else None
+        a = weld(sc, side_a, progress=progress, station=station, tacks=rule)
+        plan = plan_turn(a) if both else None
         if plan is None:
             return TurnoverRun(a, timings={"total_s": time.perf_counter() - t_all})
         refused = f"not executed: {a.error.message}" if a.error is not None else ""
@@ -167,10 +123,10 @@ def weld_part(
         if not plan.go:
             progress(f"no turn: {plan.reason}")
             return done()
-        if not execute_plan or a.error is not None:  # a preview moves nothing; a failed side A is not turned
-            return done(error=a.error if execute_plan else None)
+        if not job.execute or a.error is not None:  # a preview moves nothing; a failed side A is not turned
+            return done(error=a.error if job.execute else None)
         try:
-            b = _side_b(station, sc, method, rescan, plan, weldmap, progress)
+            b = _side_b(station, sc, side_a, plan, weldmap, progress)
         except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
             return done(error=e)
         return done(side_b=b, result=turnover_result(plan, b, weldmap))
@@ -195,13 +151,7 @@ def tack_rule(
 
 
 def _side_b(
-    station: Station,
-    sc: Scenario,
-    method: str | None,
-    rescan: Literal["none", "low", "all"] | None,
-    plan: TurnoverPlan,
-    weldmap: WeldMap,
-    progress: Progress,
+    station: Station, sc: Scenario, job: WeldJob, plan: TurnoverPlan, weldmap: WeldMap, progress: Progress
 ) -> WeldRun:
     """Turn the part (the operator) and weld the seams the turn exposed."""
     X_WR = sc.X_WR
@@ -210,7 +160,5 @@ def _side_b(
         f"for {len(plan.exposed)} seams ({', '.join(plan.exposed)})"
     )
     station.turn_part(X_WR @ plan.X_R_turn @ invert(X_WR))  # the nominal turn, carried from R into W
-    options = {"X_RM_nominal": plan.X_RM_after, "seed": near_seed(weldmap, table_z_R(sc))}
-    return weld(
-        sc, method, rescan=rescan, progress=progress, station=station, detect_options=options, only=plan.exposed
-    )
+    start = AlignStart(plan.X_RM_after, near_seed(weldmap, table_z_R(sc)))
+    return weld(sc, job, progress=progress, station=station, start=start, only=plan.exposed)

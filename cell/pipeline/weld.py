@@ -7,14 +7,15 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from contextlib import nullcontext
 from dataclasses import replace
 from functools import partial
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
-from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
-from cell.pipeline.geometry import MotionScene, motion_scene
+from cell.pipeline.detect import AlignStart, Progress, detect, quiet, read_weldmap
+from cell.pipeline.geometry import MotionScene, motion_scene, open_cell
+from cell.pipeline.job import WeldJob
 from cell.pipeline.last_check import joined, last_checked
 from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
@@ -22,12 +23,14 @@ from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
-from cell.station import Station, open_station
-from cell.types import CheckFail, Joint, SeamStatus
+from cell.station import Station
+from cell.types import CheckFail, Joint, SeamStatus, Violation, ViolationKind
+from cell.types.plan import PlanReason
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
 if TYPE_CHECKING:
+    from cell.planning.failures import SeamFailure
     from cell.types.execution import Execution
     from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
     from cell.types.trajectory import Trajectory
@@ -42,7 +45,7 @@ def plan_for(
     motion: MotionScene | None = None,
     progress: Progress = quiet,
     tacks: TackRule | None = None,
-) -> tuple[WeldPlan, Trajectory, tuple[str, ...]]:
+) -> tuple[WeldPlan, Trajectory, tuple[Violation, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
     section 7).
 
@@ -81,14 +84,15 @@ def plan_for(
     )
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     q_now = arm.q_scan if q_start is None else q_start
-    problems = []
+    problems: list[Violation] = []
     # The move home takes the transfers' ways (direct, lifted over the parts): a close-up view can leave the
     # torch low between parts, where the direct move collides. When no way is free, nothing can move: the whole
     # plan is refused (the start state, not a seam).
     way = Transfers(arm.model, process, checker, sc.motion.plan, obstacles, arm.q_home).move(q_now, arm.q_home)
     if isinstance(way, TransferFail):
         pre = ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
-        problems.append(f"move from the arm's position to home collides whichever way: {way.reason}")
+        why = f"move from the arm's position to home collides whichever way: {way.reason}"
+        problems.append(Violation(ViolationKind.COLLISION, why, 0.0))
     else:
         pre = joined(way) if way else ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
     dropped: dict[str, SeamOutcome] = {}
@@ -132,7 +136,7 @@ def plan_for(
         dropped.update(blamed)
     outcomes = {o.seam_id: o for o in plan.seams} | dropped
     plan = replace(plan, seams=tuple(outcomes[t.id] for t in (*tasks, *tack_tasks) if t.id in outcomes))
-    problems += [str(v) for v in found]
+    problems += found
     return plan, pre, tuple(problems)
 
 
@@ -186,20 +190,17 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
 
 def weld(
     scenario: Scenario,
-    method: str | None = None,
+    job: WeldJob | None = None,
     *,
-    noise: Literal["none", "realistic"] | None = None,
-    rescan: Literal["none", "low", "all"] | None = None,
-    execute_plan: bool = True,
     progress: Progress = quiet,
-    gui: bool = False,
     station: Station | None = None,
-    detect_options: Mapping[str, Any] | None = None,
+    start: AlignStart | None = None,
     only: Collection[str] | None = None,
     tacks: TackRule | None = None,
 ) -> WeldRun:
-    """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``execute_plan`` is False: a
-    preview) weld. ``rescan`` overrides the scenario's ``rescan.mode``.
+    """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``job.execute`` is False: a
+    preview) weld. ``job`` (:class:`~cell.pipeline.job.WeldJob`; None: as the scenario says) overrides the
+    scenario's locator, noise and ``rescan.mode``; its ``sides`` is :func:`cell.pipeline.turnover.weld_part`'s.
 
     A failure after detection (planning, the gate) does not lose the detection: it is returned in ``error`` with
     every seam's reason, so the report can still be written. A seam whose confidence stays below
@@ -208,26 +209,29 @@ def weld(
     (``rescan.bound_sigmas`` times an end's sigma along the seam) stays over ``rescan.end_tolerance_mm``
     (``end_uncertain``).
 
-    station : a running cell to weld on (left open; built and closed here when None). detect_options : keywords
-    for :func:`detect` (a turned part's ``X_RM_nominal`` and ``seed``). only : the seam ids this run is about
+    station : a running cell to weld on (left open; built and closed here when None). start : where the map's
+    alignment starts (a turned part's nominal pose and a search near it). only : the seam ids this run is about
     (a second side's: the others are neither re-scanned, planned nor reported). tacks : tack welds laid before
     the seams (:func:`plan_for`).
     """
     t_all = time.perf_counter()
-    sc = scenario.with_noise(noise) if noise else scenario
-    if rescan is not None:  # the override is what ran: the report's configuration says so
-        sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": rescan})})
+    job = job or WeldJob()
+    sc = scenario.with_noise(job.noise) if job.noise else scenario
+    if job.rescan is not None:  # the override is what ran: the report's configuration says so
+        sc = sc.model_copy(update={"rescan": sc.rescan.model_copy(update={"mode": job.rescan})})
+    execute_plan = job.execute
     weldmap = read_weldmap(sc)
-    with open_station(sc, weldmap, gui=gui) if station is None else nullcontext(station) as station:
-        det = detect(sc, method, progress=progress, station=station, weldmap=weldmap, **(detect_options or {}))
+    with open_cell(sc, weldmap, gui=job.gui) if station is None else nullcontext(station) as station:
+        X_RM, seed = (start.X_RM, start.seed) if start is not None else (None, None)
+        det = detect(sc, job.method, progress=progress, station=station, weldmap=weldmap, X_RM_nominal=X_RM, seed=seed)
         if only is not None:
             det = restricted(det, only)
         first, rs = det, None
         timings = dict(det.timings)
         plan = pre = ex = None
-        violations: tuple[str, ...] = ()
+        violations: tuple[Violation, ...] = ()
         error: CellError | None = None
-        hopeless: dict[str, str] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
+        hopeless: dict[str, SeamFailure] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
         checked: dict[str, CheckFail] = {}  # seams that failed the last check before the arc, re-scanned or not
         try:
             if det.error is not None:
@@ -241,7 +245,7 @@ def weld(
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
                 if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
-                    hopeless = {i: why for i, why in hopeless.items() if "beyond reach" not in why}
+                    hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             if execute_plan:  # the last check before the arc: re-scanned, then refused (cell/pipeline/last_check.py)
@@ -254,7 +258,7 @@ def weld(
             low = {
                 e.id
                 for e in det.estimates
-                if e.status is SeamStatus.FOUND and doubt(e, sc) and execute_plan and e.id not in hopeless
+                if e.status is SeamStatus.FOUND and doubt(e, sc) is not None and execute_plan and e.id not in hopeless
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
@@ -272,7 +276,10 @@ def weld(
                 )
                 timings["plan_s"] = setup_s + time.perf_counter() - t
                 if violations:
-                    raise PlanError(f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)")
+                    from cell.gate import GateRefusedError
+
+                    why = f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)"
+                    raise GateRefusedError(why, violations=violations)
                 if execute_plan:
                     t = time.perf_counter()
                     ex = execute(station, plan, pre, progress=progress)
@@ -284,5 +291,19 @@ def weld(
         seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
-        view = cell_view(sc, station.arm, plan)
-        return WeldRun(det, seams, plan, pre, ex, violations, error, timings, paths, station.arm, first, rs, view)
+        view = cell_view(sc, station.arm, plan, pre, ex)
+        return WeldRun(
+            detection=det,
+            seams=seams,
+            plan=plan,
+            pre_move=pre,
+            execution=ex,
+            violations=violations,
+            error=error,
+            timings=timings,
+            torch_paths=paths,
+            arm=station.arm,
+            first_detection=first,
+            rescan=rs,
+            view=view,
+        )

@@ -40,12 +40,14 @@ def reason_text(code: PlanReason, detail: str) -> str:
 @dataclass(frozen=True)
 class SeamFailure:
     """One candidate's failure: code, where (words), p_R (3,) [m] in R, progress [m] (how far along approach +
-    seam + depart the candidate got; negative: not even tried)."""
+    seam + depart the candidate got; negative: not even tried); obstacle: the body the torch hit where it was
+    placed at a weld end ("" when the failure is not that)."""
 
     code: PlanReason
     where: str
     p_R: FloatArray
     progress: float
+    obstacle: str = ""
 
     def reason(self) -> str:
         return reason_text(self.code, self.where)

@@ -145,7 +145,7 @@ def place(
         end = "start" if hit_start is not None else "end"
         where = f"torch vs {hit.b} at the weld {end} (p_R = {mm(hit.p_R)} mm)"
         # ranks below an IK failure at the start: the pose was not even tried
-        return SeamFailure(PlanReason.COLLISION, where, hit.p_R, PLACED)
+        return SeamFailure(PlanReason.COLLISION, where, hit.p_R, PLACED, obstacle=hit.b)
     length = task.length
     X = poses(a, b, R, pr.standoff, max(2, math.ceil(length / opt.spacing - 1e-9) + 1))
     if search.reach is not None:

@@ -167,13 +167,13 @@ def unplaceable(
     options: PlanOptions | None = None,
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
     table_z: float | None = None,
-) -> dict[str, str]:
-    """Seam id -> the reason :func:`plan_welds` would give, for the seams no torch can be placed on (out of
-    reach, or the torch against a part or the table at a weld end for every candidate): found without IK, the
-    same search's first steps with the same process per seam. A seam with no procedure is not judged here."""
+) -> dict[str, SeamFailure]:
+    """Seam id -> the failure :func:`plan_welds` would give (its code, where), for the seams no torch can be placed
+    on (out of reach, or the torch against a part or the table at a weld end for every candidate): found without
+    IK, the same search's first steps with the same process per seam. A seam with no procedure is not judged here."""
     reach, opt, chosen = reach_model(robot), options or PlanOptions(), procedures or {}
     q0 = np.asarray(q_home, dtype=float)
-    out: dict[str, str] = {}
+    out: dict[str, SeamFailure] = {}
     for task in tasks:
         sel = chosen.get(task.id)
         if isinstance(sel, NoProcedure):
@@ -185,7 +185,7 @@ def unplaceable(
             if stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0) is not None:
                 fail = None  # placed from the table stand-off, as plan_welds would
         if fail is not None:
-            out[task.id] = fail.reason()
+            out[task.id] = fail
     return out
 
 

@@ -49,11 +49,7 @@ def shortened(task: SeamTask, end: Literal["start", "end"], d: float) -> SeamTas
 def blocked_by_table(fail: SeamFailure, table_name: str) -> bool:
     """Whether a seam's failure is the torch against the table where it is placed (every candidate hit an
     obstacle before IK, and the one named is the table)."""
-    return (
-        fail.code is PlanReason.COLLISION
-        and fail.progress <= _PLACED + 1e-9
-        and f"vs {table_name} at the weld" in fail.where
-    )
+    return fail.code is PlanReason.COLLISION and fail.progress <= _PLACED + 1e-9 and fail.obstacle == table_name
 
 
 def stand_off(

@@ -134,9 +134,10 @@ def write_page(run: WeldRun, out_path: str | Path, *, title: str = "", max_point
         "<h2>The cell</h2>",
         fig3d.to_html(full_html=False, include_plotlyjs=True, div_id="cell3d", default_height="80vh"),
     ]
-    if run.plan is not None and run.plan.segments and run.arm is not None:
+    limits = run.view.limits if run.view is not None else None
+    if run.plan is not None and run.plan.segments and limits is not None:
         traj, _ = run.plan.joint_trajectory()
-        jf = joint_figure(traj, run.arm.model.limits, arc_bands(run.plan))
+        jf = joint_figure(traj, limits, arc_bands(run.plan))
         body += ["<h2>Joints</h2>", jf.to_html(full_html=False, include_plotlyjs=False, div_id="joints")]
     page = (
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>'

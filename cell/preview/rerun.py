@@ -1,12 +1,12 @@
 """A Rerun recording of a run (``cell weld --rerun FILE.rrd``, ``cell preview --rerun FILE.rrd``): the cell, the seams,
 the cameras and the robot along the motion on one timeline (what it holds: docs/cli.md, "Pictures and
-recordings"). The only module that imports ``rerun`` (an optional extra), and only inside its functions."""
+recordings"), from the run's values only (the motion: its view's :class:`~cell.types.view.ArmMotion`). The only
+module that imports ``rerun`` (an optional extra), and only inside its functions."""
 
 from __future__ import annotations
 
 import hashlib
 import uuid
-from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,11 +15,12 @@ import numpy.typing as npt
 
 from cell.errors import UsageError
 from cell.export.atomic import write_atomic
-from cell.geometry import FloatArray, invert, transform_points
+from cell.geometry import FloatArray
 from cell.preview.page import draw_inputs
-from cell.preview.timeline import Motion, motion, quaternions_xyzw, subsample
+from cell.preview.timeline import quaternions_xyzw
 from cell.preview.views import ARC_COLOUR, MM, PATH_COLOUR, STATUS_COLOURS, TRUTH_COLOUR, seam_lines, thin
 from cell.types import CellView, ShapeKind
+from cell.types.view import EYE, MOTION_HZ, TCP
 
 if TYPE_CHECKING:
     from cell.pipeline.records import WeldRun
@@ -27,11 +28,8 @@ if TYPE_CHECKING:
 APPLICATION_ID = "weld-cell"
 # no square brackets: the CLI prints error messages as rich markup, which would eat "[rerun]" of weld-cell's extra
 INSTALL_HINT = "pip install 'weld-cell[rerun]' (in a checkout: uv sync --extra rerun)"
-RATE_HZ = 20.0  # robot poses per second of motion on the timeline
+RATE_HZ = MOTION_HZ  # robot poses per second of motion on the timeline (the run's view holds them)
 MAX_POINTS = 400_000  # cloud points kept (every k-th beyond this)
-TCP = "torch_tcp"
-EYE = "camera_optical"  # the arm's optical frame of its eye-in-hand camera (as the simulator names it)
-LinkPoses = Callable[[FloatArray, tuple[str, ...]], Mapping[str, FloatArray]]
 
 
 def require_rerun() -> None:
@@ -154,60 +152,41 @@ def _log_robot_shapes(rec: Any, rr: Any, view: CellView) -> None:
             rec.log(f"cell/robot/{link}/{kind.value}", arch, static=True)
 
 
-def _log_motion(
-    rec: Any, rr: Any, run: WeldRun, mo: Motion | None, rate_hz: float, fk: LinkPoses | None, moving: frozenset[str]
-) -> None:
+def _log_motion(rec: Any, rr: Any, run: WeldRun, moving: frozenset[str]) -> None:
     """The robot's links, the cameras riding on it, the TCP, the arc and the joints on the ``time`` timeline."""
     view = run.view or CellView()
+    mo = view.motion
     if mo is None:
         if view.poses:  # no motion: the scan pose at time 0
             rec.set_time("time", duration=0.0)
             for link, X in view.poses[0].X_RL.items():
                 rec.log(f"cell/robot/{link}", rr.Transform3D(translation=X[:3, 3], mat3x3=X[:3, :3]))
         return
-    times, q, arc, marks = mo
-    idx = subsample(times, arc, rate_hz)
-    col = [rr.TimeColumn("time", duration=times[idx])]
-    if fk is not None:
-        links = _frames(run, (*view.links, TCP, EYE))
-        poses = [fk(q[i], links) for i in idx]
-        paths = [(link, f"cell/robot/{link}") for link in links if link not in (TCP, EYE)]
-        paths += [(EYE, f"cell/cameras/{name}") for name in sorted(moving) if EYE in links]
-        for link, path in paths:
-            X = np.array([p[link] for p in poses])
-            rec.send_columns(
-                path, indexes=col, columns=rr.Transform3D.columns(translation=X[:, :3, 3], mat3x3=X[:, :3, :3])
-            )
-        if TCP in links:
-            p_now = np.array([p[TCP][:3, 3] for p in poses])
-            rec.send_columns("cell/tcp/now", indexes=col, columns=rr.Points3D.columns(positions=p_now))
-    _log_tool_path(rec, rr, run, times, q, arc, fk)
-    rec.send_columns("plots/arc", indexes=col, columns=rr.Scalars.columns(scalars=arc[idx].astype(float)))
+    col = [rr.TimeColumn("time", duration=mo.times_s)]
+    paths = [(link, f"cell/robot/{link}") for link in mo.X_RL if link not in (TCP, EYE)]
+    paths += [(EYE, f"cell/cameras/{name}") for name in sorted(moving) if EYE in mo.X_RL]
+    for link, path in paths:
+        X = mo.X_RL[link]
+        rec.send_columns(
+            path, indexes=col, columns=rr.Transform3D.columns(translation=X[:, :3, 3], mat3x3=X[:, :3, :3])
+        )
+    if TCP in mo.X_RL:
+        p_now = mo.X_RL[TCP][:, :3, 3]
+        rec.send_columns("cell/tcp/now", indexes=col, columns=rr.Points3D.columns(positions=p_now))
+    _log_tool_path(rec, rr, mo.tool_R, mo.tool_arc)
+    rec.send_columns("plots/arc", indexes=col, columns=rr.Scalars.columns(scalars=mo.arc.astype(float)))
+    q = mo.q
     names = run.plan.joint_names if run.plan is not None else tuple(f"q{j + 1}" for j in range(q.shape[1]))
     for j, name in enumerate(names):
-        rec.send_columns(f"plots/joints/{name}", indexes=col, columns=rr.Scalars.columns(scalars=np.degrees(q[idx, j])))
-    for tm, text in marks:
+        rec.send_columns(f"plots/joints/{name}", indexes=col, columns=rr.Scalars.columns(scalars=np.degrees(q[:, j])))
+    for tm, text in mo.marks:
         rec.set_time("time", duration=tm)
         rec.log("log", rr.TextLog(text, level="INFO"))
 
 
-def _frames(run: WeldRun, wanted: tuple[str, ...]) -> tuple[str, ...]:
-    """The frames of ``wanted`` the run's arm has (all of them when the run carries no arm), each once."""
-    have = set(run.arm.model.frame_names) if run.arm is not None else None
-    return tuple(f for f in dict.fromkeys(wanted) if have is None or f in have)
-
-
-def _log_tool_path(
-    rec: Any, rr: Any, run: WeldRun, times: FloatArray, q: FloatArray, arc: npt.NDArray[np.bool_], fk: LinkPoses | None
-) -> None:
+def _log_tool_path(rec: Any, rr: Any, p: FloatArray, arc: npt.NDArray[np.bool_]) -> None:
     """The whole tool path (static): travel in one strip, every arc-on stretch a strip of its own."""
-    ex = run.execution
-    if ex is not None:
-        p = transform_points(invert(run.detection.scenario.X_WR), ex.tcp_W)
-    elif fk is not None and TCP in _frames(run, (TCP,)):
-        keep = subsample(times, arc, 50.0)
-        p, arc = np.array([fk(q[i], (TCP,))[TCP][:3, 3] for i in keep]), arc[keep]
-    else:
+    if len(p) == 0:
         return
     rec.log("cell/tcp/path", rr.LineStrips3D([p], colors=_rgb(PATH_COLOUR), radii=0.0015), static=True)
     edges = np.flatnonzero(np.diff(np.r_[0, arc.astype(np.int8), 0]))
@@ -231,32 +210,27 @@ def _blueprint() -> Any:
     )
 
 
-def record_run(
-    run: WeldRun, path: str | Path, *, rate_hz: float = RATE_HZ, max_points: int = MAX_POINTS,
-    link_poses: LinkPoses | None = None,
-) -> Path:  # fmt: skip
+def record_run(run: WeldRun, path: str | Path, *, max_points: int = MAX_POINTS) -> Path:
     """Write the run's Rerun recording (module docstring) to ``path`` in one piece; returns ``path``.
 
-    link_poses : (q (dof,), links) -> {link: X_RL (4, 4)}; default the run's arm's forward kinematics (without an
-        arm the robot stays out). UsageError when rerun-sdk is missing, OutputError when the file cannot be written.
+    UsageError when rerun-sdk is missing, OutputError when the file cannot be written.
     """
     require_rerun()
     import rerun as rr
 
     det = run.detection
-    fk = link_poses if link_poses is not None else (run.arm.model.fk_frames if run.arm is not None else None)
     rec = rr.RecordingStream(application_id=APPLICATION_ID, recording_id=recording_id(run))
     rec.set_log_time_enabled(False)  # the wall clock would make the "time" timeline one of two
     stream = rr.binary_stream(recording=rec)
     rec.send_recording_name(f"{det.scenario.name} · {det.method} · {'weld' if run.execution else 'preview'}")
-    mo = motion(run)
     cams = run.view.cameras if run.view is not None else ()
-    on_arm = fk is not None and mo is not None and EYE in _frames(run, (EYE,))
+    mo = run.view.motion if run.view is not None else None
+    on_arm = mo is not None and EYE in mo.X_RL
     moving = frozenset(c.name for c in cams if c.mount == "eye_in_hand" and on_arm)
     _log_scene(rec, rr, run, max_points, moving)
     if run.view is not None:
         _log_robot_shapes(rec, rr, run.view)
-    _log_motion(rec, rr, run, mo, rate_hz, fk, moving)
+    _log_motion(rec, rr, run, moving)
     rec.send_blueprint(_blueprint(), make_active=True, make_default=True)
     data = stream.read(flush=True)
     rec.disconnect()

@@ -28,8 +28,8 @@ def write_run(run: WeldRun, out_dir: str | Path) -> list[Path]:
     title = f"{det.scenario.name} · {det.method} · {det.scenario.noise} noise"
     out = Path(out_dir)
     paths = render_overview(cloud, det.weldmap_R, views, poses, tcp, out, title=title)
-    if run.plan is not None and run.plan.segments and run.arm is not None:
-        limits = run.arm.model.limits
+    limits = run.view.limits if run.view is not None else None
+    if run.plan is not None and run.plan.segments and limits is not None:
         traj, arc = run.plan.joint_trajectory()
         k = max(1, len(traj.times) // 4000)  # 1 kHz samples: a few thousand are plenty for a plot
         paths.append(

@@ -2,7 +2,7 @@
 
 The only station module that touches the simulator. It builds the as-built part from the welding map the pipeline
 read and the scenario's deviations (ground truth: :meth:`SimStation.truth`), the cameras with their noise and
-faults, and the arm at its scan configuration.
+faults, and the arm it is handed, at its scan configuration.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from cell.errors import ScenarioError
 from cell.geometry import FloatArray
 from cell.scenario import Scenario
 from cell.scenario.run_specs import CameraFaultSpec
-from cell.station.arm import load_arm, robot_urdf
+from cell.station.arm import robot_urdf
 from cell.station.ports import Arm
 from cell.types import CameraIntrinsics, DepthImage, Part, WeldMap
 
@@ -30,11 +30,11 @@ class SimStation:
     """A running simulated cell built from a scenario and its welding map (as drawn, frame M).
 
     The as-built parts are the map's parts with the scenario's deviations
-    (:func:`cell.sim.asbuilt.parts.as_built_parts`).
-    Use as a context manager; the simulator's client is released on exit.
+    (:func:`cell.sim.asbuilt.parts.as_built_parts`); ``arm`` the robot, its home and scan configurations (None: a
+    cell without one). Use as a context manager; the simulator's client is released on exit.
     """
 
-    def __init__(self, scenario: Scenario, weldmap: WeldMap, *, gui: bool = False, with_robot: bool = True) -> None:
+    def __init__(self, scenario: Scenario, weldmap: WeldMap, *, arm: Arm | None = None, gui: bool = False) -> None:
         from cell.sim import SimCell
         from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts
 
@@ -42,11 +42,10 @@ class SimStation:
         self.parts_W: tuple[Part, ...] = as_built_parts(weldmap, scenario)
         # The clamps and stops the map draws are there for the cameras too (never parts, never aligned).
         self.sim: SimCell = SimCell(scenario, self.parts_W, gui=gui, fixtures_W=as_built_fixtures(weldmap, scenario))
-        self._arm: Arm | None = None
+        self._arm = arm
         self.X_W_turned: FloatArray | None = None  # the true motion of the last turn (ground truth)
         try:
-            if with_robot and scenario.robot.urdf is not None:
-                self._arm = load_arm(scenario)
+            if self._arm is not None:
                 robot = self.sim.load_robot(
                     robot_urdf(scenario), scenario.X_WR, self._arm.q_scan, joint_names=self._arm.model.joint_names
                 )

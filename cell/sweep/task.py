@@ -13,6 +13,7 @@ import numpy as np
 from cell.errors import CellError
 from cell.scenario import Scenario
 from cell.sweep.variations import Variation, varied
+from cell.types.run import WeldReason
 
 if TYPE_CHECKING:
     from cell.pipeline import Detection, WeldRun
@@ -48,9 +49,9 @@ def run_task(scenario: Scenario, v: Variation, stage: Stage, method: str | None 
             if det.error is not None:
                 line["error"] = error_json(det.error)
         else:
-            from cell.pipeline import weld
+            from cell.pipeline import WeldJob, weld
 
-            run = weld(sc, method, execute_plan=stage == "weld")
+            run = weld(sc, WeldJob(method, execute=stage == "weld"))
             line["seams"] = weld_seams(run, sc, stage)
             timings = dict(run.timings)
             if run.error is not None:
@@ -102,15 +103,16 @@ def weld_seams(run: WeldRun, sc: Scenario, stage: Stage) -> dict[str, dict[str, 
         rec = out.setdefault(w.id, {"found": False, "reasons": []})
         code = w.code.value if w.code is not None else None
         if stage == "plan":
-            rec["planned"] = bool(w.planned and code == "preview")
+            rec["planned"] = bool(w.planned and w.code is WeldReason.PREVIEW)
             rec["plan_tcp_rms_mm"] = _mm(planned_tcp.get(w.id))
         else:
             rec["planned"] = bool(w.planned)
             rec["welded"] = bool(w.welded)
             rec["weld_rms_mm"] = _mm(w.quality.tcp_rms_mm) if w.quality is not None else None
         rec["code"] = code
-        # a preview's words say nothing, and "not located: <the estimate's reason>" says it twice
-        if w.reason and code != "preview" and not any(r in w.reason for r in rec["reasons"]):
+        # a preview's words say nothing, and an unseen or unlocated seam's repeat the estimate's reason
+        repeats = w.code in (WeldReason.NOT_VISIBLE, WeldReason.NOT_LOCATED) and rec["reasons"]
+        if w.reason and w.code is not WeldReason.PREVIEW and not repeats:
             rec["reasons"] = [*rec["reasons"], w.reason]
     return out
 

@@ -3,6 +3,7 @@ from here and nothing here imports a stage. Frames: ``W`` world, ``R`` robot bas
 optical frame, ``B`` a box part's own frame. Metres and radians inside; millimetres and degrees only at the edges."""
 
 from cell.types.execution import Event, Execution, WeldQuality
+from cell.types.gate import Violation, ViolationKind
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, UnsupportedSeam, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
@@ -21,10 +22,11 @@ from cell.types.seams import (
 )
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
 from cell.types.trajectory import PathProfile, Trajectory
-from cell.types.view import CameraView, CellView, RobotPose, Shape, ShapeKind
+from cell.types.view import ArmMotion, CameraView, CellView, RobotPose, Shape, ShapeKind
 
 __all__ = [
     "BOX_FACES",
+    "ArmMotion",
     "Box",
     "CameraIntrinsics",
     "CameraView",
@@ -64,6 +66,8 @@ __all__ = [
     "Trajectory",
     "UnsupportedSeam",
     "Viewpoint",
+    "Violation",
+    "ViolationKind",
     "VoxelTable",
     "Weave",
     "WeldMap",

@@ -11,10 +11,16 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray, readonly
 from cell.types.map import Box
+from cell.types.robot import JointLimits
 from cell.types.sensing import CameraIntrinsics
+
+MOTION_HZ = 20.0  # the arm's poses per second of motion a picture is given (plus every arc switch)
+TCP = "torch_tcp"  # the arm's frame at the torch's tool centre point
+EYE = "camera_optical"  # the arm's optical frame of its eye-in-hand camera (as the simulator names it)
 
 
 class ShapeKind(enum.StrEnum):
@@ -82,14 +88,46 @@ class CameraView:
 
 
 @dataclass(frozen=True)
+class ArmMotion:
+    """The arm's motion as pictures show it: what it did when it moved, else the plan's (the move from the scan
+    pose home, then the program), on one time axis [s] (0 where the move home starts).
+
+    At the instants ``times_s`` (k,) (every 1 / ``rate_hz`` and both sides of every arc switch): the joints ``q``
+    (k, dof) [rad], the arc ``arc`` (k,) and, per frame name, ``X_RL`` (k, 4, 4) in R [m] (the links that carry a
+    shape, the TCP, the eye-in-hand camera's optical frame: those the arm has). The whole tool path ``tool_R``
+    (m, 3) [m] in R with its arc ``tool_arc`` (m,): the executed one, else the planned TCP. ``marks``: (time [s],
+    text) of every move and arc switch.
+    """
+
+    times_s: FloatArray
+    q: FloatArray
+    arc: npt.NDArray[np.bool_]
+    X_RL: Mapping[str, FloatArray]
+    tool_R: FloatArray
+    tool_arc: npt.NDArray[np.bool_]
+    marks: tuple[tuple[float, str], ...] = ()
+    rate_hz: float = MOTION_HZ
+
+    def __post_init__(self) -> None:
+        for key in ("times_s", "q", "tool_R"):
+            object.__setattr__(self, key, readonly(getattr(self, key)))
+        for key in ("arc", "tool_arc"):
+            object.__setattr__(self, key, readonly(getattr(self, key), bool))
+        object.__setattr__(self, "X_RL", {k: readonly(v) for k, v in self.X_RL.items()})
+
+
+@dataclass(frozen=True)
 class CellView:
     """The cell around the part, in R: the table (a box, None when unknown), the robot's shapes (by link), its
-    poses (the first is where it stands when the cloud is taken: the scan pose), the cameras."""
+    poses (the first is where it stands when the cloud is taken: the scan pose), the cameras; the arm's motion
+    (None without a plan) and its joint limits (None without an arm)."""
 
     table: Box | None = None
     shapes: tuple[Shape, ...] = ()
     poses: tuple[RobotPose, ...] = ()
     cameras: tuple[CameraView, ...] = field(default_factory=tuple)
+    motion: ArmMotion | None = None
+    limits: JointLimits | None = None
 
     @property
     def links(self) -> tuple[str, ...]:

@@ -15,8 +15,9 @@ import pytest
 from cell import pipeline
 from cell.config.rescan import RescanOptions
 from cell.pipeline import rescan_seams, rescanned
+from cell.pipeline.geometry import open_cell
 from cell.seams.metrics import segment_errors
-from cell.station import SimStation, open_station
+from cell.station import SimStation
 from cell.types import SeamStatus
 
 
@@ -61,7 +62,7 @@ def test_rescan_undoes_the_fixed_cameras_calibration_error(detected: Callable[..
     as the detection left its station (every camera one image on, as ``fence1_station`` is)."""
     det = detected("faults/extrinsics-fixed-off")
     scn = det.scenario
-    with open_station(scn, pipeline.read_weldmap(scn)) as station:
+    with open_cell(scn, pipeline.read_weldmap(scn)) as station:
         station.capture()
         ids = [e.id for e in det.estimates if e.status is SeamStatus.FOUND]
         after = rescanned(det, rescan_seams(station, det, ids))

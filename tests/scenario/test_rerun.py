@@ -18,6 +18,7 @@ import pytest
 
 from cell import pipeline
 from cell.geometry import invert, transform_points
+from cell.pipeline.scene_view import cell_view
 from cell.types import SeamStatus
 
 rerun = pytest.importorskip("rerun")
@@ -135,10 +136,12 @@ def test_arc_on_intervals_one_strip_per_weld(
 
 
 def test_a_preview_records_the_plan_on_the_same_timeline(fence1_run: pipeline.WeldRun, tmp_path: Path) -> None:
-    """Without an execution (``cell preview``) the motion is the plan's: the move home, then the program."""
-    ex, plan, pre = fence1_run.execution, fence1_run.plan, fence1_run.pre_move
-    assert ex is not None and plan is not None and pre is not None
-    path = record_run(replace(fence1_run, execution=None), tmp_path / "preview.rrd")
+    """Without an execution (``cell preview``) the motion is the plan's: the move home, then the program (the
+    run's view as the pipeline makes it for a preview)."""
+    ex, plan, pre, arm = fence1_run.execution, fence1_run.plan, fence1_run.pre_move, fence1_run.arm
+    assert ex is not None and plan is not None and pre is not None and arm is not None
+    view = cell_view(fence1_run.detection.scenario, arm, plan, pre)
+    path = record_run(replace(fence1_run, execution=None, view=view), tmp_path / "preview.rrd")
     store = RrdReader(path).store()
     (entry,) = RrdReader(path).recordings()
     assert entry.recording_id != recording_id(fence1_run)  # a preview is another recording than the weld
@@ -160,7 +163,9 @@ def test_a_run_that_failed_early_still_records_what_it_has(fence1_run: pipeline.
     """Perception lost and nothing planned: the map, the seams as the map draws them, the cell and the robot at
     its scan pose, no cloud, no motion (``--rerun`` is written whatever happens)."""
     det = replace(fence1_run.detection, scene=None)
-    run = replace(fence1_run, detection=det, plan=None, execution=None, pre_move=None)
+    assert fence1_run.arm is not None
+    view = cell_view(det.scenario, fence1_run.arm, None)  # as the pipeline makes it without a plan
+    run = replace(fence1_run, detection=det, plan=None, execution=None, pre_move=None, view=view)
     path = record_run(run, tmp_path / "failed.rrd")
     entities = {c.entity_path: c for c in RrdReader(path).store().stream()}
     assert "/cell/cloud" not in entities and "/cell/tcp/path" not in entities and "/plots/arc" not in entities

@@ -50,7 +50,7 @@ def test_a_gate_option_reaches_the_safety_gate(
     plan: the session's detection of fence1 stands in for the weld's own (handed on with the scenario it was given)."""
     from cell.errors import PlanError
     from cell.export.report import weld_report
-    from cell.gate import ViolationKind
+    from cell.gate import GateRefusedError, ViolationKind
 
     scn = load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}"))
     asked: list[sc.Scenario] = []
@@ -61,8 +61,12 @@ def test_a_gate_option_reaches_the_safety_gate(
 
     monkeypatch.setattr(importlib.import_module("cell.pipeline.weld"), "detect", detect)
     assert scn.model_copy(update={"motion": fence1_detection.scenario.motion}) == fence1_detection.scenario
-    run = pipeline.weld(scn, execute_plan=False)
+    run = pipeline.weld(scn, pipeline.WeldJob(execute=False))
     assert asked == [scn]
-    assert isinstance(run.error, PlanError) and run.violations
-    assert {v.split()[0] for v in run.violations} == {ViolationKind.SINGULARITY.value}
-    assert weld_report(run)["config"]["motion"]["gate"]["min_manipulability"] == 1.0
+    assert isinstance(run.error, GateRefusedError) and run.error.exit_code == PlanError.exit_code
+    assert run.violations and run.error.violations == run.violations
+    assert {v.kind for v in run.violations} == {ViolationKind.SINGULARITY}
+    rep = weld_report(run)
+    assert rep["config"]["motion"]["gate"]["min_manipulability"] == 1.0
+    assert [v["code"] for v in rep["violations"]] == [ViolationKind.SINGULARITY.value] * len(run.violations)
+    assert rep["violations"][0]["detail"] == str(run.violations[0]) and rep["error"]["type"] == "GateRefusedError"

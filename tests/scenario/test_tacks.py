@@ -9,6 +9,7 @@ One module fixture plans side A with the tacks (and once without) on a fence1 ce
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any
@@ -20,11 +21,12 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export.krl import krl_program
 from cell.export.turnover_report import turnover_report
+from cell.pipeline.geometry import open_cell
+from cell.pipeline.turnover import tack_rule, weld_part
 from cell.pipeline.tacks import Tack, is_tack
 from cell.pipeline.turnover import tack_rule, weld_part
 from cell.pipeline.weld import plan_for
 from cell.planning.tasks import seam_tasks
-from cell.station import open_station
 from cell.types.plan import SeamTask, WeldPlan
 
 LENGTH_M = 0.015
@@ -44,7 +46,7 @@ class Tacked:
 def tacked(fence1_run: pipeline.WeldRun) -> Iterator[Tacked]:
     det = fence1_run.detection
     scn = det.scenario
-    with open_station(scn, pipeline.read_weldmap(scn)) as station:
+    with open_cell(scn, pipeline.read_weldmap(scn)) as station:
         assert station.arm is not None
         chosen: list[Tack] = []
         plan, _, violations = plan_for(station, det, tacks=tack_rule(4, LENGTH_M, chosen))
@@ -128,8 +130,8 @@ def test_weld_part_records_the_tacks_side_a_laid(
         asked.append(len(got))
         return replace(fence1_run, plan=tacked.plan)
 
-    monkeypatch.setattr(pipeline, "weld", side_a)
-    run = weld_part(sc.load("fence1-tacked"), execute_plan=False)
+    monkeypatch.setattr(importlib.import_module("cell.pipeline.turnover"), "weld", side_a)
+    run = weld_part(sc.load("fence1-tacked"), pipeline.WeldJob(execute=False))
     assert asked == [4] and run.plan is not None and run.side_b is None
     assert [(t.seam_id, t.end, t.length_mm, t.welded) for t in run.tacks] == [
         (t.seam_id, t.end, 15.0, True) for t in tacked.tacks

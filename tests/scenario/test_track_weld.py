@@ -37,7 +37,7 @@ def _scenario() -> sc.Scenario:
 
 @pytest.fixture(scope="module")
 def run() -> pipeline.WeldRun:
-    return pipeline.weld(_scenario(), rescan="none")
+    return pipeline.weld(_scenario(), pipeline.WeldJob(rescan="none"))
 
 
 def test_seams_beyond_the_fixed_reach_are_welded_from_the_track(run: pipeline.WeldRun) -> None:

@@ -21,11 +21,13 @@ from cell.cli.turnover import write_programs
 from cell.errors import AlignmentError, AlignmentFailure
 from cell.export.turnover_report import turnover_report
 from cell.geometry import invert
+from cell.perception.align.near_pose import near_seed
 from cell.pipeline import Detection
 from cell.pipeline.detect import detect, read_weldmap, table_z_R
+from cell.pipeline.geometry import robot_arm
 from cell.pipeline.records import WeldRun
 from cell.pipeline.restrict import restricted
-from cell.pipeline.turnover import near_seed, plan_turn, turnover_result, weld_part
+from cell.pipeline.turnover import plan_turn, turnover_result, weld_part
 from cell.pipeline.turnover_run import TurnoverRun
 from cell.pipeline.weld import plan_for
 from cell.planning.turnover import plan_turnover
@@ -129,7 +131,7 @@ def large_error() -> Iterator[tuple[TurnoverPlan, Detection, SimStation]]:
     w, joints, tz = wm.transformed(X_RM, "R"), find_joints(wm), table_z_R(scn)
     left = [s.id for s in w.seams if not visibility(w, joints[s.id], tz)[0]]
     plan = plan_turnover(w, joints, tz, left, X_RM)
-    with SimStation(scn, wm) as station:
+    with SimStation(scn, wm, arm=robot_arm(scn)) as station:
         station.turn_part(scn.X_WR @ plan.X_R_turn @ invert(scn.X_WR))
         det = detect(scn, station=station, weldmap=wm, X_RM_nominal=plan.X_RM_after, seed=near_seed(wm, tz))
         yield plan, restricted(det, plan.exposed), station
@@ -142,7 +144,7 @@ def test_a_large_placement_error_and_a_camera_lost_at_the_turn_still_weld_every_
     assert det.error is None and det.scene is not None
     assert det.lost_cameras and "cam_left" in det.lost_cameras[0]
     wm = read_weldmap(det.scenario)
-    res = turnover_result(plan, WeldRun(det, ()), wm)
+    res = turnover_result(plan, WeldRun(detection=det, seams=()), wm)
     assert res is not None
     # The operator's 30 mm plus the as-built part's own offset from its drawing, mirrored by the turn (its
     # deviations are a few mm): measured 32.4 mm.

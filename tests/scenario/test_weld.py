@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 from cell import pipeline
 from cell import scenario as sc
 from cell.cli import app
+from cell.geometry import invert, transform_points
 from cell.types import SeamStatus, WeldReason
 
 
@@ -85,10 +86,10 @@ def test_weld_cli_writes_report_and_robot_program(
 ) -> None:
     """``cell weld fence1`` hands the scenario to ``pipeline.weld`` and writes what it returns: the session's run
     stands in for a second one (the CLI's arguments are checked as it passes them)."""
-    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+    asked: list[tuple[sc.Scenario, pipeline.WeldJob | None, dict[str, object]]] = []
 
-    def weld(scenario: sc.Scenario, method: str | None = None, **kw: object) -> pipeline.WeldRun:
-        asked.append((scenario, method, kw))
+    def weld(scenario: sc.Scenario, job: pipeline.WeldJob | None = None, **kw: object) -> pipeline.WeldRun:
+        asked.append((scenario, job, kw))
         return fence1_run
 
     monkeypatch.setattr(pipeline, "weld", weld)
@@ -96,9 +97,9 @@ def test_weld_cli_writes_report_and_robot_program(
     report, krl = tmp_path / "r.json", tmp_path / "krl"
     result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--krl", str(krl)])
     assert result.exit_code == 0, result.stderr
-    ((scenario, method, kw),) = asked
-    assert scenario == sc.load("fence1") and method is None
-    assert kw["noise"] is None and kw["rescan"] is None and kw["gui"] is False
+    ((scenario, job, kw),) = asked
+    assert scenario == sc.load("fence1") and set(kw) == {"progress"}
+    assert job == pipeline.WeldJob(method=None, noise=None, rescan=None, execute=True, gui=False, sides="first")
     data = json.loads(report.read_text())
     assert data["welded"] == 12 and data["error"] is None
     assert data["cycle_time_s"] > 0 and data["events"]
@@ -126,3 +127,20 @@ def test_both_fixed_cameras_dead_still_welds_nothing_wrong() -> None:
         else:
             assert w.code is WeldReason.NOT_VISIBLE and w.reason, w.id  # measured: the four underside seams
     assert sum(w.welded for w in run.seams) == 12
+
+
+def test_the_runs_motion_is_values_the_pipeline_computed(fence1_run: pipeline.WeldRun) -> None:
+    """The run's view carries the motion the pictures draw (the arm's model stays out of the preview): link poses
+    at every instant by the arm's forward kinematics, the executed tool path in R, the arc at each instant."""
+    view, ex, arm = fence1_run.view, fence1_run.execution, fence1_run.arm
+    assert view is not None and ex is not None and arm is not None and view.motion is not None
+    mo = view.motion
+    k = np.searchsorted(ex.times, mo.times_s)
+    np.testing.assert_array_equal(ex.times[k], mo.times_s)
+    np.testing.assert_array_equal(mo.arc, ex.arc_on[k])
+    i = len(k) // 2
+    X = arm.model.fk_frames(ex.q[k[i]], ("link_3", "torch_tcp"))
+    np.testing.assert_allclose(mo.X_RL["link_3"][i], X["link_3"], atol=1e-12)
+    np.testing.assert_allclose(mo.X_RL["torch_tcp"][i], X["torch_tcp"], atol=1e-12)
+    np.testing.assert_allclose(mo.tool_R, transform_points(invert(fence1_run.detection.scenario.X_WR), ex.tcp_W))
+    assert not mo.q.flags.writeable and view.limits == arm.model.limits

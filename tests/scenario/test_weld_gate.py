@@ -14,7 +14,7 @@ from cell.types import SeamStatus, WeldReason
 def test_the_papers_method_welds_no_seam_more_than_a_millimetre_off() -> None:
     """`cell weld fence1 --method paper`: its first pass reports seams up to ~3.8 mm off at confidence 1; its sigma
     (0.9 mm, fixed: its error is the 1 cm voxels') re-scans every seam, and up close it is no better: refused."""
-    run = pipeline.weld(sc.load("fence1"), "paper")
+    run = pipeline.weld(sc.load("fence1"), pipeline.WeldJob("paper"))
     limit_m = run.detection.scenario.rescan.max_sigma_m
     assert run.first_detection is not None
     first = {e.id: e for e in run.first_detection.estimates}

@@ -13,7 +13,8 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.station import Station, open_station
+from cell.pipeline.geometry import open_cell
+from cell.station import Station
 from cell.types import SeamStatus
 
 GUSSET = ("GUSSET>BASE:-y", "GUSSET>BASE:+y", "GUSSET>UPRIGHT:-y", "GUSSET>UPRIGHT:+y")
@@ -24,7 +25,7 @@ def bracket_cell() -> Iterator[tuple[Station, pipeline.Detection]]:
     """``cell detect bracket`` once for this module, its station kept running for a close-up."""
     scenario = sc.load("bracket")
     weldmap = pipeline.read_weldmap(scenario)
-    with open_station(scenario, weldmap) as station:
+    with open_cell(scenario, weldmap) as station:
         yield station, pipeline.detect(scenario, None, station=station, weldmap=weldmap)
 
 

@@ -184,9 +184,11 @@ def _interrupt_after(stage: str) -> Any:
 def test_ctrl_c_writes_the_partial_report_and_exits_130(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, command: str
 ) -> None:
-    from cell import pipeline
+    import importlib
 
-    monkeypatch.setattr(pipeline, command, _interrupt_after("aligning the welding map to the cloud"))
+    # where each command finds its stage: detect in the package, weld (both sides) as weld_part's side A
+    module = importlib.import_module("cell.pipeline.turnover" if command == "weld" else "cell.pipeline")
+    monkeypatch.setattr(module, command, _interrupt_after("aligning the welding map to the cloud"))
     report, log = tmp_path / "r.json", tmp_path / "run.log"
     code, _, err = invoke("--log-file", str(log), command, "fence1", "--json", str(report))
     assert code == 130, err

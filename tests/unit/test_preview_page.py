@@ -75,6 +75,7 @@ def test_cell_view_poses_are_the_arms_forward_kinematics(arm: Arm) -> None:
     assert len(view.poses) == 1 and view.poses[0].label == "scan pose"
     assert np.allclose(view.poses[0].X_RL["torch"], arm.model.fk(arm.q_scan, "torch"))
     assert set(view.poses[0].X_RL) == set(view.links)
+    assert view.motion is None and view.limits == arm.model.limits  # no plan, no motion; the limits as values
 
 
 def test_3d_view_draws_the_cell_and_frames_the_part(arm: Arm) -> None:
@@ -137,7 +138,7 @@ def tiny_run() -> WeldRun:
     table = Box(make_pose(p=[0.0, 0.0, -1.07]), np.array([1.0, 0.6, 0.1]))
     view = CellView(table=table, cameras=cameras_R(SCENARIO))
     X = torch_along(front)
-    return WeldRun(det, welds, torch_paths={"S_front": X}, view=view)
+    return WeldRun(detection=det, seams=welds, torch_paths={"S_front": X}, view=view)
 
 
 def test_page_has_results_table_and_cell_figure(tmp_path: Path) -> None:
@@ -196,9 +197,9 @@ def test_overview_legend_lists_only_what_is_drawn(tmp_path: Path) -> None:
 
 
 def test_scan_pose_holds_the_eye_in_hand_camera_where_its_frustum_starts() -> None:
-    from cell.station.arm import load_arm
+    from cell.pipeline.geometry import robot_arm
 
-    arm = load_arm(SCENARIO)  # q_scan by IK on the camera's viewpoint
+    arm = robot_arm(SCENARIO)  # q_scan by IK on the camera's viewpoint
     view = cell_view(SCENARIO, arm, None)
     (cam,) = (c for c in view.cameras if c.mount == "eye_in_hand")
     X_R_link = view.poses[0].X_RL["camera_link"]  # the drawn camera body at the scan pose

@@ -13,10 +13,10 @@ import pytest
 from tools_loader import load_tool
 
 from cell import scenario as sc
+from cell.pipeline.geometry import robot_arm
 from cell.scenario.init import check_layout
 from cell.seams.joint import dihedral, find_joints
 from cell.seams.truth import true_seams
-from cell.station import load_arm
 from cell.types import Polyhedron, WeldMap
 from cell.weldmap import read_map
 
@@ -60,7 +60,7 @@ def test_twenty_random_cells_load_and_are_laid_out_for_the_cell(rc: ModuleType, 
         scn = sc.load(cell.scenario)
         weldmap = read_map(scn.map_path)
         assert check_layout(scn, weldmap) == [], seed
-        load_arm(scn)  # the arm reaches the scan pose (IKError otherwise)
+        robot_arm(scn)  # the arm reaches the scan pose (IKError otherwise)
         joints = find_joints(weldmap)  # every drawn seam has its joint, as the truth says
         assert sorted(joints) == sorted(s["id"] for s in truth["seams"])
         _drawn_where_the_truth_lies(weldmap)

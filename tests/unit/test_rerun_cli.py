@@ -3,6 +3,7 @@ rerun-sdk is missing; and the recording's small numerical helpers (quaternions, 
 
 from __future__ import annotations
 
+import importlib
 import re
 import sys
 from pathlib import Path
@@ -15,8 +16,9 @@ from cell import pipeline
 from cell.cli import app
 from cell.errors import UsageError
 from cell.geometry import rpy_to_matrix
+from cell.pipeline.scene_view import subsample
 from cell.preview.rerun import require_rerun
-from cell.preview.timeline import quaternions_xyzw, subsample
+from cell.preview.timeline import quaternions_xyzw
 
 runner = CliRunner()
 
@@ -29,6 +31,7 @@ def no_run(monkeypatch: pytest.MonkeyPatch) -> None:
         raise AssertionError("the pipeline ran")
 
     monkeypatch.setattr(pipeline, "weld", refuse)
+    monkeypatch.setattr(importlib.import_module("cell.pipeline.turnover"), "weld", refuse)  # weld_part's side A
 
 
 def _one_error_line(argv: list[str], *needles: str) -> None:

@@ -256,8 +256,10 @@ def test_the_gate_refuses_a_seam_whose_end_bound_stays_over_the_end_tolerance() 
     drawn = replace(
         sure, id="drawn", end_sigma_m=(1e-4, PART_TOLERANCE_M), end_source=(EndSource.EDGE, EndSource.DRAWN)
     )
-    assert end_doubt(sure, sc) == "" and doubt(sure, sc) == ""
-    assert "end tolerance 1 mm" in end_doubt(drawn, sc) and doubt(drawn, sc) == end_doubt(drawn, sc)
+    assert end_doubt(sure, sc) is None and doubt(sure, sc) is None
+    ends = end_doubt(drawn, sc)
+    assert ends is not None and ends.code is WeldReason.END_UNCERTAIN and "end tolerance 1 mm" in ends.detail
+    assert doubt(drawn, sc) == ends
     _, summary = evaluate((sure, drawn), {})
     det = Detection(sc, "ours", WeldMap((), (), "mm", "inline"), (sure, drawn), {}, {}, summary)
     welds = {w.id: w for w in seam_welds(det, None, None, 0.0, "", sc, True)}

@@ -20,7 +20,7 @@ def test_a_maps_fixture_is_a_body_of_the_station_at_its_as_built_place() -> None
     weldmap = read_weldmap(s)
     clamp = Part("CLAMP", Box(make_pose(p=(0.7, 0.35, 0.04)), np.array([0.05, 0.05, 0.08])), "3DSOLID")
     weldmap = dataclasses.replace(weldmap, fixtures=(clamp,))
-    with SimStation(s, weldmap, with_robot=False) as station:
+    with SimStation(s, weldmap, arm=None) as station:
         body = station.sim.body_id(FIXTURE_PREFIX + "CLAMP")
         p_W, _ = station.sim.client.getBasePositionAndOrientation(body)
     (expected,) = as_built_fixtures(weldmap, s)

@@ -27,8 +27,8 @@ from cell.pipeline.weld import weld
 from cell.scenario import Scenario
 from cell.station import Station
 from cell.types import SeamStatus, WeldMap
-from cell.types.turnover import TurnoverPlan, TurnoverResult
 from cell.types.plan import SeamTask
+from cell.types.turnover import TurnoverPlan, TurnoverResult
 
 
 def table_box_R(sc: Scenario) -> tuple[FloatArray, FloatArray]:

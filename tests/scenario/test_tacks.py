@@ -22,7 +22,6 @@ from cell import scenario as sc
 from cell.export.krl import krl_program
 from cell.export.turnover_report import turnover_report
 from cell.pipeline.geometry import open_cell
-from cell.pipeline.turnover import tack_rule, weld_part
 from cell.pipeline.tacks import Tack, is_tack
 from cell.pipeline.turnover import tack_rule, weld_part
 from cell.pipeline.weld import plan_for

@@ -11,11 +11,12 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams.ours._ends import end_shear, end_slopes, end_source, find_ends, side_selections
+from cell.seams.ours._ends import end_shear, end_slopes, end_source, find_ends
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
+from cell.seams.ours._sides import side_selections
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions
 from cell.seams.sigma import drawn_end_sigma, ours_end_sigma, ours_sigma

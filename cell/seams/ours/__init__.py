@@ -2,8 +2,8 @@
 
 The package's public names: :class:`OursLocator`, its :class:`OursOptions`, and the standard errors behind a seam's
 confidence (:class:`SeamErrors`); one concept per module (the driver ``locator``, ``options``, ``confidence``, the
-points ``_points``, the planes ``_planes``, the joint's geometry ``_geometry``, the faces ``_faces``, the side faces' points
-``_sides``, the ends ``_ends``).
+points ``_points``, the planes ``_planes``, the joint's geometry ``_geometry``, the faces ``_faces``, the side
+faces' points ``_sides``, the ends ``_ends``).
 
 Method (general: no assumption that a seam runs along x, y or z):
 

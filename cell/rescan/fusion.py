@@ -1,24 +1,6 @@
-"""Close-up re-scan of seams with the eye-in-hand camera, and fusion with the first estimate.
-
-The fixed cameras see the fence from 1.5-2 m (D415: sigma_z ~3-6 mm, pixel footprint 1.5-2 mm) and their
-extrinsic calibration bounds what they can do. The eye-in-hand camera, brought to ~0.35 m of a seam, sees it
-with ~0.2 mm depth noise and a ~0.35 mm footprint, and its pose comes from the robot's kinematics, not from the
-fixed cameras' calibration. Per seam (the loop is :func:`cell.pipeline.rescan.rescan_seams`, the only code that
-moves the arm for it; this module holds the values it computes):
-
-1. plan a view (:func:`cell.rescan.viewpoint.plan_view`) from where the arm is;
-2. move the simulated arm there (arc off) and take one image from the camera on the arm;
-3. deproject it with the image's believed pose, keep the points in a box around the seam (``crop_margin_m``),
-   and run the same locator on a local :class:`SeamScene` (this close cloud, the same aligned map and joints);
-4. fuse the close-up estimate with the first by inverse variance (:func:`fuse`): each estimate's standard
-   deviation is its locator's calibrated sigma (``SeamEstimate.sigma_m``, :mod:`cell.seams.sigma`; the close-up's
-   its own, with the close-up's floor); each end along the seam by its end sigmas (``SeamEstimate.end_sigma_m``,
-   :func:`fuse_along`). A failed close-up keeps the first estimate; an uncertain one gets a small weight. The fused
-   estimate carries the fused sigmas, which the weld gate reads.
-
-Finally the arm goes back to its scan configuration (when that move is free). Frames: R (robot base) for every
-estimate and pose, W for the simulator; metres, radians, seconds.
-"""
+"""The close-up re-scan's values: which seams, the close-up's scene and the fusion of the close-up's estimate with
+the first by inverse variance, across the seam and at each end (:func:`fuse`, :func:`fuse_along`). The loop that
+moves the arm is :func:`cell.pipeline.rescan.rescan_seams`. Frame R, metres. The steps: docs/seams.md section 5."""
 
 from __future__ import annotations
 

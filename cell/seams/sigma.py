@@ -1,44 +1,7 @@
-"""Each locator's sigma: the standard deviation of its seam line across the seam [m], calibrated on the scenarios.
+"""Each locator's sigma: the standard deviation of its seam line across the seam and of each end along it [m].
 
-A sigma is calibrated when about 95 % of the seams a locator finds lie within 2 sigma of their true seam (lateral
-error, what the torch feels). ``benchmarks/bench_coverage.py`` measures that on fence1-exact, fence1 and fence2
-(seeds 0-2, realistic noise) and on fence1's fault variants (``benchmarks/results/coverage.json``); the constants
-here were chosen from its rows:
-
-- ours: its own statistical standard error (the faces' offsets through the angle between them) is too small
-  alone (88 % within 2 sigma on the three scenarios: it cannot see the cameras' calibration, the voxel order, the
-  part's tilt). Combined in quadrature with a floor of 0.05 mm (``OursSettings.sigma_floor_m``) it covers 96 %
-  (lateral) and 95 % (endpoint); 0.03 mm covers 93 % / 89 %. Up close the floor is the close-up's own (the re-scan
-  sets it, :data:`cell.config.rescan.CLOSEUP_OURS_OPTIONS`). On cells nobody tuned for the standard errors
-  themselves are too small by :data:`SE_INFLATION` (calibrated on random cells of one seed, checked on another:
-  docs/trust.md section 4); across the seam and along it, our locator's standard errors are widened by it.
-- the paper's method: nothing it computes predicts its error (the start read on 1 cm voxel faces, the end from
-  the map's vector), so the sigma is fixed by what it saw: both faces read (confidence 0.9 or more: 95th
-  percentile of the lateral error 1.7 mm on the scenarios, 3.6 mm on the faults) 0.9 mm; a face not seen
-  (confidence below 0.9: the raw boundary value, up to 29 mm off on the faults) 10 mm.
-- RANSAC: the spread of its runs does not rank its errors (Spearman 0.24 on the scenarios, 0.02 on the faults),
-  and its plane fits' residuals are those of a 1 cm voxel cloud, not of its bias; fixed at 1.6 mm (95th
-  percentile of the lateral error 3.2 mm on the scenarios, 2.6 mm on the faults).
-
-The weld gate (:mod:`cell.pipeline.weld`) welds a seam only when ``rescan.bound_sigmas`` sigma is within
-``rescan.weld_tolerance_mm``.
-
-Each end has a sigma of its own ALONG the seam (``SeamEstimate.end_sigma_m``), from how it was placed
-(:class:`~cell.types.EndSource`); calibrated the same way (about 95 % of located ends within 2 end sigmas) by
-``benchmarks/bench_ends.py`` on fence1, fence2, brace, bracket, rhs and fence1's faults (seed 0, realistic noise;
-``benchmarks/results/ends.json``, figures in docs/locate.md):
-
-- an end that only the drawn length places (``drawn``) has the part tolerance as its sigma
-  (:func:`drawn_end_sigma`, from ``PART_TOLERANCE_M`` and :data:`LENGTH_SHARE`: the one place it is derived);
-- ours: its statistical standard error of the end (the side face's offset fit, the edge's likelihood, the
-  extent's order statistics) with a floor per source in quadrature (:data:`OURS_END_FLOOR_M`): what the fit cannot
-  see (a blurred edge's bias, flying pixels along it, a tack or a bead near the end); an end placed on another
-  part's face the drawn gap short of it also carries the as-built gap's uncertainty (:data:`GAP_SIGMA_M`);
-- the paper's method reads its start on 1 cm voxel faces (:data:`PAPER_START_SIGMA_M`) and takes its end from the
-  map's vector: that end carries the start's error and the drawn length's (``drawn``);
-- RANSAC's ends are the extent of its planes' inliers on a 1 cm voxel cloud: fixed and wide
-  (:data:`RANSAC_END_SIGMA_M`).
-"""
+A sigma is calibrated when about 95 % of the seams a locator finds lie within 2 sigma of their true seam; how each
+constant here was chosen, and on what: docs/seams.md section 2 and docs/trust.md section 4."""
 
 from __future__ import annotations
 

@@ -54,11 +54,15 @@ def test_the_committed_calibration_covers_about_95_percent_on_the_scenarios() ->
     assert set(scenarios) == {"ours", "paper", "ransac"}
     for method, r in scenarios.items():
         assert r["lateral_2sigma"] >= 0.90, method  # measured 95-99 %
-        # Not inflated either: twice the median sigma is about the 95th percentile of the error (ours 0.140 against
-        # 0.142 mm, the paper's 1.80 against 1.77, RANSAC's 3.2 against 3.14); a sigma that adapts to its seam covers
-        # more than 95 % (ours 107 of 108: the seams with large errors have large sigmas).
+        # Not inflated either: twice the median sigma is about the 95th percentile of the error (the paper's 1.80
+        # against 1.77 mm, RANSAC's 3.2 against 3.14); a sigma that adapts to its seam covers more than 95 %.
         lateral = sorted(x["lateral_mm"] for x in data["rows"] if x["method"] == method and x["group"] == "scenarios")
         p95 = lateral[int(0.95 * len(lateral))]
-        assert 0.67 * p95 <= 2.0 * r["sigma_median_mm"] <= 1.5 * p95, method
-    # Ours' standard error alone is too small: the floor is what brings it to 95 %.
-    assert data["calibration"]["scenarios"]["ours_se_alone_lateral_2sigma"] < 0.9  # measured 88 %
+        # Ours is calibrated on random cells nobody tuned it for (docs/trust.md section 4), where its errors are
+        # wider: on the scenarios it was developed on it is pessimistic, twice its median sigma 2.3 times the 95th
+        # percentile (0.326 against 0.143 mm), and must not grow further.
+        wide = 2.5 if method == "ours" else 1.5
+        assert 0.67 * p95 <= 2.0 * r["sigma_median_mm"] <= wide * p95, method
+    # Ours' standard error, widened by SE_INFLATION (calibrated on random cells), covers the scenarios alone
+    # (measured 100 %; unwidened it was 88 %): the floor stands for what the fit cannot see.
+    assert data["calibration"]["scenarios"]["ours_se_alone_lateral_2sigma"] >= 0.95

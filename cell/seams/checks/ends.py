@@ -1,24 +1,6 @@
-"""A located seam's ends checked against the aligned map, whatever the locator (frame R, metres).
-
-A locator places each end from what it saw (:class:`~cell.types.EndSource`); what it cannot see is what the end can
-not be. :func:`check_ends` holds every found estimate to two things the aligned map knows:
-
-1. an end never lies inside another part's body: walking from the seam's middle towards each end, where the line
-   or the bead along it (the line lifted :data:`BEAD_LIFT_M` out of the fillet corner, along its bisector) enters
-   any other part of the map (a tube the seam ends against, a rail across it) the end is cut to its face
-   (``other_part``; an end moved further than two of its sigmas keeps only the drawn end's sigma). The bead's walk
-   sees a part standing on the same face as the seam: a tube on the plate, whose bottom lies level with the seam's
-   line, so that the line alone only grazes it;
-2. the located length agrees with the drawn one to within the part tolerance on a seam of that length
-   (:func:`~cell.seams.sigma.length_tolerance_m`) plus two sigmas of the two ends together (an end run along the
-   receiving face past the abutting part's end, a mitred brace's, does not); otherwise the end that deviates
-   outwards (or inwards) most for its sigma is replaced by the aligned map's end projected on the located line
-   (``drawn``, :func:`~cell.seams.sigma.drawn_end_sigma`), then the other if that is not enough.
-
-The line across the seam never moves. A seam whose length is off by more than half the drawn length is not this
-joint and is NOT_FOUND (``length_mismatch``). Each change is said in the reason. (Where each end lies against its
-own joint's faces, off the map by as much as the parts are built off it, is the locator's to find.)
-"""
+"""A located seam's ends checked against the aligned map, whatever the locator (frame R, metres): an end never
+inside another part's body (:func:`check_ends` cuts it at that face), the located length as drawn within the part
+tolerance and two end sigmas (else the offending end from the map). The rules: docs/seams.md section 3."""
 
 from __future__ import annotations
 

@@ -1,22 +1,6 @@
-"""The last check before the arc: a located seam against what it cannot be, from the aligned map alone.
-
-A locator's sigma speaks of the spread of its fit, never of a fit to the wrong thing: a face of a third part taken
-for a weld face, an end that runs on along the receiving face past the abutting part, an end found inside a tube.
-So before a seam is welded its estimate is held against the aligned map (:func:`last_check`):
-
-* across: both ends lie within ``Budget.across_m`` of the drawn seam's line (the build's tolerance, the cameras'
-  stated calibration and the estimate's own uncertainty: :func:`budget`);
-* length: the located length lies within ``Budget.length_m`` of the drawn length (its ends' sigmas in it);
-* ends in a body: neither end lies inside another part's body (any but the joint's two) by more than
-  ``Budget.body_m``, nor beyond a face the seam or its bead enters on the way from the seam's middle (a tube's
-  wall, its bore behind it: :func:`cell.seams.checks.ends.bead_entry`) by more than that;
-* ends on the faces: each end lies within ``Budget.face_m`` of both bodies its joint joins (on the faces it joins,
-  the line being across-checked already): an end that runs on along the receiving face past the abutting part, or
-  off the receiving part's edge, is off a face.
-
-The first test failed is returned as a :class:`~cell.types.CheckFail` (a code with the value, its limit, the end
-and the part), None when the seam passes. Values in, values out: frame R (or any one frame), metres.
-"""
+"""The last check before the arc: a located seam against what it cannot be, from the aligned map alone (across,
+length, an end in a body, an end off the faces its joint joins); :func:`last_check` returns the first test failed
+as a :class:`~cell.types.CheckFail`, None when the seam passes. Frame R, metres. The tests: docs/seams.md section 4."""
 
 from __future__ import annotations
 

@@ -75,14 +75,13 @@ def ours_end_sigma(
     bias_m: float = 0.0,
 ) -> float:
     """Our locator's sigma [m] of one end along the seam: its standard error ``se_m`` [m] (widened by
-    :data:`SE_INFLATION`) and the floor of its
-    ``source`` in quadrature (:data:`OURS_END_FLOOR_M`; an end the map alone places takes :func:`drawn_end_sigma`);
-    an end ``against_part`` (A's hidden side on another part's face, the drawn gap short of it) also the as-built
-    gap's uncertainty (:data:`GAP_SIGMA_M`), and an end on a side face at an angle to the seam that gap's
-    uncertainty times the face's ``slope`` across face A (a mitred brace's, a gusset's sloped side: the end moves
-    along the seam by the slope times the gap's error). ``floor_scale``: the floor's share (a close-up's own);
-    ``bias_m`` [m]: what no fit sees (a part's turn within its angular tolerance moving an end read on its side
-    face, a section's size tolerance), not widened."""
+    :data:`SE_INFLATION`) and the floor of its ``source`` in quadrature (:data:`OURS_END_FLOOR_M`; an end the map
+    alone places takes :func:`drawn_end_sigma`); an end ``against_part`` (A's hidden side on another part's face, the
+    drawn gap short of it) also the as-built gap's uncertainty (:data:`GAP_SIGMA_M`), and an end on a side face at
+    an angle to the seam that gap's uncertainty times the face's ``slope`` across face A (a mitred brace's, a
+    gusset's sloped side: the end moves along the seam by the slope times the gap's error). ``floor_scale``: the
+    floor's share (a close-up's own); ``bias_m`` [m]: what no sample shrinks (an edge's blur and sampling where a
+    face's points stop, a section's size tolerance), not widened."""
     sigma = math.hypot(SE_INFLATION * se_m, floor_scale * OURS_END_FLOOR_M[source], slope * GAP_SIGMA_M, bias_m)
     return math.hypot(sigma, GAP_SIGMA_M) if against_part else sigma
 

@@ -90,8 +90,8 @@ class End:
         return replace(self, d=self.d + fit.offset, scale=fit.scale, sigma=None, bias=0.0)
 
     def at(self, s: float, se: float, source: str, sigma: float | None = None, bias: float = 0.0) -> End:
-        """This end placed at ``s`` along the line [m], with its standard error [m], where it came from, when
-        wider than the standard error its sigma [m] (:attr:`spread`), and its :attr:`bias` [m]."""
+        """This end placed at ``s`` along the line [m], with the standard error the confidence reads [m], where it
+        came from, its statistical standard error when another (:attr:`sigma`) and its :attr:`bias` [m]."""
         return replace(self, s=s, se=se, source=source, sigma=sigma, bias=bias)
 
     @property
@@ -135,10 +135,10 @@ class Fitted:
 def at_seam(x: Selection, fit: Fitted) -> float:
     """The standard error [m] of a side face's plane where it meets the seam: the fit holds its offset at its
     points' weighted centre, the seam's end lies at (0, 0) over faces A and B, and a part turned or leaning within
-    its angular tolerance (:data:`~cell.seams.sigma.TILT_TOLERANCE_RAD`) moves the plane there by that lever."""
-    assert x.across is not None
+    its angular tolerance (:data:`~cell.seams.sigma.TILT_TOLERANCE_RAD`) moves the plane there by that lever. A
+    selection with no heights (:attr:`Selection.across` None): the fit's own standard error."""
     w = np.asarray(fit.weights, dtype=float)
-    if len(w) != x.across.shape[1] or w.sum() <= 0.0:
+    if x.across is None or len(w) != x.across.shape[1] or w.sum() <= 0.0:
         return fit.se
     centre = x.across @ w / w.sum()  # (2,) [m]
     return float(np.hypot(fit.se, TILT_TOLERANCE_RAD * float(np.linalg.norm(centre))))
@@ -197,7 +197,7 @@ class PassFit:
             else:
                 k = END_KEYS.index(x.key)
                 moved[k] = moved[k].moved(fit)
-                side_se[k] = fit.se if x.across is None else at_seam(x, fit)
+                side_se[k] = at_seam(x, fit)
         for j, tilted in self.tilted.items():
             key = request.selections[j].key
             if tilted is not None:

@@ -86,4 +86,5 @@ def on_face(end: End, pts: Points, sel: IntArray, r_l: FloatArray, n_a: FloatArr
     if end.against is None or not len(sel):
         return np.ones(len(sel), bool)
     q = pts.xyz[:, sel].T + np.outer(min(0.5 * end.touching, _INTO_M) - r_l[sel], end.n)
-    return np.asarray(end.against.contains(q) & end.against.contains(q + band * np.asarray(n_a)), bool)
+    inside = np.asarray(end.against.contains(np.vstack([q, q + band * np.asarray(n_a)])), bool)  # one pass of the body
+    return inside[: len(sel)] & inside[len(sel) :]

@@ -99,6 +99,29 @@ def test_side_planes_and_extents_of_a_mitred_bar() -> None:
     assert side_planes(bar, ("top", "mitre"), p0, t, (0.0, length + 0.05), 0.02) is None
 
 
+def _leaning_brace() -> Polyhedron:
+    """A bar leaning from a base (z = 0) to a wall (x = 0), 30 mm wide along y, in (x, z) [mm]: foot flat on the base
+    from x = 10 to 18, top against the wall from z = 12 to 20; its underside runs from (10, 0) up to (0, 12)."""
+    outline = [(10.0, 0.0), (18.0, 0.0), (0.0, 20.0), (0.0, 12.0)]  # underside-foot, foot-overside, ...
+    v = np.array([[x, y, z] for y in (-15.0, 15.0) for x, z in outline]) / 1000.0
+    faces = ((0, 4, 5, 1), (1, 5, 6, 2), (2, 6, 7, 3), (3, 7, 4, 0), (0, 1, 2, 3), (4, 7, 6, 5))
+    return Polyhedron(v, faces, ("foot", "over", "top", "under", "cheek-", "cheek+"))
+
+
+def test_a_cheeks_end_is_the_face_that_holds_it_not_one_more_across_elsewhere() -> None:
+    """The cheek's fillet on the wall runs up from the underside's top corner: the underside ends it there. The foot,
+    flat on the base 10 mm away, is more across that line and its plane meets it 12 mm below the end: not it."""
+    brace = Part("BRACE", _leaning_brace())
+    p0, t = np.array([0.0, 0.015, 0.012]), np.array([0.0, 0.0, 1.0])
+    sides = side_planes(brace, ("cheek+", "top"), p0, t, (0.0, 0.008), 0.02)
+    assert sides is not None
+    (n0, d0), (n1, d1) = sides
+    n_under, d_under = brace.face_plane("under")
+    n_over, d_over = brace.face_plane("over")
+    assert np.allclose(n0, n_under) and d0 == pytest.approx(d_under)
+    assert np.allclose(n1, n_over) and d1 == pytest.approx(d_over)
+
+
 def test_a_box_as_a_polyhedron_gives_the_box_geometry() -> None:
     a = Box(make_pose(p=(0.0, 0.0, 0.3)), np.array([0.04, 0.04, 0.6]))
     b = Box(make_pose(p=(0.0, 0.0, -0.02)), np.array([0.8, 0.04, 0.04]))

@@ -28,6 +28,9 @@ _SIDE_COS = math.cos(math.radians(SIDE_MAX_ANGLE_DEG))
 _ACROSS_TIE = 1e-3  # faces whose normals' components along the line differ by less are as much across it
 
 
+_ADJACENT_M = 5e-4  # a face holds the map's end when its polygon passes this near it [m] (a drawing's rounding)
+
+
 def side_planes(
     part_a: Part, skip: tuple[str, ...], p0: FloatArray, t: FloatArray, s_map: tuple[float, float], reach_m: float
 ) -> tuple[tuple[FloatArray, float], tuple[FloatArray, float]] | None:
@@ -38,20 +41,30 @@ def side_planes(
     end when it points along t; of those whose plane meets the line within ``reach_m`` of the map's end ``s_map``,
     the one most across the line (a tube's side flat, not the facets of the corner radius before it: the seam
     ends short of that flat, :meth:`~cell.seams.ours._geometry.JointGeometry.end_planes`), the nearest of those as
-    much across it (within :data:`_ACROSS_TIE`). ``skip``: A's faces that hold the seam (the weld face and the end
-    face)."""
+    much across it (within :data:`_ACROSS_TIE`). Where some of them hold the map's end on their polygon (within
+    :data:`_ADJACENT_M`), only those: a mitred brace's foot, flat on the base beside its cheek's lower end, is
+    more across that cheek's line than the underside that ends it, but lies elsewhere. ``skip``: A's faces that
+    hold the seam (the weld face and the end face)."""
     N, D = face_planes(part_a)
     c_all = N @ t
-    crossing = np.array([name not in skip for name in part_a.face_names()]) & (np.abs(c_all) >= _SIDE_COS)
+    names = part_a.face_names()
+    crossing = np.array([name not in skip for name in names]) & (np.abs(c_all) >= _SIDE_COS)
     with np.errstate(divide="ignore", invalid="ignore"):
         s_all = (D - N @ p0) / c_all
+    body = part_a.body
+    adjacent = np.zeros(len(names), bool)
+    if isinstance(body, Polyhedron):
+        for i in np.flatnonzero(crossing):
+            at = p0 + s_map[1 if c_all[i] > 0.0 else 0] * t
+            adjacent[i] = float(body.face_distance(names[i], at)[0]) <= _ADJACENT_M
     best: list[tuple[float, float, int] | None] = [None, None]
     for i in np.flatnonzero(crossing):  # in the faces' order: the tie rule depends on it
         c = float(c_all[i])
         end = 1 if c > 0.0 else 0
         off = abs(float(s_all[i]) - s_map[end])
         current = best[end]
-        if off > reach_m:
+        held = adjacent[crossing & ((c_all > 0.0) == (c > 0.0))]
+        if off > reach_m or (held.any() and not adjacent[i]):
             continue
         if (
             current is None

@@ -87,6 +87,16 @@ def end_slopes(ends: tuple[End, End], n_a: FloatArray, n_b: FloatArray, t: Float
     return out[0], out[1]
 
 
+def across_lever(end: End, t: FloatArray) -> float:
+    """How far along the seam [m] an end placed on a side face moves per metre the line moves across itself, at
+    most (the worst direction across): the tangent of the face's normal's angle to the line; 0 for an end no plane
+    places, or a plane along the line."""
+    if end.source not in ("side face", "table"):
+        return 0.0
+    c = abs(float(end.n @ t))
+    return float(np.sqrt(max(1.0 - c * c, 0.0)) / c) if c > 0.2 else 0.0
+
+
 def end_shear(
     ends: tuple[End, End],
     n_a: FloatArray,
@@ -255,8 +265,13 @@ def find_ends(
             continue
         if extent is None:
             placed[k] = end.at(s_map[k], o.map_tolerance_m, "map")
-        elif dense is None:
-            placed[k] = end.at(extent[k], extent[2], "extent")
+            continue
+        # Where no edge confirms it, the extrapolated end is only as good as the density is uniform out to it: a
+        # face partly hidden or out of view thins its points unevenly, and the extrapolation then lands well away
+        # from where they stop. That disagreement joins the end's sigma as a bias.
+        unconfirmed = end.at(extent[k], extent[2], "extent", bias=abs(extent[k] - (s_a.min(), s_a.max())[k]))
+        if dense is None:
+            placed[k] = unconfirmed
         elif end.inset:
             # A flat that ends into a corner radius has no edge: its points bend away from the plane past the tangent
             # line, and the extent of those near the plane runs on into the radius. Fit the radius's profile.
@@ -265,7 +280,7 @@ def find_ends(
             d = dense(p0 + (extent[k] - wide) * t, p0 + (extent[k] + wide) * t)
             s_d, r_d = profile_a(d)
             s0, se = tangent_end(sign * s_d, r_d, sign * extent[k], end.inset, face_a.scale)
-            placed[k] = end.at(sign * s0, se, "tangent") if np.isfinite(se) else end.at(extent[k], extent[2], "extent")
+            placed[k] = end.at(sign * s0, se, "tangent") if np.isfinite(se) else unconfirmed
         else:
             # Refine the CDF's extrapolation by the edge's own sharpness (blurred-step likelihood), on every
             # point of the dense cloud within the likelihood's window about it.
@@ -284,5 +299,14 @@ def find_ends(
                 bias = edge_bias(d.pitch, max(face_a.scale, fit.blur))
                 placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", fit.se, bias)
             else:
-                placed[k] = end.at(extent[k], extent[2], "extent")
+                placed[k] = unconfirmed
     return placed[0], placed[1]
+
+
+def within_receiving(ends: tuple[End, End], s_b: tuple[float, float], margin: float) -> tuple[End, End]:
+    """The ends, one placed past where B's face stops along the line (``s_b``: the drawn face's extent [m], by more
+    than ``margin``) brought back to that edge, the map's: a fillet lies only where both faces are (a plate
+    standing over a gap ends a brace's cheek fillet at its lower edge, above the brace's foot on the base)."""
+    start = ends[0].at(s_b[0], 0.0, "map") if ends[0].s < s_b[0] - margin else ends[0]
+    stop = ends[1].at(s_b[1], 0.0, "map") if ends[1].s > s_b[1] + margin else ends[1]
+    return start, stop

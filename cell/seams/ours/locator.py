@@ -11,7 +11,8 @@ import numpy as np
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
-from cell.seams.ours._ends import end_shear, end_slopes, end_source, find_ends
+from cell.seams._truth_faces import CLIP_TOL_M, plane_extent
+from cell.seams.ours._ends import across_lever, end_shear, end_slopes, end_source, find_ends, within_receiving
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
@@ -21,6 +22,8 @@ from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors
 from cell.seams.ours.options import OursOptions
 from cell.seams.sigma import drawn_end_sigma, ours_end_sigma, ours_sigma
 from cell.types import MapSeam, Reason, SeamEstimate, SeamScene, SeamStatus
+
+PAST_B_M = 3e-4  # an end placed this far past B's drawn face's edge comes back to it [m] (an end's floor)
 
 
 class OursLocator:
@@ -214,6 +217,9 @@ class OursLocator:
                 end_face,
             )
 
+        # Where B's drawn face stops along the line (the line laid in its plane, as the truth's is).
+        on_b = p0 - (float(n_b @ p0) - d_b) * n_b
+        ends = within_receiving(ends, plane_extent(part_b, joint.face_receiving, on_b, t, CLIP_TOL_M), PAST_B_M)
         length = ends[1].s - ends[0].s
         if not 0.3 * (s_map[1] - s_map[0]) < length < 2.0 * (s_map[1] - s_map[0]) + 2.0 * o.extend_m:
             return _not_found(
@@ -237,11 +243,17 @@ class OursLocator:
         drawn = drawn_end_sigma(o.map_tolerance_m, s_map[1] - s_map[0])
         # A side face at an angle to the seam moves its end along it by the as-built gap's error times its slope.
         slopes = end_slopes(ends, face_a.n, face_b.n, t)
+        sigma = ours_sigma(float(np.hypot(errors.lateral_m, errors.tilt_m)), o.sigma_floor_m)
         end_sigmas = [
             drawn
             if e.source == "map"
             else ours_end_sigma(
-                e.spread, k, bool(e.touching) and e.source == "side face", abs(slope), o.end_floor_scale, e.bias
+                e.spread,
+                k,
+                bool(e.touching) and e.source == "side face",
+                abs(slope),
+                o.end_floor_scale,
+                float(np.hypot(e.bias, across_lever(e, t) * sigma)),
             )
             for e, k, slope in zip(ends, sources, slopes, strict=True)
         ]
@@ -252,7 +264,7 @@ class OursLocator:
             p_start=p0 + ends[0].s * t,
             p_end=p0 + ends[1].s * t,
             confidence=conf,
-            sigma_m=ours_sigma(float(np.hypot(errors.lateral_m, errors.tilt_m)), o.sigma_floor_m),
+            sigma_m=sigma,
             end_sigma_m=(end_sigmas[0], end_sigmas[1]),
             end_source=sources,
         )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -28,10 +29,18 @@ BOUND_SIGMAS = 3.0
 # each end's sigma along the seam is within END_TOLERANCE_MM (``rescan.end_tolerance_mm``).
 END_TOLERANCE_MM = 1.0
 
-# Ours' sigma floor up close [m]: the arm's pose accuracy and hand-eye calibration on a real cell (exact kinematics
-# in the simulator); the close-ups of fence1, fence1-exact and fence2 end 0.006-0.017 mm off on average (README,
-# the re-scan table), and the fixed cameras' calibration, which the first pass's floor stands for, does not apply.
-CLOSEUP_SIGMA_FLOOR_M = 0.00002
+# Ours' sigma floor up close [m]: what no number of close-up points averages away. The depth output's quantisation
+# (CLOSEUP_DEPTH_UNIT_M, the D4xx's finest depth unit) is shared by the points of a face seen at one depth: unit /
+# sqrt 12 on each weld face, the two in quadrature; and the arm's pose accuracy and hand-eye calibration on a real
+# cell (0.02 mm; exact kinematics in the simulator). The fixed cameras' calibration, which the first pass's floor
+# stands for, does not apply. docs/seams.md section 2.
+CLOSEUP_DEPTH_UNIT_M = 1e-4
+CLOSEUP_SIGMA_FLOOR_M = round(math.hypot(2e-5, math.sqrt(2.0 / 12.0) * CLOSEUP_DEPTH_UNIT_M), 7)  # 0.0455 mm
+
+# A face placed from the edge of its neighbour up close is read by one camera, whose last sample lies on average
+# half a point pitch inside the edge, a bias no second camera averages: half a pitch joins its standard error
+# (the fixed cameras' edges, read by two or three cameras at once: OursSettings.edge_pitch_factor).
+CLOSEUP_EDGE_PITCH_FACTOR = 0.5
 
 # Ours' floors of the ends' sigmas up close, as a share of the fixed cameras' (cell/seams/sigma.py): the close-ups of
 # fence1's faults/two-cameras-dead and of bracket end 0.00-0.03 mm off where an edge is seen and 0.02-0.16 mm where a
@@ -48,6 +57,7 @@ CLOSEUP_OURS_OPTIONS: dict[str, float | int | str | bool] = {
     "corner_band_m": 0.003,
     "sigma_floor_m": CLOSEUP_SIGMA_FLOOR_M,
     "end_floor_scale": CLOSEUP_END_FLOOR_SCALE,
+    "edge_pitch_factor": CLOSEUP_EDGE_PITCH_FACTOR,
 }
 
 

@@ -18,8 +18,8 @@ from cell.perception.align.cloud import FRAME as _FRAME
 from cell.perception.align.cloud import POOR_FITNESS, crop_mask, place_map
 from cell.perception.align.fit import Alignment
 from cell.perception.align.placement import flatten_to_yaw, on_table
-from cell.perception.preprocess import downsample
 from cell.perception.ground import Ground, TableSource, find_ground, floor_height
+from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, levelling
 from cell.perception.unorganised import sampling as spacing_of
 from cell.pipeline.cloud_seams import locate_seams
@@ -173,10 +173,11 @@ def _ground_in_L(ground: Ground, P_L: FloatArray, noise_m: float) -> tuple[float
 def _ground_line(ground: Ground, noise_m: float, along_m: float, between_m: float) -> str:
     """The progress line about the ground and the cloud's noise and spacing."""
     tilt = np.degrees(ground.plane.tilt_rad)
-    data = f"noise {noise_m * 1e3:.2f} mm RMS, spacing {along_m * 1e3:.1f} mm along / {between_m * 1e3:.1f} mm between lines"
+    spacing = f"{along_m * 1e3:.1f} mm along / {between_m * 1e3:.1f} mm between lines"
+    data = f"noise {noise_m * 1e3:.2f} mm RMS, spacing {spacing}"
     if ground.source is TableSource.FOUND:
         return f"table tilted {tilt:.2f} deg, {data}"
-    if ground.source is TableSource.GIVEN:
+    if ground.given_z_m is not None:
         return f"table at z = {ground.given_z_m * 1e3:.1f} mm (given), {data} on the largest upward face"
     return (
         f"no table in the cloud ({ground.below_share:.0%} of the points lie under its largest upward plane, tilted "

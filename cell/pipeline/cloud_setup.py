@@ -130,7 +130,8 @@ def scenario_for(
 ) -> Scenario:
     """The scenario of a run on a brought cloud (:func:`cloud_scenario`) from what was measured in the levelled
     frame L: the map at ``X_LM`` (None: at the points' median), the crop about it (:func:`crop_bounds`, from the
-    table up), the ground's largest upward plane's inliers and the table's height in L (``ground``), the viewpoint; X_FL (4, 4) carries them into F. With the options from the
+    table up), the largest upward plane (its inliers) and the table's height in L (``ground``), the viewpoint;
+    X_FL (4, 4) carries them into F. With the options from the
     data's ``measured`` noise and spacing along and between lines [m]."""
     from cell.seams.registry import with_method, with_options
 

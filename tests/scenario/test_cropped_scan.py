@@ -85,7 +85,7 @@ def _lateral_mm(est_ends: np.ndarray, p0: np.ndarray, t: np.ndarray) -> float:
 
 
 def test_the_measured_joint_is_a_vertical_line_off_the_centre_of_the_cross_tube(scan: tuple) -> None:
-    _, p0, t, offset_mm = scan
+    _, _, t, offset_mm = scan
     assert abs(float(t[2])) > 0.99  # the fillet is vertical (the tee lies flat)
     assert 12.0 < offset_mm < 22.0  # measured 16.8 mm: the long tube sits towards the cross tube's -y end
 

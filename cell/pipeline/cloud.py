@@ -125,7 +125,7 @@ def locate_cloud(
     scenario = scenario_for(name, weldmap, X_FL, X_LM, P_L, above, (table, table_z), viewpoint_L, measured, method)
     try:
         check_alignment_unique(map_L, dense_L, alignment, spec.symmetry)
-        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage)
+        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage, eyes_R=_eyes_L(scenario, X_FL))
     except AlignmentError as e:
         return _failed(scenario, weldmap, joints, X_FL, X_LM, table_z, method, e, timings, t_all, cloud.frame)
 
@@ -183,6 +183,12 @@ def _ground_line(ground: Ground, noise_m: float, along_m: float, between_m: floa
         f"no table in the cloud ({ground.below_share:.0%} of the points lie under its largest upward plane, tilted "
         f"{tilt:.2f} deg: a part's face): aligning on the parts' own faces, {data} on that face"
     )
+
+
+def _eyes_L(scenario: Scenario, X_FL: FloatArray) -> FloatArray:
+    """(k, 3) the synthesised scenario's sensor centres (``--viewpoint``, else above the part) in L."""
+    eyes_F = np.array([c.eye_m for c in scenario.cameras.values()], dtype=np.float64).reshape(-1, 3)
+    return transform_points(invert(X_FL), eyes_F)
 
 
 def _flat(alignment: Alignment, X_LM0: FloatArray, weldmap: WeldMap) -> tuple[Alignment, float]:

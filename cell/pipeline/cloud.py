@@ -13,11 +13,12 @@ import numpy as np
 
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert, make_pose, transform_points
-from cell.perception.align.checks import check_alignment_unique, check_parts_seen
+from cell.perception.align.checks import check_alignment_unique, check_parts_seen, cloud_tree_of
 from cell.perception.align.cloud import FRAME as _FRAME
 from cell.perception.align.cloud import POOR_FITNESS, crop_mask, place_map
 from cell.perception.align.fit import Alignment
 from cell.perception.align.placement import flatten_to_yaw, on_table
+from cell.perception.align.sight import places_in_evidence
 from cell.perception.ground import Ground, TableSource, find_ground, floor_height
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, levelling
@@ -124,8 +125,10 @@ def locate_cloud(
     measured = (noise, along, between)
     scenario = scenario_for(name, weldmap, X_FL, X_LM, P_L, above, (table, table_z), viewpoint_L, measured, method)
     try:
-        check_alignment_unique(map_L, dense_L, alignment, spec.symmetry)
-        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage, eyes_R=_eyes_L(scenario, X_FL))
+        tree = cloud_tree_of(dense_L)
+        check_alignment_unique(map_L, dense_L, alignment, spec.symmetry, tree)
+        eyes_L = viewpoint_L[None, :] if viewpoint_L is not None else places_in_evidence(map_L, tree)
+        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage, tree, eyes_L)
     except AlignmentError as e:
         return _failed(scenario, weldmap, joints, X_FL, X_LM, table_z, method, e, timings, t_all, cloud.frame)
 
@@ -183,12 +186,6 @@ def _ground_line(ground: Ground, noise_m: float, along_m: float, between_m: floa
         f"no table in the cloud ({ground.below_share:.0%} of the points lie under its largest upward plane, tilted "
         f"{tilt:.2f} deg: a part's face): aligning on the parts' own faces, {data} on that face"
     )
-
-
-def _eyes_L(scenario: Scenario, X_FL: FloatArray) -> FloatArray:
-    """(k, 3) the synthesised scenario's sensor centres (``--viewpoint``, else above the part) in L."""
-    eyes_F = np.array([c.eye_m for c in scenario.cameras.values()], dtype=np.float64).reshape(-1, 3)
-    return transform_points(invert(X_FL), eyes_F)
 
 
 def _flat(alignment: Alignment, X_LM0: FloatArray, weldmap: WeldMap) -> tuple[Alignment, float]:

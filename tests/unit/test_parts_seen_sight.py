@@ -1,6 +1,7 @@
 """The parts-seen check judges a part by the top its sensor has in sight (cell/perception/align/checks.py,
 ``part_coverage`` with ``eyes_R``): a plate whose top a standing web shadows from a low sensor is not refused for
-the shadowed share, and without the sensor's place it is (what the check did before it knew)."""
+the shadowed share, whether the sensor's place is given or read from the cloud (cell/perception/align/sight.py),
+and without it it is (what the check did before it knew); a part missing from the cloud is still missing."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ import pytest
 
 from cell.errors import AlignmentError
 from cell.geometry import make_pose
-from cell.perception.align.checks import check_parts_seen, part_coverage
+from cell.perception.align.checks import check_parts_seen, cloud_tree_of, part_coverage
+from cell.perception.align.sight import places_in_evidence
 from cell.scenario import PerceptionSpec, WorkspaceSpec
 from cell.types import Box, Cloud, Part, WeldMap
 
@@ -46,3 +48,26 @@ def test_the_shadowed_top_is_left_out_of_the_share_only_when_the_sensor_is_known
     with pytest.raises(AlignmentError):
         check_parts_seen(weldmap, _cloud(), spec, spec.coverage)
     assert check_parts_seen(weldmap, _cloud(), spec, spec.coverage, eyes_R=EYE) == {}
+
+
+def test_the_sensor_side_is_read_from_the_cloud_when_no_place_is_given() -> None:
+    weldmap = WeldMap((PLATE, WEB), (), "mm", "", "R")
+    cloud = _cloud()
+    places = places_in_evidence(weldmap, cloud_tree_of(cloud))
+    assert places is not None
+    # Only places on the sensor's side (-x) are kept: the others would see the web's far face or the plate behind it.
+    assert np.all(places[:, 0] < -0.4) and len(places) == 2  # of 25: straight towards it, at both elevations
+    spec = PerceptionSpec(workspace=WorkspaceSpec(min_m=(-1.0, -1.0, -0.1), max_m=(1.0, 1.0, 1.0)))
+    assert part_coverage(weldmap, cloud, spec, eyes_R=places)["PLATE"] > 0.95
+    assert check_parts_seen(weldmap, cloud, spec, spec.coverage, eyes_R=places) == {}
+
+
+def test_a_part_missing_from_the_cloud_is_still_missing() -> None:
+    weldmap = WeldMap((PLATE, WEB), (), "mm", "", "R")
+    g = np.arange(-0.1, 0.1, 0.002)
+    x, y = np.meshgrid(g, g)
+    plate_only = Cloud(np.column_stack([x.ravel(), y.ravel(), np.full(x.size, 0.01)]), "R")  # no web at all
+    places = places_in_evidence(weldmap, cloud_tree_of(plate_only))
+    spec = PerceptionSpec(workspace=WorkspaceSpec(min_m=(-1.0, -1.0, -0.1), max_m=(1.0, 1.0, 1.0)))
+    missing = check_parts_seen(weldmap, plate_only, spec, spec.coverage, eyes_R=places)
+    assert list(missing) == ["WEB"]

@@ -1,8 +1,8 @@
 """Where the sensor of a brought cloud was, as far as the cloud tells it, for the parts-seen check (a sensor's place
 is rarely given with a lidar sweep): of a ring of candidate places around and above the aligned map, those from
 which what the map shows in sight holds points about as well as from the best of them. A sweep from one side keeps
-the places on that side; a plate's top in a standing part's shadow from all of them is then out of the check's count (docs/locate.md, "From the
-cloud to the seams"). Frame R, metres."""
+the places on that side; a plate's top in a standing part's shadow from all of them is then out of the check's
+count (docs/locate.md, "From the cloud to the seams"). Frame R, metres."""
 
 from __future__ import annotations
 

@@ -69,7 +69,7 @@ def locate_cloud(
     :func:`~cell.perception.ground.find_ground`).
 
     Returns the usual :class:`Detection`, in F, with a scenario synthesised for the cloud. SensorError for a cloud
-    with too few or non-finite points or no table; an alignment that fails is returned as the detection's
+    with too few or non-finite points or no upward face at all; an alignment that fails is returned as the detection's
     ``error`` with every seam NOT_FOUND (or NOT_VISIBLE), as :func:`cell.pipeline.detect` does.
     """
     t_all = time.perf_counter()
@@ -91,9 +91,8 @@ def locate_cloud(
     P_L = transform_points(X_LF, P_F)
     along, between = spacing_of(P_L, _levelled(table, X_LF))
     noise = table.sigma_m
-    table_z, above = _ground_in_L(
-        ground, P_L, noise
-    )  # the table's height in L (no table: where the parts' bottoms are)
+    # The table's height in L and the points above it (no table: where the parts' bottoms are, and every point).
+    table_z, above = _ground_in_L(ground, P_L, noise)
     progress(_ground_line(ground, noise, along, between))
     timings["table_s"] = time.perf_counter() - t
 

@@ -234,16 +234,22 @@ def check_parts_seen(
 
 
 def check_alignment(
-    weldmap_R: WeldMap, cloud: Cloud, alignment: Alignment, spec: PerceptionSpec, cloud_tree: cKDTree | None = None
+    weldmap_R: WeldMap,
+    cloud: Cloud,
+    alignment: Alignment,
+    spec: PerceptionSpec,
+    cloud_tree: cKDTree | None = None,
+    eyes_R: FloatArray | None = None,
 ) -> dict[str, str]:
     """Both checks of an aligned map, :func:`check_alignment_unique` and :func:`check_parts_seen` (with the spec's
     ``symmetry`` and ``coverage`` options), side by side on two cores (scipy's KD-trees let go of the interpreter
     lock), reading one KD-tree of the cloud (``cloud_tree``, :func:`cloud_tree_of`, when the caller built it
     already); what they answer and raise is what they would one after the other: the uniqueness check's refusal
-    first. Returns the missing parts (name -> reason)."""
+    first. ``eyes_R`` : (k, 3) the cameras' centres (:func:`check_parts_seen`). Returns the missing parts (name ->
+    reason)."""
     tree = cloud_tree if cloud_tree is not None else cloud_tree_of(cloud) if len(cloud) else None
     with ThreadPoolExecutor(max_workers=1) as beside:
-        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage, tree)
+        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage, tree, eyes_R)
         try:
             check_alignment_unique(weldmap_R, cloud, alignment, spec.symmetry, tree)
         except AlignmentError:

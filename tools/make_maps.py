@@ -1,8 +1,8 @@
-"""Generate the welding maps in ``maps/`` (fence1, fence2, ladder, tee) and variants of them for tests.
+"""Generate the welding maps in ``maps/`` (fence1, fence2, ladder, tee, tee_flat) and variants of them for tests.
 
 Run from the repository root::
 
-    .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, fence2.dxf, ladder.dxf, tee.dxf
+    .venv/bin/python tools/make_maps.py            # writes maps/fence1.dxf, ..., tee.dxf, tee_flat.dxf
     .venv/bin/python tools/make_maps.py --out DIR  # somewhere else
 
 Conventions of every map: drawing units mm (``$INSUNITS`` = 4), map frame M with its origin at the fence corner and
@@ -97,6 +97,18 @@ TEE_PARTS: dict[str, BoxSpec] = {
 }
 TEE_JUNCTIONS: tuple[Junction, ...] = (("V_TUBE", "H_TUBE"),)
 TEE_SEAM_FACES = ("+x", "-x")  # the abutting faces whose seams are fillets
+
+# The T of the cropped real scan (../shared/real-scans/README.md, "A scan cropped above the table"): two 2 in square
+# tubes lying flat, a 304.8 mm tube butting into the middle of the side of a 97.6 mm cross tube (the README gives
+# no offset along it: drawn centred). Frame: z = 0 on the table, x along the long tube, y = 0 on its axis. Its welds
+# are the two vertical fillets where the long tube's side walls (y = +-25.4 mm) meet the cross tube's -x face; the
+# top edge is flush (both tubes 50.8 mm tall) and the bottom lies on the table, so those two lines are not seams.
+TEE_FLAT_PARTS: dict[str, BoxSpec] = {
+    "LONG_TUBE": ((0.0, -25.4, 0.0), (304.8, 25.4, 50.8)),
+    "CROSS_TUBE": ((304.8, -48.8, 0.0), (355.6, 48.8, 50.8)),
+}
+TEE_FLAT_JUNCTIONS: tuple[Junction, ...] = (("LONG_TUBE", "CROSS_TUBE"),)
+TEE_FLAT_SEAM_FACES = ("+y", "-y")
 
 
 def ladder_design(
@@ -391,14 +403,17 @@ def designs() -> dict[str, tuple[dict[str, BoxSpec], tuple[Junction, ...]]]:
         "fence2": (FENCE2_PARTS, FENCE2_JUNCTIONS),
         "ladder": ladder_design(),
         "tee": (TEE_PARTS, TEE_JUNCTIONS),
+        "tee_flat": (TEE_FLAT_PARTS, TEE_FLAT_JUNCTIONS),
     }
 
 
 def design_seams(name: str, parts: Mapping[str, BoxSpec], junctions: Iterable[Junction]) -> list[SeamSpec]:
-    """The seams of design ``name``: every junction's, but for the tee only its two fillets (TEE_SEAM_FACES)."""
+    """The seams of design ``name``: every junction's, but for the two tees only their fillets (TEE_SEAM_FACES,
+    TEE_FLAT_SEAM_FACES)."""
     seams = all_seams(parts, junctions)
-    if name == "tee":
-        seams = [s for s in seams if s[0].rsplit(":", 1)[1] in TEE_SEAM_FACES]
+    faces = {"tee": TEE_SEAM_FACES, "tee_flat": TEE_FLAT_SEAM_FACES}.get(name)
+    if faces is not None:
+        seams = [s for s in seams if s[0].rsplit(":", 1)[1] in faces]
     return seams
 
 

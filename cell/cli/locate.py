@@ -65,12 +65,20 @@ def locate(
     truth: Annotated[
         Path | None, typer.Option(help="True seams (JSON: seam id -> start, end in mm in the cloud's frame).")
     ] = None,
+    table_z: Annotated[
+        float | None,
+        typer.Option(help="The table's height in mm in the cloud's frame (its z up), when no table is in the cloud."),
+    ] = None,
+    no_table: Annotated[
+        bool, typer.Option("--no-table", help="There is no table in the cloud: align on the parts' own faces.")
+    ] = False,
     fmt: FormatOpt = "table",
 ) -> None:
     """Locate the welding map's seams in a point cloud you bring (a laser scan, any sensor's cloud).
 
     --place is the nominal pose of the drawing's origin in the cloud's frame; without it the map is found by a
-    global registration. Exit 3 when a seam that can be seen was not found (the report says why).
+    global registration. A cloud with no table in it (cropped above it, a part on a fixture) is recognised, or
+    said so with --no-table or --table-z. Exit 3 when a seam that can be seen was not found (the report says why).
     """
     from cell.export.report import detection_report
     from cell.perception.cloud_files import check_frame, check_units, read_cloud
@@ -88,6 +96,7 @@ def locate(
             raise UsageError(f"--map-units {map_units!r}; valid: {', '.join(METRES_PER_UNIT)}")
         X_FM = placement(place, place_rpy)
         viewpoint_F = parse_viewpoint(viewpoint)
+        table_z_m = parse_table(table_z, no_table)
         check_method(method)
         for path, option in ((map_path, "--map"), (truth, "--truth")):
             if path is not None and not path.is_file():
@@ -104,7 +113,7 @@ def locate(
         try:
             det = locate_cloud(
                 cloud_F, weldmap, X_FM, name=cloud.stem, method=method, viewpoint_F=viewpoint_F,
-                truth_F=truth_F, progress=stage,
+                truth_F=truth_F, table_z_m=table_z_m, no_table=no_table, progress=stage,
             )  # fmt: skip
             rep = detection_report(det, provenance=prov)
             writer.report(json_path, rep)
@@ -127,6 +136,18 @@ def _warn(msg: str) -> None:
     """A warning line: stderr (also with --quiet) and the log file."""
     log.warning(msg)
     err.print(f"[yellow]warning[/]: {escape(msg)}", soft_wrap=True, highlight=False)
+
+
+def parse_table(table_z_mm: float | None, no_table: bool) -> float | None:
+    """``--table-z`` [mm] as metres (None: not given); UsageError when it is not finite or comes with
+    ``--no-table``."""
+    if table_z_mm is None:
+        return None
+    if no_table:
+        raise UsageError("--table-z and --no-table together; valid: one of them (a table's height, or none)")
+    if not math.isfinite(table_z_mm):
+        raise UsageError(f"--table-z {table_z_mm}; valid: a finite height in mm in the cloud's frame")
+    return table_z_mm * 1e-3
 
 
 def parse_viewpoint(text: str | None) -> FloatArray | None:

@@ -284,11 +284,16 @@ def read_pcd(path: Path) -> FloatArray:
 
 
 def rays_hit(
-    vertices: npt.ArrayLike, triangles: npt.ArrayLike, origins: npt.ArrayLike, directions: npt.ArrayLike
+    vertices: npt.ArrayLike,
+    triangles: npt.ArrayLike,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
+    max_t: npt.ArrayLike | None = None,
 ) -> npt.NDArray[np.bool_]:
     """(n,) whether each ray (origins (n, 3) [m], directions (n, 3)) meets the triangle mesh ``vertices`` (v, 3)
     [m], ``triangles`` (t, 3) vertex indices at a distance t >= 0 (open3d's ``RaycastingScene``, Embree; single
-    precision, so about 0.1 um at a metre)."""
+    precision, so about 0.1 um at a metre), and below ``max_t`` (n,) or scalar (in units of each direction's length;
+    None: anywhere along the ray)."""
     o3d = _o3d()
     o = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
     tri = np.asarray(triangles, dtype=np.uint32).reshape(-1, 3)
@@ -298,4 +303,6 @@ def rays_hit(
     scene.add_triangles(o3d.core.Tensor(_array(vertices, np.float32)), o3d.core.Tensor(_array(tri, np.uint32)))
     rays = np.hstack([o, np.asarray(directions, dtype=np.float64).reshape(-1, 3)])
     t_hit = scene.cast_rays(o3d.core.Tensor(_array(rays, np.float32)))["t_hit"].numpy()
-    return np.asarray(np.isfinite(t_hit))
+    if max_t is None:
+        return np.asarray(np.isfinite(t_hit))
+    return np.asarray(np.isfinite(t_hit) & (t_hit < np.asarray(max_t, dtype=np.float64)))

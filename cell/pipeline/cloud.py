@@ -13,12 +13,15 @@ import numpy as np
 
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert, make_pose, transform_points
-from cell.perception.align.checks import check_alignment_unique, check_parts_seen
+from cell.perception.align.checks import check_alignment_unique, check_parts_seen, cloud_tree_of
 from cell.perception.align.cloud import FRAME as _FRAME
 from cell.perception.align.cloud import POOR_FITNESS, crop_mask, place_map
-from cell.perception.align.placement import on_table
+from cell.perception.align.fit import Alignment
+from cell.perception.align.placement import flatten_to_yaw, on_table
+from cell.perception.align.sight import places_in_evidence
+from cell.perception.ground import Ground, TableSource, find_ground, floor_height
 from cell.perception.preprocess import downsample
-from cell.perception.unorganised import TablePlane, find_table, levelling
+from cell.perception.unorganised import TablePlane, levelling
 from cell.perception.unorganised import sampling as spacing_of
 from cell.pipeline.cloud_seams import locate_seams
 from cell.pipeline.cloud_setup import scenario_for
@@ -52,6 +55,8 @@ def locate_cloud(
     method: str | None = None,
     viewpoint_F: FloatArray | None = None,
     truth_F: Mapping[str, tuple[FloatArray, FloatArray]] | None = None,
+    table_z_m: float | None = None,
+    no_table: bool = False,
     progress: Progress = quiet,
 ) -> Detection:
     """Locate ``weldmap``'s seams (frame M, as drawn) in ``cloud`` (unorganised, metres, frame F = ``cloud.frame``).
@@ -59,10 +64,12 @@ def locate_cloud(
     X_FM_nominal : (4, 4) nominal pose of the drawing's origin in F, or None (global registration).
     method : the locator (None: ours). viewpoint_F : (3,) where the sensor was (orients the normals; None: the
     heuristic of :func:`~cell.perception.unorganised.orient_normals`). truth_F : seam id -> true ends (3,), (3,) in
-    F [m]: the detection is measured against them (no truth, no error fields).
+    F [m]: the detection is measured against them (no truth, no error fields). table_z_m : the table's height in F
+    [m] when known (F's z up); no_table : there is no table in the cloud (else both are read from the data:
+    :func:`~cell.perception.ground.find_ground`).
 
     Returns the usual :class:`Detection`, in F, with a scenario synthesised for the cloud. SensorError for a cloud
-    with too few or non-finite points or no table; an alignment that fails is returned as the detection's
+    with too few or non-finite points or no upward face at all; an alignment that fails is returned as the detection's
     ``error`` with every seam NOT_FOUND (or NOT_VISIBLE), as :func:`cell.pipeline.detect` does.
     """
     t_all = time.perf_counter()
@@ -77,18 +84,16 @@ def locate_cloud(
 
     t = time.perf_counter()
     progress(f"finding the table plane in {len(P_F)} points")
-    table = find_table(P_F, rng)
-    X_LF = levelling(table)
+    ground = find_ground(P_F, rng, table_z_m=table_z_m, no_table=no_table)
+    table = ground.plane
+    X_LF = np.eye(4) if ground.source is TableSource.GIVEN else levelling(table)  # given: F's z is up
     X_FL = invert(X_LF)
     P_L = transform_points(X_LF, P_F)
-    table_z = float(table.offset)  # the table's height in L
     along, between = spacing_of(P_L, _levelled(table, X_LF))
     noise = table.sigma_m
-    progress(
-        f"table tilted {np.degrees(table.tilt_rad):.2f} deg, noise {noise * 1e3:.2f} mm RMS, spacing "
-        f"{along * 1e3:.1f} mm along / {between * 1e3:.1f} mm between lines"
-    )
-    above = P_L[:, 2] > table_z + max(0.005, 3.0 * noise)
+    # The table's height in L and the points above it (no table: where the parts' bottoms are, and every point).
+    table_z, above = _ground_in_L(ground, P_L, noise)
+    progress(_ground_line(ground, noise, along, between))
     timings["table_s"] = time.perf_counter() - t
 
     t = time.perf_counter()
@@ -96,7 +101,7 @@ def locate_cloud(
     viewpoint_L = transform_points(X_LF, np.reshape(viewpoint_F, (1, 3)))[0] if viewpoint_F is not None else None
     X_LM0 = on_table(X_LF @ X_FM_nominal, weldmap, table_z) if X_FM_nominal is not None else None
     spec_scenario = scenario_for(
-        name, weldmap, X_FL, X_LM0, P_L, above, table, viewpoint_L, (noise, along, between), method
+        name, weldmap, X_FL, X_LM0, P_L, above, (table, table_z), viewpoint_L, (noise, along, between), method
     )
     spec = spec_scenario.perception
     placed = place_map(P_L, above, weldmap, table_z, X_LM0, spec, viewpoint_L, rng, progress)
@@ -107,16 +112,22 @@ def locate_cloud(
     if alignment is None or X_LM0 is None:
         assert error is not None
         return _failed(scenario, weldmap, joints, X_FL, X_LM0, table_z, method, error, timings, t_all, cloud.frame)
+    if ground.source is not TableSource.FOUND:  # the part lies flat: the fit turned about z only
+        alignment, low = _flat(alignment, X_LM0, weldmap)
+        table_z = low if ground.given_z_m is None else table_z  # no table: the parts' bottom stands for it
     X_LM = alignment.X_RR_corr @ X_LM0
     if X_FM_nominal is not None:
         progress(_placement_error(X_FM_nominal, X_FL @ X_LM))
     map_L = weldmap.transformed(X_LM, _FRAME)
     crop = crop_mask(P_L, above, map_L)
     dense_L = Cloud(P_L[crop], _FRAME)
-    scenario = scenario_for(name, weldmap, X_FL, X_LM, P_L, above, table, viewpoint_L, (noise, along, between), method)
+    measured = (noise, along, between)
+    scenario = scenario_for(name, weldmap, X_FL, X_LM, P_L, above, (table, table_z), viewpoint_L, measured, method)
     try:
-        check_alignment_unique(map_L, dense_L, alignment, spec.symmetry)
-        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage)
+        tree = cloud_tree_of(dense_L)
+        check_alignment_unique(map_L, dense_L, alignment, spec.symmetry, tree)
+        eyes_L = viewpoint_L[None, :] if viewpoint_L is not None else places_in_evidence(map_L, tree)
+        missing = check_parts_seen(map_L, dense_L, spec, spec.coverage, tree, eyes_L)
     except AlignmentError as e:
         return _failed(scenario, weldmap, joints, X_FL, X_LM, table_z, method, e, timings, t_all, cloud.frame)
 
@@ -150,6 +161,41 @@ def _placement_error(X_FM_nominal: FloatArray, X_FM: FloatArray) -> str:
     shift_mm = 1000.0 * float(np.linalg.norm(X_FM[:3, 3] - X_FM_nominal[:3, 3]))
     angle_deg = float(np.degrees(np.arccos(np.clip((np.trace(X_d[:3, :3]) - 1.0) / 2.0, -1.0, 1.0))))
     return f"the part lies {shift_mm:.1f} mm and {angle_deg:.1f} deg from the placement given"
+
+
+def _ground_in_L(ground: Ground, P_L: FloatArray, noise_m: float) -> tuple[float, np.ndarray]:
+    """(table_z, above): the table's height in L [m] and the points above it (n,); with no table, where the parts'
+    bottoms are (:func:`~cell.perception.ground.floor_height`, a start the alignment corrects) and every point."""
+    if ground.source is TableSource.ABSENT:
+        return floor_height(P_L[:, 2]), np.ones(len(P_L), dtype=bool)
+    table_z = float(ground.given_z_m) if ground.given_z_m is not None else float(ground.plane.offset)
+    return table_z, P_L[:, 2] > table_z + max(0.005, 3.0 * noise_m)
+
+
+def _ground_line(ground: Ground, noise_m: float, along_m: float, between_m: float) -> str:
+    """The progress line about the ground and the cloud's noise and spacing."""
+    tilt = np.degrees(ground.plane.tilt_rad)
+    spacing = f"{along_m * 1e3:.1f} mm along / {between_m * 1e3:.1f} mm between lines"
+    data = f"noise {noise_m * 1e3:.2f} mm RMS, spacing {spacing}"
+    if ground.source is TableSource.FOUND:
+        return f"table tilted {tilt:.2f} deg, {data}"
+    if ground.given_z_m is not None:
+        return f"table at z = {ground.given_z_m * 1e3:.1f} mm (given), {data} on the largest upward face"
+    return (
+        f"no table in the cloud ({ground.below_share:.0%} of the points lie under its largest upward plane, tilted "
+        f"{tilt:.2f} deg: a part's face): aligning on the parts' own faces, {data} on that face"
+    )
+
+
+def _flat(alignment: Alignment, X_LM0: FloatArray, weldmap: WeldMap) -> tuple[Alignment, float]:
+    """With no table found in the data: the fit reduced to a turn about z (about the parts' centre: L is levelled by
+    the parts' own largest upward face, or F's z is up with a stated table; a part lying flat has no roll or pitch)
+    and the height [m] of the parts' lowest corner, where whatever holds them is (with no table stated, what the
+    stages take for the table: the seams' ends there, the underside)."""
+    centre = np.mean([p.center for p in weldmap.parts], axis=0)
+    X_LM = flatten_to_yaw(alignment.X_RR_corr @ X_LM0, centre)
+    low = min(float(transform_points(X_LM, p.vertices())[:, 2].min()) for p in weldmap.parts)
+    return replace(alignment, X_RR_corr=X_LM @ invert(X_LM0)), low
 
 
 def _levelled(table: TablePlane, X_LF: FloatArray) -> TablePlane:

@@ -8,6 +8,9 @@ import time
 from collections.abc import Mapping
 from dataclasses import fields, replace
 
+import numpy as np
+
+from cell.perception.align.drawn import past_drawn_edge
 from cell.perception.seam_screen import screen
 from cell.scenario import Scenario
 from cell.seams.visibility import visibility
@@ -47,8 +50,28 @@ def locate_seams(
             t = time.perf_counter()
             out[seam.id] = replace(locator.locate(ss, seam, rng), time_s=time.perf_counter() - t)
     estimates = tuple(unseen_reason(out[s.id]) for s in ss.weldmap.seams)
-    estimates = check_ends(ss.weldmap, ss.joints, estimates, part_tolerance_m(scenario, method))
+    tolerance = part_tolerance_m(scenario, method)
+    estimates = check_ends(ss.weldmap, ss.joints, estimates, tolerance)
+    estimates = tuple(not_as_drawn(ss, e, tolerance) for e in estimates)
     return screen(ss, estimates, missing, scenario.perception.screen)
+
+
+def not_as_drawn(ss: SeamScene, est: SeamEstimate, band_m: float) -> SeamEstimate:
+    """A seam not found for want of its faces' points, whose faces the cloud continues past the drawing's edge of
+    them (:func:`~cell.perception.align.drawn.past_drawn_edge`, within the part tolerance ``band_m`` [m]): the
+    reason says so and how far (the part does not lie as drawn), rather than leave it to a hidden face."""
+    if est.status is not SeamStatus.NOT_FOUND or est.code is not Reason.NO_SUPPORT:
+        return est
+    joint, seam = ss.joints[est.id], ss.weldmap.seam(est.id)
+    points = np.asarray(ss.dense.points)
+    past = [
+        found
+        for part, face in ((joint.receiving, joint.face_receiving), (joint.abutting, joint.face_abutting))
+        if (found := past_drawn_edge(ss.weldmap, part, face, seam, points, band_m)) is not None
+    ]
+    if not past:
+        return est
+    return replace(est, reason=f"{est.reason}; yet {'; '.join(p.describe() for p in past)}")
 
 
 def unseen_reason(est: SeamEstimate) -> SeamEstimate:

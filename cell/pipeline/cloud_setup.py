@@ -123,14 +123,15 @@ def scenario_for(
     X_LM: FloatArray | None,
     P_L: FloatArray,
     above: np.ndarray,
-    table: TablePlane,
+    ground: tuple[TablePlane, float],
     viewpoint_L: FloatArray | None,
     measured: tuple[float, float, float],
     method: str,
 ) -> Scenario:
     """The scenario of a run on a brought cloud (:func:`cloud_scenario`) from what was measured in the levelled
     frame L: the map at ``X_LM`` (None: at the points' median), the crop about it (:func:`crop_bounds`, from the
-    table up), the table's inliers, the viewpoint; X_FL (4, 4) carries them into F. With the options from the
+    table up), the largest upward plane (its inliers) and the table's height in L (``ground``), the viewpoint;
+    X_FL (4, 4) carries them into F. With the options from the
     data's ``measured`` noise and spacing along and between lines [m]."""
     from cell.seams.registry import with_method, with_options
 
@@ -138,11 +139,11 @@ def scenario_for(
     map_L = weldmap.transformed(X, FRAME)
     corners_L = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
     lo, hi = crop_bounds(map_L)
-    lo[2] = max(float(lo[2]), float(table.offset))  # the table itself is cut away
+    table, top = ground
+    lo[2] = max(float(lo[2]), top)  # the table itself is cut away
     box_F = transform_points(X_FL, lo + corners_L * (hi - lo))
     T = P_L[table.inliers]
     t_lo, t_hi = T.min(axis=0), T.max(axis=0)
-    top = float(table.offset)
     centre_F = transform_points(X_FL, np.array([[(t_lo[0] + t_hi[0]) / 2, (t_lo[1] + t_hi[1]) / 2, top - 0.05]]))[0]
     size = (float(t_hi[0] - t_lo[0]), float(t_hi[1] - t_lo[1]), 0.1)
     eye_L = viewpoint_L if viewpoint_L is not None else (lo + hi) / 2.0 + np.array([0.0, 0.0, 1.0])

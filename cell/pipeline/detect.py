@@ -9,6 +9,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from typing import Literal
 
+import numpy as np
+
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
 from cell.perception.align.fit import Alignment
@@ -120,7 +122,10 @@ def build_scene(
             weldmap_R = cap.weldmap.transformed(X_RM, "R")
             # A fit that a near-symmetry explains as well (a ladder one rung off) or a map half off the cloud is
             # refused; parts that are simply not there are named, and their seams are never searched.
-            missing = check_alignment(weldmap_R, cloud, alignment, sc.perception, tree.result() if tree else None)
+            # Each part is judged by the top a camera has in sight (not what another part shadows from all).
+            eyes_R = np.array([(invert(sc.X_WR) @ image.X_WC)[:3, 3] for image in cap.images.values()])
+            checks_tree = tree.result() if tree else None
+            missing = check_alignment(weldmap_R, cloud, alignment, sc.perception, checks_tree, eyes_R.reshape(-1, 3))
         return alignment, X_RM, weldmap_R, missing
 
     progress("splicing point clouds and aligning the welding map to them")

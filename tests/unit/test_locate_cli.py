@@ -111,6 +111,8 @@ def test_locate_with_truth_reports_errors(scan: tuple[Path, Path, dict]) -> None
         (["--frame", "base link"], ["--frame"]),
         (["--viewpoint", "1,2"], ["--viewpoint"]),
         (["--format", "xml"], ["--format"]),
+        (["--table-z", "-5", "--no-table"], ["--table-z and --no-table", "one of them"]),
+        (["--table-z", "nan"], ["--table-z", "finite"]),
     ],
 )
 def test_bad_options_exit_2_before_any_work(tiny: Path, extra: list[str], needles: list[str]) -> None:
@@ -192,3 +194,16 @@ def test_ctrl_c_writes_the_interrupted_report(tiny: Path, tmp_path: Path, monkey
     rep = json.loads(report.read_text())
     assert rep["interrupted"] == {"stage": "finding the table plane"} and rep["frame"] == "R" and rep["seams"] == []
     assert rep["error"]["exit_code"] == 130 and rep["provenance"]["cloud_file"] == str(tiny)
+
+
+def test_no_table_and_a_stated_table_height_are_said_and_run(tmp_path: Path) -> None:
+    """The flat tee scanned all round and cropped 5 mm above its table, as a PCD: recognised as having no table, or
+    told so, or told the table's height; each run aligns it on its own faces and finds both fillets."""
+    flat = REPO / "maps" / "tee_flat.dxf"
+    X = pose_from_xyz_rpy(np.array([-0.05, -0.02, 0.0]), [0.0, 0.0, math.radians(8.0)])
+    P = map_cloud(read_map(flat), X, np.random.default_rng(4), pitch_m=0.0025, noise_m=0.001)
+    cloud = pcd_ascii(tmp_path / "cropped.pcd", P[P[:, 2] >= 0.005])
+    for extra, line in (([], "no table in the cloud"), (["--no-table"], "no table"), (["--table-z", "0"], "given")):
+        code, out, err = invoke("locate", str(cloud), "--map", str(flat), *extra)
+        assert code == 0, err
+        assert line in err and "found 2/2 visible" in out, (out, err)

@@ -37,3 +37,15 @@ def test_the_generator_writes_the_shipped_tee(tmp_path: Path) -> None:
     parts, junctions = make_maps.designs()["tee"]
     path = make_maps.write_map(tmp_path / "tee.dxf", parts, make_maps.design_seams("tee", parts, junctions))
     assert path.read_bytes() == (REPO / "maps" / "tee.dxf").read_bytes()
+
+
+def test_the_generator_writes_the_shipped_flat_tee(tmp_path: Path) -> None:
+    make_maps = load_tool("make_maps")
+    parts, junctions = make_maps.designs()["tee_flat"]
+    path = make_maps.write_map(tmp_path / "tee_flat.dxf", parts, make_maps.design_seams("tee_flat", parts, junctions))
+    assert path.read_bytes() == (REPO / "maps" / "tee_flat.dxf").read_bytes()
+    m = read_map(path)
+    assert sorted(s.id for s in m.seams) == ["LONG_TUBE>CROSS_TUBE:+y", "LONG_TUBE>CROSS_TUBE:-y"]
+    for s in m.seams:  # vertical, where the long tube's side walls meet the cross tube's face
+        np.testing.assert_allclose(s.p_start[:2], [0.3048, 0.0254 if s.id.endswith("+y") else -0.0254], atol=1e-9)
+        np.testing.assert_allclose(s.p_end - s.p_start, [0.0, 0.0, 2 * INCH], atol=1e-9)

@@ -16,7 +16,7 @@ from cell.config.perception import CoverageOptions, SymmetryOptions
 from cell.errors import AlignmentError, AlignmentFailure
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
 from cell.perception.align.fit import Alignment, sample_map
-from cell.perception.sky import open_to_sky
+from cell.perception.sky import in_sight, open_to_sky
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, WeldMap
 
@@ -146,15 +146,21 @@ def check_alignment_unique(
 
 
 def part_coverage(
-    weldmap_R: WeldMap, cloud: Cloud, spec: PerceptionSpec, band_m: float = 0.01, cloud_tree: cKDTree | None = None
+    weldmap_R: WeldMap,
+    cloud: Cloud,
+    spec: PerceptionSpec,
+    band_m: float = 0.01,
+    cloud_tree: cKDTree | None = None,
+    eyes_R: FloatArray | None = None,
 ) -> dict[str, float]:
     """Part name -> share of its upward faces' samples (top, in R) with a cloud point within ``band_m`` [m].
 
     Upward faces open to the sky are seen by every camera above the table; a part that is on the table covers most
     of its top. Samples within :data:`_CONTACT_M` of another part are left out (covered by it: in contact, or under
     it), and so are those under any part's surface (:func:`~cell.perception.sky.open_to_sky`: an open tube's inner
-    bottom wall, under its own top wall). A part with no upward face left to sample (a gusset's sloped top, a plate
-    wholly under others) is not judged: it has no entry.
+    bottom wall, under its own top wall) and, when the sensors' centres ``eyes_R`` (k, 3) are known, those no sensor
+    has in sight (:func:`~cell.perception.sky.in_sight`: a plate's top in a standing pipe's shadow). A part with no
+    upward face left to sample (a gusset's sloped top, a plate wholly under others) is not judged: it has no entry.
     """
     spacing = max(spec.voxel_m / 2.0, 0.002)
     tree = None if not len(cloud) else cloud_tree_of(cloud) if cloud_tree is None else cloud_tree
@@ -168,6 +174,8 @@ def part_coverage(
             if other is not part and len(top):
                 top = top[~other.contains(top, _CONTACT_M)]
         top = top[open_to_sky(top, weldmap_R.parts)]
+        if eyes_R is not None and len(top):
+            top = top[in_sight(top, eyes_R, weldmap_R.parts)]
         if len(top) == 0:
             continue  # nothing of it faces up in the open: no top to judge by
         if tree is None:
@@ -195,11 +203,13 @@ def check_parts_seen(
     spec: PerceptionSpec,
     options: CoverageOptions | None = None,
     cloud_tree: cKDTree | None = None,
+    eyes_R: FloatArray | None = None,
 ) -> dict[str, str]:
     """After alignment: refuse a map that does not lie where the cloud is; name the parts that are missing.
 
     weldmap_R : the map as aligned (frame R); cloud : the dense cloud (frame R); options : the coverage thresholds
-    (:class:`~cell.config.CoverageOptions`). A part whose top is covered less than ``min_seen`` but more than
+    (:class:`~cell.config.CoverageOptions`); eyes_R : (k, 3) the sensors' centres when known (each part judged by
+    the top they have in sight: :func:`part_coverage`). A part whose top is covered less than ``min_seen`` but more than
     ``min_coverage`` lies half on, half off the cloud: the map settled in a wrong place (part displaced beyond what
     alignment corrects), or the part runs out of the workspace: AlignmentError. So it is when more than half of the
     parts are missing. Returns the missing parts (covered less than ``min_coverage``): name -> reason; their seams
@@ -207,7 +217,7 @@ def check_parts_seen(
     """
     o = options if options is not None else CoverageOptions()
     min_coverage, min_seen = o.min_coverage, o.min_seen
-    coverage = part_coverage(weldmap_R, cloud, spec, cloud_tree=cloud_tree)
+    coverage = part_coverage(weldmap_R, cloud, spec, cloud_tree=cloud_tree, eyes_R=eyes_R)
     partial = {n: c for n, c in coverage.items() if min_coverage <= c < min_seen}
     missing = missing_parts(coverage, min_coverage)
     if partial or len(missing) > len(coverage) / 2 or not coverage:
@@ -224,16 +234,22 @@ def check_parts_seen(
 
 
 def check_alignment(
-    weldmap_R: WeldMap, cloud: Cloud, alignment: Alignment, spec: PerceptionSpec, cloud_tree: cKDTree | None = None
+    weldmap_R: WeldMap,
+    cloud: Cloud,
+    alignment: Alignment,
+    spec: PerceptionSpec,
+    cloud_tree: cKDTree | None = None,
+    eyes_R: FloatArray | None = None,
 ) -> dict[str, str]:
     """Both checks of an aligned map, :func:`check_alignment_unique` and :func:`check_parts_seen` (with the spec's
     ``symmetry`` and ``coverage`` options), side by side on two cores (scipy's KD-trees let go of the interpreter
     lock), reading one KD-tree of the cloud (``cloud_tree``, :func:`cloud_tree_of`, when the caller built it
     already); what they answer and raise is what they would one after the other: the uniqueness check's refusal
-    first. Returns the missing parts (name -> reason)."""
+    first. ``eyes_R`` : (k, 3) the cameras' centres (:func:`check_parts_seen`). Returns the missing parts (name ->
+    reason)."""
     tree = cloud_tree if cloud_tree is not None else cloud_tree_of(cloud) if len(cloud) else None
     with ThreadPoolExecutor(max_workers=1) as beside:
-        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage, tree)
+        seen = beside.submit(check_parts_seen, weldmap_R, cloud, spec, spec.coverage, tree, eyes_R)
         try:
             check_alignment_unique(weldmap_R, cloud, alignment, spec.symmetry, tree)
         except AlignmentError:

@@ -6,9 +6,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.markup import escape
 
-from cell.cli.common import CONTEXT, app, cell_errors, err, log, out, say
+from cell.cli.common import CONTEXT, app, cell_errors, out, say, warn
 
 scenario_app = typer.Typer(no_args_is_help=True, context_settings=CONTEXT, help="Scenario files (YAML).")
 app.add_typer(scenario_app, name="scenario")
@@ -17,10 +16,7 @@ if TYPE_CHECKING:
     from cell.types import WeldMap
 
 
-def _warn(msg: str) -> None:
-    """A warning line: stderr (also with --quiet) and the log file."""
-    log.warning(msg)
-    err.print(f"[yellow]warning[/]: {escape(msg)}", soft_wrap=True, highlight=False)
+_warn = warn
 
 
 @app.command()

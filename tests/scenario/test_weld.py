@@ -95,7 +95,7 @@ def test_weld_cli_writes_report_and_robot_program(
     monkeypatch.setattr(pipeline, "weld", weld)
     runner = CliRunner()
     report, krl = tmp_path / "r.json", tmp_path / "krl"
-    result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--krl", str(krl)])
+    result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl)])
     assert result.exit_code == 0, result.stderr
     ((scenario, job, kw),) = asked
     assert scenario == sc.load("fence1") and set(kw) == {"progress"}

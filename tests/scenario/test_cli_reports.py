@@ -104,7 +104,9 @@ def test_weld_report_to_stdout_with_provenance_in_report_and_program(
 ) -> None:
     monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: None))
     krl = tmp_path / "krl"
-    code, out, err = invoke("weld", "fence1", "--sides", "first", "--json", "-", "--program", str(krl), "--format", "json")
+    code, out, err = invoke(
+        "weld", "fence1", "--sides", "first", "--json", "-", "--program", str(krl), "--format", "json"
+    )
     assert code == 0, err
     data = json.loads(out)  # stdout is the report alone: the table (here as JSON rows) went to stderr
     assert data["welded"] == 12 and '"seam": "POST_L>TOP_RAIL:+x"' in err

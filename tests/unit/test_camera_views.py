@@ -51,11 +51,15 @@ def test_a_face_hidden_from_the_others_is_no_disagreement() -> None:
     plane, near = _grid(0.0), _grid(0.0, half=0.1)  # what a and b see; the part of it the eye sees too
     y, z = np.meshgrid(np.arange(-0.2, 0.2, 0.005), np.arange(-0.3, -0.01, 0.005))
     face = np.column_stack([np.full(y.size, 0.1), y.ravel(), z.ravel()])  # under the plane: hidden from a and b
-    clouds = {"a": _cloud(plane), "b": _cloud(plane + [0.002, 0.0, 0.0]), "eye": _cloud(np.vstack([near, face]))}
+    clouds = {
+        "a": _cloud(plane),
+        "b": _cloud(plane + np.array([0.002, 0.0, 0.0])),
+        "eye": _cloud(np.vstack([near, face])),
+    }
     views = ({n: _looking_down(n, x) for n, x in (("a", -0.05), ("b", 0.05), ("eye", 0.0))}, X_WR)
     # Judged on everything, the eye's face (under the plane a and b see) outweighs what they share: dropped.
     assert set(disagreeing_cameras(clouds)) == {"eye"}
     assert disagreeing_cameras(clouds, views=views) == {}
     # Points where a and b see empty space (the plane lifted 10 cm) are a disagreement they can judge.
-    lifted = dict(clouds, eye=_cloud(np.vstack([near + [0.0, 0.0, 0.1], face])))
+    lifted = dict(clouds, eye=_cloud(np.vstack([near + np.array([0.0, 0.0, 0.1]), face])))
     assert set(disagreeing_cameras(lifted, views=views)) == {"eye"}

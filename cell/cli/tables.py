@@ -183,8 +183,10 @@ def weld_summary(rep: Mapping[str, Any]) -> str:
     m = rep["summary"]
     cyc = rep["cycle_time_s"] if rep["cycle_time_s"] else rep["planned_cycle_time_s"]
     unsupported = not_supported_text(m)
+    preview = any(s.get("weld_reason_code") == "preview" for s in rep["seams"])  # a dry run plans, welds nothing
+    done = f"planned {sum(bool(s.get('planned')) for s in rep['seams'])}" if preview else f"welded {rep['welded']}"
     return (
-        f"welded {rep['welded']} of {m['seams']} seams in the map" + (f"; {unsupported}" if unsupported else "")
+        f"{done} of {m['seams']} seams in the map" + (f"; {unsupported}" if unsupported else "")
         + f" · visible {m['visible']} · located {m['found']} · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm"
         + f" · cycle time {_fmt(cyc, 1)} s" + ("" if rep["cycle_time_s"] else " (planned)")
     )  # fmt: skip

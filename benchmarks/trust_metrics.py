@@ -91,7 +91,7 @@ def seam_record(entry: Mapping[str, Any], *, weld_report: bool, rescan_known: bo
         "id": entry["id"],
         "status": status,
         "reason_code": entry.get("reason_code"),
-        "visible": status != "not_visible",
+        "visible": status not in ("not_visible", "not_supported"),  # a curve the cell cannot weld is listed apart
         "located": located,
     }
     errors = None

@@ -24,6 +24,7 @@ from cell.cli.common import (
     parse_noise,
     parse_rescan_mode,
     say,
+    warn,
     was_interrupted,
 )
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
@@ -72,12 +73,20 @@ def weld(
     method: MethodOpt = None,
     noise: NoiseOpt = None,
     json_path: JsonOpt = None,
-    krl: Annotated[
-        Path | None, typer.Option(help="Write the KUKA KRL program (.src/.dat) and the trajectory (JSON, CSV) here.")
+    program: Annotated[
+        Path | None,
+        typer.Option(
+            "--program",
+            metavar="DIR",
+            help="Write the robot program (in --controller's language) and the trajectory (JSON, CSV) here.",
+        ),
     ] = None,
     controller: Annotated[
-        str, typer.Option(help="The --krl program's language: krl (KUKA .src/.dat) | rapid (ABB RAPID .mod).")
+        str, typer.Option(help="The --program's language: krl (KUKA .src/.dat) | rapid (ABB RAPID .mod).")
     ] = "krl",
+    krl: Annotated[
+        Path | None, typer.Option("--krl", metavar="DIR", hidden=True, help="Deprecated: --program DIR.")
+    ] = None,
     rescan: Annotated[
         str | None, typer.Option(help="Re-scan before welding: none | low (below the confidence threshold) | all.")
     ] = None,
@@ -102,7 +111,8 @@ def weld(
         mode = parse_rescan_mode(rescan)
         check_display(gui)
         check_file(json_path, "--json")
-        check_folder(krl, "--krl")
+        program = _program_folder(program, krl)
+        check_folder(program, "--program")
         if controller not in ("krl", "rapid"):
             raise UsageError(f"--controller {controller!r} is unknown; valid: krl, rapid")
         check_file(html, "--html", stdout_ok=False)
@@ -120,7 +130,7 @@ def weld(
                 job = weld_part(scn, asked, progress=stage)
                 run = job.side_a  # the page and the recording show side A
             partial = finish_turnover(
-                job, json_path, krl, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
+                job, json_path, program, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
             )
             if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
                 say(f"page: {html}")
@@ -233,6 +243,16 @@ def preview(
                 raise
             _interrupted(run, scn, method, stage, prov, writer, json_path)
     finish(writer, partial)
+
+
+def _program_folder(program: Path | None, krl: Path | None) -> Path | None:
+    """``--program DIR``; ``--krl DIR``, its old name, still works and says it is deprecated (not both)."""
+    if krl is None:
+        return program
+    if program is not None:
+        raise UsageError("--krl is the deprecated name of --program: give --program DIR alone")
+    warn("--krl is deprecated: use --program DIR (KUKA KRL or ABB RAPID, as --controller says)")
+    return krl
 
 
 def _interrupted(

@@ -120,6 +120,12 @@ def detail(msg: str) -> None:
         err.print(f"[dim]  {msg}[/]", soft_wrap=True, markup=False)
 
 
+def warn(msg: str) -> None:
+    """A warning line: stderr (also with --quiet) and the log file."""
+    log.warning(msg)
+    err.print(f"[yellow]warning[/]: {escape(msg)}", soft_wrap=True, highlight=False)
+
+
 def fail_line(msg: str) -> None:
     """The last line of a failed command: what went wrong (always shown, also with --quiet)."""
     log.error(msg)

@@ -24,7 +24,7 @@ def check(
         Path,
         typer.Argument(
             metavar="FOLDER_OR_FILE",
-            help="A folder with NAME.src and NAME.dat (as `cell weld --krl` writes), or one program's NAME.src:"
+            help="A folder with NAME.src and NAME.dat (as `cell weld --program` writes), or one program's NAME.src:"
             " a main program is checked with every program it calls.",
         ),
     ],

@@ -3,20 +3,20 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from cell.cli.common import CONTEXT, app, cell_errors, err, log, out, say
+from cell.cli.common import CONTEXT, app, cell_errors, out, say, warn
 
 scenario_app = typer.Typer(no_args_is_help=True, context_settings=CONTEXT, help="Scenario files (YAML).")
 app.add_typer(scenario_app, name="scenario")
 
+if TYPE_CHECKING:
+    from cell.types import WeldMap
 
-def _warn(msg: str) -> None:
-    """A warning line: stderr (also with --quiet) and the log file."""
-    log.warning(msg)
-    err.print(f"[yellow]warning[/]: {msg}", soft_wrap=True, highlight=False)
+
+_warn = warn
 
 
 @app.command()
@@ -75,12 +75,24 @@ def check(
         scn = sc.load(file)
         weldmap = pipeline.read_weldmap(scn)
         problems = check_layout(scn, weldmap)
+        problems += [
+            f"seam {u.id} will not be welded: not supported ({u.code}): {u.reason}" for u in weldmap.unsupported
+        ]
         for p in problems:
             _warn(p)
         fixed = sum(c.mount == "fixed" for c in scn.cameras.values())
         verdict = "ok" if not problems else f"{len(problems)} warning(s)"
         out.print(
-            f"{verdict}: {file}: map {scn.map_path} ({len(weldmap.parts)} parts, {len(weldmap.seams)} seams), "
+            f"{verdict}: {file}: map {scn.map_path} ({len(weldmap.parts)} parts, {seams_text(weldmap)}), "
             f"{fixed} fixed camera(s), {len(scn.cameras) - fixed} on the arm",
             soft_wrap=True,
         )
+
+
+def seams_text(weldmap: WeldMap) -> str:
+    """``3 seams: 2 to weld, 1 not supported (curved)``, or ``2 seams`` when the cell can weld every one."""
+    n = len(weldmap.seams) + len(weldmap.unsupported)
+    if not weldmap.unsupported:
+        return f"{n} seams"
+    codes = ", ".join(sorted({str(u.code) for u in weldmap.unsupported}))
+    return f"{n} seams: {len(weldmap.seams)} to weld, {len(weldmap.unsupported)} not supported ({codes})"

@@ -1,16 +1,19 @@
 """The tables and summary lines the commands print (from the JSON reports, so screen and file agree).
 
-``--format table`` (rich, as wide as the terminal), ``json`` (a list of rows, column name -> value, numbers as
-numbers and ``-`` as null) or ``csv`` (a header row, then one row per seam); json and csv print no summary.
+``--format table`` (rich) keeps every seam id whole at 80 columns and in a file: short headers with a legend line
+below, the reason as a code in the table and in words after it, one line per seam; ``json`` (a list of rows, column
+name -> value, numbers as numbers and ``-`` as null) or ``csv`` (a header row, then one row per seam) keep the long
+column names and the reasons in words; json and csv print no summary.
 """
 
 from __future__ import annotations
 
 import csv
 import json
-from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
+from rich import box
 from rich.table import Table
 
 from cell.cli.common import TableFormat, out
@@ -18,23 +21,49 @@ from cell.cli.common import TableFormat, out
 if TYPE_CHECKING:
     from cell.pipeline.records import Detection
 
+_LEFT = ("seam", "result", "why not")
+
+
+def _table(title: str, headers: Sequence[str]) -> Table:
+    """A compact table: no vertical rules, the seam id never wrapped (nor cut), numbers to the right."""
+    t = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
+    for h in headers:
+        t.add_column(h, justify="left" if h in _LEFT else "right", no_wrap=h == "seam", overflow="fold")
+    return t
+
+
+def _why_lines(whys: Sequence[tuple[str, str]]) -> None:
+    """The reasons in words after the table, one line per seam (wrapped by the terminal, whole in a file)."""
+    for sid, why in whys:
+        if why:
+            out.print(f"  {sid}: {why}", soft_wrap=True, markup=False, highlight=False)
+
+
+RESCAN_LEGEND = "lat, end: lateral and endpoint error [mm], before (0) and after the close-up"
+
 
 def print_rescan(rep: dict) -> None:
-    t = Table(title=f"re-scan {rep['scenario']} · method {rep['method']} · frame R", title_justify="left")
-    for col in ("seam", "lateral before", "lateral after", "endpoint before", "endpoint after", "weight", "why not"):
-        t.add_column(col, justify="left" if col in ("seam", "why not") else "right")
+    t = _table(
+        f"re-scan {rep['scenario']} · method {rep['method']} · frame R",
+        ("seam", "lat 0", "lat", "end 0", "end", "weight", "why not"),
+    )
+    whys = []
     for s in rep["seams"]:
         b, a = s.get("error_mm_before", {}), s.get("error_mm", {})
+        r = s["rescan"]
         t.add_row(
             s["id"],
             _fmt(b.get("lateral")),
             _fmt(a.get("lateral")),
             _fmt(b.get("endpoint")),
             _fmt(a.get("endpoint")),
-            _fmt(s["rescan"]["weight"]),
-            s["rescan"]["reason"],
+            _fmt(r["weight"]),
+            "" if r["used"] else "not used",
         )
+        whys.append((s["id"], r["reason"]))
     out.print(t)
+    out.print(RESCAN_LEGEND, soft_wrap=True, markup=False)
+    _why_lines(whys)
     b, a = rep["summary_before_rescan"], rep["summary"]
     out.print(
         f"{rep['rescan']['seams']} seams re-scanned ({rep['rescan']['used']} used) · mean lateral"
@@ -43,6 +72,15 @@ def print_rescan(rep: dict) -> None:
         f" {_fmt(rep['rescan']['motion_s'], 1)} s",
         soft_wrap=True,
     )
+
+
+def not_supported_text(summary: Mapping[str, Any]) -> str:
+    """``1 not supported: curved`` (the map's seams the cell cannot weld, by reason code), or empty."""
+    codes: Mapping[str, int] = summary.get("not_supported") or {}
+    n = sum(codes.values())
+    if not n:
+        return ""
+    return f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())
 
 
 def _value(cell: str) -> str | float | None:
@@ -54,13 +92,8 @@ def _value(cell: str) -> str | float | None:
         return cell
 
 
-def _emit(t: Table, columns: Sequence[str], rows: Sequence[Sequence[str]], fmt: TableFormat) -> bool:
-    """Print the rows in ``fmt``; True when it was a rich table (then the summary lines follow)."""
-    if fmt == "table":
-        for row in rows:
-            t.add_row(*row)
-        out.print(t)
-        return True
+def _emit(columns: Sequence[str], rows: Sequence[Sequence[str]], fmt: TableFormat) -> None:
+    """Print the rows as data in ``fmt`` (json or csv), with the long column names."""
     if fmt == "json":
         out.file.write(json.dumps([dict(zip(columns, map(_value, r), strict=True)) for r in rows], indent=2) + "\n")
     else:
@@ -68,7 +101,6 @@ def _emit(t: Table, columns: Sequence[str], rows: Sequence[Sequence[str]], fmt: 
         w.writerow(columns)
         w.writerows(rows)
     out.file.flush()
-    return False
 
 
 def _data(rep: dict) -> str:
@@ -82,52 +114,82 @@ def _frame(rep: dict) -> str:
     return str(rep.get("frame", "R"))
 
 
+WELD_COLUMNS = (
+    "seam",
+    "detected",
+    "paper ME mm",
+    "lateral mm",
+    "welded",
+    "TCP rms mm",
+    "TCP max mm",
+    "weld s",
+    "why not",
+)
+WELD_LEGEND = (
+    "ME: the paper's error measure, lat: lateral error of the located seam, rms and max: the executed TCP against the"
+    " true seam [mm]; s: weld time; result: welded, planned, or why not (in words below)"
+)
+
+
+def _result(s: Mapping[str, Any]) -> str:
+    """What became of a seam in one word: welded, planned, or the code of why not."""
+    if s["welded"]:
+        return "welded"
+    if s.get("planned"):
+        return "planned"
+    return str(s.get("weld_reason_code") or "not welded")
+
+
 def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
-    t = Table(
-        title=f"{title} {rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
-        title_justify="left",
-    )
-    columns = (
-        "seam",
-        "detected",
-        "paper ME mm",
-        "lateral mm",
-        "welded",
-        "TCP rms mm",
-        "TCP max mm",
-        "weld s",
-        "why not",
-    )
-    for col in columns:
-        t.add_column(col, justify="left" if col in ("seam", "detected", "welded", "why not") else "right")
-    rows = []
-    for s in rep["seams"]:
-        e = s.get("error_mm", {})
-        tcp = s.get("tcp_error_mm", {})
-        rows.append(
-            (
-                s["id"],
-                s["status"],
-                _fmt(e.get("paper_me")),
-                _fmt(e.get("lateral")),
-                "yes" if s["welded"] else ("planned" if s.get("planned") else "no"),
-                _fmt(tcp.get("rms")),
-                _fmt(tcp.get("max")),
-                _fmt(s.get("weld_time_s"), 1),
-                s.get("weld_reason", ""),
-            )
-        )
-    if not _emit(t, columns, rows, fmt):
+    if fmt != "table":
+        rows = []
+        for s in rep["seams"]:
+            e, tcp = s.get("error_mm", {}), s.get("tcp_error_mm", {})
+            welded = "yes" if s["welded"] else ("planned" if s.get("planned") else "no")
+            rows.append(
+                (s["id"], s["status"], _fmt(e.get("paper_me")), _fmt(e.get("lateral")), welded, _fmt(tcp.get("rms")),
+                 _fmt(tcp.get("max")), _fmt(s.get("weld_time_s"), 1), s.get("weld_reason", ""))
+            )  # fmt: skip
+        _emit(WELD_COLUMNS, rows, fmt)
         return
+    t = _table(
+        f"{title} {rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
+        ("seam", "ME", "lat", "result", "rms", "max", "s"),
+    )
+    whys = []
+    for s in rep["seams"]:
+        e, tcp = s.get("error_mm", {}), s.get("tcp_error_mm", {})
+        t.add_row(
+            s["id"],
+            _fmt(e.get("paper_me")),
+            _fmt(e.get("lateral")),
+            _result(s),
+            _fmt(tcp.get("rms")),
+            _fmt(tcp.get("max")),
+            _fmt(s.get("weld_time_s"), 1),
+        )
+        if not s["welded"] and s.get("weld_reason_code") != "preview":
+            whys.append((s["id"], s.get("weld_reason", "")))
+    out.print(t)
+    out.print(WELD_LEGEND, soft_wrap=True, markup=False)
+    _why_lines(whys)
+    out.print(weld_summary(rep), soft_wrap=True)
+    print_timings(rep)
+
+
+def weld_summary(rep: Mapping[str, Any]) -> str:
+    """The summary line of a weld (or preview): welded of every seam in the map, the seams the cell cannot weld,
+    how many were visible and located, the mean error and the cycle time."""
     m = rep["summary"]
     cyc = rep["cycle_time_s"] if rep["cycle_time_s"] else rep["planned_cycle_time_s"]
-    out.print(
-        f"welded {rep['welded']}/{m['visible']} visible seams ({m['seams']} in the map) · located {m['found']} · "
-        f"paper ME mean {_fmt(m['paper_me_mean_mm'])} mm · cycle time {_fmt(cyc, 1)} s"
-        + ("" if rep["cycle_time_s"] else " (planned)"),
-        soft_wrap=True,
-    )
-    print_timings(rep)
+    unsupported = not_supported_text(m)
+    preview = any(s.get("weld_reason_code") == "preview" for s in rep["seams"])  # a dry run plans, welds nothing
+    done = f"planned {sum(bool(s.get('planned')) for s in rep['seams'])}" if preview else f"welded {rep['welded']}"
+    return (
+        f"{done} of {m['seams']} seams in the map" + (f"; {unsupported}" if unsupported else "")
+        + f" · visible {m['visible']} · located {m['found']} · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm"
+        + f" · cycle time {_fmt(cyc, 1)} s" + ("" if rep["cycle_time_s"] else " (planned)")
+    )  # fmt: skip
 
 
 def print_timings(rep: dict) -> None:
@@ -143,39 +205,44 @@ def _fmt(v: float | None, nd: int = 2) -> str:
     return "-" if v is None else f"{v:.{nd}f}"
 
 
+DETECT_COLUMNS = ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason")
+DETECT_LEGEND = (
+    "ME: the paper's error measure, end: endpoint error, lat: lateral error [mm]; conf: confidence; ms: time to"
+    " locate; result: found, or the reason's code (in words below)"
+)
+
+
 def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
     """The detection table of a Detection or of its report."""
     from cell.export.report import detection_report
 
     rep = det if isinstance(det, dict) else detection_report(det)
-    t = Table(
-        title=f"{rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
-        title_justify="left",
-    )
-    columns = ("seam", "status", "paper ME mm", "endpoint mm", "lateral mm", "conf", "ms", "reason")
-    for col in columns:
-        t.add_column(col, justify="right" if col not in ("seam", "status", "reason") else "left")
     rows = []
     for s in rep["seams"]:
         e = s.get("error_mm", {})
+        found = s["status"] == "found"
         rows.append(
-            (
-                s["id"],
-                s["status"],
-                _fmt(e.get("paper_me")),
-                _fmt(e.get("endpoint")),
-                _fmt(e.get("lateral")),
-                _fmt(s.get("confidence")),
-                _fmt(s["time_ms"], 1) if s["status"] == "found" else "-",
-                s["reason"],
-            )
-        )
-    if not _emit(t, columns, rows, fmt):
+            (s["id"], s["status"], _fmt(e.get("paper_me")), _fmt(e.get("endpoint")), _fmt(e.get("lateral")),
+             _fmt(s.get("confidence")), _fmt(s["time_ms"], 1) if found else "-", s["reason"])
+        )  # fmt: skip
+    if fmt != "table":
+        _emit(DETECT_COLUMNS, rows, fmt)
         return
+    t = _table(
+        f"{rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
+        ("seam", "ME", "end", "lat", "conf", "ms", "result"),
+    )
+    for s, row in zip(rep["seams"], rows, strict=True):
+        t.add_row(row[0], *row[2:7], "found" if s["status"] == "found" else str(s.get("reason_code") or s["status"]))
+    out.print(t)
+    out.print(DETECT_LEGEND, soft_wrap=True, markup=False)
+    _why_lines([(s["id"], s["reason"]) for s in rep["seams"] if s["status"] != "found"])
     m = rep["summary"]
+    unsupported = not_supported_text(m)
     out.print(
-        f"found {m['found']}/{m['visible']} visible ({m['seams']} seams) · paper ME mean"
-        f" {_fmt(m['paper_me_mean_mm'])} mm (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint"
+        f"found {m['found']}/{m['visible']} visible ({m['seams']} seams in the map"
+        + (f"; {unsupported}" if unsupported else "")
+        + f") · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint"
         f" {_fmt(m['endpoint_mean_mm'])} mm · lateral"
         f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)",
         soft_wrap=True,

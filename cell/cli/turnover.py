@@ -4,7 +4,7 @@ the robot programs of both sides with the main program that stops for the operat
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -52,7 +52,8 @@ def finish_turnover(
     rep = turnover_report(run, provenance=provenance)
     writer.report(json_path, rep)
     if krl is not None:
-        written = writer.attempt(lambda: write_programs(run, krl, provenance, controller))
+        left = not_welded(rep)
+        written = writer.attempt(lambda: write_programs(run, krl, provenance, controller, left))
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
     print_weld(rep, title, fmt)
@@ -81,8 +82,25 @@ def sides_line(rep: Mapping[str, Any]) -> str:
     return " · ".join(parts)
 
 
-def write_programs(run: TurnoverRun, krl: Path, provenance: Mapping[str, Any], controller: str) -> list[Path]:
-    """The robot programs into ``krl``, each side's weld points in its own aligned map's base.
+def not_welded(rep: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
+    """The report's seams no side welded, each (id, why as codes: ``not_supported: curved``, ``end_uncertain``)."""
+    out = []
+    for s in rep["seams"]:
+        if not s.get("welded"):
+            code = str(s.get("weld_reason_code") or "not welded")
+            out.append((s["id"], f"{code}: {s['reason_code']}" if s["status"] == "not_supported" else code))
+    return tuple(out)
+
+
+def write_programs(
+    run: TurnoverRun,
+    krl: Path,
+    provenance: Mapping[str, Any],
+    controller: str,
+    not_welded: Sequence[tuple[str, str]] = (),
+) -> list[Path]:
+    """The robot programs into ``krl``, each side's weld points in its own aligned map's base; each header names
+    the map's seams the job does not weld (``not_welded``: id, why).
 
     One side welded: its program ``WELD_<SCENARIO>`` and ``trajectory.json``/``.csv``. Two:
     one program per side (``WELD_<SCENARIO>_A``, ``_B``), the main program ``WELD_<SCENARIO>`` that runs A, stops
@@ -106,7 +124,9 @@ def write_programs(run: TurnoverRun, krl: Path, provenance: Mapping[str, Any], c
         assert wr.plan is not None and wr.arm is not None
         X_RB = wr.detection.scene.X_RM if wr.detection.scene is not None else np.eye(4)
         name = base if len(runs) == 1 else f"{base}_{side}"
-        jobs.append(ProgramJob(wr.plan, wr.arm.model, name, X_RB, sc.X_WR, sc.export.krl, provenance))
+        jobs.append(
+            ProgramJob(wr.plan, wr.arm.model, name, X_RB, sc.X_WR, sc.export.krl, provenance, tuple(not_welded))
+        )
     if len(jobs) == 1:
         written = write_program(controller, jobs[0], krl)
     else:

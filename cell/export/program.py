@@ -32,6 +32,8 @@ class ProgramJob:
     X_RB : (4, 4) the part's base in R (the aligned map's pose X_RM): every weld point is written in it.
     X_WR : (4, 4) the robot's mounting in the cell's world (a comment only), or None.
     provenance : what made the program (:func:`cell.provenance.provenance`), or None.
+    not_welded : the map's seams the job does not weld, each (id, why as a code, e.g. ``not_supported: curved``):
+        the header lists them, so a program never drops a seam in silence.
     """
 
     plan: WeldPlan
@@ -41,6 +43,7 @@ class ProgramJob:
     X_WR: FloatArray | None = None
     options: KrlOptions = field(default_factory=KrlOptions)
     provenance: Mapping[str, Any] | None = None
+    not_welded: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         if not _NAME.fullmatch(self.name):
@@ -62,6 +65,15 @@ class PostProcessor(Protocol):
     name: str
 
     def texts(self, job: ProgramJob) -> dict[str, str]: ...
+
+
+def not_welded_lines(job: ProgramJob, prefix: str = ";- ") -> list[str]:
+    """The header's comment lines naming the map's seams the job does not weld and why (none when it welds all)."""
+    if not job.not_welded:
+        return []
+    lines = [f"{prefix}Not welded by this job: {len(job.not_welded)} seam(s) of the map"]
+    lines += [f"{prefix}  {sid}: {why}" for sid, why in job.not_welded]
+    return [ln.encode("ascii", errors="replace").decode("ascii") for ln in lines]
 
 
 def procedure_of(seg: Segment) -> WeldProcedure:

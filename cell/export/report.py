@@ -17,7 +17,8 @@ from cell.errors import CellError
 from cell.export.atomic import write_atomic
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection, WeldRun
-from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, Violation
+from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, UnsupportedSeam, Violation, WeldMap
+from cell.types.run import WeldReason
 
 REPORT_VERSION = 1
 
@@ -63,10 +64,26 @@ def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
     return entry
 
 
+def _unsupported_entry(u: UnsupportedSeam) -> dict[str, Any]:
+    """A seam the map draws that the cell cannot weld: never searched, with why as text and as a code."""
+    return {"id": u.id, "status": SeamStatus.NOT_SUPPORTED.value, "reason": u.reason, "reason_code": u.code.value}
+
+
+def not_supported(weldmap: WeldMap) -> dict[str, int]:
+    """The map's seams the cell cannot weld, counted by reason code (``curved``: 1), in code order."""
+    codes = [u.code.value for u in weldmap.unsupported]
+    return {c: codes.count(c) for c in sorted(set(codes))}
+
+
 def detection_report(
-    det: Detection, records: Sequence[SeamRecord] | None = None, *, provenance: Mapping[str, Any] | None = None
+    det: Detection,
+    records: Sequence[SeamRecord] | None = None,
+    *,
+    provenance: Mapping[str, Any] | None = None,
+    unsupported: bool = True,
 ) -> dict[str, Any]:
-    """The ``cell detect`` report as a JSON-ready dict (schema in docs/report.md), one entry per seam record.
+    """The ``cell detect`` report as a JSON-ready dict (schema in docs/report.md), one entry per seam record,
+    then (``unsupported``) one per seam of the map the cell cannot weld (status ``not_supported``).
 
     provenance : what made it (:func:`cell.provenance.provenance`), stored under ``provenance`` (null if None).
 
@@ -74,9 +91,12 @@ def detection_report(
     the cloud's own frame for a brought cloud (``cell locate``: ``F`` unless ``--frame`` says otherwise). Without
     ground truth (real data) the seams have no ``truth`` or ``error_mm`` and the summary's errors are null."""
     seams = [_seam_entry(rec) for rec in (records if records is not None else det.records())]
+    if unsupported:
+        seams += [_unsupported_entry(u) for u in det.weldmap_R.unsupported]
     s = det.summary
     summary = {
-        "seams": len(det.estimates),
+        "seams": len(det.estimates) + len(det.weldmap_R.unsupported),  # every seam of the map
+        "not_supported": not_supported(det.weldmap_R),
         "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),
         "found": s.found,
         "paper_me_mean_mm": _r(s.paper_me_mean_mm, 4),
@@ -117,9 +137,9 @@ def _add_rescan(rep: dict[str, Any], records: Sequence[SeamRecord], first: Detec
         return
     by_id = {rec.id: rec for rec in records}
     for entry in rep["seams"]:
-        rec = by_id[entry["id"]]
-        r = rec.rescan
-        if r is None:
+        rec = by_id.get(entry["id"])  # none for a seam the cell cannot weld
+        r = rec.rescan if rec is not None else None
+        if rec is None or r is None:
             continue
         if rec.first_metrics is not None:
             entry["error_mm_before"] = _errors(rec.first_metrics)
@@ -200,7 +220,11 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
     records = run.records()
     rep = detection_report(run.detection, records, provenance=provenance)
     plan = run.plan
-    for entry, rec in zip(rep["seams"], records, strict=True):
+    for entry in rep["seams"][len(records) :]:  # the map's seams the cell cannot weld
+        entry.update(
+            planned=False, welded=False, weld_reason=entry["reason"], weld_reason_code=WeldReason.NOT_SUPPORTED.value
+        )
+    for entry, rec in zip(rep["seams"], records, strict=False):
         w = rec.weld
         if w is None:
             raise ValueError(f"seam {rec.id}: a weld run without a weld record")
@@ -270,6 +294,6 @@ def rescan_report(
         for rec in after.records()
         if rec.id in rescans
     ]
-    rep = detection_report(after, records, provenance=provenance)
+    rep = detection_report(after, records, provenance=provenance, unsupported=False)
     _add_rescan(rep, records, before, rs)
     return rep

@@ -9,6 +9,7 @@ from typing import Any
 
 from cell.export.report import _error, _pt, _r, weld_report
 from cell.pipeline.turnover_run import TurnoverRun
+from cell.types import SeamStatus
 
 
 def turnover_report(run: TurnoverRun, *, provenance: Mapping[str, Any] | None = None) -> dict[str, Any]:
@@ -34,7 +35,8 @@ def turnover_report(run: TurnoverRun, *, provenance: Mapping[str, Any] | None = 
     seams = []
     for entry in rep["seams"]:
         e = dict(b_entries.get(entry["id"], entry))
-        e["side"] = side_of.get(entry["id"], "A")
+        listed = e["status"] == SeamStatus.NOT_SUPPORTED  # a seam the cell cannot weld is on no side
+        e["side"] = None if listed else side_of.get(entry["id"], "A")
         if entry["id"] in left and not e.get("welded"):
             e["weld_reason"] = f"{e.get('weld_reason', '')}; {left[entry['id']]}".lstrip("; ")
         seams.append(e)
@@ -55,7 +57,7 @@ def _side_entry(rep: Mapping[str, Any]) -> dict[str, Any]:
     """One side's figures from its own weld report."""
     return {
         "welded": rep["welded"],
-        "seams": [e["id"] for e in rep["seams"]],
+        "seams": [e["id"] for e in rep["seams"] if e["status"] != SeamStatus.NOT_SUPPORTED],
         "cycle_time_s": rep["cycle_time_s"],
         "summary": rep["summary"],
         "error": rep["error"],

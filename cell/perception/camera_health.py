@@ -1,6 +1,6 @@
 """Is a camera's data fit to splice? Checks before the splice that turn a broken camera into a reason: one image on its
 own (dead, stuck, garbage), and the cameras' clouds against each other (a camera knocked out of calibration, judged
-on its footprint; with two cameras none can be blamed)."""
+on its footprint and only where the other camera could have seen it; with two cameras none can be blamed)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,11 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from cell.config.perception import HealthOptions
-from cell.geometry import FloatArray
+from cell.geometry import FloatArray, invert, transform_points
 from cell.perception.preprocess import downsample
 from cell.types import Cloud, DepthImage
 
@@ -83,6 +84,25 @@ def _voxel_keys(points: np.ndarray, voxel_m: float) -> np.ndarray:
     return np.asarray((ijk[:, 0] << 42) | (ijk[:, 1] << 21) | ijk[:, 2])
 
 
+def seen_by(p_R: FloatArray, image: DepthImage, X_WR: FloatArray, tol_m: float) -> npt.NDArray[np.bool_]:
+    """(n,) which points p_R (n, 3) [m, frame R] the camera of ``image`` could have seen: in front of it, inside its
+    image, where it has a depth, and not behind the surface it saw there by more than ``tol_m`` (a point behind
+    another surface, or on a face it sees edge-on, is hidden from it: it can neither confirm nor deny it)."""
+    p_C = transform_points(invert(image.X_WC) @ X_WR, p_R)
+    k = image.intrinsics
+    z = p_C[:, 2]
+    ahead = z > 1e-6
+    u = np.full(len(z), -1, dtype=np.intp)
+    v = np.full(len(z), -1, dtype=np.intp)
+    u[ahead] = np.floor(k.fx * p_C[ahead, 0] / z[ahead] + k.cx + 0.5).astype(np.intp)
+    v[ahead] = np.floor(k.fy * p_C[ahead, 1] / z[ahead] + k.cy + 0.5).astype(np.intp)
+    inside = ahead & (u >= 0) & (u < k.width) & (v >= 0) & (v < k.height)
+    seen = np.zeros(len(z), dtype=bool)
+    d = np.asarray(image.depth[v[inside], u[inside]], dtype=np.float64)
+    seen[inside] = np.isfinite(d) & (d > 0.0) & (z[inside] <= d + tol_m)
+    return seen
+
+
 def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None) -> dict[tuple[str, str], float]:
     """(a, b) -> share of camera a's points (on a grid of ``agree_voxel_m``) with a point of camera b within
     ``agree_tol_m``; for every ordered pair of non-empty clouds (frame R, calibrated extrinsics).
@@ -94,10 +114,14 @@ def agreement(clouds: Mapping[str, Cloud], options: HealthOptions | None = None)
 
 
 def _shares(
-    clouds: Mapping[str, Cloud], options: HealthOptions | None = None
+    clouds: Mapping[str, Cloud],
+    options: HealthOptions | None = None,
+    views: tuple[Mapping[str, DepthImage], FloatArray] | None = None,
 ) -> tuple[dict[tuple[str, str], float], dict[tuple[str, str], float]]:
     """:func:`agreement`, and (a, b) -> the same share over only a's grid points inside b's footprint (the
-    voxels of ``FOOTPRINT_TOLS`` x ``agree_tol_m`` that b's points occupy; NaN when none is)."""
+    voxels of ``FOOTPRINT_TOLS`` x ``agree_tol_m`` that b's points occupy; NaN when none is). With ``views``
+    (the depth images by camera and X_WR), both shares count only a's points b could have seen (:func:`seen_by`;
+    NaN when b could see none of them)."""
     o = options if options is not None else HealthOptions()
     names = [n for n, c in clouds.items() if len(c) > 0]
 
@@ -122,28 +146,45 @@ def _shares(
             agrees = near.copy()
             dist, _ = tree.query(pa[~near], distance_upper_bound=o.agree_tol_m, workers=-1)
             agrees[~near] = np.isfinite(dist)
-            out[(a, b)] = float(np.count_nonzero(agrees) / len(pa))
-            inside = np.isin(coarse[a], coarse[b])
+            judged = np.ones(len(pa), dtype=bool)
+            if views is not None and b in views[0]:
+                judged = seen_by(pa, views[0][b], views[1], o.agree_tol_m)
+            agrees &= judged
+            n_judged = np.count_nonzero(judged)
+            out[(a, b)] = float(np.count_nonzero(agrees) / n_judged) if n_judged else float("nan")
+            inside = np.isin(coarse[a], coarse[b]) & judged
             n_in = np.count_nonzero(inside)
             within[(a, b)] = float(np.count_nonzero(agrees & inside) / n_in) if n_in else float("nan")
     return out, within
 
 
-def disagreeing_cameras(clouds: Mapping[str, Cloud], options: HealthOptions | None = None) -> dict[str, str]:
+def _least(x: float, y: float) -> float:
+    """The smaller share; 0 when either is NaN (nothing to judge by is no agreement)."""
+    return 0.0 if math.isnan(x) or math.isnan(y) else min(x, y)
+
+
+def disagreeing_cameras(
+    clouds: Mapping[str, Cloud],
+    options: HealthOptions | None = None,
+    views: tuple[Mapping[str, DepthImage], FloatArray] | None = None,
+) -> dict[str, str]:
     """Cameras whose cloud agrees with no other camera while at least two others agree with each other:
-    name -> reason. Empty when all agree, or when there is no agreeing majority to judge by."""
+    name -> reason. Empty when all agree, or when there is no agreeing majority to judge by. With ``views`` (the
+    depth images and X_WR) a camera is judged by another only on what that one could have seen: a face one camera
+    sees and another sees edge-on (or hidden) is no disagreement."""
     o = options if options is not None else HealthOptions()
-    share, within = _shares(clouds, o)
+    share, within = _shares(clouds, o, views)
     names = sorted({a for a, _ in share})
 
     def both(a: str, b: str) -> float:  # both ways: a shifted cloud can still cover the other's tops
-        return min(share[(a, b)], share[(b, a)])
+        return _least(share[(a, b)], share[(b, a)])
 
     def agree(a: str, b: str) -> bool:
         """Both ways, each camera's points where the other has any (a camera that sees a part of what the other
         sees is judged there), and one of them lies on the other's surfaces as a whole."""
-        inside = min(within[(a, b)], within[(b, a)])  # NaN (no common footprint) never agrees
-        return bool(inside >= o.min_agreement) and max(share[(a, b)], share[(b, a)]) >= o.min_agreement
+        inside = _least(within[(a, b)], within[(b, a)])  # no common footprint (NaN) never agrees
+        whole = max(np.nan_to_num(share[(a, b)], nan=0.0), np.nan_to_num(share[(b, a)], nan=0.0))
+        return inside >= o.min_agreement and whole >= o.min_agreement
 
     out = {}
     for c in names:
@@ -155,7 +196,8 @@ def disagreeing_cameras(clouds: Mapping[str, Cloud], options: HealthOptions | No
         best = max(others, key=lambda n: both(c, n))
         worst = both(c, best)
         out[c] = (
-            f"disagrees with the other cameras: at best {worst:.0%} of its points and {best}'s lie within "
+            f"disagrees with the other cameras: at best {worst:.0%} of its points and {best}'s (where each could see "
+            f"the other's) lie within "
             f"{o.agree_tol_m * 1000:.0f} mm of each other (needs {o.min_agreement:.0%}), while the others agree: "
             "knocked out of calibration?"
         )

@@ -176,7 +176,7 @@ def perceive_then(
     beside = ThreadPoolExecutor(max_workers=1)
     try:
         ahead = beside.submit(onward, guess)
-        why.update(disagreeing_cameras({n: c for n, c in clouds.items() if n not in why}, health))
+        why.update(disagreeing_cameras({n: c for n, c in clouds.items() if n not in why}, health, (images, X_WR)))
         for name in why:
             clouds[name] = clouds[name].select(np.zeros(len(clouds[name]), dtype=bool))
         lost = tuple(name for name in clouds if name in why)

@@ -96,9 +96,11 @@ class Detection:
 
     @property
     def complete(self) -> bool:
-        """Every seam that can be seen was found, with every camera working (a lost camera is a degraded run)."""
+        """Every seam that can be seen was found, with every camera working (a lost camera is a degraded run), and
+        the map holds no seam the cell cannot weld (a curve: listed, never dropped in silence)."""
         undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
-        return not self.lost_cameras and all(e.status not in undone for e in self.estimates)
+        found = all(e.status not in undone for e in self.estimates)
+        return not self.lost_cameras and found and not self.weldmap_R.unsupported
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -97,7 +97,10 @@ def _summary(run: WeldRun, records: Sequence[SeamRecord]) -> str:
     det = run.detection
     welded = sum(1 for r in records if r.weld is not None and r.weld.welded)
     planned = sum(1 for r in records if r.weld is not None and r.weld.planned)
-    parts = [f"{len(records)} seams", f"{planned} planned", f"{welded} welded"]
+    codes = [str(u.code) for u in det.weldmap_R.unsupported]
+    parts = [f"{len(records) + len(codes)} seams in the map", f"{planned} planned", f"{welded} welded"]
+    if codes:
+        parts.append(f"{len(codes)} not supported: {', '.join(sorted(set(codes)))}")
     if run.execution is not None:
         parts.append(f"cycle time {run.cycle_time_s:.1f} s")
     if det.lost_cameras:
@@ -128,7 +131,7 @@ def write_page(run: WeldRun, out_path: str | Path, *, title: str = "", max_point
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{_summary(run, records)}</p>",
         "<h2>Seams</h2>",
-        results_table(records, STATUS_COLOURS),
+        results_table(records, STATUS_COLOURS, det.weldmap_R.unsupported),
         '<p class="note">sigma: the locator\'s standard error across the seam; error: mean distance of the estimate'
         " from the true seam (when the truth is known); angles: the torch's work and travel angles as planned.</p>",
         "<h2>The cell</h2>",

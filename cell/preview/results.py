@@ -2,7 +2,8 @@
 
 Columns: seam, status, the locator's sigma [mm], the error against the true seam when the truth is known [mm],
 welded (or planned) or why not, the torch's work and travel angles [deg]. :func:`results_rows` gives the cells as
-text, :func:`results_table` an HTML ``<table>`` of them.
+text, :func:`results_table` an HTML ``<table>`` of them; the map's seams the cell cannot weld (a curve) follow, with
+status ``not_supported`` and their reason.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import html
 import math
 from collections.abc import Sequence
 
-from cell.types import SeamRecord
+from cell.types import SeamRecord, SeamStatus, UnsupportedSeam
 
 COLUMNS = ("seam", "status", "sigma [mm]", "error [mm]", "weld", "work angle [deg]", "travel angle [deg]")
 
@@ -37,8 +38,15 @@ def _weld(rec: SeamRecord) -> tuple[str, str]:
     return ("planned" if w.planned else "not planned"), w.reason
 
 
-def results_rows(records: Sequence[SeamRecord]) -> list[dict[str, str]]:
-    """One dict per seam (keys: :data:`COLUMNS` plus ``detail``, the reason in words)."""
+def _unsupported_row(u: UnsupportedSeam) -> dict[str, str]:
+    row = dict.fromkeys(COLUMNS, "–")
+    row.update(seam=u.id, status=SeamStatus.NOT_SUPPORTED.value, weld=f"not supported: {u.code}", detail=u.reason)
+    return row
+
+
+def results_rows(records: Sequence[SeamRecord], unsupported: Sequence[UnsupportedSeam] = ()) -> list[dict[str, str]]:
+    """One dict per seam, then one per seam the cell cannot weld (keys: :data:`COLUMNS` plus ``detail``, the
+    reason in words)."""
     rows = []
     for rec in records:
         e, m, o = rec.estimate, rec.metrics, rec.outcome
@@ -56,15 +64,17 @@ def results_rows(records: Sequence[SeamRecord]) -> list[dict[str, str]]:
                 "detail": detail or e.reason,
             }
         )
-    return rows
+    return rows + [_unsupported_row(u) for u in unsupported]
 
 
-def results_table(records: Sequence[SeamRecord], status_colours: dict[str, str]) -> str:
+def results_table(
+    records: Sequence[SeamRecord], status_colours: dict[str, str], unsupported: Sequence[UnsupportedSeam] = ()
+) -> str:
     """The HTML ``<table id="results">``: one ``<tr data-seam=ID data-status=STATUS>`` per seam, the status cell
     in its colour, the reason in the row's tooltip."""
     head = "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS)
     body = []
-    for row in results_rows(records):
+    for row in results_rows(records, unsupported):
         cells = []
         for c in COLUMNS:
             style = f' style="color:{status_colours[row[c]]};font-weight:bold"' if c == "status" else ""

@@ -17,7 +17,13 @@ from cell.geometry import FloatArray
 from cell.types import SeamRecord, WeldMap
 
 MM = 1000.0  # [mm/m]
-STATUS_COLOURS = {"found": "#2ca02c", "not_found": "#d62728", "not_visible": "#ff7f0e", "occluded": "#9467bd"}
+STATUS_COLOURS = {
+    "found": "#2ca02c",
+    "not_found": "#d62728",
+    "not_visible": "#ff7f0e",
+    "occluded": "#9467bd",
+    "not_supported": "#7f7f7f",
+}
 TRUTH_COLOUR = "#000000"
 PATH_COLOUR = "#17becf"
 BOX_COLOUR = "#555555"

@@ -184,7 +184,7 @@ class MotionSpec(Model):
 
 
 class ExportSpec(Model):
-    """What the cell writes for the controller: the KUKA KRL program (``cell weld --krl``)."""
+    """What the cell writes for the controller: the robot program (``cell weld --program``)."""
 
     krl: KrlOptions = KrlOptions()
 

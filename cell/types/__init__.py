@@ -4,7 +4,7 @@ optical frame, ``B`` a box part's own frame. Metres and radians inside; millimet
 
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.gate import Violation, ViolationKind
-from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, UnsupportedSeam, WeldMap
+from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, Unsupported, UnsupportedSeam, WeldMap
 from cell.types.plan import PlanReason, SeamOutcome, SeamTask, Segment, SegmentKind, WeldPlan
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 from cell.types.rescan import Rescan, SeamRescan, Viewpoint
@@ -64,6 +64,7 @@ __all__ = [
     "Shape",
     "ShapeKind",
     "Trajectory",
+    "Unsupported",
     "UnsupportedSeam",
     "Viewpoint",
     "Violation",

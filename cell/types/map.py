@@ -4,6 +4,7 @@ Frames: ``M`` welding map, ``R`` robot base, ``W`` world, ``B`` a box's own fram
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -13,7 +14,7 @@ import numpy.typing as npt
 from cell.geometry import FloatArray, invert, readonly, transform_points
 from cell.types.polyhedron import Polyhedron
 
-__all__ = ["BOX_FACES", "Box", "MapSeam", "Part", "Polyhedron", "UnsupportedSeam", "WeldMap"]
+__all__ = ["BOX_FACES", "Box", "MapSeam", "Part", "Polyhedron", "Unsupported", "UnsupportedSeam", "WeldMap"]
 
 # The six faces of a box, named by the outward normal in the box frame B.
 BOX_FACES: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
@@ -218,11 +219,20 @@ class MapSeam:
         return MapSeam(self.id, transform_points(X_CA, self.p_start), transform_points(X_CA, self.p_end))
 
 
+class Unsupported(enum.StrEnum):
+    """Why a seam the map draws is not one the cell can weld, as a code that code and tests read."""
+
+    CURVED = "curved"  # an arc, circle, ellipse, spline, helix or a polyline segment with a bulge
+    ON_FIXTURE = "on_fixture"  # it lies on a fixture, not between two parts
+
+
 class UnsupportedSeam(NamedTuple):
-    """A seam the map draws that the cell cannot weld (an arc, a seam on a fixture): its id and why, in one line."""
+    """A seam the map draws that the cell cannot weld: its id, why in one line (``reason``, for people) and why as a
+    code (``code``)."""
 
     id: str
     reason: str
+    code: Unsupported
 
 
 @dataclass(frozen=True)

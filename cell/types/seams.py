@@ -26,6 +26,7 @@ class SeamStatus(enum.StrEnum):
     NOT_VISIBLE = "not_visible"  # no camera can see it by design (against the table): turn the part over
     NOT_FOUND = "not_found"  # visible, but the data does not support a seam there
     OCCLUDED = "occluded"  # visible by design, but something the map does not know is in the way: clear it
+    NOT_SUPPORTED = "not_supported"  # drawn in the map, but not a seam the cell can weld (a curve): never searched
 
 
 class Reason(enum.StrEnum):

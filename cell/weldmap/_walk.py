@@ -77,7 +77,7 @@ class Found:
     """What the walk found, in drawing units."""
 
     seams: list[RawSeam] = field(default_factory=list)
-    unsupported: list[tuple[str, str]] = field(default_factory=list)  # (id, reason)
+    unsupported: list[tuple[str, str]] = field(default_factory=list)  # (id, reason): curved seams
     bodies: list[RawBody] = field(default_factory=list)
     kinds: Counter[str] = field(default_factory=Counter)  # every entity type met (inside blocks too)
     red: int = 0  # red (or seam-layer) entities met

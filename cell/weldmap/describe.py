@@ -65,5 +65,6 @@ def describe(weldmap: WeldMap, joints: Mapping[str, str] | None = None) -> str:
         )
     if weldmap.unsupported:
         lines.append(f"unsupported seams: {len(weldmap.unsupported)}")
-        lines += [f"  {u.id}: {u.reason}" for u in weldmap.unsupported]
+        width = max(len(u.id) for u in weldmap.unsupported)
+        lines += [f"  {u.id:<{width}}  {u.code}: {u.reason}" for u in weldmap.unsupported]
     return "\n".join(lines)

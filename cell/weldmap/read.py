@@ -11,7 +11,7 @@ from ezdxf.document import Drawing
 from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.types import Box, MapSeam, Part, Polyhedron, WeldMap
-from cell.types.map import UnsupportedSeam
+from cell.types.map import Unsupported, UnsupportedSeam
 from cell.weldmap._load import MALFORMED, ezdxf_to_log, kind_of, load, log
 from cell.weldmap._walk import Found, RawBody, RawSeam, Reader
 from cell.weldmap.boxfit import BOX_TOL, bounding_box, fit_box, open_edges, zero_area_faces
@@ -187,7 +187,7 @@ def _place(
         fx = [f for f, t in zip(fixtures, on_fixtures[i], strict=True) if t]
         if fx and len(on) < 2:
             why = f"{raw.where}: on fixture {fx[0].name}: a fixture is never welded (map.layers says what is a part)"
-            unsupported.append(UnsupportedSeam(s.id, why))
+            unsupported.append(UnsupportedSeam(s.id, why, Unsupported.ON_FIXTURE))
             continue
         kept.append(s)
         if len(on) < 2:  # a seam joins two parts: the other one may be a body that could not be read
@@ -244,12 +244,10 @@ def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns |
     seams = _seams(found, scale, src)
     parts, fixtures, bad = _bodies(found, spec, scale, src, warnings)
     kept, on_fixtures = _place(seams, parts, fixtures, bad, src, warnings)
-    unsupported = [UnsupportedSeam(i, why) for i, why in found.unsupported] + on_fixtures
+    unsupported = [UnsupportedSeam(i, why, Unsupported.CURVED) for i, why in found.unsupported] + on_fixtures
     if not kept:
-        first = unsupported[0] if unsupported else UnsupportedSeam("?", "")
-        raise MapError(
-            f"{src}: no seam can be welded: {_plural(len(unsupported), 'seam')} unsupported ({first.reason})"
-        )
+        first = unsupported[0].reason if unsupported else ""
+        raise MapError(f"{src}: no seam can be welded: {_plural(len(unsupported), 'seam')} unsupported ({first})")
     if not parts:
         raise MapError(f"{src}: no parts (every body is a fixture or skipped); {WHAT}")
     for w in warnings:

@@ -104,7 +104,9 @@ def test_weld_report_to_stdout_with_provenance_in_report_and_program(
 ) -> None:
     monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: None))
     krl = tmp_path / "krl"
-    code, out, err = invoke("weld", "fence1", "--sides", "first", "--json", "-", "--krl", str(krl), "--format", "json")
+    code, out, err = invoke(
+        "weld", "fence1", "--sides", "first", "--json", "-", "--program", str(krl), "--format", "json"
+    )
     assert code == 0, err
     data = json.loads(out)  # stdout is the report alone: the table (here as JSON rows) went to stderr
     assert data["welded"] == 12 and '"seam": "POST_L>TOP_RAIL:+x"' in err
@@ -124,7 +126,7 @@ def test_a_late_failure_loses_only_its_own_output(
     written, exit 2, and the last line names what was lost."""
     report, krl = tmp_path / "rep" / "r.json", tmp_path / "krl"
     monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: report.parent.write_text("")))
-    code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--krl", str(krl))
+    code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl))
     assert code == 2, err
     assert "Traceback" not in err and ".part" not in err
     assert err.strip().splitlines()[-1].startswith(f"exit 2: could not write '{report}'")
@@ -132,7 +134,7 @@ def test_a_late_failure_loses_only_its_own_output(
 
     report, krl = tmp_path / "r2.json", tmp_path / "krl2"
     monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: krl.write_text("")))
-    code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--krl", str(krl))
+    code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl))
     assert code == 2, err
     assert err.strip().splitlines()[-1].startswith("exit 2: could not write")
     assert json.loads(report.read_text())["welded"] == 12

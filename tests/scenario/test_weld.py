@@ -95,7 +95,7 @@ def test_weld_cli_writes_report_and_robot_program(
     monkeypatch.setattr(pipeline, "weld", weld)
     runner = CliRunner()
     report, krl = tmp_path / "r.json", tmp_path / "krl"
-    result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--krl", str(krl)])
+    result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl)])
     assert result.exit_code == 0, result.stderr
     ((scenario, job, kw),) = asked
     assert scenario == sc.load("fence1") and set(kw) == {"progress"}
@@ -111,6 +111,26 @@ def test_weld_cli_writes_report_and_robot_program(
             assert s["passes"][0]["bead"]["tcp_error_mm"].keys() == s["tcp_error_mm"].keys()
     assert (krl / "WELD_FENCE1.src").is_file() and (krl / "WELD_FENCE1.dat").is_file()
     assert json.loads((krl / "trajectory.json").read_text())["joint_names"][0] == "joint_a1"
+
+
+def test_at_80_columns_every_seam_id_is_whole(fence1_run: pipeline.WeldRun, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``COLUMNS=80 cell weld fence1``, its table read as a user does: every seam's row starts with its whole id,
+    no cell is cut short, no line is wider than the terminal, and each seam not welded says why in words."""
+    monkeypatch.setattr(pipeline, "weld", lambda *_, **__: fence1_run)
+    monkeypatch.setenv("COLUMNS", "80")
+    result = CliRunner().invoke(app, ["weld", "fence1", "--sides", "first"])
+    assert result.exit_code == 0, result.stderr
+    lines = result.stdout.splitlines()
+    table = lines[: next(i for i, ln in enumerate(lines) if ln.startswith("ME: "))]
+    assert "…" not in result.stdout and max(len(ln.rstrip()) for ln in table) <= 80
+    ids = {w.id for w in fence1_run.seams}
+    rows = {ln.split()[0]: ln.split() for ln in table if ln.strip() and ln.split()[0] in ids}
+    assert set(rows) == ids and len(ids) == 16  # each id whole (the longest, BOTTOM_RAIL>POST_R:+z, 21 characters)
+    for w in fence1_run.seams:
+        assert rows[w.id][3] == ("welded" if w.welded else "not_visible"), rows[w.id]
+        if not w.welded:
+            assert f"  {w.id}: " in result.stdout  # the reason in words, after the table
+    assert "welded 12 of 16 seams in the map · visible 12" in result.stdout
 
 
 def test_both_fixed_cameras_dead_still_welds_nothing_wrong() -> None:

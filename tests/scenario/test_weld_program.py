@@ -1,4 +1,4 @@
-"""``cell weld fence1 --krl DIR`` writes a program ``cell krl check DIR`` passes: arc statements with weld data on
+"""``cell weld fence1 --program DIR`` writes a program ``cell krl check DIR`` passes: arc statements with weld data on
 every welded seam, the INI fold, TOOL/BASE by index, S and T on every E6POS matching the arm; a corrupted copy
 fails with the finding that names what was broken. ``--controller rapid`` writes an ABB module of the same plan."""
 
@@ -22,12 +22,12 @@ runner = CliRunner()
 
 @pytest.fixture(scope="module")
 def program(tmp_path_factory: pytest.TempPathFactory, fence1_run: pipeline.WeldRun) -> Path:
-    """fence1's program as ``cell weld fence1 --krl DIR`` writes it (the session's run stands in for the weld)."""
+    """fence1's program as ``cell weld fence1 --program DIR`` writes it (the session's run stands in for the weld)."""
     krl = tmp_path_factory.mktemp("krl")
     mp = pytest.MonkeyPatch()
     mp.setattr(pipeline, "weld", lambda *_, **__: fence1_run)
     try:
-        result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--krl", str(krl)])
+        result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--program", str(krl)])
     finally:
         mp.undo()
     assert result.exit_code in (0, 3), result.stderr
@@ -120,7 +120,7 @@ def test_rapid_module_of_the_same_plan(tmp_path: Path, fence1_run: pipeline.Weld
     mp.setattr(pipeline, "weld", lambda *_, **__: fence1_run)
     try:
         result = runner.invoke(
-            app, ["weld", "fence1", "--sides", "first", "--krl", str(tmp_path), "--controller", "rapid"]
+            app, ["weld", "fence1", "--sides", "first", "--program", str(tmp_path), "--controller", "rapid"]
         )
     finally:
         mp.undo()
@@ -131,5 +131,5 @@ def test_rapid_module_of_the_same_plan(tmp_path: Path, fence1_run: pipeline.Weld
     arcs = sum(1 for k, s in enumerate(segs) if s.kind == "weld" and segs[k - 1].kind != "weld")
     starts = re.findall(r"^\s*ArcLStart (\w+),", text, flags=re.M)
     assert len(starts) == arcs == len(re.findall(r"^\s*ArcLEnd ", text, flags=re.M)) >= len(fence1_run.plan.order)
-    bad = runner.invoke(app, ["weld", "fence1", "--krl", str(tmp_path / "x"), "--controller", "inform"])
+    bad = runner.invoke(app, ["weld", "fence1", "--program", str(tmp_path / "x"), "--controller", "inform"])
     assert bad.exit_code == 2 and "valid: krl, rapid" in bad.stderr

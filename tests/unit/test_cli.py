@@ -111,6 +111,19 @@ def test_version_and_short_help() -> None:
     assert code == 0 and "--install-completion" in out and "--log-file" in out
 
 
+def test_krl_is_the_deprecated_name_of_program(tmp_path: Path) -> None:
+    """``--krl DIR`` still writes the program (whatever the controller) and says to use ``--program``; not both."""
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    code, _, err = invoke("weld", "fence1", "--krl", str(a_file), "--controller", "rapid")
+    assert_one_line_error(code, err, 2, "--program")
+    assert "warning: --krl is deprecated: use --program DIR" in " ".join(err.split())
+    code, _, err = invoke("weld", "fence1", "--krl", str(tmp_path), "--program", str(tmp_path))
+    assert_one_line_error(code, err, 2, "--krl is the deprecated name of --program")
+    code, out, _ = invoke("weld", "-h")
+    assert "--program" in out and "--krl" not in out
+
+
 @pytest.mark.parametrize(
     ("args", "option"),
     [
@@ -118,8 +131,8 @@ def test_version_and_short_help() -> None:
         (("detect", "fence1", "--save-cloud", "{dir}"), "--save-cloud"),
         (("detect", "fence1", "--save-cloud", "-"), "--save-cloud"),
         (("weld", "fence1", "--json", "{dir}"), "--json"),
-        (("weld", "fence1", "--krl", "{file}"), "--krl"),
-        (("weld", "fence1", "--krl", "{file}/krl"), "--krl"),
+        (("weld", "fence1", "--program", "{file}"), "--program"),
+        (("weld", "fence1", "--program", "{file}/krl"), "--program"),
         (("preview", "fence1", "--out", "{file}"), "--out"),
         (("rescan", "fence1", "--json", "{file}/sub/r.json"), "--json"),
         (("bench", "fence1", "--out", "{file}"), "--out"),

@@ -16,7 +16,7 @@ from dxf_factory import design, make_maps
 from cell.errors import MapError
 from cell.geometry import make_pose
 from cell.scenario.layer_specs import LayerSpec
-from cell.types import Box
+from cell.types import Box, Unsupported
 from cell.weldmap import DEFAULT_FIXTURE_LAYERS, RED_ACI, LayerRoles, read_map
 
 TOL = 1e-6  # [m]
@@ -89,7 +89,8 @@ def test_polylines_are_chains_of_straight_seams_and_curves_are_unsupported(tmp_p
     np.testing.assert_allclose([m.seams[3].p_start, m.seams[3].p_end], [[1.12, 0.7, 0.08], [1.2, 0.7, 0.08]], atol=TOL)
     np.testing.assert_allclose([m.seams[0].p_start, m.seams[0].p_end], [[0.2, 0.7, 0.08], [0.28, 0.7, 0.08]])
     np.testing.assert_allclose(m.seams[2].p_end, [0.2, 0.7, 0.08])
-    reasons = dict(m.unsupported)
+    reasons = {u.id: u.reason for u in m.unsupported}
+    assert {u.code for u in m.unsupported} == {Unsupported.CURVED}
     assert list(reasons) == [f"seam-{lw.dxf.handle}.2", m.unsupported[1].id, f"seam-{spline.dxf.handle}"]
     assert "LWPOLYLINE" in reasons[f"seam-{lw.dxf.handle}.2"] and "segment 2: a curved seam" in m.unsupported[0].reason
     assert m.unsupported[1].reason.startswith("ARC ") and "on layer WELD_SEAMS" in m.unsupported[1].reason
@@ -151,6 +152,7 @@ def test_fixtures_are_obstacles_and_seams_on_them_unsupported(tmp_path: Path) ->
     m = read_map(path)
     assert [f.name for f in m.fixtures] == ["Clamp_A"] and "Clamp_A" not in [p.name for p in m.parts]
     [u] = m.unsupported
+    assert u.code is Unsupported.ON_FIXTURE
     assert "on fixture Clamp_A: a fixture is never welded" in u.reason and u.reason.startswith("LINE ")
     # the scenario's map.layers override the defaults: the clamp's layer is a part's now, the others ignored
     spec = LayerSpec(parts=("POST_*", "TOP_RAIL", "clamp_*"), fixtures=())

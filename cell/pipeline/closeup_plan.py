@@ -150,7 +150,7 @@ def closeup_words(p: PlannedCloseup) -> str:
     if p.viewpoint is None:
         return f"cell weld could not re-scan it: {p.reason}"
     vp = p.viewpoint
-    x, y, z = (int(round(float(v) * 1000.0)) for v in vp.X_RC[:3, 3])
+    x, y, z = (round(float(v) * 1000.0) for v in vp.X_RC[:3, 3])
     return (
         f"cell weld would re-scan it up close from ({x:.0f}, {y:.0f}, {z:.0f}) mm in R, {vp.distance_m * 1000:.0f} mm"
         f" away at {vp.incidence_deg[0]:.0f}/{vp.incidence_deg[1]:.0f} deg"

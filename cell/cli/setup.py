@@ -62,9 +62,9 @@ def init(
         write_atomic(target, text.encode("utf-8"), what="scenario")
         size = lay.table_size
         say(
-            f"wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras ({', '.join(lay.cameras)} and "
-            f"the arm's), table {size[0]:.1f} x "
-            f"{size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, {lay.X_WR_xyz[1]:.2f}) m"
+            f"wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras ({', '.join(lay.cameras)} and the "
+            f"arm's), table {size[0]:.1f} x {size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, "
+            f"{lay.X_WR_xyz[1]:.2f}) m"
         )
         if lay.unreachable_risk:
             _warn(f"a seam lies {lay.far_seam_m:.2f} m from the robot base: it may be unreachable")
@@ -73,7 +73,7 @@ def init(
                 f"no fixed camera can see both faces of {', '.join(lay.closeup_only)} from around the part: only "
                 "the close-up re-scan will"
             )
-        say(f"next: cell scenario check {target}; cell weld {target}")
+        say(f"next: cell scenario check {target}; cell preview {target}; cell weld {target}")
 
 
 @scenario_app.command("check")

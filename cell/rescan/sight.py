@@ -11,14 +11,14 @@ from enum import StrEnum
 
 import numpy as np
 
-from cell.geometry import FloatArray
+from cell.geometry import FloatArray, readonly
 from cell.rescan.view_grid import ViewOptions, ViewTarget, _in_image, _incidence, _occluded, _samples
 from cell.scenario import CameraSpec, Scenario
 from cell.seams.joint import weld_faces
 from cell.seams.visibility import visibility
 from cell.types import CameraIntrinsics, Joint, Part, WeldMap
 
-NO_TORCH = np.zeros((0, 3))  # a fixed camera's torch axis: none in its image
+NO_TORCH = readonly(np.zeros((0, 3)))  # a fixed camera's torch axis: none in its image
 
 
 @dataclass(frozen=True)
@@ -83,9 +83,11 @@ class Lens:
     far_m: float
     good_deg: float
     max_deg: float
-    torch_C: FloatArray = field(
-        default_factory=lambda: NO_TORCH
-    )  # (n, 3) the torch's axis in the camera: an arm's camera sees past its torch
+    torch_C: FloatArray = field(default_factory=lambda: NO_TORCH)  # (n, 3) in the camera; none: a fixed camera
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "X_FC", readonly(self.X_FC))
+        object.__setattr__(self, "torch_C", readonly(self.torch_C))
 
 
 @dataclass(frozen=True)

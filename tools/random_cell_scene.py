@@ -14,9 +14,8 @@ from typing import Any
 import numpy as np
 
 from cell.geometry import rot_z
+from cell.scenario.camera_layout import CAMERA_ABOVE_TOP_M, CAMERA_SIDE_M
 from cell.scenario.init import (
-    CAMERA_ABOVE_TOP_M,
-    CAMERA_SIDE_M,
     EYE_IN_HAND_ABOVE_TOP_M,
     EYE_IN_HAND_FRONT_M,
     PART_CENTRE_XY_M,

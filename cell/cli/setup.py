@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -9,12 +10,13 @@ import typer
 
 from cell.cli.common import CONTEXT, app, cell_errors, out, say, warn
 
-scenario_app = typer.Typer(no_args_is_help=True, context_settings=CONTEXT, help="Scenario files (YAML).")
-app.add_typer(scenario_app, name="scenario")
-
 if TYPE_CHECKING:
+    from cell.cli.sight_lines import SightReport
+    from cell.scenario import Scenario
     from cell.types import WeldMap
 
+scenario_app = typer.Typer(no_args_is_help=True, context_settings=CONTEXT, help="Scenario files (YAML).")
+app.add_typer(scenario_app, name="scenario")
 
 _warn = warn
 
@@ -33,8 +35,11 @@ def init(
     """Write a scenario for any welding map: table, robot and cameras placed around the part, the workspace
     computed, a comment on every key. Then `cell scenario check FILE` and `cell weld FILE`."""
     from cell import scenario as sc
+    from cell.cli.sight_lines import arm_torch
+    from cell.config.motion import ViewOptions
     from cell.export.atomic import write_atomic
-    from cell.scenario.init import scenario_text
+    from cell.rescan.sight import pose_sight
+    from cell.scenario.init import ROBOT_URDF, scenario_text
     from cell.weldmap import METRES_PER_UNIT
 
     target = out_path if out_path is not None else Path(f"{map_file.stem}.yaml")
@@ -47,17 +52,24 @@ def init(
     if units is not None and units not in METRES_PER_UNIT:
         raise typer.BadParameter(f"{units!r}; valid: {', '.join(METRES_PER_UNIT)}", param_hint="--units")
     with cell_errors():
-        text, lay = scenario_text(map_file, target.absolute(), units=units)
+        sight = partial(pose_sight, torch_C=arm_torch(ROBOT_URDF, ViewOptions()))  # the scan camera sees past it
+        text, lay = scenario_text(map_file, target.absolute(), units=units, sight=sight)
         scn = sc.from_yaml(text, target.absolute().parent, target.name)  # what is written loads as it is
         write_atomic(target, text.encode("utf-8"), what="scenario")
         size = lay.table_size
         say(
-            f"wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras, table {size[0]:.1f} x "
-            f"{size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, {lay.X_WR_xyz[1]:.2f}) m"
+            f"wrote {target}: map {scn.map.file}, {len(scn.cameras)} cameras ({', '.join(lay.cameras)} and the "
+            f"arm's), table {size[0]:.1f} x {size[1]:.1f} m, robot base at ({lay.X_WR_xyz[0]:.2f}, "
+            f"{lay.X_WR_xyz[1]:.2f}) m"
         )
         if lay.unreachable_risk:
             _warn(f"a seam lies {lay.far_seam_m:.2f} m from the robot base: it may be unreachable")
-        say(f"next: cell scenario check {target}; cell weld {target}")
+        if lay.closeup_only:
+            _warn(
+                f"no fixed camera can see both faces of {', '.join(lay.closeup_only)} from around the part: only "
+                "the close-up re-scan will"
+            )
+        say(f"next: cell scenario check {target}; cell preview {target}; cell weld {target}")
 
 
 @scenario_app.command("check")
@@ -65,8 +77,9 @@ def check(
     file: Annotated[str, typer.Argument(help="A scenario YAML path (or a shipped scenario's name).")],
 ) -> None:
     """Validate a scenario: every key, the map it names (found and readable), and the layout (the part on the
-    table and inside the workspace, its seams within the arm's reach). Exit 0 when it loads; problems of the
-    layout are printed as warnings."""
+    table and inside the workspace, its seams within the arm's reach, each seam's two faces seen by a camera of
+    the first scan: one line per seam). Exit 0 when it loads; problems of the layout and seams no camera will see
+    are printed as warnings (they do not change the exit code)."""
     from cell import pipeline
     from cell import scenario as sc
     from cell.scenario.init import check_layout
@@ -80,6 +93,10 @@ def check(
         ]
         for p in problems:
             _warn(p)
+        seams = _seam_sight(scn, weldmap)  # one line per seam, and a warning per seam no camera will see
+        for w in seams.warnings:
+            _warn(w)
+        problems += seams.warnings
         fixed = sum(c.mount == "fixed" for c in scn.cameras.values())
         verdict = "ok" if not problems else f"{len(problems)} warning(s)"
         out.print(
@@ -87,6 +104,18 @@ def check(
             f"{fixed} fixed camera(s), {len(scn.cameras) - fixed} on the arm",
             soft_wrap=True,
         )
+        out.print(
+            "seams as the first scan's cameras will see them (worst incidence on each face, range):", soft_wrap=True
+        )
+        for line in seams.lines:
+            out.print(f"  {line}", soft_wrap=True, markup=False, highlight=False)
+
+
+def _seam_sight(scn: Scenario, weldmap: WeldMap) -> SightReport:
+    """``scenario check``'s seams as the cameras will see them (:mod:`cell.cli.sight_lines`)."""
+    from cell.cli.sight_lines import sight_report
+
+    return sight_report(scn, weldmap)
 
 
 def seams_text(weldmap: WeldMap) -> str:

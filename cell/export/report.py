@@ -18,6 +18,7 @@ from cell.export.atomic import write_atomic
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, UnsupportedSeam, Violation, WeldMap
+from cell.types.rescan import PlannedCloseup
 from cell.types.run import WeldReason
 
 REPORT_VERSION = 1
@@ -168,6 +169,20 @@ def _add_rescan(rep: dict[str, Any], records: Sequence[SeamRecord], first: Detec
     }
 
 
+def _closeup_plan(c: PlannedCloseup) -> dict[str, Any]:
+    """A preview's planned close-up of one seam: ``planned``, the camera's place ``eye`` in R [m], ``distance_mm``,
+    ``incidence_deg`` on face A and B; or the seam whose close-up serves it (``served_by``); or why none works."""
+    vp = c.viewpoint
+    return {
+        "planned": c.planned,
+        "eye": _pt(vp.X_RC[:3, 3]) if vp is not None else None,
+        "distance_mm": _r(vp.distance_m * 1000.0, 1) if vp is not None else None,
+        "incidence_deg": [_r(a, 1) for a in vp.incidence_deg] if vp is not None else None,
+        "served_by": c.served_by or None,
+        "reason": c.reason,
+    }
+
+
 def _error(e: CellError | None) -> dict[str, Any] | None:
     """The failure that stopped a run early (the seams still say why each was not done), or None: its class,
     message and exit code, and the fields it carries (a code, the figure that decided it, the lost cameras)."""
@@ -263,6 +278,10 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
             entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
         entry.update(procedure_entry(w))  # the weld procedure it got and the bead per pass
     _add_rescan(rep, records, run.first_detection, run.rescan)
+    planned = {c.seam_id: c for c in run.closeups}
+    for entry in rep["seams"]:
+        if entry["id"] in planned:
+            entry["closeup_plan"] = _closeup_plan(planned[entry["id"]])
     ex = run.execution
     rep["welded"] = sum(w.welded for w in run.seams)
     rep["cycle_time_s"] = _r(run.cycle_time_s, 3)

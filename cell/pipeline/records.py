@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from cell.perception import Alignment, Perceived
     from cell.types.execution import Execution
     from cell.types.plan import WeldPlan
-    from cell.types.rescan import Rescan
+    from cell.types.rescan import PlannedCloseup, Rescan
     from cell.types.trajectory import Trajectory
     from cell.types.view import CellView
 
@@ -125,6 +125,7 @@ class WeldRun:
     first_detection: Detection | None = None  # before the re-scan (the same as detection when none ran)
     rescan: Rescan | None = None
     view: CellView | None = None  # the table, the robot's shapes at its poses and the cameras, for pictures
+    closeups: tuple[PlannedCloseup, ...] = ()  # a preview's planned close-up views (cell weld would take them)
 
     @property
     def cycle_time_s(self) -> float:

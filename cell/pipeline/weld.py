@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from cell.planning.failures import SeamFailure
     from cell.types.execution import Execution
     from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
+    from cell.types.rescan import PlannedCloseup
     from cell.types.trajectory import Trajectory
 
 
@@ -232,6 +233,7 @@ def weld(
         violations: tuple[Violation, ...] = ()
         error: CellError | None = None
         hopeless: dict[str, SeamFailure] = {}  # seams no torch can be placed on (not re-scanned; the plan says why)
+        closeups: tuple[PlannedCloseup, ...] = ()  # a preview's: the views the re-scan would take
         checked: dict[str, CheckFail] = {}  # seams that failed the last check before the arc, re-scanned or not
         try:
             if det.error is not None:
@@ -248,6 +250,11 @@ def weld(
                     hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
+            if mode != "none" and not execute_plan:  # a preview plans the close-ups it cannot take
+                from cell.pipeline.closeup_plan import preview_closeups
+
+                progress("planning the close-up views cell weld would take (the arm does not move)")
+                closeups = preview_closeups(station, det, mode, motion)
             if execute_plan:  # the last check before the arc: re-scanned, then refused (cell/pipeline/last_check.py)
                 det, more, checked = last_checked(station, det, skip=hopeless, motion=motion, progress=progress)
                 rs = joined(rs, more)
@@ -289,6 +296,10 @@ def weld(
         refused = f"not executed: {error.message}" if error is not None else ""
         pre_s = pre.duration if pre is not None else 0.0
         seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)
+        if closeups:
+            from cell.pipeline.closeup_plan import with_closeups
+
+            seams = with_closeups(seams, closeups)
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan, pre, ex)
@@ -306,4 +317,5 @@ def weld(
             first_detection=first,
             rescan=rs,
             view=view,
+            closeups=closeups,
         )

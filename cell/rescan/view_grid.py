@@ -135,6 +135,44 @@ def segments_hit_box(p0: FloatArray, p1: FloatArray, part: Part, margin: float) 
     return np.asarray((enter <= leave) & (leave >= 0.0) & (enter <= 1.0))
 
 
+def _in_image(X_RC: FloatArray, pts: FloatArray, K: CameraIntrinsics, torch_C: FloatArray, o: ViewOptions) -> bool:
+    """Whether every sample point (m, 3) lies in front of the camera, in the image with its margin and clear of
+    the torch. No samples left (all under the table or inside other parts: a seam estimate of a part that is not
+    there) is nothing seen."""
+    if not len(pts):
+        return False
+    p_C = transform_points(invert(X_RC), pts)
+    z = p_C[:, 2]
+    if np.any(z <= 0.05):
+        return False
+    u = K.fx * p_C[:, 0] / z + K.cx
+    v = K.fy * p_C[:, 1] / z + K.cy
+    m = o.image_margin_px
+    if np.any((u < m) | (u > K.width - 1 - m) | (v < m) | (v > K.height - 1 - m)):
+        return False
+    ahead = torch_C[torch_C[:, 2] > 0.02]
+    if len(ahead):
+        tu = K.fx * ahead[:, 0] / ahead[:, 2] + K.cx
+        tv = K.fy * ahead[:, 1] / ahead[:, 2] + K.cy
+        radius = K.fx * o.torch_radius_m / ahead[:, 2] + o.torch_margin_px
+        near = np.hypot(u[:, None] - tu[None, :], v[:, None] - tv[None, :]) < radius[None, :]
+        if np.any(near & (ahead[None, :, 2] < z[:, None])):
+            return False
+    return True
+
+
+def _incidence(
+    X_RC: FloatArray, pts: FloatArray, normals: FloatArray, face: npt.NDArray[np.int_]
+) -> tuple[float, float, float]:
+    """The worst angle [deg] between a line of sight and its sample's normal: over every sample, on face A's and
+    on face B's."""
+    sight = X_RC[:3, 3] - pts
+    sight /= np.linalg.norm(sight, axis=1, keepdims=True)
+    cos = np.einsum("ij,ij->i", sight, normals)
+    inc = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    return float(inc.max(initial=0.0)), float(inc[face == 1].max(initial=0.0)), float(inc[face == 2].max(initial=0.0))
+
+
 def _seen(
     X_RC: FloatArray,
     pts: FloatArray,
@@ -145,34 +183,12 @@ def _seen(
     o: ViewOptions,
 ) -> tuple[bool, tuple[float, float]]:
     """Whether every sample point is in the image, clear of the torch and seen at a good incidence (the tests
-    before the line of sight); and the worst incidence on face A's and B's samples [deg]. No samples left (all
-    under the table or inside other parts: a seam estimate of a part that is not there) is nothing seen."""
-    if not len(pts):
+    before the line of sight); and the worst incidence on face A's and B's samples [deg] (90 when not in the
+    image)."""
+    if not _in_image(X_RC, pts, K, torch_C, o):
         return False, (90.0, 90.0)
-    p_C = transform_points(invert(X_RC), pts)
-    z = p_C[:, 2]
-    if np.any(z <= 0.05):
-        return False, (90.0, 90.0)
-    u = K.fx * p_C[:, 0] / z + K.cx
-    v = K.fy * p_C[:, 1] / z + K.cy
-    m = o.image_margin_px
-    if np.any((u < m) | (u > K.width - 1 - m) | (v < m) | (v > K.height - 1 - m)):
-        return False, (90.0, 90.0)
-    ahead = torch_C[torch_C[:, 2] > 0.02]
-    if len(ahead):
-        tu = K.fx * ahead[:, 0] / ahead[:, 2] + K.cx
-        tv = K.fy * ahead[:, 1] / ahead[:, 2] + K.cy
-        radius = K.fx * o.torch_radius_m / ahead[:, 2] + o.torch_margin_px
-        near = np.hypot(u[:, None] - tu[None, :], v[:, None] - tv[None, :]) < radius[None, :]
-        if np.any(near & (ahead[None, :, 2] < z[:, None])):
-            return False, (90.0, 90.0)
-    sight = X_RC[:3, 3] - pts
-    sight /= np.linalg.norm(sight, axis=1, keepdims=True)
-    cos = np.einsum("ij,ij->i", sight, normals)
-    inc = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-    inc_a = float(inc[face == 1].max(initial=0.0))
-    inc_b = float(inc[face == 2].max(initial=0.0))
-    return float(inc.max()) <= o.max_incidence_deg, (inc_a, inc_b)
+    worst, inc_a, inc_b = _incidence(X_RC, pts, normals, face)
+    return worst <= o.max_incidence_deg, (inc_a, inc_b)
 
 
 def _occluded(eye: FloatArray, pts: FloatArray, normals: FloatArray, parts: Sequence[Part], margin: float) -> bool:

@@ -14,6 +14,13 @@ from pathlib import Path
 import numpy as np
 
 from cell.geometry import FloatArray
+from cell.scenario.camera_layout import (
+    CAMERA_SECTION_M,
+    CAMERA_UP,
+    FaceSight,
+    camera_candidates,
+    choose_cameras,
+)
 from cell.scenario.model import MAP_DIR, Scenario
 from cell.types import WeldMap
 from cell.weldmap import read_map
@@ -24,13 +31,11 @@ TABLE_THICKNESS_M = 0.10
 TABLE_MIN_SIZE_M = (2.0, 1.2)  # the shipped scenarios' table [m]
 TABLE_MARGIN_M = 0.2  # table beyond the part on each side [m]
 ROBOT_BEHIND_EDGE_M = 0.45  # robot base in front of the table's near edge [m]
+ROBOT_URDF = "kr5_arc.urdf"  # in the repository's robots/ folder
 ROBOT_HOME_DEG = (-90.0, -100.0, 100.0, 0.0, 45.0, 0.0)  # arm over the table, torch well above the parts
 REACH_M = 1.45  # horizontal base-to-seam distance the shipped fences still weld at [m]
-CAMERA_ABOVE_TOP_M = 1.0
 _CALIBRATION = "    calibration: {translation_mm: 0.0, rotation_deg: 0.0}"
 _CALIBRATION_NOTE = "RMS residual from your calibration report: seams seen by it alone carry it in sigma"
-CAMERA_SIDE_M = 0.85  # fixed camera to the point it looks at, along x [m]
-CAMERA_SECTION_M = 1.6  # longest part one pair of fixed cameras covers [m]
 EYE_IN_HAND_ABOVE_TOP_M = 1.05
 EYE_IN_HAND_FRONT_M = 0.45
 WORKSPACE_MARGIN_M = 0.15
@@ -45,7 +50,9 @@ class Layout:
 
     lo_W, hi_W : (3,) the part's nominal bounds in the world. X_WM_xyz : the drawing's origin in the world.
     cameras : name -> (eye, target); the eye-in-hand camera separately. far_seam_m : the horizontal distance
-    of the farthest seam end from the robot base.
+    of the farthest seam end from the robot base. closeup_only : the seams whose faces no camera of the first scan
+    could see from where this layout may put one (only the close-up will); None: the cameras were not chosen by
+    what they see (the shipped pair per section).
     """
 
     X_WM_xyz: FloatArray
@@ -58,6 +65,7 @@ class Layout:
     eye_in_hand: tuple[FloatArray, FloatArray]
     workspace: tuple[FloatArray, FloatArray]
     far_seam_m: float
+    closeup_only: tuple[str, ...] | None = None
 
     @property
     def unreachable_risk(self) -> bool:
@@ -69,8 +77,9 @@ def _round_out(lo: FloatArray, hi: FloatArray, step: float) -> tuple[FloatArray,
     return np.floor(lo / step + 1e-9) * step, np.ceil(hi / step - 1e-9) * step
 
 
-def layout(weldmap: WeldMap) -> Layout:
-    """The cell laid out around ``weldmap``'s parts (frame M, metres) as the module docstring says."""
+def layout(weldmap: WeldMap, sight: FaceSight | None = None) -> Layout:
+    """The cell laid out around ``weldmap``'s parts (frame M, metres) as the module docstring says; the fixed
+    cameras chosen by the seams' faces they see when ``sight`` is given, else the shipped pair per section."""
     v_M = np.vstack([p.vertices() for p in weldmap.parts])
     lo_M, hi_M = v_M.min(axis=0), v_M.max(axis=0)
     centre_M = (lo_M + hi_M) / 2.0
@@ -84,19 +93,23 @@ def layout(weldmap: WeldMap) -> Layout:
     X_WR_xyz = np.array([cx, cy - size_xy[1] / 2.0 - ROBOT_BEHIND_EDGE_M, TABLE_TOP_M])
 
     mid_z = (lo_W[2] + hi_W[2]) / 2.0
-    eye_z = hi_W[2] + CAMERA_ABOVE_TOP_M
     n = max(1, math.ceil(extent[0] / CAMERA_SECTION_M - 1e-9))
-    cameras: dict[str, tuple[FloatArray, FloatArray]] = {}
-    for i in range(n):
-        tx = lo_W[0] + (i + 0.5) * extent[0] / n
-        target = np.array([tx, cy, mid_z])
-        suffix = "" if n == 1 else f"_{i + 1}"
-        cameras[f"cam_left{suffix}"] = (np.array([tx - CAMERA_SIDE_M, cy, eye_z]), target)
-        cameras[f"cam_right{suffix}"] = (np.array([tx + CAMERA_SIDE_M, cy, eye_z]), target)
+    sections = [np.array([lo_W[0] + (i + 0.5) * extent[0] / n, cy, mid_z]) for i in range(n)]
     eye_in_hand = (
         np.array([cx, cy - EYE_IN_HAND_FRONT_M, hi_W[2] + EYE_IN_HAND_ABOVE_TOP_M]),
         np.array([cx, cy, lo_W[2] + 0.4 * extent[2]]),  # a little below mid-height, as in the shipped fences
     )
+    closeup_only: tuple[str, ...] | None = None
+    if sight is None:
+        cameras: dict[str, tuple[FloatArray, FloatArray]] = {}
+        for i, target in enumerate(sections):
+            for name, eye, t in camera_candidates(target, hi_W[2], "" if n == 1 else f"_{i + 1}")[1::-1]:
+                cameras[name] = (eye, t)
+    else:
+        X_WM = np.eye(4)
+        X_WM[:3, 3] = X_WM_xyz
+        map_W = weldmap.transformed(X_WM, "W")
+        cameras, eye_in_hand, closeup_only = choose_cameras(map_W, TABLE_TOP_M, sections, hi_W[2], eye_in_hand, sight)
     ws_lo, ws_hi = _round_out(lo_W[:2] - WORKSPACE_MARGIN_M, hi_W[:2] + WORKSPACE_MARGIN_M, WORKSPACE_ROUND_M)
     workspace = (
         np.array([*ws_lo, TABLE_TOP_M + WORKSPACE_ABOVE_TABLE_M]),
@@ -104,7 +117,9 @@ def layout(weldmap: WeldMap) -> Layout:
     )
     ends_W = np.array([p for s in weldmap.seams for p in (s.p_start, s.p_end)]) + X_WM_xyz
     far = float(np.linalg.norm(ends_W[:, :2] - X_WR_xyz[:2], axis=1).max()) if len(ends_W) else 0.0
-    return Layout(X_WM_xyz, lo_W, hi_W, table_center, table_size, X_WR_xyz, cameras, eye_in_hand, workspace, far)
+    return Layout(
+        X_WM_xyz, lo_W, hi_W, table_center, table_size, X_WR_xyz, cameras, eye_in_hand, workspace, far, closeup_only
+    )
 
 
 def _str(s: str) -> str:
@@ -131,6 +146,12 @@ def map_reference(map_path: Path, scenario_dir: Path) -> str:
     return os.fspath(map_path)
 
 
+def _side(d: FloatArray) -> str:
+    """Where a camera stands from the point it looks at, in words: ``+x``, ``-x +y`` ... (the robot is at -y)."""
+    words = [f"{'+' if d[k] > 0 else '-'}{'xy'[k]}" for k in (0, 1) if abs(d[k]) > 0.1 * float(np.hypot(d[0], d[1]))]
+    return " ".join(words) + (" (the robot's side)" if d[1] < -0.1 * float(np.hypot(d[0], d[1])) else "")
+
+
 def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: Layout) -> list[tuple[str, str]]:
     """(YAML line, its comment) pairs, in file order."""
     parts = ", ".join(p.name for p in weldmap.parts)
@@ -152,7 +173,7 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
         (f"  center_m: {_vec(lay.table_center)}", "its centre in the world [m]"),
         (f"  size_m: {_vec(lay.table_size)}", "the part's footprint + 0.2 m a side, at least 2.0 x 1.2 [m]"),
         ("robot:", "a KUKA KR 5 arc on a pedestal in front of the table, facing +y"),
-        ("  urdf: kr5_arc.urdf", "in the repository's robots/ folder"),
+        (f"  urdf: {ROBOT_URDF}", "in the repository's robots/ folder"),
         ("  X_WR:", "pose of the robot base in the world"),
         (f"    xyz_m: {_vec(lay.X_WR_xyz)}", "0.45 m before the table's near edge, at table-top height [m]"),
         (f"  home_deg: {_vec(ROBOT_HOME_DEG)}", "joints A1-A6 [deg]: arm over the table, torch well above"),
@@ -160,10 +181,10 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
     ]
     for cam, (eye, target) in lay.cameras.items():
         rows += [
-            (f"  {cam}:", "a fixed camera looking down at the part from one side"),
+            (f"  {cam}:", f"a fixed camera looking down at the part from {_side(eye - target)}"),
             (f"    eye_m: {_vec(eye)}", "where it is [m]"),
             (f"    target_m: {_vec(target)}", "the point it looks at [m]"),
-            ("    up: [0.0, 1.0, 0.0]", "portrait: the image's up is +y, so near and far ends are in view"),
+            (f"    up: {_vec(CAMERA_UP)}", "portrait: the image's up is +y, its long side along x"),
             (_CALIBRATION, _CALIBRATION_NOTE),
         ]
     eye, target = lay.eye_in_hand
@@ -191,13 +212,16 @@ def _lines(name: str, map_file: str, units: str | None, weldmap: WeldMap, lay: L
     return rows
 
 
-def scenario_text(map_path: Path, scenario_path: Path, units: str | None = None) -> tuple[str, Layout]:
-    """The YAML text of a scenario for ``map_path`` to be saved at ``scenario_path``, and its layout.
+def scenario_text(
+    map_path: Path, scenario_path: Path, units: str | None = None, sight: FaceSight | None = None
+) -> tuple[str, Layout]:
+    """The YAML text of a scenario for ``map_path`` to be saved at ``scenario_path``, and its layout (its fixed
+    cameras chosen by ``sight``: :func:`layout`).
 
     Raises MapError / MapUnitsError when the map cannot be read (``units`` is used when the DXF declares none).
     """
     weldmap = read_map(map_path, units=units)
-    lay = layout(weldmap)
+    lay = layout(weldmap, sight)
     map_file = map_reference(map_path, scenario_path.parent)
     rows = _lines(scenario_path.stem, map_file, units if weldmap.units == units else None, weldmap, lay)
     width = max(len(line) for line, _ in rows) + 2
@@ -209,6 +233,11 @@ def scenario_text(map_path: Path, scenario_path: Path, units: str | None = None)
         head.append(
             f"# Note: a seam lies {lay.far_seam_m:.2f} m from the robot base (the shipped cells weld up to "
             f"{REACH_M} m): it may be unreachable; move robot.X_WR or turn the part."
+        )
+    if lay.closeup_only:
+        head.append(
+            f"# Note: no fixed camera can see both faces of {', '.join(lay.closeup_only)} from around the part: only "
+            "the close-up re-scan will (rescan.mode low re-scans a seam not found)."
         )
     body = [f"{line:<{width}}# {comment}" for line, comment in rows]
     return "\n".join([*head, *body]) + "\n", lay

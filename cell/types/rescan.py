@@ -93,3 +93,20 @@ class Rescan:
     def motion_s(self) -> float:
         """Robot time of every move of the re-scan [s]."""
         return float(sum(m.duration for m in self.moves))
+
+
+@dataclass(frozen=True)
+class PlannedCloseup:
+    """A close-up view planned without moving the arm (``cell preview``, ``cell scenario check``): the view the
+    re-scan would take of one seam (``viewpoint``), or why none works (``reason``), or the seam whose close-up
+    would serve this one too (``served_by``: no view of its own)."""
+
+    seam_id: str
+    viewpoint: Viewpoint | None = None
+    reason: str = ""
+    served_by: str = ""
+
+    @property
+    def planned(self) -> bool:
+        """A view of its own, or another seam's that sees it."""
+        return self.viewpoint is not None or bool(self.served_by)

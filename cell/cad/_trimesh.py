@@ -4,6 +4,7 @@ that imports trimesh. Coordinates in the file's units (the caller scales them)."
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import defaultdict
 from pathlib import Path
@@ -102,7 +103,7 @@ def _edge(chain: list[int], V: FloatArray, pair_faces: dict[tuple[int, int], tup
     P = V[chain]
     seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
     breaks = np.concatenate([[0.0], np.cumsum(seg)]) / max(float(seg.sum()), 1e-300)
-    faces = tuple(pair_faces[(min(a, b), max(a, b))] for a, b in zip(chain[:-1], chain[1:], strict=True))
+    faces = tuple(pair_faces[(min(a, b), max(a, b))] for a, b in itertools.pairwise(chain))
     size = float(np.ptp(P, axis=0).max())
     d = P[-1] - P[0]
     if len(chain) == 2 or (

@@ -89,9 +89,9 @@ def _joint(a: Body, b: Body, c: Contact) -> Joint:
         if fa.kind != SurfaceKind.PLANE or float(fa.normal @ c.n_free) > -_AXIS_COS:
             continue
         for fb in b.faces:
-            if fb.kind == SurfaceKind.PLANE and float(fb.normal @ fa.normal) >= _AXIS_COS:
-                if abs(fb.offset - fa.offset) <= _COPLANAR_M:
-                    return Joint.CORNER
+            flush = abs(fb.offset - fa.offset) <= _COPLANAR_M
+            if fb.kind == SurfaceKind.PLANE and float(fb.normal @ fa.normal) >= _AXIS_COS and flush:
+                return Joint.CORNER
     return Joint.T
 
 

@@ -80,7 +80,7 @@ def roles(bodies: Sequence[Body], polys: Sequence[Polyhedron], gap_m: float) -> 
     while changed:  # nuts and washers: small bodies on a fastener
         changed = False
         for i, b in enumerate(bodies):
-            if out[i] == Role.PART and small[i]:
-                if any(out[j] == Role.FASTENER and _touch(b, o, gap_m) for j, o in enumerate(bodies) if j != i):
-                    out[i], changed = Role.FASTENER, True
+            on_one = any(out[j] == Role.FASTENER and _touch(b, o, gap_m) for j, o in enumerate(bodies) if j != i)
+            if out[i] == Role.PART and small[i] and on_one:
+                out[i], changed = Role.FASTENER, True
     return out

@@ -81,7 +81,7 @@ def from_cad(
     units: Annotated[
         str | None,
         typer.Option(
-            help="Units of the file (mm, cm, m, in): needed for a mesh whose size does not tell; a STEP's own win otherwise."
+            help="Units of the file (mm, cm, m, in): a mesh needs them unless its size tells; a STEP declares its own."
         ),
     ] = None,
     gap_mm: Annotated[float, typer.Option("--gap", help="Bodies this close [mm] touch.")] = 3.0,

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import ezdxf
 import numpy as np
+from ezdxf.entities import DXFGraphic
 from ezdxf.math import OCS, Vec3
 from ezdxf.render import MeshBuilder
 
@@ -68,7 +69,8 @@ def _mesh(body: DrawnBody) -> MeshBuilder:
 
 
 def _seam(msp: ezdxf.layouts.Modelspace, s: DrawnSeam) -> None:
-    attribs = {"layer": REJECTED_LAYER if s.rejected else SEAM_LAYER, "color": 256}
+    attribs: dict[str, object] = {"layer": REJECTED_LAYER if s.rejected else SEAM_LAYER, "color": 256}
+    e: DXFGraphic
     if s.kind == "line":
         e = msp.add_line(_mm(s.points[0]), _mm(s.points[1]), dxfattribs=attribs)
     elif s.kind == "arc" and s.centre is not None and s.axis is not None and s.start is not None:

@@ -23,6 +23,7 @@ LEG_M = 0.002  # the receiving face goes on this far past the edge; the corner i
 OPEN_M = (0.002, 0.005)  # the points along the fillet's bisector that must lie in no body [m]
 STEP_M = 0.001  # the edges are sampled this finely, then each stretch's ends found by bisection [m]
 BISECTIONS = 12  # 1 mm / 2^12: the ends to 0.00025 mm
+MIN_STRETCH_M = 0.005  # a shorter stretch is where an edge grazes a body's border: no fillet, not listed [m]
 
 
 @dataclass(frozen=True)
@@ -42,25 +43,32 @@ class Contact:
     dihedral: float
 
 
-def _nearest(body: Body, p: FloatArray) -> tuple[FloatArray, np.ndarray]:
-    """Distance (n,) from each point to the body's surface, and the face (n,) of the nearest triangle."""
+def _nearest(body: Body, p: FloatArray, reach: float) -> tuple[FloatArray, np.ndarray]:
+    """Distance (n,) from each point to the body's surface, and the face (n,) of the nearest triangle; a point
+    farther than ``reach`` [m] from every triangle gets infinity (and face -1)."""
     V, T = body.vertices, body.triangles
-    a, b, c = V[T[:, 0]], V[T[:, 1]], V[T[:, 2]]
-    d = np.empty(len(p))
-    f = np.empty(len(p), dtype=np.intp)
-    step = max(1, 200_000 // max(1, len(T)))
-    for s in range(0, len(p), step):
-        q = p[s : s + step]
-        i, j = np.divmod(np.arange(len(q) * len(T)), len(T))
-        D = pair_distance(q[i], a[j], b[j], c[j]).reshape(len(q), len(T))
+    tri = V[T]
+    t_lo, t_hi = tri.min(axis=1) - reach, tri.max(axis=1) + reach
+    d = np.full(len(p), np.inf)
+    f = np.full(len(p), -1, dtype=np.intp)
+    for s in range(0, len(p), 64):  # consecutive samples lie close together: each chunk meets few triangles
+        q = p[s : s + 64]
+        near = np.flatnonzero(np.all((t_hi >= q.min(axis=0)) & (t_lo <= q.max(axis=0)), axis=1))
+        if len(near) == 0:
+            continue
+        i, j = np.divmod(np.arange(len(q) * len(near)), len(near))
+        D = pair_distance(q[i], tri[near[j], 0], tri[near[j], 1], tri[near[j], 2]).reshape(len(q), len(near))
         k = np.argmin(D, axis=1)
-        d[s : s + step], f[s : s + step] = D[np.arange(len(q)), k], body.triangle_face[k]
+        best = D[np.arange(len(q)), k]
+        hit = best <= reach
+        d[s : s + 64] = np.where(hit, best, np.inf)
+        f[s : s + 64] = np.where(hit, body.triangle_face[near[k]], -1)
     return d, f
 
 
 def _normals(body: Body, faces: np.ndarray, p: FloatArray) -> FloatArray:
     n = np.zeros((len(p), 3))
-    for face in np.unique(faces):
+    for face in np.unique(faces[faces >= 0]):
         m = faces == face
         n[m] = body.normal_at(int(face), p[m])
     return n
@@ -72,11 +80,13 @@ class _Test:
     def __init__(self, bodies: Sequence[Body], polys: Sequence[Polyhedron], a: int, b: int, edge: Edge, gap_m: float):
         self.A, self.B, self.edge, self.gap = bodies[a], bodies[b], edge, gap_m
         self.polys = polys
+        self.others = [poly for i, poly in enumerate(polys) if i not in (a, b)]
 
     def __call__(self, t: FloatArray) -> tuple[np.ndarray, FloatArray, FloatArray, FloatArray, FloatArray]:
         """Whether each parameter passes, and the resting, free and receiving normals and dihedral there."""
         p = self.edge.at(t)
-        dist, fb = _nearest(self.B, p)
+        reach = self.gap + 2.0 * LEG_M
+        dist, fb = _nearest(self.B, p, reach)
         n_b = _normals(self.B, fb, p)
         pairs = np.array(self.edge.faces)[self.edge.piece(t)]
         n1, n2 = _normals(self.A, pairs[:, 0], p), _normals(self.A, pairs[:, 1], p)
@@ -87,11 +97,14 @@ class _Test:
         cos = np.clip(np.einsum("ij,ij->i", n_free, n_b), -1.0, 1.0)
         dihedral = math.pi - np.arccos(cos)
         ok = (dist <= self.gap) & (rest1 ^ rest2) & (dihedral >= MIN_DIHEDRAL) & (dihedral <= MAX_DIHEDRAL)
+        between = p - 0.5 * np.where(ok, dist, 0.0)[:, None] * n_b  # the gap itself is empty (no washer between a head and a plate)
+        for poly in self.others:
+            ok &= ~poly.contains(between)
         # The receiving face goes on past the edge, on the free face's side (else the faces are flush: no fillet).
         u = n_free - cos[:, None] * n_b
         u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
         q = p + LEG_M * u
-        d_q, f_q = _nearest(self.B, q)
+        d_q, f_q = _nearest(self.B, q, reach)
         same = np.einsum("ij,ij->i", _normals(self.B, f_q, q), n_b) >= ANTIPARALLEL_COS
         ok &= (d_q <= self.gap + 1e-4) & same
         # The fillet's corner is open: no body (a third one covering the seam, or A or B themselves) in it.
@@ -177,6 +190,8 @@ def _edge_contacts(
     out = []
     for t0, t1 in spans:
         span = (t1 - t0) % 1.0 if t1 < t0 else t1 - t0
+        if span * edge.length < MIN_STRETCH_M:
+            continue
         mid = np.array([(t0 + span / 2.0) % 1.0])
         _, n_rest, n_free, n_b, dih = test(mid)
         out.append(Contact(a, b, k, t0, t1, n_rest[0], n_free[0], n_b[0], float(dih[0])))

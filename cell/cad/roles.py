@@ -49,7 +49,7 @@ def _in_a_hole(small: Body, big: Body, big_poly: Polyhedron) -> bool:
     inside = np.all(p @ hull.equations[:, :3].T + hull.equations[:, 3] <= -HOLE_DEPTH_M, axis=1)
     if not inside.any():
         return False
-    return bool(np.any(~big_poly.contains(p[inside], margin=HOLE_DEPTH_M)))
+    return bool(np.any(~big_poly.contains(p[inside])))
 
 
 def _touch(a: Body, b: Body, gap_m: float) -> bool:

@@ -15,6 +15,7 @@ if TYPE_CHECKING:
     from cell.cad import Proposals
 
 UNITS = ("mm", "cm", "m", "in")
+GAP_MM, MIN_LENGTH_MM = 3.0, 20.0  # cell.cad.GAP_M and MIN_LENGTH_M (held equal by a test; cell.cad loads lazily)
 
 
 def _warn(msg: str) -> None:
@@ -27,9 +28,9 @@ def convert(
     target: Path,
     *,
     units: str | None,
-    gap_mm: float,
-    min_length_mm: float,
-    picture: Path | None,
+    gap_mm: float = GAP_MM,
+    min_length_mm: float = MIN_LENGTH_MM,
+    picture: Path | None = None,
 ) -> Proposals:
     """Read ``part``, propose its seams, write the map to ``target`` and the picture beside it (or to
     ``picture``); print the proposals, one line each. Raises CellError (MapError, MapUnitsError, UsageError)."""
@@ -84,10 +85,10 @@ def from_cad(
             help="Units of the file (mm, cm, m, in): a mesh needs them unless its size tells; a STEP declares its own."
         ),
     ] = None,
-    gap_mm: Annotated[float, typer.Option("--gap", help="Bodies this close [mm] touch.")] = 3.0,
+    gap_mm: Annotated[float, typer.Option("--gap", help="Bodies this close [mm] touch.")] = GAP_MM,
     min_length_mm: Annotated[
         float, typer.Option("--min-length", help="Shorter fillets [mm] are listed as rejected, not proposed.")
-    ] = 20.0,
+    ] = MIN_LENGTH_MM,
     picture: Annotated[
         Path | None, typer.Option(help="The picture of the proposals (PNG; default: the map's name, .png).")
     ] = None,

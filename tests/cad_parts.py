@@ -25,7 +25,7 @@ TRUE_CIRCLES = {"TUBE>PLATE": ((300.0, 200.0, 12.0), 30.0)}  # the tube's outer 
 
 def _ocp_bodies() -> list[tuple[str, object]]:
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon, BRepBuilderAPI_MakeFace
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
     from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt, gp_Vec
 

@@ -67,9 +67,9 @@ def write_step_with_gusset(path: Path) -> Path:
     return write_step(path, gusset=True)
 
 
-def write_step(path: Path, names: bool = True, gusset: bool = False) -> Path:
-    """The part as a STEP assembly (AP214, millimetres), each body a named product (``names`` False: unnamed, and
-    the bolt's parts named nothing that tells what they are)."""
+def write_step(path: Path, names: bool = True, gusset: bool = False, inches: bool = False) -> Path:
+    """The part as a STEP assembly (AP214, millimetres or ``inches``), each body a named product (``names`` False:
+    unnamed, and the bolt's parts named nothing that tells what they are)."""
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.Interface import Interface_Static
     from OCP.Message import Message, Message_Gravity
@@ -95,13 +95,21 @@ def write_step(path: Path, names: bool = True, gusset: bool = False) -> Path:
         from OCP.gp import gp_Pnt
 
         bodies.append(("GUSSET", BRepPrimAPI_MakeBox(gp_Pnt(*GUSSET[0]), gp_Pnt(*GUSSET[1])).Shape()))
+    if inches:  # the same part drawn in inches, the document told so
+        from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+        from OCP.gp import gp_Pnt, gp_Trsf
+
+        scale = gp_Trsf()
+        scale.SetScale(gp_Pnt(0.0, 0.0, 0.0), 1.0 / 25.4)
+        bodies = [(n, BRepBuilderAPI_Transform(s, scale, True).Shape()) for n, s in bodies]
+        XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.0254)
     for k, (name, shape) in enumerate(bodies):
         label = tool.AddShape(shape, False)
         TDataStd_Name.Set_s(label, TCollection_ExtendedString(name if names else f"SOLID{k + 1}"))
         tool.AddComponent(assembly, label, TopLoc_Location())
     tool.UpdateAssemblies()
-    Interface_Static.SetCVal_s("write.step.unit", "MM")
-    writer = STEPCAFControl_Writer()
+    writer = STEPCAFControl_Writer()  # its controller sets the defaults: the unit after it
+    Interface_Static.SetCVal_s("write.step.unit", "INCH" if inches else "MM")
     writer.SetNameMode(True)
     writer.Transfer(doc, STEPControl_AsIs)
     assert writer.Write(str(path)) == IFSelect_RetDone

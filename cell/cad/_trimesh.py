@@ -22,16 +22,16 @@ REL_TOL = 1e-3  # a chain is a line or circle when its points lie this close (ti
 
 
 def _meshes(path: Path) -> list[tuple[str, trimesh.Trimesh]]:
-    try:
-        loaded = trimesh.load(str(path), process=True)
+    try:  # an OBJ's objects kept apart, by name, whatever their materials
+        scene = trimesh.load_scene(str(path), split_objects=True, group_material=False, process=True)
     except Exception as exc:  # trimesh raises many types on a broken file (ValueError, KeyError, struct.error)
         raise MapError(f"{path}: not a readable mesh ({type(exc).__name__}: {exc})") from None
-    stem = path.stem.upper()
-    if isinstance(loaded, trimesh.Scene):
-        return [(str(name), g) for name, g in loaded.geometry.items() if isinstance(g, trimesh.Trimesh)]
-    if isinstance(loaded, trimesh.Trimesh):
-        return [(stem, loaded)]
-    raise MapError(f"{path}: holds no triangle mesh (a point cloud?); export the part's surfaces as triangles")
+    meshes = sorted((str(n), g) for n, g in scene.geometry.items() if isinstance(g, trimesh.Trimesh) and len(g.faces))
+    if not meshes:
+        raise MapError(f"{path}: holds no triangle mesh (a point cloud?); export the part's surfaces as triangles")
+    if len(meshes) == 1:
+        return [(path.stem.upper(), meshes[0][1])]
+    return meshes
 
 
 def _faces(mesh: trimesh.Trimesh) -> tuple[list[Face], np.ndarray]:

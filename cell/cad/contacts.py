@@ -97,9 +97,8 @@ class _Test:
         cos = np.clip(np.einsum("ij,ij->i", n_free, n_b), -1.0, 1.0)
         dihedral = math.pi - np.arccos(cos)
         ok = (dist <= self.gap) & (rest1 ^ rest2) & (dihedral >= MIN_DIHEDRAL) & (dihedral <= MAX_DIHEDRAL)
-        between = (
-            p - 0.5 * np.where(ok, dist, 0.0)[:, None] * n_b
-        )  # the gap itself is empty (no washer between a head and a plate)
+        # The gap itself is empty: no washer between a bolt's head and the plate.
+        between = p - 0.5 * np.where(ok, dist, 0.0)[:, None] * n_b
         for poly in self.others:
             ok &= ~poly.contains(between)
         # The receiving face goes on past the edge, on the free face's side (else the faces are flush: no fillet).

@@ -182,3 +182,32 @@ def test_from_cad_writes_a_map_the_reader_welds(step_file: Path, tmp_path: Path)
     assert again.read_bytes() == out.read_bytes()  # byte-stable
     info = CliRunner().invoke(app, ["map", "info", str(out)])
     assert info.exit_code == 0 and "T 90 deg  WEB > PLATE" in info.stdout
+
+
+def test_units_come_from_the_step_header(tmp_path: Path) -> None:
+    inch = write_step(tmp_path / "inch.step", inches=True)
+    assert "CONVERSION_BASED_UNIT('INCH'" in inch.read_text()
+    model = read_cad(inch)
+    assert model.units == "in" and model.warnings == ()
+    _check_every_fillet(propose(model), {"WEB": "WEB", "PLATE": "PLATE", "TUBE": "TUBE"})
+    told = read_cad(inch, units="mm")  # the user's units win (a header written wrong), with a warning
+    assert told.units == "mm" and "declares in" in told.warnings[0]
+    web = next(b for b in told.bodies if b.name == "WEB")
+    assert float(web.extent[1]) == pytest.approx(0.200 / 25.4, rel=1e-9)
+
+
+def test_an_obj_keeps_its_objects_names(tmp_path: Path) -> None:
+    import trimesh  # the test writes the file; cell.cad reads it through its adapter
+
+    plate = trimesh.creation.box(extents=(400.0, 300.0, 12.0))
+    plate.apply_translation((200.0, 150.0, 6.0))
+    web = trimesh.creation.box(extents=(12.0, 200.0, 100.0))
+    web.apply_translation((150.0, 150.0, 62.0))
+    scene = trimesh.Scene()
+    scene.add_geometry(plate, geom_name="Base plate")
+    scene.add_geometry(web, geom_name="WEB")
+    path = tmp_path / "part.obj"
+    scene.export(path)
+    found = propose(read_cad(path, units="mm"))
+    assert sorted(b.name for b in found.model.bodies) == ["BASE_PLATE", "WEB"]  # a space is no layer character
+    assert sorted(s.id for s in found.proposed) == ["WEB>BASE_PLATE:+x", "WEB>BASE_PLATE:-x"]

@@ -211,3 +211,19 @@ def test_an_obj_keeps_its_objects_names(tmp_path: Path) -> None:
     found = propose(read_cad(path, units="mm"))
     assert sorted(b.name for b in found.model.bodies) == ["BASE_PLATE", "WEB"]  # a space is no layer character
     assert sorted(s.id for s in found.proposed) == ["WEB>BASE_PLATE:+x", "WEB>BASE_PLATE:-x"]
+
+
+def test_init_from_a_mesh_asks_for_its_units_and_writes_the_map_beside_the_scenario(
+    stl_file: Path, tmp_path: Path
+) -> None:
+    runner = CliRunner()
+    scenario = tmp_path / "cell" / "part.yaml"
+    scenario.parent.mkdir()
+    result = runner.invoke(app, ["init", str(stl_file), "--out", str(scenario)])
+    assert result.exit_code == 12 and "--units" in result.stderr and not scenario.exists()
+    result = runner.invoke(app, ["init", str(stl_file), "--out", str(scenario), "--units", "mm"])
+    assert result.exit_code == 0, result.stderr
+    assert (tmp_path / "cell" / "part.dxf").is_file() and (tmp_path / "cell" / "part.png").is_file()
+    assert "file: part.dxf" in scenario.read_text()
+    again = runner.invoke(app, ["init", str(stl_file), "--out", str(scenario), "--units", "mm"])
+    assert again.exit_code == 2 and "exists" in again.stderr  # neither the scenario nor its map overwritten

@@ -110,7 +110,7 @@ def _edge(chain: list[int], V: FloatArray, pair_faces: dict[tuple[int, int], tup
         np.linalg.norm(d) > 0
         and np.abs(np.cross(P - P[0], d / np.linalg.norm(d))).max() <= REL_TOL * float(np.linalg.norm(d))
     ):
-        return Edge(CurveKind.LINE, P[[0, -1]], tuple(faces[:1]) * 1 if len(faces) == 1 else (faces[0],))
+        return Edge(CurveKind.LINE, P[[0, -1]], (faces[0],))  # one piece: a line's faces do not change
     fit = _circle(P) if len(chain) >= 5 else None
     if fit is not None and fit[3] <= REL_TOL * size:
         centre, n, r, _ = fit

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.cad.model import Body, CadModel
+from cell.cad.model import Body, CadModel, Edge, Face
 from cell.errors import MapError, MapUnitsError
 from cell.weldmap import METRES_PER_UNIT
 from cell.weldmap.units import NAMES, PLAUSIBLE_EXTENT_M
@@ -41,8 +41,6 @@ def _names(bodies: list[Body]) -> list[Body]:
 def _scaled(b: Body, k: float) -> Body:
     if k == 1.0:
         return b
-    from cell.cad.model import Edge, Face
-
     faces = tuple(Face(f.kind, f.normal, f.offset * k, f.origin * k, f.axis, f.radius * k, f.sign) for f in b.faces)
     edges = tuple(
         Edge(e.kind, e.points * k, e.faces, e.breaks, e.centre * k, e.axis, e.radius * k, e.start, e.sweep)

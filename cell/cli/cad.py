@@ -85,9 +85,9 @@ def from_cad(
             help="Units of the file (mm, cm, m, in): a mesh needs them unless its size tells; a STEP declares its own."
         ),
     ] = None,
-    gap_mm: Annotated[float, typer.Option("--gap", help="Bodies this close [mm] touch.")] = GAP_MM,
+    gap_mm: Annotated[float, typer.Option("--gap", help="Bodies this close (mm) touch.")] = GAP_MM,
     min_length_mm: Annotated[
-        float, typer.Option("--min-length", help="Shorter fillets [mm] are listed as rejected, not proposed.")
+        float, typer.Option("--min-length", help="Fillets shorter than this (mm) are listed as rejected, not proposed.")
     ] = MIN_LENGTH_MM,
     picture: Annotated[
         Path | None, typer.Option(help="The picture of the proposals (PNG; default: the map's name, .png).")

@@ -23,6 +23,7 @@ LEG_M = 0.002  # the receiving face goes on this far past the edge; the corner i
 OPEN_M = (0.002, 0.005)  # the points along the fillet's bisector that must lie in no body [m]
 STEP_M = 0.001  # the edges are sampled this finely, then each stretch's ends found by bisection [m]
 BISECTIONS = 12  # 1 mm / 2^12: the ends to 0.00025 mm
+FLUSH_M = 0.0005  # past the edge the receiving face is this much farther than at it: it ended there (flush) [m]
 MIN_STRETCH_M = 0.005  # a shorter stretch is where an edge grazes a body's border: no fillet, not listed [m]
 
 
@@ -107,7 +108,7 @@ class _Test:
         q = p + LEG_M * u
         d_q, f_q = _nearest(self.B, q, reach)
         same = np.einsum("ij,ij->i", _normals(self.B, f_q, q), n_b) >= ANTIPARALLEL_COS
-        ok &= (d_q <= self.gap + 1e-4) & same
+        ok &= (d_q <= np.where(ok, dist, 0.0) + FLUSH_M) & same
         # The fillet's corner is open: no body (a third one covering the seam, or A or B themselves) in it.
         bis = n_free + n_b
         bis /= np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-300)

@@ -227,3 +227,29 @@ def test_init_from_a_mesh_asks_for_its_units_and_writes_the_map_beside_the_scena
     assert "file: part.dxf" in scenario.read_text()
     again = runner.invoke(app, ["init", str(stl_file), "--out", str(scenario), "--units", "mm"])
     assert again.exit_code == 2 and "exists" in again.stderr  # neither the scenario nor its map overwritten
+
+
+def _boxes_stl(path: Path, boxes: list[tuple[tuple[float, float, float], tuple[float, float, float]]]) -> Path:
+    import trimesh
+
+    meshes = []
+    for lo, hi in boxes:
+        m = trimesh.creation.box(extents=np.subtract(hi, lo))
+        m.apply_translation(np.add(lo, hi) / 2.0)
+        meshes.append(m)
+    trimesh.util.concatenate(meshes).export(path)
+    return path
+
+
+def test_a_lap_plate_and_an_l_corner(tmp_path: Path) -> None:
+    base = ((0.0, 0.0, 0.0), (400.0, 250.0, 12.0))
+    lap = ((50.0, 40.0, 12.0), (150.0, 210.0, 20.0))  # 8 mm plate lying on the base: four lap fillets
+    wall = ((388.0, 0.0, 12.0), (400.0, 250.0, 150.0))  # standing flush on the base's +x edge: an L
+    found = propose(read_cad(_boxes_stl(tmp_path / "l.stl", [base, lap, wall]), units="mm"))
+    names = {round(float(b.extent[2]) * 1000.0): b.name for b in found.model.bodies}  # 12, 8, 138 mm tall
+    laps = [s for s in found.proposed if s.abutting == names[8]]
+    assert len(laps) == 4 and {s.joint.value for s in laps} == {"lap"}
+    assert sorted(round(s.curve.length * 1000.0, 6) for s in laps) == [100.0, 100.0, 170.0, 170.0]
+    (inside,) = [s for s in found.proposed if s.abutting == names[138]]  # the outside of the L is flush: none
+    assert inside.joint.value == "corner" and inside.id.endswith(":-x")
+    assert np.allclose(inside.curve.points[:, 0] * 1000.0, 388.0) and inside.curve.length == pytest.approx(0.25)

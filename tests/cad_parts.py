@@ -67,7 +67,10 @@ def write_step_with_gusset(path: Path) -> Path:
     return write_step(path, gusset=True)
 
 
-def write_step(path: Path, names: bool = True, gusset: bool = False, inches: bool = False) -> Path:
+CLAMP = ((300.0, 0.0, 12.0), (340.0, 30.0, 40.0))  # a block on the plate, on layer FIXTURE_CLAMPS in the STEP
+
+
+def write_step(path: Path, names: bool = True, gusset: bool = False, inches: bool = False, clamp: bool = False) -> Path:
     """The part as a STEP assembly (AP214, millimetres or ``inches``), each body a named product (``names`` False:
     unnamed, and the bolt's parts named nothing that tells what they are)."""
     from OCP.IFSelect import IFSelect_RetDone
@@ -95,6 +98,11 @@ def write_step(path: Path, names: bool = True, gusset: bool = False, inches: boo
         from OCP.gp import gp_Pnt
 
         bodies.append(("GUSSET", BRepPrimAPI_MakeBox(gp_Pnt(*GUSSET[0]), gp_Pnt(*GUSSET[1])).Shape()))
+    if clamp:
+        from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+        from OCP.gp import gp_Pnt
+
+        bodies.append(("BLOCK", BRepPrimAPI_MakeBox(gp_Pnt(*CLAMP[0]), gp_Pnt(*CLAMP[1])).Shape()))
     if inches:  # the same part drawn in inches, the document told so
         from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
         from OCP.gp import gp_Pnt, gp_Trsf
@@ -107,6 +115,8 @@ def write_step(path: Path, names: bool = True, gusset: bool = False, inches: boo
         label = tool.AddShape(shape, False)
         TDataStd_Name.Set_s(label, TCollection_ExtendedString(name if names else f"SOLID{k + 1}"))
         tool.AddComponent(assembly, label, TopLoc_Location())
+        if name == "BLOCK":
+            XCAFDoc_DocumentTool.LayerTool_s(doc.Main()).SetLayer(label, TCollection_ExtendedString("FIXTURE_CLAMPS"))
     tool.UpdateAssemblies()
     writer = STEPCAFControl_Writer()  # its controller sets the defaults: the unit after it
     Interface_Static.SetCVal_s("write.step.unit", "INCH" if inches else "MM")

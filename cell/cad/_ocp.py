@@ -1,5 +1,5 @@
-"""STEP in through OpenCascade (cadquery-ocp): the assembly's solids with their names, exact planes and cylinders,
-sharp edges as lines and circular arcs, and a tessellation. The only module that imports OCP."""
+"""STEP in through OpenCascade (cadquery-ocp): the assembly's solids with their names and layers, exact planes and
+cylinders, sharp edges as lines and circular arcs, and a tessellation. The only module that imports OCP."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 from OCP.XCAFApp import XCAFApp_Application
-from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_LayerTool, XCAFDoc_ShapeTool
 
 from cell.cad.model import Body, CurveKind, Edge, Face, SurfaceKind
 from cell.errors import MapError
@@ -54,21 +54,30 @@ def _name(label: TDF_Label) -> str:
     return ""
 
 
-def _solids(tool: XCAFDoc_ShapeTool, source: str) -> list[tuple[str, TopoDS_Shape]]:
-    """(name, located solid) of every solid in the document, assemblies walked, in the file's order."""
-    out: list[tuple[str, TopoDS_Shape]] = []
+def _layers(layers: XCAFDoc_LayerTool, label: TDF_Label) -> tuple[str, ...]:
+    found = layers.GetLayers(label)
+    return tuple(str(found.Value(i + 1).ToExtString()) for i in range(found.Length()))
 
-    def walk(label: TDF_Label, loc: TopLoc_Location, name: str) -> None:
+
+def _solids(
+    tool: XCAFDoc_ShapeTool, layers: XCAFDoc_LayerTool, source: str
+) -> list[tuple[str, tuple[str, ...], TopoDS_Shape]]:
+    """(name, layers, located solid) of every solid in the document, assemblies walked, in the file's order; a
+    body's layers are those of its instance, of its product and of the assemblies above it."""
+    out: list[tuple[str, tuple[str, ...], TopoDS_Shape]] = []
+
+    def walk(label: TDF_Label, loc: TopLoc_Location, name: str, on: tuple[str, ...] = ()) -> None:
+        on = on + _layers(layers, label)
         if XCAFDoc_ShapeTool.IsReference_s(label):
             ref = TDF_Label()
             XCAFDoc_ShapeTool.GetReferredShape_s(label, ref)
-            walk(ref, loc.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(label)), _name(ref) or name)
+            walk(ref, loc.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(label)), _name(ref) or name, on)
             return
         if XCAFDoc_ShapeTool.IsAssembly_s(label):
             comps = TDF_LabelSequence()
             XCAFDoc_ShapeTool.GetComponents_s(label, comps)
             for i in range(comps.Length()):
-                walk(comps.Value(i + 1), loc, name)
+                walk(comps.Value(i + 1), loc, name, on)
             return
         shape = XCAFDoc_ShapeTool.GetShape_s(label).Moved(loc)
         found = TopExp_Explorer(shape, TopAbs_SOLID)
@@ -77,7 +86,7 @@ def _solids(tool: XCAFDoc_ShapeTool, source: str) -> list[tuple[str, TopoDS_Shap
             solids.append(found.Current())
             found.Next()
         for k, solid in enumerate(solids):
-            out.append((name if len(solids) == 1 else f"{name}_{k + 1}", solid))
+            out.append((name if len(solids) == 1 else f"{name}_{k + 1}", on, solid))
 
     labels = TDF_LabelSequence()
     tool.GetFreeShapes(labels)
@@ -168,7 +177,7 @@ def _tessellation(solid: TopoDS_Shape, fmap: TopTools_IndexedMapOfShape) -> tupl
     return V[first], inverse.reshape(-1)[np.array(tris)], np.array(owner, dtype=np.intp)
 
 
-def _body(name: str, solid: TopoDS_Shape) -> Body:
+def _body(name: str, layers: tuple[str, ...], solid: TopoDS_Shape) -> Body:
     fmap = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(solid, TopAbs_FACE, fmap)
     faces = tuple(_face(fmap.FindKey(i)) for i in range(1, fmap.Extent() + 1))
@@ -183,7 +192,7 @@ def _body(name: str, solid: TopoDS_Shape) -> Body:
         if edge is not None and edge.length > 1e-6:
             edges.append(edge)
     V, T, owner = _tessellation(solid, fmap)
-    return Body(name, faces, tuple(edges), V, T, owner)
+    return Body(name, faces, tuple(edges), V, T, owner, layers)
 
 
 def read_step(path: Path) -> tuple[list[Body], str]:
@@ -203,7 +212,8 @@ def read_step(path: Path) -> tuple[list[Body], str]:
     if not reader.Transfer(doc):
         raise MapError(f"{src}: OpenCascade could not transfer the STEP file's shapes")
     tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
-    bodies = [_body(name, solid) for name, solid in _solids(tool, src)]
+    layers = XCAFDoc_DocumentTool.LayerTool_s(doc.Main())
+    bodies = [_body(name, on, solid) for name, on, solid in _solids(tool, layers, src)]
     if not bodies:
         raise MapError(f"{src}: no solid bodies in the STEP file (surfaces or wires only?); the parts must be solids")
     unit = UNIT_NAMES.get(declared[0].lower(), declared[0]) if declared else "mm"

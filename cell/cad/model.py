@@ -112,9 +112,9 @@ class Edge:
 
 @dataclass(frozen=True)
 class Body:
-    """A solid of the CAD: its name (the assembly's, or the file's and a number), its faces and sharp edges, and
-    its tessellation (``vertices`` (k, 3) [m], ``triangles`` (t, 3) counter-clockwise seen from outside,
-    ``triangle_face`` (t,) the face each triangle belongs to)."""
+    """A solid of the CAD: its name (the assembly's, or the file's and a number), its layers, its faces and sharp
+    edges, and its tessellation (``vertices`` (k, 3) [m], ``triangles`` (t, 3) counter-clockwise seen from
+    outside, ``triangle_face`` (t,) the face each triangle belongs to)."""
 
     name: str
     faces: tuple[Face, ...]
@@ -122,6 +122,7 @@ class Body:
     vertices: FloatArray
     triangles: np.ndarray
     triangle_face: np.ndarray
+    layers: tuple[str, ...] = ()  # the CAD's layers the body is on (a STEP's; a mesh has none)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "vertices", readonly(self.vertices))

@@ -46,7 +46,7 @@ def _scaled(b: Body, k: float) -> Body:
         Edge(e.kind, e.points * k, e.faces, e.breaks, e.centre * k, e.axis, e.radius * k, e.start, e.sweep)
         for e in b.edges
     )
-    return Body(b.name, faces, edges, b.vertices * k, b.triangles, b.triangle_face)
+    return Body(b.name, faces, edges, b.vertices * k, b.triangles, b.triangle_face, b.layers)
 
 
 def _mesh_units(extent_units: float, src: str) -> str:

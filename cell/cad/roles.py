@@ -59,9 +59,15 @@ def _touch(a: Body, b: Body, gap_m: float) -> bool:
 
 
 def roles(bodies: Sequence[Body], polys: Sequence[Polyhedron], gap_m: float) -> list[Role]:
-    """Each body's role: a fixture by its name (the map reader's fixture layers), a fastener by its name or its
+    """Each body's role: a fixture by its name or a layer it is on (the map reader's fixture layers: FIXTURE*,
+    CLAMP*, JIG*, STOP*), a fastener by its name or its
     place (small and through a hole of a larger body, or small and touching a fastener), else a part."""
-    out = [Role.FIXTURE if body_role(b.name, b.name, LayerRoles()) == "fixture" else Role.PART for b in bodies]
+    out = [
+        Role.FIXTURE
+        if any(body_role(b.name, layer, LayerRoles()) == "fixture" for layer in (b.name, *b.layers))
+        else Role.PART
+        for b in bodies
+    ]
     if not bodies:
         return out
     largest = max(b.volume for b in bodies)

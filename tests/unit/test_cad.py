@@ -253,3 +253,14 @@ def test_a_lap_plate_and_an_l_corner(tmp_path: Path) -> None:
     (inside,) = [s for s in found.proposed if s.abutting == names[138]]  # the outside of the L is flush: none
     assert inside.joint.value == "corner" and inside.id.endswith(":-x")
     assert np.allclose(inside.curve.points[:, 0] * 1000.0, 388.0) and inside.curve.length == pytest.approx(0.25)
+
+
+def test_a_body_on_a_fixture_layer_of_the_step_is_a_fixture(tmp_path: Path) -> None:
+    from cad_parts import write_step as write
+
+    found = propose(read_cad(write(tmp_path / "clamped.step", clamp=True)))
+    block = next(b for b in found.model.bodies if b.name == "BLOCK")
+    assert block.layers == ("FIXTURE_CLAMPS",)
+    assert found.roles[found.model.bodies.index(block)] == Role.FIXTURE
+    on_it = [s for s in found.seams if "BLOCK" in (s.abutting, s.receiving)]
+    assert on_it and all(s.rejected == Rejection.FIXTURE for s in on_it)  # its fillets on the plate: not welded

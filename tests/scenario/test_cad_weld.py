@@ -39,13 +39,13 @@ def test_every_straight_seam_is_located_within_fences_bars(welded: dict[str, Any
         assert s["error_mm"]["lateral"] <= 0.2, s  # measured 0.01-0.03 mm (fence1's ours: 0.09 mm mean)
         if s["welded"]:
             assert s["tcp_error_mm"]["rms"] <= 0.2, s  # measured 0.01 mm
+    assert any(by_id[sid]["welded"] for sid in TRUE_LINES)  # the fillet away from the tube (the other: below)
 
 
 @pytest.mark.xfail(
     strict=True,
-    reason="on this part the close-up's far end of each web fillet (ends from extent / extent, 3 sigma 3-5 mm) wins "
-    "the fusion (close-up weight 0.99) over the fixed cameras' (0.07 mm off): end_uncertain; the plate and web "
-    "alone weld both fillets at 0.01 mm RMS",
+    reason="one web fillet's far end, beside the tube, is read up close from where the web's points stop, and the tube "
+    "thins them unevenly: 0.7 mm off at an end sigma of 1.8 mm, refused (end_uncertain); the other fillet is welded",
 )
 def test_every_straight_seam_is_welded(welded: dict[str, Any]) -> None:
     by_id = {s["id"]: s for s in welded["seams"]}

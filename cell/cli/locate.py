@@ -205,10 +205,11 @@ def read_truth(path: Path, seam_ids: list[str], frame: str) -> dict[str, tuple[F
 
 
 def _save_cloud(cloud: Cloud, path: Path) -> Path:
+    from cell.outputs import replacing
     from cell.perception import save_ply
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_ply(cloud, path)
+    with replacing(path, what="cloud") as tmp:  # whole: save_ply writes the file, then rewrites its header
+        save_ply(cloud, tmp)
     return path
 
 

@@ -37,7 +37,7 @@ def init(
     from cell import scenario as sc
     from cell.cli.sight_lines import arm_torch
     from cell.config.motion import ViewOptions
-    from cell.export.atomic import write_atomic
+    from cell.outputs import write_atomic
     from cell.rescan.sight import pose_sight
     from cell.scenario.init import ROBOT_URDF, scenario_text
     from cell.weldmap import METRES_PER_UNIT

@@ -234,6 +234,10 @@ def test_reports_are_written_whole_with_the_umask_permissions(
     from cell.errors import OutputError
     from cell.export.report import write_json
 
+    with pytest.raises(OutputError) as e:
+        write_json(tmp_path / "sub" / "r.json", {})  # a missing folder is not made
+    assert "'" + str(tmp_path / "sub") + "' does not exist" in e.value.message and not (tmp_path / "sub").exists()
+    (tmp_path / "sub").mkdir()
     old = os.umask(0o027)
     try:
         p = write_json(tmp_path / "sub" / "r.json", {"a": 1})

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-import click
 import typer
 
 from cell import outputs
@@ -27,7 +26,37 @@ if TYPE_CHECKING:
 
 STDOUT = "-"
 T = TypeVar("T")
-_HELD = "cell.outputs.held"  # the click context's record of the folders this command holds
+
+
+@dataclass
+class _Held:
+    """What this command holds: its folders' locks, and the folders it made for its outputs."""
+
+    locks: dict[Path, outputs.FolderLock] = field(default_factory=dict)
+    made: list[Path] = field(default_factory=list)
+
+    def release(self) -> None:
+        """Free every lock, then remove each folder made for this job that it left empty."""
+        for lock in self.locks.values():
+            lock.release()
+        for folder in reversed(self.made):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        self.locks.clear()
+        self.made.clear()
+
+
+_held: _Held | None = None  # the running command's (None outside a command: the Python API holds nothing)
+
+
+def begin_command() -> Callable[[], None]:
+    """A command starts: what it will hold is recorded from now; the function returned releases it all (the root
+    callback calls it when the command ends, however it ends; a killed process's locks are freed by the kernel)."""
+    global _held
+    if _held is not None:
+        _held.release()
+    held = _held = _Held()
+    return held.release
 
 
 def _command() -> str:
@@ -42,15 +71,10 @@ def hold_folder(folder: Path, option: str) -> None:
     """Take ``folder``'s job lock for the rest of this command (once per folder; released when the command ends,
     however it ends). Outside a command (the Python API) nothing is held. OutputError (exit 2) naming the job
     that holds it."""
-    ctx = click.get_current_context(silent=True)
-    if ctx is None:
-        return
-    held: dict[Path, outputs.FolderLock] = ctx.meta.setdefault(_HELD, {})
-    if folder in held:
+    if _held is None or folder in _held.locks:
         return
     lock = outputs.hold(folder, command=_command(), option=option)
-    held[folder] = lock
-    ctx.call_on_close(lock.release)
+    _held.locks[folder] = lock
     if lock.taken_over is not None:
         left = f"; removed {len(lock.removed)} half-written file(s) it left" if lock.removed else ""
         warn(f"{option}: took over the lock of a job that never ended in {str(folder)!r} "
@@ -80,16 +104,9 @@ def check_folder(path: Path | None, option: str) -> None:
         return
     existed = outputs.resolve(path).is_dir()
     target = outputs.check_folder(path, option, create=True)
-    if not existed:  # made for this job: gone again if the job ends before writing anything into it
-        ctx = click.get_current_context(silent=True)
-        if ctx is not None:
-            ctx.call_on_close(lambda: _remove_if_empty(target))
+    if not existed and _held is not None:  # made for this job: gone again if the job ends without writing in it
+        _held.made.append(target)
     hold_folder(target, option)
-
-
-def _remove_if_empty(folder: Path) -> None:
-    with contextlib.suppress(OSError):
-        folder.rmdir()
 
 
 @dataclass

@@ -112,7 +112,7 @@ def weld(
         check_display(gui)
         check_file(json_path, "--json")
         program = _program_folder(program, krl)
-        check_folder(program, "--krl" if krl is not None else "--program")
+        check_folder(program, "--program")
         if controller not in ("krl", "rapid"):
             raise UsageError(f"--controller {controller!r} is unknown; valid: krl, rapid")
         check_file(html, "--html", stdout_ok=False)

@@ -89,7 +89,7 @@ def locate(
     with cell_errors():
         table = parse_format(fmt)
         check_file(json_path, "--json")
-        check_file(save_cloud, "--save-cloud_F", stdout_ok=False)
+        check_file(save_cloud, "--save-cloud", stdout_ok=False)
         check_units(units)
         check_frame(frame)
         if map_units is not None and map_units not in METRES_PER_UNIT:

@@ -56,7 +56,14 @@ def begin_command() -> Callable[[], None]:
     if _held is not None:
         _held.release()
     held = _held = _Held()
-    return held.release
+
+    def end() -> None:
+        global _held
+        held.release()
+        if _held is held:
+            _held = None
+
+    return end
 
 
 def _command() -> str:

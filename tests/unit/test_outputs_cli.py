@@ -62,7 +62,8 @@ def test_a_fifo_is_refused_before_any_work(tmp_path: Path, command: list[str], o
     os.mkfifo(fifo)
     code, err = run(*command, option, str(fifo))
     kind = "not a folder" if option in FOLDER_OPTIONS else "not a regular file"
-    one_line_refusal(code, err, option, str(fifo), "FIFO", kind)
+    named = "--program" if option == "--krl" else option  # the deprecated name's errors name the option to use
+    one_line_refusal(code, err, named, str(fifo), "FIFO", kind)
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode) and sorted(os.listdir(tmp_path)) == ["pipe"]
 
 
@@ -83,7 +84,7 @@ def test_a_socket_a_device_link_a_folder_and_a_missing_folder_are_refused(tmp_pa
     one_line_refusal(*run("weld", "fence1", "--program", str(gone)), f"'{gone.parent}' does not exist")
     assert not (tmp_path / "no").exists()
     (tmp_path / "k").write_text("a file")
-    one_line_refusal(*run("weld", "fence1", "--krl", str(tmp_path / "k")), "is a file, not a folder")
+    one_line_refusal(*run("weld", "fence1", "--krl", str(tmp_path / "k")), "--program", "is a file, not a folder")
 
 
 HOLDER = """

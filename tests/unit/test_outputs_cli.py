@@ -137,3 +137,11 @@ def test_a_link_is_written_through_and_the_lock_released(tmp_path: Path, monkeyp
     assert link.is_symlink() and os.readlink(link) == str(Path("runs") / "r1.json")
     assert json.loads((tmp_path / "runs" / "r1.json").read_text())["error"]["exit_code"] == 130
     assert sorted(os.listdir(tmp_path / "runs")) == ["r1.json"]  # the lock gone with the job, no temporary file
+
+
+def test_a_log_file_that_is_a_fifo_is_refused_instead_of_blocking(tmp_path: Path) -> None:
+    fifo = tmp_path / "run.log"
+    os.mkfifo(fifo)
+    code, err = run("--log-file", str(fifo), "detect", "fence1")
+    one_line_refusal(code, err, "--log-file", "FIFO")
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)

@@ -76,7 +76,7 @@ def check_file(path: str | Path, option: str = "output", *, probe: bool = True) 
                           code=OutputFault.RESERVED)  # fmt: skip
     try:
         mode = os.lstat(target).st_mode
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # none there, or its folder is a file: said below
         mode = None
     except OSError as e:
         raise OutputError(f"{option} {shown} cannot be read ({e.strerror or e}); {VALID_FILE}", path=str(p),

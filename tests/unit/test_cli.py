@@ -163,7 +163,7 @@ def test_usage_errors_exit_2_before_any_work(monkeypatch: pytest.MonkeyPatch) ->
     code, _, err = invoke("detect", "fence1", "--format", "xml")
     assert_one_line_error(code, err, 2, "--format", "csv")
     code, _, err = invoke("--log-file", str(REPO / "README.md" / "x.log"), "scenarios")
-    assert_one_line_error(code, err, 2, "log file")
+    assert_one_line_error(code, err, 2, "--log-file", "is not a folder")
 
 
 def test_the_console_script_ends_a_usage_error_with_one_error_line() -> None:

@@ -151,10 +151,11 @@ def detect(
 
 
 def _save_cloud(cloud: Any, path: Path) -> Path:
+    from cell.outputs import replacing
     from cell.perception import save_ply
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_ply(cloud, path)
+    with replacing(path, what="cloud") as tmp:  # whole: save_ply writes the file, then rewrites its header
+        save_ply(cloud, tmp)
     return path
 
 
@@ -195,7 +196,8 @@ def bench(
     """
     from cell import bench as b
     from cell import scenario as sc
-    from cell.export import write_atomic, write_json
+    from cell.export import write_json
+    from cell.outputs import write_atomic
     from cell.provenance import provenance
     from cell.seams.registry import METHODS
 
@@ -210,6 +212,8 @@ def bench(
         except ValueError as e:
             raise typer.BadParameter(str(e), param_hint="--extrinsics") from None
         folder = bench_folder(out_dir)
+        if out_dir is None:
+            folder.parent.mkdir(exist_ok=True)  # runs/, the cell's own (untracked) folder of run folders
         check_folder(folder, "--out")
         check_file(json_path, "--json", stdout_ok=False)
         loaded = [sc.load(n) for n in names]

@@ -42,7 +42,7 @@ def init(
     from cell import scenario as sc
     from cell.cli.sight_lines import arm_torch
     from cell.config.motion import ViewOptions
-    from cell.export.atomic import write_atomic
+    from cell.outputs import make_folder, write_atomic
     from cell.rescan.sight import pose_sight
     from cell.scenario.init import ROBOT_URDF, scenario_text
     from cell.weldmap import METRES_PER_UNIT
@@ -70,6 +70,7 @@ def init(
         sight = partial(pose_sight, torch_C=arm_torch(ROBOT_URDF, ViewOptions()))  # the scan camera sees past it
         text, lay = scenario_text(map_file, target.absolute(), units=units, sight=sight)
         scn = sc.from_yaml(text, target.absolute().parent, target.name)  # what is written loads as it is
+        make_folder(target.parent, "--out")  # the scenario's own folder (cells/ of cells/my_part.yaml), one level
         write_atomic(target, text.encode("utf-8"), what="scenario")
         size = lay.table_size
         say(

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -16,6 +15,7 @@ import numpy as np
 
 from cell.errors import CaptureError
 from cell.geometry import FloatArray, invert, readonly
+from cell.outputs import write_atomic, write_text
 from cell.recorded import _fields as f
 from cell.recorded.depth_png import encode, read_png, to_metres, write_png
 from cell.types import DepthImage, Part
@@ -137,15 +137,15 @@ def write_capture(
     index["cell"] = None
     index["truth"] = None
     if cell_yaml is not None:
-        (folder / CELL).write_text(cell_yaml, encoding="utf-8")
+        write_text(folder / CELL, cell_yaml, what="capture's cell")
         index["cell"] = CELL
         if map_file is not None and Path(map_file).resolve() != (folder / Path(map_file).name).resolve():
-            shutil.copyfile(map_file, folder / Path(map_file).name)
+            write_atomic(folder / Path(map_file).name, Path(map_file).read_bytes(), what="capture's map")
     if truth_parts_W is not None:
-        (folder / TRUTH).write_text(dumps(f.truth_json(tuple(truth_parts_W))), encoding="utf-8")
+        write_text(folder / TRUTH, dumps(f.truth_json(tuple(truth_parts_W))), what="capture's truth")
         index["truth"] = TRUTH
     index["cameras"] = cameras
-    (folder / INDEX).write_text(dumps(index), encoding="utf-8")
+    write_text(folder / INDEX, dumps(index), what="capture index")
     return folder
 
 

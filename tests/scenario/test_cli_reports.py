@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import shutil
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
@@ -125,7 +126,13 @@ def test_a_late_failure_loses_only_its_own_output(
     """The report's folder (then the program's) turns into a file during the run: the other output is still
     written, exit 2, and the last line names what was lost."""
     report, krl = tmp_path / "rep" / "r.json", tmp_path / "krl"
-    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: report.parent.write_text("")))
+    report.parent.mkdir()  # there when checked (a missing folder is refused before the run), then made a file
+
+    def folder_to_file(folder: Path) -> None:
+        shutil.rmtree(folder)
+        folder.write_text("")
+
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: folder_to_file(report.parent)))
     code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl))
     assert code == 2, err
     assert "Traceback" not in err and ".part" not in err
@@ -133,7 +140,7 @@ def test_a_late_failure_loses_only_its_own_output(
     assert (krl / "WELD_FENCE1.src").is_file() and (krl / "trajectory.csv").is_file()
 
     report, krl = tmp_path / "r2.json", tmp_path / "krl2"
-    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: krl.write_text("")))
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: folder_to_file(krl)))
     code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl))
     assert code == 2, err
     assert err.strip().splitlines()[-1].startswith("exit 2: could not write")

@@ -61,6 +61,23 @@ def _floats(path: Path, tokens: list[bytes]) -> npt.NDArray[np.float64]:
         raise _fail(path, f"the value {bad[:20].decode(errors='replace')!r} is not a number", "numbers") from None
 
 
+def _typed(path: Path, table: npt.NDArray[np.float64], columns: list[tuple[str, str]]) -> npt.NDArray[np.float64]:
+    """``table`` (rows, columns) of an ASCII body, once each integer column (``columns``: name, numpy kind) is
+    checked to hold whole numbers its type can hold."""
+    for j, (name, kind) in enumerate(columns):
+        if kind[0] not in "iu":
+            continue
+        info, col = np.iinfo(kind), table[:, j]
+        bad = ~np.isfinite(col) | (col != np.round(col)) | (col < info.min) | (col > info.max)
+        if bad.any():
+            raise _fail(
+                path,
+                f"its {name!r} values are of type {kind} but {int(bad.sum())} are not (e.g. {col[bad][0]:g})",
+                f"whole numbers from {info.min} to {info.max}, or a float type",
+            )
+    return table
+
+
 def _is_number(token: bytes) -> bool:
     try:
         float(token)
@@ -185,7 +202,8 @@ def parse_ply(path: Path, data: bytes) -> Body:
         tokens = b" ".join(mine).split()
         if len(tokens) != count * len(props):
             raise _fail(path, f"its vertex rows hold {len(tokens)} values, not {count} x {len(props)}", "whole rows")
-        return Body(count, _floats(path, tokens).reshape(count, len(props))[:, cols])
+        table = _typed(path, _floats(path, tokens).reshape(count, len(props)), [(n, k) for n, k in props])
+        return Body(count, table[:, cols])
     order = _PLY_FORMATS[fmt]
     for _, n, eprops in elements[:v]:
         offset += n * np.dtype([(f"p{i}", order + k) for i, (_, k) in enumerate(eprops)]).itemsize
@@ -260,7 +278,8 @@ def parse_pcd(path: Path, data: bytes) -> Body:
             raise _too_short(path, len(tokens) // width, points, "rows")
         if len(tokens) > points * width:
             raise _fail(path, f"its body holds {len(tokens)} values, more than {points} x {width}", "POINTS rows")
-        return Body(points, _floats(path, tokens).reshape(points, width)[:, cols])
+        columns = [(f, k) for f, (k, c) in zip(fields, kinds, strict=True) for _ in range(c)]
+        return Body(points, _typed(path, _floats(path, tokens).reshape(points, width), columns)[:, cols])
     dtype = np.dtype([(f"f{i}", "<" + k, (c,)) if c > 1 else (f"f{i}", "<" + k) for i, (k, c) in enumerate(kinds)])
     if mode == "binary":
         got = max(0, len(data) - offset) // dtype.itemsize

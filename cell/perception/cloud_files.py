@@ -1,6 +1,7 @@
 """Point cloud files people bring (``cell locate CLOUD``): PLY or PCD, ASCII or binary, known by content, read into a
-:class:`Cloud` in metres; implausible sizes and unusable files refused with a :class:`~cell.errors.CloudFileError`
-(docs/locate.md, "What it reads")."""
+:class:`Cloud` in metres; implausible sizes and unusable files refused with a :class:`~cell.errors.CloudFileError`,
+NaN rows, duplicated rows and stray returns far from the cloud's bulk dropped with a warning line (docs/locate.md,
+"What it reads")."""
 
 from __future__ import annotations
 
@@ -89,9 +90,10 @@ def read_cloud(
     path : the file (its format is known by content; see the module docstring for what is read and refused).
     units : the unit of the file's numbers: ``m`` (default), ``cm``, ``mm`` or ``in``.
     frame : the name of the data's own frame (``F`` by default: the frame the file's coordinates are in).
-    warn : called with one line when rows are dropped (default: a :class:`CloudFileWarning`).
+    warn : called with one line for each thing dropped or read past (default: a :class:`CloudFileWarning`).
 
-    Returns points (n, 3) [m] in ``frame``, finite, in file order, with no camera index (-1).
+    Returns points (n, 3) [m] in ``frame``, finite, distinct, near the bulk, in file order, with no camera index
+    (-1).
     Raises :class:`~cell.errors.CloudFileError` (exit 2) for a file that cannot be used, and
     :class:`~cell.errors.UsageError` for unknown ``units`` or a bad ``frame`` name.
     """

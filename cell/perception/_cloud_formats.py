@@ -202,8 +202,8 @@ def parse_ply(path: Path, data: bytes) -> Body:
         tokens = b" ".join(mine).split()
         if len(tokens) != count * len(props):
             raise _fail(path, f"its vertex rows hold {len(tokens)} values, not {count} x {len(props)}", "whole rows")
-        table = _typed(path, _floats(path, tokens).reshape(count, len(props)), [(n, k) for n, k in props])
-        return Body(count, table[:, cols])
+        values = _typed(path, _floats(path, tokens).reshape(count, len(props)), list(props))
+        return Body(count, values[:, cols])
     order = _PLY_FORMATS[fmt]
     for _, n, eprops in elements[:v]:
         offset += n * np.dtype([(f"p{i}", order + k) for i, (_, k) in enumerate(eprops)]).itemsize

@@ -155,7 +155,7 @@ def _mutations() -> dict[str, Mutation]:
             lambda: cam.update(X_RC=cam["X_RC"][:3]),
             lambda: cam.update(mount="ceiling"),
             lambda: cam.update(depth="../" + cam["depth"]),
-            lambda: cam.update(name=data["cameras"][0]["name"]) if len(data["cameras"]) > 1 else cam.pop("name"),
+            lambda: cam.update(name=next((c["name"] for c in data["cameras"] if c is not cam), None)),
             lambda: data.update(version=2),
             lambda: data.update(format="something-else"),
             lambda: data.update(cameras=[]),

@@ -20,6 +20,7 @@ from cell.types import Cloud
 UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}  # metres per unit of the file
 PLAUSIBLE_M = 20.0  # [m] no cloud of a weld cell reaches (or spans) this far from its frame's origin
 SMALLEST_M = 1e-3  # [m] a cloud spanning less than this cannot show a part
+FEW = 10  # points: fewer have no bulk to tell stray returns from
 BULK = 0.01  # the cloud's bulk: per axis, between the quantiles BULK and 1 - BULK (stray returns left out)
 FAR_MARGIN_M = 1.0  # [m] a point this far (or the bulk's span, if larger) outside the bulk's box is a stray return
 _FRAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
@@ -164,7 +165,9 @@ def _warning(msg: str) -> None:
 
 def bulk_box(p_F: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """The box (lo, hi) (3,) [m] of the cloud's bulk: per axis the quantiles :data:`BULK` and 1 - :data:`BULK`,
-    taken inward (a point at either end is never in them unless a cloud has only a few points)."""
+    taken inward (a point at either end is never in them); a cloud of under :data:`FEW` points is all bulk."""
+    if len(p_F) < FEW:
+        return p_F.min(axis=0), p_F.max(axis=0)
     lo = np.quantile(p_F, BULK, axis=0, method="higher")
     hi = np.quantile(p_F, 1.0 - BULK, axis=0, method="lower")
     return lo, np.maximum(lo, hi)

@@ -17,7 +17,7 @@ from cell.errors import CaptureError
 from cell.geometry import FloatArray, invert, readonly
 from cell.outputs import write_atomic, write_text
 from cell.recorded import _fields as f
-from cell.recorded.depth_png import encode, read_png, to_metres, write_png
+from cell.recorded.depth_png import check_size, encode, read_png, to_metres, write_png
 from cell.types import DepthImage, Part
 
 FORMAT = "weld-cell-capture"
@@ -211,13 +211,8 @@ def _camera(
     png_name = f.field(cam, "depth", f"{where}.", path)
     if not isinstance(png_name, str) or not _NAME.match(png_name):
         raise CaptureError(f"{path}: {where}.depth {png_name!r}; valid: a file name in the folder", path=str(path))
-    units = read_png(folder / png_name)
-    if units.shape != (intr.height, intr.width):
-        raise CaptureError(
-            f"{folder / png_name} is {units.shape[1]} x {units.shape[0]} px, its CameraInfo says "
-            f"{intr.width} x {intr.height}; valid: the same size",
-            path=str(folder / png_name),
-        )
+    check_size(folder / png_name, intr.width, intr.height)  # before the PNG is opened: no image is that large
+    units = read_png(folder / png_name, (intr.width, intr.height))
     image = DepthImage(str(cam["name"]), to_metres(units, scale), intr, readonly(X_WC), str(mount))
     X_RF = None
     flange = cam.get("flange")

@@ -7,6 +7,7 @@ import json
 import shutil
 import subprocess
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -88,6 +89,30 @@ def test_alignment_failure_still_writes_every_seam_with_its_reason(
     assert all(s["status"] in ("not_found", "not_visible") for s in data["seams"])
     assert all(s["reason"] for s in data["seams"])
     assert not any("detected" in s for s in data["seams"])
+
+
+def test_save_cloud_writes_the_spliced_cloud_when_the_alignment_fails_and_says_why_when_none_was_spliced(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, detected: Callable[..., pipeline.Detection]
+) -> None:
+    """The cloud of a refused alignment is the one to look at: it is saved (every camera's registered points, what
+    ``cell locate`` reads back), and the line says how to read it; with no cloud at all, a warning says why."""
+    from cell.perception.cloud_files import read_cloud
+
+    det = detected("faults/displaced-far", True)
+    assert det.scene is None and det.perceived is not None
+    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+    monkeypatch.setattr(pipeline, "detect", _detect_returning(det, asked))
+    cloud = tmp_path / "cloud.ply"
+    code, out, err = invoke("detect", "faults/displaced-far", "--save-cloud", str(cloud))
+    assert code == 3, err
+    assert f"read it back with: cell locate {cloud} --map MAP --frame R --table-z" in out + err
+    assert len(read_cloud(cloud, frame="R")) == len(det.perceived.spliced.registered)
+    none = replace(det, perceived=None)  # perception itself failed: nothing to save
+    monkeypatch.setattr(pipeline, "detect", _detect_returning(none, asked))
+    code, out, err = invoke("detect", "faults/displaced-far", "--save-cloud", str(tmp_path / "none.ply"))
+    assert code == 3 and not (tmp_path / "none.ply").exists()
+    line = next(x for x in err.splitlines() if "--save-cloud" in x)
+    assert "nothing written" in line and "no cloud was spliced" in line
 
 
 def _weld_returning(run: pipeline.WeldRun, then: Callable[[], object]) -> Callable[..., pipeline.WeldRun]:

@@ -172,7 +172,7 @@ def place_from_edge(
 def edge_fault(edge: EdgeFit, g: str, search: float, cut: bool, o: EdgeOptions) -> str:
     """Why the edge of the adjacent face ``g``, searched ``search`` [m] about the map, does not define the
     unseen face (``cut``: it lies where the cloud stops), or "" when it does."""
-    if not np.isfinite(edge.b) or edge.n_edge < o.min_edge_points:
+    if not np.isfinite(edge.b) or not np.isfinite(edge.pitch) or edge.n_edge < o.min_edge_points:
         return f"the edge of {g} is defined by {edge.n_edge} points (needs {o.min_edge_points})"
     if cut:
         return f"the edge of {g} lies where the cloud stops (the workspace's boundary?)"
@@ -183,7 +183,7 @@ def edge_fault(edge: EdgeFit, g: str, search: float, cut: bool, o: EdgeOptions) 
         )
     if edge.blur >= max(EDGE_BLURS):
         return f"the edge of {g} is blurred over {1000 * edge.blur:.1f} mm (seen at grazing incidence only)"
-    if edge.strays > o.max_edge_strays:
+    if not edge.strays <= o.max_edge_strays:  # NaN too: no density inside the edge to compare with
         return (
             f"the edge of {g} has {edge.strays:.0%} of its density beyond it (allowed "
             f"{o.max_edge_strays:.0%}): flying pixels or another surface"

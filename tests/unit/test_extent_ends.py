@@ -59,3 +59,16 @@ def test_an_end_past_where_the_other_face_stops_comes_back_to_its_edge() -> None
     assert within_receiving(found, (-0.0049, 0.0052), 3e-4) == found
     # A drawn face the line does not cross (its extent a point far off the seam) moves nothing.
     assert within_receiving(found, (-0.93, -0.93), 3e-4) == found
+
+
+def test_an_edge_with_no_density_inside_it_places_nothing() -> None:
+    """An edge fitted below all its points (none inside it: no pitch, strays not a ratio) is no edge: a face placed
+    from it had an infinite standard error and NaN ends (random cells, detect)."""
+    from cell.seams._edge import edge_fault
+    from cell.seams._extent import EdgeFit
+
+    o = OursOptions()
+    empty = EdgeFit(b=-0.004, se=1e-4, blur=2e-4, n_edge=40, strays=float("nan"), pitch=float("inf"), at_limit=False)
+    assert edge_fault(empty, "f1", 0.006, False, o) != ""
+    good = EdgeFit(b=-0.004, se=1e-4, blur=2e-4, n_edge=40, strays=0.0, pitch=5e-4, at_limit=False)
+    assert edge_fault(good, "f1", 0.006, False, o) == ""

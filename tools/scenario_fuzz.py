@@ -10,6 +10,7 @@ robot inside the table or upside down, a scan pose out of reach, a loose weld ga
 from __future__ import annotations
 
 import copy
+import math
 import re
 import tempfile
 from collections.abc import Callable
@@ -127,10 +128,26 @@ def scan_unreachable(d: Data, rng: np.random.Generator) -> str:
     return f"scan pose of {cam} out of the arm's reach"
 
 
+def _limits_deg(urdf: str) -> list[tuple[float, float]]:
+    """(lower, upper) [deg] of each revolute joint of a robot in robots/, in the URDF's order."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(REPO / "robots" / urdf).getroot()
+    out = []
+    for joint in root.iter("joint"):
+        lim = joint.find("limit")
+        if joint.get("type") == "revolute" and lim is not None:
+            out.append((math.degrees(float(lim.get("lower", 0))), math.degrees(float(lim.get("upper", 0)))))
+    return out
+
+
 def home_out(d: Data, rng: np.random.Generator) -> str:
-    j = int(rng.integers(6))
-    d["robot"]["home_deg"][j] = float(rng.choice([400.0, -400.0, 190.0, -200.0])) if j in (0, 3, 5) else 400.0
-    return f"home_deg A{j + 1} out of its limits"
+    limits = _limits_deg(d["robot"]["urdf"])
+    j = int(rng.integers(len(limits)))
+    lo, hi = limits[j]
+    beyond = float(rng.uniform(5.0, 60.0))
+    d["robot"]["home_deg"][j] = round(hi + beyond if rng.random() < 0.5 else lo - beyond, 1)
+    return f"home_deg A{j + 1} {d['robot']['home_deg'][j]} out of its limits ({lo:.0f} to {hi:.0f})"
 
 
 def seed_text(d: Data, rng: np.random.Generator) -> str:
@@ -149,6 +166,21 @@ def part_above(d: Data, rng: np.random.Generator) -> str:
     xyz = d["map"]["X_WM"]["xyz_m"]
     xyz[2] = round(float(xyz[2]) + float(rng.uniform(0.1, 0.5)), 3)
     return "the part drawn in the air above the table"
+
+
+def unknown_name(d: Data, rng: np.random.Generator) -> str:
+    """A part or seam named that the map does not have (a typo in a name the user chose)."""
+    sim = d.setdefault("simulation", {})
+    choice = int(rng.integers(3))
+    if choice == 0 and sim.get("deviations"):
+        old = str(rng.choice(list(sim["deviations"])))
+        sim["deviations"][old + "_X"] = sim["deviations"].pop(old)
+        return f"simulation.deviations.{old} renamed {old}_X"
+    if choice == 1:
+        d.setdefault("process", {})["seam_leg_mm"] = {"NO_SUCH>SEAM:+z": 5.0}
+        return "process.seam_leg_mm for a seam not in the map"
+    sim.setdefault("faults", {})["missing_parts"] = ["NO_SUCH_PART"]
+    return "simulation.faults.missing_parts names a part not in the map"
 
 
 # -- random key and value corruption ------------------------------------------------------------------------------
@@ -243,6 +275,7 @@ DATA_KINDS: dict[str, Callable[[Data, np.random.Generator], str]] = {
     "seed_text": seed_text,
     "gate_loose": gate_loose,
     "part_above": part_above,
+    "unknown_name": unknown_name,
     "corrupt_value": corrupt_value,
     "corrupt_shape": corrupt_shape,
     "corrupt_key": corrupt_key,
@@ -273,11 +306,11 @@ TEXT_KINDS = {"duplicate_key": duplicate_key, "broken_yaml": broken_yaml}
 KINDS = (*DATA_KINDS, *TEXT_KINDS)
 
 
-def mutant(seed: int, index: int) -> Mutant:
+def mutant(seed: int, index: int, sources: tuple[str, ...] = SOURCES) -> Mutant:
     """The ``index``-th nonsense scenario of the seeded sequence ``seed`` (each kind in turn, a random source)."""
     rng = np.random.default_rng([seed, index])
     kind = KINDS[index % len(KINDS)]
-    source = SOURCES[int(rng.integers(len(SOURCES)))]
+    source = sources[int(rng.integers(len(sources)))]
     text, data = _source(source)
     if kind in TEXT_KINDS:
         new, what = TEXT_KINDS[kind](text, rng)
@@ -287,8 +320,8 @@ def mutant(seed: int, index: int) -> Mutant:
     return Mutant(index, source, kind, what, new)
 
 
-def mutants(seed: int, n: int) -> list[Mutant]:
-    return [mutant(seed, i) for i in range(n)]
+def mutants(seed: int, n: int, sources: tuple[str, ...] = SOURCES) -> list[Mutant]:
+    return [mutant(seed, i, sources) for i in range(n)]
 
 
 # -- the verdict -------------------------------------------------------------------------------------------------

@@ -114,13 +114,19 @@ def check(
 
 
 def _run_checks(scn: Scenario, weldmap: WeldMap) -> list[str]:
-    """The run's own checks before anything moves (they raise as the run would: the arm's home and scan pose), then
+    """The run's own checks before anything moves (they raise as the run would: the arm's home and scan pose, the
+    part as built), then
     the layout's warnings (:mod:`cell.scenario.layout_checks`)."""
     from cell.geometry import transform_points
     from cell.pipeline.geometry import robot_arm
     from cell.scenario import layout_checks as lc
+    from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts
+    from cell.sim.faults import built_parts
 
     arm = robot_arm(scn)  # home within the joints' limits, the scan pose within reach (IKError, exit 15)
+    # The part as the simulated station builds it: the deviations, bows, gaps and missing parts name the map's parts
+    built_parts(as_built_parts(weldmap, scn), scn.faults)
+    as_built_fixtures(weldmap, scn)
     home_W = None
     if arm is not None:
         home_W = transform_points(scn.X_WR, arm.model.fk(arm.q_home)[None, :3, 3])[0]
@@ -129,6 +135,7 @@ def _run_checks(scn: Scenario, weldmap: WeldMap) -> list[str]:
         *lc.part_height_problems(scn, weldmap),
         *lc.robot_problems(scn, weldmap, home_W),
         *lc.gate_problems(scn),
+        *lc.name_problems(scn, weldmap),
     ]
 
 

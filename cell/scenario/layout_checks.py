@@ -1,7 +1,8 @@
 """What ``cell scenario check`` finds in a scenario that loads but would spoil a run, one line each: a camera looking
 away from the workspace or with the part beyond its range, a robot base tilted or facing away from the part, a
-part drawn in the air above the table (or into it), a weld gate loosened by ``rescan.allow_loose_gate``. Each line
-names the key and what is valid there (docs/scenarios.md, "What scenario check checks")."""
+part drawn in the air above the table (or into it), a weld gate loosened by ``rescan.allow_loose_gate``, a seam's
+leg for a seam the map does not have. Each line
+names the key and what is valid there (docs/cell.md, "What the loader refuses and what scenario check warns of")."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import itertools
 import math
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray, invert, transform_points
 from cell.scenario.cell_specs import CameraSpec
@@ -24,7 +26,7 @@ def _vec(v: FloatArray | tuple[float, ...]) -> str:
     return "[" + ", ".join(f"{float(x):.2f}" for x in v) + "]"
 
 
-def _in_image(cam: CameraSpec, p_W: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _in_image(cam: CameraSpec, p_W: FloatArray) -> tuple[npt.NDArray[np.bool_], FloatArray]:
     """(in the image's field, depth along the optical axis [m]) of each world point (n, 3)."""
     p_C = transform_points(invert(cam.X_WC), p_W)
     z = p_C[:, 2]
@@ -124,3 +126,15 @@ def gate_problems(scenario: Scenario) -> list[str]:
     if not loose:
         return []
     return [f"the weld gate is loose (rescan.allow_loose_gate): {'; '.join(loose)}: seams that far off are welded"]
+
+
+def name_problems(scenario: Scenario, weldmap_M: WeldMap) -> list[str]:
+    """``process.seam_leg_mm`` keys that name no seam of the map (the run would weld those with ``leg_mm``)."""
+    ids = {s.id for s in weldmap_M.seams}
+    unknown = sorted(set(scenario.process.seam_leg_mm) - ids)
+    if not unknown:
+        return []
+    return [
+        f"process.seam_leg_mm names no seam {', '.join(unknown)} of the map: ignored (process.leg_mm "
+        f"{scenario.process.leg_mm:g} mm applies); `cell map info` lists the seam ids"
+    ]

@@ -116,7 +116,8 @@ def _explain(err: ValidationError, source: str) -> str:
 
 def _coerced(raw: Any, value: Any, path: tuple[str, ...]) -> tuple[str, Any, str] | None:
     """The first value pydantic's lax mode converted from another type (text or a bool to a number, a number to
-    a bool): (its key, what the file gave, what was needed); None when every value was given as its type."""
+    a bool, 12.0 to an integer): (its key, what the file gave, what was needed); None when every value was given as
+    its type."""
     if isinstance(raw, dict) and isinstance(value, dict):
         for k, v in raw.items():
             if k in value:
@@ -135,6 +136,8 @@ def _coerced(raw: Any, value: Any, path: tuple[str, ...]) -> tuple[str, Any, str
         return where, raw, "true or false"
     if isinstance(value, (int, float)) and not isinstance(value, bool) and isinstance(raw, (str, bool)):
         return where, raw, "a number"
+    if isinstance(value, int) and not isinstance(value, bool) and isinstance(raw, float):
+        return where, raw, "a whole number (no decimal point)"
     return None
 
 

@@ -32,7 +32,8 @@ Data = dict[str, Any]
 
 @dataclass(frozen=True)
 class Mutant:
-    """One nonsense scenario: what was done (``kind``, ``what``) to which shipped scenario, and its YAML text."""
+    """One nonsense scenario: what was done (``kind``, ``what``: its `marked` words are what the check's line must
+    name) to which shipped scenario, and its YAML text."""
 
     index: int
     source: str
@@ -69,21 +70,21 @@ def _l(v: np.ndarray) -> list[float]:
 def camera_far(d: Data, rng: np.random.Generator) -> str:
     cam = str(rng.choice(list(d["cameras"])))
     d["cameras"][cam]["eye_m"][int(rng.integers(3))] = float(rng.choice([1e300, -1e300, 1e30, 5e6]))
-    return f"camera {cam} placed absurdly far"
+    return f"camera `{cam}` placed absurdly far"
 
 
 def camera_in_table(d: Data, rng: np.random.Generator) -> str:
     cam = str(rng.choice(_cams(d)))
     c, s = np.array(d["table"]["center_m"], float), np.array(d["table"]["size_m"], float)
     d["cameras"][cam]["eye_m"] = _l(c + (rng.random(3) - 0.5) * 0.8 * s)
-    return f"camera {cam} inside the table"
+    return f"camera `{cam}` inside the table"
 
 
 def camera_away(d: Data, rng: np.random.Generator) -> str:
     cam = str(rng.choice(_cams(d)))
     eye = np.array(d["cameras"][cam]["eye_m"], float)
     d["cameras"][cam]["target_m"] = _l(eye + (eye - _ws_centre(d)))
-    return f"camera {cam} looking away from the workspace"
+    return f"camera `{cam}` looking away from the workspace"
 
 
 def camera_short(d: Data, rng: np.random.Generator) -> str:
@@ -92,7 +93,7 @@ def camera_short(d: Data, rng: np.random.Generator) -> str:
     reach = float(np.linalg.norm(eye - _ws_centre(d)))
     d["cameras"][cam]["near_m"] = 0.05
     d["cameras"][cam]["far_m"] = round(reach * float(rng.uniform(0.1, 0.4)), 3)
-    return f"camera {cam} with the workspace beyond its range"
+    return f"camera `{cam}` with the workspace beyond its range"
 
 
 def camera_moved_off(d: Data, rng: np.random.Generator) -> str:
@@ -101,23 +102,23 @@ def camera_moved_off(d: Data, rng: np.random.Generator) -> str:
     tgt = np.array(d["cameras"][cam]["target_m"], float)
     far = float(d["cameras"][cam].get("far_m", 4.0))
     d["cameras"][cam]["eye_m"] = _l(tgt + (eye - tgt) / np.linalg.norm(eye - tgt) * far * float(rng.uniform(1.5, 4)))
-    return f"camera {cam} moved beyond its range"
+    return f"camera `{cam}` moved beyond its range"
 
 
 def robot_in_table(d: Data, rng: np.random.Generator) -> str:
     c, s = np.array(d["table"]["center_m"], float), np.array(d["table"]["size_m"], float)
     d["robot"]["X_WR"] = {"xyz_m": _l(c + (rng.random(3) - 0.5) * 0.8 * s)}
-    return "robot base inside the table"
+    return "`robot.X_WR` inside the table"
 
 
 def robot_upside_down(d: Data, rng: np.random.Generator) -> str:
     d["robot"]["X_WR"]["rpy_deg"] = [float(rng.choice([180.0, -180.0, 170.0])), 0.0, 0.0]
-    return "robot upside down"
+    return "robot upside down (its `scan pose` out of reach, or not `upright`)"
 
 
 def robot_facing_away(d: Data, rng: np.random.Generator) -> str:
     d["robot"]["X_WR"]["rpy_deg"] = [0.0, 0.0, float(rng.choice([180.0, 160.0, -170.0]))]
-    return "robot facing away from the table"
+    return "robot `faces away` from the table (or its `scan pose` out of reach)"
 
 
 def scan_unreachable(d: Data, rng: np.random.Generator) -> str:
@@ -125,7 +126,7 @@ def scan_unreachable(d: Data, rng: np.random.Generator) -> str:
     eye = np.array(d["cameras"][cam]["eye_m"], float)
     eye[2] += float(rng.uniform(1.5, 3.0))
     d["cameras"][cam]["eye_m"] = _l(eye)
-    return f"scan pose of {cam} out of the arm's reach"
+    return f"`scan pose` of {cam} out of the arm's reach"
 
 
 def _limits_deg(urdf: str) -> list[tuple[float, float]]:
@@ -147,25 +148,25 @@ def home_out(d: Data, rng: np.random.Generator) -> str:
     lo, hi = limits[j]
     beyond = float(rng.uniform(5.0, 60.0))
     d["robot"]["home_deg"][j] = round(hi + beyond if rng.random() < 0.5 else lo - beyond, 1)
-    return f"home_deg A{j + 1} {d['robot']['home_deg'][j]} out of its limits ({lo:.0f} to {hi:.0f})"
+    return f"`home_deg` A{j + 1} {d['robot']['home_deg'][j]} out of its limits ({lo:.0f} to {hi:.0f})"
 
 
 def seed_text(d: Data, rng: np.random.Generator) -> str:
     d["seed"] = str(rng.choice(["12", "0", "seed", "1e3"]))
-    return "seed given as text"
+    return "`seed` given as text"
 
 
 def gate_loose(d: Data, rng: np.random.Generator) -> str:
     r = d.setdefault("rescan", {})
     key = str(rng.choice(["weld_tolerance_mm", "end_tolerance_mm", "bound_sigmas", "bound_sigmas"]))
     r[key] = float(rng.choice([100.0, 25.0, 10.0])) if key != "bound_sigmas" else float(rng.choice([0.01, 0.2, 1e-6]))
-    return f"rescan.{key} switches the weld gate off"
+    return f"rescan.`{key}` switches the weld gate off"
 
 
 def part_above(d: Data, rng: np.random.Generator) -> str:
     xyz = d["map"]["X_WM"]["xyz_m"]
     xyz[2] = round(float(xyz[2]) + float(rng.uniform(0.1, 0.5)), 3)
-    return "the part drawn in the air above the table"
+    return "the part drawn in the air `above the table`"
 
 
 def unknown_name(d: Data, rng: np.random.Generator) -> str:
@@ -175,12 +176,12 @@ def unknown_name(d: Data, rng: np.random.Generator) -> str:
     if choice == 0 and sim.get("deviations"):
         old = str(rng.choice(list(sim["deviations"])))
         sim["deviations"][old + "_X"] = sim["deviations"].pop(old)
-        return f"simulation.deviations.{old} renamed {old}_X"
+        return f"simulation.deviations.{old} renamed `{old}_X`"
     if choice == 1:
         d.setdefault("process", {})["seam_leg_mm"] = {"NO_SUCH>SEAM:+z": 5.0}
-        return "process.seam_leg_mm for a seam not in the map"
+        return "process.seam_leg_mm for a seam `NO_SUCH>SEAM:+z` not in the map"
     sim.setdefault("faults", {})["missing_parts"] = ["NO_SUCH_PART"]
-    return "simulation.faults.missing_parts names a part not in the map"
+    return "simulation.faults.missing_parts names a part `NO_SUCH_PART` not in the map"
 
 
 # -- random key and value corruption ------------------------------------------------------------------------------
@@ -209,6 +210,12 @@ def _at(d: Any, path: tuple[Any, ...]) -> Any:
     return d
 
 
+def _named(path: tuple[Any, ...]) -> str:
+    """``cameras.cam_left.`eye_m`.0``: the path with its last key marked (the check's line must name it)."""
+    keys = [i for i, k in enumerate(path) if isinstance(k, str)]
+    return ".".join(f"`{k}`" if i == keys[-1] else str(k) for i, k in enumerate(path))
+
+
 def _bad_value(old: Any, rng: np.random.Generator) -> Any:
     """A value no key of the scenario takes in place of ``old`` (a wrong type, or a non-finite or absurd number)."""
     if isinstance(old, bool):
@@ -227,7 +234,7 @@ def corrupt_value(d: Data, rng: np.random.Generator) -> str:
     parent, key = _at(d, path[:-1]), path[-1]
     new = _bad_value(parent[key], rng)
     parent[key] = new
-    return f"{'.'.join(map(str, path))} set to {new!r}"
+    return f"{_named(path)} set to {new!r}"
 
 
 def corrupt_shape(d: Data, rng: np.random.Generator) -> str:
@@ -236,9 +243,9 @@ def corrupt_shape(d: Data, rng: np.random.Generator) -> str:
     seq = _at(d, path)
     if rng.random() < 0.5 or len(seq) < 2:
         seq.append(seq[-1])
-        return f"{'.'.join(map(str, path))} given one value too many"
+        return f"{_named(path)} given one value too many"
     seq.pop()
-    return f"{'.'.join(map(str, path))} given one value too few"
+    return f"{_named(path)} given one value too few"
 
 
 def corrupt_key(d: Data, rng: np.random.Generator) -> str:
@@ -249,16 +256,16 @@ def corrupt_key(d: Data, rng: np.random.Generator) -> str:
         i = int(rng.integers(len(key) - 1))
         wrong = key[:i] + key[i + 1] + key[i] + key[i + 2 :] if key[i] != key[i + 1] else key[:i] + key[i + 1 :]
         parent[wrong] = parent.pop(key)
-        return f"key {'.'.join(map(str, path))} misspelt {wrong!r}"
+        return f"key {'.'.join(map(str, path))} misspelt `{wrong}`"
     parent[f"{key}_extra"] = copy.deepcopy(parent[key])
-    return f"unknown key {key}_extra beside {'.'.join(map(str, path))}"
+    return f"unknown key `{key}_extra` beside {'.'.join(map(str, path))}"
 
 
 def delete_required(d: Data, rng: np.random.Generator) -> str:
     required = [("seed",), ("map",), ("table",), ("cameras",), ("perception",), ("map", "file"), ("table", "size_m")]
     path = required[int(rng.integers(len(required)))]
     del _at(d, path[:-1])[path[-1]]
-    return f"required key {'.'.join(path)} deleted"
+    return f"required key `{'.'.join(path)}` deleted"
 
 
 DATA_KINDS: dict[str, Callable[[Data, np.random.Generator], str]] = {
@@ -291,7 +298,7 @@ def duplicate_key(text: str, rng: np.random.Generator) -> tuple[str, str]:
     m = re.match(r"^(\s*)([A-Za-z_]+):", lines[i])
     assert m is not None
     lines.insert(i + 1, f"{m.group(1)}{m.group(2)}: 0")
-    return "\n".join(lines) + "\n", f"key {m.group(2)} given twice (line {i + 1} and {i + 2})"
+    return "\n".join(lines) + "\n", f"key `{m.group(2)}` `given twice` (line {i + 1} and {i + 2})"
 
 
 def broken_yaml(text: str, rng: np.random.Generator) -> tuple[str, str]:
@@ -299,7 +306,7 @@ def broken_yaml(text: str, rng: np.random.Generator) -> tuple[str, str]:
     i = int(rng.integers(len(lines)))
     junk = ["  : [", "{{", "\tkey: tab", "- list: in a map", "x: [1, 2"][int(rng.integers(5))]
     lines.insert(i, junk)
-    return "\n".join(lines) + "\n", f"line {i + 1} is not YAML ({junk!r})"
+    return "\n".join(lines) + "\n", f"line {i + 1} is not `YAML` ({junk!r})"
 
 
 TEXT_KINDS = {"duplicate_key": duplicate_key, "broken_yaml": broken_yaml}
@@ -381,10 +388,19 @@ def judge(m: Mutant) -> Verdict:
         return Verdict(m, "traceback", code, (f"{type(exc).__name__}: {exc}",), seconds)
     errors = [ln.strip() for ln in output.splitlines() if ln.startswith("error")]
     if code != 0:
-        one = len(errors) == 1 and "Traceback" not in output
-        return Verdict(m, "refused" if one else "traceback", code, tuple(errors) or (output[-300:],), seconds)
+        if len(errors) != 1 or "Traceback" in output:
+            return Verdict(m, "traceback", code, tuple(errors) or (output[-300:],), seconds)
+        return Verdict(m, "refused" if _names_it(m, errors) else "silent", code, tuple(errors), seconds)
     new = sorted(_warnings(output) - base)
-    return Verdict(m, "flagged" if new else "silent", code, tuple(new), seconds)
+    return Verdict(m, "flagged" if _names_it(m, new) else "silent", code, tuple(new), seconds)
+
+
+def _names_it(m: Mutant, lines: list[str]) -> bool:
+    """Whether an error or a new warning names what was done (a `marked` word of ``m.what``, any case): a line
+    about something else does not count."""
+    marks = re.findall(r"`([^`]+)`", m.what)
+    text = " ".join(lines).lower()
+    return bool(lines) and (not marks or any(k.lower() in text for k in marks))
 
 
 def summary(verdicts: list[Verdict]) -> dict[str, Any]:

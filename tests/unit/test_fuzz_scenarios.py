@@ -92,3 +92,14 @@ def test_check_names_the_part_drawn_in_the_air_and_its_height() -> None:
     (line,) = part_height_problems(scn, pipeline.read_weldmap(scn))
     assert "is drawn 0.500 m above the table top" in line and "set map.X_WM.xyz_m z to 0.900" in line
     assert line.startswith("part ") and line.split()[1] in {"TOP_RAIL", "BOTTOM_RAIL", "POST_L", "POST_R"}
+
+
+def test_the_committed_full_count_is_clean_and_quoted_in_the_results() -> None:
+    import json
+
+    results = fuzz.REPO / "benchmarks" / "results" / "fuzz_scenarios.json"
+    data = json.loads(results.read_text())
+    assert data["n"] >= 200 and data["silent"] == 0 and data["traceback"] == 0
+    assert data["kinds"] == list(fuzz.KINDS) and data["refused"] + data["flagged"] == data["n"]
+    row = f"| now | {data['n']} | {data['refused']} | {data['flagged']} | 0 | 0 |"
+    assert row in (fuzz.REPO / "docs" / "results.md").read_text()

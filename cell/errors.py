@@ -37,14 +37,33 @@ class UsageError(CellError, ValueError):
     exit_code = EXIT_USAGE
 
 
+class OutputFault(enum.StrEnum):
+    """Why an output path cannot be written (docs/cli.md, "Outputs")."""
+
+    FOLDER = "folder"  # a file was asked for and the path is a folder
+    NOT_A_FOLDER = "not_a_folder"  # a folder was asked for and the path is something else
+    DEVICE = "device"  # a character or block device (/dev/null, /dev/full, a disk)
+    FIFO = "fifo"  # a named pipe
+    SOCKET = "socket"  # a Unix socket
+    NO_FOLDER = "no_folder"  # the folder it would go in does not exist (none is created)
+    LINK_LOOP = "link_loop"  # a symbolic link that never ends in a path
+    NOT_WRITABLE = "not_writable"  # permissions, a read-only file system
+    RESERVED = "reserved"  # the name of the folder's lock file
+    STDOUT = "stdout"  # '-' where standard output is not an option
+    HELD = "held"  # another job holds the folder (its lock names it)
+    WRITE_FAILED = "write_failed"  # the write itself failed (a full disk, a folder removed meanwhile)
+
+
 class OutputError(CellError, OSError):
-    """An output path cannot be written (found before the run when it can be; ``path`` is the one asked for)."""
+    """An output path cannot be written (found before the run when it can be; ``path`` is the one asked for,
+    ``code`` says why)."""
 
     exit_code = EXIT_USAGE
 
-    def __init__(self, message: str, *, path: str = "") -> None:
+    def __init__(self, message: str, *, path: str = "", code: OutputFault = OutputFault.WRITE_FAILED) -> None:
         super().__init__(message)
         self.path = path
+        self.code = code
 
 
 class CloudFault(enum.StrEnum):

@@ -20,7 +20,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from cell.errors import CellError, UsageError
+from cell.errors import CellError, OutputError, UsageError
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
 app = typer.Typer(
@@ -91,8 +91,14 @@ def configure(*, quiet: bool, verbose: bool, log_file: Path | None) -> None:
     log.setLevel(logging.DEBUG)
     log.propagate = False
     if log_file is not None:
+        from cell.outputs import check_file
+
         try:
+            check_file(log_file, "--log-file", probe=False)  # appended to, never replaced: a FIFO would block
             handler = logging.FileHandler(log_file, encoding="utf-8")
+        except OutputError as e:
+            err.print(f"[bold red]error[/]: {escape(e.message)}", soft_wrap=True)
+            raise typer.Exit(2) from None
         except OSError as e:
             err.print(f"[bold red]error[/]: cannot write the log file {str(log_file)!r}: {e.strerror or e}")
             raise typer.Exit(2) from None

@@ -89,7 +89,7 @@ def locate(
     with cell_errors():
         table = parse_format(fmt)
         check_file(json_path, "--json")
-        check_file(save_cloud, "--save-cloud_F", stdout_ok=False)
+        check_file(save_cloud, "--save-cloud", stdout_ok=False)
         check_units(units)
         check_frame(frame)
         if map_units is not None and map_units not in METRES_PER_UNIT:
@@ -205,10 +205,11 @@ def read_truth(path: Path, seam_ids: list[str], frame: str) -> dict[str, tuple[F
 
 
 def _save_cloud(cloud: Cloud, path: Path) -> Path:
+    from cell.outputs import replacing
     from cell.perception import save_ply
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_ply(cloud, path)
+    with replacing(path, what="cloud") as tmp:  # whole: save_ply writes the file, then rewrites its header
+        save_ply(cloud, tmp)
     return path
 
 

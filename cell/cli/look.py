@@ -23,6 +23,7 @@ from cell.cli.common import (
     parse_noise,
     progress,
     say,
+    warn,
     was_interrupted,
 )
 from cell.cli.explain import detection_exit
@@ -134,10 +135,8 @@ def detect(
             det = pipeline.detect(scn, method, progress=stage, station=station)
             rep = detection_report(det, provenance=prov)
             writer.report(json_path, rep)
-            if save_cloud is not None and det.scene is not None:
-                cloud = det.scene.perceived.dense
-                if writer.attempt(lambda: _save_cloud(cloud, save_cloud)) is not None:
-                    say(f"spliced cloud written to {save_cloud}")
+            if save_cloud is not None:
+                save_spliced(det, save_cloud, writer)
             print_detection(rep, table)
         except (KeyboardInterrupt, ImportError) as e:
             if not was_interrupted(e):
@@ -150,11 +149,32 @@ def detect(
     finish(writer, None if det.complete and det.error is None else detection_exit(rep))
 
 
+def save_spliced(det: Any, path: Path, writer: Writer) -> None:
+    """``--save-cloud``: every camera's registered points in R (unfiltered, the splice's result: what ``cell
+    locate`` aligns best), also when the alignment failed; when perception itself failed, a warning line says why
+    nothing was written. The line after a write gives the ``cell locate`` command that reads it back."""
+    from cell.pipeline import table_z_R
+
+    perceived = det.scene.perceived if det.scene is not None else det.perceived
+    if perceived is None:
+        why = det.error.message if det.error is not None else "no cloud was perceived"
+        warn(f"--save-cloud: nothing written to {path}: no cloud was spliced ({why})")
+        return
+    cloud = perceived.spliced.registered
+    if writer.attempt(lambda: _save_cloud(cloud, path)) is not None:
+        z_mm = table_z_R(det.scenario) * 1e3  # the workspace crop leaves the table out: its height says where it is
+        say(
+            f"spliced cloud ({len(cloud)} points, frame R) written to {path}; read it back with: cell locate {path}"
+            f" --map MAP --frame R --table-z {z_mm:.1f}"
+        )
+
+
 def _save_cloud(cloud: Any, path: Path) -> Path:
+    from cell.outputs import replacing
     from cell.perception import save_ply
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_ply(cloud, path)
+    with replacing(path, what="cloud") as tmp:  # whole: save_ply writes the file, then rewrites its header
+        save_ply(cloud, tmp)
     return path
 
 
@@ -195,7 +215,8 @@ def bench(
     """
     from cell import bench as b
     from cell import scenario as sc
-    from cell.export import write_atomic, write_json
+    from cell.export import write_json
+    from cell.outputs import write_atomic
     from cell.provenance import provenance
     from cell.seams.registry import METHODS
 
@@ -210,6 +231,8 @@ def bench(
         except ValueError as e:
             raise typer.BadParameter(str(e), param_hint="--extrinsics") from None
         folder = bench_folder(out_dir)
+        if out_dir is None:
+            folder.parent.mkdir(exist_ok=True)  # runs/, the cell's own (untracked) folder of run folders
         check_folder(folder, "--out")
         check_file(json_path, "--json", stdout_ok=False)
         loaded = [sc.load(n) for n in names]

@@ -1,10 +1,14 @@
-"""Outputs checked before the run and written whatever happens: a path that cannot be written is one line and exit 2
-before any capture (a probe file, since permission bits alone do not say), each output written on its own so a late
-failure loses only that one, and what Ctrl-C writes when the run had not finished (docs/cli.md)."""
+"""Outputs checked before the run and written whatever happens: a path that cannot be written (a device, a FIFO, a
+socket, a folder where a file is asked for, a missing folder) is one line and exit 2 before any work, and the job
+then holds every folder it writes into (a lock naming it, released when the command ends: :mod:`cell.outputs`);
+each output is written on its own so a late failure loses only that one; and what Ctrl-C writes when the run had
+not finished (docs/cli.md, "Outputs")."""
 
 from __future__ import annotations
 
-import tempfile
+import contextlib
+import shlex
+import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -12,9 +16,10 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import typer
 
+from cell import outputs
 from cell.cli.bar import Bar
-from cell.cli.common import detail, fail_line, results_to_stderr, say
-from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, OutputError
+from cell.cli.common import detail, fail_line, results_to_stderr, say, warn
+from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, OutputError, OutputFault
 
 if TYPE_CHECKING:
     from cell.scenario import Scenario
@@ -23,55 +28,92 @@ STDOUT = "-"
 T = TypeVar("T")
 
 
-def _absolute(path: Path) -> Path:
-    return path if path.is_absolute() else Path.cwd() / path
+@dataclass
+class _Held:
+    """What this command holds: its folders' locks, and the folders it made for its outputs."""
+
+    locks: dict[Path, outputs.FolderLock] = field(default_factory=dict)
+    made: list[Path] = field(default_factory=list)
+
+    def release(self) -> None:
+        """Free every lock, then remove each folder made for this job that it left empty."""
+        for lock in self.locks.values():
+            lock.release()
+        for folder in reversed(self.made):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        self.locks.clear()
+        self.made.clear()
 
 
-def _probe(path: Path, option: str, shown: Path) -> None:
-    """``path`` or its first existing ancestor must be a folder a file can be created in."""
-    anc = path
-    while not anc.exists() and anc != anc.parent:
-        anc = anc.parent
-    if not anc.is_dir():
-        raise OutputError(f"{option} {str(shown)!r}: {str(anc)!r} is a file, not a folder", path=str(shown))
-    try:
-        with tempfile.TemporaryFile(dir=anc):
-            pass
-    except OSError as e:
-        raise OutputError(
-            f"{option} {str(shown)!r}: cannot write in {str(anc)!r} ({e.strerror or e})", path=str(shown)
-        ) from None
+_held: _Held | None = None  # the running command's (None outside a command: the Python API holds nothing)
+
+
+def begin_command() -> Callable[[], None]:
+    """A command starts: what it will hold is recorded from now; the function returned releases it all (the root
+    callback calls it when the command ends, however it ends; a killed process's locks are freed by the kernel)."""
+    global _held
+    if _held is not None:
+        _held.release()
+    held = _held = _Held()
+
+    def end() -> None:
+        global _held
+        held.release()
+        if _held is held:
+            _held = None
+
+    return end
+
+
+def _command() -> str:
+    """The job's command line, as a lock names it."""
+    words = list(sys.argv)
+    if words:
+        words[0] = Path(words[0]).name
+    return shlex.join(words)
+
+
+def hold_folder(folder: Path, option: str) -> None:
+    """Take ``folder``'s job lock for the rest of this command (once per folder; released when the command ends,
+    however it ends). Outside a command (the Python API) nothing is held. OutputError (exit 2) naming the job
+    that holds it."""
+    if _held is None or folder in _held.locks:
+        return
+    lock = outputs.hold(folder, command=_command(), option=option)
+    _held.locks[folder] = lock
+    if lock.taken_over is not None:
+        left = f"; removed {len(lock.removed)} half-written file(s) it left" if lock.removed else ""
+        warn(f"{option}: took over the lock of a job that never ended in {str(folder)!r} "
+             f"({lock.taken_over.describe()}: killed?){left}")  # fmt: skip
+    detail(f"holding {folder / outputs.LOCK_NAME}")
 
 
 def check_file(path: Path | None, option: str, *, stdout_ok: bool = True) -> None:
-    """Before the run: ``path`` can be written as a file (``-`` is stdout where allowed). OutputError if not."""
+    """Before the run: ``path`` can be written as a regular file (``-`` is stdout where allowed; a link is written
+    through to its target), and this job holds its folder. OutputError if not."""
     if path is None:
         return
     if str(path) == STDOUT:
         if not stdout_ok:
-            raise OutputError(f"{option} cannot be '-' (standard output)", path=STDOUT)
+            raise OutputError(f"{option} cannot be '-' (standard output); valid: a file name", path=STDOUT,
+                              code=OutputFault.STDOUT)  # fmt: skip
         results_to_stderr()
         return
-    p = _absolute(path)
-    if p.is_dir():
-        raise OutputError(f"{option} {str(path)!r} is a folder; give a file name", path=str(path))
-    if p.exists():
-        try:
-            with p.open("ab"):
-                pass
-        except OSError as e:
-            raise OutputError(f"{option} {str(path)!r} cannot be written ({e.strerror or e})", path=str(path)) from None
-    _probe(p.parent, option, path)
+    target = outputs.check_file(path, option)
+    hold_folder(target.parent, option)
 
 
 def check_folder(path: Path | None, option: str) -> None:
-    """Before the run: ``path`` is (or can be created as) a folder files can be written in. OutputError if not."""
+    """Before the run: ``path`` is a folder files can be written in, made now if missing (its parent must exist),
+    and this job holds it. OutputError if not."""
     if path is None:
         return
-    p = _absolute(path)
-    if p.exists() and not p.is_dir():
-        raise OutputError(f"{option} {str(path)!r} is a file, not a folder", path=str(path))
-    _probe(p, option, path)
+    existed = outputs.resolve(path).is_dir()
+    target = outputs.check_folder(path, option, create=True)
+    if not existed and _held is not None:  # made for this job: gone again if the job ends without writing in it
+        _held.made.append(target)
+    hold_folder(target, option)
 
 
 @dataclass

@@ -11,6 +11,7 @@ import typer
 
 from cell.cli import sweep as _sweep  # noqa: F401 - registers ``cell sweep`` (a tolerance study on Ray)
 from cell.cli.common import app, configure, err, fail_line
+from cell.cli.outputs import begin_command
 from cell.errors import EXIT_INTERRUPTED, EXIT_USAGE
 
 
@@ -24,6 +25,7 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def root(
+    ctx: typer.Context,
     version: Annotated[
         bool,
         typer.Option("--version", callback=_version, is_eager=True, help="Print the version (and git commit)."),
@@ -36,6 +38,7 @@ def root(
 ) -> None:
     """Robotic weld cell: find weld seams with depth cameras and a DXF welding map, in simulation."""
     configure(quiet=quiet, verbose=verbose, log_file=log_file)
+    ctx.call_on_close(begin_command())  # the output folders this command holds, freed when it ends
 
 
 def main() -> None:

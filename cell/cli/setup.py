@@ -23,21 +23,26 @@ _warn = warn
 
 @app.command()
 def init(
-    map_file: Annotated[Path, typer.Argument(help="The welding map (DXF) to write a scenario for.")],
+    map_file: Annotated[
+        Path,
+        typer.Argument(help="The welding map (DXF), or the part's CAD (STEP, STL, OBJ, PLY: made into a map first)."),
+    ],
     out_path: Annotated[
         Path | None, typer.Option("--out", "-o", help="The scenario file to write (default: MAP's name .yaml here).")
     ] = None,
     units: Annotated[
-        str | None, typer.Option(help="Units the DXF is drawn in (mm, cm, m, in); wins over its $INSUNITS.")
+        str | None,
+        typer.Option(help="Units the DXF (or mesh) is drawn in (mm, cm, m, in); wins over its $INSUNITS."),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite the scenario file if it exists.")] = False,
 ) -> None:
     """Write a scenario for any welding map: table, robot and cameras placed around the part, the workspace
-    computed, a comment on every key. Then `cell scenario check FILE` and `cell weld FILE`."""
+    computed, a comment on every key. Then `cell scenario check FILE` and `cell weld FILE`. Given a part's CAD,
+    the map is made first beside the scenario, as `cell map from-cad` makes it (seams proposed from contacts)."""
     from cell import scenario as sc
     from cell.cli.sight_lines import arm_torch
     from cell.config.motion import ViewOptions
-    from cell.export.atomic import write_atomic
+    from cell.outputs import make_folder, write_atomic
     from cell.rescan.sight import pose_sight
     from cell.scenario.init import ROBOT_URDF, scenario_text
     from cell.weldmap import METRES_PER_UNIT
@@ -52,9 +57,20 @@ def init(
     if units is not None and units not in METRES_PER_UNIT:
         raise typer.BadParameter(f"{units!r}; valid: {', '.join(METRES_PER_UNIT)}", param_hint="--units")
     with cell_errors():
+        from cell.cad import is_cad
+
+        if is_cad(map_file):  # the map made from the CAD beside the scenario, then laid out as any map
+            from cell.cli.cad import convert
+
+            dxf = target.with_suffix(".dxf")
+            if dxf.exists() and not force:
+                raise typer.BadParameter(f"{str(dxf)!r} exists (--force overwrites it)", param_hint="--out")
+            convert(map_file, dxf, units=units)
+            map_file, units = dxf, None
         sight = partial(pose_sight, torch_C=arm_torch(ROBOT_URDF, ViewOptions()))  # the scan camera sees past it
         text, lay = scenario_text(map_file, target.absolute(), units=units, sight=sight)
         scn = sc.from_yaml(text, target.absolute().parent, target.name)  # what is written loads as it is
+        make_folder(target.parent, "--out")  # the scenario's own folder (cells/ of cells/my_part.yaml), one level
         write_atomic(target, text.encode("utf-8"), what="scenario")
         size = lay.table_size
         say(

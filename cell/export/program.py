@@ -13,8 +13,8 @@ from typing import Any, Protocol
 import numpy as np
 
 from cell.config.export import KrlOptions
-from cell.export.atomic import write_atomic
 from cell.geometry import FloatArray, readonly
+from cell.outputs import make_folder, write_atomic
 from cell.types.plan import Segment, WeldPlan
 from cell.types.procedure import WeldProcedure
 from cell.types.robot import Kinematics
@@ -85,8 +85,10 @@ def procedure_of(seg: Segment) -> WeldProcedure:
 
 def write_texts(texts: Mapping[str, str], directory: str | Path, *, crlf: bool = True) -> list[Path]:
     """Write each text (ASCII, CRLF line ends as on a controller unless ``crlf`` is False) atomically into
-    ``directory``; their paths. OutputError when a file cannot be written."""
+    ``directory`` (made if missing: its parent must exist); their paths. OutputError when a file cannot be
+    written."""
     d = Path(directory)
+    make_folder(d, "robot program folder")
     paths = []
     for name, text in texts.items():
         body = text.replace("\n", "\r\n") if crlf else text

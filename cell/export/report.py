@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from cell.errors import CellError
-from cell.export.atomic import write_atomic
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
+from cell.outputs import write_atomic
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, UnsupportedSeam, Violation, WeldMap
 from cell.types.rescan import PlannedCloseup
@@ -203,8 +203,8 @@ STDOUT = "-"  # the path that means standard output
 
 
 def write_json(path: str | Path, data: Mapping[str, Any] | list[Any]) -> Path:
-    """Write JSON atomically (a crash never leaves half a report), creating parent folders, with the umask's
-    permissions; ``-`` writes it to standard output. OutputError (one line) when the file cannot be written."""
+    """Write JSON whole (a crash never leaves half a report: :mod:`cell.outputs`) into an existing folder;
+    ``-`` writes it to standard output. OutputError (one line) when the file cannot be written."""
     text = json.dumps(data, indent=2) + "\n"
     if str(path) == STDOUT:
         sys.stdout.write(text)

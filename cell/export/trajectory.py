@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from cell.geometry import FloatArray
+from cell.outputs import replacing, write_text
 from cell.types.plan import WeldPlan
 from cell.types.trajectory import Trajectory
 
@@ -65,21 +66,21 @@ def joint_trajectory_msg(
 
 
 def write_json(plan: WeldPlan, path: str | Path, dt: float | None = 0.004) -> Path:
-    """Write the plan's joint trajectory as JointTrajectory-shaped JSON; the path written."""
+    """Write the plan's joint trajectory as JointTrajectory-shaped JSON, whole; the path written."""
     import json
 
     traj, _ = export_samples(plan, dt)
-    p = Path(path)
-    p.write_text(json.dumps(joint_trajectory_msg(traj, plan.joint_names), separators=(",", ":")))
-    return p
+    text = json.dumps(joint_trajectory_msg(traj, plan.joint_names), separators=(",", ":"))
+    return write_text(path, text, what="trajectory")
 
 
 def write_csv(plan: WeldPlan, path: str | Path, dt: float | None = 0.004) -> Path:
-    """Write ``t_s,q1_rad..qN_rad,arc_on`` rows; the path written."""
+    """Write ``t_s,q1_rad..qN_rad,arc_on`` rows, whole; the path written."""
     traj, arc = export_samples(plan, dt)
     header = ",".join(["t_s", *[f"q{i + 1}_rad" for i in range(traj.dof)], "arc_on"])
     table = np.column_stack([traj.times, traj.q, arc.astype(float)])
     fmt = ["%.6f"] + ["%.9f"] * traj.dof + ["%d"]
     p = Path(path)
-    np.savetxt(p, table, fmt=fmt, delimiter=",", header=header, comments="")
+    with replacing(p, what="trajectory") as tmp:
+        np.savetxt(tmp, table, fmt=fmt, delimiter=",", header=header, comments="")
     return p

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.errors import SensorError
+from cell.errors import CloudFileError, SensorError
 from cell.perception import _open3d
 from cell.types import Cloud
 
@@ -46,15 +46,24 @@ def save_ply(cloud: Cloud, path: str | Path) -> None:
 def load_ply(path: str | Path, frame: str = "R") -> Cloud:
     """Read a point cloud from ``path`` as a :class:`Cloud` in ``frame`` (coordinates are taken as metres).
 
-    Raises :class:`SensorError` if the file is missing, unreadable or holds no finite points.
+    Raises :class:`SensorError` if the file is missing, unreadable, disagrees with its header (checked as
+    :func:`~cell.perception.cloud_files.read_cloud` checks it) or holds no finite points.
     """
+    from cell.perception._cloud_formats import parse_ply
+
     path = Path(path)
     if not path.is_file():
         raise SensorError(f"point cloud file {str(path)!r} does not exist")
     header = _header(path)
     if not header or header[0] != b"ply":
         raise SensorError(f"{str(path)!r} is not a PLY file (it does not start with 'ply')")
+    try:
+        body = parse_ply(path, path.read_bytes())
+    except CloudFileError as e:
+        raise SensorError(e.message) from None
     points, camera = _open3d.read_ply(path)
+    if len(points) != body.count or (body.xyz is not None and not np.array_equal(points, body.xyz, equal_nan=True)):
+        raise SensorError(f"point cloud file {str(path)!r}: open3d read other points than its header and body hold")
     finite = np.all(np.isfinite(points), axis=1)
     if not finite.any():
         raise SensorError(f"point cloud file {str(path)!r} holds no finite points")

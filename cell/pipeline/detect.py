@@ -7,7 +7,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -22,6 +22,9 @@ from cell.pipeline.records import Capture, Detection, Scene
 from cell.scenario import Scenario
 from cell.station import Station
 from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldMap
+
+if TYPE_CHECKING:
+    from cell.perception.perceive import Perceived
 
 Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
 
@@ -93,12 +96,18 @@ def table_z_R(scenario: Scenario) -> float:
 
 
 def build_scene(
-    cap: Capture, *, progress: Progress = quiet, X_RM_nominal: FloatArray | None = None, seed: Seed | None = None
+    cap: Capture,
+    *,
+    progress: Progress = quiet,
+    X_RM_nominal: FloatArray | None = None,
+    seed: Seed | None = None,
+    keep: Callable[[Perceived], None] | None = None,
 ) -> Scene:
     """Perceive (deproject, splice, filter, downsample), align the map to the cloud, and pair seams with joints.
 
     X_RM_nominal : where the map is believed to lie (default: the scenario's ``map.X_WM``; the turned part's pose
-    on its second side); seed : a search of the cloud near it for a start the ICP can converge from."""
+    on its second side); seed : a search of the cloud near it for a start the ICP can converge from.
+    keep : handed the perception once it is done, before an AlignmentError is raised (its clouds can be saved)."""
     from cell.perception import align_map, check_alignment
     from cell.perception.align.checks import cloud_tree_of
     from cell.perception.perceive import perceive_then
@@ -128,11 +137,25 @@ def build_scene(
             missing = check_alignment(weldmap_R, cloud, alignment, sc.perception, checks_tree, eyes_R.reshape(-1, 3))
         return alignment, X_RM, weldmap_R, missing
 
+    def aligned_or_error(
+        cloud: Cloud, proceed: Callable[[], None]
+    ) -> tuple[Alignment, FloatArray, WeldMap, dict[str, str]] | AlignmentError:
+        try:
+            return aligned(cloud, proceed)
+        except AlignmentError as e:  # raised below, once the perception is kept
+            return e
+
     progress("splicing point clouds and aligning the welding map to them")
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
     # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud. The
     # alignment starts beside the splice (perceive_then); the stage times split the wall where the cloud was ready.
-    done = perceive_then(cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned, pose_uncertainties(sc))
+    done = perceive_then(
+        cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned_or_error, pose_uncertainties(sc)
+    )
+    if keep is not None:
+        keep(done.perceived)
+    if isinstance(done.answer, AlignmentError):
+        raise done.answer
     perceived, (alignment, X_RM, weldmap_R, missing) = done.perceived, done.answer
     timings = {"perceive_s": done.cloud_s, "align_s": done.answer_s - done.cloud_s}
 
@@ -237,12 +260,14 @@ def detect(
     method = scenario.locator.method
     t_all = time.perf_counter()
     cap = capture(scenario, gui=gui, progress=progress, station=station, weldmap=weldmap)
+    kept: list[Perceived] = []
     try:
-        scene = build_scene(cap, progress=progress, X_RM_nominal=X_RM_nominal, seed=seed)
+        scene = build_scene(cap, progress=progress, X_RM_nominal=X_RM_nominal, seed=seed, keep=kept.append)
     except (SensorError, AlignmentError) as e:
         # No seam can be searched, but every seam is still reported, with the reason; nothing is invented.
         progress(f"no seam search: {e.message}")
-        return _failed_detection(cap, method, e, time.perf_counter() - t_all, X_RM_nominal)
+        failed = _failed_detection(cap, method, e, time.perf_counter() - t_all, X_RM_nominal)
+        return replace(failed, perceived=kept[0] if kept else None)
     estimates = locate(scene, scenario, method, progress=progress)
     weldmap_R = scene.seam_scene.weldmap
     truth = truths(cap, weldmap_R)

@@ -77,6 +77,7 @@ class Detection:
     lost_cameras: tuple[str, ...] = ()
     scene: Scene | None = None
     error: CellError | None = None  # perception or alignment failed: no seam was searched (report still written)
+    perceived: Perceived | None = None  # the clouds perceived when the alignment failed (None otherwise: see scene)
     joints: Mapping[str, Joint] = field(default_factory=dict)  # seam id -> how it is made
     source: str = "simulation"  # the data's origin: simulation | capture (replayed) | cloud (brought) | camera
 

@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
+from cell.outputs import make_folder, replacing
 from cell.preview.labels import place_labels
 from cell.preview.views import (
     AXIS_COLOURS,
@@ -69,6 +70,14 @@ def new_figure(width_in: float, height_in: float) -> Figure:
     fig = Figure(figsize=(width_in, height_in), dpi=110, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+def save_figure(fig: Figure, path: str | Path, **options: Any) -> Path:
+    """Write ``fig`` to ``path`` whole (:func:`cell.outputs.replacing`; the format from its suffix)."""
+    p = Path(path)
+    with replacing(p, what="picture") as tmp:
+        fig.savefig(tmp, **options)
+    return p
 
 
 def _draw_2d(
@@ -234,8 +243,7 @@ def render_overview(
     """
     from matplotlib.ticker import MaxNLocator
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = make_folder(out_dir, "picture folder")
     all_points = np.asarray(cloud_R, dtype=float).reshape(-1, 3) * MM
     if len(all_points) == 0:
         raise ValueError("render_overview: the cloud is empty; nothing to draw")
@@ -263,7 +271,7 @@ def render_overview(
     fig.legend(handles=handles, loc="outside right upper", fontsize=8, frameon=False)
     place_labels(fig, ax, label_groups(lines))
     written.append(out / "overview_top.png")
-    fig.savefig(written[-1])
+    save_figure(fig, written[-1])
 
     fig = new_figure(12.0, 8.0)
     ax3 = fig.add_subplot(projection="3d")
@@ -275,7 +283,7 @@ def render_overview(
     ax3.set_title(caption(len(cloud3)), fontsize=9)
     fig.legend(handles=handles, loc="outside right upper", fontsize=8, frameon=False)
     written.append(out / "overview_3d.png")
-    fig.savefig(written[-1])
+    save_figure(fig, written[-1])
 
     if lines:
         ncols = min(4, len(lines))
@@ -291,5 +299,5 @@ def render_overview(
         fig.suptitle(f"{head}every seam close up (R frame; colour = depth along the axis not shown)")
         fig.legend(handles=handles, loc="outside right upper", fontsize=8, frameon=False)
         written.append(out / "overview_seams.png")
-        fig.savefig(written[-1])
+        save_figure(fig, written[-1])
     return written

@@ -14,6 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
+from cell.outputs import write_text
 from cell.preview.cell3d import cell_traces, framed_scene, path_slider, view_points
 from cell.preview.views import (
     AXIS_COLOURS,
@@ -210,7 +211,4 @@ def render_html(
     """The 3D view of :func:`figure_3d` alone, as a self-contained HTML file (plotly.js inline: it opens without
     a network). Returns ``out_path``."""
     fig = figure_3d(cloud_R, weldmap_R, seams, torch_poses, tcp_paths, title=title, max_points=max_points, view=view)
-    path = Path(out_path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.write_html(str(path), include_plotlyjs=True, full_html=True)
-    return path
+    return write_text(out_path, fig.to_html(include_plotlyjs=True, full_html=True), what="page")

@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.preview.figures import new_figure
+from cell.preview.figures import new_figure, save_figure
 from cell.preview.views import ARC_COLOUR
 from cell.types.robot import JointLimits
 
@@ -86,10 +86,7 @@ def render_joint_plots(
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8, frameon=False)
     head = f"{title}: " if title else ""
     fig.suptitle(f"{head}joint trajectory, {t[-1] - t[0]:.1f} s, {len(t)} samples")
-    path = Path(out_path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    return path
+    return save_figure(fig, out_path)
 
 
 def _runs(t: FloatArray, on: npt.NDArray[np.bool_]) -> list[tuple[float, float]]:

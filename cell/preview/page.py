@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from cell.geometry import FloatArray, invert, transform_points
+from cell.outputs import write_text
 from cell.preview.html import figure_3d
 from cell.preview.results import results_rows, results_table
 from cell.preview.views import ARC_COLOUR, STATUS_COLOURS, SeamView, seam_views
@@ -146,7 +147,4 @@ def write_page(run: WeldRun, out_path: str | Path, *, title: str = "", max_point
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>'
         f"<style>{_STYLE}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n"
     )
-    path = Path(out_path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(page, encoding="utf-8")
-    return path
+    return write_text(out_path, page, what="page")

@@ -14,8 +14,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.errors import UsageError
-from cell.export.atomic import write_atomic
 from cell.geometry import FloatArray
+from cell.outputs import write_atomic
 from cell.preview.page import draw_inputs
 from cell.preview.timeline import quaternions_xyzw
 from cell.preview.views import ARC_COLOUR, MM, PATH_COLOUR, STATUS_COLOURS, TRUTH_COLOUR, seam_lines, thin

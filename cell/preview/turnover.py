@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cell.preview.figures import new_figure
+from cell.preview.figures import new_figure, save_figure
 from cell.types import WeldMap
 
 if TYPE_CHECKING:
@@ -66,5 +66,5 @@ def write_turnover(run: TurnoverRun, out_dir: Path) -> list[Path]:
         fontsize=9,
     )
     out = Path(out_dir) / "flip.png"
-    fig.savefig(out)
+    save_figure(fig, out)
     return [out]

@@ -14,8 +14,10 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.errors import CaptureError
+from cell.outputs import replacing
 
 MAX_UNITS = 65535  # the largest depth a 16-bit PNG holds, in depth units
+MAX_PIXELS = 4096 * 4096  # the largest depth image read (a 5 Mpx structured-light camera is among the largest)
 
 
 @dataclass(frozen=True)
@@ -64,18 +66,36 @@ def write_png(path: Path, units: npt.NDArray[np.uint16]) -> None:
     from PIL import Image
 
     # zlib level 1: a quarter of the default's time for 6 % more bytes (a 1280 x 720 depth image: ~0.95 MB)
-    Image.fromarray(np.ascontiguousarray(units, dtype=np.uint16)).save(path, format="PNG", compress_level=1)
+    image = Image.fromarray(np.ascontiguousarray(units, dtype=np.uint16))
+    with replacing(path, what="depth image") as tmp:
+        image.save(tmp, format="PNG", compress_level=1)
 
 
-def read_png(path: Path) -> npt.NDArray[np.uint16]:
-    """(H, W) uint16 depth units of a 16-bit greyscale PNG; CaptureError if it is missing, not a PNG or not 16-bit
-    single-channel."""
+def check_size(path: Path, width: int, height: int) -> None:
+    """CaptureError unless a ``width`` x ``height`` image is within :data:`MAX_PIXELS`."""
+    if width * height > MAX_PIXELS:
+        raise CaptureError(
+            f"depth image {path} would be {width} x {height} px ({width * height / 1e6:.3g} Mpx); valid: at most"
+            f" {MAX_PIXELS / 1e6:.3g} Mpx (no depth camera has more)",
+            path=str(path),
+        )
+
+
+def read_png(path: Path, size: tuple[int, int] | None = None) -> npt.NDArray[np.uint16]:
+    """(H, W) uint16 depth units of a 16-bit greyscale PNG; CaptureError if it is missing, not a PNG, not 16-bit
+    single-channel, over :data:`MAX_PIXELS` or not ``size`` (width, height) when given. The size is read from the
+    PNG's header and checked before any pixel is decoded (a decompression bomb costs nothing)."""
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     if not path.is_file():
         raise CaptureError(f"depth image {path} is missing; valid: the file capture.json names", path=str(path))
     try:
-        with Image.open(path) as im:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)  # the size is checked here, below
+            im = Image.open(path)
+        with im:
             fmt, mode = im.format, im.mode
             if fmt != "PNG":
                 raise CaptureError(f"depth image {path} is {fmt or 'not an image'}; valid: a PNG", path=str(path))
@@ -84,11 +104,29 @@ def read_png(path: Path) -> npt.NDArray[np.uint16]:
                     f"depth image {path} has pixel mode {mode}; valid: 16-bit single-channel (I;16) depth units",
                     path=str(path),
                 )
+            if size is not None and im.size != size:
+                raise CaptureError(
+                    f"{path} is {im.size[0]} x {im.size[1]} px, its CameraInfo says {size[0]} x {size[1]}; valid:"
+                    " the same size",
+                    path=str(path),
+                )
+            check_size(path, *im.size)
             units = np.asarray(im, dtype=np.uint16)
     except CaptureError:
         raise
+    except Image.DecompressionBombError:
+        raise CaptureError(
+            f"depth image {path} declares more pixels than Pillow decodes (a decompression bomb); valid: at most"
+            f" {MAX_PIXELS / 1e6:.3g} Mpx",
+            path=str(path),
+        ) from None
     except UnidentifiedImageError:
         raise CaptureError(f"depth image {path} is not an image; valid: a 16-bit PNG", path=str(path)) from None
-    except (OSError, SyntaxError, ValueError) as e:  # truncated or corrupt data
+    except (OSError, SyntaxError, ValueError, EOFError) as e:  # truncated or corrupt data
         raise CaptureError(f"depth image {path} cannot be read ({e}); valid: a 16-bit PNG", path=str(path)) from None
+    if units.shape != im.size[::-1]:  # pillow decoded something else than its header said
+        raise CaptureError(
+            f"depth image {path} decoded to {units.shape} where its header says {im.size}; valid: an intact PNG",
+            path=str(path),
+        )
     return units

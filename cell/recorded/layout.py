@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -16,8 +15,9 @@ import numpy as np
 
 from cell.errors import CaptureError
 from cell.geometry import FloatArray, invert, readonly
+from cell.outputs import write_atomic, write_text
 from cell.recorded import _fields as f
-from cell.recorded.depth_png import encode, read_png, to_metres, write_png
+from cell.recorded.depth_png import check_size, encode, read_png, to_metres, write_png
 from cell.types import DepthImage, Part
 
 FORMAT = "weld-cell-capture"
@@ -137,15 +137,15 @@ def write_capture(
     index["cell"] = None
     index["truth"] = None
     if cell_yaml is not None:
-        (folder / CELL).write_text(cell_yaml, encoding="utf-8")
+        write_text(folder / CELL, cell_yaml, what="capture's cell")
         index["cell"] = CELL
         if map_file is not None and Path(map_file).resolve() != (folder / Path(map_file).name).resolve():
-            shutil.copyfile(map_file, folder / Path(map_file).name)
+            write_atomic(folder / Path(map_file).name, Path(map_file).read_bytes(), what="capture's map")
     if truth_parts_W is not None:
-        (folder / TRUTH).write_text(dumps(f.truth_json(tuple(truth_parts_W))), encoding="utf-8")
+        write_text(folder / TRUTH, dumps(f.truth_json(tuple(truth_parts_W))), what="capture's truth")
         index["truth"] = TRUTH
     index["cameras"] = cameras
-    (folder / INDEX).write_text(dumps(index), encoding="utf-8")
+    write_text(folder / INDEX, dumps(index), what="capture index")
     return folder
 
 
@@ -211,13 +211,8 @@ def _camera(
     png_name = f.field(cam, "depth", f"{where}.", path)
     if not isinstance(png_name, str) or not _NAME.match(png_name):
         raise CaptureError(f"{path}: {where}.depth {png_name!r}; valid: a file name in the folder", path=str(path))
-    units = read_png(folder / png_name)
-    if units.shape != (intr.height, intr.width):
-        raise CaptureError(
-            f"{folder / png_name} is {units.shape[1]} x {units.shape[0]} px, its CameraInfo says "
-            f"{intr.width} x {intr.height}; valid: the same size",
-            path=str(folder / png_name),
-        )
+    check_size(folder / png_name, intr.width, intr.height)  # before the PNG is opened: no image is that large
+    units = read_png(folder / png_name, (intr.width, intr.height))
     image = DepthImage(str(cam["name"]), to_metres(units, scale), intr, readonly(X_WC), str(mount))
     X_RF = None
     flange = cam.get("flange")

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from cell.outputs import replacing
 from cell.types import WeldMap
 
 _MM = 1000.0
@@ -72,7 +73,8 @@ def write_risk(path: Path, weldmap_M: WeldMap, summary: Mapping[str, Any]) -> Pa
     fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, fraction=0.03, label="probability within tolerance")
     _bars(bx, ids, seams, summary.get("stage", "detect"))
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with replacing(path, what="picture") as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
     return path
 
@@ -136,7 +138,8 @@ def write_errors(path: Path, lines: Sequence[Mapping[str, Any]], seam_ids: Seque
         ax.axis("off")
     fig.supxlabel(f"lateral error [mm] (dashed: weld tolerance {tol_mm} mm)", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    with replacing(path, what="picture") as tmp:
+        fig.savefig(tmp, dpi=100)
     plt.close(fig)
     return path
 

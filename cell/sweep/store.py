@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from cell.errors import UsageError
+from cell.outputs import write_text
 from cell.scenario import Scenario
 
 MANIFEST = "sweep.json"
@@ -113,7 +114,7 @@ def open_store(out: Path, params: dict[str, Any], *, fresh: bool, warn: Callable
             )
     elif (out / RUNS).exists():
         raise UsageError(f"--out {str(out)!r} has {RUNS} but no {MANIFEST}; give another --out, or --fresh")
-    manifest.write_text(json.dumps(params, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    write_text(manifest, json.dumps(params, indent=2, sort_keys=True) + "\n", what="sweep manifest")
     store = RunStore(out, params)
     _read_runs(store, warn)
     return store
@@ -148,4 +149,4 @@ def _read_runs(store: RunStore, warn: Callable[[str], None]) -> None:
     for msg in store.dropped:
         warn(msg)
     if store.dropped or (raw and not raw.endswith("\n")):
-        path.write_text("".join(t + "\n" for t in kept), encoding="utf-8")
+        write_text(path, "".join(t + "\n" for t in kept), what="sweep runs")

@@ -4,13 +4,13 @@ at once, the summary and pictures rewritten at intervals and at the end (also wh
 from __future__ import annotations
 
 import json
-import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from cell.outputs import write_text
 from cell.scenario import Scenario
 from cell.sweep.store import RunStore, open_store, sweep_params
 from cell.sweep.summary import summarize
@@ -118,9 +118,7 @@ class Study:
         """Rewrite ``summary.json`` (whole: written aside, then moved over) and, if asked, the pictures."""
         summary = self.summary()
         path = self.out / SUMMARY
-        tmp = path.with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")  # seams in map order
-        os.replace(tmp, path)
+        write_text(path, json.dumps(summary, indent=2) + "\n", what="sweep summary")  # seams in map order
         self._summary_t = time.monotonic()
         if pictures and self.store is not None:
             from cell.sweep.pictures import write_pictures

@@ -2,6 +2,7 @@
 from here and nothing here imports a stage. Frames: ``W`` world, ``R`` robot base, ``M`` welding map, ``C`` camera
 optical frame, ``B`` a box part's own frame. Metres and radians inside; millimetres and degrees only at the edges."""
 
+from cell.types._near import pair_distance
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.gate import Violation, ViolationKind
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, Unsupported, UnsupportedSeam, WeldMap
@@ -77,4 +78,5 @@ __all__ = [
     "WeldProcedure",
     "WeldQuality",
     "WeldReason",
+    "pair_distance",
 ]

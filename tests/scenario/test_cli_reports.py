@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import hashlib
 import json
+import shutil
 import subprocess
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -89,6 +91,30 @@ def test_alignment_failure_still_writes_every_seam_with_its_reason(
     assert not any("detected" in s for s in data["seams"])
 
 
+def test_save_cloud_writes_the_spliced_cloud_when_the_alignment_fails_and_says_why_when_none_was_spliced(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, detected: Callable[..., pipeline.Detection]
+) -> None:
+    """The cloud of a refused alignment is the one to look at: it is saved (every camera's registered points, what
+    ``cell locate`` reads back), and the line says how to read it; with no cloud at all, a warning says why."""
+    from cell.perception.cloud_files import read_cloud
+
+    det = detected("faults/displaced-far", True)
+    assert det.scene is None and det.perceived is not None
+    asked: list[tuple[sc.Scenario, str | None, dict[str, object]]] = []
+    monkeypatch.setattr(pipeline, "detect", _detect_returning(det, asked))
+    cloud = tmp_path / "cloud.ply"
+    code, out, err = invoke("detect", "faults/displaced-far", "--save-cloud", str(cloud))
+    assert code == 3, err
+    assert f"read it back with: cell locate {cloud} --map MAP --frame R --table-z" in out + err
+    assert len(read_cloud(cloud, frame="R")) == len(det.perceived.spliced.registered)
+    none = replace(det, perceived=None)  # perception itself failed: nothing to save
+    monkeypatch.setattr(pipeline, "detect", _detect_returning(none, asked))
+    code, out, err = invoke("detect", "faults/displaced-far", "--save-cloud", str(tmp_path / "none.ply"))
+    assert code == 3 and not (tmp_path / "none.ply").exists()
+    line = next(x for x in err.splitlines() if "--save-cloud" in x)
+    assert "nothing written" in line and "no cloud was spliced" in line
+
+
 def _weld_returning(run: pipeline.WeldRun, then: Callable[[], object]) -> Callable[..., pipeline.WeldRun]:
     """``pipeline.weld`` standing in: the session's run, after ``then`` (what goes wrong late in the run)."""
 
@@ -125,7 +151,13 @@ def test_a_late_failure_loses_only_its_own_output(
     """The report's folder (then the program's) turns into a file during the run: the other output is still
     written, exit 2, and the last line names what was lost."""
     report, krl = tmp_path / "rep" / "r.json", tmp_path / "krl"
-    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: report.parent.write_text("")))
+    report.parent.mkdir()  # there when checked (a missing folder is refused before the run), then made a file
+
+    def folder_to_file(folder: Path) -> None:
+        shutil.rmtree(folder)
+        folder.write_text("")
+
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: folder_to_file(report.parent)))
     code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl))
     assert code == 2, err
     assert "Traceback" not in err and ".part" not in err
@@ -133,7 +165,7 @@ def test_a_late_failure_loses_only_its_own_output(
     assert (krl / "WELD_FENCE1.src").is_file() and (krl / "trajectory.csv").is_file()
 
     report, krl = tmp_path / "r2.json", tmp_path / "krl2"
-    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: krl.write_text("")))
+    monkeypatch.setattr(pipeline, "weld", _weld_returning(fence1_run, lambda: folder_to_file(krl)))
     code, _, err = invoke("weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl))
     assert code == 2, err
     assert err.strip().splitlines()[-1].startswith("exit 2: could not write")

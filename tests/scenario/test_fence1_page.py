@@ -64,7 +64,7 @@ def check_page(path: Path, run: pipeline.WeldRun) -> None:
 
 def test_weld_html_page(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fence1_run: pipeline.WeldRun) -> None:
     monkeypatch.setattr(pipeline, "weld", lambda *a, **kw: fence1_run)
-    page = tmp_path / "page" / "fence1.html"
+    page = tmp_path / "fence1.html"
     result = CliRunner().invoke(app, ["weld", "fence1", "--sides", "first", "--html", str(page)])
     assert result.exit_code == 0, result.stderr
     check_page(page, fence1_run)

@@ -163,7 +163,7 @@ def test_usage_errors_exit_2_before_any_work(monkeypatch: pytest.MonkeyPatch) ->
     code, _, err = invoke("detect", "fence1", "--format", "xml")
     assert_one_line_error(code, err, 2, "--format", "csv")
     code, _, err = invoke("--log-file", str(REPO / "README.md" / "x.log"), "scenarios")
-    assert_one_line_error(code, err, 2, "log file")
+    assert_one_line_error(code, err, 2, "--log-file", "is not a folder")
 
 
 def test_the_console_script_ends_a_usage_error_with_one_error_line() -> None:
@@ -234,6 +234,10 @@ def test_reports_are_written_whole_with_the_umask_permissions(
     from cell.errors import OutputError
     from cell.export.report import write_json
 
+    with pytest.raises(OutputError) as e:
+        write_json(tmp_path / "sub" / "r.json", {})  # a missing folder is not made
+    assert "'" + str(tmp_path / "sub") + "' does not exist" in e.value.message and not (tmp_path / "sub").exists()
+    (tmp_path / "sub").mkdir()
     old = os.umask(0o027)
     try:
         p = write_json(tmp_path / "sub" / "r.json", {"a": 1})

@@ -57,3 +57,5 @@ def test_an_end_past_where_the_other_face_stops_comes_back_to_its_edge() -> None
     assert start.source == "map" and start.s == -0.0038
     assert end is found[1]
     assert within_receiving(found, (-0.0049, 0.0052), 3e-4) == found
+    # A drawn face the line does not cross (its extent a point far off the seam) moves nothing.
+    assert within_receiving(found, (-0.93, -0.93), 3e-4) == found

@@ -232,3 +232,32 @@ def test_joint_trajectory_json_and_csv(plan: WeldPlan, tmp_path: Path) -> None:
     on_time = float(np.sum(np.diff(times)[arc[:-1] == 1]))
     assert on_time == pytest.approx(plan.arc_time, abs=2e-6)
     assert math.isclose(times[-1], plan.cycle_time, abs_tol=1e-5)
+
+
+def test_trajectory_files_are_written_whole(plan: WeldPlan, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import errno
+    import os
+    import stat
+    from typing import Any
+
+    from cell.errors import OutputError, OutputFault
+    from cell.outputs import leftovers
+
+    path = write_csv(plan, tmp_path / "trajectory_A.csv")
+    whole = path.read_bytes()
+    savetxt = np.savetxt
+
+    def disk_full(fname: str, rows: np.ndarray, **options: Any) -> None:  # half the rows, then no space
+        savetxt(fname, rows[: len(rows) // 2], **options)
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(np, "savetxt", disk_full)
+    with pytest.raises(OutputError) as e:
+        write_csv(plan, path)
+    assert e.value.code is OutputFault.WRITE_FAILED and "trajectory" in e.value.message
+    assert path.read_bytes() == whole and leftovers(tmp_path) == []  # never cut at a line boundary
+    fifo = tmp_path / "trajectory_A.json"
+    os.mkfifo(fifo)
+    with pytest.raises(OutputError) as e:
+        write_json(plan, fifo)
+    assert e.value.code is OutputFault.FIFO and stat.S_ISFIFO(os.lstat(fifo).st_mode)

@@ -115,7 +115,7 @@ def test_joint_plots(tmp_path: Path) -> None:
     t = np.linspace(0.0, 2.0, 201)
     q = np.column_stack([np.sin(t), 0.5 * t - 1.0, np.radians(150.0) + 0.2 * np.sin(3 * t)])  # A3 crosses its limit
     qd = np.gradient(q, t, axis=0)
-    out = render_joint_plots(t, q, qd, limits(), tmp_path / "plots" / "joints.png", arc_on=(t > 0.5) & (t < 1.5))
+    out = render_joint_plots(t, q, qd, limits(), tmp_path / "joints.png", arc_on=(t > 0.5) & (t < 1.5))
     assert_png(out)
     assert colour_fraction(out, ARC_COLOUR, alpha=0.35, tol=0.02) > 0.05  # the arc-on band is shaded
     with pytest.raises(ValueError, match="q and qd"):

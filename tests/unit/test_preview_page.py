@@ -143,7 +143,7 @@ def tiny_run() -> WeldRun:
 
 def test_page_has_results_table_and_cell_figure(tmp_path: Path) -> None:
     run = tiny_run()
-    out = write_page(run, tmp_path / "page" / "cell.html", title="tiny T joint")
+    out = write_page(run, tmp_path / "cell.html", title="tiny T joint")
     text = out.read_text(encoding="utf-8")
     assert 'src="https://' not in text and text.count("Plotly.newPlot") >= 1  # plotly.js inline, offline
     figs, rows = read(out)

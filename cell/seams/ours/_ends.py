@@ -306,7 +306,10 @@ def find_ends(
 def within_receiving(ends: tuple[End, End], s_b: tuple[float, float], margin: float) -> tuple[End, End]:
     """The ends, one placed past where B's face stops along the line (``s_b``: the drawn face's extent [m], by more
     than ``margin``) brought back to that edge, the map's: a fillet lies only where both faces are (a plate
-    standing over a gap ends a brace's cheek fillet at its lower edge, above the brace's foot on the base)."""
+    standing over a gap ends a brace's cheek fillet at its lower edge, above the brace's foot on the base). Where
+    B's face does not hold the seam's middle (the line misses the drawn face: no chord of it), nothing is moved."""
+    if not s_b[0] < 0.5 * (ends[0].s + ends[1].s) < s_b[1]:
+        return ends
     start = ends[0].at(s_b[0], 0.0, "map") if ends[0].s < s_b[0] - margin else ends[0]
     stop = ends[1].at(s_b[1], 0.0, "map") if ends[1].s > s_b[1] + margin else ends[1]
     return start, stop

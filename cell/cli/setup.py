@@ -92,10 +92,12 @@ def init(
 def check(
     file: Annotated[str, typer.Argument(help="A scenario YAML path (or a shipped scenario's name).")],
 ) -> None:
-    """Validate a scenario: every key, the map it names (found and readable), and the layout (the part on the
-    table and inside the workspace, its seams within the arm's reach, each seam's two faces seen by a camera of
-    the first scan: one line per seam). Exit 0 when it loads; problems of the layout and seams no camera will see
-    are printed as warnings (they do not change the exit code)."""
+    """Validate a scenario as strictly as a run uses it: every key (typed, finite, in range, none given twice), the
+    map it names, what the run checks before it moves (the robot's home within its joints' limits, the scan pose
+    within the arm's reach, the part as built from the deviations), then the layout (the part on the table and
+    inside the workspace, the cameras aimed at it and within range, the robot upright and facing it, the weld gate,
+    each seam's two faces seen by a camera of the first scan: one line per seam). What the run would refuse is an
+    error with the run's exit code; problems of the layout and seams no camera will see are warnings (exit 0)."""
     from cell import pipeline
     from cell import scenario as sc
     from cell.scenario.init import check_layout
@@ -103,7 +105,7 @@ def check(
     with cell_errors():
         scn = sc.load(file)
         weldmap = pipeline.read_weldmap(scn)
-        problems = check_layout(scn, weldmap)
+        problems = check_layout(scn, weldmap) + _run_checks(scn, weldmap)
         problems += [
             f"seam {u.id} will not be welded: not supported ({u.code}): {u.reason}" for u in weldmap.unsupported
         ]
@@ -125,6 +127,32 @@ def check(
         )
         for line in seams.lines:
             out.print(f"  {line}", soft_wrap=True, markup=False, highlight=False)
+
+
+def _run_checks(scn: Scenario, weldmap: WeldMap) -> list[str]:
+    """The run's own checks before anything moves (they raise as the run would: the arm's home and scan pose, the
+    part as built), then
+    the layout's warnings (:mod:`cell.scenario.layout_checks`)."""
+    from cell.geometry import transform_points
+    from cell.pipeline.geometry import robot_arm
+    from cell.scenario import layout_checks as lc
+    from cell.sim.asbuilt.parts import as_built_fixtures, as_built_parts
+    from cell.sim.faults import built_parts
+
+    arm = robot_arm(scn)  # home within the joints' limits, the scan pose within reach (IKError, exit 15)
+    # The part as the simulated station builds it: the deviations, bows, gaps and missing parts name the map's parts
+    built_parts(as_built_parts(weldmap, scn), scn.faults)
+    as_built_fixtures(weldmap, scn)
+    home_W = None
+    if arm is not None:
+        home_W = transform_points(scn.X_WR, arm.model.fk(arm.q_home)[None, :3, 3])[0]
+    return [
+        *lc.camera_problems(scn, weldmap),
+        *lc.part_height_problems(scn, weldmap),
+        *lc.robot_problems(scn, weldmap, home_W),
+        *lc.gate_problems(scn),
+        *lc.name_problems(scn, weldmap),
+    ]
 
 
 def _seam_sight(scn: Scenario, weldmap: WeldMap) -> SightReport:

@@ -29,6 +29,14 @@ BOUND_SIGMAS = 3.0
 # each end's sigma along the seam is within END_TOLERANCE_MM (``rescan.end_tolerance_mm``).
 END_TOLERANCE_MM = 1.0
 
+# The sane range of the gate's figures: beyond them the gate is off in all but name (a 100 mm tolerance or a bound
+# of 0.01 sigma welds any seam found). A scenario goes beyond them only with ``rescan.allow_loose_gate: true``, and
+# ``cell scenario check`` then warns. 2 mm is half the smallest fillet leg the WPS rows weld (4 mm): a seam further off
+# puts the wire beside the root; 5 mm at an end is a bead past the joint's end by a wire's stick-out and more.
+SANE_WELD_TOLERANCE_MM = 2.0
+SANE_END_TOLERANCE_MM = 5.0
+SANE_BOUND_SIGMAS = (2.0, 6.0)  # fewer than 2 sigma lets one seam in 20 past; more than 6 welds almost nothing
+
 # Ours' sigma floor up close [m]: what no number of close-up points averages away. The depth output's quantisation
 # (CLOSEUP_DEPTH_UNIT_M, the D4xx's finest depth unit) is shared by the points of a face seen at one depth: unit /
 # sqrt 12 on each weld face, the two in quadrature; and the arm's pose accuracy and hand-eye calibration on a real

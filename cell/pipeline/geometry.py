@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cell.errors import ScenarioError
+from cell.errors import IKError, ScenarioError
 from cell.geometry import invert
 from cell.pipeline.records import Detection
 from cell.scenario import Scenario
@@ -58,11 +58,26 @@ def robot_arm(scenario: Scenario) -> Arm | None:
     if home_deg is None or len(home_deg) != model.dof:
         raise ScenarioError(f"robot.home_deg must list {model.dof} joint values in degrees, got {home_deg}")
     q_home = np.radians(np.asarray(home_deg, dtype=float))
+    lim = model.limits
+    for j in np.flatnonzero((q_home < lim.q_min - 1e-9) | (q_home > lim.q_max + 1e-9)):
+        lo, hi = np.degrees(lim.q_min[j]), np.degrees(lim.q_max[j])
+        raise ScenarioError(
+            f"robot.home_deg A{j + 1} {home_deg[j]:g} deg is outside the joint's limits ({lo:.0f} to {hi:.0f} deg)"
+        )
     q_scan = q_home
     eye = [name for name, cam in scenario.cameras.items() if cam.mount == "eye_in_hand"]
     if eye:
         X_RC = invert(scenario.X_WR) @ scenario.cameras[eye[0]].X_WC
-        q_scan = scan_configuration(model, X_RC, q_home, rng=scenario.rng("scan"), ik=scenario.motion.plan.ik)
+        try:
+            q_scan = scan_configuration(model, X_RC, q_home, rng=scenario.rng("scan"), ik=scenario.motion.plan.ik)
+        except IKError as e:
+            centre, reach = model.reach_bound("camera_optical")
+            far = float(np.linalg.norm(X_RC[:3, 3] - centre))
+            raise IKError(
+                f"cameras.{eye[0]}: the arm cannot hold the camera at its scan pose (eye_m "
+                f"{list(scenario.cameras[eye[0]].eye_m)}, {far:.2f} m from the arm's shoulder, which reaches "
+                f"{reach:.2f} m at most): {e.message}"
+            ) from None
     return Arm(model, q_home, np.asarray(q_scan, dtype=float))
 
 

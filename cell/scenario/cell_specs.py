@@ -11,7 +11,7 @@ from pydantic import Field, model_validator
 
 from cell.config import STICKOUT_MM
 from cell.geometry import FloatArray, look_at, pose_from_xyz_rpy
-from cell.scenario.base import Model, NonNeg, Pos, Vec3
+from cell.scenario.base import Angle, Angles3, Model, NonNeg, Point3, Pos, Vec3
 from cell.scenario.layer_specs import LayerSpec
 from cell.scenario.track_specs import TrackSpec
 
@@ -19,8 +19,8 @@ from cell.scenario.track_specs import TrackSpec
 class PoseSpec(Model):
     """A pose given as translation [m] and fixed-axis roll, pitch, yaw [deg]."""
 
-    xyz_m: Vec3 = (0.0, 0.0, 0.0)
-    rpy_deg: Vec3 = (0.0, 0.0, 0.0)
+    xyz_m: Point3 = (0.0, 0.0, 0.0)
+    rpy_deg: Angles3 = (0.0, 0.0, 0.0)
 
     @property
     def X(self) -> FloatArray:
@@ -49,12 +49,16 @@ class Deviation(Model):
 class TableSpec(Model):
     """The welding table, a box: centre and size in the world [m]."""
 
-    center_m: Vec3
+    center_m: Point3
     size_m: tuple[Pos, Pos, Pos]
 
     @property
     def top_z(self) -> float:
         return self.center_m[2] + self.size_m[2] / 2.0
+
+    def holds(self, p_W: Vec3) -> bool:
+        """Whether the world point lies inside the table's box."""
+        return all(abs(p_W[k] - self.center_m[k]) < self.size_m[k] / 2.0 for k in range(3))
 
 
 class RobotSpec(Model):
@@ -62,7 +66,7 @@ class RobotSpec(Model):
 
     urdf: str | None = None  # relative to the repository's robots/ folder; None: no arm in the cell
     X_WR: PoseSpec = PoseSpec()
-    home_deg: tuple[float, ...] | None = None
+    home_deg: tuple[Angle, ...] | None = None  # A1..An [deg]; each also within its joint's limits (the URDF's)
     # Wire stick-out [mm] beyond the contact tip in the URDF's torch_tcp (robots/build_kr5_arc.py STICKOUT): the
     # torch planner stands the TCP off the seam by contact_tip_distance_mm minus this (0 by default).
     stickout_mm: Pos = STICKOUT_MM
@@ -106,8 +110,8 @@ class CameraSpec(Model):
     """A depth camera looking from ``eye_m`` at ``target_m`` (world) with a pinhole of the given size and field."""
 
     mount: Literal["fixed", "eye_in_hand"] = "fixed"
-    eye_m: Vec3
-    target_m: Vec3
+    eye_m: Point3
+    target_m: Point3
     up: Vec3 = (0.0, 0.0, 1.0)
     resolution: tuple[Annotated[int, Field(ge=16, le=4096)], Annotated[int, Field(ge=16, le=4096)]] = (
         1280,
@@ -141,8 +145,8 @@ class CameraSpec(Model):
 class WorkspaceSpec(Model):
     """Passthrough crop in the world [m]: only points inside this box are kept (paper eq. 2)."""
 
-    min_m: Vec3
-    max_m: Vec3
+    min_m: Point3
+    max_m: Point3
 
     @model_validator(mode="after")
     def _check(self) -> WorkspaceSpec:

@@ -265,8 +265,6 @@ def check_layout(scenario: Scenario, weldmap: WeldMap) -> list[str]:
     t_hi = np.array(t.center_m[:2]) + np.array(t.size_m[:2]) / 2.0
     if np.any(lo_W[:2] < t_lo - tol) or np.any(hi_W[:2] > t_hi + tol):
         problems.append("the part overhangs the table")
-    if abs(lo_W[2] - t.top_z) > 1e-3:
-        problems.append(f"the part's underside (z {_num(lo_W[2])} m) is not on the table top (z {_num(t.top_z)} m)")
     if scenario.robot.urdf is not None and map_W.seams:
         ends_W = np.array([p for s in map_W.seams for p in (s.p_start, s.p_end)])
         far = float(np.linalg.norm(ends_W[:, :2] - np.array(scenario.robot.X_WR.xyz_m[:2]), axis=1).max())

@@ -10,16 +10,17 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union, get_args, get_origin, get_type_hints
 
-import yaml
 from pydantic import BaseModel, ValidationError
 
 from cell.errors import ScenarioError
 from cell.scenario.model import Scenario
 from cell.scenario.procedure_specs import with_procedures_file
+from cell.scenario.yaml_text import frozen, parse
 
 REPO_ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO_DIR = REPO_ROOT / "scenarios"
 _UNKNOWN_KEY = ("extra_forbidden", "unexpected_keyword_argument")
+_NUMBER_TYPES = ("int_type", "float_type", "int_from_float", "bool_type")
 
 
 def _members(tp: Any) -> list[Any]:
@@ -97,10 +98,47 @@ def _explain(err: ValidationError, source: str) -> str:
         close = difflib.get_close_matches(tag, tags, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         return f"{source}: {where}.method {tag!r} is unknown{hint}; valid: {', '.join(tags)}"
+    if e["type"] == "missing" and loc and isinstance(loc[-1], int):  # a list shorter than its key needs
+        return f"{source}: {where.rsplit('.', 1)[0]}: too few values (item {int(loc[-1]) + 1} is missing)"
     if e["type"] == "missing":
         return f"{source}: missing key {where!r}"
+    if e["type"] == "value_error":  # a model's own check: its message says what is valid
+        reason = str(e.get("ctx", {}).get("error", e["msg"]))
+        return f"{source}: {reason}" if where == "<top level>" else f"{source}: {where}: {reason}"
     more = f" (+{len(errors) - 1} more problems)" if len(errors) > 1 else ""
-    return f"{source}: {where}: {e['msg']} (got {e.get('input')!r}){more}"
+    got = e.get("input")
+    if isinstance(got, str) and e["type"] in _NUMBER_TYPES:  # ``seed: "12"``: typed, never read from text
+        return f"{source}: {where}: a number is needed, got the text {got!r} (write it without quotes){more}"
+    if isinstance(got, tuple):
+        got = list(got)
+    return f"{source}: {where}: {e['msg']} (got {got!r}){more}"
+
+
+def _coerced(raw: Any, value: Any, path: tuple[str, ...]) -> tuple[str, Any, str] | None:
+    """The first value pydantic's lax mode converted from another type (text or a bool to a number, a number to
+    a bool, 12.0 to an integer): (its key, what the file gave, what was needed); None when every value was given as
+    its type."""
+    if isinstance(raw, dict) and isinstance(value, dict):
+        for k, v in raw.items():
+            if k in value:
+                found = _coerced(v, value[k], (*path, str(k)))
+                if found is not None:
+                    return found
+        return None
+    if isinstance(raw, tuple) and isinstance(value, (tuple, list)) and len(raw) == len(value):
+        for i, (r, v) in enumerate(zip(raw, value, strict=True)):
+            found = _coerced(r, v, (*path, str(i)))
+            if found is not None:
+                return found
+        return None
+    where = ".".join(path)
+    if isinstance(value, bool) and not isinstance(raw, bool):
+        return where, raw, "true or false"
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and isinstance(raw, (str, bool)):
+        return where, raw, "a number"
+    if isinstance(value, int) and not isinstance(value, bool) and isinstance(raw, float):
+        return where, raw, "a whole number (no decimal point)"
+    return None
 
 
 def resolve(name_or_path: str | Path) -> Path:
@@ -128,11 +166,16 @@ def from_dict(data: Any, base_dir: Path, source: str = "<scenario>") -> Scenario
     """Validate a parsed YAML mapping into a :class:`Scenario`; paths inside resolve against ``base_dir``."""
     if not isinstance(data, dict):
         raise ScenarioError(f"{source}: a scenario must be a YAML mapping of keys, got {type(data).__name__}")
-    data = with_procedures_file(data, base_dir, source)
+    data = frozen(with_procedures_file(data, base_dir, source), source)
     try:
         scenario = Scenario.model_validate({**data, "base_dir": str(base_dir)})
     except ValidationError as err:
         raise ScenarioError(_explain(err, source)) from None
+    coerced = _coerced(data, scenario.model_dump(), ())
+    if coerced is not None:  # typed: ``seed: "12"`` or ``true`` for a number is refused, never read as 12 or 1
+        where, got, wanted = coerced
+        quotes = " (write it without quotes)" if isinstance(got, str) else ""
+        raise ScenarioError(f"{source}: {where}: {wanted} is needed, got {got!r}{quotes}")
     if not scenario.map_path.is_file():
         looked = ", then ".join(str(p) for p in dict.fromkeys(scenario.map_candidates))
         raise ScenarioError(f"{source}: map.file {scenario.map.file!r} does not exist (looked at {looked})")
@@ -141,13 +184,7 @@ def from_dict(data: Any, base_dir: Path, source: str = "<scenario>") -> Scenario
 
 def from_yaml(text: str, base_dir: Path = SCENARIO_DIR, source: str = "<inline>") -> Scenario:
     """Parse and validate scenario YAML text (used by tests for tiny inline scenarios)."""
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark is not None else ""
-        raise ScenarioError(f"{source}: not valid YAML{where}: {getattr(err, 'problem', err)}") from None
-    return from_dict(data, base_dir, source)
+    return from_dict(parse(text, source), base_dir, source)
 
 
 def load(name_or_path: str | Path) -> Scenario:

@@ -70,6 +70,20 @@ class Scenario(Model):
             )
         return self
 
+    @model_validator(mode="after")
+    def _nothing_in_the_table(self) -> Scenario:
+        """A camera or the robot's base inside the table's box is a typing error (no depth image, no arm)."""
+        t = self.table
+        where = f"inside the table (centre {list(t.center_m)}, size {list(t.size_m)} m)"
+        for name, cam in self.cameras.items():
+            if t.holds(cam.eye_m):
+                raise ValueError(f"cameras.{name}.eye_m {list(cam.eye_m)} is {where}; a camera stands outside it")
+        if self.robot.urdf is not None and t.holds(self.robot.X_WR.xyz_m):
+            raise ValueError(
+                f"robot.X_WR.xyz_m {list(self.robot.X_WR.xyz_m)} is {where}; the base stands beside or on it"
+            )
+        return self
+
     @field_validator("procedures")
     @classmethod
     def _procedure_names(cls, v: tuple[ProcedureSpec, ...]) -> tuple[ProcedureSpec, ...]:

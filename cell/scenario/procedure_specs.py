@@ -7,11 +7,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-import yaml
 from pydantic import Field, model_validator
 
 from cell.errors import ScenarioError
 from cell.scenario.base import Model, NonNeg
+from cell.scenario.yaml_text import parse
 from cell.types.procedure import Weave, WeldPass, WeldProcedure
 
 
@@ -148,11 +148,10 @@ def with_procedures_file(data: dict[str, Any], base_dir: Path, source: str) -> d
         raise ScenarioError(f"{source}: give procedures or procedures_file, not both")
     path = (base_dir / name).resolve()
     try:
-        rows = yaml.safe_load(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
         raise ScenarioError(f"{source}: procedures_file {name!r} cannot be read ({path}): {err}") from None
-    except yaml.YAMLError as err:
-        raise ScenarioError(f"{source}: procedures_file {name!r} is not valid YAML: {err}") from None
+    rows = parse(text, f"{source}: procedures_file {name!r}")  # a key twice is refused here too
     if isinstance(rows, dict) and set(rows) == {"procedures"}:
         rows = rows["procedures"]
     if not isinstance(rows, list):

@@ -22,7 +22,14 @@ from cell.config import (
     ScreenOptions,
     SymmetryOptions,
 )
-from cell.config.rescan import BOUND_SIGMAS, END_TOLERANCE_MM, WELD_TOLERANCE_MM
+from cell.config.rescan import (
+    BOUND_SIGMAS,
+    END_TOLERANCE_MM,
+    SANE_BOUND_SIGMAS,
+    SANE_END_TOLERANCE_MM,
+    SANE_WELD_TOLERANCE_MM,
+    WELD_TOLERANCE_MM,
+)
 from cell.geometry import FloatArray, pose_from_xyz_rpy
 from cell.scenario.base import Model, Pos, Vec3
 from cell.scenario.cell_specs import Deviation, PoseSpec, WorkspaceSpec
@@ -86,6 +93,10 @@ class RescanSpec(Model):
         ``SeamEstimate.end_sigma_m``) exceeds this is re-scanned in ``low`` mode and, still over after the re-scan, not
         welded (``end_uncertain``): a bead more than this past or short of its joint's end is a defect.
     weld_min_confidence : after the re-scan, a seam below this is not welded (reason ``low_confidence``).
+    allow_loose_gate : the gate's figures may go beyond their sane range (``weld_tolerance_mm`` up to
+        SANE_WELD_TOLERANCE_MM, ``end_tolerance_mm`` up to SANE_END_TOLERANCE_MM, ``bound_sigmas`` within
+        SANE_BOUND_SIGMAS, in cell.config.rescan): without it such a figure is refused; with it
+        ``cell scenario check`` warns that the gate is loose.
     escalate_mm : in ``low`` mode, a close-up that disagrees with the first estimate by more than this [mm]
         triggers a re-scan of every visible seam.
     closeup : how each close-up is taken, located and fused (:class:`~cell.config.rescan.RescanOptions`).
@@ -98,6 +109,7 @@ class RescanSpec(Model):
     weld_tolerance_mm: Annotated[float, Field(gt=0.0)] = WELD_TOLERANCE_MM
     bound_sigmas: Annotated[float, Field(gt=0.0)] = BOUND_SIGMAS
     end_tolerance_mm: Annotated[float, Field(gt=0.0)] = END_TOLERANCE_MM
+    allow_loose_gate: bool = False  # opt in to gate figures beyond their sane range (then a warning, not an error)
     # A close-up that moves its seam further than this from the first estimate means the fixed cameras cannot be
     # trusted (calibration off, a bumped camera): every other visible seam is then re-scanned too.
     escalate_mm: Annotated[float, Field(gt=0.0)] = 0.5
@@ -113,6 +125,27 @@ class RescanSpec(Model):
         """The largest sigma [m] of an end along the seam for the seam to be welded: ``end_tolerance_mm`` /
         ``bound_sigmas``."""
         return self.end_tolerance_mm / 1000.0 / self.bound_sigmas
+
+    def loose_gate(self) -> list[str]:
+        """The gate's figures beyond their sane range, one phrase each (empty when the gate is sane)."""
+        lo, hi = SANE_BOUND_SIGMAS
+        out = []
+        if self.weld_tolerance_mm > SANE_WELD_TOLERANCE_MM:
+            out.append(f"weld_tolerance_mm {self.weld_tolerance_mm:g} is over {SANE_WELD_TOLERANCE_MM:g}")
+        if self.end_tolerance_mm > SANE_END_TOLERANCE_MM:
+            out.append(f"end_tolerance_mm {self.end_tolerance_mm:g} is over {SANE_END_TOLERANCE_MM:g}")
+        if not lo <= self.bound_sigmas <= hi:
+            out.append(f"bound_sigmas {self.bound_sigmas:g} is outside {lo:g} to {hi:g}")
+        return out
+
+    @model_validator(mode="after")
+    def _sane_gate(self) -> RescanSpec:
+        loose = self.loose_gate()
+        if loose and not self.allow_loose_gate:
+            raise ValueError(
+                f"{'; '.join(loose)}: the weld gate would be off in all but name; set allow_loose_gate: true to mean it"
+            )
+        return self
 
     @model_validator(mode="after")
     def _closeup_locator_options(self) -> RescanSpec:

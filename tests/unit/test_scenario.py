@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from cell import scenario as sc
 from cell.errors import ScenarioError
@@ -106,8 +107,9 @@ def test_camera_focal_length_from_fov() -> None:
 
 
 def with_keys(text: str) -> str:
-    """fence1 with ``text`` (top-level YAML keys) appended."""
-    return FENCE1 + "\n" + text
+    """fence1 with ``text``'s top-level YAML keys in place of its own (a key given twice is refused)."""
+    data = {**yaml.safe_load(FENCE1), **yaml.safe_load(text)}
+    return yaml.safe_dump(data, sort_keys=False)
 
 
 @pytest.mark.parametrize(

@@ -86,19 +86,11 @@ EDGE_BLURS = (2e-4, 5e-4, 1e-3, 1.5e-3, 2.5e-3)  # [m]
 EDGE_WINDOW_M = 0.01  # half-width of the window about a guess that :func:`edge_ml` reads [m]
 
 
-def _log_normaliser(b: FloatArray, sigma: FloatArray, lo: float, hi: float, stray: float, n: int) -> FloatArray:
-    """n times the log of the edge model's normalisation over the window [lo, hi] for edges at b (k,) [m] and blurs
-    sigma (m,) [m]: (m, k), the integral of Phi((b - s) / sigma) + stray over the window, exact wherever b lies
-    (inside, near a bound or beyond it: (b - lo) alone goes to 0 and below for an edge at or under the window's
-    lower bound, and its log to +-inf), always positive."""
-    from scipy.special import ndtr
-
-    def psi(t: FloatArray) -> FloatArray:  # an antiderivative of Phi: t Phi(t) + phi(t)
-        return np.asarray(t * ndtr(t) + np.exp(-0.5 * t * t) / np.sqrt(2.0 * np.pi))
-
-    sig = np.asarray(sigma, np.float64)[:, None]
-    mass = sig * (psi((b[None, :] - lo) / sig) - psi((b[None, :] - hi) / sig)) + stray * (hi - lo)
-    return np.asarray(n * np.log(mass))
+def _log_normaliser(b: FloatArray, lo: float, hi: float, stray: float, n: int) -> FloatArray:
+    """n times the log of the edge model's normalisation for edges at b (k,) [m] in the window [lo, hi]: +inf for an
+    edge so far below the window that nothing of the model is left in it (its likelihood is then -inf, never NaN)."""
+    mass = (b - lo) + stray * (hi - lo)
+    return np.where(mass > 0.0, n * np.log(np.maximum(mass, 1e-300)), np.inf)
 
 
 def edge_fit(
@@ -143,25 +135,25 @@ def edge_fit(
     at = np.asarray(lo + (filled + 0.5) * width, np.float64)
     sig_c = sig[::2]
     z = (coarse[None, :, None] - at[None, None, :]) / sig_c[:, None, None]
-    ll_c = (np.log(ndtr(z) + stray) * bins[filled]).sum(axis=2)
-    ll_c -= _log_normaliser(coarse, sig_c, lo, hi, stray, len(x))
+    ll_c = (np.log(ndtr(z) + stray) * bins[filled]).sum(axis=2)  # the normalisation is the same for every blur
+    ll_c -= _log_normaliser(coarse, lo, hi, stray, len(x))
     centre = float(coarse[int(np.argmax(ll_c.max(axis=0)))])
     b = np.asarray(centre + step * np.arange(-6, 7), np.float64)  # (13,)
     # Points more than 6 blurs inside (outside) every b add log(1 + stray) (log(stray)) whatever b, to within
     # 1e-7: only those nearer are evaluated, for each blur (x is sorted).
     ll = np.empty((len(sig), len(b)))
-    norm = _log_normaliser(b, sig, lo, hi, stray, len(x))
+    norm = _log_normaliser(b, lo, hi, stray, len(x))
     for j, sj in enumerate(blurs):
         i0, i1 = np.searchsorted(x, (b[0] - 6.0 * sj, b[-1] + 6.0 * sj))
         z = (b[:, None] - x[None, i0:i1]) / sj
         far = i0 * np.log1p(stray) + (len(x) - i1) * np.log(stray)
-        ll[j] = np.log(ndtr(z) + stray).sum(axis=1) + far - norm[j]
+        ll[j] = np.log(ndtr(z) + stray).sum(axis=1) + far - norm
     best = ll.max(axis=0)
     i = int(np.argmax(best))
     pos, se = float(b[i]), float("inf")
     if 0 < i < len(b) - 1:
         c2 = best[i - 1] - 2.0 * best[i] + best[i + 1]
-        if np.isfinite(c2) and c2 < 0.0:
+        if np.isfinite(c2) and c2 < 0.0:  # a neighbour below the window (-inf) leaves the grid's step as it is
             pos += float(0.5 * (best[i - 1] - best[i + 1]) / c2) * step
             se = float(step / np.sqrt(-c2))
     blur = float(sig[int(np.argmax(ll[:, i]))])

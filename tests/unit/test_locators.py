@@ -202,7 +202,12 @@ def test_edge_fit_finds_a_blurred_edge_and_flags_a_cut_off() -> None:
     assert _extent.edge_fit(s, -0.024, 0.0235, -0.012, 0.0005).at_limit
 
 
-def test_edge_fit_searching_below_its_window_warns_nothing() -> None:
+@pytest.mark.xfail(
+    strict=True,
+    reason="the edge model's exact normaliser finds this edge, but also placed a random cell's face from an edge "
+    "2.1 mm off at 0.14 mm where the simpler one refuses (seed 0, cell 115): kept out until the edge's sigma knows",
+)
+def test_edge_fit_searching_below_its_window_finds_the_edge_inside() -> None:
     """Candidate edges so far below the window that nothing of the model is left in it have likelihood -inf (not
     the log of a negative mass: numpy's RuntimeWarning on every run of a part with such a face); the edge inside
     the window is still found."""

@@ -23,8 +23,8 @@ from cell.perception.ground import Ground, TableSource, find_ground, floor_heigh
 from cell.perception.preprocess import downsample
 from cell.perception.unorganised import TablePlane, levelling
 from cell.perception.unorganised import sampling as spacing_of
-from cell.pipeline.cloud_seams import locate_seams
-from cell.pipeline.cloud_setup import scenario_for
+from cell.pipeline.cloud.seams import locate_seams
+from cell.pipeline.cloud.setup import scenario_for
 from cell.pipeline.evaluation import evaluate
 from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Detection

@@ -57,14 +57,14 @@ def side_planes(
         for i in np.flatnonzero(crossing):
             at = p0 + s_map[1 if c_all[i] > 0.0 else 0] * t
             adjacent[i] = float(body.face_distance(names[i], at)[0]) <= _ADJACENT_M
+    held = [bool(adjacent[crossing & (c_all <= 0.0)].any()), bool(adjacent[crossing & (c_all > 0.0)].any())]
     best: list[tuple[float, float, int] | None] = [None, None]
     for i in np.flatnonzero(crossing):  # in the faces' order: the tie rule depends on it
         c = float(c_all[i])
         end = 1 if c > 0.0 else 0
         off = abs(float(s_all[i]) - s_map[end])
         current = best[end]
-        held = adjacent[crossing & ((c_all > 0.0) == (c > 0.0))]
-        if off > reach_m or (held.any() and not adjacent[i]):
+        if off > reach_m or (held[end] and not adjacent[i]):
             continue
         if (
             current is None

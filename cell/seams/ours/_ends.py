@@ -290,7 +290,9 @@ def find_ends(
             s_d = along_a(d)
             g = sign * extent[k]
             fit = edge_fit(sign * s_d, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
-            if np.isfinite(fit.b) and np.isfinite(fit.se):
+            # A best edge at the end of the range searched about the guess is no edge found (a density that
+            # falls off over millimetres, a face seen ever more edge-on): the extrapolation stands, with its miss.
+            if fit.ok:
                 # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
                 # 3 spacings; the end's sigma is the likelihood's standard error and what the sample cannot resolve
                 # (edge_bias).

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_fit
+from cell.seams._extent import EDGE_WINDOW_M, EdgeFit, cdf_extent, edge_fit
 from cell.seams._lines import line_plane_parameter
 from cell.seams.ours._geometry import within
 from cell.seams.ours._planes import End, Face
@@ -286,23 +286,42 @@ def find_ends(
             # point of the dense cloud within the likelihood's window about it.
             sign = 1.0 if k == 1 else -1.0
             reach = EDGE_WINDOW_M + o.edge_band_m + abs(c) * o.tube_radius_m  # the whole side line's points
-            d = dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t)
-            s_d = along_a(d)
-            g = sign * extent[k]
-            fit = edge_fit(sign * s_d, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
-            # A best edge at the end of the range searched about the guess is no edge found (a density that
-            # falls off over millimetres, a face seen ever more edge-on): the extrapolation stands, with its miss.
+            d, fit = _edge_in(dense, along_a, p0, t, sign, extent[k], reach)
+            if fit.at_limit:
+                # The best edge at the end of the range searched: the extrapolation was that far off (a face thinned
+                # out unevenly). Searched again about the face's last point; at the limit again, no edge was found
+                # (a density that falls off over millimetres, a face seen ever more edge-on, strays far past it):
+                # the extrapolation stands, with its miss.
+                d, fit = _edge_in(dense, along_a, p0, t, sign, (s_a.min(), s_a.max())[k], reach)
             if fit.ok:
                 # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
                 # 3 spacings; the end's sigma is the likelihood's standard error and what the sample cannot resolve
                 # (edge_bias).
-                inside = np.count_nonzero(np.abs(s_d - extent[k]) < EDGE_WINDOW_M)
+                inside = np.count_nonzero(np.abs(along_a(d) - sign * fit.b) < EDGE_WINDOW_M)
                 density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
                 bias = edge_bias(d.pitch, max(face_a.scale, fit.blur))
                 placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", fit.se, bias)
             else:
                 placed[k] = unconfirmed
     return placed[0], placed[1]
+
+
+def _edge_in(
+    dense: Callable[[FloatArray, FloatArray], Points],
+    along: Callable[[Points], FloatArray],
+    p0: FloatArray,
+    t: FloatArray,
+    sign: float,
+    guess: float,
+    reach: float,
+) -> tuple[Points, EdgeFit]:
+    """The dense points within ``reach`` [m] of ``guess`` (a parameter along p0 + s t [m]) and the edge likelihood's
+    fit of the face's end there, in its window about the guess, searched within :data:`EDGE_SEARCH_M` of it: the
+    upper end for ``sign`` +1, the lower for -1 (the fit's ``b`` is then the parameter's negative). ``along``: the
+    parameters of the face's points among dense points."""
+    d = dense(p0 + (guess - reach) * t, p0 + (guess + reach) * t)
+    s, g = sign * along(d), sign * guess
+    return d, edge_fit(s, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
 
 
 def within_receiving(ends: tuple[End, End], s_b: tuple[float, float], margin: float) -> tuple[End, End]:

@@ -101,7 +101,7 @@ class Detection:
         the map holds no seam the cell cannot weld (a curve: listed, never dropped in silence)."""
         undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
         found = all(e.status not in undone for e in self.estimates)
-        return not self.lost_cameras and found and not self.weldmap_R.unsupported
+        return not self.lost_cameras and found and not self.weldmap_R.not_welded
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -12,14 +12,15 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
   (80 x 150, a 15 mm snipe where the pipe's fillet runs under them) standing on the plate against the pipe's sides;
   the pipe's fillet is a CIRCLE (a T, cylinder on plane), the gussets' fillets are LINEs (16);
 - ``railing``: two 48.3 x 3.2 posts between a flat-bar bottom rail (lying on the table) and a flat-bar top rail
-  (60 x 10), three 30 x 8 flat balusters between the rails; the posts' four fillets are CIRCLEs, the balusters'
-  twelve are LINEs;
+  (60 x 10), three 30 x 8 x 300 flat balusters standing on the bottom rail; the posts' four fillets are CIRCLEs (those
+  under the top rail overhead), the balusters' six are LINEs;
 - ``round_brace``: an 80 x 80 post on a 500 x 300 x 15 base plate, and a 42.4 x 3.2 round brace leaning 35 degrees
   from the post's foot region to its side, both ends cut flat: the brace's fillets are ELLIPSEs (on the plate, and
   in the post's vertical face: an OCS along -x); the post's four fillets are LINEs;
 - ``tube_tee``: a 114.3 x 6 run pipe between two 250 x 250 x 15 end plates standing on the table, a 60.3 x 4 branch
   coped onto its top (the saddle: a SPLINE through the true curve), a 50 x 10 tie bar on the table between the
-  plates; the run's fillets are CIRCLEs in the plates' planes (OCS along +-x), the tie's two are LINEs.
+  plates beside the pipe; the run's fillets are CIRCLEs in the plates' planes (OCS along +-x), the tie's two are
+  LINEs.
 
 Every seam is red (BYLAYER) on layer ``WELD_SEAMS`` with its id as XDATA (``WELDCELL``). Byte-stable output.
 """
@@ -108,13 +109,12 @@ def build_railing() -> ezdxf.document.Drawing:
         m.body(name, tube_mesh(R, R - wall, 48, *_flat(bt, bt + H), pose(np.eye(3), (x, 0.0, 0.0))))
         add_circle_seam(m.msp, f"{name}>BOTTOM_RAIL:circle", (x, 0.0, bt), R, (0.0, 0.0, 1.0), SEAM_LAYER)
         add_circle_seam(m.msp, f"{name}>TOP_RAIL:circle", (x, 0.0, bt + H), R, (0.0, 0.0, -1.0), SEAM_LAYER)
-    a, b = 15.0, 4.0  # a baluster's half width (along x) and half thickness (along y)
+    a, b, h = 15.0, 4.0, 300.0  # a baluster's half width (along x), half thickness (along y), height
     for k, x in enumerate((-250.0, 0.0, 250.0)):
         name = f"BALUSTER_{k + 1}"
-        m.body(name, box_mesh((x - a, -b, bt), (x + a, b, bt + H)))
-        for rail, z in (("BOTTOM_RAIL", bt), ("TOP_RAIL", bt + H)):
-            for side, y in (("-y", -b), ("+y", b)):
-                m.line(f"{name}>{rail}:{side}", (x - a, y, z), (x + a, y, z))
+        m.body(name, box_mesh((x - a, -b, bt), (x + a, b, bt + h)))
+        for side, y in (("-y", -b), ("+y", b)):
+            m.line(f"{name}>BOTTOM_RAIL:{side}", (x - a, y, bt), (x + a, y, bt))
     return m.doc
 
 
@@ -157,9 +157,10 @@ def build_tube_tee() -> ezdxf.document.Drawing:
 
     m.body("BRANCH", tube_mesh(Rb, Rb - wb, 48, cope, lambda x, y: zc + 250.0, np.eye(4)))
     add_spline_seam(m.msp, "BRANCH>RUN:saddle", saddle_points(0.0, Rb, zc, Rr), SEAM_LAYER)
-    m.body("TIE", box_mesh((-half, -25.0, 0.0), (half, 25.0, 10.0)))
-    m.line("TIE>END_L:+z", (-half, -25.0, 10.0), (-half, 25.0, 10.0))
-    m.line("TIE>END_R:+z", (half, -25.0, 10.0), (half, 25.0, 10.0))
+    y0, y1 = 65.0, 115.0  # the tie runs beside the pipe, not under it, so its fillets are in sight
+    m.body("TIE", box_mesh((-half, y0, 0.0), (half, y1, 10.0)))
+    m.line("TIE>END_L:+z", (-half, y0, 10.0), (-half, y1, 10.0))
+    m.line("TIE>END_R:+z", (half, y0, 10.0), (half, y1, 10.0))
     return m.doc
 
 

@@ -26,7 +26,7 @@ def _on_cylinder(part: Part, p: FloatArray) -> bool:
     return bool(np.all(np.abs(c.distance_to_axis(p) - c.radius) <= tol))
 
 
-def _plane(part: Part, p: FloatArray) -> str | None:
+def holding_face(part: Part, p: FloatArray) -> str | None:
     """The face of ``part`` whose plane holds every point (the nearest, within the gap), or None."""
     best, err = None, GAP_M
     for face in part.face_names():
@@ -68,7 +68,7 @@ def curved_joint(seam: CurvedSeam, parts: Sequence[Part]) -> tuple[CurvedJoint |
             continue
         if _on_cylinder(part, p):
             held.append((part, Surface.CYLINDER, None))
-        elif (face := _plane(part, p)) is not None:
+        elif (face := holding_face(part, p)) is not None:
             held.append((part, Surface.PLANE, face))
     if len(held) != 2:
         names = ", ".join(h[0].name for h in held) or "none"

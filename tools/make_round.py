@@ -14,8 +14,8 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
 - ``railing``: two 48.3 x 3.2 posts between a flat-bar bottom rail (lying on the table) and a flat-bar top rail
   (60 x 10), three 30 x 8 x 300 flat balusters standing on the bottom rail; the posts' four fillets are CIRCLEs (those
   under the top rail overhead), the balusters' six are LINEs;
-- ``round_brace``: an 80 x 80 post on a 500 x 300 x 15 base plate, and a 42.4 x 3.2 round brace leaning 35 degrees
-  from the post's foot region to its side, both ends cut flat: the brace's fillets are ELLIPSEs (on the plate, and
+- ``round_brace``: an 80 x 80 x 350 post on a 500 x 300 x 15 base plate, and a 42.4 x 3.2 round brace leaning 35
+  degrees from the plate to the post's -x face, both ends cut flat: the brace's fillets are ELLIPSEs (on the plate, and
   in the post's vertical face: an OCS along -x); the post's four fillets are LINEs;
 - ``tube_tee``: a 114.3 x 6 run pipe between two 250 x 250 x 15 end plates standing on the table, a 60.3 x 4 branch
   coped onto its top (the saddle: a SPLINE through the true curve), a 50 x 10 tie bar on the table between the
@@ -122,7 +122,7 @@ def build_round_brace() -> ezdxf.document.Drawing:
     m = _Map()
     T = 15.0
     m.body("BASE", box_mesh((-250.0, -150.0, 0.0), (250.0, 150.0, T)))
-    post = ((100.0, -40.0, T), (180.0, 40.0, T + 600.0))
+    post = ((100.0, -40.0, T), (180.0, 40.0, T + 350.0))
     m.body("POST", box_mesh(*post))
     (x0, y0, z0), (x1, y1, _) = post
     m.line("POST>BASE:-x", (x0, y0, z0), (x0, y1, z0))
@@ -130,7 +130,7 @@ def build_round_brace() -> ezdxf.document.Drawing:
     m.line("POST>BASE:-y", (x0, y0, z0), (x1, y0, z0))
     m.line("POST>BASE:+y", (x0, y1, z0), (x1, y1, z0))
     R, wall, lean = 21.2, 3.2, 35.0
-    foot = np.array([-150.0, 0.0, T])  # the axis meets the plate here
+    foot = np.array([-60.0, 0.0, T])  # the axis meets the plate here
     X = pose(rot_y(lean), foot)  # the brace's axis leans towards +x
     axis = X[:3, 2]
     s = (x0 - foot[0]) / axis[0]  # the axis meets the post's -x face

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import ezdxf
 import numpy as np
-from make_maps import PART_LAYER_COLOR, SEAM_LAYER_COLOR, REPO_ROOT, _add_seam, box_mesh, write_stable
+from make_maps import PART_LAYER_COLOR, REPO_ROOT, SEAM_LAYER_COLOR, _add_seam, box_mesh, write_stable
 from round_meshes import (
     add_circle_seam,
     add_spline_seam,
@@ -89,7 +89,7 @@ def build_pipe_flange() -> ezdxf.document.Drawing:
         m.body(name, prism_mesh(profile, t, pose(Rz, (0.0, 0.0, 0.0))))
         for side, y in (("-", -t / 2.0), ("+", t / 2.0)):
 
-            def at(x: float, z: float, y: float = y) -> Vec:
+            def at(x: float, z: float, y: float = y, Rz: np.ndarray = Rz) -> Vec:
                 p = Rz @ np.array([x, y, z])
                 return (float(p[0]), float(p[1]), float(p[2]))
 

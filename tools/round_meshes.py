@@ -95,19 +95,28 @@ def _tag(e: object, seam_id: str) -> None:
     e.set_xdata(APPID, [(1000, seam_id)])  # type: ignore[attr-defined]
 
 
-def add_circle_seam(msp: BaseLayout, seam_id: str, centre: Sequence[float], radius: float, normal: Sequence[float],
-                    layer: str) -> None:
+def add_circle_seam(
+    msp: BaseLayout, seam_id: str, centre: Sequence[float], radius: float, normal: Sequence[float], layer: str
+) -> None:
     """A red CIRCLE in the plane through ``centre`` with ``normal`` (its OCS: centre given in OCS coordinates)."""
     from ezdxf.math import OCS
 
     ocs = OCS(Vec3(*normal))
-    e = msp.add_circle(ocs.from_wcs(Vec3(*centre)), radius, dxfattribs={"layer": layer, "color": 256,
-                                                                       "extrusion": Vec3(*normal)})
+    e = msp.add_circle(
+        ocs.from_wcs(Vec3(*centre)), radius, dxfattribs={"layer": layer, "color": 256, "extrusion": Vec3(*normal)}
+    )
     _tag(e, seam_id)
 
 
-def add_tube_on_plane_seam(msp: BaseLayout, seam_id: str, q: Sequence[float], axis: Sequence[float], radius: float,
-                           normal: Sequence[float], layer: str) -> None:
+def add_tube_on_plane_seam(
+    msp: BaseLayout,
+    seam_id: str,
+    q: Sequence[float],
+    axis: Sequence[float],
+    radius: float,
+    normal: Sequence[float],
+    layer: str,
+) -> None:
     """The seam of a tube (``axis``, ``radius``) meeting the plane through ``q`` (on the axis) with ``normal``: a
     CIRCLE when square, else an ELLIPSE (minor semi-axis the radius, major the radius / cos of the lean)."""
     a, n = np.asarray(axis, float) / np.linalg.norm(axis), np.asarray(normal, float) / np.linalg.norm(normal)

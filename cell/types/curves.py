@@ -5,6 +5,7 @@ error), a cylinder recognised in a tessellated body, and a curved seam with its 
 from __future__ import annotations
 
 import enum
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -57,7 +58,9 @@ class ArcCurve:
         object.__setattr__(self, "normal", readonly(n))
         object.__setattr__(self, "x_axis", readonly(x))
         if not (self.radius > 0.0 and 0.0 < self.sweep_rad <= _TWO_PI + 1e-12):
-            raise ValueError(f"an arc needs a positive radius and a sweep in (0, 2 pi], got {self.radius}, {self.sweep_rad}")
+            raise ValueError(
+                f"an arc needs a positive radius and a sweep in (0, 2 pi], got {self.radius}, {self.sweep_rad}"
+            )
 
     @property
     def kind(self) -> str:
@@ -92,7 +95,9 @@ class ArcCurve:
     def transformed(self, X_CA: FloatArray) -> ArcCurve:
         """The arc in frame C (a rigid X_CA)."""
         R = np.asarray(X_CA)[:3, :3]
-        return ArcCurve(transform_points(X_CA, self.centre), R @ self.normal, R @ self.x_axis, self.radius, self.sweep_rad)
+        return ArcCurve(
+            transform_points(X_CA, self.centre), R @ self.normal, R @ self.x_axis, self.radius, self.sweep_rad
+        )
 
     def scaled(self, s: float) -> ArcCurve:
         """The arc with every coordinate multiplied by ``s`` (drawing units to metres)."""
@@ -146,7 +151,9 @@ class EllipseCurve:
 
     def transformed(self, X_CA: FloatArray) -> EllipseCurve:
         R = np.asarray(X_CA)[:3, :3]
-        return EllipseCurve(transform_points(X_CA, self.centre), R @ self.major, R @ self.minor, self.start_rad, self.sweep_rad)
+        return EllipseCurve(
+            transform_points(X_CA, self.centre), R @ self.major, R @ self.minor, self.start_rad, self.sweep_rad
+        )
 
     def scaled(self, s: float) -> EllipseCurve:
         return EllipseCurve(self.centre * s, self.major * s, self.minor * s, self.start_rad, self.sweep_rad)
@@ -181,7 +188,7 @@ class SampledCurve:
         """(n, 3) points at most ``step_m`` apart along the polyline, its own points included."""
         p = self._loop()
         out = []
-        for a, b in zip(p[:-1], p[1:], strict=True):
+        for a, b in itertools.pairwise(p):
             k = max(1, math.ceil(float(np.linalg.norm(b - a)) / step_m)) if step_m > 0 else 1
             out.append(a + (b - a) * (np.arange(k) / k)[:, None])
         if not self.closed:

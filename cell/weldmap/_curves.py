@@ -42,8 +42,10 @@ def _arc(X: FloatArray, centre: Vec3, x: Vec3, y: Vec3, radius: float, sweep: fl
     if s is not None:  # a mirror flips x cross y: the normal follows, so the arc still turns the drawn way
         return ArcCurve(c, np.cross(u, v), u, radius * s, sweep)
     ce = ConstructionEllipse.from_arc(Vec3(0, 0, 0), radius, Vec3(0, 0, 1), 0.0, math.degrees(sweep))
-    return _ellipse(_matrix44(np.column_stack([np.append(u, 0), np.append(v, 0), np.append(np.cross(u, v), 0),
-                                               np.append(c, 1)])), ce)
+    return _ellipse(
+        _matrix44(np.column_stack([np.append(u, 0), np.append(v, 0), np.append(np.cross(u, v), 0), np.append(c, 1)])),
+        ce,
+    )
 
 
 def _ellipse(M: Matrix44, ce: ConstructionEllipse) -> EllipseCurve:

@@ -249,7 +249,9 @@ class Reader:
             if i < len(xyb) and xyb[i][2] != 0.0:
                 j = (i + 1) % len(xyb)
                 curve = bulge_curve(ctx.X, ocs, xyb[i][:2], xyb[j][:2], elevation, xyb[i][2])
-                self.found.curves.append(RawCurve(sid, curve, Where(where.kind, f"{where.handle} segment {i + 1}", where.layer)))
+                self.found.curves.append(
+                    RawCurve(sid, curve, Where(where.kind, f"{where.handle} segment {i + 1}", where.layer))
+                )
             else:
                 self.found.seams.append(RawSeam(sid, P[i], P[(i + 1) % len(P)], where))
 

@@ -33,10 +33,8 @@ def _bodies(title: str, bodies: tuple[Part, ...]) -> list[str]:
             line += "  rpy " + _fmt(np.degrees(matrix_to_rpy(R)), ".2f") + " deg"
         if (c := p.cylinder) is not None:
             bore = f" bore {c.inner_radius * 2000:.1f}" if c.inner_radius > 0 else " solid"
-            line += (
-                f"  round: {c.radius * 2000:.1f} mm across{bore}, {c.length * 1000:.1f} long, axis {_fmt(c.axis, '+.3f')}"
-                f", {c.facets} facets"
-            )
+            line += f"  round: {c.radius * 2000:.1f} mm across{bore}, {c.length * 1000:.1f} long"
+            line += f", axis {_fmt(c.axis, '+.3f')}, {c.facets} facets"
         lines.append(line)
     return lines
 
@@ -50,9 +48,12 @@ def _curve(c: CurvedSeam) -> str:
             what += f", {np.degrees(k.sweep_rad):.1f} deg"
     elif isinstance(k, EllipseCurve):
         a, b = float(np.linalg.norm(k.major)), float(np.linalg.norm(k.minor))
-        what = f"ellipse {a * 2000:.1f} x {b * 2000:.1f} mm, centre {_fmt(k.centre * 1000)}, normal {_fmt(k.normal, '+.3f')}"
+        what = f"ellipse {a * 2000:.1f} x {b * 2000:.1f} mm, centre {_fmt(k.centre * 1000)}"
+        what += f", normal {_fmt(k.normal, '+.3f')}"
     else:
-        what = f"curve of {len(k.points)} points within {k.chord_error_m * 1000:.3f} mm" + (" closed" if k.closed else "")
+        what = f"curve of {len(k.points)} points within {k.chord_error_m * 1000:.3f} mm" + (
+            " closed" if k.closed else ""
+        )
     joint = str(c.joint) if c.joint is not None else f"no joint: {c.note}"
     return f"{c.length * 1000:8.1f} mm  {what}  {joint}  [{c.drawn}]"
 

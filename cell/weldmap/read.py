@@ -240,7 +240,9 @@ def _curved(
         if joint is None:
             fx = [f for f in fixtures if bool(np.all(f.contains(curve.sample(0.01), TOUCH_M)))]
             if fx:
-                why = f"{raw.where}: on fixture {fx[0].name}: a fixture is never welded (map.layers says what is a part)"
+                why = (
+                    f"{raw.where}: on fixture {fx[0].name}: a fixture is never welded (map.layers says what is a part)"
+                )
                 unsupported.append(UnsupportedSeam(raw.id, why, Unsupported.ON_FIXTURE))
                 continue
             warnings.append(f"{src}: curved seam {raw.id} ({raw.where}) {why}")

@@ -34,7 +34,9 @@ def test_a_curved_seam_is_named_by_every_output(tmp_path: Path) -> None:
 
     code, out, err = cell("map", "info", str(dxf))
     assert code == 0 and "curved seams: 1 (no locator locates curved seams yet" in out, err
-    assert any(line.split()[:1] == [curve] and "circle r 15.0 mm" in line and "[CIRCLE" in line for line in out.splitlines())
+    assert any(
+        line.split()[:1] == [curve] and "circle r 15.0 mm" in line and "[CIRCLE" in line for line in out.splitlines()
+    )
 
     scenario = tmp_path / "tee.yaml"
     assert cell("init", str(dxf), "--out", str(scenario))[0] == 0

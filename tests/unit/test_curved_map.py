@@ -15,7 +15,10 @@ from ezdxf.math import Vec3
 from cell.types import ArcCurve, EllipseCurve, SampledCurve, Unsupported
 from cell.weldmap import read_map
 
-PARTS = {"POST_L": ((200.0, 700.0, 0.0), (280.0, 780.0, 600.0)), "TOP_RAIL": ((280.0, 700.0, 520.0), (1120.0, 780.0, 600.0))}
+PARTS = {
+    "POST_L": ((200.0, 700.0, 0.0), (280.0, 780.0, 600.0)),
+    "TOP_RAIL": ((280.0, 700.0, 520.0), (1120.0, 780.0, 600.0)),
+}
 M = 1e-3  # drawing units (mm) -> m
 
 
@@ -83,7 +86,9 @@ def test_a_spline_is_sampled_within_its_stated_chord_error(tmp_path: Path) -> No
     [c] = _read(doc, tmp_path).curved
     assert isinstance(c.curve, SampledCurve) and c.kind == "curve" and not c.curve.closed
     assert 0 < c.curve.chord_error_m <= 1e-4
-    exact = np.array([tuple(p) for p in doc.modelspace().query("SPLINE")[0].construction_tool().points(np.linspace(0, 1, 101))])
+    exact = np.array(
+        [tuple(p) for p in doc.modelspace().query("SPLINE")[0].construction_tool().points(np.linspace(0, 1, 101))]
+    )
     d = [_near(c.sample(c.curve.chord_error_m), q * M) for q in exact]
     assert max(d) <= 2 * c.curve.chord_error_m
 
@@ -121,11 +126,15 @@ def test_curves_in_blocks_take_the_insert_transform(tmp_path: Path) -> None:
     doc = _doc()
     block = doc.blocks.new("RINGS")
     block.add_circle((0, 0, 0), 10, dxfattribs={"color": 0})  # BYBLOCK: red through the INSERT
-    doc.modelspace().add_blockref("RINGS", (240, 740, 600), dxfattribs={"color": 1, "xscale": 2, "yscale": 2, "zscale": 2, "rotation": 30})
+    doc.modelspace().add_blockref(
+        "RINGS", (240, 740, 600), dxfattribs={"color": 1, "xscale": 2, "yscale": 2, "zscale": 2, "rotation": 30}
+    )
     doc.modelspace().add_blockref("RINGS", (600, 740, 600), dxfattribs={"color": 1, "xscale": 3, "yscale": 1})
     round_, squashed = _read(doc, tmp_path).curved
     assert isinstance(round_.curve, ArcCurve) and math.isclose(round_.curve.radius, 0.02, rel_tol=1e-12)
     np.testing.assert_allclose(round_.curve.centre, [0.24, 0.74, 0.6], atol=1e-12)
     assert isinstance(squashed.curve, EllipseCurve)  # a non-uniform scale makes the circle an ellipse
-    np.testing.assert_allclose(sorted([np.linalg.norm(squashed.curve.major), np.linalg.norm(squashed.curve.minor)]), [0.01, 0.03])
+    np.testing.assert_allclose(
+        sorted([np.linalg.norm(squashed.curve.major), np.linalg.norm(squashed.curve.minor)]), [0.01, 0.03]
+    )
     assert round_.id != squashed.id and round_.id.startswith("seam-") and round_.id.count(".") == 1

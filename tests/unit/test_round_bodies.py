@@ -9,7 +9,7 @@ from pathlib import Path
 import ezdxf
 import numpy as np
 import pytest
-from dxf_factory import make_maps  # noqa: F401  (puts tools/ on the path)
+from dxf_factory import make_maps
 from round_meshes import add_spline_seam, add_tube_on_plane_seam, plane_cut, pose, rot_y, saddle_points, tube_mesh
 
 from cell.geometry import make_pose, rpy_to_matrix
@@ -85,7 +85,9 @@ def _joint_map(tmp_path: Path, lean_deg: float) -> object:
     doc.layers.add("WELD_SEAMS", color=1)
     make_maps.box_mesh((-300, -300, 0), (300, 300, 20)).render_mesh(msp, dxfattribs={"layer": "PLATE"})
     X = pose(rot_y(lean_deg), (-150.0, 0.0, 20.0))
-    tube_mesh(30.0, 25.0, 48, plane_cut(X, (0, 0, 1), 20.0), lambda x, y: 250.0, X).render_mesh(msp, dxfattribs={"layer": "TUBE"})
+    tube_mesh(30.0, 25.0, 48, plane_cut(X, (0, 0, 1), 20.0), lambda x, y: 250.0, X).render_mesh(
+        msp, dxfattribs={"layer": "TUBE"}
+    )
     add_tube_on_plane_seam(msp, "TUBE>PLATE", (-150.0, 0.0, 20.0), X[:3, 2], 30.0, (0, 0, 1), "WELD_SEAMS")
     # A ring flange (a short wide tube whose bore is the tube's round) on the tube, 150 mm along its axis.
     q = X[:3, 3] + 150.0 * X[:3, 2]
@@ -114,7 +116,11 @@ def test_a_curved_seams_joint_comes_from_the_surfaces_it_lies_on(tmp_path: Path)
     assert ring is not None and (ring.abutting, ring.receiving) == ("RING", "TUBE")  # the tube goes on through it
     assert (ring.abutting_surface, ring.receiving_surface) == (Surface.PLANE, Surface.CYLINDER)
     np.testing.assert_allclose([ring.dihedral_min_rad, ring.dihedral_max_rad], [math.pi / 2] * 2, atol=1e-3)
-    assert saddle is not None and (saddle.abutting, saddle.receiving, saddle.surfaces) == ("BRANCH", "RUN", "cylinder_on_cylinder")
+    assert saddle is not None and (saddle.abutting, saddle.receiving, saddle.surfaces) == (
+        "BRANCH",
+        "RUN",
+        "cylinder_on_cylinder",
+    )
 
 
 def test_the_truth_of_a_leaning_tube_is_its_ellipse(tmp_path: Path) -> None:

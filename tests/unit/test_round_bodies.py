@@ -156,3 +156,39 @@ def test_the_truth_of_a_saddle_lies_on_both_pipes(tmp_path: Path) -> None:
     assert float(np.abs(run.distance_to_axis(P) - run.radius).max()) < 1e-9
     assert float(np.abs(branch.distance_to_axis(P) - branch.radius).max()) < 1e-9
     assert float(np.ptp(P[:, 2])) == pytest.approx(0.05715 - math.sqrt(0.05715**2 - 0.03015**2), abs=1e-6)
+
+
+def test_make_round_writes_the_shipped_maps_byte_for_byte(tmp_path: Path) -> None:
+    import make_round
+
+    assert make_round.main(["--out", str(tmp_path)]) == 0
+    for name in make_round.MAPS:
+        assert (tmp_path / f"{name}.dxf").read_bytes() == (make_maps.REPO_ROOT / "maps" / f"{name}.dxf").read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("scenario", "surfaces"),
+    [
+        ("pipe-flange", {"cylinder_on_plane": 1}),
+        ("railing", {"cylinder_on_plane": 4}),
+        ("round-brace", {"cylinder_on_plane": 2}),
+        ("tube-tee", {"cylinder_on_plane": 2, "cylinder_on_cylinder": 1}),
+    ],
+)
+def test_the_round_scenarios_curved_seams_have_their_joints_and_truths(scenario: str, surfaces: dict[str, int]) -> None:
+    from collections import Counter
+
+    from cell.pipeline.detect import read_weldmap
+    from cell.scenario import load
+    from cell.seams.curve_truth import true_curves
+    from cell.sim.asbuilt.parts import as_built_parts
+
+    sc = load(scenario)
+    m = read_weldmap(sc)
+    assert Counter(c.joint.surfaces for c in m.curved if c.joint is not None) == surfaces and not m.warnings
+    assert all(c.joint is not None and c.joint.kind == "T" for c in m.curved)
+    truth = true_curves(m, as_built_parts(m, sc), sc.X_WM, sc.X_WR)  # on the deviated parts, in R
+    for c in m.curved:
+        drawn_R = c.transformed(np.linalg.inv(sc.X_WR) @ sc.X_WM).sample(0.0005)
+        gap = np.linalg.norm(truth[c.id][:, None] - drawn_R[None], axis=2).min(axis=1)
+        assert 0.0 < float(gap.max()) < 0.006  # the deviations move each curve, by millimetres at most

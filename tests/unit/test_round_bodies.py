@@ -192,3 +192,42 @@ def test_the_round_scenarios_curved_seams_have_their_joints_and_truths(scenario:
         drawn_R = c.transformed(np.linalg.inv(sc.X_WR) @ sc.X_WM).sample(0.0005)
         gap = np.linalg.norm(truth[c.id][:, None] - drawn_R[None], axis=2).min(axis=1)
         assert 0.0 < float(gap.max()) < 0.006  # the deviations move each curve, by millimetres at most
+
+
+def test_a_round_tube_is_rendered_from_its_facets(tmp_path: Path) -> None:
+    from pinhole import deproject
+
+    from cell import scenario as scn
+    from cell.sim import SimCell
+
+    (tmp_path / "dummy.dxf").write_text("not read by this test\n")
+    sc = scn.from_yaml(
+        """
+name: tiny-tube
+seed: 3
+simulation: {noise: none}
+map: {file: dummy.dxf, X_WM: {xyz_m: [0.0, 0.0, 0.9]}}
+table: {center_m: [0.0, 0.0, 0.85], size_m: [1.2, 0.8, 0.1]}
+cameras:
+  above: {eye_m: [0.35, 0.05, 1.4], target_m: [0.0, 0.0, 0.95], resolution: [160, 120], hfov_deg: 30}
+perception:
+  workspace: {min_m: [-1.0, -1.0, 0.9], max_m: [1.0, 1.0, 1.5]}
+""",
+        base_dir=tmp_path,
+    )
+    mesh = tube_mesh(30.0, 25.0, 48, *_flat(900.0, 1000.0), np.eye(4))  # standing on the table top (z 0.9 m)
+    body = Polyhedron(np.array(mesh.vertices) * 1e-3, tuple(tuple(f) for f in mesh.faces))
+    c = recognise_cylinder(body)
+    assert c is not None
+    with SimCell(sc, [Part("TUBE", body, "MESH", c)]) as sim:
+        image = sim.capture("above")
+    p_W = deproject(image)[image.depth > 0]
+    side = p_W[(p_W[:, 2] > 0.902) & (p_W[:, 2] < 0.998)]
+    r = c.distance_to_axis(side)
+    outer, bore = side[r > 0.0275], r[r <= 0.0275]  # its near side outside, its far side inside the bore
+    r_out = c.distance_to_axis(outer)
+    assert len(outer) > 200 and len(bore) > 50  # every point on a facet of the round, within the facets' sagitta
+    assert float(r_out.max()) < c.radius + 2e-4 and float(r_out.min()) > c.radius - c.sagitta_m - 2e-4
+    sag_in = c.inner_radius * (1.0 - math.cos(math.pi / c.facets))
+    assert float(bore.max()) < c.inner_radius + 2e-4 and float(bore.min()) > c.inner_radius - sag_in - 2e-4
+    assert float(np.ptp(np.arctan2(outer[:, 1], outer[:, 0]))) > math.radians(120)  # across the round

@@ -12,7 +12,7 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
   (80 x 150, a 15 mm snipe where the pipe's fillet runs under them) standing on the plate against the pipe's sides;
   the pipe's fillet is a CIRCLE (a T, cylinder on plane), the gussets' fillets are LINEs (16);
 - ``railing``: two 48.3 x 3.2 posts between a flat-bar bottom rail (lying on the table) and a flat-bar top rail
-  (60 x 10), three 30 x 8 x 300 flat balusters standing on the bottom rail; the posts' four fillets are CIRCLEs (those
+  (60 x 10) 600 mm above it, three 40 x 10 x 250 flat balusters standing on the bottom rail; the posts' four fillets are CIRCLEs (those
   under the top rail overhead), the balusters' six are LINEs;
 - ``round_brace``: an 80 x 80 x 350 post on a 500 x 300 x 15 base plate, and a 42.4 x 3.2 round brace leaning 35
   degrees from the plate to the post's -x face, both ends cut flat: the brace's fillets are ELLIPSEs (on the plate, and
@@ -100,7 +100,7 @@ def build_pipe_flange() -> ezdxf.document.Drawing:
 
 def build_railing() -> ezdxf.document.Drawing:
     m = _Map()
-    L, bw, bt, H = 1200.0, 60.0, 10.0, 450.0  # rails: length, width, thickness; posts' height between the rails
+    L, bw, bt, H = 1200.0, 60.0, 10.0, 600.0  # rails: length, width, thickness; posts' height between the rails
     m.body("BOTTOM_RAIL", box_mesh((-L / 2, -bw / 2, 0.0), (L / 2, bw / 2, bt)))
     m.body("TOP_RAIL", box_mesh((-L / 2, -bw / 2, bt + H), (L / 2, bw / 2, 2 * bt + H)))
     R, wall = 24.15, 3.2
@@ -109,7 +109,7 @@ def build_railing() -> ezdxf.document.Drawing:
         m.body(name, tube_mesh(R, R - wall, 48, *_flat(bt, bt + H), pose(np.eye(3), (x, 0.0, 0.0))))
         add_circle_seam(m.msp, f"{name}>BOTTOM_RAIL:circle", (x, 0.0, bt), R, (0.0, 0.0, 1.0), SEAM_LAYER)
         add_circle_seam(m.msp, f"{name}>TOP_RAIL:circle", (x, 0.0, bt + H), R, (0.0, 0.0, -1.0), SEAM_LAYER)
-    a, b, h = 15.0, 4.0, 300.0  # a baluster's half width (along x), half thickness (along y), height
+    a, b, h = 20.0, 5.0, 250.0  # a baluster's half width (along x), half thickness (along y), height
     for k, x in enumerate((-250.0, 0.0, 250.0)):
         name = f"BALUSTER_{k + 1}"
         m.body(name, box_mesh((x - a, -b, bt), (x + a, b, bt + h)))

@@ -12,8 +12,8 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
   (80 x 150, a 15 mm snipe where the pipe's fillet runs under them) standing on the plate against the pipe's sides;
   the pipe's fillet is a CIRCLE (a T, cylinder on plane), the gussets' fillets are LINEs (16);
 - ``railing``: two 48.3 x 3.2 posts between a flat-bar bottom rail (lying on the table) and a flat-bar top rail
-  (60 x 10) 600 mm above it, three 40 x 10 x 250 flat balusters standing on the bottom rail; the posts' four fillets are CIRCLEs (those
-  under the top rail overhead), the balusters' six are LINEs;
+  (60 x 10) 600 mm above it, three 40 x 10 x 250 flat balusters standing on the bottom rail; the posts' four
+  fillets are CIRCLEs (those under the top rail overhead), the balusters' six are LINEs;
 - ``round_brace``: an 80 x 80 x 350 post on a 500 x 300 x 15 base plate, and a 42.4 x 3.2 round brace leaning 35
   degrees from the plate to the post's -x face, both ends cut flat: the brace's fillets are ELLIPSEs (on the plate, and
   in the post's vertical face: an OCS along -x); the post's four fillets are LINEs;

@@ -79,3 +79,23 @@ def hand_eye(
     t_t = [np.asarray(X[:3, 3], dtype=np.float64).reshape(3, 1) for X in X_cam_target]
     R, t = cv2.calibrateHandEye(R_g, t_g, R_t, t_t, method=_HAND_EYE[method])
     return make_pose(np.asarray(R, dtype=float), np.asarray(t, dtype=float).ravel())
+
+
+def calibrate_intrinsics(
+    p_B: Sequence[FloatArray], px: Sequence[FloatArray], size: tuple[int, int], K0: FloatArray
+) -> tuple[FloatArray, FloatArray, float]:
+    """OpenCV's ``calibrateCameraExtended`` on planar views, no distortion (as the stated model): K (3, 3), the
+    standard deviations of (fx, fy, cx, cy) [px], the RMS reprojection [px]."""
+    flags = (
+        cv2.CALIB_USE_INTRINSIC_GUESS
+        | cv2.CALIB_ZERO_TANGENT_DIST
+        | cv2.CALIB_FIX_K1
+        | cv2.CALIB_FIX_K2
+        | cv2.CALIB_FIX_K3
+    )
+    obj = [np.asarray(p, dtype=np.float32).reshape(-1, 1, 3) for p in p_B]
+    img = [np.asarray(u, dtype=np.float32).reshape(-1, 1, 2) for u in px]
+    rms, K, _, _, _, std, _, _ = cv2.calibrateCameraExtended(
+        obj, img, tuple(size), np.array(K0, dtype=np.float64), np.zeros(5), flags=flags
+    )
+    return np.asarray(K, dtype=float), np.asarray(std, dtype=float).ravel()[:4], float(rms)

@@ -65,7 +65,7 @@ class CalibrationRunSpec(Model):
     poses: Annotated[int, Field(ge=4, le=60)] = 12
     held_out: Annotated[int, Field(ge=0, le=20)] = 4
     range_m: tuple[Pos, Pos] = (0.7, 1.1)  # board distance from a fixed camera, nearest and farthest [m]
-    hand_range_m: tuple[Pos, Pos] = (0.40, 0.60)  # the arm's camera from the board on the table [m]
+    hand_range_m: tuple[Pos, Pos] = (0.50, 0.70)  # the arm's camera from the board on the table [m]
     tilt_deg: Annotated[float, Field(gt=0.0, le=60.0)] = 30.0  # largest tilt of the board against the sight line
     repeatability_mm: NonNeg = 0.03  # the robot's pose repeatability (KR 5 arc data sheet); the simulator draws it
     focal_tolerance: Annotated[float, Field(gt=0.0, le=0.5)] = 0.005  # a focal length off by more: flagged

@@ -5,15 +5,15 @@ inside); poses as 4x4 arrays in metres."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Literal
+from typing import Any
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
+from cell.calibrate import HandEyeMethod
 from cell.geometry import FloatArray, make_pose
 
-HandEyeMethod = Literal["park", "tsai", "daniilidis"]
 _HAND_EYE = {
     "park": cv2.CALIB_HAND_EYE_PARK,
     "tsai": cv2.CALIB_HAND_EYE_TSAI,

@@ -79,7 +79,7 @@ def camera_poses(
         turn = rng.uniform(-np.pi / 3.0, np.pi / 3.0)
         up = np.cos(turn) * b + np.sin(turn) * a
         side = offset[0] * intr.width * (1.0 if rng.uniform() < 0.5 else -1.0)
-        X_RC = look_at(aim + d * ray, aim, up) @ make_pose(
+        X_RC = look_at(_seq(aim + d * ray), _seq(aim), _seq(up)) @ make_pose(
             _turned_to(side / intr.fx, -offset[1] * intr.height / intr.fy)
         )
         if in_view(board, invert(X_RC) @ X_RB, intr):
@@ -92,3 +92,7 @@ def _turned_to(x: float, y: float) -> FloatArray:
     axis = np.cross(d, [0.0, 0.0, 1.0])
     n = float(np.linalg.norm(axis))
     return np.eye(3) if n < 1e-12 else axis_angle_to_matrix(axis / n, float(np.arccos(np.clip(d[2], -1.0, 1.0))))
+
+
+def _seq(v: FloatArray) -> tuple[float, float, float]:
+    return float(v[0]), float(v[1]), float(v[2])

@@ -15,7 +15,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from cell.calibrate import _opencv
+from cell.calibrate import HandEyeMethod, _opencv
 from cell.calibrate.views import Mount, View, chain_T
 from cell.errors import CalibrationError, CalibrationFault
 from cell.geometry import FloatArray, invert, make_pose, readonly
@@ -61,7 +61,7 @@ def pnp_poses(views: Sequence[View], p_B: FloatArray, K: FloatArray) -> list[Flo
 
 
 def hand_eye_start(
-    views: Sequence[View], p_B: FloatArray, K: FloatArray, mount: Mount, method: _opencv.HandEyeMethod = "park"
+    views: Sequence[View], p_B: FloatArray, K: FloatArray, mount: Mount, method: HandEyeMethod = "park"
 ) -> tuple[FloatArray, FloatArray]:
     """(X_AC, X_HB): OpenCV's hand-eye solution for the camera and the board's pose averaged over the views."""
     X_CB = pnp_poses(views, p_B, K)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cell.calibrate import HandEyeMethod
 from cell.calibrate.board import Board
 from cell.calibrate.checks import check_board_size, check_diversity, depth_scale, rotation_spread_deg
 from cell.calibrate.intrinsics import check_intrinsics
@@ -27,7 +28,7 @@ from cell.station.ports import Arm
 from cell.types import CameraIntrinsics, DepthImage
 
 Progress = Callable[[str], None]
-OPENCV_METHODS = ("park", "tsai", "daniilidis")
+OPENCV_METHODS: tuple[HandEyeMethod, ...] = ("park", "tsai", "daniilidis")  # OpenCV's hand-eye methods alone
 _SEEN_FRACTION = 0.6  # a pose counts when this much of the board's corners are found
 _OFFSET = (0.25, 0.1)  # the arm camera's board this far aside and up its image: the torch hides the lower middle
 _CLEARANCE_M = 0.05  # the board and the flange stay this far above the table top

@@ -48,7 +48,7 @@ def test_the_fixed_camera_and_the_board_on_the_flange_are_recovered_within_their
     X0, B0 = hand_eye_start(views[:10], BOARD.p_B, K, Mount.EYE_TO_HAND)
     sol = refine(views[:10], BOARD.p_B, K, Mount.EYE_TO_HAND, X0, B0)
     t, r = pose_error(sol.X_AC, X_RC)
-    t0, r0 = pose_error(X0, X_RC)
+    t0, _ = pose_error(X0, X_RC)
     assert t < 0.5e-3 and np.degrees(r) < 0.05
     assert t <= t0 + 1e-5  # the refinement does at least as well as OpenCV's hand-eye alone
     assert t < 3.0 * sol.sigma_translation_m and r < 3.0 * sol.sigma_rotation_rad

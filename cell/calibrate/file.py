@@ -91,6 +91,16 @@ def read(path: Path) -> dict[str, Any]:
     return doc
 
 
+def flagged(doc: Mapping[str, Any]) -> dict[str, list[str]]:
+    """Camera -> what its calibration flagged (``intrinsics.flags``: focal, principal_point, depth_scale)."""
+    out = {}
+    for name, entry in doc["cameras"].items():
+        flags = (entry.get("intrinsics") or {}).get("flags") or []
+        if flags:
+            out[str(name)] = [str(f) for f in flags]
+    return out
+
+
 def apply(scn: Scenario, doc: Mapping[str, Any], source: str = "--calibration") -> Scenario:
     """The scenario with each calibrated camera's measured pose and stated residual in place of its own."""
     cameras = dict(scn.cameras)

@@ -172,9 +172,12 @@ def load_scenario(name: str, calibration: Path | None = None) -> Scenario:
     scn = sc.load(name)
     if calibration is None:
         return scn
-    from cell.calibrate.file import apply, read
+    from cell.calibrate.file import apply, flagged, read
 
-    return apply(scn, read(calibration), f"--calibration {str(calibration)!r}")
+    doc = read(calibration)
+    for camera, what in flagged(doc).items():  # before any seam is located: the camera's model is in doubt
+        warn(f"--calibration: camera {camera}'s calibration images disagree with its stated {', '.join(what)}")
+    return apply(scn, doc, f"--calibration {str(calibration)!r}")
 
 
 def parse_noise(value: str | None) -> Literal["none", "realistic"] | None:

@@ -12,7 +12,7 @@ import pytest
 from cell import scenario as scn
 from cell.calibrate import solve
 from cell.calibrate.board import Board
-from cell.calibrate.file import FORMAT, apply, read
+from cell.calibrate.file import FORMAT, apply, flagged, read
 from cell.errors import UsageError
 from cell.geometry import invert, make_pose, matrix_to_rpy, pose_from_xyz_rpy
 from cell.sim import SimCell
@@ -94,6 +94,9 @@ def test_a_calibration_file_puts_its_measured_pose_in_place_of_the_perturbed_one
         told = sim.capture("above").X_WC
     assert np.allclose(told, s.X_WR @ X_RC, atol=1e-9)  # the measured pose, not the seeded error
     assert solve.pose_error(told_before, s.cameras["above"].X_WC)[0] == pytest.approx(2e-3)
+    assert flagged(doc) == {}
+    doc["cameras"]["above"]["intrinsics"] = {"flags": ["depth_scale"]}
+    assert flagged(doc) == {"above": ["depth_scale"]}
     with pytest.raises(UsageError, match="not in scenario"):
         apply(s, {"format": FORMAT, "cameras": {"nowhere": doc["cameras"]["above"]}})
     bad = tmp_path / "bad.yaml"

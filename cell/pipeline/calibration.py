@@ -7,8 +7,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.calibrate import HandEyeMethod
 from cell.calibrate.board import Board
@@ -18,14 +20,16 @@ from cell.calibrate.plan import board_poses, camera_poses
 from cell.calibrate.result import CameraCalibration
 from cell.calibrate.solve import hand_eye_start, held_out, refine
 from cell.calibrate.views import Mount, View
-from cell.errors import CalibrationError, CalibrationFault, IKError, ScenarioError, UsageError
+from cell.errors import CalibrationError, CalibrationFault, CaptureError, IKError, ScenarioError, UsageError
 from cell.geometry import FloatArray, invert, make_pose, pose_from_xyz_rpy, rot_x
 from cell.motion.ik import solve_ik
 from cell.pipeline.geometry import robot_arm
+from cell.recorded.board_capture import BoardCapture, BoardShot, read_board_capture
 from cell.scenario import Scenario
+from cell.scenario.calibration_specs import BoardSpec, CalibrationRunSpec
 from cell.station.board import SimBoardStation
 from cell.station.ports import Arm
-from cell.types import CameraIntrinsics, DepthImage
+from cell.types import CameraIntrinsics
 
 Progress = Callable[[str], None]
 OPENCV_METHODS: tuple[HandEyeMethod, ...] = ("park", "tsai", "daniilidis")  # OpenCV's hand-eye methods alone
@@ -36,17 +40,25 @@ _CLEARANCE_M = 0.05  # the board and the flange stay this far above the table to
 
 @dataclass(frozen=True)
 class CalibrationRun:
-    """Every camera calibrated, in the order asked."""
+    """Every camera calibrated, in the order asked, with the board it used; ``capture`` what the cameras saw
+    (when asked to keep it)."""
 
-    scenario: Scenario
+    board: BoardSpec
     cameras: tuple[CameraCalibration, ...]
+    capture: BoardCapture | None = None
 
 
 def calibrate(
-    scn: Scenario, cameras: Sequence[str] | None = None, *, poses: int | None = None, progress: Progress | None = None
+    scn: Scenario,
+    cameras: Sequence[str] | None = None,
+    *,
+    poses: int | None = None,
+    progress: Progress | None = None,
+    keep: bool = False,
 ) -> CalibrationRun:
     """Calibrate ``cameras`` (default: every camera) of the simulated cell; ``poses`` overrides the scenario's
-    ``calibration.poses``. CalibrationError (with its code) for a camera that cannot be calibrated."""
+    ``calibration.poses``; ``keep`` keeps the images and poses taken (a capture folder's content). CalibrationError
+    (with its code) for a camera that cannot be calibrated."""
     say = progress or (lambda _m: None)
     names = list(scn.cameras) if not cameras else list(cameras)
     unknown = [n for n in names if n not in scn.cameras]
@@ -60,23 +72,80 @@ def calibrate(
     picture, face_m, origin_m = Board(spec.board, scale=scn.simulation.board_scale).picture()
     X_FB = pose_from_xyz_rpy(spec.mount.X_FB_xyz_m, np.radians(spec.mount.X_FB_rpy_deg))
     X_WB = _table_board(scn, board)
-    out = []
+    out, shots, intrinsics = [], [], {}
     with SimBoardStation(scn, arm, picture, face_m, origin_m, X_FB=X_FB, X_WB=X_WB) as station:
         for name in names:
             mount = Mount.EYE_IN_HAND if scn.cameras[name].mount == "eye_in_hand" else Mount.EYE_TO_HAND
             say(f"{name}: taking {spec.poses + spec.held_out} board images ({mount})")
-            views, intr = _views(scn, station, arm, board, name, mount, spec.poses + spec.held_out, X_FB, X_WB)
-            cal = solve_camera(scn, name, mount, views, board, intr, spec.held_out)
+            views, intr, taken = _views(scn, station, arm, board, name, mount, spec.poses + spec.held_out, X_FB, X_WB)
+            cal = solve_camera(spec, name, mount, views, board, intr, spec.held_out)
             out.append(_with_truth(cal, station.camera_truth(name)))
             say(f"{name}: {_summary(out[-1])}")
-    return CalibrationRun(scn, tuple(out))
+            if keep:
+                shots += taken
+                intrinsics[name] = intr
+    capture = None
+    if keep:
+        mounts = {n: scn.cameras[n].mount for n in names}
+        capture = BoardCapture(spec.board.model_dump(), mounts, intrinsics, tuple(shots))
+    return CalibrationRun(spec.board, tuple(out), capture)
+
+
+def calibrate_capture(
+    folder: Path,
+    cameras: Sequence[str] | None = None,
+    *,
+    held_out: int = 4,
+    progress: Progress | None = None,
+) -> CalibrationRun:
+    """Calibrate from a capture folder (:mod:`cell.recorded.board_capture`), no simulator: the board found in each
+    colour image, the last ``held_out`` images of each camera kept out of the fit. The tolerances are the scenario
+    defaults (``calibration``)."""
+    say = progress or (lambda _m: None)
+    probe = read_board_capture(folder, ())
+    unknown = [c for c in cameras or () if c not in probe.mounts]
+    if unknown:
+        raise UsageError(f"--cameras {', '.join(unknown)}: not in the capture; cameras: {', '.join(probe.mounts)}")
+    cap = read_board_capture(folder, cameras)
+    try:
+        spec = CalibrationRunSpec(board=BoardSpec(**cap.board), held_out=held_out)
+    except ValueError as e:
+        raise CaptureError(f"{folder}: its board is not valid ({' '.join(str(e).split())})", path=str(folder)) from None
+    board = Board(spec.board)
+    out = []
+    for name, mount_name in cap.mounts.items():
+        mount = Mount.EYE_IN_HAND if mount_name == "eye_in_hand" else Mount.EYE_TO_HAND
+        views = []
+        for shot in (s for s in cap.shots if s.camera == name):
+            corners = board.detect(shot.rgb)
+            if len(corners) >= _SEEN_FRACTION * len(board.p_B):
+                views.append(View(shot.X_RF, corners, _depth_at(shot.depth_m, corners.px)))
+        n = len(views) - held_out
+        if n < 4:
+            raise CalibrationError(
+                f"{name}: the board is found in {len(views)} of the capture's images, {held_out + 4} are needed",
+                code=CalibrationFault.NOT_SEEN,
+                camera=name,
+                value=len(views),
+                needed=held_out + 4,
+            )
+        say(f"{name}: {len(views)} board images ({mount})")
+        out.append(solve_camera(spec, name, mount, views, board, cap.intrinsics[name], held_out))
+        say(f"{name}: {_summary(out[-1])}")
+    return CalibrationRun(spec.board, tuple(out))
 
 
 def solve_camera(
-    scn: Scenario, camera: str, mount: Mount, views: Sequence[View], board: Board, intr: CameraIntrinsics, n_held: int
+    spec: CalibrationRunSpec,
+    camera: str,
+    mount: Mount,
+    views: Sequence[View],
+    board: Board,
+    intr: CameraIntrinsics,
+    n_held: int,
 ) -> CameraCalibration:
     """The checks, OpenCV's start and methods alone, the joint refinement and its held-out residuals of one camera."""
-    spec, K = scn.calibration, intr.K
+    K = intr.K
     fit, rest = list(views[: len(views) - n_held]), list(views[len(views) - n_held :])
     check_diversity(fit, mount, camera)
     scale = depth_scale(views, board.p_B, K)
@@ -136,8 +205,8 @@ def _views(
     wanted: int,
     X_FB: FloatArray,
     X_WB: FloatArray,
-) -> tuple[list[View], CameraIntrinsics]:
-    """``wanted`` images of the board, each pose reached by IK and the board found in it."""
+) -> tuple[list[View], CameraIntrinsics, list[BoardShot]]:
+    """``wanted`` images of the board, each pose reached by IK and the board found in it (and what was taken)."""
     spec, cam = scn.calibration, scn.cameras[camera]
     intr = station.intrinsics(camera)
     rng = scn.rng(f"calibrate/{camera}")
@@ -156,6 +225,7 @@ def _views(
             for X_RC in camera_poses(board, X_RB, intr, spec.hand_range_m, spec.tilt_deg, rng, offset=_OFFSET)
         )
     views: list[View] = []
+    shots: list[BoardShot] = []
     q = arm.q_home
     reached = seen = 0
     for frame, X_RT in targets:
@@ -172,9 +242,10 @@ def _views(
             continue
         seen += 1
         q = q_new
-        views.append(View(X_RF, corners, _depth_at(depth, corners.px)))
+        views.append(View(X_RF, corners, _depth_at(depth.depth, corners.px)))
+        shots.append(BoardShot(camera, X_RF, rgb, depth.depth))
         if len(views) == wanted:
-            return views, intr
+            return views, intr, shots
     if reached < wanted:
         raise CalibrationError(
             f"cameras.{camera}: only {reached} of the planned board poses are within the arm's reach, {wanted} "
@@ -200,10 +271,10 @@ def _above(X_RB: FloatArray, board: Board, top_R: float, X_RF: FloatArray) -> bo
     return bool(np.all(corners[:, 2] > top_R) and X_RF[2, 3] > top_R)
 
 
-def _depth_at(depth: DepthImage, px: FloatArray) -> FloatArray:
-    """The depth image at each pixel (nearest), nan where invalid."""
-    h, w = depth.depth.shape
+def _depth_at(depth_m: npt.NDArray[np.float32], px: FloatArray) -> FloatArray:
+    """The depth image (H, W) [m] at each pixel (nearest), nan where invalid."""
+    h, w = depth_m.shape
     u = np.clip(np.rint(px[:, 0]).astype(int), 0, w - 1)
     v = np.clip(np.rint(px[:, 1]).astype(int), 0, h - 1)
-    d = depth.depth[v, u].astype(float)
+    d = depth_m[v, u].astype(float)
     return np.where(d > 0.0, d, np.nan)

@@ -1,6 +1,7 @@
 """``cell calibrate`` on fence1's cell, the real pipeline headless: one fixed camera from a few board images is
 measured within its stated bounds, its file read back by a run command moves what the cell is told; a board printed
-5 % larger than stated is refused with its reason (exit 17). Few images keep it to seconds."""
+5 % larger than stated is refused with its reason (exit 17); the images kept as a capture folder solve again
+without the simulator. Few images keep it to seconds."""
 
 from __future__ import annotations
 
@@ -32,7 +33,9 @@ def _scenario_file(tmp_path: Path, name: str, **simulation: object) -> Path:
 def test_a_fixed_camera_is_measured_and_a_board_of_the_wrong_size_is_refused(tmp_path: Path) -> None:
     scenario = _scenario_file(tmp_path, "short")
     cal = tmp_path / "cal.yaml"
-    result = runner.invoke(app, ["calibrate", str(scenario), "--cameras", "cam_right", "--out", str(cal)])
+    folder = tmp_path / "capture"
+    args = ["calibrate", str(scenario), "--cameras", "cam_right", "--out", str(cal), "--save-capture", str(folder)]
+    result = runner.invoke(app, args)
     assert result.exit_code == 0, result.stderr
     entry = read(cal)["cameras"]["cam_right"]
     err, stated = entry["truth_error"], entry["calibration"]
@@ -46,6 +49,14 @@ def test_a_fixed_camera_is_measured_and_a_board_of_the_wrong_size_is_refused(tmp
     X_true = invert(calibrated.X_WR) @ calibrated.cameras["cam_right"].X_WC
     assert np.linalg.norm(X_RC.X[:3, 3] - X_true[:3, 3]) < 1e-3
     assert apply(calibrated, read(cal)).cameras["cam_right"].calibration.translation_mm == stated["translation_mm"]
+
+    # The same images and flange poses from the capture folder, no simulator: the same pose, no truth to judge it by.
+    again = tmp_path / "again.yaml"
+    result = runner.invoke(app, ["calibrate", "--capture", str(folder), "--held-out", "2", "--out", str(again)])
+    assert result.exit_code == 0, result.stderr
+    replayed = read(again)["cameras"]["cam_right"]
+    assert "truth_error" not in replayed
+    assert np.allclose(replayed["measured"]["xyz_m"], entry["measured"]["xyz_m"], atol=2e-6)
 
     big = _scenario_file(tmp_path, "big-board", board_scale=1.05)
     result = runner.invoke(app, ["calibrate", str(big), "--cameras", "cam_right", "--poses", "4", "--out", str(cal)])

@@ -69,7 +69,7 @@ def test_the_rendered_board_is_found_where_it_lies(tmp_path: Path) -> None:
 def _view(corners: object, depth: object) -> solve.View:
     from cell.pipeline.calibration import _depth_at
 
-    return solve.View(np.eye(4), corners, _depth_at(depth, corners.px))  # type: ignore[arg-type, attr-defined]
+    return solve.View(np.eye(4), corners, _depth_at(depth.depth, corners.px))  # type: ignore[arg-type, attr-defined]
 
 
 def test_a_calibration_file_puts_its_measured_pose_in_place_of_the_perturbed_one(tmp_path: Path) -> None:

@@ -3,6 +3,12 @@ with OpenCV's hand-eye methods alone (Park, Tsai, Daniilidis) on the same images
 bounds cover the error.
 
     .venv/bin/python benchmarks/bench_calibration.py --seeds 10 [--scenario fence1] [--json PATH]
+    .venv/bin/python benchmarks/bench_calibration.py --loop [--json PATH]
+
+``--loop`` closes the loop instead: ``cell calibrate faults/extrinsics-off``, then ``cell weld`` of that scenario with
+the file, beside ``cell weld fence1`` (the same cell, its cameras where the scenario says) and ``cell weld
+faults/extrinsics-off`` told the wrong poses; per run the seams welded and the worst located, executed and end
+errors (default ``benchmarks/results/calibration_loop.json``).
 
 Each seed is the scenario with that seed (realistic colour and depth noise, the robot's repeatability of
 ``calibration.repeatability_mm`` on every flange pose, the board's mount drawn anew): every camera calibrated with
@@ -15,17 +21,21 @@ from __future__ import annotations
 
 import argparse
 import json
+import subprocess
+import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from cell import scenario as sc
 from cell.pipeline.calibration import OPENCV_METHODS, calibrate
 
 RESULTS = Path(__file__).resolve().parent / "results"
+CELL = Path(__file__).resolve().parents[1] / ".venv" / "bin" / "cell"
 
 
 def rows_of(name: str, seeds: Sequence[int]) -> list[dict[str, Any]]:
@@ -96,12 +106,65 @@ def summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
+def _weld(scenario: str, report: Path, *extra: str) -> dict[str, Any]:
+    """``cell weld SCENARIO --json`` run as a user runs it, and the figures of its report."""
+    subprocess.run([str(CELL), "-q", "weld", scenario, "--json", str(report), *extra], check=False)
+    rep = json.loads(report.read_text(encoding="utf-8"))
+    seams = rep["seams"]
+    welded = [s for s in seams if s.get("welded")]
+    ends = ("short_start", "short_end", "past_start", "past_end")
+    reasons: dict[str, int] = {}
+    for s in seams:
+        if not s.get("welded"):
+            reasons[str(s.get("weld_reason_code"))] = reasons.get(str(s.get("weld_reason_code")), 0) + 1
+    located = [s["error_mm"]["paper_me"] for s in seams if s.get("error_mm")]
+    return {
+        "command": " ".join(["cell", "weld", scenario, *("CAL.yaml" if e.endswith(".yaml") else e for e in extra)]),
+        "seams": len(seams),
+        "welded": len(welded),
+        "not_welded": reasons,
+        "paper_me_mean_mm": float(np.mean(located)) if located else None,
+        "paper_me_max_mm": float(np.max(located)) if located else None,
+        "tcp_max_mm": max((s["tcp_error_mm"]["max"] for s in welded), default=None),
+        "ends_max_mm": max((max(s["tcp_error_mm"][k] for k in ends) for s in welded), default=None),
+    }
+
+
+def loop(json_path: Path) -> None:
+    """The loop closed (see the module docstring)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        cal = folder / "cal.yaml"
+        subprocess.run([str(CELL), "-q", "calibrate", "faults/extrinsics-off", "--out", str(cal)], check=True)
+        runs = {
+            "exact": _weld("fence1", folder / "exact.json"),
+            "told_wrong": _weld("faults/extrinsics-off", folder / "off.json"),
+            "calibrated": _weld("faults/extrinsics-off", folder / "cal.json", "--calibration", str(cal)),
+        }
+        calibration = yaml.safe_load(cal.read_text(encoding="utf-8"))
+    doc = {
+        "command": ".venv/bin/python benchmarks/bench_calibration.py --loop",
+        "calibration": {
+            n: {"calibration": c["calibration"], "truth_error": c["truth_error"]}
+            for n, c in calibration["cameras"].items()
+        },
+        "runs": runs,
+    }
+    json_path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+    print(json.dumps(doc, indent=1))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1")
     ap.add_argument("--scenario", default="fence1")
-    ap.add_argument("--json", type=Path, default=RESULTS / "calibration.json")
+    ap.add_argument("--loop", action="store_true", help="calibrate faults/extrinsics-off, then weld with it")
+    ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args()
+    if args.loop:
+        loop(args.json or RESULTS / "calibration_loop.json")
+        return
+    args.json = args.json or RESULTS / "calibration.json"
     rows = rows_of(args.scenario, range(args.seeds))
     doc = {
         "command": f".venv/bin/python benchmarks/bench_calibration.py --seeds {args.seeds} --scenario {args.scenario}",

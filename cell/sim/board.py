@@ -10,13 +10,15 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 from scipy.ndimage import gaussian_filter
+from scipy.spatial.transform import Rotation
 
+from cell.geometry import FloatArray
 from cell.sim.quiet import BulletClient, pybullet
 
+Size2 = tuple[float, float]  # a width and a height, or a point in a plane [m]
 
-def add_board(
-    client: BulletClient, image: npt.ArrayLike, face_m: tuple[float, float], origin_m: tuple[float, float]
-) -> int:
+
+def add_board(client: BulletClient, image: npt.ArrayLike, face_m: Size2, origin_m: Size2) -> int:
     """A textured plate, visual only; returns its PyBullet body id. Its frame is the board's B (the printed face in
     the plane z = 0 looking along -z, x along the image's columns, y down its rows).
 
@@ -39,6 +41,12 @@ def add_board(
     body = client.createMultiBody(baseMass=0.0, baseVisualShapeIndex=face)
     client.changeVisualShape(body, -1, textureUniqueId=texture, rgbaColor=[1.0, 1.0, 1.0, 1.0])
     return int(body)
+
+
+def place_body(client: BulletClient, body: int, X_W: FloatArray) -> None:
+    """Put ``body`` at X_W (4, 4) in W."""
+    q = Rotation.from_matrix(np.asarray(X_W)[:3, :3]).as_quat()  # scipy and PyBullet: (x, y, z, w) both
+    client.resetBasePositionAndOrientation(body, [float(v) for v in X_W[:3, 3]], [float(v) for v in q])
 
 
 def colour_noise(rgb: npt.ArrayLike, blur_px: float, sigma: float, rng: np.random.Generator) -> npt.NDArray[np.uint8]:

@@ -15,11 +15,11 @@ from scipy.spatial.transform import Rotation
 from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
-from cell.sim.board import add_board, colour_noise
+from cell.sim.board import Size2, add_board, colour_noise, place_body
 from cell.sim.bodies import add_box, add_part
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
-from cell.sim.noise import apply_noise, perturb_pose, specular_dropout
+from cell.sim.noise import apply_noise, believed_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
@@ -164,11 +164,16 @@ class SimCell:
         stream starts from ``scenario.rng(camera)`` and continues across captures (a second capture has new
         noise).
         """
-        return self.capture_rgbd(camera, X_WC)[0]
+        return self._capture(camera, X_WC, colour=False)[0]
 
     def capture_rgbd(self, camera: str, X_WC: FloatArray | None = None) -> tuple[DepthImage, npt.NDArray[np.uint8]]:
         """One depth image as :meth:`capture` and the colour image (H, W, 3) uint8 taken with it (the same
         intrinsics and pose; with realistic noise the lens' blur and pixel noise, a stream of its own)."""
+        return self._capture(camera, X_WC, colour=True)
+
+    def _capture(
+        self, camera: str, X_WC: FloatArray | None, *, colour: bool
+    ) -> tuple[DepthImage, npt.NDArray[np.uint8]]:
         spec = self.camera_spec(camera)
         if X_WC is None and spec.mount == "eye_in_hand" and self._robot is not None:
             X_WC = self._robot.link_pose(EYE_IN_HAND_LINK)  # the camera rides on the arm
@@ -178,9 +183,9 @@ class SimCell:
         intr = self.intrinsics(camera)
         rgb, depth = self.render(X_true, intr, spec.near_m, spec.far_m)
         if self.scenario.noise == "realistic":
-            crng = self._noise_rngs.setdefault(camera + "/colour", self.scenario.rng(camera + "/colour"))
-            rgb = colour_noise(rgb, spec.noise.colour_blur_px, spec.noise.colour_sigma, crng)
-        if self.scenario.noise == "realistic":
+            if colour:  # its own stream: the depth noise draws are the same with colour taken or not
+                crng = self._noise_rngs.setdefault(camera + "/colour", self.scenario.rng(camera + "/colour"))
+                rgb = colour_noise(rgb, spec.noise.colour_blur_px, spec.noise.colour_sigma, crng)
             rng = self._noise_rngs.setdefault(camera, self.scenario.rng(camera))
             noisy = apply_noise(depth, intr, spec.noise, rng)
             shiny = self.scenario.simulation.specular_dropout
@@ -193,33 +198,17 @@ class SimCell:
         if fault is not None:  # a broken camera (fault scenarios); its own stream, so noise draws are unchanged
             rng = self._noise_rngs.setdefault(camera + "/fault", self.scenario.rng(camera + "/fault"))
             noisy = corrupt_depth(noisy, fault, spec.near_m, spec.far_m, rng)
-        image = DepthImage(
-            camera=camera, depth=noisy, intrinsics=intr, X_WC=self._believed(camera, X_true), mount=spec.mount
-        )
-        return image, rgb
+        X_WF = self._robot.link_pose(FLANGE_LINK) if self._robot is not None else None  # the measured X_FC's base
+        X_told = believed_pose(spec, X_true, self.scenario.X_WR, X_WF, self.scenario.rng(camera + "/extrinsics"))
+        return DepthImage(camera=camera, depth=noisy, intrinsics=intr, X_WC=X_told, mount=spec.mount), rgb
 
-    def _believed(self, camera: str, X_true: FloatArray) -> FloatArray:
-        """The pose the cell is told: its measured one (``cameras.<name>.measured``: X_RC, or X_FC on the arm's
-        flange where the arm is now), else the true pose with the camera's calibration error."""
-        spec = self.camera_spec(camera)
-        if spec.measured is None:
-            return perturb_pose(X_true, spec.extrinsic_error, self.scenario.rng(camera + "/extrinsics"))
-        if spec.mount == "eye_in_hand" and self._robot is not None:
-            return self._robot.link_pose(FLANGE_LINK) @ spec.measured.X
-        return self.scenario.X_WR @ spec.measured.X
-
-    def add_board(
-        self, name: str, image: npt.ArrayLike, face_m: tuple[float, float], origin_m: tuple[float, float]
-    ) -> None:
-        """A calibration board (:func:`cell.sim.board.add_board`) as body ``name``; put it with :meth:`place`."""
+    def add_board(self, name: str, image: npt.ArrayLike, face_m: Size2, origin_m: Size2) -> None:
+        """A calibration board (:func:`cell.sim.board.add_board`) as body ``name``, at W's origin until placed."""
         self._bodies[name] = add_board(self.client, image, face_m, origin_m)
 
     def place(self, name: str, X_W: FloatArray) -> None:
         """Put body ``name`` (a board) at X_W (4, 4) in W."""
-        q = Rotation.from_matrix(np.asarray(X_W)[:3, :3]).as_quat()  # scipy and PyBullet: (x, y, z, w) both
-        self.client.resetBasePositionAndOrientation(
-            self.body_id(name), [float(v) for v in X_W[:3, 3]], [float(v) for v in q]
-        )
+        place_body(self.client, self.body_id(name), X_W)
 
     def capture_all(self) -> dict[str, DepthImage]:
         """One capture from every camera of the scenario, by camera name: fixed cameras at their scenario pose,

@@ -246,6 +246,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "weldments-bench": lambda results: markdown_table(_load(results, "weldments-bench.json")),
     "trust": trust,
     "cell-calibration": lambda results: calibration_tables.calibration_table(_load_object(results, "calibration.json")),
+    "calibration-loop": lambda results: calibration_tables.loop_table(_load_object(results, "calibration_loop.json")),
 }
 
 

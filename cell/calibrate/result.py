@@ -8,8 +8,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-import numpy as np
-
 from cell.calibrate.intrinsics import IntrinsicsCheck
 from cell.calibrate.solve import Solution, pose_error
 from cell.calibrate.views import Mount
@@ -63,7 +61,3 @@ class CameraCalibration:
     def frame(self) -> str:
         """The frame the measured pose is given in: ``robot_base`` (X_RC) or ``flange`` (X_FC)."""
         return "robot_base" if self.mount == Mount.EYE_TO_HAND else "flange"
-
-
-def degrees(rad: float) -> float:
-    return float(np.degrees(rad))

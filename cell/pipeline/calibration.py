@@ -6,7 +6,7 @@ reached by IK before it is taken; the board must be found (most of its corners) 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -169,8 +169,6 @@ def solve_camera(
 
 
 def _with_truth(cal: CameraCalibration, X_AC_true: FloatArray) -> CameraCalibration:
-    from dataclasses import replace
-
     return replace(cal, X_AC_true=X_AC_true)
 
 

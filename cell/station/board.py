@@ -10,7 +10,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from cell.geometry import FloatArray, invert, make_pose
+from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose
 from cell.scenario import ExtrinsicErrorSpec, Scenario
 from cell.station.arm import robot_urdf
 from cell.station.ports import Arm
@@ -107,7 +107,5 @@ def _slid(X_WB: FloatArray, rng: np.random.Generator) -> FloatArray:
 
 
 def _rotvec(w: FloatArray) -> FloatArray:
-    from cell.geometry import axis_angle_to_matrix
-
     angle = float(np.linalg.norm(w))
     return np.eye(3) if angle == 0.0 else axis_angle_to_matrix(w / angle, angle)

@@ -4,7 +4,7 @@ Everything here is in the map frame M in millimetres, z = 0 on the table top (th
 ``tools/make_maps.py``). A :class:`Body` is a closed polyhedron (vertices, faces counter-clockwise seen from outside)
 built by :func:`prism` (an outline extruded, then moved) or :func:`hollow` (two outlines, an open-ended tube); a
 :class:`Seam` is a straight fillet line with the two parts it joins and its dihedral; a :class:`Circle` is a curved
-seam the cell lists as unsupported. :func:`write_map` draws them: each body on a layer named after it (MESH or
+seam the cell reads and lists as not welded. :func:`write_map` draws them: each body on a layer named after it (MESH or
 3DFACE), fixtures on ``FIXTURE_*`` layers, seams as red LINEs (circles as red CIRCLEs) on ``WELD_SEAMS`` with their
 ids as ``WELDCELL`` XDATA, byte-stable.
 """
@@ -73,7 +73,7 @@ class Seam:
 
 @dataclass(frozen=True)
 class Circle:
-    """A curved seam drawn as a red CIRCLE (centre, radius [mm], horizontal): listed by the reader as unsupported."""
+    """A curved seam drawn as a red CIRCLE (centre, radius [mm], horizontal): read as a curved seam, not welded."""
 
     id: str
     centre: tuple[float, float, float]

@@ -65,13 +65,15 @@ def _check_map(path: Path, design: Design) -> WeldMap:
     from cell.weldmap import read_map
 
     weldmap = read_map(path)
+    if not weldmap.seams:  # curved seams only: nothing the cell welds yet
+        raise RejectedDrawError(f"no straight seam ({len(weldmap.curved)} curved)")
     joints = find_joints(weldmap)
     for s in design.seams:
         j = joints[s.id]
         if (j.abutting, j.receiving) != (s.abutting, s.receiving):
             raise RejectedDrawError(f"seam {s.id} read as {j.abutting}>{j.receiving}")
-    if len(weldmap.unsupported) != len(design.circles):
-        raise RejectedDrawError(f"{len(weldmap.unsupported)} unsupported seams, {len(design.circles)} circles drawn")
+    if len(weldmap.curved) != len(design.circles) or weldmap.unsupported:
+        raise RejectedDrawError(f"{len(weldmap.curved)} curved seams read, {len(design.circles)} circles drawn")
     return weldmap
 
 

@@ -11,7 +11,8 @@ name), its type, its unit (from a ``Field`` description or comment ``[unit]``, e
 ``_m``, ``_mm``, ``_deg``, ``_s``, ``_px``, ``_mm_s``), its default (``required`` when it has none), the
 allowed range, and its description: the ``Field``'s description, the ``name : text`` entry of the class
 docstring (for a field of fixed choices, else the docstring paragraph that explains them), and the comments on
-and just above the field's line in the source of :mod:`cell.scenario`, in that order.
+and just above the field's line in the source of :mod:`cell.scenario`, in that order. Last, the scenarios shipped
+in ``scenarios/`` (name, map, description): a new scenario file needs the page regenerated too.
 """
 
 from __future__ import annotations
@@ -397,7 +398,18 @@ def render() -> str:
             continue
         lines += ["", f"## `{head.key}`", "", _cell(head.description), ""]
         lines += _table(sub)
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + _shipped()) + "\n"
+
+
+def _shipped() -> list[str]:
+    """The scenarios shipped in ``scenarios/``: name, map and description, one row each."""
+    from cell.scenario import available, load
+
+    out = ["", "## The scenarios in `scenarios/`", "", "| scenario | map | description |", "|---|---|---|"]
+    for name in available():
+        sc = load(name)
+        out.append(f"| `{name}` | `{Path(sc.map.file).name}` | {_cell(sc.description)} |")
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -107,7 +107,7 @@ def check(
         weldmap = pipeline.read_weldmap(scn)
         problems = check_layout(scn, weldmap) + _run_checks(scn, weldmap)
         problems += [
-            f"seam {u.id} will not be welded: not supported ({u.code}): {u.reason}" for u in weldmap.unsupported
+            f"seam {u.id} will not be welded: not supported ({u.code}): {u.reason}" for u in weldmap.not_welded
         ]
         for p in problems:
             _warn(p)
@@ -164,8 +164,8 @@ def _seam_sight(scn: Scenario, weldmap: WeldMap) -> SightReport:
 
 def seams_text(weldmap: WeldMap) -> str:
     """``3 seams: 2 to weld, 1 not supported (curved)``, or ``2 seams`` when the cell can weld every one."""
-    n = len(weldmap.seams) + len(weldmap.unsupported)
-    if not weldmap.unsupported:
+    n = len(weldmap.seams) + len(weldmap.not_welded)
+    if not weldmap.not_welded:
         return f"{n} seams"
-    codes = ", ".join(sorted({str(u.code) for u in weldmap.unsupported}))
-    return f"{n} seams: {len(weldmap.seams)} to weld, {len(weldmap.unsupported)} not supported ({codes})"
+    codes = ", ".join(sorted({str(u.code) for u in weldmap.not_welded}))
+    return f"{n} seams: {len(weldmap.seams)} to weld, {len(weldmap.not_welded)} not supported ({codes})"

@@ -72,7 +72,7 @@ def _unsupported_entry(u: UnsupportedSeam) -> dict[str, Any]:
 
 def not_supported(weldmap: WeldMap) -> dict[str, int]:
     """The map's seams the cell cannot weld, counted by reason code (``curved``: 1), in code order."""
-    codes = [u.code.value for u in weldmap.unsupported]
+    codes = [u.code.value for u in weldmap.not_welded]
     return {c: codes.count(c) for c in sorted(set(codes))}
 
 
@@ -93,10 +93,10 @@ def detection_report(
     ground truth (real data) the seams have no ``truth`` or ``error_mm`` and the summary's errors are null."""
     seams = [_seam_entry(rec) for rec in (records if records is not None else det.records())]
     if unsupported:
-        seams += [_unsupported_entry(u) for u in det.weldmap_R.unsupported]
+        seams += [_unsupported_entry(u) for u in det.weldmap_R.not_welded]
     s = det.summary
     summary = {
-        "seams": len(det.estimates) + len(det.weldmap_R.unsupported),  # every seam of the map
+        "seams": len(det.estimates) + len(det.weldmap_R.not_welded),  # every seam of the map
         "not_supported": not_supported(det.weldmap_R),
         "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),
         "found": s.found,

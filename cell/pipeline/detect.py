@@ -235,6 +235,16 @@ def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, Floa
     return true_seams(design_W, cap.joints, cap.parts_W, cap.scenario.X_WR)
 
 
+def curve_truths(cap: Capture) -> dict[str, FloatArray]:
+    """True curves of the map's curved seams from the as-built geometry, (n, 3) each in R, keyed by seam id (empty
+    when the station knows no truth)."""
+    from cell.seams.curve_truth import true_curves
+
+    if cap.parts_W is None or not cap.weldmap.curved:
+        return {}
+    return true_curves(cap.weldmap, cap.parts_W, cap.scenario.X_WM, cap.scenario.X_WR)
+
+
 def detect(
     scenario: Scenario,
     method: str | None = None,
@@ -288,6 +298,7 @@ def detect(
         scene=scene,
         joints=cap.joints,
         source=cap.source,
+        curve_truths=curve_truths(cap),
     )
 
 
@@ -325,4 +336,5 @@ def _failed_detection(
         error=error,
         joints=cap.joints,
         source=cap.source,
+        curve_truths=curve_truths(cap),
     )

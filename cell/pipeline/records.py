@@ -80,6 +80,7 @@ class Detection:
     perceived: Perceived | None = None  # the clouds perceived when the alignment failed (None otherwise: see scene)
     joints: Mapping[str, Joint] = field(default_factory=dict)  # seam id -> how it is made
     source: str = "simulation"  # the data's origin: simulation | capture (replayed) | cloud (brought) | camera
+    curve_truths: Mapping[str, FloatArray] = field(default_factory=dict)  # curved seam id -> true curve (n, 3) in R
 
     def records(self) -> tuple[SeamRecord, ...]:
         """One :class:`~cell.types.SeamRecord` per seam of the map, in map order: seam, joint, estimate, truth,
@@ -101,7 +102,7 @@ class Detection:
         the map holds no seam the cell cannot weld (a curve: listed, never dropped in silence)."""
         undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
         found = all(e.status not in undone for e in self.estimates)
-        return not self.lost_cameras and found and not self.weldmap_R.unsupported
+        return not self.lost_cameras and found and not self.weldmap_R.not_welded
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -3,6 +3,7 @@ from here and nothing here imports a stage. Frames: ``W`` world, ``R`` robot bas
 optical frame, ``B`` a box part's own frame. Metres and radians inside; millimetres and degrees only at the edges."""
 
 from cell.types._near import pair_distance
+from cell.types.curves import ArcCurve, CurvedJoint, CurvedSeam, Cylinder, EllipseCurve, SampledCurve, Surface
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.gate import Violation, ViolationKind
 from cell.types.map import BOX_FACES, Box, MapSeam, Part, Polyhedron, Unsupported, UnsupportedSeam, WeldMap
@@ -27,6 +28,7 @@ from cell.types.view import ArmMotion, CameraView, CellView, RobotPose, Shape, S
 
 __all__ = [
     "BOX_FACES",
+    "ArcCurve",
     "ArmMotion",
     "Box",
     "CameraIntrinsics",
@@ -34,7 +36,11 @@ __all__ = [
     "CellView",
     "CheckFail",
     "Cloud",
+    "CurvedJoint",
+    "CurvedSeam",
+    "Cylinder",
     "DepthImage",
+    "EllipseCurve",
     "EndSource",
     "Event",
     "Execution",
@@ -51,6 +57,7 @@ __all__ = [
     "Reason",
     "Rescan",
     "RobotPose",
+    "SampledCurve",
     "SeamEstimate",
     "SeamMetrics",
     "SeamOutcome",
@@ -64,6 +71,7 @@ __all__ = [
     "SegmentKind",
     "Shape",
     "ShapeKind",
+    "Surface",
     "Trajectory",
     "Unsupported",
     "UnsupportedSeam",

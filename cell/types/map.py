@@ -12,6 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, invert, readonly, transform_points
+from cell.types.curves import CurvedSeam, Cylinder
 from cell.types.polyhedron import Polyhedron
 
 __all__ = ["BOX_FACES", "Box", "MapSeam", "Part", "Polyhedron", "Unsupported", "UnsupportedSeam", "WeldMap"]
@@ -114,6 +115,7 @@ class Part:
     body : the body, a :class:`Box` (the fast special case) or a :class:`Polyhedron` (any closed planar-faced body).
     drawn_as : how the map drew it (``"3DSOLID"``, ``"MESH"``, ``"POLYFACE"``, ``"3DFACE"``; ``""`` when not read
         from a drawing).
+    cylinder : the round body its tessellated faces stand for (a tube, a pipe, a bar), when it is one; else None.
 
     The methods below are what a stage may ask of any body (its faces by name, their planes and polygons, which
     points lie inside, its vertices, triangles and edges, its centre and bounding radius, the body in another frame);
@@ -124,6 +126,7 @@ class Part:
     name: str
     body: Box | Polyhedron
     drawn_as: str = ""
+    cylinder: Cylinder | None = None
 
     @property
     def is_box(self) -> bool:
@@ -187,7 +190,8 @@ class Part:
 
     def transformed(self, X_CA: FloatArray) -> Part:
         """The same part expressed in frame C, given the pose X_CA of its current frame A in C."""
-        return Part(self.name, self.body.transformed(X_CA), self.drawn_as)
+        cylinder = self.cylinder.transformed(X_CA) if self.cylinder is not None else None
+        return Part(self.name, self.body.transformed(X_CA), self.drawn_as, cylinder)
 
 
 @dataclass(frozen=True)
@@ -222,7 +226,9 @@ class MapSeam:
 class Unsupported(enum.StrEnum):
     """Why a seam the map draws is not one the cell can weld, as a code that code and tests read."""
 
-    CURVED = "curved"  # an arc, circle, ellipse, spline, helix or a polyline segment with a bulge
+    # A curved seam (an arc, circle, ellipse, spline, helix or bulged polyline segment), read with its curve and
+    # joint (WeldMap.curved): no locator locates curved seams yet, so none is searched or welded.
+    CURVED_NOT_LOCATED = "curved_not_located"
     ON_FIXTURE = "on_fixture"  # it lies on a fixture, not between two parts
 
 
@@ -244,7 +250,9 @@ class WeldMap:
     source : where it was read from.
     fixtures : clamps, stops and jigs drawn on the fixture layers: obstacles for the arm, never parts (never
         aligned, never welded).
-    unsupported : seams drawn but not weldable (arcs, splines, seams on a fixture), each with its reason.
+    unsupported : seams drawn but not weldable (seams on a fixture), each with its reason.
+    curved : the curved seams (arcs, circles, ellipses, splines, bulged polyline segments), typed curves with their
+        joints; no locator locates them yet (:attr:`not_welded` lists them with code ``curved_not_located``).
     warnings : one line each: what the reader skipped or doubted (also logged on ``cell.weldmap``).
     """
 
@@ -256,6 +264,23 @@ class WeldMap:
     fixtures: tuple[Part, ...] = ()
     unsupported: tuple[UnsupportedSeam, ...] = ()
     warnings: tuple[str, ...] = ()
+    curved: tuple[CurvedSeam, ...] = ()
+
+    @property
+    def not_welded(self) -> tuple[UnsupportedSeam, ...]:
+        """Every seam of the map the cell will not search or weld, with its reason: the curved seams first (no
+        locator locates curved seams yet), then :attr:`unsupported`."""
+        curved = tuple(
+            UnsupportedSeam(
+                c.id,
+                f"{c.drawn}: a curved seam ({c.kind}, {c.length * 1000:.0f} mm"
+                + (f", {c.joint}" if c.joint is not None else "")
+                + "); no locator locates curved seams yet",
+                Unsupported.CURVED_NOT_LOCATED,
+            )
+            for c in self.curved
+        )
+        return curved + self.unsupported
 
     def transformed(self, X_AF: FloatArray, frame: str) -> WeldMap:
         """The whole map expressed in frame ``frame`` given the pose X_AF of its current frame F in A."""
@@ -268,6 +293,7 @@ class WeldMap:
             fixtures=tuple(f.transformed(X_AF) for f in self.fixtures),
             unsupported=self.unsupported,
             warnings=self.warnings,
+            curved=tuple(c.transformed(X_AF) for c in self.curved),
         )
 
     def part(self, name: str) -> Part:

@@ -1,4 +1,4 @@
-"""One pass over a drawing: seams (red or on a seam layer), curves that are not weldable, bodies, in drawing units.
+"""One pass over a drawing: seams (red or on a seam layer), straight and curved, and bodies, in drawing units.
 
 Entities inside INSERTs (nested, MINSERT arrays too) are read with the INSERT's transform; an entity on layer
 ``0`` inside a block takes the INSERT's layer, a BYBLOCK colour the INSERT's colour (through every level).
@@ -14,9 +14,12 @@ import numpy as np
 from ezdxf import colors
 from ezdxf.document import Drawing
 from ezdxf.entities import DXFGraphic, Insert, Layer
+from ezdxf.math import Vec3
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
+from cell.types import SampledCurve
+from cell.weldmap._curves import CURVES, Curve, bulge_curve, entity_curve
 from cell.weldmap._meshes import Mesh, UnreadableBodyError, body_meshes, face_points, is_body
 from cell.weldmap.roles import LayerPatterns, matches
 
@@ -26,8 +29,6 @@ RED_ACI = frozenset(i for i in range(1, 256) if colors.aci2rgb(i) == (255, 0, 0)
 _RED_RGB = 0xFF0000
 _BYBLOCK, _BYLAYER = 0, 256
 _MAX_NESTING = 16
-CURVES = ("ARC", "CIRCLE", "ELLIPSE", "SPLINE", "HELIX")
-_CURVED = "a curved seam; the cell welds straight seams: draw it as LINEs or a polyline without arcs"
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,13 @@ class RawSeam:
     id: str
     a: FloatArray  # (3,) drawing units, frame M
     b: FloatArray
+    where: Where
+
+
+@dataclass(frozen=True)
+class RawCurve:
+    id: str
+    curve: Curve  # drawing units, frame M
     where: Where
 
 
@@ -77,10 +85,18 @@ class Found:
     """What the walk found, in drawing units."""
 
     seams: list[RawSeam] = field(default_factory=list)
-    unsupported: list[tuple[str, str]] = field(default_factory=list)  # (id, reason): curved seams
+    curves: list[RawCurve] = field(default_factory=list)  # curved seams
     bodies: list[RawBody] = field(default_factory=list)
     kinds: Counter[str] = field(default_factory=Counter)  # every entity type met (inside blocks too)
     red: int = 0  # red (or seam-layer) entities met
+
+
+def _probe(curve: Curve) -> FloatArray:
+    """A few points of a curve, to check its coordinates are finite."""
+    if isinstance(curve, SampledCurve):
+        return np.asarray(curve.points)
+    with np.errstate(all="ignore"):
+        return curve.at(np.linspace(0.0, 1.0, 3) * curve.sweep_rad + getattr(curve, "start_rad", 0.0))
 
 
 def _layer_is_red(layer: Layer) -> bool:
@@ -137,7 +153,10 @@ class Reader:
                     self._seam(e, ctx)
             elif kind in CURVES:
                 if self._is_seam(e, ctx):
-                    self.found.unsupported.append((self._seam_id(e, ctx), f"{self._where(e, ctx)}: {_CURVED}"))
+                    curve = entity_curve(e, ctx.X)
+                    where = self._where(e, ctx)
+                    _finite(_probe(curve), where, self.source)
+                    self.found.curves.append(RawCurve(self._seam_id(e, ctx), curve, where))
             elif kind == "3DFACE":
                 p = _finite(_apply(ctx.X, face_points(e)), self._where(e, ctx), self.source)
                 self._faces[(self._name(e, ctx), self._layer(e, ctx), ctx.handles)].append((p, e.dxf.handle or "?"))
@@ -208,20 +227,31 @@ class Reader:
             p = _finite(_apply(ctx.X, np.array([e.dxf.start, e.dxf.end], dtype=float)), where, self.source)
             self.found.seams.append(RawSeam(seam_id, p[0], p[1], where))
             return
+        ocs, elevation = e.ocs(), 0.0
         if kind == "LWPOLYLINE":
             pts = [tuple(v) for v in e.vertices_in_wcs()]  # type: ignore[attr-defined]
-            bulges = [float(b) for (b,) in e.get_points("b")]  # type: ignore[attr-defined]
+            xyb = [(float(x), float(y), float(b)) for x, y, b in e.get_points("xyb")]  # type: ignore[attr-defined]
             closed = bool(e.closed)  # type: ignore[attr-defined]
+            elevation = float(e.dxf.elevation)
         else:
             pts = [tuple(v) for v in e.points_in_wcs()]  # type: ignore[attr-defined]
-            bulges = [float(v.dxf.get("bulge", 0.0)) for v in e.vertices]  # type: ignore[attr-defined]
+            flat = bool(e.is_2d_polyline)  # type: ignore[attr-defined]  # a 3D polyline's bulges mean nothing
+            xyb = [
+                (float(v.dxf.location[0]), float(v.dxf.location[1]), float(v.dxf.get("bulge", 0.0)) if flat else 0.0)
+                for v in e.vertices  # type: ignore[attr-defined]
+            ]
             closed = bool(e.is_closed)  # type: ignore[attr-defined]
+            elevation = float(Vec3(e.dxf.get("elevation", (0.0, 0.0, 0.0))).z)
         P = _finite(_apply(ctx.X, np.array(pts, dtype=float).reshape(-1, 3)), where, self.source)
         n = len(P) if closed else len(P) - 1
         for i in range(max(n, 0)):
             sid = f"{seam_id}.{i + 1}"
-            if i < len(bulges) and bulges[i] != 0.0:
-                self.found.unsupported.append((sid, f"{where}, segment {i + 1}: {_CURVED}"))
+            if i < len(xyb) and xyb[i][2] != 0.0:
+                j = (i + 1) % len(xyb)
+                curve = bulge_curve(ctx.X, ocs, xyb[i][:2], xyb[j][:2], elevation, xyb[i][2])
+                self.found.curves.append(
+                    RawCurve(sid, curve, Where(where.kind, f"{where.handle} segment {i + 1}", where.layer))
+                )
             else:
                 self.found.seams.append(RawSeam(sid, P[i], P[(i + 1) % len(P)], where))
 

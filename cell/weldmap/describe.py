@@ -1,5 +1,6 @@
-"""The text of ``cell map info``: units, parts and fixtures (type box or mesh, size, centre), seams with their joint
-(type T / corner / lap, dihedral), unsupported seams."""
+"""The text of ``cell map info``: units, parts and fixtures (type box or mesh, size, centre; a round body's cylinder),
+seams with their joint (type T / corner / lap, dihedral), curved seams with their curve and joint, unsupported
+seams."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from cell.geometry import FloatArray, matrix_to_rpy
-from cell.types import Part, WeldMap
+from cell.types import ArcCurve, CurvedSeam, EllipseCurve, Part, WeldMap
 
 
 def _fmt(v: FloatArray, f: str = "8.1f") -> str:
@@ -30,8 +31,31 @@ def _bodies(title: str, bodies: tuple[Part, ...]) -> list[str]:
         line = f"  {p.name:<{width}}  {kind:<16} {size:>24} mm  centre {_fmt(p.center * 1000)}"
         if not np.allclose(R, np.eye(3), atol=1e-9):
             line += "  rpy " + _fmt(np.degrees(matrix_to_rpy(R)), ".2f") + " deg"
+        if (c := p.cylinder) is not None:
+            bore = f" bore {c.inner_radius * 2000:.1f}" if c.inner_radius > 0 else " solid"
+            line += f"  round: {c.radius * 2000:.1f} mm across{bore}, {c.length * 1000:.1f} long"
+            line += f", axis {_fmt(c.axis, '+.3f')}, {c.facets} facets"
         lines.append(line)
     return lines
+
+
+def _curve(c: CurvedSeam) -> str:
+    """One curved seam's line: kind, size, length, plane, joint."""
+    k = c.curve
+    if isinstance(k, ArcCurve):
+        what = f"{k.kind} r {k.radius * 1000:.1f} mm, centre {_fmt(k.centre * 1000)}, normal {_fmt(k.normal, '+.3f')}"
+        if not k.closed:
+            what += f", {np.degrees(k.sweep_rad):.1f} deg"
+    elif isinstance(k, EllipseCurve):
+        a, b = float(np.linalg.norm(k.major)), float(np.linalg.norm(k.minor))
+        what = f"ellipse {a * 2000:.1f} x {b * 2000:.1f} mm, centre {_fmt(k.centre * 1000)}"
+        what += f", normal {_fmt(k.normal, '+.3f')}"
+    else:
+        what = f"curve of {len(k.points)} points within {k.chord_error_m * 1000:.3f} mm" + (
+            " closed" if k.closed else ""
+        )
+    joint = str(c.joint) if c.joint is not None else f"no joint: {c.note}"
+    return f"{c.length * 1000:8.1f} mm  {what}  {joint}  [{c.drawn}]"
 
 
 def touching(weldmap: WeldMap, margin_m: float = 0.006) -> dict[str, list[str]]:
@@ -63,6 +87,10 @@ def describe(weldmap: WeldMap, joints: Mapping[str, str] | None = None) -> str:
             f"  {s.id:<{width}}  {s.length * 1000:8.1f} mm  from {_fmt(s.p_start * 1000)}"
             f"  dir {_fmt(s.direction, '+.3f')}  {note}"
         )
+    if weldmap.curved:
+        lines.append(f"curved seams: {len(weldmap.curved)} (no locator locates curved seams yet: not welded)")
+        width = max(len(c.id) for c in weldmap.curved)
+        lines += [f"  {c.id:<{width}}  {_curve(c)}" for c in weldmap.curved]
     if weldmap.unsupported:
         lines.append(f"unsupported seams: {len(weldmap.unsupported)}")
         width = max(len(u.id) for u in weldmap.unsupported)

@@ -10,11 +10,13 @@ from ezdxf.document import Drawing
 
 from cell.errors import MapError
 from cell.geometry import FloatArray
-from cell.types import Box, MapSeam, Part, Polyhedron, WeldMap
+from cell.types import Box, CurvedSeam, MapSeam, Part, Polyhedron, WeldMap
 from cell.types.map import Unsupported, UnsupportedSeam
 from cell.weldmap._load import MALFORMED, ezdxf_to_log, kind_of, load, log
 from cell.weldmap._walk import Found, RawBody, RawSeam, Reader
 from cell.weldmap.boxfit import BOX_TOL, bounding_box, fit_box, open_edges, zero_area_faces
+from cell.weldmap.curved_joints import curved_joint
+from cell.weldmap.cylinders import recognise_cylinder
 from cell.weldmap.polyfit import fit_polyhedron
 from cell.weldmap.roles import LayerPatterns, LayerRoles, body_role
 from cell.weldmap.units import METRES_PER_UNIT, extent_warning, resolve_units
@@ -47,20 +49,31 @@ def summary(found: Found) -> str:
 
 def _points(found: Found) -> FloatArray:
     pts = [p for s in found.seams for p in (s.a, s.b)]
+    pts += [p for c in found.curves for p in _curve_probe(c.curve)]
     pts += [v for b in found.bodies if b.mesh is not None for v in b.mesh[0]]
     return np.array(pts, dtype=float).reshape(-1, 3)
+
+
+def _curve_probe(curve: object) -> FloatArray:
+    """A curve's points for the extent checks: a sampled curve's own, an arc's or ellipse's every 10 degrees."""
+    from cell.types import SampledCurve
+
+    if isinstance(curve, SampledCurve):
+        return np.asarray(curve.points)
+    t = np.linspace(0.0, curve.sweep_rad, 37) + getattr(curve, "start_rad", 0.0)  # type: ignore[attr-defined]
+    return np.asarray(curve.at(t))  # type: ignore[attr-defined]
 
 
 def _check_content(found: Found, doc: Drawing, src: str) -> None:
     if len(doc.modelspace()) == 0:
         raise MapError(f"{src}: the drawing is empty (truncated or blank?); {WHAT}")
-    if not found.seams and not found.unsupported and not found.bodies:
+    if not found.seams and not found.curves and not found.bodies:
         raise MapError(f"{src}: not a welding map: {summary(found)}; {WHAT}")
     _check_extent(found, None, src)
     P = _points(found)
     if len(P) and float(np.ptp(P[:, 2])) <= FLAT_REL * float(np.ptp(P, axis=0).max()):
         raise MapError(f"{src}: the drawing is flat (all z equal), a 2D drawing: {summary(found)}; {WHAT} in 3D")
-    if not found.seams and not found.unsupported:
+    if not found.seams and not found.curves:
         raise MapError(f"{src}: no red weld seams ({summary(found)}); {WHAT}")
     if not found.bodies:
         raise MapError(f"{src}: no parts ({summary(found)}); {WHAT}")
@@ -69,6 +82,7 @@ def _check_content(found: Found, doc: Drawing, src: str) -> None:
 def _check_extent(found: Found, scale: float | None, src: str) -> None:
     """Refuse a coordinate beyond 10 km (``scale`` None: before the units are known, beyond 10 km in any units)."""
     far = [(s.where, max(np.abs(s.a).max(), np.abs(s.b).max())) for s in found.seams]
+    far += [(c.where, np.abs(_curve_probe(c.curve)).max()) for c in found.curves]
     far += [(b.where, np.abs(b.mesh[0]).max()) for b in found.bodies if b.mesh is not None]
     least = min(METRES_PER_UNIT.values())
     for where, c in far:
@@ -91,7 +105,7 @@ def _seams(found: Found, scale: float, src: str) -> list[tuple[MapSeam, RawSeam]
         if s.length < MIN_SEAM_LENGTH:
             raise MapError(f"{src}: seam {raw.id} has zero length ({raw.where}); a seam needs two distinct end points")
         seams.append((s, raw))
-    ids = Counter([s.id for s, _ in seams] + [i for i, _ in found.unsupported])
+    ids = Counter([s.id for s, _ in seams] + [c.id for c in found.curves])
     dup = [i for i, n in ids.items() if n > 1]
     if dup:
         raise MapError(f"{src}: seam id {dup[0]} appears {ids[dup[0]]} times; seam ids must be unique")
@@ -124,7 +138,8 @@ def _named(found: list[tuple[RawBody, Box | Polyhedron]]) -> list[Part]:
     parts = []
     for b, box in found:
         index[b.name] += 1
-        parts.append(Part(f"{b.name}_{index[b.name]}" if count[b.name] > 1 else b.name, box, b.drawn_as))
+        name = f"{b.name}_{index[b.name]}" if count[b.name] > 1 else b.name
+        parts.append(Part(name, box, b.drawn_as, recognise_cylinder(box) if isinstance(box, Polyhedron) else None))
     return parts
 
 
@@ -211,6 +226,30 @@ def _place(
     return kept, unsupported
 
 
+def _curved(
+    found: Found, parts: list[Part], fixtures: list[Part], scale: float, src: str, warnings: list[str]
+) -> tuple[list[CurvedSeam], list[UnsupportedSeam]]:
+    """The curved seams [m] with their joints; one on a fixture (and not on two parts) is unsupported."""
+    curved, unsupported = [], []
+    for raw in found.curves:
+        curve = raw.curve.scaled(scale)
+        if curve.length < MIN_SEAM_LENGTH:
+            raise MapError(f"{src}: seam {raw.id} has zero length ({raw.where}); a seam needs two distinct end points")
+        seam = CurvedSeam(raw.id, curve, str(raw.where))
+        joint, why = curved_joint(seam, parts)
+        if joint is None:
+            fx = [f for f in fixtures if bool(np.all(f.contains(curve.sample(0.01), TOUCH_M)))]
+            if fx:
+                why = (
+                    f"{raw.where}: on fixture {fx[0].name}: a fixture is never welded (map.layers says what is a part)"
+                )
+                unsupported.append(UnsupportedSeam(raw.id, why, Unsupported.ON_FIXTURE))
+                continue
+            warnings.append(f"{src}: curved seam {raw.id} ({raw.where}) {why}")
+        curved.append(CurvedSeam(raw.id, curve, str(raw.where), joint, why))
+    return curved, unsupported
+
+
 def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns | None = None) -> WeldMap:
     """Read a DXF welding map into a :class:`WeldMap` in frame ``M`` [m].
 
@@ -243,9 +282,10 @@ def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns |
         warnings.append(w)
     seams = _seams(found, scale, src)
     parts, fixtures, bad = _bodies(found, spec, scale, src, warnings)
-    kept, on_fixtures = _place(seams, parts, fixtures, bad, src, warnings)
-    unsupported = [UnsupportedSeam(i, why, Unsupported.CURVED) for i, why in found.unsupported] + on_fixtures
-    if not kept:
+    kept, unsupported = _place(seams, parts, fixtures, bad, src, warnings)
+    curved, on_fixtures = _curved(found, parts, fixtures, scale, src, warnings)
+    unsupported += on_fixtures
+    if not kept and not curved:
         first = unsupported[0].reason if unsupported else ""
         raise MapError(f"{src}: no seam can be welded: {_plural(len(unsupported), 'seam')} unsupported ({first})")
     if not parts:
@@ -261,4 +301,5 @@ def read_map(path: str | Path, units: str | None = None, layers: LayerPatterns |
         fixtures=tuple(fixtures),
         unsupported=tuple(unsupported),
         warnings=tuple(warnings),
+        curved=tuple(curved),
     )

@@ -170,7 +170,12 @@ def test_from_cad_writes_a_map_the_reader_welds(step_file: Path, tmp_path: Path)
     assert (tmp_path / "bench.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     weldmap = read_map(out)
     assert sorted(s.id for s in weldmap.seams) == ["WEB>PLATE:+x", "WEB>PLATE:-x"]  # red: welded
-    assert [u.id for u in weldmap.unsupported] == ["TUBE>PLATE:circle.1"]  # the curve: listed, not welded
+    [circle] = weldmap.curved  # the curve: read as a curved seam, listed, not welded
+    assert circle.id == "TUBE>PLATE:circle.1" and circle.kind == "circle" and not weldmap.unsupported
+    tube = weldmap.part("TUBE").cylinder  # the STEP's tube, tessellated into the MESH: recognised as round again
+    assert tube is not None and abs(tube.radius - 0.03) < 1e-4 and abs(tube.inner_radius - 0.025) < 1e-4
+    assert circle.joint is not None and (circle.joint.abutting, circle.joint.receiving) == ("TUBE", "PLATE")
+    assert circle.joint.surfaces == "cylinder_on_plane" and circle.joint.kind == "T"
     assert sorted(p.name for p in weldmap.parts) == ["PLATE", "TUBE", "WEB"]
     assert sorted(f.name for f in weldmap.fixtures) == ["BOLT_M12X40", "HEX_NUT", "WASHER"]
     for s in weldmap.seams:

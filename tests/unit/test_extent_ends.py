@@ -3,8 +3,12 @@ partly hidden), the extrapolated end lands away from them, and its sigma knows b
 
 from __future__ import annotations
 
-import numpy as np
+from typing import Any
 
+import numpy as np
+import pytest
+
+from cell.seams._extent import EdgeFit, edge_fit
 from cell.seams.ours._ends import find_ends, within_receiving
 from cell.seams.ours._planes import End, Face
 from cell.seams.ours._points import Points
@@ -72,3 +76,75 @@ def test_an_edge_with_no_density_inside_it_places_nothing() -> None:
     assert edge_fault(empty, "f1", 0.006, False, o) != ""
     good = EdgeFit(b=-0.004, se=1e-4, blur=2e-4, n_edge=40, strays=0.0, pitch=5e-4, at_limit=False)
     assert edge_fault(good, "f1", 0.006, False, o) == ""
+
+
+def test_an_edge_found_at_the_limit_of_its_search_is_no_edge(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Face A's points thin out over the last 15 mm to its end (seen more and more edge-on, partly hidden): the
+    edge likelihood's best edge, with a finite standard error, lies at the end of the range it searches about the
+    extrapolated guess, which is no edge found. The end keeps the extrapolation with its miss as its bias, and
+    its sigma covers the error at two sigmas (taken as an edge, it was 5.4 mm short at a sigma of 2.5 mm)."""
+    import cell.seams.ours._ends as ends_module
+
+    fits: list[EdgeFit] = []
+
+    def spy(*args: Any) -> EdgeFit:
+        fits.append(edge_fit(*args))
+        return fits[-1]
+
+    monkeypatch.setattr(ends_module, "edge_fit", spy)
+    length, ramp = 0.08, 0.015
+    face_a = Face(np.array([-1.0, 0.0, 0.0]), 0.0, 2e-4, "A", 1e-5)
+    face_b = Face(np.array([0.0, 0.0, 1.0]), 0.0, 2e-4, "B", 1e-5)
+    t = np.array([0.0, 1.0, 0.0])
+    across = (End(-t, 0.0, False, 0.0), End(t, length, False, length))
+    rng = np.random.default_rng(0)
+    y = rng.uniform(0.0, length, 20000)
+    y = y[(y > ramp) | (rng.uniform(0.0, 1.0, len(y)) < y / ramp)]
+    noise = np.random.default_rng(1)
+
+    def points(y: np.ndarray) -> Points:
+        P = np.column_stack([np.zeros_like(y), y, noise.uniform(0.005, 0.03, len(y))])
+        return Points(P.T.copy(), np.zeros(len(y), np.intp), np.ones(len(y), bool), 5e-4, 1.0, 1)
+
+    def dense(a: np.ndarray, b: np.ndarray) -> Points:
+        lo, hi = sorted((float(a[1]), float(b[1])))
+        return points(y[(y >= lo) & (y <= hi)])
+
+    o = OursOptions(tube_radius_m=0.06)
+    start, _ = find_ends(
+        across, {}, points(y), dense, face_a, face_b, np.zeros(3), t, [0.0, length], 0.04, o, (t, length)
+    )
+    assert any(f.at_limit and np.isfinite(f.se) for f in fits)  # the case this is about
+    assert start.source == "extent"
+    assert abs(start.s) <= 2.0 * np.hypot(start.spread, start.bias)
+
+
+def test_a_sharp_edge_far_from_the_extrapolation_is_found_at_the_faces_last_point() -> None:
+    """Face A seen a third as densely over the last 30 mm at each end (a neighbour hides part of it): the
+    quantiles' line puts both ends 17-19 mm inside, where the edge likelihood finds no edge within its search.
+    Searched again about the face's last point, the sharp edge there is found, within its sigma."""
+    length, band = 0.2, 0.03
+    face_a = Face(np.array([-1.0, 0.0, 0.0]), 0.0, 2e-4, "A", 1e-5)
+    face_b = Face(np.array([0.0, 0.0, 1.0]), 0.0, 2e-4, "B", 1e-5)
+    t = np.array([0.0, 1.0, 0.0])
+    across = (End(-t, 0.0, False, 0.0), End(t, length, False, length))
+    rng = np.random.default_rng(0)
+    y = rng.uniform(0.0, length, 20000)
+    y = y[((y > band) & (y < length - band)) | (rng.uniform(0.0, 1.0, len(y)) < 0.3)]
+    noise = np.random.default_rng(1)
+
+    def points(y: np.ndarray) -> Points:
+        P = np.column_stack([np.zeros_like(y), y, noise.uniform(0.005, 0.03, len(y))])
+        return Points(P.T.copy(), np.zeros(len(y), np.intp), np.ones(len(y), bool), 5e-4, 1.0, 1)
+
+    def dense(a: np.ndarray, b: np.ndarray) -> Points:
+        lo, hi = sorted((float(a[1]), float(b[1])))
+        return points(y[(y >= lo) & (y <= hi)])
+
+    o = OursOptions(tube_radius_m=0.06)
+    ends = find_ends(across, {}, points(y), dense, face_a, face_b, np.zeros(3), t, [0.0, length], 0.04, o, (t, length))
+    for found, true in zip(ends, (0.0, length), strict=True):
+        assert found.source == "extent"
+        sigma = np.hypot(found.spread, found.bias)
+        assert abs(found.s - true) <= 2.0 * sigma  # measured 0.06-0.11 mm at 0.26 mm
+        assert sigma < 5e-4

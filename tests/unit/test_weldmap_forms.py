@@ -89,12 +89,16 @@ def test_polylines_are_chains_of_straight_seams_and_curves_are_unsupported(tmp_p
     np.testing.assert_allclose([m.seams[3].p_start, m.seams[3].p_end], [[1.12, 0.7, 0.08], [1.2, 0.7, 0.08]], atol=TOL)
     np.testing.assert_allclose([m.seams[0].p_start, m.seams[0].p_end], [[0.2, 0.7, 0.08], [0.28, 0.7, 0.08]])
     np.testing.assert_allclose(m.seams[2].p_end, [0.2, 0.7, 0.08])
-    reasons = {u.id: u.reason for u in m.unsupported}
-    assert {u.code for u in m.unsupported} == {Unsupported.CURVED}
-    assert list(reasons) == [f"seam-{lw.dxf.handle}.2", m.unsupported[1].id, f"seam-{spline.dxf.handle}"]
-    assert "LWPOLYLINE" in reasons[f"seam-{lw.dxf.handle}.2"] and "segment 2: a curved seam" in m.unsupported[0].reason
-    assert m.unsupported[1].reason.startswith("ARC ") and "on layer WELD_SEAMS" in m.unsupported[1].reason
-    assert "draw it as LINEs" in m.unsupported[2].reason
+    # The bulged segment, the arc and the spline are curved seams (typed curves), not dropped and not refused.
+    curved = {c.id: c for c in m.curved}
+    assert list(curved) == [f"seam-{lw.dxf.handle}.2", m.curved[1].id, f"seam-{spline.dxf.handle}"]
+    assert not m.unsupported and {u.code for u in m.not_welded} == {Unsupported.CURVED_NOT_LOCATED}
+    bulged = curved[f"seam-{lw.dxf.handle}.2"]
+    assert bulged.kind == "arc" and "LWPOLYLINE" in bulged.drawn and "segment 2" in bulged.drawn
+    np.testing.assert_allclose(bulged.curve.sample(0.001)[[0, -1]], [[0.28, 0.7, 0.08], [0.28, 0.65, 0.08]], atol=TOL)
+    assert m.curved[1].drawn.startswith("ARC ") and "on layer WELD_SEAMS" in m.curved[1].drawn
+    assert m.curved[2].kind == "curve" and m.curved[2].curve.chord_error_m < 1e-4
+    assert "no locator locates curved seams yet" in m.not_welded[0].reason
 
 
 def test_lines_on_a_seam_layer_are_seams_whatever_their_colour(tmp_path: Path) -> None:
@@ -302,12 +306,12 @@ def test_degenerate_and_self_intersecting_faces(tmp_path: Path) -> None:
     _one_line(exc, "MESH", "on layer POST_L: part POST_L is not closed", "holds seam POST_L>")
 
 
-def test_a_map_of_curves_only_has_no_seam_to_weld(tmp_path: Path) -> None:
+def test_a_map_of_curves_only_is_read_with_its_curved_seams(tmp_path: Path) -> None:
     doc = make_maps.build_map(PARTS, [], solid="mesh")
     doc.modelspace().add_circle((240, 700, 80), 30, dxfattribs={"color": 1})
-    with pytest.raises(MapError) as exc:
-        read_map(_save(doc, tmp_path))
-    _one_line(exc, "no seam can be welded: 1 seam unsupported (CIRCLE", "a curved seam")
+    m = read_map(_save(doc, tmp_path))
+    assert not m.seams and [c.kind for c in m.curved] == ["circle"]
+    assert m.not_welded[0].code == Unsupported.CURVED_NOT_LOCATED
 
 
 def test_fixtures_are_obstacles_of_the_motion_scene() -> None:

@@ -8,16 +8,16 @@ section 8)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.seams._extent import EDGE_WINDOW_M, cdf_extent, edge_fit
+from cell.seams._extent import EDGE_WINDOW_M, EdgeFit, cdf_extent, edge_fit
 from cell.seams._lines import line_plane_parameter
 from cell.seams.ours._geometry import within
 from cell.seams.ours._planes import End, Face
 from cell.seams.ours._points import Points
+from cell.seams.ours._shear import end_shear
 from cell.seams.ours.options import OursOptions
 from cell.types import EndSource
 
@@ -45,80 +45,6 @@ def end_source(end: End) -> EndSource:
     if end.source == "side face" and end.touching:
         return EndSource.OTHER_PART
     return _SOURCES[end.source]
-
-
-# A side face this far off square to the seam (tan of the angle) shears face A's support: below it (a box, whose
-# fitted faces tilt a little off the map's) the window along the seam stays square.
-_SHEAR_MIN = float(np.tan(np.radians(1.0)))
-
-
-@dataclass(frozen=True)
-class Shear:
-    """How A's side faces at the seam's ends run across face A (a mitred brace's, at an angle to the seam).
-
-    w : (3,) the unit direction in face A across the seam, away from face B; h0 : where along w A's edge on its end
-        face lies [m] (the drawn gap over the angle between the end face and w; 0 without one); c : a side face
-        meets that edge at ``s(h0) - c (h - h0)`` along the seam at a height h along w, so that ``s + c (h - h0)``
-        of a point of face A is where the side line through it meets A's edge at the end face: the end's place as
-        the truth has it (the edge projected on the seam). 0 for ends square to the seam (a box: all as before).
-    """
-
-    w: FloatArray
-    c: float
-    h0: float
-
-    def s(self, pts: Points, p0: FloatArray, t: FloatArray) -> FloatArray:
-        """The points' parameters along the seam p0 + s t, each carried along its side line to A's end edge."""
-        s = pts.along(t) - float(p0 @ t)
-        if not self.c:
-            return s
-        return s + self.c * (pts.along(self.w) - float(p0 @ self.w) - self.h0)
-
-
-def end_slopes(ends: tuple[End, End], n_a: FloatArray, n_b: FloatArray, t: FloatArray) -> tuple[float, float]:
-    """Each end plane's slope across face A (see :class:`Shear`): how far along the seam [m] its end moves per metre
-    that A's edge on its end face lies further from face B than drawn (an as-built gap); 0 for a plane square to the
-    seam or one that does not cross it."""
-    w = np.cross(n_a, t)
-    w = w / max(float(np.linalg.norm(w)), 1e-12)
-    if float(w @ n_b) < 0.0:
-        w = -w
-    out = [float(e.n @ w) / float(e.n @ t) if abs(float(e.n @ t)) > 0.2 else 0.0 for e in ends]
-    return out[0], out[1]
-
-
-def across_lever(end: End, t: FloatArray) -> float:
-    """How far along the seam [m] an end placed on a side face moves per metre the line moves across itself, at
-    most (the worst direction across): the tangent of the face's normal's angle to the line; 0 for an end no plane
-    places, or a plane along the line."""
-    if end.source not in ("side face", "table"):
-        return 0.0
-    c = abs(float(end.n @ t))
-    return float(np.sqrt(max(1.0 - c * c, 0.0)) / c) if c > 0.2 else 0.0
-
-
-def end_shear(
-    ends: tuple[End, End],
-    n_a: FloatArray,
-    n_b: FloatArray,
-    t: FloatArray,
-    p0: FloatArray,
-    end_face: tuple[FloatArray, float],
-) -> Shear:
-    """The :class:`Shear` of the ends' planes (the table or another part's face included: what A's side lies on;
-    their mean slope), face A (normal ``n_a``) meeting face B (``n_b``) on the line p0 + s t, A's end face the
-    plane ``end_face`` (n, d)."""
-    w = np.cross(n_a, t)
-    w = w / max(float(np.linalg.norm(w)), 1e-12)
-    if float(w @ n_b) < 0.0:
-        w = -w
-    slopes = [float(e.n @ w) / float(e.n @ t) for e in ends if abs(float(e.n @ t)) > 0.2]
-    c = float(np.mean(slopes)) if slopes else 0.0
-    if abs(c) < _SHEAR_MIN:
-        return Shear(w, 0.0, 0.0)
-    n_e, d_e = end_face
-    h0 = (d_e - float(n_e @ p0)) / float(n_e @ w) if abs(float(n_e @ w)) > 0.3 else 0.0
-    return Shear(w, c, max(h0, 0.0))
 
 
 EDGE_SEARCH_M = 0.003  # how far from the extent's guess an end's edge is searched [m] (as edge_ml's)
@@ -286,21 +212,42 @@ def find_ends(
             # point of the dense cloud within the likelihood's window about it.
             sign = 1.0 if k == 1 else -1.0
             reach = EDGE_WINDOW_M + o.edge_band_m + abs(c) * o.tube_radius_m  # the whole side line's points
-            d = dense(p0 + (extent[k] - reach) * t, p0 + (extent[k] + reach) * t)
-            s_d = along_a(d)
-            g = sign * extent[k]
-            fit = edge_fit(sign * s_d, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
-            if np.isfinite(fit.b) and np.isfinite(fit.se):
+            d, fit = _edge_in(dense, along_a, p0, t, sign, extent[k], reach)
+            if fit.at_limit:
+                # The best edge at the end of the range searched: the extrapolation was that far off (a face thinned
+                # out unevenly). Searched again about the face's last point; at the limit again, no edge was found
+                # (a density that falls off over millimetres, a face seen ever more edge-on, strays far past it):
+                # the extrapolation stands, with its miss.
+                d, fit = _edge_in(dense, along_a, p0, t, sign, (s_a.min(), s_a.max())[k], reach)
+            if fit.ok:
                 # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
                 # 3 spacings; the end's sigma is the likelihood's standard error and what the sample cannot resolve
                 # (edge_bias).
-                inside = np.count_nonzero(np.abs(s_d - extent[k]) < EDGE_WINDOW_M)
+                inside = np.count_nonzero(np.abs(along_a(d) - sign * fit.b) < EDGE_WINDOW_M)
                 density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
                 bias = edge_bias(d.pitch, max(face_a.scale, fit.blur))
                 placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", fit.se, bias)
             else:
                 placed[k] = unconfirmed
     return placed[0], placed[1]
+
+
+def _edge_in(
+    dense: Callable[[FloatArray, FloatArray], Points],
+    along: Callable[[Points], FloatArray],
+    p0: FloatArray,
+    t: FloatArray,
+    sign: float,
+    guess: float,
+    reach: float,
+) -> tuple[Points, EdgeFit]:
+    """The dense points within ``reach`` [m] of ``guess`` (a parameter along p0 + s t [m]) and the edge likelihood's
+    fit of the face's end there, in its window about the guess, searched within :data:`EDGE_SEARCH_M` of it: the
+    upper end for ``sign`` +1, the lower for -1 (the fit's ``b`` is then the parameter's negative). ``along``: the
+    parameters of the face's points among dense points."""
+    d = dense(p0 + (guess - reach) * t, p0 + (guess + reach) * t)
+    s, g = sign * along(d), sign * guess
+    return d, edge_fit(s, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
 
 
 def within_receiving(ends: tuple[End, End], s_b: tuple[float, float], margin: float) -> tuple[End, End]:

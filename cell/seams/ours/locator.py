@@ -12,11 +12,12 @@ from cell.errors import MapError
 from cell.geometry import FloatArray
 from cell.seams._edge import at_cut
 from cell.seams._truth_faces import CLIP_TOL_M, plane_extent
-from cell.seams.ours._ends import across_lever, end_shear, end_slopes, end_source, find_ends, within_receiving
+from cell.seams.ours._ends import end_source, find_ends, within_receiving
 from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outside, tilt
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
+from cell.seams.ours._shear import across_lever, end_shear, end_slopes
 from cell.seams.ours._sides import side_selections
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
 from cell.seams.ours.options import OursOptions

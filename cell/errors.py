@@ -172,3 +172,35 @@ class TimingError(MotionError):
 
 class PlanError(MotionError):
     """A plan violates limits, collides, or cannot be built."""
+
+
+class CalibrationFault(enum.StrEnum):
+    """Why ``cell calibrate`` refuses a camera (docs/calibration.md)."""
+
+    NOT_SEEN = "not_seen"  # the board is seen (enough corners) at too few poses
+    UNREACHABLE = "unreachable"  # too few of the planned board poses are within the arm's reach
+    DEGENERATE = "degenerate"  # the poses lack rotation diversity (a pure translation, one rotation axis)
+    BOARD_SIZE = "board_size"  # the depth image's scale disagrees with the board's stated size
+    NOT_CONVERGED = "not_converged"  # the joint refinement did not reach a consistent solution
+
+
+class CalibrationError(CellError, RuntimeError):
+    """A camera cannot be calibrated: ``code`` says why, ``camera`` names it, ``value`` and ``needed`` give the
+    figure that decided (nan where none applies)."""
+
+    exit_code = 17
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        code: CalibrationFault,
+        camera: str = "",
+        value: float = math.nan,
+        needed: float = math.nan,
+    ) -> None:
+        super().__init__(message)
+        self.code = code
+        self.camera = camera
+        self.value = value
+        self.needed = needed

@@ -27,6 +27,7 @@ for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the
     if str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
 
+import readme_calibration_table as calibration_tables  # noqa: E402  (after the path set-up above)
 import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
 
 from cell.bench import PAPER_TABLE1, markdown_table  # noqa: E402
@@ -244,6 +245,8 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "weldments": lambda results: cell_tables.weldments_table(_load(results, "weldments.json")),
     "weldments-bench": lambda results: markdown_table(_load(results, "weldments-bench.json")),
     "trust": trust,
+    "cell-calibration": lambda results: calibration_tables.calibration_table(_load_object(results, "calibration.json")),
+    "calibration-loop": lambda results: calibration_tables.loop_table(_load_object(results, "calibration_loop.json")),
 }
 
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from cell.cli.common import (
+    CalibrationOpt,
     FormatOpt,
     NoiseOpt,
     app,
@@ -20,6 +21,7 @@ from cell.cli.common import (
     check_display,
     check_method,
     detail,
+    load_scenario,
     parse_format,
     parse_noise,
     parse_rescan_mode,
@@ -54,15 +56,20 @@ SidesOpt = Annotated[
 ]
 
 
-def _load(scenario: str, method: str | None, noise: str | None) -> tuple[Scenario, dict[str, Any]]:
-    """The scenario as given (overrides are the pipeline's to apply) and the provenance of the run."""
+def _load(
+    scenario: str, method: str | None, noise: str | None, calibration: Path | None = None
+) -> tuple[Scenario, dict[str, Any]]:
+    """The scenario as given, with ``--calibration`` applied (other overrides are the pipeline's to apply), and the
+    provenance of the run (which records the calibration file)."""
     from cell import scenario as sc
     from cell.provenance import provenance
 
-    scn = sc.load(scenario)
+    scn = load_scenario(scenario, calibration)
     check_method(method)
     n = parse_noise(noise)
     prov = provenance(scn.with_noise(n) if n else scn, scenario_file=sc.resolve(scenario))
+    if calibration is not None:
+        prov["calibration"] = str(calibration.resolve())
     detail(f"scenario {prov['scenario_file']} (sha256 {prov['scenario_sha256']}), map {prov['map_file']}")
     return scn, prov
 
@@ -72,6 +79,7 @@ def weld(
     scenario: ScenarioArg,
     method: MethodOpt = None,
     noise: NoiseOpt = None,
+    calibration: CalibrationOpt = None,
     json_path: JsonOpt = None,
     program: Annotated[
         Path | None,
@@ -118,7 +126,7 @@ def weld(
         check_file(html, "--html", stdout_ok=False)
         _check_rerun(rerun_path)
         side_opt = parse_sides(sides)
-        scn, prov = _load(scenario, method, noise)
+        scn, prov = _load(scenario, method, noise, calibration)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
         try:
@@ -151,6 +159,7 @@ def rescan_cmd(
     all_seams: Annotated[bool, typer.Option("--all", help="Re-scan every visible seam.")] = False,
     method: MethodOpt = None,
     noise: NoiseOpt = None,
+    calibration: CalibrationOpt = None,
     json_path: JsonOpt = None,
 ) -> None:
     """Only the close-up re-scan: detect, look again at seams with the eye-in-hand camera, compare before/after.
@@ -163,7 +172,7 @@ def rescan_cmd(
 
     with cell_errors():
         check_file(json_path, "--json")
-        scn, prov = _load(scenario, method, noise)
+        scn, prov = _load(scenario, method, noise, calibration)
         scn = scn.with_noise(n) if (n := parse_noise(noise)) else scn
         ids = [s.strip() for s in seams.split(",") if s.strip()] if seams else None
         weldmap = pipeline.read_weldmap(scn)
@@ -199,6 +208,7 @@ def preview(
     out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures and the report.")] = Path("preview"),
     method: MethodOpt = None,
     noise: NoiseOpt = None,
+    calibration: CalibrationOpt = None,
     fmt: FormatOpt = "table",
     rerun_path: RerunOpt = None,
     sides: SidesOpt = "all",
@@ -218,7 +228,7 @@ def preview(
         check_folder(out_dir, "--out")
         _check_rerun(rerun_path)
         side_opt = parse_sides(sides)
-        scn, prov = _load(scenario, method, noise)
+        scn, prov = _load(scenario, method, noise, calibration)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
         json_path = out_dir / "report.json"

@@ -13,7 +13,18 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from cell.cli.common import NoiseOpt, app, cell_errors, detail, err, log, parse_noise, say
+from cell.cli.common import (
+    CalibrationOpt,
+    NoiseOpt,
+    app,
+    cell_errors,
+    detail,
+    err,
+    load_scenario,
+    log,
+    parse_noise,
+    say,
+)
 from cell.cli.outputs import check_folder
 from cell.cli.placement import placement
 from cell.errors import CellError, OutputError, UsageError
@@ -40,6 +51,7 @@ def capture(
         Path | None, typer.Option("--from-bag", help="Convert this ROS 2 bag instead of simulating SCENARIO.")
     ] = None,
     noise: NoiseOpt = None,
+    calibration: CalibrationOpt = None,
     depth_topic: Annotated[
         list[str] | None,
         typer.Option("--depth-topic", help="A bag's depth image topic to take (repeat; default: every one, by name)."),
@@ -66,6 +78,8 @@ def capture(
             raise UsageError("give SCENARIO or --from-bag BAG (one of them); valid: cell capture fence1 --out DIR")
         if from_bag is not None and noise is not None:
             raise UsageError("--noise simulates a sensor; a bag holds what its cameras saw; valid: leave it out")
+        if from_bag is not None and calibration is not None:
+            raise UsageError("--calibration goes with SCENARIO; a bag's tf tree holds its cameras' poses")
         bag_only = {"--depth-topic": depth_topic, "--base-frame": base_frame, "--time": at_time}
         if from_bag is None and (given := [k for k, v in bag_only.items() if v is not None]):
             raise UsageError(f"{', '.join(given)} only apply to --from-bag BAG; valid: leave them out for SCENARIO")
@@ -78,7 +92,7 @@ def capture(
             folder = _from_bag(from_bag, out_dir, max_tf_gap_s=max_tf_gap, **options)
         else:
             assert scenario is not None
-            folder = _simulated(scenario, out_dir, parse_noise(noise))
+            folder = _simulated(scenario, out_dir, parse_noise(noise), calibration)
         say(f"capture written to {folder} ({time.perf_counter() - t0:.1f} s)")
 
 
@@ -88,13 +102,15 @@ def _from_bag(bag: Path, out_dir: Path, **options: Any) -> Path:
     return capture_from_bag(bag, out_dir, progress=say, **options)
 
 
-def _simulated(name: str, out_dir: Path, noise: Any) -> Path:
+def _simulated(name: str, out_dir: Path, noise: Any, calibration: Path | None = None) -> Path:
     from cell import scenario as sc
     from cell.provenance import provenance
 
-    scn = sc.load(name)
+    scn = load_scenario(name, calibration)
     scn = scn.with_noise(noise) if noise else scn
     prov = provenance(scn, scenario_file=sc.resolve(name))
+    if calibration is not None:  # the capture records which calibration its poses came from
+        prov["calibration"] = str(calibration.resolve())
     detail(f"scenario {prov['scenario_file']} (sha256 {prov['scenario_sha256']}), map {prov['map_file']}")
     return write_simulated(scn, out_dir, source=name, provenance=prov)
 

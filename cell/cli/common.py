@@ -14,13 +14,16 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import typer
 from rich.console import Console
 from rich.markup import escape
 
 from cell.errors import CellError, OutputError, UsageError
+
+if TYPE_CHECKING:
+    from cell.scenario import Scenario
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
 app = typer.Typer(
@@ -38,6 +41,14 @@ log = logging.getLogger("cell")
 log.addHandler(logging.NullHandler())  # the console lines are printed here; only --log-file adds a handler
 
 NoiseOpt = Annotated[str | None, typer.Option("--noise", help="Override the scenario's noise model: none | realistic.")]
+CalibrationOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--calibration",
+        metavar="CAL.yaml",
+        help="Camera poses measured by `cell calibrate`, applied over the scenario's (and their stated residual).",
+    ),
+]
 FormatOpt = Annotated[str, typer.Option("--format", help="How the result table is printed: table | json | csv.")]
 TableFormat = Literal["table", "json", "csv"]
 
@@ -151,6 +162,22 @@ def cell_errors() -> Iterator[None]:
 
 def progress() -> Callable[[str], None]:
     return say
+
+
+def load_scenario(name: str, calibration: Path | None = None) -> Scenario:
+    """The scenario ``name`` (a shipped name or a YAML path), with ``--calibration``'s measured camera poses over
+    its own when given."""
+    from cell import scenario as sc
+
+    scn = sc.load(name)
+    if calibration is None:
+        return scn
+    from cell.calibrate.file import apply, flagged, read
+
+    doc = read(calibration)
+    for camera, what in flagged(doc).items():  # before any seam is located: the camera's model is in doubt
+        warn(f"--calibration: camera {camera}'s calibration images disagree with its stated {', '.join(what)}")
+    return apply(scn, doc, f"--calibration {str(calibration)!r}")
 
 
 def parse_noise(value: str | None) -> Literal["none", "realistic"] | None:

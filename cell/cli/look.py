@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from cell.cli.common import (
+    CalibrationOpt,
     FormatOpt,
     NoiseOpt,
     app,
@@ -17,6 +18,7 @@ from cell.cli.common import (
     check_method,
     detail,
     fail_line,
+    load_scenario,
     map_app,
     out,
     parse_format,
@@ -99,6 +101,7 @@ def detect(
     ] = None,
     place: PlaceOpt = None,
     place_rpy: PlaceRpyOpt = None,
+    calibration: CalibrationOpt = None,
 ) -> None:
     """Capture the cell, splice the clouds, align the map and locate every seam; report errors against truth.
 
@@ -122,7 +125,9 @@ def detect(
         elif scenario is None or map_path is not None or place is not None or place_rpy is not None:
             raise UsageError("give SCENARIO, or --capture DIR (which --map and --place go with)")
         else:
-            scn, scenario_file = sc.load(scenario), sc.resolve(scenario)
+            scn, scenario_file = load_scenario(scenario, calibration), sc.resolve(scenario)
+        if calibration is not None and capture_dir is not None:
+            raise UsageError("--calibration goes with SCENARIO; a capture folder records the poses it was taken with")
         check_method(method)
         scn = scn.with_noise(n) if (n := parse_noise(noise)) else scn
         prov = provenance(scn, scenario_file=scenario_file)

@@ -85,6 +85,8 @@ class NoiseSpec(Model):
     edge_flying_fraction: Annotated[float, Field(ge=0.0, le=1.0)] = 0.5  # of those, how many come back mixed
     edge_jump_m: Pos = 0.02  # depth step that counts as a discontinuity [m]
     grazing_dropout_deg: Annotated[float, Field(gt=0.0, le=90.0)] = 80.0  # incidence beyond which pixels drop
+    colour_sigma: NonNeg = 2.0  # the colour image's pixel noise, RMS [grey levels of 255]
+    colour_blur_px: NonNeg = 0.7  # the lens' blur of the colour image, a Gaussian's sigma [px]
 
 
 class ExtrinsicErrorSpec(Model):
@@ -123,6 +125,10 @@ class CameraSpec(Model):
     noise: NoiseSpec = NoiseSpec()
     extrinsic_error: ExtrinsicErrorSpec = ExtrinsicErrorSpec()
     calibration: CalibrationSpec = CalibrationSpec()
+    # The pose a calibration measured (``cell calibrate``, applied with ``--calibration``): a fixed camera's X_RC
+    # in the robot base frame, the arm camera's X_FC in the flange frame tool0. Given, the cell is told this pose
+    # (a simulation renders from eye_m/target_m still, and its extrinsic_error no longer applies).
+    measured: PoseSpec | None = None
 
     @model_validator(mode="after")
     def _check(self) -> CameraSpec:

@@ -11,6 +11,7 @@ from pydantic import Field, field_validator, model_validator
 
 from cell.geometry import FloatArray
 from cell.scenario.base import Model
+from cell.scenario.calibration_specs import CalibrationRunSpec
 from cell.scenario.cell_specs import CameraSpec, Deviation, MapSpec, RobotSpec, TableSpec
 from cell.scenario.locator_specs import LocatorSpec, OursLocatorSpec
 from cell.scenario.procedure_specs import ProcedureSpec, default_procedure
@@ -50,6 +51,7 @@ class Scenario(Model):
     export: ExportSpec = ExportSpec()
     simulation: SimulationSpec = SimulationSpec()
     flip: TurnoverSpec = TurnoverSpec()  # turning the part over for its second side (docs/flip.md)
+    calibration: CalibrationRunSpec = CalibrationRunSpec()  # the board and poses of cell calibrate
     # Set by the loader: the folder the file lives in (paths inside are relative to it).
     base_dir: str = Field(default=".", exclude=True)
 

@@ -237,6 +237,8 @@ class SimulationSpec(Model):
     tacks_present: TacksPresentSpec | None = None  # tack welds at both ends of every seam; null: none
     bow: tuple[BowSpec, ...] = ()  # bowed parts: one {part, mm} or a list of them; empty: every part straight
     specular_dropout: SpecularDropoutSpec | None = None  # shiny steel facing the cameras drops out; null: off
+    # The calibration board as printed against its stated size (cell calibrate): 1.05 is a board 5 % larger
+    board_scale: Annotated[float, Field(ge=0.5, le=2.0)] = 1.0
 
     @field_validator("bow", mode="before")
     @classmethod

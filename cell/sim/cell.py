@@ -15,10 +15,11 @@ from scipy.spatial.transform import Rotation
 from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
+from cell.sim.board import Size2, add_board, colour_noise, place_body
 from cell.sim.bodies import add_box, add_part
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
-from cell.sim.noise import apply_noise, perturb_pose, specular_dropout
+from cell.sim.noise import apply_noise, believed_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
@@ -36,6 +37,7 @@ TACK_PREFIX = "tack:"  # tack welds laid before the cell sees the part (``simula
 _TACK_RGBA = (0.3, 0.3, 0.32, 1.0)
 DEFAULT_BEAD = BeadStyle()
 EYE_IN_HAND_LINK = "camera_optical"  # the arm's optical frame of the eye-in-hand camera (z forward, y down)
+FLANGE_LINK = "tool0"  # the arm's flange frame (a hand-eye calibration's X_FC is measured from it)
 
 
 class SimCell:
@@ -134,7 +136,13 @@ class SimCell:
     def render_depth(self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float) -> FloatArray:
         """Noise-free depth (H, W) [m] along the optical axis seen from the optical frame at X_WC (4, 4) in W;
         0 where nothing lies between the near and far planes."""
-        _, _, _, buffer, _ = self.client.getCameraImage(
+        return self.render(X_WC, intrinsics, near_m, far_m)[1]
+
+    def render(
+        self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float
+    ) -> tuple[npt.NDArray[np.uint8], FloatArray]:
+        """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (as :meth:`render_depth`) from X_WC (4, 4)."""
+        _, _, rgba, buffer, _ = self.client.getCameraImage(
             intrinsics.width,
             intrinsics.height,
             viewMatrix=gl_view_matrix(X_WC),
@@ -143,7 +151,8 @@ class SimCell:
             flags=pybullet.ER_NO_SEGMENTATION_MASK,
         )
         d = np.asarray(buffer, dtype=float).reshape(intrinsics.height, intrinsics.width)
-        return linearise_depth(d, near_m, far_m)
+        rgb = np.asarray(rgba, dtype=np.uint8).reshape(intrinsics.height, intrinsics.width, 4)[..., :3]
+        return rgb, linearise_depth(d, near_m, far_m)
 
     def capture(self, camera: str, X_WC: FloatArray | None = None) -> DepthImage:
         """One depth image from ``camera``.
@@ -155,6 +164,16 @@ class SimCell:
         stream starts from ``scenario.rng(camera)`` and continues across captures (a second capture has new
         noise).
         """
+        return self._capture(camera, X_WC, colour=False)[0]
+
+    def capture_rgbd(self, camera: str, X_WC: FloatArray | None = None) -> tuple[DepthImage, npt.NDArray[np.uint8]]:
+        """One depth image as :meth:`capture` and the colour image (H, W, 3) uint8 taken with it (the same
+        intrinsics and pose; with realistic noise the lens' blur and pixel noise, a stream of its own)."""
+        return self._capture(camera, X_WC, colour=True)
+
+    def _capture(
+        self, camera: str, X_WC: FloatArray | None, *, colour: bool
+    ) -> tuple[DepthImage, npt.NDArray[np.uint8]]:
         spec = self.camera_spec(camera)
         if X_WC is None and spec.mount == "eye_in_hand" and self._robot is not None:
             X_WC = self._robot.link_pose(EYE_IN_HAND_LINK)  # the camera rides on the arm
@@ -162,8 +181,11 @@ class SimCell:
         if X_true.shape != (4, 4):
             raise ValueError(f"X_WC must be (4, 4), got {X_true.shape}")
         intr = self.intrinsics(camera)
-        depth = self.render_depth(X_true, intr, spec.near_m, spec.far_m)
+        rgb, depth = self.render(X_true, intr, spec.near_m, spec.far_m)
         if self.scenario.noise == "realistic":
+            if colour:  # its own stream: the depth noise draws are the same with colour taken or not
+                crng = self._noise_rngs.setdefault(camera + "/colour", self.scenario.rng(camera + "/colour"))
+                rgb = colour_noise(rgb, spec.noise.colour_blur_px, spec.noise.colour_sigma, crng)
             rng = self._noise_rngs.setdefault(camera, self.scenario.rng(camera))
             noisy = apply_noise(depth, intr, spec.noise, rng)
             shiny = self.scenario.simulation.specular_dropout
@@ -176,8 +198,17 @@ class SimCell:
         if fault is not None:  # a broken camera (fault scenarios); its own stream, so noise draws are unchanged
             rng = self._noise_rngs.setdefault(camera + "/fault", self.scenario.rng(camera + "/fault"))
             noisy = corrupt_depth(noisy, fault, spec.near_m, spec.far_m, rng)
-        X_believed = perturb_pose(X_true, spec.extrinsic_error, self.scenario.rng(camera + "/extrinsics"))
-        return DepthImage(camera=camera, depth=noisy, intrinsics=intr, X_WC=X_believed, mount=spec.mount)
+        X_WF = self._robot.link_pose(FLANGE_LINK) if self._robot is not None else None  # the measured X_FC's base
+        X_told = believed_pose(spec, X_true, self.scenario.X_WR, X_WF, self.scenario.rng(camera + "/extrinsics"))
+        return DepthImage(camera=camera, depth=noisy, intrinsics=intr, X_WC=X_told, mount=spec.mount), rgb
+
+    def add_board(self, name: str, image: npt.ArrayLike, face_m: Size2, origin_m: Size2) -> None:
+        """A calibration board (:func:`cell.sim.board.add_board`) as body ``name``, at W's origin until placed."""
+        self._bodies[name] = add_board(self.client, image, face_m, origin_m)
+
+    def place(self, name: str, X_W: FloatArray) -> None:
+        """Put body ``name`` (a board) at X_W (4, 4) in W."""
+        place_body(self.client, self.body_id(name), X_W)
 
     def capture_all(self) -> dict[str, DepthImage]:
         """One capture from every camera of the scenario, by camera name: fixed cameras at their scenario pose,

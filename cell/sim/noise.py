@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, axis_angle_to_matrix, make_pose
-from cell.scenario import ExtrinsicErrorSpec, NoiseSpec, SpecularDropoutSpec
+from cell.scenario import CameraSpec, ExtrinsicErrorSpec, NoiseSpec, SpecularDropoutSpec
 from cell.types import CameraIntrinsics
 
 # Kinect v1 axial noise (Nguyen, Izadi, Lovell, "Modeling Kinect sensor noise for improved 3D reconstruction
@@ -202,3 +202,16 @@ def perturb_pose(X_WC: FloatArray, spec: ExtrinsicErrorSpec, rng: np.random.Gene
     t_C = spec.translation_mm / 1000.0 * direction / np.linalg.norm(direction)  # [m]
     R_CC = axis_angle_to_matrix(axis, np.radians(spec.rotation_deg))
     return np.asarray(X @ make_pose(R_CC, t_C))
+
+
+def believed_pose(
+    spec: CameraSpec, X_WC: FloatArray, X_WR: FloatArray, X_WF: FloatArray | None, rng: np.random.Generator
+) -> FloatArray:
+    """The pose the cell is told of a camera truly at X_WC (4, 4): its measured one when the scenario has it
+    (``measured``: X_RC, or X_FC on the arm's flange, X_WF where the arm is now), else the true pose with its
+    calibration error (:func:`perturb_pose`)."""
+    if spec.measured is None:
+        return perturb_pose(X_WC, spec.extrinsic_error, rng)
+    if spec.mount == "eye_in_hand" and X_WF is not None:
+        return np.asarray(X_WF @ spec.measured.X)
+    return np.asarray(X_WR @ spec.measured.X)

@@ -27,10 +27,10 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from cycle_bound import Breakdown, best_tour, breakdown, nodes, with_track  # noqa: E402
+from cycle_bound import Breakdown, best_tour, breakdown, nodes, with_track
 
-from cell import scenario as sc  # noqa: E402
-from cell.export.report import write_json  # noqa: E402
+from cell import scenario as sc
+from cell.export.report import write_json
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SCENARIOS = ("fence1", "fence2", "ladder", "brace", "bracket", "fence1-wps")

@@ -137,7 +137,9 @@ def nodes(plan: WeldPlan, track: LinearTrack | None, limits: JointLimits) -> Nod
     ends = np.array([_state(welds[i][-1], -1, track) for i in ids])
     inner = np.array(
         [
-            sum(ptp_duration(_state(a, -1, track), _state(b, 0, track), limits) for a, b in itertools.pairwise(welds[i]))
+            sum(
+                ptp_duration(_state(a, -1, track), _state(b, 0, track), limits) for a, b in itertools.pairwise(welds[i])
+            )
             for i in ids
         ]
     )

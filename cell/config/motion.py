@@ -59,8 +59,11 @@ class PlanOptions:
     min_manipulability: float = 0.01  # [m^3] below this a Cartesian move counts as singular
     weld_accel: float = 0.5  # [m/s^2] path acceleration of the weld ramps
     weld_jerk: float = 5.0  # [m/s^3]
-    line_accel: float = 2.0  # [m/s^2] approach/depart
-    line_jerk: float = 20.0  # [m/s^3]
+    line_accel: float = 5.0  # [m/s^2] approach/depart (the joint limits scale it down where they bind)
+    line_jerk: float = 100.0  # [m/s^3]
+    # Arc-off motions approximated at the points between them (cell/planning/blend.py): at most this fraction of
+    # the shorter of two neighbouring motions runs together [0, 0.5]; 0: an exact stop at every point.
+    blend: float = 0.5
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
     # A seam ending on the table where the torch meets the table is welded from at most this far above it [m]
     # (never more than a third of the seam); 0: such a seam is refused.

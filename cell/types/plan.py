@@ -59,6 +59,13 @@ class Segment:
     arc_on: bool = False
     procedure: WeldProcedure | None = None
     pass_index: int = 0
+    zone_m: float = 0.0
+    q_target: FloatArray | None = None
+
+    @property
+    def q_end(self) -> FloatArray:
+        """(dof,) [rad] the programmed end: ``q_target`` when approximated, else where the trajectory ends."""
+        return self.q_target if self.q_target is not None else self.trajectory.q[-1]
 
     @property
     def t1(self) -> float:

@@ -244,6 +244,10 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "weldments": lambda results: cell_tables.weldments_table(_load(results, "weldments.json")),
     "weldments-bench": lambda results: markdown_table(_load(results, "weldments-bench.json")),
     "trust": trust,
+    "cycle": lambda results: cell_tables.cycle_table(
+        _load_object(results, "cycle.json"),
+        _load_object(results, "cycle_before.json") if (results / "cycle_before.json").is_file() else None,
+    ),
 }
 
 

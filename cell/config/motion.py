@@ -141,3 +141,14 @@ class ViewOptions:
             raise ValueError(f"max_incidence_deg must be in (0, 90), got {self.max_incidence_deg}")
         if not 0.0 < self.fallback_max_incidence_deg < 90.0:
             raise ValueError(f"fallback_max_incidence_deg must be in (0, 90), got {self.fallback_max_incidence_deg}")
+
+
+@dataclass(frozen=True)
+class PositionerFigures:
+    """A tilt-rotate positioner's turning axis as the report's estimate assumes it (nominal figures of a 400 kg
+    class unit; the positioner itself is not modelled): speed [rad/s], acceleration [rad/s^2], jerk [rad/s^3]. Only
+    the axis's motion is counted: the part stays clamped, nobody confirms."""
+
+    speed: float = math.radians(90.0)
+    accel: float = math.radians(180.0)
+    jerk: float = math.radians(900.0)

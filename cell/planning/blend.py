@@ -143,7 +143,7 @@ def _blend_run(
         end = out_of.exit_s if out_of is not None else tr.duration
         parts = [_piece(into.link, 0.0, into.link.duration)] if into is not None else []
         parts.append(_piece(tr, start, end))
-        new = replace(seg, trajectory=_joined(parts))
+        new = replace(seg, trajectory=_joined(parts), link_s=into.link.duration if into is not None else 0.0)
         if out_of is not None:
             target = np.asarray(tr.q[-1], dtype=float)
             zone = float(np.linalg.norm(tcp(new.trajectory.q[-1]) - tcp(target)))

@@ -339,6 +339,6 @@ def cycle_table(after: Row, before: Row | None) -> str:
         lines.append(
             f"| {r['scenario']} | {r['seams']} | {was(r, 'cycle_time_s')} | {r['arc_time_s']:.1f} "
             f"| {was(r, 'air_time_s')} | {r['approach_s'] + r['depart_s']:.1f} | {r['transfer_s']:.1f} "
-            f"| {r['home_s']:.1f} | {bound} | {was(r, 'air_over_bound', '.2f')} | {was(r, 'tcp_max_mm', '.2f')} |"
+            f"| {r['home_s']:.1f} | {bound} | {was(r, 'air_over_bound', '.2f')} | {was(r, 'tcp_max_mm', '.3f')} |"
         )
     return "\n".join(lines) + "\n"

@@ -9,7 +9,6 @@ from typing import Any
 
 from cell.export.report import _error, _pt, _r, weld_report
 from cell.pipeline.turnover_run import TurnoverRun
-from cell.planning.positioner import positioner_turn_s
 from cell.types import SeamStatus
 
 
@@ -72,7 +71,7 @@ def _turnover_entry(run: TurnoverRun) -> dict[str, Any] | None:
     if p is None:
         return None
     res = run.result
-    turn_s = positioner_turn_s(p.angle_rad)
+    turn_s = run.positioner_turn_s
     return {
         "made": run.side_b is not None,
         "allowed": p.allowed,

@@ -316,3 +316,29 @@ def planning_table(data: Row) -> str:
             f"| {r['cpu_s_per_planned_seam']:.2f} | {r['reach_precheck_us_per_seam']:.0f} | {weld} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def cycle_table(after: Row, before: Row | None) -> str:
+    """Cycle time against its bound per scenario (``cycle.json``, and ``cycle_before.json`` for the planner before
+    the cuts): both sides' plans, robot time with the arc on and off, where the air time goes, its bound and the
+    ratio, the worst executed TCP max."""
+    old = {r["scenario"]: r for r in before["rows"]} if before else {}
+    lines = [
+        "| scenario | seams | cycle [s] | arc [s] | air [s] | approach + depart [s] | transfers [s] | home legs [s] "
+        "| air bound [s] | air / bound | TCP max [mm] |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+
+    def was(r: Row, key: str, fmt: str = ".1f") -> str:
+        o = old.get(r["scenario"])
+        now = format(r[key], fmt) if r.get(key) is not None else "-"
+        return f"{format(o[key], fmt)} -> {now}" if o and o.get(key) is not None else now
+
+    for r in after["rows"]:
+        bound = f"{r['air_bound_s']:.1f}" + ("" if r["bound_exact"] else f" (>= {r['air_lower_s']:.1f})")
+        lines.append(
+            f"| {r['scenario']} | {r['seams']} | {was(r, 'cycle_time_s')} | {r['arc_time_s']:.1f} "
+            f"| {was(r, 'air_time_s')} | {r['approach_s'] + r['depart_s']:.1f} | {r['transfer_s']:.1f} "
+            f"| {r['home_s']:.1f} | {bound} | {was(r, 'air_over_bound', '.2f')} | {was(r, 'tcp_max_mm', '.3f')} |"
+        )
+    return "\n".join(lines) + "\n"

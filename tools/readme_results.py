@@ -247,6 +247,10 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "trust": trust,
     "cell-calibration": lambda results: calibration_tables.calibration_table(_load_object(results, "calibration.json")),
     "calibration-loop": lambda results: calibration_tables.loop_table(_load_object(results, "calibration_loop.json")),
+    "cycle": lambda results: cell_tables.cycle_table(
+        _load_object(results, "cycle.json"),
+        _load_object(results, "cycle_before.json") if (results / "cycle_before.json").is_file() else None,
+    ),
 }
 
 

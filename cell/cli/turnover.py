@@ -79,6 +79,10 @@ def sides_line(rep: Mapping[str, Any]) -> str:
         parts.append(f"no turn: {f['reason']}")
     if f is not None and f["made"]:
         parts.append(f"job {rep['job_time_s']:.1f} s with the operator's turn")
+        if f.get("positioner_saves_s") is not None:
+            parts.append(
+                f"a positioner would turn it in {f['positioner_turn_s']:.1f} s: {f['positioner_saves_s']:.1f} s less"
+            )
     return " · ".join(parts)
 
 

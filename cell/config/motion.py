@@ -59,8 +59,11 @@ class PlanOptions:
     min_manipulability: float = 0.01  # [m^3] below this a Cartesian move counts as singular
     weld_accel: float = 0.5  # [m/s^2] path acceleration of the weld ramps
     weld_jerk: float = 5.0  # [m/s^3]
-    line_accel: float = 2.0  # [m/s^2] approach/depart
-    line_jerk: float = 20.0  # [m/s^3]
+    line_accel: float = 5.0  # [m/s^2] approach/depart (the joint limits scale it down where they bind)
+    line_jerk: float = 100.0  # [m/s^3]
+    # Arc-off motions approximated at the points between them (cell/planning/blend.py): at most this fraction of
+    # the shorter of two neighbouring motions runs together [0, 0.5]; 0: an exact stop at every point.
+    blend: float = 0.5
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
     # A seam ending on the table where the torch meets the table is welded from at most this far above it [m]
     # (never more than a third of the seam); 0: such a seam is refused.
@@ -138,3 +141,14 @@ class ViewOptions:
             raise ValueError(f"max_incidence_deg must be in (0, 90), got {self.max_incidence_deg}")
         if not 0.0 < self.fallback_max_incidence_deg < 90.0:
             raise ValueError(f"fallback_max_incidence_deg must be in (0, 90), got {self.fallback_max_incidence_deg}")
+
+
+@dataclass(frozen=True)
+class PositionerFigures:
+    """A tilt-rotate positioner's turning axis as the report's estimate assumes it (nominal figures of a 400 kg
+    class unit; the positioner itself is not modelled): speed [rad/s], acceleration [rad/s^2], jerk [rad/s^3]. Only
+    the axis's motion is counted: the part stays clamped, nobody confirms."""
+
+    speed: float = math.radians(90.0)
+    accel: float = math.radians(180.0)
+    jerk: float = math.radians(900.0)

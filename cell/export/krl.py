@@ -1,6 +1,6 @@
-"""KUKA KRL export of a welding plan: ``NAME.src`` and ``NAME.dat``, every point an exact stop, the arc by KUKA.ArcTech
-inline forms or plain signals. What the program holds, in order: docs/programs.md; the KRL facts it relies on:
-docs/reference.md section 5."""
+"""KUKA KRL export of a welding plan: ``NAME.src`` and ``NAME.dat``, every point an exact stop but those the plan
+blends (``C_DIS``, the plan's zone), the arc by KUKA.ArcTech inline forms or plain signals. What the program holds,
+in order: docs/programs.md; the KRL facts it relies on: docs/reference.md section 5."""
 
 from __future__ import annotations
 
@@ -42,12 +42,24 @@ class _Program:
         self.geo = ArmGeometry.of(job.robot)
         self.X_BR = invert(job.X_RB)
         self.last_vel = -1.0
+        self.last_apo = -1.0
+
+    def approx(self, seg: Segment) -> str:
+        """The motion's approximation: `` C_DIS`` (after setting ``$APO.CDIS`` to its zone in mm) when the plan
+        blends it into the next motion, else "" (an exact stop)."""
+        if seg.zone_m <= 0.0:
+            return ""
+        mm = round(seg.zone_m * 1000.0, 1)
+        if abs(mm - self.last_apo) > 1e-9:
+            self.src.append(f"$APO.CDIS = {mm:.1f} ; [mm] blended into the next motion this far from its end")
+            self.last_apo = mm
+        return " C_DIS"
 
     def point(self, seg: Segment) -> str:
         """Declare the segment's end as the next point (E6POS in the base for a LIN, E6AXIS for a PTP); its name."""
         self.n += 1
         name = f"XP{self.n}"
-        q = seg.trajectory.q[-1]
+        q = seg.q_end
         if seg.kind == "move":
             self.dat.append(f"DECL E6AXIS {name}={e6axis(q, seg.e1_end)}")
         else:
@@ -60,7 +72,8 @@ class _Program:
         if abs(seg.speed - self.last_vel) > 1e-9:
             self.src.append(f"$VEL.CP = {seg.speed:.4f} ; [m/s] {seg.speed * 1000:.1f} mm/s")
             self.last_vel = seg.speed
-        self.src.append(f"LIN {self.point(seg)} ; {note}")
+        c_dis = self.approx(seg)
+        self.src.append(f"LIN {self.point(seg)}{c_dis} ; {note}")
 
     def arc_fold(self, kind: str, seg: Segment, data_of: Segment) -> None:
         """One ArcTech inline form: ``kind`` on | swi | off, the motion to the end of ``seg``, the weld data of
@@ -212,7 +225,8 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
             e1 = seg.trajectory.e1
             moves = e1 is not None and float(np.ptp(e1)) > 0.0  # the carriage moves (the arm at home)
             track = f" (track to E1 = {seg.e1_end * 1000:.1f} mm)" if moves else ""
-            b.src.append(f"PTP {b.point(seg)} ; transfer{track}")
+            c_dis = b.approx(seg)
+            b.src.append(f"PTP {b.point(seg)}{c_dis} ; transfer{track}")
         else:
             b.plain_lin(seg, "approach, exact stop at the weld start" if arc_next else seg.kind)
         if arc_next and nxt is not None:

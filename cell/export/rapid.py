@@ -99,6 +99,7 @@ def rapid_text(job: ProgramJob) -> str:
     ]
     procs: dict[tuple[str, int], int] = {}
     speeds: dict[int, str] = {}
+    zones: set[str] = set()
     body = ["  PROC main()", "    ConfJ \\On;", "    ConfL \\On;", "    MoveAbsJ jHome, v1000, fine, tWeld;"]
     segs = plan.segments
     n, current = 0, ""
@@ -109,6 +110,18 @@ def rapid_text(job: ProgramJob) -> str:
             speeds[mm_s] = f"vL{mm_s}"
             decl.append(f"  CONST speeddata vL{mm_s} := [{mm_s},500,5000,1000];")
         return speeds[mm_s]
+
+    def zone(seg: Segment) -> str:
+        """fine, or the plan's zone (the TCP's distance from the point where it blends into the next motion)."""
+        if seg.zone_m <= 0.0:
+            return "fine"
+        r = round(seg.zone_m * 1000.0, 1)
+        name = f"zB{r:g}".replace(".", "_")
+        if name not in zones:
+            zones.add(name)
+            big, ori = _n(1.5 * r, 1), _n(0.15 * r, 2)
+            decl.append(f"  CONST zonedata {name} := [FALSE,{_n(r, 1)},{big},{big},{ori},{big},{ori}];")
+        return name
 
     def proc_index(seg: Segment) -> int:
         p = procedure_of(seg)
@@ -123,7 +136,7 @@ def rapid_text(job: ProgramJob) -> str:
         if seg.seam_id and seg.seam_id != current:
             current = seg.seam_id
             body.append(f"    ! seam {current}")
-        q = seg.trajectory.q[-1]
+        q = seg.q_end
         if seg.kind == "move" and nxt is None and np.allclose(q, plan.q_home, atol=1e-9):
             body.append("    MoveAbsJ jHome, v1000, fine, tWeld;")
             continue
@@ -142,9 +155,9 @@ def rapid_text(job: ProgramJob) -> str:
             i = proc_index(nxt)
             body.append(f"    ArcLStart p{n}, {speed(seg)}, sm{i}, wd{i} \\Weave:=wv{i}, fine, {wobj};")
         elif seg.kind == "move":
-            body.append(f"    MoveJ p{n}, v1000, fine, {wobj};")
+            body.append(f"    MoveJ p{n}, v1000, {zone(seg)}, {wobj};")
         else:
-            body.append(f"    MoveL p{n}, {speed(seg)}, fine, {wobj};")
+            body.append(f"    MoveL p{n}, {speed(seg)}, {zone(seg)}, {wobj};")
     body += ["  ENDPROC", "ENDMODULE", ""]
     return "\n".join([*head, *decl, "", *body])
 

@@ -71,6 +71,7 @@ def _turnover_entry(run: TurnoverRun) -> dict[str, Any] | None:
     if p is None:
         return None
     res = run.result
+    turn_s = run.positioner_turn_s
     return {
         "made": run.side_b is not None,
         "allowed": p.allowed,
@@ -87,6 +88,9 @@ def _turnover_entry(run: TurnoverRun) -> dict[str, Any] | None:
         "placement_rotation_deg": _r(math.degrees(res.rotation_rad), 3) if res is not None else None,
         "fitness": _r(res.fitness, 4) if res is not None else None,
         "operator_s": _r(run.operator_s, 3),
+        # what a tilt-rotate positioner would take for the same turn, and what it would save of the job
+        "positioner_turn_s": _r(turn_s, 3),
+        "positioner_saves_s": _r(run.operator_s - turn_s, 3) if run.side_b is not None else None,
         "tacks_s": _r(run.tacks_s, 3),
         "tacks": [
             {

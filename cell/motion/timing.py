@@ -124,14 +124,16 @@ def _line_solve(q: FloatArray, limits: JointLimits) -> ruckig.Trajectory | None:
     return _solve(inp, "point-to-point move")
 
 
-def _ruckig_solve(q: FloatArray, v: FloatArray, limits: JointLimits) -> ruckig.Trajectory:
-    """A move with boundary velocities: one Ruckig solve over all joints within all limits (phase-synchronised
-    when the start and goal states allow it, else time-synchronised)."""
+def _ruckig_solve(
+    q: FloatArray, v: FloatArray, limits: JointLimits, acc: FloatArray | None = None
+) -> ruckig.Trajectory:
+    """A move with boundary velocities (and accelerations ``acc`` (2, dof), default 0): one Ruckig solve over all
+    joints within all limits (phase-synchronised when the start and goal states allow it, else time-synchronised)."""
     dof = limits.dof
     inp = ruckig.InputParameter(dof)
-    zeros = [0.0] * dof
-    inp.current_position, inp.current_velocity, inp.current_acceleration = q[0].tolist(), v[0].tolist(), zeros
-    inp.target_position, inp.target_velocity, inp.target_acceleration = q[1].tolist(), v[1].tolist(), zeros
+    a = np.zeros((2, dof)) if acc is None else acc
+    inp.current_position, inp.current_velocity, inp.current_acceleration = q[0].tolist(), v[0].tolist(), a[0].tolist()
+    inp.target_position, inp.target_velocity, inp.target_acceleration = q[1].tolist(), v[1].tolist(), a[1].tolist()
     inp.max_velocity = limits.v_max.tolist()
     inp.max_acceleration = limits.a_max.tolist()
     inp.max_jerk = limits.j_max.tolist()
@@ -206,6 +208,29 @@ def ptp_duration(
         line = _line_solve(q, limits)
         return 0.0 if line is None else float(line.duration)
     return float(_ruckig_solve(q, v, limits).duration)
+
+
+def connect(
+    start: tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike],
+    goal: tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike],
+    limits: JointLimits,
+    *,
+    dt: float = DEFAULT_DT,
+) -> Trajectory:
+    """The time-optimal jerk-limited move from one moving state (q, qd, qdd) (dof,) each to another, all joints
+    arriving together (a controller's blend between two motions). Raises TimingError when a state is outside
+    the limits, Ruckig finds no trajectory or the move would leave the position limits."""
+    q, v = _checked_states(start[0], goal[0], limits, start[1], goal[1])
+    acc = np.array([_vec("a0", start[2], limits.dof), _vec("a1", goal[2], limits.dof)])
+    if (np.abs(acc) > limits.a_max * (1 + 1e-9)).any():
+        raise TimingError("blend start or goal acceleration exceeds the joint acceleration limits")
+    traj = _ruckig_solve(q, v, limits, acc)
+    times = _sample_times(float(traj.duration), dt)
+    qs, qds, qdds = _at_times(traj, times)
+    if np.max(np.abs(qs[-1] - q[1])) > _END_TOL or np.max(np.abs(qds[-1] - v[1])) > _END_TOL:
+        raise TimingError("Ruckig's blend does not end at the goal state")
+    qs[-1], qds[-1], qdds[-1] = q[1], v[1], acc[1]
+    return Trajectory(times, qs, qds, qdds)
 
 
 def ptp_line_deviation(q_path: npt.ArrayLike) -> float:

@@ -112,6 +112,7 @@ def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progr
             a,
             plan,
             operator_s=sc.flip.operator_s,
+            positioner_turn_s=_positioner_s(plan),
             tacks_s=tacks_time_s(a.plan) if chosen else 0.0,
             turned_map=weldmap.transformed(plan.X_RM_after, "R"),
             tacks=tack_records(chosen, a.plan, a.execution is not None, refused),
@@ -130,6 +131,13 @@ def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progr
         except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
             return done(error=e)
         return done(side_b=b, result=turnover_result(plan, b, weldmap))
+
+
+def _positioner_s(plan: TurnoverPlan) -> float:
+    """What a positioner's axis would take for the turn [s] (:mod:`cell.planning.positioner`)."""
+    from cell.planning.positioner import positioner_turn_s
+
+    return positioner_turn_s(plan.angle_rad)
 
 
 def tack_rule(

@@ -23,7 +23,8 @@ class TurnoverRun:
     operator_s : the operator's time to turn the part (the scenario's figure) [s]. tacks : the tack welds side A
     laid first (:mod:`cell.pipeline.tacks`), each welded or why not; tacks_s their robot time in side A's plan
     (moves, approaches, welds, departs) [s], a part of side A's cycle time.
-    error : what stopped the job between the sides (the turn refused), or None.
+    error : what stopped the job between the sides (the turn refused), or None. positioner_turn_s : what a
+    positioner's axis would take for the same turn [s] (:mod:`cell.planning.positioner`).
     """
 
     side_a: WeldRun
@@ -36,6 +37,7 @@ class TurnoverRun:
     timings: Mapping[str, float] = field(default_factory=dict)
     turned_map: WeldMap | None = None  # the map at its nominal pose after the turn (R), for previews
     tacks: tuple[TackRecord, ...] = ()
+    positioner_turn_s: float = 0.0
 
     def side_of(self) -> dict[str, str]:
         """Seam id -> the side it belongs to: ``"B"`` for those side B searched, ``"A"`` for every other."""

@@ -19,6 +19,7 @@ from cell.geometry import readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.assembly import assemble
+from cell.planning.blend import blend_plan
 from cell.planning.failures import SeamFailure, reason_text
 from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
@@ -133,6 +134,10 @@ def plan_welds(
         direction = "to" if b else "from"
         detail = f"no free transfer move {direction} the seam: {why.reason}"
         outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
+    if opt.blend > 0.0:
+        segments = blend_plan(
+            segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
+        )
     for sid, sols in solved.items():
         c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
         swapped = isinstance(sel, SeamProcedure) and sel.reverse  # the search saw the task's ends swapped

@@ -4,6 +4,7 @@ section 1). Frames: everything in the robot base frame R [m]; joints [rad]; time
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol
@@ -15,6 +16,7 @@ from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import Entry, body_entry
+from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.wrist import HoseWindow
@@ -88,6 +90,23 @@ class Lift:
 
 
 @dataclass(frozen=True)
+class Hop:
+    """PTP up to the lift height (plus ``extra`` times ``transfer_lift``) above q_a's TCP, PTP across, PTP down to
+    q_b: the lift's via points reached by joint moves, faster than its straight lines where the collision check
+    finds the joint path free."""
+
+    name: str = "hop"
+    extra: int = 0
+
+    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
+        h = mover.lift_z + mover.opt.transfer_lift * self.extra
+        vias = [q for q in (mover.above(q_a, h), mover.above(q_b, h)) if q is not None]
+        qs = [q_a, *vias, q_b]
+        return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
+
+
+@dataclass(frozen=True)
 class ViaHome:
     """PTP to home, PTP on."""
 
@@ -103,7 +122,14 @@ class ViaHome:
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
 
-DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (Direct(), Lift(), Lift("lift_high", extra=1), ViaHome())
+DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (
+    Direct(),
+    Hop(),
+    Lift(),
+    Hop("hop_high", extra=1),
+    Lift("lift_high", extra=1),
+    ViaHome(),
+)
 
 
 class Transfers:
@@ -173,6 +199,12 @@ class Transfers:
             fail = TransferFail(hit.describe(), hit.p_R)
         return fail
 
+    def clear(self, tr: Trajectory) -> bool:
+        """Whether a motion touches nothing (the collision model) and takes the wire into no obstacle's body."""
+        if self.checker.check_path(tr.q, tr.times) is not None:
+            return False
+        return self._entry([Piece("move", tr, 0.0, self.robot.fk(tr.q[-1]))]) is None
+
     def _entry(self, pieces: list[Piece]) -> Entry | None:
         """Where the wire tip or the wire, which the collision model leaves out, first enters an obstacle's body
         along the motions (the safety gate's test, :mod:`cell.gate.bodies`); None: nowhere."""
@@ -204,6 +236,15 @@ class Transfers:
             f" by {np.degrees(over[k]):.1f} deg"
         )
         return TransferFail(why, self.robot.fk(q[k])[:3, 3].copy())
+
+    def above(self, q: FloatArray, height: float) -> FloatArray | None:
+        """The configuration (dof,) [rad] with q's TCP pose raised to ``height`` [m] in R (IK seeded at q); None
+        when q is already that high. Raises IKError when it cannot be reached."""
+        X = self.robot.fk(q)
+        if height - float(X[2, 3]) < 1e-3:
+            return None
+        X[2, 3] = height
+        return np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is

@@ -48,7 +48,11 @@ class Segment:
     """One motion of the plan. kind: move (PTP) | approach | weld | depart (LIN); t0 [s] its start in the plan;
     speed [m/s] the TCP speed of a LIN (0 for PTP); X_end (4, 4) the TCP pose at its end in R; arc_on: the arc
     burns during this segment (welds only: on at its start, off at its end, both at rest); procedure: the weld
-    procedure a weld segment runs (None: the process defaults), pass_index: which of its passes (0: the root)."""
+    procedure a weld segment runs (None: the process defaults), pass_index: which of its passes (0: the root).
+    zone_m [m]: the motion is approximated at its end (KRL ``C_DIS``, a RAPID zone): the next one starts when the
+    TCP is this close to the programmed end, the joint target ``q_target`` (dof,) [rad] the trajectory then never
+    reaches (0 and None: an exact stop there). link_s [s]: the first link_s of its trajectory is the blend from
+    the previous motion (0: it starts at rest where the previous one ended)."""
 
     kind: SegmentKind
     seam_id: str
@@ -59,6 +63,14 @@ class Segment:
     arc_on: bool = False
     procedure: WeldProcedure | None = None
     pass_index: int = 0
+    zone_m: float = 0.0
+    q_target: FloatArray | None = None
+    link_s: float = 0.0
+
+    @property
+    def q_end(self) -> FloatArray:
+        """(dof,) [rad] the programmed end: ``q_target`` when approximated, else where the trajectory ends."""
+        return self.q_target if self.q_target is not None else self.trajectory.q[-1]
 
     @property
     def t1(self) -> float:

@@ -1,6 +1,6 @@
 """The path the controller drives, on the session's fence1 run (``fence1_run``): every PTP move the simulator
-played lies on the straight joint line a KRC4 PTP drives between its ends, the gate checked those same samples,
-and the hose package's A6 window held."""
+played lies on the straight joint line a KRC4 PTP drives between its programmed ends (outside the blends that
+join and leave it within its zones), the gate checked those same samples, and the hose package's A6 window held."""
 
 from __future__ import annotations
 
@@ -25,26 +25,39 @@ def test_every_executed_ptp_move_is_the_krc_joint_line(fence1_run: pipeline.Weld
     run = fence1_run
     plan, pre = run.plan, run.pre_move
     assert plan is not None and pre is not None and run.execution is not None and not run.violations
-    moves = [s for s in plan.segments if s.kind == "move" and s.trajectory.duration > 0.0]
+    segs = plan.segments
+    moves = [k for k, s in enumerate(segs) if s.kind == "move" and s.trajectory.duration > 0.0]
     assert len(moves) >= 12  # home -> first seam, between seams, last seam -> home
     worst = ptp_line_deviation(_executed(run, 0.0, pre.duration, pre.q))  # scan pose -> home is a PTP too
-    for s in moves:
-        q = _executed(run, pre.duration + s.t0, pre.duration + s.t1, s.trajectory.q)
-        assert len(q) > 10
+    blended = 0
+    for k in moves:
+        # A move blended into the next motion is left inside its zone, one joined from the previous motion starts
+        # with the link: between the two it is the straight line from its programmed start to its programmed end.
+        s = segs[k]
+        start = segs[k - 1].q_end if k else plan.q_home
+        blended += s.zone_m > 0.0 or s.link_s > 0.0
+        t0, t1 = pre.duration + s.t0 + s.link_s, pre.duration + s.t1
+        q = _executed(run, t0, t1, np.array([start, s.q_end]))
+        assert len(q) >= 3  # the programmed ends and the executed samples between (recorded every 10 ms)
         worst = max(worst, ptp_line_deviation(q))
-        # synchronised axes: every moving axis starts and stops with the move (none at rest inside it)
-        dq = s.trajectory.q[-1] - s.trajectory.q[0]
+        # synchronised axes: every moving axis moves one way all along the straight part (none at rest inside it)
+        dq = s.q_end - start
         moving = np.abs(dq) > 1e-6
-        inner = s.trajectory.qd[1:-1][:, moving]
+        straight = s.trajectory.times >= s.link_s
+        inner = s.trajectory.qd[straight][1:-1][:, moving]
         assert np.all(inner * np.sign(dq[moving]) > 0.0)
     assert worst <= MAX_PTP_DEVIATION, np.degrees(worst)
+    assert blended >= len(moves) // 2  # most moves join or leave another without stopping
     # The gate checks the same path: its 1 kHz re-sampling of the plan lies on the same lines.
     assert run.arm is not None
     gate = GateInput(run.arm.model, plan, pre.q[-1], None, GateOptions())
     r = gate.resampled
-    for s in moves:
-        inside = (r.t >= s.t0) & (r.t <= s.t1)
-        assert inside.sum() > 10 and ptp_line_deviation(r.q[inside]) <= MAX_PTP_DEVIATION
+    for k in moves:
+        s = segs[k]
+        start = segs[k - 1].q_end if k else plan.q_home
+        inside = (r.t >= s.t0 + s.link_s) & (r.t <= s.t1)
+        path = np.vstack([start, r.q[inside], s.q_end])
+        assert inside.sum() > 0 and ptp_line_deviation(path) <= MAX_PTP_DEVIATION
 
 
 def test_a6_stays_in_the_hose_window_without_wrist_flips(fence1_run: pipeline.WeldRun) -> None:

@@ -176,7 +176,32 @@ def test_every_e6pos_has_the_status_and_turn_of_its_planned_configuration(robot:
     e6pos = [name for name in pts if "S" in pts[name]]
     assert len(e6pos) == len(lins) and all("T" in pts[n] for n in e6pos)
     for name, seg in zip(sorted(e6pos, key=lambda n: int(n[2:])), lins, strict=True):
-        assert (pts[name]["S"], pts[name]["T"]) == status_turn(robot, seg.trajectory.q[-1])
+        assert (pts[name]["S"], pts[name]["T"]) == status_turn(robot, seg.q_end)
+
+
+def test_blended_motions_are_approximated_by_their_zone_to_their_programmed_point(
+    robot: RobotModel, plan: WeldPlan
+) -> None:
+    from cell.export.program import ProgramJob
+    from cell.export.rapid import rapid_text
+
+    blended = [s for s in plan.segments if s.zone_m > 0.0]
+    assert blended and all(s.q_target is not None and not s.arc_on for s in blended)
+    src, dat = krl_program(plan, robot, "W")
+    zones = [float(z) for z in re.findall(r"\$APO\.CDIS = " + NUM, src)]
+    c_dis = [ln for ln in src.splitlines() if " C_DIS" in ln]
+    assert len(c_dis) == len(blended) and len(zones) >= 1
+    assert {round(s.zone_m * 1000.0, 1) for s in blended} == set(zones)
+    pts = _points(dat)
+    for ln, seg in zip(c_dis, blended, strict=True):
+        name = ln.split()[1]
+        if seg.kind == "move":  # the E6AXIS is the programmed point, not where the blend leaves the move
+            got = np.radians([pts[name][f"A{i}"] for i in range(1, 7)])
+            np.testing.assert_allclose(got, seg.q_end, atol=np.radians(0.001))  # written to 0.001 deg
+            assert not np.allclose(seg.q_end, seg.trajectory.q[-1], atol=1e-6)
+    mod = rapid_text(ProgramJob(plan, robot, "W"))
+    assert len(re.findall(r", zB[0-9_]+, tWeld", mod)) == len(blended)
+    assert "CONST zonedata zB" in mod
 
 
 def test_abc_are_rotations_about_z_y_x_with_x_along_the_wire(robot: RobotModel, plan: WeldPlan) -> None:

@@ -4,7 +4,7 @@ the robot programs of both sides with the main program that stops for the operat
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -44,18 +44,22 @@ def finish_turnover(
     writer: Writer,
     fmt: TableFormat,
     controller: str = "krl",
+    amend: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
 ) -> str | None:
     """Write the report first, then the programs; print the table and one line per side; the exit's explanation
-    when the job is partial (None when complete)."""
+    when the job is partial (None when complete). amend : the report joined with the job's journal (a resume:
+    the seams earlier runs welded)."""
     from cell.export.turnover_report import turnover_report
 
     rep = turnover_report(run, provenance=provenance)
+    rep = amend(rep) if amend is not None else rep
     writer.report(json_path, rep)
     if krl is not None:
         left = not_welded(rep)
         written = writer.attempt(lambda: write_programs(run, krl, provenance, controller, left))
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
+            writer.written("programs", written)
     print_weld(rep, title, fmt)
     if fmt == "table":
         say(sides_line(rep))

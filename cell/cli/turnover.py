@@ -73,7 +73,9 @@ def sides_line(rep: Mapping[str, Any]) -> str:
     """One line: what each side welded, the turn and what the second alignment measured, the job's time."""
     parts = [f"side {k}: welded {v['welded']} in {v['cycle_time_s'] or 0:.1f} s" for k, v in rep["sides"].items()]
     f = rep.get("flip")
-    if f is not None and f["made"]:
+    if f is not None and f["made"] and f.get("placement_error_mm") is None:  # a resume: an earlier run turned it
+        parts.append(f"turned {f['rotation_deg']:+.0f} deg about {f['axis']} by run {f.get('run')}")
+    elif f is not None and f["made"]:
         parts.append(
             f"turned {f['rotation_deg']:+.0f} deg about {f['axis']} (lean {f['tilt_deg']:.1f} deg), placement "
             f"measured {f['placement_error_mm']:.1f} mm / {f['placement_rotation_deg']:+.2f} deg, fitness "
@@ -81,7 +83,7 @@ def sides_line(rep: Mapping[str, Any]) -> str:
         )
     elif f is not None:
         parts.append(f"no turn: {f['reason']}")
-    if f is not None and f["made"]:
+    if f is not None and f["made"] and rep.get("job_time_s") is not None:
         parts.append(f"job {rep['job_time_s']:.1f} s with the operator's turn")
     return " · ".join(parts)
 

@@ -35,7 +35,10 @@ def journal_seams(state: JobState) -> list[dict[str, Any]]:
         e["welded"] = w is not None
         if w is not None:
             e.update(run=w.run, arc_on_s=w.t_on_s, arc_off_s=w.t_off_s, length_mm=w.length_mm)
-            e.update(tcp_rms_mm=w.tcp_rms_mm, tcp_max_mm=w.tcp_max_mm, weld_reason_code=None, weld_reason="")
+            e.update(tcp_error_mm={"rms": w.tcp_rms_mm, "max": w.tcp_max_mm}, weld_reason_code=None, weld_reason="")
+            e["weld_time_s"] = (
+                round(w.t_off_s - w.t_on_s, 3) if w.t_on_s is not None and w.t_off_s is not None else None
+            )
         elif sid in state.interrupted:
             i = state.interrupted[sid]
             e.update(run=i.run, arc_on_s=i.t_on_s, weld_reason_code="interrupted")
@@ -82,9 +85,16 @@ def joined_report(rep: Mapping[str, Any], state: JobState, run: str, *, on_b: bo
     seams += list(mine.values())
     out["seams"] = seams
     out["welded"] = sum(bool(e.get("welded")) for e in seams)
+    before = sum(e["id"] in earlier for e in seams)
+    if before and isinstance(out.get("summary"), Mapping):  # the part's counts: the earlier runs' seams too
+        out["summary"] = {**out["summary"]}
+        for key in ("seams", "visible", "found"):
+            out["summary"][key] = out["summary"].get(key, 0) + before
     out["journal"] = journal_block(state)
-    if on_b and out.get("flip") is None:
-        out["flip"] = _turn(state)
+    if on_b:  # this run is side B's: the turn is an earlier run's
+        out["flip"] = out.get("flip") or _turn(state)
+        sides = list(out.get("sides", {}).values())
+        out["sides"] = {"B": sides[0]} if sides else {}
     return out
 
 
@@ -107,4 +117,14 @@ def _turn(state: JobState) -> dict[str, Any] | None:
     t = state.turn
     if t is None:
         return None
-    return {"made": True, "axis": t.get("axis"), "rotation_deg": t.get("rotation_deg"), "exposed": t.get("exposed")}
+    return {
+        "made": True,
+        "axis": t.get("axis"),
+        "rotation_deg": t.get("rotation_deg"),
+        "tilt_deg": t.get("tilt_deg"),
+        "exposed": t.get("exposed"),
+        "run": t.get("run"),
+        "placement_error_mm": None,  # measured by side B's alignment: in its ``located`` record's X_RM
+        "placement_rotation_deg": None,
+        "fitness": None,
+    }

@@ -63,14 +63,14 @@ def stop_on_signals() -> Iterator[None]:
         yield
         return
     outer, st = _state, _State()
-    for s in STOP_SIGNALS:
-        st.old[s] = signal.signal(s, _handler)
+    for sig in STOP_SIGNALS:
+        st.old[int(sig)] = signal.signal(sig, _handler)
     _state = st
     try:
         yield
     finally:
-        for s, old in st.old.items():
-            signal.signal(s, old)  # type: ignore[arg-type]
+        for num, old in st.old.items():
+            signal.signal(num, old)  # type: ignore[arg-type]
         _state = outer
 
 

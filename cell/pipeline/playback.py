@@ -108,14 +108,14 @@ def _joined(pieces: Sequence[Execution], duration_s: float) -> Execution:
     events = [start, *first.events[1:]]
     for p in pieces[1:]:
         events += list(p.events[1:])
-    poses = [p.X_W_tcp for p in pieces]
+    poses = [p.X_W_tcp for p in pieces if p.X_W_tcp is not None]
     return Execution(
         times=np.concatenate([first.times] + [p.times[1:] for p in pieces[1:]]),
         q=np.concatenate([first.q] + [p.q[1:] for p in pieces[1:]]),
         tcp_W=np.concatenate([first.tcp_W] + [p.tcp_W[1:] for p in pieces[1:]]),
         arc_on=np.concatenate([first.arc_on] + [p.arc_on[1:] for p in pieces[1:]]),
         events=tuple(sorted(events, key=lambda e: e.t)),
-        X_W_tcp=None if any(x is None for x in poses) else np.concatenate([poses[0]] + [x[1:] for x in poses[1:]]),  # type: ignore[index]
+        X_W_tcp=np.concatenate([poses[0]] + [x[1:] for x in poses[1:]]) if len(poses) == len(pieces) else None,
     )
 
 

@@ -187,6 +187,7 @@ def _side_b(
         "turned",
         axis=plan.axis,
         rotation_deg=round(math.degrees(plan.angle_rad), 3),
+        tilt_deg=round(math.degrees(plan.tilt_rad), 3),
         exposed=list(plan.exposed),
         X_R_turn=np.round(plan.X_R_turn, 9),
         X_RM_after=np.round(plan.X_RM_after, 9),

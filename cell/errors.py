@@ -13,7 +13,9 @@ EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_PARTIAL = 3
-EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it (SIGTERM 143, SIGHUP 129: 128 + the signal)
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+EXIT_HANGUP = 129  # 128 + SIGHUP: cell weld stopped by its terminal closing
+EXIT_TERMINATED = 143  # 128 + SIGTERM: cell weld stopped by a supervisor
 
 
 class CellError(Exception):

@@ -110,9 +110,8 @@ def weld(
     then turn the part over for the seams against the table and weld its other side (``--sides all``). Every step
     goes to the job's journal as it happens; ``--resume`` welds what an interrupted job left (docs/journal.md)."""
     from cell import pipeline
-    from cell.cli.journal import end_job, journal_path, open_job, resumed, stopped
+    from cell.cli.journal import end_job, joined, journal_path, open_job, resumed, stopped
     from cell.cli.turnover import finish_turnover, parse_sides
-    from cell.export.journal_report import joined_report
     from cell.journal import SideLog, stop_on_signals
     from cell.journal.signals import received
     from cell.pipeline.job import WeldJob
@@ -155,8 +154,7 @@ def weld(
                 else:
                     job = weld_part(scn, asked, progress=stage, log=side_log, done=done, turned=turned)
                     run = job.side_a  # the page and the recording show side A
-                on_b = turned is not None
-                amend = (lambda r: joined_report(r, log.reread(), log.run, on_b=on_b)) if log is not None else None
+                amend = joined(log, on_b=turned is not None)
                 partial = finish_turnover(job, json_path, program, title="weld", provenance=prov, writer=writer,
                                           fmt=table, controller=controller, amend=amend)  # fmt: skip
                 if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:

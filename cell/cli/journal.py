@@ -3,7 +3,7 @@ its first and last records, and the report of a job stopped on the way, built fr
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -73,8 +73,27 @@ class JobLog:
     def run(self) -> str:
         return self.writer.run
 
-    def reread(self) -> JobState:
-        return read_journal(self.writer.path)
+    def reread(self) -> JobState | None:
+        """The journal as it stands (None when it cannot be read back: its folder removed meanwhile)."""
+        try:
+            return read_journal(self.writer.path)
+        except JournalError as e:
+            warn(f"the journal cannot be read back: {e.message}")
+            return None
+
+
+def joined(log: JobLog | None, on_b: bool) -> Callable[[dict[str, Any]], dict[str, Any]] | None:
+    """How a finished run's report is joined with its journal (each seam's run, the earlier runs' welds)."""
+    if log is None:
+        return None
+
+    def amend(rep: dict[str, Any]) -> dict[str, Any]:
+        from cell.export.journal_report import joined_report
+
+        state = log.reread()
+        return joined_report(rep, state, log.run, on_b=on_b) if state is not None else rep
+
+    return amend
 
 
 def open_job(
@@ -150,10 +169,11 @@ def stopped(
     rep = dict(base)
     rep["interrupted"] = {"stage": stage, "signal": getattr(e, "name", None)}
     rep["error"] = {"type": type(e).__name__, "message": f"{why} during: {stage}", "exit_code": code}
-    if log is not None:
-        rep = stopped_job_report(log.reread(), rep)
+    state = log.reread() if log is not None else None
+    if state is not None:
+        rep = stopped_job_report(state, rep)
     writer.report(json_path, rep)
-    done = f"; {rep.get('welded', 0)} seam(s) welded, journal {log.writer.path}" if log is not None else ""
+    done = f"; {rep.get('welded', 0)} seam(s) welded, journal {state.path}" if state is not None else ""
     where = f"; partial report in {json_path}" if json_path is not None and str(json_path) != STDOUT else ""
     fail_line(f"exit {code}: {why} during: {stage}{done}{where if not writer.failures else ''}")
     return code

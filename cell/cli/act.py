@@ -1,7 +1,8 @@
 """Commands that move the arm (or plan to): ``cell weld``, ``cell preview``, ``cell rescan``.
 
 Each checks its output paths before any work, writes the report first (it survives any later failure), then
-every other output on its own, and on Ctrl-C writes the report of the stage it reached (exit 130).
+every other output on its own, and on Ctrl-C writes the report of the stage it reached (exit 130); ``cell weld``
+keeps the job's journal and stops on SIGINT, SIGTERM or SIGHUP with a report built from it (docs/journal.md).
 """
 
 from __future__ import annotations

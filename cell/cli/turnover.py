@@ -54,7 +54,10 @@ def finish_turnover(
     rep = turnover_report(run, provenance=provenance)
     rep = amend(rep) if amend is not None else rep
     writer.report(json_path, rep)
-    if krl is not None:
+    sides = [wr for wr in (run.side_a, run.side_b) if wr is not None]
+    if krl is not None and not any(wr.plan is not None and wr.plan.segments for wr in sides):
+        say(f"no robot program written to {krl}: this run has nothing to weld")  # a resume with nothing left
+    elif krl is not None:
         left = not_welded(rep)
         written = writer.attempt(lambda: write_programs(run, krl, provenance, controller, left))
         if written:

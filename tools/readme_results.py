@@ -28,6 +28,7 @@ for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the
         sys.path.insert(0, str(_path))
 
 import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
+import readme_journal_tables as journal_tables  # noqa: E402
 
 from cell.bench import PAPER_TABLE1, markdown_table  # noqa: E402
 
@@ -244,6 +245,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "weldments": lambda results: cell_tables.weldments_table(_load(results, "weldments.json")),
     "weldments-bench": lambda results: markdown_table(_load(results, "weldments-bench.json")),
     "trust": trust,
+    "interrupts": lambda results: journal_tables.interrupts_table(_load_object(results, "interrupts.json")),
 }
 
 

@@ -163,8 +163,8 @@ def stopped(
     elif isinstance(e, KeyboardInterrupt):
         code, why = EXIT_INTERRUPTED, "interrupted (Ctrl-C)"
     else:
-        code, why = 1, f"failed ({type(e).__name__}: {e})"
-    outcome = "interrupted" if code != 1 else "failed"
+        code, why = int(getattr(e, "exit_code", 1)), f"failed ({type(e).__name__}: {e})"
+    outcome = "interrupted" if isinstance(e, KeyboardInterrupt) else "failed"
     end_job(log, outcome, code, f"{why} during: {stage}", stage=stage, signal=getattr(e, "name", None))
     rep = dict(base)
     rep["interrupted"] = {"stage": stage, "signal": getattr(e, "name", None)}

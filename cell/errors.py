@@ -14,6 +14,8 @@ EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_PARTIAL = 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+EXIT_HANGUP = 129  # 128 + SIGHUP: cell weld stopped by its terminal closing
+EXIT_TERMINATED = 143  # 128 + SIGTERM: cell weld stopped by a supervisor
 
 
 class CellError(Exception):
@@ -86,6 +88,25 @@ class CloudFileError(UsageError):
         super().__init__(message)
         self.code = code
         self.path = path
+
+
+class JournalFault(enum.StrEnum):
+    """Why a job journal cannot be resumed (docs/journal.md)."""
+
+    MISSING = "missing"  # no such file, or no journal in the folder given
+    FOREIGN = "foreign"  # not a cell journal (another file, another format version)
+    TORN = "torn"  # a record cut inside the file (not its last line): the file was damaged
+    OTHER_JOB = "other_job"  # another scenario, seed or map than the one asked for
+    FINISHED = "finished"  # the job ended (complete or partial): nothing to resume
+    UNFINISHED = "unfinished"  # a new job would replace the journal of a job that can still be resumed
+
+
+class JournalError(UsageError):
+    """A job journal that cannot be used as asked (``code`` says why); found before any work."""
+
+    def __init__(self, message: str, code: JournalFault) -> None:
+        super().__init__(message)
+        self.code = code
 
 
 class ScenarioError(CellError, ValueError):

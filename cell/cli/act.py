@@ -1,7 +1,8 @@
 """Commands that move the arm (or plan to): ``cell weld``, ``cell preview``, ``cell rescan``.
 
 Each checks its output paths before any work, writes the report first (it survives any later failure), then
-every other output on its own, and on Ctrl-C writes the report of the stage it reached (exit 130).
+every other output on its own, and on Ctrl-C writes the report of the stage it reached (exit 130); ``cell weld``
+keeps the job's journal and stops on SIGINT, SIGTERM or SIGHUP with a report built from it (docs/journal.md).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from cell.cli.common import (
 )
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
 from cell.cli.tables import print_rescan
-from cell.errors import EXIT_INTERRUPTED, UsageError
+from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, UsageError
 
 if TYPE_CHECKING:
     from cell.pipeline import WeldRun
@@ -105,11 +106,23 @@ def weld(
     ] = None,
     rerun_path: RerunOpt = None,
     sides: SidesOpt = "all",
+    journal: Annotated[
+        Path | None,
+        typer.Option(help="Write the job's journal here (default: beside --json, else in --program's folder)."),
+    ] = None,
+    resume: Annotated[
+        Path | None,
+        typer.Option(metavar="JOURNAL", help="Continue the job this journal (or the one in this folder) stopped."),
+    ] = None,
 ) -> None:
     """The whole cell: capture, locate every seam, re-scan doubtful ones up close, plan, check, weld in simulation;
-    then turn the part over for the seams against the table and weld its other side (``--sides all``)."""
+    then turn the part over for the seams against the table and weld its other side (``--sides all``). Every step
+    goes to the job's journal as it happens; ``--resume`` welds what an interrupted job left (docs/journal.md)."""
     from cell import pipeline
+    from cell.cli.journal import end_job, joined, journal_path, open_job, resumed, stopped
     from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.journal import SideLog, stop_on_signals
+    from cell.journal.signals import received
     from cell.pipeline.job import WeldJob
     from cell.pipeline.turnover import weld_part
     from cell.pipeline.turnover_run import TurnoverRun
@@ -127,26 +140,47 @@ def weld(
         _check_rerun(rerun_path)
         side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise, calibration)
+        state = resumed(resume, prov) if resume is not None else None
+        if state is not None:  # the job's own options, unless given again
+            was = state.start.get("options", {})
+            method, noise = method or was.get("method"), noise or was.get("noise")
+            mode, side_opt = mode or was.get("rescan"), parse_sides(was.get("sides") or sides)
+        opts = {"scenario": scn.name, "method": method, "noise": noise, "rescan": mode, "sides": side_opt,
+                "controller": controller, "json": json_path, "program": program,
+                "calibration": calibration}  # fmt: skip
         stage, writer = Stage(), Writer()
-        run: WeldRun | None = None
-        try:
-            asked = WeldJob(method, noise=parse_noise(noise), rescan=mode, gui=gui, sides=side_opt)
-            if side_opt == "first":  # side A alone, as the part lies
-                run = pipeline.weld(scn, asked, progress=stage)
-                job = TurnoverRun(run)
-            else:
-                job = weld_part(scn, asked, progress=stage)
-                run = job.side_a  # the page and the recording show side A
-            partial = finish_turnover(
-                job, json_path, program, title="weld", provenance=prov, writer=writer, fmt=table, controller=controller
-            )
-            if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
-                say(f"page: {html}")
-            _write_rerun(run, rerun_path, writer)
-        except (KeyboardInterrupt, ImportError) as e:
-            if not was_interrupted(e):
-                raise
-            _interrupted(run, scn, method, stage, prov, writer, json_path)
+        log = open_job(
+            journal_path(journal, json_path, program), state, prov, {k: v and str(v) for k, v in opts.items()}
+        )
+        writer.journal = log.writer if log is not None else None
+        done, turned = (tuple(state.welds), state.turn) if state is not None else ((), None)
+        with stop_on_signals():
+            try:
+                asked = WeldJob(method, noise=parse_noise(noise), rescan=mode, gui=gui, sides=side_opt)
+                side_log = SideLog(writer.journal)
+                if side_opt == "first":  # side A alone, as the part lies
+                    run = pipeline.weld(scn, asked, progress=stage, log=side_log, done=done)
+                    job = TurnoverRun(run)
+                else:
+                    job = weld_part(scn, asked, progress=stage, log=side_log, done=done, turned=turned)
+                    run = job.side_a  # the page and the recording show side A
+                amend = joined(log, on_b=turned is not None)
+                partial = finish_turnover(job, json_path, program, title="weld", provenance=prov, writer=writer,
+                                          fmt=table, controller=controller, amend=amend)  # fmt: skip
+                if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
+                    say(f"page: {html}")
+                _write_rerun(run, rerun_path, writer)
+                errs = [e for e in (job.side_a.error, job.side_b and job.side_b.error, job.error) if e is not None]
+                code = EXIT_USAGE if writer.failures else EXIT_PARTIAL if partial else 0
+                end_job(log, "failed" if errs else "partial" if partial else "complete", code, partial or "")
+            except (KeyboardInterrupt, Exception) as e:  # a signal, a bug: the report from the journal, then exit
+                signal_in_import = isinstance(e, ImportError) and (was_interrupted(e) or received() is not None)
+                stop = KeyboardInterrupt() if signal_in_import else e
+                code = stopped(log, stop, stage.last, interrupted_report(scn, method, stage.last, prov), writer,
+                               json_path)  # fmt: skip
+                if not isinstance(stop, KeyboardInterrupt):
+                    raise
+                raise typer.Exit(code) from None
     finish(writer, partial)
 
 

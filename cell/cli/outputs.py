@@ -121,6 +121,12 @@ class Writer:
     """Writes each output on its own: a failure is reported (one line each) and the next output still written."""
 
     failures: list[OutputError] = field(default_factory=list)
+    journal: Any = None  # the job's JournalWriter: each output written is an ``output`` record
+
+    def written(self, what: str, paths: list[Path]) -> None:
+        """Journal the outputs just written (nothing without a journal)."""
+        if self.journal is not None and paths:
+            self.journal.write("output", what=what, paths=[str(p) for p in paths])
 
     def attempt(self, what: Callable[[], T]) -> T | None:
         """Run one writing step; its OutputError (or any OSError) is kept, and None returned."""
@@ -141,6 +147,7 @@ class Writer:
 
         if self.attempt(lambda: write_json(path, report)) is not None and str(path) != STDOUT:
             say(f"report written to {path}")
+            self.written("report", [path])
 
     def explanation(self) -> str | None:
         """The last line when an output was lost, or None."""

@@ -4,7 +4,7 @@ the robot programs of both sides with the main program that stops for the operat
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -44,18 +44,25 @@ def finish_turnover(
     writer: Writer,
     fmt: TableFormat,
     controller: str = "krl",
+    amend: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
 ) -> str | None:
     """Write the report first, then the programs; print the table and one line per side; the exit's explanation
-    when the job is partial (None when complete)."""
+    when the job is partial (None when complete). amend : the report joined with the job's journal (a resume:
+    the seams earlier runs welded)."""
     from cell.export.turnover_report import turnover_report
 
     rep = turnover_report(run, provenance=provenance)
+    rep = amend(rep) if amend is not None else rep
     writer.report(json_path, rep)
-    if krl is not None:
+    sides = [wr for wr in (run.side_a, run.side_b) if wr is not None]
+    if krl is not None and not any(wr.plan is not None and wr.plan.segments for wr in sides):
+        say(f"no robot program written to {krl}: this run has nothing to weld")  # a resume with nothing left
+    elif krl is not None:
         left = not_welded(rep)
         written = writer.attempt(lambda: write_programs(run, krl, provenance, controller, left))
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
+            writer.written("programs", written)
     print_weld(rep, title, fmt)
     if fmt == "table":
         say(sides_line(rep))
@@ -69,7 +76,9 @@ def sides_line(rep: Mapping[str, Any]) -> str:
     """One line: what each side welded, the turn and what the second alignment measured, the job's time."""
     parts = [f"side {k}: welded {v['welded']} in {v['cycle_time_s'] or 0:.1f} s" for k, v in rep["sides"].items()]
     f = rep.get("flip")
-    if f is not None and f["made"]:
+    if f is not None and f["made"] and f.get("placement_error_mm") is None:  # a resume: an earlier run turned it
+        parts.append(f"turned {f['rotation_deg']:+.0f} deg about {f['axis']} by run {f.get('run')}")
+    elif f is not None and f["made"]:
         parts.append(
             f"turned {f['rotation_deg']:+.0f} deg about {f['axis']} (lean {f['tilt_deg']:.1f} deg), placement "
             f"measured {f['placement_error_mm']:.1f} mm / {f['placement_rotation_deg']:+.2f} deg, fitness "
@@ -77,7 +86,7 @@ def sides_line(rep: Mapping[str, Any]) -> str:
         )
     elif f is not None:
         parts.append(f"no turn: {f['reason']}")
-    if f is not None and f["made"]:
+    if f is not None and f["made"] and rep.get("job_time_s") is not None:
         parts.append(f"job {rep['job_time_s']:.1f} s with the operator's turn")
         if f.get("positioner_saves_s") is not None:
             parts.append(

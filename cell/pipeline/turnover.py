@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -16,6 +16,7 @@ import numpy as np
 
 from cell.errors import CellError
 from cell.geometry import FloatArray, invert, transform_points
+from cell.journal import NO_LOG, SideLog
 from cell.perception.align.near_pose import near_seed
 from cell.pipeline.detect import AlignStart, Progress, quiet, read_weldmap, table_z_R
 from cell.pipeline.geometry import open_cell
@@ -82,7 +83,15 @@ def turnover_result(plan: TurnoverPlan, run: WeldRun, weldmap_M: WeldMap) -> Tur
     return TurnoverResult(offset, rotation, scene.alignment.fitness, scene.X_RM)
 
 
-def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progress = quiet) -> TurnoverRun:
+def weld_part(
+    scenario: Scenario,
+    job: WeldJob | None = None,
+    *,
+    progress: Progress = quiet,
+    log: SideLog = NO_LOG,
+    done: Collection[str] = (),
+    turned: Mapping[str, Any] | None = None,
+) -> TurnoverRun:
     """The whole part: side A (:func:`cell.pipeline.weld.weld`), then with ``job.sides == "all"`` the turn and
     side B (``job``: :class:`~cell.pipeline.job.WeldJob`; None: as the scenario says).
 
@@ -91,6 +100,10 @@ def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progr
     it (``flip.allowed``), or when no stable turn exposes a seam left: the seams keep their reason. A failure on
     side B (an ambiguous second alignment, the gate) is side B's ``error``: nothing of side B is welded, the
     report is still written.
+
+    log : the job's journal (docs/journal.md). A resume (``done``: the seams earlier runs welded, never welded
+    again; ``turned``: the journal's ``turned`` record when the part was turned) captures and aligns again and
+    welds the rest, on side B alone when the part was turned (the simulator first turns it as that run did).
     """
     t_all = time.perf_counter()
     job = job or WeldJob()
@@ -101,9 +114,12 @@ def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progr
     spec = sc.flip.tacks
     both = job.sides == "all"
     with open_cell(sc, weldmap, gui=job.gui) as station:
-        # Tacks only when asked for and the part will be turned.
-        rule = tack_rule(spec.count, spec.length_mm / 1000.0, chosen) if spec.count and both else None
-        a = weld(sc, side_a, progress=progress, station=station, tacks=rule)
+        if turned is not None:  # a resume after the turn: side B's seams left
+            b = _resumed_b(station, sc, side_a, turned, weldmap, progress, log.on("B"), done)
+            return TurnoverRun(b, timings={"total_s": time.perf_counter() - t_all})
+        # Tacks only when asked for and the part will be turned (not again on a resume).
+        rule = tack_rule(spec.count, spec.length_mm / 1000.0, chosen) if spec.count and both and not done else None
+        a = weld(sc, side_a, progress=progress, station=station, tacks=rule, log=log.on("A"), done=done)
         plan = plan_turn(a) if both else None
         if plan is None:
             return TurnoverRun(a, timings={"total_s": time.perf_counter() - t_all})
@@ -118,19 +134,19 @@ def weld_part(scenario: Scenario, job: WeldJob | None = None, *, progress: Progr
             tacks=tack_records(chosen, a.plan, a.execution is not None, refused),
         )
 
-        def done(**fields: Any) -> TurnoverRun:
+        def ended(**fields: Any) -> TurnoverRun:
             return replace(base, timings={"total_s": time.perf_counter() - t_all}, **fields)
 
         if not plan.go:
             progress(f"no turn: {plan.reason}")
-            return done()
+            return ended()
         if not job.execute or a.error is not None:  # a preview moves nothing; a failed side A is not turned
-            return done(error=a.error if job.execute else None)
+            return ended(error=a.error if job.execute else None)
         try:
-            b = _side_b(station, sc, side_a, plan, weldmap, progress)
+            b = _side_b(station, sc, side_a, plan, weldmap, progress, log.on("B"), done)
         except CellError as e:  # the station cannot turn the part (a recording): side A's run stands, with why
-            return done(error=e)
-        return done(side_b=b, result=turnover_result(plan, b, weldmap))
+            return ended(error=e)
+        return ended(side_b=b, result=turnover_result(plan, b, weldmap))
 
 
 def _positioner_s(plan: TurnoverPlan) -> float:
@@ -159,7 +175,14 @@ def tack_rule(
 
 
 def _side_b(
-    station: Station, sc: Scenario, job: WeldJob, plan: TurnoverPlan, weldmap: WeldMap, progress: Progress
+    station: Station,
+    sc: Scenario,
+    job: WeldJob,
+    plan: TurnoverPlan,
+    weldmap: WeldMap,
+    progress: Progress,
+    log: SideLog,
+    done: Collection[str],
 ) -> WeldRun:
     """Turn the part (the operator) and weld the seams the turn exposed."""
     X_WR = sc.X_WR
@@ -168,5 +191,34 @@ def _side_b(
         f"for {len(plan.exposed)} seams ({', '.join(plan.exposed)})"
     )
     station.turn_part(X_WR @ plan.X_R_turn @ invert(X_WR))  # the nominal turn, carried from R into W
+    log.write(
+        "turned",
+        axis=plan.axis,
+        rotation_deg=round(math.degrees(plan.angle_rad), 3),
+        tilt_deg=round(math.degrees(plan.tilt_rad), 3),
+        exposed=list(plan.exposed),
+        X_R_turn=np.round(plan.X_R_turn, 9),
+        X_RM_after=np.round(plan.X_RM_after, 9),
+    )
     start = AlignStart(plan.X_RM_after, near_seed(weldmap, table_z_R(sc)))
-    return weld(sc, job, progress=progress, station=station, start=start, only=plan.exposed)
+    return weld(sc, job, progress=progress, station=station, start=start, only=plan.exposed, log=log, done=done)
+
+
+def _resumed_b(
+    station: Station,
+    sc: Scenario,
+    job: WeldJob,
+    turned: Mapping[str, Any],
+    weldmap: WeldMap,
+    progress: Progress,
+    log: SideLog,
+    done: Collection[str],
+) -> WeldRun:
+    """Side B of a resumed job whose part was turned: the simulated part turned as the journal says (a real part
+    lies where the operator left it), captured, aligned from its nominal turned pose, its seams left welded."""
+    X_WR = sc.X_WR
+    progress(f"resuming on side B: the part was turned {turned['rotation_deg']:+.0f} deg about {turned['axis']}")
+    station.turn_part(X_WR @ np.asarray(turned["X_R_turn"], float) @ invert(X_WR))
+    X_RM_after = np.asarray(turned["X_RM_after"], float)
+    start = AlignStart(X_RM_after, near_seed(weldmap, table_z_R(sc)))
+    return weld(sc, job, progress=progress, station=station, start=start, only=turned["exposed"], log=log, done=done)

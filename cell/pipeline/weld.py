@@ -13,12 +13,14 @@ import numpy as np
 
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
+from cell.journal import NO_LOG, SideLog
 from cell.pipeline.detect import AlignStart, Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene, open_cell
 from cell.pipeline.job import WeldJob
 from cell.pipeline.last_check import joined, last_checked
 from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
 from cell.pipeline.placeable import rescan_weldable, seam_procedures
+from cell.pipeline.playback import Measure, log_detection, log_plan, measurer, play_by_seam
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
@@ -175,8 +177,17 @@ def seam_counter(progress: Progress) -> Callable[[int, int], None]:
     return line
 
 
-def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Progress = quiet) -> Execution:
-    """Drive the simulated arm: the move from the scan pose to home, then the welding program; arc where planned."""
+def execute(
+    station: Station,
+    plan: WeldPlan,
+    pre: Trajectory,
+    *,
+    progress: Progress = quiet,
+    log: SideLog = NO_LOG,
+    measure: Measure | None = None,
+) -> Execution:
+    """Drive the simulated arm: the move from the scan pose to home, then the welding program; arc where planned,
+    seam by seam, each weld's arc on and off in the journal (``log``; ``measure``: its TCP error, where known)."""
     traj, arc = plan.joint_trajectory()
     times = np.concatenate([pre.times, traj.times[1:] + pre.duration])
     q = np.concatenate([pre.q, traj.q[1:]])
@@ -186,7 +197,7 @@ def execute(station: Station, plan: WeldPlan, pre: Trajectory, *, progress: Prog
     ]
     progress(f"executing {plan.cycle_time + pre.duration:.1f} s of robot motion in the simulator")
     e1 = None if traj.e1 is None else np.concatenate([np.zeros(len(pre.times)), traj.e1[1:]])  # the track's E1
-    return station.execute(times, q, arc_on, marks=marks, record_dt=0.01, e1=e1)
+    return play_by_seam(station, times, q, arc_on, marks, e1, plan, pre.duration, log, measure or (lambda *_: None))
 
 
 def weld(
@@ -198,6 +209,8 @@ def weld(
     start: AlignStart | None = None,
     only: Collection[str] | None = None,
     tacks: TackRule | None = None,
+    log: SideLog = NO_LOG,
+    done: Collection[str] = (),
 ) -> WeldRun:
     """The whole cell: capture, detect, re-scan up close, plan, gate and (unless ``job.execute`` is False: a
     preview) weld. ``job`` (:class:`~cell.pipeline.job.WeldJob`; None: as the scenario says) overrides the
@@ -213,7 +226,8 @@ def weld(
     station : a running cell to weld on (left open; built and closed here when None). start : where the map's
     alignment starts (a turned part's nominal pose and a search near it). only : the seam ids this run is about
     (a second side's: the others are neither re-scanned, planned nor reported). tacks : tack welds laid before
-    the seams (:func:`plan_for`).
+    the seams (:func:`plan_for`). log : the job's journal, from this side (docs/journal.md). done : seams an
+    earlier run of the job welded (a resume): neither re-scanned, planned nor reported.
     """
     t_all = time.perf_counter()
     job = job or WeldJob()
@@ -225,8 +239,9 @@ def weld(
     with open_cell(sc, weldmap, gui=job.gui) if station is None else nullcontext(station) as station:
         X_RM, seed = (start.X_RM, start.seed) if start is not None else (None, None)
         det = detect(sc, job.method, progress=progress, station=station, weldmap=weldmap, X_RM_nominal=X_RM, seed=seed)
-        if only is not None:
-            det = restricted(det, only)
+        if only is not None or done:
+            det = restricted(det, set(only if only is not None else (e.id for e in det.estimates)) - set(done))
+        log_detection(log, det)
         first, rs = det, None
         timings = dict(det.timings)
         plan = pre = ex = None
@@ -269,8 +284,9 @@ def weld(
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
-            if low and not any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates):
-                progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)")
+            if (low or done) and not any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates):
+                progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)" if low else
+                         "nothing left to weld on this side: the journal's earlier runs welded it")  # fmt: skip
             else:
                 plan, pre, violations = plan_for(
                     station,
@@ -287,12 +303,14 @@ def weld(
 
                     why = f"the safety gate refused the plan: {violations[0]} (+{len(violations) - 1} more)"
                     raise GateRefusedError(why, violations=violations)
+                log_plan(log, plan)
                 if execute_plan:
                     t = time.perf_counter()
-                    ex = execute(station, plan, pre, progress=progress)
+                    ex = execute(station, plan, pre, progress=progress, log=log, measure=measurer(det, plan, pre, sc))
                     timings["execute_s"] = time.perf_counter() - t
         except CellError as e:
             error = e
+            log.write("side_error", type=type(e).__name__, message=e.message, exit_code=e.exit_code)
         refused = f"not executed: {error.message}" if error is not None else ""
         pre_s = pre.duration if pre is not None else 0.0
         seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)

@@ -98,7 +98,8 @@ def test_weld_cli_writes_report_and_robot_program(
     result = runner.invoke(app, ["weld", "fence1", "--sides", "first", "--json", str(report), "--program", str(krl)])
     assert result.exit_code == 0, result.stderr
     ((scenario, job, kw),) = asked
-    assert scenario == sc.load("fence1") and set(kw) == {"progress"}
+    assert scenario == sc.load("fence1") and set(kw) == {"progress", "log", "done"} and kw["done"] == ()
+    assert (tmp_path / "r.journal.jsonl").is_file()  # the job's journal, beside the report
     assert job == pipeline.WeldJob(method=None, noise=None, rescan=None, execute=True, gui=False, sides="first")
     data = json.loads(report.read_text())
     assert data["welded"] == 12 and data["error"] is None

@@ -64,6 +64,7 @@ def test_the_one_table_of_exit_codes_is_what_the_code_raises() -> None:
     wrong = {n: (named[n], c.exit_code) for n, c in classes.items() if named[n] != c.exit_code}
     assert not wrong, f"docs/architecture.md section 4 gives other exit codes than cell/errors.py: {wrong}"
     constants = {errors.EXIT_OK, errors.EXIT_INTERNAL, errors.EXIT_USAGE, errors.EXIT_PARTIAL, errors.EXIT_INTERRUPTED}
+    constants |= {errors.EXIT_HANGUP, errors.EXIT_TERMINATED}  # cell weld's stop signals (cell/journal/signals.py)
     codes = [code for _, code in table]
     assert len(codes) == len(set(codes)), "one row per exit code"
     assert set(codes) == constants | {c.exit_code for c in classes.values()} | {EXIT_CHECK_FAILED}

@@ -1,0 +1,41 @@
+"""A weld job stopped by SIGTERM at its third seam's arc on, through the real command in a subprocess: the seam is
+finished (never cut mid-bead), the report lists exactly the welds the journal holds, exit 143; ``--resume`` then
+welds exactly the rest, none twice, and the report names each weld's run; a finished job is not resumed."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from cell.journal import read_journal
+
+CELL = str(Path(sys.executable).with_name("cell"))
+ARGS = ["weld", "fence1", "--sides", "first", "--noise", "none", "--json", "r.json"]
+
+
+def test_sigterm_mid_weld_then_resume_welds_exactly_the_rest(tmp_path: Path) -> None:
+    env = {**os.environ, "CELL_JOURNAL_SIGNAL": "arc_on@3=SIGTERM"}
+    first = subprocess.run([CELL, *ARGS], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    assert first.returncode == 143, first.stderr
+    last = first.stderr.strip().splitlines()[-1]
+    assert last.startswith("exit 143: interrupted (SIGTERM)") and "3 seam(s) welded" in last, last
+    st = read_journal(tmp_path / "r.journal.jsonl")
+    assert len(st.welds) == 3 and not st.interrupted and st.end is not None and st.end["outcome"] == "interrupted"
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert {s["id"] for s in rep["seams"] if s["welded"]} == set(st.welds) and rep["error"]["exit_code"] == 143
+
+    env.pop("CELL_JOURNAL_SIGNAL")
+    rest = subprocess.run([CELL, *ARGS, "--resume", "."], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert rest.returncode == 0, rest.stderr
+    st = read_journal(tmp_path / "r.journal.jsonl")
+    offs = [r["seam"] for r in st.records if r["kind"] == "arc_off"]
+    assert len(offs) == len(set(offs)) == 12 and st.runs == ("r1", "r2")  # every seam of side A once
+    rep = json.loads((tmp_path / "r.json").read_text())
+    runs = {s["id"]: s["run"] for s in rep["seams"] if s["welded"]}
+    assert rep["welded"] == 12 and sorted(runs.values()).count("r1") == 3 and set(runs.values()) == {"r1", "r2"}
+    assert all(s["tcp_error_mm"]["rms"] <= 0.3 for s in rep["seams"] if s["welded"])  # measured <= 0.1 mm
+    again = subprocess.run([CELL, *ARGS[:2], "--resume", "."], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert again.returncode == 2 and again.stderr.strip().splitlines()[-1].startswith("error: --resume")  # finished

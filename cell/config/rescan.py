@@ -86,5 +86,5 @@ class RescanOptions:
     closeup_locator_options: Mapping[str, Mapping[str, float | int | str | bool]] = field(
         default_factory=lambda: {"ours": CLOSEUP_OURS_OPTIONS}
     )
-    return_to_scan: bool = True  # go back to the scan configuration after the last view (when that move is free)
+    return_to_scan: bool = True  # go back to the scan configuration after the last view (straight, or the way it came)
     view: ViewOptions = field(default_factory=ViewOptions)

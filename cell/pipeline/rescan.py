@@ -60,6 +60,7 @@ class _Run:
     q: FloatArray
     moves: list[Trajectory] = field(default_factory=list)
     executions: list[Execution] = field(default_factory=list)
+    stops: list[FloatArray] = field(default_factory=list)  # where the arm stopped, reached by ptp legs in turn
 
     def play(self, move: Trajectory) -> None:
         """Drive the arm along ``move`` with the arc off, and record it."""
@@ -98,6 +99,7 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
         reason = f"unreachable view: {exc.message}"
         return [SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)]
     run.play(vp.move)
+    run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]
     image = run.station.capture_eye_in_hand(run.camera)
     out = [_closeup(run, seam_id, image, vp, vp.move.duration, t0)]
     for other, seen in shared_by(run, vp, pending):
@@ -183,6 +185,7 @@ def rescan_seams(
     obstacles and checker (built here when not given).
     """
     from cell.motion.timing import ptp
+    from cell.rescan.viewpoint import way_back
     from cell.seams.registry import make_locator
 
     sc = detection.scenario
@@ -200,6 +203,7 @@ def rescan_seams(
     checker = (motion or motion_scene(arm, detection)).checker
     locator = make_locator(detection.method, closeup_scenario(sc, detection.method, o))
     run = _Run(station, arm, detection, o, camera, checker, locator, station.joint_state())
+    run.stops.append(run.q)
     rng = sc.rng("rescan/view")
     done: dict[str, SeamRescan] = {}
     for k, sid in enumerate(seam_ids):
@@ -214,13 +218,15 @@ def rescan_seams(
     results = [done[sid] for sid in seam_ids]
     returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
     if o.return_to_scan and not returned:
-        back = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
-        hit = checker.check_path(back.q, back.times)
-        if hit is None:
+        # Straight back when that is free; else back the way it came to the last view it can go straight from.
+        back = way_back(arm.model, checker, run.stops, np.asarray(arm.q_scan, dtype=float), o.view.dt)
+        if back is not None:
             run.play(back)
             returned = True
         else:
-            note = f"left at the last view: the move back to the scan pose collides ({hit.describe()})"
+            direct = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
+            hit = checker.check_path(direct.q, direct.times)
+            note = f"left at the last view: no way back to the scan pose is free ({hit.describe() if hit else ''})"
     elif not returned:
         note = "left at the last view (return_to_scan is off)"
     fused_by_id = {r.id: r.fused for r in results}

@@ -198,6 +198,32 @@ def _move(
     return concatenate(legs), True
 
 
+def way_back(
+    model: RobotModel, checker: CollisionChecker, stops: Sequence[FloatArray], q_home: FloatArray, dt: float
+) -> Trajectory | None:
+    """A collision-free move from the last of ``stops`` to ``q_home``: straight there (a ptp) from the latest stop
+    that way is free from, after going back stop by stop along the straight joint lines the arm came by; None when
+    no stop has a free way home (or a leg back is not free: the arm did not come that way).
+
+    stops : (dof,) [rad] configurations the arm reached one after the other by rest-to-rest ptp moves, the first
+    where it started."""
+    legs: list[Trajectory] = []
+    for k in range(len(stops) - 1, -1, -1):
+        try:
+            home = ptp(stops[k], q_home, model.limits, dt=dt)
+        except TimingError:
+            return None
+        if checker.check_path(home.q, home.times) is None:
+            return concatenate([*legs, home])
+        if k == 0:
+            return None
+        leg = ptp(stops[k], stops[k - 1], model.limits, dt=dt)
+        if checker.check_path(leg.q, leg.times) is not None:
+            return None
+        legs.append(leg)
+    return None
+
+
 def concatenate(moves: Sequence[Trajectory]) -> Trajectory:
     """Rest-to-rest moves played one after the other, as one trajectory (each starts where the last ended)."""
     times, q, qd, qdd = [moves[0].times], [moves[0].q], [moves[0].qd], [moves[0].qdd]
@@ -223,4 +249,5 @@ __all__ = [
     "segments_hit_box",
     "torch_axis_in_camera",
     "view_candidates",
+    "way_back",
 ]

@@ -44,3 +44,33 @@ def test_no_geometric_candidate_is_a_view_error_with_nothing_tried(robot: RobotM
         plan_view(robot, CollisionChecker(robot, OBSTACLES), TOP, HOME, K, (wall,), 0.0, rng=np.random.default_rng(0))
     assert err.value.seam_id == "top" and err.value.tried == 0 and err.value.rejected == {}
     assert "no close-up view sees the seam" in err.value.message  # the words the re-scan report gives
+
+
+class _ForbiddenBox:
+    """A checker whose only obstacle is a box in joint space: a path hits when a sample's first two joints lie within
+    ``half`` [rad] of ``centre`` (offsets from HOME)."""
+
+    def __init__(self, centre: tuple[float, float], half: float) -> None:
+        self.centre, self.half = np.array(centre), half
+
+    def check_path(self, q: np.ndarray, times: np.ndarray) -> object | None:
+        inside = np.all(np.abs(q[:, :2] - HOME[:2] - self.centre) < self.half, axis=1)
+        return "hit" if inside.any() else None
+
+
+def test_the_way_back_retraces_the_legs_the_arm_came_by_when_straight_home_collides() -> None:
+    """Home -> B -> C by straight joint lines; straight from C home crosses the obstacle, from B it does not: the
+    way back is C -> B -> home, never inside the obstacle. With no stop free of it, there is no way back."""
+    from cell.rescan.viewpoint import way_back
+
+    model = RobotModel.from_urdf(URDF)
+    B, C = HOME + np.array([0.5, 0, 0, 0, 0, 0]), HOME + np.array([0.5, 0.5, 0, 0, 0, 0])
+    checker = _ForbiddenBox((0.25, 0.25), 0.05)
+    assert checker.check_path(np.linspace(C, HOME, 50), np.arange(50.0)) is not None  # straight home is not free
+    back = way_back(model, checker, [HOME, B, C], HOME, 0.01)  # type: ignore[arg-type]
+    assert back is not None
+    assert np.allclose(back.q[0], C) and np.allclose(back.q[-1], HOME)
+    assert np.min(np.linalg.norm(back.q - B, axis=1)) < 1e-9  # it passes through B
+    assert checker.check_path(back.q, back.times) is None
+    # The same obstacle on the leg C -> B as well: nothing the arm came by is free of it.
+    assert way_back(model, _ForbiddenBox((0.5, 0.25), 0.3), [HOME, B, C], HOME, 0.01) is None  # type: ignore[arg-type]

@@ -47,7 +47,7 @@ def interrupts_table(data: Row) -> str:
     lines.append("")
     lines.append(
         f"{data['passed']} of {len(data['cases'])} cases hold every check ({data['scenario']}, {data['seams']} seams; "
-        f"the uninterrupted run {data['uninterrupted_s']:.0f} s on the loaded machine; TCP bars {bars['tcp_rms']} mm "
+        f"the uninterrupted run {data['uninterrupted_s']:.0f} s; TCP bars {bars['tcp_rms']} mm "
         f"rms, {bars['tcp_max']} mm max)."
     )
     return "\n".join(lines) + "\n"

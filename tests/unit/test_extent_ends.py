@@ -78,6 +78,27 @@ def test_an_edge_with_no_density_inside_it_places_nothing() -> None:
     assert edge_fault(good, "f1", 0.006, False, o) == ""
 
 
+def _refined_ends(y: np.ndarray, length: float) -> tuple[End, End]:
+    """Both ends found with a dense cloud to refine them in (the last pass), from points of face A at the parameters
+    ``y`` [m] along a seam of ``length`` [m], spread over its height 5-30 mm."""
+    face_a = Face(np.array([-1.0, 0.0, 0.0]), 0.0, 2e-4, "A", 1e-5)
+    face_b = Face(np.array([0.0, 0.0, 1.0]), 0.0, 2e-4, "B", 1e-5)
+    t = np.array([0.0, 1.0, 0.0])
+    across = (End(-t, 0.0, False, 0.0), End(t, length, False, length))
+    noise = np.random.default_rng(1)
+
+    def points(y: np.ndarray) -> Points:
+        P = np.column_stack([np.zeros_like(y), y, noise.uniform(0.005, 0.03, len(y))])
+        return Points(P.T.copy(), np.zeros(len(y), np.intp), np.ones(len(y), bool), 5e-4, 1.0, 1)
+
+    def dense(a: np.ndarray, b: np.ndarray) -> Points:
+        lo, hi = sorted((float(a[1]), float(b[1])))
+        return points(y[(y >= lo) & (y <= hi)])
+
+    o = OursOptions(tube_radius_m=0.06)
+    return find_ends(across, {}, points(y), dense, face_a, face_b, np.zeros(3), t, [0.0, length], 0.04, o, (t, length))
+
+
 def test_an_edge_found_at_the_limit_of_its_search_is_no_edge(monkeypatch: pytest.MonkeyPatch) -> None:
     """Face A's points thin out over the last 15 mm to its end (seen more and more edge-on, partly hidden): the
     edge likelihood's best edge, with a finite standard error, lies at the end of the range it searches about the
@@ -93,27 +114,10 @@ def test_an_edge_found_at_the_limit_of_its_search_is_no_edge(monkeypatch: pytest
 
     monkeypatch.setattr(ends_module, "edge_fit", spy)
     length, ramp = 0.08, 0.015
-    face_a = Face(np.array([-1.0, 0.0, 0.0]), 0.0, 2e-4, "A", 1e-5)
-    face_b = Face(np.array([0.0, 0.0, 1.0]), 0.0, 2e-4, "B", 1e-5)
-    t = np.array([0.0, 1.0, 0.0])
-    across = (End(-t, 0.0, False, 0.0), End(t, length, False, length))
     rng = np.random.default_rng(0)
     y = rng.uniform(0.0, length, 20000)
     y = y[(y > ramp) | (rng.uniform(0.0, 1.0, len(y)) < y / ramp)]
-    noise = np.random.default_rng(1)
-
-    def points(y: np.ndarray) -> Points:
-        P = np.column_stack([np.zeros_like(y), y, noise.uniform(0.005, 0.03, len(y))])
-        return Points(P.T.copy(), np.zeros(len(y), np.intp), np.ones(len(y), bool), 5e-4, 1.0, 1)
-
-    def dense(a: np.ndarray, b: np.ndarray) -> Points:
-        lo, hi = sorted((float(a[1]), float(b[1])))
-        return points(y[(y >= lo) & (y <= hi)])
-
-    o = OursOptions(tube_radius_m=0.06)
-    start, _ = find_ends(
-        across, {}, points(y), dense, face_a, face_b, np.zeros(3), t, [0.0, length], 0.04, o, (t, length)
-    )
+    start, _ = _refined_ends(y, length)
     assert any(f.at_limit and np.isfinite(f.se) for f in fits)  # the case this is about
     assert start.source == "extent"
     assert abs(start.s) <= 2.0 * np.hypot(start.spread, start.bias)
@@ -124,26 +128,10 @@ def test_a_sharp_edge_far_from_the_extrapolation_is_found_at_the_faces_last_poin
     quantiles' line puts both ends 17-19 mm inside, where the edge likelihood finds no edge within its search.
     Searched again about the face's last point, the sharp edge there is found, within its sigma."""
     length, band = 0.2, 0.03
-    face_a = Face(np.array([-1.0, 0.0, 0.0]), 0.0, 2e-4, "A", 1e-5)
-    face_b = Face(np.array([0.0, 0.0, 1.0]), 0.0, 2e-4, "B", 1e-5)
-    t = np.array([0.0, 1.0, 0.0])
-    across = (End(-t, 0.0, False, 0.0), End(t, length, False, length))
     rng = np.random.default_rng(0)
     y = rng.uniform(0.0, length, 20000)
     y = y[((y > band) & (y < length - band)) | (rng.uniform(0.0, 1.0, len(y)) < 0.3)]
-    noise = np.random.default_rng(1)
-
-    def points(y: np.ndarray) -> Points:
-        P = np.column_stack([np.zeros_like(y), y, noise.uniform(0.005, 0.03, len(y))])
-        return Points(P.T.copy(), np.zeros(len(y), np.intp), np.ones(len(y), bool), 5e-4, 1.0, 1)
-
-    def dense(a: np.ndarray, b: np.ndarray) -> Points:
-        lo, hi = sorted((float(a[1]), float(b[1])))
-        return points(y[(y >= lo) & (y <= hi)])
-
-    o = OursOptions(tube_radius_m=0.06)
-    ends = find_ends(across, {}, points(y), dense, face_a, face_b, np.zeros(3), t, [0.0, length], 0.04, o, (t, length))
-    for found, true in zip(ends, (0.0, length), strict=True):
+    for found, true in zip(_refined_ends(y, length), (0.0, length), strict=True):
         assert found.source == "extent"
         sigma = np.hypot(found.spread, found.bias)
         assert abs(found.s - true) <= 2.0 * sigma  # measured 0.06-0.11 mm at 0.26 mm

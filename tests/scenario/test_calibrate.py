@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from PIL import Image
 from typer.testing import CliRunner
 
 from cell import scenario as sc
@@ -57,6 +58,15 @@ def test_a_fixed_camera_is_measured_and_a_board_of_the_wrong_size_is_refused(tmp
     replayed = read(again)["cameras"]["cam_right"]
     assert "truth_error" not in replayed
     assert np.allclose(replayed["measured"]["xyz_m"], entry["measured"]["xyz_m"], atol=2e-6)
+
+    # A camera that sees the board in none of its images (their colour grey: a lens cap, a camera looking away).
+    for png in folder.glob("cam_right_[0-9][0-9][0-9].png"):
+        with Image.open(png) as im:
+            size = im.size
+        Image.new("RGB", size, (128, 128, 128)).save(png, format="PNG")
+    result = runner.invoke(app, ["calibrate", "--capture", str(folder), "--held-out", "2", "--out", str(again)])
+    assert result.exit_code == 17, result.stderr
+    assert "cam_right: the board is found in 0 of the capture's images" in result.stderr
 
     big = _scenario_file(tmp_path, "big-board", board_scale=1.05)
     result = runner.invoke(app, ["calibrate", str(big), "--cameras", "cam_right", "--poses", "4", "--out", str(cal)])

@@ -217,7 +217,10 @@ def way_back(
             return concatenate([*legs, home])
         if k == 0:
             return None
-        leg = ptp(stops[k], stops[k - 1], model.limits, dt=dt)
+        try:
+            leg = ptp(stops[k], stops[k - 1], model.limits, dt=dt)
+        except TimingError:
+            return None
         if checker.check_path(leg.q, leg.times) is not None:
             return None
         legs.append(leg)

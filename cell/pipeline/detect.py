@@ -174,44 +174,24 @@ def build_scene(
 def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress = quiet) -> tuple[SeamEstimate, ...]:
     """Run one locator over every seam of the aligned map; seams no camera can see are reported, not searched."""
     from cell.perception import screen
-    from cell.seams.base import BatchSeamLocator
+    from cell.seams.base import locate_all
     from cell.seams.checks import check_ends
     from cell.seams.joint import weld_faces
     from cell.seams.registry import make_locator, part_tolerance_m
-    from cell.seams.visibility import visibility
 
     ss = scene.seam_scene
     locator = make_locator(method, scenario)
     rng = scenario.rng(f"locator/{method}")
     progress(f"locating {len(ss.weldmap.seams)} seams ({method})")
-    hidden: dict[str, SeamEstimate] = {}
-    for seam in ss.weldmap.seams:
-        visible, reason = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
-        if not visible:
-            hidden[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, reason, code=Reason.UNDERSIDE)
-    seams = [seam for seam in ss.weldmap.seams if seam.id not in hidden]
-    timed: dict[str, SeamEstimate] = {}
-    if locator.reads_voxel_cloud and seams:
-        _ = ss.cloud  # perception's work (the merge), made before the locator's clock starts
-    if isinstance(locator, BatchSeamLocator) and seams:
-        # Found together: each seam is charged an equal share of the whole batch's time.
-        t = time.perf_counter()
-        found = locator.locate_many(ss, seams, rng)
-        dt = (time.perf_counter() - t) / len(seams)
-        timed = {est.id: replace(est, time_s=dt) for est in found}
-    else:
-        for seam in seams:
-            t = time.perf_counter()
-            est = locator.locate(ss, seam, rng)
-            timed[seam.id] = replace(est, time_s=time.perf_counter() - t)
-    out = tuple(hidden[seam.id] if seam.id in hidden else timed[seam.id] for seam in ss.weldmap.seams)
+    out = locate_all(locator, ss, rng)
+    searched = [e.id for e in out if e.status is not SeamStatus.NOT_VISIBLE]
     # Ends inside another body, off their joint's faces or making a length the map does not draw: cut or replaced.
     out = check_ends(ss.weldmap, ss.joints, out, part_tolerance_m(scenario, method))
     # Missing parts, occluders (points the map does not explain) and near-zero confidence: never a guess.
     out = screen(ss, out, scene.missing, scenario.perception.screen)
     # A seam resting on one camera carries that camera's calibration error (the locator's sigma cannot see it).
     p = scene.perceived
-    faces = {s.id: weld_faces(ss.weldmap, ss.joints[s.id]) for s in seams if s.id in ss.joints}
+    faces = {i: weld_faces(ss.weldmap, ss.joints[i]) for i in searched if i in ss.joints}
     return with_calibration(
         out, p.registered, p.origins_R, pose_uncertainties(scenario), p.spliced.registrations, faces
     )

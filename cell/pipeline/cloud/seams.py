@@ -4,7 +4,6 @@ pulls in the simulator), our locator built with the crop of the brought cloud ra
 
 from __future__ import annotations
 
-import time
 from collections.abc import Mapping
 from dataclasses import fields, replace
 
@@ -13,7 +12,6 @@ import numpy as np
 from cell.perception.align.drawn import past_drawn_edge
 from cell.perception.seam_screen import screen
 from cell.scenario import Scenario
-from cell.seams.visibility import visibility
 from cell.types import Box, Reason, SeamEstimate, SeamScene, SeamStatus
 
 
@@ -22,7 +20,7 @@ def locate_seams(
 ) -> tuple[SeamEstimate, ...]:
     """Every seam of ``ss``'s map (frame L) located by ``method`` (ours with the scenario's options, cut at
     ``workspace_L``), the underside ones NOT_VISIBLE, then screened (missing parts, occluders, doubt)."""
-    from cell.seams.base import BatchSeamLocator, SeamLocator
+    from cell.seams.base import SeamLocator, locate_all
     from cell.seams.checks import check_ends
     from cell.seams.ours import OursLocator, OursOptions
     from cell.seams.registry import locator_spec, make_locator, part_tolerance_m
@@ -34,22 +32,7 @@ def locate_seams(
     else:
         locator = make_locator(method, scenario)
     rng = scenario.rng(f"locator/{method}")
-    out: dict[str, SeamEstimate] = {}
-    for seam in ss.weldmap.seams:
-        visible, why = visibility(ss.weldmap, ss.joints[seam.id], ss.table_z)
-        if not visible:
-            out[seam.id] = SeamEstimate(seam.id, SeamStatus.NOT_VISIBLE, why, code=Reason.UNDERSIDE)
-    todo = [s for s in ss.weldmap.seams if s.id not in out]
-    if isinstance(locator, BatchSeamLocator) and todo:
-        t = time.perf_counter()
-        found = locator.locate_many(ss, todo, rng)
-        dt = (time.perf_counter() - t) / len(todo)
-        out.update({e.id: replace(e, time_s=dt) for e in found})
-    else:
-        for seam in todo:
-            t = time.perf_counter()
-            out[seam.id] = replace(locator.locate(ss, seam, rng), time_s=time.perf_counter() - t)
-    estimates = tuple(unseen_reason(out[s.id]) for s in ss.weldmap.seams)
+    estimates = tuple(unseen_reason(e) for e in locate_all(locator, ss, rng))
     tolerance = part_tolerance_m(scenario, method)
     estimates = check_ends(ss.weldmap, ss.joints, estimates, tolerance)
     estimates = tuple(not_as_drawn(ss, e, tolerance) for e in estimates)

@@ -141,3 +141,20 @@ def map_cloud(
         under |= part.contains(table, margin=1e-4)
     p_M = np.vstack([p_M, table[~under]])
     return transform_points(X_FM, p_M) + rng.normal(0.0, noise_m, size=p_M.shape)
+
+
+def seen_faces(weldmap: WeldMap, spacing_m: float) -> Points:
+    """Points (n, 3) [m] in M on the map's box faces a scanner above the parts and to their side sees (normals up,
+    along +y or along x), on a ``spacing_m`` grid (:func:`cell.perception.align.fit.sample_box_faces`), none inside
+    another part."""
+    from cell.perception.align.fit import sample_box_faces
+
+    out = []
+    for part in weldmap.parts:
+        p, n = sample_box_faces(part.box, spacing_m)
+        keep = (n[:, 2] > 0.5) | (n[:, 1] > 0.5) | (np.abs(n[:, 0]) > 0.5)
+        for other in weldmap.parts:
+            if other is not part:
+                keep &= ~other.contains(p, 0.001)
+        out.append(p[keep])
+    return np.concatenate(out)

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cloud_writers import seen_faces
 
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
-from cell.perception.align.fit import sample_box_faces
 from cell.perception.ground import TableSource, find_ground
 from cell.pipeline import locate_cloud
 from cell.types import Cloud, SeamStatus, WeldMap
@@ -26,15 +26,8 @@ def _scan(weldmap: WeldMap, X_FM: FloatArray, rng: np.random.Generator) -> Float
     """A 0.7 x 0.5 m table at z = 0 (3 mm grid) and the tee's faces seen from above and from +y, with noise."""
     x, y = np.meshgrid(np.arange(-0.2, 0.5, 0.003), np.arange(-0.25, 0.25, 0.003))
     table = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
-    parts = []
-    for part in weldmap.parts:
-        p, n = sample_box_faces(part.box, 0.0025)
-        keep = (n[:, 2] > 0.5) | (n[:, 1] > 0.5) | (np.abs(n[:, 0]) > 0.5)
-        for other in weldmap.parts:
-            if other is not part:
-                keep &= ~other.contains(p, 0.001)
-        parts.append(p[keep & (p[:, 2] > 1e-4)])
-    P_F = transform_points(X_FM, np.concatenate(parts))
+    faces_M = seen_faces(weldmap, 0.0025)
+    P_F = transform_points(X_FM, faces_M[faces_M[:, 2] > 1e-4])
     under = np.any([part.contains(table, 0.0) for part in weldmap.transformed(X_FM, "F").parts], axis=0)
     P = np.vstack([table[~under], P_F])
     return P + rng.normal(0.0, NOISE, P.shape)

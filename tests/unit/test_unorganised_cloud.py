@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cloud_writers import seen_faces
 
 from cell.geometry import FloatArray, make_pose, rpy_to_matrix, transform_points
-from cell.perception.align.fit import sample_box_faces
 from cell.perception.unorganised import find_table, levelling, orient_normals, sampling
 from cell.pipeline import locate_cloud
 from cell.types import Cloud, SeamStatus, WeldMap
@@ -35,15 +35,7 @@ def _table(rng: np.random.Generator) -> FloatArray:
 
 def _part(weldmap: WeldMap, X_FM: FloatArray, rng: np.random.Generator) -> FloatArray:
     """The tee's faces seen from above and from -y (the others in shadow), 2.5 mm samples, with noise."""
-    out = []
-    for part in weldmap.parts:
-        p, n = sample_box_faces(part.box, 0.0025)
-        keep = (n[:, 2] > 0.5) | (n[:, 1] > 0.5) | (np.abs(n[:, 0]) > 0.5)
-        for other in weldmap.parts:
-            if other is not part:
-                keep &= ~other.contains(p, 0.001)
-        out.append(p[keep])
-    P = transform_points(X_FM, np.concatenate(out))
+    P = transform_points(X_FM, seen_faces(weldmap, 0.0025))
     return P + rng.normal(0.0, NOISE, P.shape)
 
 

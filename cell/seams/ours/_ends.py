@@ -212,18 +212,18 @@ def find_ends(
             # point of the dense cloud within the likelihood's window about it.
             sign = 1.0 if k == 1 else -1.0
             reach = EDGE_WINDOW_M + o.edge_band_m + abs(c) * o.tube_radius_m  # the whole side line's points
-            d, fit = _edge_in(dense, along_a, p0, t, sign, extent[k], reach)
+            d, s_d, fit = _edge_in(dense, along_a, p0, t, sign, extent[k], reach)
             if fit.at_limit:
                 # The best edge at the end of the range searched: the extrapolation was that far off (a face thinned
                 # out unevenly). Searched again about the face's last point; at the limit again, no edge was found
                 # (a density that falls off over millimetres, a face seen ever more edge-on, strays far past it):
                 # the extrapolation stands, with its miss.
-                d, fit = _edge_in(dense, along_a, p0, t, sign, (s_a.min(), s_a.max())[k], reach)
+                d, s_d, fit = _edge_in(dense, along_a, p0, t, sign, (s_a.min(), s_a.max())[k], reach)
             if fit.ok:
                 # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
                 # 3 spacings; the end's sigma is the likelihood's standard error and what the sample cannot resolve
                 # (edge_bias).
-                inside = np.count_nonzero(np.abs(along_a(d) - sign * fit.b) < EDGE_WINDOW_M)
+                inside = np.count_nonzero(np.abs(s_d - fit.b) < EDGE_WINDOW_M)
                 density = inside / (2.0 * EDGE_WINDOW_M)  # [1/m]
                 bias = edge_bias(d.pitch, max(face_a.scale, fit.blur))
                 placed[k] = end.at(sign * fit.b, max(fit.se, 3.0 / max(density, 1.0)), "extent", fit.se, bias)
@@ -240,14 +240,15 @@ def _edge_in(
     sign: float,
     guess: float,
     reach: float,
-) -> tuple[Points, EdgeFit]:
-    """The dense points within ``reach`` [m] of ``guess`` (a parameter along p0 + s t [m]) and the edge likelihood's
-    fit of the face's end there, in its window about the guess, searched within :data:`EDGE_SEARCH_M` of it: the
-    upper end for ``sign`` +1, the lower for -1 (the fit's ``b`` is then the parameter's negative). ``along``: the
-    parameters of the face's points among dense points."""
+) -> tuple[Points, FloatArray, EdgeFit]:
+    """The dense points within ``reach`` [m] of ``guess`` (a parameter along p0 + s t [m]), the face's points'
+    parameters among them times ``sign``, and the edge likelihood's fit of the face's end there, in its window about
+    the guess, searched within :data:`EDGE_SEARCH_M` of it: the upper end for ``sign`` +1, the lower for -1 (the
+    parameters and the fit's ``b`` are then negated). ``along``: the parameters of the face's points among dense
+    points."""
     d = dense(p0 + (guess - reach) * t, p0 + (guess + reach) * t)
     s, g = sign * along(d), sign * guess
-    return d, edge_fit(s, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
+    return d, s, edge_fit(s, g - EDGE_WINDOW_M, g + EDGE_WINDOW_M, g - EDGE_SEARCH_M, g + EDGE_SEARCH_M)
 
 
 def within_receiving(ends: tuple[End, End], s_b: tuple[float, float], margin: float) -> tuple[End, End]:

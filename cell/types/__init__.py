@@ -3,6 +3,7 @@ from here and nothing here imports a stage. Frames: ``W`` world, ``R`` robot bas
 optical frame, ``B`` a box part's own frame. Metres and radians inside; millimetres and degrees only at the edges."""
 
 from cell.types._near import pair_distance
+from cell.types.curve_estimate import CurveEstimate
 from cell.types.curves import ArcCurve, CurvedJoint, CurvedSeam, Cylinder, EllipseCurve, SampledCurve, Surface
 from cell.types.execution import Event, Execution, WeldQuality
 from cell.types.gate import Violation, ViolationKind
@@ -36,6 +37,7 @@ __all__ = [
     "CellView",
     "CheckFail",
     "Cloud",
+    "CurveEstimate",
     "CurvedJoint",
     "CurvedSeam",
     "Cylinder",

@@ -83,6 +83,23 @@ def not_supported_text(summary: Mapping[str, Any]) -> str:
     return f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())
 
 
+def print_curves(rep: Mapping[str, Any]) -> None:
+    """One line per curved seam of a report: found or why not, its sigmas, its error against the true curve (in
+    simulation), its time, and why it is not welded."""
+    for s in rep["seams"]:
+        if not s.get("curved"):
+            continue
+        c, e = s.get("curve"), s.get("error_mm")
+        line = f"curved {s['id']}: {s['status']}"
+        if c is not None:
+            ends = "closed" if c["closed"] else "ends +-" + "/".join(_fmt(v) for v in c["end_sigma_mm"]) + " mm"
+            line += f", {ends}, sigma max {_fmt(c['sigma_max_mm'])} mm"
+        if e is not None:
+            line += f", error rms {_fmt(e['rms'])} / max {_fmt(e['max'])} mm"
+        line += f", {_fmt(s['time_ms'], 1)} ms; not welded ({s['not_welded']['code']})"
+        out.print(line, soft_wrap=True, markup=False)
+
+
 def _value(cell: str) -> str | float | None:
     if cell == "-":
         return None
@@ -173,6 +190,7 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
     out.print(t)
     out.print(WELD_LEGEND, soft_wrap=True, markup=False)
     _why_lines(whys)
+    print_curves(rep)
     out.print(weld_summary(rep), soft_wrap=True)
     print_timings(rep)
 
@@ -237,6 +255,7 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
     out.print(t)
     out.print(DETECT_LEGEND, soft_wrap=True, markup=False)
     _why_lines([(s["id"], s["reason"]) for s in rep["seams"] if s["status"] != "found"])
+    print_curves(rep)
     m = rep["summary"]
     unsupported = not_supported_text(m)
     out.print(

@@ -116,7 +116,10 @@ def _facing(m1: SurfaceModel, m2: SurfaceModel, q1: FloatArray, q2: FloatArray) 
 
 
 def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> CurveEstimate:
-    return CurveEstimate(seam.id, SeamStatus.NOT_FOUND, f"curved seam {seam.id}: {why}", code=code)
+    """NOT_FOUND with ``why``; NOT_SUPPORTED (never searched) when ``code`` says the seam's geometry is not one
+    this locator handles."""
+    status = SeamStatus.NOT_SUPPORTED if code is Reason.NOT_SUPPORTED else SeamStatus.NOT_FOUND
+    return CurveEstimate(seam.id, status, f"curved seam {seam.id}: {why}", code=code)
 
 
 def locate_curve(scene: SeamScene, seam: CurvedSeam) -> CurveEstimate:

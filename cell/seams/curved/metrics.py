@@ -3,24 +3,11 @@ the located curve's length (its RMS and largest), and how many samples lie withi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray
-from cell.types.curve_estimate import CurveEstimate
-
-
-@dataclass(frozen=True)
-class CurveError:
-    """rms_mm, max_mm : the located samples' distances to the true curve [mm]; within_2sigma : the share of the
-    samples whose distance is at most twice their sigma; samples : how many were measured."""
-
-    rms_mm: float
-    max_mm: float
-    within_2sigma: float
-    samples: int
+from cell.types.curve_estimate import CurveEstimate, CurveMetrics
 
 
 def distances_to_polyline(p: FloatArray, truth: FloatArray, closed: bool) -> FloatArray:
@@ -39,10 +26,10 @@ def distances_to_polyline(p: FloatArray, truth: FloatArray, closed: bool) -> Flo
     return best
 
 
-def curve_error(est: CurveEstimate, truth: FloatArray) -> CurveError:
+def curve_error(est: CurveEstimate, truth: FloatArray) -> CurveMetrics:
     """``est`` (found) measured against its true curve ``truth`` (k, 3) [m], both in R."""
     d = distances_to_polyline(np.asarray(est.p_RS), truth, est.closed)
-    return CurveError(
+    return CurveMetrics(
         rms_mm=float(np.sqrt(np.mean(d**2))) * 1000.0,
         max_mm=float(d.max()) * 1000.0,
         within_2sigma=float(np.mean(d <= 2.0 * np.asarray(est.sigma_m))),

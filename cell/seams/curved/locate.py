@@ -13,13 +13,11 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray
-from cell.seams._features import NORMAL_RADIUS_SPACINGS, estimate_normals
 from cell.seams._index import dense_index
 from cell.seams.curved.cut import outside_parts
 from cell.seams.curved.fit import SurfaceFit, fit_surface
 from cell.seams.curved.surfaces import CylinderModel, PlaneModel, SurfaceModel, crossing_covariance, intersect
 from cell.seams.curved.surfaces import param_jacobian as dtheta
-from cell.seams.sigma import TILT_TOLERANCE_RAD
 from cell.types import CurvedSeam, Part, Reason, SeamScene, SeamStatus, Surface, WeldMap
 from cell.types.curve_estimate import CurveEstimate
 from cell.weldmap.curved_joints import holding_face
@@ -29,16 +27,16 @@ STEP_M = 0.001  # the located curve's samples are about this far apart [m]
 BAND_M = 0.003  # a surface's points lie within this of the map's surface [m] (the aligned map's error is less)
 CLEARANCE_M = 0.002  # points this close to the other surface are left out (the corner's blur, a tack) [m]
 REACH_M = 0.025  # how far from the other surface a plane's points are taken [m]: the fit is local
-ROUND_REACH_M = 0.060  # and a tube's [m]: its axis's direction wants a longer lever
+ROUND_REACH_M = 0.120  # and a tube's [m]: its axis's direction wants a longer lever
 RADIUS_SHARE = 0.005  # a tube's outer radius as made, one sigma: EN 10219's +-1 % of the diameter as two sigma
 SHARE = 0.25  # the dense cloud's layer looked at (one of its index's shares)
-MAX_POINTS = 3000  # per surface: more are thinned evenly (the fit's standard error shrinks little past it)
+MAX_POINTS = 1500  # per surface: more are thinned evenly (the fit's standard error shrinks little past it)
 MIN_POINTS = 60  # fewer points on a surface: the data does not hold it
 MAX_MOVE_M = 0.010  # a located curve further than this from the drawn one is not the seam [m]
 MAX_SIGMA_M = 0.002  # a located curve with a sigma larger than this somewhere is not reported [m]
 FACE_EDGE_M = 0.002  # a plane's points this close to its face's edges are left out [m]
 NORMAL_ANGLE_RAD = math.radians(45.0)  # a point whose normal is further than this from its surface's is not on it
-NORMAL_NEIGHBOURS = 12
+NORMAL_NEIGHBOURS = 8  # a point and its nearest neighbours make its patch
 OTHER_PART_M = 0.002  # points this close to (or inside) a part of the map other than the two are not theirs [m]
 
 # How much wider the spread of the located curve is than its propagated standard error, and a floor for what no
@@ -61,10 +59,10 @@ def _model(part: Part, kind: Surface, p_R: FloatArray) -> SurfaceModel | str:
     return PlaneModel(centre - (centre @ n - d) * n, n)
 
 
-def _candidates(scene: SeamScene, seam: CurvedSeam, models: Sequence[SurfaceModel]) -> FloatArray:
-    """(m, 3) the dense cloud's points of the layer :data:`SHARE` about the curve (a tube along its round part)."""
+def _candidates(scene: SeamScene, p: FloatArray, models: Sequence[SurfaceModel]) -> FloatArray:
+    """(m, 3) the dense cloud's points of the layer :data:`SHARE` about the curve through the points p (n, 3) (a
+    tube along its round part)."""
     cyl = next(m for m in models if isinstance(m, CylinderModel))
-    p = seam.sample(5 * STEP_M)
     along = (p - cyl.c0) @ cyl.u0
     a, b = cyl.c0 + (along.min() - ROUND_REACH_M) * cyl.u0, cyl.c0 + (along.max() + ROUND_REACH_M) * cyl.u0
     pts, _ = dense_index(scene).tube(a, b, cyl.r0 + REACH_M + BAND_M, 0.0, SHARE)
@@ -85,7 +83,7 @@ def _prior(model: SurfaceModel) -> FloatArray | None:
     (:data:`~cell.seams.sigma.TILT_TOLERANCE_RAD`) about the aligned map's; a plane's pose is left to the points."""
     if not isinstance(model, CylinderModel):
         return None
-    return np.array([np.inf, np.inf, TILT_TOLERANCE_RAD, TILT_TOLERANCE_RAD, RADIUS_SHARE * model.r0])
+    return np.array([np.inf, np.inf, np.inf, np.inf, RADIUS_SHARE * model.r0])
 
 
 def _on_face(part: Part, model: SurfaceModel, q: FloatArray) -> FloatArray:
@@ -99,20 +97,20 @@ def _on_face(part: Part, model: SurfaceModel, q: FloatArray) -> FloatArray:
 
 
 def _facing(m1: SurfaceModel, m2: SurfaceModel, q1: FloatArray, q2: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """The points q1, q2 (k, 3) of each surface whose normal (PCA of their neighbours among both) lies within
-    :data:`NORMAL_ANGLE_RAD` of their surface's: a side face, an edge or a bore beside the surface is not it."""
+    """The points q1, q2 (k, 3) of each surface whose neighbourhood (among both) lies flat across their surface's
+    normal g: the spread along g is at most sin^2(:data:`NORMAL_ANGLE_RAD`) / 2 of the whole (a flat patch tilted
+    by that angle from the surface; a side face, an edge or a stray point beside the surface is not on it)."""
     both = np.vstack([q1, q2])
-    if len(both) < NORMAL_NEIGHBOURS:
+    if len(both) <= NORMAL_NEIGHBOURS:
         return q1, q2
     tree = cKDTree(both)
-    d, _ = tree.query(both[:: max(1, len(both) // 200)], k=2)
-    radius = NORMAL_RADIUS_SPACINGS * max(float(np.median(d[:, 1])), 1e-4)
-    normals = estimate_normals(tree, both, radius)
-    out = []
-    for m, q, n in ((m1, q1, normals[: len(q1)]), (m2, q2, normals[len(q1) :])):
-        g = m.implicit(np.zeros(m.size))(q)[1]
-        out.append(q[np.abs(np.einsum("ij,ij->i", np.nan_to_num(n), g)) >= math.cos(NORMAL_ANGLE_RAD)])
-    return out[0], out[1]
+    _, idx = tree.query(both, k=NORMAL_NEIGHBOURS)
+    nb = both[idx] - both[idx].mean(axis=1, keepdims=True)  # (n, k, 3)
+    g = np.vstack([m1.implicit(np.zeros(m1.size))(q1)[1], m2.implicit(np.zeros(m2.size))(q2)[1]])
+    along = np.einsum("nkd,nd->nk", nb, g)
+    ratio = (along**2).sum(axis=1) / np.maximum((nb**2).sum(axis=(1, 2)), 1e-30)
+    flat = ratio <= 0.5 * math.sin(NORMAL_ANGLE_RAD) ** 2
+    return q1[flat[: len(q1)]], q2[flat[len(q1) :]]
 
 
 def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> CurveEstimate:
@@ -137,7 +135,7 @@ def locate_curve(scene: SeamScene, seam: CurvedSeam) -> CurveEstimate:
             return _not_found(seam, m, Reason.NOT_SUPPORTED)
     m1, m2 = models[0], models[1]
     assert not isinstance(m1, str) and not isinstance(m2, str)
-    p = _candidates(scene, seam, (m1, m2))
+    p = _candidates(scene, drawn, (m1, m2))
     f1, f2 = m1.value(p, np.zeros(m1.size)), m2.value(p, np.zeros(m2.size))
     on1 = (np.abs(f1) < BAND_M) & (f2 > CLEARANCE_M) & (f2 < _reach(m1))
     on2 = (np.abs(f2) < BAND_M) & (f1 > CLEARANCE_M) & (f1 < _reach(m2))

@@ -13,12 +13,16 @@ from cell.types.curve_estimate import CurveEstimate, CurveMetrics
 def distances_to_polyline(p: FloatArray, truth: FloatArray, closed: bool) -> FloatArray:
     """(n,) the distance [m] of each point p (n, 3) to the polyline ``truth`` (k, 3) (its last point joined to its
     first when ``closed``): to the nearer of the two segments at the nearest vertex."""
-    t = np.vstack([truth, truth[:1]]) if closed else np.asarray(truth)
+    t = np.asarray(truth)
+    k = len(t)
     _, i = cKDTree(t).query(p)
     best = np.full(len(p), np.inf)
     for lo in (i - 1, i):
-        ok = (lo >= 0) & (lo < len(t) - 1)
-        a, b = t[np.clip(lo, 0, len(t) - 2)], t[np.clip(lo + 1, 1, len(t) - 1)]
+        if closed:
+            ok, a, b = np.ones(len(p), bool), t[lo % k], t[(lo + 1) % k]
+        else:
+            ok = (lo >= 0) & (lo < k - 1)
+            a, b = t[np.clip(lo, 0, k - 2)], t[np.clip(lo + 1, 1, k - 1)]
         ab = b - a
         s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-30), 0.0, 1.0)
         d = np.linalg.norm(p - (a + s[:, None] * ab), axis=1)

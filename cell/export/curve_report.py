@@ -38,9 +38,11 @@ def curve_entry(u: UnsupportedSeam, est: CurveEstimate, m: CurveMetrics | None) 
             "closed": est.closed,
             "samples": len(est.p_RS),
             "length_mm": _r(est.length_m * 1000.0, 2),
-            "start": [_r(float(v), 7) for v in est.p_RS[0]],
             "sigma_max_mm": _r(est.sigma_max_m * 1000.0),
             "end_sigma_mm": None if est.closed else [_r(v * 1000.0) for v in est.end_sigma_m],
+            # The samples in the report's frame [m], about 1 mm apart, start to end, and each one's sigma [mm].
+            "points": [[_r(float(v), 7) for v in p] for p in est.p_RS],
+            "sigma_mm": [_r(float(v) * 1000.0) for v in est.sigma_m],
         }
         entry["confidence"] = _r(est.confidence)
     if m is not None:

@@ -4,15 +4,21 @@ and the other locators answering NOT_SUPPORTED."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
 import ezdxf
 import numpy as np
 import pytest
+from cloud_writers import ply_binary
 from dxf_factory import make_maps
 from round_meshes import add_tube_on_plane_seam, plane_cut, pose, rot_y, tube_mesh
+from typer.testing import CliRunner
 
+from cell.cli import app
+from cell.errors import EXIT_PARTIAL
+from cell.geometry import make_pose, rpy_to_matrix, transform_points
 from cell.seams.curved import locate_curves
 from cell.seams.curved.cut import longest_run
 from cell.seams.curved.fit import fit_surface
@@ -39,6 +45,10 @@ def _tube_on_plate(tmp_path: Path, lean_deg: float) -> WeldMap:
     path = tmp_path / "tube.dxf"
     doc.saveas(path)
     return read_map(path)
+
+
+def _flat(z0: float, z1: float):  # type: ignore[no-untyped-def]
+    return (lambda x, y: z0), (lambda x, y: z1)
 
 
 def _cloud(c: Cylinder, rng: np.random.Generator, share: float = 1.0) -> np.ndarray:
@@ -117,9 +127,10 @@ def test_the_located_curve_lies_within_two_sigma_of_the_true_one(tmp_path: Path,
         n = np.asarray(est.n_receiving_R)
         assert np.allclose(n, [0.0, 0.0, 1.0], atol=0.01)  # the plate's outward normal at every sample
     r, e = np.concatenate(ratios), np.concatenate(errs)
-    # Independent noise: the sigma covers the error (measured: every sample within 2 sigma), and is not much too wide
-    # (measured: the median sample's error 0.29 and 0.36 of its sigma; the largest error 0.11 and 0.20 mm).
-    assert float(np.mean(r <= 2.0)) >= 0.97 and 0.2 < float(np.median(r)) < 1.0
+    # Independent noise: the sigma covers the error (measured: every sample within 2 sigma) and is not much too wide
+    # though it carries a floor for a real camera's biases these points do not have (measured: the median sample's
+    # error 0.19 and 0.23 of its sigma; the largest error 0.11 and 0.20 mm).
+    assert float(np.mean(r <= 2.0)) >= 0.97 and 0.12 < float(np.median(r)) < 0.5
     assert float(e.max()) < 0.00025
 
 
@@ -149,3 +160,52 @@ def test_other_locators_say_not_supported_and_a_third_part_cuts_the_curve(tmp_pa
     assert not cut.closed and len(cut.p_RS) == len(est.p_RS) - 20
     assert np.allclose(cut.p_RS[0], est.p_RS[30]) and np.allclose(cut.p_RS[-1], est.p_RS[9])
     assert all(0.0 < s < 0.001 for s in cut.end_sigma_m)
+
+
+def test_cell_locate_finds_the_circle_in_a_brought_lidar_cloud(tmp_path: Path) -> None:
+    """A tube standing on a 400 x 240 plate off its middle, scanned (its round, the plate, the table) at a known
+    pose with lidar-like noise (1.2 mm per axis) and written as a binary PLY: ``cell locate`` finds the fillet's
+    circle within 2 mm of the true one, reports it with its sigma, and the run stays partial (no torch path yet)."""
+    doc = ezdxf.new("R2018", units=4)
+    msp = doc.modelspace()
+    doc.layers.add("WELD_SEAMS", color=1)
+    make_maps.box_mesh((-200, -120, 0), (200, 120, 20)).render_mesh(msp, dxfattribs={"layer": "PLATE"})
+    X = pose(np.eye(3), (60.0, 30.0, 20.0))
+    tube_mesh(30.15, 26.15, 64, *_flat(0.0, 180.0), X).render_mesh(msp, dxfattribs={"layer": "TUBE"})
+    add_tube_on_plane_seam(msp, "TUBE>PLATE", (60.0, 30.0, 20.0), (0, 0, 1), 30.15, (0, 0, 1), "WELD_SEAMS")
+    doc.saveas(tmp_path / "tube.dxf")
+    wm = read_map(tmp_path / "tube.dxf")
+    rng = np.random.default_rng(5)
+    c = wm.part("TUBE").cylinder
+    assert c is not None
+    t, s = rng.uniform(0.0, 2.0 * math.pi, 15000), rng.uniform(0.0, 0.18, 15000)
+    tube = c.p_base + s[:, None] * c.axis + c.radius * np.column_stack([np.cos(t), np.sin(t), np.zeros_like(t)])
+    top = rng.uniform([-0.2, -0.12], [0.2, 0.12], (20000, 2))
+    top = np.column_stack([top, np.full(len(top), 0.02)])
+    top = top[c.distance_to_axis(top) > c.radius]
+    table = rng.uniform([-0.3, -0.22], [0.3, 0.22], (20000, 2))
+    table = np.column_stack([table, np.zeros(len(table))])
+    table = table[(np.abs(table[:, 0]) > 0.2) | (np.abs(table[:, 1]) > 0.12)]
+    z = rng.uniform(0.0, 0.02, 4000)
+    u = rng.uniform(-1.0, 1.0, 4000)
+    sides = [
+        np.column_stack([np.where(u > 0, 0.2, -0.2), 0.12 * u, z]),  # the plate's four side faces
+        np.column_stack([0.2 * u, np.where(u > 0, 0.12, -0.12), z]),
+    ]
+    p_M = np.vstack([tube, top, table, *sides])
+    X_FM = make_pose(rpy_to_matrix([0.0, 0.0, math.radians(20.0)]), [0.5, -0.3, 0.0])
+    p_F = transform_points(X_FM, p_M) + rng.normal(0.0, 0.0012, p_M.shape)
+    cloud = ply_binary(tmp_path / "scan.ply", p_F)
+    report = tmp_path / "r.json"
+    r = CliRunner().invoke(app, ["locate", str(cloud), "--map", str(tmp_path / "tube.dxf"), "--place",
+                                 "505,-296,0,21", "--json", str(report)])  # fmt: skip
+    assert r.exit_code == EXIT_PARTIAL, r.stderr + r.stdout + repr(r.exception)
+    [entry] = [e for e in json.loads(report.read_text())["seams"] if e["id"] == "TUBE>PLATE"]
+    assert entry["status"] == "found", entry["reason"]
+    assert entry["not_welded"]["code"] == "curved_no_torch_path"
+    truth_F = transform_points(X_FM, seam_points := wm.curved[0].sample(0.0002))
+    assert len(seam_points) > 900
+    d = distances_to_polyline(np.array(entry["curve"]["points"]), truth_F, True)
+    # Within 2 mm is what a brought lidar cloud must give; on these unbiased surfaces it is 0.17 mm at most.
+    assert float(d.max()) < 0.0005 and entry["curve"]["closed"] and entry["curve"]["sigma_max_mm"] < 2.0
+    assert "curved TUBE>PLATE: found, closed" in r.stdout

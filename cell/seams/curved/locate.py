@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray
@@ -39,10 +40,11 @@ NORMAL_ANGLE_RAD = math.radians(45.0)  # a point whose normal is further than th
 NORMAL_NEIGHBOURS = 8  # a point and its nearest neighbours make its patch
 OTHER_PART_M = 0.002  # points this close to (or inside) a part of the map other than the two are not theirs [m]
 
-# How much wider the spread of the located curve is than its propagated standard error, and a floor for what no
-# point count shrinks (a tessellated round's facets, a depth camera's correlated errors): docs/curves.md section 3.
-SE_INFLATION = 1.6
-FLOOR_M = 0.00008
+# How much wider the spread of the located curve is than its propagated standard error, and how far either surface
+# may lie from where its points put it, for what no point count shrinks (a camera's depth bias, a tessellated round's
+# facets): calibrated on benchmarks/bench_curves.py (docs/curves.md section 3).
+SE_INFLATION = 1.2
+SURFACE_BIAS_M = 0.00012
 
 
 def _model(part: Part, kind: Surface, p_R: FloatArray) -> SurfaceModel | str:
@@ -59,18 +61,22 @@ def _model(part: Part, kind: Surface, p_R: FloatArray) -> SurfaceModel | str:
     return PlaneModel(centre - (centre @ n - d) * n, n)
 
 
-def _candidates(scene: SeamScene, p: FloatArray, models: Sequence[SurfaceModel]) -> FloatArray:
+def _candidates(
+    scene: SeamScene, p: FloatArray, models: Sequence[SurfaceModel]
+) -> tuple[FloatArray, npt.NDArray[np.intp]]:
     """(m, 3) the dense cloud's points of the layer :data:`SHARE` about the curve through the points p (n, 3) (a
-    tube along its round part)."""
+    tube along its round part), and their cameras (m,)."""
     cyl = next(m for m in models if isinstance(m, CylinderModel))
     along = (p - cyl.c0) @ cyl.u0
     a, b = cyl.c0 + (along.min() - ROUND_REACH_M) * cyl.u0, cyl.c0 + (along.max() + ROUND_REACH_M) * cyl.u0
-    pts, _ = dense_index(scene).tube(a, b, cyl.r0 + REACH_M + BAND_M, 0.0, SHARE)
-    return np.ascontiguousarray(pts.T)
+    pts, cams = dense_index(scene).tube(a, b, cyl.r0 + REACH_M + BAND_M, 0.0, SHARE)
+    return np.ascontiguousarray(pts.T), cams
 
 
-def _thin(p: FloatArray) -> FloatArray:
-    return p if len(p) <= MAX_POINTS else p[:: math.ceil(len(p) / MAX_POINTS)]
+def _thin(mask: npt.NDArray[np.bool_]) -> npt.NDArray[np.intp]:
+    """The indices of ``mask``'s True entries, evenly thinned to :data:`MAX_POINTS` at most."""
+    idx = np.flatnonzero(mask)
+    return idx if len(idx) <= MAX_POINTS else idx[:: math.ceil(len(idx) / MAX_POINTS)]
 
 
 def _reach(model: SurfaceModel) -> float:
@@ -86,23 +92,25 @@ def _prior(model: SurfaceModel) -> FloatArray | None:
     return np.array([np.inf, np.inf, np.inf, np.inf, RADIUS_SHARE * model.r0])
 
 
-def _on_face(part: Part, model: SurfaceModel, q: FloatArray) -> FloatArray:
-    """The points q (k, 3) of a plane surface that lie on its part's face away from the face's edges by
+def _on_face(part: Part, model: SurfaceModel, q: FloatArray) -> npt.NDArray[np.bool_]:
+    """(k,) which points q (k, 3) of a plane surface lie on its part's face away from the face's edges by
     :data:`FACE_EDGE_M` (another face of the part meets it there: a rail's side, a post's corner); all of a
     cylinder's."""
     if not isinstance(model, PlaneModel) or not len(q):
-        return q
+        return np.ones(len(q), bool)
     depth = model.value(q, np.zeros(model.size)) + FACE_EDGE_M + 0.0005
-    return q[part.contains(q - depth[:, None] * model.n0, -FACE_EDGE_M)]
+    return np.asarray(part.contains(q - depth[:, None] * model.n0, -FACE_EDGE_M))
 
 
-def _facing(m1: SurfaceModel, m2: SurfaceModel, q1: FloatArray, q2: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """The points q1, q2 (k, 3) of each surface whose neighbourhood (among both) lies flat across their surface's
+def _facing(
+    m1: SurfaceModel, m2: SurfaceModel, q1: FloatArray, q2: FloatArray
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+    """Which points of q1, q2 (k, 3) of each surface have a neighbourhood (among both) lies flat across their surface's
     normal g: the spread along g is at most sin^2(:data:`NORMAL_ANGLE_RAD`) / 2 of the whole (a flat patch tilted
     by that angle from the surface; a side face, an edge or a stray point beside the surface is not on it)."""
     both = np.vstack([q1, q2])
     if len(both) <= NORMAL_NEIGHBOURS:
-        return q1, q2
+        return np.ones(len(q1), bool), np.ones(len(q2), bool)
     tree = cKDTree(both)
     _, idx = tree.query(both, k=NORMAL_NEIGHBOURS)
     nb = both[idx] - both[idx].mean(axis=1, keepdims=True)  # (n, k, 3)
@@ -110,7 +118,7 @@ def _facing(m1: SurfaceModel, m2: SurfaceModel, q1: FloatArray, q2: FloatArray) 
     along = np.einsum("nkd,nd->nk", nb, g)
     ratio = (along**2).sum(axis=1) / np.maximum((nb**2).sum(axis=(1, 2)), 1e-30)
     flat = ratio <= 0.5 * math.sin(NORMAL_ANGLE_RAD) ** 2
-    return q1[flat[: len(q1)]], q2[flat[len(q1) :]]
+    return flat[: len(q1)], flat[len(q1) :]
 
 
 def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> CurveEstimate:
@@ -135,15 +143,21 @@ def locate_curve(scene: SeamScene, seam: CurvedSeam) -> CurveEstimate:
             return _not_found(seam, m, Reason.NOT_SUPPORTED)
     m1, m2 = models[0], models[1]
     assert not isinstance(m1, str) and not isinstance(m2, str)
-    p = _candidates(scene, drawn, (m1, m2))
+    p, cams = _candidates(scene, drawn, (m1, m2))
     f1, f2 = m1.value(p, np.zeros(m1.size)), m2.value(p, np.zeros(m2.size))
     on1 = (np.abs(f1) < BAND_M) & (f2 > CLEARANCE_M) & (f2 < _reach(m1))
     on2 = (np.abs(f2) < BAND_M) & (f1 > CLEARANCE_M) & (f1 < _reach(m2))
     near = np.flatnonzero(on1 | on2)
     theirs = outside_parts(wm, p[near], {joint.abutting, joint.receiving}, OTHER_PART_M)
     on1[near[~theirs]] = on2[near[~theirs]] = False
-    q1, q2 = _facing(m1, m2, _on_face(parts[0], m1, _thin(p[on1])), _on_face(parts[1], m2, _thin(p[on2])))
-    fits = (fit_surface(m1, q1, MIN_POINTS, _prior(m1)), fit_surface(m2, q2, MIN_POINTS, _prior(m2)))
+    i1, i2 = _thin(on1), _thin(on2)
+    i1, i2 = i1[_on_face(parts[0], m1, p[i1])], i2[_on_face(parts[1], m2, p[i2])]
+    f1s, f2s = _facing(m1, m2, p[i1], p[i2])
+    i1, i2 = i1[f1s], i2[f2s]
+    fits = (
+        fit_surface(m1, p[i1], MIN_POINTS, _prior(m1), cams[i1]),
+        fit_surface(m2, p[i2], MIN_POINTS, _prior(m2), cams[i2]),
+    )
     for part, kind, fit, count in zip(parts, kinds, fits, (on1.sum(), on2.sum()), strict=True):
         if not fit.ok:
             return _not_found(seam, f"the {kind} of {part.name} is not held by the cloud ({count} points near it)")
@@ -163,9 +177,10 @@ def _curve(
     moved = float(np.linalg.norm(p - drawn, axis=1).max())
     if moved > MAX_MOVE_M:
         return _not_found(seam, f"its fitted surfaces meet {moved * 1000:.1f} mm from the drawn curve")
-    cov = crossing_covariance(p, g1, g2, dtheta(a.model, p, a.theta), a.cov, dtheta(b.model, p, b.theta), b.cov)
-    se = np.sqrt(np.trace(cov, axis1=1, axis2=2))
-    sigma = np.hypot(SE_INFLATION * se, FLOOR_M)
+    k2 = SE_INFLATION**2
+    da, db = dtheta(a.model, p, a.theta), dtheta(b.model, p, b.theta)
+    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, SURFACE_BIAS_M)
+    sigma = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     closed = bool(getattr(seam.curve, "closed", False))
     keep = outside_parts(wm, p, own, OTHER_PART_M)
     end_sigma = (0.0, 0.0)

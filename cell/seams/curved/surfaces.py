@@ -161,16 +161,24 @@ def intersect(points: FloatArray, f1: Implicit, f2: Implicit) -> FloatArray:
 
 
 def crossing_covariance(
-    p: FloatArray, g1: FloatArray, g2: FloatArray, df1: FloatArray, cov1: FloatArray, df2: FloatArray, cov2: FloatArray
+    p: FloatArray,
+    g1: FloatArray,
+    g2: FloatArray,
+    df1: FloatArray,
+    cov1: FloatArray,
+    df2: FloatArray,
+    cov2: FloatArray,
+    bias_m: float = 0.0,
 ) -> FloatArray:
     """(n, 3, 3) the covariance of the crossing points p (n, 3) of two surfaces with gradients g1, g2 (n, 3) there,
     from their parameters' covariances cov1 (k1, k1), cov2 (k2, k2) through d f / d theta df1 (n, k1), df2 (n, k2):
     a change of the parameters moves each point by the least-norm step that keeps it on both surfaces (first
-    order), so within the plane across the curve."""
+    order), so within the plane across the curve. ``bias_m`` [m]: a shift of either surface along its normal that no
+    fit sees (one sigma, independent per surface)."""
     J = np.stack([g1, g2], axis=1)  # (n, 2, 3)
     pinv = np.transpose(J, (0, 2, 1)) @ np.linalg.inv(J @ np.transpose(J, (0, 2, 1)))  # (n, 3, 2)
     v1 = np.einsum("ni,ij,nj->n", df1, cov1, df1)
     v2 = np.einsum("ni,ij,nj->n", df2, cov2, df2)
     S = np.zeros((len(p), 2, 2))
-    S[:, 0, 0], S[:, 1, 1] = v1, v2  # the two fits are independent (disjoint points)
+    S[:, 0, 0], S[:, 1, 1] = v1 + bias_m**2, v2 + bias_m**2  # the two fits are independent (disjoint points)
     return np.asarray(pinv @ S @ np.transpose(pinv, (0, 2, 1)))

@@ -42,7 +42,7 @@ OTHER_PART_M = 0.002  # points this close to (or inside) a part of the map other
 
 # How much wider the spread of the located curve is than its propagated standard error, and how far either surface
 # may lie from where its points put it, for what no point count shrinks (a camera's depth bias, a tessellated round's
-# facets): calibrated on benchmarks/bench_curves.py (docs/curves.md section 3).
+# facets): checked on benchmarks/bench_curves.py (docs/curves.md sections 2 and 3).
 SE_INFLATION = 1.2
 SURFACE_BIAS_M = 0.00012
 
@@ -85,8 +85,8 @@ def _reach(model: SurfaceModel) -> float:
 
 
 def _prior(model: SurfaceModel) -> FloatArray | None:
-    """A tube's radius is known to its tolerance (:data:`RADIUS_SHARE`), its axis's direction to the as-built angle's
-    (:data:`~cell.seams.sigma.TILT_TOLERANCE_RAD`) about the aligned map's; a plane's pose is left to the points."""
+    """A tube's radius is known to its tolerance (:data:`RADIUS_SHARE`); its axis and a plane's pose are left to the
+    points."""
     if not isinstance(model, CylinderModel):
         return None
     return np.array([np.inf, np.inf, np.inf, np.inf, RADIUS_SHARE * model.r0])

@@ -17,6 +17,7 @@ from rich import box
 from rich.table import Table
 
 from cell.cli.common import TableFormat, out
+from cell.types import Unsupported
 
 if TYPE_CHECKING:
     from cell.pipeline.records import Detection
@@ -74,13 +75,19 @@ def print_rescan(rep: dict) -> None:
     )
 
 
+LOCATED_CURVE_CODE = Unsupported.CURVED_NO_TORCH_PATH.value  # a curved seam located, no torch path yet
+
+
 def not_supported_text(summary: Mapping[str, Any]) -> str:
-    """``1 not supported: curved`` (the map's seams the cell cannot weld, by reason code), or empty."""
-    codes: Mapping[str, int] = summary.get("not_supported") or {}
+    """``1 not supported: curved`` (the map's seams the cell cannot weld, by reason code), then ``2 curved located,
+    not welded (curved_no_torch_path)`` (curved seams located, with no torch path along a curve yet), or empty."""
+    codes = dict(summary.get("not_supported") or {})
+    located = codes.pop(LOCATED_CURVE_CODE, 0)
     n = sum(codes.values())
-    if not n:
-        return ""
-    return f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())
+    out = [f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())] if n else []
+    if located:
+        out.append(f"{located} curved located, not welded ({LOCATED_CURVE_CODE})")
+    return "; ".join(out)
 
 
 def print_curves(rep: Mapping[str, Any]) -> None:

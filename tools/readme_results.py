@@ -230,6 +230,26 @@ def headline(results: Path) -> str:
     return "\n".join(lines) + "\n"
 
 
+def curves(results: Path) -> str:
+    """Curved seams located on the round-part scenarios (``curves.json``, by ``benchmarks/bench_curves.py``): per
+    seam over the seeds, found of runs, the worst RMS and max error against the true curve, the share of samples
+    within 2 sigma, the largest sigma and the locator's median time (wall, and the thread's CPU)."""
+    data = _load_object(results, "curves.json")
+    lines = [
+        "| scenario | curved seam | found | RMS [mm] | max [mm] | within 2 sigma | sigma max [mm] | time [ms] "
+        "| CPU [ms] |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in data["summary"]:
+        found = f"{r['found']}/{r['runs']}" + (f" ({', '.join(r['codes'])})" if r["codes"] else "")
+        lines.append(
+            f"| {r['scenario']} | {r['seam']} | {found} | {_num(r['rms_mm_worst'])} | {_num(r['max_mm_worst'])} "
+            f"| {_pct(r['within_2sigma'])} | {_num(r['sigma_max_mm'])} | {r['time_ms_median']:.1f} "
+            f"| {r['cpu_ms_median']:.1f} |"
+        )
+    return "\n".join(lines) + f"\n\n`{data['command']}` (commit {data['commit'][:10]})\n"
+
+
 BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "table1": table1,
     "table1-noise-none": table1_noise_none,
@@ -253,6 +273,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
         _load_object(results, "cycle_before.json") if (results / "cycle_before.json").is_file() else None,
     ),
     "interrupts": lambda results: journal_tables.interrupts_table(_load_object(results, "interrupts.json")),
+    "curves": curves,
 }
 
 

@@ -230,7 +230,7 @@ def print_located(rep: dict[str, Any], fmt: str) -> None:
 
     table_fmt = parse_format(fmt)
     print_detection(rep, table_fmt)
-    found = [s for s in rep["seams"] if s["status"] == "found"]
+    found = [s for s in rep["seams"] if s["status"] == "found" and not s.get("curved")]  # a curve: its own line
     if table_fmt != "table" or not found:
         return
     t = Table(title=f"located seams · frame {rep['frame']} · mm", title_justify="left")

@@ -17,6 +17,7 @@ from rich import box
 from rich.table import Table
 
 from cell.cli.common import TableFormat, out
+from cell.types import Unsupported
 
 if TYPE_CHECKING:
     from cell.pipeline.records import Detection
@@ -74,13 +75,36 @@ def print_rescan(rep: dict) -> None:
     )
 
 
+LOCATED_CURVE_CODE = Unsupported.CURVED_NO_TORCH_PATH.value  # a curved seam located, no torch path yet
+
+
 def not_supported_text(summary: Mapping[str, Any]) -> str:
-    """``1 not supported: curved`` (the map's seams the cell cannot weld, by reason code), or empty."""
-    codes: Mapping[str, int] = summary.get("not_supported") or {}
+    """``1 not supported: curved`` (the map's seams the cell cannot weld, by reason code), then ``2 curved located,
+    not welded (curved_no_torch_path)`` (curved seams located, with no torch path along a curve yet), or empty."""
+    codes = dict(summary.get("not_supported") or {})
+    located = codes.pop(LOCATED_CURVE_CODE, 0)
     n = sum(codes.values())
-    if not n:
-        return ""
-    return f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())
+    out = [f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())] if n else []
+    if located:
+        out.append(f"{located} curved located, not welded ({LOCATED_CURVE_CODE})")
+    return "; ".join(out)
+
+
+def print_curves(rep: Mapping[str, Any]) -> None:
+    """One line per curved seam of a report: found or why not, its sigmas, its error against the true curve (in
+    simulation), its time, and why it is not welded."""
+    for s in rep["seams"]:
+        if not s.get("curved"):
+            continue
+        c, e = s.get("curve"), s.get("error_mm")
+        line = f"curved {s['id']}: {s['status']}"
+        if c is not None:
+            ends = "closed" if c["closed"] else "ends +-" + "/".join(_fmt(v) for v in c["end_sigma_mm"]) + " mm"
+            line += f", {ends}, sigma max {_fmt(c['sigma_max_mm'])} mm"
+        if e is not None:
+            line += f", error rms {_fmt(e['rms'])} / max {_fmt(e['max'])} mm"
+        line += f", {_fmt(s['time_ms'], 1)} ms; not welded ({s['not_welded']['code']})"
+        out.print(line, soft_wrap=True, markup=False)
 
 
 def _value(cell: str) -> str | float | None:
@@ -173,6 +197,7 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
     out.print(t)
     out.print(WELD_LEGEND, soft_wrap=True, markup=False)
     _why_lines(whys)
+    print_curves(rep)
     out.print(weld_summary(rep), soft_wrap=True)
     print_timings(rep)
 
@@ -237,6 +262,7 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
     out.print(t)
     out.print(DETECT_LEGEND, soft_wrap=True, markup=False)
     _why_lines([(s["id"], s["reason"]) for s in rep["seams"] if s["status"] != "found"])
+    print_curves(rep)
     m = rep["summary"]
     unsupported = not_supported_text(m)
     out.print(

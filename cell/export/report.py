@@ -14,12 +14,12 @@ from typing import Any
 import numpy as np
 
 from cell.errors import CellError
+from cell.export.curve_report import curve_summary, not_welded_entries, weld_reason_code
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.outputs import write_atomic
 from cell.pipeline.records import Detection, WeldRun
-from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, UnsupportedSeam, Violation, WeldMap
+from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, UnsupportedSeam, Violation
 from cell.types.rescan import PlannedCloseup
-from cell.types.run import WeldReason
 
 REPORT_VERSION = 1
 
@@ -65,14 +65,9 @@ def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
     return entry
 
 
-def _unsupported_entry(u: UnsupportedSeam) -> dict[str, Any]:
-    """A seam the map draws that the cell cannot weld: never searched, with why as text and as a code."""
-    return {"id": u.id, "status": SeamStatus.NOT_SUPPORTED.value, "reason": u.reason, "reason_code": u.code.value}
-
-
-def not_supported(weldmap: WeldMap) -> dict[str, int]:
-    """The map's seams the cell cannot weld, counted by reason code (``curved``: 1), in code order."""
-    codes = [u.code.value for u in weldmap.not_welded]
+def not_supported(not_welded: Sequence[UnsupportedSeam]) -> dict[str, int]:
+    """The map's seams the run does not weld, counted by reason code (``curved_not_located``: 1), in code order."""
+    codes = [u.code.value for u in not_welded]
     return {c: codes.count(c) for c in sorted(set(codes))}
 
 
@@ -93,11 +88,12 @@ def detection_report(
     ground truth (real data) the seams have no ``truth`` or ``error_mm`` and the summary's errors are null."""
     seams = [_seam_entry(rec) for rec in (records if records is not None else det.records())]
     if unsupported:
-        seams += [_unsupported_entry(u) for u in det.weldmap_R.not_welded]
+        seams += not_welded_entries(det)
     s = det.summary
     summary = {
         "seams": len(det.estimates) + len(det.weldmap_R.not_welded),  # every seam of the map
-        "not_supported": not_supported(det.weldmap_R),
+        "not_supported": not_supported(det.not_welded),
+        "curved": curve_summary(det),
         "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),
         "found": s.found,
         "paper_me_mean_mm": _r(s.paper_me_mean_mm, 4),
@@ -236,9 +232,8 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
     rep = detection_report(run.detection, records, provenance=provenance)
     plan = run.plan
     for entry in rep["seams"][len(records) :]:  # the map's seams the cell cannot weld
-        entry.update(
-            planned=False, welded=False, weld_reason=entry["reason"], weld_reason_code=WeldReason.NOT_SUPPORTED.value
-        )
+        why = entry.get("not_welded", {}).get("reason", entry["reason"])
+        entry.update(planned=False, welded=False, weld_reason=why, weld_reason_code=weld_reason_code(entry))
     for entry, rec in zip(rep["seams"], records, strict=False):
         w = rec.weld
         if w is None:

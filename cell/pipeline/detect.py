@@ -242,6 +242,7 @@ def detect(
     station, weldmap : a running cell and the map it was built around (both built here when not given).
     X_RM_nominal, seed : the map's believed pose and a search near it (:func:`build_scene`).
     """
+    from cell.seams.curved.results import curve_results
     from cell.seams.registry import with_method
 
     if noise is not None:
@@ -261,9 +262,11 @@ def detect(
     estimates = locate(scene, scenario, method, progress=progress)
     weldmap_R = scene.seam_scene.weldmap
     truth = truths(cap, weldmap_R)
+    curve_truth = curve_truths(cap)
+    curves = curve_results(method, scene.seam_scene, curve_truth)
     metrics, summary = evaluate(estimates, truth)
     timings = {"capture_s": cap.seconds, **scene.timings}
-    timings["locate_s"] = sum(e.time_s for e in estimates)
+    timings["locate_s"] = sum(e.time_s for e in estimates) + sum(e.time_s for e in curves[0])
     timings["total_s"] = time.perf_counter() - t_all
     return Detection(
         scenario=scenario,
@@ -278,7 +281,9 @@ def detect(
         scene=scene,
         joints=cap.joints,
         source=cap.source,
-        curve_truths=curve_truths(cap),
+        curve_truths=curve_truth,
+        curve_estimates=curves[0],
+        curve_metrics=curves[1],
     )
 
 
@@ -287,6 +292,7 @@ def _failed_detection(
 ) -> Detection:
     """A detection whose perception or alignment failed: every seam NOT_FOUND (underside ones NOT_VISIBLE, which
     the drawing alone tells) with the reason, against the nominal map."""
+    from cell.seams.curved.results import not_searched
     from cell.seams.visibility import visibility
 
     sc = cap.scenario
@@ -317,4 +323,5 @@ def _failed_detection(
         joints=cap.joints,
         source=cap.source,
         curve_truths=curve_truths(cap),
+        curve_estimates=not_searched(weldmap_R, error.message),
     )

@@ -22,9 +22,12 @@ from cell.types import (
     SeamMetrics,
     SeamScene,
     SeamStatus,
+    Unsupported,
+    UnsupportedSeam,
     Violation,
     WeldMap,
 )
+from cell.types.curve_estimate import CurveEstimate, CurveMetrics
 from cell.types.run import SeamRecord, SeamWeld
 
 if TYPE_CHECKING:
@@ -81,6 +84,27 @@ class Detection:
     joints: Mapping[str, Joint] = field(default_factory=dict)  # seam id -> how it is made
     source: str = "simulation"  # the data's origin: simulation | capture (replayed) | cloud (brought) | camera
     curve_truths: Mapping[str, FloatArray] = field(default_factory=dict)  # curved seam id -> true curve (n, 3) in R
+    curve_estimates: tuple[CurveEstimate, ...] = ()  # one per curved seam of the map, in its order
+    curve_metrics: Mapping[str, CurveMetrics] = field(default_factory=dict)  # found curved seams with a truth
+
+    @property
+    def not_welded(self) -> tuple[UnsupportedSeam, ...]:
+        """Every seam of the map this run will not weld, with its reason (:attr:`WeldMap.not_welded`), a curved
+        seam's from its estimate: located, it still has no torch path along a curve (``curved_no_torch_path``);
+        not located, why not (``curved_not_located``)."""
+        curves = {e.id: e for e in self.curve_estimates}
+        out = []
+        for u in self.weldmap_R.not_welded:
+            e = curves.get(u.id)
+            drawn = u.reason.rsplit("; ", 1)[0]  # where and what it is, without the map's "no locator yet"
+            if e is None:
+                out.append(u)
+            elif e.status is SeamStatus.FOUND:
+                why = f"{drawn}: located (sigma up to {e.sigma_max_m * 1000:.2f} mm); no torch path along a curve yet"
+                out.append(UnsupportedSeam(u.id, why, Unsupported.CURVED_NO_TORCH_PATH))
+            else:
+                out.append(UnsupportedSeam(u.id, f"{drawn}; {e.reason}", Unsupported.CURVED_NOT_LOCATED))
+        return tuple(out)
 
     def records(self) -> tuple[SeamRecord, ...]:
         """One :class:`~cell.types.SeamRecord` per seam of the map, in map order: seam, joint, estimate, truth,

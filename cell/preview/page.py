@@ -98,7 +98,7 @@ def _summary(run: WeldRun, records: Sequence[SeamRecord]) -> str:
     det = run.detection
     welded = sum(1 for r in records if r.weld is not None and r.weld.welded)
     planned = sum(1 for r in records if r.weld is not None and r.weld.planned)
-    codes = [str(u.code) for u in det.weldmap_R.not_welded]
+    codes = [str(u.code) for u in det.not_welded]
     parts = [f"{len(records) + len(codes)} seams in the map", f"{planned} planned", f"{welded} welded"]
     if codes:
         parts.append(f"{len(codes)} not supported: {', '.join(sorted(set(codes)))}")
@@ -132,7 +132,7 @@ def write_page(run: WeldRun, out_path: str | Path, *, title: str = "", max_point
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{_summary(run, records)}</p>",
         "<h2>Seams</h2>",
-        results_table(records, STATUS_COLOURS, det.weldmap_R.not_welded),
+        results_table(records, STATUS_COLOURS, det.not_welded),
         '<p class="note">sigma: the locator\'s standard error across the seam; error: mean distance of the estimate'
         " from the true seam (when the truth is known); angles: the torch's work and travel angles as planned.</p>",
         "<h2>The cell</h2>",

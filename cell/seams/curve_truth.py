@@ -5,39 +5,26 @@ section 8)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from cell.errors import MapError
 from cell.geometry import FloatArray, invert, transform_points
+from cell.seams.curved.surfaces import CylinderModel, Implicit, PlaneModel, intersect
 from cell.types import CurvedSeam, Cylinder, Part, Polyhedron, Surface, WeldMap
 from cell.weldmap.curved_joints import holding_face
 from cell.weldmap.cylinders import recognise_cylinder
 
 STEP_M = 0.0005  # [m] the true curve's samples are at most this far apart
-_ITERATIONS = 30
-_CONVERGED_M = 1e-12
-
-# A surface as f(p) (n,) [m] and its gradient (n, 3), for points p (n, 3).
-Implicit = Callable[[FloatArray], tuple[FloatArray, FloatArray]]
 
 
 def _cylinder_surface(c: Cylinder) -> Implicit:
-    def f(p: FloatArray) -> tuple[FloatArray, FloatArray]:
-        d = p - c.p_base
-        r = d - np.outer(d @ c.axis, c.axis)
-        norm = np.linalg.norm(r, axis=1)
-        return norm - c.radius, r / np.maximum(norm, 1e-300)[:, None]
-
-    return f
+    return CylinderModel(np.asarray(c.p_base), np.asarray(c.axis), c.radius).implicit(np.zeros(CylinderModel.size))
 
 
 def _plane_surface(n: FloatArray, d: float) -> Implicit:
-    def f(p: FloatArray) -> tuple[FloatArray, FloatArray]:
-        return p @ n - d, np.tile(n, (len(p), 1))
-
-    return f
+    return PlaneModel(n * d, n).implicit(np.zeros(PlaneModel.size))
 
 
 def rigid_motion(design: FloatArray, built: FloatArray) -> FloatArray:
@@ -49,21 +36,6 @@ def rigid_motion(design: FloatArray, built: FloatArray) -> FloatArray:
     X[:3, :3] = Vt.T @ D @ U.T
     X[:3, 3] = b - X[:3, :3] @ a
     return X
-
-
-def intersect(points: FloatArray, f1: Implicit, f2: Implicit) -> FloatArray:
-    """The points (n, 3) moved onto the curve where f1 = f2 = 0 (Gauss-Newton, the least-norm step each time)."""
-    p = np.array(points, dtype=float)
-    for _ in range(_ITERATIONS):
-        (v1, g1), (v2, g2) = f1(p), f2(p)
-        J = np.stack([g1, g2], axis=1)  # (n, 2, 3)
-        JJt = J @ np.transpose(J, (0, 2, 1))
-        lam = np.linalg.solve(JJt, np.stack([v1, v2], axis=1)[:, :, None])
-        step = (np.transpose(J, (0, 2, 1)) @ lam)[:, :, 0]
-        p -= step
-        if float(np.abs(step).max()) < _CONVERGED_M:
-            break
-    return p
 
 
 def _as_built(parts: Sequence[Part], name: str) -> Part:

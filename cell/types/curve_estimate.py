@@ -12,7 +12,7 @@ import numpy as np
 from cell.geometry import FloatArray, readonly
 from cell.types.seams import Reason, SeamStatus
 
-__all__ = ["CurveEstimate"]
+__all__ = ["CurveEstimate", "CurveMetrics"]
 
 
 def _empty() -> FloatArray:
@@ -77,3 +77,15 @@ class CurveEstimate:
     def sigma_max_m(self) -> float:
         """The largest across-seam sigma over the curve [m] (inf when not found)."""
         return float(self.sigma_m.max()) if len(self.sigma_m) else math.inf
+
+
+@dataclass(frozen=True)
+class CurveMetrics:
+    """A located curve against its true one (simulation): the located samples' distances to the true curve, their
+    RMS and largest over its length [mm]; ``within_2sigma``: the share of the samples whose distance is at most twice
+    their sigma; ``samples``: how many were measured."""
+
+    rms_mm: float
+    max_mm: float
+    within_2sigma: float
+    samples: int

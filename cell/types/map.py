@@ -229,6 +229,8 @@ class Unsupported(enum.StrEnum):
     # A curved seam (an arc, circle, ellipse, spline, helix or bulged polyline segment), read with its curve and
     # joint (WeldMap.curved): no locator locates curved seams yet, so none is searched or welded.
     CURVED_NOT_LOCATED = "curved_not_located"
+    # A curved seam located (its CurveEstimate found), but no torch path along a curve exists yet: not welded.
+    CURVED_NO_TORCH_PATH = "curved_no_torch_path"
     ON_FIXTURE = "on_fixture"  # it lies on a fixture, not between two parts
 
 

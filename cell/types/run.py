@@ -30,6 +30,7 @@ class WeldReason(enum.StrEnum):
     NOT_EXECUTED = "not_executed"  # planned, but the run stopped before the arm moved (the run's error says why)
     PREVIEW = "preview"  # planned in a dry run: nothing moves
     NOT_SUPPORTED = "not_supported"  # drawn in the map, but not a seam the cell can weld (a curve, on a fixture)
+    NO_TORCH_PATH = "no_torch_path"  # located (a curved seam), but no torch path along it exists yet
     LAST_CHECK = "last_check"  # found, but against the aligned map and the other parts it cannot be there
     #   (re-scanned, then refused: its ``check`` says which test and by how much)
 

@@ -34,6 +34,9 @@ def test_a_weld_counts_every_seam_of_the_map_and_names_the_unsupported() -> None
     assert not_supported_text({"not_supported": {"curved": 2, "on_fixture": 1}}) == (
         "3 not supported: curved (2), on_fixture"
     )
+    assert not_supported_text({"not_supported": {"curved_not_located": 1, "curved_no_torch_path": 2}}) == (
+        "1 not supported: curved_not_located; 2 curved located, not welded (curved_no_torch_path)"
+    )
     assert weld_summary(_report([None], [True], {})).startswith("welded 1 of 1 seams in the map · visible")
 
 

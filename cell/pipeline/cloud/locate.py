@@ -29,6 +29,8 @@ from cell.pipeline.evaluation import evaluate
 from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Detection
 from cell.scenario import Scenario
+from cell.seams.curved import locate_curves
+from cell.seams.curved.results import carried, not_searched
 from cell.seams.joint import find_joints
 from cell.seams.visibility import visibility
 from cell.types import (
@@ -136,6 +138,7 @@ def locate_cloud(
     ordered, voxels = voxel_order(dense_L, spec.voxel_m)
     ss = SeamScene(downsample(dense_L, spec.voxel_m), ordered, map_L, joints, table_z, voxels)
     estimates = locate_seams(ss, scenario, method, _workspace_L(P_L, crop), missing)
+    curves = tuple(carried(e, X_FL) for e in locate_curves(method, ss))
     timings["locate_s"] = time.perf_counter() - t
     estimates_F = tuple(_carried(e, X_FL) for e in estimates)
     truth = dict(truth_F) if truth_F is not None else {}
@@ -152,6 +155,7 @@ def locate_cloud(
         timings=timings,
         joints=joints,
         source="cloud",
+        curve_estimates=curves,
     )
 
 
@@ -257,6 +261,7 @@ def _failed(
         error=error,
         joints=joints,
         source="cloud",
+        curve_estimates=not_searched(map_L, error.message),
     )
 
 

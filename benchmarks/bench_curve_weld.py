@@ -103,7 +103,7 @@ def bench(name: str) -> dict[str, Any]:
             station, det, skip={e.id for e in det.estimates}, motion=motion_scene(station.arm, det), curves=curves
         )
         plan_s = time.perf_counter() - t0
-        ex = execute(station, plan, pre) if not problems else None
+        ex = execute(station, plan, pre) if not problems and plan.segments else None
     welds = curve_welds(plan, ex, pre.duration, det.curve_truths, {c.id: c.closed for c in curves}, s.X_WR)
     rows = []
     for c in curves:

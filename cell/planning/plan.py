@@ -111,7 +111,8 @@ def plan_welds(
             continue
         searches[curve.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
-    for cid, res in search_curves([e for e in found_curves if e.id in curve_ids], searches, q0).items():
+    curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
+    for cid, res in search_curves([e for e in found_curves if e.id in curve_ids], searches, q0, curve_procs).items():
         if isinstance(res, SeamFailure):
             outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
         else:

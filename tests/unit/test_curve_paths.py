@@ -104,3 +104,22 @@ def test_the_circle_through_three_points() -> None:
     assert circle_through(a, (a + c) / 2.0, c) is None  # on one line: no circle
     centre, normal, r, err = fit_circle(np.vstack([a, b, c, [0.0, -50.0, 0.0]]))
     assert r == pytest.approx(50.0) and err < 1e-9 and abs(normal[2]) == pytest.approx(1.0)
+
+
+def test_a_weave_follows_the_curve_round_across_the_local_bisector() -> None:
+    from cell.planning.curves.weave import cross_sections, woven
+    from cell.process.weave import weave_offsets
+    from cell.types.procedure import Weave, WeldProcedure
+
+    proc = WeldProcedure("weave", weave=Weave("zigzag", 3.0, 1.0))
+    path = curve_path(_tube_on_plate(r=0.05), 0.0005, overlap=0.01)
+    X = curve_poses(path, PROCESS)
+    off = woven(X, path, proc)[:, :3, 3] - X[:, :3, 3]
+    lat, _ = weave_offsets(path.s, path.length, proc.weave, 0.008)
+    e, b = cross_sections(path)
+    assert np.max(np.abs(np.sum(off * path.t_R, axis=1))) < 1e-12  # never along the curve
+    assert np.allclose(off, lat[:, None] * e, atol=1e-12)  # across the local bisector, as on a straight seam
+    assert np.max(np.abs(np.sum(e * b, axis=1))) < 1e-12
+    assert np.max(np.linalg.norm(off, axis=1)) == pytest.approx(1.5e-3, rel=0.02)  # half the width either side
+    horizontal = e[:, 2]  # a tube square on a plate: across the 45 deg bisector, half up and half in
+    assert np.allclose(np.abs(horizontal), math.sqrt(0.5), atol=1e-9)

@@ -51,12 +51,15 @@ def curve_procedures(
 
 
 def search_curves(
-    curves: Sequence[CurveEstimate], make_search: Mapping[str, SeamSearch], q_seed: npt.ArrayLike
+    curves: Sequence[CurveEstimate],
+    make_search: Mapping[str, SeamSearch],
+    q_seed: npt.ArrayLike,
+    procedures: Mapping[str, WeldProcedure] | None = None,
 ) -> dict[str, SeamSolution | SeamFailure]:
     """Each curve's torch search (:func:`cell.planning.curves.search.plan_curve`) with its own search (the
-    process its procedure gives), seeded at q_seed (dof,) [rad]."""
-    q0 = np.asarray(q_seed, dtype=float)
-    return {c.id: plan_curve(make_search[c.id], c, q0) for c in curves if c.id in make_search}
+    process its procedure gives) and its procedure's root pass and weave, seeded at q_seed (dof,) [rad]."""
+    q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
+    return {c.id: plan_curve(make_search[c.id], c, q0, procs.get(c.id)) for c in curves if c.id in make_search}
 
 
 def with_paths(segments: Sequence[Segment], paths: Mapping[str, npt.ArrayLike]) -> list[Segment]:

@@ -17,11 +17,14 @@ from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
 from cell.motion.wrist import nearest_wrist
 from cell.planning.curves.path import CurvePath, curve_path, curve_poses, start_order
+from cell.planning.curves.weave import woven
 from cell.planning.failures import SeamFailure, better, mm, unreachable
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.torch_orientations import Candidate, candidate_groups
+from cell.process.weave import knot_spacing as weave_spacing
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.plan import PlanReason, SeamTask
+from cell.types.procedure import WeldProcedure
 from cell.types.robot import JointLimits
 
 TURN_PER_KNOT = math.radians(2.0)  # [rad] the tangent turns at most this much between two IK knots
@@ -62,7 +65,9 @@ class _Preview:
     manip: float
 
 
-def plan_curve(search: SeamSearch, est: CurveEstimate, q_seed: FloatArray) -> SeamSolution | SeamFailure:
+def plan_curve(
+    search: SeamSearch, est: CurveEstimate, q_seed: FloatArray, procedure: WeldProcedure | None = None
+) -> SeamSolution | SeamFailure:
     """The first candidate that passes along the whole curve (its task a :class:`CurveTask`), or the failure that
     got furthest; q_seed (dof,) [rad] seeds IK.
 
@@ -71,7 +76,8 @@ def plan_curve(search: SeamSearch, est: CurveEstimate, q_seed: FloatArray) -> Se
     either end. Per angle setting every (start, direction, spin) is previewed by IK at :data:`PREVIEW_POINTS`
     points or more, warm-started along the curve, its A6 moved by whole turns to centre its travel in the hose window;
     those whose A6 fits, then by their least manipulability, are solved along the whole curve, ``max_full`` of
-    them."""
+    them. procedure : the seam's weld procedure: its root pass's offset and weave laid along the curve
+    (:mod:`cell.planning.curves.weave`), the knots close enough to follow the weave."""
     pr, opt = search.process, search.opt
     overlap = pr.closed_overlap if est.closed else 0.0
     starts = start_order(est, np.zeros(3), STARTS) if est.closed else [0.0]
@@ -79,6 +85,8 @@ def plan_curve(search: SeamSearch, est: CurveEstimate, q_seed: FloatArray) -> Se
     q_ref = search._reference(q_seed)
     best: SeamFailure | None = None
     spacing = knot_spacing(est, opt.spacing)
+    if procedure is not None:
+        spacing = weave_spacing(procedure, 0, spacing)
     paths = [
         (rev, curve_path(est, spacing, start=s0, reverse=rev, overlap=overlap)) for s0 in starts for rev in directions
     ]
@@ -94,6 +102,7 @@ def plan_curve(search: SeamSearch, est: CurveEstimate, q_seed: FloatArray) -> Se
                 X = curve_poses(
                     path, pr, spin=c.spin, work_offset=c.work_offset, travel_offset=c.travel_offset, flange=flange
                 )
+                X = woven(X, path, procedure)
                 got = _preview(search, task, cand, X, q_seed, q_ref, free)
                 if isinstance(got, SeamFailure):
                     best = better(best, got)

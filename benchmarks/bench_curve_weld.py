@@ -133,11 +133,35 @@ def bench(name: str) -> dict[str, Any]:
     }
 
 
+def markdown(out: Mapping[str, Any]) -> str:
+    """The results as the table of docs/curves-welding.md section 7."""
+    lines = [
+        "| scenario | curved seam | length mm | planned | TCP RMS / max mm (true curve) | arc s | why not |",
+        "|---|---|---:|---|---|---:|---|",
+    ]
+    for row in out["rows"]:
+        for r in row["seams"]:
+            tcp = f"{r['tcp_rms_mm']:.3f} / {r['tcp_max_mm']:.3f}" if r["welded"] else "-"
+            arc = f"{r['arc_s']:.1f}" if r["welded"] else "-"
+            why = r["reason"].replace("|", "/") if not r["planned"] else ""
+            kind = "closed" if r["closed"] else "open"
+            planned = "yes" if r["planned"] else "no"
+            lines.append(
+                f"| {row['scenario']} | `{r['seam']}` ({kind}) | {r['length_mm']:.0f} | {planned} | {tcp} | {arc}"
+                f" | {why} |"
+            )
+    return "\n".join(lines)
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenarios", default=",".join(SCENARIOS))
     ap.add_argument("--json", type=Path, default=OUT)
+    ap.add_argument("--markdown", action="store_true", help="print the table of an existing --json file, run nothing")
     args = ap.parse_args(argv)
+    if args.markdown:
+        print(markdown(json.loads(args.json.read_text())))
+        return
     rows = [bench(n) for n in args.scenarios.split(",")]
     command = "benchmarks/bench_curve_weld.py" + (f" --scenarios {args.scenarios}" if argv else "")
     out = {"command": f".venv/bin/python {command}", "rows": rows}

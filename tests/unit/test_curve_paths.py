@@ -123,3 +123,21 @@ def test_a_weave_follows_the_curve_round_across_the_local_bisector() -> None:
     assert np.max(np.linalg.norm(off, axis=1)) == pytest.approx(1.5e-3, rel=0.02)  # half the width either side
     horizontal = e[:, 2]  # a tube square on a plate: across the 45 deg bisector, half up and half in
     assert np.allclose(np.abs(horizontal), math.sqrt(0.5), atol=1e-9)
+
+
+def test_close_ups_look_at_the_doubtful_stretch_of_a_curve_in_nearly_straight_pieces() -> None:
+    from dataclasses import replace
+
+    from cell.rescan.curve_views import MAX_SAGITTA_M, curve_view_targets
+
+    est = _tube_on_plate(r=0.05, n=360)
+    doubtful = est.p_RS[:, 1] > 0.9  # the far half's sigma over the tolerance
+    est = replace(est, sigma_m=np.where(doubtful, 5e-4, 1e-4))
+    targets = curve_view_targets(est, 3e-4)
+    assert 3 <= len(targets) <= 6  # 157 mm in pieces of about 40 mm (a 4 mm sagitta on a 50 mm radius)
+    for t in targets:
+        assert t.p_start[1] > 0.9 - 1e-9 and t.p_end[1] > 0.9 - 1e-9
+        mid = 0.5 * (t.p_start + t.p_end)
+        assert 0.05 - np.linalg.norm(mid[:2] - [0.0, 0.9]) <= MAX_SAGITTA_M + 1e-9  # the chord near the curve
+        assert abs(float(t.bisector @ [0.0, 0.0, 1.0]) - math.sqrt(0.5)) < 0.05  # looking into the fillet
+    assert curve_view_targets(est, 1e-3) == []  # nowhere doubtful: no close-up

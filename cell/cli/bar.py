@@ -1,6 +1,6 @@
 """A count drawn as a bar on stderr (``rich.progress``) when stderr is a terminal, plain progress lines otherwise
 (a log, a pipe, CI): the ``count(what, done, total)`` a stage's progress callable may carry (the planner's seams
-planned / total, :func:`cell.pipeline.weld.seam_counter`)."""
+planned / total, :func:`cell.pipeline.progress.seam_counter`)."""
 
 from __future__ import annotations
 

@@ -12,14 +12,14 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.config.export import KrlOptions
-from cell.export.krl_data import X_TOOL, arc_data, e6axis, e6pos, num, procedure_line, setup_block
+from cell.export.circles import CHORD_TOL_M, Move, curve_moves
+from cell.export.krl_data import X_TOOL, arc_data, e6axis, e6pos, num, procedure_line, setup_block, track_header
 from cell.export.program import ProgramJob, not_welded_lines, procedure_of, write_texts
 from cell.export.status_turn import ArmGeometry, status_turn
-from cell.geometry import invert
+from cell.geometry import FloatArray, invert
 from cell.provenance import header_lines
 from cell.types.plan import Segment, WeldPlan
 from cell.types.robot import Kinematics
-from cell.types.track import LinearTrack
 
 HOME_TOL_DEG = 0.5  # the guard's tolerance between $config.dat's XHOME and the planned home
 HOME_TOL_MM = 0.5  # the same for the linear track's E1 [mm]
@@ -57,16 +57,37 @@ class _Program:
 
     def point(self, seg: Segment) -> str:
         """Declare the segment's end as the next point (E6POS in the base for a LIN, E6AXIS for a PTP); its name."""
+        if seg.kind != "move":
+            return self.pose_point(np.asarray(seg.X_end), seg.q_end, seg.e1_end)
         self.n += 1
-        name = f"XP{self.n}"
-        q = seg.q_end
-        if seg.kind == "move":
-            self.dat.append(f"DECL E6AXIS {name}={e6axis(q, seg.e1_end)}")
-        else:
-            s, t = status_turn(self.job.robot, q, self.geo)
-            X = self.X_BR @ np.asarray(seg.X_end) @ X_TOOL
-            self.dat.append(f"DECL E6POS {name}={e6pos(X, s, t, seg.e1_end)}")
-        return name
+        self.dat.append(f"DECL E6AXIS XP{self.n}={e6axis(seg.q_end, seg.e1_end)}")
+        return f"XP{self.n}"
+
+    def pose_point(self, X_RT: FloatArray, q: FloatArray, e1: float) -> str:
+        """Declare the TCP pose X_RT (4, 4) in R as the next point, an E6POS in the base with the status and turn of
+        q (dof,) [rad]; its name."""
+        self.n += 1
+        s, t = status_turn(self.job.robot, q, self.geo)
+        self.dat.append(f"DECL E6POS XP{self.n}={e6pos(self.X_BR @ X_RT @ X_TOOL, s, t, e1)}")
+        return f"XP{self.n}"
+
+    def curve_motion(self, mv: Move, e1: float) -> tuple[str, str]:
+        """(the motion, its end point's name) of one move of a curved weld, after the whole-line comment that
+        states a circular move's planned circle (``cell krl check`` holds its points to it)."""
+        if mv.kind == "CIRC" and mv.X_aux is not None and mv.centre is not None:
+            aux = self.pose_point(mv.X_aux, mv.q_end, e1)
+            end = self.pose_point(mv.X_end, mv.q_end, e1)
+            c = (self.X_BR @ np.append(mv.centre, 1.0))[:3] * 1000.0
+            self.src.append(
+                f";- circle r = {mv.radius * 1000.0:.3f} mm, centre [{', '.join(f'{v:.3f}' for v in c)}] mm"
+                f" (base), angle {np.degrees(mv.angle):.3f} deg"
+            )
+            return f"CIRC {aux}, {end}, CA {np.degrees(mv.angle):.3f}", end
+        end = self.pose_point(mv.X_end, mv.q_end, e1)
+        self.src.append(
+            f";- chord within {mv.chord * 1000.0:.3f} mm of the planned path (<= {CHORD_TOL_M * 1000:g} mm)"
+        )
+        return f"LIN {end}", end
 
     def plain_lin(self, seg: Segment, note: str) -> None:
         if abs(seg.speed - self.last_vel) > 1e-9:
@@ -75,17 +96,18 @@ class _Program:
         c_dis = self.approx(seg)
         self.src.append(f"LIN {self.point(seg)}{c_dis} ; {note}")
 
-    def arc_fold(self, kind: str, seg: Segment, data_of: Segment) -> None:
-        """One ArcTech inline form: ``kind`` on | swi | off, the motion to the end of ``seg``, the weld data of
-        ``data_of``'s procedure."""
+    def arc_fold(self, kind: str, seg: Segment, data_of: Segment, move: tuple[str, str] | None = None) -> None:
+        """One ArcTech inline form: ``kind`` on | swi | off, the motion to the end of ``seg`` (or ``move``: a curved
+        weld's motion and its end point, :meth:`curve_motion`), the weld data of ``data_of``'s procedure."""
         fold, provider, step = _ARC[kind]
         p = procedure_of(data_of)
         self.w += 1
         wdat = f"WDAT{self.w}"
         self.dat.append(arc_data(wdat, kind, p, self.opt.job_mode, self.opt.param_set))
-        xp = self.point(seg)
+        xp = self.point(seg) if move is None else move[1]
         pname = xp[1:]
-        motion = "PTP" if seg.kind == "move" else "LIN"
+        motion = "PTP" if seg.kind == "move" else "LIN" if move is None else move[0].split()[0]
+        provider = provider.replace("lin", "circ") if motion == "CIRC" else provider
         ti, bi = self.opt.tool_index, self.opt.base_index
         vel = f"{seg.speed:.4f}" if kind == "on" else "gArcBasVelDefinition"
         shown = f" Vel={num(seg.speed, 4)} m/s" if kind == "on" else ""
@@ -131,11 +153,33 @@ class _Program:
             ]
         self.src += [
             f"ArcMainNG(#{step}BeforeMoveStd, {args})",
-            f"{motion} {xp}",
+            f"{motion} {xp}" if move is None else move[0],
             f"ArcMainNG(#{step}AfterMoveStd, {args})",
             ";ENDFOLD",
         ]
         self.last_vel = -1.0  # the inline form set the path velocity itself
+
+    def curve_weld(self, seg: Segment, nxt: Segment | None) -> None:
+        """A weld along a curve (:func:`cell.export.circles.curve_moves`): each circular move or chord in its own
+        ArcTech form (ARC_SWI, the last ARC_OFF, or ARC_SWI into ``nxt``, a next weld), or plain motions then the
+        arc off."""
+        moves = curve_moves(seg, self.job.robot)
+        self.src.append(f";- weld along a curve, seam {seg.seam_id}: {len(moves)} moves")
+        if self.opt.arc == "arctech":
+            for k, mv in enumerate(moves):
+                last = k == len(moves) - 1
+                kind = "off" if last and nxt is None else "swi"
+                self.arc_fold(kind, seg, nxt if last and nxt is not None else seg, self.curve_motion(mv, seg.e1_end))
+            return
+        if abs(seg.speed - self.last_vel) > 1e-9:
+            self.src.append(f"$VEL.CP = {seg.speed:.4f} ; [m/s] {seg.speed * 1000:.1f} mm/s")
+            self.last_vel = seg.speed
+        for mv in moves:
+            self.src.append(f"{self.curve_motion(mv, seg.e1_end)[0]} ; weld, seam {seg.seam_id}")
+        if nxt is not None:
+            self.src.append(f";- {procedure_line(procedure_of(nxt), nxt.pass_index)} (set on the power source)")
+        else:
+            self.signal_off(seg)
 
     def signal_on(self, seg: Segment, p_seg: Segment) -> None:
         """Plain I/O: the arc on at the weld start, the wait for the arc with its timeout and error branch."""
@@ -205,6 +249,9 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
             current = seg.seam_id
             b.src += ["", f";- seam {current}"]
         arc_next = nxt is not None and nxt.kind == "weld"
+        if seg.kind == "weld" and seg.X_path is not None:
+            b.curve_weld(seg, nxt if arc_next else None)
+            continue
         if seg.kind == "weld":
             if opt.arc == "arctech":
                 b.arc_fold("swi" if arc_next and nxt is not None else "off", seg, nxt if arc_next and nxt else seg)
@@ -234,18 +281,6 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
     b.src += ["END", ""]
     b.dat += ["ENDDAT", ""]
     return "\n".join(b.src), "\n".join(b.dat)
-
-
-def track_header(track: LinearTrack) -> list[str]:
-    """The header comment of a plan on a linear track: the axis E1, its limits and how the frames chain."""
-    ax = ", ".join(f"{v:.4f}" for v in track.axis_R)
-    return [
-        f";- Linear track E1 (KL-style, mathematically coupled): axis [{ax}] in $ROBROOT at E1 = 0; software limits"
-        f" {track.e1_min * 1000:.1f} .. {track.e1_max * 1000:.1f} mm; speed {track.v_max * 1000:.0f} mm/s,"
-        f" acceleration {track.a_max * 1000:.0f} mm/s^2.",
-        ";- Every point carries its E1 [mm]; its X, Y, Z stay in BASE_DATA measured from the base at E1 = 0"
-        " ($ERSYSROOT = $ROBROOT at E1 = 0): the robot base at E1 is there moved by E1 along the axis.",
-    ]
 
 
 class KrlPost:

@@ -8,6 +8,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
+from cell.export.circles import circle_through
 from cell.export.krl_read import Decl, KrlFile, Statement, read_krl
 
 GLOBAL_POINTS = frozenset({"XHOME"})
@@ -18,6 +21,12 @@ _TRACK_LIMITS = re.compile(r"\blimits\s+([+-]?\d+(?:\.\d*)?)\s*\.\.\s*([+-]?\d+(
 _TRACK_AXIS = re.compile(r"\baxis\s*\[([^\]]*)\]", re.I)
 _EXT_TYPES = ("E6POS", "E6AXIS")
 E1_TOL_MM = 0.001  # E1 is written to 0.001 mm
+CIRCLE_TOL_MM = 0.05  # a circular move's points lie this close to its stated circle
+ANGLE_TOL_DEG = 0.05  # its CA this close to the angle its points turn through
+_CIRCLE = re.compile(
+    r"circle r = ([\d.]+) mm, centre \[([-\d.]+), ([-\d.]+), ([-\d.]+)\] mm \(base\), angle ([\d.]+) deg"
+)
+_CHORD = re.compile(r"chord within ([\d.]+) mm of the planned path \(<= ([\d.]+) mm\)")
 
 
 @dataclass(frozen=True)
@@ -76,6 +85,7 @@ def check_program(p: Program, e1_limits_mm: tuple[float, float] | None = None) -
     out += _check_init(p)
     out += _check_points(p)
     out += _check_arc(p)
+    out += check_circles(p)
     out += check_track(p, e1_limits_mm)
     return out
 
@@ -222,4 +232,61 @@ def _check_arc(p: Program) -> list[Finding]:
             waited = True
     if burning_since:
         out.append(Finding(p.src_name, burning_since, "arc", "the arc switched on here is never switched off"))
+    return out
+
+
+def _xyz(p: Program, point: object) -> np.ndarray | None:
+    """A motion's point as (3,) [mm] in the base (a declared or inline E6POS/POS), or None (an axis point)."""
+    v = point if isinstance(point, dict) else (d.value if (d := _decl(p, point)) is not None else None)
+    if not isinstance(v, dict) or not {"X", "Y", "Z"} <= set(v):
+        return None
+    return np.array([float(v["X"]), float(v["Y"]), float(v["Z"])])
+
+
+def check_circles(p: Program) -> list[Finding]:
+    """Each circular move (``circ``): its start (the previous motion's end), auxiliary and end points not on one
+    line; its CA the angle they turn through; the three on the circle stated before it (``;- circle r = ...``,
+    the planned path's), within :data:`CIRCLE_TOL_MM`, and the stated angle its CA. Each chord of a curved weld
+    within the tolerance it states."""
+    out: list[Finding] = []
+    comments = list(p.src.comments)
+    start: np.ndarray | None = None
+    last_line = 0
+    for s in _motions(p.src):
+        stated = [t for n, t in comments if last_line < n < s.line]
+        if s.kind in ("CIRC", "SCIRC"):
+            out += _check_circle(p, s, start, stated)
+        for t in stated:
+            if (c := _CHORD.search(t)) is not None and float(c.group(1)) > float(c.group(2)) + 1e-9:
+                out.append(
+                    Finding(p.src_name, s.line, "circ", f"chord {c.group(1)} mm from the path > {c.group(2)} mm")
+                )
+        start, last_line = _xyz(p, s.point), s.line
+    return out
+
+
+def _check_circle(p: Program, s: Statement, start: np.ndarray | None, stated: list[str]) -> list[Finding]:
+    aux, end = _xyz(p, s.aux), _xyz(p, s.point)
+    if start is None or aux is None or end is None:
+        return [
+            Finding(p.src_name, s.line, "circ", "CIRC whose start, auxiliary or end point is not a Cartesian point")
+        ]
+    circle = circle_through(start, aux, end)
+    if circle is None:
+        return [Finding(p.src_name, s.line, "circ", "CIRC: start, auxiliary and end points on one line")]
+    out = []
+    sweep = float(np.degrees(circle[2]))
+    if s.ca is not None and abs(abs(s.ca) - sweep) > ANGLE_TOL_DEG:
+        out.append(Finding(p.src_name, s.line, "circ", f"CA {s.ca:g} deg, but the points turn through {sweep:.3f} deg"))
+    plan = next((c for t in stated if (c := _CIRCLE.search(t)) is not None), None)
+    if plan is not None:
+        r = float(plan.group(1))
+        centre = np.array([float(plan.group(k)) for k in (2, 3, 4)])
+        for what, q in (("start", start), ("auxiliary point", aux), ("end", end)):
+            off = abs(float(np.linalg.norm(q - centre)) - r)
+            if off > CIRCLE_TOL_MM:
+                out.append(Finding(p.src_name, s.line, "circ", f"the {what} lies {off:.3f} mm off the planned circle"
+                                   f" (r = {r:.3f} mm; tolerance {CIRCLE_TOL_MM} mm)"))  # fmt: skip
+        if abs(float(plan.group(5)) - sweep) > ANGLE_TOL_DEG:
+            out.append(Finding(p.src_name, s.line, "circ", f"turns {sweep:.3f} deg, the plan {plan.group(5)} deg"))
     return out

@@ -11,6 +11,7 @@ import numpy.typing as npt
 from cell.export.program import ProgramJob, procedure_of
 from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
 from cell.types.procedure import WeavePattern, WeldProcedure
+from cell.types.track import LinearTrack
 
 X_TOOL = make_pose(rot_y(-math.pi / 2.0))  # torch_tcp -> KRL tool frame (KUKA tool direction #X: x along the wire)
 PREFLOW_S = 0.3  # gas pre-flow before ignition [s]
@@ -137,3 +138,15 @@ def setup_block(job: ProgramJob) -> list[str]:
                 seen.add((p.name, seg.pass_index))
                 lines.append(f";- {procedure_line(p, seg.pass_index)}")
     return [*lines, ";ENDFOLD"]
+
+
+def track_header(track: LinearTrack) -> list[str]:
+    """The header comment of a plan on a linear track: the axis E1, its limits and how the frames chain."""
+    ax = ", ".join(f"{v:.4f}" for v in track.axis_R)
+    return [
+        f";- Linear track E1 (KL-style, mathematically coupled): axis [{ax}] in $ROBROOT at E1 = 0; software limits"
+        f" {track.e1_min * 1000:.1f} .. {track.e1_max * 1000:.1f} mm; speed {track.v_max * 1000:.0f} mm/s,"
+        f" acceleration {track.a_max * 1000:.0f} mm/s^2.",
+        ";- Every point carries its E1 [mm]; its X, Y, Z stay in BASE_DATA measured from the base at E1 = 0"
+        " ($ERSYSROOT = $ROBROOT at E1 = 0): the robot base at E1 is there moved by E1 along the axis.",
+    ]

@@ -54,6 +54,8 @@ class Statement:
     line: int
     point: Any = None
     folds: tuple[str, ...] = ()
+    aux: Any = None  # a CIRC's auxiliary point (a name or an inline structure)
+    ca: float | None = None  # a CIRC's circular angle CA [deg], None when not given
 
 
 @dataclass
@@ -192,6 +194,16 @@ def read_krl(text: str, kind: str) -> KrlFile:
     return f
 
 
+def _split_first(text: str) -> tuple[str, str, str]:
+    """(first, ",", rest) of a comma-separated list whose items may be structures in braces."""
+    depth = 0
+    for i, c in enumerate(text):
+        depth += (c == "{") - (c == "}")
+        if c == "," and depth == 0:
+            return text[:i].strip(), ",", text[i + 1 :].strip()
+    raise ValueError("a CIRC needs an auxiliary point and an end point: CIRC AUX, END")
+
+
 def _statement(f: KrlFile, code: str, n: int, folds: tuple[str, ...]) -> None:
     up = code.upper()
     if code.startswith("&"):
@@ -221,8 +233,15 @@ def _statement(f: KrlFile, code: str, n: int, folds: tuple[str, ...]) -> None:
         target = m.group(2).strip()
         for approx in ("C_DIS", "C_PTP", "C_VEL", "C_ORI", "C_SPL"):
             target = re.sub(rf"\s+{approx}\b.*$", "", target, flags=re.I)
+        ca: float | None = None
+        if (c := re.search(r"\s*,?\s*\bCA\s+([+-]?[\d.]+(?:[eE][+-]?\d+)?)\s*$", target, re.I)) is not None:
+            ca, target = float(c.group(1)), target[: c.start()].strip()
+        aux: Any = None
+        if m.group(1).upper() in ("CIRC", "SCIRC"):
+            first, _, target = _split_first(target)
+            aux = parse_value(first) if first.startswith("{") else first
         point: Any = parse_value(target) if target.startswith("{") else target.split(",")[-1].strip()
-        f.statements.append(Statement(m.group(1).upper(), code, n, point, folds))
+        f.statements.append(Statement(m.group(1).upper(), code, n, point, folds, aux, ca))
         return
     head = up.split("(")[0].split()[0] if up.split() else up
     kinds = {"ARCMAINNG": "ARCMAIN", "GLOBAL": "INTERRUPT", "BAS": "CALL"}

@@ -8,6 +8,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from cell.export.circles import curve_moves
 from cell.export.program import ProgramJob, not_welded_lines, procedure_of
 from cell.export.status_turn import A1_FRAME, A2_FRAME, A3_FRAME, WRIST_FRAME
 from cell.geometry import FloatArray, invert
@@ -147,6 +148,22 @@ def rapid_text(job: ProgramJob) -> str:
         decl.append(f"  CONST robtarget p{n} := [{pose_text(X)[1:-1]},{confdata(robot, q)},{ext}];")
         wobj = "tWeld \\WObj:=wobjPart"
         arc_next = nxt is not None and nxt.kind == "weld"
+        if seg.kind == "weld" and seg.X_path is not None:  # a curve: ArcC through its circles or ArcL chords
+            n, moves = n - 1, curve_moves(seg, robot)
+            decl.pop()  # the end is the last move's
+            i = proc_index(seg)
+            for k, mv in enumerate(moves):
+                names = []
+                for X_t in [mv.X_aux, mv.X_end] if mv.X_aux is not None else [mv.X_end]:
+                    n += 1
+                    decl.append(
+                        f"  CONST robtarget p{n} := [{pose_text(X_BR @ X_t)[1:-1]},{confdata(robot, mv.q_end)},{ext}];"
+                    )
+                    names.append(f"p{n}")
+                end = "End" if k == len(moves) - 1 and not arc_next else ""
+                instr = ("ArcC" if mv.kind == "CIRC" else "ArcL") + end
+                body.append(f"    {instr} {', '.join(names)}, {speed(seg)}, sm{i}, wd{i} \\Weave:=wv{i}, fine, {wobj};")
+            continue
         if seg.kind == "weld":
             i = proc_index(seg)
             instr = "ArcL" if arc_next else "ArcLEnd"

@@ -18,7 +18,7 @@ from cell.types import CheckFail, SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
-    from cell.types.execution import Execution
+    from cell.types.execution import Execution, WeldQuality
     from cell.types.plan import SeamTask, Segment, WeldPlan
 
 
@@ -139,6 +139,34 @@ def _intended(task: SeamTask | None, reversed_: bool, seg: Segment, tcp_R: Float
     d = (b - a) / task.length
     e_R, b_R = cross_section(d, task.n_a, task.n_b)
     return intended_offsets(tcp_R, a, d, task.length, seg.procedure, seg.pass_index, e_R, b_R)
+
+
+def curve_welds(
+    plan: WeldPlan,
+    ex: Execution | None,
+    pre_s: float,
+    truths_R: Mapping[str, FloatArray],
+    closed: Mapping[str, bool],
+    X_WR: FloatArray,
+) -> dict[str, WeldQuality]:
+    """Curved seam id -> its weld measured against its true curve (:func:`cell.process.curve_quality.
+    curve_weld_quality`) on the records while its arc burned, for every welded curved seam (``closed``: seam id ->
+    a full loop) with a truth (in R); empty without an execution. pre_s [s]: the move before the plan."""
+    from cell.process.curve_quality import curve_weld_quality
+
+    if ex is None:
+        return {}
+    X_RW = invert(np.asarray(X_WR, dtype=float))
+    out: dict[str, WeldQuality] = {}
+    for sid, is_closed in closed.items():
+        welds = [g for g in plan.segments if g.arc_on and g.seam_id == sid]
+        truth = truths_R.get(sid)
+        if not welds or truth is None:
+            continue
+        t0, t1 = pre_s + welds[0].t0, pre_s + welds[-1].t1
+        k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
+        out[sid] = curve_weld_quality(ex.times[k], transform_points(X_RW, ex.tcp_W[k]), truth, is_closed)
+    return out
 
 
 def torch_paths(station: Station, plan: WeldPlan, step_s: float = 0.5) -> dict[str, FloatArray]:

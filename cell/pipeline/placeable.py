@@ -1,11 +1,13 @@
 """Which found seams no torch can be placed on (:func:`unweldable`), so the arm spends no close-up re-scan on
 them (:func:`rescan_weldable`): the planner would refuse them whatever the close-up found (out of reach, or the
 torch against a part or the table at a weld end for every torch orientation the process allows; a few mm of seam
-position change neither). And the weld procedure of every task (:func:`seam_procedures`)."""
+position change neither). The weld procedure of every task (:func:`seam_procedures`) and curved seam
+(:func:`curve_procedures_for`); the parts of each weld's joint, which the safety gate's body test leaves out along
+it (:func:`joint_parts`)."""
 
 from __future__ import annotations
 
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -19,6 +21,8 @@ from cell.station import Arm, Station
 
 if TYPE_CHECKING:
     from cell.planning.failures import SeamFailure
+    from cell.types import Joint, WeldMap
+    from cell.types.curve_estimate import CurveEstimate
     from cell.types.plan import NoProcedure, SeamProcedure, SeamTask
     from cell.types.rescan import Rescan
 
@@ -91,3 +95,37 @@ def _hopeless(
     if found:
         progress(f"not re-scanning {len(found)} of {len(ids)} seams no torch can be placed on (planned to say why)")
     return found
+
+
+def curve_procedures_for(
+    sc: Scenario, weldmap_R: WeldMap, curves: Sequence[CurveEstimate]
+) -> dict[str, SeamProcedure | NoProcedure]:
+    """The weld procedure of every found curved seam (:func:`cell.planning.curves.curve_procedures`): its joint
+    type from the map's curved joint, its leg ``process.leg_mm`` (or ``process.seam_leg_mm`` of the seam)."""
+    from cell.planning.curves import curve_procedures
+
+    if not curves:
+        return {}
+    kinds = {c.id: c.joint.kind for c in weldmap_R.curved if c.joint is not None}
+    legs = {c.id: sc.process.seam_leg_mm.get(c.id, sc.process.leg_mm) for c in curves}
+    up_R = np.asarray(sc.X_WR[:3, :3]).T @ np.array([0.0, 0.0, 1.0])
+    return curve_procedures(curves, kinds, legs, sc.weld_procedures(), up_R)
+
+
+def joint_parts(
+    joints: Mapping[str, Joint], task_ids: Sequence[str], weldmap_R: WeldMap, curves: Sequence[CurveEstimate] = ()
+) -> dict[str, tuple[str, ...]]:
+    """Per task id (a seam's, or a tack's: its seam's) and per curved seam, the two parts of its joint: the safety
+    gate leaves them out of its body test along that task's own weld."""
+    from cell.pipeline.tacks import TACK_MARK
+
+    out: dict[str, tuple[str, ...]] = {}
+    for tid in task_ids:
+        j = joints.get(tid.split(TACK_MARK)[0])
+        if j is not None:
+            out[tid] = (j.abutting, j.receiving)
+    wanted = {c.id for c in curves}
+    for c in weldmap_R.curved:
+        if c.id in wanted and c.joint is not None:
+            out[c.id] = (c.joint.abutting, c.joint.receiving)
+    return out

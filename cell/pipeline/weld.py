@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Sequence
 from contextlib import nullcontext
 from dataclasses import replace
 from functools import partial
@@ -19,20 +19,22 @@ from cell.pipeline.geometry import MotionScene, motion_scene, open_cell
 from cell.pipeline.job import WeldJob
 from cell.pipeline.last_check import joined, last_checked
 from cell.pipeline.outcomes import doubt, seam_welds, torch_paths
-from cell.pipeline.placeable import rescan_weldable, seam_procedures
+from cell.pipeline.placeable import curve_procedures_for, joint_parts, rescan_weldable, seam_procedures
 from cell.pipeline.playback import Measure, log_detection, log_plan, measurer, play_by_seam
+from cell.pipeline.progress import seam_counter
 from cell.pipeline.records import Detection, WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
 from cell.station import Station
-from cell.types import CheckFail, Joint, SeamStatus, Violation, ViolationKind
+from cell.types import CheckFail, SeamStatus, Violation, ViolationKind
 from cell.types.plan import PlanReason
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
 if TYPE_CHECKING:
     from cell.planning.failures import SeamFailure
+    from cell.types.curve_estimate import CurveEstimate
     from cell.types.execution import Execution
     from cell.types.plan import SeamOutcome, SeamTask, WeldPlan
     from cell.types.rescan import PlannedCloseup
@@ -48,6 +50,7 @@ def plan_for(
     motion: MotionScene | None = None,
     progress: Progress = quiet,
     tacks: TackRule | None = None,
+    curves: Sequence[CurveEstimate] = (),
 ) -> tuple[WeldPlan, Trajectory, tuple[Violation, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
     section 7).
@@ -59,6 +62,7 @@ def plan_for(
     tacks : the tack welds to lay first (:mod:`cell.pipeline.tacks`, from the seam tasks): welded before every
         seam, each with its seam's procedure; the plan's outcomes list them after the seams (an arm on a track
         lays none).
+    curves : located curved seams (in R) to weld too (:func:`cell.planning.plan.plan_welds`; not on a track).
     """
     from cell.gate import find_violations
     from cell.gate.blame import blamed_seams
@@ -102,7 +106,7 @@ def plan_for(
     for _ in range(_GATE_ROUNDS):
         kept = [t for t in tasks if t.id not in dropped]
         kept_tacks = [t for t in tack_tasks if t.id not in dropped]
-        procs = seam_procedures(sc, det, kept)
+        procs = seam_procedures(sc, det, kept) | curve_procedures_for(sc, ss.weldmap, curves)
         first = {t.id for t in kept_tacks}  # the tacks before every seam
         planner = partial(plan_welds, first=first) if track is None else partial(plan_on_track, track=track)
         plan = planner(
@@ -116,6 +120,7 @@ def plan_for(
             checker=checker,
             procedures=procs | tack_procedures(procs, kept_tacks),
             on_seam=seam_counter(progress) if not dropped else None,
+            **({"curves": [c for c in curves if c.id not in dropped]} if track is None else {}),
         )
         progress(
             "safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops, the wire"
@@ -129,7 +134,7 @@ def plan_for(
             options=sc.motion.gate,
             bodies=ss.weldmap.parts,  # no TCP or wire inside a part's body (the aligned map's)
             wire_m=process.stickout,
-            joint_parts=_joint_parts(ss.joints, [t.id for t in (*kept, *kept_tacks)]),
+            joint_parts=joint_parts(ss.joints, [t.id for t in (*kept, *kept_tacks)], ss.weldmap, curves),
         )
         blamed = blamed_seams(plan, found)
         if blamed is None:  # none, or one that concerns the whole plan
@@ -138,43 +143,13 @@ def plan_for(
         progress(f"safety gate: dropping {', '.join(blamed)} (their own motions violate it), planning the rest")
         dropped.update(blamed)
     outcomes = {o.seam_id: o for o in plan.seams} | dropped
-    plan = replace(plan, seams=tuple(outcomes[t.id] for t in (*tasks, *tack_tasks) if t.id in outcomes))
+    ids = [*(t.id for t in (*tasks, *tack_tasks)), *(c.id for c in curves)]
+    plan = replace(plan, seams=tuple(outcomes[i] for i in ids if i in outcomes))
     problems += found
     return plan, pre, tuple(problems)
 
 
 _GATE_ROUNDS = 4  # plans tried: after the third round of drops the gate's word is final
-
-
-def _joint_parts(joints: Mapping[str, Joint], task_ids: Sequence[str]) -> dict[str, tuple[str, ...]]:
-    """Per task id (a seam's, or a tack's: its seam's), the two parts of its joint: the safety gate leaves them out
-    of its body test along that task's own weld."""
-    from cell.pipeline.tacks import TACK_MARK
-
-    out: dict[str, tuple[str, ...]] = {}
-    for tid in task_ids:
-        j = joints.get(tid.split(TACK_MARK)[0])
-        if j is not None:
-            out[tid] = (j.abutting, j.receiving)
-    return out
-
-
-def seam_counter(progress: Progress) -> Callable[[int, int], None]:
-    """How the planner's count of seams searched reaches the user: ``progress.count(what, done, total)`` when
-    the callable has one (a bar: the CLI draws it on a terminal), else a line ``planned k/n seams`` through
-    ``progress`` at every tenth of the seams and at the end."""
-    count = getattr(progress, "count", None)
-    if callable(count):
-        return lambda done, total: count("planning seams", done, total)
-    shown = [-1]
-
-    def line(done: int, total: int) -> None:
-        tenth = 10 * done // max(total, 1)
-        if tenth > shown[0] or done == total:
-            shown[0] = tenth
-            progress(f"planned {done}/{total} seams")
-
-    return line
 
 
 def execute(

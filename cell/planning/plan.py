@@ -20,6 +20,7 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.assembly import assemble
 from cell.planning.blend import blend_plan
+from cell.planning.curves import curve_pieces, search_curves, weldable, with_paths
 from cell.planning.failures import SeamFailure, reason_text
 from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
@@ -29,6 +30,7 @@ from cell.planning.stand_off import blocked_by_table, stand_off, table_top
 from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess
 from cell.types import Part
+from cell.types.curve_estimate import CurveEstimate
 from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
 
 
@@ -45,6 +47,7 @@ def plan_welds(
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
     on_seam: Callable[[int, int], None] | None = None,
     first: Collection[str] = (),
+    curves: Sequence[CurveEstimate] = (),
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -57,6 +60,9 @@ def plan_welds(
         with ``process`` alone, one pass on the seam line.
     on_seam : called with (seams searched, seams in all) after each seam's torch search (a progress bar).
     first : task ids welded before all the others (tack welds, :mod:`cell.pipeline.tacks`).
+    curves : located curved seams (:class:`CurveEstimate`, in R; those not found are left out), each welded along
+        its curve (:mod:`cell.planning.curves`: a closed one all round with the process's start/stop overlap), its
+        procedure from ``procedures`` too; their outcomes follow the tasks'.
     Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
     SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
     """
@@ -97,6 +103,20 @@ def plan_welds(
             solved[task.id] = res if isinstance(res, tuple) else (res,)
     if on_seam is not None and tasks:
         on_seam(len(tasks), len(tasks))
+    found_curves = weldable(curves)
+    for curve in found_curves:
+        sel = chosen.get(curve.id)
+        if isinstance(sel, NoProcedure):
+            outcomes[curve.id] = _failed(curve.id, PlanReason.NO_PROCEDURE, sel.reason, curve.p_RS[0])
+            continue
+        searches[curve.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
+    curve_ids = {e.id for e in found_curves if e.id not in outcomes}
+    curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
+    for cid, res in search_curves([e for e in found_curves if e.id in curve_ids], searches, q0, curve_procs).items():
+        if isinstance(res, SeamFailure):
+            outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
+        else:
+            solved[cid] = (res,)
 
     transfers = Transfers(robot, process, checker, opt, obstacles, q0)
     seam_parts: dict[str, list[Piece]] = {}
@@ -104,7 +124,12 @@ def plan_welds(
         sel = chosen.get(sid)
         proc = sel.procedure if isinstance(sel, SeamProcedure) else None
         try:
-            parts = pass_pieces(robot, searches[sid].process, opt, transfers, solved[sid], proc)
+            pr = searches[sid].process
+            parts: list[Piece] | TransferFail = (
+                curve_pieces(robot, pr, opt, solved[sid][0], proc)
+                if sid in curve_ids
+                else pass_pieces(robot, pr, opt, transfers, solved[sid], proc)
+            )
         except TimingError as exc:
             sols = solved.pop(sid)
             outcomes[sid] = _failed(sid, PlanReason.TIMING, exc.message, sols[0].X_weld[0][:3, 3])
@@ -138,6 +163,7 @@ def plan_welds(
         segments = blend_plan(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
         )
+    segments = with_paths(segments, {sid: solved[sid][0].X_weld for sid in curve_ids if sid in solved})
     for sid, sols in solved.items():
         c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
         swapped = isinstance(sel, SeamProcedure) and sel.reverse  # the search saw the task's ends swapped
@@ -156,7 +182,7 @@ def plan_welds(
         joint_names=robot.joint_names,
         q_home=readonly(q0),
         segments=tuple(segments),
-        seams=tuple(outcomes[t.id] for t in tasks),
+        seams=tuple(outcomes[i] for i in [*(t.id for t in tasks), *(e.id for e in found_curves)]),
         order=tuple(ordered),
         planning_s=time.perf_counter() - t_start,
     )

@@ -27,7 +27,8 @@ class WeldProcess:
     travel_speed [m/s]; work_angle, travel_angle [rad]; *_tol [rad] how far the planner may move them;
     ctwd, stickout, approach, depart [m]; approach_speed [m/s]; spin_tol [rad] (pi: fully free);
     reversible: the planner may weld the seam either way (False: only from p_start to p_end, e.g. a vertical
-    seam its procedure welds upwards).
+    seam its procedure welds upwards). closed_overlap [m]: how far a closed curved seam is welded on past its
+    start (the start and the stop overlap).
     """
 
     travel_speed: float
@@ -42,6 +43,7 @@ class WeldProcess:
     depart: float
     approach_speed: float
     reversible: bool = True
+    closed_overlap: float = 0.010
 
     @classmethod
     def from_spec(cls, spec: ProcessSpec, stickout_mm: float = STICKOUT_MM) -> WeldProcess:
@@ -58,6 +60,7 @@ class WeldProcess:
             approach=spec.approach_mm / 1000.0,
             depart=spec.depart_mm / 1000.0,
             approach_speed=spec.approach_speed_mm_s / 1000.0,
+            closed_overlap=spec.closed_overlap_mm / 1000.0,
         )
 
     @property

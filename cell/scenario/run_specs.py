@@ -61,6 +61,9 @@ class ProcessSpec(Model):
     approach_speed_mm_s: Annotated[float, Field(gt=0.0, le=250.0)] = 250.0  # reduced speed, ISO 10218 (s. 7)
     leg_mm: Annotated[float, Field(gt=0.0, le=30.0)] = 4.0  # the fillet leg a seam asks for: picks its WPS row
     seam_leg_mm: dict[str, Annotated[float, Field(gt=0.0, le=30.0)]] = Field(default_factory=dict)  # per seam id
+    # A closed curved seam (a tube all round a plate) is welded on past its start by this much, over the start's
+    # bead, before the crater: the start and the stop overlap.
+    closed_overlap_mm: Annotated[float, Field(ge=0.0, le=50.0)] = 10.0
 
 
 class PerceptionSpec(Model):

@@ -52,7 +52,9 @@ class Segment:
     zone_m [m]: the motion is approximated at its end (KRL ``C_DIS``, a RAPID zone): the next one starts when the
     TCP is this close to the programmed end, the joint target ``q_target`` (dof,) [rad] the trajectory then never
     reaches (0 and None: an exact stop there). link_s [s]: the first link_s of its trajectory is the blend from
-    the previous motion (0: it starts at rest where the previous one ended)."""
+    the previous motion (0: it starts at rest where the previous one ended). X_path (n, 4, 4): the planned TCP
+    poses of a weld along a curve in R, start to end (None: a straight LIN to X_end), for the exporters'
+    circular moves."""
 
     kind: SegmentKind
     seam_id: str
@@ -66,6 +68,7 @@ class Segment:
     zone_m: float = 0.0
     q_target: FloatArray | None = None
     link_s: float = 0.0
+    X_path: FloatArray | None = None
 
     @property
     def q_end(self) -> FloatArray:

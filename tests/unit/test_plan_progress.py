@@ -14,7 +14,7 @@ from cell import scenario as sc
 from cell.cli import bar as bar_module
 from cell.cli.bar import Bar
 from cell.motion.robot import RobotModel
-from cell.pipeline.weld import seam_counter
+from cell.pipeline.progress import seam_counter
 from cell.planning.plan import plan_welds
 from cell.process.torch import WeldProcess
 from cell.types.plan import SeamTask

@@ -1,0 +1,173 @@
+"""Curved seams welded from truth-built estimates: the torch along each curved seam of the round scenarios, planned,
+gated, executed in the simulator and measured against the TRUE curve (not against what was planned).
+
+    .venv/bin/python benchmarks/bench_curve_weld.py [--scenarios pipe-flange,railing,round-brace,tube-tee]
+        [--json benchmarks/results/curve_weld.json]
+
+Until the curve locator lands, the planner is fed estimates built from the truth (:func:`truth_estimates`: the true
+curve of the as-built part in R, sampled every 2 mm, with the two faces' normals from the aligned map and a 0.1 mm
+sigma); so these figures measure the torch path, its timing and its execution, not the location. Per scenario the
+cell is captured and perceived once (no close-up re-scan), the curves are planned with the found straight seams left
+out (``plan_for(..., skip=all, curves=...)``), gated and executed; per curved seam: planned or why not, the weld's
+length, its arc time, and the TCP's distance to the true curve while the arc burns (RMS and max).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.geometry import FloatArray
+from cell.types import CurvedSeam, Part, SeamStatus, Surface, WeldMap
+from cell.types.curve_estimate import CurveEstimate
+
+STEP_M = 0.002  # [m] the truth-built estimate's samples
+SIGMA_M = 0.0001  # [m] its sigma across the seam
+SCENARIOS = ("pipe-flange", "railing", "round-brace", "tube-tee")
+OUT = Path(__file__).resolve().parent / "results" / "curve_weld.json"
+
+
+def _normals(part: Part, surface: Surface, p_R: FloatArray) -> FloatArray:
+    """(n, 3) the outward unit normals of ``part``'s surface (its cylinder's side, or its flat face holding the
+    points) at p_R (n, 3)."""
+    from cell.weldmap.curved_joints import holding_face
+
+    if surface is Surface.CYLINDER:
+        c = part.cylinder
+        assert c is not None
+        d = p_R - c.p_base
+        r = d - np.outer(d @ c.axis, c.axis)
+        return np.asarray(r / np.linalg.norm(r, axis=1, keepdims=True))
+    face = holding_face(part, p_R)
+    if face is None:
+        raise ValueError(f"no face of {part.name} holds the curve")
+    n, _ = part.face_plane(face)
+    return np.tile(n, (len(p_R), 1))
+
+
+def truth_estimate(
+    seam_R: CurvedSeam, weldmap_R: WeldMap, truth_R: FloatArray, step_m: float = STEP_M
+) -> CurveEstimate:
+    """A found :class:`CurveEstimate` built from the true curve truth_R (n, 3) in R: samples ``step_m`` apart along
+    it (a closed curve's last point dropped), the faces' normals of the aligned map's parts at them."""
+    joint = seam_R.joint
+    assert joint is not None
+    p = np.asarray(truth_R, dtype=float)
+    closed = bool(seam_R.curve.closed)
+    if closed and np.linalg.norm(p[-1] - p[0]) < 1e-6:
+        p = p[:-1]
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    total = s[-1] + (float(np.linalg.norm(p[0] - p[-1])) if closed else 0.0)
+    n = max(3, math.ceil(total / step_m))
+    u = np.linspace(0.0, total, n, endpoint=not closed)
+    loop = np.vstack([p, p[:1]]) if closed else p
+    s_loop = np.concatenate([s, [total]]) if closed else s
+    q = np.column_stack([np.interp(u, s_loop, loop[:, j]) for j in range(3)])
+    n_a = _normals(weldmap_R.part(joint.abutting), joint.abutting_surface, q)
+    n_b = _normals(weldmap_R.part(joint.receiving), joint.receiving_surface, q)
+    return CurveEstimate(
+        seam_R.id, SeamStatus.FOUND, "built from the truth", None, q, n_a, n_b, closed, np.full(len(q), SIGMA_M),
+        (0.0, 0.0) if closed else (SIGMA_M, SIGMA_M), 1.0,
+    )  # fmt: skip
+
+
+def truth_estimates(weldmap_R: WeldMap, truths_R: Mapping[str, FloatArray]) -> list[CurveEstimate]:
+    """:func:`truth_estimate` of every curved seam of the aligned map with a truth."""
+    return [truth_estimate(c, weldmap_R, truths_R[c.id]) for c in weldmap_R.curved if c.id in truths_R]
+
+
+def bench(name: str) -> dict[str, Any]:
+    """One scenario: each curved seam planned, executed and measured against its true curve."""
+    from cell import pipeline
+    from cell import scenario as sc
+    from cell.pipeline.detect import read_weldmap
+    from cell.pipeline.geometry import motion_scene, open_cell
+    from cell.pipeline.outcomes import curve_welds
+    from cell.pipeline.weld import execute, plan_for
+
+    s = sc.load(name)
+    weldmap = read_weldmap(s)
+    with open_cell(s, weldmap) as station:
+        det = pipeline.detect(s, station=station, weldmap=weldmap)
+        assert det.scene is not None and station.arm is not None
+        curves = truth_estimates(det.scene.seam_scene.weldmap, det.curve_truths)
+        t0 = time.perf_counter()
+        plan, pre, problems = plan_for(
+            station, det, skip={e.id for e in det.estimates}, motion=motion_scene(station.arm, det), curves=curves
+        )
+        plan_s = time.perf_counter() - t0
+        ex = execute(station, plan, pre) if not problems and plan.segments else None
+    welds = curve_welds(plan, ex, pre.duration, det.curve_truths, {c.id: c.closed for c in curves}, s.X_WR)
+    rows = []
+    for c in curves:
+        o = plan.outcome(c.id)
+        q = welds.get(c.id)
+        rows.append(
+            {
+                "seam": c.id,
+                "closed": c.closed,
+                "length_mm": round(c.length_m * 1000.0, 1),
+                "planned": o.feasible,
+                "reason": o.reason,
+                "welded": q is not None,
+                "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
+                "tcp_max_mm": round(q.tcp_max_mm, 3) if q else None,
+                "weld_length_mm": round(q.length_mm, 1) if q else None,
+                "arc_s": round(q.weld_time_s, 2) if q else None,
+                "speed_mm_s": round(q.speed_mm_s, 2) if q else None,
+                "unwelded_mm": round(q.short_start_mm + q.short_end_mm, 2) if q else None,
+            }
+        )
+    return {
+        "scenario": name,
+        "gate": [str(v) for v in problems],
+        "plan_s": round(plan_s, 2),
+        "seams": rows,
+    }
+
+
+def markdown(out: Mapping[str, Any]) -> str:
+    """The results as the table of docs/curves-welding.md section 7."""
+    lines = [
+        "| scenario | curved seam | length mm | planned | TCP RMS / max mm (true curve) | arc s | why not |",
+        "|---|---|---:|---|---|---:|---|",
+    ]
+    for row in out["rows"]:
+        for r in row["seams"]:
+            tcp = f"{r['tcp_rms_mm']:.3f} / {r['tcp_max_mm']:.3f}" if r["welded"] else "-"
+            arc = f"{r['arc_s']:.1f}" if r["welded"] else "-"
+            why = r["reason"].replace("|", "/") if not r["planned"] else ""
+            kind = "closed" if r["closed"] else "open"
+            planned = "yes" if r["planned"] else "no"
+            lines.append(
+                f"| {row['scenario']} | `{r['seam']}` ({kind}) | {r['length_mm']:.0f} | {planned} | {tcp} | {arc}"
+                f" | {why} |"
+            )
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scenarios", default=",".join(SCENARIOS))
+    ap.add_argument("--json", type=Path, default=OUT)
+    ap.add_argument("--markdown", action="store_true", help="print the table of an existing --json file, run nothing")
+    args = ap.parse_args(argv)
+    if args.markdown:
+        print(markdown(json.loads(args.json.read_text())))
+        return
+    rows = [bench(n) for n in args.scenarios.split(",")]
+    command = "benchmarks/bench_curve_weld.py" + (f" --scenarios {args.scenarios}" if argv else "")
+    out = {"command": f".venv/bin/python {command}", "rows": rows}
+    args.json.write_text(json.dumps(out, indent=2) + "\n")
+    print(json.dumps(out, indent=2))
+
+
+if __name__ == "__main__":
+    main()

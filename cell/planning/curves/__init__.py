@@ -1,0 +1,22 @@
+"""Torch paths along curved seams (arcs, circles, ellipses, saddles, free curves): the located curve resampled and
+the torch posed along it, the search for its start, direction and spin, its timing and its place in the plan.
+The planner's entry is :func:`cell.planning.plan.plan_welds` with ``curves`` (located :class:`CurveEstimate` s)."""
+
+from cell.planning.curves.path import CurvePath, curve_path, curve_poses
+from cell.planning.curves.plan import curve_procedures, search_curves, weldable, with_paths
+from cell.planning.curves.search import CurveTask, plan_curve
+from cell.planning.curves.timing import curve_pieces, curve_trajectory
+
+__all__ = [
+    "CurvePath",
+    "CurveTask",
+    "curve_path",
+    "curve_pieces",
+    "curve_poses",
+    "curve_procedures",
+    "curve_trajectory",
+    "plan_curve",
+    "search_curves",
+    "weldable",
+    "with_paths",
+]

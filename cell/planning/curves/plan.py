@@ -1,0 +1,70 @@
+"""Located curved seams into the plan: their weld procedures, their torch searches and timed pieces, and the
+planned path each curved weld segment carries for the exporters' circular moves (docs/curves-welding.md).
+:func:`cell.planning.plan.plan_welds` calls these for the ``curves`` it is given.
+
+Frames: everything in the robot base frame R [m]; joints [rad]."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+
+import numpy as np
+import numpy.typing as npt
+
+from cell.geometry import readonly
+from cell.planning.curves.search import plan_curve
+from cell.planning.failures import SeamFailure
+from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.process.procedures import UP_R, select_procedure
+from cell.types import SeamStatus
+from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import NoProcedure, SeamProcedure, SeamTask, Segment
+from cell.types.procedure import WeldProcedure
+
+
+def weldable(curves: Sequence[CurveEstimate]) -> list[CurveEstimate]:
+    """The found curves (a locator's other answers are its report's, never the planner's)."""
+    return [c for c in curves if c.status is SeamStatus.FOUND]
+
+
+def curve_procedures(
+    curves: Sequence[CurveEstimate],
+    joint_kinds: Mapping[str, str],
+    legs_mm: Mapping[str, float],
+    rows: Sequence[WeldProcedure],
+    up_R: npt.ArrayLike = UP_R,
+) -> dict[str, SeamProcedure | NoProcedure]:
+    """The weld procedure of each found curve (the first row of the WPS table that fits): its joint type
+    (``joint_kinds``, from the map's curved joint; ``any`` where none), its leg [mm], and its position judged where
+    it is hardest (the sample whose fillet bisector points lowest, with the tangent there). A curve's direction
+    is the planner's to choose: the procedure fixes none."""
+    out: dict[str, SeamProcedure | NoProcedure] = {}
+    for c in weldable(curves):
+        b = np.asarray(c.n_abutting_R) + np.asarray(c.n_receiving_R)
+        k = int(np.argmin(b @ np.asarray(up_R, dtype=float) / np.linalg.norm(b, axis=1)))
+        p, t = c.p_RS[k], c.tangent_R[k]
+        probe = SeamTask(c.id, p, p + 0.01 * t, c.n_abutting_R[k], c.n_receiving_R[k])
+        sel = select_procedure(probe, joint_kinds.get(c.id, "any"), legs_mm.get(c.id, 4.0), rows, up_R)
+        out[c.id] = replace(sel, reverse=False, fixed_direction=False) if isinstance(sel, SeamProcedure) else sel
+    return out
+
+
+def search_curves(
+    curves: Sequence[CurveEstimate],
+    make_search: Mapping[str, SeamSearch],
+    q_seed: npt.ArrayLike,
+    procedures: Mapping[str, WeldProcedure] | None = None,
+) -> dict[str, SeamSolution | SeamFailure]:
+    """Each curve's torch search (:func:`cell.planning.curves.search.plan_curve`) with its own search (the
+    process its procedure gives) and its procedure's root pass and weave, seeded at q_seed (dof,) [rad]."""
+    q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
+    return {c.id: plan_curve(make_search[c.id], c, q0, procs.get(c.id)) for c in curves if c.id in make_search}
+
+
+def with_paths(segments: Sequence[Segment], paths: Mapping[str, npt.ArrayLike]) -> list[Segment]:
+    """The segments with each curved seam's weld carrying its planned TCP poses (``X_path``, (n, 4, 4) in R)."""
+    return [
+        replace(s, X_path=readonly(np.asarray(paths[s.seam_id]))) if s.kind == "weld" and s.seam_id in paths else s
+        for s in segments
+    ]

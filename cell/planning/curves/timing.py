@@ -1,0 +1,102 @@
+"""A curved weld timed: the joints along the curve as a C2 spline in the length welded, the length in time a
+rest-to-rest Ruckig profile at the travel speed (the arm's joint limits scale the ramps, never the travel speed);
+with its approach and depart lines and the procedure's craters, the seam's pieces for the plan
+(docs/curves-welding.md section 3).
+
+Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from cell.config.motion import PlanOptions
+from cell.errors import TimingError
+from cell.geometry import FloatArray
+from cell.motion.robot import RobotModel
+from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile
+from cell.planning.lines import line_trajectory
+from cell.planning.passes import with_craters
+from cell.planning.seam_search import SeamSolution
+from cell.planning.transfers import Piece
+from cell.process.torch import WeldProcess
+from cell.types.procedure import WeldProcedure
+
+_SLACK = 0.98  # a joint may use this share of its limits
+
+
+def curve_trajectory(
+    robot: RobotModel,
+    q_knots: FloatArray,
+    s_knots: FloatArray,
+    speed: float,
+    accel: float,
+    jerk: float,
+    *,
+    dt: float = DEFAULT_DT,
+) -> Trajectory:
+    """The weld along a curve through its IK knots q_knots (n, dof) [rad] at the lengths welded s_knots (n,) [m]:
+    q(s) the not-a-knot cubic spline through the knots, s(t) from rest to rest at exactly ``speed`` [m/s] in its
+    middle, path acceleration ``accel`` [m/s^2] and jerk ``jerk`` [m/s^3] scaled down where a joint would pass its
+    acceleration or jerk limit. TimingError when a joint would pass its velocity limit at the travel speed."""
+    Q = np.asarray(q_knots, dtype=float)
+    s_k = np.asarray(s_knots, dtype=float)
+    spline = CubicSpline(s_k, Q, axis=0)
+    lim = robot.limits
+    length = float(s_k[-1])
+    a, j = accel, jerk
+    for _ in range(8):
+        prof = path_profile(length, speed, a, j, dt=dt)
+        s, sd, sdd = prof.s, prof.sd[:, None], prof.sdd[:, None]
+        d1, d2 = spline(s, 1), spline(s, 2)
+        q = spline(s)
+        qd = d1 * sd
+        qdd = d2 * sd**2 + d1 * sdd
+        h = np.diff(prof.times)[:, None]
+        qddd = np.diff(qdd, axis=0) / h if len(h) else np.zeros((0, Q.shape[1]))
+        rv = float(np.max(np.abs(qd) / lim.v_max))
+        ra = float(np.max(np.abs(qdd) / lim.a_max))
+        rj = float(np.max(np.abs(qddd) / lim.j_max)) if len(qddd) else 0.0
+        if rv > _SLACK:
+            k = int(np.argmax(np.max(np.abs(qd) / lim.v_max, axis=0)))
+            raise TimingError(
+                f"joint {lim.names[k]} would move at {rv * 100:.0f} % of its velocity limit along the curve at the"
+                f" travel speed {speed * 1000:.1f} mm/s"
+            )
+        if max(ra, rj) <= _SLACK:
+            q[0], q[-1] = Q[0], Q[-1]
+            qd[0] = qd[-1] = 0.0
+            return Trajectory(prof.times, q, qd, qdd)
+        if ra > _SLACK:
+            a *= 0.95 / ra
+        if rj > _SLACK:
+            j *= 0.95 / rj
+    raise TimingError(f"could not time a {length * 1000:.1f} mm curved weld within the joint limits")
+
+
+def curve_pieces(
+    robot: RobotModel,
+    process: WeldProcess,
+    options: PlanOptions,
+    sol: SeamSolution,
+    procedure: WeldProcedure | None,
+) -> list[Piece]:
+    """Approach (a line along the torch axis), the weld along the curve (its craters held at rest where the
+    procedure has them) and the depart of a solved curved seam, timed at the procedure's travel speed (the
+    process's without one). Raises TimingError."""
+    pr, opt = process, options
+    speed = procedure.travel_speed_mm_s / 1000.0 if procedure is not None else pr.travel_speed
+    X = sol.X_weld
+    s = np.linspace(0.0, sol.task.length, len(X))
+    approach = float(np.linalg.norm(X[0][:3, 3] - sol.X_approach[:3, 3]))  # the search may have shortened them
+    depart = float(np.linalg.norm(X[-1][:3, 3] - sol.X_depart[:3, 3]))
+    app, v_app = line_trajectory(
+        robot, sol.q_approach, approach, X[0][:3, 2], pr.approach_speed, opt.line_accel, opt.line_jerk, dt=opt.dt
+    )
+    weld = curve_trajectory(robot, sol.q_weld, s, speed, opt.weld_accel, opt.weld_jerk, dt=opt.dt)
+    dep, v_dep = line_trajectory(
+        robot, sol.q_depart, depart, -X[-1][:3, 2], pr.approach_speed, opt.line_accel, opt.line_jerk, dt=opt.dt
+    )
+    craters = procedure or WeldProcedure(name="default")  # the crater filled at the end, as a controller's default
+    weld_piece = with_craters(Piece("weld", weld, speed, X[-1]), craters.crater_start_s, craters.crater_end_s, opt.dt)
+    return [Piece("approach", app, v_app, X[0]), weld_piece, Piece("depart", dep, v_dep, sol.X_depart)]

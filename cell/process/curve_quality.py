@@ -1,0 +1,91 @@
+"""How well a curved seam was welded: the executed tool path against the true curve (how far the TCP strays across
+it, RMS and max; how much of it the bead leaves unwelded, how far it runs past an open curve's ends) and the
+travel speed along it. Frames: R; metres inside, millimetres in the :class:`WeldQuality` it returns."""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from scipy.spatial import cKDTree
+
+from cell.geometry import FloatArray
+from cell.types.execution import WeldQuality
+
+_MM = 1000.0
+_BIN_M = 0.001  # [m] a closed curve's coverage is counted in bins this long
+
+
+def _segments(truth_R: FloatArray, closed: bool) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """(a, b, s_a): the curve's segments from a (m, 3) to b (m, 3) and the length along the curve at each a (m,)."""
+    p = np.asarray(truth_R, dtype=float)
+    b = np.roll(p, -1, axis=0) if closed else p[1:]
+    a = p if closed else p[:-1]
+    s_a = np.concatenate([[0.0], np.cumsum(np.linalg.norm(b - a, axis=1))[:-1]])
+    return a, b, s_a
+
+
+def nearest_on_curve(p_R: npt.ArrayLike, truth_R: npt.ArrayLike, closed: bool) -> tuple[FloatArray, FloatArray]:
+    """(distance (n,) [m], s (n,) [m]): each point's distance to the polyline truth_R (m, 3) (a closed one joins its
+    last point to its first) and the length along it of the nearest point. Exact on the polyline: the nearest
+    vertex's two segments are measured (the truth's samples are dense, 0.5 mm)."""
+    p = np.asarray(p_R, dtype=float).reshape(-1, 3)
+    a, b, s_a = _segments(np.asarray(truth_R, dtype=float), closed)
+    m = len(a)
+    _, k = cKDTree(a).query(p)
+    best_d = np.full(len(p), np.inf)
+    best_s = np.zeros(len(p))
+    for j in (np.mod(k - 1, m) if closed else np.clip(k - 1, 0, m - 1), k):
+        ab = b[j] - a[j]
+        ll = np.maximum(np.sum(ab * ab, axis=1), 1e-30)
+        t = np.clip(np.sum((p - a[j]) * ab, axis=1) / ll, 0.0, 1.0)
+        d = np.linalg.norm(p - (a[j] + t[:, None] * ab), axis=1)
+        better = d < best_d
+        best_d[better] = d[better]
+        best_s[better] = (s_a[j] + t * np.sqrt(ll))[better]
+    return best_d, best_s
+
+
+def curve_weld_quality(times: npt.ArrayLike, tcp_R: npt.ArrayLike, truth_R: npt.ArrayLike, closed: bool) -> WeldQuality:
+    """Quality of one weld along a curve from the records taken while its arc burned.
+
+    times : (n,) [s]; tcp_R : (n, 3) tool positions in R [m] (n >= 2); truth_R : (m, 3) the true curve in R [m]
+    (a closed one without its first point repeated). The TCP error is each record's distance to the true curve.
+    An open curve: short_start / short_end how much of it at each end the bead leaves unwelded, past_start /
+    past_end how far it runs beyond (along the end tangent). A closed curve: short_start the length of the loop
+    no record reaches (counted in 1 mm bins), the others 0.
+    """
+    t = np.asarray(times, dtype=float)
+    p = np.asarray(tcp_R, dtype=float)
+    truth = np.asarray(truth_R, dtype=float)
+    if len(t) < 2:
+        raise ValueError("a weld needs at least two tool records")
+    d, s = nearest_on_curve(p, truth, closed)
+    a, b, s_a = _segments(truth, closed)
+    total = float(s_a[-1] + np.linalg.norm(b[-1] - a[-1]))
+    if closed:
+        bins = np.zeros(max(1, int(np.ceil(total / _BIN_M))), dtype=bool)
+        bins[np.minimum((s / _BIN_M).astype(int), len(bins) - 1)] = True
+        gaps = (float(np.sum(~bins)) * _BIN_M, 0.0, 0.0, 0.0)
+    else:
+        t0 = (truth[1] - truth[0]) / np.linalg.norm(truth[1] - truth[0])
+        t1 = (truth[-1] - truth[-2]) / np.linalg.norm(truth[-1] - truth[-2])
+        past_start = max(float(np.max((truth[0] - p) @ t0)), 0.0)
+        past_end = max(float(np.max((p - truth[-1]) @ t1)), 0.0)
+        gaps = (float(s.min()), total - float(s.max()), past_start, past_end)
+    short_start, short_end, past_start, past_end = gaps
+    step = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    dt = np.diff(t)
+    speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0) * _MM
+    cruise = speed[speed > 0.5 * speed.max()] if speed.size and speed.max() > 0 else speed
+    return WeldQuality(
+        tcp_rms_mm=float(np.sqrt(np.mean((d * _MM) ** 2))),
+        tcp_max_mm=float(d.max() * _MM),
+        weld_time_s=float(t[-1] - t[0]),
+        length_mm=float(step.sum() * _MM),
+        speed_mm_s=float(np.median(cruise)) if cruise.size else 0.0,
+        samples=len(t),
+        short_start_mm=short_start * _MM,
+        short_end_mm=short_end * _MM,
+        past_start_mm=past_start * _MM,
+        past_end_mm=past_end * _MM,
+    )

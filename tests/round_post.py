@@ -1,0 +1,58 @@
+"""A small round part for the curved-seam tests: a post standing on a plate in front of the robot (its fillet a
+CIRCLE, a T cylinder on plane), drawn with the round maps' generators, and the scenario around it (no noise, one
+small camera that no test captures with)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from tools_loader import load_tool
+
+from cell import scenario as scn
+
+RADIUS_MM = 30.0
+PLATE_MM = 10.0
+SEAM = "POST>PLATE:circle"
+SCENARIO = """
+name: round-post
+seed: 7
+simulation: {{noise: none}}
+map: {{file: post.dxf, X_WM: {{xyz_m: [{x}, {y}, 0.90]}}}}
+table: {{center_m: [0.0, 0.0, 0.85], size_m: [1.6, 1.2, 0.10]}}
+robot:
+  urdf: kr5_arc.urdf
+  X_WR: {{xyz_m: [0.0, -0.75, 0.90]}}
+  home_deg: [-90.0, -100.0, 100.0, 0.0, 45.0, 0.0]
+cameras:
+  above:
+    eye_m: [0.0, 0.0, 1.6]
+    target_m: [0.0, 0.0, 0.9]
+    resolution: [64, 48]
+perception:
+  workspace: {{min_m: [-0.5, -0.5, 0.905], max_m: [0.5, 0.5, 1.3]}}
+"""
+
+
+def post_map(path: Path, height_mm: float = 80.0) -> Path:
+    """``path`` written as a DXF: a 60 mm post ``height_mm`` tall (48 facets) on a 200 x 200 x 10 plate, its fillet a
+    red CIRCLE with the id :data:`SEAM`."""
+    rm = load_tool("round_meshes")
+    mk = load_tool("make_round")
+    maps = load_tool("make_maps")
+    m = mk._Map()
+    m.body("PLATE", maps.box_mesh((-100.0, -100.0, 0.0), (100.0, 100.0, PLATE_MM)))
+    flat = (lambda x, y: PLATE_MM), (lambda x, y: PLATE_MM + height_mm)
+    m.body("POST", rm.tube_mesh(RADIUS_MM, RADIUS_MM - 4.0, 48, *flat, np.eye(4)))
+    rm.add_circle_seam(m.msp, SEAM, (0.0, 0.0, PLATE_MM), RADIUS_MM, (0.0, 0.0, 1.0), mk.SEAM_LAYER)
+    m.doc.saveas(path)
+    return path
+
+
+def post_scenario(folder: Path, x_m: float = 0.0, y_m: float = 0.0) -> scn.Scenario:
+    """The scenario of a post on a plate at (x_m, y_m) on the table [m], the robot 0.75 m in front of it."""
+    post_map(folder / "post.dxf")
+    return scn.from_yaml(SCENARIO.format(x=x_m, y=y_m), base_dir=folder)
+
+
+__all__ = ["RADIUS_MM", "SEAM", "post_map", "post_scenario"]

@@ -16,6 +16,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
+import trust_curves as tcv
 
 from cell.seams.metrics import segment_errors
 
@@ -84,7 +85,9 @@ def seam_record(entry: Mapping[str, Any], *, weld_report: bool, rescan_known: bo
     end errors [mm] (:func:`seam_errors_mm`), the stated ``sigma_mm`` and ``end_sigma_mm`` [start, end] (in the
     truth's order; None when the report has no such key) and the errors in those sigmas (``z_across``,
     ``z_ends``); for a weld report whether it was re-scanned (``rescan_known``: the report says), welded, why not,
-    its TCP max error and its bead's ends."""
+    its TCP max error and its bead's ends. A curved seam's record is :func:`trust_curves.curve_record`'s."""
+    if entry.get("curved"):
+        return tcv.curve_record(entry, weld_report=weld_report)
     status = entry["status"]
     located = status == "found"
     rec: Row = {
@@ -187,7 +190,10 @@ def _located(seams: Sequence[Row]) -> list[Row]:
 
 
 def seam_figures(seams: Sequence[Row], stage: str) -> Row:
-    """The figures of a set of seam records (one cell's or every cell's): see the module docstring."""
+    """The figures of a set of seam records (one cell's or every cell's): see the module docstring; the curved
+    seams' apart, under ``curved`` (:func:`trust_curves.curve_figures`)."""
+    curved = [s for s in seams if s.get("curved")]
+    seams = [s for s in seams if not s.get("curved")]
     visible = [s for s in seams if s["visible"]]
     located = _located(visible)
     n_vis = len(visible)
@@ -226,6 +232,7 @@ def seam_figures(seams: Sequence[Row], stage: str) -> Row:
     out["refused"] = len(refused)
     out["refused_share"] = _share(len(refused), n_vis)
     out["refused_reasons"] = dict(sorted(codes.items()))
+    out["curved"] = tcv.curve_figures(curved, stage)
     return out
 
 

@@ -6,8 +6,8 @@ its edge (fillets on both sides), a box post or an RHS with corner radii (a fill
 flats), a flat bar lying flat (lap fillets all round), or a braced pair (two parallel plates with a flat bar lying
 between them at 20-70 degrees, its ends mitred onto their faces: ``tools/random_cell_frames.py``). A standing plate
 or post may carry a mitred brace (a flat bar from the base up to its face at 20-70 degrees). 1-2 round tubes or
-pipes stand among them (MESH or 3DFACE; half of them with a red CIRCLE at the foot, which the cell lists as
-unsupported). A post, tube or pipe may have a plate standing against it, its end flat on the post's face or a
+pipes stand among them (MESH or 3DFACE; half of them with a red CIRCLE at the foot: a curved seam the cell
+locates). A post, tube or pipe may have a plate standing against it, its end flat on the post's face or a
 facet of the tube (its fillets on the base end at that wall; on a post also the two vertical fillets of its end).
 0-2 stop blocks on a fixture layer sit near a seam. Members keep 50 mm apart (room for the torch) and inside the
 plate's edge beyond its build deviation.

@@ -30,6 +30,7 @@ for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the
 import readme_calibration_table as calibration_tables  # noqa: E402  (after the path set-up above)
 import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
 import readme_journal_tables as journal_tables  # noqa: E402
+from readme_trust_table import num, pct, trust_table  # noqa: E402
 
 from cell.bench import PAPER_TABLE1, markdown_table  # noqa: E402
 
@@ -141,52 +142,6 @@ def weld(results: Path) -> str:
     return cell_tables.weld_table(_load(results, "weld.json")[0])
 
 
-def _pct(v: float | None) -> str:
-    return "-" if v is None else f"{v:.0%}"
-
-
-def _num(v: float | int | None, fmt: str = ".2f") -> str:
-    return "-" if v is None else format(v, fmt)
-
-
-def _dist(d: Mapping[str, Any]) -> str:
-    return f"{_num(d['p95'])} / {_num(d['max'])}"
-
-
-def trust_table(data: Mapping[str, Any]) -> str:
-    """One row per stage of ``trust.json`` (docs/trust.md, "The trust benchmark"), a dash where the report had no
-    such figure; under the table, each stage's command, commit and time."""
-    lines = [
-        "| stage | cells (failed) | visible seams | located | re-scanned | refused: reasons "
-        "| lateral p95 / max [mm] | ends p95 / max [mm] | within 2 sigma across | ends within 2 end sigmas "
-        "| splice corrections, exact cameras | welded | worst welded TCP max [mm] | beads > 1 mm off a joint's end |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    notes = []
-    for stage in ("detect", "weld"):
-        b = data.get(stage)
-        if b is None:
-            continue
-        reasons = ", ".join(f"{k} {v}" for k, v in b["refused_reasons"].items())
-        lines.append(
-            f"| {stage} | {b['cells']} ({b['cells_failed']}) | {b['seams_visible']} | {_pct(b['located_share'])} "
-            f"| {_pct(b.get('rescanned_share'))} | {_pct(b['refused_share'])}{': ' + reasons if reasons else ''} "
-            f"| {_dist(b['lateral_mm'])} | {_dist(b['end_mm'])} | {_pct(b['coverage_2sigma_across'])} "
-            f"| {_pct(b['coverage_2sigma_ends'])} | {_num(b['splice_corrections_exact'], 'd')} "
-            f"in {b['cells_exact']} cells | {_pct(b.get('welded_share'))} "
-            f"| {_num(b.get('worst_welded_tcp_max_mm'))} | {_num(b.get('beads_past_end'), 'd')} |"
-        )
-        w = b["cell_wall_s"]
-        notes.append(
-            f"- {stage}: `{b['command']}` (commit {b['commit'][:12]}; {b['cells_run_now']} of the {b['cells']} "
-            f"cells run in the last sitting, {b['wall_s'] / 60.0:.1f} min on {b['workers']} workers; per cell "
-            f"{_num(w['median'], '.1f')} s median, {_num(w['max'], '.1f')} s max)"
-        )
-    if not notes:
-        return "Not run yet: `.venv/bin/python benchmarks/bench_trust.py --cells 200 --seed 0 --stage detect`.\n"
-    return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n"
-
-
 def trust(results: Path) -> str:
     """The trust benchmark's table (``trust.json``; not run yet when the file is missing)."""
     path = results / "trust.json"
@@ -223,8 +178,8 @@ def headline(results: Path) -> str:
     if trust:
         lines.append(
             f"| [{trust['cells']} random cells nobody tuned for]({link}trust-on-cells-nobody-tuned-for): welded, "
-            f"worst TCP max, beads > 1 mm off a joint's end | {_pct(trust['welded_share'])}, "
-            f"{_num(trust.get('worst_welded_tcp_max_mm'))} mm, {_num(trust.get('beads_past_end'), 'd')} "
+            f"worst TCP max, beads > 1 mm off a joint's end | {pct(trust['welded_share'])}, "
+            f"{num(trust.get('worst_welded_tcp_max_mm'))} mm, {num(trust.get('beads_past_end'), 'd')} "
             f"| of {trust['seams_visible']} visible seams; the rest refused, each with its reason |"
         )
     return "\n".join(lines) + "\n"
@@ -243,8 +198,8 @@ def curves(results: Path) -> str:
     for r in data["summary"]:
         found = f"{r['found']}/{r['runs']}" + (f" ({', '.join(r['codes'])})" if r["codes"] else "")
         lines.append(
-            f"| {r['scenario']} | {r['seam']} | {found} | {_num(r['rms_mm_worst'])} | {_num(r['max_mm_worst'])} "
-            f"| {_pct(r['within_2sigma'])} | {_num(r['sigma_max_mm'])} | {r['time_ms_median']:.1f} "
+            f"| {r['scenario']} | {r['seam']} | {found} | {num(r['rms_mm_worst'])} | {num(r['max_mm_worst'])} "
+            f"| {pct(r['within_2sigma'])} | {num(r['sigma_max_mm'])} | {r['time_ms_median']:.1f} "
             f"| {r['cpu_ms_median']:.1f} |"
         )
     return "\n".join(lines) + f"\n\n`{data['command']}` (commit {data['commit'][:10]})\n"

@@ -32,6 +32,7 @@ def _load(name: str) -> ModuleType:
 
 @pytest.fixture(scope="module")
 def tm() -> ModuleType:
+    _load("trust_curves")  # trust_metrics imports it by name, as bench_trust's path set-up lets it
     return _load("trust_metrics")
 
 
@@ -188,3 +189,33 @@ def test_the_readme_table_shows_a_dash_where_the_report_had_no_figure(tm: Module
     row = text.splitlines()[2].split(" | ")
     assert row[0] == "| detect" and row[8] == "100%" and row[9] == "-"  # across covered; no end sigma: a dash
     assert "`bench_trust.py --cells 1 --stage detect`" in text and "weld |" not in text
+
+
+def _curve(sid: str, status: str = "found", **over: Any) -> dict[str, Any]:
+    entry: dict[str, Any] = {"id": sid, "curved": True, "status": status, "reason_code": None}
+    if status == "found":
+        entry["curve"] = {"closed": True, "sigma_max_mm": 0.3}
+    return {**entry, **over}
+
+
+def test_curved_seams_are_counted_apart_from_the_straight_ones(tm: ModuleType) -> None:
+    seams = [
+        _seam(welded=True, tcp_error_mm={"max": 0.2}),
+        _curve("T>P", error_mm={"rms": 0.2, "max": 0.4, "within_2sigma": 1.0}, welded=True, tcp_error_mm={"max": 0.3}),
+        _curve("U>P", error_mm={"rms": 0.5, "max": 0.9, "within_2sigma": 0.8}, weld_reason_code="unreachable"),
+        _curve("V>P", "not_found", reason_code="no_support"),
+    ]
+    recs = tm.cell_record(_report(seams), "weld")["seams"]
+    f = tm.seam_figures(recs, "weld")
+    assert f["seams_visible"] == 1 and f["located"] == 1  # the straight seam alone
+    c = f["curved"]
+    assert (c["visible"], c["located"], c["welded"]) == (3, 2, 1)
+    assert c["max_mm"] == {"n": 2, "median": pytest.approx(0.65), "max": 0.9}
+    assert c["samples_within_2sigma"] == pytest.approx(0.9) and c["curves_within_2sigma"] == 0.5
+    assert c["worst_welded_tcp_max_mm"] == 0.3
+    assert c["refused_reasons"] == {"no_support": 1, "unreachable": 1}
+    from tools_loader import load_tool
+
+    line = load_tool("readme_trust_table").curved_line("weld", c)
+    assert "2 of 3 visible located" in line and "max 0.90 mm" in line and "welded 1" in line
+    assert line.endswith("not welded: no_support 1, unreachable 1")

@@ -13,7 +13,7 @@ located seams are carried from; angles [rad].
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,13 +94,18 @@ def position_at(pos: TiltRotatePositioner, tilt: float, rotate: float, seam: Sea
 
 
 def plan_poses(
-    pos: TiltRotatePositioner, seams: Sequence[SeamFrame], reach: Reach
+    pos: TiltRotatePositioner,
+    seams: Sequence[SeamFrame],
+    reach: Reach,
+    excluded: Collection[tuple[str, tuple[float, float]]] = (),
+    start: tuple[float, float] | None = None,
 ) -> tuple[tuple[PositionerPose, ...], dict[str, str]]:
     """The groups: greedy cover of the seams by candidate poses (each seam's closed-form poses, both tilt branches),
     each pose taking every seam it holds within ISO 6947's tolerance and ``reach`` accepts; the pose covering most
     seams first (ties: the home pose, then the smaller tilt, then the smaller rotation move from the last pose).
     Returns the poses in welding order and, per seam no pose holds, why (``unreachable`` or
-    ``beyond tilt``)."""
+    ``beyond tilt``). excluded : (seam id, pose) pairs the planner refused (a collision, IK): left out. start : where
+    the axes stand (default home); the poses are then ordered from there, nearest move first."""
     home = pos.home
     cands: list[tuple[float, float]] = [home]
     why: dict[str, str] = {}
@@ -114,7 +119,11 @@ def plan_poses(
         if c in holds:
             continue
         at = {s.id: position_at(pos, c[0], c[1], s) for s in seams}
-        holds[c] = {i: p for i, p in at.items() if p.within and reach(pos, c[0], c[1], _by_id(seams, i))}
+        holds[c] = {
+            i: p
+            for i, p in at.items()
+            if p.within and (i, c) not in excluded and reach(pos, c[0], c[1], _by_id(seams, i))
+        }
     left = {s.id for s in seams}
     order: list[PositionerPose] = []
     last = home
@@ -131,20 +140,39 @@ def plan_poses(
         last = best
     for i in sorted(left):
         why.setdefault(i, "unreachable: no pose that holds it in position is within the arm's reach")
-    return tuple(order), why
+    return _nearest_first(order, start or home), why
+
+
+def _nearest_first(poses: list[PositionerPose], start: tuple[float, float]) -> tuple[PositionerPose, ...]:
+    """The poses ordered by the nearest next move from ``start`` (the larger of the two axes' travels)."""
+    out, here, left = [], start, list(poses)
+    while left:
+        nxt = min(left, key=lambda p: max(abs(p.tilt - here[0]), abs(p.rotate - here[1])))
+        out.append(nxt)
+        left.remove(nxt)
+        here = (nxt.tilt, nxt.rotate)
+    return tuple(out)
 
 
 def _by_id(seams: Sequence[SeamFrame], sid: str) -> SeamFrame:
     return next(s for s in seams if s.id == sid)
 
 
-def shoulder_reach(centre_R: FloatArray, radius_m: float) -> Reach:
+def shoulder_reach(centre_R: FloatArray, radius_m: float, min_facing: float = -0.2) -> Reach:
     """A reach test without IK: every waypoint of the seam, carried to (tilt, rotate), within ``radius_m`` of the
-    arm's shoulder ``centre_R`` (3,) (:meth:`cell.motion.robot.RobotModel.reach_bound`)."""
+    arm's shoulder ``centre_R`` (3,) (:meth:`cell.motion.robot.RobotModel.reach_bound`), and the weld's centreline
+    facing the arm (its cosine to the shoulder's direction at least ``min_facing``: a seam on the far side of the
+    part, its bead looking away, is left for the other tilt branch)."""
+    c = np.asarray(centre_R, dtype=float)
 
     def reach(pos: TiltRotatePositioner, tilt: float, rotate: float, seam: SeamFrame) -> bool:
         X = pos.X_R_F(tilt, rotate)
         p_R = seam.p_F @ X[:3, :3].T + X[:3, 3]
-        return bool(np.all(np.linalg.norm(p_R - centre_R, axis=1) <= radius_m))
+        if not np.all(np.linalg.norm(p_R - c, axis=1) <= radius_m):
+            return False
+        b_R = (seam.n_a_F + seam.n_b_F) @ X[:3, :3].T
+        to_arm = c - p_R
+        cos = np.sum(b_R * to_arm, axis=1) / (np.linalg.norm(b_R, axis=1) * np.linalg.norm(to_arm, axis=1))
+        return bool(np.all(cos >= min_facing))
 
     return reach

@@ -13,6 +13,7 @@ import numpy.typing as npt
 
 from cell.config.export import KrlOptions
 from cell.export.krl_data import X_TOOL, arc_data, e6axis, e6pos, num, procedure_line, setup_block
+from cell.export.krl_external import base_lines, positioner_header, positioner_move
 from cell.export.program import ProgramJob, not_welded_lines, procedure_of, write_texts
 from cell.export.status_turn import ArmGeometry, status_turn
 from cell.geometry import invert
@@ -43,6 +44,7 @@ class _Program:
         self.X_BR = invert(job.X_RB)
         self.last_vel = -1.0
         self.last_apo = -1.0
+        self.ext = job.external.by_number() if job.external is not None else None  # a positioner's E2, E3 [deg]
 
     def approx(self, seg: Segment) -> str:
         """The motion's approximation: `` C_DIS`` (after setting ``$APO.CDIS`` to its zone in mm) when the plan
@@ -61,11 +63,11 @@ class _Program:
         name = f"XP{self.n}"
         q = seg.q_end
         if seg.kind == "move":
-            self.dat.append(f"DECL E6AXIS {name}={e6axis(q, seg.e1_end)}")
+            self.dat.append(f"DECL E6AXIS {name}={e6axis(q, seg.e1_end, self.ext)}")
         else:
             s, t = status_turn(self.job.robot, q, self.geo)
             X = self.X_BR @ np.asarray(seg.X_end) @ X_TOOL
-            self.dat.append(f"DECL E6POS {name}={e6pos(X, s, t, seg.e1_end)}")
+            self.dat.append(f"DECL E6POS {name}={e6pos(X, s, t, seg.e1_end, self.ext)}")
         return name
 
     def plain_lin(self, seg: Segment, note: str) -> None:
@@ -178,6 +180,7 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
         *made_by,
         *not_welded_lines(job),
         *(track_header(plan.track) if plan.track is not None else []),
+        *(positioner_header(job.external, job.X_RB) if job.external is not None else []),
         *setup_block(job),
     ]
     b.dat[1:1] = made_by
@@ -189,13 +192,14 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
         ";FOLD INI", ";FOLD BASISTECH INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
         "INTERRUPT ON 3", "BAS(#INITMOV, 0)", ";ENDFOLD (BASISTECH INI)", ";FOLD USER INI", ";ENDFOLD (USER INI)",
         ";ENDFOLD (INI)", "",
-        f"BAS(#TOOL, {opt.tool_index})", f"BAS(#BASE, {opt.base_index})",
+        f"BAS(#TOOL, {opt.tool_index})", *base_lines(job),
         f"BAS(#VEL_PTP, {opt.ptp_percent})", f"BAS(#ACC_PTP, {opt.ptp_percent})",
         f"IF {far} THEN",
         "  HALT ; $config.dat's XHOME is not the planned home XHOME_PLAN (setup block): correct it first",
         "ENDIF",
         "$H_POS = XHOME",
         "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
+        *positioner_move(b, job),
     ]  # fmt: skip
     segs = plan.segments
     current = ""

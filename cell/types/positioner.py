@@ -9,7 +9,7 @@ Angles [rad], lengths [m], speeds [rad/s], accelerations [rad/s^2], jerks [rad/s
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -120,3 +120,36 @@ class WeldPosition:
     rotation_deg: float
     target: str = ""
     within: bool = False
+
+
+@dataclass(frozen=True)
+class ExternalAxes:
+    """A positioner's axes as one program writes them (docs/positioner.md, "Programs"): their values for the whole
+    program [deg] (the positioner stands still while the arm welds), the KRL E numbers they take (E2, E3: E1 is the
+    linear track's), their limits [deg], the machine data of the kinematic chain (``MACHINE_DEF[machine]``), the
+    RAPID mechanical unit, and X_FB (4, 4): the program's base on the faceplate (the part's frame) [m]."""
+
+    values_deg: tuple[float, float]
+    limits_deg: tuple[tuple[float, float], tuple[float, float]]
+    names: tuple[str, str] = ("tilt", "rotate")
+    numbers: tuple[int, int] = (2, 3)
+    machine: int = 2
+    unit: str = "STN1"
+    X_FB: FloatArray = field(default_factory=lambda: np.eye(4))
+
+    def by_number(self) -> dict[int, float]:
+        """E number -> value [deg]."""
+        return dict(zip(self.numbers, self.values_deg, strict=True))
+
+
+def external_axes(
+    pos: TiltRotatePositioner, tilt: float, rotate: float, X_FB: FloatArray | None = None
+) -> ExternalAxes:
+    """The positioner's axes at (tilt, rotate) [rad] as a program writes them (E2, E3; the part's base ``X_FB`` on
+    the faceplate, default the faceplate's own frame)."""
+    lim = ((pos.tilt.q_min, pos.tilt.q_max), (pos.rotate.q_min, pos.rotate.q_max))
+    return ExternalAxes(
+        (math.degrees(tilt), math.degrees(rotate)),
+        tuple((math.degrees(a), math.degrees(b)) for a, b in lim),  # type: ignore[arg-type]
+        X_FB=np.eye(4) if X_FB is None else np.asarray(X_FB, dtype=float),
+    )

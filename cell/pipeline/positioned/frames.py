@@ -70,3 +70,19 @@ def truths_at(
         return {}
     sc = det.scenario
     return true_seams(weldmap_M.transformed(X_WM, "W"), det.scene.seam_scene.joints, parts_W, sc.X_WR)
+
+
+def drawn_frames(det: Detection, pos: TiltRotatePositioner, ids: Sequence[str]) -> list[SeamFrame]:
+    """:func:`seam_frames` of seams not located (the underside's), from the aligned map's drawn seams: where a pose
+    could hold them, for the report."""
+    from dataclasses import replace
+
+    from cell.types import SeamEstimate, SeamStatus
+
+    keep = set(ids)
+    drawn = [
+        SeamEstimate(s.id, SeamStatus.FOUND, p_start=s.p_start, p_end=s.p_end)
+        for s in det.weldmap_R.seams
+        if s.id in keep
+    ]
+    return seam_frames(replace(det, estimates=tuple(drawn)), pos, [e.id for e in drawn])

@@ -15,10 +15,10 @@ from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import open_cell
 from cell.pipeline.job import WeldJob
 from cell.pipeline.positioned.carry import carried, posed_motion, posed_obstacles
-from cell.pipeline.positioned.frames import axes_move_s, seam_frames, truths_at
+from cell.pipeline.positioned.frames import axes_move_s, drawn_frames, seam_frames, truths_at
 from cell.pipeline.positioned.run import GroupRun, PositionerRun
 from cell.pipeline.records import Detection
-from cell.positioner.poses import PositionerPose
+from cell.positioner.poses import PositionerPose, Reach
 from cell.scenario import Scenario
 from cell.station import SimStation
 from cell.types import SeamStatus, WeldMap, WeldReason
@@ -71,6 +71,7 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         frames = seam_frames(det, pos, [e.id for e in det.estimates if e.id not in unheld])
         centre, radius = arm.model.reach_bound("torch_tcp")
         reach = shoulder_reach(centre, radius)
+        unheld |= _hidden(det, pos, reach)
         groups: list[GroupRun] = []
         axes, choose_s = pos.home, 0.0
         excluded: set[tuple[str, tuple[float, float]]] = set()
@@ -100,6 +101,22 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
                 break
         timings = {"total_s": time.perf_counter() - t_all, "choose_poses_s": choose_s, **det.timings}
         return PositionerRun(det, tuple(groups), unheld, rescan_s, timings=timings)
+
+
+def _hidden(det: Detection, pos: TiltRotatePositioner, reach: Reach) -> dict[str, str]:
+    """Why each seam hidden at home (against the clamping table) is not welded, and whether a pose could hold it."""
+    from cell.positioner.poses import plan_poses
+
+    hidden = [e.id for e in det.estimates if e.status is SeamStatus.NOT_VISIBLE]
+    if not hidden:
+        return {}
+    poses, why = plan_poses(pos, drawn_frames(det, pos, hidden), reach)
+    out = {i: f"{NOT_LOCATED} (underside, against the clamping table); {w}" for i, w in why.items()}
+    for p in poses:
+        at = f"tilt {np.degrees(p.tilt):+.0f} deg, rotate {np.degrees(p.rotate):+.0f} deg"
+        for i in p.seams:
+            out[i] = f"{NOT_LOCATED} (underside): a pose holds it in PB ({at}) but no scan at a turned pose is built"
+    return out
 
 
 def _weld_pose(

@@ -30,6 +30,7 @@ class SimPositioner:
         parts_R = positioner_parts(self.pos, *self.axes)
         self.bodies = add_bodies(sim.client, [p.transformed(scenario.X_WR) for p in parts_R])  # type: ignore[attr-defined]
         self._rng = scenario.rng("positioner")
+        self.X_W_true = np.eye(4)  # where the clamped things really are, as a motion in W from home
 
     def error_W(self) -> FloatArray:
         """(4, 4) the repeatability's rigid error in W about the faceplate's centre: a turn of repeatability /
@@ -49,14 +50,19 @@ class SimPositioner:
         from cell.sim.positioner import move_bodies
 
         X_WR = self.scenario.X_WR
+        t_was = self.axes[0]
         X_nom = X_WR @ self.pos.move(tilt, rotate, start=self.axes) @ invert(X_WR)
-        X_true = self.error_W() @ X_nom if self.pos.repeatability_m > 0.0 else X_nom
+        self.axes = (tilt, rotate)
+        # Each pose reached within the repeatability of its nominal place (the errors do not add up move by move).
+        X_home = X_WR @ self.pos.move(tilt, rotate) @ invert(X_WR)
+        X_W_true = self.error_W() @ X_home if self.pos.repeatability_m > 0.0 else X_home
+        X_true = X_W_true @ invert(self.X_W_true)
+        self.X_W_true = X_W_true
         client = self.sim.client  # type: ignore[attr-defined]
         bodies = self.sim.bodies  # type: ignore[attr-defined]
         carried = [b for n, b in bodies.items() if n == "table" or n.startswith("fixture:")]
         move_bodies(client, carried, X_true)
         move_bodies(client, [self.bodies[FACEPLATE]], X_nom)
-        X_tilt = X_WR @ self.pos.X_R_tilt(tilt) @ invert(self.pos.X_R_tilt(self.axes[0])) @ invert(X_WR)
+        X_tilt = X_WR @ self.pos.X_R_tilt(tilt) @ invert(self.pos.X_R_tilt(t_was)) @ invert(X_WR)
         move_bodies(client, [self.bodies[CRADLE]], X_tilt)
-        self.axes = (tilt, rotate)
         return X_nom, X_true

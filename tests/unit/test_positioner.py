@@ -161,3 +161,21 @@ def test_scenario_keys_checked() -> None:
         PositionerSpec.model_validate({"base_xyz_m": [0, 0, 0], "home_deg": [170, 0]})
     with pytest.raises(ValidationError, match="tilt-rotate"):
         PositionerSpec.model_validate({"base_xyz_m": [0, 0, 0], "type": "turntable"})
+
+
+def test_a_located_seam_carried_into_a_pose() -> None:
+    from cell.pipeline.positioned.carry import carried_estimate
+    from cell.types import SeamEstimate, SeamStatus
+
+    p = _positioner()
+    X = p.move(math.radians(90.0), math.radians(30.0))
+    e = SeamEstimate("s", SeamStatus.FOUND, p_start=np.array([0.1, 0.9, 0.0]), p_end=np.array([0.2, 0.9, 0.0]),
+                     sigma_m=0.0002, end_sigma_m=(0.0003, math.inf))  # fmt: skip
+    c = carried_estimate(e, X, 0.0001)
+    assert np.allclose(c.p_start, X[:3, :3] @ e.p_start + X[:3, 3])
+    assert np.isclose(np.linalg.norm(c.p_end - c.p_start), 0.1)
+    assert np.isclose(c.sigma_m, math.hypot(0.0002, 0.0001)) and c.end_sigma_m[1] == math.inf
+    assert np.isclose(c.end_sigma_m[0], math.hypot(0.0003, 0.0001))
+    # The motion from home to a pose is the faceplate's: what sits on the faceplate stays where it sits on it.
+    X_F = p.X_R_F(math.radians(90.0), math.radians(30.0))
+    assert np.allclose(X @ p.X_R_F(*p.home), X_F)

@@ -60,6 +60,33 @@ def carried(
     return replace(det, estimates=estimates, truths=truths, weldmap_R=weldmap_R, scene=scene)
 
 
+DRAWN_SIGMA_M = 0.005  # [m] a seam placed from the aligned map's drawing only: the build tolerance's order
+
+
+def drawn_estimates(det: Detection, ids: list[str]) -> Detection:
+    """The detection with the seams ``ids`` placed where the (carried) aligned map draws them: found, confidence
+    0 and a sigma of the build tolerance's order, so the close-up re-scan locates them (never welded as drawn: the
+    weld gate refuses such a sigma)."""
+    keep = set(ids)
+    drawn = {s.id: s for s in det.weldmap_R.seams if s.id in keep}
+    estimates = tuple(
+        SeamEstimate(
+            e.id,
+            SeamStatus.FOUND,
+            "placed from the aligned map: to be located up close",
+            drawn[e.id].p_start,
+            drawn[e.id].p_end,
+            confidence=0.0,
+            sigma_m=DRAWN_SIGMA_M,
+            end_sigma_m=(DRAWN_SIGMA_M, DRAWN_SIGMA_M),
+        )
+        if e.id in drawn
+        else e
+        for e in det.estimates
+    )
+    return replace(det, estimates=estimates)
+
+
 def posed_obstacles(
     det: Detection, pos: TiltRotatePositioner, axes: tuple[float, float], X_R_nominal: FloatArray
 ) -> tuple[Part, ...]:

@@ -14,11 +14,11 @@ from cell.geometry import FloatArray, invert
 from cell.pipeline.detect import Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import open_cell
 from cell.pipeline.job import WeldJob
-from cell.pipeline.positioned.carry import carried, posed_motion, posed_obstacles
+from cell.pipeline.positioned.carry import carried, drawn_estimates, posed_motion, posed_obstacles
 from cell.pipeline.positioned.frames import axes_move_s, drawn_frames, seam_frames, truths_at
 from cell.pipeline.positioned.run import GroupRun, PositionerRun
 from cell.pipeline.records import Detection
-from cell.positioner.poses import PositionerPose, Reach
+from cell.positioner.poses import PositionerPose
 from cell.scenario import Scenario
 from cell.station import SimStation
 from cell.types import SeamStatus, WeldMap, WeldReason
@@ -64,14 +64,18 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
             if more is not None:
                 rescan_s += more.motion_s
                 q_now = more.q_end
+        # A seam against the clamping table at home is located up close at its pose (below); any other not found
+        # is not welded.
+        hidden = [e.id for e in det.estimates if e.status is SeamStatus.NOT_VISIBLE]
         unheld = {e.id: f"{NOT_LOCATED}: {e.reason or e.status.value}" for e in det.estimates
-                  if e.status is not SeamStatus.FOUND}  # fmt: skip
-        unheld |= {e.id: "low_confidence" for e in det.estimates if e.id not in unheld and doubt(e, sc) is not None}
+                  if e.status is not SeamStatus.FOUND and e.id not in hidden}  # fmt: skip
+        unheld |= {e.id: "low_confidence" for e in det.estimates
+                   if e.id not in unheld and e.id not in hidden and doubt(e, sc) is not None}  # fmt: skip
         unheld |= checked
-        frames = seam_frames(det, pos, [e.id for e in det.estimates if e.id not in unheld])
+        located = [e.id for e in det.estimates if e.id not in unheld and e.id not in hidden]
+        frames = seam_frames(det, pos, located) + drawn_frames(det, pos, hidden)
         centre, radius = arm.model.reach_bound("torch_tcp")
         reach = shoulder_reach(centre, radius)
-        unheld |= _hidden(det, pos, reach)
         groups: list[GroupRun] = []
         axes, choose_s = pos.home, 0.0
         excluded: set[tuple[str, tuple[float, float]]] = set()
@@ -103,22 +107,6 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         return PositionerRun(det, tuple(groups), unheld, rescan_s, timings=timings)
 
 
-def _hidden(det: Detection, pos: TiltRotatePositioner, reach: Reach) -> dict[str, str]:
-    """Why each seam hidden at home (against the clamping table) is not welded, and whether a pose could hold it."""
-    from cell.positioner.poses import plan_poses
-
-    hidden = [e.id for e in det.estimates if e.status is SeamStatus.NOT_VISIBLE]
-    if not hidden:
-        return {}
-    poses, why = plan_poses(pos, drawn_frames(det, pos, hidden), reach)
-    out = {i: f"{NOT_LOCATED} (underside, against the clamping table); {w}" for i, w in why.items()}
-    for p in poses:
-        at = f"tilt {np.degrees(p.tilt):+.0f} deg, rotate {np.degrees(p.rotate):+.0f} deg"
-        for i in p.seams:
-            out[i] = f"{NOT_LOCATED} (underside): a pose holds it in PB ({at}) but no scan at a turned pose is built"
-    return out
-
-
 def _weld_pose(
     station: SimStation,
     det: Detection,
@@ -131,7 +119,7 @@ def _weld_pose(
 ) -> GroupRun:
     """Turn the positioner to ``pose``, carry its seams, plan, gate and weld them."""
     from cell.gate import GateRefusedError
-    from cell.pipeline.outcomes import seam_welds
+    from cell.pipeline.outcomes import doubt, seam_welds
     from cell.pipeline.playback import measurer
     from cell.pipeline.weld import execute, plan_for
 
@@ -145,11 +133,23 @@ def _weld_pose(
     X_WM = sc.X_WR @ X_R @ invert(sc.X_WR) @ sc.X_WM
     det_g = carried(det, pose.seams, X_R, truths_at(station, det, weldmap, X_WM), pos.repeatability_m)
     motion = posed_motion(station.arm, det_g, posed_obstacles(det_g, pos, (pose.tilt, pose.rotate), X_R))
+    rescan_s = 0.0
+    hidden = [e.id for e in det_g.estimates if e.status is SeamStatus.NOT_VISIBLE]
+    if hidden:  # seen at home by no camera: located up close here, from the carried map's drawn seams
+        from cell.pipeline.rescan import rescan_chosen
+
+        progress(f"positioner: locating {', '.join(hidden)} up close at this pose (hidden at home)")
+        rs, det_g, _ = rescan_chosen(
+            station, drawn_estimates(det_g, hidden), "all", seam_ids=hidden, motion=motion, progress=progress
+        )
+        if rs is not None:
+            rescan_s, q_now = rs.motion_s, rs.q_end
+    doubtful = {e.id for e in det_g.estimates if e.status is SeamStatus.FOUND and doubt(e, sc) is not None}
     t = time.perf_counter()
     plan = pre = ex = None
     error: CellError | None = None
     try:
-        plan, pre, violations = plan_for(station, det_g, q_start=q_now, motion=motion, progress=progress)
+        plan, pre, violations = plan_for(station, det_g, skip=doubtful, q_start=q_now, motion=motion, progress=progress)
         plan_s = time.perf_counter() - t
         if violations:
             why = f"the safety gate refused the pose's plan: {violations[0]} (+{len(violations) - 1} more)"
@@ -160,4 +160,4 @@ def _weld_pose(
         error = e
     refused = f"not executed: {error.message}" if error is not None else ""
     seams = seam_welds(det_g, plan, ex, pre.duration if pre is not None else 0.0, refused, sc, True)
-    return replace(GroupRun(pose, move_s, plan, pre, ex, seams, plan_s), error=error)
+    return replace(GroupRun(pose, move_s, plan, pre, ex, seams, plan_s, rescan_s=rescan_s), error=error)

@@ -29,11 +29,12 @@ class GroupRun:
     seams: tuple[SeamWeld, ...]
     plan_wall_s: float
     error: CellError | None = None
+    rescan_s: float = 0.0  # the close-ups at this pose (the seams hidden at home) [s]
 
     @property
     def robot_s(self) -> float:
-        """The arm's time at this pose [s]: the move before the plan and the plan, as executed."""
-        return self.execution.duration if self.execution is not None else 0.0
+        """The arm's time at this pose [s]: the close-ups, the move before the plan and the plan, as executed."""
+        return self.rescan_s + (self.execution.duration if self.execution is not None else 0.0)
 
 
 @dataclass(frozen=True)

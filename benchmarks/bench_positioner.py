@@ -82,7 +82,7 @@ def positioner_row() -> dict[str, Any]:
         "in_tolerance": sum(bool(s["weld_position"] and s["weld_position"]["within_tolerance"]) for s in rep["seams"]),
         "wall_s": round(wall, 1),
         "seam_rows": rep["seams"],
-        "poses": [{k: v for k, v in p.items() if k != "seams"} for p in rep["poses"]],
+        "pose_rows": [{k: v for k, v in p.items() if k != "seams"} for p in rep["poses"]],
     }
 
 

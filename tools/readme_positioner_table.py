@@ -28,7 +28,7 @@ def positioner_table(data: Mapping[str, Any]) -> str:
         " why not |",
         "|---|---|---|---|---|---|---|",
     ]
-    poses = b.get("poses", [])
+    poses = b.get("pose_rows", [])
     for s in b["seam_rows"]:
         wp = s["weld_position"]
         k = s["pose"]

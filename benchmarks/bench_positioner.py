@@ -1,4 +1,4 @@
-"""A part on a positioner against the same part turned by an operator: ``cell positioner weld fence1-positioner``
+"""A part on a positioner against the same part turned by an operator: ``cell weld fence1-positioner``
 and ``cell weld fence1`` side by side (docs/positioner.md, "Figures").
 
     .venv/bin/python benchmarks/bench_positioner.py [--json PATH]
@@ -57,7 +57,7 @@ def fence1_row() -> dict[str, Any]:
 
 
 def positioner_row() -> dict[str, Any]:
-    """``cell positioner weld fence1-positioner``."""
+    """``cell weld fence1-positioner``."""
     from cell.pipeline.positioned import weld_on_positioner
 
     t = time.perf_counter()
@@ -67,7 +67,7 @@ def positioner_row() -> dict[str, Any]:
     plan_s = sum(g.plan_wall_s for g in run.groups) + run.timings.get("choose_poses_s", 0.0)
     planned = len({i for g in run.groups for i in g.pose.seams})
     return {
-        "job": "cell positioner weld fence1-positioner",
+        "job": "cell weld fence1-positioner",
         "welded": run.welded,
         "seams": len(rep["seams"]),
         "located": run.located(),
@@ -92,7 +92,7 @@ def main() -> None:
     args = ap.parse_args()
     _say("cell weld fence1")
     a = fence1_row()
-    _say("cell positioner weld fence1-positioner")
+    _say("cell weld fence1-positioner")
     b = positioner_row()
     out = {
         "command": "benchmarks/bench_positioner.py",

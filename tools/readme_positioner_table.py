@@ -1,4 +1,4 @@
-"""docs/results.md's positioner block (``tools/readme_results.py``): ``cell positioner weld fence1-positioner``
+"""docs/results.md's positioner block (``tools/readme_results.py``): ``cell weld fence1-positioner``
 against ``cell weld fence1`` and each seam's pose and ISO 6947 position, from ``benchmarks/results/positioner.json``
 (``benchmarks/bench_positioner.py``)."""
 

@@ -10,7 +10,6 @@ from typing import Annotated
 import typer
 
 from cell.cli import calibrate as _calibrate  # noqa: F401 - registers ``cell calibrate`` (the cameras' poses)
-from cell.cli import positioner as _positioner  # noqa: F401 - registers ``cell positioner weld``
 from cell.cli import sweep as _sweep  # noqa: F401 - registers ``cell sweep`` (a tolerance study on Ray)
 from cell.cli.common import app, configure, err, fail_line
 from cell.cli.outputs import begin_command

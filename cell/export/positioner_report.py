@@ -8,10 +8,19 @@ import math
 from typing import Any
 
 from cell.pipeline.positioned.run import PositionerRun
+from cell.types import WeldReason
+from cell.types.run import SeamWeld
 
 
 def _r(v: float, d: int = 3) -> float | None:
     return round(v, d) if math.isfinite(v) else None
+
+
+def _code(run: PositionerRun, seam_id: str, w: SeamWeld | None) -> str | None:
+    """Why a seam was not welded, as a code (None: welded)."""
+    if w is not None:
+        return None if w.welded else (w.code or WeldReason.NOT_PLANNED).value
+    return (run.unheld_codes.get(seam_id) or WeldReason.NOT_PLANNED).value
 
 
 def positioner_report(run: PositionerRun) -> dict[str, Any]:
@@ -46,6 +55,7 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
                 "weld_position": position.get(e.id),
                 "welded": bool(w is not None and w.welded),
                 "reason": (w.reason if w is not None and not w.welded else run.unheld.get(e.id, "")),
+                "reason_code": _code(run, e.id, w),
                 "tcp_max_mm": _r(q.tcp_max_mm) if q is not None else None,
                 "tcp_rms_mm": _r(q.tcp_rms_mm) if q is not None else None,
             }

@@ -109,8 +109,8 @@ def weld_part(
     job = job or WeldJob()
     if scenario.robot.positioner is not None:  # the positioner turns the part, not an operator
         raise UsageError(
-            f"scenario {scenario.name!r} clamps its part on robot.positioner: weld it with `cell positioner weld"
-            f" {scenario.name}` (the positioner turns the part; no operator turn)"
+            f"scenario {scenario.name!r} clamps its part on robot.positioner: weld it with"
+            f" cell.pipeline.positioned.weld_on_positioner (what `cell weld {scenario.name}` runs; no operator turn)"
         )
     sc = scenario.with_noise(job.noise) if job.noise else scenario
     side_a = replace(job, noise=None)  # the noise is in the scenario now

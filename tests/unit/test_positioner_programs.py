@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import re
+import time
 from pathlib import Path
 
 import numpy as np
@@ -72,3 +73,25 @@ def test_rapid_uses_a_coordinated_work_object(jobs: list[ProgramJob]) -> None:
     assert "    ActUnit STN1;" in mod and "    DeactUnit STN1;" in mod
     targets = re.findall(r"CONST robtarget p\d+ := \[.*\];", mod)
     assert targets and all(t.endswith(",[9E9,60.000,-45.000,9E9,9E9,9E9]];") for t in targets)
+
+
+def test_cell_weld_takes_a_positioner_scenario_and_refuses_what_does_not_apply(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from cell.cli import app
+
+    t0 = time.perf_counter()
+    result = CliRunner().invoke(app, ["weld", "fence1-positioner", "--sides", "first", "--json", str(tmp_path / "r")])
+    assert result.exit_code == 2, result.stderr
+    assert "--sides first" in result.stderr and "robot.positioner" in result.stderr and "--program" in result.stderr
+    assert time.perf_counter() - t0 < 5.0 and not (tmp_path / "r").exists()  # refused before any work
+
+
+def test_a_partial_positioner_job_names_each_unwelded_seams_reason() -> None:
+    from cell.cli.positioner import partial_line
+
+    codes = (None, "not_planned", "low_confidence", "not_planned")
+    seams = [{"welded": c is None, "reason_code": c} for c in codes]
+    rep = {"seams": seams, "error": None, "totals": {"welded": 1, "seams": 4}}
+    assert partial_line(rep) == "exit 3: 3 seams not welded (low_confidence: 1, not_planned: 2); 1/4 welded"
+    assert partial_line({**rep, "seams": seams[:1], "totals": {"welded": 1, "seams": 1}}) is None

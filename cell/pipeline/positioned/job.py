@@ -72,6 +72,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         unheld |= {e.id: "low_confidence" for e in det.estimates
                    if e.id not in unheld and e.id not in hidden and doubt(e, sc) is not None}  # fmt: skip
         unheld |= checked
+        codes = {i: WeldReason.LAST_CHECK if i in checked else WeldReason.LOW_CONFIDENCE if r == "low_confidence"
+                 else WeldReason.NOT_LOCATED for i, r in unheld.items()}  # fmt: skip
         located = [e.id for e in det.estimates if e.id not in unheld and e.id not in hidden]
         frames = seam_frames(det, pos, located) + drawn_frames(det, pos, hidden)
         centre, radius = arm.model.reach_bound("torch_tcp")
@@ -104,7 +106,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
             if not frames:
                 break
         timings = {"total_s": time.perf_counter() - t_all, "choose_poses_s": choose_s, **det.timings}
-        return PositionerRun(det, tuple(groups), unheld, rescan_s, timings=timings)
+        codes |= {i: WeldReason.NOT_PLANNED for i in unheld if i not in codes}  # no pose holds it
+        return PositionerRun(det, tuple(groups), unheld, rescan_s, timings=timings, unheld_codes=codes)
 
 
 def _weld_pose(

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from cell.errors import CellError
 from cell.pipeline.records import Detection
 from cell.positioner.poses import PositionerPose
-from cell.types import SeamStatus
+from cell.types import SeamStatus, WeldReason
 from cell.types.execution import Execution
 from cell.types.plan import WeldPlan
 from cell.types.run import SeamWeld
@@ -40,7 +40,7 @@ class GroupRun:
 @dataclass(frozen=True)
 class PositionerRun:
     """A whole part on a positioner. unheld : seam id -> why no pose holds it (beyond the tilt, out of reach, not
-    located at home). rescan_s : the close-ups' robot time at home [s]."""
+    located at home), its code in ``unheld_codes``. rescan_s : the close-ups' robot time at home [s]."""
 
     detection: Detection
     groups: tuple[GroupRun, ...] = ()
@@ -48,6 +48,7 @@ class PositionerRun:
     rescan_s: float = 0.0
     error: CellError | None = None
     timings: Mapping[str, float] = field(default_factory=dict)
+    unheld_codes: Mapping[str, WeldReason] = field(default_factory=dict)  # seam id -> why, as a code
 
     def welds(self) -> dict[str, SeamWeld]:
         return {w.id: w for g in self.groups for w in g.seams}

@@ -176,6 +176,12 @@ def test_a_located_seam_carried_into_a_pose() -> None:
     assert np.isclose(np.linalg.norm(c.p_end - c.p_start), 0.1)
     assert np.isclose(c.sigma_m, math.hypot(0.0002, 0.0001)) and c.end_sigma_m[1] == math.inf
     assert np.isclose(c.end_sigma_m[0], math.hypot(0.0003, 0.0001))
+    # The repeatability is the faceplate rim's: a seam twice as far out from its centre sees it doubled.
+    along = (c.p_end - c.p_start) / np.linalg.norm(c.p_end - c.p_start)
+    centre = c.p_start + 2.0 * p.faceplate_radius_m * along  # the start, the farther end, at twice the radius
+    far = carried_estimate(e, X, 0.0001, centre, p.faceplate_radius_m)
+    assert np.isclose(far.sigma_m, math.hypot(0.0002, 0.0002))
+    assert np.isclose(carried_estimate(e, X, 0.0001, c.p_end, 1.0).sigma_m, c.sigma_m)  # within the rim: as given
     # The motion from home to a pose is the faceplate's: what sits on the faceplate stays where it sits on it.
     X_F = p.X_R_F(math.radians(90.0), math.radians(30.0))
     assert np.allclose(X @ p.X_R_F(*p.home), X_F)

@@ -23,12 +23,18 @@ NO_TABLE_Z = -100.0  # [m] the clamping table tilts with the part: no horizontal
 CLAMP_TABLE = "CLAMP_TABLE"  # the clamping table as an obstacle (not the planner's horizontal TABLE)
 
 
-def carried_estimate(e: SeamEstimate, X_R: FloatArray, repeat_m: float) -> SeamEstimate:
+def carried_estimate(
+    e: SeamEstimate, X_R: FloatArray, repeat_m: float, centre_R: FloatArray | None = None, radius_m: float = math.inf
+) -> SeamEstimate:
     """One located seam moved by X_R (4, 4) in R, its sigma across and its ends' sigmas along grown by the
-    positioner's repeatability (root sum of squares)."""
+    positioner's repeatability (root sum of squares). The repeatability is a point's on the faceplate's rim
+    (``radius_m`` from its centre ``centre_R`` (3,), after the move): a seam further out sees its turning part
+    scaled by the lever, ``repeat_m`` times the farther end's distance over the radius (at least 1)."""
     if e.status is not SeamStatus.FOUND:
         return e
     ends = transform_points(X_R, np.stack([e.p_start, e.p_end]))
+    if centre_R is not None:
+        repeat_m *= max(1.0, float(np.max(np.linalg.norm(ends - np.asarray(centre_R), axis=1))) / radius_m)
     grow = lambda s: math.hypot(s, repeat_m) if math.isfinite(s) else s  # noqa: E731
     return replace(
         e,
@@ -44,13 +50,14 @@ def carried(
     ids: list[str] | tuple[str, ...],
     X_R_nominal: FloatArray,
     truths: Mapping[str, tuple[FloatArray, FloatArray]],
-    repeat_m: float,
+    repeat: tuple[float, FloatArray, float],
 ) -> Detection:
     """The detection of the seams ``ids`` carried by the nominal motion X_R_nominal (4, 4) in R; ``truths`` the
-    true seams where the part now lies (the station's, for measuring only)."""
+    true seams where the part now lies (the station's, for measuring only); ``repeat``: the repeatability [m],
+    the faceplate's centre (3,) in R after the move and its radius [m] (:func:`carried_estimate`)."""
     det = restricted(det, ids)
     X = np.asarray(X_R_nominal, dtype=float)
-    estimates = tuple(carried_estimate(e, X, repeat_m) for e in det.estimates)
+    estimates = tuple(carried_estimate(e, X, *repeat) for e in det.estimates)
     truths = {k: v for k, v in truths.items() if k in set(ids)}
     weldmap_R = det.weldmap_R.transformed(X, "R")
     scene = det.scene

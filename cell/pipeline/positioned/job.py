@@ -134,16 +134,19 @@ def _weld_pose(
     station.move_positioner(pose.tilt, pose.rotate)
     X_R = pos.move(pose.tilt, pose.rotate)
     X_WM = sc.X_WR @ X_R @ invert(sc.X_WR) @ sc.X_WM
-    det_g = carried(det, pose.seams, X_R, truths_at(station, det, weldmap, X_WM), pos.repeatability_m)
+    repeat = (pos.repeatability_m, pos.X_R_F(pose.tilt, pose.rotate)[:3, 3], pos.faceplate_radius_m)
+    det_g = carried(det, pose.seams, X_R, truths_at(station, det, weldmap, X_WM), repeat)
     motion = posed_motion(station.arm, det_g, posed_obstacles(det_g, pos, (pose.tilt, pose.rotate), X_R))
     rescan_s = 0.0
     hidden = [e.id for e in det_g.estimates if e.status is SeamStatus.NOT_VISIBLE]
-    if hidden:  # seen at home by no camera: located up close here, from the carried map's drawn seams
+    # The seams whose bound the repeatability carried over the tolerance are located up close here too.
+    grown = [e.id for e in det_g.estimates if e.status is SeamStatus.FOUND and doubt(e, sc) is not None]
+    if hidden or grown:  # hidden: seen at home by no camera, located from the carried map's drawn seams
         from cell.pipeline.rescan import rescan_chosen
 
-        progress(f"positioner: locating {', '.join(hidden)} up close at this pose (hidden at home)")
+        progress(f"positioner: locating {', '.join(hidden + grown)} up close at this pose")
         rs, det_g, _ = rescan_chosen(
-            station, drawn_estimates(det_g, hidden), "all", seam_ids=hidden, motion=motion, progress=progress
+            station, drawn_estimates(det_g, hidden), "all", seam_ids=hidden + grown, motion=motion, progress=progress
         )
         if rs is not None:
             rescan_s, q_now = rs.motion_s, rs.q_end

@@ -35,7 +35,8 @@ def positioner_table(data: Mapping[str, Any]) -> str:
         at = f"{poses[k]['tilt_deg']:+.1f} / {poses[k]['rotate_deg']:+.1f}" if k is not None and k < len(poses) else "-"
         pos = f"{wp['code']}, {wp['slope_deg']:+.2f} / {wp['rotation_deg']:.2f}" if wp else "-"
         ok = ("yes" if wp["within_tolerance"] else "no") if wp else "-"
-        why = s["reason"].split(":")[0] if not s["welded"] else ""
+        head, code = s["reason"].split(":")[0], s.get("reason_code") or ""
+        why = "" if s["welded"] else f"{code} ({head})" if code and head != code else head or code
         lines.append(
             f"| {s['id']} | {at} | {pos} | {ok} | {'yes' if s['welded'] else 'no'} | {_f(s['tcp_max_mm'])} | {why} |"
         )

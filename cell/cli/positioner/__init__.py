@@ -67,6 +67,8 @@ def weld_positioned(
                 else f"{s['reason_code']}: {s['reason']}"
             )
             done = f"TCP max {s['tcp_max_mm']} mm" if s["welded"] else f"not welded: {why}"
+            if not job.execute:  # a preview: the pose chosen, or why none
+                done = "pose chosen" if s["pose"] is not None else f"no pose: {why}"
             pose = f"p{s['pose'] + 1}" if s["pose"] is not None else "--"  # the program's number
             say(f"{s['id']:>24}  {pose}  {wp.get('code', '--')} slope {wp.get('slope_deg')} deg rotation"
                 f" {wp.get('rotation_deg')} deg  {done}")  # fmt: skip

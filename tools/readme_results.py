@@ -30,6 +30,7 @@ for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the
 import readme_calibration_table as calibration_tables  # noqa: E402  (after the path set-up above)
 import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
 import readme_journal_tables as journal_tables  # noqa: E402
+import readme_positioner_table as positioner_tables  # noqa: E402
 from readme_trust_table import num, pct, trust_table  # noqa: E402
 
 from cell.bench import PAPER_TABLE1, markdown_table  # noqa: E402
@@ -229,6 +230,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     ),
     "interrupts": lambda results: journal_tables.interrupts_table(_load_object(results, "interrupts.json")),
     "curves": curves,
+    "positioner": lambda results: positioner_tables.positioner_table(_load_object(results, "positioner.json")),
 }
 
 

@@ -26,8 +26,8 @@ from cell.cli.common import (
     parse_format,
     parse_noise,
     parse_rescan_mode,
+    program_folder,
     say,
-    warn,
     was_interrupted,
 )
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
@@ -120,6 +120,7 @@ def weld(
     goes to the job's journal as it happens; ``--resume`` welds what an interrupted job left (docs/journal.md)."""
     from cell import pipeline
     from cell.cli.journal import end_job, joined, journal_path, open_job, resumed, stopped
+    from cell.cli.positioner import weld_positioned
     from cell.cli.turnover import finish_turnover, parse_sides
     from cell.journal import SideLog, stop_on_signals
     from cell.journal.signals import received
@@ -132,7 +133,7 @@ def weld(
         mode = parse_rescan_mode(rescan)
         check_display(gui)
         check_file(json_path, "--json")
-        program = _program_folder(program, krl)
+        program = program_folder(program, krl)
         check_folder(program, "--program")
         if controller not in ("krl", "rapid"):
             raise UsageError(f"--controller {controller!r} is unknown; valid: krl, rapid")
@@ -140,6 +141,10 @@ def weld(
         _check_rerun(rerun_path)
         side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise, calibration)
+        if scn.robot.positioner is not None:  # the positioner, not an operator, turns the part (docs/positioner.md)
+            unused = {"--html": html, "--rerun": rerun_path, "--journal": journal, "--resume": resume}
+            asked = WeldJob(method, noise=parse_noise(noise), rescan=mode, gui=gui, sides=side_opt)
+            return weld_positioned(scn, prov, asked, (json_path, program, controller), table, unused)
         state = resumed(resume, prov) if resume is not None else None
         if state is not None:  # the job's own options, unless given again
             was = state.start.get("options", {})
@@ -250,6 +255,7 @@ def preview(
     """Dry run: detect and plan, move nothing; pictures of cloud, map, seams, torch poses and joint plots, and of
     the planned turn with side B's seams at their nominal turned place (``--sides all``)."""
     from cell import pipeline
+    from cell.cli.positioner import weld_positioned
     from cell.cli.turnover import finish_turnover, parse_sides
     from cell.pipeline.job import WeldJob
     from cell.pipeline.turnover import weld_part
@@ -263,9 +269,12 @@ def preview(
         _check_rerun(rerun_path)
         side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise, calibration)
+        json_path = out_dir / "report.json"
+        if scn.robot.positioner is not None:  # the poses chosen and the report, nothing moves
+            asked = WeldJob(method, noise=parse_noise(noise), execute=False, sides=side_opt)
+            return weld_positioned(scn, prov, asked, (json_path, None, "krl"), table, {"--rerun": rerun_path})
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
-        json_path = out_dir / "report.json"
         try:
             asked = WeldJob(method, noise=parse_noise(noise), execute=False, sides=side_opt)
             if side_opt == "first":
@@ -287,16 +296,6 @@ def preview(
                 raise
             _interrupted(run, scn, method, stage, prov, writer, json_path)
     finish(writer, partial)
-
-
-def _program_folder(program: Path | None, krl: Path | None) -> Path | None:
-    """``--program DIR``; ``--krl DIR``, its old name, still works and says it is deprecated (not both)."""
-    if krl is None:
-        return program
-    if program is not None:
-        raise UsageError("--krl is the deprecated name of --program: give --program DIR alone")
-    warn("--krl is deprecated: use --program DIR (KUKA KRL or ABB RAPID, as --controller says)")
-    return krl
 
 
 def _interrupted(

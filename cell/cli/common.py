@@ -213,3 +213,13 @@ def check_display(gui: bool) -> None:
     """``--gui`` needs a display: without one the simulator's window kills the process, so refuse first."""
     if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
         raise UsageError("--gui needs a display and $DISPLAY is not set; run without --gui (or under xvfb-run)")
+
+
+def program_folder(program: Path | None, krl: Path | None) -> Path | None:
+    """``--program DIR``; ``--krl DIR``, its old name, still works and says it is deprecated (not both)."""
+    if krl is None:
+        return program
+    if program is not None:
+        raise UsageError("--krl is the deprecated name of --program: give --program DIR alone")
+    warn("--krl is deprecated: use --program DIR (KUKA KRL or ABB RAPID, as --controller says)")
+    return krl

@@ -14,6 +14,7 @@ import numpy.typing as npt
 from cell.config.export import KrlOptions
 from cell.export.circles import CHORD_TOL_M, Move, curve_moves
 from cell.export.krl_data import X_TOOL, arc_data, e6axis, e6pos, num, procedure_line, setup_block, track_header
+from cell.export.krl_external import base_lines, positioner_header, positioner_move
 from cell.export.program import ProgramJob, not_welded_lines, procedure_of, write_texts
 from cell.export.status_turn import ArmGeometry, status_turn
 from cell.geometry import FloatArray, invert
@@ -43,6 +44,7 @@ class _Program:
         self.X_BR = invert(job.X_RB)
         self.last_vel = -1.0
         self.last_apo = -1.0
+        self.ext = job.external.by_number() if job.external is not None else None  # a positioner's E2, E3 [deg]
 
     def approx(self, seg: Segment) -> str:
         """The motion's approximation: `` C_DIS`` (after setting ``$APO.CDIS`` to its zone in mm) when the plan
@@ -60,7 +62,7 @@ class _Program:
         if seg.kind != "move":
             return self.pose_point(np.asarray(seg.X_end), seg.q_end, seg.e1_end)
         self.n += 1
-        self.dat.append(f"DECL E6AXIS XP{self.n}={e6axis(seg.q_end, seg.e1_end)}")
+        self.dat.append(f"DECL E6AXIS XP{self.n}={e6axis(seg.q_end, seg.e1_end, self.ext)}")
         return f"XP{self.n}"
 
     def pose_point(self, X_RT: FloatArray, q: FloatArray, e1: float) -> str:
@@ -68,7 +70,7 @@ class _Program:
         q (dof,) [rad]; its name."""
         self.n += 1
         s, t = status_turn(self.job.robot, q, self.geo)
-        self.dat.append(f"DECL E6POS XP{self.n}={e6pos(self.X_BR @ X_RT @ X_TOOL, s, t, e1)}")
+        self.dat.append(f"DECL E6POS XP{self.n}={e6pos(self.X_BR @ X_RT @ X_TOOL, s, t, e1, self.ext)}")
         return f"XP{self.n}"
 
     def curve_motion(self, mv: Move, e1: float) -> tuple[str, str]:
@@ -222,6 +224,7 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
         *made_by,
         *not_welded_lines(job),
         *(track_header(plan.track) if plan.track is not None else []),
+        *(positioner_header(job.external, job.X_RB) if job.external is not None else []),
         *setup_block(job),
     ]
     b.dat[1:1] = made_by
@@ -233,13 +236,14 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
         ";FOLD INI", ";FOLD BASISTECH INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
         "INTERRUPT ON 3", "BAS(#INITMOV, 0)", ";ENDFOLD (BASISTECH INI)", ";FOLD USER INI", ";ENDFOLD (USER INI)",
         ";ENDFOLD (INI)", "",
-        f"BAS(#TOOL, {opt.tool_index})", f"BAS(#BASE, {opt.base_index})",
+        f"BAS(#TOOL, {opt.tool_index})", *base_lines(job),
         f"BAS(#VEL_PTP, {opt.ptp_percent})", f"BAS(#ACC_PTP, {opt.ptp_percent})",
         f"IF {far} THEN",
         "  HALT ; $config.dat's XHOME is not the planned home XHOME_PLAN (setup block): correct it first",
         "ENDIF",
         "$H_POS = XHOME",
         "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
+        *positioner_move(b, job),
     ]  # fmt: skip
     segs = plan.segments
     current = ""

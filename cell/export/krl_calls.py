@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from cell.export.krl_check import Finding, Program, check_program, read_programs, stated_axis
+from cell.export.krl_external import check_positioner, stated_base, stated_positioner
 from cell.export.krl_kin import check_kinematics, frame_of
 from cell.export.krl_read import Statement, read_krl
 from cell.types.robot import Kinematics
@@ -151,6 +152,8 @@ def check_calls(p: Program, programs: Collection[Program]) -> list[Finding]:
     called = [(n, s) for n, s in calls if n in by_name and n != p.name.upper()]
     welding = [(n, s) for n, s in called if _welds(by_name[n])]
     for (a, sa), (b, sb) in itertools.pairwise(welding):
+        if stated_positioner(by_name[b]):  # a positioner turns the part for it: nobody need stop the program
+            continue
         if not _stops([s for s in p.src.statements if sa.line < s.line < sb.line]):
             msg = f"{b} runs after {a} with no operator stop between them (HALT, a message or dialog waited for,"
             out.append(Finding(p.src_name, sb.line, "operator_stop", msg + " or WAIT FOR an input)"))
@@ -221,6 +224,7 @@ def check_all(
         out += check_program(p, e1_limits_mm)
         cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
         if cartesian or not program_calls(p):
-            out += check_kinematics(fixed_base(p), robot)
+            out += check_kinematics(fixed_base(p), robot, stated_base(p))
+        out += check_positioner(p)
         out += check_calls(p, programs)
     return out + check_setup(programs)

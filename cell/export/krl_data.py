@@ -4,6 +4,7 @@ degrees (A, B, C about Z, Y, X); the data sets' parts and the power source's cha
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 import numpy.typing as npt
@@ -34,17 +35,24 @@ def frame_text(X: npt.ArrayLike) -> str:
     return f"{{X {num(x)}, Y {num(y)}, Z {num(z)}, A {num(yaw)}, B {num(pitch)}, C {num(roll)}}}"
 
 
-def e6pos(X: FloatArray, s: int, t: int, e1: float = 0.0) -> str:
+def e6pos(X: FloatArray, s: int, t: int, e1: float = 0.0, ext: Mapping[int, float] | None = None) -> str:
     """An E6POS of a pose (4, 4) [m] with Status and Turn; E1 the linear track's position [m] (written in mm),
-    the other external axes 0."""
-    return frame_text(X)[:-1] + f", S {s}, T {t}, E1 {_e1(e1)}, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+    ``ext`` other external axes by number [deg] (a positioner's E2, E3), the rest 0."""
+    return frame_text(X)[:-1] + f", S {s}, T {t}, {_e_axes(e1, ext)}}}"
 
 
-def e6axis(q: FloatArray, e1: float = 0.0) -> str:
-    """An E6AXIS of joint values (6,) [rad] in degrees; E1 the linear track's position [m] (written in mm), the
-    other external axes 0."""
+def e6axis(q: FloatArray, e1: float = 0.0, ext: Mapping[int, float] | None = None) -> str:
+    """An E6AXIS of joint values (6,) [rad] in degrees; E1 the linear track's position [m] (written in mm), ``ext``
+    other external axes by number [deg], the rest 0."""
     a = ", ".join(f"A{i + 1} {num(v)}" for i, v in enumerate(np.degrees(q)))
-    return f"{{{a}, E1 {_e1(e1)}, E2 0.0, E3 0.0, E4 0.0, E5 0.0, E6 0.0}}"
+    return f"{{{a}, {_e_axes(e1, ext)}}}"
+
+
+def _e_axes(e1: float, ext: Mapping[int, float] | None) -> str:
+    values = [f"E1 {_e1(e1)}", *(f"E{i} 0.0" for i in range(2, 7))]
+    for i, v in (ext or {}).items():
+        values[i - 1] = f"E{i} {num(v)}"
+    return ", ".join(values)
 
 
 def _e1(e1: float) -> str:
@@ -120,7 +128,10 @@ def setup_block(job: ProgramJob) -> list[str]:
         ";FOLD SETUP: the values to enter before the first run",
         f";- TOOL_DATA[{opt.tool_index}] = {frame_text(X_FT)} ; torch TCP in $FLANGE, tool direction #X = the wire",
         f";- LOAD_DATA[{opt.tool_index}] = {{M {opt.load_kg:.3f}, CM {cm}, J {{X 0.0, Y 0.0, Z 0.0}}}}",
-        f";- BASE_DATA[{opt.base_index}] = {frame_text(job.X_RB)} ; the part (aligned map) in $WORLD = $ROBROOT",
+        f";- BASE_DATA[{opt.base_index}] = {frame_text(job.X_RB)} ; the part (aligned map) in $WORLD = $ROBROOT"
+        if job.external is None
+        else f";- BASE_DATA[{opt.base_index}] = {frame_text(job.external.X_FB)} ; the part's base on the positioner's"
+        f" faceplate (MACHINE_DEF[{job.external.machine}]'s flange)",
         f";- XHOME = {e6axis(job.plan.q_home)} ; in $config.dat; the program sets $H_POS = XHOME",
     ]
     if job.X_WR is not None:

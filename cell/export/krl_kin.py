@@ -88,11 +88,12 @@ def _int(v: Any) -> str:
     return str(int(v)) if isinstance(v, float) and v.is_integer() else str(v)
 
 
-def check_kinematics(p: Program, robot: Kinematics) -> list[Finding]:
-    """S and T of every E6POS reached by a LIN against the arm (module docstring); unreachable points."""
+def check_kinematics(p: Program, robot: Kinematics, base_R: dict[str, Any] | None = None) -> list[Finding]:
+    """S and T of every E6POS reached by a LIN against the arm (module docstring); unreachable points. base_R : the
+    base in $ROBROOT when no BASE_DATA gives it (a positioner's, at the program's axes)."""
     ti, bi = _index(p, "TOOL"), _index(p, "BASE")
     tool = p.src.setup.get(f"TOOL_DATA[{ti}]") if ti is not None else None
-    base = p.src.setup.get(f"BASE_DATA[{bi}]") if bi is not None else None
+    base = base_R if base_R is not None else p.src.setup.get(f"BASE_DATA[{bi}]") if bi is not None else None
     if not isinstance(tool, dict) or not isinstance(base, dict):
         return [Finding(p.src_name, 0, "kinematics", "no BAS(#TOOL, n) / BAS(#BASE, n) with TOOL_DATA[n] and"
                         " BASE_DATA[n] values in the setup block: points not checked against the arm")]  # fmt: skip

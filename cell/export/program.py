@@ -16,6 +16,7 @@ from cell.config.export import KrlOptions
 from cell.geometry import FloatArray, readonly
 from cell.outputs import make_folder, write_atomic
 from cell.types.plan import Segment, WeldPlan
+from cell.types.positioner import ExternalAxes
 from cell.types.procedure import WeldProcedure
 from cell.types.robot import Kinematics
 
@@ -34,6 +35,8 @@ class ProgramJob:
     provenance : what made the program (:func:`cell.provenance.provenance`), or None.
     not_welded : the map's seams the job does not weld, each (id, why as a code, e.g. ``not_supported: curved``):
         the header lists them, so a program never drops a seam in silence.
+    external : a positioner's axes for the whole program (None: none); its points are then in the base on the
+        positioner's faceplate (X_RB the faceplate's base at the program's pose, ``external.X_FB`` on the flange).
     """
 
     plan: WeldPlan
@@ -44,6 +47,7 @@ class ProgramJob:
     options: KrlOptions = field(default_factory=KrlOptions)
     provenance: Mapping[str, Any] | None = None
     not_welded: tuple[tuple[str, str], ...] = ()
+    external: ExternalAxes | None = None
 
     def __post_init__(self) -> None:
         if not _NAME.fullmatch(self.name):

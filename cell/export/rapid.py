@@ -14,6 +14,7 @@ from cell.export.status_turn import A1_FRAME, A2_FRAME, A3_FRAME, WRIST_FRAME
 from cell.geometry import FloatArray, invert
 from cell.provenance import header_lines
 from cell.types.plan import Segment
+from cell.types.positioner import ExternalAxes
 from cell.types.procedure import WeavePattern, WeldProcedure
 from cell.types.robot import Kinematics
 
@@ -24,10 +25,13 @@ _SHAPE: dict[WeavePattern, int] = {"none": 0, "zigzag": 1, "triangle": 1, "circl
 _EXT = "[9E9,9E9,9E9,9E9,9E9,9E9]"
 
 
-def extax(e1: float | None) -> str:
+def extax(e1: float | None, external: ExternalAxes | None = None) -> str:
     """``extjoint`` of a point: eax_a the linear track's E1 [m] (written in mm, as RAPID gives a linear axis),
-    the others unused (9E9); all unused without a track (None)."""
-    return _EXT if e1 is None else f"[{_n(e1 * 1000.0)},9E9,9E9,9E9,9E9,9E9]"
+    eax_b and eax_c a positioner's tilt and rotate [deg], the others unused (9E9); all unused without either."""
+    if external is None:
+        return _EXT if e1 is None else f"[{_n(e1 * 1000.0)},9E9,9E9,9E9,9E9,9E9]"
+    a = "9E9" if e1 is None else _n(e1 * 1000.0)
+    return f"[{a},{_n(external.values_deg[0])},{_n(external.values_deg[1])},9E9,9E9,9E9]"
 
 
 def _n(v: float, digits: int = 3) -> str:
@@ -91,17 +95,27 @@ def rapid_text(job: ProgramJob) -> str:
             f" {_n(track.e1_min * 1000.0, 1)} .. {_n(track.e1_max * 1000.0, 1)} mm, speed {track.v_max * 1000:.0f}"
             " mm/s; every point's eax_a in mm, its pose in wobjPart measured from the base at eax_a = 0."
         ]
+    ext_ax = job.external
+    if ext_ax is not None:
+        head += [
+            f"  ! Positioner {ext_ax.unit} (tilt-rotate, coordinated): eax_b {ext_ax.names[0]}, eax_c"
+            f" {ext_ax.names[1]} [deg], standing still while the arm welds; wobjPart moves with it (ufmec)."
+        ]
     cm = ",".join(_n(v, 1) for v in opt.load_cm_mm)
     decl = [
         f"  PERS tooldata tWeld := [TRUE,{pose_text(X_FT)},[{_n(opt.load_kg)},[{cm}],[1,0,0,0],0,0,0]];",
-        f'  PERS wobjdata wobjPart := [FALSE,TRUE,"",{pose_text(job.X_RB)},[[0,0,0],[1,0,0,0]]];',
+        f'  PERS wobjdata wobjPart := [FALSE,TRUE,"",{pose_text(job.X_RB)},[[0,0,0],[1,0,0,0]]];'
+        if ext_ax is None
+        else f'  PERS wobjdata wobjPart := [FALSE,FALSE,"{ext_ax.unit}",{pose_text(ext_ax.X_FB)},[[0,0,0],[1,0,0,0]]];',
         f"  CONST jointtarget jHome := [[{','.join(_n(v) for v in np.degrees(plan.q_home))}],"
-        f"{extax(0.0 if track else None)}];",
+        f"{extax(0.0 if track else None, ext_ax)}];",
     ]
     procs: dict[tuple[str, int], int] = {}
     speeds: dict[int, str] = {}
     zones: set[str] = set()
-    body = ["  PROC main()", "    ConfJ \\On;", "    ConfL \\On;", "    MoveAbsJ jHome, v1000, fine, tWeld;"]
+    body = ["  PROC main()", "    ConfJ \\On;", "    ConfL \\On;"]
+    body += [f"    ActUnit {ext_ax.unit};"] if ext_ax is not None else []
+    body += ["    MoveAbsJ jHome, v1000, fine, tWeld;"]
     segs = plan.segments
     n, current = 0, ""
 
@@ -144,7 +158,7 @@ def rapid_text(job: ProgramJob) -> str:
         n += 1
         on_track = seg.kind != "move" or track is not None  # X_end: the TCP in R with the base where E1 put it
         X = X_BR @ np.asarray(seg.X_end) if on_track else X_BR @ robot.fk(q, "torch_tcp")
-        ext = extax(seg.e1_end if track else None)
+        ext = extax(seg.e1_end if track else None, ext_ax)
         decl.append(f"  CONST robtarget p{n} := [{pose_text(X)[1:-1]},{confdata(robot, q)},{ext}];")
         wobj = "tWeld \\WObj:=wobjPart"
         arc_next = nxt is not None and nxt.kind == "weld"
@@ -175,6 +189,7 @@ def rapid_text(job: ProgramJob) -> str:
             body.append(f"    MoveJ p{n}, v1000, {zone(seg)}, {wobj};")
         else:
             body.append(f"    MoveL p{n}, {speed(seg)}, {zone(seg)}, {wobj};")
+    body += [f"    DeactUnit {ext_ax.unit};"] if ext_ax is not None else []
     body += ["  ENDPROC", "ENDMODULE", ""]
     return "\n".join([*head, *decl, "", *body])
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from cell.errors import CellError
+from cell.errors import CellError, UsageError
 from cell.geometry import FloatArray, invert, transform_points
 from cell.journal import NO_LOG, SideLog
 from cell.perception.align.near_pose import near_seed
@@ -107,6 +107,11 @@ def weld_part(
     """
     t_all = time.perf_counter()
     job = job or WeldJob()
+    if scenario.robot.positioner is not None:  # the positioner turns the part, not an operator
+        raise UsageError(
+            f"scenario {scenario.name!r} clamps its part on robot.positioner: weld it with"
+            f" cell.pipeline.positioned.weld_on_positioner (what `cell weld {scenario.name}` runs; no operator turn)"
+        )
     sc = scenario.with_noise(job.noise) if job.noise else scenario
     side_a = replace(job, noise=None)  # the noise is in the scenario now
     weldmap = read_weldmap(sc)

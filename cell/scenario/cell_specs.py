@@ -13,6 +13,7 @@ from cell.config import STICKOUT_MM
 from cell.geometry import FloatArray, look_at, pose_from_xyz_rpy
 from cell.scenario.base import Angle, Angles3, Model, NonNeg, Point3, Pos, Vec3
 from cell.scenario.layer_specs import LayerSpec
+from cell.scenario.positioner_specs import PositionerSpec
 from cell.scenario.track_specs import TrackSpec
 
 
@@ -71,6 +72,7 @@ class RobotSpec(Model):
     # torch planner stands the TCP off the seam by contact_tip_distance_mm minus this (0 by default).
     stickout_mm: Pos = STICKOUT_MM
     track: TrackSpec | None = None  # a linear track (external axis E1) under the base: docs/track.md
+    positioner: PositionerSpec | None = None  # a tilt-rotate positioner holding the part: docs/positioner.md
 
 
 class NoiseSpec(Model):

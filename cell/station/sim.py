@@ -19,6 +19,7 @@ from cell.scenario import Scenario
 from cell.scenario.run_specs import CameraFaultSpec
 from cell.station.arm import robot_urdf
 from cell.station.ports import Arm
+from cell.station.positioner import SimPositioner
 from cell.types import CameraIntrinsics, DepthImage, Part, WeldMap
 
 if TYPE_CHECKING:
@@ -44,7 +45,10 @@ class SimStation:
         self.sim: SimCell = SimCell(scenario, self.parts_W, gui=gui, fixtures_W=as_built_fixtures(weldmap, scenario))
         self._arm = arm
         self.X_W_turned: FloatArray | None = None  # the true motion of the last turn (ground truth)
+        self.positioner: SimPositioner | None = None  # robot.positioner's axes and bodies (docs/positioner.md)
         try:
+            if scenario.robot.positioner is not None:
+                self.positioner = SimPositioner(scenario, self.sim)
             if self._arm is not None:
                 robot = self.sim.load_robot(
                     robot_urdf(scenario), scenario.X_WR, self._arm.q_scan, joint_names=self._arm.model.joint_names
@@ -120,6 +124,15 @@ class SimStation:
                 )
             dead = dict(sim.faults.cameras) | {name: CameraFaultSpec(mode="dead") for name in lost}
             self.sim.scenario = self.scenario.with_simulation(faults=sim.faults.model_copy(update={"cameras": dead}))
+
+    def move_positioner(self, tilt: float, rotate: float) -> FloatArray:
+        """Turn the positioner's axes to (tilt, rotate) [rad]: the part (its beads), the clamping table and the
+        fixtures move with the faceplate; :meth:`truth` follows. Returns the nominal motion X_W (4, 4)."""
+        if self.positioner is None:
+            raise ScenarioError(f"scenario {self.scenario.name!r} has no robot.positioner to move")
+        X_nom, X_true = self.positioner.move_to(tilt, rotate)
+        self.parts_W = self.sim.move_part(X_true)
+        return X_nom
 
     def joint_state(self) -> FloatArray:
         return np.asarray(self.sim.robot.q, dtype=float)

@@ -1,0 +1,108 @@
+"""A part on a positioner against the same part turned by an operator: ``cell weld fence1-positioner``
+and ``cell weld fence1`` side by side (docs/positioner.md, "Figures").
+
+    .venv/bin/python benchmarks/bench_positioner.py [--json PATH]
+
+Per job: seams welded, operator turns, the job's time (robot time, the positioner's moves or the operator's turn),
+the worst executed TCP max against the true seam, the planning's wall time in all and per seam planned (the
+positioner's: choosing the poses and every pose's plan and gate, each pose's retries included; fence1's: both
+sides' plan and gate), and for the positioner each seam's ISO 6947 position (default
+``benchmarks/results/positioner.json``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from cell import scenario as sc
+from cell.export.positioner_report import positioner_report
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def _say(msg: str) -> None:
+    print(f"· {msg}", file=sys.stderr, flush=True)
+
+
+def fence1_row() -> dict[str, Any]:
+    """``cell weld fence1``: side A, the operator's turn, side B."""
+    from cell.pipeline.turnover import weld_part
+
+    t = time.perf_counter()
+    run = weld_part(sc.load("fence1"))
+    wall = time.perf_counter() - t
+    sides = [s for s in (run.side_a, run.side_b) if s is not None]
+    plan_s = sum(s.timings.get("plan_s", 0.0) for s in sides)
+    planned = sum(len(s.plan.order) for s in sides if s.plan is not None)
+    tcp = [r.weld.quality.tcp_max_mm for r in run.records() if r.weld is not None and r.weld.quality is not None]
+    return {
+        "job": "cell weld fence1",
+        "welded": run.welded,
+        "seams": len(run.records()),
+        "operator_turns": 1 if run.side_b is not None else 0,
+        "job_time_s": round(run.job_time_s, 3),
+        "robot_time_s": round(run.cycle_time_s, 3),
+        "operator_s": run.operator_s,
+        "tcp_max_mm": round(max(tcp), 3),
+        "plan_s": round(plan_s, 3),
+        "seams_planned": planned,
+        "plan_per_seam_s": round(plan_s / max(planned, 1), 3),
+        "wall_s": round(wall, 1),
+    }
+
+
+def positioner_row() -> dict[str, Any]:
+    """``cell weld fence1-positioner``."""
+    from cell.pipeline.positioned import weld_on_positioner
+
+    t = time.perf_counter()
+    run = weld_on_positioner(sc.load("fence1-positioner"))
+    wall = time.perf_counter() - t
+    rep = positioner_report(run)
+    plan_s = sum(g.plan_wall_s for g in run.groups) + run.timings.get("choose_poses_s", 0.0)
+    planned = len({i for g in run.groups for i in g.pose.seams})
+    return {
+        "job": "cell weld fence1-positioner",
+        "welded": run.welded,
+        "seams": len(rep["seams"]),
+        "located": run.located(),
+        "operator_turns": 0,
+        "job_time_s": rep["totals"]["cycle_time_s"],
+        "positioner_s": rep["totals"]["positioner_s"],
+        "poses": len(run.groups),
+        "tcp_max_mm": rep["totals"]["tcp_max_mm"],
+        "plan_s": round(plan_s, 3),
+        "seams_planned": planned,
+        "plan_per_seam_s": round(plan_s / max(planned, 1), 3),
+        "in_tolerance": sum(bool(s["weld_position"] and s["weld_position"]["within_tolerance"]) for s in rep["seams"]),
+        "wall_s": round(wall, 1),
+        "seam_rows": rep["seams"],
+        "pose_rows": [{k: v for k, v in p.items() if k != "seams"} for p in rep["poses"]],
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", type=Path, default=RESULTS / "positioner.json")
+    args = ap.parse_args()
+    _say("cell weld fence1")
+    a = fence1_row()
+    _say("cell weld fence1-positioner")
+    b = positioner_row()
+    out = {
+        "command": "benchmarks/bench_positioner.py",
+        "fence1": a,
+        "fence1_positioner": b,
+        "plan_per_seam_ratio": round(b["plan_per_seam_s"] / a["plan_per_seam_s"], 2),
+    }
+    args.json.write_text(json.dumps(out, indent=1) + "\n")
+    _say(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()

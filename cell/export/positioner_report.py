@@ -1,0 +1,91 @@
+"""The report of a part welded on a positioner (docs/positioner.md, "Report"): per seam its pose, its ISO 6947
+position (``weld_position``: code, slope and rotation, the worst over its waypoints, and whether within the
+tolerance), welded or why not, the TCP against the truth; per pose the axes and times; the job's totals."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from cell.pipeline.positioned.run import PositionerRun
+from cell.types import WeldReason
+from cell.types.run import SeamWeld
+
+
+def _r(v: float, d: int = 3) -> float | None:
+    return round(v, d) if math.isfinite(v) else None
+
+
+def _code(run: PositionerRun, seam_id: str, w: SeamWeld | None) -> str | None:
+    """Why a seam was not welded, as a code (None: welded)."""
+    if w is not None:
+        return None if w.welded else (w.code or WeldReason.NOT_PLANNED).value
+    return (run.unheld_codes.get(seam_id) or WeldReason.NOT_PLANNED).value
+
+
+def positioner_report(run: PositionerRun) -> dict[str, Any]:
+    """The report as a JSON-ready dict (mm, deg, s)."""
+    welds = run.welds()
+    pose_of: dict[str, int] = {}
+    position: dict[str, dict[str, Any]] = {}
+    for k, g in enumerate(run.groups):
+        for i, wp in g.pose.positions.items():
+            pose_of[i], position[i] = (
+                k,
+                {
+                    "code": wp.code,
+                    "target": wp.target,
+                    "slope_deg": _r(wp.slope_deg),
+                    "rotation_deg": _r(wp.rotation_deg),
+                    "within_tolerance": wp.within,
+                },
+            )
+    seams: list[dict[str, Any]] = []
+    tcp: list[float] = []
+    for e in run.detection.estimates:
+        w = welds.get(e.id)
+        q = w.quality if w is not None else None
+        if q is not None:
+            tcp.append(q.tcp_max_mm)
+        seams.append(
+            {
+                "id": e.id,
+                "located": e.status.value,
+                "pose": pose_of.get(e.id),
+                "weld_position": position.get(e.id),
+                "welded": bool(w is not None and w.welded),
+                "reason": (w.reason if w is not None and not w.welded else run.unheld.get(e.id, "")),
+                "reason_code": _code(run, e.id, w),
+                "tcp_max_mm": _r(q.tcp_max_mm) if q is not None else None,
+                "tcp_rms_mm": _r(q.tcp_rms_mm) if q is not None else None,
+            }
+        )
+    poses = [
+        {
+            "tilt_deg": _r(math.degrees(g.pose.tilt)),
+            "rotate_deg": _r(math.degrees(g.pose.rotate)),
+            "seams": list(g.pose.seams),
+            "move_s": _r(g.move_s),
+            "robot_s": _r(g.robot_s),
+            "plan_wall_s": _r(g.plan_wall_s),
+            "error": g.error.message if g.error is not None else None,
+        }
+        for g in run.groups
+    ]
+    return {
+        "scenario": run.detection.scenario.name,
+        "seams": seams,
+        "poses": poses,
+        "totals": {
+            "seams": len(seams),
+            "located": run.located(),
+            "welded": run.welded,
+            "operator_turns": 0,
+            "cycle_time_s": _r(run.cycle_time_s),
+            "positioner_s": _r(run.positioner_s),
+            "rescan_s": _r(run.rescan_s),
+            "tcp_max_mm": _r(max(tcp, default=math.nan)),
+        },
+        "error": run.error.message if run.error is not None else None,
+        "timings": {k: _r(v) for k, v in run.timings.items()},
+    }

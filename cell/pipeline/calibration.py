@@ -237,6 +237,8 @@ def _views(
         X_RF, depth, rgb = station.view(camera, q_new, "flange" if mount == Mount.EYE_TO_HAND else "table")
         corners = board.detect(rgb)
         if len(corners) < _SEEN_FRACTION * len(board.p_B):
+            if seen == 0 and reached >= wanted:
+                break  # as many poses taken as were wanted and the board found in none: no use trying the rest
             continue
         seen += 1
         q = q_new
@@ -255,7 +257,7 @@ def _views(
         )
     raise CalibrationError(
         f"cameras.{camera}: the board is found in {seen} of {reached} images taken, {wanted} are needed"
-        + (": the camera cannot see the board at any pose" if seen == 0 else ""),
+        + (": the camera cannot see the board at any pose (its view, near_m/far_m, or the board)" if seen == 0 else ""),
         code=CalibrationFault.NOT_SEEN,
         camera=camera,
         value=seen,

@@ -113,3 +113,22 @@ def test_a_board_printed_at_another_scale_is_what_the_simulation_renders(tmp_pat
     picture, face_m, origin_m = printed.picture()
     assert face_m[0] == pytest.approx(1.05 * stated.picture()[1][0]) and origin_m[0] == pytest.approx(-0.0105)
     assert picture.shape == stated.picture()[0].shape  # the same picture, printed larger
+
+
+def test_a_camera_that_sees_the_board_at_no_pose_is_refused_with_its_reason() -> None:
+    import yaml
+
+    from cell.errors import CalibrationError, CalibrationFault
+    from cell.pipeline.calibration import calibrate
+
+    # fence1's right camera with its near plane beyond every planned board distance (0.7 to 1.1 m): the board is
+    # never drawn in its images. Four poses wanted, a small image: four renders, then the refusal.
+    doc = yaml.safe_load((scn.SCENARIO_DIR / "fence1.yaml").read_text(encoding="utf-8"))
+    doc["cameras"]["cam_right"].update(near_m=1.5, resolution=[320, 240])
+    doc["calibration"] = {"poses": 4, "held_out": 0}
+    s = scn.from_yaml(yaml.safe_dump(doc), base_dir=scn.SCENARIO_DIR)
+    with pytest.raises(CalibrationError) as e:
+        calibrate(s, ["cam_right"])
+    assert e.value.code == CalibrationFault.NOT_SEEN and e.value.exit_code == 17
+    assert e.value.value == 0 and e.value.needed == 4
+    assert "cannot see the board at any pose" in str(e.value) and "0 of 4 images" in str(e.value)

@@ -62,6 +62,8 @@ def camera_entry(cal: CameraCalibration) -> dict[str, Any]:
         },
         "opencv": {name: {"measured": _pose(X)} for name, X in cal.opencv.items()},
     }
+    if cal.dropped:
+        entry["poses_dropped"] = {k: int(v) for k, v in cal.dropped.items()}
     if cal.X_AC_true is not None:
         entry["truth_error"] = _error(cal.truth_error())
         for name, X in cal.opencv.items():

@@ -1,41 +1,33 @@
-"""``cell calibrate``: the board shown to every camera asked for, the images taken, each camera's pose solved
-(:mod:`cell.calibrate`). The fixed cameras see the board on the flange as the arm carries it through poses planned
-for good conditioning; the arm's camera sees it lying on the table from poses the arm holds it at. Every pose is
-reached by IK before it is taken; the board must be found (most of its corners) or the pose is skipped."""
+"""``cell calibrate``'s runs: the simulated cell's cameras calibrated from the images :mod:`.images` takes, or a
+capture folder's; each camera's checks, OpenCV's start and the joint refinement (:mod:`cell.calibrate`)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-import numpy.typing as npt
 
 from cell.calibrate import HandEyeMethod
 from cell.calibrate.board import Board
 from cell.calibrate.checks import check_board_size, check_diversity, depth_scale, rotation_spread_deg
 from cell.calibrate.intrinsics import check_intrinsics
-from cell.calibrate.plan import board_poses, camera_poses
 from cell.calibrate.result import CameraCalibration
 from cell.calibrate.solve import hand_eye_start, held_out, refine
 from cell.calibrate.views import Mount, View
-from cell.errors import CalibrationError, CalibrationFault, CaptureError, IKError, ScenarioError, UsageError
-from cell.geometry import FloatArray, invert, make_pose, pose_from_xyz_rpy, rot_x
-from cell.motion.ik import solve_ik
+from cell.errors import CalibrationError, CalibrationFault, CaptureError, ScenarioError, UsageError
+from cell.geometry import FloatArray, make_pose, pose_from_xyz_rpy, rot_x
+from cell.pipeline.calibration.images import SEEN_FRACTION, PoseScreen, depth_at, take_views
 from cell.pipeline.geometry import robot_arm
 from cell.recorded.board_capture import BoardCapture, BoardShot, read_board_capture
 from cell.scenario import Scenario
 from cell.scenario.calibration_specs import BoardSpec, CalibrationRunSpec
 from cell.station.board import SimBoardStation
-from cell.station.ports import Arm
 from cell.types import CameraIntrinsics
 
 Progress = Callable[[str], None]
 OPENCV_METHODS: tuple[HandEyeMethod, ...] = ("park", "tsai", "daniilidis")  # OpenCV's hand-eye methods alone
-_SEEN_FRACTION = 0.6  # a pose counts when this much of the board's corners are found
-_OFFSET = (0.25, 0.1)  # the arm camera's board this far aside and up its image: the torch hides the lower middle
-_CLEARANCE_M = 0.05  # the board and the flange stay this far above the table top
 
 
 @dataclass(frozen=True)
@@ -72,18 +64,21 @@ def calibrate(
     picture, face_m, origin_m = Board(spec.board, scale=scn.simulation.board_scale).picture()
     X_FB = pose_from_xyz_rpy(spec.mount.X_FB_xyz_m, np.radians(spec.mount.X_FB_rpy_deg))
     X_WB = _table_board(scn, board)
-    out, shots, intrinsics = [], [], {}
+    out: list[CameraCalibration] = []
+    shots: list[BoardShot] = []
+    intrinsics: dict[str, CameraIntrinsics] = {}
+    screen = PoseScreen(scn, arm, board, X_FB)
     with SimBoardStation(scn, arm, picture, face_m, origin_m, X_FB=X_FB, X_WB=X_WB) as station:
         for name in names:
             mount = Mount.EYE_IN_HAND if scn.cameras[name].mount == "eye_in_hand" else Mount.EYE_TO_HAND
             say(f"{name}: taking {spec.poses + spec.held_out} board images ({mount})")
-            views, intr, taken = _views(scn, station, arm, board, name, mount, spec.poses + spec.held_out, X_FB, X_WB)
-            cal = solve_camera(spec, name, mount, views, board, intr, spec.held_out)
-            out.append(_with_truth(cal, station.camera_truth(name)))
-            say(f"{name}: {_summary(out[-1])}")
+            got = take_views(scn, station, arm, board, name, mount, spec.poses + spec.held_out, X_FB, X_WB, screen)
+            cal = solve_camera(spec, name, mount, got.views, board, got.intrinsics, spec.held_out)
+            out.append(replace(cal, X_AC_true=station.camera_truth(name), dropped=got.dropped))
+            say(f"{name}: {_summary(out[-1])}; poses dropped: {_dropped(got.dropped)}")
             if keep:
-                shots += taken
-                intrinsics[name] = intr
+                shots += got.shots
+                intrinsics[name] = got.intrinsics
     capture = None
     if keep:
         mounts = {n: scn.cameras[n].mount for n in names}
@@ -118,8 +113,8 @@ def calibrate_capture(
         views = []
         for shot in (s for s in cap.shots if s.camera == name):
             corners = board.detect(shot.rgb)
-            if len(corners) >= _SEEN_FRACTION * len(board.p_B):
-                views.append(View(shot.X_RF, corners, _depth_at(shot.depth_m, corners.px)))
+            if len(corners) >= SEEN_FRACTION * len(board.p_B):
+                views.append(View(shot.X_RF, corners, depth_at(shot.depth_m, corners.px)))
         n = len(views) - held_out
         if n < 4:
             raise CalibrationError(
@@ -168,8 +163,8 @@ def solve_camera(
     )
 
 
-def _with_truth(cal: CameraCalibration, X_AC_true: FloatArray) -> CameraCalibration:
-    return replace(cal, X_AC_true=X_AC_true)
+def _dropped(dropped: dict[str, int]) -> str:
+    return ", ".join(f"{n} {why.replace('_', ' ')}" for why, n in dropped.items() if n) or "none"
 
 
 def _summary(cal: CameraCalibration) -> str:
@@ -191,90 +186,3 @@ def _table_board(scn: Scenario, board: Board) -> FloatArray:
     R = rot_x(np.pi)  # the printed face (-z_B) looks up
     centre = np.array([xy[0], xy[1], scn.table.top_z + 1e-4])
     return make_pose(R, centre - R @ board.centre_B)
-
-
-def _views(
-    scn: Scenario,
-    station: SimBoardStation,
-    arm: Arm,
-    board: Board,
-    camera: str,
-    mount: Mount,
-    wanted: int,
-    X_FB: FloatArray,
-    X_WB: FloatArray,
-) -> tuple[list[View], CameraIntrinsics, list[BoardShot]]:
-    """``wanted`` images of the board, each pose reached by IK and the board found in it (and what was taken)."""
-    spec, cam = scn.calibration, scn.cameras[camera]
-    intr = station.intrinsics(camera)
-    rng = scn.rng(f"calibrate/{camera}")
-    X_RW = invert(scn.X_WR)
-    top_R = (X_RW @ np.array([0.0, 0.0, scn.table.top_z, 1.0]))[2] + _CLEARANCE_M
-    targets: Iterator[tuple[str, FloatArray]]
-    if mount == Mount.EYE_TO_HAND:
-        X_RC = X_RW @ cam.X_WC  # the camera where the scenario says: enough to plan by
-        targets = (
-            ("tool0", X_RC @ X_CB @ invert(X_FB)) for X_CB in board_poses(board, intr, spec.range_m, spec.tilt_deg, rng)
-        )
-    else:
-        X_RB = X_RW @ X_WB
-        targets = (
-            ("camera_optical", X_RC)
-            for X_RC in camera_poses(board, X_RB, intr, spec.hand_range_m, spec.tilt_deg, rng, offset=_OFFSET)
-        )
-    views: list[View] = []
-    shots: list[BoardShot] = []
-    q = arm.q_home
-    reached = seen = 0
-    for frame, X_RT in targets:
-        if mount == Mount.EYE_TO_HAND and not _above(X_RT @ X_FB, board, top_R, X_RT):
-            continue
-        try:
-            q_new = solve_ik(arm.model, X_RT, q, frame=frame, rng=rng)
-        except IKError:
-            continue
-        reached += 1
-        X_RF, depth, rgb = station.view(camera, q_new, "flange" if mount == Mount.EYE_TO_HAND else "table")
-        corners = board.detect(rgb)
-        if len(corners) < _SEEN_FRACTION * len(board.p_B):
-            if seen == 0 and reached >= wanted:
-                break  # as many poses taken as were wanted and the board found in none: no use trying the rest
-            continue
-        seen += 1
-        q = q_new
-        views.append(View(X_RF, corners, _depth_at(depth.depth, corners.px)))
-        shots.append(BoardShot(camera, X_RF, rgb, depth.depth))
-        if len(views) == wanted:
-            return views, intr, shots
-    if reached < wanted:
-        raise CalibrationError(
-            f"cameras.{camera}: only {reached} of the planned board poses are within the arm's reach, {wanted} "
-            f"are needed (calibration.poses + held_out); move the board's range (calibration.range_m)",
-            code=CalibrationFault.UNREACHABLE,
-            camera=camera,
-            value=reached,
-            needed=wanted,
-        )
-    raise CalibrationError(
-        f"cameras.{camera}: the board is found in {seen} of {reached} images taken, {wanted} are needed"
-        + (": the camera cannot see the board at any pose (its view, near_m/far_m, or the board)" if seen == 0 else ""),
-        code=CalibrationFault.NOT_SEEN,
-        camera=camera,
-        value=seen,
-        needed=wanted,
-    )
-
-
-def _above(X_RB: FloatArray, board: Board, top_R: float, X_RF: FloatArray) -> bool:
-    """Whether the board's corners and the flange stay above the table (robot frame z, ``top_R`` with clearance)."""
-    corners = board.p_B @ X_RB[:3, :3].T + X_RB[:3, 3]
-    return bool(np.all(corners[:, 2] > top_R) and X_RF[2, 3] > top_R)
-
-
-def _depth_at(depth_m: npt.NDArray[np.float32], px: FloatArray) -> FloatArray:
-    """The depth image (H, W) [m] at each pixel (nearest), nan where invalid."""
-    h, w = depth_m.shape
-    u = np.clip(np.rint(px[:, 0]).astype(int), 0, w - 1)
-    v = np.clip(np.rint(px[:, 1]).astype(int), 0, h - 1)
-    d = depth_m[v, u].astype(float)
-    return np.where(d > 0.0, d, np.nan)

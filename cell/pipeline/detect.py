@@ -84,7 +84,9 @@ def capture(
         progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
     else:
         progress(f"reading {len(scenario.cameras)} depth cameras' images ({station.source})")
-    images = station.capture()
+    from cell.perception.lens import undistort
+
+    images = {name: undistort(image) for name, image in station.capture().items()}  # pinholes from here on
     return Capture(
         scenario, weldmap, find_joints(weldmap), station.truth(), images, time.perf_counter() - t0, station.source
     )

@@ -15,7 +15,7 @@ from cell.calibrate.checks import check_board_size, check_diversity, depth_scale
 from cell.calibrate.intrinsics import check_intrinsics
 from cell.calibrate.result import CameraCalibration
 from cell.calibrate.solve import hand_eye_start, held_out, refine
-from cell.calibrate.views import Mount, View
+from cell.calibrate.views import Mount, View, undistorted
 from cell.errors import CalibrationError, CalibrationFault, CaptureError, ScenarioError, UsageError
 from cell.geometry import FloatArray, make_pose, pose_from_xyz_rpy, rot_x
 from cell.pipeline.calibration.images import SEEN_FRACTION, PoseScreen, depth_at, take_views
@@ -139,12 +139,18 @@ def solve_camera(
     intr: CameraIntrinsics,
     n_held: int,
 ) -> CameraCalibration:
-    """The checks, OpenCV's start and methods alone, the joint refinement and its held-out residuals of one camera."""
+    """The checks, OpenCV's start and methods alone, the joint refinement and its held-out residuals of one camera.
+    The corners are solved where a pinhole puts them, through the stated lens (``intr.distortion``) or, where the
+    images show that one wrong (flagged), through the lens they measure."""
     K = intr.K
-    fit, rest = list(views[: len(views) - n_held]), list(views[len(views) - n_held :])
-    check_diversity(fit, mount, camera)
-    scale = depth_scale(views, board.p_B, K)
+    check_diversity(views[: len(views) - n_held], mount, camera)
+    ideal = undistorted(views, K, intr.distortion)
+    scale = depth_scale(ideal, board.p_B, K)
     check_board_size(scale, camera, spec.board_scale_tolerance)
+    lens = check_intrinsics(views, board.p_B, intr, scale, spec)
+    if lens.flagged_lens:
+        ideal = undistorted(views, K, lens.lens)
+    fit, rest = ideal[: len(views) - n_held], ideal[len(views) - n_held :]
     starts = {m: hand_eye_start(fit, board.p_B, K, mount, m) for m in OPENCV_METHODS}
     X0, B0 = starts["park"]
     sol = refine(fit, board.p_B, K, mount, X0, B0)
@@ -158,7 +164,7 @@ def solve_camera(
         held_out_px=px,
         held_out_3d_m=d3,
         spread_deg=rotation_spread_deg(fit, mount),
-        intrinsics=check_intrinsics(views, board.p_B, intr, scale, spec),
+        intrinsics=lens,
         opencv={m: X for m, (X, _) in starts.items()},
     )
 

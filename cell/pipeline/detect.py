@@ -25,6 +25,7 @@ from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldM
 
 if TYPE_CHECKING:
     from cell.perception.perceive import Perceived
+    from cell.perception.table_check import SensorCheck
 
 Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
 
@@ -151,8 +152,9 @@ def build_scene(
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
     # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud. The
     # alignment starts beside the splice (perceive_then); the stage times split the wall where the cloud was ready.
+    checks = sensor_checks(cap, progress)
     done = perceive_then(
-        cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned_or_error, pose_uncertainties(sc)
+        cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned_or_error, pose_uncertainties(sc), checks
     )
     if keep is not None:
         keep(done.perceived)
@@ -197,6 +199,36 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     return with_calibration(
         out, p.registered, p.origins_R, pose_uncertainties(scenario), p.spliced.registrations, faces
     )
+
+
+_BODY_PLAY_M = 0.08  # the part may lie this far off its drawn place (and the camera see its sides beyond it)
+
+
+def sensor_checks(cap: Capture, progress: Progress = quiet) -> dict[str, SensorCheck]:
+    """Each camera's depth scale and focal length checked on the table's top in its own image (no board needed;
+    :mod:`cell.perception.table_check`), against the calibration's tolerances; a flagged one is said here."""
+    from cell.perception.table_check import check_on_table
+
+    sc, t = cap.scenario, cap.scenario.table
+    lo = (t.center_m[0] - t.size_m[0] / 2.0, t.center_m[1] - t.size_m[1] / 2.0)
+    hi = (t.center_m[0] + t.size_m[0] / 2.0, t.center_m[1] + t.size_m[1] / 2.0)
+    tol = (sc.calibration.depth_scale_tolerance, sc.calibration.focal_tolerance)
+    sigma = pose_uncertainties(sc)
+    drawn = cap.weldmap.transformed(sc.X_WM, "W")
+    corners = [b.vertices()[:, :2] for b in (*drawn.parts, *drawn.fixtures)]
+    bodies = (
+        np.array([c.min(axis=0) - _BODY_PLAY_M for c in corners]).reshape(-1, 2),
+        np.array([c.max(axis=0) + _BODY_PLAY_M for c in corners]).reshape(-1, 2),
+    )
+    out = {}
+    for name, image in cap.images.items():
+        s = sigma.get(name) or PoseUncertainty()
+        check = check_on_table(image, t.top_z, lo, hi, (s.translation_m, s.rotation_rad), tol, bodies)
+        if check is not None:
+            out[name] = check
+            if check.flags:
+                progress(f"warning: {name}: {check.reason()}")
+    return out
 
 
 def pose_uncertainties(scenario: Scenario) -> dict[str, PoseUncertainty]:

@@ -20,6 +20,7 @@ from cell.scenario.cell_specs import (
     NoiseSpec,
     PoseSpec,
     RobotSpec,
+    SensorErrorSpec,
     TableSpec,
     WorkspaceSpec,
 )
@@ -76,6 +77,7 @@ __all__ = [
     "RescanSpec",
     "RobotSpec",
     "Scenario",
+    "SensorErrorSpec",
     "SimulationSpec",
     "SpecularDropoutSpec",
     "TableSpec",

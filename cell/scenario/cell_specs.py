@@ -123,6 +123,15 @@ class DistortionSpec(Model):
         return (self.k1, self.k2, self.p1, self.p2, self.k3)
 
 
+class SensorErrorSpec(Model):
+    """How a simulated camera's own model is off what it states (what only a simulation knows; a calibration's
+    intrinsics check and every run's table check look for it): its depth reads ``depth_scale`` times the true
+    depth, its true focal length is ``focal_scale`` times the stated one."""
+
+    depth_scale: Annotated[float, Field(gt=0.5, lt=2.0)] = 1.0
+    focal_scale: Annotated[float, Field(gt=0.5, lt=2.0)] = 1.0
+
+
 class CameraSpec(Model):
     """A depth camera looking from ``eye_m`` at ``target_m`` (world) with a pinhole of the given size and field."""
 
@@ -148,6 +157,7 @@ class CameraSpec(Model):
     # another (``measured_distortion``, applied with ``--calibration``): then the cell is told that one.
     distortion: DistortionSpec = DistortionSpec()
     measured_distortion: DistortionSpec | None = None
+    sensor_error: SensorErrorSpec = SensorErrorSpec()
 
     @model_validator(mode="after")
     def _check(self) -> CameraSpec:

@@ -19,7 +19,7 @@ from cell.sim.board import Size2, add_board, colour_noise, place_body
 from cell.sim.bodies import add_box, add_part
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
-from cell.sim.lens import Lens, lens_for
+from cell.sim.lens import Lens, lens_for, true_intrinsics
 from cell.sim.noise import apply_noise, believed_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
@@ -179,9 +179,9 @@ class SimCell:
         X_true = spec.X_WC if X_WC is None else np.asarray(X_WC, dtype=float)
         if X_true.shape != (4, 4):
             raise ValueError(f"X_WC must be (4, 4), got {X_true.shape}")
-        told = self.intrinsics(camera)
-        lens = self._lenses.setdefault(camera, lens_for(told, spec.distortion.coefficients))
-        intr = told if lens is None else lens.render  # a lens: a larger pinhole image rendered, then bent
+        told, true = self.intrinsics(camera), true_intrinsics(spec, self.intrinsics(camera))
+        lens = self._lenses.setdefault(camera, lens_for(true, spec.distortion.coefficients))
+        intr = true if lens is None else lens.render  # a lens: a larger pinhole image rendered, then bent
         rgb, depth = self.render(X_true, intr, spec.near_m, spec.far_m)
         rgb = rgb if lens is None else lens.colour(rgb)
         if self.scenario.noise == "realistic":
@@ -203,6 +203,7 @@ class SimCell:
         X_WF = self._robot.link_pose(FLANGE_LINK) if self._robot is not None else None  # the measured X_FC's base
         X_told = believed_pose(spec, X_true, self.scenario.X_WR, X_WF, self.scenario.rng(camera + "/extrinsics"))
         noisy = noisy if lens is None else lens.depth(noisy)
+        noisy = noisy if spec.sensor_error.depth_scale == 1.0 else noisy * np.float32(spec.sensor_error.depth_scale)
         return DepthImage(camera=camera, depth=noisy, intrinsics=told, X_WC=X_told, mount=spec.mount), rgb
 
     def add_board(self, name: str, image: npt.ArrayLike, face_m: Size2, origin_m: Size2) -> None:

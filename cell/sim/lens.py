@@ -14,6 +14,7 @@ import numpy.typing as npt
 
 from cell.calibrate.lens import resample, to_pinhole
 from cell.geometry import FloatArray
+from cell.scenario import CameraSpec
 from cell.types import CameraIntrinsics
 
 
@@ -54,3 +55,10 @@ def lens_for(sensor: CameraIntrinsics, distortion: tuple[float, float, float, fl
     render = replace(render, distortion=(0.0, 0.0, 0.0, 0.0, 0.0))
     shape = (sensor.height, sensor.width)
     return Lens(render, ideal[:, 0].reshape(shape) + m, ideal[:, 1].reshape(shape) + m)
+
+
+def true_intrinsics(spec: CameraSpec, stated: CameraIntrinsics) -> CameraIntrinsics:
+    """The sensor's pinhole as it really is: the stated one with its focal length ``sensor_error.focal_scale``
+    times (the principal point where stated)."""
+    f = spec.sensor_error.focal_scale
+    return stated if f == 1.0 else replace(stated, fx=stated.fx * f, fy=stated.fy * f)

@@ -9,14 +9,16 @@ looks like a depth scale off, and is flagged as that (the reason says both). Fra
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, axis_angle_to_matrix, make_pose
-from cell.types import DepthImage
+from cell.perception.splicing.pose_prior import PoseUncertainty
+from cell.scenario import Scenario
+from cell.types import DepthImage, WeldMap
 
 _BAND_M = 0.06  # a pixel sees the table if its point lies this near the top's plane (wide: no selection bias) ...
 _INSET_M = 0.03  # ... this far inside its edges, and outside the bodies on it (their drawn bounds, grown)
@@ -24,6 +26,7 @@ _MIN_PIXELS = 2000  # fewer table pixels: no check
 _MAX_SAMPLES = 20000  # the fit runs on at most this many of them (an even stride)
 _BLOCK_PX = 8  # neighbouring pixels' errors are not independent: the fit's noise counts blocks of this size
 _FOCAL_STEP = 1e-4
+_BODY_PLAY_M = 0.08  # the part may lie this far off its drawn place (and the camera see its sides beyond it)
 
 
 @dataclass(frozen=True)
@@ -59,6 +62,30 @@ class SensorCheck:
             "the table plane says " + " and ".join(what) + " (or its pose is that far off its calibration): "
             "recalibrate it (cell calibrate)"
         )
+
+
+def check_cameras(
+    images: Mapping[str, DepthImage], scenario: Scenario, drawn_W: WeldMap, priors: Mapping[str, PoseUncertainty]
+) -> dict[str, SensorCheck]:
+    """Every camera's check on the scenario's table (its parts and fixtures as drawn, in W, kept out), against the
+    calibration's tolerances, each camera's told pose as uncertain as its prior says; cameras seeing too little of
+    the table are left out."""
+    t = scenario.table
+    lo = (t.center_m[0] - t.size_m[0] / 2.0, t.center_m[1] - t.size_m[1] / 2.0)
+    hi = (t.center_m[0] + t.size_m[0] / 2.0, t.center_m[1] + t.size_m[1] / 2.0)
+    tol = (scenario.calibration.depth_scale_tolerance, scenario.calibration.focal_tolerance)
+    corners = [b.vertices()[:, :2] for b in (*drawn_W.parts, *drawn_W.fixtures)]
+    bodies = (
+        np.array([c.min(axis=0) - _BODY_PLAY_M for c in corners]).reshape(-1, 2),
+        np.array([c.max(axis=0) + _BODY_PLAY_M for c in corners]).reshape(-1, 2),
+    )
+    out = {}
+    for name, image in images.items():
+        s = priors.get(name) or PoseUncertainty()
+        check = check_on_table(image, t.top_z, lo, hi, (s.translation_m, s.rotation_rad), tol, bodies)
+        if check is not None:
+            out[name] = check
+    return out
 
 
 def check_on_table(

@@ -201,33 +201,15 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     )
 
 
-_BODY_PLAY_M = 0.08  # the part may lie this far off its drawn place (and the camera see its sides beyond it)
-
-
 def sensor_checks(cap: Capture, progress: Progress = quiet) -> dict[str, SensorCheck]:
-    """Each camera's depth scale and focal length checked on the table's top in its own image (no board needed;
-    :mod:`cell.perception.table_check`), against the calibration's tolerances; a flagged one is said here."""
-    from cell.perception.table_check import check_on_table
+    """Each camera's depth scale and focal length checked on the table in its own image (a flagged one said)."""
+    from cell.perception.table_check import check_cameras
 
-    sc, t = cap.scenario, cap.scenario.table
-    lo = (t.center_m[0] - t.size_m[0] / 2.0, t.center_m[1] - t.size_m[1] / 2.0)
-    hi = (t.center_m[0] + t.size_m[0] / 2.0, t.center_m[1] + t.size_m[1] / 2.0)
-    tol = (sc.calibration.depth_scale_tolerance, sc.calibration.focal_tolerance)
-    sigma = pose_uncertainties(sc)
-    drawn = cap.weldmap.transformed(sc.X_WM, "W")
-    corners = [b.vertices()[:, :2] for b in (*drawn.parts, *drawn.fixtures)]
-    bodies = (
-        np.array([c.min(axis=0) - _BODY_PLAY_M for c in corners]).reshape(-1, 2),
-        np.array([c.max(axis=0) + _BODY_PLAY_M for c in corners]).reshape(-1, 2),
-    )
-    out = {}
-    for name, image in cap.images.items():
-        s = sigma.get(name) or PoseUncertainty()
-        check = check_on_table(image, t.top_z, lo, hi, (s.translation_m, s.rotation_rad), tol, bodies)
-        if check is not None:
-            out[name] = check
-            if check.flags:
-                progress(f"warning: {name}: {check.reason()}")
+    sc = cap.scenario
+    out = check_cameras(cap.images, sc, cap.weldmap.transformed(sc.X_WM, "W"), pose_uncertainties(sc))
+    for name, check in out.items():
+        if check.flags:
+            progress(f"warning: {name}: {check.reason()}")
     return out
 
 

@@ -107,3 +107,21 @@ def test_the_simulated_sensors_errors_are_found_in_its_rendered_image(tmp_path: 
     assert abs(off.depth_scale - 1.01) < 1e-3 and abs(off.focal_scale - 0.99) < 2e-3
     assert set(off.flags) == {"depth_scale", "focal"} and good.flags == ()
     assert abs(good.depth_scale - 1.0) < 1e-3 and abs(good.focal_scale - 1.0) < 2e-3
+
+
+def test_a_flagged_camera_is_lost_with_its_reason_and_its_figures_kept() -> None:
+    from test_perception import SPEC, X_WR, paper_images
+
+    from cell.perception.perceive import perceive_then
+    from cell.perception.table_check import SensorCheck
+
+    images = paper_images()
+    checks = {
+        "cam_left": SensorCheck("cam_left", 5000, 1.012, 0.0002, 1.0, 0.001, ("depth_scale",)),
+        "cam_right": SensorCheck("cam_right", 5000, 1.0001, 0.0002, 1.0, 0.001, ()),
+    }
+    done = perceive_then(images, X_WR, SPEC, None, lambda cloud, proceed: len(cloud), None, checks)
+    p = done.perceived
+    assert p.lost == ("cam_left",) and "the table plane says its depth reads 1.0120" in p.lost_reasons["cam_left"]
+    assert len(p.clouds["cam_left"]) == 0 and set(p.sensor_checks) == {"cam_left", "cam_right"}
+    assert done.answer == len(p.registered) and done.answer > 0

@@ -92,18 +92,26 @@ def calibrate_capture(
     *,
     held_out: int = 4,
     progress: Progress | None = None,
+    run_spec: CalibrationRunSpec | None = None,
 ) -> CalibrationRun:
-    """Calibrate from a capture folder (:mod:`cell.recorded.board_capture`), no simulator: the board found in each
-    colour image, the last ``held_out`` images of each camera kept out of the fit. The tolerances are the scenario
-    defaults (``calibration``)."""
+    """Calibrate from a capture folder (:mod:`cell.recorded.board_capture`) or a ROS 2 bag
+    (:mod:`cell.recorded.board_bag`), no simulator: the board found in each colour image, the last ``held_out``
+    images of each camera kept out of the fit. ``run_spec`` (a scenario's ``calibration``) states the board a bag
+    does not hold, and the tolerances; default: the scenario defaults (a folder's own board)."""
+    from cell.recorded.board_bag import is_bag, read_board_bag
+
     say = progress or (lambda _m: None)
-    probe = read_board_capture(folder, ())
-    unknown = [c for c in cameras or () if c not in probe.mounts]
-    if unknown:
-        raise UsageError(f"--cameras {', '.join(unknown)}: not in the capture; cameras: {', '.join(probe.mounts)}")
-    cap = read_board_capture(folder, cameras)
+    base = run_spec or CalibrationRunSpec()
+    if is_bag(folder):
+        cap = read_board_bag(folder, base.board.model_dump(), cameras, progress=say)
+    else:
+        probe = read_board_capture(folder, ())
+        unknown = [c for c in cameras or () if c not in probe.mounts]
+        if unknown:
+            raise UsageError(f"--cameras {', '.join(unknown)}: not in the capture; cameras: {', '.join(probe.mounts)}")
+        cap = read_board_capture(folder, cameras)
     try:
-        spec = CalibrationRunSpec(board=BoardSpec(**cap.board), held_out=held_out)
+        spec = base.model_copy(update={"board": BoardSpec(**cap.board), "held_out": held_out})
     except ValueError as e:
         raise CaptureError(f"{folder}: its board is not valid ({' '.join(str(e).split())})", path=str(folder)) from None
     board = Board(spec.board)

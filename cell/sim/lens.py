@@ -1,5 +1,6 @@
-"""A simulated camera's lens: PyBullet renders a pinhole image, a real camera's lens bends it (Brown-Conrady, the
-scenario's ``cameras.<name>.distortion``). The pinhole image is rendered larger than the sensor (to hold what a
+"""A simulated camera's sensor as it really is (:class:`Sensor`): its lens, its true focal length and depth scale
+(``cameras.<name>.distortion`` and ``sensor_error``). PyBullet renders a pinhole image, a real camera's lens bends
+it (Brown-Conrady). The pinhole image is rendered larger than the sensor (to hold what a
 barrel lens brings into view) and each sensor pixel takes the rendered pixel its ray came from: the colour image
 bilinearly, the depth image the nearest (a depth never blends across an edge). OpenCV through the calibration's
 lens module (:mod:`cell.calibrate.lens`)."""
@@ -62,3 +63,27 @@ def true_intrinsics(spec: CameraSpec, stated: CameraIntrinsics) -> CameraIntrins
     times (the principal point where stated)."""
     f = spec.sensor_error.focal_scale
     return stated if f == 1.0 else replace(stated, fx=stated.fx * f, fy=stated.fy * f)
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """What a camera really takes: ``render`` the pinhole image to render (the true focal length, wider when a lens
+    bends it), its ``lens`` (None: a pinhole) and the factor its depth reads of the true depth."""
+
+    render: CameraIntrinsics
+    lens: Lens | None
+    depth_scale: float
+
+    def colour(self, rgb: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
+        return rgb if self.lens is None else self.lens.colour(rgb)
+
+    def depth(self, depth: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
+        z = depth if self.lens is None else self.lens.depth(depth)
+        return z if self.depth_scale == 1.0 else np.asarray(z * np.float32(self.depth_scale), dtype=np.float32)
+
+
+def sensor_for(spec: CameraSpec, stated: CameraIntrinsics) -> Sensor:
+    """The sensor of the camera ``spec`` whose intrinsics are stated as ``stated``."""
+    true = true_intrinsics(spec, stated)
+    lens = lens_for(true, spec.distortion.coefficients)
+    return Sensor(true if lens is None else lens.render, lens, spec.sensor_error.depth_scale)

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from cell.recorded.bag import CAMERA_INFO, IMAGE, _base_frame, _decode, _tf_tree
+from cell.recorded.bag import CAMERA_INFO, IMAGE, base_frame_of, decode, tf_tree_of
 from cell.recorded.board_capture import BoardCapture, BoardShot
 from cell.recorded.ros_msgs import DEPTH_SCALE_M, camera_names, depth_of, fail, info_topic_of, stamp_ns
 from cell.recorded.tf_tree import TfError, TfTree, frame_name
@@ -81,8 +81,8 @@ def _read(
     unknown = [c for c in wanted or () if c not in names.values()]
     if unknown:
         raise fail(bag, f"no camera {', '.join(unknown)}; cameras: {', '.join(names.values())}")
-    tree = _tf_tree(reader, bag)
-    base = _base_frame(tree, base_frame, bag)
+    tree = tf_tree_of(reader, bag)
+    base = base_frame_of(tree, base_frame, bag)
     if FLANGE not in tree.frames:
         raise fail(bag, f"its tf has no flange frame {FLANGE!r}: the arm's pose at each image is not known")
     mounts: dict[str, str] = {}
@@ -118,7 +118,7 @@ def _messages(reader: Any, conns: Sequence[Any], bag: Path) -> list[tuple[int, A
     """(stamp [ns], message) of every message on ``conns``, in stamp order (the record time without a header)."""
     out = []
     for conn, ts, raw in reader.messages(connections=conns):
-        msg = _decode(reader, raw, conn.msgtype, bag, conn.topic)
+        msg = decode(reader, raw, conn.msgtype, bag, conn.topic)
         out.append((stamp_ns(msg) or ts, msg))
     return sorted(out, key=lambda m: m[0])
 

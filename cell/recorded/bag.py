@@ -113,6 +113,7 @@ def _pick(reader: Any, conns: Sequence[Any], target_ns: int | None) -> tuple[int
 
 
 def base_frame_of(tree: TfTree, base_frame: str | None, bag: Path) -> str:
+    """The robot base's tf frame: ``base_frame`` when named, else ``base_link``, else the tree's one root."""
     frames = tree.frames
     if not frames:
         raise fail(bag, f"holds no tf ({TF_MESSAGE} on /tf_static or /tf): the cameras' poses cannot be looked up")

@@ -25,6 +25,8 @@ from cell.types import CameraIntrinsics
 SEEN_FRACTION = 0.6  # a pose counts when this much of the board's corners are found
 _OFFSET = (0.25, 0.1)  # the arm camera's board this far aside and up its image: the torch hides the lower middle
 _CLEARANCE_M = 0.05  # the board and the flange stay this far above the table top
+_TRIES = 1500  # candidate poses drawn at most per camera (most of a fixed camera's may collide: the wrist bent back)
+_RESTARTS = 3  # a colliding configuration: this many IK runs from random ones besides its wrist flipped
 
 
 @dataclass(frozen=True)
@@ -105,13 +107,16 @@ def take_views(
     if mount == Mount.EYE_TO_HAND:
         X_RC = X_RW @ cam.X_WC  # the camera where the scenario says: enough to plan by
         targets = (
-            ("tool0", X_RC @ X_CB @ invert(X_FB)) for X_CB in board_poses(board, intr, spec.range_m, spec.tilt_deg, rng)
+            ("tool0", X_RC @ X_CB @ invert(X_FB))
+            for X_CB in board_poses(board, intr, spec.range_m, spec.tilt_deg, rng, tries=_TRIES)
         )
     else:
         X_RB = X_RW @ X_WB
         targets = (
             ("camera_optical", X_RC)
-            for X_RC in camera_poses(board, X_RB, intr, spec.hand_range_m, spec.tilt_deg, rng, offset=_OFFSET)
+            for X_RC in camera_poses(
+                board, X_RB, intr, spec.hand_range_m, spec.tilt_deg, rng, tries=_TRIES, offset=_OFFSET
+            )
         )
     views: list[View] = []
     shots: list[BoardShot] = []
@@ -128,9 +133,11 @@ def take_views(
             dropped["unreachable"] += 1
             continue
         reached += 1
-        if screen.collides(q_new, mount, np.asarray(arm.model.fk(q_new, "tool0"))):
+        q_clear = _clear_configuration(screen, arm, mount, X_RT, frame, q_new, rng)
+        if q_clear is None:
             dropped["colliding"] += 1
             continue
+        q_new = q_clear
         clear += 1
         X_RF, depth, rgb = station.view(camera, q_new, "flange" if mount == Mount.EYE_TO_HAND else "table")
         corners = board.detect(rgb)
@@ -172,6 +179,37 @@ def take_views(
         value=seen,
         needed=wanted,
     )
+
+
+def _clear_configuration(
+    screen: PoseScreen,
+    arm: Arm,
+    mount: Mount,
+    X_RT: FloatArray,
+    frame: str,
+    q: FloatArray,
+    rng: np.random.Generator,
+) -> FloatArray | None:
+    """A configuration reaching X_RT clear of the cell: ``q`` itself, else the IK started from its wrist flipped
+    (axis 4 turned half a turn, axis 5 mirrored, axis 6 half a turn: the same flange pose, the torch on the wrist's
+    other side), else from ``_RESTARTS`` random configurations; None when every one collides."""
+    X_RF = np.asarray(arm.model.fk(q, "tool0"))
+    if not screen.collides(q, mount, X_RF):
+        return q
+    flipped = np.array(q, dtype=float)
+    flipped[3] += np.pi if flipped[3] < 0.0 else -np.pi
+    flipped[4] = -flipped[4]
+    flipped[5] += np.pi if flipped[5] < 0.0 else -np.pi
+    lim = arm.model.limits
+    seeds = [flipped] + [rng.uniform(lim.q_min, lim.q_max) for _ in range(_RESTARTS)]
+    for seed in seeds:
+        try:
+            q_alt = solve_ik(arm.model, X_RT, seed, frame=frame)
+        except IKError:
+            continue
+        if not screen.collides(q_alt, mount, np.asarray(arm.model.fk(q_alt, "tool0"))):
+            return q_alt
+    return None
 
 
 def _above(X_RB: FloatArray, board: Board, top_R: float, X_RF: FloatArray) -> bool:

@@ -26,6 +26,7 @@ SEEN_FRACTION = 0.6  # a pose counts when this much of the board's corners are f
 _OFFSET = (0.25, 0.1)  # the arm camera's board this far aside and up its image: the torch hides the lower middle
 _CLEARANCE_M = 0.05  # the board and the flange stay this far above the table top
 _TRIES = 1500  # candidate poses drawn at most per camera (most of a fixed camera's may collide: the wrist bent back)
+_HOPELESS = 5  # reachable poses per wanted one, none clear: the camera's poses are refused as colliding
 _RESTARTS = 3  # a colliding configuration: this many IK runs from random ones besides its wrist flipped
 
 
@@ -136,6 +137,8 @@ def take_views(
         q_clear = _clear_configuration(screen, arm, mount, X_RT, frame, q_new, rng)
         if q_clear is None:
             dropped["colliding"] += 1
+            if clear == 0 and reached >= _HOPELESS * wanted:
+                break  # this many reachable poses and not one clear of the cell: the rest will not be either
             continue
         q_new = q_clear
         clear += 1

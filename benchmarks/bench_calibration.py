@@ -7,8 +7,9 @@ bounds cover the error.
 
 ``--loop`` closes the loop instead: ``cell calibrate faults/extrinsics-off``, then ``cell weld`` of that scenario with
 the file, beside ``cell weld fence1`` (the same cell, its cameras where the scenario says) and ``cell weld
-faults/extrinsics-off`` told the wrong poses; per run the seams welded and the worst located, executed and end
-errors (default ``benchmarks/results/calibration_loop.json``).
+faults/extrinsics-off`` told the wrong poses; each of the two told poses also with the splice's prior off (their
+stated residual 0: the file's ``calibration:`` block, the scenario's ``cameras.<name>.calibration``); per run the
+seams welded and the worst located, executed and end errors (default ``benchmarks/results/calibration_loop.json``).
 
 Each seed is the scenario with that seed (realistic colour and depth noise, the robot's repeatability of
 ``calibration.repeatability_mm`` on every flange pose, the board's mount drawn anew): every camera calibrated with
@@ -35,6 +36,7 @@ from cell import scenario as sc
 from cell.pipeline.calibration import OPENCV_METHODS, calibrate
 
 RESULTS = Path(__file__).resolve().parent / "results"
+_ZERO = {"translation_mm": 0.0, "rotation_deg": 0.0}
 CELL = Path(__file__).resolve().parents[1] / ".venv" / "bin" / "cell"
 
 
@@ -118,8 +120,9 @@ def _weld(scenario: str, report: Path, *extra: str) -> dict[str, Any]:
         if not s.get("welded"):
             reasons[str(s.get("weld_reason_code"))] = reasons.get(str(s.get("weld_reason_code")), 0) + 1
     located = [s["error_mm"]["paper_me"] for s in seams if s.get("error_mm")]
+    name = Path(scenario).name if scenario.endswith(".yaml") else scenario
     return {
-        "command": " ".join(["cell", "weld", scenario, *("CAL.yaml" if e.endswith(".yaml") else e for e in extra)]),
+        "command": " ".join(["cell", "weld", name, *(Path(e).name if e.endswith(".yaml") else e for e in extra)]),
         "seams": len(seams),
         "welded": len(welded),
         "not_welded": reasons,
@@ -136,12 +139,24 @@ def loop(json_path: Path) -> None:
         folder = Path(tmp)
         cal = folder / "cal.yaml"
         subprocess.run([str(CELL), "-q", "calibrate", "faults/extrinsics-off", "--out", str(cal)], check=True)
+        calibration = yaml.safe_load(cal.read_text(encoding="utf-8"))
+        # The splice's prior off: the same poses told, their stated residual 0 (the splice never moves a camera and
+        # a seam seen by one camera carries no calibration term): the file's block, and the scenario's.
+        cal0, off0 = folder / "cal_no_prior.yaml", folder / "extrinsics-off-no-prior.yaml"
+        bare = {**calibration, "cameras": {n: {**c, "calibration": _ZERO} for n, c in calibration["cameras"].items()}}
+        cal0.write_text(yaml.safe_dump(bare, sort_keys=False), encoding="utf-8")
+        scenario = yaml.safe_load(sc.resolve("faults/extrinsics-off").read_text(encoding="utf-8"))
+        for cam in scenario["cameras"].values():
+            cam.pop("calibration", None)
+        scenario["name"] = "faults/extrinsics-off-no-prior"
+        off0.write_text(yaml.safe_dump(scenario, sort_keys=False), encoding="utf-8")  # the map found by its name
         runs = {
             "exact": _weld("fence1", folder / "exact.json"),
             "told_wrong": _weld("faults/extrinsics-off", folder / "off.json"),
+            "told_wrong_no_prior": _weld(str(off0), folder / "off0.json"),
             "calibrated": _weld("faults/extrinsics-off", folder / "cal.json", "--calibration", str(cal)),
+            "calibrated_no_prior": _weld("faults/extrinsics-off", folder / "cal0.json", "--calibration", str(cal0)),
         }
-        calibration = yaml.safe_load(cal.read_text(encoding="utf-8"))
     doc = {
         "command": ".venv/bin/python benchmarks/bench_calibration.py --loop",
         "calibration": {

@@ -51,7 +51,9 @@ class Extrinsics:
 
 def with_extrinsics(scenario: Scenario, ext: Extrinsics) -> Scenario:
     """The scenario with every fixed camera's calibration off by ``ext`` (directions from the scenario seed), and
-    stated so (``calibration``, as a calibration report would: the splice's prior and the seams' sigma)."""
+    stated so (``calibration``, as a calibration report would: the splice's prior and the seams' sigma). A camera
+    with a measured pose (``--calibration``) is told it and truly sits ``ext`` off it
+    (:func:`cell.sim.calibrated.off_calibration`)."""
     if ext.label == "exact":
         return scenario
     spec = ExtrinsicErrorSpec(translation_mm=ext.translation_mm, rotation_deg=ext.rotation_deg)
@@ -60,7 +62,13 @@ def with_extrinsics(scenario: Scenario, ext: Extrinsics) -> Scenario:
         name: cam.model_copy(update={"extrinsic_error": spec, "calibration": stated}) if cam.mount == "fixed" else cam
         for name, cam in scenario.cameras.items()
     }
-    return scenario.model_copy(update={"cameras": cams})
+    out = scenario.model_copy(update={"cameras": cams})
+    fixed = [n for n, c in out.cameras.items() if c.mount == "fixed" and c.measured is not None]
+    if fixed:  # a calibrated cell (--calibration): the true cameras off its measured poses by the error
+        from cell.sim.calibrated import off_calibration
+
+        out = off_calibration(out, dict.fromkeys(fixed, spec))
+    return out
 
 
 def _p95(values: Sequence[float]) -> float:

@@ -200,6 +200,7 @@ class CalibrationFault(enum.StrEnum):
 
     NOT_SEEN = "not_seen"  # the board is seen (enough corners) at too few poses
     UNREACHABLE = "unreachable"  # too few of the planned board poses are within the arm's reach
+    COLLIDING = "colliding"  # too few of the reachable board poses keep the arm clear of the cell and the part
     DEGENERATE = "degenerate"  # the poses lack rotation diversity (a pure translation, one rotation axis)
     BOARD_SIZE = "board_size"  # the depth image's scale disagrees with the board's stated size
     NOT_CONVERGED = "not_converged"  # the joint refinement did not reach a consistent solution

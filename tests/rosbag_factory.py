@@ -59,6 +59,17 @@ def image(topic: str, frame: str, depth_m: npt.ArrayLike, stamp_ns: int, encodin
     return Message(topic, "sensor_msgs/msg/Image", stamp_ns, msg)
 
 
+def colour_image(topic: str, frame: str, rgb: npt.ArrayLike, stamp_ns: int, encoding: str = "rgb8") -> Message:
+    """A colour Image of (h, w, 3) uint8 RGB pixels, stored as ``rgb8`` or ``bgr8``."""
+    px = np.asarray(rgb, dtype=np.uint8)
+    h, w = px.shape[:2]
+    data = (px[..., ::-1] if encoding == "bgr8" else px).ravel().copy()
+    msg = T["sensor_msgs/msg/Image"](
+        header=_header(frame, stamp_ns), height=h, width=w, encoding=encoding, is_bigendian=0, step=3 * w, data=data
+    )
+    return Message(topic, "sensor_msgs/msg/Image", stamp_ns, msg)
+
+
 def camera_info(topic: str, frame: str, k: CameraIntrinsics, stamp_ns: int, d: Sequence[float] = (0.0,) * 5) -> Message:
     """A CameraInfo of pinhole intrinsics ``k`` (plumb_bob with coefficients ``d``)."""
     K = np.array([k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0])

@@ -82,20 +82,43 @@ def hand_eye(
 
 
 def calibrate_intrinsics(
-    p_B: Sequence[FloatArray], px: Sequence[FloatArray], size: tuple[int, int], K0: FloatArray
-) -> tuple[FloatArray, FloatArray, float]:
-    """OpenCV's ``calibrateCameraExtended`` on planar views, no distortion (as the stated model): K (3, 3), the
-    standard deviations of (fx, fy, cx, cy) [px], the RMS reprojection [px]."""
-    flags = (
-        cv2.CALIB_USE_INTRINSIC_GUESS
-        | cv2.CALIB_ZERO_TANGENT_DIST
-        | cv2.CALIB_FIX_K1
-        | cv2.CALIB_FIX_K2
-        | cv2.CALIB_FIX_K3
-    )
+    p_B: Sequence[FloatArray], px: Sequence[FloatArray], size: tuple[int, int], K0: FloatArray, D0: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, float]:
+    """OpenCV's ``calibrateCameraExtended`` on planar views from the stated model (K0, D0), the lens' k1, k2, p1, p2
+    fitted with the pinhole (k3 held at its stated value: a dozen board views cannot pin it down): K (3, 3), the
+    distortion (5,), the standard deviations of (fx, fy, cx, cy, k1, k2, p1, p2, k3), the RMS reprojection [px]."""
+    flags = cv2.CALIB_USE_INTRINSIC_GUESS | cv2.CALIB_FIX_K3
     obj = [np.asarray(p, dtype=np.float32).reshape(-1, 1, 3) for p in p_B]
     img = [np.asarray(u, dtype=np.float32).reshape(-1, 1, 2) for u in px]
-    rms, K, _, _, _, std, _, _ = cv2.calibrateCameraExtended(
-        obj, img, tuple(size), np.array(K0, dtype=np.float64), np.zeros(5), flags=flags
+    rms, K, D, _, _, std, _, _ = cv2.calibrateCameraExtended(
+        obj, img, tuple(size), np.array(K0, dtype=np.float64), np.array(D0, dtype=np.float64), flags=flags
     )
-    return np.asarray(K, dtype=float), np.asarray(std, dtype=float).ravel()[:4], float(rms)
+    return (
+        np.asarray(K, dtype=float),
+        np.asarray(D, dtype=float).ravel()[:5],
+        np.asarray(std, dtype=float).ravel()[:9],
+        float(rms),
+    )
+
+
+def undistort_px(px: FloatArray, K: FloatArray, D: Sequence[float]) -> FloatArray:
+    """(k, 2) the pixels px (k, 2) seen through the lens (K, D) moved to where a pinhole of K puts them (OpenCV's
+    iterative ``undistortPointsIter``, converged to 1e-9)."""
+    pts = np.asarray(px, dtype=np.float64).reshape(-1, 1, 2)
+    if len(pts) == 0:
+        return np.zeros((0, 2))
+    criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-9)
+    D64 = np.asarray(D, dtype=np.float64)
+    out = cv2.undistortPointsIter(pts, K, D64, np.eye(3), np.asarray(K, dtype=np.float64), criteria)
+    return np.asarray(out, dtype=float).reshape(-1, 2)
+
+
+def remap(image: npt.ArrayLike, map_x: FloatArray, map_y: FloatArray, nearest: bool) -> npt.NDArray[Any]:
+    """OpenCV's ``remap``: out[v, u] = image at (map_x, map_y)[v, u] (bilinear, or the nearest pixel for values that
+    must not blend, such as depth); 0 outside the image."""
+    mode = cv2.INTER_NEAREST if nearest else cv2.INTER_LINEAR
+    src = np.asarray(image)
+    out = cv2.remap(
+        src, map_x.astype(np.float32), map_y.astype(np.float32), mode, borderMode=cv2.BORDER_CONSTANT, borderValue=0
+    )
+    return np.asarray(out, dtype=src.dtype)

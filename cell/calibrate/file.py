@@ -15,7 +15,7 @@ from cell.calibrate import _opencv
 from cell.calibrate.result import CameraCalibration
 from cell.errors import UsageError
 from cell.geometry import FloatArray, matrix_to_rpy
-from cell.scenario import CalibrationSpec, PoseSpec, Scenario
+from cell.scenario import CalibrationSpec, DistortionSpec, PoseSpec, Scenario
 
 FORMAT = "cell-calibration/1"
 
@@ -58,10 +58,17 @@ def camera_entry(cal: CameraCalibration) -> dict[str, Any]:
             "sigma_px": [round(v, 3) for v in ic.sigma_px],
             "depth_scale": round(ic.depth_scale, 5),
             "depth_scale_sigma": round(ic.depth_scale_sigma, 5),
+            "distortion": [round(v, 6) for v in ic.distortion],  # k1, k2, p1, p2, k3 measured
+            "distortion_sigma": [round(v, 6) for v in ic.distortion_sigma],
+            "distortion_shift_px": round(ic.distortion_shift_px, 3),  # the image's corner against the stated lens
+            "distortion_shift_sigma_px": round(ic.distortion_shift_sigma_px, 3),
+            "lens": [round(v, 6) for v in ic.lens],  # the model runs are told: the measured where flagged
             "flags": [str(f) for f in ic.flags],
         },
         "opencv": {name: {"measured": _pose(X)} for name, X in cal.opencv.items()},
     }
+    if cal.dropped:
+        entry["poses_dropped"] = {k: int(v) for k, v in cal.dropped.items()}
     if cal.X_AC_true is not None:
         entry["truth_error"] = _error(cal.truth_error())
         for name, X in cal.opencv.items():
@@ -102,7 +109,8 @@ def flagged(doc: Mapping[str, Any]) -> dict[str, list[str]]:
 
 
 def apply(scn: Scenario, doc: Mapping[str, Any], source: str = "--calibration") -> Scenario:
-    """The scenario with each calibrated camera's measured pose and stated residual in place of its own."""
+    """The scenario with each calibrated camera's measured pose and stated residual in place of its own, and the
+    lens model the calibration concluded (``intrinsics.lens``) as the one the cell is told."""
     cameras = dict(scn.cameras)
     for name, entry in doc["cameras"].items():
         if name not in cameras:
@@ -118,5 +126,16 @@ def apply(scn: Scenario, doc: Mapping[str, Any], source: str = "--calibration") 
             stated = CalibrationSpec(**entry["calibration"])
         except (TypeError, KeyError, ValueError) as e:
             raise UsageError(f"{source}: camera {name!r}: {' '.join(str(e).split())}") from None
-        cameras[name] = cam.model_copy(update={"measured": measured, "calibration": stated})
+        update: dict[str, Any] = {"measured": measured, "calibration": stated}
+        lens = (entry.get("intrinsics") or {}).get("lens")
+        if lens is not None:
+            try:
+                update["measured_distortion"] = DistortionSpec(
+                    **dict(zip(("k1", "k2", "p1", "p2", "k3"), lens, strict=True))
+                )
+            except (TypeError, ValueError):
+                raise UsageError(
+                    f"{source}: camera {name!r}: intrinsics.lens is {lens!r}; valid: five numbers k1, k2, p1, p2, k3"
+                ) from None
+        cameras[name] = cam.model_copy(update=update)
     return scn.model_copy(update={"cameras": cameras})

@@ -21,7 +21,8 @@ class CameraCalibration:
     poses / held_out_images : images fitted / held out; held_out_px, held_out_3d_m : their reprojection RMS [px]
     and the corners' 3D RMS against each image's PnP [m]; spread_deg : the poses' relative rotations on their two
     main axes [deg]; opencv : OpenCV's hand-eye method name -> its X_AC alone; X_AC_true : the simulation's truth
-    (None on a real cell).
+    (None on a real cell); dropped : the planned poses that gave no image, by why (a simulated cell's: below the
+    table's clearance, out of reach, colliding, the board not found).
     """
 
     camera: str
@@ -35,9 +36,11 @@ class CameraCalibration:
     intrinsics: IntrinsicsCheck
     opencv: Mapping[str, FloatArray] = field(default_factory=dict)
     X_AC_true: FloatArray | None = None
+    dropped: Mapping[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "opencv", MappingProxyType(dict(self.opencv)))
+        object.__setattr__(self, "dropped", MappingProxyType(dict(self.dropped)))
 
     @property
     def X_AC(self) -> FloatArray:

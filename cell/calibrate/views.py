@@ -4,11 +4,13 @@ image's values at them; and which way the board and the camera are mounted (the 
 from __future__ import annotations
 
 import enum
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
+from cell.calibrate import _opencv
 from cell.calibrate.board import Corners
 from cell.geometry import FloatArray, invert, readonly
 
@@ -45,3 +47,11 @@ def chain_T(view: View, mount: Mount) -> FloatArray:
 def stack_T(views: list[View] | tuple[View, ...], mount: Mount) -> npt.NDArray[np.float64]:
     """(n, 4, 4) :func:`chain_T` of every view."""
     return np.array([chain_T(v, mount) for v in views], dtype=float)
+
+
+def undistorted(views: Sequence[View], K: FloatArray, D: tuple[float, ...]) -> list[View]:
+    """The views with their corners moved to where a pinhole of K puts them, through the lens D (k1, k2, p1, p2,
+    k3); the views as they are for a pinhole (D all zero). Their depths stay those read at the pixels found."""
+    if not any(d != 0.0 for d in D):
+        return list(views)
+    return [View(v.X_RF, Corners(v.corners.ids, _opencv.undistort_px(v.corners.px, K, D)), v.depth_m) for v in views]

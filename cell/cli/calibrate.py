@@ -22,7 +22,8 @@ if TYPE_CHECKING:
 @app.command()
 def calibrate(
     scenario: Annotated[
-        str | None, typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path (not with --capture).")
+        str | None,
+        typer.Argument(help="A scenario name (see `cell scenarios`) or a YAML path (with --capture: a bag's board)."),
     ] = None,
     out_path: Annotated[
         Path | None, typer.Option("--out", "-o", metavar="CAL.yaml", help="The calibration file to write.")
@@ -42,7 +43,11 @@ def calibrate(
     ] = 4,
     capture_dir: Annotated[
         Path | None,
-        typer.Option("--capture", metavar="DIR", help="Solve from a calibration capture folder, no simulator."),
+        typer.Option(
+            "--capture",
+            metavar="DIR",
+            help="Solve from a calibration capture folder or a ROS 2 bag (its board: SCENARIO's, else the default).",
+        ),
     ] = None,
     save_capture: Annotated[
         Path | None,
@@ -53,21 +58,25 @@ def calibrate(
     chosen for good conditioning), the arm's camera against the flange (the board on the table); each with its
     covariance, held-out residuals, its intrinsics and depth scale checked. Refuses a degenerate pose set, a board
     of the wrong size or a camera that cannot see the board (exit 17, with the reason). With --capture DIR the images
-    and flange poses are a capture folder's (--save-capture writes one), solved without the simulator."""
+    and flange poses are a capture folder's (--save-capture writes one) or a ROS 2 bag's (colour images, CameraInfo,
+    depth, the flange from tf), solved without the simulator."""
     from cell import scenario as sc
     from cell.calibrate.file import document
     from cell.outputs import write_atomic
     from cell.pipeline.calibration import calibrate as run_calibration
     from cell.pipeline.calibration import calibrate_capture
+    from cell.recorded.board_bag import is_bag
 
     with cell_errors():
         if out_path is None:
             raise UsageError("--out CAL.yaml is missing; valid: cell calibrate fence1 --out cal.yaml")
         if out_path.suffix not in (".yaml", ".yml"):
             raise UsageError(f"--out {str(out_path)!r} must end in .yaml or .yml")
-        if (scenario is None) == (capture_dir is None):
+        bag = capture_dir is not None and is_bag(capture_dir)
+        if (scenario is None) == (capture_dir is None) and not (bag and scenario is not None):
             raise UsageError(
-                "give SCENARIO or --capture DIR (one of them); valid: cell calibrate fence1 --out cal.yaml"
+                "give SCENARIO or --capture DIR (one of them; with a bag, SCENARIO may state the board); "
+                "valid: cell calibrate fence1 --out cal.yaml"
             )
         if capture_dir is not None and (poses is not None or noise is not None or save_capture is not None):
             raise UsageError("--poses, --noise and --save-capture simulate; a capture holds what was taken")
@@ -77,7 +86,8 @@ def calibrate(
             check_folder(save_capture, "--save-capture")
         names = [c.strip() for c in cameras.split(",") if c.strip()] if cameras else None
         if capture_dir is not None:
-            run = calibrate_capture(capture_dir, names, held_out=held_out, progress=say)
+            spec = sc.load(scenario).calibration if scenario is not None else None  # a bag's board
+            run = calibrate_capture(capture_dir, names, held_out=held_out, progress=say, run_spec=spec)
             source = str(capture_dir)
         else:
             assert scenario is not None

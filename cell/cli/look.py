@@ -213,10 +213,13 @@ def bench(
     save: Annotated[
         bool, typer.Option("--save", help=f"Also write the rows to {BENCH_SAVED} (Table 1 of docs/results.md).")
     ] = False,
+    calibration: CalibrationOpt = None,
 ) -> None:
     """Table 1 of the paper, reproduced and extended: every locator on the same clouds in one run.
 
     Writes bench.json, bench.md and provenance.json into a run folder; tracked files only with --save or --json.
+    With --calibration every scenario's cameras are told the file's measured poses; an --extrinsics error then
+    moves the true fixed cameras off them (docs/calibration.md section 6).
     """
     from cell import bench as b
     from cell import scenario as sc
@@ -240,7 +243,7 @@ def bench(
             folder.parent.mkdir(exist_ok=True)  # runs/, the cell's own (untracked) folder of run folders
         check_folder(folder, "--out")
         check_file(json_path, "--json", stdout_ok=False)
-        loaded = [sc.load(n) for n in names]
+        loaded = [load_scenario(n, calibration) for n in names]
         prov: dict[str, Any] = provenance(None)
         prov["scenarios"] = [
             {k: v for k, v in provenance(s, scenario_file=sc.resolve(n)).items() if k in _PER_SCENARIO} | {"name": n}

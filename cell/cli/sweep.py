@@ -9,7 +9,16 @@ from typing import Annotated, Any
 import typer
 
 from cell.cli.bar import Bar
-from cell.cli.common import app, cell_errors, check_method, fail_line, say, was_interrupted
+from cell.cli.common import (
+    CalibrationOpt,
+    app,
+    cell_errors,
+    check_method,
+    fail_line,
+    load_scenario,
+    say,
+    was_interrupted,
+)
 from cell.cli.outputs import check_folder
 from cell.errors import EXIT_INTERRUPTED, UsageError
 
@@ -42,8 +51,11 @@ def sweep(
     ] = None,
     method: Annotated[str | None, typer.Option(help="Seam locator (default: the scenario's).")] = None,
     fresh: Annotated[bool, typer.Option(help="Replace what --out holds instead of resuming it.")] = False,
+    calibration: CalibrationOpt = None,
 ) -> None:
-    """Tolerance study: which seams are at risk under part tolerances, placement and calibration errors."""
+    """Tolerance study: which seams are at risk under part tolerances, placement and calibration errors. With
+    --calibration the file's measured poses are the cell's belief and the drawn extrinsic errors move the true
+    cameras off them (docs/calibration.md section 6)."""
     from cell import pipeline
     from cell import scenario as sc
     from cell.provenance import sha256_file
@@ -55,9 +67,10 @@ def sweep(
         st = _stage(stage)
         check_method(method)
         check_folder(out, "--out")
-        scn = sc.load(scenario)
+        scn = load_scenario(scenario, calibration)
         weldmap = pipeline.read_weldmap(scn)
-        digests = sha256_file(scn.map_path), sha256_file(sc.resolve(scenario))
+        # With a calibration the scenario is not its file's alone: the study is keyed on its values instead.
+        digests = sha256_file(scn.map_path), sha256_file(sc.resolve(scenario)) if calibration is None else None
         spec = SweepSpec(scn, weldmap, n, words, st, method, *digests)  # type: ignore[arg-type]
         bar = Bar()
         study = Study(

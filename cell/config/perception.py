@@ -17,6 +17,7 @@ class HealthOptions:
     agree_voxel_m: float = 0.005  # clouds are compared on a grid of this [m] (averages the depth noise)
     agree_tol_m: float = 0.01  # a point agrees with another camera if that camera has a point this near [m]
     min_agreement: float = 0.5  # share of a camera's points that must agree with some other camera
+    table_check: bool = True  # each camera's depth scale and focal length checked on the table (a flagged one lost)
 
 
 @dataclass(frozen=True)

@@ -116,6 +116,8 @@ def detection_report(
         "lost_cameras": list(det.lost_cameras),
         # Per registered camera: the splice's correction of its calibration, applied or refused and why.
         "splice": det.scene.perceived.splice_corrections() if det.scene is not None else None,
+        # Per camera: its depth scale and focal length checked on the table in this run's own image.
+        "camera_checks": _camera_checks(det),
         "seams": seams,
         "summary": summary,
         "timings_s": {k: _r(v, 4) for k, v in det.timings.items()},
@@ -311,3 +313,19 @@ def rescan_report(
     rep = detection_report(after, records, provenance=provenance, unsupported=False)
     _add_rescan(rep, records, before, rs)
     return rep
+
+
+def _camera_checks(det: Detection) -> dict[str, dict[str, Any]] | None:
+    if det.scene is None:
+        return None
+    return {
+        name: {
+            "table_pixels": c.pixels,
+            "depth_scale": _r(c.depth_scale, 5),
+            "depth_scale_sigma": _r(c.depth_scale_sigma, 5),
+            "focal_scale": _r(c.focal_scale, 5),
+            "focal_scale_sigma": _r(c.focal_scale_sigma, 5),
+            "flags": list(c.flags),
+        }
+        for name, c in det.scene.perceived.sensor_checks.items()
+    }

@@ -21,6 +21,7 @@ from cell.perception.deproject import clouds_in_robot_frame
 from cell.perception.preprocess import downsample, preprocess
 from cell.perception.splicing.pose_prior import PoseUncertainty
 from cell.perception.splicing.splice import Spliced, splice, stacked
+from cell.perception.table_check import SensorCheck
 from cell.scenario import PerceptionSpec
 from cell.types import Cloud, DepthImage, VoxelTable
 from cell.voxels import voxel_order
@@ -43,6 +44,8 @@ class Perceived:
     registered_voxels : where ``registered``'s voxels (``spec.voxel_m``) lie in it (what such a locator's tube
         queries read).
     origins_R : camera name -> (3,) its optical centre in R as calibrated (how far a seam is from it).
+    sensor_checks : camera name -> its depth scale and focal length checked on the table
+        (:mod:`cell.perception.table_check`; a camera it flags is lost unless already lost for another reason).
     filter_merged : the paper's cloud made from ``spliced.dense`` (filtered as ``registered``, then on the voxel
         grid): run once, on the first read of ``dense`` or ``downsampled``.
     """
@@ -56,6 +59,7 @@ class Perceived:
     timings: dict[str, float] = field(default_factory=dict)
     lost_reasons: dict[str, str] = field(default_factory=dict)
     origins_R: dict[str, FloatArray] = field(default_factory=dict)
+    sensor_checks: dict[str, SensorCheck] = field(default_factory=dict)
 
     @cached_property
     def _merged(self) -> tuple[Cloud, Cloud]:
@@ -124,6 +128,7 @@ def perceive_then(
     health: HealthOptions | None,
     then: Callable[[Cloud, Callable[[], None]], T],
     priors: Mapping[str, PoseUncertainty] | None = None,
+    checks: Mapping[str, SensorCheck] | None = None,
 ) -> PerceivedThen[T]:
     """:func:`perceive`, and ``then`` of its registered cloud (the caller's next stage: the map alignment).
 
@@ -134,7 +139,8 @@ def perceive_then(
     registrations, and are kept when the guess holds; else they run again on the registered cloud (an answer
     never depends on the speculation, only the wall time does). ``then(cloud, proceed)`` must not depend on
     anything but its cloud; it calls ``proceed()`` between its steps, which stops a moot speculation (by raising).
-    priors : as :func:`perceive`.
+    priors : as :func:`perceive`. checks : each camera's sensor check; a flagged camera is lost with its reason
+    (after the agreement check, whose reason comes first).
     """
     if not images:
         raise SensorError("no depth images to perceive from (no camera delivered one)")
@@ -177,6 +183,9 @@ def perceive_then(
     try:
         ahead = beside.submit(onward, guess)
         why.update(disagreeing_cameras({n: c for n, c in clouds.items() if n not in why}, health, (images, X_WR)))
+        for name, check in (checks or {}).items():
+            if check.flags and name in clouds:
+                why.setdefault(name, check.reason())
         for name in why:
             clouds[name] = clouds[name].select(np.zeros(len(clouds[name]), dtype=bool))
         lost = tuple(name for name in clouds if name in why)
@@ -224,6 +233,7 @@ def perceive_then(
         timings,
         {n: why[n] for n in lost},
         origins_R,
+        dict(checks or {}),
     )
     cloud_s = max(spliced_at, stamps["filtered"]) - t0
     return PerceivedThen(perceived, answer, cloud_s, max(spliced_at, stamps["answered"]) - t0, stamps["then_s"])

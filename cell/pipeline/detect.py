@@ -25,6 +25,7 @@ from cell.types import Cloud, Reason, SeamEstimate, SeamScene, SeamStatus, WeldM
 
 if TYPE_CHECKING:
     from cell.perception.perceive import Perceived
+    from cell.perception.table_check import SensorCheck
 
 Seed = Callable[[Cloud, FloatArray], FloatArray]  # (dense cloud in R, nominal X_RM) -> X_RM to align from
 
@@ -84,7 +85,9 @@ def capture(
         progress(f"rendering {len(scenario.cameras)} depth cameras ({scenario.noise} noise)")
     else:
         progress(f"reading {len(scenario.cameras)} depth cameras' images ({station.source})")
-    images = station.capture()
+    from cell.perception.lens import undistort
+
+    images = {name: undistort(image) for name, image in station.capture().items()}  # pinholes from here on
     return Capture(
         scenario, weldmap, find_joints(weldmap), station.truth(), images, time.perf_counter() - t0, station.source
     )
@@ -149,8 +152,9 @@ def build_scene(
     # Alignment and our locator read every camera's registered points (the unmerged cloud): the paper's merge keeps
     # one camera per region and throws away good data; the paper's method keeps its merged, downsampled cloud. The
     # alignment starts beside the splice (perceive_then); the stage times split the wall where the cloud was ready.
+    checks = sensor_checks(cap, progress)
     done = perceive_then(
-        cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned_or_error, pose_uncertainties(sc)
+        cap.images, sc.X_WR, sc.perception, sc.perception.health, aligned_or_error, pose_uncertainties(sc), checks
     )
     if keep is not None:
         keep(done.perceived)
@@ -195,6 +199,20 @@ def locate(scene: Scene, scenario: Scenario, method: str, *, progress: Progress 
     return with_calibration(
         out, p.registered, p.origins_R, pose_uncertainties(scenario), p.spliced.registrations, faces
     )
+
+
+def sensor_checks(cap: Capture, progress: Progress = quiet) -> dict[str, SensorCheck]:
+    """Each camera's depth scale and focal length checked on the table in its own image (a flagged one said)."""
+    from cell.perception.table_check import check_cameras
+
+    sc = cap.scenario
+    if not sc.perception.health.table_check:
+        return {}
+    out = check_cameras(cap.images, sc, cap.weldmap.transformed(sc.X_WM, "W"), pose_uncertainties(sc))
+    for name, check in out.items():
+        if check.flags:
+            progress(f"warning: {name}: {check.reason()}")
+    return out
 
 
 def pose_uncertainties(scenario: Scenario) -> dict[str, PoseUncertainty]:

@@ -16,6 +16,7 @@ from cell.config.rescan import RescanOptions
 from cell.errors import CellError, ScenarioError
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty, closeup_sigma
+from cell.perception.lens import undistort
 from cell.pipeline.detect import Progress, evaluate, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.records import Detection, Scene
@@ -100,7 +101,7 @@ def _rescan_one(run: _Run, seam_id: str, rng: np.random.Generator, pending: Sequ
         return [SeamRescan(seam_id, first, None, first, 0.0, None, 0.0, time.perf_counter() - t0, reason)]
     run.play(vp.move)
     run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]
-    image = run.station.capture_eye_in_hand(run.camera)
+    image = undistort(run.station.capture_eye_in_hand(run.camera))  # a pinhole's image from here on
     out = [_closeup(run, seam_id, image, vp, vp.move.duration, t0)]
     for other, seen in shared_by(run, vp, pending):
         out.append(_closeup(run, other, image, seen, 0.0, time.perf_counter()))

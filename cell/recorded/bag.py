@@ -67,14 +67,14 @@ class BagCapture:
         return {name: cam.image for name, cam in self.cameras.items()}
 
 
-def _tf_tree(reader: Any, bag: Path) -> TfTree:
+def tf_tree_of(reader: Any, bag: Path) -> TfTree:
     """Every transform of the bag's TFMessage topics (``*tf_static`` topics static, the others stamped)."""
     tree = TfTree()
     conns = [c for c in reader.connections if c.msgtype == TF_MESSAGE]
     if not conns:
         return tree  # (rosbags reads every message when given no connection)
     for conn, _, raw in reader.messages(connections=conns):
-        msg = _decode(reader, raw, conn.msgtype, bag, conn.topic)
+        msg = decode(reader, raw, conn.msgtype, bag, conn.topic)
         for t in msg.transforms:
             tr, q = t.transform.translation, t.transform.rotation
             try:
@@ -91,7 +91,7 @@ def _tf_tree(reader: Any, bag: Path) -> TfTree:
     return tree
 
 
-def _decode(reader: Any, raw: Any, msgtype: str, bag: Path, topic: str) -> Any:
+def decode(reader: Any, raw: Any, msgtype: str, bag: Path, topic: str) -> Any:
     """The message of ``raw`` bytes; a CaptureError when they do not decode as ``msgtype`` (a damaged bag)."""
     try:
         return reader.deserialize(raw, msgtype)
@@ -112,7 +112,8 @@ def _pick(reader: Any, conns: Sequence[Any], target_ns: int | None) -> tuple[int
     return best
 
 
-def _base_frame(tree: TfTree, base_frame: str | None, bag: Path) -> str:
+def base_frame_of(tree: TfTree, base_frame: str | None, bag: Path) -> str:
+    """The robot base's tf frame: ``base_frame`` when named, else ``base_link``, else the tree's one root."""
     frames = tree.frames
     if not frames:
         raise fail(bag, f"holds no tf ({TF_MESSAGE} on /tf_static or /tf): the cameras' poses cannot be looked up")
@@ -187,7 +188,7 @@ def _read(
                 raise fail(bag, f"{t} is not an {IMAGE} topic; image topics: {', '.join(image_topics) or 'none'}")
     asked = list(depth_topics) if depth_topics is not None else image_topics
     target_ns = None if time is None else int(reader.start_time + round(time * 1e9))
-    tree = _tf_tree(reader, bag)
+    tree = tf_tree_of(reader, bag)
 
     chosen: dict[str, tuple[int, Any]] = {}
     skipped: list[str] = []
@@ -195,7 +196,7 @@ def _read(
         picked = _pick(reader, by_topic[topic], target_ns)
         if picked is None:
             raise fail(bag, f"{topic} holds no message")
-        msg = _decode(reader, picked[1], IMAGE, bag, topic)
+        msg = decode(reader, picked[1], IMAGE, bag, topic)
         if str(msg.encoding) not in DEPTH_SCALE_M:
             if depth_topics is not None:  # asked for by name: refused (depth_of says what is valid)
                 depth_of(msg, bag, topic)
@@ -207,7 +208,7 @@ def _read(
         raise fail(bag, f"no depth images (16UC1 or 32FC1 {IMAGE}); image topics: {seen}")
     if skipped:
         progress(f"not depth, left out: {', '.join(skipped)}")
-    base = _base_frame(tree, base_frame, bag)
+    base = base_frame_of(tree, base_frame, bag)
 
     names = camera_names(list(chosen))
     cameras: dict[str, BagCamera] = {}
@@ -218,7 +219,7 @@ def _read(
         info_raw = _pick(reader, by_topic[info_topic], ts)
         if info_raw is None:
             raise fail(bag, f"{info_topic} holds no message")
-        info = _decode(reader, info_raw[1], CAMERA_INFO, bag, info_topic)
+        info = decode(reader, info_raw[1], CAMERA_INFO, bag, info_topic)
         k = intrinsics_of(info, bag, info_topic)
         depth = depth_of(msg, bag, topic)
         if depth.shape != (k.height, k.width):

@@ -67,7 +67,8 @@ def write_board_capture(folder: Path, capture: BoardCapture) -> Path:
     cameras = {
         name: {
             "mount": capture.mounts[name],
-            "intrinsics": {k: getattr(intr, k) for k in ("width", "height", "fx", "fy", "cx", "cy")},
+            "intrinsics": {k: getattr(intr, k) for k in ("width", "height", "fx", "fy", "cx", "cy")}
+            | ({"distortion": [float(d) for d in intr.distortion]} if intr.distorted else {}),
         }
         for name, intr in capture.intrinsics.items()
     }
@@ -96,7 +97,7 @@ def read_board_capture(folder: Path, cameras: Sequence[str] | None = None) -> Bo
         raise CaptureError(f"{index} is not a calibration capture (format: {FORMAT})", path=str(index))
     try:
         mounts = {str(n): str(c["mount"]) for n, c in doc["cameras"].items()}
-        intr = {str(n): CameraIntrinsics(**c["intrinsics"]) for n, c in doc["cameras"].items()}
+        intr = {str(n): _intrinsics(c["intrinsics"]) for n, c in doc["cameras"].items()}
         scale = float(doc["depth_scale_m"])
         entries = list(doc["images"])
         board = dict(doc["board"])
@@ -125,3 +126,12 @@ def read_board_capture(folder: Path, cameras: Sequence[str] | None = None) -> Bo
             raise CaptureError(f"{index}: image {entry['colour']}'s X_RF is not a finite 4 x 4 pose", path=str(index))
         shots.append(BoardShot(str(entry["camera"]), X_RF, rgb, depth))
     return BoardCapture(board, {n: mounts[n] for n in wanted}, {n: intr[n] for n in wanted}, tuple(shots))
+
+
+def _intrinsics(entry: dict[str, Any]) -> CameraIntrinsics:
+    """A camera's pinhole and, when stated, its lens' distortion (k1, k2, p1, p2, k3; absent: none)."""
+    d = [float(v) for v in entry.get("distortion", [0.0] * 5)]
+    if len(d) != 5:
+        raise ValueError(f"distortion has {len(d)} coefficients, five are needed (k1, k2, p1, p2, k3)")
+    rest = {k: v for k, v in entry.items() if k != "distortion"}
+    return CameraIntrinsics(**rest, distortion=(d[0], d[1], d[2], d[3], d[4]))

@@ -71,4 +71,5 @@ class CalibrationRunSpec(Model):
     focal_tolerance: Annotated[float, Field(gt=0.0, le=0.5)] = 0.005  # a focal length off by more: flagged
     principal_tolerance_px: Pos = 4.0  # a principal point off by more: flagged
     depth_scale_tolerance: Annotated[float, Field(gt=0.0, le=0.5)] = 0.005  # depth off by more: flagged
+    distortion_tolerance_px: Pos = 1.0  # a lens moving the image's corner this much more than stated: flagged
     board_scale_tolerance: Annotated[float, Field(gt=0.0, le=0.5)] = 0.02  # a board this far off its size: refused

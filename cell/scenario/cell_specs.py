@@ -110,6 +110,30 @@ class CalibrationSpec(Model):
     rotation_deg: NonNeg = 0.0
 
 
+class DistortionSpec(Model):
+    """A lens' Brown-Conrady distortion (OpenCV's k1, k2, p1, p2, k3 on normalised image coordinates): radial
+    (k1, k2, k3) and tangential (p1, p2). All zero (the default): a pinhole."""
+
+    k1: float = 0.0
+    k2: float = 0.0
+    p1: float = 0.0
+    p2: float = 0.0
+    k3: float = 0.0
+
+    @property
+    def coefficients(self) -> tuple[float, float, float, float, float]:
+        return (self.k1, self.k2, self.p1, self.p2, self.k3)
+
+
+class SensorErrorSpec(Model):
+    """How a simulated camera's own model is off what it states (what only a simulation knows; a calibration's
+    intrinsics check and every run's table check look for it): its depth reads ``depth_scale`` times the true
+    depth, its true focal length is ``focal_scale`` times the stated one."""
+
+    depth_scale: Annotated[float, Field(gt=0.5, lt=2.0)] = 1.0
+    focal_scale: Annotated[float, Field(gt=0.5, lt=2.0)] = 1.0
+
+
 class CameraSpec(Model):
     """A depth camera looking from ``eye_m`` at ``target_m`` (world) with a pinhole of the given size and field."""
 
@@ -131,6 +155,11 @@ class CameraSpec(Model):
     # in the robot base frame, the arm camera's X_FC in the flange frame tool0. Given, the cell is told this pose
     # (a simulation renders from eye_m/target_m still, and its extrinsic_error no longer applies).
     measured: PoseSpec | None = None
+    # The lens: a simulation renders through it, and the cell undistorts with it, unless a calibration measured
+    # another (``measured_distortion``, applied with ``--calibration``): then the cell is told that one.
+    distortion: DistortionSpec = DistortionSpec()
+    measured_distortion: DistortionSpec | None = None
+    sensor_error: SensorErrorSpec = SensorErrorSpec()
 
     @model_validator(mode="after")
     def _check(self) -> CameraSpec:
@@ -144,6 +173,11 @@ class CameraSpec(Model):
     def X_WC(self) -> FloatArray:
         """True pose of the optical frame in the world."""
         return look_at(self.eye_m, self.target_m, self.up)
+
+    @property
+    def told_distortion(self) -> tuple[float, float, float, float, float]:
+        """The lens model the cell is told: the calibration's when there is one, else the stated."""
+        return (self.measured_distortion or self.distortion).coefficients
 
     @property
     def fx_px(self) -> float:

@@ -16,10 +16,13 @@ from cell.types import CameraIntrinsics
 X_CG = np.diag([1.0, -1.0, -1.0, 1.0])
 
 
-def intrinsics_for(width: int, height: int, hfov_rad: float) -> CameraIntrinsics:
-    """Square-pixel intrinsics, principal point at the image centre, f = 0.5 * width / tan(hfov / 2) [px]."""
+def intrinsics_for(
+    width: int, height: int, hfov_rad: float, distortion: tuple[float, float, float, float, float] = (0.0,) * 5
+) -> CameraIntrinsics:
+    """Square-pixel intrinsics, principal point at the image centre, f = 0.5 * width / tan(hfov / 2) [px], with a
+    lens' ``distortion`` (k1, k2, p1, p2, k3)."""
     f = 0.5 * width / math.tan(hfov_rad / 2.0)
-    return CameraIntrinsics(width, height, f, f, (width - 1) / 2.0, (height - 1) / 2.0)
+    return CameraIntrinsics(width, height, f, f, (width - 1) / 2.0, (height - 1) / 2.0, distortion)
 
 
 def gl_view_matrix(X_WC: FloatArray) -> list[float]:

@@ -19,6 +19,7 @@ from cell.sim.board import Size2, add_board, colour_noise, place_body
 from cell.sim.bodies import add_box, add_part
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
+from cell.sim.lens import Sensor, sensor_for
 from cell.sim.noise import apply_noise, believed_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
@@ -73,6 +74,7 @@ class SimCell:
             self._client: BulletClient | None = BulletClient(connection_mode=pybullet.GUI if gui else pybullet.DIRECT)
         self._bodies: dict[str, int] = {}
         self._noise_rngs: dict[str, np.random.Generator] = {}
+        self._sensors: dict[str, Sensor] = {}
         self._robot: SimRobot | None = None
         self._beads: list[int] = []
         ground = Box(make_pose(p=(0.0, 0.0, -_GROUND_SIZE[2] / 2.0)), np.array(_GROUND_SIZE))
@@ -129,19 +131,15 @@ class SimCell:
         return spec
 
     def intrinsics(self, camera: str) -> CameraIntrinsics:
-        """Exact pinhole intrinsics [px] of ``camera``'s rendered images."""
+        """Exact pinhole intrinsics [px] of ``camera``'s images, with the lens model the cell is told."""
         spec = self.camera_spec(camera)
-        return intrinsics_for(spec.resolution[0], spec.resolution[1], np.radians(spec.hfov_deg))
-
-    def render_depth(self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float) -> FloatArray:
-        """Noise-free depth (H, W) [m] along the optical axis seen from the optical frame at X_WC (4, 4) in W;
-        0 where nothing lies between the near and far planes."""
-        return self.render(X_WC, intrinsics, near_m, far_m)[1]
+        w, h = spec.resolution
+        return intrinsics_for(w, h, np.radians(spec.hfov_deg), spec.told_distortion)
 
     def render(
         self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float
     ) -> tuple[npt.NDArray[np.uint8], FloatArray]:
-        """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (as :meth:`render_depth`) from X_WC (4, 4)."""
+        """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (0: nothing between near and far) from X_WC (4, 4)."""
         _, _, rgba, buffer, _ = self.client.getCameraImage(
             intrinsics.width,
             intrinsics.height,
@@ -180,8 +178,10 @@ class SimCell:
         X_true = spec.X_WC if X_WC is None else np.asarray(X_WC, dtype=float)
         if X_true.shape != (4, 4):
             raise ValueError(f"X_WC must be (4, 4), got {X_true.shape}")
-        intr = self.intrinsics(camera)
-        rgb, depth = self.render(X_true, intr, spec.near_m, spec.far_m)
+        told = self.intrinsics(camera)
+        sensor = self._sensors.setdefault(camera, sensor_for(spec, told))  # its lens, true focal and depth scale
+        rgb, depth = self.render(X_true, intr := sensor.render, spec.near_m, spec.far_m)
+        rgb = sensor.colour(rgb)
         if self.scenario.noise == "realistic":
             if colour:  # its own stream: the depth noise draws are the same with colour taken or not
                 crng = self._noise_rngs.setdefault(camera + "/colour", self.scenario.rng(camera + "/colour"))
@@ -200,7 +200,7 @@ class SimCell:
             noisy = corrupt_depth(noisy, fault, spec.near_m, spec.far_m, rng)
         X_WF = self._robot.link_pose(FLANGE_LINK) if self._robot is not None else None  # the measured X_FC's base
         X_told = believed_pose(spec, X_true, self.scenario.X_WR, X_WF, self.scenario.rng(camera + "/extrinsics"))
-        return DepthImage(camera=camera, depth=noisy, intrinsics=intr, X_WC=X_told, mount=spec.mount), rgb
+        return DepthImage(camera=camera, depth=sensor.depth(noisy), intrinsics=told, X_WC=X_told, mount=spec.mount), rgb
 
     def add_board(self, name: str, image: npt.ArrayLike, face_m: Size2, origin_m: Size2) -> None:
         """A calibration board (:func:`cell.sim.board.add_board`) as body ``name``, at W's origin until placed."""

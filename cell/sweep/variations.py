@@ -149,7 +149,12 @@ def varied(scenario: Scenario, v: Variation) -> Scenario:
         changes["placement_error"] = PoseSpec(xyz_m=(x, y, 0.0), rpy_deg=(0.0, 0.0, yaw))
     if changes:
         sc = sc.with_simulation(**changes)
-    if v.extrinsics is not None:
+    if v.extrinsics is not None and any(cam.measured is not None for cam in sc.cameras.values()):
+        from cell.sim.calibrated import off_calibration  # a calibrated cell: the true cameras off its belief
+
+        errors = {n: ExtrinsicErrorSpec(translation_mm=t, rotation_deg=r) for n, (t, r) in v.extrinsics.items()}
+        sc = off_calibration(sc, errors)
+    elif v.extrinsics is not None:
         cams = {
             name: cam.model_copy(
                 update={

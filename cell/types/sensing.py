@@ -15,7 +15,8 @@ from cell.geometry import FloatArray, readonly, transform_points
 
 @dataclass(frozen=True)
 class CameraIntrinsics:
-    """Pinhole intrinsics [px] of a depth image, optical frame z forward, x right, y down."""
+    """Pinhole intrinsics [px] of a depth image, optical frame z forward, x right, y down; ``distortion`` the lens'
+    Brown-Conrady model (k1, k2, p1, p2, k3), OpenCV's order and meaning (all zero: a pinhole image)."""
 
     width: int
     height: int
@@ -23,10 +24,26 @@ class CameraIntrinsics:
     fy: float
     cx: float
     cy: float
+    distortion: tuple[float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0)
 
     @property
     def K(self) -> FloatArray:
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    @property
+    def distorted(self) -> bool:
+        return any(d != 0.0 for d in self.distortion)
+
+    def distort(self, x_n: npt.ArrayLike, y_n: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """The lens model: ideal normalised image coordinates (x, y) to where the lens puts them (same shapes)."""
+        x, y = np.asarray(x_n, dtype=float), np.asarray(y_n, dtype=float)
+        k1, k2, p1, p2, k3 = self.distortion
+        r2 = x * x + y * y
+        radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+        return (
+            x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+            y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
+        )
 
 
 @dataclass(frozen=True)

@@ -67,9 +67,9 @@ def test_the_rendered_board_is_found_where_it_lies(tmp_path: Path) -> None:
 
 
 def _view(corners: object, depth: object) -> solve.View:
-    from cell.pipeline.calibration import _depth_at
+    from cell.pipeline.calibration import depth_at
 
-    return solve.View(np.eye(4), corners, _depth_at(depth.depth, corners.px))  # type: ignore[arg-type, attr-defined]
+    return solve.View(np.eye(4), corners, depth_at(depth.depth, corners.px))  # type: ignore[arg-type, attr-defined]
 
 
 def test_a_calibration_file_puts_its_measured_pose_in_place_of_the_perturbed_one(tmp_path: Path) -> None:
@@ -113,3 +113,76 @@ def test_a_board_printed_at_another_scale_is_what_the_simulation_renders(tmp_pat
     picture, face_m, origin_m = printed.picture()
     assert face_m[0] == pytest.approx(1.05 * stated.picture()[1][0]) and origin_m[0] == pytest.approx(-0.0105)
     assert picture.shape == stated.picture()[0].shape  # the same picture, printed larger
+
+
+def test_a_camera_that_sees_the_board_at_no_pose_is_refused_with_its_reason() -> None:
+    import yaml
+
+    from cell.errors import CalibrationError, CalibrationFault
+    from cell.pipeline.calibration import calibrate
+
+    # fence1's right camera with its near plane beyond every planned board distance (0.7 to 1.1 m): the board is
+    # never drawn in its images. Four poses wanted, a small image: four renders, then the refusal.
+    _, doc = _fence1()
+    doc["cameras"]["cam_right"].update(near_m=1.5, resolution=[320, 240])
+    s = scn.from_yaml(yaml.safe_dump(doc), base_dir=scn.SCENARIO_DIR)
+    with pytest.raises(CalibrationError) as e:
+        calibrate(s, ["cam_right"])
+    assert e.value.code == CalibrationFault.NOT_SEEN and e.value.exit_code == 17
+    assert e.value.value == 0 and e.value.needed == 4
+    assert "cannot see the board at any pose" in str(e.value) and "0 of 4 images" in str(e.value)
+
+
+def _fence1(**calibration: object) -> scn.Scenario:
+    import yaml
+
+    doc = yaml.safe_load((scn.SCENARIO_DIR / "fence1.yaml").read_text(encoding="utf-8"))
+    doc["calibration"] = {"poses": 4, "held_out": 0, **calibration}
+    return scn.from_yaml(yaml.safe_dump(doc), base_dir=scn.SCENARIO_DIR), doc  # type: ignore[return-value]
+
+
+def test_calibration_poses_that_collide_with_the_cell_or_the_part_are_dropped() -> None:
+    from cell.calibrate.views import Mount
+    from cell.geometry import pose_from_xyz_rpy
+    from cell.pipeline.calibration.images import PoseScreen
+    from cell.pipeline.geometry import robot_arm
+
+    s, _ = _fence1()
+    arm = robot_arm(s)
+    assert arm is not None
+    board = Board(s.calibration.board)
+    X_FB = pose_from_xyz_rpy(s.calibration.mount.X_FB_xyz_m, np.radians(s.calibration.mount.X_FB_rpy_deg))
+    screen = PoseScreen(s, arm, board, X_FB)
+    home = arm.q_home
+    X_RF = arm.model.fk(home, "tool0")
+    assert not screen.collides(home, Mount.EYE_TO_HAND, X_RF)  # the arm over the table, torch well above the parts
+    bent = np.array(home, dtype=float)
+    bent[1] += np.radians(80.0)  # the shoulder down: the flange below the table top
+    assert screen.collides(bent, Mount.EYE_TO_HAND, arm.model.fk(bent, "tool0"))
+    # The board on the flange sunk into the top rail's place, the arm itself clear: the plate counts.
+    top = next(p for p in s_parts(s) if p.name == "TOP_RAIL")
+    X_RB = make_pose(p=top.vertices().mean(axis=0) - board.centre_B)
+    assert screen.collides(home, Mount.EYE_TO_HAND, X_RB @ invert(X_FB))
+    assert not screen.collides(home, Mount.EYE_IN_HAND, X_RB @ invert(X_FB))  # the board then lies where the part would
+
+
+def s_parts(s: scn.Scenario) -> tuple:  # type: ignore[type-arg]
+    from cell.pipeline.detect import read_weldmap
+
+    return read_weldmap(s).transformed(invert(s.X_WR) @ s.X_WM, "R").parts
+
+
+def test_too_few_poses_clear_of_the_cell_is_refused_with_its_reason() -> None:
+    import yaml
+
+    from cell.errors import CalibrationError, CalibrationFault
+    from cell.pipeline.calibration import calibrate
+
+    # The table's collision box grown 1.5 m on every side: every reachable pose collides, none is rendered.
+    _, doc = _fence1()
+    doc.setdefault("motion", {}).setdefault("plan", {})["collision"] = {"table_inflation": 1.5}
+    s = scn.from_yaml(yaml.safe_dump(doc), base_dir=scn.SCENARIO_DIR)
+    with pytest.raises(CalibrationError) as e:
+        calibrate(s, ["cam_right"])
+    assert e.value.code == CalibrationFault.COLLIDING and e.value.exit_code == 17
+    assert e.value.value == 0 and e.value.needed == 4 and "keep the arm clear of the cell" in str(e.value)

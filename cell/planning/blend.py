@@ -81,12 +81,13 @@ def _blend_at(
 ) -> _Blend | None:
     """The blend between motions a and b (None: an exact stop): a left no earlier than ``entry_min`` [s] into it
     (where the previous blend joined it), b joined no later than ``exit_max`` [s] (where the next may leave)."""
-    cut = fraction * min(a.duration, b.duration)
+    # a's cut ends where the previous blend joined it (a motion blended at both ends keeps at least its middle)
+    cut_a, cut_b = min(fraction * a.duration, a.duration - entry_min - 2.0 * dt), fraction * b.duration
     for _ in range(_HALVINGS + 1):
-        if cut < _MIN_CUT:
+        if min(cut_a, cut_b) < _MIN_CUT:
             return None
-        exit_s = float(np.floor((a.duration - cut) / dt + 1e-9) * dt)  # on a's sample grid
-        entry_s = float(np.ceil(cut / dt - 1e-9) * dt)  # on b's
+        exit_s = float(np.floor((a.duration - cut_a) / dt + 1e-9) * dt)  # on a's sample grid
+        entry_s = float(np.ceil(cut_b / dt - 1e-9) * dt)  # on b's
         if exit_s > entry_min + dt and entry_s < exit_max - dt:
             try:
                 link = connect(a.sample(exit_s), b.sample(entry_s), lim, dt=dt)
@@ -94,7 +95,7 @@ def _blend_at(
                 link = None
             if link is not None and link.duration < (a.duration - exit_s) + entry_s - dt and clear(link):
                 return _Blend(exit_s, entry_s, link)
-        cut *= 0.5
+        cut_a, cut_b = 0.5 * cut_a, 0.5 * cut_b
     return None
 
 

@@ -1,6 +1,6 @@
 """Planning with a linear track under the base (an external axis E1): seams grouped along the track, one E1 per
-group, the arm planned per group with its base there, the track moved between groups with the arm at home
-(docs/track.md, "Planning").
+group, the arm planned per group with its base there, the arm and the track moved together between groups
+(:mod:`cell.planning.track_moves`; docs/track.md, "Planning").
 
 Frames: R is the base at E1 = 0; every pose of the plan stays in R. Units: metres, radians, seconds."""
 
@@ -221,7 +221,7 @@ def plan_on_track(
                 legs.append(GroupLegs.split(g.e1, plan.segments))
                 order += plan.order
         checker.set_base(base0)
-        moves = TrackMoves(robot, track, checker, obstacles, process.stickout, q0, opt.dt)
+        moves = TrackMoves(robot, track, checker, obstacles, process.stickout, q0, opt)
 
         def blend(g: GroupLegs, segs: list[Segment]) -> list[Segment]:
             if opt.blend <= 0.0:

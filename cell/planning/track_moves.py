@@ -13,11 +13,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from cell.config.motion import GateOptions
-from cell.errors import TimingError
+from cell.config.motion import GateOptions, PlanOptions
+from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import body_entry
+from cell.motion.ik import solve_ik
 from cell.motion.limits import JointLimits
 from cell.motion.robot import RobotModel
 from cell.motion.timing import ptp
@@ -78,10 +79,13 @@ class TrackMoves:
         obstacles: Sequence[Part],
         wire_m: float,
         q_home: FloatArray,
-        dt: float,
+        options: PlanOptions,
+        rises: Sequence[float] = (0.05, 0.15),
     ) -> None:
         self.robot, self.track, self.checker, self.obstacles = robot, track, checker, tuple(obstacles)
-        self.wire_m, self.q_home, self.dt = wire_m, np.asarray(q_home, dtype=float), dt
+        self.wire_m, self.q_home, self.dt, self.ik = wire_m, np.asarray(q_home, dtype=float), options.dt, options.ik
+        self.rises = tuple(rises)  # [m] via points this far above the highest obstacle, lowest first
+        self.top = max((float(np.max(o.vertices()[:, 2])) for o in self.obstacles), default=0.0)
         self.limits = arm_and_track(robot.limits, track)
         self._depth = GateOptions().body_depth
 
@@ -122,12 +126,15 @@ class TrackMoves:
         it moves; else the carriage alone with the arm at home."""
         home, e_a, e_b = self.q_home, a.e1 if a else 0.0, b.e1 if b else 0.0
         q_a, q_b = (a.q_out if a else home), (b.q_in if b else home)
-        tries = [(False, False, q_a, q_b), (False, True, q_a, home), (True, False, home, q_b), (True, True, home, home)]
+        if np.array_equal(q_a, q_b) and e_a == e_b:
+            return False, False, []
+        lifted = self.lifted(q_a, e_a, q_b, e_b)
+        if lifted is not None:
+            return False, False, lifted
+        tries = [(False, True, q_a, home), (True, False, home, q_b), (True, True, home, home)]
         for tail, head, q_from, q_to in tries:
             if (tail and a is None) or (head and b is None):
                 continue  # home is where that end already is: another try covers it
-            if np.array_equal(q_from, q_to) and e_a == e_b:
-                return tail, head, []
             try:
                 tr = self.move(q_from, e_a, q_to, e_b)
             except TimingError:
@@ -135,6 +142,38 @@ class TrackMoves:
             if (tail and head) or self.free(tr):  # the arm at home while the carriage moves: as it always was
                 return tail, head, [tr]
         raise TimingError(f"no move of the track from E1 = {e_a * 1000:.0f} mm to {e_b * 1000:.0f} mm")
+
+    def lifted(self, q_a: FloatArray, e_a: float, q_b: FloatArray, e_b: float) -> list[Trajectory] | None:
+        """The arm and the carriage together straight from (q_a, e_a) to (q_b, e_b); else the arm up to a via
+        point above its TCP at each of ``rises`` over the highest obstacle, together to the one above q_b's
+        TCP, down: the first whose moves are all free (None: none is)."""
+        try:
+            direct = self.move(q_a, e_a, q_b, e_b)
+        except TimingError:
+            direct = None
+        if direct is not None and self.free(direct):
+            return [direct]
+        for rise in self.rises:
+            try:
+                up_a, up_b = self._above(q_a, e_a, self.top + rise), self._above(q_b, e_b, self.top + rise)
+                moves = [
+                    ptp(q_a, up_a, self.robot.limits, dt=self.dt).with_e1(e_a),
+                    self.move(up_a, e_a, up_b, e_b),
+                    ptp(up_b, q_b, self.robot.limits, dt=self.dt).with_e1(e_b),
+                ]
+            except (IKError, TimingError):
+                continue
+            if all(self.free(tr) for tr in moves):
+                return moves
+        return None
+
+    def _above(self, q: FloatArray, e1: float, height: float) -> FloatArray:
+        """q (dof,) [rad] with its TCP (the base at E1 = e1 [m]) raised to ``height`` [m] in R; IKError when it
+        cannot be reached."""
+        arm = self.robot.shifted(self.track.offset_R(e1)) if e1 else self.robot
+        X = arm.fk(q)
+        X[2, 3] = max(height, float(X[2, 3]))
+        return np.asarray(solve_ik(arm, X, q, options=self.ik))
 
 
 def stitched(

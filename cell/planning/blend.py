@@ -43,8 +43,9 @@ def blend_plan(
 ) -> list[Segment]:
     """The plan's segments with every run of arc-off motions blended (welds, their starts and ends untouched).
 
-    fraction [0, 0.5]: at most this fraction of the shorter of two neighbouring motions is cut at their point (so
-    half of an approach at least stays the straight line it was). At each point the cut is halved until the
+    fraction [0, 0.5]: at most this fraction of each of two neighbouring motions is cut at their point, and no more
+    of a motion than its previous blend left (so half of an approach at least stays the straight line it was, and a
+    motion blended at both ends keeps at least its middle). At each point the cuts are halved until the
     link is faster than the two cut pieces and ``clear`` (the collision and body tests) passes for it, else
     the point is an exact stop. tcp : q (dof,) -> the TCP (3,) in R, for the zones. Segments come back to back,
     times renumbered from the first one's start.

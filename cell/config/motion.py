@@ -62,8 +62,11 @@ class PlanOptions:
     line_accel: float = 5.0  # [m/s^2] approach/depart (the joint limits scale it down where they bind)
     line_jerk: float = 100.0  # [m/s^3]
     # Arc-off motions approximated at the points between them (cell/planning/blend.py): at most this fraction of
-    # the shorter of two neighbouring motions runs together [0, 0.5]; 0: an exact stop at every point.
+    # each of two neighbouring motions is left out at their point [0, 0.5]; 0: an exact stop at every point.
     blend: float = 0.5
+    # Shorter approach and depart lines [m] a transfer between two seams may meet, shortest first, where its motions
+    # are free with them (cell/planning/short_lines.py); the process's approach and depart are the longest. (): none.
+    short_lines: tuple[float, ...] = (0.01, 0.02)
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
     # A seam ending on the table where the torch meets the table is welded from at most this far above it [m]
     # (never more than a third of the seam); 0: such a seam is refused.

@@ -274,7 +274,7 @@ def krl_texts(job: ProgramJob) -> tuple[str, str]:
             continue
         if seg.kind == "move":
             e1 = seg.trajectory.e1
-            moves = e1 is not None and float(np.ptp(e1)) > 0.0  # the carriage moves (the arm at home)
+            moves = e1 is not None and float(np.ptp(e1)) > 0.0  # the carriage moves (the arm with it, or at home)
             track = f" (track to E1 = {seg.e1_end * 1000:.1f} mm)" if moves else ""
             c_dis = b.approx(seg)
             b.src.append(f"PTP {b.point(seg)}{c_dis} ; transfer{track}")

@@ -13,6 +13,7 @@ from cell.geometry import FloatArray, readonly
 from cell.motion.robot import RobotModel
 from cell.planning.lines import line_trajectory
 from cell.planning.seam_search import SeamSolution
+from cell.planning.short_lines import LineEnd, SeamLines, join
 from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess
 from cell.types.plan import Segment
@@ -53,7 +54,7 @@ def seam_pieces(robot: RobotModel, process: WeldProcess, options: PlanOptions, s
 def assemble(
     transfers: Transfers,
     ordered: Sequence[str],
-    ends: Mapping[str, tuple[FloatArray, FloatArray]],
+    lines: Mapping[str, SeamLines],
     seam_parts: Mapping[str, Sequence[Piece]],
     q_home: FloatArray,
     procedures: Mapping[str, WeldProcedure] | None = None,
@@ -61,12 +62,14 @@ def assemble(
     """Segments back to back from home through the seams in ``ordered`` back home; or, with the segments so far,
     the first transfer (from id, to id; "" = home) that found no free way.
 
-    ends : seam id -> (dof,) where its motion starts (the first approach) and ends (the last depart) [rad].
+    lines : seam id -> its approaches and departs at every length (:mod:`cell.planning.short_lines`): each transfer
+    meets the shortest pair with which one of its strategies is free, the planned lines last.
     procedures : seam id -> its weld procedure, carried by the seam's segments; a seam's pieces are its passes
     in order (each from its approach to its depart, then the move to the next): the pass index of a segment."""
     segments: list[Segment] = []
     procs = procedures or {}
     t = 0.0
+    home = (LineEnd("move", np.asarray(q_home)[None, :], 0.0, np.zeros(3), np.eye(4), True),)
 
     def add(sid: str, piece: Piece, pass_index: int = 0) -> None:
         nonlocal t
@@ -77,18 +80,21 @@ def assemble(
         segments.append(seg)
         t += tr.duration
 
-    q, prev = q_home, ""
+    prev, last_pass = "", 0
     for sid in [*ordered, ""]:
-        q_next = ends[sid][0] if sid else q_home
-        moves = transfers.move(q, q_next)
-        if isinstance(moves, TransferFail):
-            return segments, (prev, sid, moves)
-        for piece in moves:
+        found = join(transfers, lines[prev].exits if prev else home, lines[sid].entries if sid else home)
+        if isinstance(found, TransferFail):
+            return segments, (prev, sid, found)
+        if prev:
+            add(prev, found.depart if found.depart is not None else seam_parts[prev][-1], last_pass)
+        for piece in found.moves:
             add(sid, piece)
         if sid:
-            k = -1
-            for piece in seam_parts[sid]:
-                k += piece.kind == "approach"
-                add(sid, piece, max(k, 0))
-            q, prev = ends[sid][1], sid
+            parts = list(seam_parts[sid])
+            parts[0] = found.approach if found.approach is not None else parts[0]
+            n = -1
+            for piece in parts[:-1]:  # its last depart goes with the next transfer
+                n += piece.kind == "approach"
+                add(sid, piece, max(n, 0))
+            prev, last_pass = sid, max(n, 0)
     return segments, None

@@ -43,8 +43,9 @@ def blend_plan(
 ) -> list[Segment]:
     """The plan's segments with every run of arc-off motions blended (welds, their starts and ends untouched).
 
-    fraction [0, 0.5]: at most this fraction of the shorter of two neighbouring motions is cut at their point (so
-    half of an approach at least stays the straight line it was). At each point the cut is halved until the
+    fraction [0, 0.5]: at most this fraction of each of two neighbouring motions is cut at their point, and no more
+    of a motion than its previous blend left (so half of an approach at least stays the straight line it was, and a
+    motion blended at both ends keeps at least its middle). At each point the cuts are halved until the
     link is faster than the two cut pieces and ``clear`` (the collision and body tests) passes for it, else
     the point is an exact stop. tcp : q (dof,) -> the TCP (3,) in R, for the zones. Segments come back to back,
     times renumbered from the first one's start.
@@ -81,12 +82,13 @@ def _blend_at(
 ) -> _Blend | None:
     """The blend between motions a and b (None: an exact stop): a left no earlier than ``entry_min`` [s] into it
     (where the previous blend joined it), b joined no later than ``exit_max`` [s] (where the next may leave)."""
-    cut = fraction * min(a.duration, b.duration)
+    # a's cut ends where the previous blend joined it (a motion blended at both ends keeps at least its middle)
+    cut_a, cut_b = min(fraction * a.duration, a.duration - entry_min - 2.0 * dt), fraction * b.duration
     for _ in range(_HALVINGS + 1):
-        if cut < _MIN_CUT:
+        if min(cut_a, cut_b) < _MIN_CUT:
             return None
-        exit_s = float(np.floor((a.duration - cut) / dt + 1e-9) * dt)  # on a's sample grid
-        entry_s = float(np.ceil(cut / dt - 1e-9) * dt)  # on b's
+        exit_s = float(np.floor((a.duration - cut_a) / dt + 1e-9) * dt)  # on a's sample grid
+        entry_s = float(np.ceil(cut_b / dt - 1e-9) * dt)  # on b's
         if exit_s > entry_min + dt and entry_s < exit_max - dt:
             try:
                 link = connect(a.sample(exit_s), b.sample(entry_s), lim, dt=dt)
@@ -94,7 +96,7 @@ def _blend_at(
                 link = None
             if link is not None and link.duration < (a.duration - exit_s) + entry_s - dt and clear(link):
                 return _Blend(exit_s, entry_s, link)
-        cut *= 0.5
+        cut_a, cut_b = 0.5 * cut_a, 0.5 * cut_b
     return None
 
 

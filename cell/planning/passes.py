@@ -17,6 +17,7 @@ from cell.motion.robot import RobotModel
 from cell.planning.assembly import seam_pieces
 from cell.planning.failures import SeamFailure, unreachable
 from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.short_lines import join, seam_lines
 from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess, torch_poses
 from cell.process.weave import cross_section, knot_spacing, offset_poses, pass_speed
@@ -84,12 +85,16 @@ def pass_pieces(
     pieces: list[Piece] = []
     for k, sol in enumerate(passes):
         pr = process if procedure is None else replace(process, travel_speed=pass_speed(procedure, k))
-        if k:
-            moves = transfers.move(passes[k - 1].q_depart[-1], sol.q_approach[0])
-            if isinstance(moves, TransferFail):
-                return moves
-            pieces += moves
-        pieces += seam_pieces(robot, pr, options, sol)
+        own = seam_pieces(robot, pr, options, sol)
+        if k:  # the depart before and the approach after as short as the move between them allows
+            lines = seam_lines(sol, passes[k - 1], process, options.short_lines)
+            found = join(transfers, lines.exits, lines.entries)
+            if isinstance(found, TransferFail):
+                return found
+            pieces[-1] = found.depart if found.depart is not None else pieces[-1]
+            own[0] = found.approach if found.approach is not None else own[0]
+            pieces += found.moves
+        pieces += own
         if procedure is not None:
             pieces[-2] = with_craters(pieces[-2], procedure.crater_start_s, procedure.crater_end_s, options.dt)
     return pieces

@@ -26,6 +26,7 @@ from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
 from cell.planning.reach import ReachModel
 from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.short_lines import seam_lines
 from cell.planning.stand_off import blocked_by_table, stand_off, table_top
 from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess
@@ -141,13 +142,14 @@ def plan_welds(
             continue
         seam_parts[sid] = parts
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
+    lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
     forbidden: set[tuple[str, str]] = set()
     while True:
         ids = list(solved)
         order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)
         ordered = [ids[k] for k in order]
-        segments, failed = assemble(transfers, ordered, ends, seam_parts, q0, seam_procs)
+        segments, failed = assemble(transfers, ordered, lines, seam_parts, q0, seam_procs)
         if failed is None:
             break
         a, b, why = failed

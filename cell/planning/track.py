@@ -1,6 +1,6 @@
 """Planning with a linear track under the base (an external axis E1): seams grouped along the track, one E1 per
-group, the arm planned per group with its base there, the track moved between groups with the arm at home
-(docs/track.md, "Planning").
+group, the arm planned per group with its base there, the arm and the track moved together between groups
+(:mod:`cell.planning.track_moves`; docs/track.md, "Planning").
 
 Frames: R is the base at E1 = 0; every pose of the plan stays in R. Units: metres, radians, seconds."""
 
@@ -19,8 +19,11 @@ from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
+from cell.planning.blend import blend_plan
 from cell.planning.plan import plan_welds, reach_model, seam_process
 from cell.planning.reach import ReachModel, cone_excess
+from cell.planning.track_moves import GroupLegs, TrackMoves, stitched
+from cell.planning.transfers import Transfers
 from cell.process.torch import WeldProcess, fillet_axes
 from cell.types import Part
 from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, Segment, WeldPlan
@@ -179,10 +182,11 @@ def plan_on_track(
             groups[0] = TrackGroup(groups[0].e1, groups[0].seam_ids + dead)
     by_id = {t.id: t for t in tasks}
     outcomes: dict[str, SeamOutcome] = {}
-    segments: list[Segment] = []
+    legs: list[GroupLegs] = []
     order: list[str] = []
-    t, e_now, done = 0.0, 0.0, 0
+    done = 0
     base0 = checker.base_offset_R
+    exact = replace(opt, blend=0.0)  # each group approximated once its ways from and to home are known
     try:
         for g in groups:
             group_tasks = [by_id[i] for i in g.seam_ids]
@@ -190,12 +194,12 @@ def plan_on_track(
             checker.set_base(track.offset_R(g.e1))
             try:
                 plan = plan_welds(
-                    robot.shifted(track.offset_R(g.e1)) if g.e1 else robot,
+                    _arm_at(robot, track, g.e1),
                     group_tasks,
                     q0,
                     process,
                     obstacles,
-                    options=opt,
+                    options=exact,
                     rng=rng,
                     checker=checker,
                     procedures=chosen,
@@ -213,17 +217,21 @@ def plan_on_track(
             finally:
                 done += len(group_tasks)
             outcomes.update({o.seam_id: o for o in plan.seams})
-            if not plan.segments:
-                continue
-            if g.e1 != e_now:
-                segments.append(_track_segment(robot, track, q0, e_now, g.e1, t, opt.dt))
-                t, e_now = segments[-1].t1, g.e1
-            for seg in plan.segments:
-                segments.append(replace(seg, trajectory=seg.trajectory.with_e1(g.e1), t0=seg.t0 + t))
-            t = segments[-1].t1
-            order += plan.order
-        if e_now != 0.0:
-            segments.append(_track_segment(robot, track, q0, e_now, 0.0, t, opt.dt))
+            if plan.segments:
+                legs.append(GroupLegs.split(g.e1, plan.segments))
+                order += plan.order
+        checker.set_base(base0)
+        moves = TrackMoves(robot, track, checker, obstacles, process.stickout, q0, opt)
+
+        def blend(g: GroupLegs, segs: list[Segment]) -> list[Segment]:
+            if opt.blend <= 0.0:
+                return segs
+            arm = _arm_at(robot, track, g.e1)
+            checker.set_base(track.offset_R(g.e1))
+            clear = Transfers(arm, process, checker, opt, obstacles, q0).clear
+            return blend_plan(segs, arm.limits, lambda q: arm.fk(q)[:3, 3], clear, fraction=opt.blend, dt=opt.dt)
+
+        segments = stitched(moves, legs, blend)
     finally:
         checker.set_base(base0)
     return WeldPlan(
@@ -237,13 +245,9 @@ def plan_on_track(
     )
 
 
-def _track_segment(
-    robot: RobotModel, track: LinearTrack, q_home: FloatArray, e_a: float, e_b: float, t0: float, dt: float
-) -> Segment:
-    """The track's move e_a -> e_b [m] as a plan segment (a PTP of E1 alone, no seam) starting at t0 [s]."""
-    tr = track_move(track, q_home, e_a, e_b, dt)
-    X_end = track.X_R_Re(e_b) @ robot.fk(q_home)  # robot: the arm with its base at R
-    return Segment("move", "", tr, t0, readonly(X_end))
+def _arm_at(robot: RobotModel, track: LinearTrack, e1: float) -> RobotModel:
+    """The arm with its base at E1 = e1 [m] (``robot`` itself at 0)."""
+    return robot.shifted(track.offset_R(e1)) if e1 else robot
 
 
 def _offset_counter(on_seam: Callable[[int, int], None], done: int, total: int) -> Callable[[int, int], None]:

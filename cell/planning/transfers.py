@@ -91,18 +91,23 @@ class Lift:
 
 @dataclass(frozen=True)
 class Hop:
-    """PTP up to the lift height (plus ``extra`` times ``transfer_lift``) above q_a's TCP, PTP across, PTP down to
-    q_b: the lift's via points reached by joint moves, faster than its straight lines where the collision check
-    finds the joint path free."""
+    """PTP up to a via point at the lift height above q_a's TCP, PTP across to one above q_b's, PTP down to q_b:
+    the lift's via points reached by joint moves, faster than its straight lines where the collision check finds
+    the joint path free. The lift height is ``transfer_lift`` (plus ``extra`` times it) above the highest
+    obstacle, or ``rise`` [m] above it when given; ``over`` "start" or "end" keeps only that end's via point."""
 
     name: str = "hop"
     extra: int = 0
+    rise: float | None = None
+    over: str = "both"
 
     def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
         robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
-        h = mover.lift_z + mover.opt.transfer_lift * self.extra
-        vias = [q for q in (mover.above(q_a, h), mover.above(q_b, h)) if q is not None]
-        qs = [q_a, *vias, q_b]
+        top = mover.lift_z - mover.opt.transfer_lift
+        h = top + self.rise if self.rise is not None else mover.lift_z + mover.opt.transfer_lift * self.extra
+        via_a = mover.above(q_a, h) if self.over != "end" else None
+        via_b = mover.above(q_b, h) if self.over != "start" else None
+        qs = [q_a, *(q for q in (via_a, via_b) if q is not None), q_b]
         return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
 
 
@@ -124,6 +129,9 @@ _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the g
 
 DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (
     Direct(),
+    Hop("hop_down", rise=0.02, over="end"),
+    Hop("hop_up", rise=0.02, over="start"),
+    Hop("hop_low", rise=0.02),
     Hop(),
     Lift(),
     Hop("hop_high", extra=1),
@@ -160,6 +168,9 @@ class Transfers:
         # Each move searched once: the planner re-assembles its order after a failing transfer and asks again
         # for every transfer it kept (without this, n re-orderings cost n times the whole plan's transfers).
         self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
+        self._between: dict[tuple[int, bytes], tuple[int, int, list[Piece]] | TransferFail] = {}
+        self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
+        self._above: dict[tuple[bytes, float], FloatArray | None] = {}
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """:meth:`search`, remembered per (q_a, q_b)."""
@@ -171,33 +182,71 @@ class Transfers:
     def search(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """The first strategy's motions q_a -> q_b that collide with nothing (zero-length ones left out); the
         last contact, or error, when every way collides."""
+        found = self.between([q_a], [q_b])
+        return found if isinstance(found, TransferFail) else found[2]
+
+    def between(
+        self, outs: Sequence[FloatArray], ins: Sequence[FloatArray]
+    ) -> tuple[int, int, list[Piece]] | TransferFail:
+        """The first strategy that finds free motions from one of ``outs`` to one of ``ins`` (dof,) [rad] each,
+        both ordered nearest the welds first, the planned ends last: each strategy tries the pairs (outs[i],
+        ins[i]) in turn (the shorter list's last repeated). (index into outs, index into ins, motions), or the
+        last contact or error between the last two when every way collides (remembered per pair of lists)."""
+        n = max(len(outs), len(ins))
+        pairs = [(min(i, len(outs) - 1), min(i, len(ins) - 1)) for i in range(n)]
+        key = (len(outs), b"".join(np.asarray(q, dtype=float).tobytes() for q in (*outs, *ins)))
+        if key in self._between:
+            return self._between[key]
         fail = TransferFail("no collision-free way found", np.zeros(3))
+        found: tuple[int, int, list[Piece]] | TransferFail | None = None
         for strategy in self.strategies:
-            try:
-                pieces = strategy.pieces(self, q_a, q_b)
-            except (IKError, TimingError, LineError) as exc:
-                fail = TransferFail(f"{strategy.name}: {exc}", fail.p_R)
-                continue
-            wound = self._wound(pieces, q_a, q_b)
-            if wound is not None:
-                fail = TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
-                continue
-            hit = next(
-                (
-                    h
-                    for pc in pieces
-                    if (h := self.checker.check_path(pc.trajectory.q, pc.trajectory.times)) is not None
-                ),
-                None,
+            for i, k in pairs:
+                got = self._attempt(strategy, outs[i], ins[k], fail.p_R)
+                if not isinstance(got, TransferFail):
+                    found = (i, k, got)
+                    break
+                if (i, k) == pairs[-1]:  # the planned ends' failure is the one reported
+                    fail = got
+            if found is not None:
+                break
+        self._between[key] = found if found is not None else fail
+        return self._between[key]
+
+    def _attempt(
+        self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray, p_before: FloatArray
+    ) -> list[Piece] | TransferFail:
+        """One strategy's motions q_a -> q_b (zero-length ones left out) when they are free, else why not (an error
+        that has no place keeps ``p_before`` (3,) [m], the last contact's)."""
+        try:
+            pieces = strategy.pieces(self, q_a, q_b)
+        except (IKError, TimingError, LineError) as exc:
+            return TransferFail(f"{strategy.name}: {exc}", p_before)
+        wound = self._wound(pieces, q_a, q_b)
+        if wound is not None:
+            return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
+        for pc in pieces:
+            blocked = self._blocked(pc)
+            if blocked is not None:
+                wire, why, p_R = blocked
+                return TransferFail(f"{strategy.name}: {why}" if wire else why, p_R)
+        return [pc for pc in pieces if pc.trajectory.duration > 0.0]
+
+    def _blocked(self, pc: Piece) -> tuple[bool, str, FloatArray] | None:
+        """Why one motion is not free: (the wire enters a body rather than a contact, the contact or entry in
+        words, where p_R (3,) [m]); None when it is free. Remembered per motion (strategies share via points)."""
+        tr = pc.trajectory
+        key = (pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times))
+        if key not in self._pieces:
+            hit = self.checker.check_path(tr.q, tr.times)
+            entry = self._entry([pc]) if hit is None else None
+            self._pieces[key] = (
+                (False, hit.describe(), hit.p_R)
+                if hit is not None
+                else (True, entry.describe(), entry.p_R)
+                if entry is not None
+                else None
             )
-            if hit is None:
-                entry = self._entry(pieces)
-                if entry is None:
-                    return [pc for pc in pieces if pc.trajectory.duration > 0.0]
-                fail = TransferFail(f"{strategy.name}: {entry.describe()}", entry.p_R)
-                continue
-            fail = TransferFail(hit.describe(), hit.p_R)
-        return fail
+        return self._pieces[key]
 
     def clear(self, tr: Trajectory) -> bool:
         """Whether a motion touches nothing (the collision model) and takes the wire into no obstacle's body."""
@@ -240,11 +289,14 @@ class Transfers:
     def above(self, q: FloatArray, height: float) -> FloatArray | None:
         """The configuration (dof,) [rad] with q's TCP pose raised to ``height`` [m] in R (IK seeded at q); None
         when q is already that high. Raises IKError when it cannot be reached."""
-        X = self.robot.fk(q)
-        if height - float(X[2, 3]) < 1e-3:
-            return None
-        X[2, 3] = height
-        return np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
+        key = (np.asarray(q, dtype=float).tobytes(), height)
+        if key not in self._above:
+            X = self.robot.fk(q)
+            if height - float(X[2, 3]) < 1e-3:
+                return None
+            X[2, 3] = height
+            self._above[key] = np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
+        return self._above[key]
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is

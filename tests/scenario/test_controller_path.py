@@ -38,7 +38,9 @@ def test_every_executed_ptp_move_is_the_krc_joint_line(fence1_run: pipeline.Weld
         blended += s.zone_m > 0.0 or s.link_s > 0.0
         t0, t1 = pre.duration + s.t0 + s.link_s, pre.duration + s.t1
         q = _executed(run, t0, t1, np.array([start, s.q_end]))
-        assert len(q) >= 3  # the programmed ends and the executed samples between (recorded every 10 ms)
+        # the programmed ends and the executed samples between (recorded every 10 ms); a move joined at its half and
+        # left right there (each blend takes up to half of each motion) may have no record in its straight part
+        assert len(q) >= 3 or t1 - t0 < 0.01
         worst = max(worst, ptp_line_deviation(q))
         # synchronised axes: every moving axis moves one way all along the straight part (none at rest inside it)
         dq = s.q_end - start

@@ -53,6 +53,8 @@ def test_a_blended_run_is_faster_within_the_limits_and_meets_its_neighbours(limi
     before = sum(s.trajectory.duration for s in segs[:3])
     after = sum(s.trajectory.duration for s in out[:3])
     assert after < before - 0.1  # two points flown past: a tenth of a second or more saved
+    # the middle move, joined at its half, is left right there: each blend takes up to half of each motion
+    assert out[1].trajectory.duration - out[1].link_s < 0.005 < out[1].link_s
     for a, b in itertools.pairwise(out):
         np.testing.assert_allclose(a.trajectory.q[-1], b.trajectory.q[0], atol=1e-12)
         np.testing.assert_allclose(a.trajectory.qd[-1], b.trajectory.qd[0], atol=1e-9)

@@ -11,6 +11,7 @@ import pytest
 from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
 
 from cell import scenario as sc
+from cell.config.motion import PlanOptions
 from cell.errors import IKError, ScenarioError
 from cell.export.krl import krl_program
 from cell.export.program import ProgramJob
@@ -23,6 +24,7 @@ from cell.motion.robot import RobotModel
 from cell.planning.plan import plan_welds, reach_model
 from cell.planning.reach import seam_reach
 from cell.planning.track import MARGIN, e1_grid, group_seams, plan_on_track, reach_curves, track_move
+from cell.planning.track_moves import TrackMoves
 from cell.process.torch import WeldProcess
 from cell.types import Box, Part
 from cell.types.plan import PlanReason, SeamTask
@@ -125,6 +127,12 @@ def test_plan_on_the_track_welds_what_the_fixed_base_cannot(robot: RobotModel, f
     assert [o.feasible for o in plan.seams] == [True, True] and plan.track == TRACK
     track_moves = [s for s in plan.segments if s.trajectory.e1 is not None and np.ptp(s.trajectory.e1) > 0.0]
     assert len(track_moves) == 2 and track_moves[-1].e1_end == 0.0  # out and back home
+    for move in track_moves:  # the arm and the carriage together (one PTP over A1..A6 and E1), not one then the other
+        tr = move.trajectory
+        assert float(np.ptp(tr.q, axis=0).max()) > 0.5
+        v = np.diff(np.asarray(tr.e1)) / np.diff(tr.times)
+        assert np.abs(v).max() <= TRACK.v_max * 1.001 and abs(v[0]) < 1e-3 and abs(v[-1]) < 1e-3
+    assert track_moves[0] is plan.segments[0] and track_moves[0].seam_id == plan.order[0]
     e_weld = {s.e1_end for s in plan.segments if s.arc_on}
     assert len(e_weld) == 1 and 0.8 < e_weld.pop() <= 1.2
     traj, _ = plan.joint_trajectory()
@@ -160,3 +168,22 @@ def test_the_scenario_states_the_track() -> None:
     assert (track.e1_min, track.e1_max, track.v_max) == (-0.3, 1.5, 0.5) and np.allclose(track.axis_R, [1, 0, 0])
     with pytest.raises(ScenarioError, match="min_mm"):  # E1 = 0 (the base at X_WR) must lie on the track
         sc.from_yaml(text.replace(anchor, anchor + "\n  track: {min_mm: 100, max_mm: 1500}"), sc.SCENARIO_DIR)
+
+
+def test_between_groups_the_arm_lifts_over_what_the_straight_move_would_cross(robot: RobotModel) -> None:
+    # The torch low over the table at both ends, a low wall across its way along the track: the seven-axis move
+    # straight along would drag it through; up above the wall, along with the carriage, down is free.
+    X = robot.fk(HOME)
+    X[:3, 3] = [X[0, 3], 0.95, 0.06]
+    q_low = solve_ik(robot, X, HOME, rng=np.random.default_rng(0))
+    wall = Part("WALL", Box(make_pose(p=[X[0, 3] + 0.3, 0.95, 0.05]), np.array([0.02, 0.4, 0.1])))
+    table = Part("TABLE", Box(make_pose(p=[0.8, 1.05, -0.05]), np.array([3.6, 1.2, 0.1])))
+    checker = CollisionChecker(robot, (table, wall))
+    moves = TrackMoves(robot, TRACK, checker, (table, wall), PROCESS.stickout, HOME, PlanOptions(dt=0.004))
+    straight = moves.move(q_low, 0.0, q_low, 0.6)
+    assert not moves.free(straight)
+    lifted = moves.lifted(q_low, 0.0, q_low, 0.6)
+    assert lifted is not None and [float(np.ptp(np.asarray(tr.e1))) for tr in lifted] == [0.0, 0.6, 0.0]
+    top = TRACK.X_R_Re(0.0) @ robot.fk(lifted[0].q[-1])
+    assert top[2, 3] == pytest.approx(0.1 + 0.05, abs=1e-4)  # 50 mm over the wall, the lowest via tried
+    assert np.allclose(lifted[-1].q[-1], q_low) and all(moves.free(tr) for tr in lifted)

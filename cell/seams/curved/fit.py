@@ -20,6 +20,7 @@ HUBER_SCALE_M = 0.0005  # where the start's Huber loss turns linear [m]: about a
 START_POINTS = 600  # the robust start runs on this many of the points at most (evenly thinned)
 TRIM_SCALES = 3.0  # points beyond this many robust scales of the start's residuals are not the surface
 MIN_GROUP = 30  # a camera with fewer points on the surface takes the pooled scale
+PATCH_M = 0.010  # residuals within a cube of this side share their error (a facet, a tack, a bias): one cluster [m]
 
 
 @dataclass(frozen=True)
@@ -106,4 +107,21 @@ def fit_surface(
     JtJ = J.T @ J
     if np.linalg.cond(JtJ) > 1e14:
         return SurfaceFit(model, final.x, np.full((k, k), np.inf), pooled, len(keep))
-    return SurfaceFit(model, final.x, s2 * np.linalg.inv(JtJ), pooled, len(keep))
+    inv = np.linalg.inv(JtJ)
+    cov = s2 * inv
+    robust = inv @ _cluster_meat(J[: len(keep)], res, keep) @ inv
+    return SurfaceFit(model, final.x, robust if np.trace(robust) > np.trace(cov) else cov, pooled, len(keep))
+
+
+def _cluster_meat(J: FloatArray, res: FloatArray, p: FloatArray) -> FloatArray:
+    """(k, k) the middle of the cluster-robust (sandwich) covariance: sum over the patches of :data:`PATCH_M` of
+    (J_g^T r_g)(J_g^T r_g)^T, for the points' weighted Jacobian J (n, k) and residuals ``res`` (n,): residuals that
+    share a sign over a patch (the surface is not the model there) count as one error, not as many."""
+    cells = np.floor(p / PATCH_M).astype(np.int64)
+    _, label = np.unique(cells, axis=0, return_inverse=True)
+    score = np.zeros((int(label.max()) + 1, J.shape[1]))
+    np.add.at(score, label.ravel(), J * res[:, None])
+    n, k = len(res), J.shape[1]
+    g = len(score)
+    scale = g / max(g - 1, 1) * (n - 1) / max(n - k, 1)  # the usual small-sample correction
+    return np.asarray(scale * score.T @ score)

@@ -139,6 +139,16 @@ def _from_outside(
     return keep
 
 
+def _bias(fit: SurfaceFit) -> float:
+    """[m] one sigma of a shift of the fitted surface along its normal that its covariance does not hold: the
+    cameras' common bias (:data:`SURFACE_BIAS_M`), what the model leaves unexplained over patches of its points
+    (``lack_m``), the cameras' disagreement (``cameras_m``: their pose errors) and, for a round drawn with flat facets, half the facets' sagitta (a circle fitted to a polygon)."""
+    sag = 0.0
+    if isinstance(fit.model, CylinderModel) and fit.model.facets > 0:
+        sag = fit.model.r0 * (1.0 - math.cos(math.pi / fit.model.facets))
+    return math.hypot(SURFACE_BIAS_M, fit.lack_m, fit.cameras_m, 0.5 * sag)
+
+
 def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> CurveEstimate:
     """NOT_FOUND with ``why``; NOT_SUPPORTED (never searched) when ``code`` says the seam's geometry is not one
     this locator handles."""
@@ -198,7 +208,7 @@ def _curve(
         return _not_found(seam, f"its fitted surfaces meet {moved * 1000:.1f} mm from the drawn curve")
     k2 = SE_INFLATION**2
     da, db = dtheta(a.model, p, a.theta), dtheta(b.model, p, b.theta)
-    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, SURFACE_BIAS_M)
+    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, (_bias(a), _bias(b)))
     sigma = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     closed = bool(getattr(seam.curve, "closed", False))
     keep = outside_parts(wm, p, own, OTHER_PART_M)

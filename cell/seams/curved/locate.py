@@ -142,7 +142,8 @@ def _from_outside(
 def _bias(fit: SurfaceFit) -> float:
     """[m] one sigma of a shift of the fitted surface along its normal that its covariance does not hold: the
     cameras' common bias (:data:`SURFACE_BIAS_M`), what the model leaves unexplained over patches of its points
-    (``lack_m``), the cameras' disagreement (``cameras_m``: their pose errors) and, for a round drawn with flat facets, half the facets' sagitta (a circle fitted to a polygon)."""
+    (``lack_m``), the cameras' disagreement (``cameras_m``: their pose errors) and, for a round drawn with flat
+    facets, half the facets' sagitta (a circle fitted to a polygon)."""
     sag = 0.0
     if isinstance(fit.model, CylinderModel) and fit.model.facets > 0:
         sag = fit.model.r0 * (1.0 - math.cos(math.pi / fit.model.facets))

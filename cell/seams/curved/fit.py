@@ -116,12 +116,13 @@ def fit_surface(
         return SurfaceFit(model, final.x, np.full((k, k), np.inf), pooled, len(keep))
     inv = np.linalg.inv(JtJ)
     cov = s2 * inv
-    label = _patches(keep)
+    v, g = model.implicit(final.x)(keep)
+    label = _patches(keep - v[:, None] * g)  # the patches on the surface: a point's noise must not pick its patch
     robust = inv @ _cluster_meat(J[: len(keep)], res, label) @ inv
     cov = robust if np.trace(robust) > np.trace(cov) else cov
     r_m = res / wk
     kept_groups = np.zeros(len(keep), np.intp) if groups is None else groups[inlier]
-    lack = _lack_of_fit(r_m, 1.0 / wk, label)
+    lack = _lack_of_fit(r_m, label)
     return SurfaceFit(model, final.x, cov, pooled, len(keep), lack, _camera_spread(r_m, kept_groups))
 
 
@@ -138,15 +139,16 @@ def _patches(p: FloatArray) -> npt.NDArray[np.intp]:
     return np.asarray(label.ravel(), dtype=np.intp)
 
 
-def _lack_of_fit(r: FloatArray, scale: FloatArray, label: npt.NDArray[np.intp]) -> float:
-    """[m] the RMS over patches (``label`` (n,)) of the mean residual r (n,) [m], less its share of the noise (each
-    point's ``scale`` (n,) [m]), weighted by the patches' point counts: what the model does not explain."""
+def _lack_of_fit(r: FloatArray, label: npt.NDArray[np.intp]) -> float:
+    """[m] how far the residuals' means r (n,) [m] over the patches (``label`` (n,)) scatter beyond what the
+    scatter within the patches explains (one-way analysis of variance: the between-patch variance component)."""
     g = int(label.max()) + 1
     count = np.bincount(label, minlength=g).astype(float)
     mean = np.bincount(label, r, minlength=g) / np.maximum(count, 1.0)
-    noise = np.bincount(label, scale**2, minlength=g) / np.maximum(count, 1.0) ** 2
-    excess = (mean**2 - noise) * count
-    return float(np.sqrt(max(float(excess.sum()) / max(float(count.sum()), 1.0), 0.0)))
+    used = int((count > 0).sum())
+    within = float(((r - mean[label]) ** 2).sum()) / max(len(r) - used, 1)
+    between = float((count * mean**2).sum()) - used * within
+    return math.sqrt(max(between / max(len(r), 1), 0.0))
 
 
 def _cluster_meat(J: FloatArray, res: FloatArray, label: npt.NDArray[np.intp]) -> FloatArray:

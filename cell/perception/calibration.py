@@ -20,6 +20,7 @@ __all__ = [
     "PoseUncertainty",
     "calibration_sigma",
     "closeup_sigma",
+    "curve_calibration_sigma",
     "reference_of",
     "residuals_of",
     "seam_calibration_sigma",
@@ -199,3 +200,25 @@ def closeup_sigma(est: SeamEstimate, origin_R: FloatArray, uncertainty: PoseUnce
     mid = 0.5 * (est.p_start + est.p_end)
     cal = uncertainty.sigma_at(float(np.linalg.norm(mid - np.asarray(origin_R))))
     return with_term(est, cal)
+
+
+def curve_calibration_sigma(
+    cloud: Cloud,
+    p_R: FloatArray,
+    origins_R: Mapping[str, FloatArray],
+    uncertainty: Mapping[str, PoseUncertainty],
+    registrations: Sequence[Registration],
+) -> float:
+    """sigma_cal [m] of a located curve through the samples p_R (n, 3) in R, as an RMS distance across it (both
+    axes: sqrt 2 times the per-axis :func:`calibration_sigma`, from the shares of ``cloud``'s points within
+    :data:`SUPPORT_RADIUS_M` of a sample, at the curve's middle); 0 when no camera states an uncertainty."""
+    if len(p_R) == 0 or all(u.zero for u in uncertainty.values()):
+        return 0.0
+    from scipy.spatial import cKDTree
+
+    lo, hi = p_R.min(axis=0) - SUPPORT_RADIUS_M, p_R.max(axis=0) + SUPPORT_RADIUS_M
+    box = np.all((cloud.points >= lo) & (cloud.points <= hi), axis=1)
+    d, _ = cKDTree(p_R).query(cloud.points[box])
+    shares = _shares(cloud, cloud.camera[box][d <= SUPPORT_RADIUS_M])
+    tied, left = reference_of(registrations), residuals_of(registrations)
+    return math.sqrt(2.0) * calibration_sigma(shares, p_R.mean(axis=0), origins_R, uncertainty, tied, left)

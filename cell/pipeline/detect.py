@@ -14,7 +14,7 @@ import numpy as np
 from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
 from cell.perception.align.fit import Alignment
-from cell.perception.calibration import PoseUncertainty, with_calibration
+from cell.perception.calibration import PoseUncertainty, curve_calibration_sigma, with_calibration
 from cell.pipeline.evaluation import evaluate
 from cell.pipeline.geometry import open_cell
 from cell.pipeline.progress import Progress, quiet
@@ -281,7 +281,9 @@ def detect(
     weldmap_R = scene.seam_scene.weldmap
     truth = truths(cap, weldmap_R)
     curve_truth = curve_truths(cap)
-    curves = curve_results(method, scene.seam_scene, curve_truth)
+    p, u = scene.perceived, pose_uncertainties(scenario)  # a camera's pose error moves a curve as a straight seam
+    cal = lambda q: curve_calibration_sigma(p.registered, q, p.origins_R, u, p.spliced.registrations)  # noqa: E731
+    curves = curve_results(method, scene.seam_scene, curve_truth, cal)
     metrics, summary = evaluate(estimates, truth)
     timings = {"capture_s": cap.seconds, **scene.timings}
     timings["locate_s"] = sum(e.time_s for e in estimates) + sum(e.time_s for e in curves[0])

@@ -121,6 +121,35 @@ def _facing(
     return flat[: len(q1)], flat[len(q1) :]
 
 
+def _from_outside(
+    scene: SeamScene, model: SurfaceModel, q: FloatArray, cams: npt.NDArray[np.intp]
+) -> npt.NDArray[np.bool_]:
+    """(k,) which points q (k, 3) of a surface their camera saw from its outward side (a hollow tube's bore, seen
+    down its open end, lies within the band of its outer round when the map sits a little off); every point whose
+    camera's centre is not known."""
+    keep = np.ones(len(q), bool)
+    names = scene.dense.cameras
+    g = model.implicit(np.zeros(model.size))(q)[1] if len(q) else np.zeros((0, 3))
+    for c in np.unique(cams):
+        eye = scene.eyes_R.get(names[c]) if 0 <= c < len(names) else None
+        if eye is None:
+            continue
+        mine = cams == c
+        keep[mine] = np.einsum("ij,ij->i", q[mine] - np.asarray(eye), g[mine]) < 0.0
+    return keep
+
+
+def _bias(fit: SurfaceFit) -> float:
+    """[m] one sigma of a shift of the fitted surface along its normal that its covariance does not hold: the
+    cameras' common bias (:data:`SURFACE_BIAS_M`), what the model leaves unexplained over patches of its points
+    (``lack_m``), the cameras' disagreement (``cameras_m``: their pose errors) and, for a round drawn with flat
+    facets, half the facets' sagitta (a circle fitted to a polygon)."""
+    sag = 0.0
+    if isinstance(fit.model, CylinderModel) and fit.model.facets > 0:
+        sag = fit.model.r0 * (1.0 - math.cos(math.pi / fit.model.facets))
+    return math.hypot(SURFACE_BIAS_M, fit.lack_m, fit.cameras_m, 0.5 * sag)
+
+
 def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> CurveEstimate:
     """NOT_FOUND with ``why``; NOT_SUPPORTED (never searched) when ``code`` says the seam's geometry is not one
     this locator handles."""
@@ -154,6 +183,7 @@ def locate_curve(scene: SeamScene, seam: CurvedSeam) -> CurveEstimate:
     i1, i2 = i1[_on_face(parts[0], m1, p[i1])], i2[_on_face(parts[1], m2, p[i2])]
     f1s, f2s = _facing(m1, m2, p[i1], p[i2])
     i1, i2 = i1[f1s], i2[f2s]
+    i1, i2 = i1[_from_outside(scene, m1, p[i1], cams[i1])], i2[_from_outside(scene, m2, p[i2], cams[i2])]
     fits = (
         fit_surface(m1, p[i1], MIN_POINTS, _prior(m1), cams[i1]),
         fit_surface(m2, p[i2], MIN_POINTS, _prior(m2), cams[i2]),
@@ -179,7 +209,7 @@ def _curve(
         return _not_found(seam, f"its fitted surfaces meet {moved * 1000:.1f} mm from the drawn curve")
     k2 = SE_INFLATION**2
     da, db = dtheta(a.model, p, a.theta), dtheta(b.model, p, b.theta)
-    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, SURFACE_BIAS_M)
+    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, (_bias(a), _bias(b)))
     sigma = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     closed = bool(getattr(seam.curve, "closed", False))
     keep = outside_parts(wm, p, own, OTHER_PART_M)

@@ -3,7 +3,8 @@ knows them; the answers of a run that searched nothing; a located curve carried 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -16,17 +17,36 @@ from cell.types.curve_estimate import CurveEstimate, CurveMetrics
 
 
 def curve_results(
-    method: str, scene: SeamScene, truths: Mapping[str, FloatArray]
+    method: str,
+    scene: SeamScene,
+    truths: Mapping[str, FloatArray],
+    calibration: Callable[[FloatArray], float] | None = None,
 ) -> tuple[tuple[CurveEstimate, ...], dict[str, CurveMetrics]]:
     """Every curved seam of ``scene``'s map located by ``method``, and the found ones' errors against ``truths``
-    (seam id -> true curve (n, 3), in the scene's frame; empty without a truth)."""
+    (seam id -> true curve (n, 3), in the scene's frame; empty without a truth). ``calibration``: the cameras'
+    calibration sigma [m] of a curve through given samples (n, 3), added to each found curve's sigmas."""
     estimates = locate_curves(method, scene)
+    if calibration is not None:
+        estimates = tuple(with_calibration(e, calibration(np.asarray(e.p_RS))) for e in estimates)
     metrics = {
         e.id: curve_error(e, np.asarray(truths[e.id]))
         for e in estimates
         if e.status is SeamStatus.FOUND and e.id in truths
     }
     return estimates, metrics
+
+
+def with_calibration(est: CurveEstimate, sigma_cal: float) -> CurveEstimate:
+    """``est`` (found) with a calibration term ``sigma_cal`` [m] in quadrature with every sample's sigma and each
+    end's (a camera's pose error moves its points rigidly: the whole curve, along it as much as across)."""
+    if est.status is not SeamStatus.FOUND or sigma_cal <= 0.0:
+        return est
+    ends = est.end_sigma_m
+    return replace(
+        est,
+        sigma_m=np.hypot(np.asarray(est.sigma_m), sigma_cal),
+        end_sigma_m=(math.hypot(ends[0], sigma_cal), math.hypot(ends[1], sigma_cal)) if any(ends) else ends,
+    )
 
 
 def not_searched(weldmap: WeldMap, why: str) -> tuple[CurveEstimate, ...]:

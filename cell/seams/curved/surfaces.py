@@ -41,6 +41,7 @@ class CylinderModel:
     c0: FloatArray
     u0: FloatArray
     r0: float
+    facets: int = 0  # how many flat faces draw the round (0: a true round)
     size = 5
 
     def __post_init__(self) -> None:
@@ -51,7 +52,8 @@ class CylinderModel:
     @staticmethod
     def about(c: Cylinder, p_near: FloatArray) -> CylinderModel:
         """The model of ``c`` with its axis point at the foot of ``p_near`` (3,) on the axis (good conditioning)."""
-        return CylinderModel(c.p_base + float((p_near - c.p_base) @ c.axis) * c.axis, np.asarray(c.axis), c.radius)
+        foot = c.p_base + float((p_near - c.p_base) @ c.axis) * c.axis
+        return CylinderModel(foot, np.asarray(c.axis), c.radius, c.facets)
 
     def axis(self, theta: FloatArray) -> tuple[FloatArray, FloatArray, float]:
         """(axis point (3,), unit axis (3,), radius) at ``theta``."""
@@ -168,17 +170,17 @@ def crossing_covariance(
     cov1: FloatArray,
     df2: FloatArray,
     cov2: FloatArray,
-    bias_m: float = 0.0,
+    bias_m: tuple[float, float] = (0.0, 0.0),
 ) -> FloatArray:
     """(n, 3, 3) the covariance of the crossing points p (n, 3) of two surfaces with gradients g1, g2 (n, 3) there,
     from their parameters' covariances cov1 (k1, k1), cov2 (k2, k2) through d f / d theta df1 (n, k1), df2 (n, k2):
     a change of the parameters moves each point by the least-norm step that keeps it on both surfaces (first
-    order), so within the plane across the curve. ``bias_m`` [m]: a shift of either surface along its normal that no
-    fit sees (one sigma, independent per surface)."""
+    order), so within the plane across the curve. ``bias_m`` [m]: a shift of each surface along its normal that its
+    fit does not see (one sigma, independent per surface)."""
     J = np.stack([g1, g2], axis=1)  # (n, 2, 3)
     pinv = np.transpose(J, (0, 2, 1)) @ np.linalg.inv(J @ np.transpose(J, (0, 2, 1)))  # (n, 3, 2)
     v1 = np.einsum("ni,ij,nj->n", df1, cov1, df1)
     v2 = np.einsum("ni,ij,nj->n", df2, cov2, df2)
     S = np.zeros((len(p), 2, 2))
-    S[:, 0, 0], S[:, 1, 1] = v1 + bias_m**2, v2 + bias_m**2  # the two fits are independent (disjoint points)
+    S[:, 0, 0], S[:, 1, 1] = v1 + bias_m[0] ** 2, v2 + bias_m[1] ** 2  # the two fits are independent (disjoint points)
     return np.asarray(pinv @ S @ np.transpose(pinv, (0, 2, 1)))

@@ -21,6 +21,8 @@ from cell.errors import CalibrationError, CalibrationFault
 from cell.geometry import FloatArray, invert, make_pose, readonly
 
 _MIN_CORNERS = 6  # a view with fewer corners found is not used
+WRIST_LEVER_M = 0.5  # the repeatability's rotation: the data sheet's distance over this lever [rad per m]
+_STEP = 1e-7  # finite-difference step of the flange pose's perturbation [m, rad]
 
 
 @dataclass(frozen=True)
@@ -81,21 +83,53 @@ def _project(K: FloatArray, p_C: FloatArray) -> FloatArray:
     return np.asarray(uvw[:, :2] / uvw[:, 2:3])
 
 
+def _chain_px(X_AC: FloatArray, T: FloatArray, X_HB: FloatArray, p: FloatArray, K: FloatArray) -> FloatArray:
+    X_CB = invert(X_AC) @ T @ X_HB
+    return _project(K, p @ X_CB[:3, :3].T + X_CB[:3, 3])
+
+
 def predicted_px(
     X_AC: FloatArray, X_HB: FloatArray, view: View, p_B: FloatArray, K: FloatArray, mount: Mount
 ) -> FloatArray:
     """(k, 2) where the chain puts the view's corners in its image [px]."""
-    X_CB = invert(X_AC) @ chain_T(view, mount) @ X_HB
+    return _chain_px(X_AC, chain_T(view, mount), X_HB, p_B[view.corners.ids], K)
+
+
+def flange_px_jacobian(
+    X_AC: FloatArray, X_HB: FloatArray, view: View, p_B: FloatArray, K: FloatArray, mount: Mount
+) -> FloatArray:
+    """(2k, 6) how the view's corners move in its image [px] with the flange's true pose off the reported one,
+    X_RF Exp(w, v), w [rad] then v [m] about and along the flange's axes (central differences)."""
     p = p_B[view.corners.ids]
-    return _project(K, p @ X_CB[:3, :3].T + X_CB[:3, 3])
+    cols = []
+    for j in range(6):
+        d = np.zeros(6)
+        d[j] = _STEP
+        moved = [view.X_RF @ make_pose(Rotation.from_rotvec(s * d[:3]).as_matrix(), s * d[3:]) for s in (1.0, -1.0)]
+        T = [m if mount == Mount.EYE_TO_HAND else invert(m) for m in moved]
+        cols.append((_chain_px(X_AC, T[0], X_HB, p, K) - _chain_px(X_AC, T[1], X_HB, p, K)).ravel() / (2 * _STEP))
+    return np.stack(cols, axis=1)
+
+
+def flange_covariance(repeatability_m: float) -> FloatArray:
+    """(6, 6) the covariance of the flange's true pose about the reported one, rotation [rad] then translation [m]:
+    the data sheet's repeatability on each axis, and its rotation that distance over the wrist's lever."""
+    return np.diag([(repeatability_m / WRIST_LEVER_M) ** 2] * 3 + [repeatability_m**2] * 3)
 
 
 def refine(
-    views: Sequence[View], p_B: FloatArray, K: FloatArray, mount: Mount, X_AC0: FloatArray, X_HB0: FloatArray
+    views: Sequence[View],
+    p_B: FloatArray,
+    K: FloatArray,
+    mount: Mount,
+    X_AC0: FloatArray,
+    X_HB0: FloatArray,
+    repeatability_m: float = 0.0,
 ) -> Solution:
-    """The joint refinement from a start: both poses fitted to every corner's pixel (Levenberg-Marquardt), the
-    camera's covariance the larger of the residuals' (s^2 (J^T J)^-1) and the one robust to errors shared by an
-    image's corners (the robot's repeatability: a sandwich clustered by image)."""
+    """The joint refinement from a start: both poses fitted to every corner's pixel (Levenberg-Marquardt). The
+    camera's covariance is the larger of the model's, the pixels' (s^2 (J^T J)^-1) plus the robot's repeatability
+    (each image's flange pose off by :func:`flange_covariance`, carried through the fit), and the one robust to any
+    error shared by an image's corners (a sandwich clustered by image)."""
 
     def residual(x: FloatArray) -> FloatArray:
         X_AC, X_HB = _perturbed(X_AC0, x[:6]), _perturbed(X_HB0, x[6:])
@@ -118,6 +152,8 @@ def refine(
         meat += np.outer(g, g)
         start += k
     clustered = info @ meat @ info * len(views) / max(len(views) - 1, 1)
+    if repeatability_m > 0.0:
+        cov = cov + _repeatability_cov(views, p_B, K, mount, fit.x, X_AC0, X_HB0, J, info, repeatability_m)
     pick = clustered if np.trace(clustered[:6, :6]) > np.trace(cov[:6, :6]) else cov
     return Solution(
         X_AC=_perturbed(X_AC0, fit.x[:6]),
@@ -126,6 +162,32 @@ def refine(
         rms_px=float(np.sqrt(np.mean(r**2) * 2.0)),
         corners=m // 2,
     )
+
+
+def _repeatability_cov(
+    views: Sequence[View],
+    p_B: FloatArray,
+    K: FloatArray,
+    mount: Mount,
+    x: FloatArray,
+    X_AC0: FloatArray,
+    X_HB0: FloatArray,
+    J: FloatArray,
+    info: FloatArray,
+    repeatability_m: float,
+) -> FloatArray:
+    """(12, 12) the fit's covariance from the flange poses' independent errors: a flange off by d_i moves image i's
+    corners by B_i d_i, and the fit by -(J^T J)^-1 J_i^T B_i d_i (first order)."""
+    X_AC, X_HB = _perturbed(X_AC0, x[:6]), _perturbed(X_HB0, x[6:])
+    S = flange_covariance(repeatability_m)
+    out = np.zeros((J.shape[1], J.shape[1]))
+    start = 0
+    for v in views:
+        k = 2 * len(v.corners)
+        A = info @ J[start : start + k].T @ flange_px_jacobian(X_AC, X_HB, v, p_B, K, mount)
+        out += A @ S @ A.T
+        start += k
+    return out
 
 
 def held_out(sol: Solution, views: Sequence[View], p_B: FloatArray, K: FloatArray, mount: Mount) -> tuple[float, float]:

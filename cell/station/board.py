@@ -10,6 +10,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
+from cell.calibrate.solve import WRIST_LEVER_M
 from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose
 from cell.scenario import ExtrinsicErrorSpec, Scenario
 from cell.station.arm import robot_urdf
@@ -23,7 +24,6 @@ CAMERA_LINK = "camera_optical"
 # The board's true place against its drawing: a bracket machined and bolted on the flange, a board laid on the table.
 _BRACKET_ERROR = ExtrinsicErrorSpec(translation_mm=2.0, rotation_deg=1.0)
 _TABLE_SLIDE_M, _TABLE_TURN_RAD = 0.005, np.radians(2.0)  # the board laid on the table: slid and turned on it
-_WRIST_LEVER_M = 0.5  # the repeatability's rotation: its distance over this lever [rad per m]
 
 
 class SimBoardStation:
@@ -67,7 +67,7 @@ class SimBoardStation:
         flange pose X_RF the robot reports, the depth image and the colour image."""
         self.sim.set_q(q)
         X_WF = self.sim.link_pose(FLANGE)
-        w = self._rng.normal(0.0, self._sigma_m / _WRIST_LEVER_M, 3)
+        w = self._rng.normal(0.0, self._sigma_m / WRIST_LEVER_M, 3)
         off = make_pose(_rotvec(w), self._rng.normal(0.0, self._sigma_m, 3))
         X_WF_reached = X_WF @ off  # where the flange really is: its repeatability about the commanded pose
         self.sim.place(BOARD, X_WF_reached @ self.X_FB_true if board == "flange" else self.X_WB_true)

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from cell.calibrate.board import Board, Corners
 from cell.calibrate.checks import check_board_size, check_diversity, depth_scale, rotation_spread_deg
-from cell.calibrate.solve import hand_eye_start, held_out, pose_error, refine
+from cell.calibrate.solve import WRIST_LEVER_M, hand_eye_start, held_out, pose_error, refine
 from cell.calibrate.views import Mount, View
 from cell.errors import CalibrationError, CalibrationFault
 from cell.geometry import invert, look_at, make_pose, pose_from_xyz_rpy
@@ -111,3 +112,43 @@ def test_a_board_printed_larger_than_stated_is_caught_by_the_depth_image() -> No
     with pytest.raises(CalibrationError) as e:
         check_board_size(s, "cam", 0.02)
     assert e.value.code == CalibrationFault.BOARD_SIZE and e.value.value == pytest.approx(1.05, abs=2e-3)
+
+
+def _repeatability_trials(rep_m: float, trials: int, stated_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """(trials, 2) errors and stated sigmas (translation [m], rotation [rad]) of a fixed camera over 12 board poses
+    the arm reached off its reported ones by ``rep_m`` (as the simulator draws it), corners with 0.05 px of noise,
+    the fit told a repeatability of ``stated_m``."""
+    geo = np.random.default_rng(7)
+    X_RF = []
+    for _ in range(12):
+        centre_C = np.array([geo.uniform(-0.1, 0.1), geo.uniform(-0.08, 0.08), geo.uniform(0.8, 1.0)])
+        X_CB = pose_from_xyz_rpy(centre_C, np.radians(geo.uniform(-25.0, 25.0, 3))) @ make_pose(p=-BOARD.centre_B)
+        X_RF.append(X_RC @ X_CB @ invert(X_FB))
+    err, sig = [], []
+    for trial in range(trials):
+        rng = np.random.default_rng(100 + trial)
+        off = [
+            make_pose(
+                Rotation.from_rotvec(rng.normal(0.0, rep_m / WRIST_LEVER_M, 3)).as_matrix(), rng.normal(0.0, rep_m, 3)
+            )
+            for _ in X_RF
+        ]
+        reached = [f @ o for f, o in zip(X_RF, off, strict=True)]
+        seen = _views(reached, [invert(X_RC) @ f @ X_FB for f in reached], rng, 0.05)
+        views = [View(f, v.corners, v.depth_m) for f, v in zip(X_RF, seen, strict=True)]
+        X0, B0 = hand_eye_start(views, BOARD.p_B, K, Mount.EYE_TO_HAND)
+        sol = refine(views, BOARD.p_B, K, Mount.EYE_TO_HAND, X0, B0, stated_m)
+        err.append(pose_error(sol.X_AC, X_RC))
+        sig.append((sol.sigma_translation_m, sol.sigma_rotation_rad))
+    return np.array(err), np.array(sig)
+
+
+def test_the_stated_sigma_follows_the_robots_repeatability_and_covers_a_monte_carlo() -> None:
+    for rep_m in (0.03e-3, 0.1e-3):  # the data sheet's, and a worn robot's
+        err, sig = _repeatability_trials(rep_m, 20, rep_m)
+        ratio = np.median(sig, axis=0) / np.sqrt(np.mean(err**2, axis=0))  # measured 1.06-1.10
+        assert np.all((ratio > 0.95) & (ratio < 1.25)), ratio
+        assert np.mean(np.all(err <= 2.0 * sig, axis=1)) >= 0.9  # measured 0.95
+    err, sig = _repeatability_trials(0.03e-3, 20, 0.0)  # the fit not told: the pixels' and clustered terms alone
+    ratio = np.median(sig, axis=0) / np.sqrt(np.mean(err**2, axis=0))  # measured 0.81-0.83
+    assert np.all(ratio < 0.9), ratio

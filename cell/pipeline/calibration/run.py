@@ -161,7 +161,7 @@ def solve_camera(
     fit, rest = ideal[: len(views) - n_held], ideal[len(views) - n_held :]
     starts = {m: hand_eye_start(fit, board.p_B, K, mount, m) for m in OPENCV_METHODS}
     X0, B0 = starts["park"]
-    sol = refine(fit, board.p_B, K, mount, X0, B0)
+    sol = refine(fit, board.p_B, K, mount, X0, B0, spec.repeatability_mm * 1e-3)
     px, d3 = held_out(sol, rest, board.p_B, K, mount)
     return CameraCalibration(
         camera=camera,

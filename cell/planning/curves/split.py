@@ -90,9 +90,10 @@ def split_curve(est: CurveEstimate, plan: Planner, overlap: float, p_base_R: Flo
     bead's start; open: end to end), each planned by ``plan`` (an open arc's whole torch search).
 
     The first arc: the longest of :data:`FIRST_SHARES` of the curve that plans from one of the first
-    :data:`FIRST_STARTS` of :data:`STARTS` starts (nearest the robot base ``p_base_R`` first). Then the rest, from ``overlap`` back on the last bead to the far
-    end: planned whole, else halved, and so on, until :data:`MAX_ARCS` arcs in all; a piece still failing is the
-    part no arc reaches (``failure``, the covered ``share`` of the curve)."""
+    :data:`FIRST_STARTS` of :data:`STARTS` starts (nearest the robot base ``p_base_R`` first). Then the rest,
+    from ``overlap`` back on the last bead to the far end: planned whole, else halved, and so on, until
+    :data:`MAX_ARCS` arcs in all; a piece still failing is the part no arc reaches (``failure``, the covered
+    ``share`` of the curve)."""
     total = est.length_m
     starts = start_order(est, p_base_R, STARTS)[:FIRST_STARTS] if est.closed else [0.0]
     shares = FIRST_SHARES

@@ -3,6 +3,11 @@ gated, executed in the simulator and measured against the TRUE curve (not agains
 
     .venv/bin/python benchmarks/bench_curve_weld.py [--scenarios pipe-flange,railing,round-brace,tube-tee]
         [--json benchmarks/results/curve_weld.json]
+    .venv/bin/python benchmarks/bench_curve_weld.py --located [--json benchmarks/results/curve_weld_located.json]
+
+``--located``: the real pipeline, as ``cell weld NAME --sides first`` runs it (the curves LOCATED, re-scan, plan with
+the straight seams, gate, execute), per curved seam: welded (in how many arcs) or why not, the TCP against the true
+curve; the KRL program's CIRC moves and ``cell krl check``'s findings, the RAPID program's ArcC.
 
 Until the curve locator lands, the planner is fed estimates built from the truth (:func:`truth_estimates`: the true
 curve of the as-built part in R, sampled every 2 mm, with the two faces' normals from the aligned map and a 0.1 mm
@@ -32,6 +37,7 @@ STEP_M = 0.002  # [m] the truth-built estimate's samples
 SIGMA_M = 0.0001  # [m] its sigma across the seam
 SCENARIOS = ("pipe-flange", "railing", "round-brace", "tube-tee")
 OUT = Path(__file__).resolve().parent / "results" / "curve_weld.json"
+OUT_LOCATED = Path(__file__).resolve().parent / "results" / "curve_weld_located.json"
 
 
 def _normals(part: Part, surface: Surface, p_R: FloatArray) -> FloatArray:
@@ -133,6 +139,93 @@ def bench(name: str) -> dict[str, Any]:
     }
 
 
+def bench_located(name: str) -> dict[str, Any]:
+    """One scenario through ``cell weld NAME --sides first``'s pipeline: each curved seam located, planned with the
+    rest, executed and measured against its true curve; the programs' circular moves and the KRL check."""
+    import re
+
+    from cell import scenario as sc
+    from cell.export.krl import krl_program
+    from cell.export.krl_check import Program, check_program
+    from cell.export.krl_read import read_krl
+    from cell.export.program import ProgramJob
+    from cell.export.rapid import rapid_text
+    from cell.pipeline.job import WeldJob
+    from cell.pipeline.weld import weld
+
+    t0 = time.perf_counter()
+    run = weld(sc.load(name), WeldJob(sides="first"))
+    total_s = time.perf_counter() - t0
+    det, plan = run.detection, run.plan
+    rows = []
+    for c in det.curve_estimates:
+        w = det.curve_welds.get(c.id)
+        m = det.curve_metrics.get(c.id)
+        q = w.quality if w is not None else None
+        arcs = sum(1 for g in plan.segments if g.arc_on and g.seam_id == c.id) if plan is not None else 0
+        o = plan.outcome(c.id) if plan is not None and any(x.seam_id == c.id for x in plan.seams) else None
+        rows.append(
+            {
+                "seam": c.id,
+                "closed": c.closed,
+                "located": c.status is SeamStatus.FOUND,
+                "located_rms_mm": round(m.rms_mm, 3) if m else None,
+                "located_max_mm": round(m.max_mm, 3) if m else None,
+                "length_mm": round(c.length_m * 1000.0, 1) if c.status is SeamStatus.FOUND else None,
+                "planned": bool(w and w.planned),
+                "welded": bool(w and w.welded),
+                "arcs": arcs,
+                "reason": (o.reason if o is not None and not o.feasible else (w.reason if w else c.reason)),
+                "code": (str(w.plan_code or w.code) if w is not None and not w.welded else None),
+                "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
+                "tcp_max_mm": round(q.tcp_max_mm, 3) if q else None,
+                "unwelded_mm": round(q.short_start_mm + q.short_end_mm, 2) if q else None,
+                "arc_s": round(q.weld_time_s, 2) if q else None,
+            }
+        )
+    programs: dict[str, Any] = {}
+    if plan is not None and run.arm is not None and plan.segments:
+        src, dat = krl_program(plan, run.arm.model, "CURVE")
+        p = Program("CURVE", read_krl(src, "src"), read_krl(dat, "dat"), "CURVE.src", "CURVE.dat")
+        rapid = rapid_text(ProgramJob(plan, run.arm.model, "CURVE"))
+        programs = {
+            "krl_circ": len(re.findall(r"^CIRC ", src, re.M)),
+            "krl_check": sorted({f.code for f in check_program(p)}),
+            "rapid_arcc": len(re.findall(r"^\s+ArcC(End)? ", rapid, re.M)),
+        }
+    straight = [w for w in run.seams]
+    return {
+        "scenario": name,
+        "straight_welded": sum(w.welded for w in straight),
+        "straight_seams": len(straight),
+        "error": run.error.message if run.error is not None else None,
+        "total_s": round(total_s, 1),
+        "programs": programs,
+        "seams": rows,
+    }
+
+
+def markdown_located(out: Mapping[str, Any]) -> str:
+    """The ``--located`` results as the table of docs/curves-welding.md section 8."""
+    lines = [
+        "| scenario | curved seam | located RMS / max mm | welded | arcs | TCP RMS / max mm (true curve) | KRL CIRC"
+        " / check / RAPID ArcC | why not |",
+        "|---|---|---|---|---:|---|---|---|",
+    ]
+    for row in out["rows"]:
+        pg = row["programs"]
+        prog = f"{pg['krl_circ']} / {', '.join(pg['krl_check']) or 'clean'} / {pg['rapid_arcc']}" if pg else "-"
+        for r in row["seams"]:
+            loc = f"{r['located_rms_mm']:.3f} / {r['located_max_mm']:.3f}" if r["located_rms_mm"] is not None else "-"
+            tcp = f"{r['tcp_rms_mm']:.3f} / {r['tcp_max_mm']:.3f}" if r["tcp_rms_mm"] is not None else "-"
+            why = "" if r["welded"] else f"{r['code']}: {r['reason']}".replace("|", "/")
+            lines.append(
+                f"| {row['scenario']} | `{r['seam']}` | {loc} | {'yes' if r['welded'] else 'no'} | {r['arcs']} | {tcp}"
+                f" | {prog} | {why} |"
+            )
+    return "\n".join(lines)
+
+
 def markdown(out: Mapping[str, Any]) -> str:
     """The results as the table of docs/curves-welding.md section 7."""
     lines = [
@@ -156,14 +249,18 @@ def markdown(out: Mapping[str, Any]) -> str:
 def main(argv: Sequence[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenarios", default=",".join(SCENARIOS))
-    ap.add_argument("--json", type=Path, default=OUT)
+    ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--located", action="store_true", help="through cell weld's pipeline, the curves located")
     ap.add_argument("--markdown", action="store_true", help="print the table of an existing --json file, run nothing")
     args = ap.parse_args(argv)
+    args.json = args.json or (OUT_LOCATED if args.located else OUT)
     if args.markdown:
-        print(markdown(json.loads(args.json.read_text())))
+        text = json.loads(args.json.read_text())
+        print(markdown_located(text) if args.located else markdown(text))
         return
-    rows = [bench(n) for n in args.scenarios.split(",")]
-    command = "benchmarks/bench_curve_weld.py" + (f" --scenarios {args.scenarios}" if argv else "")
+    rows = [(bench_located if args.located else bench)(n) for n in args.scenarios.split(",")]
+    command = "benchmarks/bench_curve_weld.py" + (" --located" if args.located else "")
+    command += f" --scenarios {args.scenarios}" if args.scenarios != ",".join(SCENARIOS) else ""
     out = {"command": f".venv/bin/python {command}", "rows": rows}
     args.json.write_text(json.dumps(out, indent=2) + "\n")
     print(json.dumps(out, indent=2))

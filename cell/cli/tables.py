@@ -87,6 +87,9 @@ def not_supported_text(summary: Mapping[str, Any]) -> str:
     out = [f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())] if n else []
     if located:
         out.append(f"{located} curved located, not welded ({LOCATED_CURVE_CODE})")
+    tried = dict((summary.get("curved") or {}).get("not_welded") or {})  # curves a weld run tried, by code
+    if tried:
+        out.append(f"{sum(tried.values())} curved not welded ({', '.join(sorted(tried))})")
     return "; ".join(out)
 
 
@@ -103,7 +106,8 @@ def print_curves(rep: Mapping[str, Any]) -> None:
             line += f", {ends}, sigma max {_fmt(c['sigma_max_mm'])} mm"
         if e is not None:
             line += f", error rms {_fmt(e['rms'])} / max {_fmt(e['max'])} mm"
-        line += f", {_fmt(s['time_ms'], 1)} ms; not welded ({s['not_welded']['code']})"
+        undone = s.get("not_welded")
+        line += f", {_fmt(s['time_ms'], 1)} ms; " + (f"not welded ({undone['code']})" if undone else "welded")
         out.print(line, soft_wrap=True, markup=False)
 
 

@@ -101,6 +101,7 @@ def not_welded(rep: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
     for s in rep["seams"]:
         if not s.get("welded"):
             code = str(s.get("weld_reason_code") or "not welded")
+            code += f": {s['plan_reason_code']}" if s.get("plan_reason_code") else ""
             out.append((s["id"], f"{code}: {s['reason_code']}" if s["status"] == "not_supported" else code))
     return tuple(out)
 

@@ -7,10 +7,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection
 from cell.types import SeamStatus, Unsupported, UnsupportedSeam
 from cell.types.curve_estimate import CurveEstimate, CurveMetrics
-from cell.types.run import WeldReason
+from cell.types.run import SeamWeld, WeldReason
 
 
 def _r(v: float, nd: int = 4) -> float | None:
@@ -22,17 +23,25 @@ def unsupported_entry(u: UnsupportedSeam) -> dict[str, Any]:
     return {"id": u.id, "status": SeamStatus.NOT_SUPPORTED.value, "reason": u.reason, "reason_code": u.code.value}
 
 
-def curve_entry(u: UnsupportedSeam, est: CurveEstimate, m: CurveMetrics | None) -> dict[str, Any]:
+def curve_entry(
+    u: UnsupportedSeam | None, est: CurveEstimate, m: CurveMetrics | None, w: SeamWeld | None = None
+) -> dict[str, Any]:
     """A curved seam: its locator's status and reason, the located curve's figures when found, its error against
-    the true curve (``error_mm``, simulation) and why it is not welded (``not_welded``: code and reason)."""
+    the true curve (``error_mm``, simulation); what a weld run made of it (``w``: ``planned``, ``welded``, its
+    ``tcp_error_mm`` against the true curve, or ``weld_reason_code`` and the planner's ``plan_reason_code``) and
+    why it is not welded (``not_welded``: code and reason; None when welded)."""
     entry: dict[str, Any] = {
         "id": est.id,
         "curved": True,
         "status": est.status.value,
-        "reason": est.reason if est.status is not SeamStatus.FOUND else u.reason,
-        # Never searched (no joint, no round body, another method): the map's code, as for any seam not supported.
-        "reason_code": u.code.value if est.status is SeamStatus.NOT_SUPPORTED or est.code is None else est.code.value,
+        "reason": est.reason if est.status is not SeamStatus.FOUND else (u.reason if u is not None else ""),
     }
+    # Never searched (no joint, no round body, another method): the map's code, as for any seam not supported.
+    entry["reason_code"] = (
+        est.code.value
+        if est.status is not SeamStatus.NOT_SUPPORTED and est.code is not None
+        else (u.code.value if u is not None else None)
+    )
     if est.status is SeamStatus.FOUND:
         entry["curve"] = {
             "closed": est.closed,
@@ -48,27 +57,57 @@ def curve_entry(u: UnsupportedSeam, est: CurveEstimate, m: CurveMetrics | None) 
     if m is not None:
         entry["error_mm"] = {"rms": _r(m.rms_mm), "max": _r(m.max_mm), "within_2sigma": _r(m.within_2sigma, 3)}
     entry["time_ms"] = _r(est.time_s * 1000.0, 3)
-    entry["not_welded"] = {"code": u.code.value, "reason": u.reason}
+    entry["not_welded"] = {"code": u.code.value, "reason": u.reason} if u is not None else None
+    if w is not None:
+        entry.update(weld_entry(w))
     return entry
 
 
+def weld_entry(w: SeamWeld) -> dict[str, Any]:
+    """A curved seam's weld fields, as a straight seam's: ``planned``, ``welded``, why not (``weld_reason``,
+    ``weld_reason_code``, the planner's ``plan_reason_code``), and welded, its ``tcp_error_mm`` against the true
+    curve, weld time and travel speed."""
+    out: dict[str, Any] = {"planned": w.planned, "welded": w.welded}
+    if not w.welded:
+        out["weld_reason"] = w.reason
+        out["weld_reason_code"] = w.code.value if w.code is not None else None
+        if w.plan_code is not None:
+            out["plan_reason_code"] = w.plan_code.value
+    if w.quality is not None:
+        q = w.quality
+        out["tcp_error_mm"] = tcp_error_entry(q)
+        out["weld_time_s"] = _r(q.weld_time_s, 3)
+        out["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
+    return out | procedure_entry(w)
+
+
 def not_welded_entries(det: Detection) -> list[dict[str, Any]]:
-    """One entry per seam of the map the run does not weld (:attr:`Detection.not_welded`), in its order."""
+    """One entry per seam of the map outside the straight seams' records, in its order: every curved seam (welded
+    or not: a weld run's curves carry their weld) and every other seam the run does not weld
+    (:attr:`Detection.not_welded`)."""
     curves = {e.id: e for e in det.curve_estimates}
-    return [
-        curve_entry(u, curves[u.id], det.curve_metrics.get(u.id)) if u.id in curves else unsupported_entry(u)
-        for u in det.not_welded
-    ]
+    undone = {u.id: u for u in det.not_welded}
+    out = []
+    for u in det.weldmap_R.not_welded:
+        if u.id in curves:
+            e = curves[u.id]
+            out.append(curve_entry(undone.get(u.id), e, det.curve_metrics.get(u.id), det.curve_welds.get(u.id)))
+        else:
+            out.append(unsupported_entry(undone.get(u.id, u)))
+    return out
 
 
 def curve_summary(det: Detection) -> dict[str, Any]:
-    """The curved seams at a glance: how many, found, and the largest RMS and max error over the found ones [mm]."""
+    """The curved seams at a glance: how many, found, welded, the ones not welded by code, and the largest RMS
+    and max error of the located curves [mm]."""
     found = [e for e in det.curve_estimates if e.status is SeamStatus.FOUND]
     ms = [det.curve_metrics[e.id] for e in found if e.id in det.curve_metrics]
+    undone = [u.code.value for u in det.not_welded if u.id in det.curve_welds]
     return {
         "seams": len(det.weldmap_R.curved),
         "found": len(found),
-        "welded": 0,
+        "welded": sum(w.welded for w in det.curve_welds.values()),
+        "not_welded": {c: undone.count(c) for c in sorted(set(undone))},
         "rms_max_mm": _r(max((m.rms_mm for m in ms), default=math.nan)),
         "max_mm": _r(max((m.max_mm for m in ms), default=math.nan)),
     }
@@ -76,5 +115,5 @@ def curve_summary(det: Detection) -> dict[str, Any]:
 
 def weld_reason_code(entry: dict[str, Any]) -> str:
     """Why a seam the run does not weld was not welded, as a code: a located curve has no torch path yet."""
-    code = entry.get("not_welded", {}).get("code")
+    code = (entry.get("not_welded") or {}).get("code")
     return (WeldReason.NO_TORCH_PATH if code == Unsupported.CURVED_NO_TORCH_PATH else WeldReason.NOT_SUPPORTED).value

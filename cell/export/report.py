@@ -92,7 +92,7 @@ def detection_report(
     s = det.summary
     summary = {
         "seams": len(det.estimates) + len(det.weldmap_R.not_welded),  # every seam of the map
-        "not_supported": not_supported(det.not_welded),
+        "not_supported": not_supported([u for u in det.not_welded if u.id not in det.curve_welds]),
         "curved": curve_summary(det),
         "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),
         "found": s.found,
@@ -233,7 +233,9 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
     records = run.records()
     rep = detection_report(run.detection, records, provenance=provenance)
     plan = run.plan
-    for entry in rep["seams"][len(records) :]:  # the map's seams the cell cannot weld
+    for entry in rep["seams"][len(records) :]:  # the map's seams the cell cannot weld, the curves
+        if "welded" in entry:  # a curve the run tried: its weld's own fields
+            continue
         why = entry.get("not_welded", {}).get("reason", entry["reason"])
         entry.update(planned=False, welded=False, weld_reason=why, weld_reason_code=weld_reason_code(entry))
     for entry, rec in zip(rep["seams"], records, strict=False):
@@ -280,7 +282,7 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
         if entry["id"] in planned:
             entry["closeup_plan"] = _closeup_plan(planned[entry["id"]])
     ex = run.execution
-    rep["welded"] = sum(w.welded for w in run.seams)
+    rep["welded"] = sum(w.welded for w in run.seams) + rep["summary"]["curved"]["welded"]
     rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
     rep["planned_cycle_time_s"] = (
         _r(plan.cycle_time + (run.pre_move.duration if run.pre_move is not None else 0.0), 3) if plan else None

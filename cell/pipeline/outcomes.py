@@ -163,8 +163,10 @@ def curve_welds(
         truth = truths_R.get(sid)
         if not welds or truth is None:
             continue
-        t0, t1 = pre_s + welds[0].t0, pre_s + welds[-1].t1
-        k = np.flatnonzero((ex.times >= t0 - 1e-9) & (ex.times <= t1 + 1e-9))
+        on = np.zeros(len(ex.times), dtype=bool)  # the records of its welds (arcs of a split seam: not the air)
+        for g in welds:
+            on |= (ex.times >= pre_s + g.t0 - 1e-9) & (ex.times <= pre_s + g.t1 + 1e-9)
+        k = np.flatnonzero(on)
         out[sid] = curve_weld_quality(ex.times[k], transform_points(X_RW, ex.tcp_W[k]), truth, is_closed)
     return out
 

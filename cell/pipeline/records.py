@@ -28,7 +28,7 @@ from cell.types import (
     WeldMap,
 )
 from cell.types.curve_estimate import CurveEstimate, CurveMetrics
-from cell.types.run import SeamRecord, SeamWeld
+from cell.types.run import SeamRecord, SeamWeld, WeldReason
 
 if TYPE_CHECKING:
     from cell.perception import Alignment, Perceived
@@ -87,18 +87,26 @@ class Detection:
     curve_estimates: tuple[CurveEstimate, ...] = ()  # one per curved seam of the map, in its order
     curve_metrics: Mapping[str, CurveMetrics] = field(default_factory=dict)  # found curved seams with a truth
 
+    curve_welds: Mapping[str, SeamWeld] = field(default_factory=dict)  # a weld run's word on each located curve
+
     @property
     def not_welded(self) -> tuple[UnsupportedSeam, ...]:
         """Every seam of the map this run will not weld, with its reason (:attr:`WeldMap.not_welded`), a curved
-        seam's from its estimate: located, it still has no torch path along a curve (``curved_no_torch_path``);
-        not located, why not (``curved_not_located``)."""
+        seam's from its estimate and the weld run (``curve_welds``): welded, it is left out; tried and not welded,
+        the planner's code (or the weld's: ``no_torch_path`` on a track, ``preview``); located and never tried (a
+        detection), ``curved_no_torch_path``; not located, why not (``curved_not_located``)."""
         curves = {e.id: e for e in self.curve_estimates}
         out = []
         for u in self.weldmap_R.not_welded:
-            e = curves.get(u.id)
+            e, w = curves.get(u.id), self.curve_welds.get(u.id)
             drawn = u.reason.rsplit("; ", 1)[0]  # where and what it is, without the map's "no locator yet"
             if e is None:
                 out.append(u)
+            elif w is not None and w.welded:
+                continue
+            elif w is not None:
+                code = w.plan_code or w.code or WeldReason.NOT_PLANNED
+                out.append(UnsupportedSeam(u.id, f"{drawn}: located; not welded: {w.reason}", code))
             elif e.status is SeamStatus.FOUND:
                 why = f"{drawn}: located (sigma up to {e.sigma_max_m * 1000:.2f} mm); no torch path along a curve yet"
                 out.append(UnsupportedSeam(u.id, why, Unsupported.CURVED_NO_TORCH_PATH))
@@ -126,7 +134,7 @@ class Detection:
         the map holds no seam the cell cannot weld (a curve: listed, never dropped in silence)."""
         undone = (SeamStatus.NOT_FOUND, SeamStatus.OCCLUDED)
         found = all(e.status not in undone for e in self.estimates)
-        return not self.lost_cameras and found and not self.weldmap_R.not_welded
+        return not self.lost_cameras and found and not self.not_welded
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -14,6 +14,7 @@ import numpy as np
 from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
 from cell.journal import NO_LOG, SideLog
+from cell.pipeline.curved import curve_seam_welds, curves_to_plan
 from cell.pipeline.detect import AlignStart, Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene, open_cell
 from cell.pipeline.job import WeldJob
@@ -259,7 +260,9 @@ def weld(
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
-            if (low or done) and not any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates):
+            curves = curves_to_plan(det, sc.robot.track is not None, skip=list(checked))
+            straight = any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates)
+            if (low or done) and not straight and not curves:
                 progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)" if low else
                          "nothing left to weld on this side: the journal's earlier runs welded it")  # fmt: skip
             else:
@@ -271,6 +274,7 @@ def weld(
                     motion=motion,
                     progress=progress,
                     tacks=tacks,
+                    curves=curves,
                 )
                 timings["plan_s"] = setup_s + time.perf_counter() - t
                 if violations:
@@ -289,6 +293,7 @@ def weld(
         refused = f"not executed: {error.message}" if error is not None else ""
         pre_s = pre.duration if pre is not None else 0.0
         seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)
+        det = replace(det, curve_welds=curve_seam_welds(det, plan, ex, pre_s, refused, sc.robot.track is not None))
         if closeups:
             from cell.pipeline.closeup_plan import with_closeups
 

@@ -20,7 +20,8 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.assembly import assemble
 from cell.planning.blend import blend_plan
-from cell.planning.curves import curve_pieces, search_curves, weldable, with_paths
+from cell.planning.curves import curve_pieces, search_curves, split_failed, weldable, with_paths
+from cell.planning.curves.split import seam_of
 from cell.planning.failures import SeamFailure, reason_text
 from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
@@ -77,7 +78,7 @@ def plan_welds(
     if hit is not None:
         raise PlanError(f"home configuration is in collision: {hit.describe()}")
     rng = rng or np.random.default_rng(0)
-    chosen = procedures or {}
+    chosen = dict(procedures or {})
     outcomes: dict[str, SeamOutcome] = {}
     solved: dict[str, tuple[SeamSolution, ...]] = {}  # per pass
     searches: dict[str, SeamSearch] = {}
@@ -113,11 +114,18 @@ def plan_welds(
         searches[curve.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
     curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
-    for cid, res in search_curves([e for e in found_curves if e.id in curve_ids], searches, q0, curve_procs).items():
-        if isinstance(res, SeamFailure):
-            outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
-        else:
-            solved[cid] = (res,)
+    to_search = [e for e in found_curves if e.id in curve_ids]
+    one_piece = search_curves(to_search, searches, q0, curve_procs)
+    solved |= {cid: (res,) for cid, res in one_piece.items() if isinstance(res, SeamSolution)}
+    missed = {cid: res for cid, res in one_piece.items() if isinstance(res, SeamFailure)}
+    arcs, still = split_failed(to_search, missed, searches, q0, curve_procs)  # reachable arcs, or why not
+    for cid, res in still.items():
+        outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
+    for aid, sol in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
+        solved[aid], searches[aid] = (sol,), searches[seam_of(aid)]
+        if seam_of(aid) in chosen:
+            chosen[aid] = chosen[seam_of(aid)]
+        curve_ids.add(aid)
 
     transfers = Transfers(robot, process, checker, opt, obstacles, q0)
     seam_parts: dict[str, list[Piece]] = {}
@@ -166,6 +174,7 @@ def plan_welds(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
         )
     segments = with_paths(segments, {sid: solved[sid][0].X_weld for sid in curve_ids if sid in solved})
+    segments = [replace(g, seam_id=seam_of(g.seam_id)) for g in segments]  # a split seam's arcs: its welds
     for sid, sols in solved.items():
         c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
         swapped = isinstance(sel, SeamProcedure) and sel.reverse  # the search saw the task's ends swapped
@@ -180,12 +189,17 @@ def plan_welds(
             pr.travel_angle + c.travel_offset,
             trimmed=trims.get(sid, 0.0),
         )
+    for aid in sorted(a for a in solved if a != seam_of(a)):  # a split seam: feasible, as its first arc
+        sid = seam_of(aid)
+        if sid not in outcomes or not outcomes[sid].feasible:
+            n = sum(seam_of(a) == sid for a in solved)
+            outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs")
     return WeldPlan(
         joint_names=robot.joint_names,
         q_home=readonly(q0),
         segments=tuple(segments),
         seams=tuple(outcomes[i] for i in [*(t.id for t in tasks), *(e.id for e in found_curves)]),
-        order=tuple(ordered),
+        order=tuple(dict.fromkeys(seam_of(i) for i in ordered)),
         planning_s=time.perf_counter() - t_start,
     )
 

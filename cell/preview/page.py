@@ -96,12 +96,17 @@ def draw_inputs(run: WeldRun) -> tuple[FloatArray, list[SeamView], dict[str, Flo
 
 def _summary(run: WeldRun, records: Sequence[SeamRecord]) -> str:
     det = run.detection
-    welded = sum(1 for r in records if r.weld is not None and r.weld.welded)
-    planned = sum(1 for r in records if r.weld is not None and r.weld.planned)
-    codes = [str(u.code) for u in det.not_welded]
-    parts = [f"{len(records) + len(codes)} seams in the map", f"{planned} planned", f"{welded} welded"]
+    curves = det.curve_welds.values()  # a weld run's curved seams
+    welded = sum(1 for r in records if r.weld is not None and r.weld.welded) + sum(w.welded for w in curves)
+    planned = sum(1 for r in records if r.weld is not None and r.weld.planned) + sum(w.planned for w in curves)
+    codes = [str(u.code) for u in det.not_welded if u.id not in det.curve_welds]
+    tried = [str(u.code) for u in det.not_welded if u.id in det.curve_welds]
+    parts = [f"{len(det.estimates) + len(det.weldmap_R.not_welded)} seams in the map", f"{planned} planned"]
+    parts.append(f"{welded} welded")
     if codes:
         parts.append(f"{len(codes)} not supported: {', '.join(sorted(set(codes)))}")
+    if tried:
+        parts.append(f"{len(tried)} curved not welded: {', '.join(sorted(set(tried)))}")
     if run.execution is not None:
         parts.append(f"cycle time {run.cycle_time_s:.1f} s")
     if det.lost_cameras:
@@ -132,7 +137,9 @@ def write_page(run: WeldRun, out_path: str | Path, *, title: str = "", max_point
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{_summary(run, records)}</p>",
         "<h2>Seams</h2>",
-        results_table(records, STATUS_COLOURS, det.not_welded),
+        results_table(
+            records, STATUS_COLOURS, [u for u in det.not_welded if u.id not in det.curve_welds], det.curve_welds
+        ),
         '<p class="note">sigma: the locator\'s standard error across the seam; error: mean distance of the estimate'
         " from the true seam (when the truth is known); angles: the torch's work and travel angles as planned.</p>",
         "<h2>The cell</h2>",

@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import html
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from cell.types import SeamRecord, SeamStatus, UnsupportedSeam
+from cell.types.run import SeamWeld
 
 COLUMNS = ("seam", "status", "sigma [mm]", "error [mm]", "weld", "work angle [deg]", "travel angle [deg]")
 
@@ -44,9 +45,21 @@ def _unsupported_row(u: UnsupportedSeam) -> dict[str, str]:
     return row
 
 
-def results_rows(records: Sequence[SeamRecord], unsupported: Sequence[UnsupportedSeam] = ()) -> list[dict[str, str]]:
-    """One dict per seam, then one per seam the cell cannot weld (keys: :data:`COLUMNS` plus ``detail``, the
-    reason in words)."""
+def _curve_row(w: SeamWeld) -> dict[str, str]:
+    row = dict.fromkeys(COLUMNS, "–")
+    weld = "welded" if w.welded else str(w.plan_code or w.code or "not welded").replace("_", " ")
+    detail = f"TCP {w.quality.tcp_rms_mm:.2f} mm RMS from the true curve" if w.quality is not None else w.reason
+    row.update(seam=w.id, status=SeamStatus.FOUND.value, weld=weld, detail=detail)
+    return row
+
+
+def results_rows(
+    records: Sequence[SeamRecord],
+    unsupported: Sequence[UnsupportedSeam] = (),
+    curves: Mapping[str, SeamWeld] | None = None,
+) -> list[dict[str, str]]:
+    """One dict per seam, then one per curved seam a weld run tried (``curves``: welded or why not), then one per
+    seam the cell cannot weld (keys: :data:`COLUMNS` plus ``detail``, the reason in words)."""
     rows = []
     for rec in records:
         e, m, o = rec.estimate, rec.metrics, rec.outcome
@@ -64,17 +77,20 @@ def results_rows(records: Sequence[SeamRecord], unsupported: Sequence[Unsupporte
                 "detail": detail or e.reason,
             }
         )
-    return rows + [_unsupported_row(u) for u in unsupported]
+    return rows + [_curve_row(w) for w in (curves or {}).values()] + [_unsupported_row(u) for u in unsupported]
 
 
 def results_table(
-    records: Sequence[SeamRecord], status_colours: dict[str, str], unsupported: Sequence[UnsupportedSeam] = ()
+    records: Sequence[SeamRecord],
+    status_colours: dict[str, str],
+    unsupported: Sequence[UnsupportedSeam] = (),
+    curves: Mapping[str, SeamWeld] | None = None,
 ) -> str:
     """The HTML ``<table id="results">``: one ``<tr data-seam=ID data-status=STATUS>`` per seam, the status cell
     in its colour, the reason in the row's tooltip."""
     head = "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS)
     body = []
-    for row in results_rows(records, unsupported):
+    for row in results_rows(records, unsupported, curves):
         cells = []
         for c in COLUMNS:
             style = f' style="color:{status_colours[row[c]]};font-weight:bold"' if c == "status" else ""

@@ -236,11 +236,12 @@ class Unsupported(enum.StrEnum):
 
 class UnsupportedSeam(NamedTuple):
     """A seam the map draws that the cell cannot weld: its id, why in one line (``reason``, for people) and why as a
-    code (``code``)."""
+    code (``code``: an :class:`Unsupported`; a located curve the run could not weld: the planner's or the weld's
+    code)."""
 
     id: str
     reason: str
-    code: Unsupported
+    code: enum.StrEnum
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from cell.geometry import FloatArray
 from cell.types.execution import WeldQuality
 from cell.types.map import MapSeam
-from cell.types.plan import SeamOutcome
+from cell.types.plan import PlanReason, SeamOutcome
 from cell.types.procedure import WeldProcedure
 from cell.types.rescan import SeamRescan
 from cell.types.seams import Joint, SeamEstimate, SeamMetrics
@@ -68,7 +68,8 @@ class SeamWeld:
     """What became of one seam in ``cell weld``: planned and welded, or why not (``code`` and the detail
     ``reason``); how well (the executed TCP against the true seam, when the truth is known: all passes together
     in ``quality``, each pass's bead in ``passes``, in pass order); the weld ``procedure`` it got (None: the
-    plan used none); the last check it failed (``check``, with the code ``last_check``)."""
+    plan used none); the last check it failed (``check``, with the code ``last_check``); the planner's code where
+    it refused the seam (``plan_code``)."""
 
     id: str
     planned: bool
@@ -79,6 +80,7 @@ class SeamWeld:
     procedure: WeldProcedure | None = None
     passes: tuple[WeldQuality, ...] = ()
     check: CheckFail | None = None
+    plan_code: PlanReason | None = None
 
 
 @dataclass(frozen=True)

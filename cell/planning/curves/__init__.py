@@ -3,7 +3,7 @@ the torch posed along it, the search for its start, direction and spin, its timi
 The planner's entry is :func:`cell.planning.plan.plan_welds` with ``curves`` (located :class:`CurveEstimate` s)."""
 
 from cell.planning.curves.path import CurvePath, curve_path, curve_poses
-from cell.planning.curves.plan import curve_procedures, search_curves, weldable, with_paths
+from cell.planning.curves.plan import curve_procedures, search_curves, split_failed, weldable, with_paths
 from cell.planning.curves.search import CurveTask, plan_curve
 from cell.planning.curves.timing import curve_pieces, curve_trajectory
 
@@ -17,6 +17,7 @@ __all__ = [
     "curve_trajectory",
     "plan_curve",
     "search_curves",
+    "split_failed",
     "weldable",
     "with_paths",
 ]

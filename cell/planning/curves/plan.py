@@ -8,13 +8,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import readonly
 from cell.planning.curves.search import plan_curve
-from cell.planning.failures import SeamFailure
+from cell.planning.failures import SeamFailure, better
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.procedures import UP_R, select_procedure
 from cell.types import SeamStatus
@@ -68,3 +69,41 @@ def with_paths(segments: Sequence[Segment], paths: Mapping[str, npt.ArrayLike]) 
         replace(s, X_path=readonly(np.asarray(paths[s.seam_id]))) if s.kind == "weld" and s.seam_id in paths else s
         for s in segments
     ]
+
+
+def split_failed(
+    curves: Sequence[CurveEstimate],
+    failed: Mapping[str, SeamFailure],
+    make_search: Mapping[str, SeamSearch],
+    q_seed: npt.ArrayLike,
+    procedures: Mapping[str, WeldProcedure] | None = None,
+) -> tuple[dict[str, SeamSolution], dict[str, SeamFailure]]:
+    """The curves whose one-piece search failed (``failed``: id -> its failure), each split into reachable arcs
+    (:func:`cell.planning.curves.split.split_curve`, planned with its own search and procedure from q_seed (dof,)
+    [rad]). Returns (arc id -> its solution, for the seams covered whole; seam id -> its failure, for the others:
+    where no arc reaches, with the arcs' share of the curve in its words)."""
+    from cell.planning.curves.split import split_curve
+
+    q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
+    arcs: dict[str, SeamSolution] = {}
+    still: dict[str, SeamFailure] = {}
+    for c in curves:
+        if c.id not in failed:
+            continue
+        search, proc = make_search[c.id], procs.get(c.id)
+        overlap = search.process.closed_overlap
+        got = split_curve(c, partial(_arc_plan, search, q0, proc), overlap, np.zeros(3))
+        if got.whole:
+            arcs |= {arc.id: sol for arc, sol in got.arcs}
+            continue
+        f = got.failure or failed[c.id]
+        if got.arcs:  # partly reachable: not welded, said with the share the arcs would cover
+            share = f"{len(got.arcs)} arcs would reach {got.share:.0%} of it, not all"
+            f = replace(f, where=f"{f.where} (split into arcs: {share})")
+        still[c.id] = better(failed[c.id], f) if not got.arcs else f
+    return arcs, still
+
+
+def _arc_plan(search: SeamSearch, q0: npt.NDArray[np.float64], proc: WeldProcedure | None, arc: CurveEstimate
+              ) -> SeamSolution | SeamFailure:  # fmt: skip
+    return plan_curve(search, arc, q0, proc)

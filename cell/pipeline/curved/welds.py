@@ -1,0 +1,67 @@
+"""What became of every located curved seam of a weld run: handed to the planner (the found ones, on a fixed
+arm), then welded with its executed TCP against the true curve, or why not with the planner's code
+(docs/curves-welding.md). Values in, values out; frames: R (the robot base) [m]."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from cell.pipeline.outcomes import curve_welds
+from cell.pipeline.records import Detection
+from cell.types import SeamStatus
+from cell.types.curve_estimate import CurveEstimate
+from cell.types.run import SeamWeld, WeldReason
+
+if TYPE_CHECKING:
+    from cell.types.execution import Execution
+    from cell.types.plan import WeldPlan
+
+ON_TRACK = "curved seams are not planned for an arm on a linear track (its planner takes straight seams only)"
+
+
+def curves_to_plan(det: Detection, on_track: bool, skip: Sequence[str] = ()) -> list[CurveEstimate]:
+    """The located (found) curved seams the planner is given: none for an arm on a track (each is then reported
+    ``no_torch_path``: :func:`curve_seam_welds`), never those in ``skip``."""
+    if on_track:
+        return []
+    return [c for c in det.curve_estimates if c.status is SeamStatus.FOUND and c.id not in skip]
+
+
+def curve_seam_welds(
+    det: Detection,
+    plan: WeldPlan | None,
+    ex: Execution | None,
+    pre_s: float,
+    refused: str,
+    on_track: bool,
+) -> dict[str, SeamWeld]:
+    """Curved seam id -> what became of it, for every found curve: welded (its quality against the true curve,
+    where the station knows it), or not with its code: the planner's refusal (``not_planned`` with the planner's
+    code), planned but not executed (``not_executed``: ``refused`` says why; ``preview``), or not tried on a track
+    (``no_torch_path``). pre_s [s]: the move before the plan."""
+    found = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
+    outcomes = {o.seam_id: o for o in plan.seams} if plan is not None else {}
+    closed = {c.id: c.closed for c in found if c.id in outcomes and outcomes[c.id].feasible}
+    quality = curve_welds(plan, ex, pre_s, det.curve_truths, closed, det.scenario.X_WR) if plan is not None else {}
+    out: dict[str, SeamWeld] = {}
+    for c in found:
+        o = outcomes.get(c.id)
+        welds = [g for g in plan.segments if g.arc_on and g.seam_id == c.id] if plan is not None else []
+        proc = welds[0].procedure if welds else None
+        if on_track:
+            out[c.id] = SeamWeld(c.id, False, False, ON_TRACK, code=WeldReason.NO_TORCH_PATH)
+        elif o is None:
+            why = refused or "not planned"
+            code = WeldReason.NOT_EXECUTED if refused else WeldReason.NOT_PLANNED
+            out[c.id] = SeamWeld(c.id, False, False, why, code=code)
+        elif not o.feasible:
+            out[c.id] = SeamWeld(c.id, False, False, o.reason, code=WeldReason.NOT_PLANNED, plan_code=o.code)
+        elif ex is None:
+            code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
+            why = refused or "planned, not executed (preview)"
+            out[c.id] = SeamWeld(c.id, True, False, why, code=code, procedure=proc)
+        else:
+            q = quality.get(c.id)
+            out[c.id] = SeamWeld(c.id, True, True, "", q, procedure=proc, passes=(q,) if q is not None else ())
+    return out

@@ -1,0 +1,68 @@
+"""cell weld with a located curved seam: a post's fillet found by the locator is handed to the planner, welded
+(in one go or in arcs) and measured against its true curve, and the report, the summary and the exit say so like
+a straight seam's; nothing about it is dropped."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from round_post import SEAM, post_map
+
+from cell import scenario as scn
+from cell.export.report import weld_report
+from cell.pipeline.job import WeldJob
+from cell.pipeline.weld import weld
+
+SCENARIO = """
+name: round-post-seen
+seed: 7
+simulation: {noise: none}
+map: {file: post.dxf, X_WM: {xyz_m: [0.0, 0.0, 0.90]}}
+table: {center_m: [0.0, 0.0, 0.85], size_m: [1.6, 1.2, 0.10]}
+robot:
+  urdf: kr5_arc.urdf
+  X_WR: {xyz_m: [0.0, -0.75, 0.90]}
+  home_deg: [-90.0, -100.0, 100.0, 0.0, 45.0, 0.0]
+cameras:
+  front: {eye_m: [0.0, -0.45, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}
+  back_l: {eye_m: [-0.4, 0.25, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}
+  back_r: {eye_m: [0.4, 0.25, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}
+perception:
+  workspace: {min_m: [-0.5, -0.5, 0.905], max_m: [0.5, 0.5, 1.3]}
+"""
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    folder: Path = tmp_path_factory.mktemp("post_seen")
+    post_map(folder / "post.dxf")
+    sc = scn.from_yaml(SCENARIO, base_dir=folder)
+    run = weld(sc, WeldJob(rescan="none", sides="first"))
+    return {"run": run, "rep": weld_report(run)}
+
+
+def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_the_planners_code(report: dict) -> None:
+    """The post's fillet is located and tried, in one go then in arcs; arcs reach most of it but not all, so it
+    is not welded: the planner's code, the share in its reason, counted in the summary and the programs' header,
+    the run partial."""
+    from cell.cli.turnover import not_welded
+
+    run, rep = report["run"], report["rep"]
+    det = run.detection
+    est = next(e for e in det.curve_estimates if e.id == SEAM)
+    assert est.status.value == "found", est.reason
+    entry = next(s for s in rep["seams"] if s["id"] == SEAM)
+    w = det.curve_welds[SEAM]
+    assert not w.welded and not entry["welded"] and "tcp_error_mm" not in entry
+    assert entry["weld_reason_code"] == "not_planned" and entry["plan_reason_code"] in ("ik_failed", "flip")
+    assert "arcs would reach" in entry["weld_reason"]  # the split's word: most of it, not all
+    share = float(entry["weld_reason"].split("would reach ")[1].split("%")[0])
+    assert 50.0 < share < 100.0
+    assert entry["not_welded"]["code"] == entry["plan_reason_code"] != "curved_no_torch_path"
+    assert rep["summary"]["curved"] | {"rms_max_mm": 0, "max_mm": 0} == {
+        "seams": 1, "found": 1, "welded": 0, "not_welded": {entry["plan_reason_code"]: 1}, "rms_max_mm": 0, "max_mm": 0
+    }  # fmt: skip
+    assert (SEAM, f"not_planned: {entry['plan_reason_code']}") in not_welded(rep)  # the programs' header
+    assert SEAM in {u.id for u in det.not_welded}
+    assert not run.complete and rep["welded"] == 0

@@ -7,8 +7,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from cell.pipeline.outcomes import curve_welds
+from cell.pipeline.outcomes import Doubt, curve_welds
 from cell.pipeline.records import Detection
+from cell.scenario import Scenario
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.run import SeamWeld, WeldReason
@@ -20,12 +21,37 @@ if TYPE_CHECKING:
 ON_TRACK = "curved seams are not planned for an arm on a linear track (its planner takes straight seams only)"
 
 
+def curve_doubt(c: CurveEstimate, sc: Scenario) -> Doubt | None:
+    """Why a located curve is too uncertain to weld (None when it may be): its largest bound across the seam
+    (``rescan.bound_sigmas`` times its largest sample sigma) over ``rescan.weld_tolerance_mm`` or its confidence
+    under ``rescan.weld_min_confidence`` (``low_confidence``), or, on an open curve, an end's bound along it over
+    ``rescan.end_tolerance_mm`` (``end_uncertain``): the straight seams' rule (:func:`cell.pipeline.outcomes.doubt`)
+    taken at the curve's worst sample."""
+    r = sc.rescan
+    if c.sigma_max_m > r.max_sigma_m:
+        bound_mm = r.bound_sigmas * c.sigma_max_m * 1000.0
+        why = f"bound {r.bound_sigmas:g} sigma = {bound_mm:.2f} mm at its worst sample > weld tolerance "
+        return Doubt(WeldReason.LOW_CONFIDENCE, why + f"{r.weld_tolerance_mm:g} mm")
+    if c.confidence < r.weld_min_confidence:
+        return Doubt(WeldReason.LOW_CONFIDENCE, f"confidence {c.confidence:.2f} < {r.weld_min_confidence:.2f}")
+    if not c.closed and max(c.end_sigma_m) > r.max_end_sigma_m:
+        bounds = ", ".join(f"{r.bound_sigmas * s * 1000.0:.2f}" for s in c.end_sigma_m)
+        why = f"end bound {r.bound_sigmas:g} sigma = {bounds} mm > end tolerance {r.end_tolerance_mm:g} mm"
+        return Doubt(WeldReason.END_UNCERTAIN, why)
+    return None
+
+
 def curves_to_plan(det: Detection, on_track: bool, skip: Sequence[str] = ()) -> list[CurveEstimate]:
     """The located (found) curved seams the planner is given: none for an arm on a track (each is then reported
-    ``no_torch_path``: :func:`curve_seam_welds`), never those in ``skip``."""
+    ``no_torch_path``: :func:`curve_seam_welds`), never those in ``skip`` nor one too uncertain to weld
+    (:func:`curve_doubt`)."""
     if on_track:
         return []
-    return [c for c in det.curve_estimates if c.status is SeamStatus.FOUND and c.id not in skip]
+    return [
+        c
+        for c in det.curve_estimates
+        if c.status is SeamStatus.FOUND and c.id not in skip and curve_doubt(c, det.scenario) is None
+    ]
 
 
 def curve_seam_welds(
@@ -37,9 +63,9 @@ def curve_seam_welds(
     on_track: bool,
 ) -> dict[str, SeamWeld]:
     """Curved seam id -> what became of it, for every found curve: welded (its quality against the true curve,
-    where the station knows it), or not with its code: the planner's refusal (``not_planned`` with the planner's
-    code), planned but not executed (``not_executed``: ``refused`` says why; ``preview``), or not tried on a track
-    (``no_torch_path``). pre_s [s]: the move before the plan."""
+    where the station knows it), or not with its code: too uncertain (:func:`curve_doubt`), the planner's refusal
+    (``not_planned`` with the planner's code), planned but not executed (``not_executed``: ``refused`` says why;
+    ``preview``), or not tried on a track (``no_torch_path``). pre_s [s]: the move before the plan."""
     found = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
     outcomes = {o.seam_id: o for o in plan.seams} if plan is not None else {}
     closed = {c.id: c.closed for c in found if c.id in outcomes and outcomes[c.id].feasible}
@@ -49,7 +75,10 @@ def curve_seam_welds(
         o = outcomes.get(c.id)
         welds = [g for g in plan.segments if g.arc_on and g.seam_id == c.id] if plan is not None else []
         proc = welds[0].procedure if welds else None
-        if on_track:
+        doubt = curve_doubt(c, det.scenario)
+        if doubt is not None:
+            out[c.id] = SeamWeld(c.id, False, False, doubt.detail, code=doubt.code)
+        elif on_track:
             out[c.id] = SeamWeld(c.id, False, False, ON_TRACK, code=WeldReason.NO_TORCH_PATH)
         elif o is None:
             why = refused or "not planned"

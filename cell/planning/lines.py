@@ -15,10 +15,13 @@ from scipy.interpolate import CubicSpline
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.ik import IKOptions, solve_ik
+from cell.motion.limits import JointLimits
 from cell.motion.robot import RobotModel
 from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile
 from cell.planning.failures import LineError, SeamFailure, unreachable
 from cell.types.plan import PlanReason
+
+_SLACK = 0.98  # a joint may use this share of its limits
 
 
 def solve_line(
@@ -89,7 +92,26 @@ def line_trajectory(
     twist = np.concatenate([d, np.zeros(3)])
     ends = [np.linalg.solve(robot.jacobian(q, "torch_tcp", "aligned"), twist) for q in (Q[0], Q[-1])]
     spline = CubicSpline(s_knots, Q, axis=0, bc_type=((1, ends[0]), (1, ends[1])))
-    lim = robot.limits
+    return time_spline(spline, Q, robot.limits, length, speed, accel, jerk, fixed_speed=fixed_speed, dt=dt, what="line")
+
+
+def time_spline(
+    spline: CubicSpline,
+    Q: FloatArray,
+    lim: JointLimits,
+    length: float,
+    speed: float,
+    accel: float,
+    jerk: float,
+    *,
+    fixed_speed: bool,
+    dt: float,
+    what: str,
+) -> tuple[Trajectory, float]:
+    """Time a joint path q(s) (``spline`` through the knots Q (n, dof) [rad], s from 0 to ``length`` [m]) by a
+    rest-to-rest Ruckig path profile: (trajectory, path speed used [m/s]). The path's speed, acceleration and jerk
+    are scaled down until every joint stays within ``_SLACK`` of its limits (the speed too unless ``fixed_speed``:
+    then a velocity excess is a TimingError naming the joint); ``what`` names the path in errors."""
     v, a, j = speed, accel, jerk
     for _ in range(8):
         prof = path_profile(length, v, a, j, dt=dt)
@@ -103,20 +125,20 @@ def line_trajectory(
         rv = float(np.max(np.abs(qd) / lim.v_max))
         ra = float(np.max(np.abs(qdd) / lim.a_max))
         rj = float(np.max(np.abs(qddd) / lim.j_max)) if len(qddd) else 0.0
-        if max(rv, ra, rj) <= 0.98:
+        if max(rv, ra, rj) <= _SLACK:
             q[0], q[-1] = Q[0], Q[-1]  # the knots exactly, not up to spline rounding
             qd[0] = qd[-1] = 0.0
             return Trajectory(prof.times, q, qd, qdd), v
-        if rv > 0.98:
+        if rv > _SLACK:
             if fixed_speed:
                 k = int(np.argmax(np.max(np.abs(qd) / lim.v_max, axis=0)))
                 raise TimingError(
-                    f"joint {lim.names[k]} would move at {rv * 100:.0f} % of its velocity limit at the "
-                    f"travel speed {speed * 1000:.1f} mm/s"
+                    f"joint {lim.names[k]} would move at {rv * 100:.0f} % of its velocity limit along the {what} "
+                    f"at the travel speed {speed * 1000:.1f} mm/s"
                 )
             v *= 0.95 / rv
-        if ra > 0.98:
+        if ra > _SLACK:
             a *= 0.95 / ra
-        if rj > 0.98:
+        if rj > _SLACK:
             j *= 0.95 / rj
-    raise TimingError(f"could not time a {length * 1000:.1f} mm line within the joint limits")
+    raise TimingError(f"could not time a {length * 1000:.1f} mm {what} within the joint limits")

@@ -11,18 +11,15 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from cell.config.motion import PlanOptions
-from cell.errors import TimingError
 from cell.geometry import FloatArray
 from cell.motion.robot import RobotModel
-from cell.motion.timing import DEFAULT_DT, Trajectory, path_profile
-from cell.planning.lines import line_trajectory
+from cell.motion.timing import DEFAULT_DT, Trajectory
+from cell.planning.lines import line_trajectory, time_spline
 from cell.planning.passes import with_craters
 from cell.planning.seam_search import SeamSolution
 from cell.planning.transfers import Piece
 from cell.process.torch import WeldProcess
 from cell.types.procedure import WeldProcedure
-
-_SLACK = 0.98  # a joint may use this share of its limits
 
 
 def curve_trajectory(
@@ -42,36 +39,9 @@ def curve_trajectory(
     Q = np.asarray(q_knots, dtype=float)
     s_k = np.asarray(s_knots, dtype=float)
     spline = CubicSpline(s_k, Q, axis=0)
-    lim = robot.limits
     length = float(s_k[-1])
-    a, j = accel, jerk
-    for _ in range(8):
-        prof = path_profile(length, speed, a, j, dt=dt)
-        s, sd, sdd = prof.s, prof.sd[:, None], prof.sdd[:, None]
-        d1, d2 = spline(s, 1), spline(s, 2)
-        q = spline(s)
-        qd = d1 * sd
-        qdd = d2 * sd**2 + d1 * sdd
-        h = np.diff(prof.times)[:, None]
-        qddd = np.diff(qdd, axis=0) / h if len(h) else np.zeros((0, Q.shape[1]))
-        rv = float(np.max(np.abs(qd) / lim.v_max))
-        ra = float(np.max(np.abs(qdd) / lim.a_max))
-        rj = float(np.max(np.abs(qddd) / lim.j_max)) if len(qddd) else 0.0
-        if rv > _SLACK:
-            k = int(np.argmax(np.max(np.abs(qd) / lim.v_max, axis=0)))
-            raise TimingError(
-                f"joint {lim.names[k]} would move at {rv * 100:.0f} % of its velocity limit along the curve at the"
-                f" travel speed {speed * 1000:.1f} mm/s"
-            )
-        if max(ra, rj) <= _SLACK:
-            q[0], q[-1] = Q[0], Q[-1]
-            qd[0] = qd[-1] = 0.0
-            return Trajectory(prof.times, q, qd, qdd)
-        if ra > _SLACK:
-            a *= 0.95 / ra
-        if rj > _SLACK:
-            j *= 0.95 / rj
-    raise TimingError(f"could not time a {length * 1000:.1f} mm curved weld within the joint limits")
+    traj, _ = time_spline(spline, Q, robot.limits, length, speed, accel, jerk, fixed_speed=True, dt=dt, what="curve")
+    return traj
 
 
 def curve_pieces(

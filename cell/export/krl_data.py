@@ -9,6 +9,7 @@ from collections.abc import Mapping
 import numpy as np
 import numpy.typing as npt
 
+from cell.config.export import KrlOptions
 from cell.export.program import ProgramJob, procedure_of
 from cell.geometry import FloatArray, invert, make_pose, matrix_to_rpy, rot_y
 from cell.types.procedure import WeavePattern, WeldProcedure
@@ -161,3 +162,21 @@ def track_header(track: LinearTrack) -> list[str]:
         ";- Every point carries its E1 [mm]; its X, Y, Z stay in BASE_DATA measured from the base at E1 = 0"
         " ($ERSYSROOT = $ROBROOT at E1 = 0): the robot base at E1 is there moved by E1 along the axis.",
     ]
+
+
+def main_ini(opt: KrlOptions, far: str, programs: str) -> list[str]:
+    """The INI fold, tool, PTP speed and the home check of a KRL main program that calls one program per side or
+    pose (``programs``: what they are, for the comment); ``far``: the KRL condition that XHOME is not the planned
+    home XHOME_PLAN (the program halts then)."""
+    return [
+        ";FOLD INI", ";FOLD BASISTECH INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
+        "INTERRUPT ON 3", "BAS(#INITMOV, 0)", ";ENDFOLD (BASISTECH INI)", ";FOLD USER INI", ";ENDFOLD (USER INI)",
+        ";ENDFOLD (INI)", "",
+        f"BAS(#TOOL, {opt.tool_index}) ; the torch's TOOL_DATA and LOAD_DATA (the {programs}' setup blocks)",
+        f"BAS(#VEL_PTP, {opt.ptp_percent})", f"BAS(#ACC_PTP, {opt.ptp_percent})",
+        f"IF {far} THEN",
+        "  HALT ; $config.dat's XHOME is not the planned home XHOME_PLAN: correct it first",
+        "ENDIF",
+        "$H_POS = XHOME",
+        "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
+    ]  # fmt: skip

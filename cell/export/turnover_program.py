@@ -12,7 +12,7 @@ from typing import Literal
 import numpy as np
 
 from cell.export.krl import HOME_TOL_DEG
-from cell.export.krl_data import e6axis
+from cell.export.krl_data import e6axis, main_ini
 from cell.export.post import post_processor
 from cell.export.program import _NAME, ProgramJob, not_welded_lines, write_texts
 from cell.provenance import header_lines
@@ -118,16 +118,7 @@ def krl_main_texts(main: str, jobs: Sequence[ProgramJob], message: str, stop: St
         " operator turning the part between two sides.",
         *made_by,
         *not_welded_lines(first),
-        ";FOLD INI", ";FOLD BASISTECH INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
-        "INTERRUPT ON 3", "BAS(#INITMOV, 0)", ";ENDFOLD (BASISTECH INI)", ";FOLD USER INI", ";ENDFOLD (USER INI)",
-        ";ENDFOLD (INI)", "",
-        f"BAS(#TOOL, {opt.tool_index}) ; the torch's TOOL_DATA and LOAD_DATA (the sides' setup blocks)",
-        f"BAS(#VEL_PTP, {opt.ptp_percent})", f"BAS(#ACC_PTP, {opt.ptp_percent})",
-        f"IF {far} THEN",
-        "  HALT ; $config.dat's XHOME is not the planned home XHOME_PLAN: correct it first",
-        "ENDIF",
-        "$H_POS = XHOME",
-        "PTP XHOME ; first motion: fully defined axis point (block coincidence)",
+        *main_ini(opt, far, "sides"),
     ]  # fmt: skip
     for k, job in enumerate(jobs):
         if k:

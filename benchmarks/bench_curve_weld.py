@@ -145,9 +145,9 @@ def bench_located(name: str) -> dict[str, Any]:
     import re
 
     from cell import scenario as sc
+    from cell.export.checks.program import Program, check_program
+    from cell.export.checks.read import read_krl
     from cell.export.krl import krl_program
-    from cell.export.krl_check import Program, check_program
-    from cell.export.krl_read import read_krl
     from cell.export.program import ProgramJob
     from cell.export.rapid import rapid_text
     from cell.pipeline.job import WeldJob

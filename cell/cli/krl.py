@@ -44,7 +44,7 @@ def check(
     data sets, S and T of every E6POS against the arm's kinematics; a main program's calls (each called program
     exists and is checked), the operator's stop between two sides, home at its start and end; TOOL_DATA and
     BASE_DATA the programs agree on; E1 of every point on a linear track. Exit 4 with one line per finding."""
-    from cell.export.krl_calls import check_all, read_target
+    from cell.export.checks.calls import check_all, read_target
 
     with cell_errors():
         if target.is_file() and target.suffix.lower() not in (".src", ".dat"):

@@ -1,7 +1,7 @@
 """What the cell writes: the JSON report (:mod:`cell.export.report`), the robot program through a post-processor
 (:mod:`cell.export.program`, :mod:`cell.export.post`: KUKA KRL in :mod:`cell.export.krl`, ABB RAPID in
 :mod:`cell.export.rapid`; a part turned over between sides in :mod:`cell.export.turnover_program`;
-:mod:`cell.export.krl_check` re-reads a KRL program) and the joint trajectory as JSON and CSV
+:mod:`cell.export.checks.program` re-reads a KRL program) and the joint trajectory as JSON and CSV
 (:mod:`cell.export.trajectory`); every file is written whole (:mod:`cell.outputs`). Values in,
 files out: these modules read the vocabulary and the run records, never a stage (an import-linter contract)."""
 

@@ -13,9 +13,9 @@ import pytest
 from round_post import SEAM, post_scenario
 from tools_loader import load_bench
 
+from cell.export.checks.program import Program, check_program
+from cell.export.checks.read import read_krl
 from cell.export.krl import krl_program
-from cell.export.krl_check import Program, check_program
-from cell.export.krl_read import read_krl
 from cell.export.program import ProgramJob
 from cell.export.rapid import rapid_text
 from cell.gate import find_violations

@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 from cell import pipeline
 from cell.cli import app
 from cell.cli.krl import EXIT_CHECK_FAILED
-from cell.export.krl_check import check_program, read_programs
-from cell.export.krl_kin import check_kinematics
+from cell.export.checks.kinematics import check_kinematics
+from cell.export.checks.program import check_program, read_programs
 
 runner = CliRunner()
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from test_krl import HOME, OBSTACLES, PROCESS, SEAMS, URDF
 
+from cell.export.checks.kinematics import check_kinematics
+from cell.export.checks.program import check_program, read_programs
+from cell.export.checks.read import parse_value, read_krl
 from cell.export.krl import KrlOptions, write_krl
-from cell.export.krl_check import check_program, read_programs
-from cell.export.krl_kin import check_kinematics
-from cell.export.krl_read import parse_value, read_krl
 from cell.motion.robot import RobotModel
 from cell.planning.plan import plan_welds
 from cell.types import Trajectory, Weave, WeldPass, WeldProcedure

@@ -13,9 +13,9 @@ from test_krl import HOME, OBSTACLES, PROCESS, SEAMS, URDF
 from typer.testing import CliRunner
 
 from cell.cli import app
-from cell.export.krl_calls import check_all, fixed_base
-from cell.export.krl_check import Program, check_program, read_programs, stated_track
-from cell.export.krl_kin import check_kinematics
+from cell.export.checks.calls import check_all, fixed_base
+from cell.export.checks.kinematics import check_kinematics
+from cell.export.checks.program import Program, check_program, read_programs, stated_track
 from cell.export.post import write_program
 from cell.export.program import ProgramJob
 from cell.geometry import make_pose, rot_z

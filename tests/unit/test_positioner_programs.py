@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from test_krl import HOME, OBSTACLES, PROCESS, SEAMS, URDF
 
-from cell.export.krl_calls import check_all
-from cell.export.krl_check import read_programs
+from cell.export.checks.calls import check_all
+from cell.export.checks.program import read_programs
 from cell.export.positioner_program import positioner_texts
 from cell.export.program import ProgramJob, write_texts
 from cell.motion.robot import RobotModel

@@ -15,8 +15,8 @@ from test_krl import HOME, OBSTACLES, PROCESS, SEAMS, URDF
 from typer.testing import CliRunner
 
 from cell.cli import app
+from cell.export.checks.calls import check_all, read_target
 from cell.export.krl import KrlPost
-from cell.export.krl_calls import check_all, read_target
 from cell.export.post import write_program
 from cell.export.program import ProgramJob
 from cell.export.rapid import RapidPost

@@ -12,10 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from cell.export.krl_check import Finding, Program, check_program, read_programs, stated_axis
-from cell.export.krl_external import check_positioner, stated_base, stated_positioner
-from cell.export.krl_kin import check_kinematics, frame_of
-from cell.export.krl_read import Statement, read_krl
+from cell.export.checks.kinematics import check_kinematics, frame_of
+from cell.export.checks.positioner import check_positioner, stated_base, stated_positioner
+from cell.export.checks.program import Finding, Program, check_program, read_programs, stated_axis
+from cell.export.checks.read import Statement, read_krl
 from cell.types.robot import Kinematics
 
 KSS_ROUTINES = frozenset(
@@ -194,8 +194,8 @@ def check_setup(programs: Sequence[Program]) -> list[Finding]:
 
 def fixed_base(p: Program) -> Program:
     """The program as an arm on a fixed base sees it: on a linear track whose axis the header states
-    (:func:`~cell.export.krl_check.stated_axis`), each E6POS moved back by its E1 along the axis, so that the
-    kinematic check (:mod:`cell.export.krl_kin`) finds the configuration the arm reaches it in from where the
+    (:func:`~cell.export.checks.program.stated_axis`), each E6POS moved back by its E1 along the axis, so that the
+    kinematic check (:mod:`cell.export.checks.kinematics`) finds the configuration the arm reaches it in from where the
     carriage put the base. The program itself when it states no track axis or no base to turn the axis into."""
     axis = stated_axis(p)
     bi = next((m.group(1) for s in p.src.statements if (m := _BASE.match(s.text))), None)
@@ -216,7 +216,7 @@ def fixed_base(p: Program) -> Program:
 def check_all(
     programs: Sequence[Program], robot: Kinematics, e1_limits_mm: tuple[float, float] | None = None
 ) -> list[Finding]:
-    """Every check on every program: :func:`~cell.export.krl_check.check_program` (E1 within ``e1_limits_mm``
+    """Every check on every program: :func:`~cell.export.checks.program.check_program` (E1 within ``e1_limits_mm``
     [mm] when given), the kinematics (but for a main program without Cartesian points of its own: it has nothing
     to check there), the calls and the shared setup."""
     out: list[Finding] = []

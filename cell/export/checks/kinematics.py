@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cell.export.krl_check import Finding, Program
+from cell.export.checks.program import Finding, Program
 from cell.export.status_turn import ArmGeometry, status_turn
 from cell.geometry import FloatArray, invert, make_pose, rpy_to_matrix
 from cell.types.robot import Kinematics

@@ -1,4 +1,4 @@
-"""``cell krl check``: re-read a KRL program (:mod:`cell.export.krl_read`) and list what would stop it or weld wrong,
+"""``cell krl check``: re-read a KRL program (:mod:`cell.export.checks.read`) and list what would stop it or weld wrong,
 one :class:`Finding` per problem (its checks: docs/programs.md)."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from cell.export.checks.read import Decl, KrlFile, Statement, read_krl
 from cell.export.circles import circle_through
-from cell.export.krl_read import Decl, KrlFile, Statement, read_krl
 
 GLOBAL_POINTS = frozenset({"XHOME"})
 _ARC_FOLD = re.compile(r"^(ARCON|ARCSWI|ARCOFF)\s+(\w+)", re.I)

@@ -16,6 +16,7 @@ import numpy as np
 from cell.geometry import FloatArray
 from cell.motion.limits import JointLimits
 from cell.motion.timing import ptp_duration
+from cell.planning.track_moves import arm_and_track
 from cell.types.plan import Segment, WeldPlan
 from cell.types.track import LinearTrack
 
@@ -94,17 +95,8 @@ def breakdown(plan: WeldPlan) -> Breakdown:
 
 
 def with_track(limits: JointLimits, track: LinearTrack | None) -> JointLimits:
-    """The arm's limits, with the track's E1 as a last axis when there is one."""
-    if track is None:
-        return limits
-    return JointLimits(
-        (*limits.names, "E1"),
-        np.append(limits.q_min, track.e1_min),
-        np.append(limits.q_max, track.e1_max),
-        np.append(limits.v_max, track.v_max),
-        np.append(limits.a_max, track.a_max),
-        np.append(limits.j_max, track.j_max),
-    )
+    """The arm's limits, with the track's E1 as a last axis when there is one (the planner's own)."""
+    return limits if track is None else arm_and_track(limits, track)
 
 
 def _state(seg: Segment, k: int, track: LinearTrack | None) -> FloatArray:

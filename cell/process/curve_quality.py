@@ -9,6 +9,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray
+from cell.process.quality import quality_figures
 from cell.types.execution import WeldQuality
 
 _MM = 1000.0
@@ -72,20 +73,5 @@ def curve_weld_quality(times: npt.ArrayLike, tcp_R: npt.ArrayLike, truth_R: npt.
         past_start = max(float(np.max((truth[0] - p) @ t0)), 0.0)
         past_end = max(float(np.max((p - truth[-1]) @ t1)), 0.0)
         gaps = (float(s.min()), total - float(s.max()), past_start, past_end)
-    short_start, short_end, past_start, past_end = gaps
-    step = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    dt = np.diff(t)
-    speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0) * _MM
-    cruise = speed[speed > 0.5 * speed.max()] if speed.size and speed.max() > 0 else speed
-    return WeldQuality(
-        tcp_rms_mm=float(np.sqrt(np.mean((d * _MM) ** 2))),
-        tcp_max_mm=float(d.max() * _MM),
-        weld_time_s=float(t[-1] - t[0]),
-        length_mm=float(step.sum() * _MM),
-        speed_mm_s=float(np.median(cruise)) if cruise.size else 0.0,
-        samples=len(t),
-        short_start_mm=short_start * _MM,
-        short_end_mm=short_end * _MM,
-        past_start_mm=past_start * _MM,
-        past_end_mm=past_end * _MM,
-    )
+    length_m = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+    return quality_figures(t, p, d * _MM, gaps, length_m)

@@ -64,16 +64,26 @@ def weld_quality(
         raise ValueError("a weld needs at least two tool records")
     d = distance_to_segment(p, truth_start, truth_end) * _MM
     short_start, short_end, past_start, past_end = end_coverage(p, truth_start, truth_end)
+    driven = float(np.linalg.norm(np.diff(raw, axis=0), axis=1).sum())
+    return quality_figures(t, p, d, (short_start, short_end, past_start, past_end), driven)
+
+
+def quality_figures(
+    t: FloatArray, p: FloatArray, d_mm: FloatArray, ends_m: tuple[float, float, float, float], length_m: float
+) -> WeldQuality:
+    """The figures of one weld from its records at times t (n,) [s]: the TCP error d_mm (n,) [mm] (RMS and max),
+    the travel speed along p (n, 3) [m] (the median over the records above half the top speed), the length driven
+    [m] and the ends' (short start, short end, past start, past end) [m]."""
     step = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    driven = np.linalg.norm(np.diff(raw, axis=0), axis=1)
     dt = np.diff(t)
     speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0) * _MM
     cruise = speed[speed > 0.5 * speed.max()] if speed.size and speed.max() > 0 else speed
+    short_start, short_end, past_start, past_end = ends_m
     return WeldQuality(
-        tcp_rms_mm=float(np.sqrt(np.mean(d**2))),
-        tcp_max_mm=float(d.max()),
+        tcp_rms_mm=float(np.sqrt(np.mean(d_mm**2))),
+        tcp_max_mm=float(d_mm.max()),
         weld_time_s=float(t[-1] - t[0]),
-        length_mm=float(driven.sum() * _MM),
+        length_mm=length_m * _MM,
         speed_mm_s=float(np.median(cruise)) if cruise.size else 0.0,
         samples=len(t),
         short_start_mm=short_start * _MM,

@@ -4,7 +4,8 @@ what is read and how: docs/bags.md). Bad input is a one-line :class:`~cell.error
 from __future__ import annotations
 
 import sqlite3
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -146,6 +147,15 @@ def read_bag(
     max_tf_gap_s : refuse a camera whose moving tf sample nearest its stamp is further from it than this [s] (the
         arm's pose at the image would be a guess).
     """
+    with open_bag(bag) as reader:
+        return _read(reader, Path(bag), depth_topics, base_frame, time, max_tf_gap_s, progress)
+
+
+@contextmanager
+def open_bag(bag: Path) -> Iterator[Any]:
+    """An open rosbags ``AnyReader`` on the ROS 2 bag at ``bag``, closed on leaving; a missing path, a ROS 1 bag and
+    a bag that cannot be opened or read (its storage damaged past its index, also while reading) raise
+    RecordedDataError naming it."""
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.rosbag2 import ReaderError
     from rosbags.typesys import Stores, get_typestore
@@ -161,7 +171,7 @@ def read_bag(
     except (AnyReaderError, ReaderError, OSError) as e:  # rosbags says FileNotFoundError for a folder without metadata
         raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
     try:
-        return _read(reader, bag, depth_topics, base_frame, time, max_tf_gap_s, progress)
+        yield reader
     except (AnyReaderError, ReaderError, OSError, sqlite3.Error) as e:  # storage damaged past its index
         raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
     finally:

@@ -7,7 +7,6 @@ is fixed. The board is not in a bag: the caller states it. Bad input is a one-li
 
 from __future__ import annotations
 
-import sqlite3
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -15,7 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from cell.recorded.bag import CAMERA_INFO, IMAGE, base_frame_of, decode, tf_tree_of
+from cell.recorded.bag import CAMERA_INFO, IMAGE, base_frame_of, decode, open_bag, tf_tree_of
 from cell.recorded.board_capture import BoardCapture, BoardShot
 from cell.recorded.ros_msgs import DEPTH_SCALE_M, camera_names, depth_of, fail, info_topic_of, stamp_ns
 from cell.recorded.tf_tree import TfError, TfTree, frame_name
@@ -43,21 +42,8 @@ def read_board_bag(
     """The bag's board images as a capture (only ``cameras``' when given): ``board`` the board as printed
     (``calibration.board``'s keys); ``base_frame`` as :func:`cell.recorded.bag.read_bag`'s; a depth image or a
     tf sample further than ``max_gap_s`` from an image's stamp is refused (the arm may have been moving)."""
-    from rosbags.highlevel import AnyReader, AnyReaderError
-    from rosbags.rosbag2 import ReaderError
-    from rosbags.typesys import Stores, get_typestore
-
-    try:
-        reader = AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
-        reader.open()
-    except (AnyReaderError, ReaderError, OSError) as e:
-        raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
-    try:
+    with open_bag(bag) as reader:
         return _read(reader, bag, board, cameras, base_frame, int(max_gap_s * 1e9), progress)
-    except (AnyReaderError, ReaderError, OSError, sqlite3.Error) as e:
-        raise fail(bag, f"not a readable ROS bag ({' '.join(str(e).split())})") from None
-    finally:
-        reader.close()
 
 
 def _read(

@@ -59,10 +59,12 @@ def weld_curves_coordinated(
     *,
     execute: bool = True,
     progress: Callable[[str], None] = lambda _: None,
+    refuse_doubtful: bool = True,
 ) -> tuple[list[tuple[PositionerPose, SeamWeld, CoordinatedWeld | None, object]], dict[str, str]]:
     """Each found curve of ``det`` (located at the positioner's home): (its pose record, its weld, its coordinated
     motion, its execution) for those planned; curve id -> why not (a sentence) for the others, their codes in the
-    returned welds."""
+    returned welds. ``refuse_doubtful`` False is a study's (benchmarks/bench_coordinated.py): a curve the weld
+    gate refuses is planned and welded all the same, its refusal kept in its weld's reason; never the cell's."""
     from cell.config.motion import PlanOptions
     from cell.coordinated.gate import MovingScene
     from cell.coordinated.plan import plan_coordinated
@@ -86,7 +88,7 @@ def weld_curves_coordinated(
     scene = MovingScene.build(arm.model, pos, carried, opt.collision)
     for c in found:
         doubt = curve_doubt(c, sc)
-        if doubt is not None:
+        if doubt is not None and refuse_doubtful:
             why[c.id] = doubt.detail
             out.append((PositionerPose(*pos.home, (), {}), SeamWeld(c.id, False, False, doubt.detail, code=doubt.code),
                         None, None))  # fmt: skip
@@ -121,5 +123,6 @@ def weld_curves_coordinated(
         ex, back = play(station, cw)
         truth = det.curve_truths.get(c.id)
         q = quality(ex, back, truth, c.closed) if truth is not None else None
-        out.append((pose, SeamWeld(c.id, True, True, "", q, procedure=proc, passes=(q,) if q else ()), cw, ex))
+        study = f"welded for a study despite the weld gate: {doubt.detail}" if doubt is not None else ""
+        out.append((pose, SeamWeld(c.id, True, True, study, q, procedure=proc, passes=(q,) if q else ()), cw, ex))
     return out, why

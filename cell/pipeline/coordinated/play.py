@@ -1,9 +1,12 @@
 """A coordinated weld played in the simulator: at every record the arm at its joints and the positioner's axes
-turned one step (the part, the clamping table and the faceplate carried, the clamping error riding on them), the
+turned (the part, the clamping table and the faceplate carried, the clamping error riding on them; the bodies
+moved each time an axis has turned ``BODY_STEP_RAD``, the part's pose at every record from the same motion), the
 torch's tip recorded; then measured against the true curve in the part's own frame (the tip carried back by the
 part's true motion from home). Frames: W the world, R the robot base; [m], [s]."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -13,6 +16,7 @@ from cell.station.sim import SimStation
 from cell.types.execution import Event, Execution, WeldQuality
 
 RECORD_DT = 0.01  # [s] between records, as the arm's own playback
+BODY_STEP_RAD = math.radians(0.25)  # the part's bodies moved when an axis has turned this far (0.5 mm at 0.11 m)
 
 
 def play(station: SimStation, cw: CoordinatedWeld, record_dt: float = RECORD_DT) -> tuple[Execution, FloatArray]:
@@ -28,14 +32,21 @@ def play(station: SimStation, cw: CoordinatedWeld, record_dt: float = RECORD_DT)
     axes = np.column_stack([np.interp(at, t, cw.axes[:, j]) for j in range(2)])
     arc = np.asarray(cw.arc_on, dtype=bool)[np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 1)]
     sim = station.sim
+    sp = station.positioner
     tcp_W = np.empty((len(at), 3))
     back_R = np.empty((len(at), 3))
+    moved = np.full(2, np.inf)  # the axes where the bodies were last moved to
     for i in range(len(at)):
-        station.follow_positioner(float(axes[i, 0]), float(axes[i, 1]))
+        a = axes[i]
+        if np.abs(a - moved).max() >= BODY_STEP_RAD or i == len(at) - 1:
+            station.follow_positioner(float(a[0]), float(a[1]))
+            moved = a
         sim.set_q(q[i])
         p_W = sim.link_pose("torch_tcp")[:3, 3]
         tcp_W[i] = p_W
-        X_R_true = X_RW @ station.positioner.X_W_true @ sc.X_WR  # the part's true motion from the scan, in R
+        # The part's true motion from the scan at these axes: the bodies' last step carried on by the kinematics.
+        X_step_R = sp.pos.move(float(a[0]), float(a[1])) @ np.linalg.inv(sp.pos.move(*sp.axes))
+        X_R_true = X_step_R @ X_RW @ sp.X_W_true @ sc.X_WR
         back_R[i] = (invert(X_R_true) @ np.r_[X_RW[:3, :3] @ p_W + X_RW[:3, 3], 1.0])[:3]
     events = tuple(Event(float(t0), "move", f"{kind} {cw.seam_id}") for kind, t0, _ in cw.pieces)
     return Execution(at, q, tcp_W, arc, events), back_R

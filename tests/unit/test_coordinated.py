@@ -73,7 +73,9 @@ def test_the_eight_axes_limits_name_the_positioner_axis_that_leaves_them() -> No
     assert "rotate" in (off_limits(lim, x) or "")
 
 
-def test_the_coordinated_weld_is_timed_at_the_travel_speed_on_the_part_and_gated() -> None:
+@pytest.fixture(scope="module")
+def planned() -> tuple:
+    """A pipe's fillet clamped 3.6 mm off the rotate axis of pipe-stub-positioner's positioner, planned."""
     from cell.coordinated.plan import plan_coordinated
     from cell.motion.robot import RobotModel
     from cell.process.torch import WeldProcess
@@ -89,10 +91,14 @@ def test_the_coordinated_weld_is_timed_at_the_travel_speed_on_the_part_and_gated
         n_receiving_R=curve.n_b_F @ X[:3, :3].T, closed=True, sigma_m=np.full(360, 1e-4), end_sigma_m=(0.0, 0.0),
     )  # fmt: skip
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
-    opt = sc.motion.plan
-    scene = MovingScene.build(model, pos, [], opt.collision)
+    scene = MovingScene.build(model, pos, [], sc.motion.plan.collision)
     q0 = np.radians(sc.robot.home_deg)
-    cw = plan_coordinated(model, pos, est, process, opt, scene, q0, rng=np.random.default_rng(0))
+    cw = plan_coordinated(model, pos, est, process, sc.motion.plan, scene, q0, rng=np.random.default_rng(0))
+    return sc, pos, est, process, cw, q0
+
+
+def test_the_coordinated_weld_is_timed_at_the_travel_speed_on_the_part_and_gated(planned: tuple) -> None:
+    _, pos, _, process, cw, q0 = planned
     assert cw.in_position and 2.0 < cw.tcp_spread_mm < 4.0  # the arm corrects the 3.6 mm off-centre clamping
     loop = 2 * math.pi * R_PIPE + process.closed_overlap
     assert abs(cw.s[-1] - loop) < 0.002
@@ -105,3 +111,20 @@ def test_the_coordinated_weld_is_timed_at_the_travel_speed_on_the_part_and_gated
     assert rate.max() == pytest.approx(cw.speed / R_PIPE, rel=0.05)  # the rotate axis carries the travel
     # Start and end at home: the arm where it started, the positioner at its home.
     assert np.allclose(cw.q[0], q0) and np.allclose(cw.q[-1], q0) and np.allclose(cw.axes[-1], pos.home)
+
+
+def test_the_simulator_turns_the_part_and_the_torch_follows_its_seam(planned: tuple) -> None:
+    from cell.pipeline.coordinated.play import play, quality
+    from cell.pipeline.detect import read_weldmap
+    from cell.pipeline.geometry import open_cell
+
+    sc, pos, est, _, cw, _ = planned
+    with open_cell(sc, read_weldmap(sc)) as station:
+        ex, back = play(station, cw, record_dt=0.1)
+        axes_end = station.positioner.axes  # type: ignore[union-attr]
+    assert np.allclose(axes_end, pos.home)  # the positioner played back home with the arm
+    q = quality(ex, back, np.asarray(est.p_RS), closed=True)
+    assert q.tcp_max_mm < 0.05 and q.short_start_mm == 0.0  # the whole loop, on the seam the part carries
+    assert q.speed_mm_s == pytest.approx(cw.speed * 1000.0, rel=0.01)  # relative to the turning part
+    moved = np.linalg.norm(ex.tcp_W[ex.arc_on] - ex.tcp_W[ex.arc_on].mean(axis=0), axis=1).max()
+    assert moved < 0.005  # the torch nearly still in the world while the part turns under it

@@ -56,7 +56,8 @@ def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) ->
         ";- Coordinated motion: the points are in BASE_DATA on the positioner's faceplate ($BASE = EK(...)) and each"
         " carries its own E2 and E3: the rotate axis turns the part under a nearly still torch, the controller moving"
         " the arm and the axes together along each LIN in the turning base.",
-        f";- The base at this program's first axes in $ROBROOT = {frame_text(X_RB)} (what EK gives; for checking)",
+        f";- The base at this program's axes in $ROBROOT = {frame_text(X_RB)} (at its first weld point's E2 and E3:"
+        " what EK gives; for checking)",
         chain_line(pos.X_RP, pos.tilt_height_m, pos.faceplate_offset_m, np.eye(4)),
         f";- Seam {cw.seam_id}: tilt {math.degrees(cw.knot_axes[0, 0]):.1f} deg (the fillet in PA), rotate"
         f" {math.degrees(cw.knot_axes[0, 1]):.1f} .. {math.degrees(cw.knot_axes[-1, 1]):.1f} deg, travel"
@@ -92,7 +93,8 @@ def coordinated_krl(
            f";- BASE_DATA[{o.base_index}] = {frame_text(np.eye(4))} ; the part's base on the positioner's faceplate"
            " (MACHINE_DEF[2]'s flange)", f";- XHOME = {e6axis(q_home)} ; in $config.dat"]  # fmt: skip
     src += [f";- {procedure_line(procedure, 0)}"] if procedure is not None else []
-    src += [";ENDFOLD", "BAS(#INITMOV, 0)", f"BAS(#TOOL, {o.tool_index})",
+    src += [";ENDFOLD", ";FOLD INI", "GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )", "INTERRUPT ON 3",
+            "BAS(#INITMOV, 0)", ";ENDFOLD (INI)", f"BAS(#TOOL, {o.tool_index})",
             f"$BASE = EK(MACHINE_DEF[2].ROOT, MACHINE_DEF[2].MECH_TYPE, BASE_DATA[{o.base_index}]) ; the part on the"
             " faceplate", f"BAS(#VEL_PTP, {o.ptp_percent})", "$H_POS = XHOME", "PTP XHOME",
             "PTP XAPP ; the arm and the positioner together: the fillet in PA at the torch"]  # fmt: skip
@@ -109,7 +111,11 @@ def coordinated_krl(
     src += [f"$VEL.CP = {0.05:.4f} ; [m/s] approach", f"LIN {point(n, X_start, q_app, cw.knot_axes[0])}"]
     n += 1
     src.append(f"LIN {point(n, X_FT[0], cw.knot_q[0], cw.knot_axes[0])} ; the weld's start")
-    src += [f"$OUT[{o.arc_on_output}] = TRUE ; arc on, seam {cw.seam_id}",
+    ms = round(o.arc_timeout_s * 1000.0)
+    src += [f"$OUT[{o.arc_on_output}] = TRUE ; arc on, seam {cw.seam_id}", "$TIMER_STOP[1] = TRUE",
+            f"$TIMER[1] = -{ms}", "$TIMER_STOP[1] = FALSE", f"WAIT FOR $IN[{o.arc_ok_input}] OR $TIMER_FLAG[1]",
+            "$TIMER_STOP[1] = TRUE", f"IF NOT $IN[{o.arc_ok_input}] THEN", f"  $OUT[{o.arc_on_output}] = FALSE",
+            f"  HALT ; no arc within {o.arc_timeout_s:g} s: arc off, stopped", "ENDIF",
             f"$VEL.CP = {cw.speed:.4f} ; [m/s] {cw.speed * 1000:.1f} mm/s along the turning part"]  # fmt: skip
     for i in chord_knots(cw)[1:]:
         n += 1

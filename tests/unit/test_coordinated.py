@@ -4,6 +4,8 @@ the axes' motion timed together at the travel speed relative to the part, and th
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -128,3 +130,25 @@ def test_the_simulator_turns_the_part_and_the_torch_follows_its_seam(planned: tu
     assert q.speed_mm_s == pytest.approx(cw.speed * 1000.0, rel=0.01)  # relative to the turning part
     moved = np.linalg.norm(ex.tcp_W[ex.arc_on] - ex.tcp_W[ex.arc_on].mean(axis=0), axis=1).max()
     assert moved < 0.005  # the torch nearly still in the world while the part turns under it
+
+
+def test_the_krl_program_moves_e2_e3_in_the_turning_base_and_passes_the_check(planned: tuple, tmp_path: Path) -> None:
+    from cell.export.checks.calls import check_all
+    from cell.export.checks.program import read_programs
+    from cell.export.coordinated_program import write_coordinated_programs
+    from cell.motion.robot import RobotModel
+    from cell.station.arm import robot_urdf
+
+    sc, pos, _, _, cw, _ = planned
+    robot = RobotModel.from_urdf(robot_urdf(sc))
+    write_coordinated_programs("krl", [cw], robot, pos, "pipe", tmp_path)
+    programs, found = read_programs(tmp_path)
+    assert not found and not check_all(programs, robot)  # S, T on the arm at every point's own E2 / E3
+    dat = next(tmp_path.glob("*.dat")).read_text()
+    e3 = [float(v) for v in re.findall(r"E6POS XP\d+=\{[^}]*E3 ([-\d.]+)", dat)]
+    assert len(set(e3)) > 30 and max(e3) - min(e3) > 360.0  # the rotate axis turns the loop, point by point
+    src = next(tmp_path.glob("*.src"))
+    text = src.read_text().replace("Positioner chain", "Positioner")  # the chain not stated: the base stands still
+    src.write_text(text)
+    programs, _ = read_programs(tmp_path)
+    assert any(f.code in ("kinematics", "status_turn") for f in check_all(programs, robot))

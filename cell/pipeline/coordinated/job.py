@@ -19,6 +19,7 @@ from cell.positioner.poses import PositionerPose
 from cell.station.sim import SimStation
 from cell.types import Part, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.execution import Execution
 from cell.types.positioner import TiltRotatePositioner, WeldPosition
 from cell.types.run import SeamWeld, WeldReason
 
@@ -60,7 +61,7 @@ def weld_curves_coordinated(
     execute: bool = True,
     progress: Callable[[str], None] = lambda _: None,
     refuse_doubtful: bool = True,
-) -> tuple[list[tuple[PositionerPose, SeamWeld, CoordinatedWeld | None, object]], dict[str, str]]:
+) -> tuple[list[tuple[PositionerPose, SeamWeld, CoordinatedWeld | None, Execution | None]], dict[str, str]]:
     """Each found curve of ``det`` (located at the positioner's home): (its pose record, its weld, its coordinated
     motion, its execution) for those planned; curve id -> why not (a sentence) for the others, their codes in the
     returned welds. ``refuse_doubtful`` False is a study's (benchmarks/bench_coordinated.py): a curve the weld
@@ -77,7 +78,7 @@ def weld_curves_coordinated(
     sc = det.scenario
     arm = station.arm
     assert arm is not None
-    out: list[tuple[PositionerPose, SeamWeld, CoordinatedWeld | None, object]] = []
+    out: list[tuple[PositionerPose, SeamWeld, CoordinatedWeld | None, Execution | None]] = []
     why: dict[str, str] = {}
     found = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
     if not found:

@@ -108,7 +108,7 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         from cell.pipeline.coordinated import weld_curves_coordinated  # curved seams: the part turns while welded
 
         done, why_c = weld_curves_coordinated(station, det, pos, q_now, execute=job.execute, progress=progress)
-        groups_c = [GroupRun(p, 0.0, None, None, ex, (w,), cw.plan_s) for p, w, cw, ex in done if cw is not None]  # type: ignore[arg-type]
+        groups_c = [GroupRun(p, 0.0, None, None, ex, (w,), cw.plan_s) for p, w, cw, ex in done if cw is not None]
         coordinated = tuple(cw for _, _, cw, _ in done if cw is not None)
         unheld |= why_c
         codes |= {w.id: w.code or WeldReason.NOT_PLANNED for _, w, cw, _ in done if cw is None}

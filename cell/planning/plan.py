@@ -20,7 +20,7 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.assembly import assemble
 from cell.planning.blend import blend_plan
-from cell.planning.curves import curve_pieces, search_curves, split_failed, weldable, with_paths
+from cell.planning.curves import cover_curves, curve_pieces, weldable, with_paths
 from cell.planning.curves.split import seam_of
 from cell.planning.failures import SeamFailure, reason_text
 from cell.planning.order import seam_order
@@ -115,10 +115,7 @@ def plan_welds(
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
     curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
     to_search = [e for e in found_curves if e.id in curve_ids]
-    one_piece = search_curves(to_search, searches, q0, curve_procs)
-    solved |= {cid: (res,) for cid, res in one_piece.items() if isinstance(res, SeamSolution)}
-    missed = {cid: res for cid, res in one_piece.items() if isinstance(res, SeamFailure)}
-    arcs, still = split_failed(to_search, missed, searches, q0, curve_procs)  # reachable arcs, or why not
+    arcs, still = cover_curves(to_search, searches, q0, curve_procs)  # one go or overlapping arcs, or why not
     for cid, res in still.items():
         outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
     for aid, sol in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
@@ -193,7 +190,7 @@ def plan_welds(
         sid = seam_of(aid)
         if sid not in outcomes or not outcomes[sid].feasible:
             n = sum(seam_of(a) == sid for a in solved)
-            outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs")
+            outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs" if n > 1 else "")
     return WeldPlan(
         joint_names=robot.joint_names,
         q_home=readonly(q0),

@@ -1,10 +1,11 @@
 """A curved seam planned from its reach map (cell/planning/curves/reach.py, arcs.py): the fewest stretches that
 cover a loop with the restart overlap, the share of a loop no setting reaches, and on the KR 5 arc a tube's foot
 welded whole (its arcs' torch on the circle, covering it with the overlap) or, with a gusset across it, refused
-with the share reached."""
+with the share reached; a second pass laid and measured at its offset."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -20,10 +21,12 @@ from cell.planning.curves.arcs import plan_arcs
 from cell.planning.curves.reach import Run, cover, share
 from cell.planning.plan import reach_model
 from cell.planning.seam_search import SeamSearch
+from cell.process.curve_quality import pass_truth
 from cell.process.torch import WeldProcess
 from cell.process.torch_orientations import Candidate
 from cell.types import Box, Part, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.procedure import WeldPass, WeldProcedure
 
 OVERLAP_M = 0.01
 C0 = Candidate(False, 0.0, 0.0, 0.0)
@@ -40,7 +43,7 @@ def test_the_fewest_stretches_cover_the_loop_each_restarting_over_the_last() -> 
     runs = [_run(0.0, 0.3), _run(0.25, 0.7, C1), _run(0.6, 0.95), _run(0.65, 1.05), _run(0.1, 0.2)]
     got = cover(runs, 1.0, True, OVERLAP_M, 4)
     assert got is not None and len(got) == 3
-    for prev, nxt in zip(got, got[1:], strict=False):
+    for prev, nxt in itertools.pairwise(got):
         assert nxt.a_m <= prev.b_m - OVERLAP_M + 1e-9  # each restarts on the last bead by the overlap
     assert got[-1].b_m >= got[0].a_m + 1.0 + OVERLAP_M - 1e-9  # and the last runs on over the first's start
 
@@ -74,32 +77,49 @@ def _foot(n: int = 200) -> CurveEstimate:
                          np.full(n, 1e-4), (0.0, 0.0), 1.0)  # fmt: skip
 
 
-def _search(*parts: Part) -> SeamSearch:
+def _search(*parts: Part, spec: sc.ProcessSpec | None = None) -> SeamSearch:
     robot = RobotModel.from_urdf(URDF)
     opt = PlanOptions()
-    tube = Part("TUBE", Box(make_pose(p=CENTRE_R + [0.0, 0.0, 0.1]), np.array([0.05, 0.05, 0.2])))
+    tube = Part("TUBE", Box(make_pose(p=CENTRE_R + np.array([0.0, 0.0, 0.1])), np.array([0.05, 0.05, 0.2])))
     checker = CollisionChecker(robot, (TABLE, tube, *parts), opt.collision)
-    process = WeldProcess.from_spec(sc.ProcessSpec())
+    process = WeldProcess.from_spec(spec or sc.ProcessSpec())
     return SeamSearch(robot, process, checker, opt, np.random.default_rng(0), reach_model(robot))
 
 
-def test_a_tube_foot_is_welded_whole_in_overlapping_arcs_on_the_circle() -> None:
+def test_a_tube_foot_is_welded_whole_in_overlapping_arcs_each_pass_at_its_offset() -> None:
     est = _foot()
-    got = plan_arcs(_search(), est, HOME)
+    cap = WeldPass(lateral_mm=1.5, lift_mm=2.0, travel_speed_mm_s=6.0)
+    got = plan_arcs(_search(), est, HOME, WeldProcedure(name="two passes", passes=(WeldPass(), cap)))
     assert got.whole and got.share == 1.0 and 1 <= len(got.arcs) <= 4
     covered = np.zeros(180, dtype=bool)  # 2 deg bins
-    for arc, sol in got.arcs:
-        tip = sol.X_weld[:, :3, 3] - CENTRE_R
-        assert np.allclose(np.linalg.norm(tip[:, :2], axis=1), R_M, atol=2e-4)  # the torch on the circle
+    for arc, (root, second) in got.arcs:
+        tip = root.X_weld[:, :3, 3] - CENTRE_R
+        assert np.allclose(np.linalg.norm(tip[:, :2], axis=1), R_M, atol=2e-4)  # the root pass on the circle
         assert np.allclose(tip[:, 2], 0.0, atol=2e-4)
+        # the cap pass in the local cross-section: 1.5 mm across the 45 deg bisector towards the tube, 2 mm up it
+        off = second.X_weld[:, :3, 3] - CENTRE_R
+        radial = np.linalg.norm(off[:, :2], axis=1) - R_M
+        assert np.allclose(radial, (2.0 - 1.5) * math.sqrt(0.5) * 1e-3, atol=2e-4)
+        assert np.allclose(off[:, 2], (2.0 + 1.5) * math.sqrt(0.5) * 1e-3, atol=2e-4)
         ang = np.degrees(np.arctan2(arc.p_RS[:, 1] - CENTRE_R[1], arc.p_RS[:, 0] - CENTRE_R[0]))
         covered[np.mod(np.floor(ang / 2.0).astype(int), 180)] = True
     assert covered.all()
     assert sum(a.length_m for a, _ in got.arcs) >= est.length_m + OVERLAP_M - 1e-3
 
 
+def test_a_pass_is_measured_against_the_true_curve_moved_by_its_offset() -> None:
+    est = _foot()
+    truth = np.asarray(est.p_RS)
+    moved = pass_truth(truth, est.p_RS, est.n_abutting_R, est.n_receiving_R, 0.0015, 0.002)
+    radial = np.linalg.norm((moved - CENTRE_R)[:, :2], axis=1) - R_M
+    assert np.allclose(radial, 0.5e-3 * math.sqrt(0.5), atol=1e-5)
+    assert np.allclose(moved[:, 2], 3.5e-3 * math.sqrt(0.5), atol=1e-5)
+    assert pass_truth(truth, est.p_RS, est.n_abutting_R, est.n_receiving_R, 0.0, 0.0) is truth
+
+
 def test_a_gusset_across_the_foot_is_refused_with_the_share_reached() -> None:
-    gusset = Part("GUSSET", Box(make_pose(p=CENTRE_R + [0.0, 0.09, 0.05]), np.array([0.008, 0.1, 0.1])))
-    got = plan_arcs(_search(gusset), _foot(), HOME)
+    gusset = Part("GUSSET", Box(make_pose(p=CENTRE_R + np.array([0.0, 0.09, 0.05])), np.array([0.008, 0.1, 0.1])))
+    stiff = sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0)  # the nominal angles only: quicker
+    got = plan_arcs(_search(gusset, spec=stiff), _foot(), HOME)
     assert not got.whole and got.failure is not None
     assert 0.6 < got.share < 1.0

@@ -7,6 +7,7 @@ Frames: everything in the robot base frame R [m]; joints [rad]."""
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import replace
 
 import numpy as np
@@ -15,7 +16,7 @@ from cell.errors import IKError
 from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
 from cell.planning.curves.path import curve_path, curve_poses
-from cell.planning.curves.reach import Run, cover, reach_map, settings, share, station_spacing
+from cell.planning.curves.reach import Miss, Run, cover, reach_map, settings, share, station_spacing
 from cell.planning.curves.search import _flange_axes, _Preview, _solved, _turns, curve_task, knot_spacing
 from cell.planning.curves.split import MAX_ARCS, Split, sub_arc
 from cell.planning.curves.weave import woven
@@ -35,9 +36,10 @@ def plan_arcs(
     search: SeamSearch, est: CurveEstimate, q_seed: FloatArray, procedure: WeldProcedure | None = None
 ) -> Split:
     """The arcs that weld ``est`` whole (a closed curve all round and over its overlap; an open one end to end),
-    fewest first, at most :data:`MAX_ARCS`, each solved (:class:`SeamSolution`, its task an open arc of the
-    curve, id ``<seam>#arcK``); else the share of the curve some torch setting reaches and the failure of the
-    arc that got furthest. The map walks the nominal angles first, then the tolerance's widened ones."""
+    fewest first, at most :data:`MAX_ARCS`, each solved (a :class:`SeamSolution` per pass of ``procedure``, its
+    task an open arc of the curve, id ``<seam>#arcK``); else the share of the curve some torch setting reaches
+    and the failure of the arc that got furthest. The map walks the nominal angles first, then the tolerance's
+    widened ones."""
     pr, opt = search.process, search.opt
     knot = knot_spacing(est, opt.spacing)
     if procedure is not None:
@@ -46,14 +48,17 @@ def plan_arcs(
     probe = curve_path(est, station_spacing(est))
     flange = _flange_axes(search, q_seed, curve_poses(probe, pr)[:, :3, 2])
     runs: list[Run] = []
+    misses: list[Miss] = []
     failure: SeamFailure | None = None
-    for widened in (False, True):
-        runs += reach_map(search, est, settings(search, widened), flange, q_seed, knot, overlap)
+    stiff = pr.work_angle_tol <= 0.0 and pr.travel_angle_tol <= 0.0  # no angle to widen
+    for widened in (False,) if stiff else (False, True):
+        got_runs, got_misses = reach_map(search, est, settings(search, widened), flange, q_seed, knot, overlap)
+        runs, misses = runs + got_runs, misses + got_misses
         for _ in range(TRIES):
             chosen = cover(runs, est.length_m, est.closed, overlap, MAX_ARCS)
             if chosen is None:
                 break
-            solved: list[tuple[CurveEstimate, SeamSolution]] = []
+            solved: list[tuple[CurveEstimate, tuple[SeamSolution, ...]]] = []
             for k, run in enumerate(chosen, 1):
                 arc = sub_arc(est, run.a_m, run.b_m, k)
                 got = _arc_solution(search, arc, run, flange, knot, procedure)
@@ -66,9 +71,7 @@ def plan_arcs(
                 return Split(tuple(solved), 1.0, None)
     reached = share(runs, est.length_m, est.closed)
     if failure is None:
-        where = "no torch setting holds it (IK, collisions, singular)" if not runs else _gap(runs, est)
-        code = PlanReason.IK_FAILED if not runs else PlanReason.COLLISION
-        failure = SeamFailure(code, where, np.asarray(est.p_RS[0]), 0.0)
+        failure = _gap(runs, misses, est)
     return Split((), reached, failure)
 
 
@@ -94,8 +97,10 @@ def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
     return [replace(run, a_m=run.a_m + cut_start, b_m=run.b_m - cut_end)]
 
 
-def _gap(runs: list[Run], est: CurveEstimate) -> str:
-    """Words for the part of ``est`` no stretch holds: where its widest gap starts."""
+def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate) -> SeamFailure:
+    """The failure for a curve no cover of stretches welds: where its widest stretch no setting holds starts, how
+    long it is and what stops the settings there (the commonest reason of the stations in it: its code); with
+    every point held, that no :data:`MAX_ARCS` arcs overlap by the restart overlap all round."""
     total = est.length_m
     bins = np.zeros(max(1, math.ceil(total / 0.001)), dtype=bool)
     for r in runs:
@@ -103,8 +108,16 @@ def _gap(runs: list[Run], est: CurveEstimate) -> str:
         bins[np.mod(idx, len(bins)) if est.closed else idx[(idx >= 0) & (idx < len(bins))]] = True
     free = np.flatnonzero(~bins)
     if len(free) == 0:
-        return f"no {MAX_ARCS} arcs overlap all round"
-    return f"no torch setting holds it from {free[0]:.0f} mm along it ({(~bins).sum():.0f} mm unreached)"
+        where = f"every point is held, but by stretches too short for {MAX_ARCS} arcs to overlap all round"
+        return SeamFailure(PlanReason.COLLISION if misses else PlanReason.IK_FAILED, where, est.p_RS[0], 0.0)
+    lo, hi = free[0] * 0.001, (free[0] + (~bins).sum()) * 0.001
+    there = [m for m in misses if lo - 0.01 <= m.at_m <= hi + 0.01] or misses
+    counts = Counter((m.code, m.what) for m in there).most_common(2)
+    why = ", ".join(f"{k} of {len(there)} tries {w or c.value}" for (c, w), k in counts) or "no setting tried"
+    where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(~bins).sum():.0f} mm unreached; {why})"
+    code = counts[0][0][0] if counts else PlanReason.IK_FAILED
+    p = est.p_RS[min(int(np.searchsorted(np.linspace(0, total, len(est.p_RS)), lo)), len(est.p_RS) - 1)]
+    return SeamFailure(code, where, np.asarray(p), 0.0)
 
 
 def _arc_solution(
@@ -114,21 +127,35 @@ def _arc_solution(
     flange: tuple[FloatArray, FloatArray],
     knot: float,
     procedure: WeldProcedure | None,
-) -> SeamSolution | SeamFailure:
-    """One arc (an open piece of the curve) solved with the torch setting ``run`` held along it: IK at its weld
-    start from the map's, A4 and A6 turned whole turns to centre their travel, then the straight search's full
-    solve with its approach and depart (shortened where they fail)."""
+) -> tuple[SeamSolution, ...] | SeamFailure:
+    """One arc (an open piece of the curve) solved with the torch setting ``run`` held along it, one solution per
+    pass of ``procedure`` (each at its offset and weave in the local cross-section, seeded by the pass before): IK
+    at its weld start from the map's, A4 and A6 turned whole turns to centre their travel, then the straight
+    search's full solve with its approach and depart (shortened where they fail)."""
     c, pr = run.cand, search.process
     path = curve_path(arc, knot, reverse=c.reversed)
-    X = curve_poses(path, pr, spin=c.spin, work_offset=c.work_offset, travel_offset=c.travel_offset, flange=flange)
-    X = woven(X, path, procedure)
+    X0 = curve_poses(path, pr, spin=c.spin, work_offset=c.work_offset, travel_offset=c.travel_offset, flange=flange)
     task = curve_task(arc.id, path)
-    try:
-        q0 = np.asarray(solve_ik(search.robot, X[0], run.q_start, options=search.opt.ik))
-    except IKError as exc:
-        return unreachable(exc, X[0], 0.0, 0.0)
-    q0 = q0 + _turns(_travel(search, X, q0), search.window.center, search.robot.limits)
-    return _solved(search, _Preview(c, task, X, readonly(q0), 0.0, 1.0))
+    out: list[SeamSolution] = []
+    for k in range(len(procedure.passes) if procedure is not None else 1):
+        X = woven(X0, path, procedure, k)
+        seed = out[-1].q_weld[0] if out else run.q_start
+        try:
+            q0 = np.asarray(solve_ik(search.robot, X[0], seed, options=search.opt.ik))
+        except IKError as exc:
+            return _pass(unreachable(exc, X[0], 0.0, 0.0), k)
+        if not out:
+            q0 = q0 + _turns(_travel(search, X, q0), search.window.center, search.robot.limits)
+        got = _solved(search, _Preview(c, task, X, readonly(q0), 0.0, 1.0))
+        if isinstance(got, SeamFailure):
+            return _pass(got, k)
+        out.append(got)
+    return tuple(out)
+
+
+def _pass(failure: SeamFailure, k: int) -> SeamFailure:
+    """A failure named by its pass (beyond the root)."""
+    return replace(failure, where=f"pass {k + 1}: {failure.where}") if k else failure
 
 
 def _travel(search: SeamSearch, X: FloatArray, q0: FloatArray) -> FloatArray:

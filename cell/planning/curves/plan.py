@@ -49,12 +49,15 @@ def curve_procedures(
     return out
 
 
-def with_paths(segments: Sequence[Segment], paths: Mapping[str, npt.ArrayLike]) -> list[Segment]:
-    """The segments with each curved seam's weld carrying its planned TCP poses (``X_path``, (n, 4, 4) in R)."""
-    return [
-        replace(s, X_path=readonly(np.asarray(paths[s.seam_id]))) if s.kind == "weld" and s.seam_id in paths else s
-        for s in segments
-    ]
+def with_paths(segments: Sequence[Segment], paths: Mapping[str, Sequence[npt.ArrayLike]]) -> list[Segment]:
+    """The segments with each curved seam's welds carrying their planned TCP poses (``X_path``, (n, 4, 4) in R;
+    ``paths``: seam id -> one per pass, the k-th weld of the seam the k-th pass's)."""
+    out: list[Segment] = []
+    for s in segments:
+        if s.kind == "weld" and s.seam_id in paths:
+            s = replace(s, X_path=readonly(np.asarray(paths[s.seam_id][s.pass_index])))
+        out.append(s)
+    return out
 
 
 def cover_curves(
@@ -62,15 +65,15 @@ def cover_curves(
     make_search: Mapping[str, SeamSearch],
     q_seed: npt.ArrayLike,
     procedures: Mapping[str, WeldProcedure] | None = None,
-) -> tuple[dict[str, SeamSolution], dict[str, SeamFailure]]:
+) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure]]:
     """Each curve planned from its reach map (:func:`cell.planning.curves.arcs.plan_arcs`: one go where a torch
     setting holds all round, else the fewest overlapping arcs), with its own search and procedure from q_seed
-    (dof,) [rad]. Returns (arc id -> its solution, for the seams covered whole; seam id -> its failure, for the
-    others: where no arc reaches, with the share of the curve the arm reaches in its words)."""
+    (dof,) [rad]. Returns (arc id -> its solutions, one per pass, for the seams covered whole; seam id -> its
+    failure, for the others: where no arc reaches, with the share of the curve the arm reaches in its words)."""
     from cell.planning.curves.arcs import plan_arcs
 
     q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
-    arcs: dict[str, SeamSolution] = {}
+    arcs: dict[str, tuple[SeamSolution, ...]] = {}
     still: dict[str, SeamFailure] = {}
     for c in curves:
         got = plan_arcs(make_search[c.id], c, q0, procs.get(c.id))

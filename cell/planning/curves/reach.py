@@ -19,6 +19,7 @@ from cell.planning.curves.path import CurvePath, curve_path, curve_poses
 from cell.planning.seam_search import SeamSearch
 from cell.process.torch_orientations import Candidate
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import PlanReason
 
 STATION_M = 0.008  # [m] the reach map's stations at most this far apart along the curve
 STATION_TURN = math.radians(8.0)  # [rad] and closer where the tangent would turn more than this between two
@@ -72,16 +73,33 @@ def settings(search: SeamSearch, widened: bool) -> list[Candidate]:
     return [Candidate(r, s, w, a) for w, a in angles for r in directions for s in spins]
 
 
-def _fresh(search: SeamSearch, X: FloatArray, seeds: Sequence[FloatArray]) -> FloatArray | None:
-    """IK at X (4, 4) from each seed in turn, the first clear of the parts and the arm itself and not singular."""
+@dataclass(frozen=True)
+class Miss:
+    """A station where a torch setting could not start a stretch: ``at_m`` [m] along the located curve, ``code``
+    why (IK, the arm against a part or itself, singular) and ``what`` (the bodies that met; "" otherwise)."""
+
+    at_m: float
+    code: PlanReason
+    what: str = ""
+
+
+def _fresh(search: SeamSearch, X: FloatArray, seeds: Sequence[FloatArray]) -> FloatArray | Miss:
+    """IK at X (4, 4) from each seed in turn, the first clear of the parts and the arm itself and not singular;
+    else why not (the last seed's, a collision's or singularity's before an IK failure's; ``at_m`` unset)."""
+    miss = Miss(0.0, PlanReason.IK_FAILED)
     for seed in seeds:
         try:
-            q = solve_ik(search.robot, X, seed, options=search.opt.ik)
+            q = np.asarray(solve_ik(search.robot, X, seed, options=search.opt.ik))
         except IKError:
             continue
-        if _fits(search, q):
-            return np.asarray(q)
-    return None
+        hit = search.checker.check(q)
+        if hit is not None:
+            miss = Miss(0.0, PlanReason.COLLISION, f"{hit.a} vs {hit.b}")
+        elif search.robot.manipulability(q) < search.opt.min_manipulability:
+            miss = Miss(0.0, PlanReason.SINGULAR)
+        else:
+            return q
+    return miss
 
 
 def _next(search: SeamSearch, X: FloatArray, q_prev: FloatArray, max_step: float) -> FloatArray | None:
@@ -114,13 +132,15 @@ def walk(
     q_seed: FloatArray,
     max_step: float,
     overlap_stations: int,
+    misses: list[Miss],
 ) -> list[Run]:
     """The stretches ``cand`` holds along the stations of ``path`` (the whole located curve from its first sample,
     in the candidate's direction, stations evenly spaced; a closed curve's last point is its first): IK at each
     station warm-started from the last, a stretch broken where IK fails, the arm meets a part or itself, it is
     singular, a joint steps more than ``max_step`` [rad] or A4/A6 would wind beyond their limits; restarted
     afresh at the next station. A closed curve's last stretch is walked on round its start; one that comes all
-    round and ``overlap_stations`` more is ``whole``."""
+    round and ``overlap_stations`` more is ``whole``. Each station where no stretch could start is added to
+    ``misses``."""
     X = curve_poses(path, search.process, spin=cand.spin, work_offset=cand.work_offset,
                     travel_offset=cand.travel_offset, flange=flange)  # fmt: skip
     n = len(X) - 1 if est.closed else len(X)
@@ -158,13 +178,15 @@ def walk(
                 if est.closed and k >= n:
                     break
         if q_prev is None:
-            q = _fresh(search, Xk, seeds)
-            if q is None:
+            got = _fresh(search, Xk, seeds)
+            if isinstance(got, Miss):
+                at = total - (k % n) * step if cand.reversed else (k % n) * step
+                misses.append(replace(got, at_m=at % total if est.closed else at))
                 k += 1
                 if est.closed and k >= n:
                     break
                 continue
-            start, q_first = k, q
+            q, start, q_first = got, k, got
             wind, lo, hi = np.zeros(2), np.zeros(2), np.zeros(2)
         q_prev = q
         if est.closed and k == n - 1 and start >= 0:
@@ -182,17 +204,19 @@ def reach_map(
     q_seed: FloatArray,
     knot_m: float,
     overlap_m: float,
-) -> list[Run]:
+) -> tuple[list[Run], list[Miss]]:
     """Every stretch each of ``cands`` holds along ``est`` (:func:`walk`), stations :func:`station_spacing`
-    apart; the flip bound scaled from IK knots ``knot_m`` [m] apart to the stations' spacing."""
+    apart, and every station where one could not start; the flip bound scaled from IK knots ``knot_m`` [m] apart
+    to the stations' spacing."""
     spacing = station_spacing(est)
     paths = {rev: curve_path(est, spacing, reverse=rev) for rev in {c.reversed for c in cands}}
     max_step = min(MAX_JUMP, JUMP_FACTOR * search.opt.max_joint_step * max(1.0, spacing / knot_m))
     over = math.ceil(overlap_m / spacing) if est.closed else 0
     runs: list[Run] = []
+    misses: list[Miss] = []
     for c in cands:
-        runs += walk(search, est, c, paths[c.reversed], flange, q_seed, max_step, over)
-    return runs
+        runs += walk(search, est, c, paths[c.reversed], flange, q_seed, max_step, over, misses)
+    return runs, misses
 
 
 def cover(runs: Sequence[Run], total: float, closed: bool, overlap: float, max_arcs: int) -> list[Run] | None:

@@ -25,10 +25,10 @@ ARC_MARK = "#arc"  # an arc's id: its seam's id, this mark and its number from 1
 @dataclass(frozen=True)
 class Split:
     """The arcs found for one curved seam: each arc's estimate (an open piece of the curve, id ``<seam>#arcK``) and
-    solution, in weld order; ``share`` the part of the curve they cover (1: the whole seam); ``failure`` the
-    search's word on the part no arc reaches (None when covered)."""
+    solutions (one per pass), in weld order; ``share`` the part of the curve they cover (1: the whole seam);
+    ``failure`` the search's word on the part no arc reaches (None when covered)."""
 
-    arcs: tuple[tuple[CurveEstimate, SeamSolution], ...]
+    arcs: tuple[tuple[CurveEstimate, tuple[SeamSolution, ...]], ...]
     share: float
     failure: SeamFailure | None
 

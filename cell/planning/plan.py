@@ -20,7 +20,7 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
-from cell.planning.curves import cover_curves, curve_pieces, weldable, with_paths
+from cell.planning.curves import cover_curves, curve_pieces, weldable, whole_or_none, with_paths
 from cell.planning.curves.split import seam_of
 from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
@@ -148,6 +148,7 @@ def plan_welds(
             outcomes[sid] = _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
             continue
         seam_parts[sid] = parts
+    whole_or_none(solved, outcomes, seam_parts)
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
     lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
@@ -168,6 +169,7 @@ def plan_welds(
         direction = "to" if b else "from"
         detail = f"no free transfer move {direction} the seam: {why.reason}"
         outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
+        whole_or_none(solved, outcomes)  # a seam's other arcs with it
     if opt.blend > 0.0:
         segments = blend_plan(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt

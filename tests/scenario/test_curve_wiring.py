@@ -44,9 +44,10 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> dict:
 
 
 def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_the_planners_code(report: dict) -> None:
-    """The post's fillet is located and tried, in one go then in arcs; arcs reach most of it but not all, so it
-    is not welded: the planner's code, the share in its reason, counted in the summary and the programs' header,
-    the run partial."""
+    """The post's fillet (its near side 0.72 m from the base, where the arm folds on itself) is located and tried
+    from its reach map: the arcs that cover it cannot all be reached (the arm's move into one collides), or no
+    cover exists, so it is not welded: the planner's code, the failing arc or the share reached in its reason,
+    counted in the summary and the programs' header, the run partial."""
     from cell.cli.turnover import not_welded
 
     run, rep = report["run"], report["rep"]
@@ -56,10 +57,13 @@ def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_the_planners
     entry = next(s for s in rep["seams"] if s["id"] == SEAM)
     w = det.curve_welds[SEAM]
     assert not w.welded and not entry["welded"] and "tcp_error_mm" not in entry
-    assert entry["weld_reason_code"] == "not_planned" and entry["plan_reason_code"] in ("ik_failed", "flip")
-    assert "arcs would reach" in entry["weld_reason"]  # the split's word: most of it, not all
-    share = float(entry["weld_reason"].split("would reach ")[1].split("%")[0])
-    assert 50.0 < share < 100.0
+    assert entry["weld_reason_code"] == "not_planned"
+    assert entry["plan_reason_code"] in ("ik_failed", "flip", "collision", "transfer_collision")
+    why = entry["weld_reason"]
+    if "the arm reaches" in why:  # no cover: the share of it some torch setting holds
+        assert 50.0 < float(why.split("the arm reaches ")[1].split("%")[0]) < 100.0
+    else:  # covered, but one arc fails after the search: named, and the seam's other arcs left out with it
+        assert why.split(": ")[0].startswith("arc ") and not [g for g in run.plan.segments if g.seam_id == SEAM]
     assert entry["not_welded"]["code"] == entry["plan_reason_code"] != "curved_no_torch_path"
     assert rep["summary"]["curved"] | {"rms_max_mm": 0, "max_mm": 0} == {
         "seams": 1, "found": 1, "welded": 0, "not_welded": {entry["plan_reason_code"]: 1}, "rms_max_mm": 0, "max_mm": 0

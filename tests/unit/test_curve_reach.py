@@ -123,3 +123,18 @@ def test_a_gusset_across_the_foot_is_refused_with_the_share_reached() -> None:
     got = plan_arcs(_search(gusset, spec=stiff), _foot(), HOME)
     assert not got.whole and got.failure is not None
     assert 0.6 < got.share < 1.0
+
+
+def test_a_seam_is_welded_in_arcs_whole_or_not_at_all() -> None:
+    from cell.planning.curves import whole_or_none
+    from cell.types.plan import PlanReason, SeamOutcome
+
+    seam = "TUBE>TABLE:circle"
+    solved = {f"{seam}#arc1": 1, f"{seam}#arc3": 3, "OTHER": 0}
+    parts = dict(solved)
+    outcomes = {f"{seam}#arc2": SeamOutcome(f"{seam}#arc2", False, "timing: A1 too fast", np.zeros(3),
+                                            code=PlanReason.TIMING)}  # fmt: skip
+    whole_or_none(solved, outcomes, parts)
+    assert solved == parts == {"OTHER": 0}  # the seam's other arcs dropped with the failed one
+    assert list(outcomes) == [seam] and not outcomes[seam].feasible
+    assert outcomes[seam].code is PlanReason.TIMING and outcomes[seam].reason.startswith("arc 2: timing")

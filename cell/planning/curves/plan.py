@@ -8,17 +8,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import readonly
+from cell.planning.curves.split import ARC_MARK, seam_of
 from cell.planning.failures import SeamFailure
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.procedures import UP_R, select_procedure
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.plan import NoProcedure, SeamProcedure, SeamTask, Segment
+from cell.types.plan import NoProcedure, SeamOutcome, SeamProcedure, SeamTask, Segment
 from cell.types.procedure import WeldProcedure
 
 
@@ -84,3 +86,19 @@ def cover_curves(
         assert f is not None
         still[c.id] = replace(f, where=f"{f.where} (the arm reaches {got.share:.0%} of it, not all)")
     return arcs, still
+
+
+def whole_or_none(solved: dict[str, Any], outcomes: dict[str, SeamOutcome], *others: dict[str, Any]) -> None:
+    """A seam welded in arcs is welded whole or not at all: where one of its arcs failed after the search (its
+    timing, a transfer to or from it: its outcome in ``outcomes`` under the arc's id), its other arcs leave
+    ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc."""
+    for aid, o in list(outcomes.items()):
+        sid = seam_of(aid)
+        if sid == aid or o.feasible:
+            continue
+        for other in [a for a in solved if seam_of(a) == sid]:
+            solved.pop(other)
+            for d in others:
+                d.pop(other, None)
+        del outcomes[aid]
+        outcomes[sid] = replace(o, seam_id=sid, reason=f"arc {aid.rsplit(ARC_MARK, 1)[1]}: {o.reason}")

@@ -12,17 +12,29 @@ from dataclasses import replace
 
 import numpy as np
 
-from cell.errors import IKError
+from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
-from cell.planning.curves.path import curve_path, curve_poses
-from cell.planning.curves.reach import Miss, Run, cover, reach_map, settings, share, station_spacing
-from cell.planning.curves.search import _flange_axes, _Preview, _solved, _turns, curve_task, knot_spacing
+from cell.planning.curves.path import CurvePath, curve_path, curve_poses
+from cell.planning.curves.reach import Miss, Run, balanced, cover, reach_map, settings, share, station_spacing
+from cell.planning.curves.search import (
+    CurveTask,
+    _flange_axes,
+    _Preview,
+    _preview,
+    _solved,
+    _turns,
+    curve_task,
+    knot_spacing,
+)
 from cell.planning.curves.split import MAX_ARCS, Split, sub_arc
+from cell.planning.curves.timing import curve_lines
 from cell.planning.curves.weave import woven
 from cell.planning.failures import SeamFailure, better, unreachable
 from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.transfers import Piece
 from cell.process.weave import knot_spacing as weave_spacing
+from cell.process.weave import pass_speed
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.plan import PlanReason
 from cell.types.procedure import WeldProcedure
@@ -59,12 +71,13 @@ def plan_arcs(
             if chosen is None:
                 break
             solved: list[tuple[CurveEstimate, tuple[SeamSolution, ...]]] = []
-            for k, run in enumerate(chosen, 1):
-                arc = sub_arc(est, run.a_m, run.b_m, k)
-                got = _arc_solution(search, arc, run, flange, knot, procedure)
+            arcs = balanced(chosen, est.length_m, est.closed, overlap)
+            for k, (run, part) in enumerate(zip(chosen, arcs, strict=True), 1):
+                arc = sub_arc(est, part.a_m, part.b_m, k)
+                got = _arc_solution(search, arc, part, flange, knot, procedure)
                 if isinstance(got, SeamFailure):
                     failure = better(failure, got)
-                    runs = [r for r in runs if not _same(r, run)] + _trimmed(run, got, arc)
+                    runs = [r for r in runs if not _same(r, run, est.length_m)] + _trimmed(part, got, arc)
                     break
                 solved.append((arc, got))
             else:
@@ -75,8 +88,9 @@ def plan_arcs(
     return Split((), reached, failure)
 
 
-def _same(a: Run, b: Run) -> bool:
-    return a.cand == b.cand and abs(a.length - b.length) < 1e-9 and abs(math.remainder(a.a_m - b.a_m, 1.0)) < 1e-9
+def _same(a: Run, b: Run, total: float) -> bool:
+    """Whether two stretches are one (the cover's copy a lap on)."""
+    return a.cand == b.cand and abs(a.length - b.length) < 1e-9 and abs(math.remainder(a.a_m - b.a_m, total)) < 1e-9
 
 
 def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
@@ -128,14 +142,35 @@ def _arc_solution(
     knot: float,
     procedure: WeldProcedure | None,
 ) -> tuple[SeamSolution, ...] | SeamFailure:
-    """One arc (an open piece of the curve) solved with the torch setting ``run`` held along it, one solution per
+    """One arc (an open piece of the curve) solved with the torch setting ``run`` held along it (its spin first left
+    to the arm where the process leaves it free, as the one-go search does), one solution per
     pass of ``procedure`` (each at its offset and weave in the local cross-section, seeded by the pass before): IK
     at its weld start from the map's, A4 and A6 turned whole turns to centre their travel, then the straight
-    search's full solve with its approach and depart (shortened where they fail)."""
+    search's full solve with its approach and depart (shortened where they fail) and the weld timed at its travel
+    speed (a TIMING failure, at progress 0, drops the stretch)."""
     c, pr = run.cand, search.process
     path = curve_path(arc, knot, reverse=c.reversed)
     X0 = curve_poses(path, pr, spin=c.spin, work_offset=c.work_offset, travel_offset=c.travel_offset, flange=flange)
     task = curve_task(arc.id, path)
+    if pr.spin_tol >= math.pi - 1e-9:  # the spin free: first as the arm takes it (the least joint motion)
+        free = _preview(search, task, c, X0, run.q_start, search._reference(run.q_start), True)
+        if not isinstance(free, SeamFailure):
+            got = _passes(search, task, free.X, path, run, procedure)
+            if not isinstance(got, SeamFailure):
+                return got
+    return _passes(search, task, X0, path, run, procedure)
+
+
+def _passes(
+    search: SeamSearch,
+    task: CurveTask,
+    X0: FloatArray,
+    path: CurvePath,
+    run: Run,
+    procedure: WeldProcedure | None,
+) -> tuple[SeamSolution, ...] | SeamFailure:
+    """Every pass of ``procedure`` along the root poses X0 (n, 4, 4), solved and timed (:func:`_arc_solution`)."""
+    c, pr = run.cand, search.process
     out: list[SeamSolution] = []
     for k in range(len(procedure.passes) if procedure is not None else 1):
         X = woven(X0, path, procedure, k)
@@ -149,8 +184,30 @@ def _arc_solution(
         got = _solved(search, _Preview(c, task, X, readonly(q0), 0.0, 1.0))
         if isinstance(got, SeamFailure):
             return _pass(got, k)
+        speed = pass_speed(procedure, k) if procedure is not None else pr.travel_speed
+        try:  # a joint over its velocity limit at the travel speed (a wrist near its singularity): not this arc
+            pieces = curve_lines(search.robot, replace(pr, travel_speed=speed), search.opt, got)
+        except TimingError as exc:
+            return _pass(SeamFailure(PlanReason.TIMING, exc.message, X[0][:3, 3].copy(), 0.0), k)
+        singular = _singular(search, pieces, task.length)
+        if singular is not None:
+            return _pass(singular, k)
         out.append(got)
     return tuple(out)
+
+
+def _singular(search: SeamSearch, pieces: list[Piece], length: float) -> SeamFailure | None:
+    """The first place the timed approach, weld or depart passes nearer a singularity than the safety gate allows
+    (every 10th sample of the timed motion, as the gate samples it; between the IK knots too), or None; its
+    progress beyond the curve for the approach or depart (their end trimmed), 0 for the weld (dropped)."""
+    for piece in pieces:
+        for q in piece.trajectory.q[::10]:
+            m = search.robot.manipulability(q)
+            if m < search.opt.min_manipulability:
+                where = f"manipulability {m:.4f} below {search.opt.min_manipulability:g} on the {piece.kind}"
+                p_R = search.robot.fk(q)[:3, 3].copy()
+                return SeamFailure(PlanReason.SINGULAR, where, p_R, 0.0 if piece.kind == "weld" else length)
+    return None
 
 
 def _pass(failure: SeamFailure, k: int) -> SeamFailure:

@@ -14,7 +14,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import readonly
-from cell.planning.curves.split import ARC_MARK, seam_of
+from cell.planning.curves.search import plan_curve
+from cell.planning.curves.split import ARC_MARK, arc_id, seam_of
 from cell.planning.failures import SeamFailure
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.procedures import UP_R, select_procedure
@@ -69,16 +70,24 @@ def cover_curves(
     procedures: Mapping[str, WeldProcedure] | None = None,
 ) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure]]:
     """Each curve planned from its reach map (:func:`cell.planning.curves.arcs.plan_arcs`: one go where a torch
-    setting holds all round, else the fewest overlapping arcs), with its own search and procedure from q_seed
-    (dof,) [rad]. Returns (arc id -> its solutions, one per pass, for the seams covered whole; seam id -> its
-    failure, for the others: where no arc reaches, with the share of the curve the arm reaches in its words)."""
+    setting holds all round, else the fewest overlapping arcs; an open one welded in one pass first by the one-go
+    search, :func:`cell.planning.curves.search.plan_curve`, whose ranked candidates follow it closest), with its
+    own search and procedure from q_seed (dof,) [rad]. Returns (arc id -> its solutions, one per pass, for the
+    seams covered whole; seam id -> its failure, for the others: where no arc reaches, with the share of the curve
+    the arm reaches in its words)."""
     from cell.planning.curves.arcs import plan_arcs
 
     q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
     arcs: dict[str, tuple[SeamSolution, ...]] = {}
     still: dict[str, SeamFailure] = {}
     for c in curves:
-        got = plan_arcs(make_search[c.id], c, q0, procs.get(c.id))
+        proc = procs.get(c.id)
+        if not c.closed and (proc is None or len(proc.passes) == 1):  # an open curve: the one-go search first
+            one = plan_curve(make_search[c.id], c, q0, proc)
+            if isinstance(one, SeamSolution):
+                arcs[arc_id(c.id, 1)] = (one,)
+                continue
+        got = plan_arcs(make_search[c.id], c, q0, proc)
         if got.whole:
             arcs |= {arc.id: sol for arc, sol in got.arcs}
             continue

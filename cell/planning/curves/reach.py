@@ -260,3 +260,20 @@ def share(runs: Sequence[Run], total: float, closed: bool) -> float:
         idx = np.mod(idx, len(bins)) if closed else idx[(idx >= 0) & (idx < len(bins))]
         bins[idx] = True
     return float(bins.mean())
+
+
+def balanced(chosen: Sequence[Run], total: float, closed: bool, overlap: float) -> list[Run]:
+    """A cover's arcs with each junction's spare overlap shared out: where two arcs overlap by more than
+    ``overlap`` [m] the first stops and the next starts half the excess back from their stretches' ends (a stretch
+    ends where its setting gives out, the arm at a limit: an arc should not start or stop there), as on a closed
+    curve the last one and the first (a lap on)."""
+    out = list(chosen)
+    n = len(out)
+    for i in range(n if closed else n - 1):
+        j = (i + 1) % n
+        lap = total if j == 0 else 0.0
+        excess = out[i].b_m - (out[j].a_m + lap) - overlap
+        if excess > 0.0:
+            out[i] = replace(out[i], b_m=out[i].b_m - 0.5 * excess)
+            out[j] = replace(out[j], a_m=out[j].a_m + 0.5 * excess)
+    return out

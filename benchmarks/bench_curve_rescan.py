@@ -111,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cells", type=int, default=40)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--scenarios", default=",".join(SCENARIOS))
-    ap.add_argument("--work", type=Path, default=Path("/tmp/bench_curve_rescan"), help="the random cells' folder")
+    ap.add_argument("--work", type=Path, default=tc.REPO / "runs" / "curve_rescan", help="the random cells' folder")
     ap.add_argument("--json", type=Path, default=RESULTS / "curve_rescan.json")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()

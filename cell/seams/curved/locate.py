@@ -221,9 +221,7 @@ def _curve(
         return _not_found(seam, f"its fitted surfaces meet {moved * 1000:.1f} mm from the drawn curve")
     k2 = SE_INFLATION**2
     da, db = dtheta(a.model, p, a.theta), dtheta(b.model, p, b.theta)
-    cov = crossing_covariance(
-        p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, (_bias(a, bias_share), _bias(b, bias_share))
-    )
+    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, (_bias(a, bias_share), _bias(b, bias_share)))
     sigma = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     closed = bool(getattr(seam.curve, "closed", False))
     keep = outside_parts(wm, p, own, OTHER_PART_M)

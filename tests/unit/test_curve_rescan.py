@@ -35,6 +35,36 @@ def test_the_close_ups_look_first_at_the_stretch_with_the_largest_sigma() -> Non
     assert a.min() - 1e-9 <= 2.0 <= a.max() + 1e-9
 
 
+def test_a_close_up_of_a_stretch_sees_both_faces_from_outside_the_tube_and_is_reached_without_collision() -> None:
+    from tiny_cell import HOME, TABLE, URDF
+
+    from cell.geometry import make_pose
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.robot import RobotModel
+    from cell.rescan.viewpoint import ViewOptions, plan_view
+    from cell.sim.camera import intrinsics_for
+    from cell.types import Box, Part
+
+    est = _tube_on_plate(r=0.05, n=360)  # a 100 mm tube's foot 0.9 m in front of the robot, on the table's top
+    near = est.p_RS[:, 1] < 0.9  # the half facing the robot doubtful
+    est = replace(est, sigma_m=np.where(near, 4e-4, 1e-4))
+    tube = Part("TUBE", Box(make_pose(p=[0.0, 0.9, 0.1]), np.array([0.1, 0.1, 0.2])))
+    robot = RobotModel.from_urdf(URDF)
+    checker = CollisionChecker(robot, (TABLE, tube))
+    K, opt = intrinsics_for(1280, 720, math.radians(65.0)), ViewOptions()
+    target = worst_first(est, 2e-4)[0]
+    vp = plan_view(robot, checker, target, HOME, K, (), 0.0, rng=np.random.default_rng(0), options=opt)
+    eye = vp.X_RC[:3, 3]
+    piece = np.all((est.p_RS >= np.minimum(target.p_start, target.p_end) - 1e-9)
+                   & (est.p_RS <= np.maximum(target.p_start, target.p_end) + 1e-9), axis=1) & near  # fmt: skip
+    assert piece.sum() >= 20
+    assert np.all(np.einsum("ij,ij->i", eye - est.p_RS[piece], est.n_abutting_R[piece]) > 0.0)  # outside the tube
+    assert np.all((eye - est.p_RS[piece]) @ [0.0, 0.0, 1.0] > 0.0)  # above the plate
+    assert max(vp.incidence_deg) <= opt.max_incidence_deg
+    np.testing.assert_allclose(robot.fk(vp.q, opt.camera_frame), vp.X_RC, atol=1e-6)  # reached
+    assert checker.check(vp.q) is None and checker.check_path(vp.move.q, vp.move.times) is None
+
+
 def _shifted(est: CurveEstimate, d_m: float, sigma_m: float) -> CurveEstimate:
     """``est`` moved up by ``d_m`` with every sample's sigma ``sigma_m``."""
     return replace(est, p_RS=est.p_RS + np.array([0.0, 0.0, d_m]), sigma_m=np.full(len(est.p_RS), sigma_m))

@@ -185,8 +185,6 @@ def rescan_seams(
     a seam id the detection does not have, ValueError for a detection without its scene. motion : the run's
     obstacles and checker (built here when not given).
     """
-    from cell.motion.timing import ptp
-    from cell.rescan.viewpoint import way_back
     from cell.seams.registry import make_locator
 
     sc = detection.scenario
@@ -217,25 +215,36 @@ def rescan_seams(
             progress(f"the same close-up sees {', '.join(r.id for r in got[1:])}: located there too")
         done.update((r.id, r) for r in got)
     results = [done[sid] for sid in seam_ids]
-    returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
-    if o.return_to_scan and not returned:
-        # Straight back when that is free; else back the way it came to the last view it can go straight from.
-        back = way_back(arm.model, checker, run.stops, np.asarray(arm.q_scan, dtype=float), o.view.dt)
-        if back is not None:
-            run.play(back)
-            returned = True
-        else:
-            direct = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
-            hit = checker.check_path(direct.q, direct.times)
-            note = f"left at the last view: no way back to the scan pose is free ({hit.describe() if hit else ''})"
-    elif not returned:
-        note = "left at the last view (return_to_scan is off)"
+    returned, note = back_to_scan(run)
     fused_by_id = {r.id: r.fused for r in results}
     estimates = tuple(fused_by_id.get(e.id, e) for e in detection.estimates)
     timings = {"rescan_s": time.perf_counter() - t_all}
     return Rescan(
         tuple(results), estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings
     )
+
+
+def back_to_scan(run: _Run) -> tuple[bool, str]:
+    """Take the arm back to the scan configuration after the close-ups (``options.return_to_scan``): straight when
+    that is free, else back the way it came to the last view it can go straight from. Whether it is there, and
+    why not."""
+    from cell.motion.timing import ptp
+    from cell.rescan.viewpoint import way_back
+
+    arm, o = run.arm, run.options
+    returned, note = bool(np.allclose(run.q, arm.q_scan)), ""
+    if o.return_to_scan and not returned:
+        back = way_back(arm.model, run.checker, run.stops, np.asarray(arm.q_scan, dtype=float), o.view.dt)
+        if back is not None:
+            run.play(back)
+            returned = True
+        else:
+            direct = ptp(run.q, arm.q_scan, arm.model.limits, dt=o.view.dt)
+            hit = run.checker.check_path(direct.q, direct.times)
+            note = f"left at the last view: no way back to the scan pose is free ({hit.describe() if hit else ''})"
+    elif not returned:
+        note = "left at the last view (return_to_scan is off)"
+    return returned, note
 
 
 def rescanned(detection: Detection, rescan: Rescan) -> Detection:

@@ -15,6 +15,7 @@ from cell.errors import CellError, PlanError, ScenarioError
 from cell.geometry import FloatArray
 from cell.journal import NO_LOG, SideLog
 from cell.pipeline.curved import curve_seam_welds, curves_to_plan
+from cell.pipeline.curved.rescan import curves_rescanned
 from cell.pipeline.detect import AlignStart, Progress, detect, quiet, read_weldmap
 from cell.pipeline.geometry import MotionScene, motion_scene, open_cell
 from cell.pipeline.job import WeldJob
@@ -237,6 +238,8 @@ def weld(
             mode = sc.rescan.mode
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
+                if sc.robot.track is None:  # a curve is planned on a fixed arm only: its doubtful ones up close
+                    rs, det = curves_rescanned(station, det, rs, motion=motion, progress=progress)
                 if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
                     hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:

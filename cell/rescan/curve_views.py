@@ -14,14 +14,38 @@ MAX_PIECE_M = 0.06  # [m] a piece at most this long: the close-up's image holds 
 MAX_SAGITTA_M = 0.004  # [m] and its chord at most this far from the curve
 
 
+def worst_first(est: CurveEstimate, max_sigma_m: float) -> list[ViewTarget]:
+    """:func:`curve_view_targets` of ``est`` ordered by the largest sigma of their samples, largest first (the
+    stretch the close-ups must fix first; ties in curve order)."""
+    pieces = _pieces(est, max_sigma_m)
+    sigma = np.asarray(est.sigma_m)
+    order = sorted(range(len(pieces)), key=lambda k: -float(sigma[pieces[k][0] : pieces[k][1] + 1].max()))
+    targets = curve_view_targets(est, max_sigma_m)
+    return [targets[k] for k in order]
+
+
 def curve_view_targets(est: CurveEstimate, max_sigma_m: float) -> list[ViewTarget]:
     """The view targets along ``est`` where its sigma across the seam exceeds ``max_sigma_m`` [m] (none when it
     nowhere does): each run of such samples cut into pieces at most :data:`MAX_PIECE_M` long whose chord stays
     within :data:`MAX_SAGITTA_M` of the samples; a piece's ends are its first and last samples, its faces' normals
     the mean of its samples'. Ids ``<seam>#<k>``, k from 1 along the curve."""
+    out: list[ViewTarget] = []
+    for i, j in _pieces(est, max_sigma_m):
+        na = np.mean(est.n_abutting_R[i : j + 1], axis=0)
+        nb = np.mean(est.n_receiving_R[i : j + 1], axis=0)
+        out.append(
+            ViewTarget(
+                f"{est.id}#{len(out) + 1}", est.p_RS[i], est.p_RS[j], na / np.linalg.norm(na), nb / np.linalg.norm(nb)
+            )
+        )
+    return out
+
+
+def _pieces(est: CurveEstimate, max_sigma_m: float) -> list[tuple[int, int]]:
+    """(first, last) sample indices of each piece of :func:`curve_view_targets`, in curve order."""
     p = np.asarray(est.p_RS)
     doubtful = np.asarray(est.sigma_m) > max_sigma_m
-    out: list[ViewTarget] = []
+    out: list[tuple[int, int]] = []
     i, n = 0, len(p)
     while i < n:
         if not doubtful[i]:
@@ -31,11 +55,7 @@ def curve_view_targets(est: CurveEstimate, max_sigma_m: float) -> list[ViewTarge
         while j + 1 < n and doubtful[j + 1] and _fits(p, i, j + 1):
             j += 1
         if j > i:
-            na = np.mean(est.n_abutting_R[i : j + 1], axis=0)
-            nb = np.mean(est.n_receiving_R[i : j + 1], axis=0)
-            out.append(
-                ViewTarget(f"{est.id}#{len(out) + 1}", p[i], p[j], na / np.linalg.norm(na), nb / np.linalg.norm(nb))
-            )
+            out.append((i, j))
         i = j + 1
     return out
 
@@ -54,4 +74,4 @@ def _fits(p: np.ndarray, i: int, j: int) -> bool:
     return bool(np.max(np.linalg.norm(p[i + 1 : j] - (a + t[:, None] * ab), axis=1)) <= MAX_SAGITTA_M)
 
 
-__all__ = ["MAX_PIECE_M", "MAX_SAGITTA_M", "curve_view_targets"]
+__all__ = ["MAX_PIECE_M", "MAX_SAGITTA_M", "curve_view_targets", "worst_first"]

@@ -139,15 +139,16 @@ def _from_outside(
     return keep
 
 
-def _bias(fit: SurfaceFit) -> float:
+def _bias(fit: SurfaceFit, bias_share: float | None = None) -> float:
     """[m] one sigma of a shift of the fitted surface along its normal that its covariance does not hold: the
-    cameras' common bias (:data:`SURFACE_BIAS_M`), what the model leaves unexplained over patches of its points
-    (``lack_m``), the cameras' disagreement (``cameras_m``: their pose errors) and, for a round drawn with flat
-    facets, half the facets' sagitta (a circle fitted to a polygon)."""
+    cameras' common bias (:data:`SURFACE_BIAS_M`, or ``bias_share`` of the fit's noise scale), what the model leaves
+    unexplained over patches of its points (``lack_m``), the cameras' disagreement (``cameras_m``: their pose
+    errors) and, for a round drawn with flat facets, half the facets' sagitta (a circle fitted to a polygon)."""
     sag = 0.0
     if isinstance(fit.model, CylinderModel) and fit.model.facets > 0:
         sag = fit.model.r0 * (1.0 - math.cos(math.pi / fit.model.facets))
-    return math.hypot(SURFACE_BIAS_M, fit.lack_m, fit.cameras_m, 0.5 * sag)
+    common = SURFACE_BIAS_M if bias_share is None else bias_share * fit.scale_m
+    return math.hypot(common, fit.lack_m, fit.cameras_m, 0.5 * sag)
 
 
 def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> CurveEstimate:
@@ -157,8 +158,13 @@ def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> 
     return CurveEstimate(seam.id, status, f"curved seam {seam.id}: {why}", code=code)
 
 
-def locate_curve(scene: SeamScene, seam: CurvedSeam) -> CurveEstimate:
-    """One curved seam of ``scene``'s aligned map located in its dense cloud (time left to the caller)."""
+def locate_curve(
+    scene: SeamScene, seam: CurvedSeam, *, max_sigma_m: float = MAX_SIGMA_M, bias_share: float | None = None
+) -> CurveEstimate:
+    """One curved seam of ``scene``'s aligned map located in its dense cloud (time left to the caller); NOT_FOUND
+    (``low_confidence``) when a sample's sigma exceeds ``max_sigma_m`` [m] (inf: never: close-ups that see part of
+    the curve leave the rest to the fixed cameras). ``bias_share``: each surface's shift that no fit sees as this
+    share of its points' noise scale (None: :data:`SURFACE_BIAS_M`, the fixed cameras')."""
     joint = seam.joint
     if joint is None:
         return _not_found(seam, f"no two parts hold it ({seam.note})", Reason.NOT_SUPPORTED)
@@ -191,11 +197,17 @@ def locate_curve(scene: SeamScene, seam: CurvedSeam) -> CurveEstimate:
     for part, kind, fit, count in zip(parts, kinds, fits, (on1.sum(), on2.sum()), strict=True):
         if not fit.ok:
             return _not_found(seam, f"the {kind} of {part.name} is not held by the cloud ({count} points near it)")
-    return _curve(seam, drawn, fits, wm, {joint.abutting, joint.receiving})
+    return _curve(seam, drawn, fits, wm, {joint.abutting, joint.receiving}, max_sigma_m, bias_share)
 
 
 def _curve(
-    seam: CurvedSeam, drawn: FloatArray, fits: tuple[SurfaceFit, SurfaceFit], wm: WeldMap, own: set[str]
+    seam: CurvedSeam,
+    drawn: FloatArray,
+    fits: tuple[SurfaceFit, SurfaceFit],
+    wm: WeldMap,
+    own: set[str],
+    max_sigma_m: float,
+    bias_share: float | None,
 ) -> CurveEstimate:
     """The fitted surfaces intersected from the drawn samples, cut where another part stands, with sigmas."""
     a, b = fits
@@ -209,7 +221,7 @@ def _curve(
         return _not_found(seam, f"its fitted surfaces meet {moved * 1000:.1f} mm from the drawn curve")
     k2 = SE_INFLATION**2
     da, db = dtheta(a.model, p, a.theta), dtheta(b.model, p, b.theta)
-    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, (_bias(a), _bias(b)))
+    cov = crossing_covariance(p, g1, g2, da, k2 * a.cov, db, k2 * b.cov, (_bias(a, bias_share), _bias(b, bias_share)))
     sigma = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     closed = bool(getattr(seam.curve, "closed", False))
     keep = outside_parts(wm, p, own, OTHER_PART_M)
@@ -227,16 +239,21 @@ def _curve(
         closed=closed,
         sigma_m=sigma,
         end_sigma_m=end_sigma,
-        confidence=float(np.clip(1.0 - sigma.max() / MAX_SIGMA_M, 0.0, 1.0)),
+        confidence=curve_confidence(sigma),
     )
     if not keep.all():
         from cell.seams.curved.cut import longest_run
 
         out = longest_run(out, keep)
-    if out.status is SeamStatus.FOUND and out.sigma_max_m > MAX_SIGMA_M:
+    if out.status is SeamStatus.FOUND and out.sigma_max_m > max_sigma_m:
         why = f"its surfaces are held too weakly (sigma up to {out.sigma_max_m * 1000:.1f} mm)"
         return _not_found(seam, why, Reason.LOW_CONFIDENCE)
     return out
+
+
+def curve_confidence(sigma_m: FloatArray) -> float:
+    """A located curve's confidence from its samples' sigmas (n,) [m]: 1 - the largest over :data:`MAX_SIGMA_M`."""
+    return float(np.clip(1.0 - float(np.max(sigma_m)) / MAX_SIGMA_M, 0.0, 1.0))
 
 
 def _not_supported(seam: CurvedSeam, method: str) -> CurveEstimate:

@@ -1,0 +1,165 @@
+"""The close-up re-scan of the located curves too uncertain to weld, on the straight seams' loop
+(:mod:`cell.pipeline.rescan`: its run, views, moves and way back): the stretch with the largest sigma looked at
+first (:func:`cell.rescan.curve_views.worst_first`), the curve re-located from every close-up so far and fused
+with the fixed cameras' (:mod:`cell.rescan.curve_fusion`), until it passes or the budget is spent
+(docs/curves.md section 6). Frames: R; metres, seconds."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from cell.errors import CellError
+from cell.geometry import FloatArray, invert, readonly
+from cell.perception.calibration import PoseUncertainty
+from cell.pipeline.detect import Progress, pose_uncertainties, quiet
+from cell.pipeline.geometry import MotionScene
+from cell.pipeline.records import Detection
+from cell.pipeline.rescan import _Run, back_to_scan
+from cell.types import DepthImage, SeamStatus
+from cell.types.curve_estimate import CurveEstimate
+from cell.types.rescan import Rescan
+
+if TYPE_CHECKING:
+    from cell.rescan.view_grid import ViewTarget
+    from cell.station import Station
+
+MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture and a re-location)
+MAX_TRIES = 6  # stretches tried at most (a stretch no view reaches costs the planner's search, not a move)
+MIN_GAIN = 0.1  # a close-up that lowers the worst sample's sigma by less than this share ends the curve's re-scan
+TRIED_M = 0.02  # [m] a stretch whose middle lies this near one tried already is not tried again
+
+
+def doubtful_curves(det: Detection) -> list[CurveEstimate]:
+    """The found curves whose worst sample's bound is over the weld tolerance (``rescan.max_sigma_m``): those a
+    close-up may bring within it."""
+    limit = det.scenario.rescan.max_sigma_m
+    return [c for c in det.curve_estimates if c.status is SeamStatus.FOUND and c.sigma_max_m > limit]
+
+
+def rescan_curves(
+    station: Station, det: Detection, *, motion: MotionScene, progress: Progress = quiet
+) -> tuple[Rescan | None, Detection]:
+    """Every curve of :func:`doubtful_curves` re-scanned up close with the eye-in-hand camera and re-located
+    (see the module docstring); the re-scan's moves (None when there was no such curve, or no arm, scene or
+    eye-in-hand camera) and the detection with the fused curves and their errors measured again. A curve whose
+    close-ups leave it over the tolerance keeps the better estimate and is refused at the gate as before."""
+    from cell.rescan.fusion import eye_in_hand_camera
+    from cell.seams.registry import make_locator
+
+    sc, arm = det.scenario, station.arm
+    curves = doubtful_curves(det)
+    eye = [n for n, c in sc.cameras.items() if c.mount == "eye_in_hand"]
+    if not curves or arm is None or det.scene is None or not eye:
+        return None, det
+    o = sc.rescan.closeup
+    t0 = time.perf_counter()
+    run = _Run(
+        station, arm, det, o, eye_in_hand_camera(sc, o.camera), motion.checker, make_locator(det.method, sc),
+        station.joint_state(),
+    )  # fmt: skip
+    run.stops.append(run.q)
+    rng = sc.rng("rescan/curve-view")
+    fused = {c.id: _rescan_curve(run, c, rng, progress) for c in curves}
+    returned, note = back_to_scan(run)
+    estimates = tuple(fused.get(c.id, c) for c in det.curve_estimates)
+    metrics = dict(det.curve_metrics)
+    from cell.seams.curved.metrics import curve_error
+
+    for c in estimates:
+        if c.id in fused and c.status is SeamStatus.FOUND and c.id in det.curve_truths:
+            metrics[c.id] = curve_error(c, np.asarray(det.curve_truths[c.id]))
+    timings = {"rescan_s": time.perf_counter() - t0}
+    rs = Rescan((), det.estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings)
+    return rs, replace(det, curve_estimates=estimates, curve_metrics=metrics)
+
+
+def curves_rescanned(
+    station: Station, det: Detection, rs: Rescan | None, *, motion: MotionScene, progress: Progress = quiet
+) -> tuple[Rescan | None, Detection]:
+    """:func:`rescan_curves` after the straight seams' re-scan ``rs``: one re-scan record of both (the arm where
+    the curves' close-ups left it) and the detection after both."""
+    from cell.pipeline.last_check import joined
+
+    more, after = rescan_curves(station, det, motion=motion, progress=progress)
+    return joined(rs, more), after
+
+
+def _rescan_curve(run: _Run, first: CurveEstimate, rng: np.random.Generator, progress: Progress) -> CurveEstimate:
+    """One curve's close-ups (see the module docstring): the fused curve, its reason saying what the re-scan did."""
+    from cell.perception.lens import undistort
+    from cell.rescan.curve_fusion import closeup_curve_scene, facet_floor_m, fuse_curve, relocate, shared_sigma
+    from cell.rescan.curve_views import worst_first
+    from cell.rescan.viewpoint import plan_view
+
+    det, o = run.detection, run.options
+    assert det.scene is not None
+    base = det.scene.seam_scene
+    seam = next(s for s in base.weldmap.curved if s.id == first.id)
+    assert seam.joint is not None
+    own = (seam.joint.abutting, seam.joint.receiving)
+    parts = tuple(p for p in base.weldmap.parts if p.name not in own)
+    limit = det.scenario.rescan.max_sigma_m
+    K = run.station.intrinsics(run.camera)
+    u = pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty())
+    shared = shared_sigma(first, facet_floor_m(seam, base.weldmap))
+    floor = float(shared.max())
+    if floor > limit:
+        why = f"not re-scanned: its round is drawn with flat facets, half their sagitta ({floor * 1000:.2f} mm here) is"
+        return replace(
+            first, reason=f"{why} over the tolerance's sigma ({limit * 1000:.2f} mm) whatever a close-up sees"
+        )
+    images: list[DepthImage] = []
+    tried: list[FloatArray] = []
+    cal = 0.0
+    best, weight, why = first, 0.0, ""
+    while len(images) < MAX_VIEWS and len(tried) < MAX_TRIES:
+        targets = [t for t in worst_first(best, limit) if all(np.linalg.norm(t.mid - m) > TRIED_M for m in tried)]
+        if not targets:
+            break
+        target = targets[0]
+        tried.append(target.mid)
+        progress(f"re-scan curve {first.id}: close-up {len(images) + 1} of the stretch at sigma "
+                 f"{_worst_mm(best, target):.2f} mm")  # fmt: skip
+        try:
+            vp = plan_view(
+                run.arm.model, run.checker, target, run.q, K, parts, base.table_z, rng=rng, q_via=run.arm.q_scan,
+                options=replace(o.view, fallback_tilts_deg=()),
+            )  # fmt: skip
+        except CellError as exc:
+            why = f"no view: {exc.message}"
+            continue
+        run.play(vp.move)
+        run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]
+        images.append(undistort(run.station.capture_eye_in_hand(run.camera)))
+        X_RC = invert(det.scenario.X_WR) @ images[-1].X_WC
+        cal = max(cal, float(np.sqrt(2.0)) * u.sigma_at(float(np.linalg.norm(target.mid - X_RC[:3, 3]))))
+        scene = closeup_curve_scene(images, det.scenario.X_WR, np.asarray(first.p_RS), base, o.crop_margin_m)
+        closeup = relocate(scene, seam, cal)
+        if closeup.status is not SeamStatus.FOUND:
+            why = f"close-ups: {closeup.reason}"
+            continue
+        before = best.sigma_max_m
+        best, weight = fuse_curve(first, closeup, shared)
+        if best.sigma_max_m <= limit:
+            break
+        if best.sigma_max_m > (1.0 - MIN_GAIN) * before:
+            why = f"a close-up lowered its worst sigma by less than {MIN_GAIN:.0%}: no more"
+            break
+    done = f"re-scanned up close ({len(images)} close-ups, weight {weight:.2f}; sigma up to "
+    done += f"{first.sigma_max_m * 1000:.2f} -> {best.sigma_max_m * 1000:.2f} mm)"
+    why = why if best.sigma_max_m > limit else ""
+    return replace(best, reason="; ".join(r for r in (done, why, first.reason) if r))
+
+
+def _worst_mm(est: CurveEstimate, target: ViewTarget) -> float:
+    """The largest sigma [mm] of ``est``'s samples within the stretch ``target`` looks at (its chord's box)."""
+    p = np.asarray(est.p_RS)
+    a, b = np.asarray(target.p_start), np.asarray(target.p_end)
+    lo, hi = np.minimum(a, b) - 1e-3, np.maximum(a, b) + 1e-3
+    inside = np.all((p >= lo) & (p <= hi), axis=1)
+    s = np.asarray(est.sigma_m)[inside] if inside.any() else np.asarray(est.sigma_m)
+    return float(s.max()) * 1000.0

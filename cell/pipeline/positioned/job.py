@@ -17,7 +17,9 @@ from cell.pipeline.job import WeldJob
 from cell.pipeline.positioned.carry import carried, drawn_estimates, posed_motion, posed_obstacles
 from cell.pipeline.positioned.frames import axes_move_s, drawn_frames, seam_frames, truths_at
 from cell.pipeline.positioned.run import GroupRun, PositionerRun
+from cell.pipeline.positioned.sweep import clamped, move_hit
 from cell.pipeline.records import Detection
+from cell.positioner.payload import check_load, part_load
 from cell.positioner.poses import PositionerPose
 from cell.scenario import Scenario
 from cell.station import SimStation
@@ -25,6 +27,7 @@ from cell.types import SeamStatus, WeldMap, WeldReason
 from cell.types.positioner import TiltRotatePositioner
 
 NOT_LOCATED = "not located at home"
+SWEPT = "the positioner's move to its pose sweeps the part into the arm"
 ROUNDS = 3  # poses chosen again at most this often for the seams the planner refused at theirs
 
 
@@ -43,6 +46,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         raise ScenarioError(f"scenario {sc.name!r} has no robot.positioner; valid: cell weld without one")
     pos = sc.robot.positioner.positioner(sc.X_WR)
     weldmap = read_weldmap(sc)
+    density = sc.robot.positioner.part_density_kg_m3
+    check_load(part_load(weldmap.transformed(X_F_M(sc, pos), "F").parts, pos, density), pos)
     with open_cell(sc, weldmap, gui=job.gui) as station:
         arm = station.arm
         if arm is None:
@@ -81,6 +86,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         groups: list[GroupRun] = []
         axes, choose_s = pos.home, 0.0
         excluded: set[tuple[str, tuple[float, float]]] = set()
+        on_plate, collision, sweep_s = clamped(det, pos), sc.motion.plan.collision, 0.0
+        swept: dict[str, str] = {}  # seam id -> the move to its pose that sweeps the part into the arm
         for _ in range(ROUNDS if job.execute else 1):
             t = time.perf_counter()
             poses, why = plan_poses(pos, frames, reach, excluded, start=axes)
@@ -89,6 +96,14 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
             progress(f"positioner: {len(poses)} poses for {sum(len(p.seams) for p in poses)} seams")
             refused: set[str] = set()
             for pose in poses:
+                t = time.perf_counter()
+                hit = move_hit(arm.model, q_now, on_plate, pos, axes, (pose.tilt, pose.rotate), collision)
+                sweep_s += time.perf_counter() - t
+                if hit is not None:  # the part swept into the arm: this pose is not taken, its seams try others
+                    swept |= {i: f"{SWEPT}: {hit.describe()}" for i in pose.seams}
+                    excluded |= {(i, (pose.tilt, pose.rotate)) for i in pose.seams}
+                    refused |= set(pose.seams)
+                    continue
                 move_s = axes_move_s(pos, axes, (pose.tilt, pose.rotate))
                 axes = (pose.tilt, pose.rotate)
                 if not job.execute:
@@ -105,7 +120,10 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
             frames = [f for f in frames if f.id in refused]
             if not frames:
                 break
-        timings = {"total_s": time.perf_counter() - t_all, "choose_poses_s": choose_s, **det.timings}
+        welded = {w.id for g in groups for w in g.seams if w.welded}
+        unheld |= {i: why for i, why in swept.items() if i not in welded and i not in unheld}
+        timings = {**det.timings, "choose_poses_s": choose_s, "move_check_s": sweep_s}
+        timings["total_s"] = time.perf_counter() - t_all
         codes |= {i: WeldReason.NOT_PLANNED for i in unheld if i not in codes}  # no pose holds it
         return PositionerRun(det, tuple(groups), unheld, rescan_s, timings=timings, unheld_codes=codes)
 
@@ -167,3 +185,8 @@ def _weld_pose(
     refused = f"not executed: {error.message}" if error is not None else ""
     seams = seam_welds(det_g, plan, ex, pre.duration if pre is not None else 0.0, refused, sc, True)
     return replace(GroupRun(pose, move_s, plan, pre, ex, seams, plan_s, rescan_s=rescan_s), error=error)
+
+
+def X_F_M(sc: Scenario, pos: TiltRotatePositioner) -> FloatArray:
+    """(4, 4): the map's frame M in the faceplate frame F at home (where the clamp holds the part)."""
+    return np.asarray(invert(pos.X_R_F(*pos.home)) @ invert(sc.X_WR) @ sc.X_WM, dtype=float)

@@ -14,7 +14,7 @@ from cell.errors import PositionerFault, PositionerLoadError
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.pipeline.positioned.sweep import move_hit, swept_bodies
+from cell.pipeline.positioned.sweep import clear_route, move_hit, swept_bodies
 from cell.positioner.bodies import positioner_parts
 from cell.positioner.payload import G_M_S2, check_load, part_load
 from cell.scenario.positioner_specs import PositionerSpec
@@ -78,20 +78,26 @@ def arm() -> RobotModel:
     return RobotModel.from_urdf(URDF)
 
 
-def test_a_move_that_sweeps_the_part_through_the_arm_is_found(arm: RobotModel) -> None:
-    """A 1 m bar on the faceplate tilted a quarter turn sweeps a quarter circle; the arm's torch stands on that
-    circle at 45 deg: clear of the bar at both ends of the move, hit on the way."""
-    q = np.radians([0.0, -90.0, 90.0, 0.0, 45.0, 0.0])
-    bar_F = (0.0, 0.55, 0.02)  # the bar from the faceplate's centre out along F's y
-    p_tcp = arm.fk(q)[:3, 3]
+Q_ARM = np.radians([0.0, -90.0, 90.0, 0.0, 45.0, 0.0])
+
+
+def _bar_beside(arm: RobotModel) -> tuple[TiltRotatePositioner, tuple[Part, ...]]:
+    """A positioner whose 1.1 m bar, clamped along F's y, passes the arm's torch (at ``Q_ARM``) 0.6 m out when
+    tilted 45 deg."""
     pos0 = PositionerSpec(
         base_xyz_m=(0.0, 0.0, 0.0), tilt_height_mm=900.0, faceplate_offset_mm=0.0, faceplate_diameter_mm=150.0
     )
     p_on = pos0.positioner(np.eye(4)).X_R_F(math.radians(45.0), 0.0) @ np.array([0.0, 0.6, 0.02, 1.0])
-    base = tuple(float(v) for v in p_tcp - p_on[:3])
+    base = tuple(float(v) for v in arm.fk(Q_ARM)[:3, 3] - p_on[:3])
     pos = pos0.model_copy(update={"base_xyz_m": base}).positioner(np.eye(4))
-    X0 = pos.X_R_F(0.0, 0.0)
-    home = (Part("BAR", Box(X0 @ make_pose(p=bar_F), np.array([0.05, 1.1, 0.04]))),)
+    return pos, (Part("BAR", Box(pos.X_R_F(0.0, 0.0) @ make_pose(p=(0.0, 0.55, 0.02)), np.array([0.05, 1.1, 0.04]))),)
+
+
+def test_a_move_that_sweeps_the_part_through_the_arm_is_found(arm: RobotModel) -> None:
+    """A 1 m bar on the faceplate tilted a quarter turn sweeps a quarter circle; the arm's torch stands on that
+    circle at 45 deg: clear of the bar at both ends of the move, hit on the way."""
+    q = Q_ARM
+    pos, home = _bar_beside(arm)
     opt = CollisionOptions()
     for t in (0.0, math.pi / 2):  # the ends are clear
         at = [p.transformed(pos.move(t, 0.0)) for p in home] + list(positioner_parts(pos, t, 0.0))
@@ -108,3 +114,17 @@ def test_a_move_that_sweeps_the_part_through_the_arm_is_found(arm: RobotModel) -
         len(bars) >= math.ceil(1.1 * math.pi / 2 / 0.02)
         and np.max(np.linalg.norm(np.diff(tips, axis=0), axis=1)) < 0.02
     )
+
+
+def test_a_route_round_the_arm_turns_one_axis_first(arm: RobotModel) -> None:
+    """The bar standing up, brought down and turned a quarter: both axes together sweep it through the torch;
+    turning it first where it stands and then tilting it down is clear, and that route is taken."""
+    pos, home = _bar_beside(arm)
+    a, b = (math.pi / 2, 0.0), (0.0, math.pi / 2)
+    opt = CollisionOptions()
+    assert move_hit(arm, Q_ARM, home, pos, a, b, opt) is not None
+    route, hit = clear_route(arm, Q_ARM, home, pos, a, b, opt)
+    assert hit is None and route == ((math.pi / 2, math.pi / 2), b)
+    # Turned a quarter at the flat, the bar meets the arm's base whichever way it is brought up: refused.
+    route, hit = clear_route(arm, Q_ARM, home, pos, (0.0, 0.0), (math.pi / 2, math.pi / 2), opt)
+    assert route == () and hit is not None

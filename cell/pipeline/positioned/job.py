@@ -4,6 +4,7 @@ located seams are carried by its kinematics, planned, gated and welded. No opera
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import replace
 
@@ -17,7 +18,7 @@ from cell.pipeline.job import WeldJob
 from cell.pipeline.positioned.carry import carried, drawn_estimates, posed_motion, posed_obstacles
 from cell.pipeline.positioned.frames import axes_move_s, drawn_frames, seam_frames, truths_at
 from cell.pipeline.positioned.run import GroupRun, PositionerRun
-from cell.pipeline.positioned.sweep import clamped, move_hit
+from cell.pipeline.positioned.sweep import clamped, clear_route
 from cell.pipeline.records import Detection
 from cell.positioner.payload import check_load, part_load
 from cell.positioner.poses import PositionerPose
@@ -97,14 +98,14 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
             refused: set[str] = set()
             for pose in poses:
                 t = time.perf_counter()
-                hit = move_hit(arm.model, q_now, on_plate, pos, axes, (pose.tilt, pose.rotate), collision)
+                route, hit = clear_route(arm.model, q_now, on_plate, pos, axes, (pose.tilt, pose.rotate), collision)
                 sweep_s += time.perf_counter() - t
                 if hit is not None:  # the part swept into the arm: this pose is not taken, its seams try others
                     swept |= {i: f"{SWEPT}: {hit.describe()}" for i in pose.seams}
                     excluded |= {(i, (pose.tilt, pose.rotate)) for i in pose.seams}
                     refused |= set(pose.seams)
                     continue
-                move_s = axes_move_s(pos, axes, (pose.tilt, pose.rotate))
+                move_s = sum(axes_move_s(pos, s, e) for s, e in itertools.pairwise((axes, *route)))
                 axes = (pose.tilt, pose.rotate)
                 if not job.execute:
                     groups.append(GroupRun(pose, move_s, None, None, None, (), 0.0))

@@ -5,6 +5,7 @@ stands checked against the union. Frames: R [m]; axes [rad]."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import replace
@@ -70,3 +71,31 @@ def move_hit(
     grown = replace(options, part_inflation=options.part_inflation + step_m / 2.0)
     checker = CollisionChecker(model, swept_bodies(home, pos, a, b, step_m), grown)
     return checker.check(q)
+
+
+Axes = tuple[float, float]
+
+
+def clear_route(
+    model: RobotModel,
+    q: FloatArray,
+    home: Sequence[Part],
+    pos: TiltRotatePositioner,
+    a: Axes,
+    b: Axes,
+    options: CollisionOptions,
+) -> tuple[tuple[Axes, ...], Contact | None]:
+    """The positioner's route from ``a`` to ``b`` that sweeps nothing into the arm at ``q``: both axes together,
+    else the rotation first and then the tilt, else the tilt first (a turn made where the part lies flat, or
+    where it stands). Returns the route's axes, start excluded, and None; or ((), the straight move's contact)
+    when every route meets the arm."""
+    routes: tuple[tuple[Axes, ...], ...] = ((b,), ((a[0], b[1]), b), ((b[0], a[1]), b))
+    first: Contact | None = None
+    for route in routes:
+        legs = itertools.pairwise((a, *route))
+        hits = (move_hit(model, q, home, pos, s, e, options) for s, e in legs)
+        hit = next((h for h in hits if h is not None), None)
+        if hit is None:
+            return route, None
+        first = first or hit
+    return (), first

@@ -81,7 +81,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         codes = {i: WeldReason.LAST_CHECK if i in checked else WeldReason.LOW_CONFIDENCE if r == "low_confidence"
                  else WeldReason.NOT_LOCATED for i, r in unheld.items()}  # fmt: skip
         located = [e.id for e in det.estimates if e.id not in unheld and e.id not in hidden]
-        frames = seam_frames(det, pos, located) + drawn_frames(det, pos, hidden)
+        # A seam hidden at home is first asked in PA: its bead faces up, the close-up looks down at it as at home.
+        frames = seam_frames(det, pos, located) + drawn_frames(det, pos, hidden, "PA")
         centre, radius = arm.model.reach_bound("torch_tcp")
         reach = shoulder_reach(centre, radius)
         groups: list[GroupRun] = []
@@ -115,10 +116,13 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
                 q_now = station.joint_state()
                 # A seam the planner refused at this pose (a collision, out of reach) tries its other poses.
                 for w in g.seams:
-                    if w.code is WeldReason.NOT_PLANNED:
+                    # Refused by the planner, or left doubtful by the close-up here (no view, a bound still over
+                    # the tolerance): another pose may serve.
+                    if w.code in (WeldReason.NOT_PLANNED, WeldReason.LOW_CONFIDENCE):
                         excluded.add((w.id, axes))
                         refused.add(w.id)
-            frames = [f for f in frames if f.id in refused]
+            # A seam refused in PA tries PB next (the weld's own procedure's position).
+            frames = [replace(f, target="PB") if f.target == "PA" else f for f in frames if f.id in refused]
             if not frames:
                 break
         welded = {w.id for g in groups for w in g.seams if w.welded}

@@ -86,13 +86,20 @@ def clear_route(
     options: CollisionOptions,
 ) -> tuple[tuple[Axes, ...], Contact | None]:
     """The positioner's route from ``a`` to ``b`` that sweeps nothing into the arm at ``q``: both axes together,
-    else the rotation first and then the tilt, else the tilt first (a turn made where the part lies flat, or
-    where it stands). Returns the route's axes, start excluded, and None; or ((), the straight move's contact)
-    when every route meets the arm."""
-    routes: tuple[tuple[Axes, ...], ...] = ((b,), ((a[0], b[1]), b), ((b[0], a[1]), b))
+    else the rotation first and then the tilt, else the tilt first, else laid down at the home tilt, turned
+    there and tilted up (a turn made where the part lies, stands or lies flat, as a shop would). Returns the
+    route's axes, start excluded, and None; or ((), the straight move's contact) when every route meets the
+    arm."""
+    flat = pos.home[0]
+    routes: tuple[tuple[Axes, ...], ...] = (
+        (b,),
+        ((a[0], b[1]), b),
+        ((b[0], a[1]), b),
+        ((flat, a[1]), (flat, b[1]), b),
+    )
     first: Contact | None = None
     for route in routes:
-        legs = itertools.pairwise((a, *route))
+        legs = [(s, e) for s, e in itertools.pairwise((a, *route)) if not np.allclose(s, e)]
         hits = (move_hit(model, q, home, pos, s, e, options) for s, e in legs)
         hit = next((h for h in hits if h is not None), None)
         if hit is None:

@@ -29,7 +29,7 @@ from cell.types.positioner import TiltRotatePositioner
 
 NOT_LOCATED = "not located at home"
 SWEPT = "the positioner's move to its pose sweeps the part into the arm"
-ROUNDS = 3  # poses chosen again at most this often for the seams the planner refused at theirs
+ROUNDS = 4  # poses chosen again at most this often for the seams refused at theirs (PB, then PA's two branches)
 
 
 def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progress: Progress = quiet) -> PositionerRun:
@@ -81,8 +81,7 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         codes = {i: WeldReason.LAST_CHECK if i in checked else WeldReason.LOW_CONFIDENCE if r == "low_confidence"
                  else WeldReason.NOT_LOCATED for i, r in unheld.items()}  # fmt: skip
         located = [e.id for e in det.estimates if e.id not in unheld and e.id not in hidden]
-        # A seam hidden at home is first asked in PA: its bead faces up, the close-up looks down at it as at home.
-        frames = seam_frames(det, pos, located) + drawn_frames(det, pos, hidden, "PA")
+        frames = seam_frames(det, pos, located) + drawn_frames(det, pos, hidden)
         centre, radius = arm.model.reach_bound("torch_tcp")
         reach = shoulder_reach(centre, radius)
         groups: list[GroupRun] = []
@@ -121,8 +120,9 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
                     if w.code in (WeldReason.NOT_PLANNED, WeldReason.LOW_CONFIDENCE):
                         excluded.add((w.id, axes))
                         refused.add(w.id)
-            # A seam refused in PA tries PB next (the weld's own procedure's position).
-            frames = [replace(f, target="PB") if f.target == "PA" else f for f in frames if f.id in refused]
+            # A seam hidden at home and refused in PB is asked in PA next: its bead faces up, the close-up looks
+            # down at it as at home.
+            frames = [replace(f, target="PA") if f.id in hidden else f for f in frames if f.id in refused]
             if not frames:
                 break
         welded = {w.id for g in groups for w in g.seams if w.welded}

@@ -69,8 +69,30 @@ def move_hit(
     if np.allclose(a, b):
         return None
     grown = replace(options, part_inflation=options.part_inflation + step_m / 2.0)
-    checker = CollisionChecker(model, swept_bodies(home, pos, a, b, step_m), grown)
-    return checker.check(q)
+    near = near_arm(model, q, swept_bodies(home, pos, a, b, step_m), grown.part_inflation)
+    return CollisionChecker(model, near, grown).check(q) if near else None
+
+
+ARM_RADIUS_M = 0.3  # [m] no part of the arm (links, torch, camera) lies further from its frames' chain
+
+
+def near_arm(model: RobotModel, q: FloatArray, bodies: Sequence[Part], grow_m: float) -> list[Part]:
+    """The bodies whose bounding sphere (grown by ``grow_m``) comes within ``ARM_RADIUS_M`` of the polyline
+    through the arm's frames at ``q``: the only ones the arm can touch (the rest need not enter the collision
+    model, whose building is what a sweep's check costs)."""
+    frames = model.fk_frames(q, model.frame_names)
+    p = np.array([X[:3, 3] for X in frames.values()])
+    a, b = p[:-1], p[1:]
+    ab = b - a
+    L2 = np.maximum(np.sum(ab * ab, axis=1), 1e-12)
+    out = []
+    for body in bodies:
+        c = np.asarray(body.center)
+        s = np.clip(np.sum((c - a) * ab, axis=1) / L2, 0.0, 1.0)
+        d = float(np.min(np.linalg.norm(a + s[:, None] * ab - c, axis=1)))
+        if d <= body.radius + grow_m + ARM_RADIUS_M:
+            out.append(body)
+    return out
 
 
 Axes = tuple[float, float]

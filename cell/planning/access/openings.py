@@ -7,6 +7,7 @@ out"). Frames: R [m]; joints [rad]; time [s]."""
 from __future__ import annotations
 
 import itertools
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -37,9 +38,31 @@ class Aside:
     def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
         from cell.planning.transfers import Piece
 
-        qs = [q_a, *_vias(mover, q_a, self.out_m), *_vias(mover, q_b, self.in_m)[::-1], q_b]
+        qs = [q_a, *_vias_of(mover, q_a, self.out_m), *_vias_of(mover, q_b, self.in_m)[::-1], q_b]
         robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
         return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
+
+
+# The via points of each configuration and distance, per Transfers (the strategies share them: an end's "out" serves
+# its "out" and both "both" ways); gone with the Transfers.
+_VIAS: weakref.WeakKeyDictionary[Transfers, dict[tuple[bytes, float], list[FloatArray] | IKError]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _vias_of(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray]:
+    """:func:`_vias`, remembered per mover, configuration and distance (an IKError too)."""
+    memo = _VIAS.setdefault(mover, {})
+    key = (np.asarray(q, dtype=float).tobytes(), aside_m)
+    if key not in memo:
+        try:
+            memo[key] = _vias(mover, q, aside_m)
+        except IKError as exc:
+            memo[key] = exc
+    got = memo[key]
+    if isinstance(got, IKError):
+        raise got
+    return got
 
 
 def _vias(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray]:

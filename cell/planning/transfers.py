@@ -20,7 +20,6 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory, ptp
 from cell.motion.wrist import HoseWindow
-from cell.planning.access.openings import opening_ways
 from cell.planning.failures import LineError
 from cell.planning.lines import line_trajectory, solve_line
 from cell.process.torch import WeldProcess, line_poses
@@ -138,7 +137,6 @@ DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (
     Hop("hop_high", extra=1),
     Lift("lift_high", extra=1),
     ViaHome(),
-    *opening_ways(),
 )
 
 

@@ -1,5 +1,5 @@
 """The ways into and out of a frame's opening: the torch stepped aside towards the arm, square to its axis, then
-raised; the last transfer strategies tried (tiny inline cell)."""
+raised; the planner's last transfer strategies (tiny inline cell)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from cell.config.motion import PlanOptions
 from cell.motion.collision import CollisionChecker
 from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
-from cell.planning.access.openings import Aside, opening_ways
+from cell.planning.access.openings import WAYS, Aside, opening_ways
 from cell.planning.transfers import DEFAULT_STRATEGIES, Transfers
 from cell.process.torch import WeldProcess
 
@@ -33,10 +33,9 @@ def _mover(robot: RobotModel) -> Transfers:
     )
 
 
-def test_the_opening_ways_come_after_every_other() -> None:
-    names = [s.name for s in DEFAULT_STRATEGIES]
+def test_the_planner_tries_the_opening_ways_after_every_other() -> None:
     ours = [s.name for s in opening_ways()]
-    assert names[-len(ours) :] == ours and names[-len(ours) - 1] == "home"
+    assert [s.name for s in WAYS] == [s.name for s in DEFAULT_STRATEGIES] + ours
     assert len(set(ours)) == len(ours) == 8  # in, out (two distances each) and both (every pair)
 
 

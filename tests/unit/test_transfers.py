@@ -14,7 +14,6 @@ from cell.errors import TimingError
 from cell.geometry import FloatArray, make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.planning.access.openings import opening_ways
 from cell.planning.failures import SeamFailure, better, reason_text
 from cell.planning.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
 from cell.process.torch import WeldProcess
@@ -45,7 +44,7 @@ def _mover(robot: RobotModel, obstacles: tuple[Part, ...], *strategies: Transfer
 
 def test_the_default_strategies_in_their_order() -> None:
     names = ["direct", "hop_down", "hop_up", "hop_low", "hop", "lift", "hop_high", "lift_high", "home"]
-    assert [s.name for s in DEFAULT_STRATEGIES] == names + [s.name for s in opening_ways()]
+    assert [s.name for s in DEFAULT_STRATEGIES] == names
     assert DEFAULT_STRATEGIES[5] == Lift() and DEFAULT_STRATEGIES[7] == Lift("lift_high", extra=1)
 
 

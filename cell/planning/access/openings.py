@@ -9,7 +9,6 @@ from __future__ import annotations
 import itertools
 import weakref
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -17,9 +16,7 @@ from cell.errors import IKError
 from cell.geometry import FloatArray
 from cell.motion.ik import solve_ik
 from cell.motion.timing import ptp
-
-if TYPE_CHECKING:
-    from cell.planning.transfers import Piece, Transfers
+from cell.planning.transfers import DEFAULT_STRATEGIES, Piece, Transfers, TransferStrategy
 
 ASIDE_M = (0.10, 0.15)  # [m] how far the torch steps out towards the arm, nearest first
 RISE_STEP_M = 0.05  # [m] the rise's IK is walked up in steps this long (it keeps the arm's branch)
@@ -36,8 +33,6 @@ class Aside:
     in_m: float = ASIDE_M[0]
 
     def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
-        from cell.planning.transfers import Piece
-
         qs = [q_a, *_vias_of(mover, q_a, self.out_m), *_vias_of(mover, q_b, self.in_m)[::-1], q_b]
         robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
         return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
@@ -93,8 +88,9 @@ def _vias(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray]:
 
 
 def opening_ways() -> tuple[Aside, ...]:
-    """The ways out of and into an opening, the last strategies tried (where the direct, hop, lift and home ways all
-    meet the part): in at the seam's end only, out at its start only, then both, each step the nearer first."""
+    """The ways out of and into an opening, the planner's last strategies (:data:`WAYS`: where the direct, hop, lift
+    and home ways all meet the part): in at the seam's end only, out at its start only, then both, the nearer step
+    first."""
     ins = [Aside(f"aside_in_{_mm(d)}", 0.0, d) for d in ASIDE_M]
     outs = [Aside(f"aside_out_{_mm(d)}", d, 0.0) for d in ASIDE_M]
     both = [Aside(f"aside_{_mm(a)}_{_mm(b)}", a, b) for a, b in itertools.product(ASIDE_M, ASIDE_M)]
@@ -103,3 +99,6 @@ def opening_ways() -> tuple[Aside, ...]:
 
 def _mm(d: float) -> str:
     return f"{round(d * 1000)}mm"
+
+
+WAYS: tuple[TransferStrategy, ...] = (*DEFAULT_STRATEGIES, *opening_ways())  # the planner's transfers, in order

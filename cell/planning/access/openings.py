@@ -18,7 +18,8 @@ from cell.motion.ik import solve_ik
 from cell.motion.timing import ptp
 from cell.planning.transfers import DEFAULT_STRATEGIES, Piece, Transfers, TransferStrategy
 
-ASIDE_M = (0.10, 0.15)  # [m] how far the torch steps out towards the arm, nearest first
+IN_M = 0.10  # [m] how far aside the torch comes in to a seam
+OUT_M = 0.15  # [m] how far aside it steps out of one
 RISE_STEP_M = 0.05  # [m] the rise's IK is walked up in steps this long (it keeps the arm's branch)
 
 
@@ -29,8 +30,8 @@ class Aside:
     leaves that end by a PTP move from where it is."""
 
     name: str = "aside"
-    out_m: float = ASIDE_M[0]
-    in_m: float = ASIDE_M[0]
+    out_m: float = OUT_M
+    in_m: float = IN_M
 
     def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
         qs = [q_a, *_vias_of(mover, q_a, self.out_m), *_vias_of(mover, q_b, self.in_m)[::-1], q_b]
@@ -89,16 +90,9 @@ def _vias(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray]:
 
 def opening_ways() -> tuple[Aside, ...]:
     """The ways out of and into an opening, the planner's last strategies (:data:`WAYS`: where the direct, hop, lift
-    and home ways all meet the part): in at the seam's end only, out at its start only, then both, the nearer step
-    first."""
-    ins = [Aside(f"aside_in_{_mm(d)}", 0.0, d) for d in ASIDE_M]
-    outs = [Aside(f"aside_out_{_mm(d)}", d, 0.0) for d in ASIDE_M]
-    both = [Aside(f"aside_{_mm(a)}_{_mm(b)}", a, b) for a, b in itertools.product(ASIDE_M, ASIDE_M)]
-    return (*ins, *outs, *both)
-
-
-def _mm(d: float) -> str:
-    return f"{round(d * 1000)}mm"
+    and home ways all meet the part): in at the seam's end only, out at its start only, then both. One distance
+    each way, those that served fence1-positioner's inside corners (docs/positioner.md, "Ways in and out")."""
+    return Aside("aside_in", 0.0, IN_M), Aside("aside_out", OUT_M, 0.0), Aside("aside", OUT_M, IN_M)
 
 
 WAYS: tuple[TransferStrategy, ...] = (*DEFAULT_STRATEGIES, *opening_ways())  # the planner's transfers, in order

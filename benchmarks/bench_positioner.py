@@ -100,12 +100,17 @@ def main() -> None:
     a = fence1_row()
     _say("cell weld fence1-positioner")
     b = positioner_row()
+    _say("pipe-stub-positioner (coordinated: benchmarks/bench_coordinated.py)")
+    from bench_coordinated import coordinated_row  # the circular fillet welded with the part turning
+
+    c = {k: v for k, v in coordinated_row().items() if k != "waypoints"}
     out = {
         "command": "benchmarks/bench_positioner.py",
         "fence1": a,
         "fence1_positioner": b,
         "plan_per_seam_ratio": round(b["plan_per_seam_s"] / a["plan_per_seam_s"], 2),
         "plan_and_move_check_ratio": round(b["plan_and_move_check_per_seam_s"] / a["plan_per_seam_s"], 2),
+        "pipe_stub_positioner": c,
     }
     args.json.write_text(json.dumps(out, indent=1) + "\n")
     _say(f"wrote {args.json}")

@@ -1,9 +1,10 @@
-"""Generate the round-part weldment maps: ``maps/pipe_flange.dxf``, ``maps/railing.dxf``, ``maps/round_brace.dxf`` and
-``maps/tube_tee.dxf`` (tubes tessellated as MESH bodies, their curved seams as CIRCLE, ELLIPSE and SPLINE).
+"""Generate the round-part weldment maps: ``maps/pipe_flange.dxf``, ``maps/pipe_stub.dxf``, ``maps/railing.dxf``,
+``maps/round_brace.dxf`` and ``maps/tube_tee.dxf`` (tubes tessellated as MESH bodies, their curved seams as CIRCLE,
+ELLIPSE and SPLINE).
 
 Run from the repository root::
 
-    .venv/bin/python tools/make_round.py            # writes the four maps into maps/
+    .venv/bin/python tools/make_round.py            # writes the five maps into maps/
     .venv/bin/python tools/make_round.py --out DIR  # somewhere else
 
 Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists the scenarios that use them):
@@ -11,6 +12,8 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
 - ``pipe_flange``: a 219.1 x 8.2 pipe 350 mm tall standing on a 400 x 400 x 20 flange plate, four 8 mm gussets
   (80 x 150, a 15 mm snipe where the pipe's fillet runs under them) standing on the plate against the pipe's sides;
   the pipe's fillet is a CIRCLE (a T, cylinder on plane), the gussets' fillets are LINEs (16);
+- ``pipe_stub``: the same pipe 250 mm tall on a 360 x 360 x 20 flange plate, no gussets: its fillet a CIRCLE alone,
+  welded all round on a positioner (a shop welds it before any gusset goes on);
 - ``railing``: two 48.3 x 3.2 posts between a flat-bar bottom rail (lying on the table) and a flat-bar top rail
   (60 x 10) 600 mm above it, three 40 x 10 x 250 flat balusters standing on the bottom rail; the posts' four
   fillets are CIRCLEs (those under the top rail overhead), the balusters' six are LINEs;
@@ -98,6 +101,15 @@ def build_pipe_flange() -> ezdxf.document.Drawing:
     return m.doc
 
 
+def build_pipe_stub() -> ezdxf.document.Drawing:
+    m = _Map()
+    R, wall, H, T = 109.55, 8.2, 250.0, 20.0  # a DN 200 pipe stub on a square flange plate, no gussets
+    m.body("FLANGE", box_mesh((-180.0, -180.0, 0.0), (180.0, 180.0, T)))
+    m.body("PIPE", tube_mesh(R, R - wall, 128, *_flat(T, T + H), np.eye(4)))  # 0.03 mm sagitta: a fine export
+    add_circle_seam(m.msp, "PIPE>FLANGE:circle", (0.0, 0.0, T), R, (0.0, 0.0, 1.0), SEAM_LAYER)
+    return m.doc
+
+
 def build_railing() -> ezdxf.document.Drawing:
     m = _Map()
     L, bw, bt, H = 1200.0, 60.0, 10.0, 600.0  # rails: length, width, thickness; posts' height between the rails
@@ -166,6 +178,7 @@ def build_tube_tee() -> ezdxf.document.Drawing:
 
 MAPS: dict[str, Callable[[], ezdxf.document.Drawing]] = {
     "pipe_flange": build_pipe_flange,
+    "pipe_stub": build_pipe_stub,
     "railing": build_railing,
     "round_brace": build_round_brace,
     "tube_tee": build_tube_tee,

@@ -41,3 +41,22 @@ def positioner_table(data: Mapping[str, Any]) -> str:
             f"| {s['id']} | {at} | {pos} | {ok} | {'yes' if s['welded'] else 'no'} | {_f(s['tcp_max_mm'])} | {why} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def coordinated_table(d: Mapping[str, Any]) -> str:
+    """docs/results.md's coordinated block: the pipe stub's fillet welded with the part turning, from
+    ``benchmarks/results/coordinated.json`` (``benchmarks/bench_coordinated.py``)."""
+    w = d["waypoints"]
+    lines = [
+        "| seam | located: sigma max / error RMS / max [mm] | weld gate | TCP RMS / max [mm] (study) | speed along the"
+        " part [mm/s] | ISO 6947 over its waypoints: worst slope / rotation off 180 [deg] | tilt; rotate from .. to"
+        " [deg] | torch spread [mm] | arc / job [s] | planning [s] |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+        f"| `{d['curve']}` | {_f(d['located_sigma_max_mm'])} / {_f(d['located_error_rms_mm'])} /"
+        f" {_f(d['located_error_max_mm'])} | {d['gate']} | {_f(d['tcp_rms_mm'])} / {_f(d['tcp_max_mm'])} |"
+        f" {_f(d['speed_mm_s'], '.2f')} | {_f(d['slope_worst_deg'], '.2f')} / {_f(d['rotation_worst_off_deg'], '.2f')}"
+        f" ({len(w['s_mm'])} waypoints, {'PA' if d['in_position'] else 'not PA'}) | {_f(d['tilt_deg'], '.1f')};"
+        f" {_f(d['rotate_deg'][0], '.1f')} .. {_f(d['rotate_deg'][1], '.1f')} | {_f(d['torch_spread_mm'], '.2f')} |"
+        f" {_f(d['arc_s'], '.1f')} / {_f(d['job_s'], '.1f')} | {_f(d['plan_wall_s'], '.1f')} |",
+    ]
+    return "\n".join(lines) + "\n"

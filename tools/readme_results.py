@@ -231,6 +231,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "interrupts": lambda results: journal_tables.interrupts_table(_load_object(results, "interrupts.json")),
     "curves": curves,
     "positioner": lambda results: positioner_tables.positioner_table(_load_object(results, "positioner.json")),
+    "coordinated": lambda results: positioner_tables.coordinated_table(_load_object(results, "coordinated.json")),
 }
 
 

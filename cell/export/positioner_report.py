@@ -7,8 +7,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from cell.coordinated.record import CoordinatedWeld
 from cell.pipeline.positioned.run import PositionerRun
-from cell.types import WeldReason
+from cell.types import SeamEstimate, WeldReason
+from cell.types.curve_estimate import CurveEstimate
 from cell.types.run import SeamWeld
 
 
@@ -42,7 +44,8 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
             )
     seams: list[dict[str, Any]] = []
     tcp: list[float] = []
-    for e in run.detection.estimates:
+    found: list[SeamEstimate | CurveEstimate] = [*run.detection.estimates, *run.detection.curve_estimates]
+    for e in found:
         w = welds.get(e.id)
         q = w.quality if w is not None else None
         if q is not None:
@@ -86,6 +89,29 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
             "rescan_s": _r(run.rescan_s),
             "tcp_max_mm": _r(max(tcp, default=math.nan)),
         },
+        "coordinated": [coordinated_entry(cw) for cw in run.coordinated],
         "error": run.error.message if run.error is not None else None,
         "timings": {k: _r(v) for k, v in run.timings.items()},
+    }
+
+
+def coordinated_entry(cw: CoordinatedWeld) -> dict[str, Any]:
+    """A curved seam welded with the rotate axis turning: its times, axes' sweep, the torch's spread and every
+    knot's ISO 6947 slope and rotation (mm, deg, s)."""
+    deg = lambda a: [round(math.degrees(float(v)), 3) for v in a]  # noqa: E731
+    return {
+        "id": cw.seam_id,
+        "arc_s": _r(cw.arc_s),
+        "job_s": _r(cw.duration),
+        "plan_wall_s": _r(cw.plan_s),
+        "speed_mm_s": _r(cw.speed * 1000.0),
+        "tilt_deg": _r(math.degrees(float(cw.knot_axes[0, 0]))),
+        "rotate_deg": deg((cw.knot_axes[0, 1], cw.knot_axes[-1, 1])),
+        "torch_spread_mm": _r(cw.tcp_spread_mm),
+        "in_position": cw.in_position,
+        "waypoints": {
+            "s_mm": [round(float(v) * 1000.0, 2) for v in cw.s],
+            "slope_deg": [round(float(v), 3) for v in cw.slope_deg],
+            "rotation_deg": [round(float(v), 3) for v in cw.rotation_deg],
+        },
     }

@@ -19,7 +19,14 @@ from cell.motion.timing import connect
 from cell.types.plan import Segment
 from cell.types.trajectory import Trajectory
 
-_HALVINGS = 4  # blends tried at a point: the longest, then halved this many times before an exact stop
+# The cuts tried at a point, longest first, as fractions of the longest cut of each motion (before, after): where a
+# link collides, the cut into one motion is shortened before the other's (the collision is usually near one of them)
+_CUTS = tuple(
+    sorted(
+        ((x, y) for x in (1.0, 0.5, 0.25, 0.125, 0.0625) for y in (1.0, 0.5, 0.25, 0.125, 0.0625)),
+        key=lambda c: (-(c[0] + c[1]), -min(c)),
+    )
+)
 _MIN_CUT = 0.02  # [s] a motion cut shorter than this at a point: an exact stop there
 
 
@@ -45,10 +52,11 @@ def blend_plan(
 
     fraction [0, 0.5]: at most this fraction of each of two neighbouring motions is cut at their point, and no more
     of a motion than its previous blend left (so half of an approach at least stays the straight line it was, and a
-    motion blended at both ends keeps at least its middle). At each point the cuts are halved until the
-    link is faster than the two cut pieces and ``clear`` (the collision and body tests) passes for it, else
-    the point is an exact stop. tcp : q (dof,) -> the TCP (3,) in R, for the zones. Segments come back to back,
-    times renumbered from the first one's start.
+    motion blended at both ends keeps at least its middle). At each point the cuts are shortened (each to a half,
+    a quarter ... of its longest, one motion's before both, the longest pair first) until the link is faster than
+    the two cut pieces and ``clear`` (the collision and body tests) passes for it, else the point is an exact stop.
+    tcp : q (dof,) -> the TCP (3,) in R, for the zones. Segments come back to back, times renumbered from the first
+    one's start.
     """
     if not 0.0 <= fraction <= 0.5:
         raise ValueError(f"blend fraction must be within [0, 0.5], got {fraction}")
@@ -83,10 +91,11 @@ def _blend_at(
     """The blend between motions a and b (None: an exact stop): a left no earlier than ``entry_min`` [s] into it
     (where the previous blend joined it), b joined no later than ``exit_max`` [s] (where the next may leave)."""
     # a's cut ends where the previous blend joined it (a motion blended at both ends keeps at least its middle)
-    cut_a, cut_b = min(fraction * a.duration, a.duration - entry_min - 2.0 * dt), fraction * b.duration
-    for _ in range(_HALVINGS + 1):
+    max_a, max_b = min(fraction * a.duration, a.duration - entry_min - 2.0 * dt), fraction * b.duration
+    for scale_a, scale_b in _CUTS:
+        cut_a, cut_b = scale_a * max_a, scale_b * max_b
         if min(cut_a, cut_b) < _MIN_CUT:
-            return None
+            continue
         exit_s = float(np.floor((a.duration - cut_a) / dt + 1e-9) * dt)  # on a's sample grid
         entry_s = float(np.ceil(cut_b / dt - 1e-9) * dt)  # on b's
         if exit_s > entry_min + dt and entry_s < exit_max - dt:
@@ -96,7 +105,6 @@ def _blend_at(
                 link = None
             if link is not None and link.duration < (a.duration - exit_s) + entry_s - dt and clear(link):
                 return _Blend(exit_s, entry_s, link)
-        cut_a, cut_b = 0.5 * cut_a, 0.5 * cut_b
     return None
 
 

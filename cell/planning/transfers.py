@@ -4,10 +4,7 @@ section 1). Frames: everything in the robot base frame R [m]; joints [rad]; time
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -18,126 +15,16 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import Entry, body_entry
 from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
-from cell.motion.timing import Trajectory, ptp
+from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow
 from cell.planning.failures import LineError
 from cell.planning.lines import line_trajectory, solve_line
+from cell.planning.moves.pieces import Piece, TransferFail
+from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
 from cell.process.torch import WeldProcess, line_poses
 from cell.types import Part
-from cell.types.plan import SegmentKind
-
-
-class Piece(NamedTuple):
-    """One timed motion before it gets its place in the plan: kind, trajectory, TCP speed [m/s] (0: PTP) and
-    the TCP pose X_end (4, 4) in R at its end."""
-
-    kind: SegmentKind
-    trajectory: Trajectory
-    speed: float
-    X_end: FloatArray
-
-
-@dataclass(frozen=True)
-class TransferFail:
-    """No free way: why (the last strategy's contact or error) and the contact point p_R (3,) [m] in R."""
-
-    reason: str
-    p_R: FloatArray
-
-
-class TransferStrategy(Protocol):
-    """One way to move between two configurations; ``name`` is how failure messages call it."""
-
-    @property
-    def name(self) -> str: ...
-
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
-        """The motions q_a -> q_b (dof,) [rad]; raises IKError, TimingError or LineError when it cannot time
-        them. Collisions are not checked here."""
-        ...
-
-
-@dataclass(frozen=True)
-class Direct:
-    """One PTP move."""
-
-    name: str = "direct"
-
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
-        robot = mover.robot
-        return [Piece("move", ptp(q_a, q_b, robot.limits, dt=mover.opt.dt), 0.0, robot.fk(q_b))]
-
-
-@dataclass(frozen=True)
-class Lift:
-    """Straight up to the lift height (plus ``extra`` times ``transfer_lift``), PTP across, straight down."""
-
-    name: str = "lift"
-    extra: int = 0
-
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
-        robot, opt = mover.robot, mover.opt
-        h = mover.lift_z + opt.transfer_lift * self.extra
-        up = mover.vertical(q_a, h, up=True)
-        down = mover.vertical(q_b, h, up=False)
-        top_a = up.trajectory.q[-1] if up is not None else q_a
-        top_b = down.trajectory.q[0] if down is not None else q_b
-        pieces = [up] if up is not None else []
-        pieces.append(Piece("move", ptp(top_a, top_b, robot.limits, dt=opt.dt), 0.0, robot.fk(top_b)))
-        if down is not None:
-            pieces.append(down)
-        return pieces
-
-
-@dataclass(frozen=True)
-class Hop:
-    """PTP up to a via point at the lift height above q_a's TCP, PTP across to one above q_b's, PTP down to q_b:
-    the lift's via points reached by joint moves, faster than its straight lines where the collision check finds
-    the joint path free. The lift height is ``transfer_lift`` (plus ``extra`` times it) above the highest
-    obstacle, or ``rise`` [m] above it when given; ``over`` "start" or "end" keeps only that end's via point."""
-
-    name: str = "hop"
-    extra: int = 0
-    rise: float | None = None
-    over: str = "both"
-
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
-        robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
-        top = mover.lift_z - mover.opt.transfer_lift
-        h = top + self.rise if self.rise is not None else mover.lift_z + mover.opt.transfer_lift * self.extra
-        via_a = mover.above(q_a, h) if self.over != "end" else None
-        via_b = mover.above(q_b, h) if self.over != "start" else None
-        qs = [q_a, *(q for q in (via_a, via_b) if q is not None), q_b]
-        return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
-
-
-@dataclass(frozen=True)
-class ViaHome:
-    """PTP to home, PTP on."""
-
-    name: str = "home"
-
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
-        robot, lim, dt, home = mover.robot, mover.robot.limits, mover.opt.dt, mover.q_home
-        return [
-            Piece("move", ptp(q_a, home, lim, dt=dt), 0.0, robot.fk(home)),
-            Piece("move", ptp(home, q_b, lim, dt=dt), 0.0, robot.fk(q_b)),
-        ]
-
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
-
-DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (
-    Direct(),
-    Hop("hop_down", rise=0.02, over="end"),
-    Hop("hop_up", rise=0.02, over="start"),
-    Hop("hop_low", rise=0.02),
-    Hop(),
-    Lift(),
-    Hop("hop_high", extra=1),
-    Lift("lift_high", extra=1),
-    ViaHome(),
-)
 
 
 class Transfers:
@@ -346,3 +233,17 @@ def joined(pieces: Sequence[Piece]) -> Trajectory:
         qdd.append(tr.qdd[skip:])
         t0 += tr.duration
     return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))
+
+
+__all__ = [
+    "DEFAULT_STRATEGIES",
+    "Direct",
+    "Hop",
+    "Lift",
+    "Piece",
+    "TransferFail",
+    "TransferStrategy",
+    "Transfers",
+    "ViaHome",
+    "joined",
+]

@@ -66,3 +66,24 @@ class SimPositioner:
         X_tilt = X_WR @ self.pos.X_R_tilt(tilt) @ invert(self.pos.X_R_tilt(t_was)) @ invert(X_WR)
         move_bodies(client, [self.bodies[CRADLE]], X_tilt)
         return X_nom, X_true
+
+    def follow(self, tilt: float, rotate: float) -> FloatArray:
+        """Turn the axes to (tilt, rotate) [rad] as one step of a continuous move (the arm welding meanwhile): the
+        clamped things carried by the nominal kinematics with the error they already have (nothing drawn: a part
+        clamped on the faceplate turns with it). Returns the true motion X_W (4, 4) of this step."""
+        from cell.sim.positioner import move_bodies
+
+        X_WR = self.scenario.X_WR
+        nominal = lambda a: X_WR @ self.pos.move(*a) @ invert(X_WR)  # noqa: E731  (from home, in W)
+        X_nom = nominal((tilt, rotate)) @ invert(nominal(self.axes))
+        X_W_true = X_nom @ self.X_W_true  # the error rides on the faceplate
+        X_true = X_W_true @ invert(self.X_W_true)
+        t_was = self.axes[0]
+        self.axes, self.X_W_true = (tilt, rotate), X_W_true
+        client, bodies = self.sim.client, self.sim.bodies  # type: ignore[attr-defined]
+        move_bodies(client, [b for n, b in bodies.items() if n == "table" or n.startswith("fixture:")], X_true)
+        move_bodies(client, [self.bodies[FACEPLATE]], X_nom)
+        if tilt != t_was:
+            X_tilt = X_WR @ self.pos.X_R_tilt(tilt) @ invert(self.pos.X_R_tilt(t_was)) @ invert(X_WR)
+            move_bodies(client, [self.bodies[CRADLE]], X_tilt)
+        return X_true

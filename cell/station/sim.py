@@ -134,6 +134,16 @@ class SimStation:
         self.parts_W = self.sim.move_part(X_true)
         return X_nom
 
+    def follow_positioner(self, tilt: float, rotate: float) -> FloatArray:
+        """One step of a continuous positioner move (coordinated with the arm): the part, its beads, the clamping
+        table and the fixtures carried with the faceplate, with the clamping error they have. Returns the true
+        motion X_W (4, 4) of the step."""
+        if self.positioner is None:
+            raise ScenarioError(f"scenario {self.scenario.name!r} has no robot.positioner to move")
+        X_true = self.positioner.follow(tilt, rotate)
+        self.parts_W = self.sim.move_part(X_true)
+        return X_true
+
     def joint_state(self) -> FloatArray:
         return np.asarray(self.sim.robot.q, dtype=float)
 

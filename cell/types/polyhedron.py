@@ -243,8 +243,25 @@ class Polyhedron:
         return np.asarray(np.arctan2(num, den).sum(axis=1) / (2.0 * np.pi))
 
     def transformed(self, X_CA: FloatArray) -> Polyhedron:
-        """The same body expressed in frame C, given the pose X_CA of its frame A in C."""
-        return Polyhedron(transform_points(X_CA, self.vertices), self.faces, self.names)
+        """The same body expressed in frame C, given the pose X_CA of its frame A in C. A rigid motion keeps the
+        faces' triangulation and moves the planes and the centre (no face is triangulated again)."""
+        X = np.asarray(X_CA, dtype=float)
+        R, t = X[:3, :3], X[:3, 3]
+        if not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0.0:
+            return Polyhedron(transform_points(X, self.vertices), self.faces, self.names)
+        out = object.__new__(Polyhedron)
+        n = self._planes[:, :3] @ R.T
+        vol, c, radius = self._mass
+        for k, v in (
+            ("vertices", readonly(transform_points(X, self.vertices))),
+            ("faces", self.faces),
+            ("names", self.names),
+            ("_planes", readonly(np.column_stack([n, self._planes[:, 3] + n @ t]))),
+            ("_tris", self._tris),
+            ("_mass", (vol, readonly(R @ c + t), radius)),
+        ):
+            object.__setattr__(out, k, v)
+        return out
 
     @property
     def volume(self) -> float:

@@ -85,3 +85,14 @@ def test_a_blend_that_is_not_clear_stays_an_exact_stop(limits: JointLimits) -> N
     assert all(s.zone_m == 0.0 and s.q_target is None for s in out)
     with pytest.raises(ValueError, match="within"):
         blend_plan(segs, limits, _tcp, lambda tr: True, fraction=0.7)
+
+
+def test_the_cuts_shorten_one_motion_before_both() -> None:
+    """Where the longest link is not clear, the cut into one motion is halved before both are (a link colliding near
+    one motion's point need not lose the other's cut), and every cut down to a sixteenth is tried, longest first."""
+    from cell.planning.blend import _CUTS
+
+    assert _CUTS[0] == (1.0, 1.0) and len(set(_CUTS)) == len(_CUTS) == 25
+    assert _CUTS.index((1.0, 0.5)) < _CUTS.index((0.5, 0.5)) and _CUTS.index((0.5, 1.0)) < _CUTS.index((0.5, 0.5))
+    totals = [a + b for a, b in _CUTS]
+    assert totals == sorted(totals, reverse=True)

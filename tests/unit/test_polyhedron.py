@@ -98,6 +98,15 @@ def test_transformed_moves_planes_points_and_centre() -> None:
     assert moved.radius == pytest.approx(L_SHAPE.radius)
 
 
+def test_a_rigid_move_keeps_what_a_rebuilt_body_computes() -> None:
+    X = make_pose(rpy_to_matrix([0.3, -0.2, 1.1]), [0.5, -0.4, 0.2])
+    moved = plate_with_hole().transformed(X)
+    rebuilt = Polyhedron(transform_points(X, plate_with_hole().vertices), moved.faces, moved.names)
+    assert np.allclose(moved.face_planes(), rebuilt.face_planes(), atol=1e-12)
+    assert np.array_equal(moved.triangles(), rebuilt.triangles())
+    assert moved.volume == pytest.approx(rebuilt.volume) and np.allclose(moved.center, rebuilt.center)
+
+
 def test_box_and_its_polyhedron_agree() -> None:
     box = Box(make_pose(rpy_to_matrix([0.2, 0.5, -0.7]), [0.1, 0.2, 0.3]), np.array([0.4, 0.1, 0.06]))
     poly = box.to_polyhedron()

@@ -67,7 +67,7 @@ def test_the_transfers_meet_shorter_lines_and_the_welds_are_unchanged(robot: Rob
     got, planned = _lines_mm(robot, short), _lines_mm(robot, full)
     assert len(got) == len(planned) == 4
     assert np.allclose(planned, 50.0, atol=0.1)  # without shorter lengths: the process's 50 mm
-    assert all(min(abs(d - x) for x in (10.0, 20.0, 50.0)) < 0.1 for d in got) and min(got) < 49.0, got
+    assert all(abs(d - 5.0 * round(d / 5.0)) < 0.1 and d > 4.9 for d in got) and min(got) < 49.0, got  # on the knots
     apps = [s for s in short.segments if s.kind == "approach"]
     full_apps = [s for s in full.segments if s.kind == "approach"]
     lengths = [s.trajectory.duration for s in apps]

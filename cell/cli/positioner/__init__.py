@@ -114,10 +114,18 @@ def _programs(sc: Scenario, run: Any, out_dir: Path, controller: str) -> list[Pa
         ext = external_axes(pos, g.pose.tilt, g.pose.rotate)
         jobs.append(ProgramJob(g.plan, robot, f"{sc.name.replace('-', '_')}_p{k + 1}"[:24], X_RB=X_RB,
                                X_WR=np.asarray(sc.X_WR), external=ext))  # fmt: skip
-    if not jobs:
+    coordinated = [cw for cw in run.coordinated if any(w.welded for g in run.groups for w in g.seams
+                                                       if w.id == cw.seam_id)]  # fmt: skip
+    if not jobs and not coordinated:
         return []
     make_folder(out_dir)
-    return write_positioner_programs(controller, jobs, f"{sc.name.replace('-', '_')}"[:24], out_dir)
+    stem = f"{sc.name.replace('-', '_')}"[:24]
+    written = write_positioner_programs(controller, jobs, stem, out_dir) if jobs else []
+    if coordinated:  # curved seams welded with the part turning: a program each (docs/positioner.md)
+        from cell.export.coordinated_program import write_coordinated_programs
+
+        written += write_coordinated_programs(controller, coordinated, robot, pos, stem[:20], out_dir)
+    return written
 
 
 def _robot(sc: Scenario) -> Kinematics:

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from cell.export.checks.kinematics import check_kinematics, frame_of
-from cell.export.checks.positioner import check_positioner, stated_base, stated_positioner
+from cell.export.checks.positioner import check_positioner, stated_base, stated_positioner, turning_base
 from cell.export.checks.program import Finding, Program, check_program, read_programs, stated_axis
 from cell.export.checks.read import Statement, read_krl
 from cell.types.robot import Kinematics
@@ -224,7 +224,7 @@ def check_all(
         out += check_program(p, e1_limits_mm)
         cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
         if cartesian or not program_calls(p):
-            out += check_kinematics(fixed_base(p), robot, stated_base(p))
+            out += check_kinematics(turning_base(fixed_base(p)), robot, stated_base(p))
         out += check_positioner(p)
         out += check_calls(p, programs)
     return out + check_setup(programs)

@@ -91,6 +91,7 @@ class CollisionChecker:
         self._is_obstacle_pair = self._pair_second >= self._n_robot
         self._base_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == 0]
         self._base_offset = np.zeros(3)
+        self._base_X = np.eye(4)  # the base's rigid placement (place_base)
         self.set_base(robot.base_offset_R)
 
     # -- set-up ------------------------------------------------------------------------------------------------
@@ -140,6 +141,23 @@ class CollisionChecker:
             P = obj.placement
             obj.placement = pin.SE3(np.array(P.rotation), np.array(P.translation) + move)
         self._base_offset = d.copy()
+
+    def place_base(self, X_base: npt.ArrayLike) -> None:
+        """Put the arm's base (its first joint and the shapes fixed to the base) at the rigid pose X_base (4, 4)
+        in the obstacles' frame (identity: where R puts it), as when the obstacles turn on a positioner and the arm
+        is seen from them; nothing is rebuilt. Undone by ``place_base(np.eye(4))``; not to be mixed with
+        :meth:`set_base`."""
+        X = np.asarray(X_base, dtype=float)
+        step = pin.SE3(X @ np.linalg.inv(self._base_X))
+        self._model.jointPlacements[1] = step * self._model.jointPlacements[1]
+        for i in self._base_shapes:
+            obj = self._geom.geometryObjects[i]
+            obj.placement = step * obj.placement
+        self._base_X = X.copy()
+
+    def step_bound(self, q: npt.ArrayLike) -> tuple[float, Contact | None]:
+        """The motion [m] any arm point may make from q (dof,) before the next check, or the contact at q."""
+        return self._step_bound(q)
 
     def check_trajectory(self, traj: Trajectory, track: LinearTrack | None = None) -> Contact | None:
         """:meth:`check_path` of a timed motion with the base where the track puts it at every sample

@@ -127,10 +127,18 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
                 break
         welded = {w.id for g in groups for w in g.seams if w.welded}
         unheld |= {i: why for i, why in swept.items() if i not in welded and i not in unheld}
+        from cell.pipeline.coordinated import weld_curves_coordinated  # curved seams: the part turns while welded
+
+        done, why_c = weld_curves_coordinated(station, det, pos, q_now, execute=job.execute, progress=progress)
+        groups_c = [GroupRun(p, 0.0, None, None, ex, (w,), cw.plan_s) for p, w, cw, ex in done if cw is not None]
+        coordinated = tuple(cw for _, _, cw, _ in done if cw is not None)
+        unheld |= why_c
+        codes |= {w.id: w.code or WeldReason.NOT_PLANNED for _, w, cw, _ in done if cw is None}
         timings = {**det.timings, "choose_poses_s": choose_s, "move_check_s": sweep_s}
         timings["total_s"] = time.perf_counter() - t_all
         codes |= {i: WeldReason.NOT_PLANNED for i in unheld if i not in codes}  # no pose holds it
-        return PositionerRun(det, tuple(groups), unheld, rescan_s, timings=timings, unheld_codes=codes)
+        return PositionerRun(det, (*groups, *groups_c), unheld, rescan_s, timings=timings, unheld_codes=codes,
+                             coordinated=coordinated)  # fmt: skip
 
 
 def _weld_pose(

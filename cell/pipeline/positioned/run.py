@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from cell.coordinated.record import CoordinatedWeld
 from cell.errors import CellError
 from cell.pipeline.records import Detection
 from cell.positioner.poses import PositionerPose
@@ -49,6 +50,7 @@ class PositionerRun:
     error: CellError | None = None
     timings: Mapping[str, float] = field(default_factory=dict)
     unheld_codes: Mapping[str, WeldReason] = field(default_factory=dict)  # seam id -> why, as a code
+    coordinated: tuple[CoordinatedWeld, ...] = ()  # curved seams welded with the rotate axis turning
 
     def welds(self) -> dict[str, SeamWeld]:
         return {w.id: w for g in self.groups for w in g.seams}
@@ -68,7 +70,8 @@ class PositionerRun:
         return self.rescan_s + sum(g.robot_s for g in self.groups) + self.positioner_s
 
     def seam_ids(self) -> tuple[str, ...]:
-        return tuple(e.id for e in self.detection.estimates)
+        curves = tuple(c.id for c in self.detection.curve_estimates)
+        return tuple(e.id for e in self.detection.estimates) + curves
 
     def located(self) -> int:
         return sum(e.status is SeamStatus.FOUND for e in self.detection.estimates)

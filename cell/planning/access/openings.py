@@ -16,7 +16,8 @@ from cell.errors import IKError
 from cell.geometry import FloatArray
 from cell.motion.ik import solve_ik
 from cell.motion.timing import ptp
-from cell.planning.transfers import DEFAULT_STRATEGIES, Piece, Transfers, TransferStrategy
+from cell.planning.moves.pieces import Piece
+from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Mover, TransferStrategy
 
 IN_M = 0.10  # [m] how far aside the torch comes in to a seam
 OUT_M = 0.15  # [m] how far aside it steps out of one
@@ -33,20 +34,20 @@ class Aside:
     out_m: float = OUT_M
     in_m: float = IN_M
 
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+    def pieces(self, mover: Mover, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
         qs = [q_a, *_vias_of(mover, q_a, self.out_m), *_vias_of(mover, q_b, self.in_m)[::-1], q_b]
         robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
         return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
 
 
-# The via points of each configuration and distance, per Transfers (the strategies share them: an end's "out" serves
-# its "out" and both "both" ways); gone with the Transfers.
-_VIAS: weakref.WeakKeyDictionary[Transfers, dict[tuple[bytes, float], list[FloatArray] | IKError]] = (
+# The via points of each configuration and distance, per transfer search (the strategies share them: an end's "out" serves
+# its "out" and both "both" ways); gone with the search.
+_VIAS: weakref.WeakKeyDictionary[Mover, dict[tuple[bytes, float], list[FloatArray] | IKError]] = (
     weakref.WeakKeyDictionary()
 )
 
 
-def _vias_of(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray]:
+def _vias_of(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
     """:func:`_vias`, remembered per mover, configuration and distance (an IKError too)."""
     memo = _VIAS.setdefault(mover, {})
     key = (np.asarray(q, dtype=float).tobytes(), aside_m)
@@ -61,7 +62,7 @@ def _vias_of(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray
     return got
 
 
-def _vias(mover: Transfers, q: FloatArray, aside_m: float) -> list[FloatArray]:
+def _vias(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
     """The via points (dof,) [rad] out of q: ``aside_m`` towards the shoulder square to the torch axis, then that
     pose raised towards the lift height, as high as the arm reaches it (IK seeded at q and walked up); none when
     ``aside_m`` is 0. Raises IKError when the first cannot be reached."""

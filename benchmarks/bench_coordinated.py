@@ -1,0 +1,110 @@
+"""A pipe stub's circular fillet welded on a positioner by coordinated motion: ``cell weld pipe-stub-positioner`` as
+the cell runs it (the weld gate's word on the located curve), then the same located curve planned, played and
+measured as a study whatever the gate says (docs/positioner.md, "Coordinated motion").
+
+    .venv/bin/python benchmarks/bench_coordinated.py [--json PATH] [--noise realistic|small]
+
+Per run: the located curve's sigma and its error against the truth, the gate's word; the coordinated weld's TCP
+RMS / max against the true curve the part carries (in the part's frame), its speed along the part, the torch's
+spread, the tilt and the rotate axis's sweep, every waypoint's ISO 6947 slope and rotation (worst of them), the
+arc time, the job's time and the planning's wall time (default ``benchmarks/results/coordinated.json``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+RESULTS = Path(__file__).resolve().parent / "results"
+SCENARIO = "pipe-stub-positioner"
+
+
+def _say(msg: str) -> None:
+    print(f"· {msg}", file=sys.stderr, flush=True)
+
+
+def coordinated_row(noise: str | None = None, program: Path | None = None) -> dict[str, Any]:
+    """The located curve, the gate's word and the coordinated weld measured (a study when the gate refuses);
+    ``program``: a folder for its KRL program (``krl/``) and RAPID module (``rapid/``)."""
+    from cell import scenario as sc
+    from cell.export.positioner_report import coordinated_entry
+    from cell.pipeline.coordinated import weld_curves_coordinated
+    from cell.pipeline.curved.welds import curve_doubt
+    from cell.pipeline.detect import detect, read_weldmap
+    from cell.pipeline.geometry import open_cell
+    from cell.seams.curved.metrics import curve_error
+
+    s = sc.load(SCENARIO)
+    s = s.with_noise(noise) if noise else s
+    assert s.robot.positioner is not None
+    pos = s.robot.positioner.positioner(s.X_WR)
+    wm = read_weldmap(s)
+    t = time.perf_counter()
+    with open_cell(s, wm) as station:
+        assert station.arm is not None
+        det = detect(s, "ours", station=station, weldmap=wm)
+        c = det.curve_estimates[0]
+        doubt = curve_doubt(c, s)
+        err = curve_error(c, np.asarray(det.curve_truths[c.id]))
+        done, _ = weld_curves_coordinated(station, det, pos, station.arm.q_scan, refuse_doubtful=False)
+    _, weld, cw, _ = done[0]
+    assert cw is not None and weld.quality is not None
+    if program is not None:
+        from cell.export.coordinated_program import write_coordinated_programs
+        from cell.motion.robot import RobotModel
+        from cell.station.arm import robot_urdf
+
+        robot = RobotModel.from_urdf(robot_urdf(s))
+        for controller in ("krl", "rapid"):
+            (program / controller).mkdir(parents=True, exist_ok=True)
+            write_coordinated_programs(controller, [cw], robot, pos, "pipe_stub", program / controller)
+    q = weld.quality
+    entry = coordinated_entry(cw)
+    return {
+        "scenario": SCENARIO,
+        "noise": noise or "realistic",
+        "curve": c.id,
+        "located_sigma_max_mm": round(c.sigma_max_m * 1000.0, 3),
+        "located_error_rms_mm": round(err.rms_mm, 3),
+        "located_error_max_mm": round(err.max_mm, 3),
+        "gate": "refused: " + doubt.detail if doubt is not None else "passed",
+        "welded_by_the_cell": doubt is None,
+        "tcp_rms_mm": round(q.tcp_rms_mm, 3),
+        "tcp_max_mm": round(q.tcp_max_mm, 3),
+        "speed_mm_s": round(q.speed_mm_s, 2),
+        "loop_unwelded_mm": round(q.short_start_mm, 1),
+        "slope_worst_deg": round(float(np.abs(cw.slope_deg).max()), 3),
+        "rotation_worst_off_deg": round(float(np.abs(np.asarray(cw.rotation_deg) - 180.0).max()), 3),
+        "in_position": cw.in_position,
+        "tilt_deg": entry["tilt_deg"],
+        "rotate_deg": entry["rotate_deg"],
+        "torch_spread_mm": entry["torch_spread_mm"],
+        "arc_s": entry["arc_s"],
+        "job_s": entry["job_s"],
+        "plan_wall_s": entry["plan_wall_s"],
+        "wall_s": round(time.perf_counter() - t, 1),
+        "waypoints": entry["waypoints"],
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", type=Path, default=RESULTS / "coordinated.json")
+    ap.add_argument("--noise", default=None)
+    ap.add_argument("--program", type=Path, default=None, help="write the KRL and RAPID programs here")
+    args = ap.parse_args()
+    _say(f"{SCENARIO}: locate, plan, weld with the part turning")
+    row = coordinated_row(args.noise, args.program)
+    out = {"command": "benchmarks/bench_coordinated.py" + (f" --noise {args.noise}" if args.noise else ""), **row}
+    args.json.write_text(json.dumps(out, indent=1) + "\n")
+    _say(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()

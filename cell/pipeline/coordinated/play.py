@@ -1,0 +1,61 @@
+"""A coordinated weld played in the simulator: at every record the arm at its joints and the positioner's axes
+turned (the part, the clamping table and the faceplate carried, the clamping error riding on them; the bodies
+moved each time an axis has turned ``BODY_STEP_RAD``, the part's pose at every record from the same motion), the
+torch's tip recorded; then measured against the true curve in the part's own frame (the tip carried back by the
+part's true motion from home). Frames: W the world, R the robot base; [m], [s]."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cell.coordinated.record import CoordinatedWeld
+from cell.geometry import FloatArray, invert
+from cell.station.sim import SimStation
+from cell.types.execution import Event, Execution, WeldQuality
+
+RECORD_DT = 0.01  # [s] between records, as the arm's own playback
+BODY_STEP_RAD = math.radians(0.25)  # the part's bodies moved when an axis has turned this far (0.5 mm at 0.11 m)
+
+
+def play(station: SimStation, cw: CoordinatedWeld, record_dt: float = RECORD_DT) -> tuple[Execution, FloatArray]:
+    """Drive the arm and the positioner together along ``cw``; returns the execution (TCP in W) and each record's
+    tip carried back to where the part stood at the scan (n, 3) in R (the part's frame at home)."""
+    assert station.positioner is not None
+    sc = station.scenario
+    X_RW = invert(sc.X_WR)
+    t = np.asarray(cw.times)
+    at = np.unique(np.concatenate([np.arange(0.0, t[-1], record_dt), t[np.flatnonzero(np.diff(cw.arc_on.astype(int)))
+                                   + 1], [t[-1]]]))  # fmt: skip
+    q = np.column_stack([np.interp(at, t, cw.q[:, j]) for j in range(cw.q.shape[1])])
+    axes = np.column_stack([np.interp(at, t, cw.axes[:, j]) for j in range(2)])
+    arc = np.asarray(cw.arc_on, dtype=bool)[np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 1)]
+    sim = station.sim
+    sp = station.positioner
+    tcp_W = np.empty((len(at), 3))
+    back_R = np.empty((len(at), 3))
+    moved = np.full(2, np.inf)  # the axes where the bodies were last moved to
+    for i in range(len(at)):
+        a = axes[i]
+        if np.abs(a - moved).max() >= BODY_STEP_RAD or i == len(at) - 1:
+            station.follow_positioner(float(a[0]), float(a[1]))
+            moved = a
+        sim.set_q(q[i])
+        p_W = sim.link_pose("torch_tcp")[:3, 3]
+        tcp_W[i] = p_W
+        # The part's true motion from the scan at these axes: the bodies' last step carried on by the kinematics.
+        X_step_R = sp.pos.move(float(a[0]), float(a[1])) @ np.linalg.inv(sp.pos.move(*sp.axes))
+        X_R_true = X_step_R @ X_RW @ sp.X_W_true @ sc.X_WR
+        back_R[i] = (invert(X_R_true) @ np.r_[X_RW[:3, :3] @ p_W + X_RW[:3, 3], 1.0])[:3]
+    events = tuple(Event(float(t0), "move", f"{kind} {cw.seam_id}") for kind, t0, _ in cw.pieces)
+    return Execution(at, q, tcp_W, arc, events), back_R
+
+
+def quality(ex: Execution, back_R: FloatArray, truth_R: FloatArray, closed: bool) -> WeldQuality:
+    """The weld's quality from the arc-on records carried back to the part at the scan against its true curve
+    there (n, 3) in R: the TCP error and the travel speed are the torch's relative to the part."""
+    from cell.process.curve_quality import curve_weld_quality
+
+    on = np.asarray(ex.arc_on)
+    return curve_weld_quality(np.asarray(ex.times)[on], back_R[on], truth_R, closed)

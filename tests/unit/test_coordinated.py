@@ -1,0 +1,154 @@
+"""The coordinated planner: the positioner's axes that keep a pipe's fillet in PA under the torch, the arm's and
+the axes' motion timed together at the travel speed relative to the part, and the eight-axis gate."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cell.coordinated.axes import CurveInF, knots_in_R, pa_axes, positions
+from cell.coordinated.gate import MovingScene, joint_limits, off_limits
+from cell.scenario import load
+from cell.types.curve_estimate import CurveEstimate
+from cell.types.positioner import PositionerAxis, TiltRotatePositioner
+from cell.types.seams import SeamStatus
+
+R_PIPE, Z_FILLET = 0.1096, 0.04  # [m] the fillet's radius and height above the faceplate
+
+
+def _circle_F(n: int = 360, off: tuple[float, float] = (0.0, 0.0)) -> CurveInF:
+    a = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    radial = np.column_stack([np.cos(a), np.sin(a), np.zeros(n)])
+    p = radial * R_PIPE + np.array([off[0], off[1], Z_FILLET])
+    tangent = np.column_stack([-np.sin(a), np.cos(a), np.zeros(n)])
+    up = np.broadcast_to([0.0, 0.0, 1.0], (n, 3))
+    return CurveInF(p, tangent, radial, up, a * R_PIPE)
+
+
+def _positioner(rotate_deg: float = 400.0) -> TiltRotatePositioner:
+    r = math.radians
+    return TiltRotatePositioner(
+        np.eye(4), 0.8, -0.05, 0.2,
+        PositionerAxis("tilt", r(-135), r(135), r(90), r(180), r(900)),
+        PositionerAxis("rotate", -r(rotate_deg), r(rotate_deg), r(120), r(240), r(1200)),
+    )  # fmt: skip
+
+
+def test_one_tilt_puts_every_point_of_a_pipes_fillet_in_pa_under_a_still_torch() -> None:
+    pos, curve = _positioner(), _circle_F()
+    axes = pa_axes(pos, curve)
+    assert axes is not None
+    assert np.allclose(np.abs(axes[:, 0]), math.radians(45.0))  # the bisector 45 deg from the pipe's axis
+    assert np.all(np.diff(axes[:, 1]) > 0) or np.all(np.diff(axes[:, 1]) < 0)  # the rotate axis turns one way
+    assert abs(abs(axes[-1, 1] - axes[0, 1]) - math.radians(359.0)) < 1e-6  # the whole loop, one turn
+    slope, rot, within = positions(pos, curve, axes)
+    assert within and np.abs(slope).max() < 1e-6 and np.abs(rot - 180.0).max() < 1e-6
+    p_R = knots_in_R(pos, curve, axes)[0]
+    assert np.linalg.norm(p_R - p_R.mean(axis=0), axis=1).max() < 1e-9  # the weld point stands still
+    # Clamped 5 mm off centre: the point under the torch wanders by the offset, still in PA.
+    off = _circle_F(off=(0.005, 0.0))
+    p_off = knots_in_R(pos, off, pa_axes(pos, off))[0]
+    spread = np.linalg.norm(p_off - p_off.mean(axis=0), axis=1).max()
+    assert 0.004 < spread < 0.0051
+
+
+def test_a_rotate_axis_too_short_for_the_loop_is_refused() -> None:
+    assert pa_axes(_positioner(rotate_deg=170.0), _circle_F()) is None
+
+
+def test_the_eight_axes_limits_name_the_positioner_axis_that_leaves_them() -> None:
+    sc = load("pipe-stub-positioner")
+    from cell.motion.robot import RobotModel
+    from cell.station.arm import robot_urdf
+
+    model = RobotModel.from_urdf(robot_urdf(sc))
+    pos = sc.robot.positioner.positioner(sc.X_WR)  # type: ignore[union-attr]
+    lim = joint_limits(model.limits, pos)
+    assert lim.names[-2:] == ("tilt", "rotate") and lim.dof == model.dof + 2
+    x = np.zeros((3, lim.dof))
+    assert off_limits(lim, x) is None
+    x[1, -1] = pos.rotate.q_max + 0.01
+    assert "rotate" in (off_limits(lim, x) or "")
+
+
+@pytest.fixture(scope="module")
+def planned() -> tuple:
+    """A pipe's fillet clamped 3.6 mm off the rotate axis of pipe-stub-positioner's positioner, planned."""
+    from cell.coordinated.plan import plan_coordinated
+    from cell.motion.robot import RobotModel
+    from cell.process.torch import WeldProcess
+    from cell.station.arm import robot_urdf
+
+    sc = load("pipe-stub-positioner")
+    model = RobotModel.from_urdf(robot_urdf(sc))
+    pos = sc.robot.positioner.positioner(sc.X_WR)  # type: ignore[union-attr]
+    curve = _circle_F(off=(0.003, -0.002))
+    X = pos.X_R_F(*pos.home)
+    est = CurveEstimate(
+        "C", SeamStatus.FOUND, p_RS=curve.p_F @ X[:3, :3].T + X[:3, 3], n_abutting_R=curve.n_a_F @ X[:3, :3].T,
+        n_receiving_R=curve.n_b_F @ X[:3, :3].T, closed=True, sigma_m=np.full(360, 1e-4), end_sigma_m=(0.0, 0.0),
+    )  # fmt: skip
+    process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
+    scene = MovingScene.build(model, pos, [], sc.motion.plan.collision)
+    q0 = np.radians(sc.robot.home_deg)
+    cw = plan_coordinated(model, pos, est, process, sc.motion.plan, scene, q0, rng=np.random.default_rng(0))
+    return sc, pos, est, process, cw, q0
+
+
+def test_the_coordinated_weld_is_timed_at_the_travel_speed_on_the_part_and_gated(planned: tuple) -> None:
+    _, pos, _, process, cw, q0 = planned
+    assert cw.in_position and 2.0 < cw.tcp_spread_mm < 4.0  # the arm corrects the 3.6 mm off-centre clamping
+    loop = 2 * math.pi * R_PIPE + process.closed_overlap
+    assert abs(cw.s[-1] - loop) < 0.002
+    # The weld's speed along the part is the travel speed; its piece lasts the loop at it, the ramps and the crater.
+    assert cw.speed == pytest.approx(process.travel_speed)
+    ideal = loop / cw.speed
+    assert ideal < cw.arc_s < ideal + 2.0
+    weld = (cw.times >= cw.pieces[2][1]) & (cw.times <= cw.pieces[2][2])
+    rate = np.abs(np.gradient(cw.axes[weld, 1], cw.times[weld]))
+    assert rate.max() == pytest.approx(cw.speed / R_PIPE, rel=0.05)  # the rotate axis carries the travel
+    # Start and end at home: the arm where it started, the positioner at its home.
+    assert np.allclose(cw.q[0], q0) and np.allclose(cw.q[-1], q0) and np.allclose(cw.axes[-1], pos.home)
+
+
+def test_the_simulator_turns_the_part_and_the_torch_follows_its_seam(planned: tuple) -> None:
+    from cell.pipeline.coordinated.play import play, quality
+    from cell.pipeline.detect import read_weldmap
+    from cell.pipeline.geometry import open_cell
+
+    sc, pos, est, _, cw, _ = planned
+    with open_cell(sc, read_weldmap(sc)) as station:
+        ex, back = play(station, cw, record_dt=0.1)
+        axes_end = station.positioner.axes  # type: ignore[union-attr]
+    assert np.allclose(axes_end, pos.home)  # the positioner played back home with the arm
+    q = quality(ex, back, np.asarray(est.p_RS), closed=True)
+    assert q.tcp_max_mm < 0.05 and q.short_start_mm == 0.0  # the whole loop, on the seam the part carries
+    assert q.speed_mm_s == pytest.approx(cw.speed * 1000.0, rel=0.01)  # relative to the turning part
+    moved = np.linalg.norm(ex.tcp_W[ex.arc_on] - ex.tcp_W[ex.arc_on].mean(axis=0), axis=1).max()
+    assert moved < 0.005  # the torch nearly still in the world while the part turns under it
+
+
+def test_the_krl_program_moves_e2_e3_in_the_turning_base_and_passes_the_check(planned: tuple, tmp_path: Path) -> None:
+    from cell.export.checks.calls import check_all
+    from cell.export.checks.program import read_programs
+    from cell.export.coordinated_program import write_coordinated_programs
+    from cell.motion.robot import RobotModel
+    from cell.station.arm import robot_urdf
+
+    sc, pos, _, _, cw, _ = planned
+    robot = RobotModel.from_urdf(robot_urdf(sc))
+    write_coordinated_programs("krl", [cw], robot, pos, "pipe", tmp_path)
+    programs, found = read_programs(tmp_path)
+    assert not found and not check_all(programs, robot)  # S, T on the arm at every point's own E2 / E3
+    dat = next(tmp_path.glob("*.dat")).read_text()
+    e3 = [float(v) for v in re.findall(r"E6POS XP\d+=\{[^}]*E3 ([-\d.]+)", dat)]
+    assert len(set(e3)) > 30 and max(e3) - min(e3) > 360.0  # the rotate axis turns the loop, point by point
+    src = next(tmp_path.glob("*.src"))
+    text = src.read_text().replace("Positioner chain", "Positioner")  # the chain not stated: the base stands still
+    src.write_text(text)
+    programs, _ = read_programs(tmp_path)
+    assert any(f.code in ("kinematics", "status_turn") for f in check_all(programs, robot))

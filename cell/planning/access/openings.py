@@ -40,8 +40,8 @@ class Aside:
         return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
 
 
-# The via points of each configuration and distance, per transfer search (the strategies share them: an end's "out" serves
-# its "out" and both "both" ways); gone with the search.
+# The via points of each configuration and distance, per transfer search (the strategies share them: an end's
+# "out" serves its "out" and both "both" ways); gone with the search.
 _VIAS: weakref.WeakKeyDictionary[Mover, dict[tuple[bytes, float], list[FloatArray] | IKError]] = (
     weakref.WeakKeyDictionary()
 )

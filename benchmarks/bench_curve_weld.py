@@ -4,6 +4,7 @@ gated, executed in the simulator and measured against the TRUE curve (not agains
     .venv/bin/python benchmarks/bench_curve_weld.py [--scenarios pipe-flange,railing,round-brace,tube-tee]
         [--json benchmarks/results/curve_weld.json]
     .venv/bin/python benchmarks/bench_curve_weld.py --located [--json benchmarks/results/curve_weld_located.json]
+    .venv/bin/python tools/readme_results.py   # their tables in docs/results.md
 
 ``--located``: the real pipeline, as ``cell weld NAME --sides first`` runs it (the curves LOCATED, re-scan, plan with
 the straight seams, gate, execute), per curved seam: welded (in how many arcs) or why not, the TCP against the true
@@ -110,7 +111,8 @@ def bench(name: str) -> dict[str, Any]:
         )
         plan_s = time.perf_counter() - t0
         ex = execute(station, plan, pre) if not problems and plan.segments else None
-    welds = curve_welds(plan, ex, pre.duration, det.curve_truths, {c.id: c.closed for c in curves}, s.X_WR)
+    closed, ests = {c.id: c.closed for c in curves}, {c.id: c for c in curves}
+    welds = curve_welds(plan, ex, pre.duration, det.curve_truths, closed, s.X_WR, ests)
     rows = []
     for c in curves:
         o = plan.outcome(c.id)
@@ -121,6 +123,7 @@ def bench(name: str) -> dict[str, Any]:
                 "closed": c.closed,
                 "length_mm": round(c.length_m * 1000.0, 1),
                 "planned": o.feasible,
+                "arcs": sum(1 for g in plan.segments if g.arc_on and g.seam_id == c.id),
                 "reason": o.reason,
                 "welded": q is not None,
                 "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
@@ -205,63 +208,19 @@ def bench_located(name: str) -> dict[str, Any]:
     }
 
 
-def markdown_located(out: Mapping[str, Any]) -> str:
-    """The ``--located`` results as the table of docs/curves-welding.md section 8."""
-    lines = [
-        "| scenario | curved seam | located RMS / max mm | welded | arcs | TCP RMS / max mm (true curve) | KRL CIRC"
-        " / check / RAPID ArcC | why not |",
-        "|---|---|---|---|---:|---|---|---|",
-    ]
-    for row in out["rows"]:
-        pg = row["programs"]
-        prog = f"{pg['krl_circ']} / {', '.join(pg['krl_check']) or 'clean'} / {pg['rapid_arcc']}" if pg else "-"
-        for r in row["seams"]:
-            loc = f"{r['located_rms_mm']:.3f} / {r['located_max_mm']:.3f}" if r["located_rms_mm"] is not None else "-"
-            tcp = f"{r['tcp_rms_mm']:.3f} / {r['tcp_max_mm']:.3f}" if r["tcp_rms_mm"] is not None else "-"
-            why = "" if r["welded"] else f"{r['code']}: {r['reason']}".replace("|", "/")
-            lines.append(
-                f"| {row['scenario']} | `{r['seam']}` | {loc} | {'yes' if r['welded'] else 'no'} | {r['arcs']} | {tcp}"
-                f" | {prog} | {why} |"
-            )
-    return "\n".join(lines)
-
-
-def markdown(out: Mapping[str, Any]) -> str:
-    """The results as the table of docs/curves-welding.md section 7."""
-    lines = [
-        "| scenario | curved seam | length mm | planned | TCP RMS / max mm (true curve) | arc s | why not |",
-        "|---|---|---:|---|---|---:|---|",
-    ]
-    for row in out["rows"]:
-        for r in row["seams"]:
-            tcp = f"{r['tcp_rms_mm']:.3f} / {r['tcp_max_mm']:.3f}" if r["welded"] else "-"
-            arc = f"{r['arc_s']:.1f}" if r["welded"] else "-"
-            why = r["reason"].replace("|", "/") if not r["planned"] else ""
-            kind = "closed" if r["closed"] else "open"
-            planned = "yes" if r["planned"] else "no"
-            lines.append(
-                f"| {row['scenario']} | `{r['seam']}` ({kind}) | {r['length_mm']:.0f} | {planned} | {tcp} | {arc}"
-                f" | {why} |"
-            )
-    return "\n".join(lines)
-
-
 def main(argv: Sequence[str] | None = None) -> None:
+    from cell.provenance import git_commit
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenarios", default=",".join(SCENARIOS))
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--located", action="store_true", help="through cell weld's pipeline, the curves located")
-    ap.add_argument("--markdown", action="store_true", help="print the table of an existing --json file, run nothing")
     args = ap.parse_args(argv)
     args.json = args.json or (OUT_LOCATED if args.located else OUT)
-    if args.markdown:
-        text = json.loads(args.json.read_text())
-        print(markdown_located(text) if args.located else markdown(text))
-        return
     rows = [(bench_located if args.located else bench)(n) for n in args.scenarios.split(",")]
     command = "benchmarks/bench_curve_weld.py" + (" --located" if args.located else "")
     command += f" --scenarios {args.scenarios}" if args.scenarios != ",".join(SCENARIOS) else ""
-    out = {"command": f".venv/bin/python {command}", "rows": rows}
+    out = {"command": f".venv/bin/python {command}", "commit": git_commit(), "rows": rows}
     args.json.write_text(json.dumps(out, indent=2) + "\n")
     print(json.dumps(out, indent=2))
 

@@ -29,6 +29,7 @@ for _path in (REPO, TOOLS):  # run as a script from anywhere: the package is the
 
 import readme_calibration_table as calibration_tables  # noqa: E402  (after the path set-up above)
 import readme_cell_tables as cell_tables  # noqa: E402  (after the path set-up above)
+import readme_curve_weld_table as curve_weld_tables  # noqa: E402
 import readme_journal_tables as journal_tables  # noqa: E402
 import readme_positioner_table as positioner_tables  # noqa: E402
 from readme_trust_table import num, pct, trust_table  # noqa: E402
@@ -230,6 +231,10 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     ),
     "interrupts": lambda results: journal_tables.interrupts_table(_load_object(results, "interrupts.json")),
     "curves": curves,
+    "curve-weld": lambda results: curve_weld_tables.truth_table(_load_object(results, "curve_weld.json")),
+    "curve-weld-located": lambda results: curve_weld_tables.located_table(
+        _load_object(results, "curve_weld_located.json")
+    ),
     "positioner": lambda results: positioner_tables.positioner_table(_load_object(results, "positioner.json")),
     "coordinated": lambda results: positioner_tables.coordinated_table(_load_object(results, "coordinated.json")),
 }

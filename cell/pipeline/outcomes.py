@@ -18,6 +18,7 @@ from cell.types import CheckFail, SeamEstimate, SeamStatus
 from cell.types.run import SeamWeld, WeldReason
 
 if TYPE_CHECKING:
+    from cell.types.curve_estimate import CurveEstimate
     from cell.types.execution import Execution, WeldQuality
     from cell.types.plan import SeamTask, Segment, WeldPlan
 
@@ -148,11 +149,15 @@ def curve_welds(
     truths_R: Mapping[str, FloatArray],
     closed: Mapping[str, bool],
     X_WR: FloatArray,
+    estimates: Mapping[str, CurveEstimate] | None = None,
 ) -> dict[str, WeldQuality]:
     """Curved seam id -> its weld measured against its true curve (:func:`cell.process.curve_quality.
     curve_weld_quality`) on the records while its arc burned, for every welded curved seam (``closed``: seam id ->
-    a full loop) with a truth (in R); empty without an execution. pre_s [s]: the move before the plan."""
-    from cell.process.curve_quality import curve_weld_quality
+    a full loop) with a truth (in R), all passes together; a pass off the root against the true curve moved by its
+    offset (:func:`cell.process.curve_quality.pass_truth`, the cross-section from ``estimates``: seam id -> its
+    located curve). Empty without an execution. pre_s [s]: the move before the plan."""
+    from cell.process.curve_quality import curve_weld_quality, pass_truth
+    from cell.process.quality import combined
 
     if ex is None:
         return {}
@@ -163,11 +168,19 @@ def curve_welds(
         truth = truths_R.get(sid)
         if not welds or truth is None:
             continue
-        on = np.zeros(len(ex.times), dtype=bool)  # the records of its welds (arcs of a split seam: not the air)
-        for g in welds:
-            on |= (ex.times >= pre_s + g.t0 - 1e-9) & (ex.times <= pre_s + g.t1 + 1e-9)
-        k = np.flatnonzero(on)
-        out[sid] = curve_weld_quality(ex.times[k], transform_points(X_RW, ex.tcp_W[k]), truth, is_closed)
+        passes = []
+        for k in sorted({g.pass_index for g in welds}):
+            on = np.zeros(len(ex.times), dtype=bool)  # the records of its welds (arcs of a split seam: not the air)
+            for g in (g for g in welds if g.pass_index == k):
+                on |= (ex.times >= pre_s + g.t0 - 1e-9) & (ex.times <= pre_s + g.t1 + 1e-9)
+            i = np.flatnonzero(on)
+            proc, est = welds[0].procedure, (estimates or {}).get(sid)
+            aim = truth
+            if k and proc is not None and est is not None:
+                lat, lift = proc.passes[k].lateral_mm / 1000.0, proc.passes[k].lift_mm / 1000.0
+                aim = pass_truth(truth, est.p_RS, est.n_abutting_R, est.n_receiving_R, lat, lift)
+            passes.append(curve_weld_quality(ex.times[i], transform_points(X_RW, ex.tcp_W[i]), aim, is_closed))
+        out[sid] = combined(passes)
     return out
 
 

@@ -6,6 +6,7 @@ Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -78,14 +79,16 @@ def pass_pieces(
     transfers: Transfers,
     passes: tuple[SeamSolution, ...],
     procedure: WeldProcedure | None,
+    timed: Callable[[RobotModel, WeldProcess, PlanOptions, SeamSolution], list[Piece]] = seam_pieces,
 ) -> list[Piece] | TransferFail:
     """Approach, weld and depart of every pass, timed, with a transfer (arc off) between passes; the travel speed
-    of each pass is its own or the procedure's (``process``'s without a procedure). Raises TimingError when a
-    weld cannot be timed; a TransferFail when no free move joins two passes."""
+    of each pass is its own or the procedure's (``process``'s without a procedure); ``timed`` times one pass
+    (a straight one's by default; a curve's: :func:`cell.planning.curves.timing.curve_lines`). Raises
+    TimingError when a weld cannot be timed; a TransferFail when no free move joins two passes."""
     pieces: list[Piece] = []
     for k, sol in enumerate(passes):
         pr = process if procedure is None else replace(process, travel_speed=pass_speed(procedure, k))
-        own = seam_pieces(robot, pr, options, sol)
+        own = timed(robot, pr, options, sol)
         if k:  # the depart before and the approach after as short as the move between them allows
             lines = seam_lines(sol, passes[k - 1], process, options.short_lines)
             found = join(transfers, lines.exits, lines.entries)

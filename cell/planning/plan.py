@@ -19,10 +19,11 @@ from cell.geometry import readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.access.openings import WAYS
-from cell.planning.assembly import assemble
+from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
-from cell.planning.curves import curve_pieces, search_curves, split_failed, weldable, with_paths
+from cell.planning.curves import cover_curves, curve_pieces, weldable, whole_or_none, with_paths
 from cell.planning.curves.split import seam_of
+from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
 from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
@@ -116,14 +117,11 @@ def plan_welds(
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
     curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
     to_search = [e for e in found_curves if e.id in curve_ids]
-    one_piece = search_curves(to_search, searches, q0, curve_procs)
-    solved |= {cid: (res,) for cid, res in one_piece.items() if isinstance(res, SeamSolution)}
-    missed = {cid: res for cid, res in one_piece.items() if isinstance(res, SeamFailure)}
-    arcs, still = split_failed(to_search, missed, searches, q0, curve_procs)  # reachable arcs, or why not
+    arcs, still = cover_curves(to_search, searches, q0, curve_procs)  # one go or overlapping arcs, or why not
     for cid, res in still.items():
         outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
-    for aid, sol in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
-        solved[aid], searches[aid] = (sol,), searches[seam_of(aid)]
+    for aid, sols in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
+        solved[aid], searches[aid] = sols, searches[seam_of(aid)]
         if seam_of(aid) in chosen:
             chosen[aid] = chosen[seam_of(aid)]
         curve_ids.add(aid)
@@ -135,10 +133,11 @@ def plan_welds(
         proc = sel.procedure if isinstance(sel, SeamProcedure) else None
         try:
             pr = searches[sid].process
+            timed = curve_lines if sid in curve_ids else seam_pieces
             parts: list[Piece] | TransferFail = (
-                curve_pieces(robot, pr, opt, solved[sid][0], proc)
-                if sid in curve_ids
-                else pass_pieces(robot, pr, opt, transfers, solved[sid], proc)
+                curve_pieces(robot, pr, opt, solved[sid][0], None)  # one pass, the controller's crater
+                if sid in curve_ids and proc is None
+                else pass_pieces(robot, pr, opt, transfers, solved[sid], proc, timed)
             )
         except TimingError as exc:
             sols = solved.pop(sid)
@@ -150,6 +149,7 @@ def plan_welds(
             outcomes[sid] = _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
             continue
         seam_parts[sid] = parts
+    whole_or_none(solved, outcomes, seam_parts)
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
     lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
@@ -170,11 +170,12 @@ def plan_welds(
         direction = "to" if b else "from"
         detail = f"no free transfer move {direction} the seam: {why.reason}"
         outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
+        whole_or_none(solved, outcomes)  # a seam's other arcs with it
     if opt.blend > 0.0:
         segments = blend_plan(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
         )
-    segments = with_paths(segments, {sid: solved[sid][0].X_weld for sid in curve_ids if sid in solved})
+    segments = with_paths(segments, {sid: [p.X_weld for p in solved[sid]] for sid in curve_ids if sid in solved})
     segments = [replace(g, seam_id=seam_of(g.seam_id)) for g in segments]  # a split seam's arcs: its welds
     for sid, sols in solved.items():
         c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
@@ -194,7 +195,7 @@ def plan_welds(
         sid = seam_of(aid)
         if sid not in outcomes or not outcomes[sid].feasible:
             n = sum(seam_of(a) == sid for a in solved)
-            outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs")
+            outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs" if n > 1 else "")
     return WeldPlan(
         joint_names=robot.joint_names,
         q_home=readonly(q0),

@@ -75,3 +75,25 @@ def curve_weld_quality(times: npt.ArrayLike, tcp_R: npt.ArrayLike, truth_R: npt.
         gaps = (float(s.min()), total - float(s.max()), past_start, past_end)
     length_m = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
     return quality_figures(t, p, d * _MM, gaps, length_m)
+
+
+def pass_truth(truth_R: npt.ArrayLike, p_R: npt.ArrayLike, n_a_R: npt.ArrayLike, n_b_R: npt.ArrayLike,
+               lateral_m: float, lift_m: float) -> FloatArray:  # fmt: skip
+    """The true curve truth_R (m, 3) moved where a pass offset ``lateral_m`` across the local bisector towards face
+    A and ``lift_m`` along it out of the root is meant to run: the cross-section at each true sample from the
+    located curve's nearest sample p_R (k, 3) and its faces' normals n_a_R, n_b_R (k, 3) (as the planner lays the
+    pass, :mod:`cell.planning.curves.weave`)."""
+    truth = np.asarray(truth_R, dtype=float)
+    if lateral_m == 0.0 and lift_m == 0.0:
+        return truth
+    _, k = cKDTree(np.asarray(p_R, dtype=float)).query(truth)
+    na, nb = np.asarray(n_a_R, dtype=float)[k], np.asarray(n_b_R, dtype=float)[k]
+    d = np.gradient(truth, axis=0)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    b = na + nb
+    b -= np.sum(b * d, axis=1, keepdims=True) * d
+    b /= np.linalg.norm(b, axis=1, keepdims=True)
+    e = nb - na
+    e -= np.sum(e * d, axis=1, keepdims=True) * d + np.sum(e * b, axis=1, keepdims=True) * b
+    e /= np.linalg.norm(e, axis=1, keepdims=True)
+    return np.asarray(truth + lateral_m * e + lift_m * b)

@@ -43,10 +43,11 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> dict:
     return {"run": run, "rep": weld_report(run)}
 
 
-def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_the_planners_code(report: dict) -> None:
-    """The post's fillet is located and tried, in one go then in arcs; arcs reach most of it but not all, so it
-    is not welded: the planner's code, the share in its reason, counted in the summary and the programs' header,
-    the run partial."""
+def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_its_code(report: dict) -> None:
+    """The post's fillet (its near side 0.72 m from the base, where the arm folds on itself) is located and tried
+    from its reach map; it is not welded, for the planner's reason (no cover: the share reached; an arc failing
+    after the search: named, the seam's other arcs left out with it) or the safety gate's (its arcs planned, the
+    move into one passing a singularity), counted in the summary and the programs' header, the run partial."""
     from cell.cli.turnover import not_welded
 
     run, rep = report["run"], report["rep"]
@@ -56,14 +57,22 @@ def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_the_planners
     entry = next(s for s in rep["seams"] if s["id"] == SEAM)
     w = det.curve_welds[SEAM]
     assert not w.welded and not entry["welded"] and "tcp_error_mm" not in entry
-    assert entry["weld_reason_code"] == "not_planned" and entry["plan_reason_code"] in ("ik_failed", "flip")
-    assert "arcs would reach" in entry["weld_reason"]  # the split's word: most of it, not all
-    share = float(entry["weld_reason"].split("would reach ")[1].split("%")[0])
-    assert 50.0 < share < 100.0
-    assert entry["not_welded"]["code"] == entry["plan_reason_code"] != "curved_no_torch_path"
+    why, code = entry["weld_reason"], entry["weld_reason_code"]
+    if code == "not_executed":  # planned in arcs, the gate refused the plan
+        assert w.planned and "safety gate" in why
+        code = "not_executed"
+    else:
+        assert code == "not_planned"
+        assert entry["plan_reason_code"] in ("ik_failed", "flip", "collision", "transfer_collision", "singular")
+        code = entry["plan_reason_code"]
+        if "the arm reaches" in why:  # no cover: the share of it some torch setting holds
+            assert 50.0 < float(why.split("the arm reaches ")[1].split("%")[0]) < 100.0
+        else:  # covered, one arc failing after the search: named, the seam's other arcs left out with it
+            assert why.split(": ")[0].startswith("arc ") and not [g for g in run.plan.segments if g.seam_id == SEAM]
+        assert entry["not_welded"]["code"] == code
+        assert (SEAM, f"not_planned: {code}") in not_welded(rep)  # the programs' header
     assert rep["summary"]["curved"] | {"rms_max_mm": 0, "max_mm": 0} == {
-        "seams": 1, "found": 1, "welded": 0, "not_welded": {entry["plan_reason_code"]: 1}, "rms_max_mm": 0, "max_mm": 0
+        "seams": 1, "found": 1, "welded": 0, "not_welded": {code: 1}, "rms_max_mm": 0, "max_mm": 0
     }  # fmt: skip
-    assert (SEAM, f"not_planned: {entry['plan_reason_code']}") in not_welded(rep)  # the programs' header
     assert SEAM in {u.id for u in det.not_welded}
     assert not run.complete and rep["welded"] == 0

@@ -69,7 +69,10 @@ def curve_seam_welds(
     found = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
     outcomes = {o.seam_id: o for o in plan.seams} if plan is not None else {}
     closed = {c.id: c.closed for c in found if c.id in outcomes and outcomes[c.id].feasible}
-    quality = curve_welds(plan, ex, pre_s, det.curve_truths, closed, det.scenario.X_WR) if plan is not None else {}
+    ests = {c.id: c for c in found}
+    quality = {}
+    if plan is not None:
+        quality = curve_welds(plan, ex, pre_s, det.curve_truths, closed, det.scenario.X_WR, ests)
     out: dict[str, SeamWeld] = {}
     for c in found:
         o = outcomes.get(c.id)

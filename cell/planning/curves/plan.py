@@ -8,19 +8,20 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from functools import partial
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import readonly
 from cell.planning.curves.search import plan_curve
-from cell.planning.failures import SeamFailure, better
+from cell.planning.curves.split import ARC_MARK, arc_id, seam_of
+from cell.planning.failures import SeamFailure
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.procedures import UP_R, select_procedure
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.plan import NoProcedure, SeamProcedure, SeamTask, Segment
+from cell.types.plan import NoProcedure, SeamOutcome, SeamProcedure, SeamTask, Segment
 from cell.types.procedure import WeldProcedure
 
 
@@ -51,59 +52,62 @@ def curve_procedures(
     return out
 
 
-def search_curves(
+def with_paths(segments: Sequence[Segment], paths: Mapping[str, Sequence[npt.ArrayLike]]) -> list[Segment]:
+    """The segments with each curved seam's welds carrying their planned TCP poses (``X_path``, (n, 4, 4) in R;
+    ``paths``: seam id -> one per pass, the k-th weld of the seam the k-th pass's)."""
+    out: list[Segment] = []
+    for s in segments:
+        if s.kind == "weld" and s.seam_id in paths:
+            s = replace(s, X_path=readonly(np.asarray(paths[s.seam_id][s.pass_index])))
+        out.append(s)
+    return out
+
+
+def cover_curves(
     curves: Sequence[CurveEstimate],
     make_search: Mapping[str, SeamSearch],
     q_seed: npt.ArrayLike,
     procedures: Mapping[str, WeldProcedure] | None = None,
-) -> dict[str, SeamSolution | SeamFailure]:
-    """Each curve's torch search (:func:`cell.planning.curves.search.plan_curve`) with its own search (the
-    process its procedure gives) and its procedure's root pass and weave, seeded at q_seed (dof,) [rad]."""
-    q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
-    return {c.id: plan_curve(make_search[c.id], c, q0, procs.get(c.id)) for c in curves if c.id in make_search}
-
-
-def with_paths(segments: Sequence[Segment], paths: Mapping[str, npt.ArrayLike]) -> list[Segment]:
-    """The segments with each curved seam's weld carrying its planned TCP poses (``X_path``, (n, 4, 4) in R)."""
-    return [
-        replace(s, X_path=readonly(np.asarray(paths[s.seam_id]))) if s.kind == "weld" and s.seam_id in paths else s
-        for s in segments
-    ]
-
-
-def split_failed(
-    curves: Sequence[CurveEstimate],
-    failed: Mapping[str, SeamFailure],
-    make_search: Mapping[str, SeamSearch],
-    q_seed: npt.ArrayLike,
-    procedures: Mapping[str, WeldProcedure] | None = None,
-) -> tuple[dict[str, SeamSolution], dict[str, SeamFailure]]:
-    """The curves whose one-piece search failed (``failed``: id -> its failure), each split into reachable arcs
-    (:func:`cell.planning.curves.split.split_curve`, planned with its own search and procedure from q_seed (dof,)
-    [rad]). Returns (arc id -> its solution, for the seams covered whole; seam id -> its failure, for the others:
-    where no arc reaches, with the arcs' share of the curve in its words)."""
-    from cell.planning.curves.split import split_curve
+) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure]]:
+    """Each curve planned from its reach map (:func:`cell.planning.curves.arcs.plan_arcs`: one go where a torch
+    setting holds all round, else the fewest overlapping arcs; an open one welded in one pass first by the one-go
+    search, :func:`cell.planning.curves.search.plan_curve`, whose ranked candidates follow it closest), with its
+    own search and procedure from q_seed (dof,) [rad]. Returns (arc id -> its solutions, one per pass, for the
+    seams covered whole; seam id -> its failure, for the others: where no arc reaches, with the share of the curve
+    the arm reaches in its words)."""
+    from cell.planning.curves.arcs import plan_arcs
 
     q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
-    arcs: dict[str, SeamSolution] = {}
+    arcs: dict[str, tuple[SeamSolution, ...]] = {}
     still: dict[str, SeamFailure] = {}
     for c in curves:
-        if c.id not in failed:
-            continue
-        search, proc = make_search[c.id], procs.get(c.id)
-        overlap = search.process.closed_overlap
-        got = split_curve(c, partial(_arc_plan, search, q0, proc), overlap, np.zeros(3))
+        proc = procs.get(c.id)
+        if not c.closed and (proc is None or len(proc.passes) == 1):  # an open curve: the one-go search first
+            one = plan_curve(make_search[c.id], c, q0, proc)
+            if isinstance(one, SeamSolution):
+                arcs[arc_id(c.id, 1)] = (one,)
+                continue
+        got = plan_arcs(make_search[c.id], c, q0, proc)
         if got.whole:
             arcs |= {arc.id: sol for arc, sol in got.arcs}
             continue
-        f = got.failure or failed[c.id]
-        if got.arcs:  # partly reachable: not welded, said with the share the arcs would cover
-            share = f"{len(got.arcs)} arcs would reach {got.share:.0%} of it, not all"
-            f = replace(f, where=f"{f.where} (split into arcs: {share})")
-        still[c.id] = better(failed[c.id], f) if not got.arcs else f
+        f = got.failure
+        assert f is not None
+        still[c.id] = replace(f, where=f"{f.where} (the arm reaches {got.share:.0%} of it, not all)")
     return arcs, still
 
 
-def _arc_plan(search: SeamSearch, q0: npt.NDArray[np.float64], proc: WeldProcedure | None, arc: CurveEstimate
-              ) -> SeamSolution | SeamFailure:  # fmt: skip
-    return plan_curve(search, arc, q0, proc)
+def whole_or_none(solved: dict[str, Any], outcomes: dict[str, SeamOutcome], *others: dict[str, Any]) -> None:
+    """A seam welded in arcs is welded whole or not at all: where one of its arcs failed after the search (its
+    timing, a transfer to or from it: its outcome in ``outcomes`` under the arc's id), its other arcs leave
+    ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc."""
+    for aid, o in list(outcomes.items()):
+        sid = seam_of(aid)
+        if sid == aid or o.feasible:
+            continue
+        for other in [a for a in solved if seam_of(a) == sid]:
+            solved.pop(other)
+            for d in others:
+                d.pop(other, None)
+        del outcomes[aid]
+        outcomes[sid] = replace(o, seam_id=sid, reason=f"arc {aid.rsplit(ARC_MARK, 1)[1]}: {o.reason}")

@@ -7,6 +7,8 @@ Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from scipy.interpolate import CubicSpline
 
@@ -54,8 +56,16 @@ def curve_pieces(
     """Approach (a line along the torch axis), the weld along the curve (its craters held at rest where the
     procedure has them) and the depart of a solved curved seam, timed at the procedure's travel speed (the
     process's without one). Raises TimingError."""
+    speed = procedure.travel_speed_mm_s / 1000.0 if procedure is not None else process.travel_speed
+    app, weld, dep = curve_lines(robot, replace(process, travel_speed=speed), options, sol)
+    craters = procedure or WeldProcedure(name="default")  # the crater filled at the end, as a controller's default
+    return [app, with_craters(weld, craters.crater_start_s, craters.crater_end_s, options.dt), dep]
+
+
+def curve_lines(robot: RobotModel, process: WeldProcess, options: PlanOptions, sol: SeamSolution) -> list[Piece]:
+    """Approach, weld along the curve at ``process.travel_speed`` (no craters) and depart of one solved pass of a
+    curved seam (the pieces :func:`cell.planning.passes.pass_pieces` joins pass after pass). Raises TimingError."""
     pr, opt = process, options
-    speed = procedure.travel_speed_mm_s / 1000.0 if procedure is not None else pr.travel_speed
     X = sol.X_weld
     s = np.linspace(0.0, sol.task.length, len(X))
     approach = float(np.linalg.norm(X[0][:3, 3] - sol.X_approach[:3, 3]))  # the search may have shortened them
@@ -63,10 +73,9 @@ def curve_pieces(
     app, v_app = line_trajectory(
         robot, sol.q_approach, approach, X[0][:3, 2], pr.approach_speed, opt.line_accel, opt.line_jerk, dt=opt.dt
     )
-    weld = curve_trajectory(robot, sol.q_weld, s, speed, opt.weld_accel, opt.weld_jerk, dt=opt.dt)
+    weld = curve_trajectory(robot, sol.q_weld, s, pr.travel_speed, opt.weld_accel, opt.weld_jerk, dt=opt.dt)
     dep, v_dep = line_trajectory(
         robot, sol.q_depart, depart, -X[-1][:3, 2], pr.approach_speed, opt.line_accel, opt.line_jerk, dt=opt.dt
     )
-    craters = procedure or WeldProcedure(name="default")  # the crater filled at the end, as a controller's default
-    weld_piece = with_craters(Piece("weld", weld, speed, X[-1]), craters.crater_start_s, craters.crater_end_s, opt.dt)
-    return [Piece("approach", app, v_app, X[0]), weld_piece, Piece("depart", dep, v_dep, sol.X_depart)]
+    return [Piece("approach", app, v_app, X[0]), Piece("weld", weld, pr.travel_speed, X[-1]),
+            Piece("depart", dep, v_dep, sol.X_depart)]  # fmt: skip

@@ -1,0 +1,279 @@
+"""Where along a curve the arm can hold the torch, and the fewest arcs that cover it: a reach map of the curve
+(stations a few millimetres apart, each torch setting walked along them by warm-started IK) and the cover of the
+curve by the stretches each setting holds without a break (docs/curves-welding.md section 10).
+
+Frames: everything in the robot base frame R [m]; joints [rad]."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from cell.errors import IKError
+from cell.geometry import FloatArray
+from cell.motion.ik import solve_ik
+from cell.planning.curves.path import CurvePath, curve_path, curve_poses
+from cell.planning.seam_search import SeamSearch
+from cell.process.torch_orientations import Candidate
+from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import PlanReason
+
+STATION_M = 0.008  # [m] the reach map's stations at most this far apart along the curve
+STATION_TURN = math.radians(8.0)  # [rad] and closer where the tangent would turn more than this between two
+SPINS = 8  # torch spins about its axis tried, evenly round (the flange's axis held, then spun by each)
+JUMP_FACTOR = 3.0  # a joint's step between stations beyond this many times the knot's flip bound breaks a stretch
+STATION_SEEDS = 2  # random IK seeds tried, besides the home seed, where a stretch starts afresh
+MAX_JUMP = math.radians(60.0)  # [rad] and beyond this in any case
+
+
+@dataclass(frozen=True)
+class Run:
+    """A stretch of the curve one torch setting holds without a break: ``cand`` (direction, spin, angle offsets),
+    from a_m to b_m [m] along the located curve's own order (b_m may pass a closed curve's length: round its
+    start), the weld starting at a_m (b_m when reversed) with the arm at ``q_start`` (dof,) [rad]; ``whole``: a
+    closed curve held all round and on over its overlap."""
+
+    cand: Candidate
+    a_m: float
+    b_m: float
+    q_start: FloatArray
+    whole: bool = False
+
+    @property
+    def length(self) -> float:
+        return self.b_m - self.a_m
+
+
+def station_spacing(est: CurveEstimate) -> float:
+    """The reach map's station spacing [m] along ``est``: :data:`STATION_M`, closer on a tight curve."""
+    t = est.tangent_R
+    step = np.linalg.norm(np.diff(np.asarray(est.p_RS), axis=0), axis=1)
+    turn = np.arccos(np.clip(np.sum(t[1:] * t[:-1], axis=1), -1.0, 1.0))
+    ok = step > 1e-9
+    per_m = float(np.max(turn[ok] / step[ok])) if np.any(ok) else 0.0
+    return min(STATION_M, STATION_TURN / per_m) if per_m > 0.0 else STATION_M
+
+
+def settings(search: SeamSearch, widened: bool) -> list[Candidate]:
+    """The torch settings the map walks: both directions (one if the process is not reversible) x
+    :data:`SPINS` spins (within the spin tolerance) at the nominal angles; ``widened``: the work and travel
+    angles each at either end of their tolerance instead."""
+    pr = search.process
+    spins = sorted({round(math.remainder(2.0 * math.pi * k / SPINS, 2.0 * math.pi), 9) for k in range(SPINS)})
+    spins = [s for s in spins if abs(s) <= pr.spin_tol + 1e-9] or [0.0]
+    if widened:
+        w, t = pr.work_angle_tol, pr.travel_angle_tol
+        angles = [(w, 0.0), (-w, 0.0), (0.0, t), (0.0, -t)]
+    else:
+        angles = [(0.0, 0.0)]
+    directions = (False, True) if pr.reversible else (False,)
+    return [Candidate(r, s, w, a) for w, a in angles for r in directions for s in spins]
+
+
+@dataclass(frozen=True)
+class Miss:
+    """A station where a torch setting could not start a stretch: ``at_m`` [m] along the located curve, ``code``
+    why (IK, the arm against a part or itself, singular) and ``what`` (the bodies that met; "" otherwise)."""
+
+    at_m: float
+    code: PlanReason
+    what: str = ""
+
+
+def _fresh(search: SeamSearch, X: FloatArray, seeds: Sequence[FloatArray]) -> FloatArray | Miss:
+    """IK at X (4, 4) from each seed in turn, the first clear of the parts and the arm itself and not singular;
+    else why not (the last seed's, a collision's or singularity's before an IK failure's; ``at_m`` unset)."""
+    miss = Miss(0.0, PlanReason.IK_FAILED)
+    for seed in seeds:
+        try:
+            q = np.asarray(solve_ik(search.robot, X, seed, options=search.opt.ik))
+        except IKError:
+            continue
+        hit = search.checker.check(q)
+        if hit is not None:
+            miss = Miss(0.0, PlanReason.COLLISION, f"{hit.a} vs {hit.b}")
+        elif search.robot.manipulability(q) < search.opt.min_manipulability:
+            miss = Miss(0.0, PlanReason.SINGULAR)
+        else:
+            return q
+    return miss
+
+
+def _next(search: SeamSearch, X: FloatArray, q_prev: FloatArray, max_step: float) -> FloatArray | None:
+    """IK at X (4, 4) warm-started from q_prev (dof,): None where it fails, a joint steps more than max_step [rad]
+    or the arm meets a part or itself or is singular."""
+    try:
+        q = np.asarray(solve_ik(search.robot, X, q_prev, options=search.opt.ik))
+    except IKError:
+        return None
+    jump = np.abs(np.angle(np.exp(1j * (q - q_prev))))
+    return q if float(jump.max()) <= max_step and _fits(search, q) else None
+
+
+def _fits(search: SeamSearch, q: FloatArray) -> bool:
+    return search.checker.check(q) is None and search.robot.manipulability(q) >= search.opt.min_manipulability
+
+
+def _a46_fits(search: SeamSearch, span4: float, span6: float) -> bool:
+    """Whether A4's and A6's travel so far fit their limits and A6 its hose window."""
+    lim = search.robot.limits
+    return span4 <= float(lim.q_max[-3] - lim.q_min[-3]) and span6 <= 2.0 * search.window.half_width
+
+
+def walk(
+    search: SeamSearch,
+    est: CurveEstimate,
+    cand: Candidate,
+    path: CurvePath,
+    flange: tuple[FloatArray, FloatArray] | None,
+    q_seed: FloatArray,
+    max_step: float,
+    overlap_stations: int,
+    misses: list[Miss],
+) -> list[Run]:
+    """The stretches ``cand`` holds along the stations of ``path`` (the whole located curve from its first sample,
+    in the candidate's direction, stations evenly spaced; a closed curve's last point is its first): IK at each
+    station warm-started from the last, a stretch broken where IK fails, the arm meets a part or itself, it is
+    singular, a joint steps more than ``max_step`` [rad] or A4/A6 would wind beyond their limits; restarted
+    afresh at the next station. A closed curve's last stretch is walked on round its start; one that comes all
+    round and ``overlap_stations`` more is ``whole``. Each station where no stretch could start is added to
+    ``misses``."""
+    X = curve_poses(path, search.process, spin=cand.spin, work_offset=cand.work_offset,
+                    travel_offset=cand.travel_offset, flange=flange)  # fmt: skip
+    n = len(X) - 1 if est.closed else len(X)
+    total, step = est.length_m, path.length / (len(X) - 1)
+    rng = np.random.default_rng(7)
+    lim = search.robot.limits
+    seeds = [q_seed, *(lim.sample(rng, 0.1) for _ in range(STATION_SEEDS))]
+    runs: list[Run] = []
+    k, limit = 0, n
+    start, q_prev, q_first = -1, None, np.asarray(q_seed)
+    wind = np.zeros(2)  # A4's and A6's travel from the stretch's start, unwrapped
+    lo, hi = wind.copy(), wind.copy()
+
+    def close(last: int) -> None:
+        if start >= 0 and last > start:
+            lo_m, hi_m = start * step, last * step
+            a, b = (total - hi_m, total - lo_m) if cand.reversed else (lo_m, hi_m)
+            shift = math.floor(a / total) * total if est.closed else 0.0
+            runs.append(Run(cand, a - shift, b - shift, q_first, whole=last - start >= n + overlap_stations))
+
+    while k < limit:
+        Xk = X[k % n]
+        q = None
+        if q_prev is not None:
+            q = _next(search, Xk, q_prev, max_step)
+            if q is not None:
+                w = wind + np.angle(np.exp(1j * (q[[-3, -1]] - q_prev[[-3, -1]])))
+                if _a46_fits(search, *(np.maximum(hi, w) - np.minimum(lo, w))):
+                    wind, lo, hi = w, np.minimum(lo, w), np.maximum(hi, w)
+                else:
+                    q = None
+            if q is None:
+                close(k - 1)
+                start, q_prev = -1, None
+                if est.closed and k >= n:
+                    break
+        if q_prev is None:
+            got = _fresh(search, Xk, seeds)
+            if isinstance(got, Miss):
+                at = total - (k % n) * step if cand.reversed else (k % n) * step
+                misses.append(replace(got, at_m=at % total if est.closed else at))
+                k += 1
+                if est.closed and k >= n:
+                    break
+                continue
+            q, start, q_first = got, k, got
+            wind, lo, hi = np.zeros(2), np.zeros(2), np.zeros(2)
+        q_prev = q
+        if est.closed and k == n - 1 and start >= 0:
+            limit = start + n + overlap_stations + 1  # walk the last stretch on round the start
+        k += 1
+    close(k - 1)
+    return runs
+
+
+def reach_map(
+    search: SeamSearch,
+    est: CurveEstimate,
+    cands: Sequence[Candidate],
+    flange: tuple[FloatArray, FloatArray] | None,
+    q_seed: FloatArray,
+    knot_m: float,
+    overlap_m: float,
+) -> tuple[list[Run], list[Miss]]:
+    """Every stretch each of ``cands`` holds along ``est`` (:func:`walk`), stations :func:`station_spacing`
+    apart, and every station where one could not start; the flip bound scaled from IK knots ``knot_m`` [m] apart
+    to the stations' spacing."""
+    spacing = station_spacing(est)
+    paths = {rev: curve_path(est, spacing, reverse=rev) for rev in {c.reversed for c in cands}}
+    max_step = min(MAX_JUMP, JUMP_FACTOR * search.opt.max_joint_step * max(1.0, spacing / knot_m))
+    over = math.ceil(overlap_m / spacing) if est.closed else 0
+    runs: list[Run] = []
+    misses: list[Miss] = []
+    for c in cands:
+        runs += walk(search, est, c, paths[c.reversed], flange, q_seed, max_step, over, misses)
+    return runs, misses
+
+
+def cover(runs: Sequence[Run], total: float, closed: bool, overlap: float, max_arcs: int) -> list[Run] | None:
+    """The fewest stretches (at most ``max_arcs``) that cover a curve ``total`` [m] long whole, each next one
+    starting at least ``overlap`` [m] back on the last (a closed curve: the last one on over the first's start by
+    as much), greedy from every stretch as the first; None when none does."""
+    best: list[Run] | None = None
+    for first in sorted(runs, key=lambda r: -r.length):
+        chosen, end = [first], first.b_m
+        goal = first.a_m + total + overlap if closed else total - 1e-9
+        if not closed and first.a_m > 1e-9:
+            continue
+        while end < goal and len(chosen) < max_arcs:
+            nxt = _furthest(runs, end - overlap, end, total, closed)
+            if nxt is None or nxt.b_m <= end + 1e-9:
+                break
+            chosen.append(nxt)
+            end = nxt.b_m
+        if end >= goal and (best is None or len(chosen) < len(best)):
+            best = chosen
+    return best
+
+
+def _furthest(runs: Sequence[Run], lo: float, hi: float, total: float, closed: bool) -> Run | None:
+    """The stretch starting at most at ``lo`` (and after ``hi``'s last cover start) that reaches furthest past
+    ``hi``, shifted by whole laps of a closed curve to follow on."""
+    best: Run | None = None
+    for r in runs:
+        for lap in (0.0, total, 2.0 * total) if closed else (0.0,):
+            a, b = r.a_m + lap, r.b_m + lap
+            if a <= lo + 1e-9 and b > hi and (best is None or b > best.b_m):
+                best = replace(r, a_m=a, b_m=b)
+    return best
+
+
+def share(runs: Sequence[Run], total: float, closed: bool) -> float:
+    """The part of a curve ``total`` [m] long that at least one stretch holds."""
+    bins = np.zeros(max(1, math.ceil(total / 0.001)), dtype=bool)
+    for r in runs:
+        idx = np.arange(math.floor(r.a_m / 0.001), math.ceil(r.b_m / 0.001))
+        idx = np.mod(idx, len(bins)) if closed else idx[(idx >= 0) & (idx < len(bins))]
+        bins[idx] = True
+    return float(bins.mean())
+
+
+def balanced(chosen: Sequence[Run], total: float, closed: bool, overlap: float) -> list[Run]:
+    """A cover's arcs with each junction's spare overlap shared out: where two arcs overlap by more than
+    ``overlap`` [m] the first stops and the next starts half the excess back from their stretches' ends (a stretch
+    ends where its setting gives out, the arm at a limit: an arc should not start or stop there), as on a closed
+    curve the last one and the first (a lap on)."""
+    out = list(chosen)
+    n = len(out)
+    for i in range(n if closed else n - 1):
+        j = (i + 1) % n
+        lap = total if j == 0 else 0.0
+        excess = out[i].b_m - (out[j].a_m + lap) - overlap
+        if excess > 0.0:
+            out[i] = replace(out[i], b_m=out[i].b_m - 0.5 * excess)
+            out[j] = replace(out[j], a_m=out[j].a_m + 0.5 * excess)
+    return out

@@ -1,0 +1,59 @@
+"""docs/results.md's curved-weld blocks (``tools/readme_results.py``): the round scenarios' curved seams welded from
+truth-built estimates (``benchmarks/results/curve_weld.json``) and through ``cell weld`` with the located curves
+(``benchmarks/results/curve_weld_located.json``), both by ``benchmarks/bench_curve_weld.py``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+
+def _tcp(r: Mapping[str, Any]) -> str:
+    return f"{r['tcp_rms_mm']:.3f} / {r['tcp_max_mm']:.3f}" if r.get("tcp_rms_mm") is not None else "-"
+
+
+def _why(r: Mapping[str, Any]) -> str:
+    return "" if r["welded"] else str(r["reason"]).replace("|", "/")
+
+
+def truth_table(data: Mapping[str, Any]) -> str:
+    """Per curved seam from a truth-built estimate: planned in how many arcs, TCP against the true curve, the
+    length no record reached, arc time, why not; the planning time per scenario."""
+    lines = [
+        "| scenario | curved seam | length mm | welded | arcs | TCP RMS / max mm (true curve) | unwelded mm | arc s"
+        " | plan s | why not |",
+        "|---|---|---:|---|---:|---|---:|---:|---:|---|",
+    ]
+    for row in data["rows"]:
+        for r in row["seams"]:
+            kind = "closed" if r["closed"] else "open"
+            unw = f"{r['unwelded_mm']:.1f}" if r.get("unwelded_mm") is not None else "-"
+            arc = f"{r['arc_s']:.1f}" if r.get("arc_s") is not None else "-"
+            welded = "yes" if r["welded"] else "no"
+            lines.append(
+                f"| {row['scenario']} | `{r['seam']}` ({kind}) | {r['length_mm']:.0f} | {welded}"
+                f" | {r.get('arcs', 0)} | {_tcp(r)} | {unw} | {arc} | {row['plan_s']:.0f} | {_why(r)} |"
+            )
+    return "\n".join(lines) + f"\n\n`{data['command']}` (commit {str(data.get('commit', ''))[:10]})\n"
+
+
+def located_table(data: Mapping[str, Any]) -> str:
+    """Per scenario through ``cell weld NAME --sides first``: straight seams welded, and per curved seam located
+    (RMS / max against the true curve), welded in how many arcs, TCP, the programs' circular moves, why not."""
+    lines = [
+        "| scenario | straight welded | curved seam | located RMS / max mm | welded | arcs | TCP RMS / max mm"
+        " | KRL CIRC / check / RAPID ArcC | run s | why not |",
+        "|---|---|---|---|---|---:|---|---|---:|---|",
+    ]
+    for row in data["rows"]:
+        pg = row["programs"]
+        prog = f"{pg['krl_circ']} / {', '.join(pg['krl_check']) or 'clean'} / {pg['rapid_arcc']}" if pg else "-"
+        straight = f"{row['straight_welded']}/{row['straight_seams']}"
+        for r in row["seams"]:
+            loc = f"{r['located_rms_mm']:.3f} / {r['located_max_mm']:.3f}" if r["located_rms_mm"] is not None else "-"
+            why = "" if r["welded"] else f"{r['code'] or 'not located'}: {r['reason']}".replace("|", "/")
+            lines.append(
+                f"| {row['scenario']} | {straight} | `{r['seam']}` | {loc} | {'yes' if r['welded'] else 'no'}"
+                f" | {r['arcs']} | {_tcp(r)} | {prog} | {row['total_s']:.0f} | {why} |"
+            )
+    return "\n".join(lines) + f"\n\n`{data['command']}` (commit {str(data.get('commit', ''))[:10]})\n"

@@ -5,8 +5,9 @@ and ``cell weld fence1`` side by side (docs/positioner.md, "Figures").
 
 Per job: seams welded, operator turns, the job's time (robot time, the positioner's moves or the operator's turn),
 the worst executed TCP max against the true seam, the planning's wall time in all and per seam planned (the
-positioner's: choosing the poses and every pose's plan and gate, each pose's retries included; fence1's: both
-sides' plan and gate), and for the positioner each seam's ISO 6947 position (default
+positioner's: choosing the poses and every pose's plan and gate, each pose's retries included, and apart from it
+the checks of the positioner's moves against the arm; fence1's: both sides' plan and gate), and for the
+positioner each seam's ISO 6947 position and how many in PA and PB (default
 ``benchmarks/results/positioner.json``).
 """
 
@@ -65,7 +66,9 @@ def positioner_row() -> dict[str, Any]:
     wall = time.perf_counter() - t
     rep = positioner_report(run)
     plan_s = sum(g.plan_wall_s for g in run.groups) + run.timings.get("choose_poses_s", 0.0)
+    check_s = run.timings.get("move_check_s", 0.0)
     planned = len({i for g in run.groups for i in g.pose.seams})
+    codes = [s["weld_position"]["code"] for s in rep["seams"] if s["weld_position"]]
     return {
         "job": "cell weld fence1-positioner",
         "welded": run.welded,
@@ -79,6 +82,9 @@ def positioner_row() -> dict[str, Any]:
         "plan_s": round(plan_s, 3),
         "seams_planned": planned,
         "plan_per_seam_s": round(plan_s / max(planned, 1), 3),
+        "move_check_s": round(check_s, 3),
+        "plan_and_move_check_per_seam_s": round((plan_s + check_s) / max(planned, 1), 3),
+        "positions": {c: codes.count(c) for c in sorted(set(codes))},
         "in_tolerance": sum(bool(s["weld_position"] and s["weld_position"]["within_tolerance"]) for s in rep["seams"]),
         "wall_s": round(wall, 1),
         "seam_rows": rep["seams"],
@@ -103,6 +109,7 @@ def main() -> None:
         "fence1": a,
         "fence1_positioner": b,
         "plan_per_seam_ratio": round(b["plan_per_seam_s"] / a["plan_per_seam_s"], 2),
+        "plan_and_move_check_ratio": round(b["plan_and_move_check_per_seam_s"] / a["plan_per_seam_s"], 2),
         "pipe_stub_positioner": c,
     }
     args.json.write_text(json.dumps(out, indent=1) + "\n")

@@ -115,6 +115,25 @@ class ScenarioError(CellError, ValueError):
     exit_code = 10
 
 
+class PositionerFault(enum.StrEnum):
+    """Why a part cannot go on the scenario's positioner (docs/positioner.md, "The load")."""
+
+    PAYLOAD = "payload"  # the part's mass over the rated payload
+    TILT_TORQUE = "tilt_torque"  # its weight's moment about the tilt axis over the tilt axis's rated torque
+    ROTATE_TORQUE = "rotate_torque"  # its weight's moment about the rotate axis over the rotate axis's rating
+
+
+class PositionerLoadError(ScenarioError):
+    """The part is too heavy, or its centre of mass too far out, for the positioner: ``code`` says which, ``value``
+    the part's figure and ``needed`` the rating (kg or N m)."""
+
+    def __init__(self, message: str, *, code: PositionerFault, value: float, needed: float) -> None:
+        super().__init__(message)
+        self.code = code
+        self.value = value
+        self.needed = needed
+
+
 class MapError(CellError, ValueError):
     """The DXF welding map cannot be read or holds no usable seams/parts."""
 

@@ -18,6 +18,7 @@ from cell.errors import MotionError, PlanError, TimingError
 from cell.geometry import readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.planning.access.openings import WAYS
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
 from cell.planning.curves import cover_curves, curve_pieces, weldable, whole_or_none, with_paths
@@ -125,7 +126,7 @@ def plan_welds(
             chosen[aid] = chosen[seam_of(aid)]
         curve_ids.add(aid)
 
-    transfers = Transfers(robot, process, checker, opt, obstacles, q0)
+    transfers = Transfers(robot, process, checker, opt, obstacles, q0, WAYS)
     seam_parts: dict[str, list[Piece]] = {}
     for sid in list(solved):
         sel = chosen.get(sid)

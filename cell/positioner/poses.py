@@ -88,6 +88,20 @@ def axes_for_up(pos: TiltRotatePositioner, u_F: FloatArray, rotate_ref: float = 
     return out
 
 
+def tilt_reachable(pos: TiltRotatePositioner, u_F: FloatArray, margin_rad: float = 1e-3) -> FloatArray:
+    """The up-vector ``u_F`` (3,) turned towards the faceplate's axis until its tilt is within the tilt axis's
+    limits (``margin_rad`` inside them); itself when it already is. A position just beyond the limits (PA on a
+    face against the faceplate asks 135 deg) is then reached as nearly as the axis allows: whether that is within
+    ISO 6947's tolerance is :func:`position_at`'s to say."""
+    u = np.asarray(u_F, dtype=float) / np.linalg.norm(u_F)
+    limit = max(abs(pos.tilt.q_min), abs(pos.tilt.q_max)) - margin_rad
+    t = math.acos(float(np.clip(u[2], -1.0, 1.0)))
+    if t <= limit or math.hypot(u[0], u[1]) < 1e-9:
+        return u
+    side = np.array([u[0], u[1], 0.0]) / math.hypot(u[0], u[1])
+    return np.asarray(math.cos(limit) * np.array([0.0, 0.0, 1.0]) + math.sin(limit) * side, dtype=float)
+
+
 def position_at(pos: TiltRotatePositioner, tilt: float, rotate: float, seam: SeamFrame) -> WeldPosition:
     """The seam's worst waypoint's position with the positioner at (tilt, rotate) [rad]."""
     return weld_position(seam.d_F, seam.n_a_F, seam.n_b_F, pos.up_F(tilt, rotate), seam.target)
@@ -111,6 +125,9 @@ def plan_poses(
     why: dict[str, str] = {}
     for s in seams:
         found = [a for u in up_candidates(s) for a in axes_for_up(pos, u, home[1])]
+        if not found:  # just beyond the tilt: as near as the axis reaches, when that is within the tolerance
+            near = [a for u in up_candidates(s) for a in axes_for_up(pos, tilt_reachable(pos, u), home[1])]
+            found = [a for a in near if position_at(pos, a[0], a[1], s).within]
         if not found:
             why[s.id] = "beyond tilt: the position asks a tilt outside the tilt axis's limits"
         cands.extend(found)

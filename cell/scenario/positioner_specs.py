@@ -44,7 +44,8 @@ class AxisSpec(Model):
 class PositionerSpec(Model):
     """A tilt-rotate positioner: where its base stands on the floor (``base_xyz_m``, turned ``base_yaw_deg`` about
     the vertical; the tilt axis runs along its x), the tilt axis's height and the faceplate's offset from it [mm],
-    the faceplate's diameter [mm], the two axes, home, rated payload [kg] and repeatability [mm]."""
+    the faceplate's diameter [mm], the two axes, home, rated payload [kg], repeatability [mm], each axis's rated
+    torque [N m] and the part's density [kg/m^3]."""
 
     type: Literal["tilt-rotate"] = "tilt-rotate"
     base_xyz_m: Point3  # the base's origin in the world (on the floor, under the tilt axis) [m]
@@ -57,6 +58,9 @@ class PositionerSpec(Model):
     home_deg: tuple[Angle, Angle] = (0.0, 0.0)  # (tilt, rotate) where the part is loaded and scanned
     payload_kg: Pos = 400.0
     repeatability_mm: NonNeg = 0.1  # a point on the faceplate, one sigma, after a move
+    tilt_torque_nm: Pos = 1100.0  # the tilt axis's rated static torque [N m] (a DKP-400 class unit)
+    rotate_torque_nm: Pos = 650.0  # the rotate axis's [N m]
+    part_density_kg_m3: Pos = 7850.0  # the part's material (steel), for its mass from its volume
 
     @model_validator(mode="after")
     def _check(self) -> PositionerSpec:
@@ -90,4 +94,6 @@ class PositionerSpec(Model):
             (math.radians(self.home_deg[0]), math.radians(self.home_deg[1])),
             self.payload_kg,
             self.repeatability_mm / 1000.0,
+            self.tilt_torque_nm,
+            self.rotate_torque_nm,
         )

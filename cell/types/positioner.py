@@ -47,6 +47,7 @@ class TiltRotatePositioner:
     it). faceplate_radius_m : the faceplate's radius (its body, for rendering and collisions). tilt, rotate : the
     two axes. home : (tilt, rotate) where the part is loaded and scanned [rad]. payload_kg : the rated payload.
     repeatability_m : how far a point on the faceplate lands from where the kinematics put it (one sigma).
+    tilt_torque_nm, rotate_torque_nm : each axis's rated torque [N m].
     """
 
     X_RP: FloatArray
@@ -58,6 +59,8 @@ class TiltRotatePositioner:
     home: tuple[float, float] = (0.0, 0.0)
     payload_kg: float = 400.0
     repeatability_m: float = 0.0001
+    tilt_torque_nm: float = 1100.0  # the tilt axis's rated static torque [N m]
+    rotate_torque_nm: float = 650.0  # the rotate axis's [N m]
 
     def __post_init__(self) -> None:
         X = np.asarray(self.X_RP, dtype=float)

@@ -185,3 +185,24 @@ def test_a_located_seam_carried_into_a_pose() -> None:
     # The motion from home to a pose is the faceplate's: what sits on the faceplate stays where it sits on it.
     X_F = p.X_R_F(math.radians(90.0), math.radians(30.0))
     assert np.allclose(X @ p.X_R_F(*p.home), X_F)
+
+
+def test_an_underside_fillet_is_brought_to_pa_as_nearly_as_the_tilt_allows() -> None:
+    """PA on the underside's fillet (faces -z and -y) asks a tilt of 135 deg: with limits of 133 deg the pose
+    is the nearest the axis reaches, 2 deg short, within ISO 6947's 10; with limits of 120 it is 15 deg short and
+    out of tolerance, so no pose holds it in PA."""
+    from dataclasses import replace
+
+    from cell.positioner.poses import tilt_reachable
+
+    under = replace(_fence_seams()[2], target="PA")
+    u = up_candidates(under)[0]
+    for limit, within in ((133.0, True), (120.0, False)):
+        p = _positioner(tilt_deg=limit)
+        assert not axes_for_up(p, u)  # the exact pose is beyond the tilt
+        axes = axes_for_up(p, tilt_reachable(p, u))
+        assert axes and all(abs(abs(math.degrees(t)) - limit) < 0.1 for t, _ in axes)
+        wp = position_at(p, *axes[0], under)
+        assert wp.within is within and abs(wp.rotation_deg - (180.0 - (135.0 - limit))) < 0.1
+        poses, why = plan_poses(p, [under], lambda *_: True)
+        assert bool(poses) is within and (under.id in why) is not within

@@ -72,9 +72,9 @@ def truths_at(
     return true_seams(weldmap_M.transformed(X_WM, "W"), det.scene.seam_scene.joints, parts_W, sc.X_WR)
 
 
-def drawn_frames(det: Detection, pos: TiltRotatePositioner, ids: Sequence[str]) -> list[SeamFrame]:
+def drawn_frames(det: Detection, pos: TiltRotatePositioner, ids: Sequence[str], target: str = "PB") -> list[SeamFrame]:
     """:func:`seam_frames` of seams not located (the underside's), from the aligned map's drawn seams: where a pose
-    could hold them, for the report."""
+    could hold them (asking ``target``) and the close-up could find them."""
     from dataclasses import replace
 
     from cell.types import SeamEstimate, SeamStatus
@@ -85,4 +85,4 @@ def drawn_frames(det: Detection, pos: TiltRotatePositioner, ids: Sequence[str]) 
         for s in det.weldmap_R.seams
         if s.id in keep
     ]
-    return seam_frames(replace(det, estimates=tuple(drawn)), pos, [e.id for e in drawn])
+    return seam_frames(replace(det, estimates=tuple(drawn)), pos, [e.id for e in drawn], target)

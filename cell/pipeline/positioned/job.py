@@ -4,6 +4,7 @@ located seams are carried by its kinematics, planned, gated and welded. No opera
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import replace
 
@@ -17,7 +18,9 @@ from cell.pipeline.job import WeldJob
 from cell.pipeline.positioned.carry import carried, drawn_estimates, posed_motion, posed_obstacles
 from cell.pipeline.positioned.frames import axes_move_s, drawn_frames, seam_frames, truths_at
 from cell.pipeline.positioned.run import GroupRun, PositionerRun
+from cell.pipeline.positioned.sweep import clamped, clear_route
 from cell.pipeline.records import Detection
+from cell.positioner.payload import check_load, part_load
 from cell.positioner.poses import PositionerPose
 from cell.scenario import Scenario
 from cell.station import SimStation
@@ -25,7 +28,8 @@ from cell.types import SeamStatus, WeldMap, WeldReason
 from cell.types.positioner import TiltRotatePositioner
 
 NOT_LOCATED = "not located at home"
-ROUNDS = 3  # poses chosen again at most this often for the seams the planner refused at theirs
+SWEPT = "the positioner's move to its pose sweeps the part into the arm"
+ROUNDS = 4  # poses chosen again at most this often for the seams refused at theirs (PB, then PA's two branches)
 
 
 def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progress: Progress = quiet) -> PositionerRun:
@@ -43,6 +47,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         raise ScenarioError(f"scenario {sc.name!r} has no robot.positioner; valid: cell weld without one")
     pos = sc.robot.positioner.positioner(sc.X_WR)
     weldmap = read_weldmap(sc)
+    density = sc.robot.positioner.part_density_kg_m3
+    check_load(part_load(weldmap.transformed(X_F_M(sc, pos), "F").parts, pos, density), pos)
     with open_cell(sc, weldmap, gui=job.gui) as station:
         arm = station.arm
         if arm is None:
@@ -81,6 +87,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         groups: list[GroupRun] = []
         axes, choose_s = pos.home, 0.0
         excluded: set[tuple[str, tuple[float, float]]] = set()
+        on_plate, collision, sweep_s = clamped(det, pos), sc.motion.plan.collision, 0.0
+        swept: dict[str, str] = {}  # seam id -> the move to its pose that sweeps the part into the arm
         for _ in range(ROUNDS if job.execute else 1):
             t = time.perf_counter()
             poses, why = plan_poses(pos, frames, reach, excluded, start=axes)
@@ -89,7 +97,15 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
             progress(f"positioner: {len(poses)} poses for {sum(len(p.seams) for p in poses)} seams")
             refused: set[str] = set()
             for pose in poses:
-                move_s = axes_move_s(pos, axes, (pose.tilt, pose.rotate))
+                t = time.perf_counter()
+                route, hit = clear_route(arm.model, q_now, on_plate, pos, axes, (pose.tilt, pose.rotate), collision)
+                sweep_s += time.perf_counter() - t
+                if hit is not None:  # the part swept into the arm: this pose is not taken, its seams try others
+                    swept |= {i: f"{SWEPT}: {hit.describe()}" for i in pose.seams}
+                    excluded |= {(i, (pose.tilt, pose.rotate)) for i in pose.seams}
+                    refused |= set(pose.seams)
+                    continue
+                move_s = sum(axes_move_s(pos, s, e) for s, e in itertools.pairwise((axes, *route)))
                 axes = (pose.tilt, pose.rotate)
                 if not job.execute:
                     groups.append(GroupRun(pose, move_s, None, None, None, (), 0.0))
@@ -99,12 +115,18 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
                 q_now = station.joint_state()
                 # A seam the planner refused at this pose (a collision, out of reach) tries its other poses.
                 for w in g.seams:
-                    if w.code is WeldReason.NOT_PLANNED:
+                    # Refused by the planner, or left doubtful by the close-up here (no view, a bound still over
+                    # the tolerance): another pose may serve.
+                    if w.code in (WeldReason.NOT_PLANNED, WeldReason.LOW_CONFIDENCE):
                         excluded.add((w.id, axes))
                         refused.add(w.id)
-            frames = [f for f in frames if f.id in refused]
+            # A seam hidden at home and refused in PB is asked in PA next: its bead faces up, the close-up looks
+            # down at it as at home.
+            frames = [replace(f, target="PA") if f.id in hidden else f for f in frames if f.id in refused]
             if not frames:
                 break
+        welded = {w.id for g in groups for w in g.seams if w.welded}
+        unheld |= {i: why for i, why in swept.items() if i not in welded and i not in unheld}
         from cell.pipeline.coordinated import weld_curves_coordinated  # curved seams: the part turns while welded
 
         done, why_c = weld_curves_coordinated(station, det, pos, q_now, execute=job.execute, progress=progress)
@@ -112,7 +134,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         coordinated = tuple(cw for _, _, cw, _ in done if cw is not None)
         unheld |= why_c
         codes |= {w.id: w.code or WeldReason.NOT_PLANNED for _, w, cw, _ in done if cw is None}
-        timings = {"total_s": time.perf_counter() - t_all, "choose_poses_s": choose_s, **det.timings}
+        timings = {**det.timings, "choose_poses_s": choose_s, "move_check_s": sweep_s}
+        timings["total_s"] = time.perf_counter() - t_all
         codes |= {i: WeldReason.NOT_PLANNED for i in unheld if i not in codes}  # no pose holds it
         return PositionerRun(det, (*groups, *groups_c), unheld, rescan_s, timings=timings, unheld_codes=codes,
                              coordinated=coordinated)  # fmt: skip
@@ -175,3 +198,8 @@ def _weld_pose(
     refused = f"not executed: {error.message}" if error is not None else ""
     seams = seam_welds(det_g, plan, ex, pre.duration if pre is not None else 0.0, refused, sc, True)
     return replace(GroupRun(pose, move_s, plan, pre, ex, seams, plan_s, rescan_s=rescan_s), error=error)
+
+
+def X_F_M(sc: Scenario, pos: TiltRotatePositioner) -> FloatArray:
+    """(4, 4): the map's frame M in the faceplate frame F at home (where the clamp holds the part)."""
+    return np.asarray(invert(pos.X_R_F(*pos.home)) @ invert(sc.X_WR) @ sc.X_WM, dtype=float)

@@ -1,0 +1,130 @@
+"""A positioner move checked against the arm (docs/positioner.md, "The load and the moves"): the part, its
+fixtures, the clamping table and the positioner's tilting bodies swept from one pose to the next, sampled so that no
+point of them travels more than ``STEP_M`` between samples, each sample grown by half that, and the arm where it
+stands checked against the union. Frames: R [m]; axes [rad]."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from cell.config.motion import CollisionOptions
+from cell.geometry import FloatArray
+from cell.motion.collision import CollisionChecker, Contact
+from cell.motion.robot import RobotModel
+from cell.pipeline.positioned.carry import posed_obstacles
+from cell.pipeline.records import Detection
+from cell.positioner.bodies import PEDESTAL, positioner_parts
+from cell.types import Part
+from cell.types.positioner import TiltRotatePositioner
+
+STEP_M = 0.02  # [m] the most any swept point travels between two samples
+
+
+def clamped(det: Detection, pos: TiltRotatePositioner) -> tuple[Part, ...]:
+    """What the faceplate carries, in R at home: the aligned map's parts and fixtures and the clamping table."""
+    return tuple(p for p in posed_obstacles(det, pos, pos.home, np.eye(4)) if not p.name.startswith("POSITIONER_"))
+
+
+def swept_bodies(
+    home: Sequence[Part],
+    pos: TiltRotatePositioner,
+    a: tuple[float, float],
+    b: tuple[float, float],
+    step_m: float = STEP_M,
+) -> tuple[Part, ...]:
+    """The bodies ``home`` (in R, clamped on the faceplate, where they lie at the positioner's home) and the
+    positioner's tilting bodies at samples of the move from axes ``a`` to ``b`` (tilt, rotate) [rad], along the
+    straight line between them in the axes' space (both axes synchronised), in R; the still pedestal once."""
+    centre = pos.X_R_tilt(0.0)[:3, 3]
+    reach = max(float(np.max(np.linalg.norm(p.vertices() - centre, axis=1))) for p in home)
+    turn = abs(b[0] - a[0]) + abs(b[1] - a[1])  # an upper bound on the angle any point turns [rad]
+    n = max(1, math.ceil(reach * turn / step_m))
+    out = [p for p in positioner_parts(pos, *a) if p.name == PEDESTAL]
+    for k, s in enumerate(np.linspace(0.0, 1.0, n + 1)):
+        t, r = a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])
+        X = pos.move(t, r)
+        moving = [*(p.transformed(X) for p in home), *(p for p in positioner_parts(pos, t, r) if p.name != PEDESTAL)]
+        out.extend(replace(p, name=f"{p.name}@{k}") for p in moving)
+    return tuple(out)
+
+
+def move_hit(
+    model: RobotModel,
+    q: FloatArray,
+    home: Sequence[Part],
+    pos: TiltRotatePositioner,
+    a: tuple[float, float],
+    b: tuple[float, float],
+    options: CollisionOptions,
+    step_m: float = STEP_M,
+) -> Contact | None:
+    """Where the arm at ``q`` (dof,) [rad] meets what the positioner's move from ``a`` to ``b`` sweeps of the
+    clamped bodies ``home`` (:func:`swept_bodies`; the samples grown by half a step on top of the parts'
+    inflation); None when it is clear."""
+    if np.allclose(a, b):
+        return None
+    grown = replace(options, part_inflation=options.part_inflation + step_m / 2.0)
+    near = near_arm(model, q, swept_bodies(home, pos, a, b, step_m), grown.part_inflation)
+    return CollisionChecker(model, near, grown).check(q) if near else None
+
+
+ARM_RADIUS_M = 0.3  # [m] no part of the arm (links, torch, camera) lies further from its frames' chain
+
+
+def near_arm(model: RobotModel, q: FloatArray, bodies: Sequence[Part], grow_m: float) -> list[Part]:
+    """The bodies whose bounding sphere (grown by ``grow_m``) comes within ``ARM_RADIUS_M`` of the polyline
+    through the arm's frames at ``q``: the only ones the arm can touch (the rest need not enter the collision
+    model, whose building is what a sweep's check costs)."""
+    frames = model.fk_frames(q, model.frame_names)
+    p = np.array([X[:3, 3] for X in frames.values()])
+    a, b = p[:-1], p[1:]
+    ab = b - a
+    L2 = np.maximum(np.sum(ab * ab, axis=1), 1e-12)
+    out = []
+    for body in bodies:
+        c = np.asarray(body.center)
+        s = np.clip(np.sum((c - a) * ab, axis=1) / L2, 0.0, 1.0)
+        d = float(np.min(np.linalg.norm(a + s[:, None] * ab - c, axis=1)))
+        if d <= body.radius + grow_m + ARM_RADIUS_M:
+            out.append(body)
+    return out
+
+
+Axes = tuple[float, float]
+
+
+def clear_route(
+    model: RobotModel,
+    q: FloatArray,
+    home: Sequence[Part],
+    pos: TiltRotatePositioner,
+    a: Axes,
+    b: Axes,
+    options: CollisionOptions,
+) -> tuple[tuple[Axes, ...], Contact | None]:
+    """The positioner's route from ``a`` to ``b`` that sweeps nothing into the arm at ``q``: both axes together,
+    else the rotation first and then the tilt, else the tilt first, else laid down at the home tilt, turned
+    there and tilted up (a turn made where the part lies, stands or lies flat, as a shop would). Returns the
+    route's axes, start excluded, and None; or ((), the straight move's contact) when every route meets the
+    arm."""
+    flat = pos.home[0]
+    routes: tuple[tuple[Axes, ...], ...] = (
+        (b,),
+        ((a[0], b[1]), b),
+        ((b[0], a[1]), b),
+        ((flat, a[1]), (flat, b[1]), b),
+    )
+    first: Contact | None = None
+    for route in routes:
+        legs = [(s, e) for s, e in itertools.pairwise((a, *route)) if not np.allclose(s, e)]
+        hits = (move_hit(model, q, home, pos, s, e, options) for s, e in legs)
+        hit = next((h for h in hits if h is not None), None)
+        if hit is None:
+            return route, None
+        first = first or hit
+    return (), first

@@ -38,10 +38,18 @@ def base_lines(job: ProgramJob) -> list[str]:
 
 
 def positioner_move(b: Any, job: ProgramJob) -> list[str]:
-    """The positioner's axes to the program's values, the arm at home (declared in the .dat ``b.dat``)."""
+    """The positioner's axes to the program's values, the arm at home, through the route's via points when the
+    move check sent it round the arm (declared in the .dat ``b.dat``)."""
     ext = job.external
     if ext is None:
         return []
+    lines = []
+    for k, via in enumerate(ext.via_deg, start=1):
+        b.dat.append(f"DECL E6AXIS XPOSVIA{k}={e6axis(job.plan.q_home, 0.0, dict(zip(ext.numbers, via, strict=True)))}")
+        lines.append(f"PTP XPOSVIA{k} ; on the way: {_axes_text(ext.names, via)} (a straight move meets the arm)")
     b.dat.append(f"DECL E6AXIS XPOSITIONER={e6axis(job.plan.q_home, 0.0, ext.by_number())}")
-    values = ", ".join(f"{name} {num(v, 1)} deg" for name, v in zip(ext.names, ext.values_deg, strict=True))
-    return [f"PTP XPOSITIONER ; the positioner to {values}, the arm at home"]
+    return [*lines, f"PTP XPOSITIONER ; the positioner to {_axes_text(ext.names, ext.values_deg)}, the arm at home"]
+
+
+def _axes_text(names: tuple[str, str], values_deg: tuple[float, float]) -> str:
+    return ", ".join(f"{name} {num(v, 1)} deg" for name, v in zip(names, values_deg, strict=True))

@@ -4,6 +4,7 @@ RAPID facts it relies on: docs/reference.md section 5)."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -115,6 +116,11 @@ def rapid_text(job: ProgramJob) -> str:
     zones: set[str] = set()
     body = ["  PROC main()", "    ConfJ \\On;", "    ConfL \\On;"]
     body += [f"    ActUnit {ext_ax.unit};"] if ext_ax is not None else []
+    home = ",".join(_n(v) for v in np.degrees(plan.q_home))
+    for k, via in enumerate(ext_ax.via_deg if ext_ax is not None else (), start=1):  # round the arm at home
+        e = extax(0.0 if track else None, replace(ext_ax, values_deg=via) if ext_ax is not None else None)
+        decl.append(f"  CONST jointtarget jPosVia{k} := [[{home}],{e}];")
+        body.append(f"    MoveAbsJ jPosVia{k}, v1000, fine, tWeld;  ! on the way: a straight move meets the arm")
     body += ["    MoveAbsJ jHome, v1000, fine, tWeld;"]
     segs = plan.segments
     n, current = 0, ""

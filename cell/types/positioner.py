@@ -9,6 +9,7 @@ Angles [rad], lengths [m], speeds [rad/s], accelerations [rad/s^2], jerks [rad/s
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -130,7 +131,9 @@ class ExternalAxes:
     """A positioner's axes as one program writes them (docs/positioner.md, "Programs"): their values for the whole
     program [deg] (the positioner stands still while the arm welds), the KRL E numbers they take (E2, E3: E1 is the
     linear track's), their limits [deg], the machine data of the kinematic chain (``MACHINE_DEF[machine]``), the
-    RAPID mechanical unit, and X_FB (4, 4): the program's base on the faceplate (the part's frame) [m]."""
+    RAPID mechanical unit, X_FB (4, 4): the program's base on the faceplate (the part's frame) [m], and
+    ``via_deg``: the axes' values on the way to ``values_deg`` [deg], in order (a route that keeps the part clear
+    of the arm at home; empty: the axes move straight)."""
 
     values_deg: tuple[float, float]
     limits_deg: tuple[tuple[float, float], tuple[float, float]]
@@ -139,6 +142,7 @@ class ExternalAxes:
     machine: int = 2
     unit: str = "STN1"
     X_FB: FloatArray = field(default_factory=lambda: np.eye(4))
+    via_deg: tuple[tuple[float, float], ...] = ()
 
     def by_number(self) -> dict[int, float]:
         """E number -> value [deg]."""
@@ -146,13 +150,18 @@ class ExternalAxes:
 
 
 def external_axes(
-    pos: TiltRotatePositioner, tilt: float, rotate: float, X_FB: FloatArray | None = None
+    pos: TiltRotatePositioner,
+    tilt: float,
+    rotate: float,
+    X_FB: FloatArray | None = None,
+    via: Sequence[tuple[float, float]] = (),
 ) -> ExternalAxes:
     """The positioner's axes at (tilt, rotate) [rad] as a program writes them (E2, E3; the part's base ``X_FB`` on
-    the faceplate, default the faceplate's own frame)."""
+    the faceplate, default the faceplate's own frame; ``via``: (tilt, rotate) [rad] on the way there)."""
     lim = ((pos.tilt.q_min, pos.tilt.q_max), (pos.rotate.q_min, pos.rotate.q_max))
     return ExternalAxes(
         (math.degrees(tilt), math.degrees(rotate)),
         tuple((math.degrees(a), math.degrees(b)) for a, b in lim),  # type: ignore[arg-type]
         X_FB=np.eye(4) if X_FB is None else np.asarray(X_FB, dtype=float),
+        via_deg=tuple((math.degrees(t), math.degrees(r)) for t, r in via),
     )

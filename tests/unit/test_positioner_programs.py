@@ -66,6 +66,38 @@ def test_krl_check_finds_a_positioner_axis_beyond_its_limit(jobs: list[ProgramJo
     ]
 
 
+def test_a_route_round_the_arm_is_driven_as_the_move_check_cleared_it(jobs: list[ProgramJob], tmp_path: Path) -> None:
+    """The positioner's via points (the route :func:`~cell.pipeline.positioned.sweep.clear_route` found when the
+    straight move sweeps the part into the arm) come before the move to the pose, in both languages, and
+    ``cell krl check`` holds them to the axes' limits."""
+    from dataclasses import replace
+
+    ext = jobs[1].external
+    assert ext is not None
+    routed = replace(jobs[1], external=replace(ext, via_deg=((0.0, -45.0), (60.0, -45.0))))
+    texts = positioner_texts("krl", [routed], "pos")
+    src, dat = texts["POS_P2.src"], texts["POS_P2.dat"]
+    moves = re.findall(r"^PTP (XPOS\w+)", src, flags=re.M)
+    assert moves == ["XPOSVIA1", "XPOSVIA2", "XPOSITIONER"]
+    assert re.search(r"DECL E6AXIS XPOSVIA1=\{.*, E2 0\.000, E3 -45\.000", dat)
+    write_texts(texts, tmp_path)
+    programs, _ = read_programs(tmp_path)
+    assert check_all(programs, jobs[0].robot) == []
+    beyond = replace(jobs[1], external=replace(ext, via_deg=((150.0, -45.0),)))
+    write_texts(positioner_texts("krl", [beyond], "pos"), tmp_path / "beyond")
+    programs, _ = read_programs(tmp_path / "beyond")
+    found = [f.message for f in check_all(programs, jobs[0].robot) if f.code == "positioner"]
+    assert found == ["XPOSVIA1: E2 150 deg is outside its limits -135 .. 135"]
+    mod = positioner_texts("rapid", [routed], "pos")["POS_P2.mod"]
+    body = [ln.strip() for ln in mod.splitlines() if ln.strip().startswith("MoveAbsJ")]
+    assert body[:3] == [
+        "MoveAbsJ jPosVia1, v1000, fine, tWeld;  ! on the way: a straight move meets the arm",
+        "MoveAbsJ jPosVia2, v1000, fine, tWeld;  ! on the way: a straight move meets the arm",
+        "MoveAbsJ jHome, v1000, fine, tWeld;",
+    ]
+    assert re.search(r"CONST jointtarget jPosVia1 := \[\[.*\],\[9E9,0\.000,-45\.000,9E9,9E9,9E9\]\];", mod)
+
+
 def test_rapid_uses_a_coordinated_work_object(jobs: list[ProgramJob]) -> None:
     mod = positioner_texts("rapid", jobs[1:], "pos")["POS_P2.mod"]
     assert 'PERS wobjdata wobjPart := [FALSE,FALSE,"STN1",' in mod

@@ -111,7 +111,7 @@ def _programs(sc: Scenario, run: Any, out_dir: Path, controller: str) -> list[Pa
         if g.plan is None or not g.plan.segments or g.execution is None:
             continue
         X_RB = pos.X_R_F(g.pose.tilt, g.pose.rotate)
-        ext = external_axes(pos, g.pose.tilt, g.pose.rotate)
+        ext = external_axes(pos, g.pose.tilt, g.pose.rotate, via=g.via)  # the route the move check cleared
         jobs.append(ProgramJob(g.plan, robot, f"{sc.name.replace('-', '_')}_p{k + 1}"[:24], X_RB=X_RB,
                                X_WR=np.asarray(sc.X_WR), external=ext))  # fmt: skip
     coordinated = [cw for cw in run.coordinated if any(w.welded for g in run.groups for w in g.seams

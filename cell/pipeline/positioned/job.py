@@ -108,9 +108,9 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
                 move_s = sum(axes_move_s(pos, s, e) for s, e in itertools.pairwise((axes, *route)))
                 axes = (pose.tilt, pose.rotate)
                 if not job.execute:
-                    groups.append(GroupRun(pose, move_s, None, None, None, (), 0.0))
+                    groups.append(GroupRun(pose, move_s, None, None, None, (), 0.0, via=route[:-1]))
                     continue
-                g = _weld_pose(station, det, weldmap, pos, pose, move_s, q_now, progress)
+                g = replace(_weld_pose(station, det, weldmap, pos, pose, move_s, q_now, progress), via=route[:-1])
                 groups.append(g)
                 q_now = station.joint_state()
                 # A seam the planner refused at this pose (a collision, out of reach) tries its other poses.

@@ -31,6 +31,7 @@ class GroupRun:
     plan_wall_s: float
     error: CellError | None = None
     rescan_s: float = 0.0  # the close-ups at this pose (the seams hidden at home) [s]
+    via: tuple[tuple[float, float], ...] = ()  # the positioner's (tilt, rotate) [rad] on its way here (around the arm)
 
     @property
     def robot_s(self) -> float:

@@ -164,8 +164,8 @@ def _seam_sight(scn: Scenario, weldmap: WeldMap) -> SightReport:
 
 def seams_text(weldmap: WeldMap) -> str:
     """``3 seams: 2 to weld, 1 not supported (curved)``, or ``2 seams`` when the cell can weld every one."""
-    n = len(weldmap.seams) + len(weldmap.not_welded)
+    n = len(weldmap.seams) + len(weldmap.not_straight)
     if not weldmap.not_welded:
         return f"{n} seams"
     codes = ", ".join(sorted({str(u.code) for u in weldmap.not_welded}))
-    return f"{n} seams: {len(weldmap.seams)} to weld, {len(weldmap.not_welded)} not supported ({codes})"
+    return f"{n} seams: {n - len(weldmap.not_welded)} to weld, {len(weldmap.not_welded)} not supported ({codes})"

@@ -65,9 +65,10 @@ class PlanOptions:
     # each of two neighbouring motions is left out at their point [0, 0.5]; 0: an exact stop at every point.
     blend: float = 0.5
     # Shorter approach and depart lines [m] a transfer between two seams may meet, shortest first, where its motions
-    # are free with them (cell/planning/short_lines.py): every knot of the lines (line_spacing) from 5 mm, so each
-    # transfer meets the shortest lines the collision and body tests let it; the process's are the longest. (): none.
-    short_lines: tuple[float, ...] = (0.005, 0.01, 0.015, 0.02, 0.025, 0.03, 0.035, 0.04, 0.045)
+    # are free with them (cell/planning/short_lines.py): every 5 mm to 20 mm, then 30 and 40 mm (each length is
+    # one more collision check of every strategy that fails: the 5 mm knots beyond 20 mm cost a fifth of the
+    # planner's time for a few tenths of a second per side, docs/cycle.md); the process's are the longest. (): none.
+    short_lines: tuple[float, ...] = (0.005, 0.01, 0.015, 0.02, 0.03, 0.04)
     transfer_lift: float = 0.15  # [m] via-points this far above the highest obstacle when a transfer collides
     # A seam ending on the table where the torch meets the table is welded from at most this far above it [m]
     # (never more than a third of the seam); 0: such a seam is refused.

@@ -88,7 +88,7 @@ def not_welded_entries(det: Detection) -> list[dict[str, Any]]:
     curves = {e.id: e for e in det.curve_estimates}
     undone = {u.id: u for u in det.not_welded}
     out = []
-    for u in det.weldmap_R.not_welded:
+    for u in det.weldmap_R.not_straight:
         if u.id in curves:
             e = curves[u.id]
             out.append(curve_entry(undone.get(u.id), e, det.curve_metrics.get(u.id), det.curve_welds.get(u.id)))

@@ -91,7 +91,7 @@ def detection_report(
         seams += not_welded_entries(det)
     s = det.summary
     summary = {
-        "seams": len(det.estimates) + len(det.weldmap_R.not_welded),  # every seam of the map
+        "seams": len(det.estimates) + len(det.weldmap_R.not_straight),  # every seam of the map
         "not_supported": not_supported([u for u in det.not_welded if u.id not in det.curve_welds]),
         "curved": curve_summary(det),
         "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),

@@ -91,15 +91,15 @@ class Detection:
 
     @property
     def not_welded(self) -> tuple[UnsupportedSeam, ...]:
-        """Every seam of the map this run will not weld, with its reason (:attr:`WeldMap.not_welded`), a curved
+        """Every seam of the map this run will not weld, with its reason (:attr:`WeldMap.not_straight`), a curved
         seam's from its estimate and the weld run (``curve_welds``): welded, it is left out; tried and not welded,
         the planner's code (or the weld's: ``no_torch_path`` on a track, ``preview``); located and never tried (a
         detection), ``curved_no_torch_path``; not located, why not (``curved_not_located``)."""
         curves = {e.id: e for e in self.curve_estimates}
         out = []
-        for u in self.weldmap_R.not_welded:
+        for u in self.weldmap_R.not_straight:
             e, w = curves.get(u.id), self.curve_welds.get(u.id)
-            drawn = u.reason.rsplit("; ", 1)[0]  # where and what it is, without the map's "no locator yet"
+            drawn = u.reason.rsplit("; ", 1)[0]  # where and what it is, without the map's "not located"
             if e is None:
                 out.append(u)
             elif w is not None and w.welded:

@@ -101,7 +101,7 @@ def _summary(run: WeldRun, records: Sequence[SeamRecord]) -> str:
     planned = sum(1 for r in records if r.weld is not None and r.weld.planned) + sum(w.planned for w in curves)
     codes = [str(u.code) for u in det.not_welded if u.id not in det.curve_welds]
     tried = [str(u.code) for u in det.not_welded if u.id in det.curve_welds]
-    parts = [f"{len(det.estimates) + len(det.weldmap_R.not_welded)} seams in the map", f"{planned} planned"]
+    parts = [f"{len(det.estimates) + len(det.weldmap_R.not_straight)} seams in the map", f"{planned} planned"]
     parts.append(f"{welded} welded")
     if codes:
         parts.append(f"{len(codes)} not supported: {', '.join(sorted(set(codes)))}")

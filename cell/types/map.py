@@ -226,8 +226,8 @@ class MapSeam:
 class Unsupported(enum.StrEnum):
     """Why a seam the map draws is not one the cell can weld, as a code that code and tests read."""
 
-    # A curved seam (an arc, circle, ellipse, spline, helix or bulged polyline segment), read with its curve and
-    # joint (WeldMap.curved): no locator locates curved seams yet, so none is searched or welded.
+    # A curved seam (an arc, circle, ellipse, spline, helix or bulged polyline segment) not located: no two parts
+    # hold it (no joint), the locator cannot take it, or the run never came to locate it.
     CURVED_NOT_LOCATED = "curved_not_located"
     # A curved seam located (its CurveEstimate found), but no torch path along a curve exists yet: not welded.
     CURVED_NO_TORCH_PATH = "curved_no_torch_path"
@@ -255,7 +255,8 @@ class WeldMap:
         aligned, never welded).
     unsupported : seams drawn but not weldable (seams on a fixture), each with its reason.
     curved : the curved seams (arcs, circles, ellipses, splines, bulged polyline segments), typed curves with their
-        joints; no locator locates them yet (:attr:`not_welded` lists them with code ``curved_not_located``).
+        joints; one that no two parts hold (no joint) cannot be located (:attr:`not_welded` lists it with code
+        ``curved_not_located``); the others are located and welded or refused by a run, each with its reason.
     warnings : one line each: what the reader skipped or doubted (also logged on ``cell.weldmap``).
     """
 
@@ -270,20 +271,28 @@ class WeldMap:
     curved: tuple[CurvedSeam, ...] = ()
 
     @property
-    def not_welded(self) -> tuple[UnsupportedSeam, ...]:
-        """Every seam of the map the cell will not search or weld, with its reason: the curved seams first (no
-        locator locates curved seams yet), then :attr:`unsupported`."""
+    def not_straight(self) -> tuple[UnsupportedSeam, ...]:
+        """Every seam of the map outside :attr:`seams`, map order: each curved seam (what and where it is; a run
+        locates it and welds or refuses it with its reason, :attr:`Detection.not_welded`), then
+        :attr:`unsupported`."""
         curved = tuple(
             UnsupportedSeam(
                 c.id,
                 f"{c.drawn}: a curved seam ({c.kind}, {c.length * 1000:.0f} mm"
                 + (f", {c.joint}" if c.joint is not None else "")
-                + "); no locator locates curved seams yet",
+                + ("); not located in this run" if c.joint is not None else "); no two parts hold it: not located"),
                 Unsupported.CURVED_NOT_LOCATED,
             )
             for c in self.curved
         )
         return curved + self.unsupported
+
+    @property
+    def not_welded(self) -> tuple[UnsupportedSeam, ...]:
+        """Every seam of the map the cell will not weld whatever a run finds, with its reason: the curved seams no
+        two parts hold (nothing to locate), then :attr:`unsupported`."""
+        held = {c.id for c in self.curved if c.joint is not None}
+        return tuple(u for u in self.not_straight if u.id not in held)
 
     def transformed(self, X_AF: FloatArray, frame: str) -> WeldMap:
         """The whole map expressed in frame ``frame`` given the pose X_AF of its current frame F in A."""

@@ -88,7 +88,11 @@ def describe(weldmap: WeldMap, joints: Mapping[str, str] | None = None) -> str:
             f"  dir {_fmt(s.direction, '+.3f')}  {note}"
         )
     if weldmap.curved:
-        lines.append(f"curved seams: {len(weldmap.curved)} (no locator locates curved seams yet: not welded)")
+        loose = sum(c.joint is None for c in weldmap.curved)
+        lines.append(
+            f"curved seams: {len(weldmap.curved)} (a run locates each and welds it or says why not"
+            + (f"; {loose} with no joint: not located)" if loose else ")")
+        )
         width = max(len(c.id) for c in weldmap.curved)
         lines += [f"  {c.id:<{width}}  {_curve(c)}" for c in weldmap.curved]
     if weldmap.unsupported:

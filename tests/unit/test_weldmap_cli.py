@@ -28,7 +28,7 @@ def test_map_info_lists_joints_fixtures_and_unsupported_seams(tmp_path: Path) ->
     assert code == 0, err
     assert "TOP_RAIL     box (MESH)" in out and "fixtures: 1" in out and "CLAMP_1" in out
     assert "POST_L>TOP_RAIL:+z" in out and "T 90 deg  POST_L > TOP_RAIL" in out
-    assert "unsupported seams" not in out and "curved seams: 1 (no locator locates curved seams yet" in out
+    assert "unsupported seams" not in out and "curved seams: 1 (a run locates each and welds it or says why not" in out
     assert "arc r 40.0 mm" in out and "[ARC " in out
 
 

@@ -92,13 +92,13 @@ def test_polylines_are_chains_of_straight_seams_and_curves_are_unsupported(tmp_p
     # The bulged segment, the arc and the spline are curved seams (typed curves), not dropped and not refused.
     curved = {c.id: c for c in m.curved}
     assert list(curved) == [f"seam-{lw.dxf.handle}.2", m.curved[1].id, f"seam-{spline.dxf.handle}"]
-    assert not m.unsupported and {u.code for u in m.not_welded} == {Unsupported.CURVED_NOT_LOCATED}
+    assert not m.unsupported and {u.code for u in m.not_straight} == {Unsupported.CURVED_NOT_LOCATED}
     bulged = curved[f"seam-{lw.dxf.handle}.2"]
     assert bulged.kind == "arc" and "LWPOLYLINE" in bulged.drawn and "segment 2" in bulged.drawn
     np.testing.assert_allclose(bulged.curve.sample(0.001)[[0, -1]], [[0.28, 0.7, 0.08], [0.28, 0.65, 0.08]], atol=TOL)
     assert m.curved[1].drawn.startswith("ARC ") and "on layer WELD_SEAMS" in m.curved[1].drawn
     assert m.curved[2].kind == "curve" and m.curved[2].curve.chord_error_m < 1e-4
-    assert "no locator locates curved seams yet" in m.not_welded[0].reason
+    assert m.not_straight[0].reason.endswith("not located") and "a curved seam (arc" in m.not_straight[0].reason
 
 
 def test_lines_on_a_seam_layer_are_seams_whatever_their_colour(tmp_path: Path) -> None:

@@ -50,3 +50,16 @@ def test_every_straight_seam_is_welded_whole(welded: dict[str, Any]) -> None:
         tcp = by_id[sid]["tcp_error_mm"]
         assert tcp["max"] <= 0.1, tcp  # measured 0.02 mm
         assert max(tcp["short_start"], tcp["short_end"], tcp["past_start"], tcp["past_end"]) <= 0.3, tcp  # 0.09 mm
+
+
+def test_the_tubes_fillet_is_located_close_up_and_welded_all_round(welded: dict[str, Any]) -> None:
+    """The tube's fillet on the plate (a closed circle): its fixed cameras' bound fails the gate, a close-up brings
+    it down, the planner welds it all round from the arm's reach map, and the bead follows the true curve."""
+    curves = [s for s in welded["seams"] if s.get("curved")]
+    assert len(curves) == 1, [s["id"] for s in curves]
+    c = curves[0]
+    assert c["status"] == "found" and c["curve"]["closed"] and c["welded"], c.get("weld_reason")
+    assert 3.0 * c["curve"]["sigma_max_mm"] <= 0.5  # the gate's bound: measured 0.05 mm sigma after the close-up
+    assert c["error_mm"]["within_2sigma"] == 1.0 and c["error_mm"]["max"] <= 0.15  # measured 0.05 mm
+    tcp = c["tcp_error_mm"]
+    assert tcp["max"] <= 0.15 and tcp["past_start"] == tcp["past_end"] == 0.0, tcp  # measured 0.05 mm, all round

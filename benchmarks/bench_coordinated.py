@@ -1,6 +1,7 @@
 """A pipe stub's circular fillet welded on a positioner by coordinated motion: ``cell weld pipe-stub-positioner`` as
-the cell runs it (the weld gate's word on the located curve), then the same located curve planned, played and
-measured as a study whatever the gate says (docs/positioner.md, "Coordinated motion").
+the cell runs it (the located curve re-scanned up close at home, the weld gate's word on it, the coordinated weld);
+should the gate refuse it, the first located curve planned, played and measured as a study (docs/positioner.md,
+"Coordinated motion").
 
     .venv/bin/python benchmarks/bench_coordinated.py [--json PATH] [--noise realistic|small]
 
@@ -38,23 +39,33 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
     from cell.pipeline.curved.welds import curve_doubt
     from cell.pipeline.detect import detect, read_weldmap
     from cell.pipeline.geometry import open_cell
+    from cell.pipeline.positioned import weld_on_positioner
     from cell.seams.curved.metrics import curve_error
 
     s = sc.load(SCENARIO)
     s = s.with_noise(noise) if noise else s
     assert s.robot.positioner is not None
     pos = s.robot.positioner.positioner(s.X_WR)
-    wm = read_weldmap(s)
     t = time.perf_counter()
-    with open_cell(s, wm) as station:
-        assert station.arm is not None
-        det = detect(s, "ours", station=station, weldmap=wm)
-        c = det.curve_estimates[0]
-        doubt = curve_doubt(c, s)
-        err = curve_error(c, np.asarray(det.curve_truths[c.id]))
-        done, _ = weld_curves_coordinated(station, det, pos, station.arm.q_scan, refuse_doubtful=False)
-    _, weld, cw, _ = done[0]
-    assert cw is not None and weld.quality is not None
+    run = weld_on_positioner(s)  # what `cell weld` runs: detect, the close-ups at home, the coordinated weld
+    det = run.detection
+    c = det.curve_estimates[0]
+    doubt = curve_doubt(c, s)
+    err = curve_error(c, np.asarray(det.curve_truths[c.id]))
+    welds = [w for g in run.groups for w in g.seams if w.id == c.id and w.welded]
+    if run.coordinated and welds:
+        cw, weld = run.coordinated[0], welds[0]
+    else:  # the gate refused it: the same located curve planned, played and measured as a study
+        wm = read_weldmap(s)
+        with open_cell(s, wm) as station:
+            assert station.arm is not None
+            det = detect(s, "ours", station=station, weldmap=wm)
+            c = det.curve_estimates[0]
+            done, _ = weld_curves_coordinated(station, det, pos, station.arm.q_scan, refuse_doubtful=False)
+        _, weld, study, _ = done[0]
+        assert study is not None
+        cw = study
+    assert weld.quality is not None
     if program is not None:
         from cell.export.coordinated_program import write_coordinated_programs
         from cell.motion.robot import RobotModel

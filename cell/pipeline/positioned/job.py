@@ -35,6 +35,7 @@ ROUNDS = 4  # poses chosen again at most this often for the seams refused at the
 def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progress: Progress = quiet) -> PositionerRun:
     """The whole part on ``robot.positioner`` (``job``: locator, noise, re-scan mode, gui as for ``cell weld``;
     ``job.execute`` False plans the poses and moves nothing)."""
+    from cell.pipeline.curved.rescan import curves_rescanned
     from cell.pipeline.last_check import last_checked
     from cell.pipeline.outcomes import doubt
     from cell.pipeline.placeable import rescan_weldable
@@ -61,6 +62,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         rescan_s, q_now = 0.0, arm.q_scan
         if mode != "none" and job.execute:
             rs, det, _ = rescan_weldable(station, det, mode, motion=home, progress=progress)
+            # the doubtful curves up close too, the positioner at home (the part where it was scanned)
+            rs, det = curves_rescanned(station, det, rs, motion=home, progress=progress)
             if rs is not None:
                 rescan_s, q_now = rs.motion_s, rs.q_end
         checked: dict[str, str] = {}

@@ -13,7 +13,8 @@ from pathlib import Path
 from cell.journal import read_journal
 
 CELL = str(Path(sys.executable).with_name("cell"))
-ARGS = ["weld", "fence1", "--sides", "first", "--noise", "none", "--json", "r.json"]
+# No close-ups: the journal is what is tested, and side A's nine seams that pass the gate without them are enough.
+ARGS = ["weld", "fence1", "--sides", "first", "--noise", "none", "--rescan", "none", "--json", "r.json"]
 
 
 def test_sigterm_mid_weld_then_resume_welds_exactly_the_rest(tmp_path: Path) -> None:
@@ -29,13 +30,13 @@ def test_sigterm_mid_weld_then_resume_welds_exactly_the_rest(tmp_path: Path) -> 
 
     env.pop("CELL_JOURNAL_SIGNAL")
     rest = subprocess.run([CELL, *ARGS, "--resume", "."], cwd=tmp_path, env=env, capture_output=True, text=True)
-    assert rest.returncode == 0, rest.stderr
+    assert rest.returncode == 3, rest.stderr  # partial: the three seams the gate refuses without their close-ups
     st = read_journal(tmp_path / "r.journal.jsonl")
     offs = [r["seam"] for r in st.records if r["kind"] == "arc_off"]
-    assert len(offs) == len(set(offs)) == 12 and st.runs == ("r1", "r2")  # every seam of side A once
+    assert len(offs) == len(set(offs)) == 9 and st.runs == ("r1", "r2")  # every weldable seam of side A once
     rep = json.loads((tmp_path / "r.json").read_text())
     runs = {s["id"]: s["run"] for s in rep["seams"] if s["welded"]}
-    assert rep["welded"] == 12 and sorted(runs.values()).count("r1") == 3 and set(runs.values()) == {"r1", "r2"}
+    assert rep["welded"] == 9 and sorted(runs.values()).count("r1") == 3 and set(runs.values()) == {"r1", "r2"}
     assert all(s["tcp_error_mm"]["rms"] <= 0.3 for s in rep["seams"] if s["welded"])  # measured <= 0.1 mm
     again = subprocess.run([CELL, *ARGS[:2], "--resume", "."], cwd=tmp_path, env=env, capture_output=True, text=True)
     assert again.returncode == 2 and again.stderr.strip().splitlines()[-1].startswith("error: --resume")  # finished

@@ -309,7 +309,7 @@ class SimCell:
             self.client.resetBasePositionAndOrientation(
                 body, [float(v) for v in X_new[:3, 3]], [float(v) for v in q_new]
             )
-        self.parts_W = tuple(p.transformed(X) for p in self.parts_W)
+        self.parts_W = tuple(p.moved(X) for p in self.parts_W)
         return self.parts_W
 
     def capture_from_link(self, camera: str, link: str = EYE_IN_HAND_LINK) -> DepthImage:

@@ -193,6 +193,12 @@ class Part:
         cylinder = self.cylinder.transformed(X_CA) if self.cylinder is not None else None
         return Part(self.name, self.body.transformed(X_CA), self.drawn_as, cylinder)
 
+    def moved(self, X_CA: FloatArray) -> Part:
+        """:meth:`transformed` for a part moved rigidly many times (:meth:`Polyhedron.moved`)."""
+        cylinder = self.cylinder.transformed(X_CA) if self.cylinder is not None else None
+        body = self.body.moved(X_CA) if isinstance(self.body, Polyhedron) else self.body.transformed(X_CA)
+        return Part(self.name, body, self.drawn_as, cylinder)
+
 
 @dataclass(frozen=True)
 class MapSeam:

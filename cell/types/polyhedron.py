@@ -243,12 +243,18 @@ class Polyhedron:
         return np.asarray(np.arctan2(num, den).sum(axis=1) / (2.0 * np.pi))
 
     def transformed(self, X_CA: FloatArray) -> Polyhedron:
-        """The same body expressed in frame C, given the pose X_CA of its frame A in C. A rigid motion keeps the
-        faces' triangulation and moves the planes and the centre (no face is triangulated again)."""
+        """The same body expressed in frame C, given the pose X_CA of its frame A in C (its faces triangulated
+        again in C: what the simulator renders, so a scene's noise does not hang on how the body was moved)."""
+        return Polyhedron(transform_points(X_CA, self.vertices), self.faces, self.names)
+
+    def moved(self, X_CA: FloatArray) -> Polyhedron:
+        """:meth:`transformed` for a body moved rigidly many times (a part turning on a positioner): the faces'
+        triangulation kept, the planes and the centre moved (no face triangulated again); a motion that is not
+        rigid is :meth:`transformed`."""
         X = np.asarray(X_CA, dtype=float)
         R, t = X[:3, :3], X[:3, 3]
         if not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0.0:
-            return Polyhedron(transform_points(X, self.vertices), self.faces, self.names)
+            return self.transformed(X)
         out = object.__new__(Polyhedron)
         n = self._planes[:, :3] @ R.T
         vol, c, radius = self._mass

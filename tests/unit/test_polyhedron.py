@@ -100,7 +100,7 @@ def test_transformed_moves_planes_points_and_centre() -> None:
 
 def test_a_rigid_move_keeps_what_a_rebuilt_body_computes() -> None:
     X = make_pose(rpy_to_matrix([0.3, -0.2, 1.1]), [0.5, -0.4, 0.2])
-    moved = plate_with_hole().transformed(X)
+    moved = plate_with_hole().moved(X)
     rebuilt = Polyhedron(transform_points(X, plate_with_hole().vertices), moved.faces, moved.names)
     assert np.allclose(moved.face_planes(), rebuilt.face_planes(), atol=1e-12)
     assert np.array_equal(moved.triangles(), rebuilt.triangles())

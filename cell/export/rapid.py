@@ -117,9 +117,9 @@ def rapid_text(job: ProgramJob) -> str:
     body = ["  PROC main()", "    ConfJ \\On;", "    ConfL \\On;"]
     body += [f"    ActUnit {ext_ax.unit};"] if ext_ax is not None else []
     home = ",".join(_n(v) for v in np.degrees(plan.q_home))
-    for k, via in enumerate(ext_ax.via_deg if ext_ax is not None else (), start=1):  # round the arm at home
-        e = extax(0.0 if track else None, replace(ext_ax, values_deg=via) if ext_ax is not None else None)
-        decl.append(f"  CONST jointtarget jPosVia{k} := [[{home}],{e}];")
+    vias = [replace(ext_ax, values_deg=v) for v in ext_ax.via_deg] if ext_ax is not None else []
+    for k, via in enumerate(vias, start=1):  # the positioner's route round the arm at home
+        decl.append(f"  CONST jointtarget jPosVia{k} := [[{home}],{extax(0.0 if track else None, via)}];")
         body.append(f"    MoveAbsJ jPosVia{k}, v1000, fine, tWeld;  ! on the way: a straight move meets the arm")
     body += ["    MoveAbsJ jHome, v1000, fine, tWeld;"]
     segs = plan.segments

@@ -44,19 +44,12 @@ OUT_LOCATED = Path(__file__).resolve().parent / "results" / "curve_weld_located.
 def _normals(part: Part, surface: Surface, p_R: FloatArray) -> FloatArray:
     """(n, 3) the outward unit normals of ``part``'s surface (its cylinder's side, or its flat face holding the
     points) at p_R (n, 3)."""
-    from cell.weldmap.curved_joints import holding_face
+    from cell.weldmap.curved_joints import holding_face, surface_normals
 
-    if surface is Surface.CYLINDER:
-        c = part.cylinder
-        assert c is not None
-        d = p_R - c.p_base
-        r = d - np.outer(d @ c.axis, c.axis)
-        return np.asarray(r / np.linalg.norm(r, axis=1, keepdims=True))
-    face = holding_face(part, p_R)
-    if face is None:
+    face = None if surface is Surface.CYLINDER else holding_face(part, p_R)
+    if surface is not Surface.CYLINDER and face is None:
         raise ValueError(f"no face of {part.name} holds the curve")
-    n, _ = part.face_plane(face)
-    return np.tile(n, (len(p_R), 1))
+    return surface_normals(part, surface, face, p_R)
 
 
 def truth_estimate(

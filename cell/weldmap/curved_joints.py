@@ -37,8 +37,9 @@ def holding_face(part: Part, p: FloatArray) -> str | None:
     return best
 
 
-def _normals(part: Part, surface: Surface, face: str | None, p: FloatArray) -> FloatArray:
-    """(n, 3) outward unit normals of the part's surface at the points."""
+def surface_normals(part: Part, surface: Surface, face: str | None, p: FloatArray) -> FloatArray:
+    """(n, 3) outward unit normals at the points p (n, 3) of the part's surface: its cylinder's side, or its flat
+    face ``face``."""
     if surface is Surface.CYLINDER:
         c = part.cylinder
         assert c is not None
@@ -82,7 +83,7 @@ def curved_joint(seam: CurvedSeam, parts: Sequence[Part]) -> tuple[CurvedJoint |
             (a, sa, fa), (b, sb, fb) = (b, sb, fb), (a, sa, fa)
         if not _ends_at(a, p):  # the round part goes on through: the flat part abuts it
             (a, sa, fa), (b, sb, fb) = (b, sb, fb), (a, sa, fa)
-    cos = np.einsum("ij,ij->i", _normals(a, sa, fa, p), _normals(b, sb, fb, p))
+    cos = np.einsum("ij,ij->i", surface_normals(a, sa, fa, p), surface_normals(b, sb, fb, p))
     dihedral = math.pi - np.arccos(np.clip(cos, -1.0, 1.0))
     lo, hi = float(dihedral.min()), float(dihedral.max())
     kind = "T" if math.radians(30.0) <= lo and hi <= math.radians(150.0) else "corner"

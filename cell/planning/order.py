@@ -1,5 +1,5 @@
-"""The welding order (step 4 of :func:`cell.planning.plan.plan_welds`): greedy nearest neighbour then 2-opt and Or-opt on
-the point-to-point durations between seams, home at both ends. Joints [rad]; durations [s]."""
+"""The welding order (step 4 of :func:`cell.planning.plan.plan_welds`): greedy nearest neighbour then 2-opt and Or-opt
+on the point-to-point durations between seams, home at both ends. Joints [rad]; durations [s]."""
 
 from __future__ import annotations
 

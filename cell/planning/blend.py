@@ -19,11 +19,16 @@ from cell.motion.timing import connect
 from cell.types.plan import Segment
 from cell.types.trajectory import Trajectory
 
-# The cuts tried at a point, longest first, as fractions of the longest cut of each motion (before, after): where a
-# link collides, the cut into one motion is shortened before the other's (the collision is usually near one of them)
+# The cuts tried at a point, longest first, as fractions of the longest cut of each motion (before, after), down to a
+# sixteenth, three quarters and three eighths between the halvings: where a link collides, the cut into one motion is
+# shortened before the other's (the collision is usually near one of them)
 _CUTS = tuple(
     sorted(
-        ((x, y) for x in (1.0, 0.5, 0.25, 0.125, 0.0625) for y in (1.0, 0.5, 0.25, 0.125, 0.0625)),
+        (
+            (x, y)
+            for x in (1.0, 0.75, 0.5, 0.375, 0.25, 0.125, 0.0625)
+            for y in (1.0, 0.75, 0.5, 0.375, 0.25, 0.125, 0.0625)
+        ),
         key=lambda c: (-(c[0] + c[1]), -min(c)),
     )
 )

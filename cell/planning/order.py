@@ -62,13 +62,13 @@ def seam_order(
         tour.append(nxt)
         left.remove(nxt)
     two = _improved(tour, cost, 0)
-    moved = _improved(two, cost, 3)
+    moved = _improved(two, cost, n)
     return moved if cost(moved) < (1.0 - OR_OPT_GAIN) * cost(two) else two
 
 
 def _improved(tour: list[int], cost: Callable[[list[int]], float], longest: int) -> list[int]:
     """2-opt (a stretch reversed) and Or-opt (a stretch of up to ``longest`` seams moved elsewhere, as it is or
-    reversed) until neither shortens the tour."""
+    reversed; 0: none) until neither shortens the tour."""
     n, best, improved = len(tour), cost(tour), True
     while improved:
         improved = False

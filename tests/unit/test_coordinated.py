@@ -124,7 +124,17 @@ def test_the_simulator_turns_the_part_and_the_torch_follows_its_seam(planned: tu
     with open_cell(sc, read_weldmap(sc)) as station:
         ex, back = play(station, cw, record_dt=0.1)
         axes_end = station.positioner.axes  # type: ignore[union-attr]
+        # The bead, where the part now lies, carried back into the faceplate's frame at home.
+        X_W_F = station.positioner.X_W_true @ sc.X_WR @ pos.X_R_F(*pos.home)  # type: ignore[union-attr]
+        ends_W = station.sim.bead_segments().reshape(-1, 3)
     assert np.allclose(axes_end, pos.home)  # the positioner played back home with the arm
+    # The bead was laid on the turning part where the wire's tip was: on the fillet all round (laid in the world
+    # it would be a short smear where the torch stands, off the fillet once the part turns home).
+    p_F = (ends_W - X_W_F[:3, 3]) @ X_W_F[:3, :3]
+    d = p_F[:, :2] - np.array([0.003, -0.002])
+    assert np.hypot(np.linalg.norm(d, axis=1) - R_PIPE, p_F[:, 2] - Z_FILLET).max() < 0.01e-3  # measured 0.001 mm
+    turn = np.sort(np.arctan2(d[:, 1], d[:, 0]))
+    assert np.diff(np.r_[turn, turn[0] + 2 * math.pi]).max() < math.radians(3.0)  # the whole loop, no gap
     q = quality(ex, back, np.asarray(est.p_RS), closed=True)
     assert q.tcp_max_mm < 0.05 and q.short_start_mm == 0.0  # the whole loop, on the seam the part carries
     assert q.speed_mm_s == pytest.approx(cw.speed * 1000.0, rel=0.01)  # relative to the turning part

@@ -154,11 +154,35 @@ def test_the_krl_program_moves_e2_e3_in_the_turning_base_and_passes_the_check(pl
     write_coordinated_programs("krl", [cw], robot, pos, "pipe", tmp_path)
     programs, found = read_programs(tmp_path)
     assert not found and not check_all(programs, robot)  # S, T on the arm at every point's own E2 / E3
-    dat = next(tmp_path.glob("*.dat")).read_text()
+    dat_path = next(tmp_path.glob("*.dat"))
+    dat = dat_path.read_text()
     e3 = [float(v) for v in re.findall(r"E6POS XP\d+=\{[^}]*E3 ([-\d.]+)", dat)]
-    assert len(set(e3)) > 30 and max(e3) - min(e3) > 360.0  # the rotate axis turns the loop, point by point
+    assert len(set(e3)) > 10 and max(e3) - min(e3) > 360.0  # the rotate axis turns the loop, point by point
     src = next(tmp_path.glob("*.src"))
+    # The fillet is a circle in the part: five CIRC of about 73 deg (the loop and its overlap) in the turning base,
+    # their points on the planned circle; an auxiliary point moved 0.2 mm off it is found by the check.
+    circs = re.findall(r"^CIRC (XP\d+), XP\d+, CA ([\d.]+)$", src.read_text(), re.M)
+    assert len(circs) == 5 and sum(float(ca) for _, ca in circs) == pytest.approx(365.2, abs=0.2)
+    aux = re.search(rf"(DECL E6POS {circs[1][0]}=\{{X )([-\d.]+)", dat)
+    assert aux is not None
+    dat_path.write_text(dat.replace(aux.group(0), f"{aux.group(1)}{float(aux.group(2)) + 0.2:.4f}"))
+    assert any(f.code == "circ" for f in check_all(read_programs(tmp_path)[0], robot))
+    dat_path.write_text(dat)
     text = src.read_text().replace("Positioner chain", "Positioner")  # the chain not stated: the base stands still
     src.write_text(text)
     programs, _ = read_programs(tmp_path)
     assert any(f.code in ("kinematics", "status_turn") for f in check_all(programs, robot))
+
+
+def test_a_seam_that_is_no_circle_in_the_part_is_written_in_chords(planned: tuple) -> None:
+    from dataclasses import replace
+
+    from cell.export.coordinated_program import CHORD_TOL_M, coordinated_moves
+
+    cw = planned[4]
+    X = np.array(cw.X_FT)
+    X[:, 0, 3] *= 1.02  # an ellipse 2 % out of round: no circle within the tolerance
+    moves = coordinated_moves(replace(cw, X_FT=X))
+    assert {mv.kind for mv in moves} == {"LIN"} and max(mv.chord for mv in moves) <= CHORD_TOL_M
+    assert moves[0].start == 0 and moves[-1].end == len(X) - 1
+    assert max(mv.axes_dev for mv in moves) < math.radians(0.01)  # the axes turn in step with the chords

@@ -8,13 +8,16 @@ should the gate refuse it, the first located curve planned, played and measured 
 Per run: the located curve's sigma and its error against the truth, the gate's word; the coordinated weld's TCP
 RMS / max against the true curve the part carries (in the part's frame), its speed along the part, the torch's
 spread, the tilt and the rotate axis's sweep, every waypoint's ISO 6947 slope and rotation (worst of them), the
-arc time, the job's time and the planning's wall time (default ``benchmarks/results/coordinated.json``).
+arc time, the job's time and the planning's wall time; the programs' moves (circular or chords, in the turning base),
+the weld's knots' largest distance from them as the controller runs them and the planned axes' from the
+controller's synchronous interpolation (default ``benchmarks/results/coordinated.json``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -34,6 +37,7 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
     """The located curve, the gate's word and the coordinated weld measured (a study when the gate refuses);
     ``program``: a folder for its KRL program (``krl/``) and RAPID module (``rapid/``)."""
     from cell import scenario as sc
+    from cell.export.coordinated_program import coordinated_moves, program_path_off
     from cell.export.positioner_report import coordinated_entry
     from cell.pipeline.coordinated import weld_curves_coordinated
     from cell.pipeline.curved.welds import curve_doubt
@@ -77,6 +81,7 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
             write_coordinated_programs(controller, [cw], robot, pos, "pipe_stub", program / controller)
     q = weld.quality
     entry = coordinated_entry(cw)
+    moves = coordinated_moves(cw)
     return {
         "scenario": SCENARIO,
         "noise": noise or "realistic",
@@ -99,6 +104,9 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
         "arc_s": entry["arc_s"],
         "job_s": entry["job_s"],
         "plan_wall_s": entry["plan_wall_s"],
+        "program_moves": {k: sum(mv.kind == k for mv in moves) for k in ("CIRC", "LIN")},
+        "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4),
+        "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
         "wall_s": round(time.perf_counter() - t, 1),
         "waypoints": entry["waypoints"],
     }

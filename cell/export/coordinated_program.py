@@ -80,6 +80,25 @@ def coordinated_moves(cw: CoordinatedWeld) -> list[CoordMove]:
             for a, b in itertools.pairwise(knots)]  # fmt: skip
 
 
+def program_path_off(cw: CoordinatedWeld, moves: list[CoordMove]) -> float:
+    """[m] the largest distance of a weld knot (in the part's frame) from the move that stands for it as the
+    controller runs it: the circle through a CIRC's start, auxiliary and end points, or a LIN's chord."""
+    p = np.asarray(cw.X_FT)[:, :3, 3]
+    worst = 0.0
+    for mv in moves:
+        three = circle_through(p[mv.start], p[mv.aux], p[mv.end]) if mv.kind == "CIRC" else None
+        if three is None:
+            worst = max(worst, _chord(p, mv.start, mv.end))
+            continue
+        centre, r, _ = three
+        normal = np.cross(p[mv.aux] - p[mv.start], p[mv.end] - p[mv.start])
+        normal /= np.linalg.norm(normal)
+        d = p[mv.start : mv.end + 1] - centre
+        h = d @ normal
+        worst = max(worst, float(np.hypot(np.linalg.norm(d - np.outer(h, normal), axis=1) - r, h).max()))
+    return worst
+
+
 def _chord(p: FloatArray, a: int, b: int) -> float:
     """The largest distance [m] of the knots p[a..b] from the chord p[a]-p[b]."""
     u = (p[b] - p[a]) / max(float(np.linalg.norm(p[b] - p[a])), 1e-12)

@@ -20,6 +20,7 @@ from cell.export.checks.positioner import chain_line
 from cell.export.circles import CIRCLE_TOL_M, MAX_SWEEP_RAD, circle_through, fit_circle, swept
 from cell.export.krl_data import X_TOOL, e6axis, e6pos, frame_text, num, procedure_line
 from cell.export.program import write_texts
+from cell.export.rapid import _procedure_data as procedure_data
 from cell.export.rapid import confdata, pose_text
 from cell.export.status_turn import ArmGeometry, status_turn
 from cell.geometry import FloatArray, invert
@@ -56,11 +57,12 @@ def _axes_dev(cw: CoordinatedWeld, a: int, b: int) -> float:
     return float(np.abs(A - (A[0] + f[:, None] * (A[-1] - A[0]))).max())
 
 
-def coordinated_moves(cw: CoordinatedWeld) -> list[CoordMove]:
+def coordinated_moves(cw: CoordinatedWeld, woven: bool = True) -> list[CoordMove]:
     """The weld's moves: circular ones when its knots in the part's frame lie on a circle (within
     :data:`CIRCLE_TOL_M`), each at most :data:`MAX_SWEEP_RAD` and split further until the planned axes stay within
-    :data:`MAX_AXES_DEV_RAD` of the controller's interpolation; else the chords of :func:`chord_knots`."""
-    p = np.asarray(cw.X_FT)[:, :3, 3]
+    :data:`MAX_AXES_DEV_RAD` of the controller's interpolation; else the chords of :func:`chord_knots`. ``woven``
+    False: along the pass's line (the weave left to the controller)."""
+    p = _knots(cw, woven)
     centre, normal, r, err = fit_circle(p)
     if err <= CIRCLE_TOL_M and r > 0.0:
         ang = np.abs(swept(p, centre, normal))
@@ -75,15 +77,20 @@ def coordinated_moves(cw: CoordinatedWeld) -> list[CoordMove]:
                 moves.append(CoordMove("CIRC", a, b, m, sweep, centre, r, axes_dev=_axes_dev(cw, a, b)))
             if all(mv.axes_dev <= MAX_AXES_DEV_RAD and 0 < mv.aux < mv.end for mv in moves):
                 return moves
-    knots = chord_knots(cw)
+    knots = chord_knots(cw, woven=woven)
     return [CoordMove("LIN", a, b, chord=_chord(p, a, b), axes_dev=_axes_dev(cw, a, b))
             for a, b in itertools.pairwise(knots)]  # fmt: skip
 
 
-def program_path_off(cw: CoordinatedWeld, moves: list[CoordMove]) -> float:
+def _knots(cw: CoordinatedWeld, woven: bool) -> FloatArray:
+    """(m, 3) [m] the weld's knots in F: the torch's (woven) or its pass line's."""
+    return np.asarray(cw.X_FT if woven else cw.line_FT)[:, :3, 3]
+
+
+def program_path_off(cw: CoordinatedWeld, moves: list[CoordMove], woven: bool = True) -> float:
     """[m] the largest distance of a weld knot (in the part's frame) from the move that stands for it as the
     controller runs it: the circle through a CIRC's start, auxiliary and end points, or a LIN's chord."""
-    p = np.asarray(cw.X_FT)[:, :3, 3]
+    p = _knots(cw, woven)
     worst = 0.0
     for mv in moves:
         three = circle_through(p[mv.start], p[mv.aux], p[mv.end]) if mv.kind == "CIRC" else None
@@ -106,10 +113,10 @@ def _chord(p: FloatArray, a: int, b: int) -> float:
     return float(np.linalg.norm(mid - np.outer(mid @ u, u), axis=1).max())
 
 
-def chord_knots(cw: CoordinatedWeld, tol: float = CHORD_TOL_M) -> list[int]:
+def chord_knots(cw: CoordinatedWeld, tol: float = CHORD_TOL_M, woven: bool = True) -> list[int]:
     """The knots written (indices, first and last included): each chord the longest whose knots between lie
     within ``tol`` [m] of it in the part's frame and along which the rotate axis turns at most ``MAX_TURN_DEG``."""
-    p = np.asarray(cw.X_FT)[:, :3, 3]
+    p = _knots(cw, woven)
     r = np.asarray(cw.knot_axes)[:, 1]
     out, i, n = [0], 0, len(p)
     while i < n - 1:
@@ -165,6 +172,7 @@ def coordinated_krl(
     positioner), the approach, the arc on, the chords with E2/E3 moving, the crater, the arc off, the depart and
     home (the positioner back at its home)."""
     o = opt or KrlOptions()
+    procedure = procedure or cw.procedure
     geo = ArmGeometry.of(robot)
     X_RB0 = pos.X_R_F(*cw.knot_axes[0])
     q_home = cw.q[-1]
@@ -207,6 +215,9 @@ def coordinated_krl(
             f"$VEL.CP = {cw.speed:.4f} ; [m/s] {cw.speed * 1000:.1f} mm/s along the turning part"]  # fmt: skip
     moves = coordinated_moves(cw)
     src += [_moves_line(moves)]
+    src += [";- The weave is in the points (the path weaves in the part's frame): no weave package"] * (
+        cw.weave_F is not None
+    )
     if any(mv.kind == "CIRC" for mv in moves):
         src.append("$CIRC_TYPE = #BASE ; the torch's orientation interpolated in the turning base (the part's)")
     for mv in moves:
@@ -237,8 +248,10 @@ def coordinated_krl(
 def coordinated_rapid(
     cw: CoordinatedWeld, robot: Kinematics, name: str, procedure: WeldProcedure | None = None, unit: str = "STN1"
 ) -> str:
-    """The RAPID module ``name``: ``ActUnit``, the work object moved by the unit (``ufmec``), ``ArcLStart`` /
-    ``ArcL`` / ``ArcLEnd`` chords whose robtargets' eax_b (tilt) and eax_c (rotate) change, ``DeactUnit``."""
+    """The RAPID module ``name``: ``ActUnit``, the work object moved by the unit (``ufmec``), ``ArcLStart`` then
+    ``ArcC`` circles or ``ArcL`` chords along the pass's line whose robtargets' eax_b (tilt) and eax_c (rotate)
+    change, the weave (if any) the controller's (``\\Weave``, the weld procedure's ``weavedata``), ``DeactUnit``."""
+    procedure = procedure or cw.procedure
     deg = lambda a: f"[9E9,{math.degrees(a[0]):.3f},{math.degrees(a[1]):.3f},9E9,9E9,9E9]"  # noqa: E731
     q0 = cw.knot_q[0]
     X_q = invert(robot.fk(q0, "tool0")) @ robot.fk(q0, "torch_tcp")
@@ -249,24 +262,26 @@ def coordinated_rapid(
             "[9E9,0,0,9E9,9E9,9E9]];",
             f"  CONST speeddata vWeld := [{v},500,5000,1000];"]  # fmt: skip
     body = ["  PROC main()", "    ConfL \\Off;", f"    ActUnit {unit};", "    MoveAbsJ jHome, v1000, fine, tWeld;"]
-    moves, names = coordinated_moves(cw), list[str]()
+    moves, names, line = coordinated_moves(cw, woven=False), list[str](), cw.line_FT
+    weave = " \\Weave:=wv1" if procedure is not None else ""
 
     def target(i: int) -> str:
         names.append(f"p{len(names) + 1}")
-        decl.append(f"  CONST robtarget {names[-1]} := [{pose_text(cw.X_FT[i])[1:-1]},"
+        decl.append(f"  CONST robtarget {names[-1]} := [{pose_text(line[i])[1:-1]},"
                     f"{confdata(robot, cw.knot_q[i])},{deg(cw.knot_axes[i])}];")  # fmt: skip
         return names[-1]
 
-    body.append(f"    ArcLStart {target(0)}, v100, sm1, wd1, fine, tWeld \\WObj:=wobjPart;")
+    body.append(f"    ArcLStart {target(0)}, v100, sm1, wd1{weave}, fine, tWeld \\WObj:=wobjPart;")
     for k, mv in enumerate(moves):
         end = "End" if k == len(moves) - 1 else ""
         to = [target(mv.aux), target(mv.end)] if mv.kind == "CIRC" else [target(mv.end)]
         instr = ("ArcC" if mv.kind == "CIRC" else "ArcL") + end
-        body.append(f"    {instr} {', '.join(to)}, vWeld, sm1, wd1, fine, tWeld \\WObj:=wobjPart;")
-    sp = procedure.travel_speed_mm_s if procedure is not None else cw.speed * 1000.0
-    decl += ["  PERS seamdata sm1 := [0,0.3,[0,0,21.5,7,0,190,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0.3,0.05,0,"
-             "[0,0,0,0,0,0,0,0,0],0.5];", f"  PERS welddata wd1 := [{sp:.2f},0,[0,0,21.5,7,0,190,0,0,0],"
-             "[0,0,0,0,0,0,0,0,0]];"]  # fmt: skip
+        body.append(f"    {instr} {', '.join(to)}, vWeld, sm1, wd1{weave}, fine, tWeld \\WObj:=wobjPart;")
+    sp = cw.speed * 1000.0
+    default = ["  PERS seamdata sm1 := [0,0.3,[0,0,21.5,7,0,190,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0.3,0.05,0,"
+               "[0,0,0,0,0,0,0,0,0],0.5];", f"  PERS welddata wd1 := [{sp:.2f},0,[0,0,21.5,7,0,190,0,0,0],"
+               "[0,0,0,0,0,0,0,0,0]];"]  # fmt: skip
+    decl += procedure_data(1, procedure) if procedure is not None else default
     body += ["    MoveAbsJ jHome, v1000, fine, tWeld;", f"    DeactUnit {unit};", "  ENDPROC", "ENDMODULE", ""]
     head = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {name}",
             f"  ! Generated by the weld cell (cell.export.coordinated_program): {cw.seam_id} welded with {unit}"

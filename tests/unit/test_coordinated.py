@@ -188,3 +188,70 @@ def test_a_seam_that_is_no_circle_in_the_part_is_written_in_chords(planned: tupl
     assert {mv.kind for mv in moves} == {"LIN"} and program_path_off(replace(cw, X_FT=X), moves) <= CHORD_TOL_M
     assert moves[0].start == 0 and moves[-1].end == len(X) - 1
     assert max(mv.axes_dev for mv in moves) < math.radians(0.01)  # the axes turn in step with the chords
+
+
+@pytest.fixture(scope="module")
+def woven(planned: tuple) -> tuple:
+    """The same fillet welded with a zigzag weave (3 mm at 0.5 Hz, 8 mm/s)."""
+    from cell.coordinated.gate import MovingScene
+    from cell.coordinated.plan import plan_coordinated
+    from cell.motion.robot import RobotModel
+    from cell.station.arm import robot_urdf
+    from cell.types.procedure import Weave, WeldProcedure
+
+    sc, pos, est, process, _, q0 = planned
+    model = RobotModel.from_urdf(robot_urdf(sc))
+    proc = WeldProcedure(name="PA-weave", travel_speed_mm_s=8.0, weave=Weave("zigzag", 3.0, 0.5, (0.2, 0.2)))
+    scene = MovingScene.build(model, pos, [], sc.motion.plan.collision)
+    cw = plan_coordinated(model, pos, est, process, sc.motion.plan, scene, q0, rng=np.random.default_rng(0),
+                          procedure=proc)  # fmt: skip
+    return sc, pos, est, cw, model
+
+
+def test_a_weave_is_laid_across_the_fillet_in_the_parts_frame_and_measured_without_it(woven: tuple) -> None:
+    from cell.export.coordinated_program import coordinated_moves, program_path_off
+    from cell.pipeline.coordinated.play import quality, weave_at_records
+    from cell.types.execution import Execution
+
+    _, pos, est, cw, model = woven
+    assert cw.weave_F is not None
+    w = np.asarray(cw.weave_F)
+    # Across the fillet in its local cross-section in F: square to the circle's tangent, in the faceplate's
+    # plane's radial-up cross-section, 1.5 mm either side at most.
+    p = np.asarray(cw.line_FT)[:, :3, 3]
+    tangent = np.gradient(p, axis=0)
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    assert np.abs(np.sum(w * tangent, axis=1)).max() < 1e-5
+    assert 1.45e-3 < np.linalg.norm(w, axis=1).max() <= 1.5e-3 + 1e-9
+    # The pass's line is the circle (the controller's weave on ArcC); the woven torch only chords.
+    line_moves = coordinated_moves(cw, woven=False)
+    assert {mv.kind for mv in line_moves} == {"CIRC"} and program_path_off(cw, line_moves, woven=False) < 1e-6
+    # The planned torch every 0.1 s, carried back into the part's frame at home by the positioner's motion (the
+    # simulator's playback of the same is measured by the benchmark: benchmarks/bench_coordinated.py --weave).
+    k = np.unique(np.r_[np.searchsorted(cw.times, np.arange(0.0, cw.times[-1], 0.1)), len(cw.times) - 1])
+    tip_R = np.array([model.fk(q)[:3, 3] for q in cw.q[k]])
+    back = np.array([np.linalg.solve(pos.move(*a), np.r_[p, 1.0])[:3] for a, p in zip(cw.axes[k], tip_R, strict=True)])
+    ex = Execution(cw.times[k], cw.q[k], tip_R, np.asarray(cw.arc_on, bool)[k], ())
+    raw = quality(ex, back, np.asarray(est.p_RS), closed=True)
+    weave = weave_at_records(cw, ex, pos.X_R_F(*pos.home)[:3, :3])
+    q = quality(ex, back, np.asarray(est.p_RS), closed=True, weave_R=weave)
+    assert raw.tcp_max_mm > 1.4  # the torch weaves 1.5 mm either side of the fillet
+    assert q.tcp_max_mm < 0.05 and q.short_start_mm == 0.0  # taken off: on the fillet all round (0.021 mm)
+
+
+def test_the_weaving_programs_weave_as_the_fixed_arms_do(woven: tuple, tmp_path: Path) -> None:
+    from cell.export.checks.calls import check_all
+    from cell.export.checks.program import read_programs
+    from cell.export.coordinated_program import write_coordinated_programs
+
+    _, pos, _, cw, model = woven
+    write_coordinated_programs("rapid", [cw], model, pos, "pipe", tmp_path)
+    mod = next(tmp_path.glob("*.mod")).read_text()
+    # RAPID: the circle's ArcC along the pass's line, the weave the controller's (ABB's zigzag, 3 mm wide).
+    assert len(re.findall(r"ArcCE?n?d? p\d+, p\d+, vWeld, sm1, wd1 \\Weave:=wv1,", mod)) == 5
+    assert re.search(r"weavedata wv1 := \[1,0,16(\.0+)?,3(\.0+)?,", mod) is not None
+    # KRL (plain I/O, no weave package): the woven path itself in chords in the turning base, checked as ever.
+    write_coordinated_programs("krl", [cw], model, pos, "pipe", tmp_path)
+    src = next(tmp_path.glob("*.src")).read_text()
+    assert "\nCIRC " not in src and src.count("\nLIN ") > 200 and "weave zigzag 3 mm at 0.5 Hz" in src
+    assert not check_all(read_programs(tmp_path)[0], model)

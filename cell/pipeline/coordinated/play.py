@@ -80,10 +80,31 @@ class _Bead:
             self.pending = []
 
 
-def quality(ex: Execution, back_R: FloatArray, truth_R: FloatArray, closed: bool) -> WeldQuality:
+def weave_at_records(cw: CoordinatedWeld, ex: Execution, R_R_F0: FloatArray) -> FloatArray:
+    """(n, 3) [m]: the weave the plan meant at each record, in the part's frame at the scan (R at home; R_R_F0
+    (3, 3) the faceplate's rotation there): each record's place along the weld from its rotate axis (it turns one
+    way along a loop; else the knot nearest the record's planned torch), the weave interpolated there."""
+    w_F = np.zeros((len(cw.s), 3)) if cw.weave_F is None else np.asarray(cw.weave_F)
+    r, s = np.asarray(cw.knot_axes)[:, 1], np.asarray(cw.s)
+    rec = np.interp(np.asarray(ex.times), np.asarray(cw.times), np.asarray(cw.axes)[:, 1])
+    if np.all(np.diff(r) > 0) or np.all(np.diff(r) < 0):
+        order = np.argsort(r)
+        at = np.interp(rec, r[order], s[order])
+    else:
+        at = s[np.abs(rec[:, None] - r[None, :]).argmin(axis=1)]
+    w = np.column_stack([np.interp(at, s, w_F[:, j]) for j in range(3)])
+    return np.asarray(w @ np.asarray(R_R_F0).T)
+
+
+def quality(
+    ex: Execution, back_R: FloatArray, truth_R: FloatArray, closed: bool, weave_R: FloatArray | None = None
+) -> WeldQuality:
     """The weld's quality from the arc-on records carried back to the part at the scan against its true curve
-    there (n, 3) in R: the TCP error and the travel speed are the torch's relative to the part."""
+    there (n, 3) in R: the TCP error and the travel speed are the torch's relative to the part; ``weave_R`` (n, 3)
+    the weave meant at each record (:func:`weave_at_records`), taken off first: the torch against the curve
+    without its weave."""
     from cell.process.curve_quality import curve_weld_quality
 
     on = np.asarray(ex.arc_on)
-    return curve_weld_quality(np.asarray(ex.times)[on], back_R[on], truth_R, closed)
+    p = back_R if weave_R is None else back_R - weave_R
+    return curve_weld_quality(np.asarray(ex.times)[on], p[on], truth_R, closed)

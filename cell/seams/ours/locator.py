@@ -17,6 +17,7 @@ from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outsid
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
+from cell.seams.ours._round import round_facet
 from cell.seams.ours._shear import across_lever, end_shear, end_slopes
 from cell.seams.ours._sides import side_selections
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
@@ -130,12 +131,15 @@ class OursLocator:
         end_face = part_a.face_plane(joint.end_face)
         skew = abs(end_shear(ends, n_a, n_b, t, p0, end_face).c) * o.tube_radius_m
         pts = gather(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m + skew, joint, rng, o)
+        # B a round's facet along the seam: its points beside the seam are the round's, their heights off its round.
+        round_b = round_facet(part_b, joint.face_receiving, p0, t)
+        flat_b = round_b.flattening(pts.P) if round_b is not None else 0.0
 
         for it in range(o.passes):
             first, last = it == 0, it == o.passes - 1
             p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
             r_a = pts.along(face_a.n) - face_a.d
-            r_b = pts.along(face_b.n) - face_b.d
+            r_b = pts.along(face_b.n) - face_b.d - flat_b
             # Along the seam as A's side faces run across face A (square for a box; a mitred brace's at an angle).
             s = end_shear(ends, face_a.n, face_b.n, t, p0, end_face).s(pts, p0, t)
             slack = o.map_tolerance_m if first else 0.0
@@ -152,7 +156,11 @@ class OursLocator:
             # The widest gate B's points pass below (the region test on a polyhedron is costly: only on those).
             gate_b = max(o.map_tolerance_m + 3.0 * o.sensor_sigma_m, o.gate_sigmas * face_b.scale)
             beside_a = ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
-            in_b = geo.in_face_b(pts, slack, pts.ok & beside_a & (np.abs(r_b) < gate_b)) & beside_a & pts.ok
+            where_b = pts.ok & beside_a & (np.abs(r_b) < gate_b)
+            if round_b is None:
+                in_b = geo.in_face_b(pts, slack, where_b) & beside_a & pts.ok
+            else:
+                in_b = where_b & round_b.over(pts.P, o.edge_band_m + slack)
             planes: list[Selection] = []
             for key, face, r, region, part, face_name, skip in (
                 ("a", face_a, r_a, in_a, part_a, joint.face_abutting, joint.end_face),

@@ -51,6 +51,8 @@ def test_a_facet_along_the_axis_is_the_rounds_and_its_points_heights_are_off_the
     p0 = c.p_base + (d - float(n @ c.p_base)) * n + 0.004 * side + 0.1 * c.axis
     rf = round_facet(pipe, face, p0, c.axis)
     assert rf is not None
+    # Its sigma's share that no fit sees: half the 64 facets' sagitta (0.13 mm on this pipe).
+    assert math.isclose(rf.bias_m, 0.5e-3 * R_MM * (1.0 - math.cos(math.pi / FACETS)), rel_tol=1e-3)
     # Not a facet's: a seam across the axis, or a plate's face.
     assert round_facet(pipe, face, p0, side) is None
     top = _facet_towards(plate, np.array([0.0, 0.0, 1.0]))

@@ -30,6 +30,13 @@ class RoundFace:
     d: float
     rho0: float
 
+    @property
+    def bias_m(self) -> float:
+        """[m] one sigma of the round's shift at the seam that no fit sees: half the facets' sagitta (the map's
+        round runs through the facets' corners; the facets lie up to the sagitta inside it), as the round locator's
+        (:func:`cell.seams.curved.locate._bias`)."""
+        return 0.5 * self.cylinder.sagitta_m
+
     def flattening(self, P: FloatArray) -> FloatArray:
         """(k,) [m] how far the map's round at each point (k, 3) lies off the facet's plane along its normal there:
         a point's residual off the plane less this is its height over the round (its radial distance less the seam

@@ -57,7 +57,8 @@ class Transfers:
         self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
         self._between: dict[tuple[int, bytes], tuple[int, int, list[Piece]] | TransferFail] = {}
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
-        self._above: dict[tuple[bytes, float], FloatArray | None] = {}
+        self._above: dict[tuple[bytes, float], FloatArray | None | IKError] = {}
+        self._vertical: dict[tuple[bytes, float, bool], Piece | None | Exception] = {}
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """:meth:`search`, remembered per (q_a, q_b)."""
@@ -175,19 +176,38 @@ class Transfers:
 
     def above(self, q: FloatArray, height: float) -> FloatArray | None:
         """The configuration (dof,) [rad] with q's TCP pose raised to ``height`` [m] in R (IK seeded at q); None
-        when q is already that high. Raises IKError when it cannot be reached."""
+        when q is already that high. Raises IKError when it cannot be reached (remembered too)."""
         key = (np.asarray(q, dtype=float).tobytes(), height)
         if key not in self._above:
             X = self.robot.fk(q)
             if height - float(X[2, 3]) < 1e-3:
                 return None
             X[2, 3] = height
-            self._above[key] = np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
-        return self._above[key]
+            try:
+                self._above[key] = np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
+            except IKError as exc:
+                self._above[key] = exc
+        got = self._above[key]
+        if isinstance(got, IKError):
+            raise got.with_traceback(None)
+        return got
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is
-        already that high): up from q (a depart) or down to q (an approach)."""
+        already that high): up from q (a depart) or down to q (an approach). Remembered per (q, height, up), a
+        failure too: a search tries the same line ends with every pair and strategy."""
+        key = (np.asarray(q, dtype=float).tobytes(), height, up)
+        if key not in self._vertical:
+            try:
+                self._vertical[key] = self._vertical_line(q, height, up)
+            except (IKError, TimingError, LineError) as exc:
+                self._vertical[key] = exc
+        got = self._vertical[key]
+        if isinstance(got, Exception):
+            raise got.with_traceback(None)
+        return got
+
+    def _vertical_line(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         robot, pr, opt = self.robot, self.process, self.opt
         X = robot.fk(q)
         rise = height - float(X[2, 3])

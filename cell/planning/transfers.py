@@ -57,8 +57,8 @@ class Transfers:
         self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
         self._between: dict[tuple[int, bytes], tuple[int, int, list[Piece]] | TransferFail] = {}
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
-        self._above: dict[tuple[bytes, float], FloatArray | None | IKError] = {}
-        self._vertical: dict[tuple[bytes, float, bool], Piece | None | Exception] = {}
+        self._above: dict[tuple[bytes, float], FloatArray | IKError | None] = {}
+        self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = {}
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """:meth:`search`, remembered per (q_a, q_b)."""

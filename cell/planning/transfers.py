@@ -9,7 +9,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from cell.config.motion import GateOptions, PlanOptions
-from cell.errors import IKError, TimingError
+from cell.errors import IKError, MotionError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import Entry, body_entry
@@ -17,12 +17,14 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow
-from cell.planning.failures import LineError
+from cell.planning.failures import LineError, SeamFailure
 from cell.planning.lines import line_trajectory, solve_line
 from cell.planning.moves.pieces import Piece, TransferFail
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
+from cell.planning.reach import ReachModel
 from cell.process.torch import WeldProcess, line_poses
 from cell.types import Part
+from cell.types.plan import PlanReason
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
 
@@ -207,6 +209,15 @@ class Transfers:
             raise got.with_traceback(None)
         return got
 
+    def _reach_model(self) -> ReachModel | None:
+        """The arm's reach pre-check (built once, None for an arm it does not fit)."""
+        if not hasattr(self, "_reach"):
+            try:
+                self._reach: ReachModel | None = ReachModel.from_robot(self.robot)
+            except (ValueError, MotionError):
+                self._reach = None
+        return self._reach
+
     def _vertical_line(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         robot, pr, opt = self.robot, self.process, self.opt
         X = robot.fk(q)
@@ -216,7 +227,9 @@ class Transfers:
         X_top = X.copy()
         X_top[2, 3] = height
         poses = line_poses(X, X_top, opt.line_spacing)
-        knots = solve_line(robot, poses, q, "lift", 0.0, rise / (len(poses) - 1), opt.max_joint_step, ik=opt.ik)
+        step = rise / (len(poses) - 1)
+        _within_reach(self._reach_model(), poses, step)
+        knots = solve_line(robot, poses, q, "lift", 0.0, step, opt.max_joint_step, ik=opt.ik)
         if up:
             tr, v = line_trajectory(
                 robot,
@@ -240,6 +253,22 @@ class Transfers:
             dt=opt.dt,
         )
         return Piece("approach", tr, v, X)
+
+
+def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> None:
+    """Raise LineError (BEYOND_REACH) when a pose of the line (n, 4, 4) in R puts the wrist centre beyond the
+    shoulder's reach (no IK can solve it: refused before any is tried); ``step`` [m] between poses."""
+    if reach is None:
+        return
+    over = reach.pose_excess(poses)
+    k = int(np.argmax(over > 0.0))
+    if over[k] > 0.0:
+        where = (
+            f"beyond reach: at {k * step * 1000:.1f} mm along the lift the wrist centre lies {over[k] * 1000:.0f} mm"
+        )
+        raise LineError(
+            SeamFailure(PlanReason.BEYOND_REACH, f"{where} beyond the shoulder's reach", poses[k][:3, 3], k * step)
+        )
 
 
 def joined(pieces: Sequence[Piece]) -> Trajectory:

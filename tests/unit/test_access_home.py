@@ -1,5 +1,5 @@
-"""A seam joined to home neither way, found from the transfers' own searches; the transfers' vertical lines asked
-once per end (tiny inline cell)."""
+"""A seam joined to home neither way, found from the transfers' own searches; the transfers' vertical lines solved
+once per end, and not at all when their top is beyond reach (tiny inline cell)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from tiny_cell import HOME, OBSTACLES, URDF
 import cell.planning.transfers as transfers_module
 from cell import scenario as sc
 from cell.config.motion import PlanOptions
-from cell.errors import IKError, TimingError
+from cell.errors import TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
@@ -23,6 +23,7 @@ from cell.planning.moves.strategies import Mover
 from cell.planning.short_lines import LineEnd, SeamLines
 from cell.planning.transfers import Direct, TransferFail, Transfers, TransferStrategy
 from cell.process.torch import WeldProcess
+from cell.types.plan import PlanReason
 
 PROCESS = WeldProcess.from_spec(sc.ProcessSpec())
 Q_SEAM = HOME + np.radians([30.0, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -92,7 +93,8 @@ def test_a_vertical_line_is_solved_once_per_end_height_and_direction(
     up = tr.vertical(HOME, z + 0.1, True)
     assert up is not None and up is tr.vertical(HOME, z + 0.1, True) and len(calls) == 1
     assert float(robot.fk(up.trajectory.q[-1])[2, 3]) == pytest.approx(z + 0.1, abs=1e-4)
-    for _ in range(2):  # far out of reach: the failure is remembered, not solved again
-        with pytest.raises((IKError, LineError)):
+    for _ in range(2):  # the top 5 m up: beyond the shoulder's reach, refused before any IK
+        with pytest.raises(LineError) as err:
             tr.vertical(HOME, z + 5.0, False)
-    assert len(calls) == 2
+        assert err.value.failure.code is PlanReason.BEYOND_REACH
+    assert len(calls) == 1

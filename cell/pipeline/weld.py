@@ -112,11 +112,8 @@ def plan_for(
         kept_tacks = [t for t in tack_tasks if t.id not in dropped]
         procs = seam_procedures(sc, det, kept) | curve_procedures_for(sc, ss.weldmap, curves)
         first = {t.id for t in kept_tacks}  # the tacks before every seam
-        planner = (
-            partial(plan_welds, first=first, elsewhere=elsewhere)
-            if track is None
-            else partial(plan_on_track, track=track)
-        )
+        fixed = partial(plan_welds, first=first, elsewhere=elsewhere)
+        planner = fixed if track is None else partial(plan_on_track, track=track)
         plan = planner(
             arm.model,
             [*kept, *kept_tacks],

@@ -14,15 +14,18 @@ def _f(v: Any, fmt: str = ".3f") -> str:
 
 def positioner_table(data: Mapping[str, Any]) -> str:
     a, b = data["fence1"], data["fence1_positioner"]
+    cpu_ratio = data.get("plan_cpu_per_seam_ratio")
     lines = [
         "| job | seams welded | operator turns | job time [s] | of it: operator / positioner [s] | TCP max [mm] |"
-        " planning per seam planned [s] |",
+        " planning per seam planned: wall / CPU [s] |",
         "|---|---|---|---|---|---|---|",
         f"| `{a['job']}` | {a['welded']}/{a['seams']} | {a['operator_turns']} | {_f(a['job_time_s'], '.1f')} |"
-        f" {_f(a['operator_s'], '.0f')} / - | {_f(a['tcp_max_mm'])} | {_f(a['plan_per_seam_s'], '.2f')} |",
+        f" {_f(a['operator_s'], '.0f')} / - | {_f(a['tcp_max_mm'])} | {_f(a['plan_per_seam_s'], '.2f')} /"
+        f" {_f(a.get('plan_cpu_per_seam_s'), '.2f')} |",
         f"| `{b['job']}` | {b['welded']}/{b['seams']} | 0 | {_f(b['job_time_s'], '.1f')} |"
         f" - / {_f(b['positioner_s'], '.1f')} ({b['poses']} poses) | {_f(b['tcp_max_mm'])} |"
-        f" {_f(b['plan_per_seam_s'], '.2f')} ({data['plan_per_seam_ratio']:.1f}x) |",
+        f" {_f(b['plan_per_seam_s'], '.2f')} / {_f(b.get('plan_cpu_per_seam_s'), '.2f')}"
+        f" ({data['plan_per_seam_ratio']:.1f}x / {_f(cpu_ratio, '.1f')}x) |",
         "",
         "| seam | pose: tilt / rotate [deg] | ISO 6947: code, S / R [deg] | in tolerance | welded | TCP max [mm] |"
         " why not |",

@@ -8,13 +8,16 @@ should the gate refuse it, the first located curve planned, played and measured 
 Per run: the located curve's sigma and its error against the truth, the gate's word; the coordinated weld's TCP
 RMS / max against the true curve the part carries (in the part's frame), its speed along the part, the torch's
 spread, the tilt and the rotate axis's sweep, every waypoint's ISO 6947 slope and rotation (worst of them), the
-arc time, the job's time and the planning's wall time (default ``benchmarks/results/coordinated.json``).
+arc time, the job's time and the planning's wall time; the programs' moves (circular or chords, in the turning base),
+the weld's knots' largest distance from them as the controller runs them and the planned axes' from the
+controller's synchronous interpolation (default ``benchmarks/results/coordinated.json``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -34,6 +37,7 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
     """The located curve, the gate's word and the coordinated weld measured (a study when the gate refuses);
     ``program``: a folder for its KRL program (``krl/``) and RAPID module (``rapid/``)."""
     from cell import scenario as sc
+    from cell.export.coordinated_program import coordinated_moves, program_path_off
     from cell.export.positioner_report import coordinated_entry
     from cell.pipeline.coordinated import weld_curves_coordinated
     from cell.pipeline.curved.welds import curve_doubt
@@ -77,6 +81,7 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
             write_coordinated_programs(controller, [cw], robot, pos, "pipe_stub", program / controller)
     q = weld.quality
     entry = coordinated_entry(cw)
+    moves = coordinated_moves(cw)
     return {
         "scenario": SCENARIO,
         "noise": noise or "realistic",
@@ -99,8 +104,50 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
         "arc_s": entry["arc_s"],
         "job_s": entry["job_s"],
         "plan_wall_s": entry["plan_wall_s"],
+        "program_moves": {k: sum(mv.kind == k for mv in moves) for k in ("CIRC", "LIN")},
+        "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4),
+        "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
         "wall_s": round(time.perf_counter() - t, 1),
         "waypoints": entry["waypoints"],
+    }
+
+
+WEAVE = {"pattern": "zigzag", "width_mm": 3.0, "frequency_hz": 1.0, "dwell_s": (0.1, 0.1)}  # a PA fillet's weave
+
+
+def weave_row(noise: str | None = None) -> dict[str, Any]:
+    """The same cell with a weaving procedure (:data:`WEAVE`, at 8 mm/s) as its WPS: the coordinated weld's TCP
+    against the true curve with the weave meant at each record taken off, the weave's half width, the times and
+    the programs' moves (RAPID along the pass's line with the controller's weave, KRL the woven path)."""
+    from cell import scenario as sc
+    from cell.export.coordinated_program import coordinated_moves
+    from cell.pipeline.positioned import weld_on_positioner
+    from cell.scenario.procedure_specs import ProcedureSpec, WeaveSpec
+
+    s = sc.load(SCENARIO)
+    s = s.with_noise(noise) if noise else s
+    row = ProcedureSpec(name="PA-weave", travel_speed_mm_s=8.0, weave=WeaveSpec(**WEAVE))
+    s = s.model_copy(update={"procedures": (row,)})
+    run = weld_on_positioner(s)
+    welds = [w for g in run.groups for w in g.seams if w.welded and w.quality is not None]
+    if not run.coordinated or not welds or welds[0].quality is None:
+        return {"procedure": WEAVE, "welded": False}
+    cw, q = run.coordinated[0], welds[0].quality
+    assert cw.weave_F is not None
+    return {
+        "procedure": {**WEAVE, "travel_speed_mm_s": 8.0},
+        "welded": True,
+        "tcp_rms_mm": round(q.tcp_rms_mm, 3),
+        "tcp_max_mm": round(q.tcp_max_mm, 3),
+        "weave_half_width_mm": round(float(np.linalg.norm(cw.weave_F, axis=1).max()) * 1000.0, 3),
+        "speed_mm_s": round(q.speed_mm_s, 2),
+        "loop_unwelded_mm": round(q.short_start_mm, 1),
+        "knots": len(cw.s),
+        "arc_s": round(cw.arc_s, 2),
+        "job_s": round(cw.duration, 2),
+        "plan_wall_s": round(cw.plan_s, 2),
+        "rapid_moves": {k: sum(mv.kind == k for mv in coordinated_moves(cw, woven=False)) for k in ("CIRC", "LIN")},
+        "krl_moves": {k: sum(mv.kind == k for mv in coordinated_moves(cw)) for k in ("CIRC", "LIN")},
     }
 
 
@@ -112,6 +159,8 @@ def main() -> None:
     args = ap.parse_args()
     _say(f"{SCENARIO}: locate, plan, weld with the part turning")
     row = coordinated_row(args.noise, args.program)
+    _say(f"{SCENARIO}: the same with a weaving procedure")
+    row["weave"] = weave_row(args.noise)
     out = {"command": "benchmarks/bench_coordinated.py" + (f" --noise {args.noise}" if args.noise else ""), **row}
     args.json.write_text(json.dumps(out, indent=1) + "\n")
     _say(f"wrote {args.json}")

@@ -8,15 +8,21 @@ the worst executed TCP max against the true seam, the planning's wall time in al
 positioner's: choosing the poses and every pose's plan and gate, each pose's retries included, and apart from it
 the checks of the positioner's moves against the arm; fence1's: both sides' plan and gate), and for the
 positioner each seam's ISO 6947 position and how many in PA and PB (default
-``benchmarks/results/positioner.json``).
+``benchmarks/results/positioner.json``). The planning's CPU time too (``plan_cpu_s``: the process's CPU seconds in
+every call of the planner and gate, ``cell.pipeline.weld.plan_for``, on either side), which a loaded machine
+stretches far less than the wall time, and the load average before and after.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
+import os
 import sys
 import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +34,34 @@ RESULTS = Path(__file__).resolve().parent / "results"
 
 def _say(msg: str) -> None:
     print(f"· {msg}", file=sys.stderr, flush=True)
+
+
+@contextmanager
+def plan_cpu() -> Iterator[list[float]]:
+    """The process's CPU seconds in ``plan_for`` while inside (summed into the one-element list yielded)."""
+    weld = importlib.import_module("cell.pipeline.weld")  # the module (the package's ``weld`` is its function)
+    spent, inner = [0.0], weld.plan_for
+
+    def timed(*args: Any, **kwargs: Any) -> Any:
+        t = time.process_time()
+        try:
+            return inner(*args, **kwargs)
+        finally:
+            spent[0] += time.process_time() - t
+
+    weld.plan_for = timed
+    try:
+        yield spent
+    finally:
+        weld.plan_for = inner
+
+
+def _cpu_row(run: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+    with plan_cpu() as spent:
+        row = run()
+    row["plan_cpu_s"] = round(spent[0], 3)
+    row["plan_cpu_per_seam_s"] = round(spent[0] / max(row["seams_planned"], 1), 3)
+    return row
 
 
 def fence1_row() -> dict[str, Any]:
@@ -96,10 +130,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", type=Path, default=RESULTS / "positioner.json")
     args = ap.parse_args()
+    load_before = os.getloadavg()[0]
     _say("cell weld fence1")
-    a = fence1_row()
+    a = _cpu_row(fence1_row)
     _say("cell weld fence1-positioner")
-    b = positioner_row()
+    b = _cpu_row(positioner_row)
+    load_after = os.getloadavg()[0]
     _say("pipe-stub-positioner (coordinated: benchmarks/bench_coordinated.py)")
     from bench_coordinated import coordinated_row  # the circular fillet welded with the part turning
 
@@ -110,6 +146,8 @@ def main() -> None:
         "fence1_positioner": b,
         "plan_per_seam_ratio": round(b["plan_per_seam_s"] / a["plan_per_seam_s"], 2),
         "plan_and_move_check_ratio": round(b["plan_and_move_check_per_seam_s"] / a["plan_per_seam_s"], 2),
+        "plan_cpu_per_seam_ratio": round(b["plan_cpu_per_seam_s"] / a["plan_cpu_per_seam_s"], 2),
+        "load_average_1min": [round(load_before, 2), round(load_after, 2)],
         "pipe_stub_positioner": c,
     }
     args.json.write_text(json.dumps(out, indent=1) + "\n")

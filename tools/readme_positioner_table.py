@@ -14,15 +14,18 @@ def _f(v: Any, fmt: str = ".3f") -> str:
 
 def positioner_table(data: Mapping[str, Any]) -> str:
     a, b = data["fence1"], data["fence1_positioner"]
+    cpu_ratio = data.get("plan_cpu_per_seam_ratio")
     lines = [
         "| job | seams welded | operator turns | job time [s] | of it: operator / positioner [s] | TCP max [mm] |"
-        " planning per seam planned [s] |",
+        " planning per seam planned: wall / CPU [s] |",
         "|---|---|---|---|---|---|---|",
         f"| `{a['job']}` | {a['welded']}/{a['seams']} | {a['operator_turns']} | {_f(a['job_time_s'], '.1f')} |"
-        f" {_f(a['operator_s'], '.0f')} / - | {_f(a['tcp_max_mm'])} | {_f(a['plan_per_seam_s'], '.2f')} |",
+        f" {_f(a['operator_s'], '.0f')} / - | {_f(a['tcp_max_mm'])} | {_f(a['plan_per_seam_s'], '.2f')} /"
+        f" {_f(a.get('plan_cpu_per_seam_s'), '.2f')} |",
         f"| `{b['job']}` | {b['welded']}/{b['seams']} | 0 | {_f(b['job_time_s'], '.1f')} |"
         f" - / {_f(b['positioner_s'], '.1f')} ({b['poses']} poses) | {_f(b['tcp_max_mm'])} |"
-        f" {_f(b['plan_per_seam_s'], '.2f')} ({data['plan_per_seam_ratio']:.1f}x) |",
+        f" {_f(b['plan_per_seam_s'], '.2f')} / {_f(b.get('plan_cpu_per_seam_s'), '.2f')}"
+        f" ({data['plan_per_seam_ratio']:.1f}x / {_f(cpu_ratio, '.1f')}x) |",
         "",
         "| seam | pose: tilt / rotate [deg] | ISO 6947: code, S / R [deg] | in tolerance | welded | TCP max [mm] |"
         " why not |",
@@ -48,7 +51,7 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
     ``benchmarks/results/coordinated.json`` (``benchmarks/bench_coordinated.py``)."""
     w = d["waypoints"]
     lines = [
-        "| seam | located: sigma max / error RMS / max [mm] | weld gate | TCP RMS / max [mm] (study) | speed along the"
+        "| seam | located: sigma max / error RMS / max [mm] | weld gate | TCP RMS / max [mm] | speed along the"
         " part [mm/s] | ISO 6947 over its waypoints: worst slope / rotation off 180 [deg] | tilt; rotate from .. to"
         " [deg] | torch spread [mm] | arc / job [s] | planning [s] |",
         "|---|---|---|---|---|---|---|---|---|---|",
@@ -59,4 +62,23 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
         f" {_f(d['rotate_deg'][0], '.1f')} .. {_f(d['rotate_deg'][1], '.1f')} | {_f(d['torch_spread_mm'], '.2f')} |"
         f" {_f(d['arc_s'], '.1f')} / {_f(d['job_s'], '.1f')} | {_f(d['plan_wall_s'], '.1f')} |",
     ]
+    if "program_moves" in d:
+        moves = ", ".join(f"{n} {k}" for k, n in d["program_moves"].items() if n)
+        off, dev = _f(d["program_path_off_mm"], ".4f"), _f(d["program_axes_off_deg"], ".3f")
+        lines += ["", f"Programs: {moves} in the turning base; the weld's knots within {off} mm of the moves as"
+                  f" the controller runs them, the planned E2/E3 within {dev} deg of its synchronous"
+                  " interpolation."]  # fmt: skip
+    wv = d.get("weave")
+    if wv and wv.get("welded"):
+        p = wv["procedure"]
+        rm = ", ".join(f"{n} {k}" for k, n in wv["rapid_moves"].items() if n)
+        km = ", ".join(f"{n} {k}" for k, n in wv["krl_moves"].items() if n)
+        lines += ["", "| with a weave | TCP RMS / max without the weave [mm] | weave half width [mm] | speed [mm/s] |"
+                  " knots | arc / job [s] | planning [s] | RAPID (controller's weave) | KRL (woven path) |",
+                  "|---|---|---|---|---|---|---|---|---|",
+                  f"| {p['pattern']} {_f(p['width_mm'], 'g')} mm at {_f(p['frequency_hz'], 'g')} Hz, dwell"
+                  f" {_f(p['dwell_s'][0], 'g')} s | {_f(wv['tcp_rms_mm'])} / {_f(wv['tcp_max_mm'])} |"
+                  f" {_f(wv['weave_half_width_mm'], '.2f')} | {_f(wv['speed_mm_s'], '.2f')} | {wv['knots']} |"
+                  f" {_f(wv['arc_s'], '.1f')} / {_f(wv['job_s'], '.1f')} | {_f(wv['plan_wall_s'], '.1f')} | {rm} |"
+                  f" {km} |"]  # fmt: skip
     return "\n".join(lines) + "\n"

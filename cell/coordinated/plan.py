@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -22,14 +23,16 @@ from cell.motion.ik import solve_ik, solve_path
 from cell.motion.robot import RobotModel
 from cell.motion.timing import ptp
 from cell.planning.curves import CurvePath, curve_path, curve_poses
+from cell.planning.curves.weave import curve_offsets
 from cell.planning.failures import LineError
 from cell.planning.lines import line_trajectory, solve_line, time_spline
 from cell.planning.passes import with_craters
 from cell.planning.transfers import Piece
 from cell.process.torch import WeldProcess
+from cell.process.weave import knot_spacing
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.positioner import TiltRotatePositioner
-from cell.types.procedure import WeldProcedure
+from cell.types.procedure import Weave, WeldProcedure
 from cell.types.trajectory import Trajectory
 
 SPINS_DEG = (0.0, 90.0, -90.0, 180.0, 45.0, -45.0, 135.0, -135.0)  # the torch's spin about its axis, tried in turn
@@ -129,6 +132,18 @@ def _joined(pieces: list[tuple[str, FloatArray, FloatArray, bool]]) -> tuple[Flo
     return np.concatenate(times), np.concatenate(xs), np.concatenate(arcs), spans  # type: ignore[return-value]
 
 
+def _offsets(cp: CurvePath, procedure: WeldProcedure | None) -> tuple[FloatArray, FloatArray | None]:
+    """(n, 3) [m] in R: the root pass's offset and weave at each knot of ``cp`` (each knot where the positioner
+    holds it), laid in the curve's local cross-section (:func:`cell.planning.curves.weave.curve_offsets`), so in
+    the part's frame, carried by the axes; and the weave's share of it (None without a weave)."""
+    if procedure is None:
+        return np.zeros((len(cp.s), 3)), None
+    off = curve_offsets(cp, procedure)
+    if not procedure.weave.active:
+        return off, None
+    return off, off - curve_offsets(cp, replace(procedure, weave=Weave()))
+
+
 def plan_coordinated(
     robot: RobotModel,
     pos: TiltRotatePositioner,
@@ -148,10 +163,11 @@ def plan_coordinated(
     proc = procedure or WeldProcedure(name="default")
     speed = proc.travel_speed_mm_s / 1000.0 if procedure is not None else process.travel_speed
     X_FR = np.asarray(np.linalg.inv(pos.X_R_F(*pos.home)), dtype=float)
+    spacing = knot_spacing(procedure, 0, opt.spacing) if procedure is not None else opt.spacing  # follows a weave
     centre, _ = robot.reach_bound("torch_tcp")
     cands = []
     for rev in (False, True):
-        path = curve_path(est, opt.spacing, reverse=rev, overlap=process.closed_overlap if est.closed else 0.0)
+        path = curve_path(est, spacing, reverse=rev, overlap=process.closed_overlap if est.closed else 0.0)
         curve = _in_F(X_FR, path)
         for branch in (1, -1):
             axes = pa_axes(pos, curve, branch)
@@ -164,8 +180,10 @@ def plan_coordinated(
     for _, _, _, path, curve, axes in sorted(cands, key=lambda c: c[0]):
         p_R, t_R, na_R, nb_R = knots_in_R(pos, curve, axes)
         cp = CurvePath(p_R, t_R, na_R, nb_R, path.s, path.closed, path.overlap, path.start, path.reversed)
+        off_R, weave_R = _offsets(cp, procedure)
         for spin in SPINS_DEG:
-            X_RT = np.asarray(curve_poses(cp, process, spin=math.radians(spin)))
+            X_RT = np.array(curve_poses(cp, process, spin=math.radians(spin)))
+            X_RT[:, :3, 3] += off_R
             try:
                 q0 = solve_ik(robot, X_RT[0], q_start, rng=rng)
                 Q = np.asarray(solve_path(robot, X_RT, q0, max_joint_step=opt.max_joint_step))
@@ -178,11 +196,13 @@ def plan_coordinated(
                 continue
             times, x, arc, spans = _joined(pieces)
             slope, rot, within = positions(pos, curve, axes)
-            X_FT = np.array([np.linalg.inv(pos.X_R_F(*a)) @ X for a, X in zip(axes, X_RT, strict=True)])
+            X_FR_k = np.array([np.linalg.inv(pos.X_R_F(*a)) for a in axes])
+            X_FT = X_FR_k @ X_RT
+            weave_F = None if weave_R is None else np.einsum("nij,nj->ni", X_FR_k[:, :3, :3], weave_R)
             tcp = np.array([robot.fk(q)[:3, 3] for q in Q])
             spread = float(np.max(np.linalg.norm(tcp - tcp.mean(axis=0), axis=1))) * 1000.0
             dof = robot.dof
             return CoordinatedWeld(est.id, times, x[:, :dof], x[:, dof:], arc, tuple(spans), Q, axes, X_FT, path.s,
                                    slope, rot, within, v, est.closed, path.overlap,
-                                   time.perf_counter() - t_wall, spread)  # fmt: skip
+                                   time.perf_counter() - t_wall, spread, weave_F, procedure)  # fmt: skip
     raise PlanError(f"curved seam {est.id}: no coordinated motion: {why}")

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray, readonly
+from cell.types.procedure import WeldProcedure
 
 PIECES = ("transfer", "approach", "weld", "depart", "retreat")  # in this order
 
@@ -44,10 +45,23 @@ class CoordinatedWeld:
     overlap: float
     plan_s: float = 0.0
     tcp_spread_mm: float = 0.0  # the torch's knots in R: the largest distance from their mean (how still it stands)
+    weave_F: FloatArray | None = None  # (m, 3) [m] the weave in X_FT, in F, at each knot (None: no weave)
+    procedure: WeldProcedure | None = None  # the weld procedure it was planned with (its weave, for the programs)
 
     def __post_init__(self) -> None:
         for name in ("times", "q", "axes", "arc_on", "knot_q", "knot_axes", "X_FT", "s", "slope_deg", "rotation_deg"):
             object.__setattr__(self, name, readonly(np.asarray(getattr(self, name))))
+        if self.weave_F is not None:
+            object.__setattr__(self, "weave_F", readonly(np.asarray(self.weave_F, dtype=float)))
+
+    @property
+    def line_FT(self) -> FloatArray:
+        """(m, 4, 4) the torch along the pass's line in F: X_FT without its weave (a pass's offset stays), what a
+        controller weaving by itself is given."""
+        X = np.array(self.X_FT)
+        if self.weave_F is not None:
+            X[:, :3, 3] -= np.asarray(self.weave_F)
+        return X
 
     @property
     def duration(self) -> float:

@@ -1,12 +1,15 @@
 """The programs of a curved seam welded with the positioner turning the part (docs/positioner.md, "Coordinated
 motion"): every point in the base on the faceplate with its own positioner axes. KRL: ``$BASE = EK(...)`` on the
-positioner's chain, LIN chords along the seam whose E6POS carry E2 (tilt) and E3 (rotate) changing from point to
-point (the controller moves the arm and the axes together along each chord in the turning base); RAPID: the work
-object on the mechanical unit (``ufmec``) and every robtarget's eax_b / eax_c moving, ``ArcL`` chords."""
+positioner's chain, CIRC moves where the seam is a circle in the part (else LIN chords) whose E6POS carry E2 (tilt)
+and E3 (rotate) changing from point to point: the controller interpolates each move in the turning base, the axes
+moved synchronously from its start to its end; RAPID: the work object on the mechanical unit (``ufmec``), every
+robtarget's eax_b / eax_c moving, ``ArcC`` circles or ``ArcL`` chords."""
 
 from __future__ import annotations
 
+import itertools
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +17,10 @@ import numpy as np
 from cell.config.export import KrlOptions
 from cell.coordinated.record import CoordinatedWeld
 from cell.export.checks.positioner import chain_line
+from cell.export.circles import CIRCLE_TOL_M, MAX_SWEEP_RAD, circle_through, fit_circle, swept
 from cell.export.krl_data import X_TOOL, e6axis, e6pos, frame_text, num, procedure_line
 from cell.export.program import write_texts
+from cell.export.rapid import _procedure_data as procedure_data
 from cell.export.rapid import confdata, pose_text
 from cell.export.status_turn import ArmGeometry, status_turn
 from cell.geometry import FloatArray, invert
@@ -25,12 +30,93 @@ from cell.types.robot import Kinematics
 
 CHORD_TOL_M = 0.0001  # [m] a chord stays this close to every knot it stands for (in the part's frame)
 MAX_TURN_DEG = 10.0  # and the rotate axis turns at most this much along it
+MAX_AXES_DEV_RAD = math.radians(0.5)  # the planned axes this close to the controller's interpolation along a move
 
 
-def chord_knots(cw: CoordinatedWeld, tol: float = CHORD_TOL_M) -> list[int]:
+@dataclass(frozen=True)
+class CoordMove:
+    """One move of a coordinated weld from knot ``start`` to knot ``end``: ``CIRC`` through knot ``aux``, turning
+    ``angle`` [rad] about the circle planned (``centre`` (3,) in F, ``radius`` [m]); or ``LIN`` within
+    ``chord`` [m] of the knots it passes (in F). ``axes_dev`` [rad]: the planned axes' largest departure from the
+    controller's synchronous interpolation (the axes moved in proportion to the path from start to end)."""
+
+    kind: str
+    start: int
+    end: int
+    aux: int = -1
+    angle: float = 0.0
+    centre: FloatArray | None = None
+    radius: float = 0.0
+    chord: float = 0.0
+    axes_dev: float = 0.0
+
+
+def _axes_dev(cw: CoordinatedWeld, a: int, b: int) -> float:
+    s, A = np.asarray(cw.s)[a : b + 1], np.asarray(cw.knot_axes)[a : b + 1]
+    f = (s - s[0]) / max(float(s[-1] - s[0]), 1e-12)
+    return float(np.abs(A - (A[0] + f[:, None] * (A[-1] - A[0]))).max())
+
+
+def coordinated_moves(cw: CoordinatedWeld, woven: bool = True) -> list[CoordMove]:
+    """The weld's moves: circular ones when its knots in the part's frame lie on a circle (within
+    :data:`CIRCLE_TOL_M`), each at most :data:`MAX_SWEEP_RAD` and split further until the planned axes stay within
+    :data:`MAX_AXES_DEV_RAD` of the controller's interpolation; else the chords of :func:`chord_knots`. ``woven``
+    False: along the pass's line (the weave left to the controller)."""
+    p = _knots(cw, woven)
+    centre, normal, r, err = fit_circle(p)
+    if err <= CIRCLE_TOL_M and r > 0.0:
+        ang = np.abs(swept(p, centre, normal))
+        k0 = max(1, math.ceil(ang[-1] / MAX_SWEEP_RAD - 1e-9))
+        for k in range(k0, 4 * k0 + 1):
+            cuts = [int(np.argmin(np.abs(ang - ang[-1] * i / k))) for i in range(k + 1)]
+            cuts[0], cuts[-1] = 0, len(p) - 1
+            moves = []
+            for a, b in itertools.pairwise(cuts):
+                m = int(np.argmin(np.abs(ang - 0.5 * (ang[a] + ang[b]))))
+                sweep = float(ang[b] - ang[a])
+                moves.append(CoordMove("CIRC", a, b, m, sweep, centre, r, axes_dev=_axes_dev(cw, a, b)))
+            if all(mv.axes_dev <= MAX_AXES_DEV_RAD and 0 < mv.aux < mv.end for mv in moves):
+                return moves
+    knots = chord_knots(cw, woven=woven)
+    return [CoordMove("LIN", a, b, chord=_chord(p, a, b), axes_dev=_axes_dev(cw, a, b))
+            for a, b in itertools.pairwise(knots)]  # fmt: skip
+
+
+def _knots(cw: CoordinatedWeld, woven: bool) -> FloatArray:
+    """(m, 3) [m] the weld's knots in F: the torch's (woven) or its pass line's."""
+    return np.asarray(cw.X_FT if woven else cw.line_FT)[:, :3, 3]
+
+
+def program_path_off(cw: CoordinatedWeld, moves: list[CoordMove], woven: bool = True) -> float:
+    """[m] the largest distance of a weld knot (in the part's frame) from the move that stands for it as the
+    controller runs it: the circle through a CIRC's start, auxiliary and end points, or a LIN's chord."""
+    p = _knots(cw, woven)
+    worst = 0.0
+    for mv in moves:
+        three = circle_through(p[mv.start], p[mv.aux], p[mv.end]) if mv.kind == "CIRC" else None
+        if three is None:
+            worst = max(worst, _chord(p, mv.start, mv.end))
+            continue
+        centre, r, _ = three
+        normal = np.cross(p[mv.aux] - p[mv.start], p[mv.end] - p[mv.start])
+        normal /= np.linalg.norm(normal)
+        d = p[mv.start : mv.end + 1] - centre
+        h = d @ normal
+        worst = max(worst, float(np.hypot(np.linalg.norm(d - np.outer(h, normal), axis=1) - r, h).max()))
+    return worst
+
+
+def _chord(p: FloatArray, a: int, b: int) -> float:
+    """The largest distance [m] of the knots p[a..b] from the chord p[a]-p[b]."""
+    u = (p[b] - p[a]) / max(float(np.linalg.norm(p[b] - p[a])), 1e-12)
+    mid = p[a : b + 1] - p[a]
+    return float(np.linalg.norm(mid - np.outer(mid @ u, u), axis=1).max())
+
+
+def chord_knots(cw: CoordinatedWeld, tol: float = CHORD_TOL_M, woven: bool = True) -> list[int]:
     """The knots written (indices, first and last included): each chord the longest whose knots between lie
     within ``tol`` [m] of it in the part's frame and along which the rotate axis turns at most ``MAX_TURN_DEG``."""
-    p = np.asarray(cw.X_FT)[:, :3, 3]
+    p = _knots(cw, woven)
     r = np.asarray(cw.knot_axes)[:, 1]
     out, i, n = [0], 0, len(p)
     while i < n - 1:
@@ -47,6 +133,15 @@ def chord_knots(cw: CoordinatedWeld, tol: float = CHORD_TOL_M) -> list[int]:
     return out
 
 
+def _moves_line(moves: list[CoordMove]) -> str:
+    """The comment that says how the weld is written and how near the controller's axes keep to the plan."""
+    kinds = ", ".join(f"{sum(mv.kind == k for mv in moves)} {k}" for k in ("CIRC", "LIN") if any(mv.kind == k
+                      for mv in moves))  # fmt: skip
+    dev = max(math.degrees(mv.axes_dev) for mv in moves)
+    return (f";- The weld: {kinds} in the turning base (the seam's path in the part); E2/E3 within {dev:.3f} deg of"
+            " the plan where the controller moves them in proportion to the path along each move")  # fmt: skip
+
+
 def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) -> list[str]:
     lim = [(n, name, math.degrees(a.q_min), math.degrees(a.q_max)) for n, name, a in
            ((2, "tilt", pos.tilt), (3, "rotate", pos.rotate))]  # fmt: skip
@@ -55,7 +150,7 @@ def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) ->
         f";- Positioner (tilt-rotate, coordinated, MACHINE_DEF[2]): {axes}.",
         ";- Coordinated motion: the points are in BASE_DATA on the positioner's faceplate ($BASE = EK(...)) and each"
         " carries its own E2 and E3: the rotate axis turns the part under a nearly still torch, the controller moving"
-        " the arm and the axes together along each LIN in the turning base.",
+        " the arm and the axes together along each move (CIRC or LIN) in the turning base.",
         f";- The base at this program's axes in $ROBROOT = {frame_text(X_RB)} (at its first weld point's E2 and E3:"
         " what EK gives; for checking)",
         chain_line(pos.X_RP, pos.tilt_height_m, pos.faceplate_offset_m, np.eye(4)),
@@ -77,6 +172,7 @@ def coordinated_krl(
     positioner), the approach, the arc on, the chords with E2/E3 moving, the crater, the arc off, the depart and
     home (the positioner back at its home)."""
     o = opt or KrlOptions()
+    procedure = procedure or cw.procedure
     geo = ArmGeometry.of(robot)
     X_RB0 = pos.X_R_F(*cw.knot_axes[0])
     q_home = cw.q[-1]
@@ -117,9 +213,28 @@ def coordinated_krl(
             "$TIMER_STOP[1] = TRUE", f"IF NOT $IN[{o.arc_ok_input}] THEN", f"  $OUT[{o.arc_on_output}] = FALSE",
             f"  HALT ; no arc within {o.arc_timeout_s:g} s: arc off, stopped", "ENDIF",
             f"$VEL.CP = {cw.speed:.4f} ; [m/s] {cw.speed * 1000:.1f} mm/s along the turning part"]  # fmt: skip
-    for i in chord_knots(cw)[1:]:
+    moves = coordinated_moves(cw)
+    src += [_moves_line(moves)]
+    src += [";- The weave is in the points (the path weaves in the part's frame): no weave package"] * (
+        cw.weave_F is not None
+    )
+    if any(mv.kind == "CIRC" for mv in moves):
+        src.append("$CIRC_TYPE = #BASE ; the torch's orientation interpolated in the turning base (the part's)")
+    for mv in moves:
+        if mv.kind == "CIRC" and mv.centre is not None:
+            n += 1
+            aux = point(n, X_FT[mv.aux], cw.knot_q[mv.aux], cw.knot_axes[mv.aux])
+            c = ", ".join(f"{v:.3f}" for v in mv.centre * 1000.0)
+            src.append(f";- circle r = {mv.radius * 1000.0:.3f} mm, centre [{c}] mm (base), angle"
+                       f" {math.degrees(abs(mv.angle)):.3f} deg")  # fmt: skip
+            n += 1
+            end = point(n, X_FT[mv.end], cw.knot_q[mv.end], cw.knot_axes[mv.end])
+            three = circle_through(*(X_FT[i][:3, 3] for i in (mv.start, mv.aux, mv.end)))
+            src.append(f"CIRC {aux}, {end}, CA {math.degrees(three[2] if three else abs(mv.angle)):.3f}")
+            continue
         n += 1
-        src.append(f"LIN {point(n, X_FT[i], cw.knot_q[i], cw.knot_axes[i])}")
+        src.append(f";- chord within {mv.chord * 1000.0:.3f} mm of the planned path (<= {CHORD_TOL_M * 1000:g} mm)")
+        src.append(f"LIN {point(n, X_FT[mv.end], cw.knot_q[mv.end], cw.knot_axes[mv.end])}")
     crater = procedure.crater_end_s if procedure is not None else 0.3
     src += [f"WAIT SEC {num(crater)} ; crater fill at rest", f"$OUT[{o.arc_on_output}] = FALSE ; arc off"]
     X_end = X_FT[-1].copy()
@@ -133,8 +248,10 @@ def coordinated_krl(
 def coordinated_rapid(
     cw: CoordinatedWeld, robot: Kinematics, name: str, procedure: WeldProcedure | None = None, unit: str = "STN1"
 ) -> str:
-    """The RAPID module ``name``: ``ActUnit``, the work object moved by the unit (``ufmec``), ``ArcLStart`` /
-    ``ArcL`` / ``ArcLEnd`` chords whose robtargets' eax_b (tilt) and eax_c (rotate) change, ``DeactUnit``."""
+    """The RAPID module ``name``: ``ActUnit``, the work object moved by the unit (``ufmec``), ``ArcLStart`` then
+    ``ArcC`` circles or ``ArcL`` chords along the pass's line whose robtargets' eax_b (tilt) and eax_c (rotate)
+    change, the weave (if any) the controller's (``\\Weave``, the weld procedure's ``weavedata``), ``DeactUnit``."""
+    procedure = procedure or cw.procedure
     deg = lambda a: f"[9E9,{math.degrees(a[0]):.3f},{math.degrees(a[1]):.3f},9E9,9E9,9E9]"  # noqa: E731
     q0 = cw.knot_q[0]
     X_q = invert(robot.fk(q0, "tool0")) @ robot.fk(q0, "torch_tcp")
@@ -145,17 +262,26 @@ def coordinated_rapid(
             "[9E9,0,0,9E9,9E9,9E9]];",
             f"  CONST speeddata vWeld := [{v},500,5000,1000];"]  # fmt: skip
     body = ["  PROC main()", "    ConfL \\Off;", f"    ActUnit {unit};", "    MoveAbsJ jHome, v1000, fine, tWeld;"]
-    knots = chord_knots(cw)
-    for k, i in enumerate(knots):
-        decl.append(f"  CONST robtarget p{k + 1} := [{pose_text(cw.X_FT[i])[1:-1]},{confdata(robot, cw.knot_q[i])},"
-                    f"{deg(cw.knot_axes[i])}];")  # fmt: skip
-        instr = "ArcLStart" if k == 0 else "ArcLEnd" if k == len(knots) - 1 else "ArcL"
-        speed = "v100" if k == 0 else "vWeld"
-        body.append(f"    {instr} p{k + 1}, {speed}, sm1, wd1, fine, tWeld \\WObj:=wobjPart;")
-    sp = procedure.travel_speed_mm_s if procedure is not None else cw.speed * 1000.0
-    decl += ["  PERS seamdata sm1 := [0,0.3,[0,0,21.5,7,0,190,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0.3,0.05,0,"
-             "[0,0,0,0,0,0,0,0,0],0.5];", f"  PERS welddata wd1 := [{sp:.2f},0,[0,0,21.5,7,0,190,0,0,0],"
-             "[0,0,0,0,0,0,0,0,0]];"]  # fmt: skip
+    moves, names, line = coordinated_moves(cw, woven=False), list[str](), cw.line_FT
+    weave = " \\Weave:=wv1" if procedure is not None else ""
+
+    def target(i: int) -> str:
+        names.append(f"p{len(names) + 1}")
+        decl.append(f"  CONST robtarget {names[-1]} := [{pose_text(line[i])[1:-1]},"
+                    f"{confdata(robot, cw.knot_q[i])},{deg(cw.knot_axes[i])}];")  # fmt: skip
+        return names[-1]
+
+    body.append(f"    ArcLStart {target(0)}, v100, sm1, wd1{weave}, fine, tWeld \\WObj:=wobjPart;")
+    for k, mv in enumerate(moves):
+        end = "End" if k == len(moves) - 1 else ""
+        to = [target(mv.aux), target(mv.end)] if mv.kind == "CIRC" else [target(mv.end)]
+        instr = ("ArcC" if mv.kind == "CIRC" else "ArcL") + end
+        body.append(f"    {instr} {', '.join(to)}, vWeld, sm1, wd1{weave}, fine, tWeld \\WObj:=wobjPart;")
+    sp = cw.speed * 1000.0
+    default = ["  PERS seamdata sm1 := [0,0.3,[0,0,21.5,7,0,190,0,0,0],0,0,0,0,0,[0,0,0,0,0,0,0,0,0],0,0.3,0.05,0,"
+               "[0,0,0,0,0,0,0,0,0],0.5];", f"  PERS welddata wd1 := [{sp:.2f},0,[0,0,21.5,7,0,190,0,0,0],"
+               "[0,0,0,0,0,0,0,0,0]];"]  # fmt: skip
+    decl += procedure_data(1, procedure) if procedure is not None else default
     body += ["    MoveAbsJ jHome, v1000, fine, tWeld;", f"    DeactUnit {unit};", "  ENDPROC", "ENDMODULE", ""]
     head = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {name}",
             f"  ! Generated by the weld cell (cell.export.coordinated_program): {cw.seam_id} welded with {unit}"

@@ -53,6 +53,7 @@ def plan_for(
     progress: Progress = quiet,
     tacks: TackRule | None = None,
     curves: Sequence[CurveEstimate] = (),
+    elsewhere: bool = False,
 ) -> tuple[WeldPlan, Trajectory, tuple[Violation, ...]]:
     """Plan the found seams of a detection (but those in ``skip``) and run the safety gate (docs/reference.md
     section 7).
@@ -65,6 +66,7 @@ def plan_for(
         seam, each with its seam's procedure; the plan's outcomes list them after the seams (an arm on a track
         lays none).
     curves : located curved seams (in R) to weld too (:func:`cell.planning.plan.plan_welds`; not on a track).
+    elsewhere : another pose may hold a seam (a positioner's): :func:`~cell.planning.plan.plan_welds`'s.
     """
     from cell.gate import find_violations
     from cell.gate.blame import blamed_seams
@@ -110,7 +112,8 @@ def plan_for(
         kept_tacks = [t for t in tack_tasks if t.id not in dropped]
         procs = seam_procedures(sc, det, kept) | curve_procedures_for(sc, ss.weldmap, curves)
         first = {t.id for t in kept_tacks}  # the tacks before every seam
-        planner = partial(plan_welds, first=first) if track is None else partial(plan_on_track, track=track)
+        fixed = partial(plan_welds, first=first, elsewhere=elsewhere)
+        planner = fixed if track is None else partial(plan_on_track, track=track)
         plan = planner(
             arm.model,
             [*kept, *kept_tacks],

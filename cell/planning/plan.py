@@ -18,6 +18,7 @@ from cell.errors import MotionError, PlanError, TimingError
 from cell.geometry import readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.planning.access.home import first_cut_off
 from cell.planning.access.openings import WAYS
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
@@ -52,6 +53,7 @@ def plan_welds(
     on_seam: Callable[[int, int], None] | None = None,
     first: Collection[str] = (),
     curves: Sequence[CurveEstimate] = (),
+    elsewhere: bool = False,
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -67,6 +69,9 @@ def plan_welds(
     curves : located curved seams (:class:`CurveEstimate`, in R; those not found are left out), each welded along
         its curve (:mod:`cell.planning.curves`: a closed one all round with the process's start/stop overlap), its
         procedure from ``procedures`` too; their outcomes follow the tasks'.
+    elsewhere : another place may hold a seam (a positioner's other poses): one whose transfer fails and that no
+        transfer joins to home either way is refused at once (:mod:`cell.planning.access.home`), not tried from
+        every other seam in turn.
     Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
     SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
     """
@@ -162,13 +167,17 @@ def plan_welds(
         if failed is None:
             break
         a, b, why = failed
-        if (a, b) not in forbidden and len(ids) > 1:
+        again = (a, b) not in forbidden and len(ids) > 1  # another order may do without this transfer
+        cut = first_cut_off(transfers, lines, q0, (b, a)) if elsewhere and again else None
+        if cut is None and again:
             forbidden.add((a, b))  # try an order without this transfer first
             continue
         drop = b or a  # the seam this transfer leads to (or, on the way home, comes from)
+        move = f"transfer move {'to' if b else 'from'} the seam"
+        if cut is not None:
+            (drop, why), move = cut, "transfer move between home and the seam, either way"
         solved.pop(drop)
-        direction = "to" if b else "from"
-        detail = f"no free transfer move {direction} the seam: {why.reason}"
+        detail = f"no free {move}: {why.reason}"
         outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
         whole_or_none(solved, outcomes)  # a seam's other arcs with it
     if opt.blend > 0.0:

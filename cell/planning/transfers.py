@@ -9,7 +9,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from cell.config.motion import GateOptions, PlanOptions
-from cell.errors import IKError, TimingError
+from cell.errors import IKError, MotionError, TimingError
 from cell.geometry import FloatArray
 from cell.motion.collision import CollisionChecker
 from cell.motion.collision.wire import Entry, body_entry
@@ -17,12 +17,14 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow
-from cell.planning.failures import LineError
+from cell.planning.failures import LineError, SeamFailure
 from cell.planning.lines import line_trajectory, solve_line
 from cell.planning.moves.pieces import Piece, TransferFail
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
+from cell.planning.reach import ReachModel
 from cell.process.torch import WeldProcess, line_poses
 from cell.types import Part
+from cell.types.plan import PlanReason
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
 
@@ -57,7 +59,8 @@ class Transfers:
         self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
         self._between: dict[tuple[int, bytes], tuple[int, int, list[Piece]] | TransferFail] = {}
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
-        self._above: dict[tuple[bytes, float], FloatArray | None] = {}
+        self._above: dict[tuple[bytes, float], FloatArray | IKError | None] = {}
+        self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = {}
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """:meth:`search`, remembered per (q_a, q_b)."""
@@ -175,15 +178,21 @@ class Transfers:
 
     def above(self, q: FloatArray, height: float) -> FloatArray | None:
         """The configuration (dof,) [rad] with q's TCP pose raised to ``height`` [m] in R (IK seeded at q); None
-        when q is already that high. Raises IKError when it cannot be reached."""
+        when q is already that high. Raises IKError when it cannot be reached (remembered too)."""
         key = (np.asarray(q, dtype=float).tobytes(), height)
         if key not in self._above:
             X = self.robot.fk(q)
             if height - float(X[2, 3]) < 1e-3:
                 return None
             X[2, 3] = height
-            self._above[key] = np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
-        return self._above[key]
+            try:
+                self._above[key] = np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
+            except IKError as exc:
+                self._above[key] = exc
+        got = self._above[key]
+        if isinstance(got, IKError):
+            raise got.with_traceback(None)
+        return got
 
     def midway(self, q_a: FloatArray, q_b: FloatArray, height: float) -> FloatArray:
         """The configuration (dof,) [rad] with the TCP above the middle of q_a's and q_b's TCPs at ``height`` [m]
@@ -203,7 +212,29 @@ class Transfers:
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is
-        already that high): up from q (a depart) or down to q (an approach)."""
+        already that high): up from q (a depart) or down to q (an approach). Remembered per (q, height, up), a
+        failure too: a search tries the same line ends with every pair and strategy."""
+        key = (np.asarray(q, dtype=float).tobytes(), height, up)
+        if key not in self._vertical:
+            try:
+                self._vertical[key] = self._vertical_line(q, height, up)
+            except (IKError, TimingError, LineError) as exc:
+                self._vertical[key] = exc
+        got = self._vertical[key]
+        if isinstance(got, Exception):
+            raise got.with_traceback(None)
+        return got
+
+    def _reach_model(self) -> ReachModel | None:
+        """The arm's reach pre-check (built once, None for an arm it does not fit)."""
+        if not hasattr(self, "_reach"):
+            try:
+                self._reach: ReachModel | None = ReachModel.from_robot(self.robot)
+            except (ValueError, MotionError):
+                self._reach = None
+        return self._reach
+
+    def _vertical_line(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         robot, pr, opt = self.robot, self.process, self.opt
         X = robot.fk(q)
         rise = height - float(X[2, 3])
@@ -212,7 +243,9 @@ class Transfers:
         X_top = X.copy()
         X_top[2, 3] = height
         poses = line_poses(X, X_top, opt.line_spacing)
-        knots = solve_line(robot, poses, q, "lift", 0.0, rise / (len(poses) - 1), opt.max_joint_step, ik=opt.ik)
+        step = rise / (len(poses) - 1)
+        _within_reach(self._reach_model(), poses, step)
+        knots = solve_line(robot, poses, q, "lift", 0.0, step, opt.max_joint_step, ik=opt.ik)
         if up:
             tr, v = line_trajectory(
                 robot,
@@ -236,6 +269,22 @@ class Transfers:
             dt=opt.dt,
         )
         return Piece("approach", tr, v, X)
+
+
+def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> None:
+    """Raise LineError (BEYOND_REACH) when a pose of the line (n, 4, 4) in R puts the wrist centre beyond the
+    shoulder's reach (no IK can solve it: refused before any is tried); ``step`` [m] between poses."""
+    if reach is None:
+        return
+    over = reach.pose_excess(poses)
+    k = int(np.argmax(over > 0.0))
+    if over[k] > 0.0:
+        where = (
+            f"beyond reach: at {k * step * 1000:.1f} mm along the lift the wrist centre lies {over[k] * 1000:.0f} mm"
+        )
+        raise LineError(
+            SeamFailure(PlanReason.BEYOND_REACH, f"{where} beyond the shoulder's reach", poses[k][:3, 3], k * step)
+        )
 
 
 def joined(pieces: Sequence[Piece]) -> Trajectory:

@@ -4,7 +4,7 @@ arm added to it plays back trajectories, draws the bead and carries the eye-in-h
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType, TracebackType
 
@@ -279,9 +279,12 @@ class SimCell:
             times, q, arc_on, tcp_link=tcp_link, record_dt=record_dt, record_poses=record_poses, marks=marks
         )
         if bead is not None:
-            for a, b in bead_chords(ex.tcp_W, ex.arc_on, bead.step_m):
-                self._beads.append(add_bead(self.client, a, b, bead))
+            self.add_beads(bead_chords(ex.tcp_W, ex.arc_on, bead.step_m), bead)
         return ex
+
+    def add_beads(self, chords: Iterable[tuple[FloatArray, FloatArray]], style: BeadStyle) -> None:
+        """Draw a weld bead (visual capsules) along the chords (a, b) [m] in W; it moves with the part."""
+        self._beads.extend(add_bead(self.client, a, b, style) for a, b in chords)
 
     def bead_segments(self) -> FloatArray:
         """(m, 2, 3) end points [m] in W of every bead capsule drawn so far, read back from PyBullet."""

@@ -124,7 +124,17 @@ def test_the_simulator_turns_the_part_and_the_torch_follows_its_seam(planned: tu
     with open_cell(sc, read_weldmap(sc)) as station:
         ex, back = play(station, cw, record_dt=0.1)
         axes_end = station.positioner.axes  # type: ignore[union-attr]
+        # The bead, where the part now lies, carried back into the faceplate's frame at home.
+        X_W_F = station.positioner.X_W_true @ sc.X_WR @ pos.X_R_F(*pos.home)  # type: ignore[union-attr]
+        ends_W = station.sim.bead_segments().reshape(-1, 3)
     assert np.allclose(axes_end, pos.home)  # the positioner played back home with the arm
+    # The bead was laid on the turning part where the wire's tip was: on the fillet all round (laid in the world
+    # it would be a short smear where the torch stands, off the fillet once the part turns home).
+    p_F = (ends_W - X_W_F[:3, 3]) @ X_W_F[:3, :3]
+    d = p_F[:, :2] - np.array([0.003, -0.002])
+    assert np.hypot(np.linalg.norm(d, axis=1) - R_PIPE, p_F[:, 2] - Z_FILLET).max() < 0.01e-3  # measured 0.001 mm
+    turn = np.sort(np.arctan2(d[:, 1], d[:, 0]))
+    assert np.diff(np.r_[turn, turn[0] + 2 * math.pi]).max() < math.radians(3.0)  # the whole loop, no gap
     q = quality(ex, back, np.asarray(est.p_RS), closed=True)
     assert q.tcp_max_mm < 0.05 and q.short_start_mm == 0.0  # the whole loop, on the seam the part carries
     assert q.speed_mm_s == pytest.approx(cw.speed * 1000.0, rel=0.01)  # relative to the turning part
@@ -144,11 +154,104 @@ def test_the_krl_program_moves_e2_e3_in_the_turning_base_and_passes_the_check(pl
     write_coordinated_programs("krl", [cw], robot, pos, "pipe", tmp_path)
     programs, found = read_programs(tmp_path)
     assert not found and not check_all(programs, robot)  # S, T on the arm at every point's own E2 / E3
-    dat = next(tmp_path.glob("*.dat")).read_text()
+    dat_path = next(tmp_path.glob("*.dat"))
+    dat = dat_path.read_text()
     e3 = [float(v) for v in re.findall(r"E6POS XP\d+=\{[^}]*E3 ([-\d.]+)", dat)]
-    assert len(set(e3)) > 30 and max(e3) - min(e3) > 360.0  # the rotate axis turns the loop, point by point
+    assert len(set(e3)) > 10 and max(e3) - min(e3) > 360.0  # the rotate axis turns the loop, point by point
     src = next(tmp_path.glob("*.src"))
+    # The fillet is a circle in the part: five CIRC of about 73 deg (the loop and its overlap) in the turning base,
+    # their points on the planned circle; an auxiliary point moved 0.2 mm off it is found by the check.
+    circs = re.findall(r"^CIRC (XP\d+), XP\d+, CA ([\d.]+)$", src.read_text(), re.M)
+    assert len(circs) == 5 and sum(float(ca) for _, ca in circs) == pytest.approx(365.2, abs=0.2)
+    aux = re.search(rf"(DECL E6POS {circs[1][0]}=\{{X )([-\d.]+)", dat)
+    assert aux is not None
+    dat_path.write_text(dat.replace(aux.group(0), f"{aux.group(1)}{float(aux.group(2)) + 0.2:.4f}"))
+    assert any(f.code == "circ" for f in check_all(read_programs(tmp_path)[0], robot))
+    dat_path.write_text(dat)
     text = src.read_text().replace("Positioner chain", "Positioner")  # the chain not stated: the base stands still
     src.write_text(text)
     programs, _ = read_programs(tmp_path)
     assert any(f.code in ("kinematics", "status_turn") for f in check_all(programs, robot))
+
+
+def test_a_seam_that_is_no_circle_in_the_part_is_written_in_chords(planned: tuple) -> None:
+    from dataclasses import replace
+
+    from cell.export.coordinated_program import CHORD_TOL_M, coordinated_moves, program_path_off
+
+    cw = planned[4]
+    circles = coordinated_moves(cw)
+    assert {mv.kind for mv in circles} == {"CIRC"} and program_path_off(cw, circles) < 1e-6  # a true circle
+    X = np.array(cw.X_FT)
+    X[:, 0, 3] *= 1.02  # an ellipse 2 % out of round: no circle within the tolerance
+    moves = coordinated_moves(replace(cw, X_FT=X))
+    assert {mv.kind for mv in moves} == {"LIN"} and program_path_off(replace(cw, X_FT=X), moves) <= CHORD_TOL_M
+    assert moves[0].start == 0 and moves[-1].end == len(X) - 1
+    assert max(mv.axes_dev for mv in moves) < math.radians(0.01)  # the axes turn in step with the chords
+
+
+@pytest.fixture(scope="module")
+def woven(planned: tuple) -> tuple:
+    """The same fillet welded with a zigzag weave (3 mm at 0.5 Hz, 8 mm/s)."""
+    from cell.coordinated.gate import MovingScene
+    from cell.coordinated.plan import plan_coordinated
+    from cell.motion.robot import RobotModel
+    from cell.station.arm import robot_urdf
+    from cell.types.procedure import Weave, WeldProcedure
+
+    sc, pos, est, process, _, q0 = planned
+    model = RobotModel.from_urdf(robot_urdf(sc))
+    proc = WeldProcedure(name="PA-weave", travel_speed_mm_s=8.0, weave=Weave("zigzag", 3.0, 0.5, (0.2, 0.2)))
+    scene = MovingScene.build(model, pos, [], sc.motion.plan.collision)
+    cw = plan_coordinated(model, pos, est, process, sc.motion.plan, scene, q0, rng=np.random.default_rng(0),
+                          procedure=proc)  # fmt: skip
+    return sc, pos, est, cw, model
+
+
+def test_a_weave_is_laid_across_the_fillet_in_the_parts_frame_and_measured_without_it(woven: tuple) -> None:
+    from cell.export.coordinated_program import coordinated_moves, program_path_off
+    from cell.pipeline.coordinated.play import quality, weave_at_records
+    from cell.types.execution import Execution
+
+    _, pos, est, cw, model = woven
+    assert cw.weave_F is not None
+    w = np.asarray(cw.weave_F)
+    # Across the fillet in its local cross-section in F: square to the circle's tangent, in the faceplate's
+    # plane's radial-up cross-section, 1.5 mm either side at most.
+    p = np.asarray(cw.line_FT)[:, :3, 3]
+    tangent = np.gradient(p, axis=0)
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    assert np.abs(np.sum(w * tangent, axis=1)).max() < 1e-5
+    assert 1.45e-3 < np.linalg.norm(w, axis=1).max() <= 1.5e-3 + 1e-9
+    # The pass's line is the circle (the controller's weave on ArcC); the woven torch only chords.
+    line_moves = coordinated_moves(cw, woven=False)
+    assert {mv.kind for mv in line_moves} == {"CIRC"} and program_path_off(cw, line_moves, woven=False) < 1e-6
+    # The planned torch every 0.1 s, carried back into the part's frame at home by the positioner's motion (the
+    # simulator's playback of the same is measured by the benchmark: benchmarks/bench_coordinated.py --weave).
+    k = np.unique(np.r_[np.searchsorted(cw.times, np.arange(0.0, cw.times[-1], 0.1)), len(cw.times) - 1])
+    tip_R = np.array([model.fk(q)[:3, 3] for q in cw.q[k]])
+    back = np.array([np.linalg.solve(pos.move(*a), np.r_[p, 1.0])[:3] for a, p in zip(cw.axes[k], tip_R, strict=True)])
+    ex = Execution(cw.times[k], cw.q[k], tip_R, np.asarray(cw.arc_on, bool)[k], ())
+    raw = quality(ex, back, np.asarray(est.p_RS), closed=True)
+    weave = weave_at_records(cw, ex, pos.X_R_F(*pos.home)[:3, :3])
+    q = quality(ex, back, np.asarray(est.p_RS), closed=True, weave_R=weave)
+    assert raw.tcp_max_mm > 1.4  # the torch weaves 1.5 mm either side of the fillet
+    assert q.tcp_max_mm < 0.05 and q.short_start_mm == 0.0  # taken off: on the fillet all round (0.021 mm)
+
+
+def test_the_weaving_programs_weave_as_the_fixed_arms_do(woven: tuple, tmp_path: Path) -> None:
+    from cell.export.checks.calls import check_all
+    from cell.export.checks.program import read_programs
+    from cell.export.coordinated_program import write_coordinated_programs
+
+    _, pos, _, cw, model = woven
+    write_coordinated_programs("rapid", [cw], model, pos, "pipe", tmp_path)
+    mod = next(tmp_path.glob("*.mod")).read_text()
+    # RAPID: the circle's ArcC along the pass's line, the weave the controller's (ABB's zigzag, 3 mm wide).
+    assert len(re.findall(r"ArcCE?n?d? p\d+, p\d+, vWeld, sm1, wd1 \\Weave:=wv1,", mod)) == 5
+    assert re.search(r"weavedata wv1 := \[1,0,16(\.0+)?,3(\.0+)?,", mod) is not None
+    # KRL (plain I/O, no weave package): the woven path itself in chords in the turning base, checked as ever.
+    write_coordinated_programs("krl", [cw], model, pos, "pipe", tmp_path)
+    src = next(tmp_path.glob("*.src")).read_text()
+    assert "\nCIRC " not in src and src.count("\nLIN ") > 200 and "weave zigzag 3 mm at 0.5 Hz" in src
+    assert not check_all(read_programs(tmp_path)[0], model)

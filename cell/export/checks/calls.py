@@ -224,7 +224,8 @@ def check_all(
         out += check_program(p, e1_limits_mm)
         cartesian = any(d.type in ("E6POS", "POS") for d in p.dat.decls.values())
         if cartesian or not program_calls(p):
-            out += check_kinematics(turning_base(fixed_base(p)), robot, stated_base(p))
+            on_positioner = bool(stated_positioner(p))  # a coordinated weld's circles: the torch nearly still
+            out += check_kinematics(turning_base(fixed_base(p)), robot, stated_base(p), circles=on_positioner)
         out += check_positioner(p)
         out += check_calls(p, programs)
     return out + check_setup(programs)

@@ -88,9 +88,13 @@ def _int(v: Any) -> str:
     return str(int(v)) if isinstance(v, float) and v.is_integer() else str(v)
 
 
-def check_kinematics(p: Program, robot: Kinematics, base_R: dict[str, Any] | None = None) -> list[Finding]:
+def check_kinematics(
+    p: Program, robot: Kinematics, base_R: dict[str, Any] | None = None, circles: bool = False
+) -> list[Finding]:
     """S and T of every E6POS reached by a LIN against the arm (module docstring); unreachable points. base_R : the
-    base in $ROBROOT when no BASE_DATA gives it (a positioner's, at the program's axes)."""
+    base in $ROBROOT when no BASE_DATA gives it (a positioner's, at the program's axes). ``circles``: a CIRC's
+    auxiliary and end points too, each reached from the point before (a coordinated weld's, where the torch nearly
+    stands still while the part turns)."""
     ti, bi = _index(p, "TOOL"), _index(p, "BASE")
     tool = p.src.setup.get(f"TOOL_DATA[{ti}]") if ti is not None else None
     base = base_R if base_R is not None else p.src.setup.get(f"BASE_DATA[{bi}]") if bi is not None else None
@@ -101,13 +105,13 @@ def check_kinematics(p: Program, robot: Kinematics, base_R: dict[str, Any] | Non
     geo = ArmGeometry.of(robot)
     out: list[Finding] = []
     q: FloatArray | None = None
-    for s in p.src.statements:
-        if s.kind not in ("PTP", "LIN", "SPTP", "SLIN"):
-            continue
-        name = s.point.upper() if isinstance(s.point, str) else ""
+    moves = [(s.kind, pt) for s in p.src.statements for pt in ([s.aux, s.point] if s.kind == "CIRC" else [s.point])
+             if s.kind in ("PTP", "LIN", "SPTP", "SLIN") or (circles and s.kind == "CIRC")]  # fmt: skip
+    for kind, point in moves:
+        name = point.upper() if isinstance(point, str) else ""
         d = p.dat.decls.get("XHOME_PLAN" if name == "XHOME" else name)
-        value = s.point if isinstance(s.point, dict) else (d.value if d is not None else None)
-        if s.kind in ("PTP", "SPTP"):
+        value = point if isinstance(point, dict) else (d.value if d is not None else None)
+        if kind in ("PTP", "SPTP"):
             q = _axes(value)
             continue
         if d is None or d.type not in ("E6POS", "POS") or not isinstance(value, dict) or q is None:

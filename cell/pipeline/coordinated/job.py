@@ -69,7 +69,7 @@ def weld_curves_coordinated(
     from cell.config.motion import PlanOptions
     from cell.coordinated.gate import MovingScene
     from cell.coordinated.plan import plan_coordinated
-    from cell.pipeline.coordinated.play import play, quality
+    from cell.pipeline.coordinated.play import play, quality, weave_at_records
     from cell.pipeline.curved.welds import curve_doubt
     from cell.pipeline.placeable import curve_procedures_for
     from cell.process.torch import WeldProcess
@@ -123,7 +123,8 @@ def weld_curves_coordinated(
         station.move_positioner(*pos.home)
         ex, back = play(station, cw)
         truth = det.curve_truths.get(c.id)
-        q = quality(ex, back, truth, c.closed) if truth is not None else None
+        weave = weave_at_records(cw, ex, pos.X_R_F(*pos.home)[:3, :3]) if cw.weave_F is not None else None
+        q = quality(ex, back, truth, c.closed, weave) if truth is not None else None
         study = f"welded for a study despite the weld gate: {doubt.detail}" if doubt is not None else ""
         out.append((pose, SeamWeld(c.id, True, True, study, q, procedure=proc, passes=(q,) if q else ()), cw, ex))
     return out, why

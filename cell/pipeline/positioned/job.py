@@ -189,7 +189,9 @@ def _weld_pose(
     plan = pre = ex = None
     error: CellError | None = None
     try:
-        plan, pre, violations = plan_for(station, det_g, skip=doubtful, q_start=q_now, motion=motion, progress=progress)
+        plan, pre, violations = plan_for(
+            station, det_g, skip=doubtful, q_start=q_now, motion=motion, progress=progress, elsewhere=True
+        )
         plan_s = time.perf_counter() - t
         if violations:
             why = f"the safety gate refused the pose's plan: {violations[0]} (+{len(violations) - 1} more)"

@@ -7,6 +7,7 @@ section 8)."""
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -125,7 +126,7 @@ def find_ends(
     shear = end_shear(ends, face_a.n, face_b.n, t, p0, end_face)
     # A side face at an angle meets the seam's line past A's edge on its end face (by the gap seen across it): the
     # end is where it meets the line through that edge (the edge projected on the seam), as for a square one.
-    at_edge = p0 + shear.h0 * shear.w if shear.c else p0
+    at_edge = p0 + shear.h0 * shear.w if shear.c or shear.ends else p0
     for k, end in enumerate(ends):
         if end.on_table:
             placed[k] = end.at(line_plane_parameter(at_edge, t, end.n, end.d - end.inset), 2e-4, "table")
@@ -160,14 +161,16 @@ def find_ends(
     band_b = within(max(o.corner_band_m, 3.0 * face_b.scale), face_a_height)
     cut = o.edge_band_m + 3.0 * face_a.scale
     s_known = [end.s for end in placed]
-    c = shear.c
 
-    def along_a(pts: Points) -> FloatArray:
-        """The parameters along the line of the points of face A's support among ``pts``."""
+    def along_a(pts: Points, k: int | None = None) -> FloatArray:
+        """The parameters along the line of the points of face A's support among ``pts``, carried along end k's
+        side lines (None: the mean slope's)."""
         r_a = pts.along(face_a.n) - face_a.d
         r_b = pts.along(face_b.n) - face_b.d
-        s = shear.s(pts, p0, t)
+        s = shear.s(pts, p0, t, k)
         near_a = (np.abs(r_a) < 2.5 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
+        if k is not None:  # only where end k's own side face ends A
+            near_a &= shear.beside(pts, p0, k, 0.0)
         near_a &= pts.facing(face_a.n, face_a.d)
         if known[0]:
             near_a &= s > s_known[0] + cut
@@ -175,20 +178,25 @@ def find_ends(
             near_a &= s < s_known[1] - cut
         return s[near_a]
 
-    def profile_a(pts: Points) -> tuple[FloatArray, FloatArray]:
-        """Parameters along the line and offsets from face A of the points of A's flat and of the corner radius
-        it ends into (down to a third of the radius below the plane) among ``pts``."""
+    def profile_a(pts: Points, k: int) -> tuple[FloatArray, FloatArray]:
+        """Parameters along the line (end k's side lines) and offsets from face A of the points of A's flat and of
+        the corner radius it ends into (down to a third of the radius below the plane) among ``pts``."""
         r_a = pts.along(face_a.n) - face_a.d
         r_b = pts.along(face_b.n) - face_b.d
-        s = shear.s(pts, p0, t)
+        s = shear.s(pts, p0, t, k)
         on = (r_a < 3.0 * face_a.scale) & (r_b >= band_b) & (r_b <= o.tube_radius_m) & pts.ok
         return s[on], r_a[on]
 
-    s_a = along_a(pts)
-    extent = cdf_extent(s_a) if len(s_a) >= pts.least(o.min_face_points) else None
+    extents: dict[float, tuple[FloatArray, tuple[float, float, float] | None]] = {}
     for k, end in enumerate(ends):
         if known[k]:
             continue
+        # Each end's extent along its own side lines (a gusset's snipe and its square toe lean differently).
+        c = shear.slope(k)
+        if c not in extents:
+            s_c = along_a(pts, k)
+            extents[c] = (s_c, cdf_extent(s_c) if len(s_c) >= pts.least(o.min_face_points) else None)
+        s_a, extent = extents[c]
         if extent is None:
             placed[k] = end.at(s_map[k], o.map_tolerance_m, "map")
             continue
@@ -204,7 +212,7 @@ def find_ends(
             sign = 1.0 if k == 1 else -1.0
             wide = TANGENT_WINDOW_M + abs(c) * o.tube_radius_m
             d = dense(p0 + (extent[k] - wide) * t, p0 + (extent[k] + wide) * t)
-            s_d, r_d = profile_a(d)
+            s_d, r_d = profile_a(d, k)
             s0, se = tangent_end(sign * s_d, r_d, sign * extent[k], end.inset, face_a.scale)
             placed[k] = end.at(sign * s0, se, "tangent") if np.isfinite(se) else unconfirmed
         else:
@@ -212,13 +220,14 @@ def find_ends(
             # point of the dense cloud within the likelihood's window about it.
             sign = 1.0 if k == 1 else -1.0
             reach = EDGE_WINDOW_M + o.edge_band_m + abs(c) * o.tube_radius_m  # the whole side line's points
-            d, s_d, fit = _edge_in(dense, along_a, p0, t, sign, extent[k], reach)
+            mine = functools.partial(along_a, k=k)
+            d, s_d, fit = _edge_in(dense, mine, p0, t, sign, extent[k], reach)
             if fit.at_limit:
                 # The best edge at the end of the range searched: the extrapolation was that far off (a face thinned
                 # out unevenly). Searched again about the face's last point; at the limit again, no edge was found
                 # (a density that falls off over millimetres, a face seen ever more edge-on, strays far past it):
                 # the extrapolation stands, with its miss.
-                d, s_d, fit = _edge_in(dense, along_a, p0, t, sign, (s_a.min(), s_a.max())[k], reach)
+                d, s_d, fit = _edge_in(dense, mine, p0, t, sign, (s_a.min(), s_a.max())[k], reach)
             if fit.ok:
                 # The curvature understates the scatter of a blurred edge: the confidence reads it no better than
                 # 3 spacings; the end's sigma is the likelihood's standard error and what the sample cannot resolve

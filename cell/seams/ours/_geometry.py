@@ -50,6 +50,7 @@ class JointGeometry:
     # From the seam line to A's edge on its end face, in face A across the seam [m] (a polyhedron's: the drawn gap
     # seen across face A): where a side face's inset is measured (a skewed side face meets the line past that edge).
     to_end_edge: FloatArray | None = None
+    w: FloatArray | None = None  # a polyhedron A's unit direction in face A across the seam, away from B
     # The region tests of this seam's points, computed once per point over the passes: "a" or "b" -> (points, test).
     _regions: dict[str, tuple[Points, Region]] = field(default_factory=dict, compare=False, repr=False)
 
@@ -92,6 +93,7 @@ class JointGeometry:
                 else coplanar_boundary(part_a, joint.face_abutting),
                 region_b,
                 max(h0, 0.0) * w,
+                w,
             )
         box_a = part_a.box
         k_a = "xyz".index(joint.face_abutting[1])
@@ -144,11 +146,20 @@ class JointGeometry:
             near = () if at is None else [p for p in others if np.linalg.norm(at - p.center) <= p.radius + TOUCH_M]
             found = [(g, p) for p in near if at is not None and (g := touch_gap(p, n, d, at)) is not None]
             if not found:
-                out.append(End(n, d, False, s, inset=self._inset(n, d, at)))
+                out.append(End(n, d, False, s, inset=self._inset(n, d, at), span=self._span(n, d, at)))
                 continue
             gap, other = min(found, key=lambda x: abs(x[0]))
             out.append(End(n, d + gap, False, s, touching=extent_behind(other, -n, -d - gap), gap=gap, against=other))
         return out[0], out[1]
+
+    def _span(self, n: FloatArray, d: float, at: FloatArray | None) -> tuple[float, float] | None:
+        """The heights [m] over the map's line (through ``at`` (3,)) across face A of A's vertices on its side face
+        n . p = d: how far across A that face runs (None for a box, or fewer than two vertices on it)."""
+        if at is None or self.w is None or self.part_a.is_box:
+            return None
+        v = self.part_a.vertices()
+        h = (v[np.abs(v @ n - d) < _INSET_MIN_M] - at) @ self.w
+        return (float(h.min()), float(h.max())) if len(h) >= 2 else None
 
     def _inset(self, n: FloatArray, d: float, at: FloatArray | None) -> float:
         """How far [m] the map's end ``at`` (3,) lies short of the plane n . p = d: a tube's flat ends into its

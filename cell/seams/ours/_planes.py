@@ -79,6 +79,9 @@ class End:
     # a face's points stop, a section's size tolerance (an end a drawn width from the other); added to the sigma,
     # not widened with the statistical part.
     bias: float = 0.0
+    # How far across face A, away from B, A's own side face here runs [m] (lowest, highest height over the map's
+    # line): past it another face ends A (a gusset's snipe stops at the pipe). None: not known (a box, the table).
+    span: tuple[float, float] | None = None
 
     @property
     def spread(self) -> float:

@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.seams.ours._planes import End
@@ -27,18 +28,37 @@ class Shear:
         meets that edge at ``s(h0) - c (h - h0)`` along the seam at a height h along w, so that ``s + c (h - h0)``
         of a point of face A is where the side line through it meets A's edge at the end face: the end's place as
         the truth has it (the edge projected on the seam). 0 for ends square to the seam (a box: all as before).
+        ``ends``: each end's own slope (a gusset's sniped corner at 45 deg at one end, its square toe or its
+        hypotenuse at the other), c for both when they share it.
     """
 
     w: FloatArray
     c: float
     h0: float
+    ends: tuple[float, float] | None = None
+    spans: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)  # each end's :attr:`End.span`
 
-    def s(self, pts: Points, p0: FloatArray, t: FloatArray) -> FloatArray:
-        """The points' parameters along the seam p0 + s t, each carried along its side line to A's end edge."""
+    def slope(self, k: int | None) -> float:
+        """End k's slope (0: the start, 1: the end); None: the mean, :attr:`c`."""
+        return self.c if k is None or self.ends is None else self.ends[k]
+
+    def s(self, pts: Points, p0: FloatArray, t: FloatArray, k: int | None = None) -> FloatArray:
+        """The points' parameters along the seam p0 + s t, each carried along its side line (end k's; None: the
+        mean slope) to A's end edge."""
         s = pts.along(t) - float(p0 @ t)
-        if not self.c:
+        c = self.slope(k)
+        if not c:
             return s
-        return s + self.c * (pts.along(self.w) - float(p0 @ self.w) - self.h0)
+        return s + c * (pts.along(self.w) - float(p0 @ self.w) - self.h0)
+
+    def beside(self, pts: Points, p0: FloatArray, k: int, margin: float) -> npt.NDArray[np.bool_]:
+        """(n,) which points lie across face A within end k's side face's :attr:`End.span` (grown by ``margin``
+        [m]): where that face is what ends A (past it, another face does); all when the ends share a slope."""
+        span = self.spans[k]
+        if self.ends is None or span is None:
+            return np.ones(len(pts.cam), bool)
+        h = pts.along(self.w) - float(p0 @ self.w)
+        return np.asarray((h >= span[0] - margin) & (h <= span[1] + margin))
 
 
 def end_slopes(ends: tuple[End, End], n_a: FloatArray, n_b: FloatArray, t: FloatArray) -> tuple[float, float]:
@@ -78,10 +98,14 @@ def end_shear(
     w = w / max(float(np.linalg.norm(w)), 1e-12)
     if float(w @ n_b) < 0.0:
         w = -w
-    slopes = [float(e.n @ w) / float(e.n @ t) for e in ends if abs(float(e.n @ t)) > 0.2]
+    each = [float(e.n @ w) / float(e.n @ t) if abs(float(e.n @ t)) > 0.2 else None for e in ends]
+    slopes = [x for x in each if x is not None]
     c = float(np.mean(slopes)) if slopes else 0.0
-    if abs(c) < _SHEAR_MIN:
+    own = (c if each[0] is None else each[0], c if each[1] is None else each[1])
+    if max(abs(own[0]), abs(own[1])) < _SHEAR_MIN:
         return Shear(w, 0.0, 0.0)
     n_e, d_e = end_face
     h0 = (d_e - float(n_e @ p0)) / float(n_e @ w) if abs(float(n_e @ w)) > 0.3 else 0.0
-    return Shear(w, c, max(h0, 0.0))
+    if abs(own[0] - own[1]) < _SHEAR_MIN:
+        return Shear(w, c, max(h0, 0.0))
+    return Shear(w, c, max(h0, 0.0), own, (ends[0].span, ends[1].span))

@@ -17,6 +17,7 @@ from cell.seams.ours._faces import away_from, face_from_edge, fit_planes, outsid
 from cell.seams.ours._geometry import JointGeometry, against_table, joint_of, line, within
 from cell.seams.ours._planes import Face, FitRequest, Fitted, PassFit, Selection, Tilt, thin
 from cell.seams.ours._points import Points, crop_box, gather
+from cell.seams.ours._round import round_facet
 from cell.seams.ours._shear import across_lever, end_shear, end_slopes
 from cell.seams.ours._sides import side_selections
 from cell.seams.ours.confidence import NO_ERRORS, SeamErrors, confidence, errors_of
@@ -128,16 +129,23 @@ class OursLocator:
         ends = geo.end_planes(t, s_map, scene.table_z, o.map_tolerance_m, others, p0)
         # A side face at an angle to the seam (a mitred brace's) ends face A's points that far further along it.
         end_face = part_a.face_plane(joint.end_face)
-        skew = abs(end_shear(ends, n_a, n_b, t, p0, end_face).c) * o.tube_radius_m
+        shear0 = end_shear(ends, n_a, n_b, t, p0, end_face)
+        skew = max(abs(shear0.slope(0)), abs(shear0.slope(1))) * o.tube_radius_m
         pts = gather(scene, seam.p_start, seam.p_end, o.tube_radius_m, o.extend_m + skew, joint, rng, o)
+        # B a round's facet along the seam: its points beside the seam are the round's, their heights off its round.
+        round_b = round_facet(part_b, joint.face_receiving, p0, t)
+        flat_b = round_b.flattening(pts.P) if round_b is not None else 0.0
 
         for it in range(o.passes):
             first, last = it == 0, it == o.passes - 1
             p0, t = line(face_a.n, face_a.d, face_b.n, face_b.d, mid, seam.direction)
             r_a = pts.along(face_a.n) - face_a.d
-            r_b = pts.along(face_b.n) - face_b.d
+            r_b = pts.along(face_b.n) - face_b.d - flat_b
             # Along the seam as A's side faces run across face A (square for a box; a mitred brace's at an angle).
-            s = end_shear(ends, face_a.n, face_b.n, t, p0, end_face).s(pts, p0, t)
+            # Each end along its own side lines (a gusset's snipe at one end, its square toe at the other).
+            shear = end_shear(ends, face_a.n, face_b.n, t, p0, end_face)
+            s0 = shear.s(pts, p0, t, 0)
+            s1 = shear.s(pts, p0, t, 1) if shear.ends else s0
             slack = o.map_tolerance_m if first else 0.0
             band_a = max(o.corner_band_m, 3.0 * face_a.scale) + slack
             band_b = max(o.corner_band_m, 3.0 * face_b.scale) + slack
@@ -146,13 +154,17 @@ class OursLocator:
             # Across face A (its height over B), the bands leave a thin plate's side a window.
             lo_a, hi_a = within(band_b, geo.length_a), geo.length_a - within(eb, geo.length_a)
             eb_s = within(eb, s_map[1] - s_map[0])  # a 19 mm seam keeps a window along it too
-            in_a = (r_b >= lo_a) & (r_b <= hi_a) & (s >= e0 + eb_s) & (s <= e1 - eb_s) & pts.ok
+            in_a = (r_b >= lo_a) & (r_b <= hi_a) & (s0 >= e0 + eb_s) & (s1 <= e1 - eb_s) & pts.ok
             if geo.region_a is not None:  # a polyhedron's face need not fill its extents: only points over it
                 in_a &= geo.in_face_a(pts, joint.face_abutting, within(eb, geo.length_a))
             # The widest gate B's points pass below (the region test on a polyhedron is costly: only on those).
             gate_b = max(o.map_tolerance_m + 3.0 * o.sensor_sigma_m, o.gate_sigmas * face_b.scale)
-            beside_a = ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s > e0 - band_a) & (s < e1 + band_a))
-            in_b = geo.in_face_b(pts, slack, pts.ok & beside_a & (np.abs(r_b) < gate_b)) & beside_a & pts.ok
+            beside_a = ~((r_a < band_a) & (r_a > -geo.depth_a - band_a) & (s0 > e0 - band_a) & (s1 < e1 + band_a))
+            where_b = pts.ok & beside_a & (np.abs(r_b) < gate_b)
+            if round_b is None:
+                in_b = geo.in_face_b(pts, slack, where_b) & beside_a & pts.ok
+            else:
+                in_b = where_b & round_b.over(pts.P, o.edge_band_m + slack)
             planes: list[Selection] = []
             for key, face, r, region, part, face_name, skip in (
                 ("a", face_a, r_a, in_a, part_a, joint.face_abutting, joint.end_face),
@@ -245,6 +257,8 @@ class OursLocator:
         # A side face at an angle to the seam moves its end along it by the as-built gap's error times its slope.
         slopes = end_slopes(ends, face_a.n, face_b.n, t)
         sigma = ours_sigma(float(np.hypot(errors.lateral_m, errors.tilt_m)), o.sigma_floor_m)
+        if round_b is not None:  # B's points lie on facets, the fit takes them off the round through their corners
+            sigma = float(np.hypot(sigma, round_b.bias_m))
         end_sigmas = [
             drawn
             if e.source == "map"

@@ -19,11 +19,16 @@ from cell.motion.timing import connect
 from cell.types.plan import Segment
 from cell.types.trajectory import Trajectory
 
-# The cuts tried at a point, longest first, as fractions of the longest cut of each motion (before, after): where a
-# link collides, the cut into one motion is shortened before the other's (the collision is usually near one of them)
+# The cuts tried at a point, longest first, as fractions of the longest cut of each motion (before, after), down to a
+# sixteenth, three quarters and three eighths between the halvings: where a link collides, the cut into one motion is
+# shortened before the other's (the collision is usually near one of them)
 _CUTS = tuple(
     sorted(
-        ((x, y) for x in (1.0, 0.5, 0.25, 0.125, 0.0625) for y in (1.0, 0.5, 0.25, 0.125, 0.0625)),
+        (
+            (x, y)
+            for x in (1.0, 0.75, 0.5, 0.375, 0.25, 0.125, 0.0625)
+            for y in (1.0, 0.75, 0.5, 0.375, 0.25, 0.125, 0.0625)
+        ),
         key=lambda c: (-(c[0] + c[1]), -min(c)),
     )
 )
@@ -158,5 +163,100 @@ def _blend_run(
             target = np.asarray(tr.q[-1], dtype=float)
             zone = float(np.linalg.norm(tcp(new.trajectory.q[-1]) - tcp(target)))
             new = replace(new, zone_m=zone, q_target=readonly(target))
+        out.append(new)
+    return out
+
+
+def blend_track(
+    segments: Sequence[Segment],
+    limits: JointLimits,
+    tcp: Callable[[FloatArray], FloatArray],
+    clear: Callable[[Trajectory], bool],
+    *,
+    fraction: float = 0.5,
+    dt: float = 0.001,
+) -> list[Segment]:
+    """The plan's segments (each with E1) with every run of arc-off motions in which the track moves blended, the
+    arm's axes and E1 together, at the points between them not blended yet (the rules of :func:`blend_plan`).
+
+    limits : the arm's and E1's (dof + 1 axes); tcp : (dof + 1,) -> the TCP (3,) in R; clear : a motion with E1 ->
+    whether it is free. Segments come back to back, times renumbered from the first one's start."""
+    out: list[Segment] = []
+    run: list[Segment] = []
+    for seg in [*segments, None]:
+        if seg is not None and not seg.arc_on:
+            run.append(seg)
+            continue
+        moves = any(float(np.ptp(s.trajectory.e1)) > 0.0 for s in run if s.trajectory.e1 is not None)
+        out += _track_run(run, limits, tcp, clear, fraction, dt) if len(run) > 1 and moves else run
+        run = []
+        if seg is not None:
+            out.append(seg)
+    t = segments[0].t0 if segments else 0.0
+    timed = []
+    for seg in out:
+        timed.append(replace(seg, t0=t))
+        t += seg.trajectory.duration
+    return timed
+
+
+def _with_e1(tr: Trajectory) -> Trajectory:
+    """A motion with E1 as one trajectory over the arm's axes and E1 (E1's rates from its samples)."""
+    e1 = np.zeros(len(tr.times)) if tr.e1 is None else np.asarray(tr.e1, dtype=float)
+    if len(tr.times) > 2 and float(np.ptp(e1)) > 0.0:
+        e1d = np.gradient(e1, tr.times)
+        e1d[[0, -1]] = 0.0
+        e1dd = np.gradient(e1d, tr.times)
+    else:
+        e1d = e1dd = np.zeros_like(e1)
+    return Trajectory(tr.times, np.c_[tr.q, e1], np.c_[tr.qd, e1d], np.c_[tr.qdd, e1dd])
+
+
+def _split_e1(tr: Trajectory) -> Trajectory:
+    return Trajectory(tr.times, tr.q[:, :-1], tr.qd[:, :-1], tr.qdd[:, :-1], tr.q[:, -1])
+
+
+def _track_run(
+    segs: list[Segment],
+    lim: JointLimits,
+    tcp: Callable[[FloatArray], FloatArray],
+    clear: Callable[[Trajectory], bool],
+    fraction: float,
+    dt: float,
+) -> list[Segment]:
+    """One run blended over the arm's axes and E1 at each point not blended yet (a motion joined or left there
+    already keeps its blend)."""
+    views = [_with_e1(s.trajectory) for s in segs]
+    blends: list[_Blend | None] = [None]
+    for k in range(1, len(segs)):
+        if segs[k].link_s > 0.0 or segs[k - 1].zone_m > 0.0:
+            blends.append(None)
+            continue
+        prev = blends[k - 1]
+        entry_min = prev.entry_s if prev is not None else segs[k - 1].link_s
+        blends.append(
+            _blend_at(
+                views[k - 1], views[k], entry_min, views[k].duration, lim, lambda x: clear(_split_e1(x)), fraction, dt
+            )
+        )
+    blends.append(None)
+    if not any(blends):
+        return segs
+    out = []
+    for k, seg in enumerate(segs):
+        tr, into, out_of = views[k], blends[k], blends[k + 1]
+        if into is None and out_of is None:
+            out.append(seg)
+            continue
+        start = into.entry_s if into is not None else 0.0
+        end = out_of.exit_s if out_of is not None else tr.duration
+        parts = [_piece(into.link, 0.0, into.link.duration)] if into is not None else []
+        parts.append(_piece(tr, start, end))
+        joined = _joined(parts)
+        new = replace(seg, trajectory=_split_e1(joined), link_s=into.link.duration if into is not None else seg.link_s)
+        if out_of is not None:
+            target = np.asarray(tr.q[-1], dtype=float)
+            zone = float(np.linalg.norm(tcp(joined.q[-1]) - tcp(target)))
+            new = replace(new, zone_m=zone, q_target=readonly(target[:-1]), e1_target=float(target[-1]))
         out.append(new)
     return out

@@ -19,7 +19,7 @@ from cell.geometry import FloatArray, readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
-from cell.planning.blend import blend_plan
+from cell.planning.blend import blend_plan, blend_track
 from cell.planning.plan import plan_welds, reach_model, seam_process
 from cell.planning.reach import ReachModel, cone_excess
 from cell.planning.track_moves import GroupLegs, TrackMoves, stitched
@@ -232,6 +232,8 @@ def plan_on_track(
             return blend_plan(segs, arm.limits, lambda q: arm.fk(q)[:3, 3], clear, fraction=opt.blend, dt=opt.dt)
 
         segments = stitched(moves, legs, blend)
+        if opt.blend > 0.0:  # the moves with the track joined to the arm's motions either side
+            segments = blend_track(segments, moves.limits, moves.tcp, moves.free, fraction=opt.blend, dt=opt.dt)
     finally:
         checker.set_base(base0)
     return WeldPlan(

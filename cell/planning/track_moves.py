@@ -113,6 +113,10 @@ class TrackMoves:
         )
         return hit is None
 
+    def tcp(self, q: FloatArray) -> FloatArray:
+        """The TCP (3,) [m] in R of a configuration over the arm's axes and E1 (dof + 1,)."""
+        return np.asarray((self.track.X_R_Re(float(q[-1])) @ self.robot.fk(q[:-1]))[:3, 3])
+
     def segment(self, tr: Trajectory, seam_id: str, t0: float) -> Segment:
         """A move (E1 in it) as a plan segment of kind ``move`` for ``seam_id`` ("" for the way home)."""
         e = float(np.asarray(tr.e1)[-1])

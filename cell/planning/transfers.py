@@ -194,6 +194,27 @@ class Transfers:
             raise got.with_traceback(None)
         return got
 
+    def midway(self, q_a: FloatArray, q_b: FloatArray, height: float) -> FloatArray:
+        """The configuration (dof,) [rad] with the TCP above the middle of q_a's and q_b's TCPs at ``height`` [m]
+        in R (at least as high as both), oriented as the joints' midpoint holds it (IK seeded there). Raises
+        IKError when it cannot be reached (remembered too)."""
+        key = (np.asarray(q_a, dtype=float).tobytes() + np.asarray(q_b, dtype=float).tobytes(), height)
+        if key not in self._above:
+            q_mid = 0.5 * (np.asarray(q_a, dtype=float) + np.asarray(q_b, dtype=float))
+            X = self.robot.fk(q_mid)
+            p_a, p_b = self.robot.fk(q_a)[:3, 3], self.robot.fk(q_b)[:3, 3]
+            X[:3, 3] = 0.5 * (p_a + p_b)
+            X[2, 3] = max(height, float(p_a[2]), float(p_b[2]))
+            try:
+                self._above[key] = np.asarray(solve_ik(self.robot, X, q_mid, options=self.opt.ik))
+            except IKError as exc:
+                self._above[key] = exc
+        got = self._above[key]
+        if isinstance(got, IKError):
+            raise got.with_traceback(None)
+        assert got is not None
+        return got
+
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is
         already that high): up from q (a depart) or down to q (an approach). Remembered per (q, height, up), a

@@ -54,7 +54,8 @@ class Segment:
     reaches (0 and None: an exact stop there). link_s [s]: the first link_s of its trajectory is the blend from
     the previous motion (0: it starts at rest where the previous one ended). X_path (n, 4, 4): the planned TCP
     poses of a weld along a curve in R, start to end (None: a straight LIN to X_end), for the exporters'
-    circular moves."""
+    circular moves. e1_target [m]: the linear track's programmed E1 at an approximated end (None: where the
+    trajectory ends)."""
 
     kind: SegmentKind
     seam_id: str
@@ -69,6 +70,7 @@ class Segment:
     q_target: FloatArray | None = None
     link_s: float = 0.0
     X_path: FloatArray | None = None
+    e1_target: float | None = None
 
     @property
     def q_end(self) -> FloatArray:
@@ -81,7 +83,10 @@ class Segment:
 
     @property
     def e1_end(self) -> float:
-        """E1 [m] of the linear track at the segment's end (0 without a track)."""
+        """E1 [m] of the linear track at the segment's programmed end (0 without a track): ``e1_target`` when the
+        motion is approximated there, else where the trajectory ends."""
+        if self.e1_target is not None:
+            return self.e1_target
         e1 = self.trajectory.e1
         return float(e1[-1]) if e1 is not None else 0.0
 

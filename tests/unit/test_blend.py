@@ -88,11 +88,13 @@ def test_a_blend_that_is_not_clear_stays_an_exact_stop(limits: JointLimits) -> N
 
 
 def test_the_cuts_shorten_one_motion_before_both() -> None:
-    """Where the longest link is not clear, the cut into one motion is halved before both are (a link colliding near
-    one motion's point need not lose the other's cut), and every cut down to a sixteenth is tried, longest first."""
+    """Where the longest link is not clear, the cut into one motion is shortened before both are (a link colliding
+    near one motion's point need not lose the other's cut), and every cut down to a sixteenth is tried (three
+    quarters and three eighths among them), longest first."""
     from cell.planning.blend import _CUTS
 
-    assert _CUTS[0] == (1.0, 1.0) and len(set(_CUTS)) == len(_CUTS) == 25
+    assert _CUTS[0] == (1.0, 1.0) and len(set(_CUTS)) == len(_CUTS) == 49
+    assert _CUTS.index((1.0, 0.75)) < _CUTS.index((0.75, 0.75)) < _CUTS.index((1.0, 0.5))
     assert _CUTS.index((1.0, 0.5)) < _CUTS.index((0.5, 0.5)) and _CUTS.index((0.5, 1.0)) < _CUTS.index((0.5, 0.5))
     totals = [a + b for a, b in _CUTS]
     assert totals == sorted(totals, reverse=True)

@@ -28,6 +28,8 @@ class Mover(Protocol):
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None: ...
 
+    def midway(self, q_a: FloatArray, q_b: FloatArray, height: float) -> FloatArray: ...
+
 
 class TransferStrategy(Protocol):
     """One way to move between two configurations; ``name`` is how failure messages call it."""
@@ -78,7 +80,8 @@ class Hop:
     """PTP up to a via point at the lift height above q_a's TCP, PTP across to one above q_b's, PTP down to q_b:
     the lift's via points reached by joint moves, faster than its straight lines where the collision check finds
     the joint path free. The lift height is ``transfer_lift`` (plus ``extra`` times it) above the highest
-    obstacle, or ``rise`` [m] above it when given; ``over`` "start" or "end" keeps only that end's via point."""
+    obstacle, or ``rise`` [m] above it when given; ``over`` "start" or "end" keeps only that end's via point, "mid"
+    takes one via point above the middle of the two ends instead (across a member between two seams)."""
 
     name: str = "hop"
     extra: int = 0
@@ -89,9 +92,12 @@ class Hop:
         robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
         top = mover.lift_z - mover.opt.transfer_lift
         h = top + self.rise if self.rise is not None else mover.lift_z + mover.opt.transfer_lift * self.extra
-        via_a = mover.above(q_a, h) if self.over != "end" else None
-        via_b = mover.above(q_b, h) if self.over != "start" else None
-        qs = [q_a, *(q for q in (via_a, via_b) if q is not None), q_b]
+        if self.over == "mid":
+            qs = [q_a, mover.midway(q_a, q_b, h), q_b]
+        else:
+            via_a = mover.above(q_a, h) if self.over != "end" else None
+            via_b = mover.above(q_b, h) if self.over != "start" else None
+            qs = [q_a, *(q for q in (via_a, via_b) if q is not None), q_b]
         return [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(qs)]
 
 
@@ -113,6 +119,7 @@ DEFAULT_STRATEGIES: tuple[TransferStrategy, ...] = (
     Direct(),
     Hop("hop_down", rise=0.02, over="end"),
     Hop("hop_up", rise=0.02, over="start"),
+    Hop("hop_mid", rise=0.02, over="mid"),
     Hop("hop_low", rise=0.02),
     Hop(),
     Lift(),

@@ -15,8 +15,9 @@ import numpy as np
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
+from cell.planning.curves.graph import gaps, graph_map, refined, settings_along
 from cell.planning.curves.path import CurvePath, curve_path, curve_poses
-from cell.planning.curves.reach import Miss, Run, balanced, cover, reach_map, settings, share, station_spacing
+from cell.planning.curves.reach import Miss, Run, balanced, cover, settings, share, station_spacing
 from cell.planning.curves.search import (
     CurveTask,
     _flange_axes,
@@ -33,6 +34,7 @@ from cell.planning.curves.weave import woven
 from cell.planning.failures import SeamFailure, better, unreachable
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.planning.transfers import Piece
+from cell.process.torch_orientations import Candidate
 from cell.process.weave import knot_spacing as weave_spacing
 from cell.process.weave import pass_speed
 from cell.types.curve_estimate import CurveEstimate
@@ -42,6 +44,7 @@ from cell.types.procedure import WeldProcedure
 TRIES = 10  # covers tried per map (an arc that fails its full solve is trimmed or dropped, the cover found again)
 TRIM_M = 0.015  # [m] an arc whose approach or depart fails is shortened by this much at that end
 MIN_ARC_M = 0.02  # [m] no shorter arc is kept
+GAP_MARGIN_M = 0.015  # [m] a gap in the map is walked again with finer settings this far either side of it
 
 
 def plan_arcs(
@@ -63,8 +66,14 @@ def plan_arcs(
     misses: list[Miss] = []
     failure: SeamFailure | None = None
     stiff = pr.work_angle_tol <= 0.0 and pr.travel_angle_tol <= 0.0  # no angle to widen
-    for widened in (False,) if stiff else (False, True):
-        got_runs, got_misses = reach_map(search, est, settings(search, widened), flange, q_seed, knot, overlap)
+    memo: dict[Candidate, list[FloatArray | None]] = {}  # each setting's joints at the stations, walked once
+    for stage in range(1 if stiff else 3):  # nominal angles; their tolerance's ends; finer in the map's gaps
+        cands = settings(search, False) + (settings(search, True) if stage else [])
+        windows = gaps(runs, est.length_m, est.closed, GAP_MARGIN_M) if stage > 1 else []
+        if stage > 1 and not windows:
+            break
+        cands += refined(search) if stage > 1 else []
+        got_runs, got_misses = graph_map(search, est, cands, flange, q_seed, knot, overlap, memo, windows)
         runs, misses = runs + got_runs, misses + got_misses
         for _ in range(TRIES):
             chosen = cover(runs, est.length_m, est.closed, overlap, MAX_ARCS)
@@ -150,7 +159,8 @@ def _arc_solution(
     speed (a TIMING failure, at progress 0, drops the stretch)."""
     c, pr = run.cand, search.process
     path = curve_path(arc, knot, reverse=c.reversed)
-    X0 = curve_poses(path, pr, spin=c.spin, work_offset=c.work_offset, travel_offset=c.travel_offset, flange=flange)
+    spin, work, travel = settings_along(run, run.b_m - path.s if c.reversed else run.a_m + path.s)
+    X0 = curve_poses(path, pr, spin=spin, work_offset=work, travel_offset=travel, flange=flange)
     task = curve_task(arc.id, path)
     if pr.spin_tol >= math.pi - 1e-9:  # the spin free: first as the arm takes it (the least joint motion)
         free = _preview(search, task, c, X0, run.q_start, search._reference(run.q_start), True)

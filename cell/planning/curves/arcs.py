@@ -53,8 +53,8 @@ def plan_arcs(
     """The arcs that weld ``est`` whole (a closed curve all round and over its overlap; an open one end to end),
     fewest first, at most :data:`MAX_ARCS`, each solved (a :class:`SeamSolution` per pass of ``procedure``, its
     task an open arc of the curve, id ``<seam>#arcK``); else the share of the curve some torch setting reaches
-    and the failure of the arc that got furthest. The map walks the nominal angles first, then the tolerance's
-    widened ones."""
+    and the failure of the arc that got furthest. The map's graph (:mod:`.graph`) holds the nominal angles first,
+    then the tolerance's ends too, then finer settings in its gaps."""
     pr, opt = search.process, search.opt
     knot = knot_spacing(est, opt.spacing)
     if procedure is not None:
@@ -93,7 +93,7 @@ def plan_arcs(
                 return Split(tuple(solved), 1.0, None)
     reached = share(runs, est.length_m, est.closed)
     if failure is None:
-        failure = _gap(runs, misses, est)
+        failure = _gap(runs, misses, est, overlap)
     return Split((), reached, failure)
 
 
@@ -120,27 +120,33 @@ def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
     return [replace(run, a_m=run.a_m + cut_start, b_m=run.b_m - cut_end)]
 
 
-def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate) -> SeamFailure:
+def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate, overlap: float) -> SeamFailure:
     """The failure for a curve no cover of stretches welds: where its widest stretch no setting holds starts, how
-    long it is and what stops the settings there (the commonest reason of the stations in it: its code); with
-    every point held, that no :data:`MAX_ARCS` arcs overlap by the restart overlap all round."""
+    long it is (and how many such stretches, how much in all) and what stops the settings there (the commonest
+    reason of the stations in it: its code); with every point held, that no :data:`MAX_ARCS` arcs overlap by the
+    restart ``overlap`` [m] all round."""
     total = est.length_m
-    bins = np.zeros(max(1, math.ceil(total / 0.001)), dtype=bool)
-    for r in runs:
-        idx = np.arange(math.floor(r.a_m / 0.001), math.ceil(r.b_m / 0.001))
-        bins[np.mod(idx, len(bins)) if est.closed else idx[(idx >= 0) & (idx < len(bins))]] = True
-    free = np.flatnonzero(~bins)
-    if len(free) == 0:
-        where = f"every point is held, but by stretches too short for {MAX_ARCS} arcs to overlap all round"
+    free = gaps(runs, total, est.closed, 0.0)
+    if not free:
+        where = (f"every point is held, but no {MAX_ARCS} arcs overlap by {overlap * 1000:.0f} mm at every restart "
+                 "(the torch cannot turn through where the stretches give out fast enough)")  # fmt: skip
         return SeamFailure(PlanReason.COLLISION if misses else PlanReason.IK_FAILED, where, est.p_RS[0], 0.0)
-    lo, hi = free[0] * 0.001, (free[0] + (~bins).sum()) * 0.001
-    there = [m for m in misses if lo - 0.01 <= m.at_m <= hi + 0.01] or misses
+    lo, hi = max(free, key=lambda g: g[1] - g[0])
+    lo, hi = lo % total if est.closed else lo, (lo % total if est.closed else lo) + (hi - lo)
+    there = [m for m in misses if _within(m.at_m, lo - 0.01, hi + 0.01, total, est.closed)] or misses
     counts = Counter((m.code, m.what) for m in there).most_common(2)
     why = ", ".join(f"{k} of {len(there)} tries {w or c.value}" for (c, w), k in counts) or "no setting tried"
-    where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(~bins).sum():.0f} mm unreached; {why})"
+    unheld = sum(b - a for a, b in free)
+    more = f"; {len(free)} such stretches, {unheld * 1000:.0f} mm in all" if len(free) > 1 else ""
+    where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(hi - lo) * 1000:.0f} mm{more}; {why})"
     code = counts[0][0][0] if counts else PlanReason.IK_FAILED
     p = est.p_RS[min(int(np.searchsorted(np.linspace(0, total, len(est.p_RS)), lo)), len(est.p_RS) - 1)]
     return SeamFailure(code, where, np.asarray(p), 0.0)
+
+
+def _within(x: float, lo: float, hi: float, total: float, closed: bool) -> bool:
+    """Whether x [m] along a curve ``total`` long lies in [lo, hi] (round a closed one's start)."""
+    return 0.0 <= ((x - lo) % total if closed else x - lo) <= hi - lo
 
 
 def _arc_solution(

@@ -34,7 +34,7 @@ from cell.planning.seam_search import SeamSearch
 from cell.process.torch_orientations import Candidate
 from cell.types.curve_estimate import CurveEstimate
 
-SWITCH_STATIONS = 2  # a setting changes to a neighbouring one over this many stations (not from one to the next)
+SWITCH_STATIONS = 4  # a setting changes to a neighbouring one over this many stations (a spin step: 11 deg each)
 EDGE_TRIES = 2  # where a setting's walk does not join a path, IK warm-started from at most this many paths' ends
 EDGE_BUDGET = 64  # and at most this many such IK per station
 
@@ -137,7 +137,7 @@ def _paths(
                 p = nodes.get((t0, s0))
                 if p is None or t - p.start > whole_len:
                     continue
-                if t0 < t - 1 and (t - 1, s0) not in nodes and (t - 1, s) not in nodes:
+                if any((k, s0) not in nodes and (k, s) not in nodes for k in range(t0 + 1, t)):
                     continue  # a turn over a station neither setting holds
                 preds.append(((p.start, p.switches + (s0 != s)), t0, s0, p))
             preds.sort(key=lambda e: e[0])

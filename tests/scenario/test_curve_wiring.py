@@ -66,7 +66,8 @@ def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_its_code(rep
         assert entry["plan_reason_code"] in ("ik_failed", "flip", "collision", "transfer_collision", "singular")
         code = entry["plan_reason_code"]
         if "the arm reaches" in why:  # no cover: the share of it some torch setting holds
-            assert 50.0 < float(why.split("the arm reaches ")[1].split("%")[0]) < 100.0
+            held = float(why.split("the arm reaches ")[1].split("%")[0])
+            assert 50.0 < held <= 100.0  # all held: no arcs overlapping enough, or the covers' arcs failed their solve
         else:  # covered, one arc failing after the search: named, the seam's other arcs left out with it
             assert why.split(": ")[0].startswith("arc ") and not [g for g in run.plan.segments if g.seam_id == SEAM]
         assert entry["not_welded"]["code"] == code

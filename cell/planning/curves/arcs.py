@@ -15,8 +15,9 @@ import numpy as np
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
+from cell.planning.curves.graph import gaps, graph_map, refined, settings_along
 from cell.planning.curves.path import CurvePath, curve_path, curve_poses
-from cell.planning.curves.reach import Miss, Run, balanced, cover, reach_map, settings, share, station_spacing
+from cell.planning.curves.reach import Miss, Run, balanced, cover, settings, share, station_spacing
 from cell.planning.curves.search import (
     CurveTask,
     _flange_axes,
@@ -33,6 +34,7 @@ from cell.planning.curves.weave import woven
 from cell.planning.failures import SeamFailure, better, unreachable
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.planning.transfers import Piece
+from cell.process.torch_orientations import Candidate
 from cell.process.weave import knot_spacing as weave_spacing
 from cell.process.weave import pass_speed
 from cell.types.curve_estimate import CurveEstimate
@@ -42,6 +44,7 @@ from cell.types.procedure import WeldProcedure
 TRIES = 10  # covers tried per map (an arc that fails its full solve is trimmed or dropped, the cover found again)
 TRIM_M = 0.015  # [m] an arc whose approach or depart fails is shortened by this much at that end
 MIN_ARC_M = 0.02  # [m] no shorter arc is kept
+GAP_MARGIN_M = 0.015  # [m] a gap in the map is walked again with finer settings this far either side of it
 
 
 def plan_arcs(
@@ -50,8 +53,8 @@ def plan_arcs(
     """The arcs that weld ``est`` whole (a closed curve all round and over its overlap; an open one end to end),
     fewest first, at most :data:`MAX_ARCS`, each solved (a :class:`SeamSolution` per pass of ``procedure``, its
     task an open arc of the curve, id ``<seam>#arcK``); else the share of the curve some torch setting reaches
-    and the failure of the arc that got furthest. The map walks the nominal angles first, then the tolerance's
-    widened ones."""
+    and the failure of the arc that got furthest. The map's graph (:mod:`.graph`) holds the nominal angles first,
+    then the tolerance's ends too, then finer settings in its gaps."""
     pr, opt = search.process, search.opt
     knot = knot_spacing(est, opt.spacing)
     if procedure is not None:
@@ -63,8 +66,14 @@ def plan_arcs(
     misses: list[Miss] = []
     failure: SeamFailure | None = None
     stiff = pr.work_angle_tol <= 0.0 and pr.travel_angle_tol <= 0.0  # no angle to widen
-    for widened in (False,) if stiff else (False, True):
-        got_runs, got_misses = reach_map(search, est, settings(search, widened), flange, q_seed, knot, overlap)
+    memo: dict[Candidate, list[FloatArray | None]] = {}  # each setting's joints at the stations, walked once
+    for stage in range(1 if stiff else 3):  # nominal angles; their tolerance's ends; finer in the map's gaps
+        cands = settings(search, False) + (settings(search, True) if stage else [])
+        windows = gaps(runs, est.length_m, est.closed, GAP_MARGIN_M) if stage > 1 else []
+        if stage > 1 and not windows:
+            break
+        cands += refined(search) if stage > 1 else []
+        got_runs, got_misses = graph_map(search, est, cands, flange, q_seed, knot, overlap, memo, windows)
         runs, misses = runs + got_runs, misses + got_misses
         for _ in range(TRIES):
             chosen = cover(runs, est.length_m, est.closed, overlap, MAX_ARCS)
@@ -84,7 +93,7 @@ def plan_arcs(
                 return Split(tuple(solved), 1.0, None)
     reached = share(runs, est.length_m, est.closed)
     if failure is None:
-        failure = _gap(runs, misses, est)
+        failure = _gap(runs, misses, est, overlap)
     return Split((), reached, failure)
 
 
@@ -111,27 +120,33 @@ def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
     return [replace(run, a_m=run.a_m + cut_start, b_m=run.b_m - cut_end)]
 
 
-def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate) -> SeamFailure:
+def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate, overlap: float) -> SeamFailure:
     """The failure for a curve no cover of stretches welds: where its widest stretch no setting holds starts, how
-    long it is and what stops the settings there (the commonest reason of the stations in it: its code); with
-    every point held, that no :data:`MAX_ARCS` arcs overlap by the restart overlap all round."""
+    long it is (and how many such stretches, how much in all) and what stops the settings there (the commonest
+    reason of the stations in it: its code); with every point held, that no :data:`MAX_ARCS` arcs overlap by the
+    restart ``overlap`` [m] all round."""
     total = est.length_m
-    bins = np.zeros(max(1, math.ceil(total / 0.001)), dtype=bool)
-    for r in runs:
-        idx = np.arange(math.floor(r.a_m / 0.001), math.ceil(r.b_m / 0.001))
-        bins[np.mod(idx, len(bins)) if est.closed else idx[(idx >= 0) & (idx < len(bins))]] = True
-    free = np.flatnonzero(~bins)
-    if len(free) == 0:
-        where = f"every point is held, but by stretches too short for {MAX_ARCS} arcs to overlap all round"
+    free = gaps(runs, total, est.closed, 0.0)
+    if not free:
+        where = (f"every point is held, but no {MAX_ARCS} arcs overlap by {overlap * 1000:.0f} mm at every restart "
+                 "(the torch cannot turn through where the stretches give out fast enough)")  # fmt: skip
         return SeamFailure(PlanReason.COLLISION if misses else PlanReason.IK_FAILED, where, est.p_RS[0], 0.0)
-    lo, hi = free[0] * 0.001, (free[0] + (~bins).sum()) * 0.001
-    there = [m for m in misses if lo - 0.01 <= m.at_m <= hi + 0.01] or misses
+    lo, hi = max(free, key=lambda g: g[1] - g[0])
+    lo, hi = lo % total if est.closed else lo, (lo % total if est.closed else lo) + (hi - lo)
+    there = [m for m in misses if _within(m.at_m, lo - 0.01, hi + 0.01, total, est.closed)] or misses
     counts = Counter((m.code, m.what) for m in there).most_common(2)
     why = ", ".join(f"{k} of {len(there)} tries {w or c.value}" for (c, w), k in counts) or "no setting tried"
-    where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(~bins).sum():.0f} mm unreached; {why})"
+    unheld = sum(b - a for a, b in free)
+    more = f"; {len(free)} such stretches, {unheld * 1000:.0f} mm in all" if len(free) > 1 else ""
+    where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(hi - lo) * 1000:.0f} mm{more}; {why})"
     code = counts[0][0][0] if counts else PlanReason.IK_FAILED
     p = est.p_RS[min(int(np.searchsorted(np.linspace(0, total, len(est.p_RS)), lo)), len(est.p_RS) - 1)]
     return SeamFailure(code, where, np.asarray(p), 0.0)
+
+
+def _within(x: float, lo: float, hi: float, total: float, closed: bool) -> bool:
+    """Whether x [m] along a curve ``total`` long lies in [lo, hi] (round a closed one's start)."""
+    return 0.0 <= ((x - lo) % total if closed else x - lo) <= hi - lo
 
 
 def _arc_solution(
@@ -150,7 +165,8 @@ def _arc_solution(
     speed (a TIMING failure, at progress 0, drops the stretch)."""
     c, pr = run.cand, search.process
     path = curve_path(arc, knot, reverse=c.reversed)
-    X0 = curve_poses(path, pr, spin=c.spin, work_offset=c.work_offset, travel_offset=c.travel_offset, flange=flange)
+    spin, work, travel = settings_along(run, run.b_m - path.s if c.reversed else run.a_m + path.s)
+    X0 = curve_poses(path, pr, spin=spin, work_offset=work, travel_offset=travel, flange=flange)
     task = curve_task(arc.id, path)
     if pr.spin_tol >= math.pi - 1e-9:  # the spin free: first as the arm takes it (the least joint motion)
         free = _preview(search, task, c, X0, run.q_start, search._reference(run.q_start), True)

@@ -105,11 +105,12 @@ def _along(v: FloatArray, d: FloatArray) -> FloatArray:
 
 
 def torch_rotations(
-    t_R: FloatArray, n_a_R: FloatArray, n_b_R: FloatArray, work_angle: float, travel_angle: float
-) -> FloatArray:
+    t_R: FloatArray, n_a_R: FloatArray, n_b_R: FloatArray, work_angle: float | FloatArray,
+    travel_angle: float | FloatArray,
+) -> FloatArray:  # fmt: skip
     """R_RT (n, 3, 3): :func:`cell.process.torch.torch_rotation` (spin 0) at n samples at once, for tangents t_R
     and the faces' outward normals n_a_R, n_b_R (n, 3) each: the work angle about the local bisector of the local
-    dihedral, the travel angle along the local tangent."""
+    dihedral, the travel angle along the local tangent (each one value or one per sample, (n,))."""
     d = _unit_rows(np.asarray(t_R, dtype=float))
     na = _unit_rows(np.asarray(n_a_R, dtype=float))
     nb_raw = _unit_rows(np.asarray(n_b_R, dtype=float))
@@ -120,9 +121,11 @@ def torch_rotations(
     t_a = _unit_rows(ta - _along(ta, d) * d)
     angle = np.arctan2(_along(t_a, nb), _along(t_a, t_b))
     angle = np.where(np.abs(angle - 0.5 * math.pi) < 1e-9, 0.5 * math.pi, angle)
-    w = work_angle + 0.5 * angle - 0.25 * math.pi
+    work = np.reshape(np.asarray(work_angle, dtype=float), (-1, 1))  # one value, or one per sample
+    travel = np.reshape(np.asarray(travel_angle, dtype=float), (-1, 1))
+    w = work + 0.5 * angle - 0.25 * math.pi
     u = np.cos(w) * t_b + np.sin(w) * nb
-    z = -math.cos(travel_angle) * u + math.sin(travel_angle) * d
+    z = -np.cos(travel) * u + np.sin(travel) * d
     x = _unit_rows(d - _along(d, z) * z)
     return np.stack([x, np.cross(z, x), z], axis=2)
 
@@ -131,9 +134,9 @@ def curve_poses(
     path: CurvePath,
     process: WeldProcess,
     *,
-    spin: float = 0.0,
-    work_offset: float = 0.0,
-    travel_offset: float = 0.0,
+    spin: float | FloatArray = 0.0,
+    work_offset: float | FloatArray = 0.0,
+    travel_offset: float | FloatArray = 0.0,
     flange: tuple[FloatArray, FloatArray] | None = None,
 ) -> FloatArray:
     """X_RT (n, 4, 4), read-only: the torch poses along ``path``, at each sample the orientation
@@ -146,12 +149,13 @@ def curve_poses(
         unit: at each sample the torch is spun about its axis to bring the flange's axis nearest z_R (the wrist
         held as it is at home while the torch goes round the curve, so A4 and A5 stay put and A6 alone turns with
         the curve), then by ``spin`` [rad] more. None, or a flange axis along the torch's: ``spin`` alone.
-    The orientation is continuous wherever the curve's tangent and normals are (spins unwrapped)."""
+    ``spin``, ``work_offset``, ``travel_offset``: one value, or one per sample (n,) (the torch turned and tilted
+    along the curve). The orientation is continuous wherever the curve's tangent and normals are (spins unwrapped)."""
     work = process.work_angle + work_offset
     travel = process.travel_angle + travel_offset
     n = len(path.s)
     base = torch_rotations(path.t_R, path.n_a_R, path.n_b_R, work, travel)
-    spins = np.full(n, spin)
+    spins = np.broadcast_to(np.asarray(spin, dtype=float), (n,)).copy()
     if flange is not None and float(np.hypot(flange[0][0], flange[0][1])) > 0.2:
         z_T, z_R = flange
         w = np.einsum("nji,j->ni", base, z_R)  # z_R in each unspun torch frame

@@ -15,7 +15,6 @@ import numpy as np
 from cell.errors import IKError
 from cell.geometry import FloatArray
 from cell.motion.ik import solve_ik
-from cell.planning.curves.path import CurvePath, curve_path, curve_poses
 from cell.planning.seam_search import SeamSearch
 from cell.process.torch_orientations import Candidate
 from cell.types.curve_estimate import CurveEstimate
@@ -31,16 +30,20 @@ MAX_JUMP = math.radians(60.0)  # [rad] and beyond this in any case
 
 @dataclass(frozen=True)
 class Run:
-    """A stretch of the curve one torch setting holds without a break: ``cand`` (direction, spin, angle offsets),
-    from a_m to b_m [m] along the located curve's own order (b_m may pass a closed curve's length: round its
-    start), the weld starting at a_m (b_m when reversed) with the arm at ``q_start`` (dof,) [rad]; ``whole``: a
-    closed curve held all round and on over its overlap."""
+    """A stretch of the curve the torch holds without a break: ``cand`` (direction, spin, angle offsets at its
+    weld start), from a_m to b_m [m] along the located curve's own order (b_m may pass a closed curve's length:
+    round its start), the weld starting at a_m (b_m when reversed) with the arm at ``q_start`` (dof,) [rad];
+    ``whole``: a closed curve held all round and on over its overlap; ``track`` (m, 4): the settings at its
+    stations (position along the located curve [m] less ``origin_m``, spin, work and travel offsets [rad]), the
+    torch turned and tilted from one to the next (None: ``cand`` held throughout)."""
 
     cand: Candidate
     a_m: float
     b_m: float
     q_start: FloatArray
     whole: bool = False
+    track: FloatArray | None = None
+    origin_m: float = 0.0
 
     @property
     def length(self) -> float:
@@ -123,102 +126,6 @@ def _a46_fits(search: SeamSearch, span4: float, span6: float) -> bool:
     return span4 <= float(lim.q_max[-3] - lim.q_min[-3]) and span6 <= 2.0 * search.window.half_width
 
 
-def walk(
-    search: SeamSearch,
-    est: CurveEstimate,
-    cand: Candidate,
-    path: CurvePath,
-    flange: tuple[FloatArray, FloatArray] | None,
-    q_seed: FloatArray,
-    max_step: float,
-    overlap_stations: int,
-    misses: list[Miss],
-) -> list[Run]:
-    """The stretches ``cand`` holds along the stations of ``path`` (the whole located curve from its first sample,
-    in the candidate's direction, stations evenly spaced; a closed curve's last point is its first): IK at each
-    station warm-started from the last, a stretch broken where IK fails, the arm meets a part or itself, it is
-    singular, a joint steps more than ``max_step`` [rad] or A4/A6 would wind beyond their limits; restarted
-    afresh at the next station. A closed curve's last stretch is walked on round its start; one that comes all
-    round and ``overlap_stations`` more is ``whole``. Each station where no stretch could start is added to
-    ``misses``."""
-    X = curve_poses(path, search.process, spin=cand.spin, work_offset=cand.work_offset,
-                    travel_offset=cand.travel_offset, flange=flange)  # fmt: skip
-    n = len(X) - 1 if est.closed else len(X)
-    total, step = est.length_m, path.length / (len(X) - 1)
-    rng = np.random.default_rng(7)
-    lim = search.robot.limits
-    seeds = [q_seed, *(lim.sample(rng, 0.1) for _ in range(STATION_SEEDS))]
-    runs: list[Run] = []
-    k, limit = 0, n
-    start, q_prev, q_first = -1, None, np.asarray(q_seed)
-    wind = np.zeros(2)  # A4's and A6's travel from the stretch's start, unwrapped
-    lo, hi = wind.copy(), wind.copy()
-
-    def close(last: int) -> None:
-        if start >= 0 and last > start:
-            lo_m, hi_m = start * step, last * step
-            a, b = (total - hi_m, total - lo_m) if cand.reversed else (lo_m, hi_m)
-            shift = math.floor(a / total) * total if est.closed else 0.0
-            runs.append(Run(cand, a - shift, b - shift, q_first, whole=last - start >= n + overlap_stations))
-
-    while k < limit:
-        Xk = X[k % n]
-        q = None
-        if q_prev is not None:
-            q = _next(search, Xk, q_prev, max_step)
-            if q is not None:
-                w = wind + np.angle(np.exp(1j * (q[[-3, -1]] - q_prev[[-3, -1]])))
-                if _a46_fits(search, *(np.maximum(hi, w) - np.minimum(lo, w))):
-                    wind, lo, hi = w, np.minimum(lo, w), np.maximum(hi, w)
-                else:
-                    q = None
-            if q is None:
-                close(k - 1)
-                start, q_prev = -1, None
-                if est.closed and k >= n:
-                    break
-        if q_prev is None:
-            got = _fresh(search, Xk, seeds)
-            if isinstance(got, Miss):
-                at = total - (k % n) * step if cand.reversed else (k % n) * step
-                misses.append(replace(got, at_m=at % total if est.closed else at))
-                k += 1
-                if est.closed and k >= n:
-                    break
-                continue
-            q, start, q_first = got, k, got
-            wind, lo, hi = np.zeros(2), np.zeros(2), np.zeros(2)
-        q_prev = q
-        if est.closed and k == n - 1 and start >= 0:
-            limit = start + n + overlap_stations + 1  # walk the last stretch on round the start
-        k += 1
-    close(k - 1)
-    return runs
-
-
-def reach_map(
-    search: SeamSearch,
-    est: CurveEstimate,
-    cands: Sequence[Candidate],
-    flange: tuple[FloatArray, FloatArray] | None,
-    q_seed: FloatArray,
-    knot_m: float,
-    overlap_m: float,
-) -> tuple[list[Run], list[Miss]]:
-    """Every stretch each of ``cands`` holds along ``est`` (:func:`walk`), stations :func:`station_spacing`
-    apart, and every station where one could not start; the flip bound scaled from IK knots ``knot_m`` [m] apart
-    to the stations' spacing."""
-    spacing = station_spacing(est)
-    paths = {rev: curve_path(est, spacing, reverse=rev) for rev in {c.reversed for c in cands}}
-    max_step = min(MAX_JUMP, JUMP_FACTOR * search.opt.max_joint_step * max(1.0, spacing / knot_m))
-    over = math.ceil(overlap_m / spacing) if est.closed else 0
-    runs: list[Run] = []
-    misses: list[Miss] = []
-    for c in cands:
-        runs += walk(search, est, c, paths[c.reversed], flange, q_seed, max_step, over, misses)
-    return runs, misses
-
-
 def cover(runs: Sequence[Run], total: float, closed: bool, overlap: float, max_arcs: int) -> list[Run] | None:
     """The fewest stretches (at most ``max_arcs``) that cover a curve ``total`` [m] long whole, each next one
     starting at least ``overlap`` [m] back on the last (a closed curve: the last one on over the first's start by
@@ -248,7 +155,7 @@ def _furthest(runs: Sequence[Run], lo: float, hi: float, total: float, closed: b
         for lap in (0.0, total, 2.0 * total) if closed else (0.0,):
             a, b = r.a_m + lap, r.b_m + lap
             if a <= lo + 1e-9 and b > hi and (best is None or b > best.b_m):
-                best = replace(r, a_m=a, b_m=b)
+                best = replace(r, a_m=a, b_m=b, origin_m=r.origin_m + lap)
     return best
 
 

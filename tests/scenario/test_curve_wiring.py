@@ -63,7 +63,14 @@ def test_a_located_curve_the_arm_cannot_weld_whole_is_reported_with_its_code(rep
         code = "not_executed"
     else:
         assert code == "not_planned"
-        assert entry["plan_reason_code"] in ("ik_failed", "flip", "collision", "transfer_collision", "singular")
+        assert entry["plan_reason_code"] in (
+            "ik_failed",
+            "flip",
+            "collision",
+            "transfer_collision",
+            "singular",
+            "hose_window",
+        )
         code = entry["plan_reason_code"]
         if "the arm reaches" in why:  # no cover: the share of it some torch setting holds
             held = float(why.split("the arm reaches ")[1].split("%")[0])

@@ -14,6 +14,7 @@ from cell import scenario as sc
 from cell.config.motion import PlanOptions
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.planning.curves.arcs import _same
 from cell.planning.curves.graph import _neighbours, _paths, _runs, gaps, settings_along
 from cell.planning.curves.reach import Run
 from cell.planning.plan import reach_model
@@ -85,3 +86,18 @@ def test_the_gaps_of_a_map_widened_either_side_one_across_a_loops_start() -> Non
     assert len(got) == 1 and math.isclose(got[0][0], 0.88) and math.isclose(got[0][1] - 1.0, 0.12)
     assert gaps([run], 0.9, False, 0.0) == [(0.0, 0.1)]
     assert gaps([Run(run.cand, 0.0, 1.0, np.zeros(6))], 1.0, True, 0.02) == []
+
+
+def test_every_setting_that_reaches_furthest_from_a_start_is_kept_for_the_cover_to_fall_back_on() -> None:
+    search = _search()
+    q = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
+    n = 10
+    held = [q + 0.01 * k for k in range(n)]
+    cands = [Candidate(False, 0.0, 0.0, 0.0), Candidate(False, SPIN, 0.0, 0.0)]  # both hold every station
+    poses = [np.zeros((n, 4, 4))] * 2
+    nodes = _paths(search, poses, [held, [x + 0.05 for x in held]], _neighbours(cands, True, W, T), False, n,
+                   math.radians(60.0), np.zeros(n, dtype=bool))  # fmt: skip
+    runs = [r for r in _runs(nodes, cands, 0.01, 0.09, False, False, n) if r.a_m == 0.0]
+    assert len(runs) == 2 and all(math.isclose(r.b_m, 0.09) for r in runs)  # a second whole path if one fails
+    assert [r.spare for r in runs] == [False, True]  # tried only once no cover of the first ones welds
+    assert not _same(runs[0], runs[1], 0.09) and _same(runs[0], runs[0], 0.09)

@@ -74,23 +74,28 @@ def plan_arcs(
             break
         cands += refined(search) if stage > 1 else []
         got_runs, got_misses = graph_map(search, est, cands, flange, q_seed, knot, overlap, memo, windows)
-        runs, misses = runs + got_runs, misses + got_misses
-        for _ in range(TRIES):
-            chosen = cover(runs, est.length_m, est.closed, overlap, MAX_ARCS)
-            if chosen is None:
+        runs, misses = runs + [r for r in got_runs if not r.spare], misses + got_misses
+        spare = [r for r in got_runs if r.spare]
+        for pool in range(2):  # the map's paths; then, once no cover of them welds, the spare paths too
+            if pool and not spare:
                 break
-            solved: list[tuple[CurveEstimate, tuple[SeamSolution, ...]]] = []
-            arcs = balanced(chosen, est.length_m, est.closed, overlap)
-            for k, (run, part) in enumerate(zip(chosen, arcs, strict=True), 1):
-                arc = sub_arc(est, part.a_m, part.b_m, k)
-                got = _arc_solution(search, arc, part, flange, knot, procedure)
-                if isinstance(got, SeamFailure):
-                    failure = better(failure, got)
-                    runs = [r for r in runs if not _same(r, run, est.length_m)] + _trimmed(part, got, arc)
+            runs = runs + spare if pool else runs
+            for _ in range(TRIES):
+                chosen = cover(runs, est.length_m, est.closed, overlap, MAX_ARCS)
+                if chosen is None:
                     break
-                solved.append((arc, got))
-            else:
-                return Split(tuple(solved), 1.0, None)
+                solved: list[tuple[CurveEstimate, tuple[SeamSolution, ...]]] = []
+                arcs = balanced(chosen, est.length_m, est.closed, overlap)
+                for k, (run, part) in enumerate(zip(chosen, arcs, strict=True), 1):
+                    arc = sub_arc(est, part.a_m, part.b_m, k)
+                    got = _arc_solution(search, arc, part, flange, knot, procedure)
+                    if isinstance(got, SeamFailure):
+                        failure = better(failure, got)
+                        runs = [r for r in runs if not _same(r, run, est.length_m)] + _trimmed(part, got, arc)
+                        break
+                    solved.append((arc, got))
+                else:
+                    return Split(tuple(solved), 1.0, None)
     reached = share(runs, est.length_m, est.closed)
     if failure is None:
         failure = _gap(runs, misses, est, overlap)
@@ -98,8 +103,17 @@ def plan_arcs(
 
 
 def _same(a: Run, b: Run, total: float) -> bool:
-    """Whether two stretches are one (the cover's copy a lap on)."""
-    return a.cand == b.cand and abs(a.length - b.length) < 1e-9 and abs(math.remainder(a.a_m - b.a_m, total)) < 1e-9
+    """Whether two stretches are one (the cover's copy a lap on): the same place, the same settings along it."""
+    ta, tb = a.track, b.track
+    same_track = (ta is None and tb is None) or (
+        ta is not None and tb is not None and ta.shape == tb.shape and bool(np.allclose(ta[:, 1:], tb[:, 1:]))
+    )
+    return (
+        a.cand == b.cand
+        and abs(a.length - b.length) < 1e-9
+        and abs(math.remainder(a.a_m - b.a_m, total)) < 1e-9
+        and same_track
+    )
 
 
 def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:

@@ -234,19 +234,23 @@ def _runs(
     nodes: dict[tuple[int, int], _Node], group: Sequence[Candidate], step: float, total: float, closed: bool,
     rev: bool, whole_len: int,
 ) -> list[Run]:  # fmt: skip
-    """The furthest-reaching path from each start, those inside another dropped, as :class:`Run` (positions along
-    the located curve's own order, the settings along it in ``track``)."""
-    far: dict[int, tuple[int, int]] = {}
-    for (t, s), node in nodes.items():
-        if node.start not in far or t > far[node.start][0]:
-            far[node.start] = (t, s)
-    spans = sorted(far.items(), key=lambda kv: (kv[0], -kv[1][0]))
+    """The furthest-reaching paths from each start, one per setting they end in (the first found first, the
+    others ``spare``: the cover falls back on them when it fails its full solve), those inside another start's
+    dropped, as :class:`Run` (positions along the located curve's own order, the settings along it in
+    ``track``)."""
+    far: dict[int, int] = {}
+    for (t, _), node in nodes.items():
+        far[node.start] = max(t, far.get(node.start, -1))
+    ends = sorted(  # each start's first found (the map's own choice) first
+        (node.start, k, s) for k, ((t, s), node) in enumerate(nodes.items()) if t == far[node.start]
+    )
     out: list[Run] = []
-    reach = -1
-    for start, (t, s) in spans:
-        if t <= reach or t == start:
+    reach, last = -1, -1
+    for start, _, s in ends:
+        t = far[start]
+        if start != last and (t <= reach or t == start):
             continue
-        reach = t
+        reach, last = t, start
         chain: list[tuple[int, int]] = [(t, s)]
         while nodes[chain[-1]].pred is not None:
             chain.append(nodes[chain[-1]].pred)  # type: ignore[arg-type]
@@ -262,7 +266,8 @@ def _runs(
         track = np.column_stack([pos[order] - shift, vals[order]])
         first = group[chain[0][1]]
         q0 = nodes[chain[0]].q
-        out.append(Run(first, a - shift, b - shift, q0, whole=t - start >= whole_len, track=readonly(track)))
+        spare = bool(out) and out[-1].a_m == a - shift and out[-1].b_m == b - shift
+        out.append(Run(first, a - shift, b - shift, q0, t - start >= whole_len, readonly(track), spare=spare))
     return out
 
 

@@ -35,7 +35,8 @@ class Run:
     round its start), the weld starting at a_m (b_m when reversed) with the arm at ``q_start`` (dof,) [rad];
     ``whole``: a closed curve held all round and on over its overlap; ``track`` (m, 4): the settings at its
     stations (position along the located curve [m] less ``origin_m``, spin, work and travel offsets [rad]), the
-    torch turned and tilted from one to the next (None: ``cand`` held throughout)."""
+    torch turned and tilted from one to the next (None: ``cand`` held throughout); ``spare``: another path over a
+    stretch some run already holds, for when that one fails its full solve."""
 
     cand: Candidate
     a_m: float
@@ -44,6 +45,7 @@ class Run:
     whole: bool = False
     track: FloatArray | None = None
     origin_m: float = 0.0
+    spare: bool = False
 
     @property
     def length(self) -> float:

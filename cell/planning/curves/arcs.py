@@ -42,6 +42,7 @@ from cell.types.plan import PlanReason
 from cell.types.procedure import WeldProcedure
 
 TRIES = 10  # covers tried per map (an arc that fails its full solve is trimmed or dropped, the cover found again)
+SPARE_TRIES = 4  # covers tried more once the map's spare paths are added (each a full solve of its arcs)
 TRIM_M = 0.015  # [m] an arc whose approach or depart fails is shortened by this much at that end
 MIN_ARC_M = 0.02  # [m] no shorter arc is kept
 GAP_MARGIN_M = 0.015  # [m] a gap in the map is walked again with finer settings this far either side of it
@@ -75,12 +76,12 @@ def plan_arcs(
         cands += refined(search) if stage > 1 else []
         got_runs, got_misses = graph_map(search, est, cands, flange, q_seed, knot, overlap, memo, windows)
         runs, misses = runs + [r for r in got_runs if not r.spare], misses + got_misses
-        spare = [r for r in got_runs if r.spare]
+        spare = sorted((r for r in got_runs if r.spare), key=_setting_changes)  # the fewest turns of the torch first
         for pool in range(2):  # the map's paths; then, once no cover of them welds, the spare paths too
             if pool and not spare:
                 break
             runs = runs + spare if pool else runs
-            for _ in range(TRIES):
+            for _ in range(SPARE_TRIES if pool else TRIES):
                 chosen = cover(runs, est.length_m, est.closed, overlap, MAX_ARCS)
                 if chosen is None:
                     break
@@ -100,6 +101,13 @@ def plan_arcs(
     if failure is None:
         failure = _gap(runs, misses, est, overlap)
     return Split((), reached, failure)
+
+
+def _setting_changes(run: Run) -> int:
+    """How many times the torch's setting changes along ``run``."""
+    if run.track is None:
+        return 0
+    return int(np.count_nonzero(np.any(np.abs(np.diff(run.track[:, 1:], axis=0)) > 1e-9, axis=1)))
 
 
 def _same(a: Run, b: Run, total: float) -> bool:

@@ -59,7 +59,7 @@ class Transfers:
         self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
         self._between: dict[tuple[int, bytes], tuple[int, int, list[Piece]] | TransferFail] = {}
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
-        self._above: dict[tuple[bytes, float], FloatArray | IKError | None] = {}
+        self._above: dict[tuple[bytes, float], FloatArray | IKError] = {}
         self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = {}
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
@@ -179,40 +179,36 @@ class Transfers:
     def above(self, q: FloatArray, height: float) -> FloatArray | None:
         """The configuration (dof,) [rad] with q's TCP pose raised to ``height`` [m] in R (IK seeded at q); None
         when q is already that high. Raises IKError when it cannot be reached (remembered too)."""
-        key = (np.asarray(q, dtype=float).tobytes(), height)
-        if key not in self._above:
-            X = self.robot.fk(q)
-            if height - float(X[2, 3]) < 1e-3:
-                return None
-            X[2, 3] = height
-            try:
-                self._above[key] = np.asarray(solve_ik(self.robot, X, q, options=self.opt.ik))
-            except IKError as exc:
-                self._above[key] = exc
-        got = self._above[key]
-        if isinstance(got, IKError):
-            raise got.with_traceback(None)
-        return got
+        X = self.robot.fk(q)
+        if height - float(X[2, 3]) < 1e-3:
+            return None
+        X[2, 3] = height
+        return self._ik((np.asarray(q, dtype=float).tobytes(), height), X, q)
 
     def midway(self, q_a: FloatArray, q_b: FloatArray, height: float) -> FloatArray:
         """The configuration (dof,) [rad] with the TCP above the middle of q_a's and q_b's TCPs at ``height`` [m]
         in R (at least as high as both), oriented as the joints' midpoint holds it (IK seeded there). Raises
         IKError when it cannot be reached (remembered too)."""
-        key = (np.asarray(q_a, dtype=float).tobytes() + np.asarray(q_b, dtype=float).tobytes(), height)
+        q_mid = 0.5 * (np.asarray(q_a, dtype=float) + np.asarray(q_b, dtype=float))
+        X = self.robot.fk(q_mid)
+        p_a, p_b = self.robot.fk(q_a)[:3, 3], self.robot.fk(q_b)[:3, 3]
+        X[:3, 3] = 0.5 * (p_a + p_b)
+        X[2, 3] = max(height, float(p_a[2]), float(p_b[2]))
+        return self._ik(
+            (np.asarray(q_a, dtype=float).tobytes() + np.asarray(q_b, dtype=float).tobytes(), height), X, q_mid
+        )
+
+    def _ik(self, key: tuple[bytes, float], X: FloatArray, seed: FloatArray) -> FloatArray:
+        """The IK solution (dof,) [rad] for pose X (4, 4) in R seeded at ``seed``, remembered under ``key`` (the
+        ends it was asked from), a failure too. Raises the IKError remembered."""
         if key not in self._above:
-            q_mid = 0.5 * (np.asarray(q_a, dtype=float) + np.asarray(q_b, dtype=float))
-            X = self.robot.fk(q_mid)
-            p_a, p_b = self.robot.fk(q_a)[:3, 3], self.robot.fk(q_b)[:3, 3]
-            X[:3, 3] = 0.5 * (p_a + p_b)
-            X[2, 3] = max(height, float(p_a[2]), float(p_b[2]))
             try:
-                self._above[key] = np.asarray(solve_ik(self.robot, X, q_mid, options=self.opt.ik))
+                self._above[key] = np.asarray(solve_ik(self.robot, X, seed, options=self.opt.ik))
             except IKError as exc:
                 self._above[key] = exc
         got = self._above[key]
         if isinstance(got, IKError):
             raise got.with_traceback(None)
-        assert got is not None
         return got
 
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:

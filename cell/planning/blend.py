@@ -65,13 +65,25 @@ def blend_plan(
     """
     if not 0.0 <= fraction <= 0.5:
         raise ValueError(f"blend fraction must be within [0, 0.5], got {fraction}")
+    return _each_run(
+        segments,
+        lambda seg: not seg.arc_on and seg.trajectory.e1 is None,
+        lambda run: _blend_run(run, limits, tcp, clear, fraction, dt),
+    )
+
+
+def _each_run(
+    segments: Sequence[Segment], joins: Callable[[Segment], bool], blend: Callable[[list[Segment]], list[Segment]]
+) -> list[Segment]:
+    """``segments`` with every run of two or more consecutive ones that ``joins`` takes put through ``blend``,
+    back to back, times renumbered from the first one's start."""
     out: list[Segment] = []
     run: list[Segment] = []
     for seg in [*segments, None]:
-        if seg is not None and not seg.arc_on and seg.trajectory.e1 is None:
+        if seg is not None and joins(seg):
             run.append(seg)
             continue
-        out += _blend_run(run, limits, tcp, clear, fraction, dt) if len(run) > 1 else run
+        out += blend(run) if len(run) > 1 else run
         run = []
         if seg is not None:
             out.append(seg)
@@ -181,23 +193,12 @@ def blend_track(
 
     limits : the arm's and E1's (dof + 1 axes); tcp : (dof + 1,) -> the TCP (3,) in R; clear : a motion with E1 ->
     whether it is free. Segments come back to back, times renumbered from the first one's start."""
-    out: list[Segment] = []
-    run: list[Segment] = []
-    for seg in [*segments, None]:
-        if seg is not None and not seg.arc_on:
-            run.append(seg)
-            continue
+
+    def blend(run: list[Segment]) -> list[Segment]:
         moves = any(float(np.ptp(s.trajectory.e1)) > 0.0 for s in run if s.trajectory.e1 is not None)
-        out += _track_run(run, limits, tcp, clear, fraction, dt) if len(run) > 1 and moves else run
-        run = []
-        if seg is not None:
-            out.append(seg)
-    t = segments[0].t0 if segments else 0.0
-    timed = []
-    for seg in out:
-        timed.append(replace(seg, t0=t))
-        t += seg.trajectory.duration
-    return timed
+        return _track_run(run, limits, tcp, clear, fraction, dt) if moves else run
+
+    return _each_run(segments, lambda seg: not seg.arc_on, blend)
 
 
 def _with_e1(tr: Trajectory) -> Trajectory:

@@ -3,6 +3,8 @@ mesh about its centroid (docs/bodies.md section 1). Every body is static; poses 
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -54,3 +56,17 @@ def add_part(client: BulletClient, part_W: Part, rgba: Rgba) -> int:
         return add_box(client, part_W.box, rgba)
     vertices, triangles = part_W.triangles()
     return add_mesh(client, vertices, triangles, rgba)
+
+
+def move_bodies(client: BulletClient, bodies: Iterable[int], X_W_new_old: FloatArray) -> None:
+    """Move each body by the rigid motion X_W_new_old (4, 4) in W (their poses composed in one batch)."""
+    ids = list(bodies)
+    if not ids:
+        return
+    poses = [client.getBasePositionAndOrientation(b) for b in ids]
+    X = np.asarray(X_W_new_old, dtype=float)
+    R_W = X[:3, :3] @ Rotation.from_quat([q for _, q in poses]).as_matrix()  # (n, 3, 3)
+    p_W = np.array([p for p, _ in poses], dtype=float) @ X[:3, :3].T + X[:3, 3]
+    quats = Rotation.from_matrix(R_W).as_quat()
+    for body, p, q in zip(ids, p_W.tolist(), quats.tolist(), strict=True):
+        client.resetBasePositionAndOrientation(body, p, q)

@@ -10,13 +10,12 @@ from types import MappingProxyType, TracebackType
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
 from cell.sim.board import Size2, add_board, colour_noise, place_body
-from cell.sim.bodies import add_box, add_part
+from cell.sim.bodies import add_box, add_part, move_bodies
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.lens import Sensor, sensor_for
@@ -304,14 +303,7 @@ class SimCell:
         X = np.asarray(X_W_new_old, dtype=float)
         names = {p.name for p in self.parts_W}
         bodies = [b for n, b in self._bodies.items() if n in names or n in self._tacks] + list(self._beads)
-        for body in bodies:
-            pos, quat = self.client.getBasePositionAndOrientation(body)
-            X_old = make_pose(Rotation.from_quat(quat).as_matrix(), np.asarray(pos, dtype=float))
-            X_new = X @ X_old
-            q_new = Rotation.from_matrix(X_new[:3, :3]).as_quat()
-            self.client.resetBasePositionAndOrientation(
-                body, [float(v) for v in X_new[:3, 3]], [float(v) for v in q_new]
-            )
+        move_bodies(self.client, bodies, X)
         self.parts_W = tuple(p.moved(X) for p in self.parts_W)
         return self.parts_W
 

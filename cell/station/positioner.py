@@ -47,7 +47,7 @@ class SimPositioner:
     def move_to(self, tilt: float, rotate: float) -> tuple[FloatArray, FloatArray]:
         """Turn the axes to (tilt, rotate) [rad]; returns (X_W nominal, X_W true): the motions in W the kinematics
         give and the one the clamped things really made (the nominal with the repeatability's error)."""
-        from cell.sim.positioner import move_bodies
+        from cell.sim.bodies import move_bodies
 
         X_WR = self.scenario.X_WR
         t_was = self.axes[0]
@@ -71,7 +71,7 @@ class SimPositioner:
         """Turn the axes to (tilt, rotate) [rad] as one step of a continuous move (the arm welding meanwhile): the
         clamped things carried by the nominal kinematics with the error they already have (nothing drawn: a part
         clamped on the faceplate turns with it). Returns the true motion X_W (4, 4) of this step."""
-        from cell.sim.positioner import move_bodies
+        from cell.sim.bodies import move_bodies
 
         X_WR = self.scenario.X_WR
         nominal = lambda a: X_WR @ self.pos.move(*a) @ invert(X_WR)  # noqa: E731  (from home, in W)

@@ -18,6 +18,7 @@ import pytest
 
 if TYPE_CHECKING:
     from cell import pipeline
+    from cell.pipeline.turnover import TurnoverRun
     from cell.station import SimStation
 
 HERE = Path(__file__).resolve().parent
@@ -29,12 +30,18 @@ from shared_runs import Preview, half_resolution  # noqa: E402
 
 
 @pytest.fixture(scope="session")
-def fence1_run() -> pipeline.WeldRun:
-    """``cell weld fence1`` once per session: detection, re-scan, plan, gate and execution (read-only)."""
-    from cell import pipeline
+def fence1_both() -> TurnoverRun:
+    """``cell weld fence1`` once per session: side A, the operator's turn and side B (read-only)."""
     from cell import scenario as sc
+    from cell.pipeline.turnover import weld_part
 
-    return pipeline.weld(sc.load("fence1"))
+    return weld_part(sc.load("fence1"))
+
+
+@pytest.fixture(scope="session")
+def fence1_run(fence1_both: TurnoverRun) -> pipeline.WeldRun:
+    """Its side A: detection, re-scan, plan, gate and execution, as ``pipeline.weld(fence1)`` gives them."""
+    return fence1_both.side_a
 
 
 @pytest.fixture(scope="session")

@@ -1,9 +1,9 @@
 """The whole part welded (docs/flip.md): fence1 on both sides, the turn planned and measured, a forbidden turn, and a
 large placement error by the operator (30 mm, 5 deg) that side B's alignment still takes.
 
-One module fixture runs the two-sided fence1 job (side A, the turn, side B) and every assertion on it reads that
-run; the large placement error runs only side B's capture, detection and plan on a fresh cell (no side A beads:
-what it tests is the second alignment and the seams it finds, not welding them again).
+The session's two-sided fence1 job (tests/conftest.py: side A, the turn, side B) is what most assertions read;
+the large placement error runs only side B's capture, detection and plan on a fresh cell (no side A beads: what it
+tests is the second alignment and the seams it finds, not welding them again).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from cell.pipeline.detect import detect, read_weldmap, table_z_R
 from cell.pipeline.geometry import robot_arm
 from cell.pipeline.records import WeldRun
 from cell.pipeline.restrict import restricted
-from cell.pipeline.turnover import plan_turn, turnover_result, weld_part
+from cell.pipeline.turnover import plan_turn, turnover_result
 from cell.pipeline.turnover_run import TurnoverRun
 from cell.pipeline.weld import plan_for
 from cell.planning.turnover import plan_turnover
@@ -41,8 +41,8 @@ from cell.types.turnover import TurnoverPlan
 
 
 @pytest.fixture(scope="module")
-def both() -> TurnoverRun:
-    return weld_part(sc.load("fence1"))
+def both(fence1_both: TurnoverRun) -> TurnoverRun:
+    return fence1_both  # the session's fence1 job (tests/conftest.py)
 
 
 def test_every_seam_of_fence1_is_welded_within_a_millimetre_of_its_true_seam(both: TurnoverRun) -> None:

@@ -1,0 +1,61 @@
+"""Curved seams on a linear track (docs/curves-welding.md section 11): the E1 values a curve is tried from, on a
+made-up room profile and on a tube's fillet beside the KR 5 arc's reach (no IK: the reach pre-check's bound)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from tiny_cell import URDF
+
+from cell import scenario as sc
+from cell.motion.robot import RobotModel
+from cell.planning.curves.track import curve_e1s, curve_probes
+from cell.planning.plan import reach_model
+from cell.planning.track import MARGIN, e1_grid, reach_curves
+from cell.process.torch import WeldProcess
+from cell.types import SeamStatus
+from cell.types.curve_estimate import CurveEstimate
+from cell.types.track import LinearTrack
+
+TRACK = LinearTrack(np.array([1.0, 0.0, 0.0]), -0.5, 2.0, 0.8, 1.5, 6.0)
+
+
+def _fillet(centre: tuple[float, float, float], radius: float = 0.03, n: int = 120) -> CurveEstimate:
+    """A tube's foot on a plate: a closed circle about z, the tube's normals outward, the plate's up."""
+    a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    radial = np.stack([np.cos(a), np.sin(a), np.zeros(n)], axis=1)
+    up = np.tile([0.0, 0.0, 1.0], (n, 1))
+    p = np.asarray(centre) + radius * radial
+    return CurveEstimate("TUBE>PLATE", SeamStatus.FOUND, p_RS=p, n_abutting_R=radial, n_receiving_R=up,
+                         closed=True, sigma_m=np.full(n, 1e-4), end_sigma_m=(0.0, 0.0), confidence=1.0)  # fmt: skip
+
+
+def test_a_curve_is_tried_where_a_group_stands_then_where_it_has_most_room() -> None:
+    grid = np.round(np.arange(-0.5, 2.0001, 0.01), 10)
+    room = 0.5 * (grid - 0.6) ** 2 - 0.3  # most room (0.3 m) at 0.6; margin (0.15 m) within 0.55 m of it
+    assert curve_e1s(room, grid, [0.0], MARGIN) == pytest.approx((0.6, 0.5, 0.7))  # E1 = 0: too little room
+    assert curve_e1s(room, grid, [0.0, 0.3], MARGIN) == pytest.approx((0.3, 0.6, 0.5))  # a group's E1 first
+    assert curve_e1s(room, grid, [0.3, 0.2], MARGIN, tries=2) == pytest.approx((0.3, 0.6))  # the roomier group
+    never = 2.0 * (grid - 0.6) ** 2 - 0.1  # never 0.15 m of room: within 5 mm of its best only (0.55-0.65)
+    assert curve_e1s(never, grid, [0.3], MARGIN) == pytest.approx((0.6,))
+    assert curve_e1s(room + 0.4, grid, [0.0], MARGIN) == pytest.approx((0.6,))  # out of reach everywhere: its best
+
+
+def test_a_tube_beyond_the_fixed_reach_is_tried_with_the_base_abreast_of_it() -> None:
+    """A 60 mm tube 1.6 m along the track and 0.6 m out from it: no torch reaches its far side from E1 = 0 for sure;
+    its first E1 puts the base within a few centimetres of abreast of it, every try with the whole fillet in reach."""
+    reach = reach_model(RobotModel.from_urdf(URDF))
+    assert reach is not None
+    process = WeldProcess.from_spec(sc.ProcessSpec())
+    curve = _fillet((1.6, 0.6, 0.01))
+    probes = curve_probes(curve)
+    assert 19 <= len(probes) <= 21  # every 10 mm round its 188 mm
+    grid = e1_grid(TRACK)
+    room = reach_curves(reach, probes, [process] * len(probes), TRACK, grid).max(axis=0)
+    sure = reach_curves(reach, probes, [process] * len(probes), TRACK, np.array([0.0]), cone=True)
+    assert sure.max() > 0.0  # from E1 = 0 some of it is out of reach whatever the torch
+    tries = curve_e1s(room, grid, [0.0], MARGIN)
+    assert len(tries) == 3 and abs(tries[0] - 1.6) <= 0.05
+    assert sorted(abs(e - tries[0]) for e in tries[1:]) == pytest.approx([0.1, 0.1])
+    for e in tries:
+        assert room[int(np.argmin(np.abs(grid - e)))] <= -MARGIN

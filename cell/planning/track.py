@@ -284,7 +284,8 @@ def _curve_e1s(
     probes = curve_probes(curve)
     proc = seam_process(process, sel)
     room = reach_curves(reach, probes, [proc] * len(probes), track, grid).max(axis=0)
-    return curve_e1s(room, grid, [0.0, *(g.e1 for g in groups)], MARGIN)
+    sure = reach_curves(reach, probes, [proc] * len(probes), track, grid, cone=True).max(axis=0)
+    return curve_e1s(room, grid, [0.0, *(g.e1 for g in groups)], MARGIN, sure)
 
 
 def _arm_at(robot: RobotModel, track: LinearTrack, e1: float) -> RobotModel:

@@ -36,9 +36,11 @@ def test_a_curve_is_tried_where_a_group_stands_then_where_it_has_most_room() -> 
     assert curve_e1s(room, grid, [0.0], MARGIN) == pytest.approx((0.6, 0.5, 0.7))  # E1 = 0: too little room
     assert curve_e1s(room, grid, [0.0, 0.3], MARGIN) == pytest.approx((0.3, 0.6, 0.5))  # a group's E1 first
     assert curve_e1s(room, grid, [0.3, 0.2], MARGIN, tries=2) == pytest.approx((0.3, 0.6))  # the roomier group
-    never = 2.0 * (grid - 0.6) ** 2 - 0.1  # never 0.15 m of room: within 5 mm of its best only (0.55-0.65)
-    assert curve_e1s(never, grid, [0.3], MARGIN) == pytest.approx((0.6,))
-    assert curve_e1s(room + 0.4, grid, [0.0], MARGIN) == pytest.approx((0.6,))  # out of reach everywhere: its best
+    never = 2.0 * (grid - 0.6) ** 2 - 0.1  # never 0.15 m of room: no group's E1; 0.05 m less than its best or more
+    assert curve_e1s(never, grid, [0.3, 0.0], MARGIN) == pytest.approx((0.6, 0.5, 0.7))
+    assert curve_e1s(8.0 * never, grid, [0.0], MARGIN) == pytest.approx((0.6,))  # too little room 0.1 m away
+    hopeless = np.full(len(grid), 0.02)  # every torch out of reach everywhere: its best E1 only
+    assert curve_e1s(room, grid, [0.0], MARGIN, sure=hopeless) == pytest.approx((0.6,))
 
 
 def test_a_tube_beyond_the_fixed_reach_is_tried_with_the_base_abreast_of_it() -> None:

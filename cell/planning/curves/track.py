@@ -18,7 +18,7 @@ from cell.types.plan import PlanReason, SeamOutcome, SeamTask, WeldPlan
 TRIES = 3  # E1 values a curve is tried from at most (a refused curve costs a full reach map at each)
 APART = 0.1  # [m] at least this far between two E1 values a curve is tried from
 PROBE_STEP = 0.01  # [m] along the curve between the points whose reach is judged
-_BEST_TOL = 0.005  # [m] a curve that never gets the margin: E1 values within this of its best are usable
+SLACK = 0.05  # [m] the further E1 values tried give the curve at most this much less room than its best
 _SOMEWHERE_ELSE = frozenset({PlanReason.NO_PROCEDURE})  # codes no other E1 changes
 
 
@@ -39,22 +39,23 @@ def curve_e1s(
     grid: FloatArray,
     taken: Sequence[float],
     margin: float,
+    sure: FloatArray | None = None,
     tries: int = TRIES,
     apart: float = APART,
 ) -> tuple[float, ...]:
     """The E1 values [m] a curve is tried from, in order. ``room`` (G,) [m]: the worst over the curve's points of how
-    far the nominal torch's wrist lies past the arm's reach at each E1 of ``grid`` (negative: inside by that much).
-    A value is usable where the whole curve has ``margin`` [m] of room (or, for a curve that never does, within
-    5 mm of its best). First the usable one of ``taken`` (E1 = 0 and the straight seams' groups: no carriage move
-    of its own) with the most room; then the grid's value with the most room; then usable values ``apart`` [m] on
-    either side of it, nearest first; at most ``tries`` in all. A curve out of reach everywhere: its best E1 only
-    (the planner refuses it there with its reason)."""
+    far the nominal torch's wrist lies past the arm's reach at each E1 of ``grid`` (negative: inside by that much;
+    round a tube the torch leans out on the far side, so the planner's tilts may reach where this says not).
+    First the one of ``taken`` (E1 = 0 and the straight seams' groups: no carriage move of its own) where the whole
+    curve has ``margin`` [m] of room, the most room first; then the grid's value with the most room; then values
+    ``apart`` [m] on from those, nearest it first, with at most :data:`SLACK` less room; at most ``tries`` in all.
+    ``sure`` (G,): the reach pre-check's bound for every torch (> 0: out of reach for sure); a curve out of reach
+    for sure everywhere gets its best E1 only (the planner refuses it there with its reason)."""
     g = np.asarray(grid, dtype=float)
     r = np.asarray(room, dtype=float)
     best = int(np.argmin(r))
-    if r[best] > 0.0:
+    if sure is not None and float(np.min(sure)) > 0.0:
         return (float(g[best]),)
-    usable = r <= max(-margin, float(r[best]) + _BEST_TOL)
     out: list[float] = []
 
     def add(e: float) -> None:
@@ -62,11 +63,11 @@ def curve_e1s(
             out.append(e)
 
     near = [int(np.argmin(np.abs(g - e))) for e in taken]
-    for i in sorted({i for i in near if usable[i]}, key=lambda i: (r[i], abs(g[i]))):
+    for i in sorted({i for i in near if r[i] <= -margin}, key=lambda i: (r[i], abs(g[i]))):
         add(float(g[i]))
         break
     add(float(g[best]))
-    for k in sorted(np.flatnonzero(usable), key=lambda i: (round(abs(g[i] - g[best]), 6), g[i])):
+    for k in sorted(np.flatnonzero(r <= r[best] + SLACK), key=lambda i: (round(abs(g[i] - g[best]), 6), g[i])):
         add(float(g[k]))
     return tuple(out)
 

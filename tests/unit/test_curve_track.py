@@ -1,20 +1,22 @@
 """Curved seams on a linear track (docs/curves-welding.md section 11): the E1 values a curve is tried from, on a
-made-up room profile and on a tube's fillet beside the KR 5 arc's reach (no IK: the reach pre-check's bound)."""
+made-up room profile and on a tube's fillet beside the KR 5 arc's reach (no IK: the reach pre-check's bound); a
+curve no E1 brings in reach planned on the track beside a straight seam, refused with its reason, not dropped."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from tiny_cell import URDF
+from tiny_cell import HOME, OBSTACLES, TOP_SEAM, URDF
 
 from cell import scenario as sc
 from cell.motion.robot import RobotModel
 from cell.planning.curves.track import curve_e1s, curve_probes
 from cell.planning.plan import reach_model
-from cell.planning.track import MARGIN, e1_grid, reach_curves
+from cell.planning.track import MARGIN, e1_grid, plan_on_track, reach_curves
 from cell.process.torch import WeldProcess
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import SeamTask
 from cell.types.track import LinearTrack
 
 TRACK = LinearTrack(np.array([1.0, 0.0, 0.0]), -0.5, 2.0, 0.8, 1.5, 6.0)
@@ -61,3 +63,21 @@ def test_a_tube_beyond_the_fixed_reach_is_tried_with_the_base_abreast_of_it() ->
     assert sorted(abs(e - tries[0]) for e in tries[1:]) == pytest.approx([0.1, 0.1])
     for e in tries:
         assert room[int(np.argmin(np.abs(grid - e)))] <= -MARGIN
+
+
+def test_a_curve_out_of_reach_from_every_e1_is_tried_once_and_refused_beside_the_welded_seams() -> None:
+    """The tiny cell's top seam (welded from E1 = 0) and a tube 2.4 m beyond the track's end: every torch is out of
+    reach of it wherever the carriage stands, so it is planned once, at its best E1, and refused with the planner's
+    code; its outcome follows the straight seam's, and the plan welds the seam alone."""
+    robot = RobotModel.from_urdf(URDF)
+    track = LinearTrack(np.array([1.0, 0.0, 0.0]), -0.5, 1.2, 0.8, 1.5, 6.0)
+    process = WeldProcess.from_spec(sc.ProcessSpec())
+    sid, a, b, n_a, n_b = TOP_SEAM
+    far = _fillet((3.6, 0.8, 0.05))
+    plan = plan_on_track(robot, [SeamTask(sid, a, b, n_a, n_b)], HOME, process, OBSTACLES, track=track, curves=[far])
+    assert [o.seam_id for o in plan.seams] == [sid, far.id]
+    seam, curve = plan.seams
+    assert seam.feasible and not curve.feasible and curve.code is not None
+    assert "tried from E1" not in curve.reason  # one try, at its best E1
+    assert {s.seam_id for s in plan.segments if s.arc_on} == {sid}
+    assert plan.track is track and {s.e1_end for s in plan.segments if s.arc_on} == {0.0}

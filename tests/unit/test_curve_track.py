@@ -81,3 +81,32 @@ def test_a_curve_out_of_reach_from_every_e1_is_tried_once_and_refused_beside_the
     assert "tried from E1" not in curve.reason  # one try, at its best E1
     assert {s.seam_id for s in plan.segments if s.arc_on} == {sid}
     assert plan.track is track and {s.e1_end for s in plan.segments if s.arc_on} == {0.0}
+
+
+def test_a_circles_joints_are_found_with_the_base_where_the_track_has_it() -> None:
+    """A weld that turns A1 alone sweeps a circle about the base's axis; on a track 0.5 m along, its planned path
+    (in R) is 0.5 m off the arm's own kinematics: each circular move's joints are those of the trajectory where it
+    passes the move's end, found with the base moved (without it, the nearest sample is the wrong one)."""
+    from cell.export.circles import base_at, curve_moves
+    from cell.geometry import make_pose
+    from cell.types.plan import Segment, WeldPlan
+    from cell.types.trajectory import Trajectory
+
+    robot = RobotModel.from_urdf(URDF)
+    track = LinearTrack(np.array([1.0, 0.0, 0.0]), -0.5, 1.2, 0.8, 1.5, 6.0)
+    n = 301
+    q = np.tile(np.asarray(HOME, dtype=float), (n, 1))
+    q[:, 0] += np.linspace(-1.2, 1.2, n)  # A1 through 138 deg: a circle about the base's z axis
+    tr = Trajectory(np.linspace(0.0, 3.0, n), q, np.zeros_like(q), np.zeros_like(q)).with_e1(0.5)
+    d_R = track.offset_R(0.5)
+    X_path = np.stack([make_pose(p=d_R) @ robot.fk(qi) for qi in q])
+    seg = Segment("weld", "C", tr, 0.0, X_path[-1], speed=0.01, arc_on=True, X_path=X_path)
+    plan = WeldPlan(robot.joint_names, np.asarray(HOME, dtype=float), (seg,), (), (), 0.0, track=track)
+    np.testing.assert_allclose(base_at(plan, seg), d_R)
+    moves = curve_moves(seg, robot, base_at(plan, seg))
+    assert len(moves) == 2 and all(m.kind == "CIRC" for m in moves)  # 138 deg: two circular moves of 69
+    k = int(np.argmin(np.linalg.norm(X_path[:, :3, 3] - moves[0].X_end[:3, 3], axis=1)))
+    np.testing.assert_allclose(moves[0].q_end, q[k], atol=1e-9)
+    assert 0.4 * n < k < 0.6 * n
+    wrong = curve_moves(seg, robot)[0].q_end  # as on a fixed base: a sample far from the move's end
+    assert abs(wrong[0] - q[k][0]) > 0.1

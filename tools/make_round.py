@@ -1,10 +1,10 @@
-"""Generate the round-part weldment maps: ``maps/pipe_flange.dxf``, ``maps/pipe_stub.dxf``, ``maps/railing.dxf``,
-``maps/round_brace.dxf`` and ``maps/tube_tee.dxf`` (tubes tessellated as MESH bodies, their curved seams as CIRCLE,
-ELLIPSE and SPLINE).
+"""Generate the round-part weldment maps: ``maps/pipe_flange.dxf``, ``maps/pipe_stub.dxf``, ``maps/post_plate.dxf``,
+``maps/railing.dxf``, ``maps/round_brace.dxf`` and ``maps/tube_tee.dxf`` (tubes tessellated as MESH bodies, their
+curved seams as CIRCLE, ELLIPSE and SPLINE).
 
 Run from the repository root::
 
-    .venv/bin/python tools/make_round.py            # writes the five maps into maps/
+    .venv/bin/python tools/make_round.py            # writes the six maps into maps/
     .venv/bin/python tools/make_round.py --out DIR  # somewhere else
 
 Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists the scenarios that use them):
@@ -14,6 +14,8 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
   the pipe's fillet is a CIRCLE (a T, cylinder on plane), the gussets' fillets are LINEs (16);
 - ``pipe_stub``: the same pipe 250 mm tall on a 360 x 360 x 20 flange plate, no gussets: its fillet a CIRCLE alone,
   welded all round on a positioner (a shop welds it before any gusset goes on);
+- ``post_plate``: a 60 x 4 post 80 mm tall (48 facets) on a 200 x 200 x 10 base plate: its fillet a CIRCLE alone
+  (the ``track-post`` scenario, welded from a linear track);
 - ``railing``: two 48.3 x 3.2 posts between a flat-bar bottom rail (lying on the table) and a flat-bar top rail
   (60 x 10) 600 mm above it, three 40 x 10 x 250 flat balusters standing on the bottom rail; the posts' four
   fillets are CIRCLEs (those under the top rail overhead), the balusters' six are LINEs;
@@ -110,6 +112,15 @@ def build_pipe_stub() -> ezdxf.document.Drawing:
     return m.doc
 
 
+def build_post_plate() -> ezdxf.document.Drawing:
+    m = _Map()
+    R, wall, H, T = 30.0, 4.0, 80.0, 10.0  # a 60 mm post standing on a small base plate (welded on a track)
+    m.body("PLATE", box_mesh((-100.0, -100.0, 0.0), (100.0, 100.0, T)))
+    m.body("POST", tube_mesh(R, R - wall, 48, *_flat(T, T + H), np.eye(4)))
+    add_circle_seam(m.msp, "POST>PLATE:circle", (0.0, 0.0, T), R, (0.0, 0.0, 1.0), SEAM_LAYER)
+    return m.doc
+
+
 def build_railing() -> ezdxf.document.Drawing:
     m = _Map()
     L, bw, bt, H = 1200.0, 60.0, 10.0, 600.0  # rails: length, width, thickness; posts' height between the rails
@@ -179,6 +190,7 @@ def build_tube_tee() -> ezdxf.document.Drawing:
 MAPS: dict[str, Callable[[], ezdxf.document.Drawing]] = {
     "pipe_flange": build_pipe_flange,
     "pipe_stub": build_pipe_stub,
+    "post_plate": build_post_plate,
     "railing": build_railing,
     "round_brace": build_round_brace,
     "tube_tee": build_tube_tee,

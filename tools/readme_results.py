@@ -235,6 +235,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
     "curve-weld-located": lambda results: curve_weld_tables.located_table(
         _load_object(results, "curve_weld_located.json")
     ),
+    "curve-track": lambda results: curve_weld_tables.located_table(_load_object(results, "curve_track.json")),
     "positioner": lambda results: positioner_tables.positioner_table(_load_object(results, "positioner.json")),
     "coordinated": lambda results: positioner_tables.coordinated_table(_load_object(results, "coordinated.json")),
 }

@@ -10,9 +10,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray
-from cell.types.plan import Segment
+from cell.types.plan import Segment, WeldPlan
 from cell.types.robot import Kinematics
 
 CHORD_TOL_M = 0.0001  # [m] a chord's largest distance from the path it stands for
@@ -63,7 +64,8 @@ def swept(p: FloatArray, centre: FloatArray, normal: FloatArray) -> FloatArray:
 
 
 def _q_at(seg: Segment, robot: Kinematics, p: FloatArray) -> FloatArray:
-    """(dof,) the weld trajectory's joints where its TCP passes nearest p (3,) (every 10 ms, then refined)."""
+    """(dof,) the weld trajectory's joints where its TCP passes nearest p (3,) (every 10 ms, then refined; p in the
+    arm's own base frame)."""
     tr = seg.trajectory
     step = max(1, len(tr.times) // max(1, int(tr.duration / 0.01)))
     idx = np.arange(0, len(tr.times), step)
@@ -74,12 +76,19 @@ def _q_at(seg: Segment, robot: Kinematics, p: FloatArray) -> FloatArray:
     return np.asarray(tr.q[near])
 
 
-def curve_moves(seg: Segment, robot: Kinematics) -> list[Move]:
+def base_at(plan: WeldPlan, seg: Segment) -> FloatArray:
+    """(3,) [m] in R: where the plan's linear track has the arm's base at the end of ``seg`` (zero without one)."""
+    return np.zeros(3) if plan.track is None else np.asarray(plan.track.offset_R(seg.e1_end), dtype=float)
+
+
+def curve_moves(seg: Segment, robot: Kinematics, base_R: npt.ArrayLike = (0.0, 0.0, 0.0)) -> list[Move]:
     """The moves of a curved weld segment (``seg.X_path``): circular moves when its path is a circle or an arc of
     one (within :data:`CIRCLE_TOL_M`), each through the path's middle knot between its ends; else the fewest
-    chords each within :data:`CHORD_TOL_M` of every knot it passes."""
+    chords each within :data:`CHORD_TOL_M` of every knot it passes. ``base_R`` (3,) [m]: where a linear track has
+    the arm's base during the weld (its E1 times the axis), each move's joints found with it."""
     X = np.asarray(seg.X_path)
     p = X[:, :3, 3]
+    p_arm = p - np.asarray(base_R, dtype=float)
     centre, n, r, err = fit_circle(p)
     out: list[Move] = []
     if err <= CIRCLE_TOL_M and r > 0.0:
@@ -90,7 +99,7 @@ def curve_moves(seg: Segment, robot: Kinematics) -> list[Move]:
         cuts[0], cuts[-1] = 0, len(X) - 1
         for a, b in itertools.pairwise(cuts):
             m = int(np.argmin(np.abs(np.abs(ang) - 0.5 * (abs(ang[a]) + abs(ang[b])))))
-            q = seg.q_end if b == len(X) - 1 else _q_at(seg, robot, p[b])
+            q = seg.q_end if b == len(X) - 1 else _q_at(seg, robot, p_arm[b])
             out.append(Move("CIRC", X[b], q, X[m], float(abs(ang[b] - ang[a])), centre, r))
         return out
     i = 0
@@ -98,7 +107,7 @@ def curve_moves(seg: Segment, robot: Kinematics) -> list[Move]:
         j = i + 1
         while j + 1 < len(X) and _chord_error(p, i, j + 1) <= CHORD_TOL_M:
             j += 1
-        q = seg.q_end if j == len(X) - 1 else _q_at(seg, robot, p[j])
+        q = seg.q_end if j == len(X) - 1 else _q_at(seg, robot, p_arm[j])
         out.append(Move("LIN", X[j], q, chord=_chord_error(p, i, j)))
         i = j
     return out

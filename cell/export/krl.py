@@ -12,7 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.config.export import KrlOptions
-from cell.export.circles import CHORD_TOL_M, Move, curve_moves
+from cell.export.circles import CHORD_TOL_M, Move, base_at, curve_moves
 from cell.export.krl_data import X_TOOL, arc_data, e6axis, e6pos, num, procedure_line, setup_block, track_header
 from cell.export.krl_external import base_lines, positioner_header, positioner_move
 from cell.export.program import ProgramJob, not_welded_lines, procedure_of, write_texts
@@ -165,7 +165,7 @@ class _Program:
         """A weld along a curve (:func:`cell.export.circles.curve_moves`): each circular move or chord in its own
         ArcTech form (ARC_SWI, the last ARC_OFF, or ARC_SWI into ``nxt``, a next weld), or plain motions then the
         arc off."""
-        moves = curve_moves(seg, self.job.robot)
+        moves = curve_moves(seg, self.job.robot, base_at(self.job.plan, seg))
         self.src.append(f";- weld along a curve, seam {seg.seam_id}: {len(moves)} moves")
         if self.opt.arc == "arctech":
             for k, mv in enumerate(moves):

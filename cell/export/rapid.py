@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cell.export.circles import curve_moves
+from cell.export.circles import base_at, curve_moves
 from cell.export.program import ProgramJob, not_welded_lines, procedure_of
 from cell.export.status_turn import A1_FRAME, A2_FRAME, A3_FRAME, WRIST_FRAME
 from cell.geometry import FloatArray, invert
@@ -169,7 +169,7 @@ def rapid_text(job: ProgramJob) -> str:
         wobj = "tWeld \\WObj:=wobjPart"
         arc_next = nxt is not None and nxt.kind == "weld"
         if seg.kind == "weld" and seg.X_path is not None:  # a curve: ArcC through its circles or ArcL chords
-            n, moves = n - 1, curve_moves(seg, robot)
+            n, moves = n - 1, curve_moves(seg, robot, base_at(plan, seg))
             decl.pop()  # the end is the last move's
             i = proc_index(seg)
             for k, mv in enumerate(moves):

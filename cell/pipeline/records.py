@@ -93,7 +93,7 @@ class Detection:
     def not_welded(self) -> tuple[UnsupportedSeam, ...]:
         """Every seam of the map this run will not weld, with its reason (:attr:`WeldMap.not_straight`), a curved
         seam's from its estimate and the weld run (``curve_welds``): welded, it is left out; tried and not welded,
-        the planner's code (or the weld's: ``no_torch_path`` on a track, ``preview``); located and never tried (a
+        the planner's code (or the weld's: ``preview``, ``not_executed``); located and never tried (a
         detection), ``curved_no_torch_path``; not located, why not (``curved_not_located``)."""
         curves = {e.id: e for e in self.curve_estimates}
         out = []

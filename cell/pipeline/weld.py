@@ -65,7 +65,7 @@ def plan_for(
     tacks : the tack welds to lay first (:mod:`cell.pipeline.tacks`, from the seam tasks): welded before every
         seam, each with its seam's procedure; the plan's outcomes list them after the seams (an arm on a track
         lays none).
-    curves : located curved seams (in R) to weld too (:func:`cell.planning.plan.plan_welds`; not on a track).
+    curves : located curved seams (in R) to weld too (:func:`cell.planning.plan.plan_welds`; on a track too).
     elsewhere : another pose may hold a seam (a positioner's): :func:`~cell.planning.plan.plan_welds`'s.
     """
     from cell.gate import find_violations
@@ -125,7 +125,7 @@ def plan_for(
             checker=checker,
             procedures=procs | tack_procedures(procs, kept_tacks),
             on_seam=seam_counter(progress) if not dropped else None,
-            **({"curves": [c for c in curves if c.id not in dropped]} if track is None else {}),
+            curves=[c for c in curves if c.id not in dropped],
         )
         progress(
             "safety gate: limits at 1 kHz, collisions along the path, singularities, arc at exact stops, the wire"
@@ -241,8 +241,7 @@ def weld(
             mode = sc.rescan.mode
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
-                if sc.robot.track is None:  # a curve is planned on a fixed arm only: its doubtful ones up close
-                    rs, det = curves_rescanned(station, det, rs, motion=motion, progress=progress)
+                rs, det = curves_rescanned(station, det, rs, motion=motion, progress=progress)  # a track's: at E1 0
                 if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
                     hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:
@@ -266,7 +265,7 @@ def weld(
             }
             t = time.perf_counter()
             q_start = rs.q_end if rs is not None else None
-            curves = curves_to_plan(det, sc.robot.track is not None, skip=list(checked))
+            curves = curves_to_plan(det, skip=list(checked))
             straight = any(e.status is SeamStatus.FOUND and e.id not in low for e in det.estimates)
             if (low or done) and not straight and not curves:
                 progress(f"nothing to weld: all {len(low)} found seams too uncertain (low_confidence)" if low else
@@ -299,7 +298,7 @@ def weld(
         refused = f"not executed: {error.message}" if error is not None else ""
         pre_s = pre.duration if pre is not None else 0.0
         seams = seam_welds(det, plan, ex, pre_s, refused, sc, execute_plan, hopeless, checked)
-        det = replace(det, curve_welds=curve_seam_welds(det, plan, ex, pre_s, refused, sc.robot.track is not None))
+        det = replace(det, curve_welds=curve_seam_welds(det, plan, ex, pre_s, refused))
         if closeups:
             from cell.pipeline.closeup_plan import with_closeups
 

@@ -20,12 +20,15 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
 from cell.planning.blend import blend_plan, blend_track
+from cell.planning.curves import weldable
+from cell.planning.curves.track import curve_e1s, curve_probes, retried
 from cell.planning.plan import plan_welds, reach_model, seam_process
 from cell.planning.reach import ReachModel, cone_excess
 from cell.planning.track_moves import GroupLegs, TrackMoves, stitched
 from cell.planning.transfers import Transfers
 from cell.process.torch import WeldProcess, fillet_axes
 from cell.types import Part
+from cell.types.curve_estimate import CurveEstimate
 from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, Segment, WeldPlan
 from cell.types.track import LinearTrack
 from cell.types.trajectory import Trajectory
@@ -158,10 +161,13 @@ def plan_on_track(
     checker: CollisionChecker | None = None,
     procedures: Mapping[str, SeamProcedure | NoProcedure] | None = None,
     on_seam: Callable[[int, int], None] | None = None,
+    curves: Sequence[CurveEstimate] = (),
 ) -> WeldPlan:
     """:func:`~cell.planning.plan.plan_welds` for an arm on ``track`` (module docstring): the same arguments and the
     same plan, whose segments carry E1 and whose ``track`` is set. ``robot`` is the arm with its base at R
-    (E1 = 0). Raises PlanError when home is outside the limits or collides at E1 = 0; a group whose home collides
+    (E1 = 0). Each found curve of ``curves`` is welded whole from one E1, the carriage still while its arcs burn
+    (:mod:`cell.planning.curves.track`): in a group of the straight seams where it has the room, else in one of
+    its own. Raises PlanError when home is outside the limits or collides at E1 = 0; a group whose home collides
     at its E1 has its seams refused (collision) with that reason."""
     t_start = time.perf_counter()
     opt = options or PlanOptions()
@@ -171,54 +177,69 @@ def plan_on_track(
     chosen = procedures or {}
     reach = reach_model(robot)
     live = [t for t in tasks if not isinstance(chosen.get(t.id), NoProcedure)]
+    found = weldable(curves)
+    grid = e1_grid(track)
     if reach is None or not live:
-        groups = [TrackGroup(0.0, tuple(t.id for t in tasks))]
+        groups = [TrackGroup(0.0, tuple(t.id for t in tasks))] if tasks else []
     else:
         procs = [seam_process(process, s if isinstance(s := chosen.get(t.id), SeamProcedure) else None) for t in live]
-        grid = e1_grid(track)
         groups = group_seams([t.id for t in live], reach_curves(reach, live, procs, track, grid), grid)
         dead = tuple(t.id for t in tasks if isinstance(chosen.get(t.id), NoProcedure))
         if dead:  # no procedure: refused by the planner wherever it is planned
             groups[0] = TrackGroup(groups[0].e1, groups[0].seam_ids + dead)
+    tries = {c.id: _curve_e1s(reach, c, process, chosen.get(c.id), track, grid, groups) for c in found}
+    at: dict[float, tuple[list[SeamTask], list[CurveEstimate]]] = {}
     by_id = {t.id: t for t in tasks}
+    for g in groups:
+        at[g.e1] = ([by_id[i] for i in g.seam_ids], [])
+    for c in found:
+        at.setdefault(tries[c.id][0], ([], []))[1].append(c)
     outcomes: dict[str, SeamOutcome] = {}
-    legs: list[GroupLegs] = []
-    order: list[str] = []
+    plans: list[tuple[float, WeldPlan]] = []
     done = 0
     base0 = checker.base_offset_R
     exact = replace(opt, blend=0.0)  # each group approximated once its ways from and to home are known
+
+    def plan_at(e1: float, seams: list[SeamTask], arcs: list[CurveEstimate], count: bool = True) -> WeldPlan | None:
+        nonlocal done
+        counter = None if on_seam is None or not count else _offset_counter(on_seam, done, len(tasks))
+        checker.set_base(track.offset_R(e1))
+        try:
+            return plan_welds(
+                _arm_at(robot, track, e1),
+                seams,
+                q0,
+                process,
+                obstacles,
+                options=exact,
+                rng=rng,
+                checker=checker,
+                procedures=chosen,
+                on_seam=counter,
+                curves=arcs,
+            )
+        except PlanError as exc:
+            if e1 == 0.0:
+                raise
+            why = f"home collides with the base at E1 = {e1 * 1000:.0f} mm on the track: {exc.message}"
+            for sid, p in [*((t.id, t.p_start) for t in seams), *((c.id, c.p_RS[0]) for c in arcs)]:
+                outcomes[sid] = SeamOutcome(sid, False, f"collision: {why}", readonly(p), code=PlanReason.COLLISION)
+            return None
+        finally:
+            done += len(seams) if count else 0
+
     try:
-        for g in groups:
-            group_tasks = [by_id[i] for i in g.seam_ids]
-            counter = None if on_seam is None else _offset_counter(on_seam, done, len(tasks))
-            checker.set_base(track.offset_R(g.e1))
-            try:
-                plan = plan_welds(
-                    _arm_at(robot, track, g.e1),
-                    group_tasks,
-                    q0,
-                    process,
-                    obstacles,
-                    options=exact,
-                    rng=rng,
-                    checker=checker,
-                    procedures=chosen,
-                    on_seam=counter,
-                )
-            except PlanError as exc:
-                if g.e1 == 0.0:
-                    raise
-                why = f"home collides with the base at E1 = {g.e1 * 1000:.0f} mm on the track: {exc.message}"
-                for task in group_tasks:
-                    outcomes[task.id] = SeamOutcome(
-                        task.id, False, f"collision: {why}", readonly(task.p_start), code=PlanReason.COLLISION
-                    )
-                continue
-            finally:
-                done += len(group_tasks)
-            outcomes.update({o.seam_id: o for o in plan.seams})
+        for e1 in sorted(at):
+            plan = plan_at(e1, *at[e1])
+            if plan is not None:
+                outcomes.update({o.seam_id: o for o in plan.seams})
+                plans.append((e1, plan))
+        plans += retried(found, tries, outcomes, lambda e1, c: plan_at(e1, [], [c], count=False))
+        legs: list[GroupLegs] = []
+        order: list[str] = []
+        for e1, plan in sorted(plans, key=lambda ep: ep[0]):  # the carriage one way out, back home at the end
             if plan.segments:
-                legs.append(GroupLegs.split(g.e1, plan.segments))
+                legs.append(GroupLegs.split(e1, plan.segments))
                 order += plan.order
         checker.set_base(base0)
         moves = TrackMoves(robot, track, checker, obstacles, process.stickout, q0, opt)
@@ -240,11 +261,31 @@ def plan_on_track(
         joint_names=robot.joint_names,
         q_home=readonly(q0),
         segments=tuple(segments),
-        seams=tuple(outcomes[t.id] for t in tasks),
+        seams=tuple(outcomes[i] for i in [*(t.id for t in tasks), *(c.id for c in found)]),
         order=tuple(order),
         planning_s=time.perf_counter() - t_start,
         track=track,
     )
+
+
+def _curve_e1s(
+    reach: ReachModel | None,
+    curve: CurveEstimate,
+    process: WeldProcess,
+    sel: SeamProcedure | NoProcedure | None,
+    track: LinearTrack,
+    grid: FloatArray,
+    groups: Sequence[TrackGroup],
+) -> tuple[float, ...]:
+    """The E1 values [m] a found curve is tried from (:func:`cell.planning.curves.track.curve_e1s`): E1 = 0 only
+    without a reach model; a curve with no procedure where the first group is (the planner refuses it)."""
+    if isinstance(sel, NoProcedure) or reach is None:
+        return (groups[0].e1 if groups else 0.0,)
+    probes = curve_probes(curve)
+    proc = seam_process(process, sel)
+    room = reach_curves(reach, probes, [proc] * len(probes), track, grid).max(axis=0)
+    sure = reach_curves(reach, probes, [proc] * len(probes), track, grid, cone=True).max(axis=0)
+    return curve_e1s(room, grid, [0.0, *(g.e1 for g in groups)], MARGIN, sure)
 
 
 def _arm_at(robot: RobotModel, track: LinearTrack, e1: float) -> RobotModel:

@@ -92,9 +92,10 @@ def check_kinematics(
     p: Program, robot: Kinematics, base_R: dict[str, Any] | None = None, circles: bool = False
 ) -> list[Finding]:
     """S and T of every E6POS reached by a LIN against the arm (module docstring); unreachable points. base_R : the
-    base in $ROBROOT when no BASE_DATA gives it (a positioner's, at the program's axes). ``circles``: a CIRC's
-    auxiliary and end points too, each reached from the point before (a coordinated weld's, where the torch nearly
-    stands still while the part turns)."""
+    base in $ROBROOT when no BASE_DATA gives it (a positioner's, at the program's axes). A CIRC's auxiliary and
+    end points are followed too, each from the point before (so that a LIN after a circle starts where the circle
+    left the wrist: round a tube A4 and A6 wind on); their S and T are checked with ``circles`` only (a coordinated
+    weld's, where the torch nearly stands still while the part turns: the controller ignores them on a CIRC)."""
     ti, bi = _index(p, "TOOL"), _index(p, "BASE")
     tool = p.src.setup.get(f"TOOL_DATA[{ti}]") if ti is not None else None
     base = base_R if base_R is not None else p.src.setup.get(f"BASE_DATA[{bi}]") if bi is not None else None
@@ -106,7 +107,7 @@ def check_kinematics(
     out: list[Finding] = []
     q: FloatArray | None = None
     moves = [(s.kind, pt) for s in p.src.statements for pt in ([s.aux, s.point] if s.kind == "CIRC" else [s.point])
-             if s.kind in ("PTP", "LIN", "SPTP", "SLIN") or (circles and s.kind == "CIRC")]  # fmt: skip
+             if s.kind in ("PTP", "LIN", "SPTP", "SLIN", "CIRC")]  # fmt: skip
     for kind, point in moves:
         name = point.upper() if isinstance(point, str) else ""
         d = p.dat.decls.get("XHOME_PLAN" if name == "XHOME" else name)
@@ -123,6 +124,8 @@ def check_kinematics(
             msg = f"{d.name}: the arm does not reach it on a line from the point before ({off})"
             out.append(Finding(p.dat_name, d.line, "kinematics", msg))
             q = None
+            continue
+        if kind == "CIRC" and not circles:
             continue
         st = status_turn(robot, q, geo)
         written = (value.get("S"), value.get("T"))

@@ -1,5 +1,5 @@
-"""What became of every located curved seam of a weld run: handed to the planner (the found ones, on a fixed
-arm), then welded with its executed TCP against the true curve, or why not with the planner's code
+"""What became of every located curved seam of a weld run: handed to the planner (the found ones; on a track
+too), then welded with its executed TCP against the true curve, or why not with the planner's code
 (docs/curves-welding.md). Values in, values out; frames: R (the robot base) [m]."""
 
 from __future__ import annotations
@@ -17,8 +17,6 @@ from cell.types.run import SeamWeld, WeldReason
 if TYPE_CHECKING:
     from cell.types.execution import Execution
     from cell.types.plan import WeldPlan
-
-ON_TRACK = "curved seams are not planned for an arm on a linear track (its planner takes straight seams only)"
 
 
 def curve_doubt(c: CurveEstimate, sc: Scenario) -> Doubt | None:
@@ -41,12 +39,9 @@ def curve_doubt(c: CurveEstimate, sc: Scenario) -> Doubt | None:
     return None
 
 
-def curves_to_plan(det: Detection, on_track: bool, skip: Sequence[str] = ()) -> list[CurveEstimate]:
-    """The located (found) curved seams the planner is given: none for an arm on a track (each is then reported
-    ``no_torch_path``: :func:`curve_seam_welds`), never those in ``skip`` nor one too uncertain to weld
-    (:func:`curve_doubt`)."""
-    if on_track:
-        return []
+def curves_to_plan(det: Detection, skip: Sequence[str] = ()) -> list[CurveEstimate]:
+    """The located (found) curved seams the planner is given (a fixed arm's or one on a track), never those in
+    ``skip`` nor one too uncertain to weld (:func:`curve_doubt`)."""
     return [
         c
         for c in det.curve_estimates
@@ -60,12 +55,11 @@ def curve_seam_welds(
     ex: Execution | None,
     pre_s: float,
     refused: str,
-    on_track: bool,
 ) -> dict[str, SeamWeld]:
     """Curved seam id -> what became of it, for every found curve: welded (its quality against the true curve,
     where the station knows it), or not with its code: too uncertain (:func:`curve_doubt`), the planner's refusal
     (``not_planned`` with the planner's code), planned but not executed (``not_executed``: ``refused`` says why;
-    ``preview``), or not tried on a track (``no_torch_path``). pre_s [s]: the move before the plan."""
+    ``preview``). pre_s [s]: the move before the plan."""
     found = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
     outcomes = {o.seam_id: o for o in plan.seams} if plan is not None else {}
     closed = {c.id: c.closed for c in found if c.id in outcomes and outcomes[c.id].feasible}
@@ -81,8 +75,6 @@ def curve_seam_welds(
         doubt = curve_doubt(c, det.scenario)
         if doubt is not None:
             out[c.id] = SeamWeld(c.id, False, False, doubt.detail, code=doubt.code)
-        elif on_track:
-            out[c.id] = SeamWeld(c.id, False, False, ON_TRACK, code=WeldReason.NO_TORCH_PATH)
         elif o is None:
             why = refused or "not planned"
             code = WeldReason.NOT_EXECUTED if refused else WeldReason.NOT_PLANNED

@@ -25,7 +25,10 @@ from cell.weldmap.curved_joints import holding_face
 
 CURVE_METHODS = ("ours",)  # the locators that locate curved seams; the others answer NOT_SUPPORTED
 STEP_M = 0.001  # the located curve's samples are about this far apart [m]
-BAND_M = 0.003  # a surface's points lie within this of the map's surface [m] (the aligned map's error is less)
+# A surface's points are taken within this of the map's surface [m]: three of the noisiest fixed camera's scatter
+# about a surface (1.5 mm) beyond the aligned map's own offset (up to 1 mm), so that the cut keeps the scatter
+# whole on both sides (a narrower one shifts the points' mean towards the map); the fit's trim does the rest.
+BAND_M = 0.006
 CLEARANCE_M = 0.002  # points this close to the other surface are left out (the corner's blur, a tack) [m]
 REACH_M = 0.025  # how far from the other surface a plane's points are taken [m]: the fit is local
 ROUND_REACH_M = 0.120  # and a tube's [m]: its axis's direction wants a longer lever

@@ -27,10 +27,12 @@ CURVE_METHODS = ("ours",)  # the locators that locate curved seams; the others a
 STEP_M = 0.001  # the located curve's samples are about this far apart [m]
 # A surface's points are taken within a band of the map's surface [m]: three of their depth noise's scale (each
 # point's scatter about its neighbours across the surface: a camera's pose error, which moves its neighbours with
-# it, is not in it) beyond the aligned map's own offset, between these bounds: a band cut narrower than the scatter
-# shifts the points' mean towards the map (round-brace's plate, 1.5 mm of noise, 0.6 mm off the map: 0.14 mm).
+# it, is not in it) beyond the aligned map's own offset, between these bounds. A band cut narrower than the scatter
+# shifts the points' mean towards the map (round-brace's plate, 1.5 mm of noise, 0.6 mm off the map: 0.14 mm); past
+# 4.5 mm the noisiest cameras' points (2-2.5 mm on random cells) add more scatter than they take bias away
+# (docs/curves.md section 8).
 BAND_M = 0.003
-MAX_BAND_M = 0.006
+MAX_BAND_M = 0.0045
 BAND_SCALES = 3.0
 MAP_OFFSET_M = 0.001
 CLEARANCE_M = 0.002  # points this close to the other surface are left out (the corner's blur, a tack) [m]

@@ -9,7 +9,10 @@ aligned once, and its curved seams located by ours (:func:`cell.seams.curved.loc
 seed: the status and reason code, the RMS and largest distance of the located samples to the true curve [mm], the
 share of samples within 2 sigma of it, the largest ratio of error to sigma, the largest sigma, and the locator's time:
 the median of ``--repeats`` runs on the same scene, perception (the dense cloud's index) made before the clock
-starts, as wall time and as the thread's CPU time (what a loaded machine does not inflate). The rows and their
+starts, as wall time, as the process's CPU time (every thread's: a library's worker threads count too) and as the
+calling thread's, with the run's involuntary and voluntary context switches (the scheduler giving the core to
+another process; the locator waiting on something) and the machine's load average: on a shared machine the wall
+time is the CPU time plus the time the core was given to others (docs/curves.md section 3). The rows and their
 summary per seam go to ``--json`` (default ``benchmarks/results/curves.json``), which ``tools/readme_results.py``
 renders into docs/results.md.
 """
@@ -17,6 +20,8 @@ renders into docs/results.md.
 from __future__ import annotations
 
 import argparse
+import os
+import resource
 import shlex
 import statistics
 import sys
@@ -54,16 +59,9 @@ def rows_of(name: str, seed: int, repeats: int) -> list[dict[str, Any]]:
     truths = curve_truths(cap)
     ss = scene.seam_scene
     estimates = locate_curves("ours", ss)  # what the pipeline runs (and builds the dense cloud's index first)
-    wall, cpu = [], []  # [s] per curved seam, one list per repeat
-    for _ in range(repeats):
-        w, c = [], []
-        for seam in ss.weldmap.curved:
-            t0, c0 = time.perf_counter(), time.thread_time()
-            locate_curve(ss, seam)
-            w.append(time.perf_counter() - t0)
-            c.append(time.thread_time() - c0)
-        wall.append(w)
-        cpu.append(c)
+    # Per repeat, per curved seam: wall, process CPU, thread CPU [s], involuntary and voluntary switches.
+    runs = [[_timed(ss, seam) for seam in ss.weldmap.curved] for _ in range(repeats)]
+    load = os.getloadavg()[0]
     rows = []
     for k, est in enumerate(estimates):
         row: dict[str, Any] = {
@@ -72,8 +70,12 @@ def rows_of(name: str, seed: int, repeats: int) -> list[dict[str, Any]]:
             "seam": est.id,
             "status": est.status.value,
             "code": est.code.value if est.code is not None else None,
-            "time_ms": statistics.median(r[k] for r in wall) * 1000.0,
-            "cpu_ms": statistics.median(r[k] for r in cpu) * 1000.0,
+            "time_ms": statistics.median(r[k][0] for r in runs) * 1000.0,
+            "cpu_ms": statistics.median(r[k][1] for r in runs) * 1000.0,
+            "thread_cpu_ms": statistics.median(r[k][2] for r in runs) * 1000.0,
+            "preempted": statistics.median(r[k][3] for r in runs),
+            "waited": statistics.median(r[k][4] for r in runs),
+            "load": round(load, 2),
         }
         if est.status is SeamStatus.FOUND and est.id in truths:
             m = curve_error(est, truths[est.id])
@@ -93,9 +95,20 @@ def rows_of(name: str, seed: int, repeats: int) -> list[dict[str, Any]]:
     return rows
 
 
+def _timed(ss: Any, seam: Any) -> tuple[float, float, float, int, int]:
+    """One run of the locator on ``seam``: wall, process CPU and thread CPU time [s], and the involuntary and
+    voluntary context switches during it."""
+    r0 = resource.getrusage(resource.RUSAGE_SELF)
+    t0, p0, c0 = time.perf_counter(), time.process_time(), time.thread_time()
+    locate_curve(ss, seam)
+    t, p, c = time.perf_counter() - t0, time.process_time() - p0, time.thread_time() - c0
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
+    return t, p, c, r1.ru_nivcsw - r0.ru_nivcsw, r1.ru_nvcsw - r0.ru_nvcsw
+
+
 def summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Per scenario and curved seam, over the seeds: found of runs, the worst RMS and max error [mm], the share of
-    all samples within 2 sigma, the worst sigma and the median time [ms]."""
+    all samples within 2 sigma, the worst sigma, the median times [ms], context switches and load average."""
     out = []
     keys = list(dict.fromkeys((r["scenario"], r["seam"]) for r in rows))
     for name, seam in keys:
@@ -115,6 +128,10 @@ def summary(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
                 "sigma_max_mm": max((r["sigma_max_mm"] for r in found), default=None),
                 "time_ms_median": statistics.median(r["time_ms"] for r in mine),
                 "cpu_ms_median": statistics.median(r["cpu_ms"] for r in mine),
+                "thread_cpu_ms_median": statistics.median(r["thread_cpu_ms"] for r in mine),
+                "preempted_median": statistics.median(r["preempted"] for r in mine),
+                "waited_median": statistics.median(r["waited"] for r in mine),
+                "load_median": statistics.median(r["load"] for r in mine),
             }
         )
     return out

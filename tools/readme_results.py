@@ -190,10 +190,11 @@ def headline(results: Path) -> str:
 def curves(results: Path) -> str:
     """Curved seams located on the round-part scenarios (``curves.json``, by ``benchmarks/bench_curves.py``): per
     seam over the seeds, found of runs, the worst RMS and max error against the true curve, the share of samples
-    within 2 sigma, the largest sigma and the locator's median time (wall, and the thread's CPU)."""
+    within 2 sigma, the largest sigma and the locator's median time (wall, and the process's CPU), with the load
+    average and the context switches during a run where the results have them."""
     data = _load_object(results, "curves.json")
     lines = [
-        "| scenario | curved seam | found | RMS [mm] | max [mm] | within 2 sigma | sigma max [mm] | time [ms] "
+        "| scenario | curved seam | found | RMS [mm] | max [mm] | within 2 sigma | sigma max [mm] | wall [ms] "
         "| CPU [ms] |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
@@ -204,7 +205,19 @@ def curves(results: Path) -> str:
             f"| {pct(r['within_2sigma'])} | {num(r['sigma_max_mm'])} | {r['time_ms_median']:.1f} "
             f"| {r['cpu_ms_median']:.1f} |"
         )
-    return "\n".join(lines) + f"\n\n`{data['command']}` (commit {data['commit'][:10]})\n"
+    rows = data["summary"]
+    note = ""
+    if rows and "load_median" in rows[0]:
+        loads = [r["load_median"] for r in rows]
+        apart = max(abs(r["cpu_ms_median"] - r["thread_cpu_ms_median"]) for r in rows)
+        note = (
+            f"\n\nLoad average {min(loads):.1f}-{max(loads):.1f} on 2 cores; per run "
+            f"{min(r['preempted_median'] for r in rows):.0f}-{max(r['preempted_median'] for r in rows):.0f} "
+            f"involuntary context switches (the core given to another process) and "
+            f"{max(r['waited_median'] for r in rows):.0f} voluntary ones (nothing waited on); the process's CPU "
+            f"time equals the thread's within {apart:.1f} ms."
+        )
+    return "\n".join(lines) + note + f"\n\n`{data['command']}` (commit {data['commit'][:10]})\n"
 
 
 BLOCKS: Mapping[str, Callable[[Path], str]] = {

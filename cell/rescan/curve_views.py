@@ -5,13 +5,26 @@ takes a straight seam's (docs/curves-welding.md section 8). Frames: R; metres.""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from cell.config.motion import ViewOptions
 from cell.rescan.view_grid import ViewTarget
 from cell.types.curve_estimate import CurveEstimate
 
 MAX_PIECE_M = 0.06  # [m] a piece at most this long: the close-up's image holds it with its faces
 MAX_SAGITTA_M = 0.004  # [m] and its chord at most this far from the curve
+# [m] a curve's close-up stand-offs where the usual ones (ViewOptions.distances_m, 0.33-0.44 m) give no view the arm
+# takes: a fillet under a rail, seen from below at its post, wants the camera nearer. A stereo camera measures this
+# near with its disparity search shifted (the D4xx's "disparity shift": its far range, which a close-up does not
+# need, is given up); its depth noise shrinks as the distance squared.
+NEAR_DISTANCES_M = (0.30, 0.26, 0.22)
+
+
+def near_view(view: ViewOptions) -> ViewOptions:
+    """``view`` with the stand-offs of :data:`NEAR_DISTANCES_M` (the middle one preferred) and no fallback grid."""
+    return replace(view, distances_m=NEAR_DISTANCES_M, preferred_distance_m=NEAR_DISTANCES_M[1], fallback_tilts_deg=())
 
 
 def worst_first(est: CurveEstimate, max_sigma_m: float) -> list[ViewTarget]:
@@ -74,4 +87,4 @@ def _fits(p: np.ndarray, i: int, j: int) -> bool:
     return bool(np.max(np.linalg.norm(p[i + 1 : j] - (a + t[:, None] * ab), axis=1)) <= MAX_SAGITTA_M)
 
 
-__all__ = ["MAX_PIECE_M", "MAX_SAGITTA_M", "curve_view_targets", "worst_first"]
+__all__ = ["MAX_PIECE_M", "MAX_SAGITTA_M", "NEAR_DISTANCES_M", "curve_view_targets", "near_view", "worst_first"]

@@ -149,3 +149,22 @@ def test_the_close_ups_re_locate_the_curve_and_the_fusion_keeps_it_within_two_si
 
 def _scene(wm: object, cloud: Cloud) -> SeamScene:
     return SeamScene(voxel=cloud, dense=cloud, weldmap=wm, joints={}, table_z=0.0)  # type: ignore[arg-type]
+
+
+def test_a_curve_no_fixed_camera_sees_is_looked_for_where_the_map_draws_it_and_nearer(tmp_path: Path) -> None:
+    from cell.config.motion import ViewOptions
+    from cell.rescan.curve_views import near_view
+    from cell.seams.curved.drawn import drawn_estimate
+
+    wm = _drawn_tube_on_plate(tmp_path, 0.0)
+    [seam] = wm.curved
+    est = drawn_estimate(wm, seam, 0.006)
+    assert est is not None and est.status is SeamStatus.FOUND and est.closed and est.end_sigma_m == (0.0, 0.0)
+    assert float(distances_to_polyline(est.p_RS, seam.sample(0.0002), True).max()) < 1e-6
+    radial = est.p_RS * [1.0, 1.0, 0.0]
+    np.testing.assert_allclose(est.n_abutting_R, radial / np.linalg.norm(radial, axis=1, keepdims=True), atol=1e-9)
+    np.testing.assert_allclose(est.n_receiving_R, np.tile([0.0, 0.0, 1.0], (len(est.p_RS), 1)), atol=1e-9)
+    assert len(worst_first(est, 2e-4)) >= 3  # the whole curve is doubtful: every stretch is a view target
+    usual, near = ViewOptions(), near_view(ViewOptions())
+    assert max(near.distances_m) < min(usual.distances_m) and near.preferred_distance_m in near.distances_m
+    assert near.fallback_tilts_deg == () and near.rolls_deg == usual.rolls_deg

@@ -19,7 +19,7 @@ from cell.pipeline.detect import Progress, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
 from cell.pipeline.rescan import _Run, back_to_scan
-from cell.types import DepthImage, SeamStatus
+from cell.types import DepthImage, Reason, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.rescan import Rescan
 
@@ -35,9 +35,14 @@ TRIED_M = 0.02  # [m] a stretch whose middle lies this near one tried already is
 
 def doubtful_curves(det: Detection) -> list[CurveEstimate]:
     """The found curves whose worst sample's bound is over the weld tolerance (``rescan.max_sigma_m``): those a
-    close-up may bring within it."""
+    close-up may bring within it; and those not found for a surface no fixed camera sees (``no_support``)."""
     limit = det.scenario.rescan.max_sigma_m
-    return [c for c in det.curve_estimates if c.status is SeamStatus.FOUND and c.sigma_max_m > limit]
+    return [
+        c
+        for c in det.curve_estimates
+        if (c.status is SeamStatus.FOUND and c.sigma_max_m > limit)
+        or (c.status is SeamStatus.NOT_FOUND and c.code is Reason.NO_SUPPORT)
+    ]
 
 
 def rescan_curves(
@@ -88,17 +93,24 @@ def curves_rescanned(
     return joined(rs, more), after
 
 
-def _rescan_curve(run: _Run, first: CurveEstimate, rng: np.random.Generator, progress: Progress) -> CurveEstimate:
-    """One curve's close-ups (see the module docstring): the fused curve, its reason saying what the re-scan did."""
+def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, progress: Progress) -> CurveEstimate:
+    """One curve's close-ups (see the module docstring): the fused curve, its reason saying what the re-scan did. A
+    curve not found (``found`` NOT_FOUND) is looked at where the aligned map draws it and located from the close-ups
+    alone, or stays not found."""
     from cell.perception.lens import undistort
     from cell.rescan.curve_fusion import closeup_curve_scene, facet_floor_m, fuse_curve, relocate, shared_sigma
-    from cell.rescan.curve_views import worst_first
+    from cell.rescan.curve_views import near_view, worst_first
     from cell.rescan.viewpoint import plan_view
+    from cell.seams.curved.drawn import drawn_estimate
 
     det, o = run.detection, run.options
     assert det.scene is not None
     base = det.scene.seam_scene
-    seam = next(s for s in base.weldmap.curved if s.id == first.id)
+    seam = next(s for s in base.weldmap.curved if s.id == found.id)
+    unseen = found.status is not SeamStatus.FOUND
+    first = drawn_estimate(base.weldmap, seam) if unseen else found
+    if first is None:
+        return found
     assert seam.joint is not None
     own = (seam.joint.abutting, seam.joint.receiving)
     parts = tuple(p for p in base.weldmap.parts if p.name not in own)
@@ -110,7 +122,7 @@ def _rescan_curve(run: _Run, first: CurveEstimate, rng: np.random.Generator, pro
     if floor > limit:
         why = f"not re-scanned: its round is drawn with flat facets, half their sagitta ({floor * 1000:.2f} mm here) is"
         return replace(
-            first, reason=f"{why} over the tolerance's sigma ({limit * 1000:.2f} mm) whatever a close-up sees"
+            found, reason=f"{why} over the tolerance's sigma ({limit * 1000:.2f} mm) whatever a close-up sees"
         )
     images: list[DepthImage] = []
     tried: list[FloatArray] = []
@@ -124,13 +136,17 @@ def _rescan_curve(run: _Run, first: CurveEstimate, rng: np.random.Generator, pro
         tried.append(target.mid)
         progress(f"re-scan curve {first.id}: close-up {len(images) + 1} of the stretch at sigma "
                  f"{_worst_mm(best, target):.2f} mm")  # fmt: skip
-        try:
-            vp = plan_view(
-                run.arm.model, run.checker, target, run.q, K, parts, base.table_z, rng=rng, q_via=run.arm.q_scan,
-                options=replace(o.view, fallback_tilts_deg=()),
-            )  # fmt: skip
-        except CellError as exc:
-            why = f"no view: {exc.message}"
+        vp = None
+        for view in (replace(o.view, fallback_tilts_deg=()), near_view(o.view)):  # the usual stand-offs, then nearer
+            try:
+                vp = plan_view(
+                    run.arm.model, run.checker, target, run.q, K, parts, base.table_z, rng=rng, q_via=run.arm.q_scan,
+                    options=view,
+                )  # fmt: skip
+                break
+            except CellError as exc:
+                why = f"no view: {exc.message}"
+        if vp is None:
             continue
         run.play(vp.move)
         run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]
@@ -143,7 +159,7 @@ def _rescan_curve(run: _Run, first: CurveEstimate, rng: np.random.Generator, pro
             why = f"close-ups: {closeup.reason}"
             continue
         before = best.sigma_max_m
-        best, weight = fuse_curve(first, closeup, shared)
+        best, weight = (closeup, 1.0) if unseen else fuse_curve(first, closeup, shared)
         if best.sigma_max_m <= limit:
             break
         if best.sigma_max_m > (1.0 - MIN_GAIN) * before:
@@ -151,8 +167,12 @@ def _rescan_curve(run: _Run, first: CurveEstimate, rng: np.random.Generator, pro
             break
     done = f"re-scanned up close ({len(images)} close-ups, weight {weight:.2f}; sigma up to "
     done += f"{first.sigma_max_m * 1000:.2f} -> {best.sigma_max_m * 1000:.2f} mm)"
+    if unseen:
+        if weight == 0.0:  # no close-up located it: it stays not found, the reason says what was tried
+            return replace(found, reason="; ".join(r for r in (found.reason, f"looked for up close: {why}") if r))
+        done = f"located from {len(images)} close-ups alone (sigma up to {best.sigma_max_m * 1000:.2f} mm)"
     why = why if best.sigma_max_m > limit else ""
-    return replace(best, reason="; ".join(r for r in (done, why, first.reason) if r))
+    return replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
 
 
 def _worst_mm(est: CurveEstimate, target: ViewTarget) -> float:

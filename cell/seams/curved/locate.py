@@ -25,7 +25,16 @@ from cell.weldmap.curved_joints import holding_face
 
 CURVE_METHODS = ("ours",)  # the locators that locate curved seams; the others answer NOT_SUPPORTED
 STEP_M = 0.001  # the located curve's samples are about this far apart [m]
-BAND_M = 0.003  # a surface's points lie within this of the map's surface [m] (the aligned map's error is less)
+# A surface's points are taken within a band of the map's surface [m]: three of their depth noise's scale (each
+# point's scatter about its neighbours across the surface: a camera's pose error, which moves its neighbours with
+# it, is not in it) beyond the aligned map's own offset, between these bounds. A band cut narrower than the scatter
+# shifts the points' mean towards the map (round-brace's plate, 1.5 mm of noise, 0.6 mm off the map: 0.14 mm); past
+# 4.5 mm the noisiest cameras' points (2-2.5 mm on random cells) add more scatter than they take bias away
+# (docs/curves.md section 8).
+BAND_M = 0.003
+MAX_BAND_M = 0.0045
+BAND_SCALES = 3.0
+MAP_OFFSET_M = 0.001
 CLEARANCE_M = 0.002  # points this close to the other surface are left out (the corner's blur, a tack) [m]
 REACH_M = 0.025  # how far from the other surface a plane's points are taken [m]: the fit is local
 ROUND_REACH_M = 0.120  # and a tube's [m]: its axis's direction wants a longer lever
@@ -47,7 +56,7 @@ SE_INFLATION = 1.2
 SURFACE_BIAS_M = 0.00012
 
 
-def _model(part: Part, kind: Surface, p_R: FloatArray) -> SurfaceModel | str:
+def reference_surface(part: Part, kind: Surface, p_R: FloatArray) -> SurfaceModel | str:
     """The reference surface of ``part`` of ``kind`` holding the curve's samples p_R (n, 3), or why there is none."""
     centre = p_R.mean(axis=0)
     if kind is Surface.CYLINDER:
@@ -69,7 +78,7 @@ def _candidates(
     cyl = next(m for m in models if isinstance(m, CylinderModel))
     along = (p - cyl.c0) @ cyl.u0
     a, b = cyl.c0 + (along.min() - ROUND_REACH_M) * cyl.u0, cyl.c0 + (along.max() + ROUND_REACH_M) * cyl.u0
-    pts, cams = dense_index(scene).tube(a, b, cyl.r0 + REACH_M + BAND_M, 0.0, SHARE)
+    pts, cams = dense_index(scene).tube(a, b, cyl.r0 + REACH_M + MAX_BAND_M, 0.0, SHARE)
     return np.ascontiguousarray(pts.T), cams
 
 
@@ -104,13 +113,14 @@ def _on_face(part: Part, model: SurfaceModel, q: FloatArray) -> npt.NDArray[np.b
 
 def _facing(
     m1: SurfaceModel, m2: SurfaceModel, q1: FloatArray, q2: FloatArray
-) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray]:
     """Which points of q1, q2 (k, 3) of each surface have a neighbourhood (among both) lies flat across their surface's
     normal g: the spread along g is at most sin^2(:data:`NORMAL_ANGLE_RAD`) / 2 of the whole (a flat patch tilted
-    by that angle from the surface; a side face, an edge or a stray point beside the surface is not on it)."""
+    by that angle from the surface; a side face, an edge or a stray point beside the surface is not on it); and each
+    point's neighbourhood's standard deviation along g [m] (the points of q1, then q2)."""
     both = np.vstack([q1, q2])
     if len(both) <= NORMAL_NEIGHBOURS:
-        return np.ones(len(q1), bool), np.ones(len(q2), bool)
+        return np.ones(len(q1), bool), np.ones(len(q2), bool), np.zeros(len(both))
     tree = cKDTree(both)
     _, idx = tree.query(both, k=NORMAL_NEIGHBOURS)
     nb = both[idx] - both[idx].mean(axis=1, keepdims=True)  # (n, k, 3)
@@ -118,7 +128,8 @@ def _facing(
     along = np.einsum("nkd,nd->nk", nb, g)
     ratio = (along**2).sum(axis=1) / np.maximum((nb**2).sum(axis=(1, 2)), 1e-30)
     flat = ratio <= 0.5 * math.sin(NORMAL_ANGLE_RAD) ** 2
-    return flat[: len(q1)], flat[len(q1) :]
+    spread = np.sqrt((along**2).sum(axis=1) / (NORMAL_NEIGHBOURS - 1))
+    return flat[: len(q1)], flat[len(q1) :], spread
 
 
 def _from_outside(
@@ -158,6 +169,37 @@ def _not_found(seam: CurvedSeam, why: str, code: Reason = Reason.NO_SUPPORT) -> 
     return CurveEstimate(seam.id, status, f"curved seam {seam.id}: {why}", code=code)
 
 
+def _select(
+    scene: SeamScene,
+    p: FloatArray,
+    cams: npt.NDArray[np.intp],
+    models: tuple[SurfaceModel, SurfaceModel],
+    parts: tuple[Part, Part],
+    own: set[str],
+) -> tuple[tuple[npt.NDArray[np.intp], npt.NDArray[np.intp]], tuple[int, int]]:
+    """The indices of the points p (k, 3) on each surface (docs/curves.md section 1, step 2), and how many lay in
+    each's widest band before the thinning: each band :data:`BAND_SCALES` of the surface's depth noise (the median
+    of its points' neighbourhoods' spread across it) beyond :data:`MAP_OFFSET_M`, within [BAND_M, MAX_BAND_M]."""
+    m1, m2 = models
+    f1, f2 = m1.value(p, np.zeros(m1.size)), m2.value(p, np.zeros(m2.size))
+    on1 = (np.abs(f1) < MAX_BAND_M) & (f2 > CLEARANCE_M) & (f2 < _reach(m1))
+    on2 = (np.abs(f2) < MAX_BAND_M) & (f1 > CLEARANCE_M) & (f1 < _reach(m2))
+    near = np.flatnonzero(on1 | on2)
+    theirs = outside_parts(scene.weldmap, p[near], own, OTHER_PART_M)
+    on1[near[~theirs]] = on2[near[~theirs]] = False
+    i1, i2 = _thin(on1), _thin(on2)
+    i1, i2 = i1[_on_face(parts[0], m1, p[i1])], i2[_on_face(parts[1], m2, p[i2])]
+    f1s, f2s, spread = _facing(m1, m2, p[i1], p[i2])
+    out = []
+    for idx, flat, s, f in ((i1, f1s, spread[: len(i1)], f1), (i2, f2s, spread[len(i1) :], f2)):
+        noise = float(np.median(s[flat])) if flat.any() else 0.0
+        band = min(MAX_BAND_M, max(BAND_M, BAND_SCALES * noise + MAP_OFFSET_M))
+        out.append(idx[flat & (np.abs(f[idx]) < band)])
+    i1, i2 = out
+    i1, i2 = i1[_from_outside(scene, m1, p[i1], cams[i1])], i2[_from_outside(scene, m2, p[i2], cams[i2])]
+    return (i1, i2), (int(on1.sum()), int(on2.sum()))
+
+
 def locate_curve(
     scene: SeamScene, seam: CurvedSeam, *, max_sigma_m: float = MAX_SIGMA_M, bias_share: float | None = None
 ) -> CurveEstimate:
@@ -172,32 +214,23 @@ def locate_curve(
     drawn = seam.sample(STEP_M)
     parts = (wm.part(joint.abutting), wm.part(joint.receiving))
     kinds = (joint.abutting_surface, joint.receiving_surface)
-    models = [_model(part, kind, drawn) for part, kind in zip(parts, kinds, strict=True)]
+    models = [reference_surface(part, kind, drawn) for part, kind in zip(parts, kinds, strict=True)]
     for m in models:
         if isinstance(m, str):
             return _not_found(seam, m, Reason.NOT_SUPPORTED)
     m1, m2 = models[0], models[1]
     assert not isinstance(m1, str) and not isinstance(m2, str)
     p, cams = _candidates(scene, drawn, (m1, m2))
-    f1, f2 = m1.value(p, np.zeros(m1.size)), m2.value(p, np.zeros(m2.size))
-    on1 = (np.abs(f1) < BAND_M) & (f2 > CLEARANCE_M) & (f2 < _reach(m1))
-    on2 = (np.abs(f2) < BAND_M) & (f1 > CLEARANCE_M) & (f1 < _reach(m2))
-    near = np.flatnonzero(on1 | on2)
-    theirs = outside_parts(wm, p[near], {joint.abutting, joint.receiving}, OTHER_PART_M)
-    on1[near[~theirs]] = on2[near[~theirs]] = False
-    i1, i2 = _thin(on1), _thin(on2)
-    i1, i2 = i1[_on_face(parts[0], m1, p[i1])], i2[_on_face(parts[1], m2, p[i2])]
-    f1s, f2s = _facing(m1, m2, p[i1], p[i2])
-    i1, i2 = i1[f1s], i2[f2s]
-    i1, i2 = i1[_from_outside(scene, m1, p[i1], cams[i1])], i2[_from_outside(scene, m2, p[i2], cams[i2])]
+    own = {joint.abutting, joint.receiving}
+    (i1, i2), counts = _select(scene, p, cams, (m1, m2), parts, own)
     fits = (
         fit_surface(m1, p[i1], MIN_POINTS, _prior(m1), cams[i1]),
         fit_surface(m2, p[i2], MIN_POINTS, _prior(m2), cams[i2]),
     )
-    for part, kind, fit, count in zip(parts, kinds, fits, (on1.sum(), on2.sum()), strict=True):
+    for part, kind, fit, count in zip(parts, kinds, fits, counts, strict=True):
         if not fit.ok:
             return _not_found(seam, f"the {kind} of {part.name} is not held by the cloud ({count} points near it)")
-    return _curve(seam, drawn, fits, wm, {joint.abutting, joint.receiving}, max_sigma_m, bias_share)
+    return _curve(seam, drawn, fits, wm, own, max_sigma_m, bias_share)
 
 
 def _curve(

@@ -27,6 +27,8 @@ from cell.types import Part
 from cell.types.plan import PlanReason
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
+_NO_PLACE = np.full(3, np.nan)  # a failure's place not known (an error without one, a collision not located)
+_COLLIDES = (False, "collides", _NO_PLACE)  # a motion known to collide, where not asked
 
 
 class Transfers:
@@ -87,26 +89,38 @@ class Transfers:
         key = (len(outs), b"".join(np.asarray(q, dtype=float).tobytes() for q in (*outs, *ins)))
         if key in self._between:
             return self._between[key]
-        fail = TransferFail("no collision-free way found", np.zeros(3))
         found: tuple[int, int, list[Piece]] | TransferFail | None = None
         for strategy in self.strategies:
             for i, k in pairs:
-                got = self._attempt(strategy, outs[i], ins[k], fail.p_R)
+                got = self._attempt(strategy, outs[i], ins[k], _NO_PLACE, exact=False)
                 if not isinstance(got, TransferFail):
                     found = (i, k, got)
                     break
-                if (i, k) == pairs[-1]:  # the planned ends' failure is the one reported
-                    fail = got
             if found is not None:
                 break
-        self._between[key] = found if found is not None else fail
+        last = pairs[-1]
+        self._between[key] = found if found is not None else self._failure(outs[last[0]], ins[last[1]])
         return self._between[key]
 
+    def _failure(self, q_a: FloatArray, q_b: FloatArray) -> TransferFail:
+        """Why no strategy is free between the planned ends q_a, q_b: the last strategy's contact or error, an
+        error having no place of its own keeping the last contact's before it (none: the origin). Only the
+        attempts that say it are asked where they first collide (the search asked only whether they do)."""
+        last: TransferFail | None = None
+        for strategy in reversed(self.strategies):
+            got = self._attempt(strategy, q_a, q_b, _NO_PLACE, exact=True)
+            assert isinstance(got, TransferFail), "the search found every strategy collide"
+            last = last or got
+            if got.p_R is not _NO_PLACE:
+                return TransferFail(last.reason, got.p_R)
+        return TransferFail(last.reason if last is not None else "no collision-free way found", np.zeros(3))
+
     def _attempt(
-        self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray, p_before: FloatArray
+        self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray, p_before: FloatArray, exact: bool = True
     ) -> list[Piece] | TransferFail:
         """One strategy's motions q_a -> q_b (zero-length ones left out) when they are free, else why not (an error
-        that has no place keeps ``p_before`` (3,) [m], the last contact's)."""
+        that has no place keeps ``p_before`` (3,) [m], the last contact's). exact : False when only whether they
+        are free matters (a collision's reason and place are then left unknown: :meth:`_blocked`)."""
         try:
             pieces = strategy.pieces(self, q_a, q_b)
         except (IKError, TimingError, LineError) as exc:
@@ -115,32 +129,38 @@ class Transfers:
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
         for pc in pieces:
-            blocked = self._blocked(pc)
+            blocked = self._blocked(pc, exact)
             if blocked is not None:
                 wire, why, p_R = blocked
                 return TransferFail(f"{strategy.name}: {why}" if wire else why, p_R)
         return [pc for pc in pieces if pc.trajectory.duration > 0.0]
 
-    def _blocked(self, pc: Piece) -> tuple[bool, str, FloatArray] | None:
+    def _blocked(self, pc: Piece, exact: bool = True) -> tuple[bool, str, FloatArray] | None:
         """Why one motion is not free: (the wire enters a body rather than a contact, the contact or entry in
-        words, where p_R (3,) [m]); None when it is free. Remembered per motion (strategies share via points)."""
+        words, where p_R (3,) [m]); None when it is free. Remembered per motion (strategies share via points).
+        exact : False when only whether it is free matters: a motion found running deep into something
+        (:meth:`CollisionChecker.deep_contact`) is then remembered as colliding, where unknown (``_NO_PLACE``)."""
         tr = pc.trajectory
         key = (pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times))
-        if key not in self._pieces:
-            hit = self.checker.check_path(tr.q, tr.times)
-            entry = self._entry([pc]) if hit is None else None
-            self._pieces[key] = (
-                (False, hit.describe(), hit.p_R)
-                if hit is not None
-                else (True, entry.describe(), entry.p_R)
-                if entry is not None
-                else None
-            )
+        if key in self._pieces and (self._pieces[key] is not _COLLIDES or not exact):
+            return self._pieces[key]
+        if not exact and self.checker.deep_contact(tr.q) is not None:
+            self._pieces[key] = _COLLIDES
+            return _COLLIDES
+        hit = self.checker.check_path(tr.q, tr.times)
+        entry = self._entry([pc]) if hit is None else None
+        self._pieces[key] = (
+            (False, hit.describe(), hit.p_R)
+            if hit is not None
+            else (True, entry.describe(), entry.p_R)
+            if entry is not None
+            else None
+        )
         return self._pieces[key]
 
     def clear(self, tr: Trajectory) -> bool:
         """Whether a motion touches nothing (the collision model) and takes the wire into no obstacle's body."""
-        if self.checker.check_path(tr.q, tr.times) is not None:
+        if self.checker.collides(tr.q):
             return False
         return self._entry([Piece("move", tr, 0.0, self.robot.fk(tr.q[-1]))]) is None
 

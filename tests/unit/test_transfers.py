@@ -14,6 +14,7 @@ from cell.errors import TimingError
 from cell.geometry import FloatArray, make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.motion.timing import ptp
 from cell.planning.failures import SeamFailure, better, reason_text
 from cell.planning.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
 from cell.process.torch import WeldProcess
@@ -90,3 +91,22 @@ def test_reasons_are_codes_with_the_report_text() -> None:
     far = SeamFailure(PlanReason.COLLISION, "b", np.zeros(3), 0.02)
     assert better(None, near) is near and better(near, far) is far and better(far, near) is far
     assert better(near, SeamFailure(PlanReason.FLIP, "c", np.zeros(3), 0.01)) is near  # ties: the earlier
+
+
+def test_a_failure_names_the_last_strategy_s_first_contact(robot: RobotModel) -> None:
+    # The search asks only whether each way collides; the failure it reports is still the last strategy's first
+    # contact along its motion, and an error without a place keeps the contact of the strategy before it.
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    obstacles = (*OBSTACLES, wall)
+    direct = ptp(HOME, Q_B, robot.limits, dt=PlanOptions().dt)
+    first = CollisionChecker(robot, obstacles).check_path(direct.q, direct.times)
+    assert first is not None and first.b == "WALL"
+    fail = _mover(robot, obstacles, _Untimeable(), Direct()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and fail.reason == first.describe()
+    np.testing.assert_allclose(fail.p_R, first.p_R, atol=1e-12)
+    fail = _mover(robot, obstacles, Direct(), _Untimeable()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and fail.reason == "broken: no profile"
+    np.testing.assert_allclose(fail.p_R, first.p_R, atol=1e-12)
+    fail = _mover(robot, obstacles, _Untimeable()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and not np.any(fail.p_R)  # no place at all: the origin

@@ -19,7 +19,7 @@ from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow
 from cell.planning.failures import LineError, SeamFailure
 from cell.planning.lines import line_trajectory, solve_line
-from cell.planning.moves.pieces import Piece, TransferFail
+from cell.planning.moves.pieces import Piece, TransferFail, joined
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
 from cell.planning.reach import ReachModel
 from cell.process.torch import WeldProcess, line_poses
@@ -128,6 +128,8 @@ class Transfers:
         wound = self._wound(pieces, q_a, q_b)
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
+        if not exact and any(self._runs_deep(pc) for pc in pieces):  # before any motion is checked in full
+            return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
         for pc in pieces:
             blocked = self._blocked(pc, exact)
             if blocked is not None:
@@ -135,18 +137,25 @@ class Transfers:
                 return TransferFail(f"{strategy.name}: {why}" if wire else why, p_R)
         return [pc for pc in pieces if pc.trajectory.duration > 0.0]
 
+    def _runs_deep(self, pc: Piece) -> bool:
+        """Whether one motion is known not to be free, or runs deep into something
+        (:meth:`CollisionChecker.deep_contact`: remembered as colliding, where unknown); False: it may be free."""
+        key = _key(pc)
+        if key not in self._pieces:
+            if self.checker.deep_contact(pc.trajectory.q) is None:
+                return False
+            self._pieces[key] = _COLLIDES
+        return self._pieces[key] is not None
+
     def _blocked(self, pc: Piece, exact: bool = True) -> tuple[bool, str, FloatArray] | None:
         """Why one motion is not free: (the wire enters a body rather than a contact, the contact or entry in
         words, where p_R (3,) [m]); None when it is free. Remembered per motion (strategies share via points).
-        exact : False when only whether it is free matters: a motion found running deep into something
-        (:meth:`CollisionChecker.deep_contact`) is then remembered as colliding, where unknown (``_NO_PLACE``)."""
+        exact : False when only whether it is free matters (a motion :meth:`_runs_deep` found colliding is not
+        then asked where it first does)."""
         tr = pc.trajectory
-        key = (pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times))
+        key = _key(pc)
         if key in self._pieces and (self._pieces[key] is not _COLLIDES or not exact):
             return self._pieces[key]
-        if not exact and self.checker.deep_contact(tr.q) is not None:
-            self._pieces[key] = _COLLIDES
-            return _COLLIDES
         hit = self.checker.check_path(tr.q, tr.times)
         entry = self._entry([pc]) if hit is None else None
         self._pieces[key] = (
@@ -292,6 +301,12 @@ class Transfers:
         return Piece("approach", tr, v, X)
 
 
+def _key(pc: Piece) -> tuple[str, bytes, bytes, int]:
+    """A motion's key among those remembered: its kind, ends and samples."""
+    tr = pc.trajectory
+    return pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times)
+
+
 def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> None:
     """Raise LineError (BEYOND_REACH) when a pose of the line (n, 4, 4) in R puts the wrist centre beyond the
     shoulder's reach (no IK can solve it: refused before any is tried); ``step`` [m] between poses."""
@@ -306,19 +321,6 @@ def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> N
         raise LineError(
             SeamFailure(PlanReason.BEYOND_REACH, f"{where} beyond the shoulder's reach", poses[k][:3, 3], k * step)
         )
-
-
-def joined(pieces: Sequence[Piece]) -> Trajectory:
-    """One trajectory of timed motions put back to back (each starts where the last ended, at rest)."""
-    times, q, qd, qdd, t0 = [], [], [], [], 0.0
-    for k, pc in enumerate(pieces):
-        tr, skip = pc.trajectory, int(k > 0)  # a piece's first sample is the last one's final sample
-        times.append(tr.times[skip:] + t0)
-        q.append(tr.q[skip:])
-        qd.append(tr.qd[skip:])
-        qdd.append(tr.qdd[skip:])
-        t0 += tr.duration
-    return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))
 
 
 __all__ = [

@@ -20,6 +20,7 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.access.home import first_cut_off
 from cell.planning.access.openings import WAYS
+from cell.planning.access.screen import first_unjoined
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
 from cell.planning.curves import cover_curves, curve_pieces, weldable, whole_or_none, with_paths
@@ -71,7 +72,8 @@ def plan_welds(
         procedure from ``procedures`` too; their outcomes follow the tasks'.
     elsewhere : another place may hold a seam (a positioner's other poses): one whose transfer fails and that no
         transfer joins to home either way is refused at once (:mod:`cell.planning.access.home`), not tried from
-        every other seam in turn.
+        every other seam in turn; and the order search leaves out a transfer that no strategy makes between the
+        planned lines before searching it in full (:mod:`cell.planning.access.screen`).
     Raises PlanError when q_home is outside the limits or in collision; a seam that cannot be planned is a
     SeamOutcome with ``feasible=False``, its code and its reason, never an exception.
     """
@@ -163,9 +165,12 @@ def plan_welds(
         ids = list(solved)
         order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)
         ordered = [ids[k] for k in order]
-        segments, failed = assemble(transfers, ordered, lines, seam_parts, q0, seam_procs)
+        # elsewhere: a transfer no strategy makes between the planned lines is left out before any full search
+        failed = first_unjoined(transfers, ordered, lines, q0, forbidden) if elsewhere and len(ids) > 1 else None
         if failed is None:
-            break
+            segments, failed = assemble(transfers, ordered, lines, seam_parts, q0, seam_procs)
+            if failed is None:
+                break
         a, b, why = failed
         again = (a, b) not in forbidden and len(ids) > 1  # another order may do without this transfer
         cut = first_cut_off(transfers, lines, q0, (b, a)) if elsewhere and again else None

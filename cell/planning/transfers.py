@@ -19,7 +19,7 @@ from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow
 from cell.planning.failures import LineError, SeamFailure
 from cell.planning.lines import line_trajectory, solve_line
-from cell.planning.moves.pieces import Piece, TransferFail
+from cell.planning.moves.pieces import Piece, TransferFail, joined
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
 from cell.planning.reach import ReachModel
 from cell.process.torch import WeldProcess, line_poses
@@ -27,6 +27,8 @@ from cell.types import Part
 from cell.types.plan import PlanReason
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
+_NO_PLACE = np.full(3, np.nan)  # a failure's place not known (an error without one, a collision not located)
+_COLLIDES = (False, "collides", _NO_PLACE)  # a motion known to collide, where not asked
 
 
 class Transfers:
@@ -87,26 +89,38 @@ class Transfers:
         key = (len(outs), b"".join(np.asarray(q, dtype=float).tobytes() for q in (*outs, *ins)))
         if key in self._between:
             return self._between[key]
-        fail = TransferFail("no collision-free way found", np.zeros(3))
         found: tuple[int, int, list[Piece]] | TransferFail | None = None
         for strategy in self.strategies:
             for i, k in pairs:
-                got = self._attempt(strategy, outs[i], ins[k], fail.p_R)
+                got = self._attempt(strategy, outs[i], ins[k], _NO_PLACE, exact=False)
                 if not isinstance(got, TransferFail):
                     found = (i, k, got)
                     break
-                if (i, k) == pairs[-1]:  # the planned ends' failure is the one reported
-                    fail = got
             if found is not None:
                 break
-        self._between[key] = found if found is not None else fail
+        last = pairs[-1]
+        self._between[key] = found if found is not None else self._failure(outs[last[0]], ins[last[1]])
         return self._between[key]
 
+    def _failure(self, q_a: FloatArray, q_b: FloatArray) -> TransferFail:
+        """Why no strategy is free between the planned ends q_a, q_b: the last strategy's contact or error, an
+        error having no place of its own keeping the last contact's before it (none: the origin). Only the
+        attempts that say it are asked where they first collide (the search asked only whether they do)."""
+        last: TransferFail | None = None
+        for strategy in reversed(self.strategies):
+            got = self._attempt(strategy, q_a, q_b, _NO_PLACE, exact=True)
+            assert isinstance(got, TransferFail), "the search found every strategy collide"
+            last = last or got
+            if got.p_R is not _NO_PLACE:
+                return TransferFail(last.reason, got.p_R)
+        return TransferFail(last.reason if last is not None else "no collision-free way found", np.zeros(3))
+
     def _attempt(
-        self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray, p_before: FloatArray
+        self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray, p_before: FloatArray, exact: bool = True
     ) -> list[Piece] | TransferFail:
         """One strategy's motions q_a -> q_b (zero-length ones left out) when they are free, else why not (an error
-        that has no place keeps ``p_before`` (3,) [m], the last contact's)."""
+        that has no place keeps ``p_before`` (3,) [m], the last contact's). exact : False when only whether they
+        are free matters (a collision's reason and place are then left unknown: :meth:`_blocked`)."""
         try:
             pieces = strategy.pieces(self, q_a, q_b)
         except (IKError, TimingError, LineError) as exc:
@@ -114,33 +128,48 @@ class Transfers:
         wound = self._wound(pieces, q_a, q_b)
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
+        if not exact and any(self._runs_deep(pc) for pc in pieces):  # before any motion is checked in full
+            return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
         for pc in pieces:
-            blocked = self._blocked(pc)
+            blocked = self._blocked(pc, exact)
             if blocked is not None:
                 wire, why, p_R = blocked
                 return TransferFail(f"{strategy.name}: {why}" if wire else why, p_R)
         return [pc for pc in pieces if pc.trajectory.duration > 0.0]
 
-    def _blocked(self, pc: Piece) -> tuple[bool, str, FloatArray] | None:
-        """Why one motion is not free: (the wire enters a body rather than a contact, the contact or entry in
-        words, where p_R (3,) [m]); None when it is free. Remembered per motion (strategies share via points)."""
-        tr = pc.trajectory
-        key = (pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times))
+    def _runs_deep(self, pc: Piece) -> bool:
+        """Whether one motion is known not to be free, or runs deep into something
+        (:meth:`CollisionChecker.deep_contact`: remembered as colliding, where unknown); False: it may be free."""
+        key = _key(pc)
         if key not in self._pieces:
-            hit = self.checker.check_path(tr.q, tr.times)
-            entry = self._entry([pc]) if hit is None else None
-            self._pieces[key] = (
-                (False, hit.describe(), hit.p_R)
-                if hit is not None
-                else (True, entry.describe(), entry.p_R)
-                if entry is not None
-                else None
-            )
+            if self.checker.deep_contact(pc.trajectory.q) is None:
+                return False
+            self._pieces[key] = _COLLIDES
+        return self._pieces[key] is not None
+
+    def _blocked(self, pc: Piece, exact: bool = True) -> tuple[bool, str, FloatArray] | None:
+        """Why one motion is not free: (the wire enters a body rather than a contact, the contact or entry in
+        words, where p_R (3,) [m]); None when it is free. Remembered per motion (strategies share via points).
+        exact : False when only whether it is free matters (a motion :meth:`_runs_deep` found colliding is not
+        then asked where it first does)."""
+        tr = pc.trajectory
+        key = _key(pc)
+        if key in self._pieces and (self._pieces[key] is not _COLLIDES or not exact):
+            return self._pieces[key]
+        hit = self.checker.check_path(tr.q, tr.times)
+        entry = self._entry([pc]) if hit is None else None
+        self._pieces[key] = (
+            (False, hit.describe(), hit.p_R)
+            if hit is not None
+            else (True, entry.describe(), entry.p_R)
+            if entry is not None
+            else None
+        )
         return self._pieces[key]
 
     def clear(self, tr: Trajectory) -> bool:
         """Whether a motion touches nothing (the collision model) and takes the wire into no obstacle's body."""
-        if self.checker.check_path(tr.q, tr.times) is not None:
+        if self.checker.collides(tr.q):
             return False
         return self._entry([Piece("move", tr, 0.0, self.robot.fk(tr.q[-1]))]) is None
 
@@ -272,6 +301,12 @@ class Transfers:
         return Piece("approach", tr, v, X)
 
 
+def _key(pc: Piece) -> tuple[str, bytes, bytes, int]:
+    """A motion's key among those remembered: its kind, ends and samples."""
+    tr = pc.trajectory
+    return pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times)
+
+
 def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> None:
     """Raise LineError (BEYOND_REACH) when a pose of the line (n, 4, 4) in R puts the wrist centre beyond the
     shoulder's reach (no IK can solve it: refused before any is tried); ``step`` [m] between poses."""
@@ -286,19 +321,6 @@ def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> N
         raise LineError(
             SeamFailure(PlanReason.BEYOND_REACH, f"{where} beyond the shoulder's reach", poses[k][:3, 3], k * step)
         )
-
-
-def joined(pieces: Sequence[Piece]) -> Trajectory:
-    """One trajectory of timed motions put back to back (each starts where the last ended, at rest)."""
-    times, q, qd, qdd, t0 = [], [], [], [], 0.0
-    for k, pc in enumerate(pieces):
-        tr, skip = pc.trajectory, int(k > 0)  # a piece's first sample is the last one's final sample
-        times.append(tr.times[skip:] + t0)
-        q.append(tr.q[skip:])
-        qd.append(tr.qd[skip:])
-        qdd.append(tr.qdd[skip:])
-        t0 += tr.duration
-    return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))
 
 
 __all__ = [

@@ -14,7 +14,9 @@ from cell.errors import TimingError
 from cell.geometry import FloatArray, make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
+from cell.motion.timing import ptp
 from cell.planning.failures import SeamFailure, better, reason_text
+from cell.planning.moves.strategies import Mover
 from cell.planning.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
 from cell.process.torch import WeldProcess
 from cell.types import Box, Part
@@ -33,7 +35,7 @@ def robot() -> RobotModel:
 class _Untimeable:
     name: str = "broken"
 
-    def pieces(self, mover: Transfers, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+    def pieces(self, mover: Mover, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
         raise TimingError("no profile")
 
 
@@ -90,3 +92,53 @@ def test_reasons_are_codes_with_the_report_text() -> None:
     far = SeamFailure(PlanReason.COLLISION, "b", np.zeros(3), 0.02)
     assert better(None, near) is near and better(near, far) is far and better(far, near) is far
     assert better(near, SeamFailure(PlanReason.FLIP, "c", np.zeros(3), 0.01)) is near  # ties: the earlier
+
+
+def test_a_failure_names_the_last_strategy_s_first_contact(robot: RobotModel) -> None:
+    # The search asks only whether each way collides; the failure it reports is still the last strategy's first
+    # contact along its motion, and an error without a place keeps the contact of the strategy before it.
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    obstacles = (*OBSTACLES, wall)
+    direct = ptp(HOME, Q_B, robot.limits, dt=PlanOptions().dt)
+    first = CollisionChecker(robot, obstacles).check_path(direct.q, direct.times)
+    assert first is not None and first.b == "WALL"
+    fail = _mover(robot, obstacles, _Untimeable(), Direct()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and fail.reason == first.describe()
+    np.testing.assert_allclose(fail.p_R, first.p_R, atol=1e-12)
+    fail = _mover(robot, obstacles, Direct(), _Untimeable()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and fail.reason == "broken: no profile"
+    np.testing.assert_allclose(fail.p_R, first.p_R, atol=1e-12)
+    fail = _mover(robot, obstacles, _Untimeable()).move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and not np.any(fail.p_R)  # no place at all: the origin
+
+
+@dataclass(frozen=True)
+class _FreeThenWall:
+    """Two motions: a free one out and back, then the direct move through the wall."""
+
+    name: str = "free_then_wall"
+
+    def pieces(self, mover: Mover, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        out = Direct().pieces(mover, q_a, HOME + np.radians([5.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
+        back = Direct().pieces(mover, out[0].trajectory.q[-1], q_a)
+        return [*out, *back, *Direct().pieces(mover, q_a, q_b)]
+
+
+def test_a_search_checks_no_motion_in_full_when_another_of_its_way_runs_deep(robot: RobotModel) -> None:
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    mover = _mover(robot, (*OBSTACLES, wall), _FreeThenWall(), Direct())
+    asked: list[int] = []
+    check_path = mover.checker.check_path
+
+    def counted(q: FloatArray, *args: object, **kwargs: object) -> object:
+        asked.append(len(q))
+        return check_path(q, *args, **kwargs)  # type: ignore[arg-type]
+
+    mover.checker.check_path = counted  # type: ignore[method-assign, assignment]
+    fail = mover.move(HOME, Q_B)
+    assert isinstance(fail, TransferFail) and "WALL" in fail.reason
+    # the free motions out and back are never advanced along (the wall's move runs deep); only the failure
+    # reported, the last strategy's, is placed: one full check
+    assert len(asked) == 1

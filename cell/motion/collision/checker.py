@@ -14,7 +14,7 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, readonly
-from cell.motion.collision.contact import Contact, advance_along
+from cell.motion.collision.contact import Contact, advance_along, deep_sample
 from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts, trim_near_tcp
 from cell.motion.robot import RobotModel
 from cell.types import Part
@@ -279,6 +279,18 @@ class CollisionChecker:
         missed). Returns None when the whole path is clear.
         """
         return advance_along(self._step_bound, self.motion_bound, q_path, times, min_step)
+
+    def deep_contact(self, q_path: npt.ArrayLike, min_step: float = 0.001) -> Contact | None:
+        """A contact :meth:`check_path` cannot miss, found quickly where the path (n, dof) runs deep into something:
+        a sample of it, probed coarse to fine (at most 16), more than twice ``min_step`` inside a contact (between
+        two of the advancement's checks no distance falls by more than that). None: none found, the path may
+        still collide (only :meth:`check_path` says). Not the path's first contact."""
+        return deep_sample(self.check, q_path, 2.0 * min_step + 0.001 - self.options.min_clearance, probes=16)
+
+    def collides(self, q_path: npt.ArrayLike, min_step: float = 0.001) -> bool:
+        """Whether :meth:`check_path` finds a contact along the path (n, dof): :meth:`deep_contact` first, for a
+        search that needs only to know that a motion collides, not where it first does."""
+        return self.deep_contact(q_path, min_step) is not None or self.check_path(q_path, None, min_step) is not None
 
     def torch_clear(self, X_RT: npt.ArrayLike, q_ref: npt.ArrayLike) -> Contact | None:
         """Contact of the tool-side shapes (everything rigid with the flange) against the obstacles when the TCP

@@ -6,7 +6,8 @@ between bounding spheres and boxes (:func:`sphere_box_distance`), and conservati
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import itertools
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -87,3 +88,31 @@ def advance_along(
                     t = float("nan") if T is None else float(T[-1])
                     return Contact(hit.a, hit.b, hit.depth, hit.p_R, hit.q, n - 1, t)
                 return None
+
+
+def deep_sample(
+    check: Callable[[FloatArray], Contact | None], q_path: npt.ArrayLike, depth: float, probes: int = 32
+) -> Contact | None:
+    """A contact at least ``depth`` [m] deep (its distance at most -depth) at one of a path's samples (n, dof),
+    probed coarse to fine (the middle sample, then the quarters, the eighths, ...), at most ``probes`` of them;
+    None when none of those is that deep. ``check(q)`` is the contact at q or None."""
+    Q = np.asarray(q_path, dtype=float)
+    for k in itertools.islice(coarse_to_fine(len(Q)), probes):
+        hit = check(Q[k])
+        if hit is not None and hit.depth <= -depth:
+            return hit
+    return None
+
+
+def coarse_to_fine(n: int) -> Iterator[int]:
+    """The indices 0..n-1, each once, level by level: n // 2, then the quarters, the eighths, ...; the two ends
+    last."""
+    seen, level = {0, n - 1}, 1
+    while len(seen) < n:
+        for j in range(1, 2 * level, 2):
+            k = (j * (n - 1)) // (2 * level)
+            if k not in seen:
+                seen.add(k)
+                yield k
+        level *= 2
+    yield from (k for k in sorted({0, n - 1}) if n > 0)

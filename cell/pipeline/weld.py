@@ -248,9 +248,11 @@ def weld(
                     timings["rescan_s"] = rs.timings.get("rescan_s", 0.0)
             if mode != "none" and not execute_plan:  # a preview plans the close-ups it cannot take
                 from cell.pipeline.closeup_plan import preview_closeups
+                from cell.pipeline.curved.rescan import preview_curve_closeups
 
                 progress("planning the close-up views cell weld would take (the arm does not move)")
                 closeups = preview_closeups(station, det, mode, motion)
+                closeups += preview_curve_closeups(station, det, motion, closeups)
             if execute_plan:  # the last check before the arc: re-scanned, then refused (cell/pipeline/last_check.py)
                 det, more, checked = last_checked(station, det, skip=hopeless, motion=motion, progress=progress)
                 rs = joined(rs, more)
@@ -303,6 +305,7 @@ def weld(
             from cell.pipeline.closeup_plan import with_closeups
 
             seams = with_closeups(seams, closeups)
+            det = replace(det, curve_welds={w.id: w for w in with_closeups(tuple(det.curve_welds.values()), closeups)})
         paths = torch_paths(station, plan) if plan is not None else {}
         timings["total_s"] = time.perf_counter() - t_all
         view = cell_view(sc, station.arm, plan, pre, ex)

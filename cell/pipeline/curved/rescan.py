@@ -24,8 +24,14 @@ from cell.types.curve_estimate import CurveEstimate
 from cell.types.rescan import Rescan
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from cell.config.rescan import RescanOptions
+    from cell.motion.collision import CollisionChecker
     from cell.rescan.view_grid import ViewTarget
-    from cell.station import Station
+    from cell.station import Arm, Station
+    from cell.types import CameraIntrinsics, Part
+    from cell.types.rescan import PlannedCloseup, Viewpoint
 
 MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture and a re-location)
 MAX_TRIES = 6  # stretches tried at most (a stretch no view reaches costs the planner's search, not a move)
@@ -93,14 +99,61 @@ def curves_rescanned(
     return joined(rs, more), after
 
 
+def preview_curve_closeups(
+    station: Station, det: Detection, motion: MotionScene, straight: Sequence[PlannedCloseup] = ()
+) -> tuple[PlannedCloseup, ...]:
+    """The first close-up ``cell weld`` would take of each curve of :func:`doubtful_curves`, planned and not taken
+    (``cell preview``): the view of its worst stretch (for a curve no fixed camera sees, where the aligned map draws
+    it) from where the last view leaves the arm (the scan configuration, or the last of the straight seams' planned
+    close-ups ``straight`` where the re-scan does not return), as :func:`rescan_curves` plans it; or why none
+    works. The close-ups after the first depend on what it sees: not planned."""
+    from cell.rescan.curve_fusion import facet_floor_m, shared_sigma
+    from cell.rescan.curve_views import worst_first
+    from cell.rescan.fusion import eye_in_hand_camera
+    from cell.seams.curved.drawn import drawn_estimate
+    from cell.types.rescan import PlannedCloseup
+
+    sc, arm = det.scenario, station.arm
+    curves = doubtful_curves(det)
+    if not curves or arm is None or det.scene is None or not any(c.mount == "eye_in_hand" for c in sc.cameras.values()):
+        return ()
+    o, base, limit = sc.rescan.closeup, det.scene.seam_scene, sc.rescan.max_sigma_m
+    K = station.intrinsics(eye_in_hand_camera(sc, o.camera))
+    views = [p.viewpoint for p in straight if p.viewpoint is not None and not o.return_to_scan]
+    rng, q = sc.rng("rescan/curve-view"), np.asarray(views[-1].q if views else arm.q_scan, dtype=float)
+    out: list[PlannedCloseup] = []
+    for c in curves:
+        seam = next(s for s in base.weldmap.curved if s.id == c.id)
+        first = drawn_estimate(base.weldmap, seam) if c.status is not SeamStatus.FOUND else c
+        if first is None or seam.joint is None:
+            continue
+        if float(shared_sigma(first, facet_floor_m(seam, base.weldmap)).max()) > limit:
+            out.append(PlannedCloseup(c.id, reason="not re-scanned: half its facets' sagitta is over the tolerance"))
+            continue
+        parts = tuple(p for p in base.weldmap.parts if p.name not in (seam.joint.abutting, seam.joint.receiving))
+        vp, why = None, "no stretch over the tolerance to look at"
+        tried: list[FloatArray] = []
+        for target in worst_first(first, limit):
+            if len(tried) == MAX_TRIES:
+                break
+            if any(np.linalg.norm(target.mid - m) <= TRIED_M for m in tried):
+                continue
+            tried.append(target.mid)
+            vp, why = _view_of(arm, motion.checker, target, q, K, parts, base.table_z, rng, o)
+            if vp is not None:
+                break
+        out.append(PlannedCloseup(c.id, vp, reason="" if vp is not None else f"unreachable view: {why}"))
+        q = np.asarray(vp.q, dtype=float) if vp is not None else q
+    return tuple(out)
+
+
 def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, progress: Progress) -> CurveEstimate:
     """One curve's close-ups (see the module docstring): the fused curve, its reason saying what the re-scan did. A
     curve not found (``found`` NOT_FOUND) is looked at where the aligned map draws it and located from the close-ups
     alone, or stays not found."""
     from cell.perception.lens import undistort
     from cell.rescan.curve_fusion import closeup_curve_scene, facet_floor_m, fuse_curve, relocate, shared_sigma
-    from cell.rescan.curve_views import near_view, worst_first
-    from cell.rescan.viewpoint import plan_view
+    from cell.rescan.curve_views import worst_first
     from cell.seams.curved.drawn import drawn_estimate
 
     det, o = run.detection, run.options
@@ -136,17 +189,9 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         tried.append(target.mid)
         progress(f"re-scan curve {first.id}: close-up {len(images) + 1} of the stretch at sigma "
                  f"{_worst_mm(best, target):.2f} mm")  # fmt: skip
-        vp = None
-        for view in (replace(o.view, fallback_tilts_deg=()), near_view(o.view)):  # the usual stand-offs, then nearer
-            try:
-                vp = plan_view(
-                    run.arm.model, run.checker, target, run.q, K, parts, base.table_z, rng=rng, q_via=run.arm.q_scan,
-                    options=view,
-                )  # fmt: skip
-                break
-            except CellError as exc:
-                why = f"no view: {exc.message}"
+        vp, no_view = _view_of(run.arm, run.checker, target, run.q, K, parts, base.table_z, rng, o)
         if vp is None:
+            why = no_view
             continue
         run.play(vp.move)
         run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]
@@ -173,6 +218,25 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         done = f"located from {len(images)} close-ups alone (sigma up to {best.sigma_max_m * 1000:.2f} mm)"
     why = why if best.sigma_max_m > limit else ""
     return replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
+
+
+def _view_of(
+    arm: Arm, checker: CollisionChecker, target: ViewTarget, q: FloatArray, K: CameraIntrinsics,
+    parts: Sequence[Part], table_z: float, rng: np.random.Generator, o: RescanOptions,
+) -> tuple[Viewpoint | None, str]:  # fmt: skip
+    """A close-up's view of the stretch ``target`` from ``q``: at the usual stand-offs, then nearer
+    (:func:`cell.rescan.curve_views.near_view`); or None and why no view works."""
+    from cell.rescan.curve_views import near_view
+    from cell.rescan.viewpoint import plan_view
+
+    why = ""
+    for view in (replace(o.view, fallback_tilts_deg=()), near_view(o.view)):
+        try:
+            vp = plan_view(arm.model, checker, target, q, K, parts, table_z, rng=rng, q_via=arm.q_scan, options=view)
+            return vp, ""
+        except CellError as exc:
+            why = f"no view: {exc.message}"
+    return None, why
 
 
 def _worst_mm(est: CurveEstimate, target: ViewTarget) -> float:

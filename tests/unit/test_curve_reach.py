@@ -17,8 +17,7 @@ from cell.config.motion import PlanOptions
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.planning.curves.arcs import plan_arcs
-from cell.planning.curves.arcs import _gap, _windows
+from cell.planning.curves.arcs import _gap, _windows, plan_arcs
 from cell.planning.curves.reach import Miss, Run, cover, pinch, share
 from cell.planning.plan import reach_model
 from cell.planning.seam_search import SeamSearch

@@ -17,8 +17,8 @@ from cell.config.motion import PlanOptions
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.planning.curves.arcs import plan_arcs
-from cell.planning.curves.reach import Run, cover, share
+from cell.planning.curves.arcs import _gap, _windows, plan_arcs
+from cell.planning.curves.reach import Miss, Run, cover, pinch, share
 from cell.planning.plan import reach_model
 from cell.planning.seam_search import SeamSearch
 from cell.process.curve_quality import pass_truth
@@ -26,6 +26,7 @@ from cell.process.torch import WeldProcess
 from cell.process.torch_orientations import Candidate
 from cell.types import Box, Part, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import PlanReason
 from cell.types.procedure import WeldPass, WeldProcedure
 
 OVERLAP_M = 0.01
@@ -61,6 +62,31 @@ def test_an_open_curve_is_covered_end_to_end() -> None:
     got = cover(runs, 1.0, False, 0.0, 4)
     assert got is not None and [r.cand for r in got] == [C0, C1]
     assert cover([_run(0.05, 1.0)], 1.0, False, 0.0, 4) is None  # its start is not held
+
+
+def test_a_point_every_stretch_gives_out_near_is_passed_by_no_cover_however_many_arcs() -> None:
+    # every point held, but both stretches through 1.0 (= 0) give out 2 mm from it: a restart there overlaps 4 mm
+    runs = [_run(0.1, 1.002), _run(0.998, 1.15, C1), *(_run(0.1 * k, 0.1 * k + 0.3) for k in range(1, 7))]
+    assert share(runs, 1.0, True) == 1.0
+    at = pinch(runs, 1.0, OVERLAP_M)
+    assert at is not None and min(at[0], 1.0 - at[0]) <= 0.0005 and at[1] == pytest.approx(0.002, abs=0.0006)
+    assert cover(runs, 1.0, True, OVERLAP_M, 20) is None
+    assert cover(runs, 1.0, True, 0.003, 4) is not None and pinch(runs, 1.0, 0.003) is None  # a 3 mm restart would
+    short = [_run(0.2 * k, 0.2 * k + 0.25) for k in range(5)]  # five arcs needed, each junction 50 mm deep
+    assert pinch(short, 1.0, OVERLAP_M) is None and pinch([_run(0.0, 0.5)], 1.0, OVERLAP_M) is None  # not a gap
+
+
+def test_a_curve_held_all_round_but_pinched_is_refused_where_and_why_and_walked_finer_there() -> None:
+    est = _foot()
+    total = est.length_m
+    runs = [_run(0.02, total + 0.001), _run(total - 0.001, total + 0.05, C1)]
+    misses = [Miss(total - 0.002, PlanReason.COLLISION, "torch vs POST")] * 3 + [Miss(0.1, PlanReason.IK_FAILED)] * 5
+    f = _gap(runs, misses, est, OVERLAP_M)
+    assert f.code is PlanReason.COLLISION and "torch vs POST" in f.where and "gives out within 1.0 mm" in f.where
+    assert np.linalg.norm(f.p_R - est.p_RS[0]) < 0.002
+    [(lo, hi)] = _windows(runs, est, OVERLAP_M)  # walked again with finer settings: the overlap and 15 mm either side
+    assert lo == pytest.approx(-0.025, abs=0.001) or lo == pytest.approx(total - 0.025, abs=0.001)
+    assert hi - lo == pytest.approx(0.05, abs=0.001)
 
 
 def test_share_counts_what_some_stretch_holds() -> None:

@@ -17,7 +17,7 @@ from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
 from cell.planning.curves.graph import gaps, graph_map, refined, settings_along
 from cell.planning.curves.path import CurvePath, curve_path, curve_poses
-from cell.planning.curves.reach import Miss, Run, balanced, cover, settings, share, station_spacing
+from cell.planning.curves.reach import Miss, Run, balanced, cover, pinch, settings, share, station_spacing
 from cell.planning.curves.search import (
     CurveTask,
     _flange_axes,
@@ -70,7 +70,7 @@ def plan_arcs(
     memo: dict[Candidate, list[FloatArray | None]] = {}  # each setting's joints at the stations, walked once
     for stage in range(1 if stiff else 3):  # nominal angles; their tolerance's ends; finer in the map's gaps
         cands = settings(search, False) + (settings(search, True) if stage else [])
-        windows = gaps(runs, est.length_m, est.closed, GAP_MARGIN_M) if stage > 1 else []
+        windows = _windows(runs, est, overlap) if stage > 1 else []
         if stage > 1 and not windows:
             break
         cands += refined(search) if stage > 1 else []
@@ -101,6 +101,17 @@ def plan_arcs(
     if failure is None:
         failure = _gap(runs, misses, est, overlap)
     return Split((), reached, failure)
+
+
+def _windows(runs: list[Run], est: CurveEstimate, overlap: float) -> list[tuple[float, float]]:
+    """Where the map is walked again with finer settings (from, to) [m] along the located curve: its gaps, or with
+    none, where every stretch through a point of a closed curve gives out short of the restart ``overlap`` [m]
+    (:func:`.reach.pinch`), the overlap either side; each widened by :data:`GAP_MARGIN_M`."""
+    out = gaps(runs, est.length_m, est.closed, GAP_MARGIN_M)
+    at = pinch(runs, est.length_m, overlap) if est.closed and not out else None
+    if at is not None:
+        out.append((at[0] - overlap - GAP_MARGIN_M, at[0] + overlap + GAP_MARGIN_M))
+    return out
 
 
 def _setting_changes(run: Run) -> int:
@@ -145,25 +156,44 @@ def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
 def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate, overlap: float) -> SeamFailure:
     """The failure for a curve no cover of stretches welds: where its widest stretch no setting holds starts, how
     long it is (and how many such stretches, how much in all) and what stops the settings there (the commonest
-    reason of the stations in it: its code); with every point held, that no :data:`MAX_ARCS` arcs overlap by the
-    restart ``overlap`` [m] all round."""
+    reason of the stations in it: its code); with every point held, where every stretch gives out short of the
+    restart ``overlap`` [m] (:func:`.reach.pinch`, and what stops the settings there), else that no
+    :data:`MAX_ARCS` arcs overlap by it all round."""
     total = est.length_m
     free = gaps(runs, total, est.closed, 0.0)
+    at = pinch(runs, total, overlap) if est.closed and not free else None
+    if at is not None:
+        code, why = _why(misses, at[0] - overlap, at[0] + overlap, total, est.closed)
+        where = (f"every point is held, but every stretch through {at[0] * 1000:.0f} mm along it gives out within "
+                 f"{at[1] * 1000:.1f} mm of it: no arc passes there to restart {overlap * 1000:.0f} mm back over the "
+                 f"last ({why})")  # fmt: skip
+        return SeamFailure(code, where, _point(est, at[0]), 0.0)
     if not free:
         where = (f"every point is held, but no {MAX_ARCS} arcs overlap by {overlap * 1000:.0f} mm at every restart "
                  "(the torch cannot turn through where the stretches give out fast enough)")  # fmt: skip
         return SeamFailure(PlanReason.COLLISION if misses else PlanReason.IK_FAILED, where, est.p_RS[0], 0.0)
     lo, hi = max(free, key=lambda g: g[1] - g[0])
     lo, hi = lo % total if est.closed else lo, (lo % total if est.closed else lo) + (hi - lo)
-    there = [m for m in misses if _within(m.at_m, lo - 0.01, hi + 0.01, total, est.closed)] or misses
-    counts = Counter((m.code, m.what) for m in there).most_common(2)
-    why = ", ".join(f"{k} of {len(there)} tries {w or c.value}" for (c, w), k in counts) or "no setting tried"
+    code, why = _why(misses, lo - 0.01, hi + 0.01, total, est.closed)
     unheld = sum(b - a for a, b in free)
     more = f"; {len(free)} such stretches, {unheld * 1000:.0f} mm in all" if len(free) > 1 else ""
     where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(hi - lo) * 1000:.0f} mm{more}; {why})"
-    code = counts[0][0][0] if counts else PlanReason.IK_FAILED
-    p = est.p_RS[min(int(np.searchsorted(np.linspace(0, total, len(est.p_RS)), lo)), len(est.p_RS) - 1)]
-    return SeamFailure(code, where, np.asarray(p), 0.0)
+    return SeamFailure(code, where, _point(est, lo), 0.0)
+
+
+def _why(misses: list[Miss], lo: float, hi: float, total: float, closed: bool) -> tuple[PlanReason, str]:
+    """What stops the torch settings from lo to hi [m] along a curve ``total`` long: the commonest reason of the
+    stations there (every station's where none lies there) as the code, and the two commonest in words."""
+    there = [m for m in misses if _within(m.at_m, lo, hi, total, closed)] or misses
+    counts = Counter((m.code, m.what) for m in there).most_common(2)
+    why = ", ".join(f"{k} of {len(there)} tries {w or c.value}" for (c, w), k in counts) or "no setting tried"
+    return (counts[0][0][0] if counts else PlanReason.IK_FAILED), why
+
+
+def _point(est: CurveEstimate, at_m: float) -> FloatArray:
+    """The located curve's sample nearest ``at_m`` [m] along it (3,)."""
+    k = int(np.searchsorted(np.linspace(0, est.length_m, len(est.p_RS)), at_m % est.length_m))
+    return np.asarray(est.p_RS[min(k, len(est.p_RS) - 1)])
 
 
 def _within(x: float, lo: float, hi: float, total: float, closed: bool) -> bool:

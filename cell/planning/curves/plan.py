@@ -93,7 +93,8 @@ def cover_curves(
             continue
         f = got.failure
         assert f is not None
-        still[c.id] = replace(f, where=f"{f.where} (the arm reaches {got.share:.0%} of it, not all)")
+        tail = "not all" if got.share < 1.0 else "but in no overlapping arcs"
+        still[c.id] = replace(f, where=f"{f.where} (the arm reaches {got.share:.0%} of it, {tail})")
     return arcs, still
 
 

@@ -171,6 +171,24 @@ def share(runs: Sequence[Run], total: float, closed: bool) -> float:
     return float(bins.mean())
 
 
+def pinch(runs: Sequence[Run], total: float, overlap: float, step: float = 0.0005) -> tuple[float, float] | None:
+    """Where on a closed curve ``total`` [m] long, every point of it held by some stretch, each stretch through a
+    point gives out less than half the restart ``overlap`` [m] from it: (that point [m] along the located curve,
+    how far the deepest stretch through it holds on either side [m]), the shallowest such point, sampled ``step``
+    [m] apart; None where there is none or a point is held by no stretch (a gap). No cover of arcs each restarting
+    ``overlap`` back over the last passes such a point, however many arcs: the arc that would pass it gives out
+    there, and the next must start further back than any stretch through it reaches."""
+    x = np.arange(0.0, total, step)
+    deep = np.full(len(x), -1.0)
+    for r in runs:
+        for lap in (-2.0 * total, -total, 0.0, total):
+            a, b = r.a_m + lap, r.b_m + lap
+            inside = (x >= a) & (x <= b)
+            deep[inside] = np.maximum(deep[inside], np.minimum(x[inside] - a, b - x[inside]))
+    k = int(np.argmin(deep))
+    return (float(x[k]), float(deep[k])) if 0.0 <= deep[k] < 0.5 * overlap else None
+
+
 def balanced(chosen: Sequence[Run], total: float, closed: bool, overlap: float) -> list[Run]:
     """A cover's arcs with each junction's spare overlap shared out: where two arcs overlap by more than
     ``overlap`` [m] the first stops and the next starts half the excess back from their stretches' ends (a stretch

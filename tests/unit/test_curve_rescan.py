@@ -35,6 +35,19 @@ def test_the_close_ups_look_first_at_the_stretch_with_the_largest_sigma() -> Non
     assert a.min() - 1e-9 <= 2.0 <= a.max() + 1e-9
 
 
+def test_round_a_thin_tube_a_stretch_no_view_reached_leaves_the_others_to_try() -> None:
+    """A 25 mm tube's foot doubtful all round: every stretch's middle lies within 20 mm of every other's, so a
+    distance alone would leave nothing to try after the first stretch; the others (not the tried one) are tried."""
+    from cell.pipeline.curved.rescan import TRIED_M, _near_tried
+
+    est = replace(_tube_on_plate(r=0.0127, n=120), sigma_m=np.full(120, 1e-3))
+    first, *others = worst_first(est, 2e-4)
+    assert len(others) >= 3
+    assert all(np.linalg.norm(t.mid - first.mid) <= TRIED_M for t in others)  # what the old rule skipped
+    assert _near_tried(first, [first.mid])
+    assert not any(_near_tried(t, [first.mid]) for t in others)
+
+
 def test_a_close_up_of_a_stretch_sees_both_faces_from_outside_the_tube_and_is_reached_without_collision() -> None:
     from tiny_cell import HOME, TABLE, URDF
 

@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture and a re-location)
 MAX_TRIES = 6  # stretches tried at most (a stretch no view reaches costs the planner's search, not a move)
 MIN_GAIN = 0.1  # a close-up that lowers the worst sample's sigma by less than this share ends the curve's re-scan
-TRIED_M = 0.02  # [m] a stretch whose middle lies this near one tried already is not tried again
+TRIED_M = 0.02  # [m] a stretch whose middle lies this near one tried already (or half its chord) is not tried again
 
 
 def doubtful_curves(det: Detection) -> list[CurveEstimate]:
@@ -136,7 +136,7 @@ def preview_curve_closeups(
         for target in worst_first(first, limit):
             if len(tried) == MAX_TRIES:
                 break
-            if any(np.linalg.norm(target.mid - m) <= TRIED_M for m in tried):
+            if _near_tried(target, tried):
                 continue
             tried.append(target.mid)
             vp, why = _view_of(arm, motion.checker, target, q, K, parts, base.table_z, rng, o)
@@ -182,7 +182,7 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
     cal = 0.0
     best, weight, why = first, 0.0, ""
     while len(images) < MAX_VIEWS and len(tried) < MAX_TRIES:
-        targets = [t for t in worst_first(best, limit) if all(np.linalg.norm(t.mid - m) > TRIED_M for m in tried)]
+        targets = [t for t in worst_first(best, limit) if not _near_tried(t, tried)]
         if not targets:
             break
         target = targets[0]
@@ -218,6 +218,13 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         done = f"located from {len(images)} close-ups alone (sigma up to {best.sigma_max_m * 1000:.2f} mm)"
     why = why if best.sigma_max_m > limit else ""
     return replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
+
+
+def _near_tried(target: ViewTarget, tried: Sequence[FloatArray]) -> bool:
+    """Whether the stretch ``target``'s middle lies near one tried already: within :data:`TRIED_M`, or half its
+    chord where that is shorter (round a thin tube every stretch's middle lies within 20 mm of every other's)."""
+    near = min(TRIED_M, 0.5 * float(np.linalg.norm(target.p_end - target.p_start)))
+    return any(float(np.linalg.norm(target.mid - m)) <= near for m in tried)
 
 
 def _view_of(

@@ -1,6 +1,6 @@
-"""The torch search for one seam: candidates placed without IK, IK at the weld start, ranked, then solved along the
-seam, the approach and the depart; the first that passes is kept, else the failure that got furthest
-(docs/planning.md section 2).
+"""The torch search for one seam: candidates placed without IK, IK at the weld start, ranked, the arm checked there,
+then solved along the seam, the approach and the depart; the first that passes is kept, else the failure that got
+furthest (docs/planning.md section 2).
 
 Frames: everything in the robot base frame R [m]; joints [rad]."""
 
@@ -26,6 +26,7 @@ from cell.process.torch_orientations import Candidate, candidate_groups
 from cell.types.plan import PlanReason, SeamTask
 
 _GOOD = 0.6  # candidates within this share of the best start manipulability are ranked by their wrist
+AT_START = 1e-6  # a SeamFailure's progress [m] when the arm collides at the weld start (above IK failing there)
 
 
 @dataclass(frozen=True)
@@ -87,10 +88,12 @@ class SeamSearch:
 
         With a reach model, a seam out of reach for every torch within the process's angles fails at once
         (BEYOND_REACH, no candidate built), and a candidate whose wrist centre is out of reach anywhere along the
-        seam is dropped before IK. When no candidate of the nominal group can be placed, the other groups are
-        swept for one that can (:func:`cell.planning.placement.sweep`, a few broad-phase queries): a seam none can
-        be placed on is refused there, with the failure the group-by-group search would keep; otherwise the search
-        goes on from the first group that places one (the groups before it only add their placement failures)."""
+        seam is dropped before IK; one whose arm lies deep in something at the weld start is refused there
+        (:meth:`arm_at_start`) before its lines are solved. When no candidate of the nominal group can be placed,
+        the other groups are swept for one that can (:func:`cell.planning.placement.sweep`, a few broad-phase
+        queries): a seam none can be placed on is refused there, with the failure the group-by-group search would
+        keep; otherwise the search goes on from the first group that places one (the groups before it only add
+        their placement failures)."""
         pr, opt = self.process, self.opt
         if self.reach is not None:
             out = seam_reach(self.reach, task, pr)
@@ -131,7 +134,7 @@ class SeamSearch:
                 q0 = nearest_wrist(self.robot, q0, q_ref, self.window)
                 found.append((cand, X, q0))
             for cand, X, q0 in self._ranked(found, q_ref)[: opt.max_full]:
-                res = self.solve_candidate(task, cand, X, q0)
+                res = self.arm_at_start(task, q0) or self.solve_candidate(task, cand, X, q0)
                 if isinstance(res, SeamSolution):
                     return res
                 best_fail = better(best_fail, res)
@@ -156,6 +159,16 @@ class SeamSearch:
                 return out
         at, fail = sweep(self, task, candidate_groups(self.process, self.opt), q_seed)
         return None if at is not None else fail
+
+    def arm_at_start(self, task: SeamTask, q0: FloatArray) -> SeamFailure | None:
+        """The collision of a candidate whose arm, at its weld start q0 (dof,) [rad], lies deep in an obstacle or
+        itself (a contact :meth:`solve_candidate`'s path check could not step past: the candidate fails there if
+        nowhere else), found before its lines are solved; None when it does not (it may still collide)."""
+        hit = self.checker.deep_contact(np.asarray(q0, dtype=float)[None])
+        if hit is None:
+            return None
+        where = f"{hit.a} vs {hit.b} at {where_on_path(0.0, task.length)} (p_R = {mm(hit.p_R)} mm)"
+        return SeamFailure(PlanReason.COLLISION, where, hit.p_R, AT_START)
 
     def _ik(self, X: FloatArray, seed: FloatArray, restarts: bool = False) -> FloatArray:
         return solve_ik(self.robot, X, seed, rng=self.rng if restarts else None, options=self.opt.ik)

@@ -14,8 +14,8 @@ from cell import scenario as scn
 RADIUS_MM = 30.0
 PLATE_MM = 10.0
 SEAM = "POST>PLATE:circle"
-SCENARIO = """
-name: round-post
+_HEAD = """
+name: {name}
 seed: 7
 simulation: {{noise: none}}
 map: {{file: post.dxf, X_WM: {{xyz_m: [{x}, {y}, 0.90]}}}}
@@ -24,7 +24,10 @@ robot:
   urdf: kr5_arc.urdf
   X_WR: {{xyz_m: [0.0, -0.75, 0.90]}}
   home_deg: [-90.0, -100.0, 100.0, 0.0, 45.0, 0.0]
-cameras:
+"""  # the post on its plate and the robot in front of it: the head of the two .format templates below
+SCENARIO = (
+    _HEAD
+    + """cameras:
   above:
     eye_m: [0.0, 0.0, 1.6]
     target_m: [0.0, 0.0, 0.9]
@@ -32,6 +35,28 @@ cameras:
 perception:
   workspace: {{min_m: [-0.5, -0.5, 0.905], max_m: [0.5, 0.5, 1.3]}}
 """
+)
+SEEN = (
+    _HEAD
+    + """cameras:
+  front: {{eye_m: [0.0, -0.45, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}}
+  back_l: {{eye_m: [-0.4, 0.25, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}}
+  back_r: {{eye_m: [0.4, 0.25, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}}{more}
+perception:
+  workspace: {{min_m: [-0.5, -0.5, 0.905], max_m: [0.5, 0.5, 1.3]}}
+rescan: {{weld_tolerance_mm: {tol_mm}}}
+"""
+)
+EYE_IN_HAND = """
+  eye_in_hand: {mount: eye_in_hand, eye_m: [0.0, -0.3, 1.5], target_m: [0.0, 0.0, 0.93], resolution: [320, 240]}"""
+
+
+def seen_scenario(folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False) -> scn.Scenario:
+    """The post 0.75 m in front of the robot seen by three 160 x 120 cameras (they state about 0.18 mm sigma on its
+    fillet), with the arm's camera too if asked, and the weld tolerance ``tol_mm``."""
+    post_map(folder / "post.dxf")
+    text = SEEN.format(name=name, x=0.0, y=0.0, more=EYE_IN_HAND if eye_in_hand else "", tol_mm=tol_mm)
+    return scn.from_yaml(text, base_dir=folder)
 
 
 def post_map(path: Path, height_mm: float = 80.0) -> Path:
@@ -52,7 +77,7 @@ def post_map(path: Path, height_mm: float = 80.0) -> Path:
 def post_scenario(folder: Path, x_m: float = 0.0, y_m: float = 0.0) -> scn.Scenario:
     """The scenario of a post on a plate at (x_m, y_m) on the table [m], the robot 0.75 m in front of it."""
     post_map(folder / "post.dxf")
-    return scn.from_yaml(SCENARIO.format(x=x_m, y=y_m), base_dir=folder)
+    return scn.from_yaml(SCENARIO.format(name="round-post", x=x_m, y=y_m), base_dir=folder)
 
 
-__all__ = ["RADIUS_MM", "SEAM", "post_map", "post_scenario"]
+__all__ = ["RADIUS_MM", "SEAM", "post_map", "post_scenario", "seen_scenario"]

@@ -7,38 +7,18 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from round_post import SEAM, post_map
+from round_post import SEAM, seen_scenario
 
-from cell import scenario as scn
 from cell.export.report import weld_report
 from cell.pipeline.job import WeldJob
 from cell.pipeline.weld import weld
-
-SCENARIO = """
-name: round-post-seen
-seed: 7
-simulation: {noise: none}
-map: {file: post.dxf, X_WM: {xyz_m: [0.0, 0.0, 0.90]}}
-table: {center_m: [0.0, 0.0, 0.85], size_m: [1.6, 1.2, 0.10]}
-robot:
-  urdf: kr5_arc.urdf
-  X_WR: {xyz_m: [0.0, -0.75, 0.90]}
-  home_deg: [-90.0, -100.0, 100.0, 0.0, 45.0, 0.0]
-cameras:
-  front: {eye_m: [0.0, -0.45, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}
-  back_l: {eye_m: [-0.4, 0.25, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}
-  back_r: {eye_m: [0.4, 0.25, 1.35], target_m: [0.0, 0.0, 0.93], resolution: [160, 120]}
-perception:
-  workspace: {min_m: [-0.5, -0.5, 0.905], max_m: [0.5, 0.5, 1.3]}
-rescan: {weld_tolerance_mm: 0.6}  # three 160 x 120 cameras state 0.18 mm (3 sigma 0.54 mm): let the planner try it
-"""
 
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory: pytest.TempPathFactory) -> dict:
     folder: Path = tmp_path_factory.mktemp("post_seen")
-    post_map(folder / "post.dxf")
-    sc = scn.from_yaml(SCENARIO, base_dir=folder)
+    # three 160 x 120 cameras state 0.18 mm (3 sigma 0.54 mm): a 0.6 mm tolerance lets the planner try it
+    sc = seen_scenario(folder, "round-post-seen", 0.6)
     run = weld(sc, WeldJob(rescan="none", sides="first"))
     return {"run": run, "rep": weld_report(run)}
 

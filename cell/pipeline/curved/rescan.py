@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from cell.motion.collision import CollisionChecker
     from cell.rescan.view_grid import ViewTarget
     from cell.station import Arm, Station
-    from cell.types import CameraIntrinsics, Part
+    from cell.types import CameraIntrinsics, CurvedSeam, Part, SeamScene
     from cell.types.rescan import PlannedCloseup, Viewpoint
 
 MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture and a re-location)
@@ -107,10 +107,8 @@ def preview_curve_closeups(
     it) from where the last view leaves the arm (the scan configuration, or the last of the straight seams' planned
     close-ups ``straight`` where the re-scan does not return), as :func:`rescan_curves` plans it; or why none
     works. The close-ups after the first depend on what it sees: not planned."""
-    from cell.rescan.curve_fusion import facet_floor_m, shared_sigma
     from cell.rescan.curve_views import worst_first
     from cell.rescan.fusion import eye_in_hand_camera
-    from cell.seams.curved.drawn import drawn_estimate
     from cell.types.rescan import PlannedCloseup
 
     sc, arm = det.scenario, station.arm
@@ -123,14 +121,13 @@ def preview_curve_closeups(
     rng, q = sc.rng("rescan/curve-view"), np.asarray(views[-1].q if views else arm.q_scan, dtype=float)
     out: list[PlannedCloseup] = []
     for c in curves:
-        seam = next(s for s in base.weldmap.curved if s.id == c.id)
-        first = drawn_estimate(base.weldmap, seam) if c.status is not SeamStatus.FOUND else c
-        if first is None or seam.joint is None:
+        start = _start(base, c)
+        if start is None:
             continue
-        if float(shared_sigma(first, facet_floor_m(seam, base.weldmap)).max()) > limit:
-            out.append(PlannedCloseup(c.id, reason="not re-scanned: half its facets' sagitta is over the tolerance"))
+        _, first, parts, shared = start
+        if float(shared.max()) > limit:
+            out.append(PlannedCloseup(c.id, reason=_facets_over(float(shared.max()), limit)))
             continue
-        parts = tuple(p for p in base.weldmap.parts if p.name not in (seam.joint.abutting, seam.joint.receiving))
         vp, why = None, "no stretch over the tolerance to look at"
         tried: list[FloatArray] = []
         for target in worst_first(first, limit):
@@ -152,31 +149,22 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
     curve not found (``found`` NOT_FOUND) is looked at where the aligned map draws it and located from the close-ups
     alone, or stays not found."""
     from cell.perception.lens import undistort
-    from cell.rescan.curve_fusion import closeup_curve_scene, facet_floor_m, fuse_curve, relocate, shared_sigma
+    from cell.rescan.curve_fusion import closeup_curve_scene, fuse_curve, relocate
     from cell.rescan.curve_views import worst_first
-    from cell.seams.curved.drawn import drawn_estimate
 
     det, o = run.detection, run.options
     assert det.scene is not None
     base = det.scene.seam_scene
-    seam = next(s for s in base.weldmap.curved if s.id == found.id)
-    unseen = found.status is not SeamStatus.FOUND
-    first = drawn_estimate(base.weldmap, seam) if unseen else found
-    if first is None:
+    start = _start(base, found)
+    if start is None:
         return found
-    assert seam.joint is not None
-    own = (seam.joint.abutting, seam.joint.receiving)
-    parts = tuple(p for p in base.weldmap.parts if p.name not in own)
+    seam, first, parts, shared = start
+    unseen = found.status is not SeamStatus.FOUND
     limit = det.scenario.rescan.max_sigma_m
     K = run.station.intrinsics(run.camera)
     u = pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty())
-    shared = shared_sigma(first, facet_floor_m(seam, base.weldmap))
-    floor = float(shared.max())
-    if floor > limit:
-        why = f"not re-scanned: its round is drawn with flat facets, half their sagitta ({floor * 1000:.2f} mm here) is"
-        return replace(
-            found, reason=f"{why} over the tolerance's sigma ({limit * 1000:.2f} mm) whatever a close-up sees"
-        )
+    if float(shared.max()) > limit:
+        return replace(found, reason=_facets_over(float(shared.max()), limit))
     images: list[DepthImage] = []
     tried: list[FloatArray] = []
     cal = 0.0
@@ -218,6 +206,31 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         done = f"located from {len(images)} close-ups alone (sigma up to {best.sigma_max_m * 1000:.2f} mm)"
     why = why if best.sigma_max_m > limit else ""
     return replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
+
+
+def _start(
+    base: SeamScene, found: CurveEstimate
+) -> tuple[CurvedSeam, CurveEstimate, tuple[Part, ...], FloatArray] | None:
+    """What a curve's close-ups start from: its seam in the map, the estimate they improve (a curve not found:
+    where the aligned map draws it), the other parts (that may stand in a view's way) and each sample's sigma no
+    close-up takes away (half the facets' sagitta, :func:`cell.rescan.curve_fusion.shared_sigma`); None: nothing
+    to start from."""
+    from cell.rescan.curve_fusion import facet_floor_m, shared_sigma
+    from cell.seams.curved.drawn import drawn_estimate
+
+    seam = next(s for s in base.weldmap.curved if s.id == found.id)
+    first = drawn_estimate(base.weldmap, seam) if found.status is not SeamStatus.FOUND else found
+    if first is None or seam.joint is None:
+        return None
+    own = (seam.joint.abutting, seam.joint.receiving)
+    parts = tuple(p for p in base.weldmap.parts if p.name not in own)
+    return seam, first, parts, shared_sigma(first, facet_floor_m(seam, base.weldmap))
+
+
+def _facets_over(floor_m: float, limit_m: float) -> str:
+    """Why a curve is not re-scanned: its facets alone put a sample's sigma ``floor_m`` over ``limit_m`` [m]."""
+    why = f"not re-scanned: its round is drawn with flat facets, half their sagitta ({floor_m * 1000:.2f} mm here) is"
+    return f"{why} over the tolerance's sigma ({limit_m * 1000:.2f} mm) whatever a close-up sees"
 
 
 def _near_tried(target: ViewTarget, tried: Sequence[FloatArray]) -> bool:

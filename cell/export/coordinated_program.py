@@ -146,7 +146,7 @@ def _moves_line(moves: list[CoordMove]) -> str:
 def _tilt_text(cw: CoordinatedWeld) -> str:
     """The weld's tilt [deg]: one value where it is held, else the range it follows."""
     t = np.degrees(np.asarray(cw.knot_axes)[:, 0])
-    return f"{t[0]:.1f}" if np.ptp(t) < 0.05 else f"{t.min():.1f} .. {t.max():.1f} (following the seam)"
+    return f"{t[0]:.1f} deg" if np.ptp(t) < 0.05 else f"{t.min():.1f} .. {t.max():.1f} deg (following the seam)"
 
 
 def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) -> list[str]:
@@ -161,7 +161,7 @@ def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) ->
         f";- The base at this program's axes in $ROBROOT = {frame_text(X_RB)} (at its first weld point's E2 and E3:"
         " what EK gives; for checking)",
         chain_line(pos.X_RP, pos.tilt_height_m, pos.faceplate_offset_m, np.eye(4)),
-        f";- Seam {cw.seam_id}: tilt {_tilt_text(cw)} deg (the fillet in PA), rotate"
+        f";- Seam {cw.seam_id}: tilt {_tilt_text(cw)} (the fillet in PA), rotate"
         f" {math.degrees(cw.knot_axes[0, 1]):.1f} .. {math.degrees(cw.knot_axes[-1, 1]):.1f} deg, travel"
         f" {cw.speed * 1000:.1f} mm/s along the part, overlap {cw.overlap * 1000:.1f} mm",
     ]

@@ -35,12 +35,17 @@ def _say(msg: str) -> None:
     print(f"· {msg}", file=sys.stderr, flush=True)
 
 
-def _seam(w: Any) -> dict[str, Any]:
-    """One seam of the cell's run: welded or why not (its code and sentence), its TCP max."""
-    q = w.quality
-    code = w.code.value if w.code else None
-    tcp = round(q.tcp_max_mm, 3) if q is not None else None
-    return {"id": w.id, "welded": w.welded, "code": code, "reason": w.reason, "tcp_max_mm": tcp}
+def _seams(run: Any) -> list[dict[str, Any]]:
+    """Every seam of the cell's run (a PositionerRun): welded or why not (its code and sentence), its TCP max."""
+    welds, out = run.welds(), []
+    for sid in run.seam_ids():
+        w = welds.get(sid)
+        q = w.quality if w is not None else None
+        code = w.code if w is not None else run.unheld_codes.get(sid)
+        out.append({"id": sid, "welded": bool(w and w.welded), "code": code.value if code else None,
+                    "reason": w.reason if w is not None else run.unheld.get(sid, ""),
+                    "tcp_max_mm": round(q.tcp_max_mm, 3) if q is not None else None})  # fmt: skip
+    return out
 
 
 def coordinated_row(
@@ -123,7 +128,7 @@ def coordinated_row(
         "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4),
         "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
         "wall_s": round(time.perf_counter() - t, 1),
-        "seams": [_seam(w) for g in run.groups for w in g.seams],
+        "seams": _seams(run),
         "waypoints": entry["waypoints"],
     }
 

@@ -65,13 +65,17 @@ def knot_tilt_rotate(b_F: npt.ArrayLike, branch: int = 1) -> FloatArray:
 
 
 def _smooth(v: FloatArray, s: FloatArray, sigma: float) -> FloatArray:
-    """v (n,) along s (n,) [m]: at each knot the value of the line fitted to its neighbours with Gaussian weights
-    of ``sigma`` [m] (a linear trend kept, also at the ends)."""
-    d = s[None, :] - s[:, None]
-    w = np.exp(-0.5 * (d / sigma) ** 2)
-    s0, s1, s2 = w.sum(axis=1), (w * d).sum(axis=1), (w * d * d).sum(axis=1)
-    t0, t1 = w @ v, (w * d) @ v
-    return np.asarray((s2 * t0 - s1 * t1) / np.maximum(s0 * s2 - s1 * s1, 1e-300))
+    """v (n,) along s (n,) [m] (increasing): at each knot the value of the line fitted to its neighbours within
+    4 ``sigma`` with Gaussian weights of ``sigma`` [m] (a linear trend kept, also at the ends)."""
+    lo, hi = np.searchsorted(s, s - 4.0 * sigma), np.searchsorted(s, s + 4.0 * sigma, side="right")
+    out = np.empty(len(v))
+    for i in range(len(v)):
+        d = s[lo[i] : hi[i]] - s[i]
+        w = np.exp(-0.5 * (d / sigma) ** 2)
+        s0, s1, s2 = w.sum(), w @ d, w @ (d * d)
+        t0, t1 = w @ v[lo[i] : hi[i]], (w * d) @ v[lo[i] : hi[i]]
+        out[i] = (s2 * t0 - s1 * t1) / max(s0 * s2 - s1 * s1, 1e-300)
+    return out
 
 
 def pa_axes(pos: TiltRotatePositioner, curve: CurveInF, branch: int = 1) -> FloatArray | None:

@@ -1,7 +1,8 @@
 """A pipe stub's circular fillet welded on a positioner by coordinated motion: ``cell weld pipe-stub-positioner`` as
 the cell runs it (the located curve re-scanned up close at home, the weld gate's word on it, the coordinated weld);
 should the gate refuse it, the first located curve planned, played and measured as a study (docs/positioner.md,
-"Coordinated motion").
+"Coordinated motion"). Then the same of ``tube-tee-positioner``'s saddle (``tube_tee``: the tilt following the
+seam as well), with every seam of that cell and why it was not welded.
 
     .venv/bin/python benchmarks/bench_coordinated.py [--json PATH] [--noise realistic|small]
 
@@ -27,15 +28,31 @@ import numpy as np
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SCENARIO = "pipe-stub-positioner"
+TEE, SADDLE = "tube-tee-positioner", "BRANCH>RUN:saddle"  # the saddle: the tilt follows its turning bisector
 
 
 def _say(msg: str) -> None:
     print(f"· {msg}", file=sys.stderr, flush=True)
 
 
-def coordinated_row(noise: str | None = None, program: Path | None = None) -> dict[str, Any]:
-    """The located curve, the gate's word and the coordinated weld measured (a study when the gate refuses);
-    ``program``: a folder for its KRL program (``krl/``) and RAPID module (``rapid/``)."""
+def _seams(run: Any) -> list[dict[str, Any]]:
+    """Every seam of the cell's run (a PositionerRun): welded or why not (its code and sentence), its TCP max."""
+    welds, out = run.welds(), []
+    for sid in run.seam_ids():
+        w = welds.get(sid)
+        q = w.quality if w is not None else None
+        code = w.code if w is not None else run.unheld_codes.get(sid)
+        out.append({"id": sid, "welded": bool(w and w.welded), "code": code.value if code else None,
+                    "reason": w.reason if w is not None else run.unheld.get(sid, ""),
+                    "tcp_max_mm": round(q.tcp_max_mm, 3) if q is not None else None})  # fmt: skip
+    return out
+
+
+def coordinated_row(
+    noise: str | None = None, program: Path | None = None, scenario: str = SCENARIO, curve: str | None = None
+) -> dict[str, Any]:
+    """The located curve (``curve``, default the first), the gate's word and the coordinated weld measured (a study
+    when the gate refuses); ``program``: a folder for its KRL program (``krl/``) and RAPID module (``rapid/``)."""
     from cell import scenario as sc
     from cell.export.coordinated_program import coordinated_moves, program_path_off
     from cell.export.positioner_report import coordinated_entry
@@ -46,27 +63,29 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
     from cell.pipeline.positioned import weld_on_positioner
     from cell.seams.curved.metrics import curve_error
 
-    s = sc.load(SCENARIO)
+    s = sc.load(scenario)
     s = s.with_noise(noise) if noise else s
     assert s.robot.positioner is not None
     pos = s.robot.positioner.positioner(s.X_WR)
+    pick = lambda cs: next(c for c in cs if curve is None or c.id == curve)  # noqa: E731
     t = time.perf_counter()
     run = weld_on_positioner(s)  # what `cell weld` runs: detect, the close-ups at home, the coordinated weld
     det = run.detection
-    c = det.curve_estimates[0]
+    c = pick(det.curve_estimates)
     doubt = curve_doubt(c, s)
     err = curve_error(c, np.asarray(det.curve_truths[c.id]))
     welds = [w for g in run.groups for w in g.seams if w.id == c.id and w.welded]
-    if run.coordinated and welds:
-        cw, weld = run.coordinated[0], welds[0]
+    mine = [cw for cw in run.coordinated if cw.seam_id == c.id]
+    if mine and welds:
+        cw, weld = mine[0], welds[0]
     else:  # the gate refused it: the same located curve planned, played and measured as a study
         wm = read_weldmap(s)
         with open_cell(s, wm) as station:
             assert station.arm is not None
             det = detect(s, "ours", station=station, weldmap=wm)
-            c = det.curve_estimates[0]
+            c = pick(det.curve_estimates)
             done, _ = weld_curves_coordinated(station, det, pos, station.arm.q_scan, refuse_doubtful=False)
-        _, weld, study, _ = done[0]
+        _, weld, study, _ = next(d for d in done if d[1].id == c.id)
         assert study is not None
         cw = study
     assert weld.quality is not None
@@ -78,12 +97,12 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
         robot = RobotModel.from_urdf(robot_urdf(s))
         for controller in ("krl", "rapid"):
             (program / controller).mkdir(parents=True, exist_ok=True)
-            write_coordinated_programs(controller, [cw], robot, pos, "pipe_stub", program / controller)
+            write_coordinated_programs(controller, [cw], robot, pos, scenario.replace("-", "_"), program / controller)
     q = weld.quality
     entry = coordinated_entry(cw)
     moves = coordinated_moves(cw)
     return {
-        "scenario": SCENARIO,
+        "scenario": scenario,
         "noise": noise or "realistic",
         "curve": c.id,
         "located_sigma_max_mm": round(c.sigma_max_m * 1000.0, 3),
@@ -99,6 +118,7 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
         "rotation_worst_off_deg": round(float(np.abs(np.asarray(cw.rotation_deg) - 180.0).max()), 3),
         "in_position": cw.in_position,
         "tilt_deg": entry["tilt_deg"],
+        "tilt_range_deg": entry["tilt_range_deg"],
         "rotate_deg": entry["rotate_deg"],
         "torch_spread_mm": entry["torch_spread_mm"],
         "arc_s": entry["arc_s"],
@@ -108,6 +128,7 @@ def coordinated_row(noise: str | None = None, program: Path | None = None) -> di
         "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4),
         "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
         "wall_s": round(time.perf_counter() - t, 1),
+        "seams": _seams(run),
         "waypoints": entry["waypoints"],
     }
 
@@ -161,6 +182,9 @@ def main() -> None:
     row = coordinated_row(args.noise, args.program)
     _say(f"{SCENARIO}: the same with a weaving procedure")
     row["weave"] = weave_row(args.noise)
+    _say(f"{TEE}: the saddle welded with the tilt following it and the rotate axis turning")
+    tee_program = args.program / "tube_tee" if args.program is not None else None
+    row["tube_tee"] = coordinated_row(args.noise, tee_program, TEE, SADDLE)
     out = {"command": "benchmarks/bench_coordinated.py" + (f" --noise {args.noise}" if args.noise else ""), **row}
     args.json.write_text(json.dumps(out, indent=1) + "\n")
     _say(f"wrote {args.json}")

@@ -25,7 +25,7 @@ Millimetres, map frame M with z = 0 on the table top (docs/scenarios.md lists th
 - ``tube_tee``: a 114.3 x 6 run pipe between two 250 x 250 x 15 end plates standing on the table, a 60.3 x 4 branch
   coped onto its top (the saddle: a SPLINE through the true curve), a 50 x 10 tie bar on the table between the
   plates beside the pipe; the run's fillets are CIRCLEs in the plates' planes (OCS along +-x), the tie's two are
-  LINEs.
+  LINEs (``tube-tee``; ``tube-tee-positioner`` clamps it on a positioner).
 
 Every seam is red (BYLAYER) on layer ``WELD_SEAMS`` with its id as XDATA (``WELDCELL``). Byte-stable output.
 """

@@ -47,20 +47,16 @@ def positioner_table(data: Mapping[str, Any]) -> str:
 
 
 def coordinated_table(d: Mapping[str, Any]) -> str:
-    """docs/results.md's coordinated block: the pipe stub's fillet welded with the part turning, from
+    """docs/results.md's coordinated block: the pipe stub's fillet welded with the part turning (and tube-tee's
+    saddle, the tilt following it), from
     ``benchmarks/results/coordinated.json`` (``benchmarks/bench_coordinated.py``)."""
-    w = d["waypoints"]
+    tee = d.get("tube_tee")
     lines = [
-        "| seam | located: sigma max / error RMS / max [mm] | weld gate | TCP RMS / max [mm] | speed along the"
-        " part [mm/s] | ISO 6947 over its waypoints: worst slope / rotation off 180 [deg] | tilt; rotate from .. to"
-        " [deg] | torch spread [mm] | arc / job [s] | planning [s] |",
+        "| scenario: seam | located: sigma max / error RMS / max [mm] | weld gate | TCP RMS / max [mm] | speed along"
+        " the part [mm/s] | ISO 6947 over its waypoints: worst slope / rotation off 180 [deg] | tilt; rotate from .."
+        " to [deg] | torch spread [mm] | arc / job [s] | planning [s] |",
         "|---|---|---|---|---|---|---|---|---|---|",
-        f"| `{d['curve']}` | {_f(d['located_sigma_max_mm'])} / {_f(d['located_error_rms_mm'])} /"
-        f" {_f(d['located_error_max_mm'])} | {d['gate']} | {_f(d['tcp_rms_mm'])} / {_f(d['tcp_max_mm'])} |"
-        f" {_f(d['speed_mm_s'], '.2f')} | {_f(d['slope_worst_deg'], '.2f')} / {_f(d['rotation_worst_off_deg'], '.2f')}"
-        f" ({len(w['s_mm'])} waypoints, {'PA' if d['in_position'] else 'not PA'}) | {_f(d['tilt_deg'], '.1f')};"
-        f" {_f(d['rotate_deg'][0], '.1f')} .. {_f(d['rotate_deg'][1], '.1f')} | {_f(d['torch_spread_mm'], '.2f')} |"
-        f" {_f(d['arc_s'], '.1f')} / {_f(d['job_s'], '.1f')} | {_f(d['plan_wall_s'], '.1f')} |",
+        *(_coordinated_row(r) for r in (d, tee) if r),
     ]
     if "program_moves" in d:
         moves = ", ".join(f"{n} {k}" for k, n in d["program_moves"].items() if n)
@@ -68,6 +64,16 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
         lines += ["", f"Programs: {moves} in the turning base; the weld's knots within {off} mm of the moves as"
                   f" the controller runs them, the planned E2/E3 within {dev} deg of its synchronous"
                   " interpolation."]  # fmt: skip
+    if tee and "program_moves" in tee:
+        moves = ", ".join(f"{n} {k}" for k, n in tee["program_moves"].items() if n)
+        off, dev = _f(tee["program_path_off_mm"], ".4f"), _f(tee["program_axes_off_deg"], ".3f")
+        seams = tee.get("seams", [])
+        done = ", ".join(f"`{x['id']}`" for x in seams if x["welded"])
+        left = "; ".join(f"`{x['id']}`: {x['code']} ({x['reason'].split(': ', 2)[-1][:90]})" for x in seams
+                         if not x["welded"])  # fmt: skip
+        lines += ["", f"{tee['scenario']}: programs {moves} in the turning base (knots within {off} mm, E2/E3"
+                  f" within {dev} deg of the controller's interpolation); welded {done}; not welded:"
+                  f" {left or 'none'}."]  # fmt: skip
     wv = d.get("weave")
     if wv and wv.get("welded"):
         p = wv["procedure"]
@@ -82,3 +88,17 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
                   f" {_f(wv['arc_s'], '.1f')} / {_f(wv['job_s'], '.1f')} | {_f(wv['plan_wall_s'], '.1f')} | {rm} |"
                   f" {km} |"]  # fmt: skip
     return "\n".join(lines) + "\n"
+
+
+def _coordinated_row(d: Mapping[str, Any]) -> str:
+    """One coordinated weld's row: the located curve, the gate, the weld measured, its axes and times."""
+    w, t = d["waypoints"], d.get("tilt_range_deg")
+    tilt = _f(d["tilt_deg"], ".1f") if not t or t[1] - t[0] < 0.05 else f"{_f(t[0], '.1f')} .. {_f(t[1], '.1f')}"
+    return (
+        f"| {d.get('scenario', '')}: `{d['curve']}` | {_f(d['located_sigma_max_mm'])} / {_f(d['located_error_rms_mm'])}"
+        f" / {_f(d['located_error_max_mm'])} | {d['gate']} | {_f(d['tcp_rms_mm'])} / {_f(d['tcp_max_mm'])} |"
+        f" {_f(d['speed_mm_s'], '.2f')} | {_f(d['slope_worst_deg'], '.2f')} / {_f(d['rotation_worst_off_deg'], '.2f')}"
+        f" ({len(w['s_mm'])} waypoints, {'PA' if d['in_position'] else 'not PA'}) | {tilt};"
+        f" {_f(d['rotate_deg'][0], '.1f')} .. {_f(d['rotate_deg'][1], '.1f')} | {_f(d['torch_spread_mm'], '.2f')} |"
+        f" {_f(d['arc_s'], '.1f')} / {_f(d['job_s'], '.1f')} | {_f(d['plan_wall_s'], '.1f')} |"
+    )

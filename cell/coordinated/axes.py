@@ -1,5 +1,6 @@
 """The positioner's axes along a curved seam that keep each point of it in PA (its fillet's bisector straight up)
-where the torch stands: the tilt fixed, the rotate axis turning with the weld (docs/positioner.md, "Coordinated
+where the torch stands: the rotate axis turning with the weld, the tilt held where the seam's bisector keeps its
+angle to the faceplate's axis and following it where it does not (docs/positioner.md, "Coordinated
 motion"). Frames: F the faceplate at home (the part's frame while it turns), R the robot base; angles [rad]."""
 
 from __future__ import annotations
@@ -36,21 +37,66 @@ class CurveInF:
         return np.asarray(b / np.linalg.norm(b, axis=1, keepdims=True))
 
 
-def pa_axes(pos: TiltRotatePositioner, curve: CurveInF, branch: int = 1) -> FloatArray | None:
-    """(n, 2) (tilt, rotate) [rad] putting each knot's bisector as near straight up as one fixed tilt allows.
+TILT_HELD_DEG = 1.0  # the knots' tilts spread at most this much: one tilt held, their median (a pipe on its plate)
+TILT_SMOOTH_M = 0.005  # [m] the following tilt smoothed along the seam (a local line, Gaussian weights of this sigma)
 
-    With P upright the world's up in F is u_F = (sin t sin r, sin t cos r, cos t): the bisector b = u_F needs
-    t = acos(b_z) and r = atan2(b_x, b_y). The tilt is held at the knots' median (``branch`` -1: the other branch,
-    -t with r + pi), the rotation follows each knot, unwrapped along the weld and shifted by whole turns to the
-    middle of the rotate axis's range. None when the tilt or the rotation's sweep does not fit the limits."""
-    b = curve.bisector_F
-    t = float(np.median(np.arccos(np.clip(b[:, 2], -1.0, 1.0)))) * (1.0 if branch > 0 else -1.0)
-    r = np.unwrap(np.arctan2(b[:, 0], b[:, 1]) + (0.0 if branch > 0 else math.pi))
+
+def knot_tilt_rotate(b_F: npt.ArrayLike, branch: int = 1) -> FloatArray:
+    """(n, 2) (tilt, rotate) [rad] that put each unit bisector b (n, 3) in F straight up: t = acos(b_z),
+    r = atan2(b_x, b_y) (``branch`` -1 at the first knot: -t, r + pi), each later knot on the branch nearer its
+    predecessor's axes (a bisector passing the faceplate's axis changes branch rather than jump half a turn),
+    the rotation unwrapped along the seam."""
+    b = np.asarray(b_F, dtype=float)
+    t = np.arccos(np.clip(b[:, 2], -1.0, 1.0))
+    r = np.arctan2(b[:, 0], b[:, 1])
+    out = np.empty((len(b), 2))
+    out[0] = (t[0], r[0]) if branch > 0 else (-t[0], r[0] + math.pi)
+    for i in range(1, len(b)):
+        prev = out[i - 1]
+        best = None
+        for cand in ((t[i], r[i]), (-t[i], r[i] + math.pi)):
+            rr = cand[1] + 2.0 * math.pi * round((prev[1] - cand[1]) / (2.0 * math.pi))
+            d = abs(cand[0] - prev[0]) + abs(math.sin(prev[0])) * abs(rr - prev[1])
+            if best is None or d < best[0]:
+                best = (d, cand[0], rr)
+        assert best is not None
+        out[i] = best[1:]
+    return out
+
+
+def _smooth(v: FloatArray, s: FloatArray, sigma: float) -> FloatArray:
+    """v (n,) along s (n,) [m] (increasing): at each knot the value of the line fitted to its neighbours within
+    4 ``sigma`` with Gaussian weights of ``sigma`` [m] (a linear trend kept, also at the ends)."""
+    lo, hi = np.searchsorted(s, s - 4.0 * sigma), np.searchsorted(s, s + 4.0 * sigma, side="right")
+    out = np.empty(len(v))
+    for i in range(len(v)):
+        d = s[lo[i] : hi[i]] - s[i]
+        w = np.exp(-0.5 * (d / sigma) ** 2)
+        s0, s1, s2 = w.sum(), w @ d, w @ (d * d)
+        t0, t1 = w @ v[lo[i] : hi[i]], (w * d) @ v[lo[i] : hi[i]]
+        out[i] = (s2 * t0 - s1 * t1) / max(s0 * s2 - s1 * s1, 1e-300)
+    return out
+
+
+def pa_axes(pos: TiltRotatePositioner, curve: CurveInF, branch: int = 1) -> FloatArray | None:
+    """(n, 2) (tilt, rotate) [rad] putting each knot's bisector straight up (:func:`knot_tilt_rotate`).
+
+    Where the knots' tilts spread less than ``TILT_HELD_DEG`` the tilt is held at their median (a pipe square
+    on its plate: only the rotate axis moves); else it follows the seam, smoothed (``TILT_SMOOTH_M``): an
+    ellipse of a leaning tube, a saddle. The rotation follows each knot, shifted by whole turns to the middle of
+    the rotate axis's range. None when a tilt or the rotation's sweep does not fit the limits."""
+    tr = knot_tilt_rotate(curve.bisector_F, branch)
+    t, r = tr[:, 0], tr[:, 1]
+    if np.ptp(t) <= math.radians(TILT_HELD_DEG):
+        t = np.full(len(t), float(np.median(t)))
+    elif len(t) > 2:
+        t = _smooth(t, np.asarray(curve.s), TILT_SMOOTH_M)
     lo, hi = pos.rotate.q_min, pos.rotate.q_max
     r = r + 2.0 * math.pi * round((0.5 * (lo + hi) - 0.5 * (r.min() + r.max())) / (2.0 * math.pi))
-    if not pos.tilt.contains(t) or r.min() < lo or r.max() > hi:
+    tilt = pos.tilt
+    if t.min() < tilt.q_min - 1e-9 or t.max() > tilt.q_max + 1e-9 or r.min() < lo or r.max() > hi:
         return None
-    return readonly(np.column_stack([np.full(len(r), t), r]))
+    return readonly(np.column_stack([t, r]))
 
 
 def knots_in_R(pos: TiltRotatePositioner, curve: CurveInF, axes: npt.ArrayLike) -> tuple[FloatArray, ...]:

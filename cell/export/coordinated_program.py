@@ -115,13 +115,14 @@ def _chord(p: FloatArray, a: int, b: int) -> float:
 
 def chord_knots(cw: CoordinatedWeld, tol: float = CHORD_TOL_M, woven: bool = True) -> list[int]:
     """The knots written (indices, first and last included): each chord the longest whose knots between lie
-    within ``tol`` [m] of it in the part's frame and along which the rotate axis turns at most ``MAX_TURN_DEG``."""
+    within ``tol`` [m] of it in the part's frame and along which each axis (tilt, rotate) turns at most
+    ``MAX_TURN_DEG``."""
     p = _knots(cw, woven)
-    r = np.asarray(cw.knot_axes)[:, 1]
+    A = np.degrees(np.asarray(cw.knot_axes))
     out, i, n = [0], 0, len(p)
     while i < n - 1:
         j = i + 1
-        while j + 1 < n and abs(math.degrees(r[j + 1] - r[i])) <= MAX_TURN_DEG:
+        while j + 1 < n and float(np.abs(A[j + 1] - A[i]).max()) <= MAX_TURN_DEG:
             a, b = p[i], p[j + 1]
             u = (b - a) / max(float(np.linalg.norm(b - a)), 1e-12)
             mid = p[i + 1 : j + 1] - a
@@ -142,6 +143,12 @@ def _moves_line(moves: list[CoordMove]) -> str:
             " the plan where the controller moves them in proportion to the path along each move")  # fmt: skip
 
 
+def _tilt_text(cw: CoordinatedWeld) -> str:
+    """The weld's tilt [deg]: one value where it is held, else the range it follows."""
+    t = np.degrees(np.asarray(cw.knot_axes)[:, 0])
+    return f"{t[0]:.1f} deg" if np.ptp(t) < 0.05 else f"{t.min():.1f} .. {t.max():.1f} deg (following the seam)"
+
+
 def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) -> list[str]:
     lim = [(n, name, math.degrees(a.q_min), math.degrees(a.q_max)) for n, name, a in
            ((2, "tilt", pos.tilt), (3, "rotate", pos.rotate))]  # fmt: skip
@@ -154,7 +161,7 @@ def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) ->
         f";- The base at this program's axes in $ROBROOT = {frame_text(X_RB)} (at its first weld point's E2 and E3:"
         " what EK gives; for checking)",
         chain_line(pos.X_RP, pos.tilt_height_m, pos.faceplate_offset_m, np.eye(4)),
-        f";- Seam {cw.seam_id}: tilt {math.degrees(cw.knot_axes[0, 0]):.1f} deg (the fillet in PA), rotate"
+        f";- Seam {cw.seam_id}: tilt {_tilt_text(cw)} (the fillet in PA), rotate"
         f" {math.degrees(cw.knot_axes[0, 1]):.1f} .. {math.degrees(cw.knot_axes[-1, 1]):.1f} deg, travel"
         f" {cw.speed * 1000:.1f} mm/s along the part, overlap {cw.overlap * 1000:.1f} mm",
     ]

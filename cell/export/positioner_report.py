@@ -106,6 +106,7 @@ def coordinated_entry(cw: CoordinatedWeld) -> dict[str, Any]:
         "plan_wall_s": _r(cw.plan_s),
         "speed_mm_s": _r(cw.speed * 1000.0),
         "tilt_deg": _r(math.degrees(float(cw.knot_axes[0, 0]))),
+        "tilt_range_deg": deg((cw.knot_axes[:, 0].min(), cw.knot_axes[:, 0].max())),
         "rotate_deg": deg((cw.knot_axes[0, 1], cw.knot_axes[-1, 1])),
         "torch_spread_mm": _r(cw.tcp_spread_mm),
         "in_position": cw.in_position,

@@ -56,6 +56,76 @@ def test_one_tilt_puts_every_point_of_a_pipes_fillet_in_pa_under_a_still_torch()
     assert 0.004 < spread < 0.0051
 
 
+def _ellipse_F(lean_deg: float = 35.0, n: int = 240) -> CurveInF:
+    """A 42.4 mm tube leaning ``lean_deg`` towards +x, cut flat on the faceplate's plane: the ellipse of its foot."""
+    R, lean = 0.0212, math.radians(lean_deg)
+    axis, e1 = np.array([math.sin(lean), 0.0, math.cos(lean)]), np.array([math.cos(lean), 0.0, -math.sin(lean)])
+    phi = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    u = np.outer(np.cos(phi), e1) + np.outer(np.sin(phi), [0.0, 1.0, 0.0])
+    p = R * u - np.outer(R * u[:, 2] / axis[2], axis) + [0.0, 0.0, Z_FILLET]
+    return _loop(p, u, np.broadcast_to([0.0, 0.0, 1.0], (n, 3)))
+
+
+def _saddle_F(n: int = 240, crown_z: float = Z_FILLET) -> CurveInF:
+    """A 60.3 mm branch standing on a 114.3 mm run pipe (its axis along x), the saddle's crowns ``crown_z`` [m] up."""
+    Rb, Rr = 0.03015, 0.05715
+    phi = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    x, y = Rb * np.cos(phi), Rb * np.sin(phi)
+    z = np.sqrt(Rr**2 - y**2)
+    p = np.column_stack([x, y, z - Rr + crown_z])
+    n_run = np.column_stack([np.zeros(n), y, z]) / Rr
+    return _loop(p, np.column_stack([np.cos(phi), np.sin(phi), np.zeros(n)]), n_run)
+
+
+def _loop(p: np.ndarray, n_a: np.ndarray, n_b: np.ndarray) -> CurveInF:
+    t = np.roll(p, -1, axis=0) - np.roll(p, 1, axis=0)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+    return CurveInF(p, t, n_a, n_b, s)
+
+
+@pytest.mark.parametrize(("make", "spread_deg"), [(_ellipse_F, 35.0), (_saddle_F, 16.0)])
+def test_the_tilt_follows_a_seam_whose_bisector_turns_and_keeps_every_knot_in_pa(make, spread_deg: float) -> None:
+    pos, curve = _positioner(), make()
+    axes = pa_axes(pos, curve)
+    assert axes is not None
+    spread = math.degrees(float(np.ptp(axes[:, 0])))
+    assert spread_deg - 2.0 < spread < spread_deg + 2.0  # the tilt follows the bisector's angle to the axis
+    assert np.all(np.diff(axes[:, 1]) > 0) or np.all(np.diff(axes[:, 1]) < 0)  # the rotate axis turns one way
+    slope, rot, within = positions(pos, curve, axes)
+    assert within and np.abs(slope).max() < 0.5 and np.abs(rot - 180.0).max() < 1.0
+    # The tilt held at the knots' median: the ellipse's acute and obtuse sides 17.5 deg of rotation off PA (out of
+    # tolerance), the saddle's crown and flanks 9.2 deg (just within it).
+    held = np.column_stack([np.full(len(axes), np.median(axes[:, 0])), axes[:, 1]])
+    assert np.abs(positions(pos, curve, held)[1] - 180.0).max() > 8.0
+
+
+def test_a_saddle_is_welded_in_pa_with_the_tilt_and_the_rotate_axis_turning_together() -> None:
+    """tube-tee-positioner's saddle (its crowns 227 mm above the faceplate) planned, timed and gated as one."""
+    from cell.coordinated.plan import plan_coordinated
+    from cell.motion.robot import RobotModel
+    from cell.process.torch import WeldProcess
+    from cell.station.arm import robot_urdf
+
+    sc = load("tube-tee-positioner")
+    model = RobotModel.from_urdf(robot_urdf(sc))
+    pos = sc.robot.positioner.positioner(sc.X_WR)  # type: ignore[union-attr]
+    curve = _saddle_F(crown_z=0.22715)
+    process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
+    scene = MovingScene.build(model, pos, [], sc.motion.plan.collision)
+    q0 = np.radians(sc.robot.home_deg)
+    cw = plan_coordinated(model, pos, _estimate(pos, curve), process, sc.motion.plan, scene, q0,
+                          rng=np.random.default_rng(0))  # fmt: skip
+    assert cw.in_position and np.abs(cw.slope_deg).max() < 1.0 and np.abs(cw.rotation_deg - 180.0).max() < 1.0
+    weld = (cw.times >= cw.pieces[2][1]) & (cw.times <= cw.pieces[2][2])
+    tilt = np.degrees(cw.axes[weld, 0])
+    assert 14.0 < np.ptp(tilt) < 18.0  # the tilt follows the saddle, crowns to flanks, while the arc burns
+    rate = np.abs(np.gradient(cw.axes[weld], cw.times[weld], axis=0)).max(axis=0)
+    assert rate[0] <= pos.tilt.v_max and rate[1] <= pos.rotate.v_max
+    ideal = float(cw.s[-1]) / cw.speed  # the travel speed relative to the part: the loop and overlap at it
+    assert ideal < cw.arc_s < ideal + 2.0
+
+
 def test_a_rotate_axis_too_short_for_the_loop_is_refused() -> None:
     assert pa_axes(_positioner(rotate_deg=170.0), _circle_F()) is None
 
@@ -75,6 +145,16 @@ def test_the_eight_axes_limits_name_the_positioner_axis_that_leaves_them() -> No
     assert "rotate" in (off_limits(lim, x) or "")
 
 
+def _estimate(pos: TiltRotatePositioner, curve: CurveInF) -> CurveEstimate:
+    """The closed curve ``curve`` (in F) located exactly, in R at the positioner's home."""
+    X = pos.X_R_F(*pos.home)
+    n = len(curve.p_F)
+    return CurveEstimate(
+        "C", SeamStatus.FOUND, p_RS=curve.p_F @ X[:3, :3].T + X[:3, 3], n_abutting_R=curve.n_a_F @ X[:3, :3].T,
+        n_receiving_R=curve.n_b_F @ X[:3, :3].T, closed=True, sigma_m=np.full(n, 1e-4), end_sigma_m=(0.0, 0.0),
+    )  # fmt: skip
+
+
 @pytest.fixture(scope="module")
 def planned() -> tuple:
     """A pipe's fillet clamped 3.6 mm off the rotate axis of pipe-stub-positioner's positioner, planned."""
@@ -86,12 +166,7 @@ def planned() -> tuple:
     sc = load("pipe-stub-positioner")
     model = RobotModel.from_urdf(robot_urdf(sc))
     pos = sc.robot.positioner.positioner(sc.X_WR)  # type: ignore[union-attr]
-    curve = _circle_F(off=(0.003, -0.002))
-    X = pos.X_R_F(*pos.home)
-    est = CurveEstimate(
-        "C", SeamStatus.FOUND, p_RS=curve.p_F @ X[:3, :3].T + X[:3, 3], n_abutting_R=curve.n_a_F @ X[:3, :3].T,
-        n_receiving_R=curve.n_b_F @ X[:3, :3].T, closed=True, sigma_m=np.full(360, 1e-4), end_sigma_m=(0.0, 0.0),
-    )  # fmt: skip
+    est = _estimate(pos, _circle_F(off=(0.003, -0.002)))
     process = WeldProcess.from_spec(sc.process, sc.robot.stickout_mm)
     scene = MovingScene.build(model, pos, [], sc.motion.plan.collision)
     q0 = np.radians(sc.robot.home_deg)

@@ -15,6 +15,8 @@ import numpy as np
 from cell.errors import IKError, TimingError
 from cell.geometry import FloatArray, readonly
 from cell.motion.ik import solve_ik
+from cell.planning.curves.gapseed import seeded
+from cell.planning.curves.gapwalk import walked
 from cell.planning.curves.graph import gaps, graph_map, refined, settings_along
 from cell.planning.curves.path import CurvePath, curve_path, curve_poses
 from cell.planning.curves.reach import Miss, Run, balanced, cover, pinch, settings, share, station_spacing
@@ -49,13 +51,19 @@ GAP_MARGIN_M = 0.015  # [m] a gap in the map is walked again with finer settings
 
 
 def plan_arcs(
-    search: SeamSearch, est: CurveEstimate, q_seed: FloatArray, procedure: WeldProcedure | None = None
+    search: SeamSearch,
+    est: CurveEstimate,
+    q_seed: FloatArray,
+    procedure: WeldProcedure | None = None,
+    gap_walk: bool = False,
 ) -> Split:
     """The arcs that weld ``est`` whole (a closed curve all round and over its overlap; an open one end to end),
     fewest first, at most :data:`MAX_ARCS`, each solved (a :class:`SeamSolution` per pass of ``procedure``, its
     task an open arc of the curve, id ``<seam>#arcK``); else the share of the curve some torch setting reaches
     and the failure of the arc that got furthest. The map's graph (:mod:`.graph`) holds the nominal angles first,
-    then the tolerance's ends too, then finer settings in its gaps."""
+    then the tolerance's ends too, then finer settings in its gaps; ``gap_walk``: then the gaps walked at finer
+    stations (:mod:`.gapwalk`, :mod:`.gapseed`: no round scenario's curve welded by it yet, 10-60 s more per curve
+    with a gap, so not in ``cell weld``; docs/curves-welding.md section 10)."""
     pr, opt = search.process, search.opt
     knot = knot_spacing(est, opt.spacing)
     if procedure is not None:
@@ -68,13 +76,18 @@ def plan_arcs(
     failure: SeamFailure | None = None
     stiff = pr.work_angle_tol <= 0.0 and pr.travel_angle_tol <= 0.0  # no angle to widen
     memo: dict[Candidate, list[FloatArray | None]] = {}  # each setting's joints at the stations, walked once
-    for stage in range(1 if stiff else 3):  # nominal angles; their tolerance's ends; finer in the map's gaps
+    for stage in range(1 if stiff else 4 if gap_walk else 3):  # nominal; tolerance's ends; finer settings, stations
         cands = settings(search, False) + (settings(search, True) if stage else [])
         windows = _windows(runs, est, overlap) if stage > 1 else []
         if stage > 1 and not windows:
             break
         cands += refined(search) if stage > 1 else []
-        got_runs, got_misses = graph_map(search, est, cands, flange, q_seed, knot, overlap, memo, windows)
+        if stage == 3:
+            got_runs = walked(search, est, runs, windows, flange, knot, overlap)
+            got_runs += seeded(search, est, windows, flange, q_seed, knot, overlap)
+            got_misses: list[Miss] = []
+        else:
+            got_runs, got_misses = graph_map(search, est, cands, flange, q_seed, knot, overlap, memo, windows)
         runs, misses = runs + [r for r in got_runs if not r.spare], misses + got_misses
         spare = sorted((r for r in got_runs if r.spare), key=_setting_changes)  # the fewest turns of the torch first
         for pool in range(2):  # the map's paths; then, once no cover of them welds, the spare paths too

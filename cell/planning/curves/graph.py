@@ -267,7 +267,9 @@ def _runs(
         first = group[chain[0][1]]
         q0 = nodes[chain[0]].q
         spare = bool(out) and out[-1].a_m == a - shift and out[-1].b_m == b - shift
-        out.append(Run(first, a - shift, b - shift, q0, t - start >= whole_len, readonly(track), spare=spare))
+        q_track = readonly(np.array([nodes[c].q for c in chain])[order])
+        whole = t - start >= whole_len
+        out.append(Run(first, a - shift, b - shift, q0, whole, readonly(track), spare=spare, q_track=q_track))
     return out
 
 

@@ -36,7 +36,8 @@ class Run:
     ``whole``: a closed curve held all round and on over its overlap; ``track`` (m, 4): the settings at its
     stations (position along the located curve [m] less ``origin_m``, spin, work and travel offsets [rad]), the
     torch turned and tilted from one to the next (None: ``cand`` held throughout); ``spare``: another path over a
-    stretch some run already holds, for when that one fails its full solve."""
+    stretch some run already holds, for when that one fails its full solve; ``q_track`` (m, dof): the joints
+    holding the torch at ``track``'s stations [rad] (None: not kept)."""
 
     cand: Candidate
     a_m: float
@@ -46,6 +47,7 @@ class Run:
     track: FloatArray | None = None
     origin_m: float = 0.0
     spare: bool = False
+    q_track: FloatArray | None = None
 
     @property
     def length(self) -> float:

@@ -96,6 +96,8 @@ def _curve_rescans(rep: dict) -> None:
             line += ", closed"
         line += f" ({'within' if r['within_tolerance'] else 'over'} the tolerance); {r['views']} close-ups"
         line += f", {_fmt(r['motion_s'], 1)} s, weight {_fmt(r['weight'])}"
+        if any(r.get("e1_mm") or ()):  # a linear track's carriage moved for them
+            line += ", from E1 = " + "/".join(_fmt(e, 0) for e in r["e1_mm"]) + " mm"
         b, a = s.get("error_mm_before"), s.get("error_mm")
         if b is not None or a is not None:
             b, a = b or {}, a or {}

@@ -153,8 +153,8 @@ def add_curve_rescan(rep: dict[str, Any], before: Detection, after: Detection, r
 def curve_rescan_entry(r: CurveRescan, limit_m: float) -> dict[str, Any]:
     """What the re-scan did for one curve: ``chosen``, ``views`` taken, ``used`` and ``weight`` (the close-ups'
     share), the fixed cameras' ``sigma_max_mm_before`` and ``end_sigma_mm_before`` (null: closed or not located),
-    ``within_tolerance`` after (its worst sigma within ``limit_m``), ``motion_s``, each view's ``distance_mm``,
-    and ``reason``: why it was not re-scanned or is still over the tolerance."""
+    ``within_tolerance`` after (its worst sigma within ``limit_m``), ``motion_s``, each view's ``distance_mm`` and
+    ``e1_mm``, and ``reason``: why it was not re-scanned or is still over the tolerance."""
     b, a = r.before, r.after
     found = b.status is SeamStatus.FOUND
     return {
@@ -167,5 +167,6 @@ def curve_rescan_entry(r: CurveRescan, limit_m: float) -> dict[str, Any]:
         "within_tolerance": a.status is SeamStatus.FOUND and a.sigma_max_m <= limit_m,
         "motion_s": _r(r.motion_s, 3),
         "distance_mm": [_r(v.distance_m * 1000.0, 1) for v in r.views],
+        "e1_mm": [_r(v.e1_m * 1000.0, 1) for v in r.views],  # a linear track's carriage for each view (0: fixed)
         "reason": r.reason,
     }

@@ -36,6 +36,7 @@ class Viewpoint:
     roll_deg: float
     tried: int
     via: bool = False  # the move passes through q_via
+    e1_m: float = 0.0  # [m] where a linear track's carriage stood for it (X_RC and q with the base there)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "X_RC", readonly(self.X_RC))
@@ -75,9 +76,9 @@ class CurveRescan:
 
     before : the fixed cameras' curve (not found: as located); after : what the cell uses now (the fused curve, or
     ``before`` kept); views : the close-ups taken, in order; weight : the close-ups' share of the fused curve (0:
-    ``before`` kept); motion_s : robot time of the moves to its views [s]; chosen : whether the re-scan's choice
-    took it (``cell rescan`` lists the curves it left, each with why); reason : why it was not re-scanned, or why
-    the close-ups left it over the tolerance ('' when they brought it within).
+    ``before`` kept); motion_s : robot time of the moves for its views [s] (a track's carriage's too); chosen :
+    whether the re-scan's choice took it (``cell rescan`` lists the curves it left, each with why); reason : why
+    it was not re-scanned, or why the close-ups left it over the tolerance ('' when they brought it within).
     """
 
     id: str

@@ -55,3 +55,41 @@ def test_a_curve_within_the_tolerance_asked_for_by_id_is_looked_at_once(tmp_path
     assert r.chosen and len(r.views) == 1 and r.weight > 0.9
     assert r.after.sigma_max_m < 0.5 * before.sigma_max_m
     assert after.curve_estimates == (r.after,) and after.curve_metrics[SEAM].within_2sigma == 1.0
+
+
+FAR_POST = """
+name: far-post
+seed: 33
+simulation: {noise: none}
+map: {file: ../maps/post_plate.dxf, X_WM: {xyz_m: [1.0, 0.25, 0.90]}}
+table: {center_m: [0.0, 0.0, 0.85], size_m: [3.0, 1.2, 0.10]}
+robot:
+  urdf: kr5_arc.urdf
+  X_WR: {xyz_m: [-1.0, -0.75, 0.90]}
+  home_deg: [-90.0, -100.0, 100.0, 0.0, 45.0, 0.0]
+  track: {axis_W: [1.0, 0.0, 0.0], min_mm: -200.0, max_mm: 2400.0, speed_mm_s: 1000.0, accel_mm_s2: 1500.0,
+          jerk_mm_s3: 6000.0}
+cameras:
+  front: {eye_m: [1.0, -0.2, 1.35], target_m: [1.0, 0.25, 0.93], resolution: [160, 120]}
+  back_l: {eye_m: [0.6, 0.5, 1.35], target_m: [1.0, 0.25, 0.93], resolution: [160, 120]}
+  back_r: {eye_m: [1.4, 0.5, 1.35], target_m: [1.0, 0.25, 0.93], resolution: [160, 120]}
+  eye_in_hand: {mount: eye_in_hand, eye_m: [-0.45, -0.2, 1.8], target_m: [0.0, 0.25, 0.93], resolution: [320, 240]}
+perception:
+  workspace: {min_m: [0.85, 0.10, 0.905], max_m: [1.15, 0.40, 1.05]}
+rescan: {weld_tolerance_mm: 0.3}
+"""  # track-post's post 2 m along the track (1 m further): beyond the arm's reach from E1 = 0
+
+
+def test_on_a_track_the_close_up_is_taken_with_the_carriage_abreast_of_the_curve() -> None:
+    sc = scn.from_yaml(FAR_POST)
+    wm = read_weldmap(sc)
+    with open_cell(sc, wm) as station:
+        det = detect(sc, station=station, weldmap=wm)
+        rs, _ = rescan_all(station, det, "low")
+    [r] = rs.curves
+    assert r.chosen and len(r.views) == 1 and r.after.sigma_max_m <= sc.rescan.max_sigma_m, r.reason
+    assert 1.9 < r.views[0].e1_m < 2.1  # abreast of the post, 10 mm grid
+    carriage = [m.e1 for m in rs.moves if m.e1 is not None]
+    assert [round(float(e[-1]), 3) for e in carriage] == [round(r.views[0].e1_m, 3), 0.0]  # out, and back to 0
+    assert rs.returned and rs.note == ""
+    assert r.motion_s > 2.0  # the carriage's 2 m is its own (0.9 s of it the view's move, measured)

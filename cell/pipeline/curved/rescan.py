@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cell.errors import CellError
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty
+from cell.pipeline.curved.views import Carriage, view_of
 from cell.pipeline.detect import Progress, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
@@ -26,11 +26,9 @@ from cell.types.rescan import CurveRescan, Rescan, Viewpoint
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from cell.config.rescan import RescanOptions
-    from cell.motion.collision import CollisionChecker
     from cell.rescan.view_grid import ViewTarget
-    from cell.station import Arm, Station
-    from cell.types import CameraIntrinsics, CurvedSeam, Part, SeamScene
+    from cell.station import Station
+    from cell.types import CurvedSeam, Part, SeamScene
     from cell.types.rescan import PlannedCloseup
 
 MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture and a re-location)
@@ -81,8 +79,11 @@ def rescan_curves(
     )  # fmt: skip
     run.stops.append(run.q)
     rng = sc.rng("rescan/curve-view")
-    done = [_rescan_curve(run, c, rng, progress) for c in curves]
+    carriage = Carriage(sc.robot.track.track(sc.X_WR)) if sc.robot.track is not None else None
+    done = [_rescan_curve(run, c, rng, progress, carriage) for c in curves]
+    parked = carriage.home(run) if carriage is not None else ""
     returned, note = back_to_scan(run)
+    returned, note = returned and not parked, "; ".join(n for n in (parked, note) if n)
     fused = {r.id: r.after for r in done}
     estimates = tuple(fused.get(c.id, c) for c in det.curve_estimates)
     metrics = dict(det.curve_metrics)
@@ -147,7 +148,7 @@ def preview_curve_closeups(
             if _near_tried(target, tried):
                 continue
             tried.append(target.mid)
-            vp, why = _view_of(arm, motion.checker, target, q, K, parts, base.table_z, rng, o)
+            vp, why = view_of(arm, motion.checker, target, q, K, parts, base.table_z, rng, o)
             if vp is not None:
                 break
         out.append(PlannedCloseup(c.id, vp, reason="" if vp is not None else f"unreachable view: {why}"))
@@ -155,7 +156,9 @@ def preview_curve_closeups(
     return tuple(out)
 
 
-def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, progress: Progress) -> CurveRescan:
+def _rescan_curve(
+    run: _Run, found: CurveEstimate, rng: np.random.Generator, progress: Progress, carriage: Carriage | None = None
+) -> CurveRescan:
     """One curve's close-ups (see the module docstring): the fused curve, its reason saying what the re-scan did. A
     curve not found (``found`` NOT_FOUND) is looked at where the aligned map draws it and located from the close-ups
     alone, or stays not found. A curve within the tolerance already is looked at along its whole length."""
@@ -180,6 +183,7 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         return CurveRescan(found.id, found, replace(found, reason=why), reason=why)
     images: list[DepthImage] = []
     views: list[Viewpoint] = []
+    moves_before = len(run.moves)
     tried: list[FloatArray] = []
     cal = 0.0
     best, weight, why = first, 0.0, ""
@@ -191,7 +195,11 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         tried.append(target.mid)
         progress(f"re-scan curve {first.id}: close-up {len(images) + 1} of the stretch at sigma "
                  f"{_worst_mm(best, target):.2f} mm")  # fmt: skip
-        vp, no_view = _view_of(run.arm, run.checker, target, run.q, K, parts, base.table_z, rng, o)
+        arm = carriage.arm(run.arm) if carriage is not None else run.arm
+        vp, no_view = view_of(arm, run.checker, target, run.q, K, parts, base.table_z, rng, o)
+        if vp is None and carriage is not None:  # on a track: the carriage abreast of the stretch
+            vp, elsewhere = carriage.view_elsewhere(run, target, K, parts, base.table_z, rng, o)
+            no_view = "; ".join(w for w in (no_view, elsewhere) if w)
         if vp is None:
             why = no_view
             continue
@@ -213,7 +221,7 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         if best.sigma_max_m > (1.0 - MIN_GAIN) * before:
             why = f"a close-up lowered its worst sigma by less than {MIN_GAIN:.0%}: no more"
             break
-    motion_s = sum(v.move.duration for v in views)
+    motion_s = sum(m.duration for m in run.moves[moves_before:])  # its views', the carriage's and the ways back
     done = f"re-scanned up close ({len(images)} close-ups, weight {weight:.2f}; sigma up to "
     done += f"{first.sigma_max_m * 1000:.2f} -> {best.sigma_max_m * 1000:.2f} mm)"
     if unseen:
@@ -260,25 +268,6 @@ def _near_tried(target: ViewTarget, tried: Sequence[FloatArray]) -> bool:
     chord where that is shorter (round a thin tube every stretch's middle lies within 20 mm of every other's)."""
     near = min(TRIED_M, 0.5 * float(np.linalg.norm(target.p_end - target.p_start)))
     return any(float(np.linalg.norm(target.mid - m)) <= near for m in tried)
-
-
-def _view_of(
-    arm: Arm, checker: CollisionChecker, target: ViewTarget, q: FloatArray, K: CameraIntrinsics,
-    parts: Sequence[Part], table_z: float, rng: np.random.Generator, o: RescanOptions,
-) -> tuple[Viewpoint | None, str]:  # fmt: skip
-    """A close-up's view of the stretch ``target`` from ``q``: at the usual stand-offs, then nearer
-    (:func:`cell.rescan.curve_views.near_view`); or None and why no view works."""
-    from cell.rescan.curve_views import near_view
-    from cell.rescan.viewpoint import plan_view
-
-    why = ""
-    for view in (replace(o.view, fallback_tilts_deg=()), near_view(o.view)):
-        try:
-            vp = plan_view(arm.model, checker, target, q, K, parts, table_z, rng=rng, q_via=arm.q_scan, options=view)
-            return vp, ""
-        except CellError as exc:
-            why = f"no view: {exc.message}"
-    return None, why
 
 
 def _worst_mm(est: CurveEstimate, target: ViewTarget) -> float:

@@ -7,14 +7,16 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 from round_post import SEAM, seen_yaml
 from typer.testing import CliRunner
 
 from cell import scenario as scn
 from cell.cli import app
+from cell.pipeline.curved.rescan import preview_curve_closeups
 from cell.pipeline.curved.rescan_all import rescan_all
 from cell.pipeline.detect import detect, read_weldmap
-from cell.pipeline.geometry import open_cell
+from cell.pipeline.geometry import motion_scene, open_cell
 
 
 def test_cell_rescan_brings_a_doubtful_curve_within_the_tolerance_and_reports_it(tmp_path: Path) -> None:
@@ -81,14 +83,20 @@ rescan: {weld_tolerance_mm: 0.3}
 
 
 def test_on_a_track_the_close_up_is_taken_with_the_carriage_abreast_of_the_curve() -> None:
+    """... and ``cell preview`` plans that view, carriage and all."""
     sc = scn.from_yaml(FAR_POST)
     wm = read_weldmap(sc)
     with open_cell(sc, wm) as station:
         det = detect(sc, station=station, weldmap=wm)
-        rs, _ = rescan_all(station, det, "low")
+        assert station.arm is not None
+        motion = motion_scene(station.arm, det)
+        [planned] = preview_curve_closeups(station, det, motion)
+        rs, _ = rescan_all(station, det, "low", motion=motion)
     [r] = rs.curves
     assert r.chosen and len(r.views) == 1 and r.after.sigma_max_m <= sc.rescan.max_sigma_m, r.reason
     assert 1.9 < r.views[0].e1_m < 2.1  # abreast of the post, 10 mm grid
+    assert planned.viewpoint is not None and planned.viewpoint.e1_m == r.views[0].e1_m
+    np.testing.assert_allclose(planned.viewpoint.q, r.views[0].q, atol=1e-9)
     carriage = [m.e1 for m in rs.moves if m.e1 is not None]
     assert [round(float(e[-1]), 3) for e in carriage] == [round(r.views[0].e1_m, 3), 0.0]  # out, and back to 0
     assert rs.returned and rs.note == ""

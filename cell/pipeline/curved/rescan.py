@@ -14,7 +14,7 @@ import numpy as np
 
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty
-from cell.pipeline.curved.views import Carriage, view_of
+from cell.pipeline.curved.views import Carriage, planned_view
 from cell.pipeline.detect import Progress, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
@@ -131,6 +131,7 @@ def preview_curve_closeups(
     K = station.intrinsics(eye_in_hand_camera(sc, o.camera))
     views = [p.viewpoint for p in straight if p.viewpoint is not None and not o.return_to_scan]
     rng, q = sc.rng("rescan/curve-view"), np.asarray(views[-1].q if views else arm.q_scan, dtype=float)
+    carriage = Carriage(sc.robot.track.track(sc.X_WR)) if sc.robot.track is not None else None
     out: list[PlannedCloseup] = []
     for c in curves:
         start = _start(base, c)
@@ -148,11 +149,13 @@ def preview_curve_closeups(
             if _near_tried(target, tried):
                 continue
             tried.append(target.mid)
-            vp, why = view_of(arm, motion.checker, target, q, K, parts, base.table_z, rng, o)
+            vp, why = planned_view(arm, motion.checker, target, q, K, parts, base.table_z, rng, o, carriage)
             if vp is not None:
                 break
         out.append(PlannedCloseup(c.id, vp, reason="" if vp is not None else f"unreachable view: {why}"))
         q = np.asarray(vp.q, dtype=float) if vp is not None else q
+        if vp is not None and carriage is not None:  # the weld's carriage stays there for the next curve
+            carriage.e1 = vp.e1_m
     return tuple(out)
 
 
@@ -195,13 +198,12 @@ def _rescan_curve(
         tried.append(target.mid)
         progress(f"re-scan curve {first.id}: close-up {len(images) + 1} of the stretch at sigma "
                  f"{_worst_mm(best, target):.2f} mm")  # fmt: skip
-        arm = carriage.arm(run.arm) if carriage is not None else run.arm
-        vp, no_view = view_of(arm, run.checker, target, run.q, K, parts, base.table_z, rng, o)
-        if vp is None and carriage is not None:  # on a track: the carriage abreast of the stretch
-            vp, elsewhere = carriage.view_elsewhere(run, target, K, parts, base.table_z, rng, o)
-            no_view = "; ".join(w for w in (no_view, elsewhere) if w)
+        vp, why_not = planned_view(run.arm, run.checker, target, run.q, K, parts, base.table_z, rng, o, carriage)
+        if vp is not None and carriage is not None and vp.e1_m != carriage.e1:  # the carriage abreast of the stretch
+            moved = carriage.to(run, vp.e1_m)
+            vp, why_not = (vp, "") if not moved else (None, f"from E1 = {vp.e1_m * 1000:.0f} mm on the track: {moved}")
         if vp is None:
-            why = no_view
+            why = why_not
             continue
         run.play(vp.move)
         run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]

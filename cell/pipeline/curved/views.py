@@ -27,6 +27,27 @@ if TYPE_CHECKING:
 E1_STEP = 0.01  # [m] the carriage is moved to E1 values on this grid (the track planner's)
 
 
+def planned_view(
+    arm: Arm, checker: CollisionChecker, target: ViewTarget, q: FloatArray, K: CameraIntrinsics,
+    parts: Sequence[Part], table_z: float, rng: np.random.Generator, o: RescanOptions, carriage: Carriage | None,
+) -> tuple[Viewpoint | None, str]:  # fmt: skip
+    """:func:`view_of` from ``q`` with the base where ``carriage`` stands (None: a fixed arm); on a track, when no
+    view works from there, :meth:`Carriage.plan_abreast`'s (its ``e1_m`` says where; moving the carriage there is
+    the caller's). The checker's base is left where it was."""
+    if carriage is None:
+        return view_of(arm, checker, target, q, K, parts, table_z, rng, o)
+    keep = checker.base_offset_R
+    checker.set_base(carriage.track.offset_R(carriage.e1))
+    try:
+        vp, why = view_of(carriage.arm(arm), checker, target, q, K, parts, table_z, rng, o)
+    finally:
+        checker.set_base(keep)
+    if vp is not None:
+        return replace(vp, e1_m=carriage.e1), ""
+    vp, elsewhere = carriage.plan_abreast(arm, checker, target, K, parts, table_z, rng, o)
+    return vp, "" if vp is not None else "; ".join(w for w in (why, elsewhere) if w)
+
+
 def view_of(
     arm: Arm, checker: CollisionChecker, target: ViewTarget, q: FloatArray, K: CameraIntrinsics,
     parts: Sequence[Part], table_z: float, rng: np.random.Generator, o: RescanOptions,
@@ -63,38 +84,32 @@ class Carriage:
         e = round(float(np.dot(p_R, self.track.axis_R)) / E1_STEP) * E1_STEP
         return float(np.clip(e, self.track.e1_min, self.track.e1_max))
 
-    def view_elsewhere(
-        self, run: _Run, target: ViewTarget, K: CameraIntrinsics, parts: Sequence[Part], table_z: float,
-        rng: np.random.Generator, o: RescanOptions,
+    def plan_abreast(
+        self, arm: Arm, checker: CollisionChecker, target: ViewTarget, K: CameraIntrinsics, parts: Sequence[Part],
+        table_z: float, rng: np.random.Generator, o: RescanOptions,
     ) -> tuple[Viewpoint | None, str]:  # fmt: skip
-        """The view of ``target`` with the carriage :meth:`abreast` of it, from the scan configuration there: when
-        one works and the carriage's move (the arm at its scan configuration) is free, the arm goes back to its
-        scan configuration, the carriage there (played on ``run``), and the view (its ``e1_m`` set) is returned
-        for its move to be played; else None and why, nothing moved. None and "" when the carriage stands there
-        already."""
+        """The view of ``target`` with the carriage :meth:`abreast` of it, from the scan configuration there, planned
+        and not taken (its ``e1_m`` set; the checker's base left where it was); or None and why, and None and ""
+        when the carriage stands there already."""
         e = self.abreast(target.mid)
         if abs(e - self.e1) < 1e-9:
             return None, ""
-        at = f"from E1 = {e * 1000:.0f} mm on the track"
-        run.checker.set_base(self.track.offset_R(e))
+        keep = checker.base_offset_R
+        checker.set_base(self.track.offset_R(e))
         try:
-            vp, why = view_of(Carriage(self.track, e).arm(run.arm), run.checker, target, run.arm.q_scan, K, parts,
-                              table_z, rng, o)  # fmt: skip
+            vp, why = view_of(Carriage(self.track, e).arm(arm), checker, target, arm.q_scan, K, parts, table_z, rng, o)
         finally:
-            run.checker.set_base(self.track.offset_R(self.e1))
+            checker.set_base(keep)
         if vp is None:
-            return None, f"{at}: {why}"
-        way = self._to(run, e)
-        if way:
-            return None, f"{at}: {way}"
+            return None, f"from E1 = {e * 1000:.0f} mm on the track: {why}"
         return replace(vp, e1_m=e), ""
 
     def home(self, run: _Run) -> str:
         """The carriage back to E1 = 0 (the arm at its scan configuration as it moves), played on ``run``; ""
         when it is there, else why it is not (the re-scan's note says it)."""
-        return self._to(run, 0.0) if self.e1 else ""
+        return self.to(run, 0.0) if self.e1 else ""
 
-    def _to(self, run: _Run, e: float) -> str:
+    def to(self, run: _Run, e: float) -> str:
         """The arm back to its scan configuration where it stands (the way it came), then the carriage to E1 = ``e``
         [m], both checked and played on ``run``; "" when done, else why not (nothing played)."""
         from cell.planning.track import track_move

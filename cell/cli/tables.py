@@ -66,7 +66,7 @@ def print_rescan(rep: dict) -> None:
     out.print(RESCAN_LEGEND, soft_wrap=True, markup=False)
     _why_lines(whys)
     _curve_rescans(rep)
-    b, a, c = rep["summary_before_rescan"], rep["summary"], rep["rescan"].get("curves")
+    b, a, c = rep["summary_before_rescan"], rep["summary"], rep["rescan"].get("curves") or {}
     out.print(
         f"{rep['rescan']['seams']} seams re-scanned ({rep['rescan']['used']} used) · mean lateral"
         f" {_fmt(b['lateral_mean_mm'], 3)} -> {_fmt(a['lateral_mean_mm'], 3)} mm · mean endpoint"

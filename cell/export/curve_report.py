@@ -127,8 +127,8 @@ def weld_reason_code(entry: dict[str, Any]) -> str:
 def add_curve_rescan(rep: dict[str, Any], before: Detection, after: Detection, rs: Rescan) -> None:
     """The ``cell rescan`` report's curved seams: one entry per :class:`CurveRescan` of ``rs`` (every curved seam of
     the map), as :func:`curve_entry` after the re-scan with its reason, ``error_mm_before`` and ``rescan``
-    (:func:`curve_rescan_entry`); and at the top ``rescan.curves`` {``seams``: re-scanned, ``used``,
-    ``within_tolerance``: of those, now within the weld tolerance}."""
+    (:func:`curve_rescan_entry`); and at the top, when the map has curves, ``rescan.curves`` {``seams``:
+    re-scanned, ``used``, ``within_tolerance``: of those, now within the weld tolerance}."""
     limit = before.scenario.rescan.max_sigma_m
     entries = []
     for r in rs.curves:
@@ -142,7 +142,7 @@ def add_curve_rescan(rep: dict[str, Any], before: Detection, after: Detection, r
         entries.append(entry)
     rep["seams"] += entries
     taken = [e["rescan"] for e in entries if e["rescan"]["chosen"]]
-    if rep.get("rescan") is not None:
+    if rep.get("rescan") is not None and entries:  # a map without curves: none
         rep["rescan"]["curves"] = {
             "seams": len(taken),
             "used": sum(t["used"] for t in taken),

@@ -62,7 +62,8 @@ def rescan_curves(
     was no such curve, or no arm, scene or eye-in-hand camera) and the detection with the fused curves and their
     errors measured again. A curve whose close-ups leave it over the tolerance keeps the better estimate and is
     refused at the gate as before; one already within it (``cell rescan --all``) is looked at once, worst stretch
-    first."""
+    first. On a linear track the carriage may move for a view (:mod:`cell.pipeline.curved.views`) and is back at
+    E1 = 0 at the end (PlanError if it cannot be)."""
     from cell.rescan.fusion import eye_in_hand_camera
     from cell.seams.registry import make_locator
 
@@ -81,9 +82,9 @@ def rescan_curves(
     rng = sc.rng("rescan/curve-view")
     carriage = Carriage(sc.robot.track.track(sc.X_WR)) if sc.robot.track is not None else None
     done = [_rescan_curve(run, c, rng, progress, carriage) for c in curves]
-    parked = carriage.home(run) if carriage is not None else ""
+    if carriage is not None:
+        carriage.home(run)
     returned, note = back_to_scan(run)
-    returned, note = returned and not parked, "; ".join(n for n in (parked, note) if n)
     fused = {r.id: r.after for r in done}
     estimates = tuple(fused.get(c.id, c) for c in det.curve_estimates)
     metrics = dict(det.curve_metrics)

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cell.errors import CellError
+from cell.errors import CellError, PlanError
 from cell.geometry import FloatArray
 from cell.station import Arm
 from cell.types.rescan import Viewpoint
@@ -104,10 +104,13 @@ class Carriage:
             return None, f"from E1 = {e * 1000:.0f} mm on the track: {why}"
         return replace(vp, e1_m=e), ""
 
-    def home(self, run: _Run) -> str:
-        """The carriage back to E1 = 0 (the arm at its scan configuration as it moves), played on ``run``; ""
-        when it is there, else why it is not (the re-scan's note says it)."""
-        return self.to(run, 0.0) if self.e1 else ""
+    def home(self, run: _Run) -> None:
+        """The carriage back to E1 = 0 (the arm at its scan configuration as it moves), played on ``run``. Raises
+        PlanError when it cannot go (the way out reversed: not expected): the plan after the re-scan starts at
+        E1 = 0, and nothing is planned from a carriage elsewhere."""
+        why = self.to(run, 0.0) if self.e1 else ""
+        if why:
+            raise PlanError(f"the carriage cannot go back to E1 = 0 after the curves' close-ups: {why}")
 
     def to(self, run: _Run, e: float) -> str:
         """The arm back to its scan configuration where it stands (the way it came), then the carriage to E1 = ``e``

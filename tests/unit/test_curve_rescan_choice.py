@@ -4,14 +4,12 @@ tests/scenario/test_curve_rescan_cli.py."""
 
 from __future__ import annotations
 
-import io
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
 
-from cell.cli import common
 from cell.cli.tables import print_rescan
 from cell.export.curve_report import add_curve_rescan
 from cell.pipeline import Detection, evaluate
@@ -71,7 +69,7 @@ def test_all_takes_every_located_curve_and_ids_take_exactly_those_asked() -> Non
 
 
 def test_the_report_and_the_table_show_each_curve_before_and_after_or_why_it_was_left(
-    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     before = _detection(CURVES[:2])
     fused = _curve("over", 0.04e-3, closed=False)  # made open to show its ends
@@ -94,10 +92,8 @@ def test_the_report_and_the_table_show_each_curve_before_and_after_or_why_it_was
     rep |= {"scenario": "s", "method": "ours", "summary": {"lateral_mean_mm": None, "endpoint_mean_mm": None}}
     rep["summary_before_rescan"] = rep["summary"]
     rep["rescan"] |= {"used": 0, "motion_s": 1.5}
-    buf = io.StringIO()
-    monkeypatch.setattr(common.out, "file", buf)
     print_rescan(rep)
-    text = buf.getvalue()
+    text = capsys.readouterr().out
     assert "curve over: sigma max 0.300 -> 0.040 mm, ends +-0.60/0.90 -> 0.08/0.12 mm (within the tolerance)" in text
     assert "curve within: not re-scanned: within it" in text
     assert "1 curves re-scanned, 1 now within the tolerance" in text

@@ -54,9 +54,15 @@ EYE_IN_HAND = """
 def seen_scenario(folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False) -> scn.Scenario:
     """The post 0.75 m in front of the robot seen by three 160 x 120 cameras (they state about 0.18 mm sigma on its
     fillet), with the arm's camera too if asked, and the weld tolerance ``tol_mm``."""
+    return scn.load(seen_yaml(folder, name, tol_mm, eye_in_hand=eye_in_hand))
+
+
+def seen_yaml(folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False) -> Path:
+    """:func:`seen_scenario`'s file (``folder/<name>.yaml`` beside its map), for the command line."""
     post_map(folder / "post.dxf")
-    text = SEEN.format(name=name, x=0.0, y=0.0, more=EYE_IN_HAND if eye_in_hand else "", tol_mm=tol_mm)
-    return scn.from_yaml(text, base_dir=folder)
+    path = folder / f"{name}.yaml"
+    path.write_text(SEEN.format(name=name, x=0.0, y=0.0, more=EYE_IN_HAND if eye_in_hand else "", tol_mm=tol_mm))
+    return path
 
 
 def post_map(path: Path, height_mm: float = 80.0) -> Path:
@@ -80,4 +86,4 @@ def post_scenario(folder: Path, x_m: float = 0.0, y_m: float = 0.0) -> scn.Scena
     return scn.from_yaml(SCENARIO.format(name="round-post", x=x_m, y=y_m), base_dir=folder)
 
 
-__all__ = ["RADIUS_MM", "SEAM", "post_map", "post_scenario", "seen_scenario"]
+__all__ = ["RADIUS_MM", "SEAM", "post_map", "post_scenario", "seen_scenario", "seen_yaml"]

@@ -193,9 +193,9 @@ def weld(
 def rescan_cmd(
     scenario: ScenarioArg,
     seams: Annotated[
-        str | None, typer.Option(help="Comma-separated seam ids (default: the scenario's rescan.mode choice).")
+        str | None, typer.Option(help="Comma-separated seam ids, curved ones too (default: rescan.mode's choice).")
     ] = None,
-    all_seams: Annotated[bool, typer.Option("--all", help="Re-scan every visible seam.")] = False,
+    all_seams: Annotated[bool, typer.Option("--all", help="Re-scan every visible seam and located curve.")] = False,
     method: MethodOpt = None,
     noise: NoiseOpt = None,
     calibration: CalibrationOpt = None,
@@ -203,10 +203,11 @@ def rescan_cmd(
 ) -> None:
     """Only the close-up re-scan: detect, look again at seams with the eye-in-hand camera, compare before/after.
 
-    The same re-scan as ``cell weld`` (its selection and its escalation when a close-up disagrees).
+    The same re-scan as ``cell weld`` (its selection and its escalation when a close-up disagrees), curves too.
     """
     from cell import pipeline
     from cell.export.report import detection_report, rescan_report
+    from cell.pipeline.curved.rescan_all import rescan_all
     from cell.pipeline.geometry import open_cell
 
     with cell_errors():
@@ -215,10 +216,9 @@ def rescan_cmd(
         scn = scn.with_noise(n) if (n := parse_noise(noise)) else scn
         ids = [s.strip() for s in seams.split(",") if s.strip()] if seams else None
         weldmap = pipeline.read_weldmap(scn)
-        unknown = sorted(set(ids or ()) - {s.id for s in weldmap.seams})
-        if unknown:  # before any capture
-            valid = ", ".join(s.id for s in weldmap.seams)
-            raise UsageError(f"--seams: no seam {', '.join(unknown)} in the map; seams: {valid}")
+        valid = [s.id for s in weldmap.seams] + [c.id for c in weldmap.curved]
+        if unknown := sorted(set(ids or ()) - set(valid)):  # before any capture
+            raise UsageError(f"--seams: no seam {', '.join(unknown)} in the map; seams: {', '.join(valid)}")
         stage, writer = Stage(), Writer()
         det: pipeline.Detection | None = None
         try:
@@ -228,7 +228,7 @@ def rescan_cmd(
                     writer.report(json_path, detection_report(det, provenance=prov))
                     raise det.error
                 rmode: pipeline.RescanMode = "all" if all_seams else "low"
-                rs, after = pipeline.rescan_detection(station, det, rmode, seam_ids=ids, progress=stage)
+                rs, after = rescan_all(station, det, rmode, seam_ids=ids, progress=stage)
             rep = rescan_report(det, after, rs, provenance=prov)
             writer.report(json_path, rep)
             print_rescan(rep)

@@ -49,7 +49,7 @@ def print_rescan(rep: dict) -> None:
         ("seam", "lat 0", "lat", "end 0", "end", "weight", "why not"),
     )
     whys = []
-    for s in rep["seams"]:
+    for s in (s for s in rep["seams"] if not s.get("curved")):
         b, a = s.get("error_mm_before", {}), s.get("error_mm", {})
         r = s["rescan"]
         t.add_row(
@@ -65,14 +65,45 @@ def print_rescan(rep: dict) -> None:
     out.print(t)
     out.print(RESCAN_LEGEND, soft_wrap=True, markup=False)
     _why_lines(whys)
-    b, a = rep["summary_before_rescan"], rep["summary"]
+    _curve_rescans(rep)
+    b, a, c = rep["summary_before_rescan"], rep["summary"], rep["rescan"].get("curves") or {}
     out.print(
         f"{rep['rescan']['seams']} seams re-scanned ({rep['rescan']['used']} used) · mean lateral"
         f" {_fmt(b['lateral_mean_mm'], 3)} -> {_fmt(a['lateral_mean_mm'], 3)} mm · mean endpoint"
         f" {_fmt(b['endpoint_mean_mm'], 3)} -> {_fmt(a['endpoint_mean_mm'], 3)} mm · robot time"
-        f" {_fmt(rep['rescan']['motion_s'], 1)} s",
+        f" {_fmt(rep['rescan']['motion_s'], 1)} s"
+        + (f" · {c['seams']} curves re-scanned, {c['within_tolerance']} now within the tolerance" if c else ""),
         soft_wrap=True,
     )
+
+
+def _curve_rescans(rep: dict) -> None:
+    """One line per curved seam of a ``cell rescan`` report: its worst sigma and its ends' (or closed) before and
+    after, the close-ups taken and their robot time, its error before and after (simulation); then why it was not
+    re-scanned or is still over the tolerance."""
+    for s in (s for s in rep["seams"] if s.get("curved")):
+        r, c = s["rescan"], s.get("curve")
+        line = f"curve {s['id']}: "
+        if not r["chosen"]:
+            out.print(line + r["reason"], soft_wrap=True, markup=False, highlight=False)
+            continue
+        after = c["sigma_max_mm"] if c is not None else None
+        line += f"sigma max {_fmt(r['sigma_max_mm_before'], 3)} -> {_fmt(after, 3)} mm"
+        if c is not None and c["end_sigma_mm"] is not None:
+            ends = r["end_sigma_mm_before"] or [None, None]
+            line += ", ends +-" + "/".join(map(_fmt, ends)) + " -> " + "/".join(map(_fmt, c["end_sigma_mm"])) + " mm"
+        elif c is not None:
+            line += ", closed"
+        line += f" ({'within' if r['within_tolerance'] else 'over'} the tolerance); {r['views']} close-ups"
+        line += f", {_fmt(r['motion_s'], 1)} s, weight {_fmt(r['weight'])}"
+        if any(r.get("e1_mm") or ()):  # a linear track's carriage moved for them
+            line += ", from E1 = " + "/".join(_fmt(e, 0) for e in r["e1_mm"]) + " mm"
+        b, a = s.get("error_mm_before"), s.get("error_mm")
+        if b is not None or a is not None:
+            b, a = b or {}, a or {}
+            line += f"; error rms {_fmt(b.get('rms'))} -> {_fmt(a.get('rms'))} mm"
+        out.print(line, soft_wrap=True, markup=False, highlight=False)
+        _why_lines([(s["id"], r["reason"])])
 
 
 LOCATED_CURVE_CODE = Unsupported.CURVED_NO_TORCH_PATH.value  # a curved seam located, no torch path yet

@@ -11,11 +11,16 @@ from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection
 from cell.types import SeamStatus, Unsupported, UnsupportedSeam
 from cell.types.curve_estimate import CurveEstimate, CurveMetrics
+from cell.types.rescan import CurveRescan, Rescan
 from cell.types.run import SeamWeld, WeldReason
 
 
 def _r(v: float, nd: int = 4) -> float | None:
     return None if not math.isfinite(v) else round(float(v), nd)
+
+
+def _errors(m: CurveMetrics) -> dict[str, Any]:
+    return {"rms": _r(m.rms_mm), "max": _r(m.max_mm), "within_2sigma": _r(m.within_2sigma, 3)}
 
 
 def unsupported_entry(u: UnsupportedSeam) -> dict[str, Any]:
@@ -55,7 +60,7 @@ def curve_entry(
         }
         entry["confidence"] = _r(est.confidence)
     if m is not None:
-        entry["error_mm"] = {"rms": _r(m.rms_mm), "max": _r(m.max_mm), "within_2sigma": _r(m.within_2sigma, 3)}
+        entry["error_mm"] = _errors(m)
     entry["time_ms"] = _r(est.time_s * 1000.0, 3)
     entry["not_welded"] = {"code": u.code.value, "reason": u.reason} if u is not None else None
     if w is not None:
@@ -117,3 +122,51 @@ def weld_reason_code(entry: dict[str, Any]) -> str:
     """Why a seam the run does not weld was not welded, as a code: a located curve has no torch path yet."""
     code = (entry.get("not_welded") or {}).get("code")
     return (WeldReason.NO_TORCH_PATH if code == Unsupported.CURVED_NO_TORCH_PATH else WeldReason.NOT_SUPPORTED).value
+
+
+def add_curve_rescan(rep: dict[str, Any], before: Detection, after: Detection, rs: Rescan) -> None:
+    """The ``cell rescan`` report's curved seams: one entry per :class:`CurveRescan` of ``rs`` (every curved seam of
+    the map), as :func:`curve_entry` after the re-scan with its reason, ``error_mm_before`` and ``rescan``
+    (:func:`curve_rescan_entry`); and at the top, when the map has curves, ``rescan.curves`` {``seams``:
+    re-scanned, ``used``, ``within_tolerance``: of those, now within the weld tolerance}."""
+    limit = before.scenario.rescan.max_sigma_m
+    entries = []
+    for r in rs.curves:
+        entry = curve_entry(None, r.after, after.curve_metrics.get(r.id))
+        del entry["not_welded"]  # a re-scan welds nothing
+        entry["reason"] = r.after.reason
+        m = before.curve_metrics.get(r.id)
+        if m is not None:
+            entry["error_mm_before"] = _errors(m)
+        entry["rescan"] = curve_rescan_entry(r, limit)
+        entries.append(entry)
+    rep["seams"] += entries
+    taken = [e["rescan"] for e in entries if e["rescan"]["chosen"]]
+    if rep.get("rescan") is not None and entries:  # a map without curves: none
+        rep["rescan"]["curves"] = {
+            "seams": len(taken),
+            "used": sum(t["used"] for t in taken),
+            "within_tolerance": sum(t["within_tolerance"] for t in taken),
+        }
+
+
+def curve_rescan_entry(r: CurveRescan, limit_m: float) -> dict[str, Any]:
+    """What the re-scan did for one curve: ``chosen``, ``views`` taken, ``used`` and ``weight`` (the close-ups'
+    share), the fixed cameras' ``sigma_max_mm_before`` and ``end_sigma_mm_before`` (null: closed or not located),
+    ``within_tolerance`` after (its worst sigma within ``limit_m``), ``motion_s``, each view's ``distance_mm`` and
+    ``e1_mm``, and ``reason``: why it was not re-scanned or is still over the tolerance."""
+    b, a = r.before, r.after
+    found = b.status is SeamStatus.FOUND
+    return {
+        "chosen": r.chosen,
+        "views": len(r.views),
+        "used": r.weight > 0.0,
+        "weight": _r(r.weight, 3),
+        "sigma_max_mm_before": _r(b.sigma_max_m * 1000.0) if found else None,
+        "end_sigma_mm_before": [_r(v * 1000.0) for v in b.end_sigma_m] if found and not b.closed else None,
+        "within_tolerance": a.status is SeamStatus.FOUND and a.sigma_max_m <= limit_m,
+        "motion_s": _r(r.motion_s, 3),
+        "distance_mm": [_r(v.distance_m * 1000.0, 1) for v in r.views],
+        "e1_mm": [_r(v.e1_m * 1000.0, 1) for v in r.views],  # a linear track's carriage for each view (0: fixed)
+        "reason": r.reason,
+    }

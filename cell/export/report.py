@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from cell.errors import CellError
-from cell.export.curve_report import curve_summary, not_welded_entries, weld_reason_code
+from cell.export.curve_report import add_curve_rescan, curve_summary, not_welded_entries, weld_reason_code
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.outputs import write_atomic
 from cell.pipeline.records import Detection, WeldRun
@@ -314,6 +314,7 @@ def rescan_report(
     ]
     rep = detection_report(after, records, provenance=provenance, unsupported=False)
     _add_rescan(rep, records, before, rs)
+    add_curve_rescan(rep, before, after, rs)  # every curved seam: re-scanned, or why not
     return rep
 
 

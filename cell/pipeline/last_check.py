@@ -100,6 +100,7 @@ def joined(first: Rescan | None, more: Rescan | None) -> Rescan | None:
     return replace(
         more,
         seams=first.seams + more.seams,
+        curves=first.curves + more.curves,
         moves=first.moves + more.moves,
         executions=first.executions + more.executions,
         timings=dict(timings),

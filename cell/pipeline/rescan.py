@@ -64,9 +64,10 @@ class _Run:
     stops: list[FloatArray] = field(default_factory=list)  # where the arm stopped, reached by ptp legs in turn
 
     def play(self, move: Trajectory) -> None:
-        """Drive the arm along ``move`` with the arc off, and record it."""
+        """Drive the arm (and a linear track's carriage, where ``move`` has E1) along ``move`` with the arc off,
+        and record it."""
         arc = np.zeros(len(move.times), bool)
-        self.executions.append(self.station.execute(move.times, move.q, arc, record_dt=0.02, bead=False))
+        self.executions.append(self.station.execute(move.times, move.q, arc, record_dt=0.02, bead=False, e1=move.e1))
         self.moves.append(move)
         self.q = np.asarray(move.q[-1], dtype=float)
 

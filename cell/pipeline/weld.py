@@ -241,7 +241,7 @@ def weld(
             mode = sc.rescan.mode
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
-                rs, det = curves_rescanned(station, det, rs, motion=motion, progress=progress)  # a track's: at E1 0
+                rs, det = curves_rescanned(station, det, rs, motion=motion, progress=progress)  # E1 back at 0
                 if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
                     hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:

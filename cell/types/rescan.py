@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from cell.geometry import FloatArray, readonly
+from cell.types.curve_estimate import CurveEstimate
 from cell.types.execution import Execution
 from cell.types.seams import SeamEstimate
 from cell.types.trajectory import Trajectory
@@ -35,6 +36,7 @@ class Viewpoint:
     roll_deg: float
     tried: int
     via: bool = False  # the move passes through q_via
+    e1_m: float = 0.0  # [m] where a linear track's carriage stood for it (X_RC and q with the base there)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "X_RC", readonly(self.X_RC))
@@ -69,6 +71,27 @@ class SeamRescan:
 
 
 @dataclass(frozen=True)
+class CurveRescan:
+    """What the re-scan did for one curved seam (all in R).
+
+    before : the fixed cameras' curve (not found: as located); after : what the cell uses now (the fused curve, or
+    ``before`` kept); views : the close-ups taken, in order; weight : the close-ups' share of the fused curve (0:
+    ``before`` kept); motion_s : robot time of the moves for its views [s] (a track's carriage's too); chosen :
+    whether the re-scan's choice took it (``cell rescan`` lists the curves it left, each with why); reason : why
+    it was not re-scanned, or why the close-ups left it over the tolerance ('' when they brought it within).
+    """
+
+    id: str
+    before: CurveEstimate
+    after: CurveEstimate
+    views: tuple[Viewpoint, ...] = ()
+    weight: float = 0.0
+    motion_s: float = 0.0
+    chosen: bool = True
+    reason: str = ""
+
+
+@dataclass(frozen=True)
 class Rescan:
     """The outcome of :func:`rescan_seams`.
 
@@ -77,6 +100,7 @@ class Rescan:
     moves : the moves played (to each view, then back), executions : what the simulated arm did.
     q_end : (dof,) [rad] where the arm was left; returned : whether that is the scan configuration; note : why
     not. escalated_mm : the close-up disagreement [mm] that made the re-scan take every seam (0: no escalation).
+    curves : one :class:`CurveRescan` per curved seam the re-scan took (``cell rescan``: every curved seam).
     """
 
     seams: tuple[SeamRescan, ...]
@@ -88,6 +112,7 @@ class Rescan:
     note: str = ""
     timings: dict[str, float] = field(default_factory=dict)
     escalated_mm: float = 0.0
+    curves: tuple[CurveRescan, ...] = ()
 
     @property
     def motion_s(self) -> float:

@@ -164,6 +164,8 @@ def test_usage_errors_exit_2_before_any_work(monkeypatch: pytest.MonkeyPatch) ->
     assert_one_line_error(code, err, 2, "--gui", "DISPLAY")
     code, _, err = invoke("rescan", "fence1", "--seams", "BOGUS")
     assert_one_line_error(code, err, 2, "--seams", "BOGUS", "POST_L>TOP_RAIL:+x")
+    code, _, err = invoke("rescan", "track-post", "--seams", "POST>PLATE:circle,BOGUS")  # a curve's id is one
+    assert_one_line_error(code, err, 2, "--seams: no seam BOGUS in the map; seams: POST>PLATE:circle")
     code, _, err = invoke("detect", "fence1", "--format", "xml")
     assert_one_line_error(code, err, 2, "--format", "csv")
     code, _, err = invoke("--log-file", str(REPO / "README.md" / "x.log"), "scenarios")

@@ -12,26 +12,24 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cell.errors import CellError
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty
+from cell.pipeline.curved.views import Carriage, planned_view
 from cell.pipeline.detect import Progress, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
 from cell.pipeline.rescan import _Run, back_to_scan
 from cell.types import DepthImage, Reason, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.rescan import Rescan
+from cell.types.rescan import CurveRescan, Rescan, Viewpoint
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from cell.config.rescan import RescanOptions
-    from cell.motion.collision import CollisionChecker
     from cell.rescan.view_grid import ViewTarget
-    from cell.station import Arm, Station
-    from cell.types import CameraIntrinsics, CurvedSeam, Part, SeamScene
-    from cell.types.rescan import PlannedCloseup, Viewpoint
+    from cell.station import Station
+    from cell.types import CurvedSeam, Part, SeamScene
+    from cell.types.rescan import PlannedCloseup
 
 MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture and a re-location)
 MAX_TRIES = 6  # stretches tried at most (a stretch no view reaches costs the planner's search, not a move)
@@ -52,17 +50,25 @@ def doubtful_curves(det: Detection) -> list[CurveEstimate]:
 
 
 def rescan_curves(
-    station: Station, det: Detection, *, motion: MotionScene, progress: Progress = quiet
+    station: Station,
+    det: Detection,
+    *,
+    motion: MotionScene,
+    progress: Progress = quiet,
+    curves: Sequence[CurveEstimate] | None = None,
 ) -> tuple[Rescan | None, Detection]:
-    """Every curve of :func:`doubtful_curves` re-scanned up close with the eye-in-hand camera and re-located
-    (see the module docstring); the re-scan's moves (None when there was no such curve, or no arm, scene or
-    eye-in-hand camera) and the detection with the fused curves and their errors measured again. A curve whose
-    close-ups leave it over the tolerance keeps the better estimate and is refused at the gate as before."""
+    """Every curve of ``curves`` (None: :func:`doubtful_curves`) re-scanned up close with the eye-in-hand camera and
+    re-located (see the module docstring); the re-scan (its moves, a :class:`CurveRescan` per curve; None when there
+    was no such curve, or no arm, scene or eye-in-hand camera) and the detection with the fused curves and their
+    errors measured again. A curve whose close-ups leave it over the tolerance keeps the better estimate and is
+    refused at the gate as before; one already within it (``cell rescan --all``) is looked at once, worst stretch
+    first. On a linear track the carriage may move for a view (:mod:`cell.pipeline.curved.views`) and is back at
+    E1 = 0 at the end (PlanError if it cannot be)."""
     from cell.rescan.fusion import eye_in_hand_camera
     from cell.seams.registry import make_locator
 
     sc, arm = det.scenario, station.arm
-    curves = doubtful_curves(det)
+    curves = doubtful_curves(det) if curves is None else list(curves)
     eye = [n for n, c in sc.cameras.items() if c.mount == "eye_in_hand"]
     if not curves or arm is None or det.scene is None or not eye:
         return None, det
@@ -74,8 +80,12 @@ def rescan_curves(
     )  # fmt: skip
     run.stops.append(run.q)
     rng = sc.rng("rescan/curve-view")
-    fused = {c.id: _rescan_curve(run, c, rng, progress) for c in curves}
+    carriage = Carriage(sc.robot.track.track(sc.X_WR)) if sc.robot.track is not None else None
+    done = [_rescan_curve(run, c, rng, progress, carriage) for c in curves]
+    if carriage is not None:
+        carriage.home(run)
     returned, note = back_to_scan(run)
+    fused = {r.id: r.after for r in done}
     estimates = tuple(fused.get(c.id, c) for c in det.curve_estimates)
     metrics = dict(det.curve_metrics)
     from cell.seams.curved.metrics import curve_error
@@ -84,7 +94,10 @@ def rescan_curves(
         if c.id in fused and c.status is SeamStatus.FOUND and c.id in det.curve_truths:
             metrics[c.id] = curve_error(c, np.asarray(det.curve_truths[c.id]))
     timings = {"rescan_s": time.perf_counter() - t0}
-    rs = Rescan((), det.estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings)
+    rs = Rescan(
+        (), det.estimates, tuple(run.moves), tuple(run.executions), readonly(run.q), returned, note, timings,
+        curves=tuple(done),
+    )  # fmt: skip
     return rs, replace(det, curve_estimates=estimates, curve_metrics=metrics)
 
 
@@ -119,6 +132,7 @@ def preview_curve_closeups(
     K = station.intrinsics(eye_in_hand_camera(sc, o.camera))
     views = [p.viewpoint for p in straight if p.viewpoint is not None and not o.return_to_scan]
     rng, q = sc.rng("rescan/curve-view"), np.asarray(views[-1].q if views else arm.q_scan, dtype=float)
+    carriage = Carriage(sc.robot.track.track(sc.X_WR)) if sc.robot.track is not None else None
     out: list[PlannedCloseup] = []
     for c in curves:
         start = _start(base, c)
@@ -136,18 +150,22 @@ def preview_curve_closeups(
             if _near_tried(target, tried):
                 continue
             tried.append(target.mid)
-            vp, why = _view_of(arm, motion.checker, target, q, K, parts, base.table_z, rng, o)
+            vp, why = planned_view(arm, motion.checker, target, q, K, parts, base.table_z, rng, o, carriage)
             if vp is not None:
                 break
         out.append(PlannedCloseup(c.id, vp, reason="" if vp is not None else f"unreachable view: {why}"))
         q = np.asarray(vp.q, dtype=float) if vp is not None else q
+        if vp is not None and carriage is not None:  # the weld's carriage stays there for the next curve
+            carriage.e1 = vp.e1_m
     return tuple(out)
 
 
-def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, progress: Progress) -> CurveEstimate:
+def _rescan_curve(
+    run: _Run, found: CurveEstimate, rng: np.random.Generator, progress: Progress, carriage: Carriage | None = None
+) -> CurveRescan:
     """One curve's close-ups (see the module docstring): the fused curve, its reason saying what the re-scan did. A
     curve not found (``found`` NOT_FOUND) is looked at where the aligned map draws it and located from the close-ups
-    alone, or stays not found."""
+    alone, or stays not found. A curve within the tolerance already is looked at along its whole length."""
     from cell.perception.lens import undistort
     from cell.rescan.curve_fusion import closeup_curve_scene, fuse_curve, relocate
     from cell.rescan.curve_views import worst_first
@@ -157,32 +175,40 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
     base = det.scene.seam_scene
     start = _start(base, found)
     if start is None:
-        return found
+        return CurveRescan(found.id, found, found, reason=NOTHING_TO_START)
     seam, first, parts, shared = start
     unseen = found.status is not SeamStatus.FOUND
     limit = det.scenario.rescan.max_sigma_m
+    look = limit if unseen or first.sigma_max_m > limit else 0.0  # the stretches over it; within it: every one
     K = run.station.intrinsics(run.camera)
     u = pose_uncertainties(det.scenario).get(run.camera, PoseUncertainty())
     if float(shared.max()) > limit:
-        return replace(found, reason=_facets_over(float(shared.max()), limit))
+        why = _facets_over(float(shared.max()), limit)
+        return CurveRescan(found.id, found, replace(found, reason=why), reason=why)
     images: list[DepthImage] = []
+    views: list[Viewpoint] = []
+    moves_before = len(run.moves)
     tried: list[FloatArray] = []
     cal = 0.0
     best, weight, why = first, 0.0, ""
     while len(images) < MAX_VIEWS and len(tried) < MAX_TRIES:
-        targets = [t for t in worst_first(best, limit) if not _near_tried(t, tried)]
+        targets = [t for t in worst_first(best, look) if not _near_tried(t, tried)]
         if not targets:
             break
         target = targets[0]
         tried.append(target.mid)
         progress(f"re-scan curve {first.id}: close-up {len(images) + 1} of the stretch at sigma "
                  f"{_worst_mm(best, target):.2f} mm")  # fmt: skip
-        vp, no_view = _view_of(run.arm, run.checker, target, run.q, K, parts, base.table_z, rng, o)
+        vp, why_not = planned_view(run.arm, run.checker, target, run.q, K, parts, base.table_z, rng, o, carriage)
+        if vp is not None and carriage is not None and vp.e1_m != carriage.e1:  # the carriage abreast of the stretch
+            moved = carriage.to(run, vp.e1_m)
+            vp, why_not = (vp, "") if not moved else (None, f"from E1 = {vp.e1_m * 1000:.0f} mm on the track: {moved}")
         if vp is None:
-            why = no_view
+            why = why_not
             continue
         run.play(vp.move)
         run.stops += [run.arm.q_scan, vp.q] if vp.via else [vp.q]
+        views.append(vp)
         images.append(undistort(run.station.capture_eye_in_hand(run.camera)))
         X_RC = invert(det.scenario.X_WR) @ images[-1].X_WC
         cal = max(cal, float(np.sqrt(2.0)) * u.sigma_at(float(np.linalg.norm(target.mid - X_RC[:3, 3]))))
@@ -198,14 +224,21 @@ def _rescan_curve(run: _Run, found: CurveEstimate, rng: np.random.Generator, pro
         if best.sigma_max_m > (1.0 - MIN_GAIN) * before:
             why = f"a close-up lowered its worst sigma by less than {MIN_GAIN:.0%}: no more"
             break
+    motion_s = sum(m.duration for m in run.moves[moves_before:])  # its views', the carriage's and the ways back
     done = f"re-scanned up close ({len(images)} close-ups, weight {weight:.2f}; sigma up to "
     done += f"{first.sigma_max_m * 1000:.2f} -> {best.sigma_max_m * 1000:.2f} mm)"
     if unseen:
         if weight == 0.0:  # no close-up located it: it stays not found, the reason says what was tried
-            return replace(found, reason="; ".join(r for r in (found.reason, f"looked for up close: {why}") if r))
+            why = f"looked for up close: {why or 'no stretch to look at'}"
+            after = replace(found, reason="; ".join(r for r in (found.reason, why) if r))
+            return CurveRescan(found.id, found, after, tuple(views), 0.0, motion_s, reason=why)
         done = f"located from {len(images)} close-ups alone (sigma up to {best.sigma_max_m * 1000:.2f} mm)"
     why = why if best.sigma_max_m > limit else ""
-    return replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
+    after = replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
+    return CurveRescan(found.id, found, after, tuple(views), weight, motion_s, reason=why)
+
+
+NOTHING_TO_START = "not re-scanned: no two parts hold it, or the map draws no curve to look at"
 
 
 def _start(
@@ -238,25 +271,6 @@ def _near_tried(target: ViewTarget, tried: Sequence[FloatArray]) -> bool:
     chord where that is shorter (round a thin tube every stretch's middle lies within 20 mm of every other's)."""
     near = min(TRIED_M, 0.5 * float(np.linalg.norm(target.p_end - target.p_start)))
     return any(float(np.linalg.norm(target.mid - m)) <= near for m in tried)
-
-
-def _view_of(
-    arm: Arm, checker: CollisionChecker, target: ViewTarget, q: FloatArray, K: CameraIntrinsics,
-    parts: Sequence[Part], table_z: float, rng: np.random.Generator, o: RescanOptions,
-) -> tuple[Viewpoint | None, str]:  # fmt: skip
-    """A close-up's view of the stretch ``target`` from ``q``: at the usual stand-offs, then nearer
-    (:func:`cell.rescan.curve_views.near_view`); or None and why no view works."""
-    from cell.rescan.curve_views import near_view
-    from cell.rescan.viewpoint import plan_view
-
-    why = ""
-    for view in (replace(o.view, fallback_tilts_deg=()), near_view(o.view)):
-        try:
-            vp = plan_view(arm.model, checker, target, q, K, parts, table_z, rng=rng, q_via=arm.q_scan, options=view)
-            return vp, ""
-        except CellError as exc:
-            why = f"no view: {exc.message}"
-    return None, why
 
 
 def _worst_mm(est: CurveEstimate, target: ViewTarget) -> float:

@@ -83,7 +83,8 @@ class Transfers:
         """The first strategy that finds free motions from one of ``outs`` to one of ``ins`` (dof,) [rad] each,
         both ordered nearest the welds first, the planned ends last: each strategy tries the pairs (outs[i],
         ins[i]) in turn (the shorter list's last repeated). (index into outs, index into ins, motions), or the
-        last contact or error between the last two when every way collides (remembered per pair of lists)."""
+        last contact or error between the last two when every way collides (remembered per pair of lists; placed
+        only when its reason or place is read)."""
         n = max(len(outs), len(ins))
         pairs = [(min(i, len(outs) - 1), min(i, len(ins) - 1)) for i in range(n)]
         key = (len(outs), b"".join(np.asarray(q, dtype=float).tobytes() for q in (*outs, *ins)))
@@ -99,7 +100,8 @@ class Transfers:
             if found is not None:
                 break
         last = pairs[-1]
-        self._between[key] = found if found is not None else self._failure(outs[last[0]], ins[last[1]])
+        q_a, q_b = outs[last[0]], ins[last[1]]
+        self._between[key] = found if found is not None else TransferFail.deferred(lambda: self._failure(q_a, q_b))
         return self._between[key]
 
     def _failure(self, q_a: FloatArray, q_b: FloatArray) -> TransferFail:

@@ -98,3 +98,22 @@ def test_a_vertical_line_is_solved_once_per_end_height_and_direction(
             tr.vertical(HOME, z + 5.0, False)
         assert err.value.failure.code is PlanReason.BEYOND_REACH
     assert len(calls) == 1
+
+
+def test_a_failed_search_is_placed_only_when_its_reason_is_read(
+    robot: RobotModel, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    placed: list[int] = []
+    failure = Transfers._failure
+
+    def counted(self: Transfers, q_a: FloatArray, q_b: FloatArray) -> TransferFail:
+        placed.append(1)
+        return failure(self, q_a, q_b)
+
+    monkeypatch.setattr(Transfers, "_failure", counted)
+    tr = _transfers(robot, _NotFrom((tuple(HOME), tuple(Q_SEAM))))
+    got = tr.between([HOME], [Q_SEAM])
+    assert isinstance(got, TransferFail) and placed == []
+    assert got.reason == "not_from: refused" and placed == [1]
+    assert got.p_R.shape == (3,) and got.reason == "not_from: refused" and placed == [1]
+    assert tr.between([HOME], [Q_SEAM]) is got and placed == [1]

@@ -100,6 +100,28 @@ def test_a_vertical_line_is_solved_once_per_end_height_and_direction(
     assert len(calls) == 1
 
 
+def test_a_seam_joined_between_its_planned_lines_and_home_is_not_searched_over_its_shorter_lines(
+    robot: RobotModel, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    asked: list[tuple[int, int]] = []
+    between = Transfers.between
+
+    def counted(self: Transfers, outs: list[FloatArray], ins: list[FloatArray]) -> object:
+        asked.append((len(outs), len(ins)))
+        return between(self, outs, ins)
+
+    monkeypatch.setattr(Transfers, "between", counted)
+    full = _lines(Q_SEAM)
+    knots = np.stack([Q_SEAM + 0.01, Q_SEAM])  # a shorter line's knots, ending at the seam
+    shorter = LineEnd("approach", knots, 0.01, np.array([0.0, 0.0, -1.0]), np.eye(4), False)
+    lines = SeamLines((shorter, *full.entries), full.exits)
+    assert cut_off(_transfers(robot, Direct()), lines, HOME) is None
+    assert asked == [(1, 1)]  # the planned pair only: the search over both lengths would make it too
+    asked.clear()  # refused from home: then every length in, and out to home
+    assert cut_off(_transfers(robot, _NotFrom((tuple(HOME),))), lines, HOME) is None
+    assert asked == [(1, 1), (1, 2), (1, 1)]
+
+
 def test_a_failed_search_is_placed_only_when_its_reason_is_read(
     robot: RobotModel, monkeypatch: pytest.MonkeyPatch
 ) -> None:

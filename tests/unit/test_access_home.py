@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from tiny_cell import HOME, OBSTACLES, URDF
 
-import cell.planning.transfers as transfers_module
+import cell.planning.moves.lifts as lifts_module
 from cell import scenario as sc
 from cell.config.motion import PlanOptions
 from cell.errors import TimingError
@@ -81,13 +81,13 @@ def test_a_vertical_line_is_solved_once_per_end_height_and_direction(
     robot: RobotModel, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls: list[float] = []
-    solve = transfers_module.solve_line
+    solve = lifts_module.solve_line
 
     def counted(*args: object, **kwargs: object) -> FloatArray:
         calls.append(1.0)
         return solve(*args, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(transfers_module, "solve_line", counted)
+    monkeypatch.setattr(lifts_module, "solve_line", counted)
     tr = _transfers(robot, Direct())
     z = float(robot.fk(HOME)[2, 3])
     up = tr.vertical(HOME, z + 0.1, True)

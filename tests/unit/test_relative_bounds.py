@@ -64,14 +64,14 @@ def test_the_path_check_finds_what_the_whole_arms_bound_found_in_fewer_checks(ro
 
     checker._budgets = counted_budgets  # type: ignore[method-assign]
     hits = 0
-    for _ in range(40):
+    for _ in range(12):
         q_a = lim.q_min + (lim.q_max - lim.q_min) * rng.random(6)
-        path = q_a + np.linspace(0.0, 1.0, 50)[:, None] * rng.normal(0.0, 0.4, 6)
+        path = q_a + np.linspace(0.0, 1.0, 50)[:, None] * rng.normal(0.0, 0.2, 6)
         new = checker.check_path(path)
         old = advance_along(counted_step, checker.motion_bound, path)
         assert (new is None) == (old is None)
         if new is not None and old is not None:
             hits += 1
             assert abs((new.index + 0.5) - (old.index + 0.5)) <= 1  # the same first contact, to a sample
-    assert 15 < hits < 35  # measured 26 of 40
-    assert 0 < calls["budgets"] < 0.5 * calls["step"]  # measured 1668 against 5853
+    assert 4 <= hits <= 10  # measured 7 of 12
+    assert 0 < calls["budgets"] < 0.5 * calls["step"]  # measured 443 against 1171

@@ -7,6 +7,7 @@ Frames: everything in the robot base frame R [m]; joints [rad]; time [s].
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -34,9 +35,11 @@ def solve_line(
     max_joint_step: float,
     *,
     ik: IKOptions | None = None,
+    probe: Callable[[int, FloatArray], None] | None = None,
 ) -> FloatArray:
     """Warm-started IK (n, dof) [rad] along poses X (n, 4, 4) in R from q0 (the solution at X[0]), with the solver
-    settings ``ik`` (its defaults when None).
+    settings ``ik`` (its defaults when None). ``probe(i, q)`` is called with each knot solved after the first (it
+    may raise to stop the line there).
 
     what : the line's name in messages (seam, approach, depart, lift); step [m] between poses; offset [m] where
     the line starts on the candidate's path (the failure's progress). Raises :class:`LineError` when IK fails
@@ -62,6 +65,8 @@ def solve_line(
                 )
             )
         out.append(q)
+        if probe is not None:
+            probe(i, q)
     return np.array(out)
 
 

@@ -17,14 +17,13 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow
-from cell.planning.failures import LineError, SeamFailure
-from cell.planning.lines import line_trajectory, solve_line
+from cell.planning.failures import LineError
+from cell.planning.moves.lifts import DeepKnotError, vertical_line
 from cell.planning.moves.pieces import Piece, TransferFail, joined
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
 from cell.planning.reach import ReachModel
-from cell.process.torch import WeldProcess, line_poses
+from cell.process.torch import WeldProcess
 from cell.types import Part
-from cell.types.plan import PlanReason
 
 _BODY_STEP = 0.001  # [m] TCP travel between the body tests of a transfer (the gate tests it again, finer)
 _NO_PLACE = np.full(3, np.nan)  # a failure's place not known (an error without one, a collision not located)
@@ -63,6 +62,7 @@ class Transfers:
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
         self._above: dict[tuple[bytes, float], FloatArray | IKError] = {}
         self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = {}
+        self._probing = False
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """:meth:`search`, remembered per (q_a, q_b)."""
@@ -83,7 +83,8 @@ class Transfers:
         """The first strategy that finds free motions from one of ``outs`` to one of ``ins`` (dof,) [rad] each,
         both ordered nearest the welds first, the planned ends last: each strategy tries the pairs (outs[i],
         ins[i]) in turn (the shorter list's last repeated). (index into outs, index into ins, motions), or the
-        last contact or error between the last two when every way collides (remembered per pair of lists)."""
+        last contact or error between the last two when every way collides (remembered per pair of lists; placed
+        only when its reason or place is read)."""
         n = max(len(outs), len(ins))
         pairs = [(min(i, len(outs) - 1), min(i, len(ins) - 1)) for i in range(n)]
         key = (len(outs), b"".join(np.asarray(q, dtype=float).tobytes() for q in (*outs, *ins)))
@@ -99,7 +100,8 @@ class Transfers:
             if found is not None:
                 break
         last = pairs[-1]
-        self._between[key] = found if found is not None else self._failure(outs[last[0]], ins[last[1]])
+        q_a, q_b = outs[last[0]], ins[last[1]]
+        self._between[key] = found if found is not None else TransferFail.deferred(lambda: self._failure(q_a, q_b))
         return self._between[key]
 
     def _failure(self, q_a: FloatArray, q_b: FloatArray) -> TransferFail:
@@ -121,10 +123,15 @@ class Transfers:
         """One strategy's motions q_a -> q_b (zero-length ones left out) when they are free, else why not (an error
         that has no place keeps ``p_before`` (3,) [m], the last contact's). exact : False when only whether they
         are free matters (a collision's reason and place are then left unknown: :meth:`_blocked`)."""
+        self._probing = not exact  # a lift's line may stop at a knot deep in a contact (its place not asked)
         try:
             pieces = strategy.pieces(self, q_a, q_b)
         except (IKError, TimingError, LineError) as exc:
             return TransferFail(f"{strategy.name}: {exc}", p_before)
+        except DeepKnotError:
+            return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
+        finally:
+            self._probing = False
         wound = self._wound(pieces, q_a, q_b)
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
@@ -243,12 +250,17 @@ class Transfers:
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None:
         """A straight vertical TCP line between q's pose and the same pose at ``height`` [m] in R (None when q is
         already that high): up from q (a depart) or down to q (an approach). Remembered per (q, height, up), a
-        failure too: a search tries the same line ends with every pair and strategy."""
+        failure too: a search tries the same line ends with every pair and strategy. While a search asks only
+        whether a way is free, the line is probed (:class:`~cell.planning.moves.lifts.DeepKnotError`: its lift
+        collides), and solved in full when asked otherwise."""
         key = (np.asarray(q, dtype=float).tobytes(), height, up)
-        if key not in self._vertical:
+        if key not in self._vertical or (isinstance(self._vertical[key], DeepKnotError) and not self._probing):
+            probed = self.checker if self._probing else None
             try:
-                self._vertical[key] = self._vertical_line(q, height, up)
-            except (IKError, TimingError, LineError) as exc:
+                self._vertical[key] = vertical_line(
+                    self.robot, self.process, self.opt, self._reach_model(), q, height, up, probed
+                )
+            except (IKError, TimingError, LineError, DeepKnotError) as exc:
                 self._vertical[key] = exc
         got = self._vertical[key]
         if isinstance(got, Exception):
@@ -264,63 +276,11 @@ class Transfers:
                 self._reach = None
         return self._reach
 
-    def _vertical_line(self, q: FloatArray, height: float, up: bool) -> Piece | None:
-        robot, pr, opt = self.robot, self.process, self.opt
-        X = robot.fk(q)
-        rise = height - float(X[2, 3])
-        if rise < 1e-3:
-            return None
-        X_top = X.copy()
-        X_top[2, 3] = height
-        poses = line_poses(X, X_top, opt.line_spacing)
-        step = rise / (len(poses) - 1)
-        _within_reach(self._reach_model(), poses, step)
-        knots = solve_line(robot, poses, q, "lift", 0.0, step, opt.max_joint_step, ik=opt.ik)
-        if up:
-            tr, v = line_trajectory(
-                robot,
-                knots,
-                rise,
-                np.array([0.0, 0.0, 1.0]),
-                pr.approach_speed,
-                opt.line_accel,
-                opt.line_jerk,
-                dt=opt.dt,
-            )
-            return Piece("depart", tr, v, X_top)
-        tr, v = line_trajectory(
-            robot,
-            knots[::-1],
-            rise,
-            np.array([0.0, 0.0, -1.0]),
-            pr.approach_speed,
-            opt.line_accel,
-            opt.line_jerk,
-            dt=opt.dt,
-        )
-        return Piece("approach", tr, v, X)
-
 
 def _key(pc: Piece) -> tuple[str, bytes, bytes, int]:
     """A motion's key among those remembered: its kind, ends and samples."""
     tr = pc.trajectory
     return pc.kind, tr.q[0].tobytes(), tr.q[-1].tobytes(), len(tr.times)
-
-
-def _within_reach(reach: ReachModel | None, poses: FloatArray, step: float) -> None:
-    """Raise LineError (BEYOND_REACH) when a pose of the line (n, 4, 4) in R puts the wrist centre beyond the
-    shoulder's reach (no IK can solve it: refused before any is tried); ``step`` [m] between poses."""
-    if reach is None:
-        return
-    over = reach.pose_excess(poses)
-    k = int(np.argmax(over > 0.0))
-    if over[k] > 0.0:
-        where = (
-            f"beyond reach: at {k * step * 1000:.1f} mm along the lift the wrist centre lies {over[k] * 1000:.0f} mm"
-        )
-        raise LineError(
-            SeamFailure(PlanReason.BEYOND_REACH, f"{where} beyond the shoulder's reach", poses[k][:3, 3], k * step)
-        )
 
 
 __all__ = [

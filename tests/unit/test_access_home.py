@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from tiny_cell import HOME, OBSTACLES, URDF
 
-import cell.planning.transfers as transfers_module
+import cell.planning.moves.lifts as lifts_module
 from cell import scenario as sc
 from cell.config.motion import PlanOptions
 from cell.errors import TimingError
@@ -81,13 +81,13 @@ def test_a_vertical_line_is_solved_once_per_end_height_and_direction(
     robot: RobotModel, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls: list[float] = []
-    solve = transfers_module.solve_line
+    solve = lifts_module.solve_line
 
     def counted(*args: object, **kwargs: object) -> FloatArray:
         calls.append(1.0)
         return solve(*args, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(transfers_module, "solve_line", counted)
+    monkeypatch.setattr(lifts_module, "solve_line", counted)
     tr = _transfers(robot, Direct())
     z = float(robot.fk(HOME)[2, 3])
     up = tr.vertical(HOME, z + 0.1, True)
@@ -98,3 +98,44 @@ def test_a_vertical_line_is_solved_once_per_end_height_and_direction(
             tr.vertical(HOME, z + 5.0, False)
         assert err.value.failure.code is PlanReason.BEYOND_REACH
     assert len(calls) == 1
+
+
+def test_a_seam_joined_between_its_planned_lines_and_home_is_not_searched_over_its_shorter_lines(
+    robot: RobotModel, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    asked: list[tuple[int, int]] = []
+    between = Transfers.between
+
+    def counted(self: Transfers, outs: list[FloatArray], ins: list[FloatArray]) -> object:
+        asked.append((len(outs), len(ins)))
+        return between(self, outs, ins)
+
+    monkeypatch.setattr(Transfers, "between", counted)
+    full = _lines(Q_SEAM)
+    knots = np.stack([Q_SEAM + 0.01, Q_SEAM])  # a shorter line's knots, ending at the seam
+    shorter = LineEnd("approach", knots, 0.01, np.array([0.0, 0.0, -1.0]), np.eye(4), False)
+    lines = SeamLines((shorter, *full.entries), full.exits)
+    assert cut_off(_transfers(robot, Direct()), lines, HOME) is None
+    assert asked == [(1, 1)]  # the planned pair only: the search over both lengths would make it too
+    asked.clear()  # refused from home: then every length in, and out to home
+    assert cut_off(_transfers(robot, _NotFrom((tuple(HOME),))), lines, HOME) is None
+    assert asked == [(1, 1), (1, 2), (1, 1)]
+
+
+def test_a_failed_search_is_placed_only_when_its_reason_is_read(
+    robot: RobotModel, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    placed: list[int] = []
+    failure = Transfers._failure
+
+    def counted(self: Transfers, q_a: FloatArray, q_b: FloatArray) -> TransferFail:
+        placed.append(1)
+        return failure(self, q_a, q_b)
+
+    monkeypatch.setattr(Transfers, "_failure", counted)
+    tr = _transfers(robot, _NotFrom((tuple(HOME), tuple(Q_SEAM))))
+    got = tr.between([HOME], [Q_SEAM])
+    assert isinstance(got, TransferFail) and placed == []
+    assert got.reason == "not_from: refused" and placed == [1]
+    assert got.p_R.shape == (3,) and got.reason == "not_from: refused" and placed == [1]
+    assert tr.between([HOME], [Q_SEAM]) is got and placed == [1]

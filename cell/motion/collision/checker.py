@@ -14,7 +14,8 @@ import pinocchio as pin
 
 from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, readonly
-from cell.motion.collision.contact import Contact, advance_along, deep_sample
+from cell.motion.collision.contact import Contact, advance_along, advance_linear, deep_sample
+from cell.motion.collision.relative import RelativeBounds
 from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts, trim_near_tcp
 from cell.motion.robot import RobotModel
 from cell.types import Part
@@ -69,7 +70,9 @@ class CollisionChecker:
         self._geom = geom
         self._gdata = pin.GeometryData(geom)
         self._data = self._model.createData()
-        self._radius = self._joint_radii()
+        self._radius, pairs = self._joint_radii(), geom.collisionPairs
+        ends = [(objs[pairs[k].first].parentJoint, objs[pairs[k].second].parentJoint) for k in self._pairs.self_]
+        self._relative = RelativeBounds.build(list(parents), self._radius, ends)  # the path check's step bounds
         self._tool_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == self._model.njoints - 1]
         self._obstacle_ids = list(range(self._n_robot, len(objs)))
         self._tool = ToolShapes.build(self._model, self._data, self._geom, self._tcp_frame, self._tool_shapes)
@@ -85,7 +88,6 @@ class CollisionChecker:
             self._radius_G.append(float(np.linalg.norm(hi - lo)) / 2.0)
         self._radius_arr = np.array(self._radius_G)
         self._centre_arr = np.array(self._centre_G).reshape(-1, 3)
-        pairs = geom.collisionPairs
         self._pair_first = np.array([p.first for p in pairs], dtype=int)
         self._pair_second = np.array([p.second for p in pairs], dtype=int)
         self._is_obstacle_pair = self._pair_second >= self._n_robot
@@ -265,6 +267,17 @@ class CollisionChecker:
         free = min(obs, slf / 2.0) - self.options.min_clearance
         return float(min(free, self.options.max_step)), None
 
+    def _budgets(self, q: npt.ArrayLike) -> tuple[FloatArray, Contact | None]:
+        """:meth:`_step_bound` per class of pairs (:class:`RelativeBounds`): each one's motion [m] allowed from q."""
+        q = np.asarray(q, dtype=float)
+        mc, step = self.options.min_clearance, self.options.max_step
+        d = self._near_distances(q, mc + step + 1e-9, mc + step + 1e-9)  # a farther pair cannot shorten the step
+        k = int(np.argmin(d))
+        if d[k] <= mc:
+            return np.zeros(len(self._relative.weights)), self._contact(k, float(d[k]), q, 0, float("nan"))
+        obs = float(d[self._pairs.obstacle].min()) if self._pairs.obstacle else np.inf
+        return self._relative.budgets(obs - mc, d[self._pairs.self_] - mc, step), None
+
     def motion_bound(self, dq: npt.ArrayLike) -> float:
         """Upper bound [m] on how far any arm point moves for a joint step dq (dof,) [rad]."""
         return float(np.abs(np.asarray(dq, dtype=float)) @ self._radius)
@@ -278,7 +291,7 @@ class CollisionChecker:
         between two checks (near contact the check spacing shrinks to this, so a touch thinner than it can be
         missed). Returns None when the whole path is clear.
         """
-        return advance_along(self._step_bound, self.motion_bound, q_path, times, min_step)
+        return advance_linear(self._budgets, self._relative.weights, q_path, times, min_step)
 
     def deep_contact(self, q_path: npt.ArrayLike, min_step: float = 0.001) -> Contact | None:
         """A contact :meth:`check_path` cannot miss, found quickly where the path (n, dof) runs deep into something:

@@ -116,3 +116,39 @@ def coarse_to_fine(n: int) -> Iterator[int]:
                 yield k
         level *= 2
     yield from (k for k in sorted({0, n - 1}) if n > 0)
+
+
+def advance_linear(
+    budgets: Callable[[FloatArray], tuple[FloatArray, Contact | None]],
+    weights: FloatArray,
+    q_path: npt.ArrayLike,
+    times: npt.ArrayLike | None = None,
+    min_step: float = 0.001,
+) -> Contact | None:
+    """:func:`advance_along` with a budget per class of pairs whose bound is linear in the joints' steps: class c
+    nears by at most ``weights[c] @ |dq|`` [m] for a joint step dq (:mod:`cell.motion.collision.relative`);
+    ``budgets(q)`` gives each class's allowed motion from q (m,) [m] or the contact at q. A step ends where the first
+    class's budget (at least ``min_step``) is used; the classes' motions are summed along the path once."""
+    Q = np.asarray(q_path, dtype=float)
+    T = None if times is None else np.asarray(times, dtype=float)
+    n = len(Q)
+    seg = np.abs(np.diff(Q, axis=0)) @ np.asarray(weights, dtype=float).T  # (n - 1, classes)
+    used = np.vstack([np.zeros(seg.shape[1]), np.cumsum(seg, axis=0)])  # each class's motion from the start
+    x = 0.0  # where along the path: sample i and the fraction frac of the way to the next
+    while True:
+        i = min(int(x), n - 1)
+        frac = x - i
+        q = Q[i] if frac == 0.0 or i + 1 >= n else Q[i] + frac * (Q[i + 1] - Q[i])
+        step, hit = budgets(q)
+        if hit is not None:
+            t = float("nan") if T is None else float(T[i] + frac * (T[min(i + 1, n - 1)] - T[i]))
+            return Contact(hit.a, hit.b, hit.depth, hit.p_R, hit.q, i, t)
+        if i + 1 >= n:
+            return None
+        here = used[i] + frac * seg[i]
+        reach = here + np.maximum(step, min_step)
+        x = n - 1.0
+        for c in range(len(reach)):  # where each class's budget runs out: the first of them
+            k = int(np.searchsorted(used[:, c], reach[c], side="right")) - 1
+            if k < n - 1:
+                x = min(x, k + (reach[c] - used[k, c]) / seg[k, c])

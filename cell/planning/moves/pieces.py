@@ -3,8 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -24,12 +23,41 @@ class Piece(NamedTuple):
     X_end: FloatArray
 
 
-@dataclass(frozen=True)
 class TransferFail:
-    """No free way: why (the last strategy's contact or error) and the contact point p_R (3,) [m] in R."""
+    """No free way: why (the last strategy's contact or error) and the contact point p_R (3,) [m] in R. A failure
+    made by :meth:`deferred` finds both when first asked: placing it takes full collision checks, and the order
+    search reads few of the failures it meets (docs/positioner.md, "Planning time")."""
 
-    reason: str
-    p_R: FloatArray
+    __slots__ = ("_place", "_placed")
+
+    def __init__(self, reason: str, p_R: FloatArray) -> None:
+        self._placed: tuple[str, FloatArray] | None = (reason, p_R)
+        self._place: Callable[[], TransferFail] | None = None
+
+    @classmethod
+    def deferred(cls, place: Callable[[], TransferFail]) -> TransferFail:
+        """The failure ``place()`` gives, asked once, when its reason or place is first read."""
+        fail = cls.__new__(cls)
+        fail._placed, fail._place = None, place
+        return fail
+
+    @property
+    def reason(self) -> str:
+        return self._found()[0]
+
+    @property
+    def p_R(self) -> FloatArray:
+        return self._found()[1]
+
+    def _found(self) -> tuple[str, FloatArray]:
+        if self._placed is None:
+            assert self._place is not None
+            got = self._place()
+            self._placed, self._place = (got.reason, got.p_R), None
+        return self._placed
+
+    def __repr__(self) -> str:
+        return f"TransferFail({self.reason!r}, {self.p_R!r})"
 
 
 def joined(pieces: Sequence[Piece]) -> Trajectory:

@@ -36,7 +36,7 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.errors import CellError
 from cell.export.report import write_json
-from cell.pipeline.detect import curve_truths
+from cell.pipeline.evaluation import curve_truths
 from cell.provenance import git_commit
 from cell.seams.curved import locate_curves
 from cell.seams.curved.locate import locate_curve

@@ -12,8 +12,8 @@ from cell.pipeline.detect import (
     locate,
     read_weldmap,
     table_z_R,
-    truths,
 )
+from cell.pipeline.evaluation import truths
 from cell.pipeline.geometry import open_cell, robot_arm
 from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun

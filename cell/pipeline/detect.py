@@ -15,7 +15,7 @@ from cell.errors import AlignmentError, CellError, SensorError
 from cell.geometry import FloatArray, invert
 from cell.perception.align.fit import Alignment
 from cell.perception.calibration import PoseUncertainty, curve_calibration_sigma, with_calibration
-from cell.pipeline.evaluation import evaluate
+from cell.pipeline.evaluation import curve_truths, evaluate, truths
 from cell.pipeline.geometry import open_cell
 from cell.pipeline.progress import Progress, quiet
 from cell.pipeline.records import Capture, Detection, Scene
@@ -221,26 +221,6 @@ def pose_uncertainties(scenario: Scenario) -> dict[str, PoseUncertainty]:
         name: PoseUncertainty(cam.calibration.translation_mm * 1e-3, math.radians(cam.calibration.rotation_deg))
         for name, cam in scenario.cameras.items()
     }
-
-
-def truths(cap: Capture, weldmap_R: WeldMap) -> dict[str, tuple[FloatArray, FloatArray]]:
-    """True seams from the as-built geometry, in R, keyed by seam id (empty when the station knows no truth)."""
-    from cell.seams.truth import true_seams
-
-    if cap.parts_W is None:
-        return {}
-    design_W = cap.weldmap.transformed(cap.scenario.X_WM, "W")
-    return true_seams(design_W, cap.joints, cap.parts_W, cap.scenario.X_WR)
-
-
-def curve_truths(cap: Capture) -> dict[str, FloatArray]:
-    """True curves of the map's curved seams from the as-built geometry, (n, 3) each in R, keyed by seam id (empty
-    when the station knows no truth)."""
-    from cell.seams.curve_truth import true_curves
-
-    if cap.parts_W is None or not cap.weldmap.curved:
-        return {}
-    return true_curves(cap.weldmap, cap.parts_W, cap.scenario.X_WM, cap.scenario.X_WR)
 
 
 def detect(

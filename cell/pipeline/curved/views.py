@@ -36,14 +36,9 @@ def planned_view(
     the caller's). The checker's base is left where it was."""
     if carriage is None:
         return view_of(arm, checker, target, q, K, parts, table_z, rng, o)
-    keep = checker.base_offset_R
-    checker.set_base(carriage.track.offset_R(carriage.e1))
-    try:
-        vp, why = view_of(carriage.arm(arm), checker, target, q, K, parts, table_z, rng, o)
-    finally:
-        checker.set_base(keep)
+    vp, why = carriage.view_at(carriage.e1, arm, checker, target, q, K, parts, table_z, rng, o)
     if vp is not None:
-        return replace(vp, e1_m=carriage.e1), ""
+        return vp, ""
     vp, elsewhere = carriage.plan_abreast(arm, checker, target, K, parts, table_z, rng, o)
     return vp, "" if vp is not None else "; ".join(w for w in (why, elsewhere) if w)
 
@@ -94,15 +89,22 @@ class Carriage:
         e = self.abreast(target.mid)
         if abs(e - self.e1) < 1e-9:
             return None, ""
+        vp, why = self.view_at(e, arm, checker, target, arm.q_scan, K, parts, table_z, rng, o)
+        return (vp, "") if vp is not None else (None, f"from E1 = {e * 1000:.0f} mm on the track: {why}")
+
+    def view_at(
+        self, e: float, arm: Arm, checker: CollisionChecker, target: ViewTarget, q: FloatArray, K: CameraIntrinsics,
+        parts: Sequence[Part], table_z: float, rng: np.random.Generator, o: RescanOptions,
+    ) -> tuple[Viewpoint | None, str]:  # fmt: skip
+        """:func:`view_of` from ``q`` with the base at E1 = ``e`` [m] (the view's ``e1_m`` set; the checker's base
+        left where it was)."""
         keep = checker.base_offset_R
         checker.set_base(self.track.offset_R(e))
         try:
-            vp, why = view_of(Carriage(self.track, e).arm(arm), checker, target, arm.q_scan, K, parts, table_z, rng, o)
+            vp, why = view_of(Carriage(self.track, e).arm(arm), checker, target, q, K, parts, table_z, rng, o)
         finally:
             checker.set_base(keep)
-        if vp is None:
-            return None, f"from E1 = {e * 1000:.0f} mm on the track: {why}"
-        return replace(vp, e1_m=e), ""
+        return (replace(vp, e1_m=e), "") if vp is not None else (None, why)
 
     def home(self, run: _Run) -> None:
         """The carriage back to E1 = 0 (the arm at its scan configuration as it moves), played on ``run``. Raises

@@ -22,7 +22,7 @@ map: {{file: post.dxf, X_WM: {{xyz_m: [{x}, {y}, 0.90]}}}}
 table: {{center_m: [0.0, 0.0, 0.85], size_m: [1.6, 1.2, 0.10]}}
 robot:
   urdf: kr5_arc.urdf
-  X_WR: {{xyz_m: [0.0, -0.75, 0.90]}}
+  X_WR: {{xyz_m: [0.0, {robot_y}, 0.90]}}
   home_deg: [-90.0, -100.0, 100.0, 0.0, 45.0, 0.0]
 """  # the post on its plate and the robot in front of it: the head of the two .format templates below
 SCENARIO = (
@@ -51,17 +51,23 @@ EYE_IN_HAND = """
   eye_in_hand: {mount: eye_in_hand, eye_m: [0.0, -0.3, 1.5], target_m: [0.0, 0.0, 0.93], resolution: [320, 240]}"""
 
 
-def seen_scenario(folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False) -> scn.Scenario:
-    """The post 0.75 m in front of the robot seen by three 160 x 120 cameras (they state about 0.18 mm sigma on its
-    fillet), with the arm's camera too if asked, and the weld tolerance ``tol_mm``."""
-    return scn.load(seen_yaml(folder, name, tol_mm, eye_in_hand=eye_in_hand))
+def seen_scenario(
+    folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False, robot_y_m: float = -0.75
+) -> scn.Scenario:
+    """The post 0.75 m in front of the robot (``robot_y_m``: the robot's base at that y [m] in W, the post at 0)
+    seen by three 160 x 120 cameras (they state about 0.18 mm sigma on its fillet), with the arm's camera too if
+    asked, and the weld tolerance ``tol_mm``."""
+    return scn.load(seen_yaml(folder, name, tol_mm, eye_in_hand=eye_in_hand, robot_y_m=robot_y_m))
 
 
-def seen_yaml(folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False) -> Path:
+def seen_yaml(
+    folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False, robot_y_m: float = -0.75
+) -> Path:
     """:func:`seen_scenario`'s file (``folder/<name>.yaml`` beside its map), for the command line."""
     post_map(folder / "post.dxf")
     path = folder / f"{name}.yaml"
-    path.write_text(SEEN.format(name=name, x=0.0, y=0.0, more=EYE_IN_HAND if eye_in_hand else "", tol_mm=tol_mm))
+    more = EYE_IN_HAND if eye_in_hand else ""
+    path.write_text(SEEN.format(name=name, x=0.0, y=0.0, robot_y=robot_y_m, more=more, tol_mm=tol_mm))
     return path
 
 
@@ -83,7 +89,7 @@ def post_map(path: Path, height_mm: float = 80.0) -> Path:
 def post_scenario(folder: Path, x_m: float = 0.0, y_m: float = 0.0) -> scn.Scenario:
     """The scenario of a post on a plate at (x_m, y_m) on the table [m], the robot 0.75 m in front of it."""
     post_map(folder / "post.dxf")
-    return scn.from_yaml(SCENARIO.format(name="round-post", x=x_m, y=y_m), base_dir=folder)
+    return scn.from_yaml(SCENARIO.format(name="round-post", x=x_m, y=y_m, robot_y=-0.75), base_dir=folder)
 
 
 __all__ = ["RADIUS_MM", "SEAM", "post_map", "post_scenario", "seen_scenario", "seen_yaml"]

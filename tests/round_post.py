@@ -48,7 +48,7 @@ rescan: {{weld_tolerance_mm: {tol_mm}}}
 """
 )
 EYE_IN_HAND = """
-  eye_in_hand: {mount: eye_in_hand, eye_m: [0.0, -0.3, 1.5], target_m: [0.0, 0.0, 0.93], resolution: [320, 240]}"""
+  eye_in_hand: {{mount: eye_in_hand, eye_m: [0.0, {eye_y}, 1.5], target_m: [0.0, 0.0, 0.93], resolution: [320, 240]}}"""
 
 
 def seen_scenario(
@@ -66,7 +66,7 @@ def seen_yaml(
     """:func:`seen_scenario`'s file (``folder/<name>.yaml`` beside its map), for the command line."""
     post_map(folder / "post.dxf")
     path = folder / f"{name}.yaml"
-    more = EYE_IN_HAND if eye_in_hand else ""
+    more = EYE_IN_HAND.format(eye_y=robot_y_m + 0.45) if eye_in_hand else ""  # 0.45 m on from the base
     path.write_text(SEEN.format(name=name, x=0.0, y=0.0, robot_y=robot_y_m, more=more, tol_mm=tol_mm))
     return path
 

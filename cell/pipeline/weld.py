@@ -241,7 +241,9 @@ def weld(
             mode = sc.rescan.mode
             if mode != "none" and execute_plan:
                 rs, det, hopeless = rescan_weldable(station, det, mode, motion=motion, progress=progress)
-                rs, det = curves_rescanned(station, det, rs, motion=motion, progress=progress)  # E1 back at 0
+                rs, det = curves_rescanned(
+                    station, det, rs, mode=mode, motion=motion, progress=progress
+                )  # E1 back at 0
                 if sc.robot.track is not None:  # out of reach at E1 = 0 only: the track may bring it in reach
                     hopeless = {i: f for i, f in hopeless.items() if f.code is not PlanReason.BEYOND_REACH}
                 if rs is not None:
@@ -252,7 +254,7 @@ def weld(
 
                 progress("planning the close-up views cell weld would take (the arm does not move)")
                 closeups = preview_closeups(station, det, mode, motion)
-                closeups += preview_curve_closeups(station, det, motion, closeups)
+                closeups += preview_curve_closeups(station, det, motion, closeups, mode)
             if execute_plan:  # the last check before the arc: re-scanned, then refused (cell/pipeline/last_check.py)
                 det, more, checked = last_checked(station, det, skip=hopeless, motion=motion, progress=progress)
                 rs = joined(rs, more)

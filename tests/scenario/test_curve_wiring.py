@@ -19,9 +19,10 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> dict:
     folder: Path = tmp_path_factory.mktemp("post_seen")
     # three 160 x 120 cameras state 0.18 mm (3 sigma 0.54 mm): a 0.6 mm tolerance lets the planner try it; the arm
     # stands 2.2 m from the post, beyond its reach bound (2.01 m from A1 to the torch's tip), so the planner's
-    # refusal costs no search (the search's own refusals are tests/unit/test_curve_reach.py's)
-    sc = seen_scenario(folder, "round-post-far", 0.6, robot_y_m=-2.2)
-    run = weld(sc, WeldJob(rescan="none", sides="first"))
+    # refusal costs no search (the search's own refusals are tests/unit/test_curve_reach.py's); --rescan all asks
+    # its camera for a close-up of the curve the gate would pass
+    sc = seen_scenario(folder, "round-post-far", 0.6, robot_y_m=-2.2, eye_in_hand=True)
+    run = weld(sc, WeldJob(rescan="all", sides="first"))
     return {"run": run, "rep": weld_report(run)}
 
 
@@ -48,3 +49,16 @@ def test_a_located_curve_the_arm_cannot_reach_is_reported_with_the_planners_code
     }  # fmt: skip
     assert SEAM in {u.id for u in det.not_welded}
     assert not run.complete and rep["welded"] == 0
+
+
+def test_rescan_all_looks_again_at_a_curve_within_the_tolerance_and_says_why_it_could_not(report: dict) -> None:
+    """``cell weld --rescan all`` chooses every located curve for a close-up, as ``cell rescan --all`` does, not only
+    those over the tolerance (this one's 3-sigma bound, 0.54 mm, is within its 0.6 mm); the arm's camera cannot come
+    near it, and the re-scan's record says so rather than nothing."""
+    run = report["run"]
+    est = next(e for e in run.detection.curve_estimates if e.id == SEAM)
+    assert est.sigma_max_m <= run.detection.scenario.rescan.max_sigma_m  # the gate would pass it
+    assert run.rescan is not None
+    (rec,) = [r for r in run.rescan.curves if r.id == SEAM]
+    assert rec.chosen and not rec.views
+    assert rec.reason.startswith("no view") and "unreachable" in rec.reason, rec.reason

@@ -18,7 +18,7 @@ from cell.pipeline.curved.views import Carriage, planned_view
 from cell.pipeline.detect import Progress, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
-from cell.pipeline.rescan import _Run, back_to_scan
+from cell.pipeline.rescan import RescanMode, _Run, back_to_scan
 from cell.types import DepthImage, Reason, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.rescan import CurveRescan, Rescan, Viewpoint
@@ -102,30 +102,48 @@ def rescan_curves(
 
 
 def curves_rescanned(
-    station: Station, det: Detection, rs: Rescan | None, *, motion: MotionScene, progress: Progress = quiet
+    station: Station,
+    det: Detection,
+    rs: Rescan | None,
+    *,
+    mode: RescanMode,
+    motion: MotionScene,
+    progress: Progress = quiet,
 ) -> tuple[Rescan | None, Detection]:
-    """:func:`rescan_curves` after the straight seams' re-scan ``rs``: one re-scan record of both (the arm where
-    the curves' close-ups left it) and the detection after both."""
+    """:func:`rescan_curves` after the straight seams' re-scan ``rs`` on the curves ``mode`` chooses (``low``:
+    :func:`doubtful_curves`; ``all``: every located curve too, as ``cell rescan --all``): one re-scan record of
+    both (the arm where the curves' close-ups left it) and the detection after both."""
+    from cell.pipeline.curved.rescan_all import chosen_curves
     from cell.pipeline.last_check import joined
 
-    more, after = rescan_curves(station, det, motion=motion, progress=progress)
+    curves = chosen_curves(det, mode)[0] if mode == "all" else None
+    more, after = rescan_curves(station, det, motion=motion, progress=progress, curves=curves)
     return joined(rs, more), after
 
 
 def preview_curve_closeups(
-    station: Station, det: Detection, motion: MotionScene, straight: Sequence[PlannedCloseup] = ()
+    station: Station,
+    det: Detection,
+    motion: MotionScene,
+    straight: Sequence[PlannedCloseup] = (),
+    mode: RescanMode = "low",
 ) -> tuple[PlannedCloseup, ...]:
-    """The first close-up ``cell weld`` would take of each curve of :func:`doubtful_curves`, planned and not taken
-    (``cell preview``): the view of its worst stretch (for a curve no fixed camera sees, where the aligned map draws
-    it) from where the last view leaves the arm (the scan configuration, or the last of the straight seams' planned
-    close-ups ``straight`` where the re-scan does not return), as :func:`rescan_curves` plans it; or why none
-    works. The close-ups after the first depend on what it sees: not planned."""
+    """The first close-up ``cell weld`` would take of each curve ``mode`` chooses (:func:`curves_rescanned`),
+    planned and not taken (``cell preview``): the view of its worst stretch (for a curve no fixed camera sees, where
+    the aligned map draws it) from where the last view leaves the arm (the scan configuration, or the last of the
+    straight seams' planned close-ups ``straight`` where the re-scan does not return), as :func:`rescan_curves`
+    plans it; or why none works. The close-ups after the first depend on what it sees: not planned."""
     from cell.rescan.curve_views import worst_first
     from cell.rescan.fusion import eye_in_hand_camera
     from cell.types.rescan import PlannedCloseup
 
     sc, arm = det.scenario, station.arm
-    curves = doubtful_curves(det)
+    if mode == "all":
+        from cell.pipeline.curved.rescan_all import chosen_curves
+
+        curves = chosen_curves(det, mode)[0]
+    else:
+        curves = doubtful_curves(det)
     if not curves or arm is None or det.scene is None or not any(c.mount == "eye_in_hand" for c in sc.cameras.values()):
         return ()
     o, base, limit = sc.rescan.closeup, det.scene.seam_scene, sc.rescan.max_sigma_m
@@ -233,7 +251,7 @@ def _rescan_curve(
             after = replace(found, reason="; ".join(r for r in (found.reason, why) if r))
             return CurveRescan(found.id, found, after, tuple(views), 0.0, motion_s, reason=why)
         done = f"located from {len(images)} close-ups alone (sigma up to {best.sigma_max_m * 1000:.2f} mm)"
-    why = why if best.sigma_max_m > limit else ""
+    why = why if best.sigma_max_m > limit or not images else ""  # within it: why no close-up was taken, if none
     after = replace(best, reason="; ".join(r for r in (done, why, found.reason) if r))
     return CurveRescan(found.id, found, after, tuple(views), weight, motion_s, reason=why)
 

@@ -62,8 +62,8 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         rescan_s, q_now = 0.0, arm.q_scan
         if mode != "none" and job.execute:
             rs, det, _ = rescan_weldable(station, det, mode, motion=home, progress=progress)
-            # the doubtful curves up close too, the positioner at home (the part where it was scanned)
-            rs, det = curves_rescanned(station, det, rs, motion=home, progress=progress)
+            # the curves the mode chooses up close too, the positioner at home (the part where it was scanned)
+            rs, det = curves_rescanned(station, det, rs, mode=mode, motion=home, progress=progress)
             if rs is not None:
                 rescan_s, q_now = rs.motion_s, rs.q_end
         checked: dict[str, str] = {}

@@ -60,9 +60,7 @@ def seen_scenario(
     return scn.load(seen_yaml(folder, name, tol_mm, eye_in_hand=eye_in_hand, robot_y_m=robot_y_m))
 
 
-def seen_yaml(
-    folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False, robot_y_m: float = -0.75
-) -> Path:
+def seen_yaml(folder: Path, name: str, tol_mm: float, *, eye_in_hand: bool = False, robot_y_m: float = -0.75) -> Path:
     """:func:`seen_scenario`'s file (``folder/<name>.yaml`` beside its map), for the command line."""
     post_map(folder / "post.dxf")
     path = folder / f"{name}.yaml"

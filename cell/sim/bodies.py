@@ -36,6 +36,26 @@ def add_box(client: BulletClient, box_W: Box, rgba: Rgba) -> int:
     return _place(client, collision, visual, box_W.center, box_W.X_AB[:3, :3])
 
 
+def add_floor(client: BulletClient, box_W: Box, rgba: Rgba) -> int:
+    """The floor: a static body that collides as the thin box ``box_W`` (axis-aligned, its top face the floor) and is
+    drawn as that top face alone (two triangles, normals up), since nothing in the cell looks at the floor from
+    below or beside it; returns the PyBullet body id. The images are those of the box to the bit (docs/bodies.md
+    section 1): each of the box's twelve triangles spans the screen, and TinyRenderer walks each one's screen
+    rectangle, so the faces no camera sees cost as much as the one it does."""
+    half = box_W.size / 2.0
+    collision = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[float(h) for h in half])
+    hx, hy, hz = (float(h) for h in half)
+    top = [[-hx, -hy, hz], [hx, -hy, hz], [hx, hy, hz], [-hx, hy, hz]]
+    visual = client.createVisualShape(
+        pybullet.GEOM_MESH,
+        vertices=top,
+        indices=[0, 1, 2, 0, 2, 3],
+        normals=[[0.0, 0.0, 1.0]] * 4,
+        rgbaColor=list(rgba),
+    )
+    return _place(client, collision, visual, box_W.center, box_W.X_AB[:3, :3])
+
+
 def add_mesh(client: BulletClient, vertices_W: FloatArray, triangles: np.ndarray, rgba: Rgba) -> int:
     """A static body from a closed triangle mesh: vertices (k, 3) [m] in W, triangles (t, 3) vertex indices with
     outward winding; placed at the vertices' mean. Returns the PyBullet body id."""

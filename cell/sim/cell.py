@@ -15,7 +15,7 @@ from cell.errors import ScenarioError, SensorError
 from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
 from cell.sim.board import Size2, add_board, colour_noise, place_body
-from cell.sim.bodies import add_box, add_part, move_bodies
+from cell.sim.bodies import add_box, add_floor, add_part, move_bodies
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.lens import Sensor, sensor_for
@@ -77,7 +77,7 @@ class SimCell:
         self._robot: SimRobot | None = None
         self._beads: list[int] = []
         ground = Box(make_pose(p=(0.0, 0.0, -_GROUND_SIZE[2] / 2.0)), np.array(_GROUND_SIZE))
-        self._add_box(GROUND, ground, _RGBA[GROUND])
+        self._bodies[GROUND] = add_floor(self.client, ground, _RGBA[GROUND])
         table = scenario.table
         self._add_box(TABLE, Box(make_pose(p=table.center_m), np.array(table.size_m)), _RGBA[TABLE])
         # Faults (scenario ``faults:``): parts not built are left out, objects the map does not know are added.

@@ -45,17 +45,13 @@ def _one_sided_step(z: FloatArray, valid: npt.NDArray[np.bool_], axis: int) -> t
     The step is taken on the side with the smaller depth change, so that a pixel next to a discontinuity gets
     the slope of its own surface; NaN where neither side is valid.
     """
-    n = z.shape[axis]
-    lo = np.take(z, np.arange(n - 1), axis=axis)
-    hi = np.take(z, np.arange(1, n), axis=axis)
-    ok = np.take(valid, np.arange(n - 1), axis=axis) & np.take(valid, np.arange(1, n), axis=axis)
-    diff = np.where(ok, hi - lo, np.nan)
-    pad_after = [(0, 0), (0, 0)]
-    pad_before = [(0, 0), (0, 0)]
-    pad_after[axis] = (0, 1)
-    pad_before[axis] = (1, 0)
-    fwd = np.pad(diff, pad_after, constant_values=np.nan)  # z[i+1] - z[i]
-    bwd = np.pad(diff, pad_before, constant_values=np.nan)  # z[i] - z[i-1]
+    head = (slice(None),) * axis + (slice(None, -1),)  # every index but the last along ``axis`` (views, no copies)
+    tail = (slice(None),) * axis + (slice(1, None),)  # every index but the first
+    diff = np.where(valid[head] & valid[tail], z[tail] - z[head], np.nan)
+    fwd = np.full(z.shape, np.nan)  # z[i+1] - z[i]
+    fwd[head] = diff
+    bwd = np.full(z.shape, np.nan)  # z[i] - z[i-1]
+    bwd[tail] = diff
     use_bwd = np.isnan(fwd) | (np.abs(bwd) < np.abs(fwd))
     step = np.where(use_bwd, bwd, fwd)
     neighbour = np.where(use_bwd, z - bwd, z + fwd)

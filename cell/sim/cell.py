@@ -16,11 +16,12 @@ from cell.geometry import FloatArray, make_pose
 from cell.scenario import CameraSpec, Scenario
 from cell.sim.board import Size2, add_board, colour_noise, place_body
 from cell.sim.bodies import add_box, add_floor, add_part, move_bodies
-from cell.sim.camera import gl_projection_matrix, gl_view_matrix, intrinsics_for, linearise_depth
+from cell.sim.camera import intrinsics_for
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
 from cell.sim.lens import Sensor, sensor_for
 from cell.sim.noise import apply_noise, believed_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
+from cell.sim.render_cache import draw, mesh_digest
 from cell.sim.robot import BeadStyle, SimRobot, add_bead, bead_chords, bead_segment
 from cell.types import Box, CameraIntrinsics, DepthImage, Part
 from cell.types.execution import Execution
@@ -77,19 +78,21 @@ class SimCell:
         self._robot: SimRobot | None = None
         self._beads: list[int] = []
         ground = Box(make_pose(p=(0.0, 0.0, -_GROUND_SIZE[2] / 2.0)), np.array(_GROUND_SIZE))
+        self._drawn: dict[int, bytes] = {}  # what a vertex mesh's shape data does not say (render_cache.scene_key)
         self._bodies[GROUND] = add_floor(self.client, ground, _RGBA[GROUND])
+        self._drawn[self._bodies[GROUND]] = mesh_digest(ground.size[None, :], np.zeros((0, 3)))  # its top face
         table = scenario.table
         self._add_box(TABLE, Box(make_pose(p=table.center_m), np.array(table.size_m)), _RGBA[TABLE])
         # Faults (scenario ``faults:``): parts not built are left out, objects the map does not know are added.
         for part in built_parts(self.parts_W, scenario.faults):
-            self._bodies[part.name] = add_part(self.client, part, _PART_RGBA)
+            self._bodies[part.name] = self._add_part(part, _PART_RGBA)
         self._tacks: list[str] = []  # tack welds' beads (``tack:...``): on the part, they turn with it
         for fixture in fixtures_W:
             if fixture.name.startswith(TACK_PREFIX):
-                self._bodies[fixture.name] = add_part(self.client, fixture, _TACK_RGBA)
+                self._bodies[fixture.name] = self._add_part(fixture, _TACK_RGBA)
                 self._tacks.append(fixture.name)
                 continue
-            self._bodies[FIXTURE_PREFIX + fixture.name] = add_part(self.client, fixture, _FIXTURE_RGBA)
+            self._bodies[FIXTURE_PREFIX + fixture.name] = self._add_part(fixture, _FIXTURE_RGBA)
         for name, box in occluder_boxes(scenario.faults):
             self._add_box(name, box, _OCCLUDER_RGBA)
 
@@ -112,6 +115,12 @@ class SimCell:
         if name not in self._bodies:
             raise KeyError(f"no body {name!r}; bodies: {', '.join(self._bodies)}")
         return self._bodies[name]
+
+    def _add_part(self, part_W: Part, rgba: tuple[float, float, float, float]) -> int:
+        body = add_part(self.client, part_W, rgba)
+        if not part_W.is_box:  # drawn from its vertices: the image's key needs them
+            self._drawn[body] = mesh_digest(*part_W.triangles())
+        return body
 
     def _add_box(self, name: str, box_W: Box, rgba: tuple[float, float, float, float]) -> int:
         body = add_box(self.client, box_W, rgba)
@@ -138,18 +147,9 @@ class SimCell:
     def render(
         self, X_WC: FloatArray, intrinsics: CameraIntrinsics, near_m: float, far_m: float
     ) -> tuple[npt.NDArray[np.uint8], FloatArray]:
-        """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (0: nothing between near and far) from X_WC (4, 4)."""
-        _, _, rgba, buffer, _ = self.client.getCameraImage(
-            intrinsics.width,
-            intrinsics.height,
-            viewMatrix=gl_view_matrix(X_WC),
-            projectionMatrix=gl_projection_matrix(intrinsics, near_m, far_m),
-            renderer=pybullet.ER_TINY_RENDERER,
-            flags=pybullet.ER_NO_SEGMENTATION_MASK,
-        )
-        d = np.asarray(buffer, dtype=float).reshape(intrinsics.height, intrinsics.width)
-        rgb = np.asarray(rgba, dtype=np.uint8).reshape(intrinsics.height, intrinsics.width, 4)[..., :3]
-        return rgb, linearise_depth(d, near_m, far_m)
+        """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (0: nothing between near and far) from X_WC (4, 4);
+        read back when this process drew the same scene from the same camera before (:mod:`cell.sim.render_cache`)."""
+        return draw(self.client, self._drawn, X_WC, intrinsics, near_m, far_m)
 
     def capture(self, camera: str, X_WC: FloatArray | None = None) -> DepthImage:
         """One depth image from ``camera``.

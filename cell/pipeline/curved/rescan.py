@@ -14,12 +14,13 @@ import numpy as np
 
 from cell.geometry import FloatArray, invert, readonly
 from cell.perception.calibration import PoseUncertainty
+from cell.pipeline.curved.choice import chosen_curves, doubtful_curves
 from cell.pipeline.curved.views import Carriage, planned_view
 from cell.pipeline.detect import Progress, pose_uncertainties, quiet
 from cell.pipeline.geometry import MotionScene
 from cell.pipeline.records import Detection
 from cell.pipeline.rescan import RescanMode, _Run, back_to_scan
-from cell.types import DepthImage, Reason, SeamStatus
+from cell.types import DepthImage, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.rescan import CurveRescan, Rescan, Viewpoint
 
@@ -35,18 +36,6 @@ MAX_VIEWS = 4  # close-ups taken of one curve at most (each a move, a capture an
 MAX_TRIES = 6  # stretches tried at most (a stretch no view reaches costs the planner's search, not a move)
 MIN_GAIN = 0.1  # a close-up that lowers the worst sample's sigma by less than this share ends the curve's re-scan
 TRIED_M = 0.02  # [m] a stretch whose middle lies this near one tried already (or half its chord) is not tried again
-
-
-def doubtful_curves(det: Detection) -> list[CurveEstimate]:
-    """The found curves whose worst sample's bound is over the weld tolerance (``rescan.max_sigma_m``): those a
-    close-up may bring within it; and those not found for a surface no fixed camera sees (``no_support``)."""
-    limit = det.scenario.rescan.max_sigma_m
-    return [
-        c
-        for c in det.curve_estimates
-        if (c.status is SeamStatus.FOUND and c.sigma_max_m > limit)
-        or (c.status is SeamStatus.NOT_FOUND and c.code is Reason.NO_SUPPORT)
-    ]
 
 
 def rescan_curves(
@@ -113,7 +102,6 @@ def curves_rescanned(
     """:func:`rescan_curves` after the straight seams' re-scan ``rs`` on the curves ``mode`` chooses (``low``:
     :func:`doubtful_curves`; ``all``: every located curve too, as ``cell rescan --all``): one re-scan record of
     both (the arm where the curves' close-ups left it) and the detection after both."""
-    from cell.pipeline.curved.rescan_all import chosen_curves
     from cell.pipeline.last_check import joined
 
     curves = chosen_curves(det, mode)[0] if mode == "all" else None
@@ -138,12 +126,7 @@ def preview_curve_closeups(
     from cell.types.rescan import PlannedCloseup
 
     sc, arm = det.scenario, station.arm
-    if mode == "all":
-        from cell.pipeline.curved.rescan_all import chosen_curves
-
-        curves = chosen_curves(det, mode)[0]
-    else:
-        curves = doubtful_curves(det)
+    curves = chosen_curves(det, mode)[0] if mode == "all" else doubtful_curves(det)
     if not curves or arm is None or det.scene is None or not any(c.mount == "eye_in_hand" for c in sc.cameras.values()):
         return ()
     o, base, limit = sc.rescan.closeup, det.scene.seam_scene, sc.rescan.max_sigma_m

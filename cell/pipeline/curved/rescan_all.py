@@ -7,47 +7,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from cell.pipeline.curved.rescan import doubtful_curves, rescan_curves
+from cell.pipeline.curved.choice import chosen_curves
+from cell.pipeline.curved.rescan import rescan_curves
 from cell.pipeline.detect import Progress, quiet
 from cell.pipeline.geometry import MotionScene, motion_scene
 from cell.pipeline.last_check import joined
 from cell.pipeline.records import Detection
 from cell.pipeline.rescan import RescanMode, rescan_detection
 from cell.station import Station
-from cell.types import SeamStatus
-from cell.types.curve_estimate import CurveEstimate
 from cell.types.rescan import CurveRescan, Rescan
-
-
-def chosen_curves(
-    det: Detection, mode: RescanMode, curve_ids: Sequence[str] | None = None
-) -> tuple[list[CurveEstimate], dict[str, str]]:
-    """The curved seams to re-scan, in map order, and those left (id -> why). ``curve_ids``: those asked for, but
-    one never searched (no two parts hold it, another method); else mode ``low``: :func:`doubtful_curves` (``cell
-    weld``'s choice); ``all``: every located curve and those :func:`doubtful_curves` looks for where the map draws
-    them."""
-    limit = det.scenario.rescan.max_sigma_m
-    doubtful = {c.id for c in doubtful_curves(det)}
-    chosen: list[CurveEstimate] = []
-    left: dict[str, str] = {}
-    for c in det.curve_estimates:
-        if c.status is SeamStatus.NOT_SUPPORTED:
-            left[c.id] = f"not re-scanned: never searched ({c.reason})"
-        elif curve_ids is not None:
-            if c.id in curve_ids:
-                chosen.append(c)
-            else:
-                left[c.id] = "not re-scanned: not among --seams"
-        elif c.id in doubtful or (mode == "all" and c.status is SeamStatus.FOUND):
-            chosen.append(c)
-        elif c.status is SeamStatus.FOUND:
-            left[c.id] = (
-                f"not re-scanned: sigma up to {c.sigma_max_m * 1000:.3f} mm, within the {limit * 1000:.3f} mm the"
-                " weld tolerance allows (--all looks again)"
-            )
-        else:
-            left[c.id] = f"not re-scanned: not located ({c.reason}); --seams {c.id} looks for it where the map draws it"
-    return chosen, left
 
 
 def rescan_all(

@@ -1,9 +1,10 @@
 """A probe, by hand (not a test, not a benchmark table): a round scenario's curves planned from truth-built estimates
-(:mod:`bench_curve_weld`'s) with the reach map's gap walk on (``plan_arcs(..., gap_walk=True)``), printing every
+(:mod:`bench_curve_weld`'s; ``--located``: the curves located and re-scanned up close as ``cell weld`` locates them)
+with the reach map's gap walk on (``plan_arcs(..., gap_walk=True)``), printing every
 stage's stretches, every arc of every cover tried and why it failed, and the CPU time; the figures of
 docs/curves-welding.md section 7 on the railing's bottom fillets.
 
-    .venv/bin/python benchmarks/probe_gap_walk.py [--scenario railing] [--seams POST_L>BOTTOM_RAIL,...]
+    .venv/bin/python benchmarks/probe_gap_walk.py [--scenario railing] [--seams POST_L>BOTTOM_RAIL,...] [--located]
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import cell.planning.curves.arcs as arcs_mod
 from cell.planning.curves.split import Split
 from cell.planning.failures import SeamFailure
 from cell.types.plan import PlanReason
+from cell.types.seams import SeamStatus
 
 
 def _runs(label: str, runs: list[Any]) -> None:
@@ -31,11 +33,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="railing")
     ap.add_argument("--seams", default="POST_L>BOTTOM_RAIL,POST_R>BOTTOM_RAIL")
+    ap.add_argument("--located", action="store_true", help="the located curves, re-scanned up close, not the truth")
     args = ap.parse_args()
     import bench_curve_weld as bench
 
     from cell import pipeline
     from cell import scenario as sc
+    from cell.pipeline.curved.rescan_all import rescan_all
     from cell.pipeline.detect import read_weldmap
     from cell.pipeline.geometry import motion_scene, open_cell
     from cell.pipeline.weld import plan_for
@@ -55,6 +59,9 @@ def main() -> None:
             det = pipeline.detect(s, station=station, weldmap=weldmap)
             assert det.scene is not None and station.arm is not None
             curves = bench.truth_estimates(det.scene.seam_scene.weldmap, det.curve_truths)
+            if args.located:
+                det = rescan_all(station, det, "low")[1]
+                curves = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
             skip = {e.id for e in det.estimates}
             plan_for(station, det, skip=skip, motion=motion_scene(station.arm, det), curves=curves)
     finally:

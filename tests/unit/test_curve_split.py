@@ -8,9 +8,14 @@ import math
 import numpy as np
 import pytest
 
+from cell.planning.curves.arcs import TRIM_M, _trimmed
+from cell.planning.curves.reach import Run
 from cell.planning.curves.split import seam_of, sub_arc
+from cell.planning.failures import SeamFailure
+from cell.process.torch_orientations import Candidate
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import PlanReason
 
 R_M = 0.05
 OVERLAP_M = 0.01
@@ -37,3 +42,18 @@ def test_sub_arc_is_an_open_piece_of_the_loop_round_its_start() -> None:
     assert arc.length_m == pytest.approx(0.3 * total, rel=0.01)
     assert np.allclose(np.linalg.norm(arc.p_RS[:, :2], axis=1), R_M, atol=2e-5)  # on the circle
     assert np.allclose(np.linalg.norm(arc.n_abutting_R, axis=1), 1.0)
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_an_arc_failing_on_its_approach_is_trimmed_at_its_start_not_dropped(reverse: bool) -> None:
+    est = _circle()
+    arc = sub_arc(est, 0.0, 0.1, 1)
+    run = Run(Candidate(reverse, 0.0, 0.0, 0.0), 0.0, 0.1, np.zeros(6))
+    far = np.array([0.0, 0.0, 0.05])  # 50 mm out along the torch: the approach's end
+    on_approach = SeamFailure(PlanReason.HOSE_WINDOW, "A6 out of the window on the approach", far, -0.05)
+    (left,) = _trimmed(run, on_approach, arc)
+    assert (left.a_m, left.b_m) == pytest.approx((0.0, 0.1 - TRIM_M) if reverse else (TRIM_M, 0.1))
+    on_weld = SeamFailure(PlanReason.FLIP, "A3 jumps", far, 0.05)  # 50 mm along the weld
+    (left,) = _trimmed(run, on_weld, arc)
+    kept = 0.05 - TRIM_M
+    assert (left.a_m, left.b_m) == pytest.approx((0.1 - kept, 0.1) if reverse else (0.0, kept), abs=1e-5)

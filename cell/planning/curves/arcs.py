@@ -150,11 +150,14 @@ def _same(a: Run, b: Run, total: float) -> bool:
 
 def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
     """What is left of a stretch whose arc failed its full solve: cut short of where the weld itself failed
-    (``failure.progress`` along it), else (its approach or depart) without :data:`TRIM_M` at the end nearer the
-    failure; nothing when less than :data:`MIN_ARC_M` would be left. Lengths along the located curve."""
+    (``failure.progress`` along it; before 0: on the approach), else (its approach or depart) without
+    :data:`TRIM_M` at the end nearer the failure; nothing when less than :data:`MIN_ARC_M` would be left. Lengths
+    along the located curve."""
     length = arc.length_m
-    if failure.progress < length:  # the curve itself: keep the weld up to short of there
+    if 0.0 <= failure.progress < length:  # the curve itself: keep the weld up to short of there
         cut_start, cut_end = 0.0, length - (failure.progress - TRIM_M)
+    elif failure.progress < 0.0:  # the approach's checks (a body, the hose window, a singularity) before the start
+        cut_start, cut_end = TRIM_M, 0.0
     else:
         ends = np.asarray(arc.p_RS)[[-1, 0] if run.cand.reversed else [0, -1]]  # the weld's start and end
         near_start = np.linalg.norm(ends[0] - failure.p_R) < np.linalg.norm(ends[1] - failure.p_R)

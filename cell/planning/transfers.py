@@ -150,7 +150,11 @@ class Transfers:
         wound = self._wound(pieces, q_a, q_b)
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
-        if not exact and any(self._runs_deep(pc) for pc in pieces):  # before any motion is checked in full
+        # Where only whether the way is free matters: a motion already known not to be free ends it before any
+        # other is probed, then one that runs deep before any is checked in full.
+        if not exact and any(self._pieces.get(_key(pc)) is not None for pc in pieces):
+            return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
+        if not exact and any(self._runs_deep(pc) for pc in pieces):
             return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
         for pc in pieces:
             blocked = self._blocked(pc, exact)

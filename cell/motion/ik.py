@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
+from numpy.linalg import _umath_linalg
 
 from cell.config.motion import IKOptions
 from cell.errors import IKError
@@ -96,7 +97,8 @@ def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
 
 def _vee(R: FloatArray) -> FloatArray:
     """sin(angle) * axis of a rotation matrix (half the skew part)."""
-    return 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    r = R.tolist()  # the differences of the same doubles, without indexing the array nine times
+    return 0.5 * np.array([r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]])
 
 
 def _descend(
@@ -105,6 +107,7 @@ def _descend(
     """One damped least-squares run from q0; returns the best iterate."""
     lim = model.limits
     q_min, q_max, multi = lim.q_min, lim.q_max, model.multi_turn
+    single = ~multi
     q = np.minimum(np.maximum(q0, q_min), q_max)  # np.clip's arithmetic (the limits)
     best = _Attempt(q, np.inf, np.inf, False)
     best_score = np.inf
@@ -127,7 +130,7 @@ def _descend(
         dq = _dls_step(J, e, eye, opt.damping)
         # Joints at a limit that the step pushes further out are frozen and the step is solved again
         # (multi-turn joints are not: they wrap by a full turn below).
-        out = (((q <= q_min) & (dq < 0)) | ((q >= q_max) & (dq > 0))) & ~multi
+        out = (((q <= q_min) & (dq < 0)) | ((q >= q_max) & (dq > 0))) & single
         if out.any():
             dq = _dls_step(J * ~out, e, eye, opt.damping)
         big = float(np.abs(dq).max())
@@ -141,8 +144,9 @@ def _descend(
 
 
 def _dls_step(J: FloatArray, e: FloatArray, eye: FloatArray, damping: float) -> FloatArray:
-    """dq = J^T (J J^T + lambda^2 I)^-1 e."""
-    return np.asarray(J.T @ np.linalg.solve(J @ J.T + damping * eye, e))
+    """dq = J^T (J J^T + lambda^2 I)^-1 e: ``np.linalg.solve``'s own LAPACK kernel (the damping keeps the matrix
+    positive definite, so its singular-matrix check has nothing to catch), without its dispatch."""
+    return np.asarray(J.T @ _umath_linalg.solve1(J @ J.T + damping * eye, e, signature="dd->d"))
 
 
 def solve_ik(

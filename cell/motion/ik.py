@@ -4,11 +4,13 @@ Frames: targets ``X_RT`` in the robot base frame R [m]; the solved frame (defaul
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
+from numpy.linalg import _umath_linalg
 
 from cell.config.motion import IKOptions
 from cell.errors import IKError
@@ -62,8 +64,8 @@ class _Attempt:
 def _align_z(R_RF: FloatArray, z_RT: FloatArray) -> FloatArray:
     """R_RF turned by the smallest rotation that carries its z axis onto z_RT (unit, in R)."""
     z_RF = R_RF[:, 2]
-    axis = np.cross(z_RF, z_RT)
-    s, c = float(np.linalg.norm(axis)), float(z_RF @ z_RT)
+    axis = _cross(z_RF, z_RT)
+    s, c = math.sqrt(float(axis @ axis)), float(z_RF @ z_RT)
     if s < 1e-12:
         if c > 0.0:
             return R_RF
@@ -72,19 +74,31 @@ def _align_z(R_RF: FloatArray, z_RT: FloatArray) -> FloatArray:
 
 
 def _errors(X_RF: FloatArray, X_RT: FloatArray, free_axis: bool) -> tuple[float, float]:
-    """Position error [m] and orientation error [rad] (angle between z axes when free_axis)."""
-    pos = float(np.linalg.norm(X_RT[:3, 3] - X_RF[:3, 3]))
+    """Position error [m] and orientation error [rad] (angle between z axes when free_axis). The norms are
+    ``np.linalg.norm``'s own arithmetic (the square root of the dot product), without its dispatch."""
+    d = X_RT[:3, 3] - X_RF[:3, 3]
+    pos = math.sqrt(float(d @ d))
     if free_axis:
         zf, zt = X_RF[:3, 2], X_RT[:3, 2]
-        return pos, float(np.arctan2(np.linalg.norm(np.cross(zf, zt)), zf @ zt))
-    cos = (np.trace(X_RF[:3, :3].T @ X_RT[:3, :3]) - 1.0) / 2.0
-    sin = np.linalg.norm(_vee(X_RF[:3, :3].T @ X_RT[:3, :3]))
-    return pos, float(np.arctan2(sin, cos))
+        c = _cross(zf, zt)
+        return pos, math.atan2(math.sqrt(float(c @ c)), float(zf @ zt))
+    R = X_RF[:3, :3].T @ X_RT[:3, :3]
+    cos = (float(R.trace()) - 1.0) / 2.0
+    v = _vee(R)
+    return pos, math.atan2(math.sqrt(float(v @ v)), cos)
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """a x b of two (3,) vectors: ``np.cross``'s products and differences, without its broadcasting set-up."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def _vee(R: FloatArray) -> FloatArray:
     """sin(angle) * axis of a rotation matrix (half the skew part)."""
-    return 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    r = R.tolist()  # the differences of the same doubles, without indexing the array nine times
+    return 0.5 * np.array([r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]])
 
 
 def _descend(
@@ -92,19 +106,23 @@ def _descend(
 ) -> _Attempt:
     """One damped least-squares run from q0; returns the best iterate."""
     lim = model.limits
-    q = lim.clip(q0)
+    q_min, q_max, multi = lim.q_min, lim.q_max, model.multi_turn
+    single = ~multi
+    q = np.minimum(np.maximum(q0, q_min), q_max)  # np.clip's arithmetic (the limits)
     best = _Attempt(q, np.inf, np.inf, False)
+    best_score = np.inf
     eye = np.eye(5 if free_axis else 6)
     for _ in range(opt.max_iters + 1):
-        X_RF, J_F = model.pose_and_jacobian(q, fid)
-        X_goal = X_RT
         if free_axis:  # the target turned about its z axis to the orientation nearest to F's
+            X_RF, J_F = model.pose_and_jacobian(q, fid)
             X_goal = X_RT.copy()
             X_goal[:3, :3] = _align_z(X_RF[:3, :3], X_RT[:3, 2])
-        e, J = model.pose_residual(X_RF, X_goal, J_F)
+            e, J = model.pose_residual(X_RF, X_goal, J_F)
+        else:
+            X_RF, e, J = model.pose_residual_at(q, fid, X_RT)
         pos_err, rot_err = _errors(X_RF, X_RT, free_axis)
-        if pos_err + rot_err * 0.1 < best.pos_err + best.rot_err * 0.1:
-            best = _Attempt(q, pos_err, rot_err, False)
+        if pos_err + rot_err * 0.1 < best_score:
+            best, best_score = _Attempt(q, pos_err, rot_err, False), pos_err + rot_err * 0.1
         if pos_err <= opt.pos_tol and rot_err <= opt.rot_tol:
             return _Attempt(q, pos_err, rot_err, True)
         if free_axis:  # e[5] (turn about F's z) is zero by construction of X_goal: drop that row
@@ -112,22 +130,23 @@ def _descend(
         dq = _dls_step(J, e, eye, opt.damping)
         # Joints at a limit that the step pushes further out are frozen and the step is solved again
         # (multi-turn joints are not: they wrap by a full turn below).
-        out = (((q <= lim.q_min) & (dq < 0)) | ((q >= lim.q_max) & (dq > 0))) & ~model.multi_turn
-        if np.any(out):
+        out = (((q <= q_min) & (dq < 0)) | ((q >= q_max) & (dq > 0))) & single
+        if out.any():
             dq = _dls_step(J * ~out, e, eye, opt.damping)
-        big = float(np.max(np.abs(dq)))
+        big = float(np.abs(dq).max())
         if big > opt.max_step:
             dq *= opt.max_step / big
         q = model.integrate(q, dq)
-        q -= 2.0 * np.pi * (model.multi_turn & (q > lim.q_max))
-        q += 2.0 * np.pi * (model.multi_turn & (q < lim.q_min))
-        q = lim.clip(q)
+        q -= 2.0 * np.pi * (multi & (q > q_max))
+        q += 2.0 * np.pi * (multi & (q < q_min))
+        q = np.minimum(np.maximum(q, q_min), q_max)
     return best
 
 
 def _dls_step(J: FloatArray, e: FloatArray, eye: FloatArray, damping: float) -> FloatArray:
-    """dq = J^T (J J^T + lambda^2 I)^-1 e."""
-    return np.asarray(J.T @ np.linalg.solve(J @ J.T + damping * eye, e))
+    """dq = J^T (J J^T + lambda^2 I)^-1 e: ``np.linalg.solve``'s own LAPACK kernel (the damping keeps the matrix
+    positive definite, so its singular-matrix check has nothing to catch), without its dispatch."""
+    return np.asarray(J.T @ _umath_linalg.solve1(J @ J.T + damping * eye, e, signature="dd->d"))
 
 
 def solve_ik(

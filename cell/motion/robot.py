@@ -181,6 +181,17 @@ class RobotModel:
         M_FT = pin.SE3(X_RF).actInv(pin.SE3(X_RT))
         return np.array(pin.log6(M_FT).vector), pin.Jlog6(M_FT.inverse()) @ J_F
 
+    def pose_residual_at(
+        self, q: FloatArray, frame_id: int, X_RT: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:meth:`pose_and_jacobian` and :meth:`pose_residual` in one: (X_RF (4, 4), e (6,), J (6, dof)) at q (dof,),
+        the same numbers without the placement's round trip through an array (an IK iteration's kinematics)."""
+        pin.computeJointJacobians(self._model, self._data, q)
+        M_RF = pin.updateFramePlacement(self._model, self._data, frame_id)
+        J_F = pin.getFrameJacobian(self._model, self._data, frame_id, pin.LOCAL)
+        M_FT = M_RF.actInv(pin.SE3(X_RT))
+        return np.array(M_RF.homogeneous), np.array(pin.log6(M_FT).vector), pin.Jlog6(M_FT.inverse()) @ J_F
+
     def integrate(self, q: npt.ArrayLike, dq: npt.ArrayLike) -> FloatArray:
         """q (+) dq on the configuration space (plain addition for revolute joints), as a new array."""
         return np.array(pin.integrate(self._model, self._q(q), np.asarray(dq, dtype=float)))

@@ -62,6 +62,11 @@ class Transfers:
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
         self._above: dict[tuple[bytes, float], FloatArray | IKError] = {}
         self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = {}
+        # A search's attempts, each answered once: the order search, its screen and the shorter lines ask the same
+        # strategy between the same ends again (None: not free), and a motion found not to run deep is not probed
+        # again (the strategies share via points).
+        self._tried: dict[tuple[TransferStrategy, bytes, bytes], list[Piece] | None] = {}
+        self._shallow: set[tuple[str, bytes, bytes, int]] = set()
         self._probing = False
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
@@ -93,8 +98,8 @@ class Transfers:
         found: tuple[int, int, list[Piece]] | TransferFail | None = None
         for strategy in self.strategies:
             for i, k in pairs:
-                got = self._attempt(strategy, outs[i], ins[k], _NO_PLACE, exact=False)
-                if not isinstance(got, TransferFail):
+                got = self._tries(strategy, outs[i], ins[k])
+                if got is not None:
                     found = (i, k, got)
                     break
             if found is not None:
@@ -117,6 +122,16 @@ class Transfers:
                 return TransferFail(last.reason, got.p_R)
         return TransferFail(last.reason if last is not None else "no collision-free way found", np.zeros(3))
 
+    def _tries(self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | None:
+        """:meth:`_attempt` where only whether the way is free matters: its motions, or None when it is not free;
+        remembered per strategy and ends."""
+        key = (strategy, np.asarray(q_a, dtype=float).tobytes(), np.asarray(q_b, dtype=float).tobytes())
+        if key not in self._tried:
+            got = self._attempt(strategy, q_a, q_b, _NO_PLACE, exact=False)
+            self._tried[key] = None if isinstance(got, TransferFail) else got
+        found = self._tried[key]
+        return None if found is None else list(found)
+
     def _attempt(
         self, strategy: TransferStrategy, q_a: FloatArray, q_b: FloatArray, p_before: FloatArray, exact: bool = True
     ) -> list[Piece] | TransferFail:
@@ -135,7 +150,11 @@ class Transfers:
         wound = self._wound(pieces, q_a, q_b)
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
-        if not exact and any(self._runs_deep(pc) for pc in pieces):  # before any motion is checked in full
+        # Where only whether the way is free matters: a motion already known not to be free ends it before any
+        # other is probed, then one that runs deep before any is checked in full.
+        if not exact and any(self._pieces.get(_key(pc)) is not None for pc in pieces):
+            return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
+        if not exact and any(self._runs_deep(pc) for pc in pieces):
             return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
         for pc in pieces:
             blocked = self._blocked(pc, exact)
@@ -149,7 +168,10 @@ class Transfers:
         (:meth:`CollisionChecker.deep_contact`: remembered as colliding, where unknown); False: it may be free."""
         key = _key(pc)
         if key not in self._pieces:
+            if key in self._shallow:
+                return False
             if self.checker.deep_contact(pc.trajectory.q) is None:
+                self._shallow.add(key)
                 return False
             self._pieces[key] = _COLLIDES
         return self._pieces[key] is not None

@@ -55,3 +55,22 @@ def test_a_deep_contact_is_one_the_advancement_finds_too() -> None:
         assert (deep is not None) is deep_enough
         if deep is not None:
             assert deep.depth < -0.003 and deep.b == "WALL" and deep.t != deep.t  # a sample's, not placed in time
+
+
+def test_check_deep_is_check_s_contact_when_that_deep() -> None:
+    # Along a move through a wall: the deep probe's contact is check's (pair, depth) where that lies 3 mm or more
+    # deep, and None elsewhere, though it queries only the pairs whose bounding spheres overlap by that much.
+    robot = RobotModel.from_urdf(URDF)
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    checker = CollisionChecker(robot, (*OBSTACLES, wall))
+    deep_seen = 0
+    for q in ptp(HOME, Q_B, robot.limits, dt=0.004).q[::10]:
+        full, deep = checker.check(q), checker.check_deep(q, 0.003)
+        if full is not None and full.depth <= -0.003:
+            deep_seen += 1
+            assert deep is not None and (deep.a, deep.b) == (full.a, full.b)
+            assert deep.depth == pytest.approx(full.depth, abs=1e-7)  # coal warm-starts from the query before
+        else:
+            assert deep is None
+    assert deep_seen > 0

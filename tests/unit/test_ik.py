@@ -270,3 +270,17 @@ def test_limits_file_errors(tmp_path: Path) -> None:
     (tmp_path / "arm.limits.yaml").write_text(re.sub(r"velocity: [0-9.]+", "velocity: 30.0", text, count=1))
     with pytest.raises(ScenarioError, match="exceeds"):
         RobotModel.from_urdf(urdf)
+
+
+def test_pose_residual_at_is_the_two_calls_to_the_bit(robot: RobotModel) -> None:
+    # The IK's one-call kinematics: the same numbers as pose_and_jacobian then pose_residual, bit for bit.
+    rng = np.random.default_rng(3)
+    fid = robot.frame_id("torch_tcp")
+    for _ in range(5):
+        q, q_t = robot.limits.sample(rng), robot.limits.sample(rng)
+        X_RT = robot.fk(q_t)
+        X_RF, J_F = robot.pose_and_jacobian(q, fid)
+        e, J = robot.pose_residual(X_RF, X_RT, J_F)
+        got = robot.pose_residual_at(q, fid, X_RT)
+        for a, b in zip(got, (X_RF, e, J), strict=True):
+            np.testing.assert_array_equal(a, b)

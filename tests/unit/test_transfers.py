@@ -142,3 +142,37 @@ def test_a_search_checks_no_motion_in_full_when_another_of_its_way_runs_deep(rob
     # the free motions out and back are never advanced along (the wall's move runs deep); only the failure
     # reported, the last strategy's, is placed: one full check
     assert len(asked) == 1
+
+
+def test_a_strategy_is_asked_once_between_the_same_ends(robot: RobotModel) -> None:
+    # The wall blocks the direct move: a search, then another whose lists end in the same pair (the order search's
+    # screen, then the shorter lines), asks each strategy between those ends once, and probes no motion twice.
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    mover = _mover(robot, (*OBSTACLES, wall), _FreeThenWall(), Direct())
+    asked: list[tuple[str, bytes, bytes]] = []
+    probed: list[int] = []
+    deep = mover.checker.deep_contact
+    plain = mover.strategies
+
+    @dataclass(frozen=True)
+    class Counted:
+        inner: TransferStrategy
+        name: str = "counted"
+
+        def pieces(self, m: Mover, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+            asked.append((self.inner.name, q_a.tobytes(), q_b.tobytes()))
+            return self.inner.pieces(m, q_a, q_b)
+
+    def counted_deep(q: FloatArray, *args: object, **kwargs: object) -> object:
+        probed.append(len(q))
+        return deep(q, *args, **kwargs)  # type: ignore[arg-type]
+
+    mover.strategies = tuple(Counted(s) for s in plain)
+    mover.checker.deep_contact = counted_deep  # type: ignore[method-assign, assignment]
+    first = mover.between([HOME], [Q_B])
+    n_asked, n_probed = len(asked), len(probed)
+    again = mover.between([HOME, HOME], [Q_B + np.radians([0.0, 0.0, 0.0, 0.0, 0.0, 1.0]), Q_B])
+    assert isinstance(first, TransferFail) and isinstance(again, TransferFail)
+    assert len(asked) == len(set(asked)) == n_asked + 2  # the new pair with either strategy, the old one never
+    assert n_probed == 3 and len(probed) == n_probed + 1  # the free motions out and back probed once

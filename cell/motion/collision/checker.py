@@ -252,6 +252,14 @@ class CollisionChecker:
             return self._contact(k, float(d[k]), q, index, t)
         return None
 
+    def check_deep(self, q: npt.ArrayLike, depth: float) -> Contact | None:
+        """:meth:`check`'s deepest contact at q (dof,) when it lies ``depth`` [m] or more deep, else None; only the
+        pairs whose bounding spheres overlap by that much are queried (a probe for a deep contact)."""
+        q = np.asarray(q, dtype=float)
+        d = self._near_distances(q, -depth, -depth)
+        k = int(np.argmin(d))
+        return self._contact(k, float(d[k]), q, 0, float("nan")) if d[k] <= -depth else None
+
     def _step_bound(self, q: npt.ArrayLike) -> tuple[float, Contact | None]:
         """Allowed motion [m] from q before the next check, or the contact at q."""
         q = np.asarray(q, dtype=float)
@@ -298,7 +306,8 @@ class CollisionChecker:
         a sample of it, probed coarse to fine (at most 16), more than twice ``min_step`` inside a contact (between
         two of the advancement's checks no distance falls by more than that). None: none found, the path may
         still collide (only :meth:`check_path` says). Not the path's first contact."""
-        return deep_sample(self.check, q_path, 2.0 * min_step + 0.001 - self.options.min_clearance, probes=16)
+        depth = 2.0 * min_step + 0.001 - self.options.min_clearance
+        return deep_sample(lambda q: self.check_deep(q, depth), q_path, depth, probes=16)
 
     def collides(self, q_path: npt.ArrayLike, min_step: float = 0.001) -> bool:
         """Whether :meth:`check_path` finds a contact along the path (n, dof): :meth:`deep_contact` first, for a

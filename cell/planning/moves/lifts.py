@@ -78,8 +78,8 @@ def _deep_probe(checker: CollisionChecker) -> Callable[[int, FloatArray], None]:
 
     def probe(i: int, q: FloatArray) -> None:
         if i % PROBE_EVERY == 0:
-            hit = checker.check(q)
-            if hit is not None and hit.depth <= -DEEP_KNOT_M:
+            hit = checker.check_deep(q, DEEP_KNOT_M)
+            if hit is not None:
                 raise DeepKnotError(i, hit.depth)
 
     return probe

@@ -2,7 +2,8 @@
 the cell runs it (the located curve re-scanned up close at home, the weld gate's word on it, the coordinated weld);
 should the gate refuse it, the first located curve planned, played and measured as a study (docs/positioner.md,
 "Coordinated motion"). Then the same of ``tube-tee-positioner``'s saddle (``tube_tee``: the tilt following the
-seam as well), with every seam of that cell and why it was not welded.
+seam as well), with every seam of that cell and why it was not welded; and every seam of ``round-brace-positioner``
+(``round_brace``: the leaning brace's elliptical feet, both refused) welded or why not.
 
     .venv/bin/python benchmarks/bench_coordinated.py [--json PATH] [--noise realistic|small]
 
@@ -29,6 +30,7 @@ import numpy as np
 RESULTS = Path(__file__).resolve().parent / "results"
 SCENARIO = "pipe-stub-positioner"
 TEE, SADDLE = "tube-tee-positioner", "BRANCH>RUN:saddle"  # the saddle: the tilt follows its turning bisector
+BRACE = "round-brace-positioner"  # the leaning brace's elliptical feet: refused (torch vs POST; the tilt limit)
 
 
 def _say(msg: str) -> None:
@@ -133,6 +135,20 @@ def coordinated_row(
     }
 
 
+def seams_row(noise: str | None = None, scenario: str = BRACE) -> dict[str, Any]:
+    """``cell weld``'s run of ``scenario`` on its positioner: every seam welded or why not, and the run's wall time
+    (a cell whose curves are all refused, so no coordinated weld to measure)."""
+    from cell import scenario as sc
+    from cell.pipeline.positioned import weld_on_positioner
+
+    s = sc.load(scenario)
+    s = s.with_noise(noise) if noise else s
+    t = time.perf_counter()
+    run = weld_on_positioner(s)
+    return {"scenario": scenario, "noise": noise or "realistic", "wall_s": round(time.perf_counter() - t, 1),
+            "seams": _seams(run)}  # fmt: skip
+
+
 WEAVE = {"pattern": "zigzag", "width_mm": 3.0, "frequency_hz": 1.0, "dwell_s": (0.1, 0.1)}  # a PA fillet's weave
 
 
@@ -185,6 +201,8 @@ def main() -> None:
     _say(f"{TEE}: the saddle welded with the tilt following it and the rotate axis turning")
     tee_program = args.program / "tube_tee" if args.program is not None else None
     row["tube_tee"] = coordinated_row(args.noise, tee_program, TEE, SADDLE)
+    _say(f"{BRACE}: the brace's feet with the tilt following them")
+    row["round_brace"] = seams_row(args.noise)
     out = {"command": "benchmarks/bench_coordinated.py" + (f" --noise {args.noise}" if args.noise else ""), **row}
     args.json.write_text(json.dumps(out, indent=1) + "\n")
     _say(f"wrote {args.json}")

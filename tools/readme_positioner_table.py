@@ -25,7 +25,12 @@ def positioner_table(data: Mapping[str, Any]) -> str:
         f"| `{b['job']}` | {b['welded']}/{b['seams']} | 0 | {_f(b['job_time_s'], '.1f')} |"
         f" - / {_f(b['positioner_s'], '.1f')} ({b['poses']} poses) | {_f(b['tcp_max_mm'])} |"
         f" {_f(b['plan_per_seam_s'], '.2f')} / {_f(b.get('plan_cpu_per_seam_s'), '.2f')}"
-        f" ({data['plan_per_seam_ratio']:.1f}x / {_f(cpu_ratio, '.1f')}x) |",
+        f" ({data['plan_per_seam_ratio']:.2f}x / {_f(cpu_ratio, '.2f')}x) |",
+        "",
+        "The positioner's moves between poses, each checked against the arm where it stands (a route chosen that"
+        f" sweeps nothing into it), take {_f(b.get('move_check_s'), '.2f')} s more: with them"
+        f" {_f(b.get('plan_and_move_check_per_seam_s'), '.2f')} s per seam,"
+        f" {_f(data.get('plan_and_move_check_ratio'), '.2f')}x fence1's planning (wall).",
         "",
         "| seam | pose: tilt / rotate [deg] | ISO 6947: code, S / R [deg] | in tolerance | welded | TCP max [mm] |"
         " why not |",

@@ -9,10 +9,11 @@ opens its own (:func:`fence1_station`); none is shared, so no result depends on 
 
 from __future__ import annotations
 
+import re
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
@@ -27,6 +28,32 @@ if str(HERE) not in sys.path:  # the helper modules (dxf_factory, fakes, pinhole
 
 from scenes import Noise, Perceived  # noqa: E402  (after the path set-up above)
 from shared_runs import Preview, half_resolution  # noqa: E402
+
+# The test files that read the session's fence1 weld or perceived scenes (the fixtures below): one work unit of
+# ``--dist loadfile``, so one worker builds each (fence1's weld is 20 s of CPU); the other worker takes the rest.
+_SHARED_RUNS = re.compile(r"\b(fence1_(both|run|detection|station)|perceived)\b")
+SHARED_UNIT = "tests/<the files that read the session's shared runs>"
+
+
+def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
+    """``--dist loadfile`` with the files that read the session's shared runs in one unit (:data:`SHARED_UNIT`);
+    any other distribution as xdist has it."""
+    if config.getoption("dist", None) != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    root = Path(str(config.rootpath))
+    shared: dict[str, bool] = {}
+
+    class SharedRunsTogether(LoadFileScheduling):  # type: ignore[misc]
+        def _split_scope(self, nodeid: str) -> str:
+            path = super()._split_scope(nodeid)
+            if path not in shared:
+                file = root / path
+                shared[path] = file.is_file() and bool(_SHARED_RUNS.search(file.read_text()))
+            return SHARED_UNIT if shared[path] else path
+
+    return SharedRunsTogether(config, log)
 
 
 @pytest.fixture(scope="session")

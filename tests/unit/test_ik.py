@@ -284,3 +284,17 @@ def test_pose_residual_at_is_the_two_calls_to_the_bit(robot: RobotModel) -> None
         got = robot.pose_residual_at(q, fid, X_RT)
         for a, b in zip(got, (X_RF, e, J), strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+def test_the_damped_step_is_numpys_public_solve_to_the_bit() -> None:
+    """The damped step calls numpy's private LAPACK kernel to skip the public wrapper's dispatch: it must stay the
+    same numbers as ``np.linalg.solve`` (a numpy upgrade that changes the kernel fails here, not in the plans)."""
+    from cell.motion.ik import _dls_step
+
+    rng = np.random.default_rng(5)
+    for rows in (5, 6):
+        eye = np.eye(rows)
+        for _ in range(50):
+            J, e = rng.normal(size=(rows, 6)), rng.normal(size=rows)
+            public = J.T @ np.linalg.solve(J @ J.T + 1e-6 * eye, e)
+            assert np.array_equal(_dls_step(J, e, eye, 1e-6), public)

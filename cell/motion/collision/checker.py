@@ -218,16 +218,20 @@ class CollisionChecker:
         slf = d[self._pairs.self_] if self._pairs.self_ else np.array([np.inf])
         return float(obs.min()), float(slf.min())
 
+    def shape_spheres(self, q: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """Each arm shape's bounding sphere at q (dof,) [rad]: centres (n, 3) in R [m] and radii (n,) [m]."""
+        m, data, gdata = self._model, self._data, self._gdata
+        pin.forwardKinematics(m, data, np.asarray(q, dtype=float))
+        pin.updateGeometryPlacements(m, data, self._geom, gdata)
+        X = np.array([g.homogeneous for g in gdata.oMg[: self._n_robot]])
+        return np.einsum("nij,nj->ni", X[:, :3, :3], self._centre_arr) + X[:, :3, 3], self._radius_arr
+
     def _near_distances(self, q: FloatArray, cut_obstacle: float, cut_self: float) -> FloatArray:
         """Like :meth:`_distances`, but a pair whose bounding spheres (a robot shape's against another's, or
         against an obstacle box) are farther apart than ``cut_obstacle`` / ``cut_self`` [m] holds that lower
         bound instead of its distance (not queried): exact wherever the distance could be at most the cut."""
-        m, data, geom, gdata = self._model, self._data, self._geom, self._gdata
-        pin.forwardKinematics(m, data, q)
-        pin.updateGeometryPlacements(m, data, geom, gdata)
-        n = self._n_robot
-        X = np.array([g.homogeneous for g in gdata.oMg[:n]])
-        c = np.einsum("nij,nj->ni", X[:, :3, :3], self._centre_arr) + X[:, :3, 3]
+        geom, gdata, n = self._geom, self._gdata, self._n_robot
+        c, _ = self.shape_spheres(q)
         a, b, obs = self._pair_first, self._pair_second, self._is_obstacle_pair
         lower = np.empty(len(a))
         to_box = self._boxes.sphere_distance(c, self._radius_arr)  # (robot shapes, boxes)

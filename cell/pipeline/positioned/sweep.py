@@ -70,7 +70,38 @@ def move_hit(
         return None
     grown = replace(options, part_inflation=options.part_inflation + step_m / 2.0)
     near = near_arm(model, q, swept_bodies(home, pos, a, b, step_m), grown.part_inflation)
-    return CollisionChecker(model, near, grown).check(q) if near else None
+    if not near:
+        return None
+    arm = CollisionChecker(model, (), grown)
+    touch = touching(arm, q, near)
+    return CollisionChecker(model, touch, grown).check(q) if touch else arm.check(q)
+
+
+def sphere_gaps(arm: CollisionChecker, q: FloatArray, bodies: Sequence[Part]) -> FloatArray:
+    """Per body, a lower bound [m] on its clearance to the arm at q as ``arm``'s options grow it: the least gap
+    between an arm shape's bounding sphere and the body grown by the inflation (a box as itself, any other body
+    as its bounding sphere)."""
+    centres, radii = arm.shape_spheres(q)
+    grow = max(arm.options.part_inflation, arm.options.table_inflation)
+    out = np.empty(len(bodies))
+    for i, p in enumerate(bodies):
+        if p.is_box:  # each sphere centre's distance to the box, in the box's frame
+            X = p.box.X_AB
+            local = np.abs((centres - X[:3, 3]) @ X[:3, :3]) - p.box.size / 2.0
+            out[i] = float(np.min(np.linalg.norm(np.maximum(local, 0.0), axis=1) - radii)) - grow
+        else:
+            out[i] = float(np.min(np.linalg.norm(centres - p.center, axis=1) - radii)) - p.radius - grow
+    return out
+
+
+def touching(arm: CollisionChecker, q: FloatArray, bodies: Sequence[Part]) -> list[Part]:
+    """The bodies (in order) whose :func:`sphere_gaps` bound is within the clearance: every body ``arm``'s check at
+    q could find in contact; the others are left out of the collision model, whose building is the check's cost."""
+    gaps = sphere_gaps(arm, q, bodies) if bodies else np.zeros(0)
+    return [p for p, g in zip(bodies, gaps, strict=True) if g <= arm.options.min_clearance + _SLACK_M]
+
+
+_SLACK_M = 1e-9  # [m] rounding apart, a body at the clearance's edge is kept
 
 
 ARM_RADIUS_M = 0.3  # [m] no part of the arm (links, torch, camera) lies further from its frames' chain

@@ -138,16 +138,13 @@ def test_a_sweep_is_checked_against_the_bodies_that_can_touch_the_arm_with_the_s
     arm: RobotModel, a: tuple[float, float], b: tuple[float, float]
 ) -> None:
     """The check leaves out the swept samples no arm shape's sphere comes within the clearance of: the contact (or
-    none) is the one a collision model of every near sample finds, to the pair and the distance."""
+    none) is the one a collision model of every sample finds, to the pair and the depth."""
     from dataclasses import replace
-
-    from cell.pipeline.positioned.sweep import near_arm
 
     pos, home = _bar_beside(arm)
     opt = CollisionOptions()
     grown = replace(opt, part_inflation=opt.part_inflation + 0.01)
-    every = near_arm(arm, Q_ARM, swept_bodies(home, pos, a, b, 0.02), grown.part_inflation)
-    full = CollisionChecker(arm, every, grown).check(Q_ARM) if every else None
+    full = CollisionChecker(arm, swept_bodies(home, pos, a, b, 0.02), grown).check(Q_ARM)
     got = move_hit(arm, Q_ARM, home, pos, a, b, opt)
     if full is None:
         assert got is None
@@ -156,15 +153,15 @@ def test_a_sweep_is_checked_against_the_bodies_that_can_touch_the_arm_with_the_s
 
 
 def test_the_sphere_gap_is_a_lower_bound_on_each_swept_bodys_clearance(arm: RobotModel) -> None:
-    """What lets the sweep's check leave bodies out: each near sample's sphere gap is at most its clearance to the
-    arm as a collision model of that body alone measures it, and some samples are left out."""
+    """What lets the sweep's check leave bodies out: each swept sample's gap is at most its clearance to the arm as
+    a collision model of that body alone measures it, and some samples are left out."""
     from dataclasses import replace
 
-    from cell.pipeline.positioned.sweep import near_arm, sphere_gaps, touching
+    from cell.pipeline.positioned.sweep import sphere_gaps, touching
 
     pos, home = _bar_beside(arm)
     grown = replace(CollisionOptions(), part_inflation=CollisionOptions().part_inflation + 0.01)
-    near = near_arm(arm, Q_ARM, swept_bodies(home, pos, (0.0, 0.0), (math.pi / 2, 0.0), 0.02), grown.part_inflation)
+    near = swept_bodies(home, pos, (0.0, 0.0), (math.pi / 2, 0.0), 0.02)
     checker = CollisionChecker(arm, (), grown)
     gaps = sphere_gaps(checker, Q_ARM, near)
     clear = np.array([CollisionChecker(arm, [p], grown).clearance(Q_ARM)[0] for p in near])

@@ -69,61 +69,75 @@ def move_hit(
     if np.allclose(a, b):
         return None
     grown = replace(options, part_inflation=options.part_inflation + step_m / 2.0)
-    near = near_arm(model, q, swept_bodies(home, pos, a, b, step_m), grown.part_inflation)
-    if not near:
-        return None
     arm = CollisionChecker(model, (), grown)
-    touch = touching(arm, q, near)
+    touch = _touching_sweep(arm, q, home, pos, a, b, step_m)
     return CollisionChecker(model, touch, grown).check(q) if touch else arm.check(q)
 
 
-def sphere_gaps(arm: CollisionChecker, q: FloatArray, bodies: Sequence[Part]) -> FloatArray:
-    """Per body, a lower bound [m] on its clearance to the arm at q as ``arm``'s options grow it: the least gap
-    between an arm shape's bounding sphere and the body grown by the inflation (a box as itself, any other body
-    as its bounding sphere)."""
-    centres, radii = arm.shape_spheres(q)
+def _touching_sweep(
+    arm: CollisionChecker,
+    q: FloatArray,
+    home: Sequence[Part],
+    pos: TiltRotatePositioner,
+    a: tuple[float, float],
+    b: tuple[float, float],
+    step_m: float,
+) -> list[Part]:
+    """``touching(arm, q, swept_bodies(home, pos, a, b, step_m))``, in its order: each clamped body's gaps at every
+    sample at once, a sample moved only when it is kept."""
+    spheres = arm.shape_spheres(q)
     grow = max(arm.options.part_inflation, arm.options.table_inflation)
-    out = np.empty(len(bodies))
-    for i, p in enumerate(bodies):
-        if p.is_box:  # each sphere centre's distance to the box, in the box's frame
-            X = p.box.X_AB
-            local = np.abs((centres - X[:3, 3]) @ X[:3, :3]) - p.box.size / 2.0
-            out[i] = float(np.min(np.linalg.norm(np.maximum(local, 0.0), axis=1) - radii)) - grow
-        else:
-            out[i] = float(np.min(np.linalg.norm(centres - p.center, axis=1) - radii)) - p.radius - grow
+    limit = arm.options.min_clearance + _SLACK_M
+    centre = pos.X_R_tilt(0.0)[:3, 3]
+    reach = max(float(np.max(np.linalg.norm(p.vertices() - centre, axis=1))) for p in home)
+    n = max(1, math.ceil(reach * (abs(b[0] - a[0]) + abs(b[1] - a[1])) / step_m))
+    axes = [(a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])) for s in np.linspace(0.0, 1.0, n + 1)]
+    X = np.array([pos.move(t, r) for t, r in axes])
+    keep = np.array([_gaps_moved(spheres, p, X, grow) <= limit for p in home]).reshape(len(home), len(X))
+    still = [p for p in positioner_parts(pos, *a) if p.name == PEDESTAL]
+    out = touching(arm, q, still)
+    for k, (t, r) in enumerate(axes):
+        out += [replace(p.transformed(X[k]), name=f"{p.name}@{k}") for i, p in enumerate(home) if keep[i, k]]
+        moving = [p for p in positioner_parts(pos, t, r) if p.name != PEDESTAL]
+        out += [replace(p, name=f"{p.name}@{k}") for p in touching(arm, q, moving, spheres)]
     return out
 
 
-def touching(arm: CollisionChecker, q: FloatArray, bodies: Sequence[Part]) -> list[Part]:
+def _gaps_moved(spheres: tuple[FloatArray, FloatArray], p: Part, X: FloatArray, grow: float) -> FloatArray:
+    """:func:`sphere_gaps`'s bound for body ``p`` moved by each of X (n, 4, 4): (n,) [m]."""
+    centres, radii = spheres
+    if p.is_box:
+        M = X @ p.box.X_AB
+        d = centres[None, :, :] - M[:, None, :3, 3]
+        local = np.abs(np.einsum("nki,nij->nkj", d, M[:, :3, :3])) - p.box.size / 2.0
+        return np.min(np.linalg.norm(np.maximum(local, 0.0), axis=2) - radii[None, :], axis=1) - grow
+    c = np.einsum("nij,j->ni", X[:, :3, :3], np.asarray(p.center)) + X[:, :3, 3]
+    return (
+        np.min(np.linalg.norm(centres[None, :, :] - c[:, None, :], axis=2) - radii[None, :], axis=1) - p.radius - grow
+    )
+
+
+def sphere_gaps(
+    arm: CollisionChecker, q: FloatArray, bodies: Sequence[Part], spheres: tuple[FloatArray, FloatArray] | None = None
+) -> FloatArray:
+    """Per body, a lower bound [m] on its clearance to the arm at q as ``arm``'s options grow it: the least gap
+    between an arm shape's bounding sphere (``spheres``: :meth:`CollisionChecker.shape_spheres` at q, computed when
+    None) and the body grown by the inflation (a box as itself, any other body as its bounding sphere)."""
+    spheres = arm.shape_spheres(q) if spheres is None else spheres
+    grow = max(arm.options.part_inflation, arm.options.table_inflation)
+    return np.array([float(_gaps_moved(spheres, p, np.eye(4)[None], grow)[0]) for p in bodies])
+
+
+def touching(
+    arm: CollisionChecker, q: FloatArray, bodies: Sequence[Part], spheres: tuple[FloatArray, FloatArray] | None = None
+) -> list[Part]:
     """The bodies (in order) whose :func:`sphere_gaps` bound is within the clearance: every body ``arm``'s check at
     q could find in contact; the others are left out of the collision model, whose building is the check's cost."""
-    gaps = sphere_gaps(arm, q, bodies) if bodies else np.zeros(0)
+    gaps = sphere_gaps(arm, q, bodies, spheres) if bodies else np.zeros(0)
     return [p for p, g in zip(bodies, gaps, strict=True) if g <= arm.options.min_clearance + _SLACK_M]
 
 
 _SLACK_M = 1e-9  # [m] rounding apart, a body at the clearance's edge is kept
-
-
-ARM_RADIUS_M = 0.3  # [m] no part of the arm (links, torch, camera) lies further from its frames' chain
-
-
-def near_arm(model: RobotModel, q: FloatArray, bodies: Sequence[Part], grow_m: float) -> list[Part]:
-    """The bodies whose bounding sphere (grown by ``grow_m``) comes within ``ARM_RADIUS_M`` of the polyline
-    through the arm's frames at ``q``: the only ones the arm can touch (the rest need not enter the collision
-    model, whose building is what a sweep's check costs)."""
-    frames = model.fk_frames(q, model.frame_names)
-    p = np.array([X[:3, 3] for X in frames.values()])
-    a, b = p[:-1], p[1:]
-    ab = b - a
-    L2 = np.maximum(np.sum(ab * ab, axis=1), 1e-12)
-    out = []
-    for body in bodies:
-        c = np.asarray(body.center)
-        s = np.clip(np.sum((c - a) * ab, axis=1) / L2, 0.0, 1.0)
-        d = float(np.min(np.linalg.norm(a + s[:, None] * ab - c, axis=1)))
-        if d <= body.radius + grow_m + ARM_RADIUS_M:
-            out.append(body)
-    return out
 
 
 Axes = tuple[float, float]

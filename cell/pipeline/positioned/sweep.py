@@ -40,17 +40,24 @@ def swept_bodies(
     """The bodies ``home`` (in R, clamped on the faceplate, where they lie at the positioner's home) and the
     positioner's tilting bodies at samples of the move from axes ``a`` to ``b`` (tilt, rotate) [rad], along the
     straight line between them in the axes' space (both axes synchronised), in R; the still pedestal once."""
-    centre = pos.X_R_tilt(0.0)[:3, 3]
-    reach = max(float(np.max(np.linalg.norm(p.vertices() - centre, axis=1))) for p in home)
-    turn = abs(b[0] - a[0]) + abs(b[1] - a[1])  # an upper bound on the angle any point turns [rad]
-    n = max(1, math.ceil(reach * turn / step_m))
     out = [p for p in positioner_parts(pos, *a) if p.name == PEDESTAL]
-    for k, s in enumerate(np.linspace(0.0, 1.0, n + 1)):
-        t, r = a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])
+    for k, (t, r) in enumerate(_samples(home, pos, a, b, step_m)):
         X = pos.move(t, r)
         moving = [*(p.transformed(X) for p in home), *(p for p in positioner_parts(pos, t, r) if p.name != PEDESTAL)]
         out.extend(replace(p, name=f"{p.name}@{k}") for p in moving)
     return tuple(out)
+
+
+def _samples(
+    home: Sequence[Part], pos: TiltRotatePositioner, a: tuple[float, float], b: tuple[float, float], step_m: float
+) -> list[tuple[float, float]]:
+    """The axes (tilt, rotate) [rad] of :func:`swept_bodies`' samples of the move from ``a`` to ``b``: evenly along
+    the straight line in the axes' space, so that no point of ``home`` travels more than ``step_m`` between two."""
+    centre = pos.X_R_tilt(0.0)[:3, 3]
+    reach = max(float(np.max(np.linalg.norm(p.vertices() - centre, axis=1))) for p in home)
+    turn = abs(b[0] - a[0]) + abs(b[1] - a[1])  # an upper bound on the angle any point turns [rad]
+    n = max(1, math.ceil(reach * turn / step_m))
+    return [(a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])) for s in np.linspace(0.0, 1.0, n + 1)]
 
 
 def move_hit(
@@ -86,16 +93,12 @@ def _touching_sweep(
     """``touching(arm, q, swept_bodies(home, pos, a, b, step_m))``, in its order: each clamped body's gaps at every
     sample at once, a sample moved only when it is kept."""
     spheres = arm.shape_spheres(q)
-    grow = max(arm.options.part_inflation, arm.options.table_inflation)
-    limit = arm.options.min_clearance + _SLACK_M
-    centre = pos.X_R_tilt(0.0)[:3, 3]
-    reach = max(float(np.max(np.linalg.norm(p.vertices() - centre, axis=1))) for p in home)
-    n = max(1, math.ceil(reach * (abs(b[0] - a[0]) + abs(b[1] - a[1])) / step_m))
-    axes = [(a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])) for s in np.linspace(0.0, 1.0, n + 1)]
+    axes = _samples(home, pos, a, b, step_m)
     X = np.array([pos.move(t, r) for t, r in axes])
-    keep = np.array([_gaps_moved(spheres, p, X, grow) <= limit for p in home]).reshape(len(home), len(X))
+    limit = arm.options.min_clearance + _SLACK_M
+    keep = np.array([_gaps_moved(spheres, p, X, _grow(arm)) <= limit for p in home]).reshape(len(home), len(X))
     still = [p for p in positioner_parts(pos, *a) if p.name == PEDESTAL]
-    out = touching(arm, q, still)
+    out = touching(arm, q, still, spheres)
     for k, (t, r) in enumerate(axes):
         out += [replace(p.transformed(X[k]), name=f"{p.name}@{k}") for i, p in enumerate(home) if keep[i, k]]
         moving = [p for p in positioner_parts(pos, t, r) if p.name != PEDESTAL]
@@ -124,8 +127,12 @@ def sphere_gaps(
     between an arm shape's bounding sphere (``spheres``: :meth:`CollisionChecker.shape_spheres` at q, computed when
     None) and the body grown by the inflation (a box as itself, any other body as its bounding sphere)."""
     spheres = arm.shape_spheres(q) if spheres is None else spheres
-    grow = max(arm.options.part_inflation, arm.options.table_inflation)
-    return np.array([float(_gaps_moved(spheres, p, np.eye(4)[None], grow)[0]) for p in bodies])
+    return np.array([float(_gaps_moved(spheres, p, np.eye(4)[None], _grow(arm))[0]) for p in bodies])
+
+
+def _grow(arm: CollisionChecker) -> float:
+    """The most ``arm``'s collision model grows an obstacle by [m]."""
+    return max(arm.options.part_inflation, arm.options.table_inflation)
 
 
 def touching(

@@ -51,24 +51,33 @@ def joint_figure(traj: Trajectory, limits: JointLimits, bands: Sequence[tuple[fl
     lo, hi = np.degrees(limits.q_min), np.degrees(limits.q_max)
     titles = [f"{n} (limits {a:.0f} .. {b:.0f} deg)" for n, a, b in zip(limits.names, lo, hi, strict=True)]
     fig = make_subplots(rows=limits.dof, cols=1, shared_xaxes=True, subplot_titles=titles, vertical_spacing=0.03)
+    # The limits, bands and labels are laid out at once: plotly's add_hline / add_vrect validate the whole layout
+    # at each call (seconds for a job of many welds).
+    shapes: list[dict[str, Any]] = []
+    labels: list[dict[str, Any]] = []
     for j in range(limits.dof):
         row = j + 1
         fig.add_trace(
             go.Scatter(x=t, y=q[:, j], mode="lines", name=limits.names[j], line={"color": "#1f77b4"}), row=row, col=1
         )
+        axes = fig.get_subplot(row, 1)
+        x, y = axes.xaxis.plotly_name.replace("axis", ""), axes.yaxis.plotly_name.replace("axis", "")
         span = max(float(np.ptp(q[:, j])), 5.0)
         ylo, yhi = float(q[:, j].min()) - 0.15 * span, float(q[:, j].max()) + 0.15 * span
-        for limit in (lo[j], hi[j]):
-            if ylo <= limit <= yhi:
-                fig.add_hline(y=float(limit), line={"color": "#d62728", "dash": "dash", "width": 1}, row=row, col=1)
+        shapes += [
+            {"type": "line", "xref": f"{x} domain", "x0": 0, "x1": 1, "yref": y, "y0": float(limit),
+             "y1": float(limit), "line": {"color": "#d62728", "dash": "dash", "width": 1}}
+            for limit in (lo[j], hi[j]) if ylo <= limit <= yhi
+        ]  # fmt: skip
         fig.update_yaxes(range=[ylo, yhi], title_text="[deg]", row=row, col=1)
         for a, b, seam in bands:
-            fig.add_vrect(x0=a, x1=b, fillcolor=ARC_COLOUR, opacity=0.35, line_width=0, row=row, col=1)
+            shapes.append({"type": "rect", "xref": x, "x0": a, "x1": b, "yref": f"{y} domain", "y0": 0, "y1": 1,
+                           "fillcolor": ARC_COLOUR, "opacity": 0.35, "line": {"width": 0}})  # fmt: skip
             if j == 0:
-                fig.add_annotation(
-                    x=(a + b) / 2.0, y=1.0, yref="y domain", text=seam, showarrow=False, textangle=-90,
-                    yanchor="bottom", font={"size": 9}, row=1, col=1,
-                )  # fmt: skip
+                labels.append({"x": (a + b) / 2.0, "xref": x, "y": 1.0, "yref": f"{y} domain", "text": seam,
+                               "showarrow": False, "textangle": -90, "yanchor": "bottom",
+                               "font": {"size": 9}})  # fmt: skip
+    fig.update_layout(shapes=shapes, annotations=[*fig.layout.annotations, *labels])
     fig.update_xaxes(title_text="time [s]", row=limits.dof, col=1)
     fig.update_layout(
         height=170 * limits.dof + 160,

@@ -204,3 +204,26 @@ def test_scan_pose_holds_the_eye_in_hand_camera_where_its_frustum_starts() -> No
     (cam,) = (c for c in view.cameras if c.mount == "eye_in_hand")
     X_R_link = view.poses[0].X_RL["camera_link"]  # the drawn camera body at the scan pose
     assert np.linalg.norm(X_R_link[:3, 3] - cam.frustum()[0]) < 0.01  # measured 3e-6 m (the optical origin)
+
+
+def test_joint_plots_shade_each_weld_on_every_row_and_draw_only_the_limits_in_view() -> None:
+    """Two welds shaded on each joint's own axes and labelled once on the top row; A1 runs near its upper limit
+    (drawn, dashed), A2 far from both (none drawn)."""
+    from types import SimpleNamespace
+
+    from cell.preview.page import joint_figure
+    from cell.types import JointLimits
+
+    t = np.linspace(0.0, 10.0, 101)
+    q = np.zeros((len(t), 2))
+    q[:, 0] = 2.97 + 0.02 * np.sin(t)  # its +3 rad limit within the axis's 15 % margin over the motion
+    ones = np.ones(2)
+    limits = JointLimits(("A1", "A2"), np.full(2, -3.0), np.full(2, 3.0), ones, ones, ones)
+    bands = [(1.0, 2.5, "S1"), (6.0, 7.0, "S2")]
+    layout = joint_figure(SimpleNamespace(times=t, q=q), limits, bands).to_plotly_json()["layout"]
+    rects = [(s["xref"], s["yref"], s["x0"], s["x1"]) for s in layout["shapes"] if s["type"] == "rect"]
+    assert rects == [(x, f"{y} domain", a, b) for x, y in (("x", "y"), ("x2", "y2")) for a, b, _ in bands]
+    lines = [(s["yref"], s["y0"]) for s in layout["shapes"] if s["type"] == "line"]
+    assert lines == [("y", pytest.approx(math.degrees(3.0)))]
+    labels = [(a["text"], a["x"], a["xref"]) for a in layout["annotations"] if a["text"] in ("S1", "S2")]
+    assert labels == [("S1", 1.75, "x"), ("S2", 6.5, "x")]

@@ -13,53 +13,10 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, readonly, transform_points
+from cell.types._faces import faces_planes_triangles
 from cell.types._near import pair_distance, within
 
 _CHUNK = 200_000  # point-triangle pairs evaluated at once in contains() (bounds the memory)
-
-
-def _newell(poly: FloatArray) -> FloatArray:
-    """Area-weighted normal (3,) of a planar polygon (m, 3) (Newell's method): 2 x area along the normal."""
-    nxt = np.roll(poly, -1, axis=0)
-    return np.asarray(np.cross(poly, nxt).sum(axis=0))
-
-
-def _ear_clip(uv: FloatArray) -> list[tuple[int, int, int]]:
-    """Triangles (local indices) of a simple counter-clockwise 2D polygon (m, 2), convex or not (ear clipping).
-
-    A convex polygon comes out as the fan from its first vertex; degenerate leftovers fall back to a fan.
-    """
-    idx = list(range(len(uv)))
-    out: list[tuple[int, int, int]] = []
-    guard = 0
-    while len(idx) > 3 and guard < 4 * len(uv) * len(uv):
-        guard += 1
-        m = len(idx)
-        for k in range(m):
-            i, j, l_ = idx[k], idx[(k + 1) % m], idx[(k + 2) % m]
-            a, b, c = uv[i], uv[j], uv[l_]
-            cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-            if cross <= 1e-15:
-                continue  # reflex or flat corner: not an ear
-            others = [q for q in idx if q not in (i, j, l_)]
-            if others and _any_in_triangle(uv[others], a, b, c):
-                continue
-            out.append((i, j, l_))
-            idx.pop((k + 1) % m)
-            break
-        else:
-            break
-    for k in range(1, len(idx) - 1):  # what is left (a triangle, or a degenerate rest): a fan
-        out.append((idx[0], idx[k], idx[k + 1]))
-    return out
-
-
-def _any_in_triangle(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> bool:
-    def side(u: FloatArray, v: FloatArray) -> FloatArray:
-        return np.asarray((v[0] - u[0]) * (p[:, 1] - u[1]) - (v[1] - u[1]) * (p[:, 0] - u[0]))
-
-    s1, s2, s3 = side(a, b), side(b, c), side(c, a)
-    return bool(np.any((s1 >= -1e-15) & (s2 >= -1e-15) & (s3 >= -1e-15)))
 
 
 def _point_triangle_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
@@ -98,24 +55,9 @@ class Polyhedron:
             raise ValueError("Polyhedron needs at least 4 faces, each with its own name")
         if any(len(f) < 3 or min(f) < 0 or max(f) >= k for f in faces):
             raise ValueError(f"Polyhedron faces need 3 or more vertex indices in 0..{k - 1}")
-        planes = np.zeros((len(faces), 4))
-        tris: list[tuple[int, int, int]] = []
-        for i, f in enumerate(faces):
-            poly = self.vertices[list(f)]
-            nw = _newell(poly)
-            norm = float(np.linalg.norm(nw))
-            if norm <= 1e-18:
-                raise ValueError(f"Polyhedron face {self.names[i]} has zero area")
-            n = nw / norm
-            planes[i, :3], planes[i, 3] = n, float(n @ poly.mean(axis=0))
-            u = poly[1] - poly[0] if len(poly) > 1 else np.array([1.0, 0.0, 0.0])
-            u = u - (u @ n) * n
-            u = u / max(float(np.linalg.norm(u)), 1e-300)
-            v = np.cross(n, u)
-            uv = np.stack([poly @ u, poly @ v], axis=1)
-            tris.extend((f[a], f[b], f[c]) for a, b, c in _ear_clip(uv))
+        planes, tris = faces_planes_triangles(self.vertices, faces, self.names)
         object.__setattr__(self, "_planes", readonly(planes))
-        object.__setattr__(self, "_tris", readonly(np.array(tris, dtype=np.intp).reshape(-1, 3), np.intp))
+        object.__setattr__(self, "_tris", readonly(tris, np.intp))
         vol, c = self._volume_centroid()
         object.__setattr__(self, "_mass", (vol, readonly(c), float(np.max(np.linalg.norm(self.vertices - c, axis=1)))))
 

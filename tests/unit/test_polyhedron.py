@@ -84,6 +84,20 @@ def test_triangles_wind_outward_on_non_convex_faces() -> None:
     assert area[top].sum() == pytest.approx(0.3 * 0.3 - 0.2 * 0.2)  # no triangle spills into the notch
 
 
+def test_a_dart_quad_face_is_cut_at_its_reflex_corner_not_fanned() -> None:
+    """A prism over an arrowhead (four corners, the fourth reflex): each cap is two triangles that lie inside it
+    (a fan from its first corner would cover 6 cm2 of a 3 cm2 face, part of it twice); the side quads, convex,
+    are the fan of their first corner."""
+    dart = prism([(0.0, 0.0), (0.03, 0.015), (0.0, 0.03), (0.01, 0.015)], 0.01)
+    tri = dart.vertices[dart.triangles()]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    top, bottom = n[:, 2] > 1e-12, n[:, 2] < -1e-12
+    assert np.count_nonzero(top) == np.count_nonzero(bottom) == 2
+    assert 0.5 * n[top, 2].sum() == pytest.approx(3e-4) and -0.5 * n[bottom, 2].sum() == pytest.approx(3e-4)
+    assert dart.volume == pytest.approx(3e-6)
+    assert [tuple(t) for t in dart.triangles()[4:6]] == [(0, 1, 5), (0, 5, 4)]  # the first side quad's fan
+
+
 def test_transformed_moves_planes_points_and_centre() -> None:
     X = make_pose(rpy_to_matrix([0.3, -0.2, 1.1]), [0.5, -0.4, 0.2])
     moved = L_SHAPE.transformed(X)

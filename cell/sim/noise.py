@@ -93,16 +93,26 @@ def depth_edges(depth_m: npt.ArrayLike, jump_m: float) -> tuple[npt.NDArray[np.b
     an edge).
     """
     z = np.asarray(depth_m, dtype=float)
-    H, W = z.shape
-    padded = np.pad(z, 1, constant_values=0.0)
-    best_jump = np.zeros((H, W))
-    other = np.full((H, W), np.nan)
-    for dv, du in ((-1, 0), (1, 0), (0, -1), (0, 1)):
-        nb = padded[1 + dv : 1 + dv + H, 1 + du : 1 + du + W]
-        jump = np.where((z > 0) & (nb > 0), np.abs(nb - z), 0.0)
+    valid = z > 0
+    # Each pair of 4-neighbours' jump once (0 unless both valid), read from either side: |a - b| is |b - a|.
+    down = np.where(valid[1:] & valid[:-1], np.abs(z[1:] - z[:-1]), 0.0)  # (H - 1, W): row i+1 against row i
+    right = np.where(valid[:, 1:] & valid[:, :-1], np.abs(z[:, 1:] - z[:, :-1]), 0.0)  # (H, W - 1)
+    best_jump = np.zeros(z.shape)
+    other = np.full(z.shape, np.nan)
+    jump = np.empty(z.shape)
+    nb = np.empty(z.shape)
+    for axis, back in ((0, True), (0, False), (1, True), (1, False)):  # up, down, left, right: ties to the first
+        pair = down if axis == 0 else right
+        lead: tuple[slice, ...] = (slice(None),) * axis
+        own = (*lead, slice(1, None) if back else slice(None, -1))  # the pixels that have this neighbour
+        far = (*lead, slice(None, -1) if back else slice(1, None))  # and the neighbour's pixels
+        jump.fill(0.0)
+        jump[own] = pair
+        nb.fill(0.0)
+        nb[own] = z[far]
         better = (jump > jump_m) & (jump > best_jump)
-        best_jump = np.where(better, jump, best_jump)
-        other = np.where(better, nb, other)
+        np.copyto(best_jump, jump, where=better)
+        np.copyto(other, nb, where=better)
     return best_jump > jump_m, other
 
 

@@ -155,10 +155,10 @@ def _table_pixels(
     on = np.abs(p_W[:, 2] - top_z) < _BAND_M
     on &= (p_W[:, 0] > lo_xy[0] + _INSET_M) & (p_W[:, 0] < hi_xy[0] - _INSET_M)
     on &= (p_W[:, 1] > lo_xy[1] + _INSET_M) & (p_W[:, 1] < hi_xy[1] - _INSET_M)
-    if bodies is not None and len(bodies[0]):
-        xy = p_W[:, None, :2]
-        on &= ~np.any(np.all((xy >= bodies[0][None]) & (xy <= bodies[1][None]), axis=2), axis=1)
     idx = np.flatnonzero(on)
+    if bodies is not None and len(bodies[0]):  # only the points on the table's top can be under a body
+        xy = p_W[idx, None, :2]
+        idx = idx[~np.any(np.all((xy >= bodies[0][None]) & (xy <= bodies[1][None]), axis=2), axis=1)]
     idx = idx[:: max(1, len(idx) // _MAX_SAMPLES)]
     return v[idx].astype(float), u[idx].astype(float), z[idx]
 

@@ -57,3 +57,26 @@ def _segment_at(plan: WeldPlan, t: float) -> Segment:
     t0 = np.array([s.t0 for s in plan.segments])
     k = int(np.clip(np.searchsorted(t0, t, side="left") - 1, 0, len(t0) - 1))
     return plan.segments[k]
+
+
+def incoming(plan: WeldPlan, violations: Sequence[Violation]) -> dict[str, tuple[str, str]]:
+    """Seam id -> the transfer into it, (the seam before it in the plan's order or "" for home, itself), for each
+    seam whose first violation lies on that move or on its approach (before its first arc: the move blended into
+    the approach is motion the seam's own search never checked, so another order may weld it)."""
+    out: dict[str, tuple[str, str]] = {}
+    seen: set[str] = set()
+    for v in violations:
+        sid = seam_of(plan, v)
+        if not sid or sid in seen:
+            continue
+        seen.add(sid)
+        seg = _segment_at(plan, v.t)
+        if seg.seam_id != sid or seg.kind not in ("move", "approach") or sid not in plan.order:
+            continue
+        at = next(i for i, s in enumerate(plan.segments) if s is seg)
+        before = [s for s in plan.segments[:at] if s.seam_id == sid and s.arc_on]
+        k = plan.order.index(sid)
+        if before:
+            continue  # past its first arc (a pass, a curve's next arc): not the move into the seam
+        out[sid] = (plan.order[k - 1] if k else "", sid)
+    return out

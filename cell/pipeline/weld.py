@@ -69,7 +69,7 @@ def plan_for(
     elsewhere : another pose may hold a seam (a positioner's): :func:`~cell.planning.plan.plan_welds`'s.
     """
     from cell.gate import find_violations
-    from cell.gate.blame import blamed_seams
+    from cell.gate.blame import blamed_seams, incoming
     from cell.motion.timing import ptp
     from cell.pipeline.tacks import tack_procedures
     from cell.planning.plan import plan_welds
@@ -107,12 +107,13 @@ def plan_for(
     else:
         pre = joined(way) if way else ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
     dropped: dict[str, SeamOutcome] = {}
+    avoid: set[tuple[str, str]] = set()  # transfers the gate found at fault: another order is tried first
     for _ in range(_GATE_ROUNDS):
         kept = [t for t in tasks if t.id not in dropped]
         kept_tacks = [t for t in tack_tasks if t.id not in dropped]
         procs = seam_procedures(sc, det, kept) | curve_procedures_for(sc, ss.weldmap, curves)
         first = {t.id for t in kept_tacks}  # the tacks before every seam
-        fixed = partial(plan_welds, first=first, elsewhere=elsewhere)
+        fixed = partial(plan_welds, first=first, elsewhere=elsewhere, avoid=set(avoid))
         planner = fixed if track is None else partial(plan_on_track, track=track)
         plan = planner(
             arm.model,
@@ -124,7 +125,7 @@ def plan_for(
             rng=sc.rng("plan"),
             checker=checker,
             procedures=procs | tack_procedures(procs, kept_tacks),
-            on_seam=seam_counter(progress) if not dropped else None,
+            on_seam=seam_counter(progress) if not dropped and not avoid else None,
             curves=[c for c in curves if c.id not in dropped],
         )
         progress(
@@ -144,9 +145,17 @@ def plan_for(
         blamed = blamed_seams(plan, found)
         if blamed is None:  # none, or one that concerns the whole plan
             break
-        # A violation in one seam's motions (its transfer, its weld) drops that seam; the rest are planned again.
-        progress(f"safety gate: dropping {', '.join(blamed)} (their own motions violate it), planning the rest")
-        dropped.update(blamed)
+        # A violation on the move into a seam (or its approach, the move blended into it) is first answered by
+        # another order, without that transfer; a seam blamed again, or for its own motions (its weld), is
+        # dropped and the rest are planned again.
+        moves = {sid: e for sid, e in incoming(plan, found).items() if e not in avoid} if track is None else {}
+        if moves:
+            progress(f"safety gate: {', '.join(moves)} again in another order (the move into it violates it)")
+            avoid |= set(moves.values())
+        if set(blamed) - set(moves):
+            rest = [sid for sid in blamed if sid not in moves]
+            progress(f"safety gate: dropping {', '.join(rest)} (their own motions violate it), planning the rest")
+            dropped.update({sid: o for sid, o in blamed.items() if sid not in moves})
     outcomes = {o.seam_id: o for o in plan.seams} | dropped
     ids = [*(t.id for t in (*tasks, *tack_tasks)), *(c.id for c in curves)]
     plan = replace(plan, seams=tuple(outcomes[i] for i in ids if i in outcomes))
@@ -154,7 +163,7 @@ def plan_for(
     return plan, pre, tuple(problems)
 
 
-_GATE_ROUNDS = 4  # plans tried: after the third round of drops the gate's word is final
+_GATE_ROUNDS = 6  # plans tried: after the fifth round of other orders and drops the gate's word is final
 
 
 def execute(

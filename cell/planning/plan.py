@@ -55,6 +55,7 @@ def plan_welds(
     first: Collection[str] = (),
     curves: Sequence[CurveEstimate] = (),
     elsewhere: bool = False,
+    avoid: Collection[tuple[str, str]] = (),
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -67,6 +68,8 @@ def plan_welds(
         with ``process`` alone, one pass on the seam line.
     on_seam : called with (seams searched, seams in all) after each seam's torch search (a progress bar).
     first : task ids welded before all the others (tack welds, :mod:`cell.pipeline.tacks`).
+    avoid : (from id, to id) transfers ("" = home) the order takes only when no order does without them (the
+        safety gate found the move along one, blended into the next approach, at fault).
     curves : located curved seams (:class:`CurveEstimate`, in R; those not found are left out), each welded along
         its curve (:mod:`cell.planning.curves`: a closed one all round with the process's start/stop overlap), its
         procedure from ``procedures`` too; their outcomes follow the tasks'.
@@ -160,7 +163,8 @@ def plan_welds(
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
     lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
-    forbidden: set[tuple[str, str]] = set()
+    pieces = {sid: [k for k in solved if seam_of(k) == sid] or [sid] for pair in avoid for sid in pair if sid}
+    forbidden = {(x, y) for a, b in avoid for x in pieces.get(a, [a]) for y in pieces.get(b, [b])}  # arcs too
     while True:
         ids = list(solved)
         order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)

@@ -170,3 +170,21 @@ def test_the_gate_refuses_a_planned_weld_that_runs_into_a_third_part_and_blames_
     blamed = blamed_seams(plan, found)
     assert blamed is not None and set(blamed) == {"top"}
     assert blamed["top"].code is PlanReason.ENTERS_BODY and "TUBE" in blamed["top"].reason
+
+
+def test_a_transfer_the_gate_found_at_fault_is_left_out_of_the_order() -> None:
+    """``plan_welds(avoid=...)``: the move from home into the first seam avoided, the two seams are welded the
+    other way round (the order goes without it when it can); both still planned."""
+    from tiny_cell import HOME, OBSTACLES, SIDE_SEAM, TOP_SEAM, URDF
+
+    from cell import scenario as sc
+    from cell.planning.plan import plan_welds
+    from cell.process.torch import WeldProcess
+    from cell.types.plan import SeamTask
+
+    robot = RobotModel.from_urdf(URDF)
+    process = WeldProcess.from_spec(sc.ProcessSpec())
+    tasks = [SeamTask(*TOP_SEAM), SeamTask(*SIDE_SEAM)]
+    plan = plan_welds(robot, tasks, HOME, process, OBSTACLES)
+    again = plan_welds(robot, tasks, HOME, process, OBSTACLES, avoid={("", plan.order[0])})
+    assert again.order == plan.order[::-1] and all(o.feasible for o in again.seams)

@@ -11,7 +11,7 @@ from tiny_cell import HOME, OBSTACLES, TOP_SEAM, URDF
 from cell import scenario as sc
 from cell.config.motion import PlanOptions
 from cell.gate.base import Violation, ViolationKind
-from cell.gate.blame import blamed_seams, seam_of
+from cell.gate.blame import blamed_seams, incoming, seam_of
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
@@ -160,7 +160,7 @@ def test_the_torch_tests_broad_phase_finds_what_every_box_finds(robot: RobotMode
 def _plan() -> WeldPlan:
     def seg(kind: str, sid: str, t0: float) -> Segment:
         tr = Trajectory(np.array([0.0, 1.0]), np.zeros((2, 6)), np.zeros((2, 6)), np.zeros((2, 6)))
-        return Segment(kind, sid, tr, t0, make_pose(p=[0.0, 1.0, 0.1]))  # type: ignore[arg-type]
+        return Segment(kind, sid, tr, t0, make_pose(p=[0.0, 1.0, 0.1]), arc_on=kind == "weld")  # type: ignore[arg-type]
 
     kinds = [
         ("move", "a"),
@@ -189,6 +189,21 @@ def test_a_gate_violation_is_its_seams() -> None:
     both = [Violation(ViolationKind.SINGULARITY, "x", 2.5), Violation(ViolationKind.SINGULARITY, "x", 5.5)]
     assert blamed_seams(plan, both) is None  # every seam at fault: the whole plan is refused
     assert blamed_seams(plan, []) is None
+
+
+def test_a_violation_on_the_move_into_a_seam_names_that_transfer() -> None:
+    """On the move into a seam or its approach (the move blended into it): that transfer, from the seam before or
+    home (""), for the gate to try another order; on its weld, or the move home after the last seam: none."""
+    plan = _plan()
+
+    def at(*ts: float) -> dict[str, tuple[str, str]]:
+        return incoming(plan, [Violation(ViolationKind.SINGULARITY, "x", t) for t in ts])
+
+    assert at(0.5) == at(1.5) == {"a": ("", "a")}
+    assert at(4.5) == {"b": ("a", "b")}
+    assert at(2.5) == at(3.5) == at(5.5) == at(6.5) == {}
+    assert at(4.5, 0.5) == {"b": ("a", "b"), "a": ("", "a")}
+    assert at(2.5, 1.5) == {}  # a seam's first violation decides: its weld
 
 
 def test_the_checks_broad_phase_keeps_every_answer(robot: RobotModel) -> None:

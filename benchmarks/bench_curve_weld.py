@@ -122,7 +122,7 @@ def bench(name: str) -> dict[str, Any]:
                 "planned": o.feasible,
                 "arcs": sum(1 for g in plan.segments if g.arc_on and g.seam_id == c.id),
                 "reason": o.reason,
-                "welded": q is not None,
+                "welded": q is not None and not o.partial,  # whole: a curve welded in part is ``partial``
                 "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
                 "tcp_max_mm": round(q.tcp_max_mm, 3) if q else None,
                 "weld_length_mm": round(q.length_mm, 1) if q else None,
@@ -220,6 +220,9 @@ def bench_located(name: str) -> dict[str, Any]:
                 "arcs": arcs,
                 "reason": (o.reason if o is not None and not o.feasible else (w.reason if w else c.reason)),
                 "code": (str(w.plan_code or w.code) if w is not None and not w.welded else None),
+                "partial": bool(w and w.partial),  # welded in part: its share and the length left for a manual weld
+                "share": round(w.share, 4) if w is not None and w.partial else None,
+                "remainder_mm": round(w.manual_m * 1000.0, 1) if w is not None and w.partial else None,
                 "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
                 "tcp_max_mm": round(q.tcp_max_mm, 3) if q else None,
                 "unwelded_mm": round(q.short_start_mm + q.short_end_mm, 2) if q else None,

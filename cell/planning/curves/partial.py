@@ -26,6 +26,7 @@ from cell.types.plan import PlanReason, Remainder
 from cell.types.procedure import WeldProcedure
 
 EPS_M = 1e-6  # [m] two ends this close are one place
+SHORT_OR_BEYOND = "too short to weld or beyond the arcs' bound"
 HELD_SLACK_M = 0.001  # [m] the map's held stretches are binned by the millimetre (:func:`.graph.gaps`)
 
 
@@ -43,7 +44,7 @@ def partial_cover(
         return []
     free = gaps(runs, total, closed, 0.0)
     laps = (-total, 0.0, total, 2.0 * total) if closed else (0.0,)
-    copies = [replace(r, a_m=r.a_m + k, b_m=r.b_m + k, origin_m=r.origin_m + k) for r in runs for k in laps]
+    copies = [_lap(r, k) for r in runs for k in laps]
     out: list[tuple[Run, Run]] = []
     if closed and not free:
         at = pinch(runs, total, overlap)
@@ -62,10 +63,19 @@ def partial_cover(
             chain = _chain(inside, first, hi - HELD_SLACK_M, overlap)
             out += list(zip(chain, balanced(chain, total, False, overlap), strict=True))
     out = [(r, p) for r, p in out if p.length >= min_arc]
+    if closed:  # each arc from its start on the located curve's own lap
+        out = [
+            (_lap(r, -math.floor(p.a_m / total) * total), _lap(p, -math.floor(p.a_m / total) * total)) for r, p in out
+        ]
     if len(out) > max_arcs:
         keep = sorted(sorted(range(len(out)), key=lambda k: -out[k][1].length)[:max_arcs])
         out = [out[k] for k in keep]
     return out
+
+
+def _lap(r: Run, by: float) -> Run:
+    """``r`` moved ``by`` [m] along the curve (whole laps of a closed one)."""
+    return replace(r, a_m=r.a_m + by, b_m=r.b_m + by, origin_m=r.origin_m + by)
 
 
 def _held(free: list[tuple[float, float]], total: float, closed: bool) -> list[tuple[float, float]]:
@@ -160,11 +170,13 @@ def _unwelded(
         words = f"no torch setting holds {unheld * 1000:.0f} mm of it ({why})"
         if f is not None and hi - lo > unheld + 0.002:
             words += f"; an arc over the rest failed its full solve ({f.code}: {f.where})"
+        elif hi - lo > unheld + 0.002:
+            words += f"; the rest held only in stretches {SHORT_OR_BEYOND}"
         return Remainder(lo, hi, code, words)
     if f is not None:
         return Remainder(lo, hi, f.code or PlanReason.IK_FAILED, f"an arc over it failed its full solve: {f.where}")
     code, _ = _why(list(misses), lo - 0.01, hi + 0.01, total, closed)
-    return Remainder(lo, hi, code, "the arm holds it only in stretches too short to weld or beyond the arcs' bound")
+    return Remainder(lo, hi, code, f"the arm holds it only in stretches {SHORT_OR_BEYOND}")
 
 
 def _overlap(a: float, b: float, lo: float, hi: float, total: float, closed: bool) -> float:

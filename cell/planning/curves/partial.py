@@ -141,7 +141,7 @@ def remainder(
         elif end - a_next < overlap - EPS_M:
             mid = 0.5 * (end + a_next)
             code, why = _why(list(misses), mid - overlap, mid + overlap, total, closed)
-            words = (f"the arcs restart over each other by {(end - a_next) * 1000:.1f} mm < the WPS's "
+            words = (f"the arcs restart over each other by {max(end - a_next, 0.0) * 1000:.1f} mm < the WPS's "
                      f"{overlap * 1000:.0f} mm: the arm holds no setting through here further ({why})")  # fmt: skip
             out.append(Remainder(mid - 0.5 * overlap, mid + 0.5 * overlap, code, words))
         end = max(end, b_next)

@@ -127,3 +127,29 @@ def test_a_partial_curve_is_said_apart_in_the_outcome_the_exit_line_and_the_tabl
     rep = {"seams": [straight, curve], "lost_cameras": [], "error": None, "welded": 1, "summary": summary}
     assert weld_exit(rep) == "exit 3: 1 curved seam partly welded: 21 mm left for a manual weld; 1/2 welded"
     assert not_supported_text(summary) == "1 curved seam partly welded: 21 mm left for a manual weld"
+
+
+def test_on_a_track_a_curve_no_carriage_position_welds_whole_is_welded_in_part_from_its_first() -> None:
+    from types import SimpleNamespace
+
+    from cell.planning.curves.track import in_part_at
+
+    gap = (Remainder(0.1, 0.12, PlanReason.COLLISION, "no torch setting holds 20 mm of it"),)
+    curves = [SimpleNamespace(id=k) for k in ("A", "B", "C")]
+    refused = SeamOutcome("A", False, "no torch setting holds it", code=PlanReason.COLLISION)
+    outcomes = {
+        "A": refused,
+        "B": SeamOutcome("B", True),  # welded whole from some E1: left alone
+        "C": replace_id(refused, "C"),
+    }
+    asked: list[tuple[float, str]] = []
+
+    def plan_at(e1: float, c: SimpleNamespace) -> SimpleNamespace:
+        asked.append((e1, c.id))
+        part = SeamOutcome(c.id, True, "welded in part", remainder=gap, share=0.97)
+        return SimpleNamespace(seams=(part if c.id == "A" else replace_id(refused, c.id),))
+
+    got = in_part_at(curves, {"A": (0.4, 0.0), "B": (0.0,), "C": (0.2,)}, outcomes, plan_at)  # type: ignore[arg-type]
+    assert asked == [(0.4, "A"), (0.2, "C")]  # each from its first E1 only
+    assert [e1 for e1, _ in got] == [0.4] and outcomes["A"].partial and outcomes["A"].share == 0.97
+    assert outcomes["C"] is not refused and not outcomes["C"].feasible and outcomes["B"].feasible

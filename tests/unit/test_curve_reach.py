@@ -160,7 +160,7 @@ def test_a_gusset_across_the_foot_is_welded_up_to_it_the_rest_left_for_a_manual_
     est = _foot()
     got = plan_arcs(_search(GUSSET, spec=stiff), est, HOME)
     assert got.partial and not got.whole and got.failure is not None and 2 <= len(got.arcs) <= 8
-    assert 0.75 < got.share < 0.9  # measured 0.83: 3 arcs, 42 mm of 251 left
+    assert 0.7 < got.share < 0.8  # measured 0.73: 3 arcs, 68 mm of 251 left (each 5 mm off a gap's edge)
     gusset = [r for r in got.remainder if "torch vs GUSSET" in r.why]
     assert len(gusset) == 1 and gusset[0].code is PlanReason.COLLISION
     # where the planned arcs' TCP never passes on the true curve is the remainder, within 2 mm at each end

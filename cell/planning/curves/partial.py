@@ -27,6 +27,9 @@ from cell.types.procedure import WeldProcedure
 
 EPS_M = 1e-6  # [m] two ends this close are one place
 SHORT_OR_BEYOND = "too short to weld or beyond the arcs' bound"
+# [m] an arc stops (or starts) this far short of a gap's edge: its stretch gives out there with the arm at a
+# limit (a joint, the hose window, against itself or a part), and the depart and the move on need room
+STOP_BACK_M = 0.005
 HELD_SLACK_M = 0.001  # [m] the map's held stretches are binned by the millimetre (:func:`.graph.gaps`)
 
 
@@ -36,10 +39,11 @@ def partial_cover(
     """The arcs that weld the most of a curve ``total`` [m] long its stretches hold, as (the stretch, the arc: that
     stretch cut to where it welds) in order along the curve: in each held piece between two stretches no setting
     holds (the whole of a closed curve held all round: from its pinch, :func:`.reach.pinch`), greedy from the
-    piece's start, each next stretch starting at least ``overlap`` [m] back on the last where one does, else the one
-    that reaches furthest from where the last gives out (a restart short of the overlap: :func:`remainder` lists
-    it); excess overlaps shared out as in a whole cover (:func:`.reach.balanced`). Arcs shorter than ``min_arc`` [m]
-    are left out, and beyond ``max_arcs`` the shortest."""
+    piece's start, each next stretch starting at least ``overlap`` [m] back on the last where one does, else the
+    one that reaches furthest from where the last gives out (a restart short of the overlap: :func:`remainder`
+    lists it); excess overlaps shared out as in a whole cover (:func:`.reach.balanced`), the piece's arcs
+    :data:`STOP_BACK_M` off a gap's edge at either end. Arcs shorter than ``min_arc`` [m] are left out, and beyond
+    ``max_arcs`` the shortest."""
     if not runs:
         return []
     free = gaps(runs, total, closed, 0.0)
@@ -61,7 +65,12 @@ def partial_cover(
             starts = [r for r in inside if r.a_m <= lo + HELD_SLACK_M] or [min(inside, key=lambda r: r.a_m)]
             first = max(starts, key=lambda r: r.b_m)
             chain = _chain(inside, first, hi - HELD_SLACK_M, overlap)
-            out += list(zip(chain, balanced(chain, total, False, overlap), strict=True))
+            parts = balanced(chain, total, False, overlap)
+            if closed or lo > EPS_M:  # off a gap's edge, not the curve's own start
+                parts[0] = replace(parts[0], a_m=parts[0].a_m + STOP_BACK_M)
+            if closed or hi < total - EPS_M:
+                parts[-1] = replace(parts[-1], b_m=parts[-1].b_m - STOP_BACK_M)
+            out += list(zip(chain, parts, strict=True))
     out = [(r, p) for r, p in out if p.length >= min_arc]
     if closed:  # each arc from its start on the located curve's own lap
         out = [

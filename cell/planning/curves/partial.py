@@ -179,8 +179,10 @@ def _unwelded(
         words = f"no torch setting holds {unheld * 1000:.0f} mm of it ({why})"
         if f is not None and hi - lo > unheld + 0.002:
             words += f"; an arc over the rest failed its full solve ({f.code}: {f.where})"
-        elif hi - lo > unheld + 0.002:
+        elif hi - lo > unheld + 2.0 * STOP_BACK_M + 0.002:
             words += f"; the rest held only in stretches {SHORT_OR_BEYOND}"
+        elif hi - lo > unheld + 0.002:
+            words += f"; the arcs stop {STOP_BACK_M * 1000:.0f} mm short of it (the arm at a limit where it gives out)"
         return Remainder(lo, hi, code, words)
     if f is not None:
         return Remainder(lo, hi, f.code or PlanReason.IK_FAILED, f"an arc over it failed its full solve: {f.where}")
@@ -214,15 +216,17 @@ def partial_arcs(
     procedure: WeldProcedure | None,
     failure: SeamFailure,
 ) -> Split:
-    """``est`` welded in part (:func:`partial_cover`), each arc solved as a whole cover's (:func:`.arcs._arc_solution`);
-    an arc that fails is trimmed or dropped (:func:`.arcs._trimmed`) and the arcs chosen again, up to
-    :data:`.arcs.TRIES` times, then the arcs that solved kept and the failed ones' stretches left to the manual
-    weld. ``failure``: why no cover welds it whole (kept as the split's). No arc solved: that failure alone."""
+    """``est`` welded in part (:func:`partial_cover`), each arc solved as a whole cover's
+    (:func:`.arc_solve._arc_solution`); an arc that fails is trimmed or dropped (:func:`.arc_solve._trimmed`) and
+    the arcs chosen again, up to :data:`.arc_solve.TRIES` times; then the solved arcs of the try that welds the
+    most are kept and the failed ones' stretches left to the manual weld. ``failure``: why no cover welds it whole
+    (kept as the split's). No arc solved: that failure alone."""
     pr, total = search.process, est.length_m
     overlap = pr.closed_overlap if est.closed else 0.0
     memo: dict[tuple[float, float, Candidate], tuple[SeamSolution, ...] | SeamFailure] = {}
     failed: list[tuple[float, float, SeamFailure]] = []
     kept: list[tuple[Run, tuple[SeamSolution, ...]]] = []
+    best: list[tuple[Run, tuple[SeamSolution, ...]]] = []
     mapped = list(runs)  # what the map holds, before failed arcs are trimmed out of it
     for _ in range(TRIES):
         chosen = partial_cover(runs, total, est.closed, overlap, MIN_ARC_M)
@@ -238,8 +242,11 @@ def partial_arcs(
                 again = True
             else:
                 kept.append((part, got))
+        if sum(p.length for p, _ in kept) > sum(p.length for p, _ in best):
+            best = kept
         if not again:
             break
+    kept = best  # the try whose solved arcs weld the most (a later try may lose what an earlier one solved)
     if not kept:
         return Split((), 0.0, failure)
     rest = remainder([(p.a_m, p.b_m) for p, _ in kept], mapped, misses, total, est.closed, overlap, failed)

@@ -153,3 +153,24 @@ def test_on_a_track_a_curve_no_carriage_position_welds_whole_is_welded_in_part_f
     assert asked == [(0.4, "A"), (0.2, "C")]  # each from its first E1 only
     assert [e1 for e1, _ in got] == [0.4] and outcomes["A"].partial and outcomes["A"].share == 0.97
     assert outcomes["C"] is not refused and not outcomes["C"].feasible and outcomes["B"].feasible
+
+
+def test_a_partial_curve_in_the_report_and_the_programs_header() -> None:
+    from cell.cli.turnover import not_welded
+    from cell.export.curve_report import weld_entry
+    from cell.types.run import SeamWeld, WeldReason
+
+    rest = (Remainder(0.161, 0.179, PlanReason.IK_FAILED, "no torch setting holds 7 mm of it"),)
+    w = SeamWeld("PIPE>FLANGE:circle", True, False, "welded in part: ...", code=WeldReason.PARTIAL, share=0.974,
+                 remainder=rest)  # fmt: skip
+    assert w.partial and w.manual_m == pytest.approx(0.018)
+    entry = weld_entry(w)
+    assert entry["welded"] is False and entry["planned"] is True and entry["weld_reason_code"] == "partial"
+    assert entry["share"] == 0.974 and entry["manual_mm"] == 18.0
+    assert entry["remainder"] == [
+        {"from_mm": 161.0, "to_mm": 179.0, "length_mm": 18.0, "code": "ik_failed", "why": rest[0].why}
+    ]
+    rep = {"seams": [{"id": w.id, "status": "found", "reason_code": None, **entry}]}
+    assert not_welded(rep) == (
+        (w.id, "partial: 18 mm left for a manual weld at 161-179 mm (ik_failed) along it"),
+    )  # the programs' header

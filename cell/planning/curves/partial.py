@@ -1,6 +1,6 @@
 """A curved seam welded in part (the process's ``curve_remainder: manual``): where no cover of arcs welds it whole,
 the arcs that weld the most of what the arm holds, each restarting the WPS overlap back over the bead before it
-within a held stretch, stopping with its crater at the edge of a stretch no torch setting holds; and the stretches
+within a held stretch, stopping with its crater just short of a stretch no torch setting holds; and the stretches
 they leave for a manual weld, each with what stops the arm there (docs/curves-welding.md section 10).
 
 Frames: everything in the robot base frame R [m]; joints [rad]."""
@@ -55,8 +55,11 @@ def partial_cover(
         x0 = at[0] if at is not None else max(runs, key=lambda r: r.length).a_m
         through = [r for r in copies if r.a_m <= x0 + EPS_M and r.b_m > x0 + EPS_M]
         first = max(through, key=lambda r: r.b_m)
-        chain = _chain(copies, first, first.a_m + total + overlap, overlap, ring=first.a_m + total)
-        out = list(zip(chain, balanced(chain, total, True, overlap), strict=True))
+        goal = first.a_m + total + overlap
+        chain = _chain(copies, first, goal, overlap, ring=first.a_m + total)
+        parts = balanced(chain, total, True, overlap)
+        parts[-1] = replace(parts[-1], b_m=max(min(parts[-1].b_m, goal), parts[-1].a_m))  # no further round
+        out = list(zip(chain, parts, strict=True))
     else:
         for lo, hi in _held(free, total, closed):
             inside = [r for r in copies if r.a_m >= lo - HELD_SLACK_M and r.b_m <= hi + HELD_SLACK_M]
@@ -113,8 +116,6 @@ def _chain(runs: Sequence[Run], first: Run, goal: float, overlap: float, ring: f
             break
         chain.append(nxt)
         end = nxt.b_m
-    if ring is not None and chain[-1].b_m > goal:  # no further round than the first arc's start and the overlap
-        chain[-1] = replace(chain[-1], b_m=max(goal, chain[-1].a_m))
     return chain
 
 

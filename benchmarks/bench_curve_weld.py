@@ -26,13 +26,17 @@ import math
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from cell.geometry import FloatArray
 from cell.types import CurvedSeam, Part, SeamStatus, Surface, WeldMap
 from cell.types.curve_estimate import CurveEstimate
+
+if TYPE_CHECKING:
+    from cell.types.execution import Execution
+    from cell.types.plan import SeamOutcome, WeldPlan
 
 STEP_M = 0.002  # [m] the truth-built estimate's samples
 SIGMA_M = 0.0001  # [m] its sigma across the seam
@@ -118,13 +122,14 @@ def bench(name: str) -> dict[str, Any]:
                 "planned": o.feasible,
                 "arcs": sum(1 for g in plan.segments if g.arc_on and g.seam_id == c.id),
                 "reason": o.reason,
-                "welded": q is not None,
+                "welded": q is not None and not o.partial,  # whole: a curve welded in part is ``partial``
                 "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
                 "tcp_max_mm": round(q.tcp_max_mm, 3) if q else None,
                 "weld_length_mm": round(q.length_mm, 1) if q else None,
                 "arc_s": round(q.weld_time_s, 2) if q else None,
                 "speed_mm_s": round(q.speed_mm_s, 2) if q else None,
                 "unwelded_mm": round(q.short_start_mm + q.short_end_mm, 2) if q else None,
+                **_in_part(o, _root_stretches(plan, ex, pre.duration, c.id, det.curve_truths.get(c.id), s.X_WR)),
             }
         )
     return {
@@ -132,6 +137,48 @@ def bench(name: str) -> dict[str, Any]:
         "gate": [str(v) for v in problems],
         "plan_s": round(plan_s, 2),
         "seams": rows,
+    }
+
+
+def _root_stretches(
+    plan: WeldPlan, ex: Execution | None, pre_s: float, sid: str, truth_R: FloatArray | None, X_WR: FloatArray
+) -> list[tuple[float, float]] | None:
+    """The stretches along the true curve the executed root pass of seam ``sid`` leaves unwelded (from, to) [m]
+    (:func:`cell.process.curve_quality.unwelded_stretches`); None where nothing of it was welded."""
+    from cell.geometry import invert, transform_points
+    from cell.process.curve_quality import unwelded_stretches
+
+    welds = [g for g in plan.segments if g.arc_on and g.seam_id == sid and g.pass_index == 0]
+    if ex is None or truth_R is None or not welds:
+        return None
+    on = np.zeros(len(ex.times), dtype=bool)
+    for g in welds:
+        on |= (ex.times >= pre_s + g.t0 - 1e-9) & (ex.times <= pre_s + g.t1 + 1e-9)
+    tcp_R = transform_points(invert(np.asarray(X_WR, dtype=float)), ex.tcp_W[on])
+    truth = np.asarray(truth_R, dtype=float)
+    closed = bool(np.linalg.norm(truth[0] - truth[-1]) < 0.01)
+    return unwelded_stretches(tcp_R, truth, closed)
+
+
+def _in_part(o: SeamOutcome, measured: list[tuple[float, float]] | None) -> dict[str, Any]:
+    """A curved seam's share welded, its planned remainder (each stretch [mm] along the located curve, its code
+    and why) and the stretches the executed root pass left unwelded along the true curve [mm]."""
+    return {
+        "partial": o.partial,
+        "share": round(o.share, 4) if o.feasible else 0.0,
+        "remainder_mm": round(sum(r.length_m for r in o.remainder) * 1000.0, 1) if o.feasible else None,
+        "remainder": [
+            {
+                "from_mm": round(r.from_m * 1000.0, 1),
+                "to_mm": round(r.to_m * 1000.0, 1),
+                "code": r.code.value,
+                "why": r.why,
+            }
+            for r in o.remainder
+        ],
+        "measured_unwelded_mm": None
+        if measured is None
+        else [[round(a * 1000.0, 1), round(b * 1000.0, 1)] for a, b in measured],
     }
 
 
@@ -173,6 +220,9 @@ def bench_located(name: str) -> dict[str, Any]:
                 "arcs": arcs,
                 "reason": (o.reason if o is not None and not o.feasible else (w.reason if w else c.reason)),
                 "code": (str(w.plan_code or w.code) if w is not None and not w.welded else None),
+                "partial": bool(w and w.partial),  # welded in part: its share and the length left for a manual weld
+                "share": round(w.share, 4) if w is not None and w.partial else None,
+                "remainder_mm": round(w.manual_m * 1000.0, 1) if w is not None and w.partial else None,
                 "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q else None,
                 "tcp_max_mm": round(q.tcp_max_mm, 3) if q else None,
                 "unwelded_mm": round(q.short_start_mm + q.short_end_mm, 2) if q else None,

@@ -52,6 +52,7 @@ def curve_record(entry: Mapping[str, Any], *, weld_report: bool) -> Row:
         rec["welded"] = bool(entry.get("welded"))
         rec["weld_reason_code"] = entry.get("weld_reason_code") or (entry.get("not_welded") or {}).get("code")
         rec["tcp_max_mm"] = tcp.get("max") if tcp else None
+        rec["manual_mm"] = entry.get("manual_mm")  # a curve welded in part: the length left for a manual weld
     return rec
 
 
@@ -76,6 +77,11 @@ def curve_figures(curves: Sequence[Row], stage: str) -> Row:
         tcp = [c["tcp_max_mm"] for c in welded if c["tcp_max_mm"] is not None]
         out["welded"] = len(welded)
         out["worst_welded_tcp_max_mm"] = max(tcp) if tcp else None
+        part = [c for c in visible if c.get("manual_mm") is not None]  # welded in part: never counted as welded
+        out["partial"] = len(part)
+        out["manual_mm"] = round(sum(float(c["manual_mm"]) for c in part), 1)
+        tcp_part = [c["tcp_max_mm"] for c in part if c["tcp_max_mm"] is not None]
+        out["worst_partial_tcp_max_mm"] = max(tcp_part) if tcp_part else None
         codes = Counter(c.get("weld_reason_code") or c["reason_code"] or "unknown" for c in visible if not c["welded"])
     else:
         codes = Counter(c["reason_code"] or "unknown" for c in visible if not c["located"])

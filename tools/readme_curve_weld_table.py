@@ -13,12 +13,22 @@ def _tcp(r: Mapping[str, Any]) -> str:
 
 
 def _why(r: Mapping[str, Any]) -> str:
+    if r.get("partial"):  # welded in part: each stretch left for a manual weld, where and why (its code)
+        return "; ".join(f"{m['from_mm']:.0f}-{m['to_mm']:.0f} mm {m['code']}" for m in r["remainder"])
     return "" if r["welded"] else str(r["reason"]).replace("|", "/")
 
 
+def _welded(r: Mapping[str, Any]) -> str:
+    """yes (whole), partial with its share and the length left for a manual weld, or no."""
+    if r.get("partial"):
+        return f"partial {r['share']:.1%}, {r['remainder_mm']:.0f} mm manual"
+    return "yes" if r["welded"] else "no"
+
+
 def truth_table(data: Mapping[str, Any]) -> str:
-    """Per curved seam from a truth-built estimate: planned in how many arcs, TCP against the true curve, the
-    length no record reached, arc time, why not; the planning time per scenario."""
+    """Per curved seam from a truth-built estimate: welded whole, in part (its share, the length left for a manual
+    weld and where, why) or not, in how many arcs, TCP against the true curve, the length no record reached, arc
+    time, why not; the planning time per scenario."""
     lines = [
         "| scenario | curved seam | length mm | welded | arcs | TCP RMS / max mm (true curve) | unwelded mm | arc s"
         " | plan s | why not |",
@@ -29,7 +39,7 @@ def truth_table(data: Mapping[str, Any]) -> str:
             kind = "closed" if r["closed"] else "open"
             unw = f"{r['unwelded_mm']:.1f}" if r.get("unwelded_mm") is not None else "-"
             arc = f"{r['arc_s']:.1f}" if r.get("arc_s") is not None else "-"
-            welded = "yes" if r["welded"] else "no"
+            welded = _welded(r)
             lines.append(
                 f"| {row['scenario']} | `{r['seam']}` ({kind}) | {r['length_mm']:.0f} | {welded}"
                 f" | {r.get('arcs', 0)} | {_tcp(r)} | {unw} | {arc} | {row['plan_s']:.0f} | {_why(r)} |"
@@ -53,7 +63,7 @@ def located_table(data: Mapping[str, Any]) -> str:
             loc = f"{r['located_rms_mm']:.3f} / {r['located_max_mm']:.3f}" if r["located_rms_mm"] is not None else "-"
             why = "" if r["welded"] else f"{r['code'] or 'not located'}: {r['reason']}".replace("|", "/")
             lines.append(
-                f"| {row['scenario']} | {straight} | `{r['seam']}` | {loc} | {'yes' if r['welded'] else 'no'}"
+                f"| {row['scenario']} | {straight} | `{r['seam']}` | {loc} | {_welded(r)}"
                 f" | {r['arcs']} | {_tcp(r)} | {prog} | {row['total_s']:.0f} | {why} |"
             )
     return "\n".join(lines) + f"\n\n`{data['command']}` (commit {str(data.get('commit', ''))[:10]})\n"

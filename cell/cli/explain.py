@@ -2,7 +2,8 @@
 
 For example ``exit 3: camera cam_left lost (no valid pixels); 12/12 welded`` or
 ``exit 3: 2 seams not welded (low_confidence: 1, not_planned: 1); 10/12 welded`` or
-``exit 3: 1 seam not supported (curved: 1); 2/2 welded``.
+``exit 3: 1 seam not supported (curved: 1); 2/2 welded`` or
+``exit 3: 1 curved seam partly welded: 21 mm left for a manual weld; 2/3 welded``.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from collections import Counter
 from collections.abc import Mapping
 from typing import Any
 
+from cell.cli.tables import partial_text
 from cell.errors import EXIT_PARTIAL
 
 
@@ -59,16 +61,20 @@ def detection_exit(rep: Mapping[str, Any]) -> str:
 
 def weld_exit(rep: Mapping[str, Any]) -> str:
     """Why ``cell weld`` (or ``cell preview``) exits 3: the error, lost cameras, seams not welded by reason code,
-    seams the cell cannot weld; then how many visible seams were welded (planned, for a preview)."""
+    curved seams welded in part, seams the cell cannot weld; then how many visible seams were welded (planned, for
+    a preview)."""
     visible = [s for s in rep["seams"] if s["status"] not in ("not_visible", "not_supported")]
     preview = not any(s["welded"] for s in visible) and any(s.get("weld_reason_code") == "preview" for s in visible)
     if preview:
         undone = Counter(str(s.get("weld_reason_code")) for s in visible if not s.get("planned"))
     else:
         undone = Counter(str(s.get("weld_reason_code") or "?") for s in visible if not s["welded"])
+    part = undone.pop("partial", 0)  # curves welded in part: said apart, with what is left for a manual weld
     n = sum(undone.values())
     verb = "planned" if preview else "welded"
     parts = _error(rep) + _lost(rep) + ([f"{n} seam{'s' * (n != 1)} not {verb} ({_counted(undone)})"] if n else [])
+    if part:
+        parts.append(partial_text(part, (rep["summary"].get("curved") or {}).get("manual_mm")))
     parts += _unsupported(rep)
     done = sum(bool(s.get("planned")) for s in visible) if preview else rep["welded"]
     return f"exit {EXIT_PARTIAL}: {'; '.join(parts) or 'partial result'}; {done}/{len(visible)} {verb}"

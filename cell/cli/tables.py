@@ -118,10 +118,19 @@ def not_supported_text(summary: Mapping[str, Any]) -> str:
     out = [f"{n} not supported: " + ", ".join(c if k == 1 else f"{c} ({k})" for c, k in codes.items())] if n else []
     if located:
         out.append(f"{located} curved located, not welded ({LOCATED_CURVE_CODE})")
-    tried = dict((summary.get("curved") or {}).get("not_welded") or {})  # curves a weld run tried, by code
+    curved = summary.get("curved") or {}
+    tried = dict(curved.get("not_welded") or {})  # curves a weld run tried, by code
+    part = tried.pop("partial", 0)
+    if part:
+        out.append(partial_text(part, curved.get("manual_mm")))
     if tried:
         out.append(f"{sum(tried.values())} curved not welded ({', '.join(sorted(tried))})")
     return "; ".join(out)
+
+
+def partial_text(n: int, manual_mm: float | None) -> str:
+    """``1 curved seam partly welded: 21 mm left for a manual weld``."""
+    return f"{n} curved seam{'s' * (n != 1)} partly welded: {manual_mm or 0.0:.0f} mm left for a manual weld"
 
 
 def print_curves(rep: Mapping[str, Any]) -> None:
@@ -139,7 +148,13 @@ def print_curves(rep: Mapping[str, Any]) -> None:
             line += f", error rms {_fmt(e['rms'])} / max {_fmt(e['max'])} mm"
         undone = s.get("not_welded")
         line += f", {_fmt(s['time_ms'], 1)} ms; " + (f"not welded ({undone['code']})" if undone else "welded")
+        if s.get("remainder"):  # welded in part: its share, then each stretch left for a manual weld
+            line = line.replace("not welded (partial)", "partly welded")
+            line += f" {s['share']:.0%}, {s['manual_mm']:.0f} mm left for a manual weld"
         out.print(line, soft_wrap=True, markup=False)
+        for r in s.get("remainder") or ():
+            where = f"{r['from_mm']:.0f}-{r['to_mm']:.0f} mm along it ({r['length_mm']:.0f} mm, {r['code']})"
+            out.print(f"  manual weld: {where}: {r['why']}", soft_wrap=True, markup=False, highlight=False)
 
 
 def _value(cell: str) -> str | float | None:
@@ -191,9 +206,12 @@ WELD_LEGEND = (
 
 
 def _result(s: Mapping[str, Any]) -> str:
-    """What became of a seam in one word: welded, planned, or the code of why not."""
+    """What became of a seam in one word: welded, partial (a curve welded in part), planned, or the code of why
+    not."""
     if s["welded"]:
         return "welded"
+    if s.get("weld_reason_code") == "partial":  # a curve's arcs welded, the rest left for a manual weld
+        return "partial"
     if s.get("planned"):
         return "planned"
     return str(s.get("weld_reason_code") or "not welded")
@@ -204,7 +222,9 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
         rows = []
         for s in rep["seams"]:
             e, tcp = s.get("error_mm", {}), s.get("tcp_error_mm", {})
-            welded = "yes" if s["welded"] else ("planned" if s.get("planned") else "no")
+            welded = (
+                "yes" if s["welded"] else "partial" if s.get("remainder") else "planned" if s.get("planned") else "no"
+            )
             rows.append(
                 (s["id"], s["status"], _fmt(e.get("paper_me")), _fmt(e.get("lateral")), welded, _fmt(tcp.get("rms")),
                  _fmt(tcp.get("max")), _fmt(s.get("weld_time_s"), 1), s.get("weld_reason", ""))

@@ -96,12 +96,16 @@ def sides_line(rep: Mapping[str, Any]) -> str:
 
 
 def not_welded(rep: Mapping[str, Any]) -> tuple[tuple[str, str], ...]:
-    """The report's seams no side welded, each (id, why as codes: ``not_supported: curved``, ``end_uncertain``)."""
+    """The report's seams no side welded, each (id, why as codes: ``not_supported: curved``, ``end_uncertain``; a
+    curve welded in part: ``partial`` with what is left for a manual weld and where along it)."""
     out = []
     for s in rep["seams"]:
         if not s.get("welded"):
             code = str(s.get("weld_reason_code") or "not welded")
             code += f": {s['plan_reason_code']}" if s.get("plan_reason_code") else ""
+            if s.get("remainder"):  # a curve welded in part: what is left for a manual weld, where
+                left = ", ".join(f"{r['from_mm']:.0f}-{r['to_mm']:.0f} mm ({r['code']})" for r in s["remainder"])
+                code += f": {s['manual_mm']:.0f} mm left for a manual weld at {left} along it"
             out.append((s["id"], f"{code}: {s['reason_code']}" if s["status"] == "not_supported" else code))
     return tuple(out)
 

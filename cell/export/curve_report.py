@@ -11,6 +11,7 @@ from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.pipeline.records import Detection
 from cell.types import SeamStatus, Unsupported, UnsupportedSeam
 from cell.types.curve_estimate import CurveEstimate, CurveMetrics
+from cell.types.plan import Remainder
 from cell.types.rescan import CurveRescan, Rescan
 from cell.types.run import SeamWeld, WeldReason
 
@@ -71,19 +72,36 @@ def curve_entry(
 def weld_entry(w: SeamWeld) -> dict[str, Any]:
     """A curved seam's weld fields, as a straight seam's: ``planned``, ``welded``, why not (``weld_reason``,
     ``weld_reason_code``, the planner's ``plan_reason_code``), and welded, its ``tcp_error_mm`` against the true
-    curve, weld time and travel speed."""
+    curve, weld time and travel speed; welded in part (``weld_reason_code`` ``partial``), the ``share`` its arcs
+    weld, ``manual_mm`` left for a manual weld and each stretch of the ``remainder`` (:func:`remainder_entry`)."""
     out: dict[str, Any] = {"planned": w.planned, "welded": w.welded}
     if not w.welded:
         out["weld_reason"] = w.reason
         out["weld_reason_code"] = w.code.value if w.code is not None else None
         if w.plan_code is not None:
             out["plan_reason_code"] = w.plan_code.value
+    if w.partial:  # welded (planned, in a preview) in part: the rest left for a manual weld
+        out["share"] = _r(w.share, 4)
+        out["manual_mm"] = _r(w.manual_m * 1000.0, 1)
+        out["remainder"] = [remainder_entry(r) for r in w.remainder]
     if w.quality is not None:
         q = w.quality
         out["tcp_error_mm"] = tcp_error_entry(q)
         out["weld_time_s"] = _r(q.weld_time_s, 3)
         out["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
     return out | procedure_entry(w)
+
+
+def remainder_entry(r: Remainder) -> dict[str, Any]:
+    """A stretch of a curved seam left for a manual weld: from and to [mm] along the located curve, its length,
+    what stops the arm there as a code and in words."""
+    return {
+        "from_mm": _r(r.from_m * 1000.0, 1),
+        "to_mm": _r(r.to_m * 1000.0, 1),
+        "length_mm": _r(r.length_m * 1000.0, 1),
+        "code": r.code.value,
+        "why": r.why,
+    }
 
 
 def not_welded_entries(det: Detection) -> list[dict[str, Any]]:
@@ -103,8 +121,9 @@ def not_welded_entries(det: Detection) -> list[dict[str, Any]]:
 
 
 def curve_summary(det: Detection) -> dict[str, Any]:
-    """The curved seams at a glance: how many, found, welded, the ones not welded by code, and the largest RMS
-    and max error of the located curves [mm]."""
+    """The curved seams at a glance: how many, found, welded whole, welded in part (``partial``, with the length
+    left for a manual weld, ``manual_mm``), the ones not welded whole by code (``partial`` among them), and the
+    largest RMS and max error of the located curves [mm]."""
     found = [e for e in det.curve_estimates if e.status is SeamStatus.FOUND]
     ms = [det.curve_metrics[e.id] for e in found if e.id in det.curve_metrics]
     undone = [u.code.value for u in det.not_welded if u.id in det.curve_welds]
@@ -112,6 +131,8 @@ def curve_summary(det: Detection) -> dict[str, Any]:
         "seams": len(det.weldmap_R.curved),
         "found": len(found),
         "welded": sum(w.welded for w in det.curve_welds.values()),
+        "partial": sum(w.code is WeldReason.PARTIAL for w in det.curve_welds.values()),
+        "manual_mm": _r(sum(w.manual_m for w in det.curve_welds.values() if w.code is WeldReason.PARTIAL) * 1000, 1),
         "not_welded": {c: undone.count(c) for c in sorted(set(undone))},
         "rms_max_mm": _r(max((m.rms_mm for m in ms), default=math.nan)),
         "max_mm": _r(max((m.max_mm for m in ms), default=math.nan)),

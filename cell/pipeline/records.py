@@ -92,9 +92,10 @@ class Detection:
     @property
     def not_welded(self) -> tuple[UnsupportedSeam, ...]:
         """Every seam of the map this run will not weld, with its reason (:attr:`WeldMap.not_straight`), a curved
-        seam's from its estimate and the weld run (``curve_welds``): welded, it is left out; tried and not welded,
-        the planner's code (or the weld's: ``preview``, ``not_executed``); located and never tried (a
-        detection), ``curved_no_torch_path``; not located, why not (``curved_not_located``)."""
+        seam's from its estimate and the weld run (``curve_welds``): welded, it is left out; welded in part,
+        ``partial`` (the remainder left for a manual weld in its reason); tried and not welded, the planner's code
+        (or the weld's: ``preview``, ``not_executed``); located and never tried (a detection),
+        ``curved_no_torch_path``; not located, why not (``curved_not_located``)."""
         curves = {e.id: e for e in self.curve_estimates}
         out = []
         for u in self.weldmap_R.not_straight:
@@ -104,6 +105,8 @@ class Detection:
                 out.append(u)
             elif w is not None and w.welded:
                 continue
+            elif w is not None and w.code is WeldReason.PARTIAL:
+                out.append(UnsupportedSeam(u.id, f"{drawn}: located; {w.reason}", w.code))
             elif w is not None:
                 code = w.plan_code or w.code or WeldReason.NOT_PLANNED
                 out.append(UnsupportedSeam(u.id, f"{drawn}: located; not welded: {w.reason}", code))

@@ -23,7 +23,7 @@ from cell.planning.access.openings import WAYS
 from cell.planning.access.screen import first_unjoined
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
-from cell.planning.curves import cover_curves, curve_pieces, weldable, whole_or_none, with_paths
+from cell.planning.curves import cover_curves, curve_pieces, in_part, weldable, whole_or_none, with_paths
 from cell.planning.curves.split import seam_of
 from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
@@ -127,7 +127,7 @@ def plan_welds(
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
     curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
     to_search = [e for e in found_curves if e.id in curve_ids]
-    arcs, still = cover_curves(to_search, searches, q0, curve_procs)  # one go or overlapping arcs, or why not
+    arcs, still, in_parts = cover_curves(to_search, searches, q0, curve_procs)  # one go, arcs, in part, or why not
     for cid, res in still.items():
         outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
     for aid, sols in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
@@ -159,7 +159,7 @@ def plan_welds(
             outcomes[sid] = _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
             continue
         seam_parts[sid] = parts
-    whole_or_none(solved, outcomes, seam_parts)
+    whole_or_none(solved, outcomes, seam_parts, parts=in_parts)
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
     lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
@@ -188,7 +188,7 @@ def plan_welds(
         solved.pop(drop)
         detail = f"no free {move}: {why.reason}"
         outcomes[drop] = _failed(drop, PlanReason.TRANSFER_COLLISION, detail, why.p_R)
-        whole_or_none(solved, outcomes)  # a seam's other arcs with it
+        whole_or_none(solved, outcomes, parts=in_parts)  # a seam's other arcs with it (a partial seam's: that arc)
     if opt.blend > 0.0:
         segments = blend_plan(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
@@ -214,6 +214,8 @@ def plan_welds(
         if sid not in outcomes or not outcomes[sid].feasible:
             n = sum(seam_of(a) == sid for a in solved)
             outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs" if n > 1 else "")
+            if sid in in_parts:  # welded in part: what is left for a manual weld
+                outcomes[sid] = in_part(outcomes[sid], in_parts[sid], n)
     return WeldPlan(
         joint_names=robot.joint_names,
         q_home=readonly(q0),

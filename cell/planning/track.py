@@ -21,7 +21,7 @@ from cell.motion.robot import RobotModel
 from cell.motion.timing import path_profile
 from cell.planning.blend import blend_plan, blend_track
 from cell.planning.curves import weldable
-from cell.planning.curves.track import curve_e1s, curve_probes, retried
+from cell.planning.curves.track import curve_e1s, curve_probes, in_part_at, retried
 from cell.planning.plan import plan_welds, reach_model, seam_process
 from cell.planning.reach import ReachModel, cone_excess
 from cell.planning.track_moves import GroupLegs, TrackMoves, stitched
@@ -167,8 +167,9 @@ def plan_on_track(
     same plan, whose segments carry E1 and whose ``track`` is set. ``robot`` is the arm with its base at R
     (E1 = 0). Each found curve of ``curves`` is welded whole from one E1, the carriage still while its arcs burn
     (:mod:`cell.planning.curves.track`): in a group of the straight seams where it has the room, else in one of
-    its own. Raises PlanError when home is outside the limits or collides at E1 = 0; a group whose home collides
-    at its E1 has its seams refused (collision) with that reason."""
+    its own; one no E1 welds whole, in part from its first E1 (``process.curve_remainder: manual``). Raises
+    PlanError when home is outside the limits or collides at E1 = 0; a group whose home collides at its E1 has its
+    seams refused (collision) with that reason."""
     t_start = time.perf_counter()
     opt = options or PlanOptions()
     q0 = np.asarray(q_home, dtype=float)
@@ -200,7 +201,11 @@ def plan_on_track(
     base0 = checker.base_offset_R
     exact = replace(opt, blend=0.0)  # each group approximated once its ways from and to home are known
 
-    def plan_at(e1: float, seams: list[SeamTask], arcs: list[CurveEstimate], count: bool = True) -> WeldPlan | None:
+    whole = replace(process, curve_remainder="refuse")  # whole from some E1 first; in part only as a last resort
+
+    def plan_at(
+        e1: float, seams: list[SeamTask], arcs: list[CurveEstimate], count: bool = True, pr: WeldProcess = whole
+    ) -> WeldPlan | None:
         nonlocal done
         counter = None if on_seam is None or not count else _offset_counter(on_seam, done, len(tasks))
         checker.set_base(track.offset_R(e1))
@@ -209,7 +214,7 @@ def plan_on_track(
                 _arm_at(robot, track, e1),
                 seams,
                 q0,
-                process,
+                pr,
                 obstacles,
                 options=exact,
                 rng=rng,
@@ -235,6 +240,8 @@ def plan_on_track(
                 outcomes.update({o.seam_id: o for o in plan.seams})
                 plans.append((e1, plan))
         plans += retried(found, tries, outcomes, lambda e1, c: plan_at(e1, [], [c], count=False))
+        if process.curve_remainder == "manual":  # a curve no E1 welds whole: in part from its first E1, alone
+            plans += in_part_at(found, tries, outcomes, lambda e1, c: plan_at(e1, [], [c], False, process))
         legs: list[GroupLegs] = []
         order: list[str] = []
         for e1, plan in sorted(plans, key=lambda ep: ep[0]):  # the carriage one way out, back home at the end

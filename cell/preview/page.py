@@ -19,6 +19,7 @@ from cell.preview.html import figure_3d
 from cell.preview.results import results_rows, results_table
 from cell.preview.views import ARC_COLOUR, STATUS_COLOURS, SeamView, seam_views
 from cell.types import JointLimits, SeamRecord, Trajectory, WeldPlan
+from cell.types.run import WeldReason
 
 if TYPE_CHECKING:
     from cell.pipeline.records import WeldRun
@@ -109,11 +110,16 @@ def _summary(run: WeldRun, records: Sequence[SeamRecord]) -> str:
     welded = sum(1 for r in records if r.weld is not None and r.weld.welded) + sum(w.welded for w in curves)
     planned = sum(1 for r in records if r.weld is not None and r.weld.planned) + sum(w.planned for w in curves)
     codes = [str(u.code) for u in det.not_welded if u.id not in det.curve_welds]
-    tried = [str(u.code) for u in det.not_welded if u.id in det.curve_welds]
+    part = [w for w in curves if w.code is WeldReason.PARTIAL]  # welded in part, the rest for a manual weld
+    tried = [str(u.code) for u in det.not_welded if u.id in det.curve_welds and str(u.code) != WeldReason.PARTIAL]
     parts = [f"{len(det.estimates) + len(det.weldmap_R.not_straight)} seams in the map", f"{planned} planned"]
     parts.append(f"{welded} welded")
     if codes:
         parts.append(f"{len(codes)} not supported: {', '.join(sorted(set(codes)))}")
+    if part:
+        manual_mm = sum(w.manual_m for w in part) * 1000.0
+        parts.append(f"{len(part)} curved seam{'s' * (len(part) != 1)} partly welded: {manual_mm:.0f} mm left for a "
+                     "manual weld")  # fmt: skip
     if tried:
         parts.append(f"{len(tried)} curved not welded: {', '.join(sorted(set(tried)))}")
     if run.execution is not None:

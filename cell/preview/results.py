@@ -49,6 +49,10 @@ def _curve_row(w: SeamWeld) -> dict[str, str]:
     row = dict.fromkeys(COLUMNS, "–")
     weld = "welded" if w.welded else str(w.plan_code or w.code or "not welded").replace("_", " ")
     detail = f"TCP {w.quality.tcp_rms_mm:.2f} mm RMS from the true curve" if w.quality is not None else w.reason
+    if w.partial:  # its arcs welded (planned), each stretch left for a manual weld in the detail
+        weld = f"partial {w.share:.0%}, {w.manual_m * 1000.0:.0f} mm manual"
+        left = "; ".join(f"manual weld {r.describe()}" for r in w.remainder)
+        detail = f"{detail}; {left}" if w.quality is not None else w.reason
     row.update(seam=w.id, status=SeamStatus.FOUND.value, weld=weld, detail=detail)
     return row
 

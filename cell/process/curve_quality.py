@@ -97,3 +97,27 @@ def pass_truth(truth_R: npt.ArrayLike, p_R: npt.ArrayLike, n_a_R: npt.ArrayLike,
     e -= np.sum(e * d, axis=1, keepdims=True) * d + np.sum(e * b, axis=1, keepdims=True) * b
     e /= np.linalg.norm(e, axis=1, keepdims=True)
     return np.asarray(truth + lateral_m * e + lift_m * b)
+
+
+def unwelded_stretches(
+    tcp_R: npt.ArrayLike, truth_R: npt.ArrayLike, closed: bool, min_m: float = 0.002
+) -> list[tuple[float, float]]:
+    """The stretches (from, to) [m] along the true curve truth_R (m, 3) in R that no record of tcp_R (n, 3) in R
+    reaches (its nearest point on the curve, in 1 mm bins), each at least ``min_m`` [m] long, in order along the
+    curve (a closed curve's stretch across its start: from before its length to past it)."""
+    a, b, s_a = _segments(np.asarray(truth_R, dtype=float), closed)
+    total = float(s_a[-1] + np.linalg.norm(b[-1] - a[-1]))
+    _, s = nearest_on_curve(tcp_R, truth_R, closed)
+    bins = np.zeros(max(1, int(np.ceil(total / _BIN_M))), dtype=bool)
+    bins[np.minimum((s / _BIN_M).astype(int), len(bins) - 1)] = True
+    if bins.all():
+        return []
+    shift = int(np.argmax(bins)) if closed else 0  # a closed curve scanned from a welded bin
+    free = np.roll(~bins, -shift)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], free.astype(int), [0]])))
+    out = [
+        ((i + shift) * _BIN_M, min((j + shift) * _BIN_M, total + shift * _BIN_M))
+        for i, j in zip(edges[::2], edges[1::2], strict=True)
+    ]
+    out = [(lo, hi) for lo, hi in out if hi - lo >= min_m]
+    return sorted(((lo - total, hi - total) if lo >= total else (lo, hi) for lo, hi in out), key=lambda g: g[0])

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -28,7 +29,8 @@ class WeldProcess:
     ctwd, stickout, approach, depart [m]; approach_speed [m/s]; spin_tol [rad] (pi: fully free);
     reversible: the planner may weld the seam either way (False: only from p_start to p_end, e.g. a vertical
     seam its procedure welds upwards). closed_overlap [m]: how far a closed curved seam is welded on past its
-    start (the start and the stop overlap).
+    start (the start and the stop overlap). curve_remainder: ``manual`` welds what the arm reaches of a curved seam
+    it cannot weld whole and lists the rest for a manual weld; ``refuse`` welds none of such a seam.
     """
 
     travel_speed: float
@@ -44,6 +46,7 @@ class WeldProcess:
     approach_speed: float
     reversible: bool = True
     closed_overlap: float = 0.010
+    curve_remainder: Literal["manual", "refuse"] = "manual"
 
     @classmethod
     def from_spec(cls, spec: ProcessSpec, stickout_mm: float = STICKOUT_MM) -> WeldProcess:
@@ -61,6 +64,7 @@ class WeldProcess:
             depart=spec.depart_mm / 1000.0,
             approach_speed=spec.approach_speed_mm_s / 1000.0,
             closed_overlap=spec.closed_overlap_mm / 1000.0,
+            curve_remainder=spec.curve_remainder,
         )
 
     @property

@@ -64,6 +64,10 @@ class ProcessSpec(Model):
     # A closed curved seam (a tube all round a plate) is welded on past its start by this much, over the start's
     # bead, before the crater: the start and the stop overlap.
     closed_overlap_mm: Annotated[float, Field(ge=0.0, le=50.0)] = 10.0
+    # A curved seam the arm cannot weld whole: ``manual`` welds the stretches it reaches (in arcs, each restart over
+    # the last bead by the overlap) and lists the rest, with why, for a manual weld (the run is partial, exit 3);
+    # ``refuse`` welds none of it. Curves only: a straight seam is welded whole or not at all.
+    curve_remainder: Literal["manual", "refuse"] = "manual"
 
 
 class PerceptionSpec(Model):

@@ -107,13 +107,37 @@ class PlanReason(StrEnum):
 
 
 @dataclass(frozen=True)
+class Remainder:
+    """A stretch of a curved seam its planned arcs leave for a manual weld: from ``from_m`` to ``to_m`` [m] along the
+    located curve (a closed curve's ``to_m`` may pass its length: round its start), ``code`` what stops the arm
+    there and ``why`` in words (no torch setting holds it, a restart whose overlap is short of the WPS's, an arc
+    that failed its full solve)."""
+
+    from_m: float
+    to_m: float
+    code: PlanReason
+    why: str
+
+    @property
+    def length_m(self) -> float:
+        return self.to_m - self.from_m
+
+    def describe(self) -> str:
+        """One line: where along the curve, how long, why."""
+        a, b = self.from_m * 1000.0, self.to_m * 1000.0
+        return f"{a:.0f}-{b:.0f} mm along it ({b - a:.0f} mm, {self.code.value}: {self.why})"
+
+
+@dataclass(frozen=True)
 class SeamOutcome:
     """What became of one seam: feasible, or the reason and the failing point p_fail (3,) in R (empty if none).
 
     For a planned seam: reversed (welded from p_end to p_start), spin, work and travel angle [rad]. code: why it
     could not be planned (None when feasible); reason: the same in words, with where and by how much.
     trimmed : the length [m] not welded at the seam's table end (the torch's stand-off above the table,
-    :mod:`cell.planning.stand_off`); 0 for a seam welded whole."""
+    :mod:`cell.planning.stand_off`); 0 for a seam welded whole.
+    remainder : a curved seam welded in part (``curve_remainder: manual``): the stretches its arcs leave for a
+    manual weld (feasible: its arcs are planned; never welded whole); share : the part of it the arcs weld."""
 
     seam_id: str
     feasible: bool
@@ -125,6 +149,13 @@ class SeamOutcome:
     travel_angle: float = float("nan")
     code: PlanReason | None = None
     trimmed: float = 0.0
+    remainder: tuple[Remainder, ...] = ()
+    share: float = 1.0
+
+    @property
+    def partial(self) -> bool:
+        """A curved seam planned in part: its arcs weld what the arm reaches, the rest is left for a manual weld."""
+        return self.feasible and bool(self.remainder)
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from cell.geometry import FloatArray
 from cell.types.execution import WeldQuality
 from cell.types.map import MapSeam
-from cell.types.plan import PlanReason, SeamOutcome
+from cell.types.plan import PlanReason, Remainder, SeamOutcome
 from cell.types.procedure import WeldProcedure
 from cell.types.rescan import SeamRescan
 from cell.types.seams import Joint, SeamEstimate, SeamMetrics
@@ -33,6 +33,8 @@ class WeldReason(enum.StrEnum):
     NO_TORCH_PATH = "no_torch_path"  # located (a curved seam), but no torch path along it exists yet
     LAST_CHECK = "last_check"  # found, but against the aligned map and the other parts it cannot be there
     #   (re-scanned, then refused: its ``check`` says which test and by how much)
+    PARTIAL = "partial"  # a curved seam welded in part: the arm welds what it reaches, the ``remainder`` of the
+    #   weld (each stretch along it and why) is left for a manual weld; never counted as welded
 
 
 class LastCheck(enum.StrEnum):
@@ -69,7 +71,9 @@ class SeamWeld:
     ``reason``); how well (the executed TCP against the true seam, when the truth is known: all passes together
     in ``quality``, each pass's bead in ``passes``, in pass order); the weld ``procedure`` it got (None: the
     plan used none); the last check it failed (``check``, with the code ``last_check``); the planner's code where
-    it refused the seam (``plan_code``)."""
+    it refused the seam (``plan_code``). A curved seam welded in part (code ``partial``, ``welded`` False: never
+    counted as welded whole): ``share`` the part of it its arcs weld, ``remainder`` the stretches left for a manual
+    weld, its arcs' ``quality``."""
 
     id: str
     planned: bool
@@ -81,6 +85,18 @@ class SeamWeld:
     passes: tuple[WeldQuality, ...] = ()
     check: CheckFail | None = None
     plan_code: PlanReason | None = None
+    share: float = 1.0
+    remainder: tuple[Remainder, ...] = ()
+
+    @property
+    def partial(self) -> bool:
+        """Welded (or planned, in a preview) in part, the remainder left for a manual weld."""
+        return bool(self.remainder)
+
+    @property
+    def manual_m(self) -> float:
+        """The length [m] left for a manual weld."""
+        return sum(r.length_m for r in self.remainder)
 
 
 @dataclass(frozen=True)

@@ -45,7 +45,8 @@ def test_a_located_curve_the_arm_cannot_reach_is_reported_with_the_planners_code
     assert entry["not_welded"]["code"] == "ik_failed"
     assert (SEAM, "not_planned: ik_failed") in not_welded(rep)  # the programs' header
     assert rep["summary"]["curved"] | {"rms_max_mm": 0, "max_mm": 0} == {
-        "seams": 1, "found": 1, "welded": 0, "not_welded": {"ik_failed": 1}, "rms_max_mm": 0, "max_mm": 0
+        "seams": 1, "found": 1, "welded": 0, "partial": 0, "manual_mm": 0.0, "not_welded": {"ik_failed": 1},
+        "rms_max_mm": 0, "max_mm": 0,
     }  # fmt: skip
     assert SEAM in {u.id for u in det.not_welded}
     assert not run.complete and rep["welded"] == 0

@@ -143,12 +143,32 @@ def test_a_pass_is_measured_against_the_true_curve_moved_by_its_offset() -> None
     assert pass_truth(truth, est.p_RS, est.n_abutting_R, est.n_receiving_R, 0.0, 0.0) is truth
 
 
-def test_a_gusset_across_the_foot_is_refused_with_the_share_reached() -> None:
-    gusset = Part("GUSSET", Box(make_pose(p=CENTRE_R + np.array([0.0, 0.09, 0.05])), np.array([0.008, 0.1, 0.1])))
-    stiff = sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0)  # the nominal angles only: quicker
-    got = plan_arcs(_search(gusset, spec=stiff), _foot(), HOME)
-    assert not got.whole and got.failure is not None
+GUSSET = Part("GUSSET", Box(make_pose(p=CENTRE_R + np.array([0.0, 0.09, 0.05])), np.array([0.008, 0.1, 0.1])))
+
+
+def test_a_gusset_across_the_foot_is_refused_with_the_share_reached_when_the_process_refuses_a_remainder() -> None:
+    stiff = sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0, curve_remainder="refuse")  # quicker
+    got = plan_arcs(_search(GUSSET, spec=stiff), _foot(), HOME)
+    assert not got.whole and not got.partial and got.failure is not None and got.arcs == ()
     assert 0.6 < got.share < 1.0
+
+
+def test_a_gusset_across_the_foot_is_welded_up_to_it_the_rest_left_for_a_manual_weld() -> None:
+    from cell.process.curve_quality import unwelded_stretches
+
+    stiff = sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0)  # the nominal angles only: quicker
+    est = _foot()
+    got = plan_arcs(_search(GUSSET, spec=stiff), est, HOME)
+    assert got.partial and not got.whole and got.failure is not None and 2 <= len(got.arcs) <= 8
+    assert 0.7 < got.share < 0.8  # measured 0.73: 3 arcs, 68 mm of 251 left (each 5 mm off a gap's edge)
+    gusset = [r for r in got.remainder if "torch vs GUSSET" in r.why]
+    assert len(gusset) == 1 and gusset[0].code is PlanReason.COLLISION
+    # where the planned arcs' TCP never passes on the true curve is the remainder, within 2 mm at each end
+    tcp = np.vstack([sols[0].X_weld[:, :3, 3] for _, sols in got.arcs])
+    measured = unwelded_stretches(tcp, np.asarray(est.p_RS), True)
+    assert len(measured) == len(got.remainder)
+    for (lo, hi), r in zip(measured, got.remainder, strict=True):
+        assert abs(lo - r.from_m) < 0.002 and abs(hi - r.to_m) < 0.002
 
 
 def test_a_seam_is_welded_in_arcs_whole_or_not_at_all() -> None:

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from cell.planning.curves.arcs import TRIM_M, _trimmed
+from cell.planning.curves.arc_solve import TRIM_M, _trimmed
 from cell.planning.curves.reach import Run
 from cell.planning.curves.split import seam_of, sub_arc
 from cell.planning.failures import SeamFailure

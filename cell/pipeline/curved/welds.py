@@ -59,7 +59,8 @@ def curve_seam_welds(
     """Curved seam id -> what became of it, for every found curve: welded (its quality against the true curve,
     where the station knows it), or not with its code: too uncertain (:func:`curve_doubt`), the planner's refusal
     (``not_planned`` with the planner's code), planned but not executed (``not_executed``: ``refused`` says why;
-    ``preview``). pre_s [s]: the move before the plan."""
+    ``preview``); welded in part (``partial``: its arcs' quality, the remainder left for a manual weld). pre_s
+    [s]: the move before the plan."""
     found = [c for c in det.curve_estimates if c.status is SeamStatus.FOUND]
     outcomes = {o.seam_id: o for o in plan.seams} if plan is not None else {}
     closed = {c.id: c.closed for c in found if c.id in outcomes and outcomes[c.id].feasible}
@@ -83,9 +84,15 @@ def curve_seam_welds(
             out[c.id] = SeamWeld(c.id, False, False, o.reason, code=WeldReason.NOT_PLANNED, plan_code=o.code)
         elif ex is None:
             code = WeldReason.NOT_EXECUTED if refused else WeldReason.PREVIEW
-            why = refused or "planned, not executed (preview)"
-            out[c.id] = SeamWeld(c.id, True, False, why, code=code, procedure=proc)
+            why = refused or ("planned, not executed (preview)" + (f"; {o.reason}" if o.partial else ""))
+            out[c.id] = SeamWeld(c.id, True, False, why, code=code, procedure=proc, share=o.share,
+                                 remainder=o.remainder)  # fmt: skip
         else:
             q = quality.get(c.id)
-            out[c.id] = SeamWeld(c.id, True, True, "", q, procedure=proc, passes=(q,) if q is not None else ())
+            passes = (q,) if q is not None else ()
+            if o.partial:  # its arcs welded, the rest left for a manual weld: never counted as welded
+                out[c.id] = SeamWeld(c.id, True, False, o.reason, q, WeldReason.PARTIAL, proc, passes, share=o.share,
+                                     remainder=o.remainder)  # fmt: skip
+            else:
+                out[c.id] = SeamWeld(c.id, True, True, "", q, procedure=proc, passes=passes)
     return out

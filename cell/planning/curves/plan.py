@@ -14,14 +14,15 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import readonly
+from cell.planning.curves.partial import welded_share
 from cell.planning.curves.search import plan_curve
-from cell.planning.curves.split import ARC_MARK, arc_id, seam_of
+from cell.planning.curves.split import ARC_MARK, Partial, arc_id, seam_of
 from cell.planning.failures import SeamFailure
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.procedures import UP_R, select_procedure
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.plan import NoProcedure, SeamOutcome, SeamProcedure, SeamTask, Segment
+from cell.types.plan import NoProcedure, PlanReason, Remainder, SeamOutcome, SeamProcedure, SeamTask, Segment
 from cell.types.procedure import WeldProcedure
 
 
@@ -68,18 +69,20 @@ def cover_curves(
     make_search: Mapping[str, SeamSearch],
     q_seed: npt.ArrayLike,
     procedures: Mapping[str, WeldProcedure] | None = None,
-) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure]]:
+) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure], dict[str, Partial]]:
     """Each curve planned from its reach map (:func:`cell.planning.curves.arcs.plan_arcs`: one go where a torch
     setting holds all round, else the fewest overlapping arcs; an open one welded in one pass first by the one-go
     search, :func:`cell.planning.curves.search.plan_curve`, whose ranked candidates follow it closest), with its
     own search and procedure from q_seed (dof,) [rad]. Returns (arc id -> its solutions, one per pass, for the
-    seams covered whole; seam id -> its failure, for the others: where no arc reaches, with the share of the curve
-    the arm reaches in its words)."""
+    seams covered whole or in part; seam id -> its failure, for the others: where no arc reaches, with the share
+    of the curve the arm reaches in its words; seam id -> what is left for a manual weld, for the seams welded in
+    part)."""
     from cell.planning.curves.arcs import plan_arcs
 
     q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
     arcs: dict[str, tuple[SeamSolution, ...]] = {}
     still: dict[str, SeamFailure] = {}
+    parts: dict[str, Partial] = {}
     for c in curves:
         proc = procs.get(c.id)
         if not c.closed and (proc is None or len(proc.passes) == 1):  # an open curve: the one-go search first
@@ -88,27 +91,59 @@ def cover_curves(
                 arcs[arc_id(c.id, 1)] = (one,)
                 continue
         got = plan_arcs(make_search[c.id], c, q0, proc)
-        if got.whole:
+        if got.whole or got.partial:
             arcs |= {arc.id: sol for arc, sol in got.arcs}
+            if got.partial:
+                spans = {aid: (a, b) for aid, a, b in got.spans}
+                parts[c.id] = Partial(c.length_m, c.closed, got.share, got.remainder, spans)
             continue
         f = got.failure
         assert f is not None
         tail = "not all" if got.share < 1.0 else "but in no overlapping arcs"
         still[c.id] = replace(f, where=f"{f.where} (the arm reaches {got.share:.0%} of it, {tail})")
-    return arcs, still
+    return arcs, still, parts
 
 
-def whole_or_none(solved: dict[str, Any], outcomes: dict[str, SeamOutcome], *others: dict[str, Any]) -> None:
+def whole_or_none(
+    solved: dict[str, Any],
+    outcomes: dict[str, SeamOutcome],
+    *others: dict[str, Any],
+    parts: dict[str, Partial] | None = None,
+) -> None:
     """A seam welded in arcs is welded whole or not at all: where one of its arcs failed after the search (its
     timing, a transfer to or from it: its outcome in ``outcomes`` under the arc's id), its other arcs leave
-    ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc."""
+    ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc. A seam
+    already welded in part (in ``parts``) loses only that arc: its stretch joins the seam's remainder, with the
+    failure as its reason (the seam is refused only when no arc is left)."""
     for aid, o in list(outcomes.items()):
         sid = seam_of(aid)
         if sid == aid or o.feasible:
             continue
-        for other in [a for a in solved if seam_of(a) == sid]:
+        why = f"arc {aid.rsplit(ARC_MARK, 1)[1]}: {o.reason}"
+        part = (parts or {}).get(sid)
+        left = [a for a in solved if seam_of(a) == sid]
+        if part is not None and left:
+            del outcomes[aid]
+            a, b = part.spans[aid]
+            rest = (*part.remainder, Remainder(a, b, o.code or PlanReason.IK_FAILED, why))
+            rest = tuple(sorted(rest, key=lambda r: r.from_m % part.length_m))
+            assert parts is not None
+            parts[sid] = replace(part, remainder=rest, share=welded_share(rest, part.length_m, part.closed))
+            continue
+        for other in left:
             solved.pop(other)
             for d in others:
                 d.pop(other, None)
         del outcomes[aid]
-        outcomes[sid] = replace(o, seam_id=sid, reason=f"arc {aid.rsplit(ARC_MARK, 1)[1]}: {o.reason}")
+        outcomes[sid] = replace(o, seam_id=sid, reason=why)
+        (parts or {}).pop(sid, None)
+
+
+def in_part(outcome: SeamOutcome, part: Partial, n_arcs: int) -> SeamOutcome:
+    """A seam's planned outcome (feasible, as its first arc) welded in part: its share, its remainder and, in words,
+    how much of it the ``n_arcs`` arcs weld and each stretch they leave for a manual weld."""
+    left = sum(r.length_m for r in part.remainder)
+    stretches = "; ".join(r.describe() for r in part.remainder)
+    why = (f"welded in part: {part.share:.0%} in {n_arcs} arc{'s' * (n_arcs != 1)}, {left * 1000:.0f} mm left for a "
+           f"manual weld: {stretches}")  # fmt: skip
+    return replace(outcome, reason=why, remainder=part.remainder, share=part.share)

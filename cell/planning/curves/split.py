@@ -17,8 +17,14 @@ from cell.planning.curves.path import _loop
 from cell.planning.failures import SeamFailure
 from cell.planning.seam_search import SeamSolution
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.plan import Remainder
 
 MAX_ARCS = 4  # a seam welded in more pieces than this is refused (each stop is a crater, each restart a defect risk)
+# A seam welded in part (``curve_remainder: manual``) may take up to this many arcs: every stretch the arm cannot
+# hold already stops an arc with its crater at its edge (pipe-flange: 3 gaps between 4 gussets, one arc between
+# each two), so the bound is the whole cover's plus one more per such stop; beyond it the shortest arcs are left
+# to the manual weld too (more restarts than that on one seam is a welder's job, not the robot's).
+MAX_PARTIAL_ARCS = 2 * MAX_ARCS
 ARC_MARK = "#arc"  # an arc's id: its seam's id, this mark and its number from 1
 
 
@@ -26,15 +32,36 @@ ARC_MARK = "#arc"  # an arc's id: its seam's id, this mark and its number from 1
 class Split:
     """The arcs found for one curved seam: each arc's estimate (an open piece of the curve, id ``<seam>#arcK``) and
     solutions (one per pass), in weld order; ``share`` the part of the curve they cover (1: the whole seam);
-    ``failure`` the search's word on the part no arc reaches (None when covered)."""
+    ``failure`` the search's word on the part no arc reaches (None when covered); ``remainder``: a seam welded in
+    part, the stretches its arcs leave for a manual weld (``spans``: each arc's id -> its (from, to) [m] along the
+    located curve)."""
 
     arcs: tuple[tuple[CurveEstimate, tuple[SeamSolution, ...]], ...]
     share: float
     failure: SeamFailure | None
+    remainder: tuple[Remainder, ...] = ()
+    spans: tuple[tuple[str, float, float], ...] = ()
 
     @property
     def whole(self) -> bool:
-        return self.failure is None and bool(self.arcs)
+        return self.failure is None and bool(self.arcs) and not self.remainder
+
+    @property
+    def partial(self) -> bool:
+        return bool(self.arcs) and bool(self.remainder)
+
+
+@dataclass(frozen=True)
+class Partial:
+    """A curved seam planned in part: its length [m] (``closed``: all round), the part its arcs weld (``share``),
+    what they leave for a manual weld (``remainder``) and each arc's stretch (``spans``: arc id -> (from, to) [m]
+    along the curve)."""
+
+    length_m: float
+    closed: bool
+    share: float
+    remainder: tuple[Remainder, ...]
+    spans: dict[str, tuple[float, float]]
 
 
 def arc_id(seam_id: str, k: int) -> str:

@@ -98,3 +98,25 @@ def retried(
             at = ", ".join(f"{e * 1000:.0f}" for e in tries[c.id])
             outcomes[c.id] = replace(first, reason=f"{first.reason} (tried from E1 = {at} mm on the track)")
     return out
+
+
+def in_part_at(
+    curves: Sequence[CurveEstimate],
+    tries: dict[str, tuple[float, ...]],
+    outcomes: dict[str, SeamOutcome],
+    plan_at: Callable[[float, CurveEstimate], WeldPlan | None],
+) -> list[tuple[float, WeldPlan]]:
+    """Each curve no E1 welds whole (its outcome refused for a reason another E1 may change), planned alone from its
+    first E1 with the process's ``curve_remainder: manual`` (``plan_at(e1, curve)``); the (E1, plan) of those
+    welded in part, ``outcomes`` getting their partial outcome; the others keep their refusal."""
+    out: list[tuple[float, WeldPlan]] = []
+    for c in curves:
+        first = outcomes.get(c.id)
+        if first is None or first.feasible or first.code in _SOMEWHERE_ELSE:
+            continue
+        plan = plan_at(tries[c.id][0], c)
+        got = next((o for o in plan.seams if o.seam_id == c.id), None) if plan is not None else None
+        if plan is not None and got is not None and got.partial:
+            outcomes[c.id] = got
+            out.append((tries[c.id][0], plan))
+    return out

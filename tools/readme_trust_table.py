@@ -58,7 +58,8 @@ def trust_table(data: Mapping[str, Any]) -> str:
 
 def curved_line(stage: str, c: Mapping[str, Any]) -> str:
     """A stage's curved seams in one line: located of visible, the error against the true curve (median / max of
-    the seams' max), the samples within 2 sigma, the curves wholly within, and for a weld what was welded."""
+    the seams' max), the samples within 2 sigma, the curves wholly within, and for a weld what was welded (whole, and
+    in part with what it leaves for a manual weld)."""
     reasons = ", ".join(f"{k} {v}" for k, v in c["refused_reasons"].items())
     line = (
         f"- {stage}, curved seams: {c['located']} of {c['visible']} visible located ({pct(c['located_share'])}); "
@@ -68,4 +69,7 @@ def curved_line(stage: str, c: Mapping[str, Any]) -> str:
     )
     if "welded" in c:
         line += f"; welded {c['welded']}, worst TCP max {num(c['worst_welded_tcp_max_mm'])} mm"
+    if c.get("partial"):  # welded in part: the arcs' worst TCP, the length left for a manual weld
+        line += (f"; welded in part {c['partial']} (worst TCP max {num(c['worst_partial_tcp_max_mm'])} mm, "
+                 f"{c['manual_mm']:.0f} mm left for a manual weld)")  # fmt: skip
     return line + (f"; not {'welded' if 'welded' in c else 'located'}: {reasons}" if reasons else "")

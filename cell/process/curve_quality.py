@@ -9,7 +9,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from cell.geometry import FloatArray
-from cell.process.quality import quality_figures
+from cell.process.quality import continuous, quality_figures
 from cell.types.execution import WeldQuality
 
 _MM = 1000.0
@@ -73,7 +73,7 @@ def curve_weld_quality(times: npt.ArrayLike, tcp_R: npt.ArrayLike, truth_R: npt.
         past_start = max(float(np.max((truth[0] - p) @ t0)), 0.0)
         past_end = max(float(np.max((p - truth[-1]) @ t1)), 0.0)
         gaps = (float(s.min()), total - float(s.max()), past_start, past_end)
-    length_m = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+    length_m = float(np.linalg.norm(np.diff(p, axis=0), axis=1)[continuous(t)].sum())  # the arcs, not the air
     return quality_figures(t, p, d * _MM, gaps, length_m)
 
 

@@ -68,14 +68,24 @@ def weld_quality(
     return quality_figures(t, p, d, (short_start, short_end, past_start, past_end), driven)
 
 
+def continuous(t: FloatArray) -> npt.NDArray[np.bool_]:
+    """Which steps between records at times t (n,) [s] are of one weld (n - 1,): all but those that last more than
+    ten times the median step (the air between two arcs of a seam welded in pieces)."""
+    dt = np.diff(np.asarray(t, dtype=float))
+    return dt <= 10.0 * float(np.median(dt)) if dt.size else np.zeros(0, dtype=bool)
+
+
 def quality_figures(
     t: FloatArray, p: FloatArray, d_mm: FloatArray, ends_m: tuple[float, float, float, float], length_m: float
 ) -> WeldQuality:
     """The figures of one weld from its records at times t (n,) [s]: the TCP error d_mm (n,) [mm] (RMS and max),
-    the travel speed along p (n, 3) [m] (the median over the records above half the top speed), the length driven
-    [m] and the ends' (short start, short end, past start, past end) [m]."""
+    the travel speed along p (n, 3) [m] (the median over the records above half the top speed, between records
+    that follow each other: :func:`continuous`), the length driven [m] and the ends' (short start, short end, past
+    start, past end) [m]."""
     step = np.linalg.norm(np.diff(p, axis=0), axis=1)
     dt = np.diff(t)
+    keep = continuous(t)  # not the air between two arcs of one seam: its jump is no travel speed
+    step, dt = step[keep], dt[keep]
     speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0) * _MM
     cruise = speed[speed > 0.5 * speed.max()] if speed.size and speed.max() > 0 else speed
     short_start, short_end, past_start, past_end = ends_m

@@ -94,6 +94,24 @@ def test_a_weld_along_a_circle_is_measured_across_it() -> None:
     assert q.short_start_mm == pytest.approx(0.2 * 2.0 * math.pi * 50.0, abs=2.0)  # the loop's 20 % unwelded
 
 
+def test_a_curve_welded_in_two_arcs_is_measured_over_its_arcs_not_the_air_between() -> None:
+    """The far arc welded first, then the near one after 5 s in the air: travel speed 8 mm/s and the 450 mm the
+    two arcs weld, not the jump between them (before: 23.9 mm/s, 570 mm)."""
+
+    def arc(a0: float, a1: float, t0: float) -> tuple[np.ndarray, np.ndarray]:
+        t = t0 + np.arange(int(0.1 * (a1 - a0) / 0.008 * 1000.0)) / 1000.0
+        a = a0 + (t - t0) * 0.008 / 0.1
+        return t, np.column_stack([0.1 * np.cos(a), 0.1 * np.sin(a), np.zeros_like(a)])
+
+    u = np.linspace(0.0, 2.0 * math.pi, 4001)
+    truth = np.column_stack([0.1 * np.cos(u), 0.1 * np.sin(u), np.zeros_like(u)])
+    t_far, p_far = arc(2.5, 5.0, 0.0)
+    t_near, p_near = arc(0.0, 2.0, t_far[-1] + 5.0)
+    q = curve_weld_quality(np.r_[t_far, t_near], np.r_[p_far, p_near], truth, closed=True)
+    assert q.speed_mm_s == pytest.approx(8.0, abs=0.01)
+    assert q.length_mm == pytest.approx(450.0, abs=0.5)
+
+
 def test_the_circle_through_three_points() -> None:
     a, b, c = np.array([50.0, 0.0, 0.0]), np.array([0.0, 50.0, 0.0]), np.array([-50.0, 0.0, 0.0])
     got = circle_through(a, b, c)

@@ -146,8 +146,8 @@ def plan_for(
         if blamed is None:  # none, or one that concerns the whole plan
             break
         # A violation on the move into a seam (or its approach, the move blended into it) is first answered by
-        # another order, without that transfer; a seam blamed again, or for its own motions (its weld), is
-        # dropped and the rest are planned again.
+        # another order, without that transfer; a seam blamed on a move already avoided, or for its own motions
+        # (its weld), is dropped and the rest are planned again (at most _GATE_ROUNDS plans in all).
         moves = {sid: e for sid, e in incoming(plan, found).items() if e not in avoid} if track is None else {}
         if moves:
             progress(f"safety gate: {', '.join(moves)} again in another order (the move into it violates it)")

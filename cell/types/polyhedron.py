@@ -164,9 +164,9 @@ class Polyhedron:
                 out[near[s : s + step]] = inside
                 continue
             inside = self._winding(q, a, b, c) > 0.5
-            if margin != 0.0:
-                d = _point_triangle_distance(q, a, b, c).min(axis=1)
-                inside = inside & (d >= -margin)
+            if margin != 0.0:  # shrunk: of the points inside, those at least |margin| from the surface
+                k = np.flatnonzero(inside)
+                inside[k] = _point_triangle_distance(q[k], a, b, c).min(axis=1) >= -margin
             out[near[s : s + step]] = inside
         return out[0] if single else out
 

@@ -41,6 +41,7 @@ class Polyhedron:
     _planes: FloatArray = field(init=False, repr=False, compare=False)
     _tris: npt.NDArray[np.intp] = field(init=False, repr=False, compare=False)
     _mass: tuple[float, FloatArray, float] = field(init=False, repr=False, compare=False)  # volume, centre, radius
+    _bounds: FloatArray = field(init=False, repr=False, compare=False)  # (2, 3) the vertices' lowest and highest
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "vertices", readonly(self.vertices))
@@ -60,6 +61,7 @@ class Polyhedron:
         object.__setattr__(self, "_tris", readonly(tris, np.intp))
         vol, c = self._volume_centroid()
         object.__setattr__(self, "_mass", (vol, readonly(c), float(np.max(np.linalg.norm(self.vertices - c, axis=1)))))
+        object.__setattr__(self, "_bounds", readonly(np.array([self.vertices.min(axis=0), self.vertices.max(axis=0)])))
 
     def _index(self, face: str) -> int:
         try:
@@ -148,9 +150,7 @@ class Polyhedron:
         out = np.zeros(len(p), dtype=bool)
         # Only points within the body's bounds (grown by the margin) can be inside: most that a stage asks are not.
         grow = max(margin, 0.0)
-        near = np.flatnonzero(
-            np.all((p >= self.vertices.min(axis=0) - grow) & (p <= self.vertices.max(axis=0) + grow), axis=1)
-        )
+        near = np.flatnonzero(np.all((p >= self._bounds[0] - grow) & (p <= self._bounds[1] + grow), axis=1))
         tri = self.vertices[self._tris]
         a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
         step = max(1, _CHUNK // max(1, len(tri)))

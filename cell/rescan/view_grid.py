@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.config.motion import ViewOptions
-from cell.geometry import FloatArray, axis_angle_to_matrix, invert, make_pose, transform_points
+from cell.geometry import FloatArray, axis_angle_to_matrix, cross3, invert, make_pose, transform_points
 from cell.motion.robot import RobotModel
 from cell.types import Box, CameraIntrinsics, Part
 from cell.types.plan import SeamTask
@@ -95,7 +95,7 @@ def _camera_pose(target: ViewTarget, u: FloatArray, distance: float, roll: float
     z0 = -u
     x = target.direction - float(target.direction @ z0) * z0
     x /= np.linalg.norm(x)
-    y0 = np.cross(z0, x)
+    y0 = cross3(z0, x)
     # Midpoint direction = cos(offset) z - sin(offset) y: above the centre (image y points down).
     z = np.cos(offset) * z0 + np.sin(offset) * y0
     y = np.cos(offset) * y0 - np.sin(offset) * z0

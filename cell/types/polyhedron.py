@@ -200,13 +200,15 @@ class Polyhedron:
         out = object.__new__(Polyhedron)
         n = self._planes[:, :3] @ R.T
         vol, c, radius = self._mass
+        V = transform_points(X, self.vertices)
         for k, v in (
-            ("vertices", readonly(transform_points(X, self.vertices))),
+            ("vertices", readonly(V)),
             ("faces", self.faces),
             ("names", self.names),
             ("_planes", readonly(np.column_stack([n, self._planes[:, 3] + n @ t]))),
             ("_tris", self._tris),
             ("_mass", (vol, readonly(R @ c + t), radius)),
+            ("_bounds", readonly(np.array([V.min(axis=0), V.max(axis=0)]))),
         ):
             object.__setattr__(out, k, v)
         return out

@@ -119,6 +119,9 @@ def test_a_rigid_move_keeps_what_a_rebuilt_body_computes() -> None:
     assert np.allclose(moved.face_planes(), rebuilt.face_planes(), atol=1e-12)
     assert np.array_equal(moved.triangles(), rebuilt.triangles())
     assert moved.volume == pytest.approx(rebuilt.volume) and np.allclose(moved.center, rebuilt.center)
+    q = transform_points(X, np.random.default_rng(3).uniform(-0.12, 0.12, (400, 3)) * [1.0, 1.0, 0.2])
+    for margin in (-0.002, 0.0, 0.002):  # its answers too (its bounds moved with it)
+        assert np.array_equal(moved.contains(q, margin), rebuilt.contains(q, margin))
 
 
 def test_box_and_its_polyhedron_agree() -> None:

@@ -2,7 +2,6 @@
 from here and nothing here imports a stage. Frames: ``W`` world, ``R`` robot base, ``M`` welding map, ``C`` camera
 optical frame, ``B`` a box part's own frame. Metres and radians inside; millimetres and degrees only at the edges."""
 
-from cell.types._near import pair_distance
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.curves import ArcCurve, CurvedJoint, CurvedSeam, Cylinder, EllipseCurve, SampledCurve, Surface
 from cell.types.execution import Event, Execution, WeldQuality
@@ -24,6 +23,7 @@ from cell.types.seams import (
     SeamStatus,
 )
 from cell.types.sensing import CameraIntrinsics, Cloud, DepthImage, VoxelTable
+from cell.types.solid import pair_distance
 from cell.types.trajectory import PathProfile, Trajectory
 from cell.types.view import ArmMotion, CameraView, CellView, RobotPose, Shape, ShapeKind
 

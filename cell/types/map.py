@@ -13,7 +13,7 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray, invert, readonly, transform_points
 from cell.types.curves import CurvedSeam, Cylinder
-from cell.types.polyhedron import Polyhedron
+from cell.types.solid import Polyhedron
 
 __all__ = ["BOX_FACES", "Box", "MapSeam", "Part", "Polyhedron", "Unsupported", "UnsupportedSeam", "WeldMap"]
 

@@ -15,7 +15,7 @@ from cell.sim import SimCell
 from cell.sim.bodies import add_mesh
 from cell.sim.render_cache import RenderCache, draw, scene_key
 from cell.types import Box, Part
-from cell.types.polyhedron import Polyhedron
+from cell.types.solid import Polyhedron
 
 BOX = Box(pose_from_xyz_rpy([0.05, 0.02, 0.95], [0.0, 0.0, math.radians(20.0)]), np.array([0.2, 0.1, 0.1]))
 PRISM = np.array([[0.2, 0.1, 0.9], [0.3, 0.1, 0.9], [0.25, 0.2, 0.9], [0.25, 0.15, 1.0]])  # a tetrahedron on the table

@@ -33,7 +33,7 @@ TRIES = 10  # covers tried per map (an arc that fails its full solve is trimmed 
 TRIM_M = 0.015  # [m] an arc whose approach or depart fails is shortened by this much at that end
 MIN_ARC_M = 0.02  # [m] no shorter arc is kept
 # [m] the timed weld's TCP stays this close to its planned path between the IK knots: the 0.5 mm a weld's TCP is
-# held to against the true curve (issue 30), less the controller's tracking (0.01-0.05 mm measured)
+# held to against the true curve, less the controller's tracking (0.01-0.05 mm measured)
 PATH_TOL_M = 0.0004
 
 

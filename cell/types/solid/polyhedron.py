@@ -13,15 +13,15 @@ import numpy as np
 import numpy.typing as npt
 
 from cell.geometry import FloatArray, readonly, transform_points
-from cell.types._faces import faces_planes_triangles
-from cell.types._near import pair_distance, within
+from cell.types.solid.faces import faces_planes_triangles
+from cell.types.solid.near import pair_distance, within
 
 _CHUNK = 200_000  # point-triangle pairs evaluated at once in contains() (bounds the memory)
 
 
 def _point_triangle_distance(p: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
     """Distances (n, t) from points p (n, 3) to triangles given by corners a, b, c (t, 3) each: every pair's
-    :func:`cell.types._near.pair_distance`."""
+    :func:`cell.types.solid.near.pair_distance`."""
     i, j = np.divmod(np.arange(len(p) * len(a)), max(len(a), 1))
     return pair_distance(p[i], a[j], b[j], c[j]).reshape(len(p), len(a))
 

@@ -1,4 +1,4 @@
-"""The planar polygon faces of a :class:`~cell.types.polyhedron.Polyhedron`: each face's plane (Newell's normal)
+"""The planar polygon faces of a :class:`~cell.types.solid.polyhedron.Polyhedron`: each face's plane (Newell's normal)
 and its triangles (ear clipping in the face's own plane; a triangle or a strictly convex quad, a mesh's faces, is
 the fan of its first corner, computed for all of them at once).
 

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from cell.planning.curves.arc_solve import TRIM_M, _trimmed
+from cell.planning.curves.arc_solve import TRIM_M, trimmed
 from cell.planning.curves.reach import Run
 from cell.planning.curves.split import seam_of, sub_arc
 from cell.planning.failures import SeamFailure
@@ -51,9 +51,9 @@ def test_an_arc_failing_on_its_approach_is_trimmed_at_its_start_not_dropped(reve
     run = Run(Candidate(reverse, 0.0, 0.0, 0.0), 0.0, 0.1, np.zeros(6))
     far = np.array([0.0, 0.0, 0.05])  # 50 mm out along the torch: the approach's end
     on_approach = SeamFailure(PlanReason.HOSE_WINDOW, "A6 out of the window on the approach", far, -0.05)
-    (left,) = _trimmed(run, on_approach, arc)
+    (left,) = trimmed(run, on_approach, arc)
     assert (left.a_m, left.b_m) == pytest.approx((0.0, 0.1 - TRIM_M) if reverse else (TRIM_M, 0.1))
     on_weld = SeamFailure(PlanReason.FLIP, "A3 jumps", far, 0.05)  # 50 mm along the weld
-    (left,) = _trimmed(run, on_weld, arc)
+    (left,) = trimmed(run, on_weld, arc)
     kept = 0.05 - TRIM_M
     assert (left.a_m, left.b_m) == pytest.approx((0.1 - kept, 0.1) if reverse else (0.0, kept), abs=1e-5)

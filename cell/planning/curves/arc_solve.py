@@ -37,7 +37,7 @@ MIN_ARC_M = 0.02  # [m] no shorter arc is kept
 PATH_TOL_M = 0.0004
 
 
-def _same(a: Run, b: Run, total: float) -> bool:
+def same_stretch(a: Run, b: Run, total: float) -> bool:
     """Whether two stretches are one (the cover's copy a lap on): the same place, the same settings along it."""
     ta, tb = a.track, b.track
     same_track = (ta is None and tb is None) or (
@@ -51,7 +51,7 @@ def _same(a: Run, b: Run, total: float) -> bool:
     )
 
 
-def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
+def trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
     """What is left of a stretch whose arc failed its full solve: cut short of where the weld itself failed
     (``failure.progress`` along it; before 0: on the approach), else (its approach or depart) without
     :data:`TRIM_M` at the end nearer the failure; nothing when less than :data:`MIN_ARC_M` would be left. Lengths
@@ -72,7 +72,7 @@ def _trimmed(run: Run, failure: SeamFailure, arc: CurveEstimate) -> list[Run]:
     return [replace(run, a_m=run.a_m + cut_start, b_m=run.b_m - cut_end)]
 
 
-def _why(misses: list[Miss], lo: float, hi: float, total: float, closed: bool) -> tuple[PlanReason, str]:
+def why_stopped(misses: list[Miss], lo: float, hi: float, total: float, closed: bool) -> tuple[PlanReason, str]:
     """What stops the torch settings from lo to hi [m] along a curve ``total`` long: the commonest reason of the
     stations there (every station's where none lies there) as the code, and the two commonest in words."""
     there = [m for m in misses if _within(m.at_m, lo, hi, total, closed)] or misses
@@ -86,7 +86,7 @@ def _within(x: float, lo: float, hi: float, total: float, closed: bool) -> bool:
     return 0.0 <= ((x - lo) % total if closed else x - lo) <= hi - lo
 
 
-def _arc_solution(
+def arc_solution(
     search: SeamSearch,
     arc: CurveEstimate,
     run: Run,
@@ -122,7 +122,7 @@ def _passes(
     run: Run,
     procedure: WeldProcedure | None,
 ) -> tuple[SeamSolution, ...] | SeamFailure:
-    """Every pass of ``procedure`` along the root poses X0 (n, 4, 4), solved and timed (:func:`_arc_solution`)."""
+    """Every pass of ``procedure`` along the root poses X0 (n, 4, 4), solved and timed (:func:`arc_solution`)."""
     c, pr = run.cand, search.process
     out: list[SeamSolution] = []
     for k in range(len(procedure.passes) if procedure is not None else 1):
@@ -155,7 +155,7 @@ def _passes(
 def _off_path(search: SeamSearch, pieces: list[Piece], X: FloatArray) -> SeamFailure | None:
     """Where the timed weld's TCP (every 5th sample of its joint spline, between the IK knots too) leaves the planned
     path X (n, 4, 4) by more than :data:`PATH_TOL_M`, worst first, its progress along the weld (the arc cut short
-    of there: :func:`_trimmed`); None when it keeps within. Near a wrist singularity the knots lie on the curve
+    of there: :func:`trimmed`); None when it keeps within. Near a wrist singularity the knots lie on the curve
     but the joints swing between them (railing's posts: 0.6-0.8 mm off the true curve between knots 0.8 mm
     apart)."""
     from cell.process.curve_quality import nearest_on_curve

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.planning.curves.arc_solve import TRIES, _arc_solution, _same, _trimmed, _why
+from cell.planning.curves.arc_solve import TRIES, arc_solution, same_stretch, trimmed, why_stopped
 from cell.planning.curves.gapseed import seeded
 from cell.planning.curves.gapwalk import walked
 from cell.planning.curves.graph import gaps, graph_map, refined
@@ -87,10 +87,10 @@ def plan_arcs(
                 arcs = balanced(chosen, est.length_m, est.closed, overlap)
                 for k, (run, part) in enumerate(zip(chosen, arcs, strict=True), 1):
                     arc = sub_arc(est, part.a_m, part.b_m, k)
-                    got = _arc_solution(search, arc, part, flange, knot, procedure)
+                    got = arc_solution(search, arc, part, flange, knot, procedure)
                     if isinstance(got, SeamFailure):
                         failure = better(failure, got)
-                        runs = [r for r in runs if not _same(r, run, est.length_m)] + _trimmed(part, got, arc)
+                        runs = [r for r in runs if not same_stretch(r, run, est.length_m)] + trimmed(part, got, arc)
                         break
                     solved.append((arc, got))
                 else:
@@ -133,7 +133,7 @@ def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate, overlap: float
     free = gaps(runs, total, est.closed, 0.0)
     at = pinch(runs, total, overlap) if est.closed and not free else None
     if at is not None:
-        code, why = _why(misses, at[0] - overlap, at[0] + overlap, total, est.closed)
+        code, why = why_stopped(misses, at[0] - overlap, at[0] + overlap, total, est.closed)
         where = (f"every point is held, but every stretch through {at[0] * 1000:.0f} mm along it gives out within "
                  f"{at[1] * 1000:.1f} mm of it: no arc passes there to restart {overlap * 1000:.0f} mm back over the "
                  f"last ({why})")  # fmt: skip
@@ -144,7 +144,7 @@ def _gap(runs: list[Run], misses: list[Miss], est: CurveEstimate, overlap: float
         return SeamFailure(PlanReason.COLLISION if misses else PlanReason.IK_FAILED, where, est.p_RS[0], 0.0)
     lo, hi = max(free, key=lambda g: g[1] - g[0])
     lo, hi = lo % total if est.closed else lo, (lo % total if est.closed else lo) + (hi - lo)
-    code, why = _why(misses, lo - 0.01, hi + 0.01, total, est.closed)
+    code, why = why_stopped(misses, lo - 0.01, hi + 0.01, total, est.closed)
     unheld = sum(b - a for a, b in free)
     more = f"; {len(free)} such stretches, {unheld * 1000:.0f} mm in all" if len(free) > 1 else ""
     where = f"no torch setting holds it from {lo * 1000:.0f} mm along it ({(hi - lo) * 1000:.0f} mm{more}; {why})"

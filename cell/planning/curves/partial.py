@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from cell.geometry import FloatArray
-from cell.planning.curves.arc_solve import MIN_ARC_M, TRIES, _arc_solution, _same, _trimmed, _why
+from cell.planning.curves.arc_solve import MIN_ARC_M, TRIES, arc_solution, same_stretch, trimmed, why_stopped
 from cell.planning.curves.graph import gaps
 from cell.planning.curves.reach import Miss, Run, balanced, pinch
 from cell.planning.curves.split import MAX_PARTIAL_ARCS, Split, arc_id, sub_arc
@@ -135,7 +135,7 @@ def remainder(
     ``overlap`` about that restart (the arcs give out there: a pinch; the restart is a manual weld's, never the
     robot's with a shorter overlap)."""
     if not spans:
-        code, why = _why(list(misses), 0.0, total, total, closed)
+        code, why = why_stopped(list(misses), 0.0, total, total, closed)
         return [Remainder(0.0, total, code, f"no arc welds any of it ({why})")]
     arcs = sorted(((a % total, a % total + (b - a)) if closed else (a, b) for a, b in spans), key=lambda s: s[0])
     out: list[Remainder] = []
@@ -150,7 +150,7 @@ def remainder(
             out.append(_unwelded(end, a_next, runs, misses, total, closed, failed))
         elif end - a_next < overlap - EPS_M:
             mid = 0.5 * (end + a_next)
-            code, why = _why(list(misses), mid - overlap, mid + overlap, total, closed)
+            code, why = why_stopped(list(misses), mid - overlap, mid + overlap, total, closed)
             words = (f"the arcs restart over each other by {max(end - a_next, 0.0) * 1000:.1f} mm < the WPS's "
                      f"{overlap * 1000:.0f} mm: the arm holds no setting through here further ({why})")  # fmt: skip
             out.append(Remainder(mid - 0.5 * overlap, mid + 0.5 * overlap, code, words))
@@ -176,7 +176,7 @@ def _unwelded(
     f = next((f for a, b, f in failed if _overlap(a, b, lo, hi, total, closed) > EPS_M), None)
     unheld = sum(_overlap(a, b, lo, hi, total, closed) for a, b in gaps(runs, total, closed, 0.0))
     if unheld > EPS_M or not runs:
-        code, why = _why(list(misses), lo - 0.01, hi + 0.01, total, closed)
+        code, why = why_stopped(list(misses), lo - 0.01, hi + 0.01, total, closed)
         words = f"no torch setting holds {unheld * 1000:.0f} mm of it ({why})"
         if f is not None and hi - lo > unheld + 0.002:
             words += f"; an arc over the rest failed its full solve ({f.code}: {f.where})"
@@ -187,7 +187,7 @@ def _unwelded(
         return Remainder(lo, hi, code, words)
     if f is not None:
         return Remainder(lo, hi, f.code or PlanReason.IK_FAILED, f"an arc over it failed its full solve: {f.where}")
-    code, _ = _why(list(misses), lo - 0.01, hi + 0.01, total, closed)
+    code, _ = why_stopped(list(misses), lo - 0.01, hi + 0.01, total, closed)
     return Remainder(lo, hi, code, f"the arm holds it only in stretches {SHORT_OR_BEYOND}")
 
 
@@ -218,7 +218,7 @@ def partial_arcs(
     failure: SeamFailure,
 ) -> Split:
     """``est`` welded in part (:func:`partial_cover`), each arc solved as a whole cover's
-    (:func:`.arc_solve._arc_solution`); an arc that fails is trimmed or dropped (:func:`.arc_solve._trimmed`) and
+    (:func:`.arc_solve.arc_solution`); an arc that fails is trimmed or dropped (:func:`.arc_solve.trimmed`) and
     the arcs chosen again, up to :data:`.arc_solve.TRIES` times; then the solved arcs of the try that welds the
     most are kept and the failed ones' stretches left to the manual weld. ``failure``: why no cover welds it whole
     (kept as the split's). No arc solved: that failure alone."""
@@ -235,11 +235,11 @@ def partial_arcs(
         for k, (run, part) in enumerate(chosen, 1):
             key = (round(part.a_m % total if est.closed else part.a_m, 6), round(part.length, 6), part.cand)
             arc = sub_arc(est, part.a_m, part.b_m, k)
-            got = memo.get(key) or _arc_solution(search, arc, part, flange, knot, procedure)
+            got = memo.get(key) or arc_solution(search, arc, part, flange, knot, procedure)
             memo[key] = got
             if isinstance(got, SeamFailure):
                 failed.append((part.a_m, part.b_m, got))
-                runs = [r for r in runs if not _same(r, run, total)] + _trimmed(part, got, arc)
+                runs = [r for r in runs if not same_stretch(r, run, total)] + trimmed(part, got, arc)
                 again = True
             else:
                 kept.append((part, got))

@@ -147,10 +147,11 @@ def print_curves(rep: Mapping[str, Any]) -> None:
         if e is not None:
             line += f", error rms {_fmt(e['rms'])} / max {_fmt(e['max'])} mm"
         undone = s.get("not_welded")
-        line += f", {_fmt(s['time_ms'], 1)} ms; " + (f"not welded ({undone['code']})" if undone else "welded")
         if s.get("remainder"):  # welded in part: its share, then each stretch left for a manual weld
-            line = line.replace("not welded (partial)", "partly welded")
-            line += f" {s['share']:.0%}, {s['manual_mm']:.0f} mm left for a manual weld"
+            done = f"partly welded {s['share']:.0%}, {s['manual_mm']:.0f} mm left for a manual weld"
+        else:
+            done = f"not welded ({undone['code']})" if undone else "welded"
+        line += f", {_fmt(s['time_ms'], 1)} ms; {done}"
         out.print(line, soft_wrap=True, markup=False)
         for r in s.get("remainder") or ():
             where = f"{r['from_mm']:.0f}-{r['to_mm']:.0f} mm along it ({r['length_mm']:.0f} mm, {r['code']})"

@@ -66,7 +66,7 @@ def main() -> None:
             plan_for(station, det, skip=skip, motion=motion_scene(station.arm, det), curves=curves)
     finally:
         arcs_mod.plan_arcs = plan_arcs
-    graph_map, walked, seeded, solve = arcs_mod.graph_map, arcs_mod.walked, arcs_mod.seeded, arcs_mod._arc_solution
+    graph_map, walked, seeded, solve = arcs_mod.graph_map, arcs_mod.walked, arcs_mod.seeded, arcs_mod.arc_solution
 
     def graph_map_(*a: Any, **k: Any) -> Any:
         got = graph_map(*a, **k)
@@ -92,7 +92,7 @@ def main() -> None:
         print(f"    arc {'rev' if run.cand.reversed else 'fwd'} {run.a_m * 1e3:.1f} -> {run.b_m * 1e3:.1f} mm: {why}")
         return got
 
-    arcs_mod.graph_map, arcs_mod.walked, arcs_mod.seeded, arcs_mod._arc_solution = graph_map_, walked_, seeded_, solve_
+    arcs_mod.graph_map, arcs_mod.walked, arcs_mod.seeded, arcs_mod.arc_solution = graph_map_, walked_, seeded_, solve_
     for cid, (search, est, q0, proc) in captured.items():
         if not any(cid.startswith(w) for w in args.seams.split(",")):
             continue

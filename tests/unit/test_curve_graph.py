@@ -14,7 +14,7 @@ from cell import scenario as sc
 from cell.config.motion import PlanOptions
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
-from cell.planning.curves.arcs import _same
+from cell.planning.curves.arc_solve import same_stretch
 from cell.planning.curves.graph import _neighbours, _paths, _runs, gaps, settings_along
 from cell.planning.curves.reach import Run
 from cell.planning.plan import reach_model
@@ -100,4 +100,4 @@ def test_every_setting_that_reaches_furthest_from_a_start_is_kept_for_the_cover_
     runs = [r for r in _runs(nodes, cands, 0.01, 0.09, False, False, n) if r.a_m == 0.0]
     assert len(runs) == 2 and all(math.isclose(r.b_m, 0.09) for r in runs)  # a second whole path if one fails
     assert [r.spare for r in runs] == [False, True]  # tried only once no cover of the first ones welds
-    assert not _same(runs[0], runs[1], 0.09) and _same(runs[0], runs[0], 0.09)
+    assert not same_stretch(runs[0], runs[1], 0.09) and same_stretch(runs[0], runs[0], 0.09)

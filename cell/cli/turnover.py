@@ -49,6 +49,7 @@ def finish_turnover(
     """Write the report first, then the programs; print the table and one line per side; the exit's explanation
     when the job is partial (None when complete). amend : the report joined with the job's journal (a resume:
     the seams earlier runs welded)."""
+    from cell.export.curve_report import write_manual_welds
     from cell.export.turnover_report import turnover_report
 
     rep = turnover_report(run, provenance=provenance)
@@ -59,7 +60,9 @@ def finish_turnover(
         say(f"no robot program written to {krl}: this run has nothing to weld")  # a resume with nothing left
     elif krl is not None:
         left = not_welded(rep)
-        written = writer.attempt(lambda: write_programs(run, krl, provenance, controller, left))
+        written = writer.attempt(
+            lambda: [*write_programs(run, krl, provenance, controller, left), *write_manual_welds(rep, krl)]
+        )
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
             writer.written("programs", written)

@@ -4,10 +4,13 @@ its reason (docs/report.md). Millimetres where named _mm."""
 
 from __future__ import annotations
 
+import csv
 import math
+from pathlib import Path
 from typing import Any
 
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
+from cell.geometry import FloatArray, invert, transform_points
 from cell.pipeline.records import Detection
 from cell.types import SeamStatus, Unsupported, UnsupportedSeam
 from cell.types.curve_estimate import CurveEstimate, CurveMetrics
@@ -30,12 +33,17 @@ def unsupported_entry(u: UnsupportedSeam) -> dict[str, Any]:
 
 
 def curve_entry(
-    u: UnsupportedSeam | None, est: CurveEstimate, m: CurveMetrics | None, w: SeamWeld | None = None
+    u: UnsupportedSeam | None,
+    est: CurveEstimate,
+    m: CurveMetrics | None,
+    w: SeamWeld | None = None,
+    X_MR: FloatArray | None = None,
 ) -> dict[str, Any]:
     """A curved seam: its locator's status and reason, the located curve's figures when found, its error against
     the true curve (``error_mm``, simulation); what a weld run made of it (``w``: ``planned``, ``welded``, its
     ``tcp_error_mm`` against the true curve, or ``weld_reason_code`` and the planner's ``plan_reason_code``) and
-    why it is not welded (``not_welded``: code and reason; None when welded)."""
+    why it is not welded (``not_welded``: code and reason; None when welded). ``X_MR``: the robot frame in the
+    aligned map's (the drawing's), where a remainder's ends are given (:func:`remainder_entry`)."""
     entry: dict[str, Any] = {
         "id": est.id,
         "curved": True,
@@ -65,15 +73,16 @@ def curve_entry(
     entry["time_ms"] = _r(est.time_s * 1000.0, 3)
     entry["not_welded"] = {"code": u.code.value, "reason": u.reason} if u is not None else None
     if w is not None:
-        entry.update(weld_entry(w))
+        entry.update(weld_entry(w, est if X_MR is not None else None, X_MR))
     return entry
 
 
-def weld_entry(w: SeamWeld) -> dict[str, Any]:
+def weld_entry(w: SeamWeld, est: CurveEstimate | None = None, X_MR: FloatArray | None = None) -> dict[str, Any]:
     """A curved seam's weld fields, as a straight seam's: ``planned``, ``welded``, why not (``weld_reason``,
     ``weld_reason_code``, the planner's ``plan_reason_code``), and welded, its ``tcp_error_mm`` against the true
     curve, weld time and travel speed; welded in part (``weld_reason_code`` ``partial``), the ``share`` its arcs
-    weld, ``manual_mm`` left for a manual weld and each stretch of the ``remainder`` (:func:`remainder_entry`)."""
+    weld, ``manual_mm`` left for a manual weld and each stretch of the ``remainder`` (:func:`remainder_entry`; its
+    ends in the drawing's frame with the located curve ``est`` and ``X_MR``)."""
     out: dict[str, Any] = {"planned": w.planned, "welded": w.welded}
     if not w.welded:
         out["weld_reason"] = w.reason
@@ -83,7 +92,7 @@ def weld_entry(w: SeamWeld) -> dict[str, Any]:
     if w.partial:  # welded (planned, in a preview) in part: the rest left for a manual weld
         out["share"] = _r(w.share, 4)
         out["manual_mm"] = _r(w.manual_m * 1000.0, 1)
-        out["remainder"] = [remainder_entry(r) for r in w.remainder]
+        out["remainder"] = [remainder_entry(r, est, X_MR) for r in w.remainder]
     if w.quality is not None:
         q = w.quality
         out["tcp_error_mm"] = tcp_error_entry(q)
@@ -92,16 +101,22 @@ def weld_entry(w: SeamWeld) -> dict[str, Any]:
     return out | procedure_entry(w)
 
 
-def remainder_entry(r: Remainder) -> dict[str, Any]:
+def remainder_entry(r: Remainder, est: CurveEstimate | None = None, X_MR: FloatArray | None = None) -> dict[str, Any]:
     """A stretch of a curved seam left for a manual weld: from and to [mm] along the located curve, its length,
-    what stops the arm there as a code and in words."""
-    return {
+    what stops the arm there as a code and in words; with the located curve ``est`` and the robot frame in the
+    drawing's ``X_MR``, where the stretch starts and ends on the part (``from_xyz_mm``, ``to_xyz_mm``: in the
+    drawing's frame M, as the welder reads the drawing)."""
+    out: dict[str, Any] = {
         "from_mm": _r(r.from_m * 1000.0, 1),
         "to_mm": _r(r.to_m * 1000.0, 1),
         "length_mm": _r(r.length_m * 1000.0, 1),
         "code": r.code.value,
         "why": r.why,
     }
+    if est is not None and X_MR is not None and est.status is SeamStatus.FOUND:
+        p_MS = transform_points(X_MR, est.points_at([r.from_m, r.to_m])) * 1000.0
+        out["from_xyz_mm"], out["to_xyz_mm"] = ([_r(float(v), 1) for v in p] for p in p_MS)
+    return out
 
 
 def not_welded_entries(det: Detection) -> list[dict[str, Any]]:
@@ -110,11 +125,12 @@ def not_welded_entries(det: Detection) -> list[dict[str, Any]]:
     (:attr:`Detection.not_welded`)."""
     curves = {e.id: e for e in det.curve_estimates}
     undone = {u.id: u for u in det.not_welded}
+    X_MR = invert(det.scene.X_RM) if det.scene is not None else None
     out = []
     for u in det.weldmap_R.not_straight:
         if u.id in curves:
             e = curves[u.id]
-            out.append(curve_entry(undone.get(u.id), e, det.curve_metrics.get(u.id), det.curve_welds.get(u.id)))
+            out.append(curve_entry(undone.get(u.id), e, det.curve_metrics.get(u.id), det.curve_welds.get(u.id), X_MR))
         else:
             out.append(unsupported_entry(undone.get(u.id, u)))
     return out
@@ -191,3 +207,28 @@ def curve_rescan_entry(r: CurveRescan, limit_m: float) -> dict[str, Any]:
         "e1_mm": [_r(v.e1_m * 1000.0, 1) for v in r.views],  # a linear track's carriage for each view (0: fixed)
         "reason": r.reason,
     }
+
+
+MANUAL_WELDS = "manual_welds.csv"  # beside the programs: the stretches of curves the arm leaves to a welder
+_MANUAL_COLUMNS = (
+    "seam", "from_mm", "to_mm", "length_mm", "from_x_mm", "from_y_mm", "from_z_mm", "to_x_mm", "to_y_mm",
+    "to_z_mm", "code", "why",
+)  # fmt: skip
+
+
+def write_manual_welds(rep: dict[str, Any], folder: Path) -> list[Path]:
+    """The welder's list of what the programs leave undone on the report's curves welded in part: one row per
+    stretch of a ``remainder`` (seam, from and to along the located curve, its length, where it starts and ends
+    in the drawing's frame [mm], why the arm leaves it) in ``folder``/:data:`MANUAL_WELDS`; nothing written
+    (and [] returned) when no curve is welded in part."""
+    rows = [(s["id"], r) for s in rep["seams"] for r in s.get("remainder") or ()]
+    if not rows:
+        return []
+    path = folder / MANUAL_WELDS
+    with path.open("w", newline="") as f:
+        out = csv.writer(f)
+        out.writerow(_MANUAL_COLUMNS)
+        for sid, r in rows:
+            a, b = r.get("from_xyz_mm") or [None] * 3, r.get("to_xyz_mm") or [None] * 3
+            out.writerow([sid, r["from_mm"], r["to_mm"], r["length_mm"], *a, *b, r["code"], r["why"]])
+    return [path]

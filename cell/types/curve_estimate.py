@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 from cell.geometry import FloatArray, readonly
 from cell.types.seams import Reason, SeamStatus
@@ -72,6 +73,17 @@ class CurveEstimate:
         if self.closed and len(p):
             p = np.vstack([p, p[:1]])
         return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0
+
+    def points_at(self, s_m: npt.ArrayLike) -> FloatArray:
+        """(k, 3) [m] the located curve's points ``s_m`` (k,) [m] along it from its first sample, in R: a closed
+        curve's taken round its start, an open one's clipped to its ends (the planner's lengths along it)."""
+        p = np.asarray(self.p_RS)
+        if self.closed:
+            p = np.vstack([p, p[:1]])
+        s_k = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        s = np.asarray(s_m, dtype=float).reshape(-1)
+        s = np.mod(s, s_k[-1]) if self.closed else np.clip(s, 0.0, s_k[-1])
+        return np.column_stack([np.interp(s, s_k, p[:, j]) for j in range(3)])
 
     @property
     def sigma_max_m(self) -> float:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -174,3 +175,42 @@ def test_a_partial_curve_in_the_report_and_the_programs_header() -> None:
     assert not_welded(rep) == (
         (w.id, "partial: 18 mm left for a manual weld at 161-179 mm (ik_failed) along it"),
     )  # the programs' header
+
+
+def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(tmp_path: Path) -> None:
+    """A remainder's ends are the located curve's points that far along it, in the drawing's frame (the part's
+    pose undone); the list beside the programs has one row per stretch, none when no curve is welded in part."""
+    import csv
+
+    from cell.export.curve_report import MANUAL_WELDS, weld_entry, write_manual_welds
+    from cell.geometry import invert, make_pose
+    from cell.types import SeamStatus
+    from cell.types.curve_estimate import CurveEstimate
+    from cell.types.run import SeamWeld, WeldReason
+
+    r_m, n = 0.05, 400  # a 50 mm circle about the drawing's z axis, sampled from +x anticlockwise
+    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    p_MS = np.column_stack([r_m * np.cos(t), r_m * np.sin(t), np.zeros(n)])
+    X_RM = make_pose(np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), [0.4, 0.9, 0.1])
+    p_RS = p_MS @ X_RM[:3, :3].T + X_RM[:3, 3]
+    est = CurveEstimate("TUBE>PLATE:circle", SeamStatus.FOUND, p_RS=p_RS, n_abutting_R=np.tile([0, 0, 1.0], (n, 1)),
+                        n_receiving_R=np.tile([1.0, 0, 0], (n, 1)), closed=True, sigma_m=np.full(n, 1e-4))  # fmt: skip
+    quarter = est.length_m / 4  # a quarter round from +x: the drawing's +y; the stretch passes the curve's start
+    rest = (Remainder(quarter, 2 * quarter, PlanReason.COLLISION, "torch vs GUSSET_1"),
+            Remainder(3.5 * quarter, 4.5 * quarter, PlanReason.IK_FAILED, "no torch setting holds it"))  # fmt: skip
+    w = SeamWeld(est.id, True, False, "welded in part", code=WeldReason.PARTIAL, share=0.625, remainder=rest)
+    entry = weld_entry(w, est, invert(X_RM))
+    got = [(e["from_xyz_mm"], e["to_xyz_mm"]) for e in entry["remainder"]]
+    s45 = 50.0 * np.sqrt(0.5)
+    want = [([0.0, 50.0, 0.0], [-50.0, 0.0, 0.0]), ([s45, -s45, 0.0], [s45, s45, 0.0])]
+    for (a, b), (wa, wb) in zip(got, want, strict=True):
+        assert np.allclose(a, wa, atol=0.1) and np.allclose(b, wb, atol=0.1), (a, b)  # chords of a 0.8 mm step
+    assert "from_xyz_mm" not in weld_entry(w)["remainder"][0]  # no pose: along the curve only
+
+    rep = {"seams": [{"id": "PLATE>BASE:+x", "welded": True}, {"id": est.id, **entry}]}
+    (path,) = write_manual_welds(rep, tmp_path)
+    assert path == tmp_path / MANUAL_WELDS
+    rows = list(csv.DictReader(path.open()))
+    assert [r["seam"] for r in rows] == [est.id, est.id] and rows[0]["why"] == "torch vs GUSSET_1"
+    assert float(rows[1]["from_x_mm"]) == pytest.approx(s45, abs=0.1) and rows[1]["code"] == "ik_failed"
+    assert write_manual_welds({"seams": rep["seams"][:1]}, tmp_path / "none") == []

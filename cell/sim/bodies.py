@@ -36,14 +36,16 @@ def add_box(client: BulletClient, box_W: Box, rgba: Rgba) -> int:
     return _place(client, collision, visual, box_W.center, box_W.X_AB[:3, :3])
 
 
-def add_floor(client: BulletClient, box_W: Box, rgba: Rgba) -> int:
-    """The floor: a static body that collides as the thin box ``box_W`` (axis-aligned, its top face the floor) and is
-    drawn as that top face alone (two triangles, normals up), since nothing in the cell looks at the floor from
-    below or beside it; returns the PyBullet body id. The images are those of the box to the bit (docs/bodies.md
-    section 1): each of the box's twelve triangles spans the screen, and TinyRenderer walks each one's screen
-    rectangle, so the faces no camera sees cost as much as the one it does."""
+def add_floor(client: BulletClient, box_W: Box, rgba: Rgba, *, drawn: bool = False) -> int:
+    """The floor: a static body that collides as the thin box ``box_W`` (axis-aligned, its top face the floor);
+    returns the PyBullet body id. The cameras' images get it from :class:`cell.sim.floor.Floor` after TinyRenderer
+    has drawn the rest (docs/bodies.md section 1); ``drawn`` (a GUI's view) gives it a visual shape too: its top
+    face alone (two triangles, normals up), since nothing in the cell looks at the floor from below or beside it."""
     half = box_W.size / 2.0
     collision = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[float(h) for h in half])
+    if not drawn:  # a clear speck: with no visual shape at all TinyRenderer would draw the collision box
+        speck = client.createVisualShape(pybullet.GEOM_BOX, halfExtents=[1e-3] * 3, rgbaColor=[0.0, 0.0, 0.0, 0.0])
+        return _place(client, collision, speck, box_W.center, box_W.X_AB[:3, :3])
     hx, hy, hz = (float(h) for h in half)
     top = [[-hx, -hy, hz], [hx, -hy, hz], [hx, hy, hz], [-hx, hy, hz]]
     visual = client.createVisualShape(

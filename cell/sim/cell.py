@@ -18,6 +18,7 @@ from cell.sim.board import Size2, add_board, colour_noise, place_body
 from cell.sim.bodies import add_box, add_floor, add_part, move_bodies
 from cell.sim.camera import intrinsics_for
 from cell.sim.faults import built_parts, corrupt_depth, occluder_boxes
+from cell.sim.floor import Floor, floor_colour
 from cell.sim.lens import Sensor, sensor_for
 from cell.sim.noise import apply_noise, believed_pose, specular_dropout
 from cell.sim.quiet import BulletClient, pybullet, silenced_fds
@@ -79,8 +80,9 @@ class SimCell:
         self._beads: list[int] = []
         ground = Box(make_pose(p=(0.0, 0.0, -_GROUND_SIZE[2] / 2.0)), np.array(_GROUND_SIZE))
         self._drawn: dict[int, bytes] = {}  # what a vertex mesh's shape data does not say (render_cache.scene_key)
-        self._bodies[GROUND] = add_floor(self.client, ground, _RGBA[GROUND])
-        self._drawn[self._bodies[GROUND]] = mesh_digest(ground.size[None, :], np.zeros((0, 3)))  # its top face
+        self._bodies[GROUND] = add_floor(self.client, ground, _RGBA[GROUND], drawn=gui)
+        self._floor = Floor(0.0, (ground.size[0] / 2.0, ground.size[1] / 2.0), floor_colour(_RGBA[GROUND]))
+        self._drawn[self._bodies[GROUND]] = mesh_digest(ground.size[None, :], np.array([self._floor.rgb]))
         table = scenario.table
         self._add_box(TABLE, Box(make_pose(p=table.center_m), np.array(table.size_m)), _RGBA[TABLE])
         # Faults (scenario ``faults:``): parts not built are left out, objects the map does not know are added.
@@ -149,7 +151,7 @@ class SimCell:
     ) -> tuple[npt.NDArray[np.uint8], FloatArray]:
         """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (0: nothing between near and far) from X_WC (4, 4);
         read back when this process drew the same scene from the same camera before (:mod:`cell.sim.render_cache`)."""
-        return draw(self.client, self._drawn, X_WC, intrinsics, near_m, far_m)
+        return draw(self.client, self._drawn, X_WC, intrinsics, near_m, far_m, floor=self._floor)
 
     def capture(self, camera: str, X_WC: FloatArray | None = None) -> DepthImage:
         """One depth image from ``camera``.

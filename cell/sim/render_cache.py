@@ -15,6 +15,7 @@ import numpy.typing as npt
 
 from cell.geometry import FloatArray
 from cell.sim.camera import gl_projection_matrix, gl_view_matrix, linearise_depth
+from cell.sim.floor import Floor
 from cell.sim.quiet import BulletClient, pybullet
 from cell.types import CameraIntrinsics
 
@@ -108,10 +109,12 @@ def draw(
     near_m: float,
     far_m: float,
     cache: RenderCache = IMAGES,
+    floor: Floor | None = None,
 ) -> Image:
     """Noise-free colour (H, W, 3) uint8 and depth (H, W) [m] (0: nothing between near and far) of ``client``'s
     scene from X_WC (4, 4) in W, read back from ``cache`` when it holds this scene's image from this camera
-    (:func:`scene_key`, ``drawn`` as there)."""
+    (:func:`scene_key`, ``drawn`` as there); ``floor`` put in where nothing else was drawn (its body's entry in
+    ``drawn`` must say it)."""
     key = scene_key(client, drawn, X_WC, intrinsics, near_m, far_m)
     if key is not None and (kept := cache.get(key)) is not None:
         return kept
@@ -126,6 +129,8 @@ def draw(
     d = np.asarray(buffer, dtype=float).reshape(intrinsics.height, intrinsics.width)
     rgb = np.asarray(rgba, dtype=np.uint8).reshape(intrinsics.height, intrinsics.width, 4)[..., :3]
     depth = linearise_depth(d, near_m, far_m)
+    if floor is not None:
+        rgb, depth = floor.fill(rgb, depth, X_WC, intrinsics, near_m, far_m)
     if key is not None:
         cache.put(key, rgb, depth)
     return rgb, depth

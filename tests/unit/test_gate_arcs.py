@@ -114,3 +114,36 @@ def test_a_seam_whose_every_arc_is_refused_is_refused_with_the_gates_reason() ->
     gates = [Remainder(a, b, PlanReason.SINGULAR, f"arc {k}: the safety gate: x") for k, (_, a, b) in enumerate(SPANS)]
     arcs, still, parts, _ = _covered(_split(SPANS, (GAP,)), gates)
     assert not arcs and not parts and still[SEAM].where == "arc 0: the safety gate: x"
+
+
+def test_a_transfers_via_point_past_the_hose_window_is_taken_a_whole_turn_back_into_it() -> None:
+    """A hop's via point solved by continuity from a wrist wound far round (A6 past the window) holds the same pose
+    with A6 a whole turn back: the way is no longer refused for the window (railing's POST_R bottom fillet: every
+    lifted way out of its arc's depart left the window by 10-33 deg)."""
+    from tiny_cell import HOME, OBSTACLES, URDF
+
+    import cell.planning.transfers as tr_mod
+    from cell import scenario as sc
+    from cell.config.motion import PlanOptions
+    from cell.motion.collision import CollisionChecker
+    from cell.motion.robot import RobotModel
+    from cell.process.torch import WeldProcess
+
+    robot = RobotModel.from_urdf(URDF)
+    opt = PlanOptions()
+    moves = tr_mod.Transfers(
+        robot, WeldProcess.from_spec(sc.ProcessSpec()), CollisionChecker(robot, OBSTACLES), opt, OBSTACLES, HOME
+    )
+    q = np.asarray(HOME, dtype=float).copy()
+    q[-1] = opt.a6_center - opt.a6_window + np.radians(5.0)  # inside the window, 5 deg from its edge
+    wound = q.copy()
+    wound[-1] -= np.radians(20.0)  # the IK's answer by continuity: 15 deg past the edge
+    mp = pytest.MonkeyPatch()
+    mp.setattr(tr_mod, "solve_ik", lambda *_a, **_k: wound)
+    try:
+        via = moves.above(q, float(robot.fk(q)[2, 3]) + 0.1)
+    finally:
+        mp.undo()
+    assert via is not None and moves.window.excess(via) == 0.0
+    assert np.degrees(via[-1] - wound[-1]) == pytest.approx(360.0) and np.allclose(via[:-1], wound[:-1])
+    assert np.allclose(robot.fk(via), robot.fk(wound), atol=1e-9)

@@ -218,7 +218,7 @@ def plan_welds(
         if sid not in outcomes or not outcomes[sid].feasible:
             n = sum(seam_of(a) == sid for a in solved)
             outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs" if n > 1 else "")
-            if sid in in_parts:  # welded in part: what is left for a manual weld
+            if sid in in_parts and in_parts[sid].remainder:  # welded in part: what is left for a manual weld
                 outcomes[sid] = in_part(outcomes[sid], in_parts[sid], n)
     return WeldPlan(
         joint_names=robot.joint_names,

@@ -147,3 +147,28 @@ def test_a_transfers_via_point_past_the_hose_window_is_taken_a_whole_turn_back_i
     assert via is not None and moves.window.excess(via) == 0.0
     assert np.degrees(via[-1] - wound[-1]) == pytest.approx(360.0) and np.allclose(via[:-1], wound[:-1])
     assert np.allclose(robot.fk(via), robot.fk(wound), atol=1e-9)
+
+
+def test_a_whole_covers_arc_no_transfer_reaches_leaves_the_seam_in_part_under_manual() -> None:
+    """cover_curves lists a seam covered whole in several arcs among the parts (no remainder) with
+    ``curve_remainder: manual``; an arc of it that a transfer cannot reach then leaves alone (whole_or_none), its
+    stretch less what the other arcs weld in the remainder, as a partial seam's; with ``refuse``: refused whole."""
+    from cell.planning.curves import whole_or_none
+    from cell.types.plan import SeamOutcome
+
+    whole = ((A1, 0.0, 0.51), (A2, 0.50, 1.01))
+    for manual in (True, False):
+        arcs, _, parts, _ = _covered(_split(whole, ()), [], manual=manual)
+        assert sorted(arcs) == [A1, A2] and (SEAM in parts) == manual
+        solved = {A1: 1, "OTHER": 0}
+        why = "transfer_collision: no free transfer move to the seam: ..."
+        no_way = SeamOutcome(A2, False, why, np.zeros(3), code=PlanReason.TRANSFER_COLLISION)
+        outcomes = {A2: no_way}
+        whole_or_none(solved, outcomes, parts=parts)
+        if manual:
+            assert solved == {A1: 1, "OTHER": 0} and outcomes == {}
+            rest = parts[SEAM].remainder
+            assert [(r.from_m, r.to_m, r.code) for r in rest] == [(0.51, 1.0, PlanReason.TRANSFER_COLLISION)]
+            assert rest[0].why == f"arc 2: {why}" and parts[SEAM].share == pytest.approx(0.51, abs=0.002)
+        else:
+            assert solved == {"OTHER": 0} and not outcomes[SEAM].feasible

@@ -103,8 +103,10 @@ def cover_curves(
     part, only with ``curve_remainder: manual``; else, or with no arc left, the seam refused with that reason).
     Returns (arc id -> its solutions, one per pass, for the seams covered whole or in part; seam id -> its
     failure, for the others: where no arc reaches, with the share of the curve the arm reaches in its words; seam
-    id -> what is left for a manual weld, for the seams welded in part; arc id -> its (from, to) [m] along its
-    curve, for the seams welded in arcs)."""
+    id -> what is left for a manual weld, for the seams welded in part, and with ``curve_remainder: manual`` for
+    those covered whole in several arcs too, with no remainder, so that one failing after the search leaves the
+    seam in part (:func:`whole_or_none`); arc id -> its (from, to) [m] along its curve, for the seams welded in
+    arcs)."""
     from cell.planning.curves.arcs import plan_arcs
 
     q0, procs, out = np.asarray(q_seed, dtype=float), procedures or {}, refused or {}
@@ -130,9 +132,10 @@ def cover_curves(
         if got.whole or got.partial:
             arcs |= {arc.id: sol for arc, sol in got.arcs}
             spans |= {aid: (a, b) for aid, a, b in got.spans}
-            if got.partial:
+            pr = make_search[c.id].process
+            if got.partial or (len(got.arcs) > 1 and pr.curve_remainder == "manual"):  # a whole cover: may lose one
                 own = {aid: (a, b) for aid, a, b in got.spans}
-                lap = make_search[c.id].process.closed_overlap if c.closed else 0.0
+                lap = pr.closed_overlap if c.closed else 0.0
                 parts[c.id] = Partial(c.length_m, c.closed, got.share, got.remainder, own, lap)
             continue
         f = got.failure
@@ -174,7 +177,9 @@ def whole_or_none(
     timing, a transfer to or from it: its outcome in ``outcomes`` under the arc's id), its other arcs leave
     ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc. A seam
     already welded in part (in ``parts``) loses only that arc: its stretch joins the seam's remainder, with the
-    failure as its reason, less what its other arcs weld or the remainder lists already
+    failure as its reason, less what its other arcs weld or the remainder lists already (a seam covered whole in
+    ``parts``, with no remainder, is so welded in part: :func:`cover_curves` puts those there with
+    ``curve_remainder: manual``)
     (:func:`.refused.left_over`); the seam is refused only when no arc is left."""
     for aid, o in list(outcomes.items()):
         sid = seam_of(aid)

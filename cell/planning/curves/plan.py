@@ -177,10 +177,10 @@ def whole_or_none(
     timing, a transfer to or from it: its outcome in ``outcomes`` under the arc's id), its other arcs leave
     ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc. A seam
     already welded in part (in ``parts``) loses only that arc: its stretch joins the seam's remainder, with the
-    failure as its reason, less what its other arcs weld or the remainder lists already (a seam covered whole in
-    ``parts``, with no remainder, is so welded in part: :func:`cover_curves` puts those there with
-    ``curve_remainder: manual``)
-    (:func:`.refused.left_over`); the seam is refused only when no arc is left."""
+    failure as its reason, less what its other arcs weld or the remainder lists already
+    (:func:`.refused.left_over`); the seam is refused only when no arc is left. A seam covered whole that is in
+    ``parts`` (no remainder: :func:`cover_curves` puts those there with ``curve_remainder: manual``) is so left
+    welded in part."""
     for aid, o in list(outcomes.items()):
         sid = seam_of(aid)
         if sid == aid or o.feasible:

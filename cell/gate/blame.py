@@ -4,14 +4,16 @@ start-state violation, or one that blames every seam, concerns the whole plan.""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 import numpy as np
 
 from cell.gate.base import Violation, ViolationKind
 from cell.geometry import readonly
+from cell.planning.curves.split import ARC_MARK
+from cell.planning.curves.split import seam_of as seam_of_arc
 from cell.planning.failures import reason_text
-from cell.types.plan import PlanReason, SeamOutcome, Segment, WeldPlan
+from cell.types.plan import PlanReason, Remainder, SeamOutcome, Segment, WeldPlan
 
 _CODE = {
     ViolationKind.COLLISION: PlanReason.COLLISION,
@@ -31,25 +33,59 @@ def seam_of(plan: WeldPlan, v: Violation) -> str:
     return plan.order[-1] if plan.order else ""  # the move home: the transfer from the last seam
 
 
-def blamed_seams(plan: WeldPlan, violations: Sequence[Violation]) -> dict[str, SeamOutcome] | None:
+def blamed_seams(
+    plan: WeldPlan, violations: Sequence[Violation], split: Collection[str] = ()
+) -> dict[str, SeamOutcome] | None:
     """Per seam to drop, its outcome with the first violation as the reason; None when some violation concerns
     the whole plan (then the plan is refused), when every seam of the plan is at fault (nothing would be left:
-    the reason is the whole's, e.g. a gate threshold no pose meets), or there is none."""
+    the reason is the whole's, e.g. a gate threshold no pose meets) and none is in ``split`` (curved seams
+    welded in arcs, which lose only the arc at fault: :func:`blamed_arcs`), or there is none."""
     out: dict[str, SeamOutcome] = {}
     for v in violations:
         sid = seam_of(plan, v)
         if not sid:
             return None
-        if sid in out:
-            continue
-        seg = next(s for s in plan.segments if s.seam_id == sid)
-        transfer = v.kind is ViolationKind.COLLISION and _segment_at(plan, v.t).kind == "move"
-        code = PlanReason.TRANSFER_COLLISION if transfer else _CODE.get(v.kind, PlanReason.TIMING)
-        detail = f"the safety gate: {v}"
-        out[sid] = SeamOutcome(sid, False, reason_text(code, detail), readonly(seg.X_end[:3, 3].copy()), code=code)
-    if set(out) >= set(plan.order):  # every seam at fault: a reason that concerns the whole (e.g. a gate setting)
+        if sid not in out:
+            out[sid] = _outcome(plan, v, sid)
+    if set(out) >= set(plan.order) and not set(out) & set(split):  # every seam at fault: the whole's reason
         return None
     return out or None
+
+
+def in_arcs(plan: WeldPlan) -> set[str]:
+    """The curved seams of ``plan`` welded in several arcs (:attr:`WeldPlan.arcs`)."""
+    return {seam_of_arc(a.arc_id) for a in plan.arcs}
+
+
+def _outcome(plan: WeldPlan, v: Violation, sid: str) -> SeamOutcome:
+    """Seam ``sid`` (or one of its arcs) refused for violation ``v``."""
+    seg = next(s for s in plan.segments if s.seam_id == seam_of_arc(sid))
+    transfer = v.kind is ViolationKind.COLLISION and _segment_at(plan, v.t).kind == "move"
+    code = PlanReason.TRANSFER_COLLISION if transfer else _CODE.get(v.kind, PlanReason.TIMING)
+    detail = f"the safety gate: {v}"
+    return SeamOutcome(sid, False, reason_text(code, detail), readonly(seg.X_end[:3, 3].copy()), code=code)
+
+
+def blamed_arcs(plan: WeldPlan, violations: Sequence[Violation], seams: Collection[str]) -> dict[str, Remainder]:
+    """Arc id -> its stretch along its curve with the first violation on it as the reason (code and words, "arc K:
+    the safety gate: ..."), for each arc of ``seams`` (curved seams welded in arcs, :attr:`WeldPlan.arcs`) that a
+    violation falls on: on its move in, approach, weld or depart (the move home after it: the last arc's)."""
+    out: dict[str, Remainder] = {}
+    for v in violations:
+        sid = seam_of(plan, v)
+        if sid not in seams:
+            continue
+        t = _segment_at(plan, v.t).t0
+        mine = [a for a in plan.arcs if seam_of_arc(a.arc_id) == sid and a.t0 <= t + 1e-9]
+        if not mine:
+            continue
+        arc = max(mine, key=lambda a: a.t0)
+        if arc.arc_id not in out:
+            o = _outcome(plan, v, sid)
+            assert o.code is not None
+            why = f"arc {arc.arc_id.rsplit(ARC_MARK, 1)[1]}: the safety gate: {v}"
+            out[arc.arc_id] = Remainder(arc.from_m, arc.to_m, o.code, why)
+    return out
 
 
 def _segment_at(plan: WeldPlan, t: float) -> Segment:

@@ -30,7 +30,7 @@ from cell.pipeline.scene_view import cell_view
 from cell.scenario import Scenario
 from cell.station import Station
 from cell.types import CheckFail, SeamStatus, Violation, ViolationKind
-from cell.types.plan import PlanReason
+from cell.types.plan import PlanReason, Remainder
 
 TackRule = Callable[[Detection, Sequence["SeamTask"]], Sequence["SeamTask"]]  # seam tasks -> tack tasks (tacks.py)
 
@@ -69,9 +69,10 @@ def plan_for(
     elsewhere : another pose may hold a seam (a positioner's): :func:`~cell.planning.plan.plan_welds`'s.
     """
     from cell.gate import find_violations
-    from cell.gate.blame import blamed_seams, incoming
+    from cell.gate.answer import gate_answer
     from cell.motion.timing import ptp
     from cell.pipeline.tacks import tack_procedures
+    from cell.planning.curves.split import seam_of
     from cell.planning.plan import plan_welds
     from cell.planning.tasks import seam_tasks
     from cell.planning.track import plan_on_track
@@ -108,12 +109,13 @@ def plan_for(
         pre = joined(way) if way else ptp(q_now, arm.q_home, arm.model.limits, dt=0.001)
     dropped: dict[str, SeamOutcome] = {}
     avoid: set[tuple[str, str]] = set()  # transfers the gate found at fault: another order is tried first
+    refused: dict[str, list[Remainder]] = {}  # curved seam -> its arcs' stretches the gate found at fault
     for _ in range(_GATE_ROUNDS):
         kept = [t for t in tasks if t.id not in dropped]
         kept_tacks = [t for t in tack_tasks if t.id not in dropped]
         procs = seam_procedures(sc, det, kept) | curve_procedures_for(sc, ss.weldmap, curves)
         first = {t.id for t in kept_tacks}  # the tacks before every seam
-        fixed = partial(plan_welds, first=first, elsewhere=elsewhere, avoid=set(avoid))
+        fixed = partial(plan_welds, first=first, elsewhere=elsewhere, avoid=set(avoid), refused=dict(refused))
         planner = fixed if track is None else partial(plan_on_track, track=track)
         plan = planner(
             arm.model,
@@ -125,7 +127,7 @@ def plan_for(
             rng=sc.rng("plan"),
             checker=checker,
             procedures=procs | tack_procedures(procs, kept_tacks),
-            on_seam=seam_counter(progress) if not dropped and not avoid else None,
+            on_seam=seam_counter(progress) if not dropped and not avoid and not refused else None,
             curves=[c for c in curves if c.id not in dropped],
         )
         progress(
@@ -142,20 +144,22 @@ def plan_for(
             wire_m=process.stickout,
             joint_parts=joint_parts(ss.joints, [t.id for t in (*kept, *kept_tacks)], ss.weldmap, curves),
         )
-        blamed = blamed_seams(plan, found)
-        if blamed is None:  # none, or one that concerns the whole plan
+        # Another order first for a move into a seam; an arc of a curve welded in arcs left out alone (its stretch
+        # for a manual weld, with the gate's reason); else the seam dropped (at most _GATE_ROUNDS plans in all).
+        manual = process.curve_remainder == "manual" and track is None
+        got = gate_answer(plan, found, avoid, by_arc=manual, reorder=track is None)
+        if got is None:  # none, or one that concerns the whole plan
             break
-        # A violation on the move into a seam (or its approach, the move blended into it) is first answered by
-        # another order, without that transfer; a seam blamed on a move already avoided, or for its own motions
-        # (its weld), is dropped and the rest are planned again (at most _GATE_ROUNDS plans in all).
-        moves = {sid: e for sid, e in incoming(plan, found).items() if e not in avoid} if track is None else {}
-        if moves:
-            progress(f"safety gate: {', '.join(moves)} again in another order (the move into it violates it)")
-            avoid |= set(moves.values())
-        if set(blamed) - set(moves):
-            rest = [sid for sid in blamed if sid not in moves]
-            progress(f"safety gate: dropping {', '.join(rest)} (their own motions violate it), planning the rest")
-            dropped.update({sid: o for sid, o in blamed.items() if sid not in moves})
+        if got.moves:
+            progress(f"safety gate: {', '.join(got.moves)} again in another order (the move into it violates it)")
+            avoid |= set(got.moves.values())
+        if got.arcs:
+            progress(f"safety gate: leaving out {', '.join(got.arcs)} (its own motions violate it), planning the rest")
+            for aid, r in got.arcs.items():
+                refused.setdefault(seam_of(aid), []).append(r)
+        if got.drop:
+            progress(f"safety gate: dropping {', '.join(got.drop)} (their own motions violate it), planning the rest")
+            dropped.update(got.drop)
     outcomes = {o.seam_id: o for o in plan.seams} | dropped
     ids = [*(t.id for t in (*tasks, *tack_tasks)), *(c.id for c in curves)]
     plan = replace(plan, seams=tuple(outcomes[i] for i in ids if i in outcomes))

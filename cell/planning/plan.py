@@ -23,7 +23,7 @@ from cell.planning.access.openings import WAYS
 from cell.planning.access.screen import first_unjoined
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
-from cell.planning.curves import cover_curves, curve_pieces, in_part, weldable, whole_or_none, with_paths
+from cell.planning.curves import arc_spans, cover_curves, curve_pieces, in_part, weldable, whole_or_none, with_paths
 from cell.planning.curves.split import seam_of
 from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
@@ -37,7 +37,7 @@ from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess
 from cell.types import Part
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.plan import NoProcedure, PlanReason, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
+from cell.types.plan import NoProcedure, PlanReason, Remainder, SeamOutcome, SeamProcedure, SeamTask, WeldPlan
 
 
 def plan_welds(
@@ -56,6 +56,7 @@ def plan_welds(
     curves: Sequence[CurveEstimate] = (),
     elsewhere: bool = False,
     avoid: Collection[tuple[str, str]] = (),
+    refused: Mapping[str, Sequence[Remainder]] | None = None,
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -73,6 +74,8 @@ def plan_welds(
     curves : located curved seams (:class:`CurveEstimate`, in R; those not found are left out), each welded along
         its curve (:mod:`cell.planning.curves`: a closed one all round with the process's start/stop overlap), its
         procedure from ``procedures`` too; their outcomes follow the tasks'.
+    refused : curved seam id -> stretches along it (from, to [m], code, why) whose arc the safety gate refused:
+        that arc is left out alone, its stretch left for a manual weld (:func:`cell.planning.curves.cover_curves`).
     elsewhere : another place may hold a seam (a positioner's other poses): one whose transfer fails and that no
         transfer joins to home either way is refused at once (:mod:`cell.planning.access.home`), not tried from
         every other seam in turn; and the order search leaves out a transfer that no strategy makes between the
@@ -127,7 +130,7 @@ def plan_welds(
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
     curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
     to_search = [e for e in found_curves if e.id in curve_ids]
-    arcs, still, in_parts = cover_curves(to_search, searches, q0, curve_procs)  # one go, arcs, in part, or why not
+    arcs, still, in_parts, spans = cover_curves(to_search, searches, q0, curve_procs, refused)  # one go, arcs, part
     for cid, res in still.items():
         outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
     for aid, sols in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
@@ -194,6 +197,7 @@ def plan_welds(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
         )
     segments = with_paths(segments, {sid: [p.X_weld for p in solved[sid]] for sid in curve_ids if sid in solved})
+    timed_arcs = arc_spans(segments, {aid: s for aid, s in spans.items() if aid in solved})
     segments = [replace(g, seam_id=seam_of(g.seam_id)) for g in segments]  # a split seam's arcs: its welds
     for sid, sols in solved.items():
         c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
@@ -214,7 +218,7 @@ def plan_welds(
         if sid not in outcomes or not outcomes[sid].feasible:
             n = sum(seam_of(a) == sid for a in solved)
             outcomes[sid] = replace(outcomes[aid], seam_id=sid, reason=f"welded in {n} arcs" if n > 1 else "")
-            if sid in in_parts:  # welded in part: what is left for a manual weld
+            if sid in in_parts and in_parts[sid].remainder:  # welded in part: what is left for a manual weld
                 outcomes[sid] = in_part(outcomes[sid], in_parts[sid], n)
     return WeldPlan(
         joint_names=robot.joint_names,
@@ -223,6 +227,7 @@ def plan_welds(
         seams=tuple(outcomes[i] for i in [*(t.id for t in tasks), *(e.id for e in found_curves)]),
         order=tuple(dict.fromkeys(seam_of(i) for i in ordered)),
         planning_s=time.perf_counter() - t_start,
+        arcs=timed_arcs,
     )
 
 

@@ -16,7 +16,7 @@ from cell.motion.collision.wire import Entry, body_entry
 from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
-from cell.motion.wrist import HoseWindow
+from cell.motion.wrist import HoseWindow, nearest_wrist
 from cell.planning.failures import LineError
 from cell.planning.moves.lifts import DeepKnotError, vertical_line
 from cell.planning.moves.pieces import Piece, TransferFail, joined
@@ -258,10 +258,13 @@ class Transfers:
 
     def _ik(self, key: tuple[bytes, float], X: FloatArray, seed: FloatArray) -> FloatArray:
         """The IK solution (dof,) [rad] for pose X (4, 4) in R seeded at ``seed``, remembered under ``key`` (the
-        ends it was asked from), a failure too. Raises the IKError remembered."""
+        ends it was asked from), a failure too; one whose A6 lies past the hose window is taken by whole turns
+        (or the flipped wrist) back into it where the limits allow (:func:`nearest_wrist`: the same pose; a via
+        point past the window fails every way through it). Raises the IKError remembered."""
         if key not in self._above:
             try:
-                self._above[key] = np.asarray(solve_ik(self.robot, X, seed, options=self.opt.ik))
+                q = np.asarray(solve_ik(self.robot, X, seed, options=self.opt.ik))
+                self._above[key] = nearest_wrist(self.robot, q, seed, self.window) if self.window.excess(q) else q
             except IKError as exc:
                 self._above[key] = exc
         got = self._above[key]

@@ -94,7 +94,8 @@ def plan_arcs(
                         break
                     solved.append((arc, got))
                 else:
-                    return Split(tuple(solved), 1.0, None)
+                    spans = tuple((a.id, p.a_m, p.b_m) for (a, _), p in zip(solved, arcs, strict=True))
+                    return Split(tuple(solved), 1.0, None, spans=spans)
     reached = share(runs, est.length_m, est.closed)
     if failure is None:
         failure = _gap(runs, misses, est, overlap)

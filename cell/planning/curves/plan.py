@@ -6,6 +6,7 @@ Frames: everything in the robot base frame R [m]; joints [rad]."""
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
@@ -15,14 +16,24 @@ import numpy.typing as npt
 
 from cell.geometry import readonly
 from cell.planning.curves.partial import welded_share
+from cell.planning.curves.refused import left_over, without_refused
 from cell.planning.curves.search import plan_curve
-from cell.planning.curves.split import ARC_MARK, Partial, arc_id, seam_of
+from cell.planning.curves.split import ARC_MARK, Partial, Split, arc_id, seam_of
 from cell.planning.failures import SeamFailure
 from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.procedures import UP_R, select_procedure
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.plan import NoProcedure, PlanReason, Remainder, SeamOutcome, SeamProcedure, SeamTask, Segment
+from cell.types.plan import (
+    ArcSpan,
+    NoProcedure,
+    PlanReason,
+    Remainder,
+    SeamOutcome,
+    SeamProcedure,
+    SeamTask,
+    Segment,
+)
 from cell.types.procedure import WeldProcedure
 
 
@@ -64,44 +75,96 @@ def with_paths(segments: Sequence[Segment], paths: Mapping[str, Sequence[npt.Arr
     return out
 
 
+def arc_spans(segments: Sequence[Segment], spans: Mapping[str, tuple[float, float]]) -> tuple[ArcSpan, ...]:
+    """The arcs of the seams welded in several (``spans``: arc id -> (from, to) [m] along its curve), each with when
+    it runs among ``segments`` (their ids still the arcs'): from the start of the move into it to the end of its
+    depart, in time order."""
+    many = Counter(seam_of(a) for a in spans)
+    runs: dict[str, tuple[float, float]] = {}
+    for g in segments:
+        if g.seam_id in spans and many[seam_of(g.seam_id)] > 1:
+            runs[g.seam_id] = (runs.get(g.seam_id, (g.t0, 0.0))[0], g.t1)
+    return tuple(sorted((ArcSpan(a, *spans[a], t0, t1) for a, (t0, t1) in runs.items()), key=lambda x: x.t0))
+
+
 def cover_curves(
     curves: Sequence[CurveEstimate],
     make_search: Mapping[str, SeamSearch],
     q_seed: npt.ArrayLike,
     procedures: Mapping[str, WeldProcedure] | None = None,
-) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure], dict[str, Partial]]:
+    refused: Mapping[str, Sequence[Remainder]] | None = None,
+) -> tuple[dict[str, tuple[SeamSolution, ...]], dict[str, SeamFailure], dict[str, Partial], dict[str, Span]]:
     """Each curve planned from its reach map (:func:`cell.planning.curves.arcs.plan_arcs`: one go where a torch
     setting holds all round, else the fewest overlapping arcs; an open one welded in one pass first by the one-go
     search, :func:`cell.planning.curves.search.plan_curve`, whose ranked candidates follow it closest), with its
-    own search and procedure from q_seed (dof,) [rad]. Returns (arc id -> its solutions, one per pass, for the
-    seams covered whole or in part; seam id -> its failure, for the others: where no arc reaches, with the share
-    of the curve the arm reaches in its words; seam id -> what is left for a manual weld, for the seams welded in
-    part)."""
+    own search and procedure from q_seed (dof,) [rad]. ``refused``: seam id -> stretches along it whose arc was
+    refused after the search (the safety gate), each with its code and why: that arc is left out alone
+    (:func:`.refused.without_refused`), its stretch joined to the remainder (a seam covered whole then welded in
+    part, only with ``curve_remainder: manual``; else, or with no arc left, the seam refused with that reason).
+    Returns (arc id -> its solutions, one per pass, for the seams covered whole or in part; seam id -> its
+    failure, for the others: where no arc reaches, with the share of the curve the arm reaches in its words; seam
+    id -> what is left for a manual weld, for the seams welded in part, and with ``curve_remainder: manual`` for
+    those covered whole in several arcs too, with no remainder, so that one failing after the search leaves the
+    seam in part (:func:`whole_or_none`); arc id -> its (from, to) [m] along its curve, for the seams welded in
+    arcs)."""
     from cell.planning.curves.arcs import plan_arcs
 
-    q0, procs = np.asarray(q_seed, dtype=float), procedures or {}
+    q0, procs, out = np.asarray(q_seed, dtype=float), procedures or {}, refused or {}
     arcs: dict[str, tuple[SeamSolution, ...]] = {}
     still: dict[str, SeamFailure] = {}
     parts: dict[str, Partial] = {}
+    spans: dict[str, Span] = {}
     for c in curves:
         proc = procs.get(c.id)
+        got: Split | None = None
         if not c.closed and (proc is None or len(proc.passes) == 1):  # an open curve: the one-go search first
             one = plan_curve(make_search[c.id], c, q0, proc)
             if isinstance(one, SeamSolution):
-                arcs[arc_id(c.id, 1)] = (one,)
+                aid = arc_id(c.id, 1)
+                got = Split(((replace(c, id=aid), (one,)),), 1.0, None, spans=((aid, 0.0, c.length_m),))
+        got = got or plan_arcs(make_search[c.id], c, q0, proc)
+        if out.get(c.id) and got.arcs:
+            got = _without(got, c, out[c.id], make_search[c.id])
+            if not got.arcs:  # every arc refused: the refusal's reason
+                assert got.failure is not None
+                still[c.id] = got.failure
                 continue
-        got = plan_arcs(make_search[c.id], c, q0, proc)
         if got.whole or got.partial:
             arcs |= {arc.id: sol for arc, sol in got.arcs}
-            if got.partial:
-                spans = {aid: (a, b) for aid, a, b in got.spans}
-                parts[c.id] = Partial(c.length_m, c.closed, got.share, got.remainder, spans)
+            spans |= {aid: (a, b) for aid, a, b in got.spans}
+            pr = make_search[c.id].process
+            if got.partial or (len(got.arcs) > 1 and pr.curve_remainder == "manual"):  # a whole cover: may lose one
+                own = {aid: (a, b) for aid, a, b in got.spans}
+                lap = pr.closed_overlap if c.closed else 0.0
+                parts[c.id] = Partial(c.length_m, c.closed, got.share, got.remainder, own, lap)
             continue
         f = got.failure
         assert f is not None
         tail = "not all" if got.share < 1.0 else "but in no overlapping arcs"
         still[c.id] = replace(f, where=f"{f.where} (the arm reaches {got.share:.0%} of it, {tail})")
-    return arcs, still, parts
+    return arcs, still, parts, spans
+
+
+Span = tuple[float, float]  # (from, to) [m] along a curve
+
+
+def _without(got: Split, c: CurveEstimate, refused: Sequence[Remainder], search: SeamSearch) -> Split:
+    """``got`` with its arcs that the ``refused`` stretches name left out (:func:`.refused.without_refused`); a
+    seam covered whole that would be left in part without the process's ``curve_remainder: manual``, or with no
+    arc left: refused, with the first refusal's reason (share 0)."""
+    pr = search.process
+    spans = {aid: (a, b) for aid, a, b in got.spans}
+    overlap = pr.closed_overlap if c.closed else 0.0
+    gone, rest, share = without_refused(spans, refused, got.remainder, c.length_m, c.closed, overlap)
+    if not gone:
+        return got
+    left = tuple((arc, sol) for arc, sol in got.arcs if arc.id not in gone)
+    first = next(iter(gone.values()))
+    if not left or (rest and not got.partial and pr.curve_remainder != "manual"):
+        k = int(np.argmin(np.abs(np.linspace(0.0, c.length_m, len(c.p_RS)) - first.from_m % c.length_m)))
+        return Split((), 0.0, SeamFailure(first.code, first.why, np.asarray(c.p_RS[k]), 0.0))
+    kept_spans = tuple(s for s in got.spans if s[0] not in gone)
+    return Split(left, share, got.failure, rest, kept_spans)
 
 
 def whole_or_none(
@@ -114,7 +177,10 @@ def whole_or_none(
     timing, a transfer to or from it: its outcome in ``outcomes`` under the arc's id), its other arcs leave
     ``solved`` (and each of ``others``) too and the seam takes the failed arc's outcome, named by the arc. A seam
     already welded in part (in ``parts``) loses only that arc: its stretch joins the seam's remainder, with the
-    failure as its reason (the seam is refused only when no arc is left)."""
+    failure as its reason, less what its other arcs weld or the remainder lists already
+    (:func:`.refused.left_over`); the seam is refused only when no arc is left. A seam covered whole that is in
+    ``parts`` (no remainder: :func:`cover_curves` puts those there with ``curve_remainder: manual``) is so left
+    welded in part."""
     for aid, o in list(outcomes.items()):
         sid = seam_of(aid)
         if sid == aid or o.feasible:
@@ -125,8 +191,9 @@ def whole_or_none(
         if part is not None and left:
             del outcomes[aid]
             a, b = part.spans[aid]
-            rest = (*part.remainder, Remainder(a, b, o.code or PlanReason.IK_FAILED, why))
-            rest = tuple(sorted(rest, key=lambda r: r.from_m % part.length_m))
+            gone = Remainder(a, b, o.code or PlanReason.IK_FAILED, why)
+            kept = [part.spans[k] for k in left if k in part.spans]
+            rest = left_over(kept, [gone], part.remainder, part.length_m, part.closed, part.overlap_m)
             assert parts is not None
             parts[sid] = replace(part, remainder=rest, share=welded_share(rest, part.length_m, part.closed))
             continue

@@ -33,8 +33,8 @@ class Split:
     """The arcs found for one curved seam: each arc's estimate (an open piece of the curve, id ``<seam>#arcK``) and
     solutions (one per pass), in weld order; ``share`` the part of the curve they cover (1: the whole seam);
     ``failure`` the search's word on the part no arc reaches (None when covered); ``remainder``: a seam welded in
-    part, the stretches its arcs leave for a manual weld (``spans``: each arc's id -> its (from, to) [m] along the
-    located curve)."""
+    part, the stretches its arcs leave for a manual weld; ``spans``: each arc's id -> its (from, to) [m] along the
+    located curve (a whole cover's too)."""
 
     arcs: tuple[tuple[CurveEstimate, tuple[SeamSolution, ...]], ...]
     share: float
@@ -54,14 +54,15 @@ class Split:
 @dataclass(frozen=True)
 class Partial:
     """A curved seam planned in part: its length [m] (``closed``: all round), the part its arcs weld (``share``),
-    what they leave for a manual weld (``remainder``) and each arc's stretch (``spans``: arc id -> (from, to) [m]
-    along the curve)."""
+    what they leave for a manual weld (``remainder``), each arc's stretch (``spans``: arc id -> (from, to) [m]
+    along the curve) and the WPS's restart overlap [m] between its arcs (``overlap_m``; 0: an open curve's)."""
 
     length_m: float
     closed: bool
     share: float
     remainder: tuple[Remainder, ...]
     spans: dict[str, tuple[float, float]]
+    overlap_m: float = 0.0
 
 
 def arc_id(seam_id: str, k: int) -> str:

@@ -5,12 +5,14 @@ its reason (docs/report.md). Millimetres where named _mm."""
 from __future__ import annotations
 
 import csv
+import io
 import math
 from pathlib import Path
 from typing import Any
 
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
 from cell.geometry import FloatArray, invert, transform_points
+from cell.outputs import write_text
 from cell.pipeline.records import Detection
 from cell.types import SeamStatus, Unsupported, UnsupportedSeam
 from cell.types.curve_estimate import CurveEstimate, CurveMetrics
@@ -219,16 +221,15 @@ _MANUAL_COLUMNS = (
 def write_manual_welds(rep: dict[str, Any], folder: Path) -> list[Path]:
     """The welder's list of what the programs leave undone on the report's curves welded in part: one row per
     stretch of a ``remainder`` (seam, from and to along the located curve, its length, where it starts and ends
-    in the drawing's frame [mm], why the arm leaves it) in ``folder``/:data:`MANUAL_WELDS`; nothing written
+    in the drawing's frame [mm], why the arm leaves it) in ``folder``/:data:`MANUAL_WELDS`, whole; nothing written
     (and [] returned) when no curve is welded in part."""
     rows = [(s["id"], r) for s in rep["seams"] for r in s.get("remainder") or ()]
     if not rows:
         return []
-    path = folder / MANUAL_WELDS
-    with path.open("w", newline="") as f:
-        out = csv.writer(f)
-        out.writerow(_MANUAL_COLUMNS)
-        for sid, r in rows:
-            a, b = r.get("from_xyz_mm") or [None] * 3, r.get("to_xyz_mm") or [None] * 3
-            out.writerow([sid, r["from_mm"], r["to_mm"], r["length_mm"], *a, *b, r["code"], r["why"]])
-    return [path]
+    text = io.StringIO()
+    out = csv.writer(text, lineterminator="\n")
+    out.writerow(_MANUAL_COLUMNS)
+    for sid, r in rows:
+        a, b = r.get("from_xyz_mm") or [None] * 3, r.get("to_xyz_mm") or [None] * 3
+        out.writerow([sid, r["from_mm"], r["to_mm"], r["length_mm"], *a, *b, r["code"], r["why"]])
+    return [write_text(folder / MANUAL_WELDS, text.getvalue(), what="welder's list")]

@@ -14,11 +14,12 @@ from cell.pipeline.detect import (
     table_z_R,
 )
 from cell.pipeline.evaluation import truths
+from cell.pipeline.gated import plan_for
 from cell.pipeline.geometry import open_cell, robot_arm
 from cell.pipeline.job import WeldJob
 from cell.pipeline.records import Capture, Detection, Scene, SeamWeld, WeldRun
 from cell.pipeline.rescan import RescanMode, rescan_detection, rescan_seams, rescanned
-from cell.pipeline.weld import execute, plan_for, torch_paths, weld
+from cell.pipeline.weld import execute, torch_paths, weld
 
 __all__ = [
     "AlignStart",

@@ -1,5 +1,5 @@
 """Tack welds before the turn (docs/flip.md): short welds on the seam line that hold the parts together
-while the operator turns the part over. Side A's plan welds them first (:func:`cell.pipeline.weld.plan_for`'s
+while the operator turns the part over. Side A's plan welds them first (:func:`cell.pipeline.gated.plan_for`'s
 ``tacks``), each as its own task ``<seam id>~tack<k>`` with its seam's procedure (one pass, no weave); the full
 welds then run over them. Lengths in metres inside, millimetres in :class:`TackRecord`."""
 

@@ -164,7 +164,7 @@ def _positioner_s(plan: TurnoverPlan) -> float:
 def tack_rule(
     count: int, length_m: float, chosen: list[Tack]
 ) -> Callable[[Detection, Sequence[SeamTask]], Sequence[SeamTask]]:
-    """The tacks side A lays (:func:`cell.pipeline.weld.plan_for`'s ``tacks``): ``count`` of ``length_m`` on its
+    """The tacks side A lays (:func:`cell.pipeline.gated.plan_for`'s ``tacks``): ``count`` of ``length_m`` on its
     seams (:func:`cell.pipeline.tacks.choose_tacks`, each pair of parts its first tack before any gets a second)
     when the turn will be made, none otherwise; what it chose is put in ``chosen`` (the run's record of them)."""
 

@@ -24,12 +24,12 @@ from cell.geometry import invert
 from cell.perception.align.near_pose import near_seed
 from cell.pipeline import Detection
 from cell.pipeline.detect import detect, read_weldmap, table_z_R
+from cell.pipeline.gated import plan_for
 from cell.pipeline.geometry import robot_arm
 from cell.pipeline.records import WeldRun
 from cell.pipeline.restrict import restricted
 from cell.pipeline.turnover import plan_turn, turnover_result
 from cell.pipeline.turnover_run import TurnoverRun
-from cell.pipeline.weld import plan_for
 from cell.planning.turnover import plan_turnover
 from cell.scenario.cell_specs import PoseSpec
 from cell.seams.joint import find_joints

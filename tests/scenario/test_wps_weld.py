@@ -13,8 +13,9 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.export.procedure_report import procedure_entry
 from cell.geometry import invert, point_line_distance, transform_points
+from cell.pipeline.gated import plan_for
 from cell.pipeline.outcomes import seam_welds
-from cell.pipeline.weld import execute, plan_for
+from cell.pipeline.weld import execute
 from cell.station.sim import SimStation
 
 WEAVE, TWO = "BOTTOM_RAIL>POST_R:+y", "BOTTOM_RAIL>POST_R:+z"  # a vertical T fillet, a top corner fillet

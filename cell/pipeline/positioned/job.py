@@ -159,9 +159,10 @@ def _weld_pose(
 ) -> GroupRun:
     """Turn the positioner to ``pose``, carry its seams, plan, gate and weld them."""
     from cell.gate import GateRefusedError
+    from cell.pipeline.gated import plan_for
     from cell.pipeline.outcomes import doubt, seam_welds
     from cell.pipeline.playback import measurer
-    from cell.pipeline.weld import execute, plan_for
+    from cell.pipeline.weld import execute
 
     sc = det.scenario
     progress(

@@ -178,11 +178,14 @@ def test_a_partial_curve_in_the_report_and_the_programs_header() -> None:
     )  # the programs' header
 
 
-def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(tmp_path: Path) -> None:
+def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A remainder's ends are the located curve's points that far along it, in the drawing's frame (the part's
     pose undone); the list beside the programs has one row per stretch, none when no curve is welded in part."""
     import csv
 
+    from cell.cli.tables import print_curves
     from cell.export.curve_report import MANUAL_WELDS, weld_entry, write_manual_welds
     from cell.geometry import invert, make_pose
     from cell.types import SeamStatus
@@ -209,6 +212,9 @@ def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(tmp_pa
     assert "from_xyz_mm" not in weld_entry(w)["remainder"][0]  # no pose: along the curve only
 
     rep = {"seams": [{"id": "PLATE>BASE:+x", "welded": True}, {"id": est.id, **entry}]}
+    seam = {"curved": True, "status": "found", "curve": None, "error_mm": None, "time_ms": 9.0, "not_welded": None}
+    print_curves({"seams": [{**seam, **rep["seams"][1]}]})  # the console: each stretch where it lies
+    assert "from (0, 50, 0) to (-50, 0, 0) mm on the drawing: torch vs GUSSET_1" in capsys.readouterr().out
     (path,) = write_manual_welds(rep, tmp_path)
     assert path == tmp_path / MANUAL_WELDS
     rows = list(csv.DictReader(path.open()))

@@ -82,6 +82,7 @@ class SimCell:
         self._drawn: dict[int, bytes] = {}  # what a vertex mesh's shape data does not say (render_cache.scene_key)
         self._bodies[GROUND] = add_floor(self.client, ground, _RGBA[GROUND], drawn=gui)
         self._floor = Floor(0.0, (ground.size[0] / 2.0, ground.size[1] / 2.0), floor_colour(_RGBA[GROUND]))
+        # The floor's key: its size and colour (drawn by Floor, not by TinyRenderer: its body has no face to digest).
         self._drawn[self._bodies[GROUND]] = mesh_digest(ground.size[None, :], np.array([self._floor.rgb]))
         table = scenario.table
         self._add_box(TABLE, Box(make_pose(p=table.center_m), np.array(table.size_m)), _RGBA[TABLE])

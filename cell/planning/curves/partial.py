@@ -173,8 +173,8 @@ def _unwelded(
     failed: Sequence[tuple[float, float, SeamFailure]],
 ) -> Remainder:
     """A stretch from lo to hi [m] no arc welds, with why (:func:`remainder`)."""
-    f = next((f for a, b, f in failed if _overlap(a, b, lo, hi, total, closed) > EPS_M), None)
-    unheld = sum(_overlap(a, b, lo, hi, total, closed) for a, b in gaps(runs, total, closed, 0.0))
+    f = next((f for a, b, f in failed if shared_m(a, b, lo, hi, total, closed) > EPS_M), None)
+    unheld = sum(shared_m(a, b, lo, hi, total, closed) for a, b in gaps(runs, total, closed, 0.0))
     if unheld > EPS_M or not runs:
         code, why = why_stopped(list(misses), lo - 0.01, hi + 0.01, total, closed)
         words = f"no torch setting holds {unheld * 1000:.0f} mm of it ({why})"
@@ -191,7 +191,7 @@ def _unwelded(
     return Remainder(lo, hi, code, f"the arm holds it only in stretches {SHORT_OR_BEYOND}")
 
 
-def _overlap(a: float, b: float, lo: float, hi: float, total: float, closed: bool) -> float:
+def shared_m(a: float, b: float, lo: float, hi: float, total: float, closed: bool) -> float:
     """How long [m] [a, b] and [lo, hi] (along a curve ``total`` long, round a closed one's start) share."""
     shifts = (-total, 0.0, total) if closed else (0.0,)
     return sum(max(0.0, min(b + k, hi) - max(a + k, lo)) for k in shifts)

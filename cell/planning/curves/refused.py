@@ -8,15 +8,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from cell.planning.curves.partial import EPS_M, welded_share
+from cell.planning.curves.partial import EPS_M, shared_m, welded_share
 from cell.types.plan import Remainder
-
-
-def shared_m(a: float, b: float, c: float, d: float, total: float, closed: bool) -> float:
-    """How long [m] the stretches [a, b] and [c, d] along a curve ``total`` long share (round a closed one's
-    start)."""
-    shifts = (-total, 0.0, total) if closed else (0.0,)
-    return sum(max(0.0, min(b, d + k) - max(a, c + k)) for k in shifts)
 
 
 def refused_arc(spans: Mapping[str, tuple[float, float]], r: Remainder, total: float, closed: bool) -> str | None:

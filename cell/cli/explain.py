@@ -12,8 +12,8 @@ from collections import Counter
 from collections.abc import Mapping
 from typing import Any
 
-from cell.cli.tables import partial_text
 from cell.errors import EXIT_PARTIAL
+from cell.types.run import partial_text
 
 
 def _counted(counts: Counter[str]) -> str:

@@ -18,6 +18,7 @@ from rich.table import Table
 
 from cell.cli.common import TableFormat, out
 from cell.types import Unsupported
+from cell.types.run import partial_text
 
 if TYPE_CHECKING:
     from cell.pipeline.records import Detection
@@ -126,11 +127,6 @@ def not_supported_text(summary: Mapping[str, Any]) -> str:
     if tried:
         out.append(f"{sum(tried.values())} curved not welded ({', '.join(sorted(tried))})")
     return "; ".join(out)
-
-
-def partial_text(n: int, manual_mm: float | None) -> str:
-    """``1 curved seam partly welded: 21 mm left for a manual weld``."""
-    return f"{n} curved seam{'s' * (n != 1)} partly welded: {manual_mm or 0.0:.0f} mm left for a manual weld"
 
 
 def print_curves(rep: Mapping[str, Any]) -> None:

@@ -19,7 +19,7 @@ from cell.preview.html import figure_3d
 from cell.preview.results import results_rows, results_table
 from cell.preview.views import ARC_COLOUR, STATUS_COLOURS, SeamView, seam_views
 from cell.types import JointLimits, SeamRecord, Trajectory, WeldPlan
-from cell.types.run import WeldReason
+from cell.types.run import WeldReason, partial_text
 
 if TYPE_CHECKING:
     from cell.pipeline.records import WeldRun
@@ -117,9 +117,7 @@ def _summary(run: WeldRun, records: Sequence[SeamRecord]) -> str:
     if codes:
         parts.append(f"{len(codes)} not supported: {', '.join(sorted(set(codes)))}")
     if part:
-        manual_mm = sum(w.manual_m for w in part) * 1000.0
-        parts.append(f"{len(part)} curved seam{'s' * (len(part) != 1)} partly welded: {manual_mm:.0f} mm left for a "
-                     "manual weld")  # fmt: skip
+        parts.append(partial_text(len(part), sum(w.manual_m for w in part) * 1000.0))
     if tried:
         parts.append(f"{len(tried)} curved not welded: {', '.join(sorted(set(tried)))}")
     if run.execution is not None:

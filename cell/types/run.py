@@ -37,6 +37,12 @@ class WeldReason(enum.StrEnum):
     #   weld (each stretch along it and why) is left for a manual weld; never counted as welded
 
 
+def partial_text(n: int, manual_mm: float | None) -> str:
+    """How ``n`` curved seams welded in part are said everywhere (the console, the exit line, the page):
+    ``1 curved seam partly welded: 21 mm left for a manual weld``."""
+    return f"{n} curved seam{'s' * (n != 1)} partly welded: {manual_mm or 0.0:.0f} mm left for a manual weld"
+
+
 class LastCheck(enum.StrEnum):
     """Which test of the last check before the arc a located seam failed (:mod:`cell.seams.checks.last_check`)."""
 

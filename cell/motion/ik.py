@@ -14,7 +14,7 @@ from numpy.linalg import _umath_linalg
 
 from cell.config.motion import IKOptions
 from cell.errors import IKError
-from cell.geometry import FloatArray, axis_angle_to_matrix, readonly
+from cell.geometry import FloatArray, axis_angle_to_matrix, cross3, readonly
 from cell.motion.robot import RobotModel
 
 
@@ -64,7 +64,7 @@ class _Attempt:
 def _align_z(R_RF: FloatArray, z_RT: FloatArray) -> FloatArray:
     """R_RF turned by the smallest rotation that carries its z axis onto z_RT (unit, in R)."""
     z_RF = R_RF[:, 2]
-    axis = _cross(z_RF, z_RT)
+    axis = cross3(z_RF, z_RT)
     s, c = math.sqrt(float(axis @ axis)), float(z_RF @ z_RT)
     if s < 1e-12:
         if c > 0.0:
@@ -80,19 +80,12 @@ def _errors(X_RF: FloatArray, X_RT: FloatArray, free_axis: bool) -> tuple[float,
     pos = math.sqrt(float(d @ d))
     if free_axis:
         zf, zt = X_RF[:3, 2], X_RT[:3, 2]
-        c = _cross(zf, zt)
+        c = cross3(zf, zt)
         return pos, math.atan2(math.sqrt(float(c @ c)), float(zf @ zt))
     R = X_RF[:3, :3].T @ X_RT[:3, :3]
     cos = (float(R.trace()) - 1.0) / 2.0
     v = _vee(R)
     return pos, math.atan2(math.sqrt(float(v @ v)), cos)
-
-
-def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
-    """a x b of two (3,) vectors: ``np.cross``'s products and differences, without its broadcasting set-up."""
-    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
-    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def _vee(R: FloatArray) -> FloatArray:

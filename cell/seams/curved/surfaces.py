@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cell.geometry import FloatArray, readonly
+from cell.geometry import FloatArray, cross3, readonly
 from cell.types import Cylinder
 
 # A surface as f(p) (n,) [m] and its gradient (n, 3), for points p (n, 3).
@@ -21,16 +21,12 @@ _ITERATIONS = 30
 _CONVERGED_M = 1e-12
 
 
-def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def basis(u: FloatArray) -> FloatArray:
     """(2, 3) two unit vectors perpendicular to the unit ``u`` (3,) and to each other."""
     helper = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = _cross(u, helper)
+    e1 = cross3(u, helper)
     e1 /= np.linalg.norm(e1)
-    return np.stack([e1, _cross(u, e1)])
+    return np.stack([e1, cross3(u, e1)])
 
 
 @dataclass(frozen=True)

@@ -133,6 +133,8 @@ def print_curves(rep: Mapping[str, Any]) -> None:
     """One line per curved seam of a report: found or why not, its sigmas, its error against the true curve (in
     simulation), its time, and why it is not welded; welded in part, a line per stretch left for a manual weld
     (along the curve, and its ends on the drawing where the report has them)."""
+    from cell.export.curve_report import remainder_words
+
     for s in rep["seams"]:
         if not s.get("curved"):
             continue
@@ -151,11 +153,7 @@ def print_curves(rep: Mapping[str, Any]) -> None:
         line += f", {_fmt(s['time_ms'], 1)} ms; {done}"
         out.print(line, soft_wrap=True, markup=False)
         for r in s.get("remainder") or ():
-            where = f"{r['from_mm']:.0f}-{r['to_mm']:.0f} mm along it ({r['length_mm']:.0f} mm, {r['code']})"
-            if r.get("from_xyz_mm") and r.get("to_xyz_mm"):  # where it lies on the drawing
-                a, b = ("(" + ", ".join(str(round(v)) for v in r[k]) + ")" for k in ("from_xyz_mm", "to_xyz_mm"))
-                where += f" from {a} to {b} mm on the drawing"
-            out.print(f"  manual weld: {where}: {r['why']}", soft_wrap=True, markup=False, highlight=False)
+            out.print(f"  manual weld: {remainder_words(r)}", soft_wrap=True, markup=False, highlight=False)
 
 
 def _value(cell: str) -> str | float | None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -119,6 +120,16 @@ def remainder_entry(r: Remainder, est: CurveEstimate | None = None, X_MR: FloatA
         p_MS = transform_points(X_MR, est.points_at([r.from_m, r.to_m])) * 1000.0
         out["from_xyz_mm"], out["to_xyz_mm"] = ([_r(float(v), 1) for v in p] for p in p_MS)
     return out
+
+
+def remainder_words(entry: Mapping[str, Any]) -> str:
+    """A stretch left for a manual weld (a :func:`remainder_entry`) in the words the console and the page give it:
+    along the curve, how long, its code, and its ends on the drawing where the entry has them (whole mm)."""
+    where = f"{entry['from_mm']:.0f}-{entry['to_mm']:.0f} mm along it ({entry['length_mm']:.0f} mm, {entry['code']})"
+    if entry.get("from_xyz_mm") and entry.get("to_xyz_mm"):
+        a, b = ("(" + ", ".join(str(round(v)) for v in entry[k]) + ")" for k in ("from_xyz_mm", "to_xyz_mm"))
+        where += f" from {a} to {b} mm on the drawing"
+    return f"{where}: {entry['why']}"
 
 
 def not_welded_entries(det: Detection) -> list[dict[str, Any]]:

@@ -54,11 +54,12 @@ def figure_3d(
     max_points: int = 30_000,
     view: CellView | None = None,
     hover: Mapping[str, str] | None = None,
+    extra: Sequence[Mapping[str, Any]] = (),
 ) -> Any:
     """The interactive 3D view (a plotly ``Figure``) in R [mm]: cloud, part boxes, seams by status (hover: the
-    seam's ``hover`` text), true ends, torch axes, tool paths; with ``view`` also the table, the robot's links
-    (a slider moves them along the path) and the camera frusta, and the camera framed to the part. Arguments as
-    :func:`render_overview`."""
+    seam's ``hover`` text), true ends, torch axes, tool paths, the ``extra`` traces (plotly dicts: the curved seams,
+    :mod:`cell.preview.curves3d`); with ``view`` also the table, the robot's links (a slider moves them along the
+    path) and the camera frusta, and the camera framed to the part. Arguments as :func:`render_overview`."""
     import plotly.graph_objects as go
 
     cloud = thin(cloud_R, max_points) * MM
@@ -160,6 +161,7 @@ def figure_3d(
                 line={"color": PATH_COLOUR, "width": 3},
             )
         )
+    traces += [dict(t) for t in extra]
     layout: dict[str, Any] = {
         "title": {"text": title or "weld cell preview (robot frame R, mm)"},
         # legend on the left, the cloud's colour bar on the right: never over each other

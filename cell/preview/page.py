@@ -15,6 +15,7 @@ import numpy as np
 
 from cell.geometry import FloatArray, invert, transform_points
 from cell.outputs import write_text
+from cell.preview.curves3d import curve_traces
 from cell.preview.html import figure_3d
 from cell.preview.results import results_rows, results_table
 from cell.preview.views import ARC_COLOUR, STATUS_COLOURS, SeamView, seam_views
@@ -143,9 +144,12 @@ def write_page(run: WeldRun, out_path: str | Path, *, title: str = "", max_point
         for r in results_rows(records)
     }
     cloud, views, poses, tcp = draw_inputs(run)
+    X_MR = invert(det.scene.X_RM) if det.scene is not None else None
+    curves = curve_traces(det.curve_estimates, det.curve_welds, X_MR)
     fig3d = figure_3d(
-        cloud, det.weldmap_R, views, poses, tcp, title=title, max_points=max_points, view=run.view, hover=hover
-    )
+        cloud, det.weldmap_R, views, poses, tcp, title=title, max_points=max_points, view=run.view, hover=hover,
+        extra=curves,
+    )  # fmt: skip
     body = [
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{_summary(run, records)}</p>",

@@ -227,3 +227,52 @@ def test_joint_plots_shade_each_weld_on_every_row_and_draw_only_the_limits_in_vi
     assert lines == [("y", pytest.approx(math.degrees(3.0)))]
     labels = [(a["text"], a["x"], a["xref"]) for a in layout["annotations"] if a["text"] in ("S1", "S2")]
     assert labels == [("S1", 1.75, "x"), ("S2", 6.5, "x")]
+
+
+def test_the_page_marks_the_stretches_left_for_a_manual_weld_on_their_located_curve(tmp_path: Path) -> None:
+    """A curve welded in part is drawn with its remainder dashed over it, each stretch from its start to its end
+    along the located curve (one passing the closed curve's start), hovering the console's words; a curve not
+    welded goes in its own trace; with the map's pose, the stretch's ends on the drawing."""
+    from cell.export.curve_report import remainder_entry, remainder_words
+    from cell.geometry import invert
+    from cell.preview.curves3d import curve_traces
+    from cell.types.curve_estimate import CurveEstimate
+    from cell.types.plan import PlanReason, Remainder
+
+    def circle(cid: str, x0: float) -> CurveEstimate:
+        t = np.linspace(0.0, 2 * np.pi, 300, endpoint=False)
+        p = np.column_stack([x0 + 0.05 * np.cos(t), 0.05 * np.sin(t), np.zeros_like(t)])
+        up, out = np.tile([0.0, 0.0, 1.0], (300, 1)), np.column_stack([np.cos(t), np.sin(t), 0 * t])
+        return CurveEstimate(cid, SeamStatus.FOUND, p_RS=p, n_abutting_R=out, n_receiving_R=up, closed=True,
+                             sigma_m=np.full(300, 1e-4))  # fmt: skip
+
+    part, refused = circle("TUBE>PLATE:circle", 0.0), circle("POST>PLATE:circle", 0.3)
+    L = part.length_m
+    rest = (Remainder(0.25 * L, 0.5 * L, PlanReason.COLLISION, "torch vs GUSSET_1"),
+            Remainder(0.9 * L, 1.1 * L, PlanReason.IK_FAILED, "no torch setting holds it"))  # fmt: skip
+    welds = {
+        part.id: SeamWeld(part.id, True, False, "welded in part", code=WeldReason.PARTIAL, share=0.55, remainder=rest),
+        refused.id: SeamWeld(refused.id, False, False, "no IK", code=WeldReason.NOT_PLANNED),
+    }
+    run = tiny_run()
+    run = replace(run, detection=replace(run.detection, curve_estimates=(part, refused), curve_welds=welds))
+    figs, _ = read(write_page(run, tmp_path / "cell.html"))
+    data = {t.get("name"): t for t in figs["cell3d"]["data"]}
+    assert data["curves welded in part"]["text"][0].startswith(part.id)
+    assert data["curves not welded"]["text"][0] == f"{refused.id}<br>not welded: no IK"
+    manual = data["manual weld"]
+    xyz = np.array([manual[k] for k in "xyz"], dtype=float).T  # None breaks -> nan
+    pieces = np.split(xyz, np.flatnonzero(np.isnan(xyz[:, 0])))
+    pieces = [p[~np.isnan(p[:, 0])] for p in pieces if (~np.isnan(p[:, 0])).any()]
+    assert len(pieces) == 2
+    for p, r in zip(pieces, rest, strict=True):
+        ends = part.points_at([r.from_m, r.to_m]) * 1000.0
+        assert np.allclose(p[[0, -1]], ends, atol=0.06)
+        assert np.allclose(np.hypot(p[:, 0], p[:, 1]), 50.0, atol=0.1)  # along the curve, not its chord
+        assert np.linalg.norm(np.diff(p, axis=0), axis=1).sum() == pytest.approx(r.length_m * 1000.0, rel=0.01)
+    words = remainder_words(remainder_entry(rest[0]))  # the console's line for it
+    assert manual["text"][0] == f"{part.id}<br>manual weld {words}" and words.startswith("78-157 mm along it")
+    X_RM = make_pose(p=[0.2, 0.0, 0.1])  # the drawing 0.2 m behind and 0.1 m below R: the ends moved by it
+    (_, _, mark) = curve_traces((part, refused), welds, invert(X_RM))
+    a = np.round(part.points_at([rest[0].from_m])[0] * 1000.0 - [200.0, 0.0, 100.0]).astype(int)
+    assert f"from ({a[0]}, {a[1]}, {a[2]})" in mark["text"][0] and mark["text"][0].endswith("torch vs GUSSET_1")

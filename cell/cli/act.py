@@ -7,7 +7,6 @@ keeps the job's journal and stops on SIGINT, SIGTERM or SIGHUP with a report bui
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -30,7 +29,19 @@ from cell.cli.common import (
     say,
     was_interrupted,
 )
-from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
+from cell.cli.outputs import (
+    Stage,
+    Writer,
+    check_file,
+    check_folder,
+    check_rerun,
+    finish,
+    interrupted,
+    interrupted_report,
+    on_interrupt,
+    write_page,
+    write_rerun,
+)
 from cell.cli.tables import print_rescan
 from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, UsageError
 
@@ -138,7 +149,7 @@ def weld(
         if controller not in ("krl", "rapid"):
             raise UsageError(f"--controller {controller!r} is unknown; valid: krl, rapid")
         check_file(html, "--html", stdout_ok=False)
-        _check_rerun(rerun_path)
+        check_rerun(rerun_path)
         side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise, calibration)
         if scn.robot.positioner is not None:  # the positioner, not an operator, turns the part (docs/positioner.md)
@@ -172,9 +183,9 @@ def weld(
                 amend = joined(log, on_b=turned is not None)
                 partial = finish_turnover(job, json_path, program, title="weld", provenance=prov, writer=writer,
                                           fmt=table, controller=controller, amend=amend)  # fmt: skip
-                if html is not None and writer.attempt(lambda: _write_page(run, html)) is not None:
+                if html is not None and writer.attempt(lambda: write_page(run, html)) is not None:
                     say(f"page: {html}")
-                _write_rerun(run, rerun_path, writer)
+                write_rerun(run, rerun_path, writer)
                 errs = [e for e in (job.side_a.error, job.side_b and job.side_b.error, job.error) if e is not None]
                 code = EXIT_USAGE if writer.failures else EXIT_PARTIAL if partial else 0
                 end_job(log, "failed" if errs else "partial" if partial else "complete", code, partial or "")
@@ -266,7 +277,7 @@ def preview(
     with cell_errors():
         table = parse_format(fmt)
         check_folder(out_dir, "--out")
-        _check_rerun(rerun_path)
+        check_rerun(rerun_path)
         side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise, calibration)
         json_path = out_dir / "report.json"
@@ -284,7 +295,7 @@ def preview(
                 job = weld_part(scn, asked, progress=stage)
                 run = job.side_a
             partial = finish_turnover(job, json_path, None, title="preview", provenance=prov, writer=writer, fmt=table)
-            _write_rerun(run, rerun_path, writer)  # before the pictures: it needs no cloud, they do
+            write_rerun(run, rerun_path, writer)  # before the pictures: it needs no cloud, they do
             stage(f"drawing pictures into {out_dir}/")
             done = run
             paths = writer.attempt(lambda: write_run(done, out_dir)) or []
@@ -294,51 +305,5 @@ def preview(
         except (KeyboardInterrupt, ImportError) as e:
             if not was_interrupted(e):
                 raise
-            _interrupted(run, scn, method, stage, prov, writer, json_path)
+            interrupted(run, scn, method, stage, prov, writer, json_path)
     finish(writer, partial)
-
-
-def _interrupted(
-    run: WeldRun | None,
-    scn: Scenario,
-    method: str | None,
-    stage: Stage,
-    prov: Mapping[str, Any],
-    writer: Writer,
-    json_path: Path | None,
-) -> None:
-    """Ctrl-C: the run's report if the pipeline returned, else what ran and where it stopped; exit 130."""
-    from cell.export.report import weld_report
-
-    rep = weld_report(run, provenance=prov) if run is not None else interrupted_report(scn, method, stage.last, prov)
-    on_interrupt(writer, json_path, rep, stage.last)
-    raise typer.Exit(EXIT_INTERRUPTED) from None
-
-
-def _write_page(run: WeldRun | None, path: Path) -> Path:
-    """The run's page (results, 3D cell, joint plots: :func:`cell.preview.write_page`)."""
-    from cell.preview import write_page
-
-    if run is None:
-        raise ValueError("no run to draw")
-    return write_page(run, path)
-
-
-def _check_rerun(path: Path | None) -> None:
-    """Before the run: ``--rerun`` needs rerun-sdk installed and a file it can write (UsageError/OutputError)."""
-    if path is None:
-        return
-    from cell.preview.rerun import require_rerun
-
-    require_rerun()
-    check_file(path, "--rerun", stdout_ok=False)
-
-
-def _write_rerun(run: WeldRun, path: Path | None, writer: Writer) -> None:
-    """The run's Rerun recording (:func:`cell.preview.rerun.record_run`), if asked for; its failure is the writer's."""
-    if path is None:
-        return
-    from cell.preview.rerun import record_run
-
-    if writer.attempt(lambda: record_run(run, path)) is not None:
-        say(f"rerun recording: {path}")

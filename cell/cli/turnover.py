@@ -51,6 +51,7 @@ def finish_turnover(
     the seams earlier runs welded)."""
     from cell.export.curve_report import write_manual_welds
     from cell.export.turnover_report import turnover_report
+    from cell.preview.welder_sheet import write_welder_sheet
 
     rep = turnover_report(run, provenance=provenance)
     rep = amend(rep) if amend is not None else rep
@@ -63,6 +64,7 @@ def finish_turnover(
         written = writer.attempt(
             lambda: [*write_programs(run, krl, provenance, controller, left), *write_manual_welds(rep, krl)]
         )
+        written = [*(written or []), *(writer.attempt(lambda: write_welder_sheet(sides, rep, krl)) or [])]
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
             writer.written("programs", written)

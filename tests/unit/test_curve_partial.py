@@ -221,3 +221,21 @@ def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(
     assert [r["seam"] for r in rows] == [est.id, est.id] and rows[0]["why"] == "torch vs GUSSET_1"
     assert float(rows[1]["from_x_mm"]) == pytest.approx(s45, abs=0.1) and rows[1]["code"] == "ik_failed"
     assert write_manual_welds({"seams": rep["seams"][:1]}, tmp_path / "none") == []
+
+    # The welder's sheet: each stretch drawn from the list's row's start to its end on the drawing, numbered as the
+    # row; the part's outline under it; nothing drawn when no curve is welded in part.
+    from test_preview import colour_fraction
+
+    from cell.preview.curves3d import MANUAL_COLOUR
+    from cell.preview.welder_sheet import SHEET, draw_sheet, stretches_M, write_welder_sheet
+
+    rows_in = [(est.id, r) for r in entry["remainder"]]
+    got_m = stretches_M(rows_in, {est.id: (est, invert(X_RM))})
+    assert [n for n, _ in got_m] == [1, 2]
+    for (_, p), r in zip(got_m, entry["remainder"], strict=True):
+        assert np.allclose(p[0], r["from_xyz_mm"], atol=0.1) and np.allclose(p[-1], r["to_xyz_mm"], atol=0.1)
+        assert np.allclose(np.hypot(p[:, 0], p[:, 1]), 50.0, atol=0.1) and np.allclose(p[:, 2], 0.0, atol=1e-6)
+    plate = np.array([[[-60.0, -60.0, 0.0], [60.0, -60.0, 0.0]], [[60.0, -60.0, 0.0], [60.0, 60.0, 0.0]]])
+    sheet = draw_sheet("tube-on-plate", rows_in, {est.id: (est, invert(X_RM))}, plate, tmp_path)
+    assert sheet == tmp_path / SHEET and colour_fraction(sheet, MANUAL_COLOUR) > 1e-3
+    assert write_welder_sheet([], rep, tmp_path / "none") == []  # no run drawn from: nothing written

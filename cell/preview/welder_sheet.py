@@ -1,0 +1,133 @@
+"""The welder's sheet: the part in the drawing's frame with every stretch a curve welded in part leaves for a manual
+weld drawn along its located curve and numbered as the rows of the welder's list (``manual_welds.csv``), in a plan
+and an elevation, each row's words below them.
+
+matplotlib is imported inside the functions (through :mod:`cell.preview.figures`). Values only: the run records
+and the report's entries (:func:`cell.export.curve_report.remainder_entry`); drawn in millimetres in the aligned
+map's frame M, as the welder reads the drawing.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from cell.export.curve_report import remainder_words
+from cell.geometry import FloatArray, invert, transform_points
+from cell.preview.curves3d import MANUAL_COLOUR
+from cell.preview.figures import new_figure, save_figure
+from cell.preview.views import BOX_COLOUR, MM, STATUS_COLOURS
+from cell.types import SeamStatus
+from cell.types.curve_estimate import CurveEstimate
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from cell.pipeline.records import WeldRun
+
+SHEET = "manual_welds.png"
+_VIEWS = (((0, 1), "plan (looking down -z_M)"), ((0, 2), "elevation (looking along +y_M)"))
+_ROW_CHARS = 150  # a row's words are wrapped at this many characters (monospace, 7 pt, on an 11 in sheet)
+
+
+def _curves(runs: Sequence[WeldRun]) -> dict[str, tuple[CurveEstimate, FloatArray]]:
+    """Seam id -> (its located curve in R, the drawing's pose X_MR of that run's robot frame) for every located
+    curve of the runs; a curve located on both sides is taken from the side that welded it in part."""
+    out: dict[str, tuple[CurveEstimate, FloatArray]] = {}
+    for run in runs:
+        det = run.detection
+        if det.scene is None:
+            continue
+        X_MR = invert(det.scene.X_RM)
+        for e in det.curve_estimates:
+            w = det.curve_welds.get(e.id)
+            if e.status is SeamStatus.FOUND and (e.id not in out or (w is not None and w.partial)):
+                out[e.id] = (e, X_MR)
+    return out
+
+
+def _in_M(est: CurveEstimate, X_MR: FloatArray, s_mm: FloatArray | None = None) -> FloatArray:
+    """(k, 3) [mm] in M: the located curve's samples (a closed one's first repeated at its end), or its points
+    ``s_mm`` along it (the report's lengths: :meth:`CurveEstimate.points_at`)."""
+    if s_mm is None:
+        p = np.asarray(est.p_RS)
+        p = np.vstack([p, p[:1]]) if est.closed else p
+    else:
+        p = est.points_at(np.asarray(s_mm) / MM)
+    return transform_points(X_MR, p) * MM
+
+
+def _draw(ax: Axes, ij: tuple[int, int], edges_mm: FloatArray, curves_mm: Sequence[FloatArray],
+          stretches: Sequence[tuple[int, FloatArray]]) -> None:  # fmt: skip
+    """Projection onto axes ij of M [mm]: the parts' edges, the located curves, then each numbered stretch."""
+    i, j = ij
+    for e in edges_mm:
+        ax.plot(e[:, i], e[:, j], color=BOX_COLOUR, lw=0.4, alpha=0.5, zorder=1)
+    for p in curves_mm:
+        ax.plot(p[:, i], p[:, j], color=STATUS_COLOURS["found"], lw=1.0, zorder=2)
+    for n, s in stretches:
+        ax.plot(s[:, i], s[:, j], color=MANUAL_COLOUR, lw=3.5, solid_capstyle="round", zorder=3)
+        mid = s[len(s) // 2]
+        ax.annotate(str(n), (mid[i], mid[j]), xytext=(6, 6), textcoords="offset points", fontsize=8, zorder=4,
+                    bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": MANUAL_COLOUR})  # fmt: skip
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{'xyz'[i]}_M [mm]", fontsize=8)
+    ax.set_ylabel(f"{'xyz'[j]}_M [mm]", fontsize=8)
+    ax.tick_params(labelsize=7)
+
+
+def stretches_M(
+    rows: Sequence[tuple[str, Mapping[str, Any]]], curves: Mapping[str, tuple[CurveEstimate, FloatArray]]
+) -> list[tuple[int, FloatArray]]:
+    """(its number in the welder's list, (k, 3) [mm] in M) for each row (seam id, remainder entry) whose curve is
+    among ``curves``: the located curve from the entry's ``from_mm`` to its ``to_mm``, a point every 2 mm or so."""
+    out = []
+    for n, (sid, r) in enumerate(rows, start=1):
+        if sid in curves:
+            s_mm = np.linspace(r["from_mm"], r["to_mm"], max(2, int(r["length_mm"] / 2.0) + 1))
+            out.append((n, _in_M(*curves[sid], s_mm)))
+    return out
+
+
+def draw_sheet(
+    name: str,
+    rows: Sequence[tuple[str, Mapping[str, Any]]],
+    curves: Mapping[str, tuple[CurveEstimate, FloatArray]],
+    edges_mm: FloatArray,
+    folder: Path,
+) -> Path:
+    """``folder``/:data:`SHEET` for the welder's list's ``rows`` (seam id, remainder entry) on the located
+    ``curves`` (seam id -> (curve in R, X_MR)) and the parts' edges (m, 2, 3) in M [mm]; ``name`` the scenario's."""
+    stretches, drawn = stretches_M(rows, curves), [_in_M(*c) for c in curves.values()]
+    fig = new_figure(11.0, 8.5)
+    grid = fig.add_gridspec(2, 2, height_ratios=[3.0, 1.0])
+    for k, (ij, view) in enumerate(_VIEWS):
+        ax = fig.add_subplot(grid[0, k])
+        _draw(ax, ij, edges_mm, drawn, stretches)
+        ax.set_title(view, fontsize=9)
+    text = fig.add_subplot(grid[1, :])
+    text.axis("off")
+    lines = [
+        textwrap.fill(f"{n:>2}  {sid}: {remainder_words(r)}", _ROW_CHARS, subsequent_indent="    ")
+        for n, (sid, r) in enumerate(rows, start=1)
+    ]
+    text.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", fontsize=7, family="monospace", transform=text.transAxes)
+    fig.suptitle(f"{name}: left for a manual weld (the drawing's frame M, mm)", fontsize=10)
+    return save_figure(fig, folder / SHEET)
+
+
+def write_welder_sheet(runs: Sequence[WeldRun], rep: Mapping[str, Any], folder: Path) -> list[Path]:
+    """The welder's sheet (:func:`draw_sheet`) of the report's stretches left for a manual weld, on the runs'
+    located curves over the aligned map's parts (from the first run that has a scene); [] and nothing written when
+    no curve is welded in part, or no run has a scene to draw from."""
+    rows = [(s["id"], r) for s in rep["seams"] for r in s.get("remainder") or ()]
+    first = next((r.detection for r in runs if r.detection.scene is not None), None)
+    if not rows or first is None or first.scene is None:
+        return []
+    X_MR = invert(first.scene.X_RM)
+    edges = [transform_points(X_MR, e) * MM for p in first.weldmap_R.parts for e in p.edges()]
+    return [draw_sheet(first.scenario.name, rows, _curves(runs), np.asarray(edges).reshape(-1, 2, 3), folder)]

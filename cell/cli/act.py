@@ -34,13 +34,9 @@ from cell.cli.outputs import (
     Writer,
     check_file,
     check_folder,
-    check_rerun,
     finish,
-    interrupted,
     interrupted_report,
     on_interrupt,
-    write_page,
-    write_rerun,
 )
 from cell.cli.tables import print_rescan
 from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, UsageError
@@ -132,7 +128,7 @@ def weld(
     from cell import pipeline
     from cell.cli.journal import end_job, joined, journal_path, open_job, resumed, stopped
     from cell.cli.positioner import weld_positioned
-    from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.cli.turnover import check_rerun, finish_turnover, parse_sides, write_page, write_rerun
     from cell.journal import SideLog, stop_on_signals
     from cell.journal.signals import received
     from cell.pipeline.job import WeldJob
@@ -267,7 +263,7 @@ def preview(
     the planned turn with side B's seams at their nominal turned place (``--sides all``)."""
     from cell import pipeline
     from cell.cli.positioner import weld_positioned
-    from cell.cli.turnover import finish_turnover, parse_sides
+    from cell.cli.turnover import check_rerun, finish_turnover, interrupted, parse_sides, write_rerun
     from cell.pipeline.job import WeldJob
     from cell.pipeline.turnover import weld_part
     from cell.pipeline.turnover_run import TurnoverRun

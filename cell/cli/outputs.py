@@ -22,7 +22,6 @@ from cell.cli.common import detail, fail_line, results_to_stderr, say, warn
 from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, OutputError, OutputFault
 
 if TYPE_CHECKING:
-    from cell.pipeline import WeldRun
     from cell.scenario import Scenario
 
 STDOUT = "-"
@@ -243,49 +242,3 @@ def finish(writer: Writer, partial: str | None) -> None:
         raise typer.Exit(EXIT_USAGE)
     if partial is not None:
         raise typer.Exit(EXIT_PARTIAL)
-
-
-def write_page(run: WeldRun | None, path: Path) -> Path:
-    """The run's page (results, 3D cell, joint plots: :func:`cell.preview.write_page`)."""
-    from cell.preview import write_page as page
-
-    if run is None:
-        raise ValueError("no run to draw")
-    return page(run, path)
-
-
-def check_rerun(path: Path | None) -> None:
-    """Before the run: ``--rerun`` needs rerun-sdk installed and a file it can write (UsageError/OutputError)."""
-    if path is None:
-        return
-    from cell.preview.rerun import require_rerun
-
-    require_rerun()
-    check_file(path, "--rerun", stdout_ok=False)
-
-
-def write_rerun(run: WeldRun, path: Path | None, writer: Writer) -> None:
-    """The run's Rerun recording (:func:`cell.preview.rerun.record_run`), if asked for; its failure is the writer's."""
-    if path is None:
-        return
-    from cell.preview.rerun import record_run
-
-    if writer.attempt(lambda: record_run(run, path)) is not None:
-        say(f"rerun recording: {path}")
-
-
-def interrupted(
-    run: WeldRun | None,
-    scn: Scenario,
-    method: str | None,
-    stage: Stage,
-    prov: Mapping[str, Any],
-    writer: Writer,
-    json_path: Path | None,
-) -> None:
-    """Ctrl-C: the run's report if the pipeline returned, else what ran and where it stopped; exit 130."""
-    from cell.export.report import weld_report
-
-    rep = weld_report(run, provenance=prov) if run is not None else interrupted_report(scn, method, stage.last, prov)
-    on_interrupt(writer, json_path, rep, stage.last)
-    raise typer.Exit(EXIT_INTERRUPTED) from None

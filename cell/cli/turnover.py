@@ -1,5 +1,6 @@
 """``cell weld`` / ``cell preview`` of a whole part (docs/flip.md): the two-sided report, its table and
-the robot programs of both sides with the main program that stops for the operator's turn."""
+the robot programs of both sides with the main program that stops for the operator's turn; the run's page and
+recording, and what Ctrl-C writes."""
 
 from __future__ import annotations
 
@@ -8,15 +9,19 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import typer
+
 from cell.cli.common import TableFormat, fail_line, say
 from cell.cli.explain import weld_exit
-from cell.cli.outputs import Writer
+from cell.cli.outputs import Stage, Writer, check_file, interrupted_report, on_interrupt
 from cell.cli.tables import print_weld
-from cell.errors import UsageError
+from cell.errors import EXIT_INTERRUPTED, UsageError
 from cell.pipeline.job import Sides
 
 if TYPE_CHECKING:
+    from cell.pipeline import WeldRun
     from cell.pipeline.turnover_run import TurnoverRun
+    from cell.scenario import Scenario
     from cell.types.turnover import TurnoverPlan
 
 
@@ -160,3 +165,49 @@ def write_programs(
         stem = "trajectory" if len(runs) == 1 else f"trajectory_{side}"
         written += [write_json(wr.plan, krl / f"{stem}.json"), write_csv(wr.plan, krl / f"{stem}.csv")]
     return list(written)
+
+
+def write_page(run: WeldRun | None, path: Path) -> Path:
+    """The run's page (results, 3D cell, joint plots: :func:`cell.preview.write_page`)."""
+    from cell.preview import write_page as page
+
+    if run is None:
+        raise ValueError("no run to draw")
+    return page(run, path)
+
+
+def check_rerun(path: Path | None) -> None:
+    """Before the run: ``--rerun`` needs rerun-sdk installed and a file it can write (UsageError/OutputError)."""
+    if path is None:
+        return
+    from cell.preview.rerun import require_rerun
+
+    require_rerun()
+    check_file(path, "--rerun", stdout_ok=False)
+
+
+def write_rerun(run: WeldRun, path: Path | None, writer: Writer) -> None:
+    """The run's Rerun recording (:func:`cell.preview.rerun.record_run`), if asked for; its failure is the writer's."""
+    if path is None:
+        return
+    from cell.preview.rerun import record_run
+
+    if writer.attempt(lambda: record_run(run, path)) is not None:
+        say(f"rerun recording: {path}")
+
+
+def interrupted(
+    run: WeldRun | None,
+    scn: Scenario,
+    method: str | None,
+    stage: Stage,
+    prov: Mapping[str, Any],
+    writer: Writer,
+    json_path: Path | None,
+) -> None:
+    """Ctrl-C: the run's report if the pipeline returned, else what ran and where it stopped; exit 130."""
+    from cell.export.report import weld_report
+
+    rep = weld_report(run, provenance=prov) if run is not None else interrupted_report(scn, method, stage.last, prov)
+    on_interrupt(writer, json_path, rep, stage.last)
+    raise typer.Exit(EXIT_INTERRUPTED) from None

@@ -77,10 +77,9 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
         left = "; ".join(f"`{x['id']}`: {x['code']} ({x['reason'].split(': ', 2)[-1][:90]})" for x in seams
                          if not x["welded"] and x["code"] != "partial")  # fmt: skip
         part = ", ".join(f"`{x['id']}`" for x in seams if x["code"] == "partial")
-        left = "; ".join(v for v in (left, f"welded in part (below): {part}" if part else "") if v)
         lines += ["", f"{tee['scenario']}: programs {moves} in the turning base (knots within {off} mm, E2/E3"
                   f" within {dev} deg of the controller's interpolation); welded {done}; not welded:"
-                  f" {left or 'none'}."]  # fmt: skip
+                  f" {left or 'none'}{f'; welded in part (below): {part}' if part else ''}."]  # fmt: skip
     lines += _in_part_lines([r for r in (tee, d.get("round_brace")) if r])
     wv = d.get("weave")
     if wv and wv.get("welded"):
@@ -104,7 +103,8 @@ def _in_part_lines(rows: list[Mapping[str, Any]]) -> list[str]:
     parts = [(r["scenario"], p) for r in rows for p in r.get("in_part") or ()]
     if not parts:
         return []
-    out = ["", "| welded in part: scenario: seam | stretch welded [mm along it] (share) | TCP RMS / max [mm] | worst"
+    out = ["", "| welded in part: scenario: seam | stretch welded [mm along the located curve, past its length: round"
+           " its start] (share) | TCP RMS / max [mm] | worst"
            " slope / rotation off 180 [deg] | tilt; rotate from .. to [deg] | arc / job [s] | planning [s] | program"
            " (knots off / E2-E3 off) | left for a manual weld |", "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for sc, p in parts:

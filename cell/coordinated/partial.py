@@ -115,6 +115,11 @@ def walk(su: Setup, est: CurveEstimate, cand: Candidate, X_RT: FloatArray, rng: 
     link: list[bool] = []
     miss: list[Miss] = []
     q_last: FloatArray | None = None
+
+    def at_m(i: int) -> float:  # knot i's place along the located curve
+        at = path.start - float(path.s[i]) if path.reversed else path.start + float(path.s[i])
+        return at % total if est.closed else at
+
     k = 0
     while k < len(order):
         i = order[k]
@@ -126,16 +131,19 @@ def walk(su: Setup, est: CurveEstimate, cand: Candidate, X_RT: FloatArray, rng: 
                 raise PlanError(f"{hit.a} vs {hit.b}")
         except MotionError as e:
             code, what = (PlanReason.COLLISION, e.message) if isinstance(e, PlanError) else _ik_what(e)
-            at = path.start - float(path.s[i]) if path.reversed else path.start + float(path.s[i])
-            miss.append(Miss(at % total if est.closed else at, code, what))
+            miss.append(Miss(at_m(i), code, what))
             ok.append(False)
             link.append(False)
         else:
-            prev_ok = bool(ok) and ok[-1]
+            jump = float(np.max(np.abs(q - q_last))) if q_last is not None and ok and ok[-1] else None
+            if jump is not None and jump > lim:  # held, but not from the knot before: a configuration flip
+                miss.append(
+                    Miss(at_m(i), PlanReason.FLIP, f"a joint jumps {np.degrees(jump):.0f} deg from the knot before")
+                )
             ok.append(True)
-            link.append(prev_ok and q_last is not None and float(np.max(np.abs(q - q_last))) <= lim)
+            link.append(jump is not None and jump <= lim)
             q_last = q
-        if est.closed and k == n - 1 and not all(ok):  # the second lap: on round the start to the first break
+        if est.closed and k == n - 1 and not all(link[1:] + ok[:1]):  # on round the start to the first break
             cut = next(j for j in range(n) if not ok[j] or (j > 0 and not link[j]))
             order += list(range(cut + (0 if ok[cut] else 1)))
         k += 1
@@ -163,10 +171,12 @@ def plan_in_part(su: Setup, est: CurveEstimate, rng: np.random.Generator) -> Coo
     a manual weld (:func:`leftover`) and its ``share`` of the curve. PlanError when none is planned."""
     t_wall = time.perf_counter()
     total = est.length_m
-    options = []
+    options = []  # a candidate whose every knot is held (its motion refused it whole) leaves no stretch to list
     for cand in candidates(su, est):
         for spin in SPINS_DEG:
             w = walk(su, est, cand, torch_poses(su, cand, spin)[1], rng)
+            if not w.misses:
+                continue
             for k0, k1 in stretches(w.ok, w.link):
                 s_a, s_b = float(w.s_m[k0]), float(w.s_m[k1])
                 whole_start = not est.closed and k0 == 0

@@ -61,3 +61,32 @@ def test_the_positioner_exit_line_says_a_curve_welded_in_part_as_the_fixed_arm_d
         "exit 3: 1 seam not welded (low_confidence: 1); 1 curved seam partly welded: 137 mm left for a manual weld; "
         "1/3 welded"
     )
+
+
+def test_a_loop_is_welded_in_part_only_with_curve_remainder_manual(monkeypatch: pytest.MonkeyPatch) -> None:
+    from types import SimpleNamespace
+
+    import cell.coordinated.partial as partial
+    import cell.coordinated.plan as plan
+    from cell.errors import PlanError
+    from cell.pipeline.coordinated.job import _planned
+
+    def whole(*_a: object, **_k: object) -> None:
+        raise PlanError("no coordinated motion: the torch vs POST")
+
+    monkeypatch.setattr(plan, "plan_coordinated", whole)
+    monkeypatch.setattr(plan, "candidates", lambda su, c: ["a candidate"])
+    monkeypatch.setattr(partial, "plan_in_part", lambda su, c, rng: "in part")
+    opt = SimpleNamespace(spacing=0.0025)
+
+    def planned(remainder: str) -> object:
+        process = SimpleNamespace(travel_speed=0.008, curve_remainder=remainder)
+        c = SimpleNamespace(id="C")
+        return _planned(None, None, c, process, opt, None, [0.0] * 6, None, None, lambda _: None)  # type: ignore[arg-type]
+
+    assert planned("manual") == "in part"
+    with pytest.raises(PlanError, match="torch vs POST"):  # refused whole, as before
+        planned("refuse")
+    monkeypatch.setattr(plan, "candidates", lambda su, c: [])  # no axes hold it in PA: nothing to weld in part
+    with pytest.raises(PlanError, match="torch vs POST"):
+        planned("manual")

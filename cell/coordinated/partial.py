@@ -131,7 +131,8 @@ def walk(su: Setup, est: CurveEstimate, cand: Candidate, X_RT: FloatArray, rng: 
                 raise PlanError(f"{hit.a} vs {hit.b}")
         except MotionError as e:
             code, what = (PlanReason.COLLISION, e.message) if isinstance(e, PlanError) else _ik_what(e)
-            miss.append(Miss(at_m(i), code, what))
+            if k < n:  # a knot tried again on the second lap is counted once
+                miss.append(Miss(at_m(i), code, what))
             ok.append(False)
             link.append(False)
         else:

@@ -3,7 +3,8 @@ the cell runs it (the located curve re-scanned up close at home, the weld gate's
 should the gate refuse it, the first located curve planned, played and measured as a study (docs/positioner.md,
 "Coordinated motion"). Then the same of ``tube-tee-positioner``'s saddle (``tube_tee``: the tilt following the
 seam as well), with every seam of that cell and why it was not welded; and every seam of ``round-brace-positioner``
-(``round_brace``: the leaning brace's elliptical feet, both refused) welded or why not.
+(``round_brace``: the leaning brace's elliptical feet) welded or why not; the curves welded in part with the part
+turning (``in_part``: tube-tee's end-plate circles, the brace's foot), each measured as a weld.
 
     .venv/bin/python benchmarks/bench_coordinated.py [--json PATH] [--noise realistic|small]
 
@@ -30,7 +31,7 @@ import numpy as np
 RESULTS = Path(__file__).resolve().parent / "results"
 SCENARIO = "pipe-stub-positioner"
 TEE, SADDLE = "tube-tee-positioner", "BRANCH>RUN:saddle"  # the saddle: the tilt follows its turning bisector
-BRACE = "round-brace-positioner"  # the leaning brace's elliptical feet: refused (torch vs POST; the tilt limit)
+BRACE = "round-brace-positioner"  # the brace's foot welded in part (torch vs POST at its toe); its top refused
 
 
 def _say(msg: str) -> None:
@@ -38,15 +39,51 @@ def _say(msg: str) -> None:
 
 
 def _seams(run: Any) -> list[dict[str, Any]]:
-    """Every seam of the cell's run (a PositionerRun): welded or why not (its code and sentence), its TCP max."""
+    """Every seam of the cell's run (a PositionerRun): welded or why not (its code and sentence), its TCP RMS and
+    max; a curve welded in part, the share welded and what is left for a manual weld [mm]."""
     welds, out = run.welds(), []
     for sid in run.seam_ids():
         w = welds.get(sid)
         q = w.quality if w is not None else None
         code = w.code if w is not None else run.unheld_codes.get(sid)
-        out.append({"id": sid, "welded": bool(w and w.welded), "code": code.value if code else None,
-                    "reason": w.reason if w is not None else run.unheld.get(sid, ""),
-                    "tcp_max_mm": round(q.tcp_max_mm, 3) if q is not None else None})  # fmt: skip
+        row = {"id": sid, "welded": bool(w and w.welded), "code": code.value if code else None,
+               "reason": w.reason if w is not None else run.unheld.get(sid, ""),
+               "tcp_rms_mm": round(q.tcp_rms_mm, 3) if q is not None else None,
+               "tcp_max_mm": round(q.tcp_max_mm, 3) if q is not None else None}  # fmt: skip
+        if w is not None and w.partial:
+            row |= {"share": round(w.share, 4), "manual_mm": round(w.manual_m * 1000.0, 1)}
+        out.append(row)
+    return out
+
+
+def _in_part(run: Any) -> list[dict[str, Any]]:
+    """Each curve of the cell's run welded in part with the part turning: the stretch welded (from, to along the
+    located curve [mm]) and its share, the TCP RMS / max against the true curve, the weld's ISO 6947 position at
+    its waypoints (worst slope, rotation off 180), the axes, the times, the programs' moves (chords or circles in
+    the turning base, the knots' distance from them, E2/E3 against the controller's interpolation) and what is
+    left for a manual weld (each stretch, its code and why)."""
+    from cell.export.coordinated_program import coordinated_moves, program_path_off
+    from cell.export.positioner_report import coordinated_entry
+
+    welds, out = run.welds(), []
+    for cw in run.coordinated:
+        w = welds.get(cw.seam_id)
+        if not cw.remainder or w is None or w.quality is None:
+            continue
+        e, q, moves = coordinated_entry(cw), w.quality, coordinated_moves(cw)
+        out.append({
+            "curve": cw.seam_id, "span_mm": e["span_mm"], "share": round(cw.share, 4),
+            "tcp_rms_mm": round(q.tcp_rms_mm, 3), "tcp_max_mm": round(q.tcp_max_mm, 3),
+            "slope_worst_deg": round(float(np.abs(cw.slope_deg).max()), 3),
+            "rotation_worst_off_deg": round(float(np.abs(np.asarray(cw.rotation_deg) - 180.0).max()), 3),
+            "in_position": cw.in_position, "tilt_range_deg": e["tilt_range_deg"], "rotate_deg": e["rotate_deg"],
+            "arc_s": e["arc_s"], "job_s": e["job_s"], "plan_wall_s": e["plan_wall_s"],
+            "program_moves": {k: sum(mv.kind == k for mv in moves) for k in ("CIRC", "LIN")},
+            "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4),
+            "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
+            "remainder": [{"from_mm": round(r.from_m * 1000.0, 1), "to_mm": round(r.to_m * 1000.0, 1),
+                           "code": r.code.value, "why": r.why} for r in cw.remainder],
+        })  # fmt: skip
     return out
 
 
@@ -131,6 +168,7 @@ def coordinated_row(
         "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
         "wall_s": round(time.perf_counter() - t, 1),
         "seams": _seams(run),
+        "in_part": _in_part(run),
         "waypoints": entry["waypoints"],
     }
 
@@ -146,7 +184,7 @@ def seams_row(noise: str | None = None, scenario: str = BRACE) -> dict[str, Any]
     t = time.perf_counter()
     run = weld_on_positioner(s)
     return {"scenario": scenario, "noise": noise or "realistic", "wall_s": round(time.perf_counter() - t, 1),
-            "seams": _seams(run)}  # fmt: skip
+            "seams": _seams(run), "in_part": _in_part(run)}  # fmt: skip
 
 
 WEAVE = {"pattern": "zigzag", "width_mm": 3.0, "frequency_hz": 1.0, "dwell_s": (0.1, 0.1)}  # a PA fillet's weave
@@ -203,7 +241,10 @@ def main() -> None:
     row["tube_tee"] = coordinated_row(args.noise, tee_program, TEE, SADDLE)
     _say(f"{BRACE}: the brace's feet with the tilt following them")
     row["round_brace"] = seams_row(args.noise)
-    out = {"command": "benchmarks/bench_coordinated.py" + (f" --noise {args.noise}" if args.noise else ""), **row}
+    from cell.provenance import git_commit
+
+    command = "benchmarks/bench_coordinated.py" + (f" --noise {args.noise}" if args.noise else "")
+    out = {"command": command, "commit": git_commit(), **row}
     args.json.write_text(json.dumps(out, indent=1) + "\n")
     _say(f"wrote {args.json}")
 

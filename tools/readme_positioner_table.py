@@ -75,10 +75,12 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
         seams = tee.get("seams", [])
         done = ", ".join(f"`{x['id']}`" for x in seams if x["welded"])
         left = "; ".join(f"`{x['id']}`: {x['code']} ({x['reason'].split(': ', 2)[-1][:90]})" for x in seams
-                         if not x["welded"])  # fmt: skip
+                         if not x["welded"] and x["code"] != "partial")  # fmt: skip
+        part = ", ".join(f"`{x['id']}`" for x in seams if x["code"] == "partial")
         lines += ["", f"{tee['scenario']}: programs {moves} in the turning base (knots within {off} mm, E2/E3"
                   f" within {dev} deg of the controller's interpolation); welded {done}; not welded:"
-                  f" {left or 'none'}."]  # fmt: skip
+                  f" {left or 'none'}{f'; welded in part (below): {part}' if part else ''}."]  # fmt: skip
+    lines += _in_part_lines([r for r in (tee, d.get("round_brace")) if r])
     wv = d.get("weave")
     if wv and wv.get("welded"):
         p = wv["procedure"]
@@ -93,6 +95,29 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
                   f" {_f(wv['arc_s'], '.1f')} / {_f(wv['job_s'], '.1f')} | {_f(wv['plan_wall_s'], '.1f')} | {rm} |"
                   f" {km} |"]  # fmt: skip
     return "\n".join(lines) + "\n"
+
+
+def _in_part_lines(rows: list[Mapping[str, Any]]) -> list[str]:
+    """The curves welded in part with the part turning (each row's ``in_part``): the stretch welded and its share,
+    the TCP, the position, the axes, the times, the programs and what is left for a manual weld."""
+    parts = [(r["scenario"], p) for r in rows for p in r.get("in_part") or ()]
+    if not parts:
+        return []
+    out = ["", "| welded in part: scenario: seam | stretch welded [mm along the located curve, past its length: round"
+           " its start] (share) | TCP RMS / max [mm] | worst"
+           " slope / rotation off 180 [deg] | tilt; rotate from .. to [deg] | arc / job [s] | planning [s] | program"
+           " (knots off / E2-E3 off) | left for a manual weld |", "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    for sc, p in parts:
+        t, r = p["tilt_range_deg"], p["rotate_deg"]
+        moves = ", ".join(f"{n} {k}" for k, n in p["program_moves"].items() if n)
+        rest = "; ".join(f"{x['from_mm']:.0f}-{x['to_mm']:.0f} mm ({x['code']})" for x in p["remainder"])
+        out.append(f"| {sc}: `{p['curve']}` | {p['span_mm'][0]:.0f}-{p['span_mm'][1]:.0f} ({p['share']:.0%}) |"
+                   f" {_f(p['tcp_rms_mm'])} / {_f(p['tcp_max_mm'])} | {_f(p['slope_worst_deg'], '.2f')} /"
+                   f" {_f(p['rotation_worst_off_deg'], '.2f')} | {_f(t[0], '.1f')} .. {_f(t[1], '.1f')};"
+                   f" {_f(r[0], '.1f')} .. {_f(r[1], '.1f')} | {_f(p['arc_s'], '.1f')} / {_f(p['job_s'], '.1f')} |"
+                   f" {_f(p['plan_wall_s'], '.1f')} | {moves} ({_f(p['program_path_off_mm'], '.3f')} mm /"
+                   f" {_f(p['program_axes_off_deg'], '.2f')} deg) | {rest} |")  # fmt: skip
+    return out
 
 
 def _coordinated_row(d: Mapping[str, Any]) -> str:

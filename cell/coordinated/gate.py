@@ -81,6 +81,15 @@ class MovingScene:
     def _motion(self, dx: FloatArray) -> float:
         return self.still.motion_bound(dx[:-2]) + self.lever_m * float(np.abs(dx[-2:]).sum())
 
+    def contact_at(self, x: npt.ArrayLike) -> Contact | None:
+        """The arm and torch at one state x (dof + 2,) (arm joints, tilt, rotate) [rad] against every group, or
+        None when clear (no motion: a knot's pose alone)."""
+        try:
+            return self._step(np.asarray(x, dtype=float))[1]
+        finally:
+            for checker in (self.tilting, self.turning):
+                checker.place_base(np.eye(4))
+
     def check(self, times: npt.ArrayLike, x: npt.ArrayLike) -> Contact | None:
         """The first contact along the states x (n, dof + 2) (arm joints, tilt, rotate) [rad], linear between
         samples, or None: every check's distance at most ``max_step`` of arm motion relative to each group."""

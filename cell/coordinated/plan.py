@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -144,6 +144,88 @@ def _offsets(cp: CurvePath, procedure: WeldProcedure | None) -> tuple[FloatArray
     return off, off - curve_offsets(cp, replace(procedure, weave=Weave()))
 
 
+@dataclass(frozen=True)
+class Setup:
+    """What every candidate of one seam's coordinated weld shares: the arm, the positioner, the process, the
+    planning options, the moving scene, where the arm starts (dof,) [rad], the weld procedure (None: the process's
+    defaults) and its travel speed [m/s] and knot spacing [m]."""
+
+    robot: RobotModel
+    pos: TiltRotatePositioner
+    process: WeldProcess
+    opt: PlanOptions
+    scene: MovingScene
+    q_start: FloatArray
+    procedure: WeldProcedure | None
+    speed: float
+    spacing: float
+
+    @classmethod
+    def of(cls, robot: RobotModel, pos: TiltRotatePositioner, process: WeldProcess, opt: PlanOptions,
+           scene: MovingScene, q_start: FloatArray, procedure: WeldProcedure | None) -> Setup:  # fmt: skip
+        proc = procedure or WeldProcedure(name="default")
+        speed = proc.travel_speed_mm_s / 1000.0 if procedure is not None else process.travel_speed
+        spacing = knot_spacing(procedure, 0, opt.spacing) if procedure is not None else opt.spacing  # follows a weave
+        return cls(robot, pos, process, opt, scene, np.asarray(q_start, dtype=float), procedure, speed, spacing)
+
+
+Candidate = tuple[bool, int, CurvePath, CurveInF, FloatArray]  # (reversed, tilt branch, path, in F, axes (n, 2))
+
+
+def candidates(su: Setup, est: CurveEstimate) -> list[Candidate]:
+    """Either way round ``est``, either tilt branch, whose axes hold it in PA within the limits: the weld point
+    nearest the arm's shoulder first."""
+    X_FR = np.asarray(np.linalg.inv(su.pos.X_R_F(*su.pos.home)), dtype=float)
+    centre, _ = su.robot.reach_bound("torch_tcp")
+    out = []
+    for rev in (False, True):
+        path = curve_path(est, su.spacing, reverse=rev, overlap=su.process.closed_overlap if est.closed else 0.0)
+        curve = _in_F(X_FR, path)
+        for branch in (1, -1):
+            axes = pa_axes(su.pos, curve, branch)
+            if axes is not None:
+                p_R = knots_in_R(su.pos, curve, axes)[0]
+                out.append((float(np.linalg.norm(p_R.mean(axis=0) - centre)), (rev, branch, path, curve, axes)))
+    return [c for _, c in sorted(out, key=lambda c: c[0])]
+
+
+def torch_poses(su: Setup, cand: Candidate, spin_deg: float) -> tuple[CurvePath, FloatArray, FloatArray | None]:
+    """The candidate's knots where its axes hold them (in R), the torch X_RT (n, 4, 4) there at ``spin_deg`` with
+    the pass's offset and weave, and the weave's share of that offset (None: no weave)."""
+    _, _, path, curve, axes = cand
+    p_R, t_R, na_R, nb_R = knots_in_R(su.pos, curve, axes)
+    cp = CurvePath(p_R, t_R, na_R, nb_R, path.s, path.closed, path.overlap, path.start, path.reversed)
+    off_R, weave_R = _offsets(cp, su.procedure)
+    X_RT = np.array(curve_poses(cp, su.process, spin=math.radians(spin_deg)))
+    X_RT[:, :3, 3] += off_R
+    return cp, X_RT, weave_R
+
+
+def solve_candidate(su: Setup, seam_id: str, cand: Candidate, spin_deg: float, rng: np.random.Generator,
+                    t_wall: float) -> CoordinatedWeld:  # fmt: skip
+    """The candidate welded at one spin: IK along its knots, the pieces timed and gated; MotionError otherwise."""
+    robot, pos = su.robot, su.pos
+    _, _, path, curve, axes = cand
+    _, X_RT, weave_R = torch_poses(su, cand, spin_deg)
+    proc = su.procedure or WeldProcedure(name="default")
+    q0 = solve_ik(robot, X_RT[0], su.q_start, rng=rng)
+    Q = np.asarray(solve_path(robot, X_RT, q0, max_joint_step=su.opt.max_joint_step))
+    pieces, v = _motion(robot, pos, su.process, su.opt, X_RT, Q, axes, path.s, su.speed, proc,
+                        (su.q_start, np.asarray(pos.home)))  # fmt: skip
+    _gated(su.scene, pos, robot, pieces)
+    times, x, arc, spans = _joined(pieces)
+    slope, rot, within = positions(pos, curve, axes)
+    X_FR_k = np.array([np.linalg.inv(pos.X_R_F(*a)) for a in axes])
+    X_FT = X_FR_k @ X_RT
+    weave_F = None if weave_R is None else np.einsum("nij,nj->ni", X_FR_k[:, :3, :3], weave_R)
+    tcp = np.array([robot.fk(q)[:3, 3] for q in Q])
+    spread = float(np.max(np.linalg.norm(tcp - tcp.mean(axis=0), axis=1))) * 1000.0
+    dof = robot.dof
+    return CoordinatedWeld(seam_id, times, x[:, :dof], x[:, dof:], arc, tuple(spans), Q, axes, X_FT, path.s, slope,
+                           rot, within, v, path.closed, path.overlap, time.perf_counter() - t_wall, spread, weave_F,
+                           su.procedure)  # fmt: skip
+
+
 def plan_coordinated(
     robot: RobotModel,
     pos: TiltRotatePositioner,
@@ -160,49 +242,15 @@ def plan_coordinated(
     ``q_start`` (dof,) and the positioner at home, back to both. Either way round the seam, either tilt branch,
     the spins ``SPINS_DEG`` tried until one is solved, timed and gated; PlanError with the last reason otherwise."""
     t_wall = time.perf_counter()
-    proc = procedure or WeldProcedure(name="default")
-    speed = proc.travel_speed_mm_s / 1000.0 if procedure is not None else process.travel_speed
-    X_FR = np.asarray(np.linalg.inv(pos.X_R_F(*pos.home)), dtype=float)
-    spacing = knot_spacing(procedure, 0, opt.spacing) if procedure is not None else opt.spacing  # follows a weave
-    centre, _ = robot.reach_bound("torch_tcp")
-    cands = []
-    for rev in (False, True):
-        path = curve_path(est, spacing, reverse=rev, overlap=process.closed_overlap if est.closed else 0.0)
-        curve = _in_F(X_FR, path)
-        for branch in (1, -1):
-            axes = pa_axes(pos, curve, branch)
-            if axes is not None:
-                p_R = knots_in_R(pos, curve, axes)[0]
-                cands.append((float(np.linalg.norm(p_R.mean(axis=0) - centre)), rev, branch, path, curve, axes))
+    su = Setup.of(robot, pos, process, opt, scene, q_start, procedure)
+    cands = candidates(su, est)
     if not cands:
         raise PlanError(f"curved seam {est.id}: no tilt within the limits puts it in PA with the rotation's sweep")
     why = "no candidate tried"
-    for _, _, _, path, curve, axes in sorted(cands, key=lambda c: c[0]):
-        p_R, t_R, na_R, nb_R = knots_in_R(pos, curve, axes)
-        cp = CurvePath(p_R, t_R, na_R, nb_R, path.s, path.closed, path.overlap, path.start, path.reversed)
-        off_R, weave_R = _offsets(cp, procedure)
+    for cand in cands:
         for spin in SPINS_DEG:
-            X_RT = np.array(curve_poses(cp, process, spin=math.radians(spin)))
-            X_RT[:, :3, 3] += off_R
             try:
-                q0 = solve_ik(robot, X_RT[0], q_start, rng=rng)
-                Q = np.asarray(solve_path(robot, X_RT, q0, max_joint_step=opt.max_joint_step))
-                pieces, v = _motion(
-                    robot, pos, process, opt, X_RT, Q, axes, path.s, speed, proc, (q_start, np.asarray(pos.home))
-                )
-                _gated(scene, pos, robot, pieces)
+                return solve_candidate(su, est.id, cand, spin, rng, t_wall)
             except MotionError as e:
                 why = f"spin {spin:+.0f} deg: {e.message}"
-                continue
-            times, x, arc, spans = _joined(pieces)
-            slope, rot, within = positions(pos, curve, axes)
-            X_FR_k = np.array([np.linalg.inv(pos.X_R_F(*a)) for a in axes])
-            X_FT = X_FR_k @ X_RT
-            weave_F = None if weave_R is None else np.einsum("nij,nj->ni", X_FR_k[:, :3, :3], weave_R)
-            tcp = np.array([robot.fk(q)[:3, 3] for q in Q])
-            spread = float(np.max(np.linalg.norm(tcp - tcp.mean(axis=0), axis=1))) * 1000.0
-            dof = robot.dof
-            return CoordinatedWeld(est.id, times, x[:, :dof], x[:, dof:], arc, tuple(spans), Q, axes, X_FT, path.s,
-                                   slope, rot, within, v, est.closed, path.overlap,
-                                   time.perf_counter() - t_wall, spread, weave_F, procedure)  # fmt: skip
     raise PlanError(f"curved seam {est.id}: no coordinated motion: {why}")

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cell.geometry import FloatArray, readonly
+from cell.types.plan import Remainder
 from cell.types.procedure import WeldProcedure
 
 PIECES = ("transfer", "approach", "weld", "depart", "retreat")  # in this order
@@ -47,6 +48,11 @@ class CoordinatedWeld:
     tcp_spread_mm: float = 0.0  # the torch's knots in R: the largest distance from their mean (how still it stands)
     weave_F: FloatArray | None = None  # (m, 3) [m] the weave in X_FT, in F, at each knot (None: no weave)
     procedure: WeldProcedure | None = None  # the weld procedure it was planned with (its weave, for the programs)
+    # Welded in part (the process's ``curve_remainder: manual``): the stretches left for a manual weld, the share
+    # of the curve welded and the weld's (from, to) [m] along the located curve (an open weld of a closed one).
+    remainder: tuple[Remainder, ...] = ()
+    share: float = 1.0
+    span_m: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         for name in ("times", "q", "axes", "arc_on", "knot_q", "knot_axes", "X_FT", "s", "slope_deg", "rotation_deg"):

@@ -8,6 +8,8 @@ import math
 from typing import Any
 
 from cell.coordinated.record import CoordinatedWeld
+from cell.export.curve_report import remainder_entry
+from cell.geometry import FloatArray, invert
 from cell.pipeline.positioned.run import PositionerRun
 from cell.types import SeamEstimate, WeldReason
 from cell.types.curve_estimate import CurveEstimate
@@ -45,6 +47,7 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
     seams: list[dict[str, Any]] = []
     tcp: list[float] = []
     found: list[SeamEstimate | CurveEstimate] = [*run.detection.estimates, *run.detection.curve_estimates]
+    X_MR = invert(run.detection.scene.X_RM) if run.detection.scene is not None else None
     for e in found:
         w = welds.get(e.id)
         q = w.quality if w is not None else None
@@ -62,6 +65,7 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
                 "tcp_max_mm": _r(q.tcp_max_mm) if q is not None else None,
                 "tcp_rms_mm": _r(q.tcp_rms_mm) if q is not None else None,
             }
+            | (_in_part(w, e, X_MR) if w is not None and w.partial else {})
         )
     poses = [
         {
@@ -88,10 +92,23 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
             "positioner_s": _r(run.positioner_s),
             "rescan_s": _r(run.rescan_s),
             "tcp_max_mm": _r(max(tcp, default=math.nan)),
+            "partial": sum(w.partial and w.planned for w in welds.values()),
+            "manual_mm": _r(sum(w.manual_m for w in welds.values()) * 1000.0, 1),
         },
         "coordinated": [coordinated_entry(cw) for cw in run.coordinated],
         "error": run.error.message if run.error is not None else None,
         "timings": {k: _r(v) for k, v in run.timings.items()},
+    }
+
+
+def _in_part(w: SeamWeld, e: SeamEstimate | CurveEstimate, X_MR: FloatArray | None) -> dict[str, Any]:
+    """A curved seam welded in part: the ``share`` welded, ``manual_mm`` left for a manual weld and each stretch of
+    its ``remainder``, its ends on the drawing (as the fixed arm's report: :func:`.curve_report.remainder_entry`)."""
+    est = e if isinstance(e, CurveEstimate) else None
+    return {
+        "share": _r(w.share, 4),
+        "manual_mm": _r(w.manual_m * 1000.0, 1),
+        "remainder": [remainder_entry(r, est, X_MR) for r in w.remainder],
     }
 
 
@@ -110,6 +127,8 @@ def coordinated_entry(cw: CoordinatedWeld) -> dict[str, Any]:
         "rotate_deg": deg((cw.knot_axes[0, 1], cw.knot_axes[-1, 1])),
         "torch_spread_mm": _r(cw.tcp_spread_mm),
         "in_position": cw.in_position,
+        "closed": cw.closed,
+        "span_mm": None if cw.span_m is None else [_r(v * 1000.0, 1) for v in cw.span_m],  # welded in part: its stretch
         "waypoints": {
             "s_mm": [round(float(v) * 1000.0, 2) for v in cw.s],
             "slope_deg": [round(float(v), 3) for v in cw.slope_deg],

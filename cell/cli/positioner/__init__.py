@@ -16,6 +16,7 @@ from cell.cli.outputs import Writer, finish
 from cell.errors import EXIT_PARTIAL, UsageError
 from cell.scenario import Scenario
 from cell.types import Kinematics
+from cell.types.run import partial_text
 
 if TYPE_CHECKING:
     from cell.pipeline.job import WeldJob
@@ -54,7 +55,9 @@ def weld_positioned(
     rep = {**positioner_report(run), "provenance": dict(prov)}
     writer.report(json_path, rep)
     if program is not None and job.execute:
-        written = writer.attempt(lambda: _programs(sc, run, program, controller))
+        from cell.export.curve_report import write_manual_welds
+
+        written = writer.attempt(lambda: [*_programs(sc, run, program, controller), *write_manual_welds(rep, program)])
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
             writer.written("programs", written)
@@ -87,12 +90,15 @@ def partial_line(rep: Mapping[str, Any]) -> str | None:
     undone = Counter(str(s["reason_code"]) for s in rep["seams"] if not s["welded"])
     if not undone and rep.get("error") is None:
         return None
+    part = undone.pop("partial", 0)  # curves welded in part: said apart, with what is left for a manual weld
     n = sum(undone.values())
     parts = [str(rep["error"])] if rep.get("error") else []
     if n:
         parts.append(
             f"{n} seam{'s' * (n != 1)} not welded ({', '.join(f'{c}: {k}' for c, k in sorted(undone.items()))})"
         )
+    if part:
+        parts.append(partial_text(part, rep["totals"].get("manual_mm")))
     return f"exit {EXIT_PARTIAL}: {'; '.join(parts)}; {rep['totals']['welded']}/{rep['totals']['seams']} welded"
 
 
@@ -101,6 +107,7 @@ def _programs(sc: Scenario, run: Any, out_dir: Path, controller: str) -> list[Pa
     from cell.export.positioner_program import write_positioner_programs
     from cell.export.program import ProgramJob
     from cell.outputs import make_folder
+    from cell.types import WeldReason
     from cell.types.positioner import external_axes
 
     assert sc.robot.positioner is not None
@@ -114,8 +121,8 @@ def _programs(sc: Scenario, run: Any, out_dir: Path, controller: str) -> list[Pa
         ext = external_axes(pos, g.pose.tilt, g.pose.rotate, via=g.via)  # the route the move check cleared
         jobs.append(ProgramJob(g.plan, robot, f"{sc.name.replace('-', '_')}_p{k + 1}"[:24], X_RB=X_RB,
                                X_WR=np.asarray(sc.X_WR), external=ext))  # fmt: skip
-    coordinated = [cw for cw in run.coordinated if any(w.welded for g in run.groups for w in g.seams
-                                                       if w.id == cw.seam_id)]  # fmt: skip
+    coordinated = [cw for cw in run.coordinated if any(w.welded or w.code is WeldReason.PARTIAL for g in run.groups
+                                                       for w in g.seams if w.id == cw.seam_id)]  # fmt: skip
     if not jobs and not coordinated:
         return []
     make_folder(out_dir)

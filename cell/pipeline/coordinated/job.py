@@ -8,11 +8,12 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from cell.coordinated.record import CoordinatedWeld
-from cell.errors import MotionError
+from cell.errors import MotionError, PlanError
 from cell.geometry import FloatArray
 from cell.pipeline.records import Detection
 from cell.positioner.poses import PositionerPose
@@ -22,6 +23,13 @@ from cell.types.curve_estimate import CurveEstimate
 from cell.types.execution import Execution
 from cell.types.positioner import TiltRotatePositioner, WeldPosition
 from cell.types.run import SeamWeld, WeldReason
+
+if TYPE_CHECKING:
+    from cell.config.motion import PlanOptions
+    from cell.coordinated.gate import MovingScene
+    from cell.motion.robot import RobotModel
+    from cell.process.torch import WeldProcess
+    from cell.types.procedure import WeldProcedure
 
 
 def _pa_probe(pos: TiltRotatePositioner, c: CurveEstimate, cw_axes: FloatArray) -> CurveEstimate:
@@ -66,9 +74,7 @@ def weld_curves_coordinated(
     motion, its execution) for those planned; curve id -> why not (a sentence) for the others, their codes in the
     returned welds. ``refuse_doubtful`` False is a study's (benchmarks/bench_coordinated.py): a curve the weld
     gate refuses is planned and welded all the same, its refusal kept in its weld's reason; never the cell's."""
-    from cell.config.motion import PlanOptions
     from cell.coordinated.gate import MovingScene
-    from cell.coordinated.plan import plan_coordinated
     from cell.pipeline.coordinated.play import play, quality, weave_at_records
     from cell.pipeline.curved.welds import curve_doubt
     from cell.pipeline.placeable import curve_procedures_for
@@ -100,8 +106,8 @@ def weld_curves_coordinated(
             probe = _pa_probe(pos, c, np.array([1.0]))
             sel = curve_procedures_for(sc, det.weldmap_R, [probe]).get(c.id)
             proc = sel.procedure if isinstance(sel, SeamProcedure) else None
-            cw = plan_coordinated(arm.model, pos, c, process, opt, scene, np.asarray(q_now), rng=sc.rng("coordinated"),
-                                  procedure=proc)  # fmt: skip
+            cw = _planned(arm.model, pos, c, process, opt, scene, np.asarray(q_now), sc.rng("coordinated"), proc,
+                          progress)  # fmt: skip
         except MotionError as e:
             why[c.id] = e.message
             pose = PositionerPose(*pos.home, (), {})
@@ -116,9 +122,11 @@ def weld_curves_coordinated(
             f"{math.degrees(cw.knot_axes[0, 0]):+.1f} deg, rotate {math.degrees(cw.knot_axes[0, 1]):+.1f} to "
             f"{math.degrees(cw.knot_axes[-1, 1]):+.1f} deg, arc {cw.arc_s:.1f} s of {cw.duration:.1f} s"
         )
+        in_part = _in_part_text(cw)
         if not execute:
-            out.append((pose, SeamWeld(c.id, True, False, "planned, not executed (preview)", code=WeldReason.PREVIEW,
-                                       procedure=proc), cw, None))  # fmt: skip
+            said = "planned, not executed (preview)" + (f"; {in_part}" if in_part else "")
+            out.append((pose, SeamWeld(c.id, True, False, said, code=WeldReason.PREVIEW, procedure=proc,
+                                       share=cw.share, remainder=cw.remainder), cw, None))  # fmt: skip
             continue
         station.move_positioner(*pos.home)
         ex, back = play(station, cw)
@@ -126,5 +134,42 @@ def weld_curves_coordinated(
         weave = weave_at_records(cw, ex, pos.X_R_F(*pos.home)[:3, :3]) if cw.weave_F is not None else None
         q = quality(ex, back, truth, c.closed, weave) if truth is not None else None
         study = f"welded for a study despite the weld gate: {doubt.detail}" if doubt is not None else ""
+        if in_part:  # its stretch welded, the rest left for a manual weld: never counted as welded
+            out.append((pose, SeamWeld(c.id, True, False, in_part, q, WeldReason.PARTIAL, proc, (q,) if q else (),
+                                       share=cw.share, remainder=cw.remainder), cw, ex))  # fmt: skip
+            continue
         out.append((pose, SeamWeld(c.id, True, True, study, q, procedure=proc, passes=(q,) if q else ()), cw, ex))
     return out, why
+
+
+def _planned(robot: RobotModel, pos: TiltRotatePositioner, c: CurveEstimate, process: WeldProcess, opt: PlanOptions,
+             scene: MovingScene, q_now: FloatArray, rng: np.random.Generator, proc: WeldProcedure | None,
+             progress: Callable[[str], None]) -> CoordinatedWeld:  # fmt: skip
+    """``c`` welded whole with the part turning; else, with the process's ``curve_remainder: manual``, in part
+    (:func:`cell.coordinated.partial.plan_in_part`: the longest stretch the arm holds, the rest left for a manual
+    weld); MotionError with the whole weld's reason when neither is planned."""
+    from cell.coordinated.partial import plan_in_part
+    from cell.coordinated.plan import Setup, candidates, plan_coordinated
+
+    try:
+        return plan_coordinated(robot, pos, c, process, opt, scene, q_now, rng=rng, procedure=proc)
+    except MotionError as whole:
+        su = Setup.of(robot, pos, process, opt, scene, q_now, proc)
+        if process.curve_remainder != "manual" or not candidates(su, c):  # no axes hold it in PA: nothing held
+            raise
+        progress(f"coordinated: {c.id} not welded whole ({whole.message}); planning the stretch the arm holds")
+        try:
+            return plan_in_part(su, c, rng)
+        except MotionError as e:
+            raise PlanError(f"{whole.message}; in part: {e.message}") from e
+
+
+def _in_part_text(cw: CoordinatedWeld) -> str:
+    """A coordinated weld of part of its curve in words (as the fixed arm's): the share welded and each stretch
+    left for a manual weld; "" for a weld of the whole curve."""
+    if not cw.remainder:
+        return ""
+    left = sum(r.length_m for r in cw.remainder)
+    stretches = "; ".join(r.describe() for r in cw.remainder)
+    return (f"welded in part: {cw.share:.0%} in 1 arc with the part turning, {left * 1000:.0f} mm left for a "
+            f"manual weld: {stretches}")  # fmt: skip

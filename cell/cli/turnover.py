@@ -69,7 +69,8 @@ def finish_turnover(
         written = writer.attempt(
             lambda: [*write_programs(run, krl, provenance, controller, left), *write_manual_welds(rep, krl)]
         )
-        written = [*(written or []), *(writer.attempt(lambda: write_welder_sheet(sides, rep, krl)) or [])]
+        sheet = writer.attempt(lambda: write_welder_sheet([wr.detection for wr in sides], rep, krl))
+        written = [*(written or []), *(sheet or [])]
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
             writer.written("programs", written)

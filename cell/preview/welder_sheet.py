@@ -27,19 +27,18 @@ from cell.types.curve_estimate import CurveEstimate
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from cell.pipeline.records import WeldRun
+    from cell.pipeline.records import Detection
 
 SHEET = "manual_welds.png"
 _VIEWS = (((0, 1), "plan (looking down -z_M)"), ((0, 2), "elevation (looking along +y_M)"))
 _ROW_CHARS = 150  # a row's words are wrapped at this many characters (monospace, 7 pt, on an 11 in sheet)
 
 
-def _curves(runs: Sequence[WeldRun]) -> dict[str, tuple[CurveEstimate, FloatArray]]:
-    """Seam id -> (its located curve in R, the drawing's pose X_MR of that run's robot frame) for every located
-    curve of the runs; a curve located on both sides is taken from the side that welded it in part."""
+def _curves(dets: Sequence[Detection]) -> dict[str, tuple[CurveEstimate, FloatArray]]:
+    """Seam id -> (its located curve in R, the drawing's pose X_MR of that detection's robot frame) for every
+    located curve; a curve located on both sides is taken from the side that welded it in part."""
     out: dict[str, tuple[CurveEstimate, FloatArray]] = {}
-    for run in runs:
-        det = run.detection
+    for det in dets:
         if det.scene is None:
             continue
         X_MR = invert(det.scene.X_RM)
@@ -120,14 +119,14 @@ def draw_sheet(
     return save_figure(fig, folder / SHEET)
 
 
-def write_welder_sheet(runs: Sequence[WeldRun], rep: Mapping[str, Any], folder: Path) -> list[Path]:
-    """The welder's sheet (:func:`draw_sheet`) of the report's stretches left for a manual weld, on the runs'
-    located curves over the aligned map's parts (from the first run that has a scene); [] and nothing written when
-    no curve is welded in part, or no run has a scene to draw from."""
+def write_welder_sheet(dets: Sequence[Detection], rep: Mapping[str, Any], folder: Path) -> list[Path]:
+    """The welder's sheet (:func:`draw_sheet`) of the report's stretches left for a manual weld, on the located
+    curves of a job's detections (a side each; a positioner's, at its home) over the aligned map's parts (from the
+    first that has a scene); [] and nothing written when no curve is welded in part, or none has a scene."""
     rows = [(s["id"], r) for s in rep["seams"] for r in s.get("remainder") or ()]
-    first = next((r.detection for r in runs if r.detection.scene is not None), None)
+    first = next((d for d in dets if d.scene is not None), None)
     if not rows or first is None or first.scene is None:
         return []
     X_MR = invert(first.scene.X_RM)
     edges = [transform_points(X_MR, e) * MM for p in first.weldmap_R.parts for e in p.edges()]
-    return [draw_sheet(first.scenario.name, rows, _curves(runs), np.asarray(edges).reshape(-1, 2, 3), folder)]
+    return [draw_sheet(first.scenario.name, rows, _curves(dets), np.asarray(edges).reshape(-1, 2, 3), folder)]

@@ -56,8 +56,11 @@ def weld_positioned(
     writer.report(json_path, rep)
     if program is not None and job.execute:
         from cell.export.curve_report import write_manual_welds
+        from cell.preview.welder_sheet import write_welder_sheet
 
         written = writer.attempt(lambda: [*_programs(sc, run, program, controller), *write_manual_welds(rep, program)])
+        sheet = writer.attempt(lambda: write_welder_sheet([run.detection], rep, program))
+        written = [*(written or []), *(sheet or [])]
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
             writer.written("programs", written)

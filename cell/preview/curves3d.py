@@ -20,15 +20,18 @@ from cell.geometry import FloatArray
 from cell.preview.views import MM, STATUS_COLOURS
 from cell.types import SeamStatus
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.run import SeamWeld
+from cell.types.run import SeamWeld, WeldReason
 
 CURVE_COLOURS = {
     "curves welded": STATUS_COLOURS["found"],
+    "curves planned": STATUS_COLOURS["found"],
     "curves welded in part": "#66a61e",
+    "curves planned in part": "#66a61e",
     "curves not welded": STATUS_COLOURS["not_found"],
     "curves located": STATUS_COLOURS["found"],  # a run that welds nothing (detect, locate)
 }
 MANUAL_COLOUR = "#d95f02"  # the stretches left for a manual weld: dashed over their curve
+_LEFT = (WeldReason.PARTIAL, WeldReason.PREVIEW)  # a curve whose stretches are left for a manual weld (or would be)
 _STEP_M = 0.002  # a manual stretch is drawn through a point of the located curve every 2 mm
 
 
@@ -38,11 +41,13 @@ def _outcome(e: CurveEstimate, w: SeamWeld | None) -> tuple[str, str]:
         return "curves located", f"located, sigma up to {e.sigma_max_m * MM:.2f} mm"
     if w.welded:
         return "curves welded", "welded"
-    if w.partial:
-        return (
-            "curves welded in part",
-            f"welded in part ({w.share:.0%}), {w.manual_m * MM:.0f} mm left for a manual weld",
-        )
+    left = f"{w.manual_m * MM:.0f} mm left for a manual weld"
+    if w.code is WeldReason.PREVIEW:  # a preview's: planned, nothing moves
+        if w.partial:
+            return "curves planned in part", f"planned in part ({w.share:.0%}), {left}"
+        return "curves planned", "planned (preview: nothing moves)"
+    if w.code is WeldReason.PARTIAL:
+        return "curves welded in part", f"welded in part ({w.share:.0%}), {left}"
     return "curves not welded", f"not welded: {w.reason}"
 
 
@@ -87,7 +92,7 @@ def curve_traces(
             p = np.vstack([p, p[:1]])
         xyz, text = groups.setdefault(group, ([[], [], []], []))
         _polyline(xyz, text, p, f"{e.id}<br>{html.escape(words)}")
-        for r in w.remainder if w is not None else ():
+        for r in w.remainder if w is not None and w.code in _LEFT else ():  # not when nothing ran
             n = max(2, math.ceil(r.length_m / _STEP_M) + 1)
             stretch = e.points_at(np.linspace(r.from_m, r.to_m, n)) * MM
             tip = f"{e.id}<br>manual weld {html.escape(remainder_words(remainder_entry(r, e, X_MR)))}"

@@ -272,6 +272,11 @@ def test_the_page_marks_the_stretches_left_for_a_manual_weld_on_their_located_cu
         assert np.linalg.norm(np.diff(p, axis=0), axis=1).sum() == pytest.approx(r.length_m * 1000.0, rel=0.01)
     words = remainder_words(remainder_entry(rest[0]))  # the console's line for it
     assert manual["text"][0] == f"{part.id}<br>manual weld {words}" and words.startswith("78-157 mm along it")
+    planned = {part.id: replace(welds[part.id], code=WeldReason.PREVIEW)}  # a preview: planned in part
+    (in_part, _) = curve_traces((part,), planned)
+    assert in_part["name"] == "curves planned in part" and "planned in part (55%)" in in_part["text"][0]
+    stopped = {part.id: replace(welds[part.id], code=WeldReason.NOT_EXECUTED)}  # the gate stopped the job
+    assert [t["name"] for t in curve_traces((part,), stopped)] == ["curves not welded"]
     X_RM = make_pose(p=[0.2, 0.0, 0.1])  # the drawing 0.2 m behind and 0.1 m below R: the ends moved by it
     (_, _, mark) = curve_traces((part, refused), welds, invert(X_RM))
     a = np.round(part.points_at([rest[0].from_m])[0] * 1000.0 - [200.0, 0.0, 100.0]).astype(int)

@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
 SHEET = "manual_welds.png"
 _VIEWS = (((0, 1), "plan (looking down -z_M)"), ((0, 2), "elevation (looking along +y_M)"))
+_LABEL_APART_MM = 15.0  # stretches whose middles lie closer in a view share one label ("1,3")
 _ROW_CHARS = 150  # a row's words are wrapped at this many characters (monospace, 7 pt, on an 11 in sheet)
 
 
@@ -68,11 +69,18 @@ def _draw(ax: Axes, ij: tuple[int, int], edges_mm: FloatArray, curves_mm: Sequen
         ax.plot(e[:, i], e[:, j], color=BOX_COLOUR, lw=0.4, alpha=0.5, zorder=1)
     for p in curves_mm:
         ax.plot(p[:, i], p[:, j], color=STATUS_COLOURS["found"], lw=1.0, zorder=2)
+    labels: list[tuple[list[str], FloatArray]] = []  # numbers whose stretches' middles fall together in this view
     for n, s in stretches:
         ax.plot(s[:, i], s[:, j], color=MANUAL_COLOUR, lw=3.5, solid_capstyle="round", zorder=3)
-        mid = s[len(s) // 2]
-        ax.annotate(str(n), (mid[i], mid[j]), xytext=(6, 6), textcoords="offset points", fontsize=8, zorder=4,
-                    bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": MANUAL_COLOUR})  # fmt: skip
+        mid = s[len(s) // 2][[i, j]]
+        near = next((lb for lb in labels if np.linalg.norm(lb[1] - mid) < _LABEL_APART_MM), None)
+        if near is None:
+            labels.append(([str(n)], mid))
+        else:
+            near[0].append(str(n))
+    for names, (x, y) in labels:
+        ax.annotate(",".join(names), (x, y), xytext=(6, 6), textcoords="offset points", fontsize=8, zorder=4,
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": MANUAL_COLOUR})  # fmt: skip
     ax.set_aspect("equal")
     ax.set_xlabel(f"{'xyz'[i]}_M [mm]", fontsize=8)
     ax.set_ylabel(f"{'xyz'[j]}_M [mm]", fontsize=8)

@@ -149,9 +149,9 @@ def weld(
         side_opt = parse_sides(sides)
         scn, prov = _load(scenario, method, noise, calibration)
         if scn.robot.positioner is not None:  # the positioner, not an operator, turns the part (docs/positioner.md)
-            unused = {"--html": html, "--rerun": rerun_path, "--journal": journal, "--resume": resume}
+            unused = {"--rerun": rerun_path, "--journal": journal, "--resume": resume}
             asked = WeldJob(method, noise=parse_noise(noise), rescan=mode, gui=gui, sides=side_opt)
-            return weld_positioned(scn, prov, asked, (json_path, program, controller), table, unused)
+            return weld_positioned(scn, prov, asked, (json_path, program, controller), table, unused, html)
         state = resumed(resume, prov) if resume is not None else None
         if state is not None:  # the job's own options, unless given again
             was = state.start.get("options", {})

@@ -35,6 +35,7 @@ from cell.types import (
     ShapeKind,
     WeldReason,
 )
+from cell.types.curve_estimate import CurveEstimate
 
 SCENARIO = sc.load("fence1")
 
@@ -229,6 +230,15 @@ def test_joint_plots_shade_each_weld_on_every_row_and_draw_only_the_limits_in_vi
     assert labels == [("S1", 1.75, "x"), ("S2", 6.5, "x")]
 
 
+def circle(cid: str, x0: float) -> CurveEstimate:
+    """A located 50 mm circle about z through (x0, 0, 0) in R, 300 samples."""
+    t = np.linspace(0.0, 2 * np.pi, 300, endpoint=False)
+    p = np.column_stack([x0 + 0.05 * np.cos(t), 0.05 * np.sin(t), np.zeros_like(t)])
+    up, out = np.tile([0.0, 0.0, 1.0], (300, 1)), np.column_stack([np.cos(t), np.sin(t), 0 * t])
+    return CurveEstimate(cid, SeamStatus.FOUND, p_RS=p, n_abutting_R=out, n_receiving_R=up, closed=True,
+                         sigma_m=np.full(300, 1e-4))  # fmt: skip
+
+
 def test_the_page_marks_the_stretches_left_for_a_manual_weld_on_their_located_curve(tmp_path: Path) -> None:
     """A curve welded in part is drawn with its remainder dashed over it, each stretch from its start to its end
     along the located curve (one passing the closed curve's start), hovering the console's words; a curve not
@@ -236,15 +246,7 @@ def test_the_page_marks_the_stretches_left_for_a_manual_weld_on_their_located_cu
     from cell.export.curve_report import remainder_entry, remainder_words
     from cell.geometry import invert
     from cell.preview.curves3d import curve_traces
-    from cell.types.curve_estimate import CurveEstimate
     from cell.types.plan import PlanReason, Remainder
-
-    def circle(cid: str, x0: float) -> CurveEstimate:
-        t = np.linspace(0.0, 2 * np.pi, 300, endpoint=False)
-        p = np.column_stack([x0 + 0.05 * np.cos(t), 0.05 * np.sin(t), np.zeros_like(t)])
-        up, out = np.tile([0.0, 0.0, 1.0], (300, 1)), np.column_stack([np.cos(t), np.sin(t), 0 * t])
-        return CurveEstimate(cid, SeamStatus.FOUND, p_RS=p, n_abutting_R=out, n_receiving_R=up, closed=True,
-                             sigma_m=np.full(300, 1e-4))  # fmt: skip
 
     part, refused = circle("TUBE>PLATE:circle", 0.0), circle("POST>PLATE:circle", 0.3)
     L = part.length_m
@@ -281,3 +283,30 @@ def test_the_page_marks_the_stretches_left_for_a_manual_weld_on_their_located_cu
     (_, _, mark) = curve_traces((part, refused), welds, invert(X_RM))
     a = np.round(part.points_at([rest[0].from_m])[0] * 1000.0 - [200.0, 0.0, 100.0]).astype(int)
     assert f"from ({a[0]}, {a[1]}, {a[2]})" in mark["text"][0] and mark["text"][0].endswith("torch vs GUSSET_1")
+
+
+def test_a_positioner_job_has_a_page_with_every_seam_and_its_curves_in_part(tmp_path: Path) -> None:
+    """A positioner job's page: the straight seams' welds from its poses, a seam no pose holds with why, and its
+    curve welded in part with its stretch marked (no robot, no joint plots: the part moves between poses)."""
+    from cell.pipeline.positioned.run import GroupRun, PositionerRun
+    from cell.positioner.poses import PositionerPose
+    from cell.types.plan import PlanReason, Remainder
+
+    base = tiny_run().detection
+    tube = circle("TUBE>PLATE:circle", 0.3)
+    rest = (Remainder(0.1, 0.15, PlanReason.IK_FAILED, "joint_a3 at its limit"),)
+    seams = (
+        SeamWeld("S_front", True, True, ""),
+        SeamWeld(tube.id, True, False, "welded in part", code=WeldReason.PARTIAL, share=0.84, remainder=rest),
+    )
+    group = GroupRun(PositionerPose(0.0, 0.0, (), {}), 0.0, None, None, None, seams, 0.0)
+    run = PositionerRun(replace(base, curve_estimates=(tube,)), (group,), unheld={"S_left": "beyond the tilt"},
+                        unheld_codes={"S_left": WeldReason.NOT_PLANNED})  # fmt: skip
+    page = write_page(run.as_weld_run(), tmp_path / "cell.html")
+    figs, rows = read(page)
+    assert set(figs) == {"cell3d"}
+    cells = {r["seam"]: r["cells"][4] for r in rows}
+    assert cells["S_front"] == "welded" and cells["S_left"] == "not planned" and tube.id in cells
+    assert "beyond the tilt" in page.read_text(encoding="utf-8")  # why no pose holds it
+    data = {t.get("name"): t for t in figs["cell3d"]["data"]}
+    assert "curves welded in part" in data and data["manual weld"]["text"][0].startswith(tube.id)

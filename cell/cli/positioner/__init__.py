@@ -28,7 +28,7 @@ def refuse_options(scenario: str, options: Mapping[str, object]) -> None:
     if given:
         raise UsageError(
             f"{given[0]} does not apply to scenario {scenario!r}: its part is on robot.positioner (no operator"
-            f" turn, no sides, one report and a program per pose); valid: --json, --program, --controller,"
+            f" turn, no sides, one report and a program per pose); valid: --json, --program, --html, --controller,"
             f" --method, --noise, --rescan, --calibration, --gui"
         )
 
@@ -40,11 +40,13 @@ def weld_positioned(
     outputs: tuple[Path | None, Path | None, str],
     fmt: TableFormat,
     unused: Mapping[str, object],
+    html: Path | None = None,
 ) -> None:
     """Run the job, write the report first (``outputs``: the --json path, the --program folder, the controller),
     then the programs; one line per seam, the last line; exit 3 when a seam is not welded (each one's reason code
     counted). ``unused``: the options given that a positioner job has no use for (refused, with ``--sides
-    first``)."""
+    first``). ``html``: the job's page (:meth:`PositionerRun.as_weld_run`: results, the cloud and the map at home,
+    the curves and their stretches left for a manual weld; no robot or joint plots: the part moves between poses)."""
     from cell.export.positioner_report import positioner_report
     from cell.pipeline.positioned import weld_on_positioner
 
@@ -64,6 +66,11 @@ def weld_positioned(
         if written:
             say(f"robot programs: {', '.join(map(str, written))}")
             writer.written("programs", written)
+    if html is not None:  # the results, the cloud and the map at home, the curves and what is left of them
+        from cell.preview import write_page
+
+        if writer.attempt(lambda: write_page(run.as_weld_run(), html)) is not None:
+            say(f"page: {html}")
     if fmt == "table":
         for s in rep["seams"]:
             wp = s["weld_position"] or {}

@@ -4,11 +4,11 @@ execution, each seam's weld and ISO 6947 position, and what no pose could hold. 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from cell.coordinated.record import CoordinatedWeld
 from cell.errors import CellError
-from cell.pipeline.records import Detection
+from cell.pipeline.records import Detection, WeldRun
 from cell.positioner.poses import PositionerPose
 from cell.types import SeamStatus, WeldReason
 from cell.types.execution import Execution
@@ -76,3 +76,16 @@ class PositionerRun:
 
     def located(self) -> int:
         return sum(e.status is SeamStatus.FOUND for e in self.detection.estimates)
+
+    def as_weld_run(self) -> WeldRun:
+        """The job as one :class:`~cell.pipeline.records.WeldRun` for its page (:func:`cell.preview.write_page`):
+        the detection at home with each curved seam's weld, every straight seam's weld or why no pose holds it; no
+        plan and no execution (the poses' plans are many, and the part moves between them)."""
+        welds = self.welds()
+        for sid, why in self.unheld.items():
+            code = self.unheld_codes.get(sid, WeldReason.NOT_PLANNED)
+            welds.setdefault(sid, SeamWeld(sid, False, False, why, code=code))
+        curves = {c.id for c in self.detection.curve_estimates}
+        det = replace(self.detection, curve_welds={k: w for k, w in welds.items() if k in curves})
+        straight = tuple(w for k, w in welds.items() if k not in curves)
+        return WeldRun(detection=det, seams=straight, error=self.error, timings=dict(self.timings))

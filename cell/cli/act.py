@@ -279,7 +279,8 @@ def preview(
         json_path = out_dir / "report.json"
         if scn.robot.positioner is not None:  # the poses chosen and the report, nothing moves
             asked = WeldJob(method, noise=parse_noise(noise), execute=False, sides=side_opt)
-            return weld_positioned(scn, prov, asked, (json_path, None, "krl"), table, {"--rerun": rerun_path})
+            page = out_dir / "cell.html"  # the page as a fixed arm's preview writes it (no robot: docs/positioner.md)
+            return weld_positioned(scn, prov, asked, (json_path, None, "krl"), table, {"--rerun": rerun_path}, page)
         stage, writer = Stage(), Writer()
         run: WeldRun | None = None
         try:

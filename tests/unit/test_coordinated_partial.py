@@ -34,15 +34,15 @@ def test_the_remainder_of_a_loop_runs_from_the_welds_end_round_to_its_start_with
     misses = [Miss(0.22, PlanReason.IK_FAILED, "IK: joint_a3 at its limit")] * 3 + [
         Miss(0.25, PlanReason.COLLISION, "camera_link vs POSITIONER_CRADLE")
     ]
-    (rest,) = leftover(0.32, 0.52, total, True, misses)  # welded 0.32 round to 0.16 m
+    (rest,) = leftover([(0.32, 0.52)], total, True, misses)  # welded 0.32 round to 0.16 m
     assert (rest.from_m, rest.to_m) == pytest.approx((0.16, 0.32))  # from 0.16 m on the curve's own lap
-    assert leftover(0.02, 0.30, total, True, misses)[0].to_m == pytest.approx(0.38)  # round its start
+    assert leftover([(0.02, 0.30)], total, True, misses)[0].to_m == pytest.approx(0.38)  # round its start
     assert rest.code is PlanReason.IK_FAILED and "3 of 4 tries IK: joint_a3 at its limit" in rest.why
     assert "stops 5 mm short" in rest.why
     # An open curve: what lies before and after the weld, each on its own.
-    ends = leftover(0.03, 0.15, 0.20, False, misses)
+    ends = leftover([(0.03, 0.15)], 0.20, False, misses)
     assert [v for r in ends for v in (r.from_m, r.to_m)] == pytest.approx([0.0, 0.03, 0.15, 0.20])
-    assert leftover(0.0, 0.20, 0.20, False, misses) == ()
+    assert leftover([(0.0, 0.20)], 0.20, False, misses) == ()
 
 
 def test_the_positioner_exit_line_says_a_curve_welded_in_part_as_the_fixed_arm_does() -> None:

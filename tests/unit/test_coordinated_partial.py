@@ -90,3 +90,23 @@ def test_a_loop_is_welded_in_part_only_with_curve_remainder_manual(monkeypatch: 
     monkeypatch.setattr(plan, "candidates", lambda su, c: [])  # no axes hold it in PA: nothing to weld in part
     with pytest.raises(PlanError, match="torch vs POST"):
         planned("manual")
+
+
+def test_a_loop_is_covered_by_arcs_restarting_the_overlap_over_the_bead_or_left_with_the_smaller_remainder() -> None:
+    from cell.coordinated.cover import cover, loop_gaps
+
+    total, ov, arc = 0.36, 0.010, 0.02
+    # Two candidates' stretches: the first arc 0.00-0.22 m; the other holds 0.21-0.37 m (round the start): it
+    # reaches 10 mm back over the bead at both ends, so the loop is welded whole in two arcs.
+    (i, lo, hi), *more = cover((0.0, 0.22), [(0.0, 0.22), (0.21, 0.37)], total, ov, arc)
+    assert (i, more) == (1, []) and (lo, hi) == pytest.approx((0.21, 0.37))
+    assert loop_gaps([(0.0, 0.22), (lo, hi)], total) == []
+    # Held 5 mm short of either overlap (0.215-0.365 m): each end a free end 10 mm off the bead, 20 mm left.
+    ((_, lo, hi),) = cover((0.0, 0.22), [(0.0, 0.22), (0.215, 0.365)], total, ov, arc)
+    assert (lo, hi) == pytest.approx((0.23, 0.35))
+    assert sum(b - a for a, b in loop_gaps([(0.0, 0.22), (lo, hi)], total)) == pytest.approx(0.02)
+    # Nothing holds 0.25-0.30 m (tube-tee's end plates): two more arcs, one from each junction, 50 mm left.
+    arcs = cover((0.0, 0.22), [(0.0, 0.22), (0.15, 0.25), (0.30, 0.40)], total, ov, arc)
+    assert sorted((round(a, 3), round(b, 3)) for _, a, b in arcs) == [(0.21, 0.25), (0.3, 0.37)]
+    left = loop_gaps([(0.0, 0.22), *((a, b) for _, a, b in arcs)], total)
+    assert [v for g in left for v in g] == pytest.approx([0.25, 0.30])

@@ -121,6 +121,11 @@ def weld_curves_coordinated(
             f"coordinated: {c.id} planned in {time.perf_counter() - t0:.1f} s: tilt "
             f"{math.degrees(cw.knot_axes[0, 0]):+.1f} deg, rotate {math.degrees(cw.knot_axes[0, 1]):+.1f} to "
             f"{math.degrees(cw.knot_axes[-1, 1]):+.1f} deg, arc {cw.arc_s:.1f} s of {cw.duration:.1f} s"
+            + "".join(
+                f"; then {math.degrees(a.knot_axes[0, 1]):+.1f} to {math.degrees(a.knot_axes[-1, 1]):+.1f} deg,"
+                f" arc {a.arc_s:.1f} s of {a.duration:.1f} s"
+                for a in cw.then
+            )
         )
         in_part = _in_part_text(cw)
         if not execute:

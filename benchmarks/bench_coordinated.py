@@ -68,7 +68,8 @@ def _in_part(run: Any) -> list[dict[str, Any]]:
     welds, out = run.welds(), []
     for cw in run.coordinated:
         w = welds.get(cw.seam_id)
-        if not cw.remainder or w is None or w.quality is None:
+        arcs = [a for a in run.coordinated if a.seam_id == cw.seam_id]
+        if arcs[0] is not cw or (not cw.remainder and len(arcs) == 1) or w is None or w.quality is None:
             continue
         e, q, moves = coordinated_entry(cw), w.quality, coordinated_moves(cw)
         out.append({
@@ -81,10 +82,26 @@ def _in_part(run: Any) -> list[dict[str, Any]]:
             "program_moves": {k: sum(mv.kind == k for mv in moves) for k in ("CIRC", "LIN")},
             "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4),
             "program_axes_off_deg": round(math.degrees(max(mv.axes_dev for mv in moves)), 4),
+            "arcs": [_arc_row(a, aq) for a, aq in zip(arcs, w.arc_quality or (q,), strict=False)],
             "remainder": [{"from_mm": round(r.from_m * 1000.0, 1), "to_mm": round(r.to_m * 1000.0, 1),
                            "code": r.code.value, "why": r.why} for r in cw.remainder],
         })  # fmt: skip
     return out
+
+
+def _arc_row(cw: Any, q: Any) -> dict[str, Any]:
+    """One coordinated arc of a curve welded in several (the first's figures above are its own; the TCP there the
+    seam's over all its arcs): its stretch along the located curve [mm], its TCP against the true curve, its times
+    and its program's moves."""
+    from cell.export.coordinated_program import coordinated_moves, program_path_off
+    from cell.export.positioner_report import coordinated_entry
+
+    e, moves = coordinated_entry(cw), coordinated_moves(cw)
+    return {"span_mm": e["span_mm"], "tcp_rms_mm": round(q.tcp_rms_mm, 3), "tcp_max_mm": round(q.tcp_max_mm, 3),
+            "tilt_range_deg": e["tilt_range_deg"], "rotate_deg": e["rotate_deg"], "arc_s": e["arc_s"],
+            "job_s": e["job_s"], "plan_wall_s": e["plan_wall_s"],
+            "program_moves": {k: sum(mv.kind == k for mv in moves) for k in ("CIRC", "LIN")},
+            "program_path_off_mm": round(program_path_off(cw, moves) * 1000.0, 4)}  # fmt: skip
 
 
 def coordinated_row(

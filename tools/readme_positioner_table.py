@@ -98,8 +98,9 @@ def coordinated_table(d: Mapping[str, Any]) -> str:
 
 
 def _in_part_lines(rows: list[Mapping[str, Any]]) -> list[str]:
-    """The curves welded in part with the part turning (each row's ``in_part``): the stretch welded and its share,
-    the TCP, the position, the axes, the times, the programs and what is left for a manual weld."""
+    """The curves welded in part with the part turning (each row's ``in_part``): the stretch welded (each arc's,
+    in more than one) and its share, the TCP (over all its arcs), the position, the axes, the times, the programs
+    (the first arc's) and what is left for a manual weld."""
     parts = [(r["scenario"], p) for r in rows for p in r.get("in_part") or ()]
     if not parts:
         return []
@@ -111,7 +112,9 @@ def _in_part_lines(rows: list[Mapping[str, Any]]) -> list[str]:
         t, r = p["tilt_range_deg"], p["rotate_deg"]
         moves = ", ".join(f"{n} {k}" for k, n in p["program_moves"].items() if n)
         rest = "; ".join(f"{x['from_mm']:.0f}-{x['to_mm']:.0f} mm ({x['code']})" for x in p["remainder"])
-        out.append(f"| {sc}: `{p['curve']}` | {p['span_mm'][0]:.0f}-{p['span_mm'][1]:.0f} ({p['share']:.0%}) |"
+        spans = [a["span_mm"] for a in p.get("arcs") or ()] or [p["span_mm"]]  # more than one arc: each one's
+        span = " + ".join(f"{a:.0f}-{b:.0f}" for a, b in spans)
+        out.append(f"| {sc}: `{p['curve']}` | {span} ({p['share']:.0%}{f', {len(spans)} arcs' * (len(spans) > 1)}) |"
                    f" {_f(p['tcp_rms_mm'])} / {_f(p['tcp_max_mm'])} | {_f(p['slope_worst_deg'], '.2f')} /"
                    f" {_f(p['rotation_worst_off_deg'], '.2f')} | {_f(t[0], '.1f')} .. {_f(t[1], '.1f')};"
                    f" {_f(r[0], '.1f')} .. {_f(r[1], '.1f')} | {_f(p['arc_s'], '.1f')} / {_f(p['job_s'], '.1f')} |"

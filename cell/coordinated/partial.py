@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
+from cell.coordinated.cover import MAX_ARCS, loop_gaps, next_arcs
 from cell.coordinated.plan import SPINS_DEG, Candidate, Setup, candidates, solve_candidate, torch_poses
 from cell.coordinated.record import CoordinatedWeld
 from cell.errors import MotionError, PlanError
@@ -72,11 +73,17 @@ def on_curve(start_m: float, rev: bool, s_a: float, s_b: float, total: float, cl
     return max(a, 0.0), min(b, total)
 
 
-def leftover(a: float, b: float, total: float, closed: bool, misses: Sequence[Miss]) -> tuple[Remainder, ...]:
-    """What an open weld from ``a`` to ``b`` [m] along a curve ``total`` long leaves for a manual weld: the rest of
-    a closed loop (from ``b`` round to ``a``, from within the curve's length), or an open curve's ends beyond it;
-    each with what stops the arm there (the knots' ``misses``: the commonest code, the two commonest in words)."""
-    pieces = [(b % total, b % total + total - (b - a))] if closed else [(0.0, a), (b, total)]
+def leftover(spans: Sequence[tuple[float, float]], total: float, closed: bool,
+             misses: Sequence[Miss]) -> tuple[Remainder, ...]:  # fmt: skip
+    """What open welds over ``spans`` (from, to) [m] along a curve ``total`` long leave for a manual weld: the
+    stretches of a closed loop no span covers (each from within the curve's length), or an open curve's ends
+    beyond its one span; each with what stops the arm there (the knots' ``misses``: the commonest code, the two
+    commonest in words)."""
+    if closed:
+        pieces = loop_gaps(spans, total)
+    else:
+        (a, b), *_ = spans
+        pieces = [(0.0, a), (b, total)]
     out = []
     for lo, hi in pieces:
         if hi - lo <= EPS_M:
@@ -165,37 +172,88 @@ def _stretch_plan(su: Setup, est: CurveEstimate, cand: Candidate, spin: float, l
     raise PlanError(f"curved seam {est.id}: no tilt within the limits puts {lo * 1000:.0f}-{hi * 1000:.0f} mm in PA")
 
 
-def plan_in_part(su: Setup, est: CurveEstimate, rng: np.random.Generator) -> CoordinatedWeld:
-    """``est`` welded in part with the part turning: every candidate's held stretches (:func:`walk`), the longest
-    (after :data:`STOP_BACK_M` off each end where the arm gives out) planned as an open coordinated weld, the next
-    longest where one is not timed or gated, up to :data:`MAX_TRIES`; the weld's ``remainder`` what it leaves for
-    a manual weld (:func:`leftover`) and its ``share`` of the curve. PlanError when none is planned."""
-    t_wall = time.perf_counter()
-    total = est.length_m
-    options = []  # a candidate whose every knot is held (its motion refused it whole) leaves no stretch to list
+@dataclass(frozen=True)
+class Held:
+    """A stretch of a candidate's knots the arm holds at one spin, cut :data:`STOP_BACK_M` back from where it gives
+    out: ``cand``, ``spin`` [deg], from ``lo_m`` to ``hi_m`` [m] along the located curve's own order (a closed one's
+    from within its length), ``misses`` its walk's (why each knot not held is not)."""
+
+    cand: Candidate
+    spin: float
+    lo_m: float
+    hi_m: float
+    misses: tuple[Miss, ...]
+
+    @property
+    def length(self) -> float:
+        return self.hi_m - self.lo_m
+
+
+def held_stretches(su: Setup, est: CurveEstimate, rng: np.random.Generator) -> list[Held]:
+    """Every candidate's held stretches at every spin (:func:`walk`, :func:`stretches`) at least
+    :data:`MIN_ARC_M` long, the longest first; a candidate whose every knot is held (its motion refused it whole)
+    leaves none."""
+    out = []
     for cand in candidates(su, est):
+        path = cand[2]
         for spin in SPINS_DEG:
             w = walk(su, est, cand, torch_poses(su, cand, spin)[1], rng)
             if not w.misses:
                 continue
             for k0, k1 in stretches(w.ok, w.link):
                 s_a, s_b = float(w.s_m[k0]), float(w.s_m[k1])
-                whole_start = not est.closed and k0 == 0
-                whole_end = not est.closed and k1 == len(w.ok) - 1
-                s_a += 0.0 if whole_start else STOP_BACK_M
-                s_b -= 0.0 if whole_end else STOP_BACK_M
+                s_a += 0.0 if not est.closed and k0 == 0 else STOP_BACK_M
+                s_b -= 0.0 if not est.closed and k1 == len(w.ok) - 1 else STOP_BACK_M
                 if s_b - s_a >= MIN_ARC_M:
-                    options.append((s_b - s_a, cand, spin, s_a, s_b, w.misses))
-    options.sort(key=lambda o: -o[0])
+                    lo, hi = on_curve(path.start, path.reversed, s_a, s_b, est.length_m, est.closed)
+                    out.append(Held(cand, spin, lo, hi, w.misses))
+    return sorted(out, key=lambda h: -h.length)
+
+
+def plan_in_part(su: Setup, est: CurveEstimate, rng: np.random.Generator) -> CoordinatedWeld:
+    """``est`` welded in part with the part turning: every candidate's held stretches (:func:`held_stretches`),
+    the longest planned as an open coordinated weld, the next longest where one is not timed or gated, up to
+    :data:`MAX_TRIES`; on a closed curve then further arcs over what it leaves (:func:`further_arcs`); the weld's
+    ``remainder`` what they leave for a manual weld (:func:`leftover`) and its ``share`` of the curve. PlanError
+    when none is planned."""
+    t_wall = time.perf_counter()
+    total = est.length_m
+    held = held_stretches(su, est, rng)
     why = "the arm holds no stretch of it long enough to weld"
-    for _, cand, spin, s_a, s_b, misses in options[:MAX_TRIES]:
-        path = cand[2]
-        lo, hi = on_curve(path.start, path.reversed, s_a, s_b, total, est.closed)
+    for h in held[:MAX_TRIES]:
         try:
-            cw = _stretch_plan(su, est, cand, spin, lo, hi, rng, t_wall)
+            cw = _stretch_plan(su, est, h.cand, h.spin, h.lo_m, h.hi_m, rng, t_wall)
         except MotionError as e:
-            why = f"{lo * 1000:.0f}-{hi * 1000:.0f} mm at spin {spin:+.0f} deg: {e.message}"
+            why = f"{h.lo_m * 1000:.0f}-{h.hi_m * 1000:.0f} mm at spin {h.spin:+.0f} deg: {e.message}"
             continue
-        rest = leftover(lo, hi, total, est.closed, misses)
-        return replace(cw, remainder=rest, share=welded_share(rest, total, est.closed), span_m=(lo, hi))
+        then = further_arcs(su, est, held, (h.lo_m, h.hi_m), rng) if est.closed else ()
+        spans = [(h.lo_m, h.hi_m), *(a.span_m for a in then if a.span_m is not None)]
+        rest = leftover(spans, total, est.closed, h.misses)
+        return replace(cw, remainder=rest, share=welded_share(rest, total, est.closed), span_m=(h.lo_m, h.hi_m),
+                       then=then)  # fmt: skip
     raise PlanError(f"curved seam {est.id}: no coordinated motion, whole or in part: {why}")
+
+
+def further_arcs(su: Setup, est: CurveEstimate, held: Sequence[Held], first: tuple[float, float],
+                 rng: np.random.Generator) -> tuple[CoordinatedWeld, ...]:  # fmt: skip
+    """The coordinated arcs after the ``first`` (from, to) [m] over what it leaves of a closed curve: each time the
+    held stretch that welds the most of what is left, restarting the process's ``closed_overlap`` back over the
+    bead at each junction (:func:`cell.coordinated.cover.next_arcs`), the next where one is not timed or gated (up
+    to :data:`MAX_TRIES`), up to :data:`cell.coordinated.cover.MAX_ARCS` arcs in all."""
+    spans = [first]
+    out: list[CoordinatedWeld] = []
+    while len(spans) < MAX_ARCS:
+        opts = next_arcs(spans, [(h.lo_m, h.hi_m) for h in held], est.length_m, su.process.closed_overlap,
+                         MIN_ARC_M)  # fmt: skip
+        t_wall = time.perf_counter()
+        for _, i, lo, hi in opts[:MAX_TRIES]:
+            try:
+                cw = _stretch_plan(su, est, held[i].cand, held[i].spin, lo, hi, rng, t_wall)
+            except MotionError:
+                continue
+            out.append(replace(cw, span_m=(lo, hi)))
+            spans.append((lo, hi))
+            break
+        else:
+            break
+    return tuple(out)

@@ -53,6 +53,14 @@ class CoordinatedWeld:
     remainder: tuple[Remainder, ...] = ()
     share: float = 1.0
     span_m: tuple[float, float] | None = None
+    # A closed curve welded in more than one arc (cell.coordinated.cover): the arcs after this one, in order, each
+    # its own open coordinated weld from home and back (its span_m its stretch), restarting over the beads before.
+    then: tuple[CoordinatedWeld, ...] = ()
+
+    @property
+    def arcs(self) -> tuple[CoordinatedWeld, ...]:
+        """This weld and the arcs after it."""
+        return (self, *self.then)
 
     def __post_init__(self) -> None:
         for name in ("times", "q", "axes", "arc_on", "knot_q", "knot_axes", "X_FT", "s", "slope_deg", "rotation_deg"):

@@ -153,6 +153,8 @@ def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) ->
     lim = [(n, name, math.degrees(a.q_min), math.degrees(a.q_max)) for n, name, a in
            ((2, "tilt", pos.tilt), (3, "rotate", pos.rotate))]  # fmt: skip
     axes = "; ".join(f"E{n} {name} limits {lo:.1f} .. {hi:.1f} deg" for n, name, lo, hi in lim)
+    lo_hi = cw.span_m
+    span = "" if lo_hi is None else f"; an open arc of it, {lo_hi[0] * 1000:.1f} to {lo_hi[1] * 1000:.1f} mm along it"
     return [
         f";- Positioner (tilt-rotate, coordinated, MACHINE_DEF[2]): {axes}.",
         ";- Coordinated motion: the points are in BASE_DATA on the positioner's faceplate ($BASE = EK(...)) and each"
@@ -163,7 +165,7 @@ def _header(pos: TiltRotatePositioner, cw: CoordinatedWeld, X_RB: FloatArray) ->
         chain_line(pos.X_RP, pos.tilt_height_m, pos.faceplate_offset_m, np.eye(4)),
         f";- Seam {cw.seam_id}: tilt {_tilt_text(cw)} (the fillet in PA), rotate"
         f" {math.degrees(cw.knot_axes[0, 1]):.1f} .. {math.degrees(cw.knot_axes[-1, 1]):.1f} deg, travel"
-        f" {cw.speed * 1000:.1f} mm/s along the part, overlap {cw.overlap * 1000:.1f} mm",
+        f" {cw.speed * 1000:.1f} mm/s along the part, overlap {cw.overlap * 1000:.1f} mm{span}",
     ]
 
 

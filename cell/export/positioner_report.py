@@ -13,6 +13,7 @@ from cell.geometry import FloatArray, invert
 from cell.pipeline.positioned.run import PositionerRun
 from cell.types import SeamEstimate, WeldReason
 from cell.types.curve_estimate import CurveEstimate
+from cell.types.execution import WeldQuality
 from cell.types.run import SeamWeld
 
 
@@ -66,6 +67,7 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
                 "tcp_rms_mm": _r(q.tcp_rms_mm) if q is not None else None,
             }
             | (_in_part(w, e, X_MR) if w is not None and w.partial else {})
+            | ({"arcs": [_tcp(a) for a in w.arc_quality]} if w is not None and w.arc_quality else {})
         )
     poses = [
         {
@@ -99,6 +101,11 @@ def positioner_report(run: PositionerRun) -> dict[str, Any]:
         "error": run.error.message if run.error is not None else None,
         "timings": {k: _r(v) for k, v in run.timings.items()},
     }
+
+
+def _tcp(q: WeldQuality) -> dict[str, Any]:
+    """One coordinated arc of a seam welded in several: its TCP against the true curve [mm]."""
+    return {"tcp_rms_mm": _r(q.tcp_rms_mm), "tcp_max_mm": _r(q.tcp_max_mm)}
 
 
 def _in_part(w: SeamWeld, e: SeamEstimate | CurveEstimate, X_MR: FloatArray | None) -> dict[str, Any]:

@@ -79,7 +79,8 @@ class SeamWeld:
     plan used none); the last check it failed (``check``, with the code ``last_check``); the planner's code where
     it refused the seam (``plan_code``). A curved seam welded in part (code ``partial``, ``welded`` False: never
     counted as welded whole): ``share`` the part of it its arcs weld, ``remainder`` the stretches left for a manual
-    weld, its arcs' ``quality``."""
+    weld, its arcs' ``quality`` (a loop the positioner turns welded in more than one arc: each arc's in
+    ``arc_quality``, in order)."""
 
     id: str
     planned: bool
@@ -93,6 +94,7 @@ class SeamWeld:
     plan_code: PlanReason | None = None
     share: float = 1.0
     remainder: tuple[Remainder, ...] = ()
+    arc_quality: tuple[WeldQuality, ...] = ()
 
     @property
     def partial(self) -> bool:

@@ -34,15 +34,15 @@ def test_the_remainder_of_a_loop_runs_from_the_welds_end_round_to_its_start_with
     misses = [Miss(0.22, PlanReason.IK_FAILED, "IK: joint_a3 at its limit")] * 3 + [
         Miss(0.25, PlanReason.COLLISION, "camera_link vs POSITIONER_CRADLE")
     ]
-    (rest,) = leftover(0.32, 0.52, total, True, misses)  # welded 0.32 round to 0.16 m
+    (rest,) = leftover([(0.32, 0.52)], total, True, misses)  # welded 0.32 round to 0.16 m
     assert (rest.from_m, rest.to_m) == pytest.approx((0.16, 0.32))  # from 0.16 m on the curve's own lap
-    assert leftover(0.02, 0.30, total, True, misses)[0].to_m == pytest.approx(0.38)  # round its start
+    assert leftover([(0.02, 0.30)], total, True, misses)[0].to_m == pytest.approx(0.38)  # round its start
     assert rest.code is PlanReason.IK_FAILED and "3 of 4 tries IK: joint_a3 at its limit" in rest.why
     assert "stops 5 mm short" in rest.why
     # An open curve: what lies before and after the weld, each on its own.
-    ends = leftover(0.03, 0.15, 0.20, False, misses)
+    ends = leftover([(0.03, 0.15)], 0.20, False, misses)
     assert [v for r in ends for v in (r.from_m, r.to_m)] == pytest.approx([0.0, 0.03, 0.15, 0.20])
-    assert leftover(0.0, 0.20, 0.20, False, misses) == ()
+    assert leftover([(0.0, 0.20)], 0.20, False, misses) == ()
 
 
 def test_the_positioner_exit_line_says_a_curve_welded_in_part_as_the_fixed_arm_does() -> None:
@@ -90,3 +90,27 @@ def test_a_loop_is_welded_in_part_only_with_curve_remainder_manual(monkeypatch: 
     monkeypatch.setattr(plan, "candidates", lambda su, c: [])  # no axes hold it in PA: nothing to weld in part
     with pytest.raises(PlanError, match="torch vs POST"):
         planned("manual")
+
+
+def test_a_loop_is_covered_by_arcs_restarting_the_overlap_over_the_bead_or_left_with_the_smaller_remainder() -> None:
+    from cell.coordinated.cover import cover, loop_gaps
+
+    total, ov, arc = 0.36, 0.010, 0.02
+    # Two candidates' stretches: the first arc 0.00-0.22 m; the other holds 0.21-0.37 m (round the start): it
+    # reaches 10 mm back over the bead at both ends, so the loop is welded whole in two arcs.
+    (i, lo, hi), *more = cover((0.0, 0.22), [(0.0, 0.22), (0.21, 0.37)], total, ov, arc)
+    assert (i, more) == (1, []) and (lo, hi) == pytest.approx((0.21, 0.37))
+    assert loop_gaps([(0.0, 0.22), (lo, hi)], total) == []
+    # Held 5 mm short of either overlap (0.215-0.365 m): each end a free end 10 mm off the bead, 20 mm left.
+    ((_, lo, hi),) = cover((0.0, 0.22), [(0.0, 0.22), (0.215, 0.365)], total, ov, arc)
+    assert (lo, hi) == pytest.approx((0.23, 0.35))
+    assert sum(b - a for a, b in loop_gaps([(0.0, 0.22), (lo, hi)], total)) == pytest.approx(0.02)
+    # Nothing holds 0.25-0.30 m (tube-tee's end plates): two more arcs, one from each junction, 50 mm left.
+    arcs = cover((0.0, 0.22), [(0.0, 0.22), (0.15, 0.25), (0.30, 0.40)], total, ov, arc)
+    assert sorted((round(a, 3), round(b, 3)) for _, a, b in arcs) == [(0.21, 0.25), (0.3, 0.37)]
+    left = loop_gaps([(0.0, 0.22), *((a, b) for _, a, b in arcs)], total)
+    assert [v for g in left for v in g] == pytest.approx([0.25, 0.30])
+    # What the arcs leave for a manual weld, with the first arc's words: that stretch alone.
+    misses = [Miss(0.27, PlanReason.IK_FAILED, "IK: joint_a3 at its limit")]
+    (rest,) = leftover([(0.0, 0.22), *((a, b) for _, a, b in arcs)], total, True, misses)
+    assert (rest.from_m, rest.to_m) == pytest.approx((0.25, 0.30)) and rest.code is PlanReason.IK_FAILED

@@ -75,7 +75,7 @@ def weld_curves_coordinated(
     returned welds. ``refuse_doubtful`` False is a study's (benchmarks/bench_coordinated.py): a curve the weld
     gate refuses is planned and welded all the same, its refusal kept in its weld's reason; never the cell's."""
     from cell.coordinated.gate import MovingScene
-    from cell.pipeline.coordinated.play import play, quality, weave_at_records
+    from cell.pipeline.coordinated.play import joined, play_arcs, quality
     from cell.pipeline.curved.welds import curve_doubt
     from cell.pipeline.placeable import curve_procedures_for
     from cell.process.torch import WeldProcess
@@ -121,6 +121,11 @@ def weld_curves_coordinated(
             f"coordinated: {c.id} planned in {time.perf_counter() - t0:.1f} s: tilt "
             f"{math.degrees(cw.knot_axes[0, 0]):+.1f} deg, rotate {math.degrees(cw.knot_axes[0, 1]):+.1f} to "
             f"{math.degrees(cw.knot_axes[-1, 1]):+.1f} deg, arc {cw.arc_s:.1f} s of {cw.duration:.1f} s"
+            + "".join(
+                f"; then {math.degrees(a.knot_axes[0, 1]):+.1f} to {math.degrees(a.knot_axes[-1, 1]):+.1f} deg,"
+                f" arc {a.arc_s:.1f} s of {a.duration:.1f} s"
+                for a in cw.then
+            )
         )
         in_part = _in_part_text(cw)
         if not execute:
@@ -128,17 +133,19 @@ def weld_curves_coordinated(
             out.append((pose, SeamWeld(c.id, True, False, said, code=WeldReason.PREVIEW, procedure=proc,
                                        share=cw.share, remainder=cw.remainder), cw, None))  # fmt: skip
             continue
-        station.move_positioner(*pos.home)
-        ex, back = play(station, cw)
+        played = play_arcs(station, cw, pos.X_R_F(*pos.home)[:3, :3])
+        ex, back, weave = joined(played)
         truth = det.curve_truths.get(c.id)
-        weave = weave_at_records(cw, ex, pos.X_R_F(*pos.home)[:3, :3]) if cw.weave_F is not None else None
         q = quality(ex, back, truth, c.closed, weave) if truth is not None else None
+        per_arc = tuple(quality(*p[:2], truth, c.closed, p[2]) for p in played) if truth is not None and cw.then else ()
         study = f"welded for a study despite the weld gate: {doubt.detail}" if doubt is not None else ""
-        if in_part:  # its stretch welded, the rest left for a manual weld: never counted as welded
-            out.append((pose, SeamWeld(c.id, True, False, in_part, q, WeldReason.PARTIAL, proc, (q,) if q else (),
-                                       share=cw.share, remainder=cw.remainder), cw, ex))  # fmt: skip
+        if in_part:  # its stretches welded, the rest left for a manual weld: never counted as welded
+            w = SeamWeld(c.id, True, False, in_part, q, WeldReason.PARTIAL, proc, (q,) if q else (), share=cw.share,
+                         remainder=cw.remainder, arc_quality=per_arc)  # fmt: skip
+            out.append((pose, w, cw, ex))
             continue
-        out.append((pose, SeamWeld(c.id, True, True, study, q, procedure=proc, passes=(q,) if q else ()), cw, ex))
+        out.append((pose, SeamWeld(c.id, True, True, study or _arcs_text(cw), q, procedure=proc,
+                                   passes=(q,) if q else (), arc_quality=per_arc), cw, ex))  # fmt: skip
     return out, why
 
 
@@ -171,5 +178,12 @@ def _in_part_text(cw: CoordinatedWeld) -> str:
         return ""
     left = sum(r.length_m for r in cw.remainder)
     stretches = "; ".join(r.describe() for r in cw.remainder)
-    return (f"welded in part: {cw.share:.0%} in 1 arc with the part turning, {left * 1000:.0f} mm left for a "
-            f"manual weld: {stretches}")  # fmt: skip
+    n = len(cw.arcs)
+    return (f"welded in part: {cw.share:.0%} in {n} arc{'s' * (n > 1)} with the part turning, {left * 1000:.0f} mm "
+            f"left for a manual weld: {stretches}")  # fmt: skip
+
+
+def _arcs_text(cw: CoordinatedWeld) -> str:
+    """A loop welded whole in more than one coordinated arc, in words ("": in one)."""
+    n = len(cw.arcs)
+    return f"welded whole in {n} arcs with the part turning, each restarting over the bead before" if n > 1 else ""

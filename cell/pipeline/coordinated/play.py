@@ -55,6 +55,40 @@ def play(station: SimStation, cw: CoordinatedWeld, record_dt: float = RECORD_DT)
     return Execution(at, q, tcp_W, arc, events), back_R
 
 
+def play_arcs(station: SimStation, cw: CoordinatedWeld,
+              R_R_F0: FloatArray) -> list[tuple[Execution, FloatArray, FloatArray | None]]:  # fmt: skip
+    """Each arc of ``cw`` (:attr:`CoordinatedWeld.arcs`: each from home and back) played in turn from the
+    positioner at home: its execution, its records' tips in the part's frame at the scan (:func:`play`) and the
+    weave meant at them (:func:`weave_at_records`, R_R_F0 (3, 3) the faceplate's rotation at home; None without
+    a weave)."""
+    assert station.positioner is not None
+    home = station.positioner.pos.home
+    out = []
+    for arc in cw.arcs:
+        station.move_positioner(*home)
+        ex, back = play(station, arc)
+        out.append((ex, back, weave_at_records(arc, ex, R_R_F0) if arc.weave_F is not None else None))
+    return out
+
+
+def joined(played: list[tuple[Execution, FloatArray, FloatArray | None]]) -> tuple[Execution, FloatArray,
+                                                                                   FloatArray | None]:  # fmt: skip
+    """Arcs played one after the other (:func:`play_arcs`) as one execution (each arc's times after the last's end),
+    their tips and weaves (None: no arc weaves)."""
+    if len(played) == 1:
+        return played[0]
+    times, t0, events = [], 0.0, []
+    for ex, _, _ in played:
+        times.append(np.asarray(ex.times) + t0)
+        events += [Event(e.t + t0, e.kind, e.detail) for e in ex.events]
+        t0 = float(times[-1][-1]) + RECORD_DT
+    cat = lambda f: np.concatenate([f(p) for p in played])  # noqa: E731
+    ex = Execution(np.concatenate(times), cat(lambda p: p[0].q), cat(lambda p: p[0].tcp_W), cat(lambda p: p[0].arc_on),
+                   tuple(events))  # fmt: skip
+    weave = None if all(p[2] is None for p in played) else cat(lambda p: p[2] if p[2] is not None else 0.0 * p[1])
+    return ex, cat(lambda p: p[1]), weave
+
+
 class _Bead:
     """The bead of a coordinated weld, laid on the turning part: the tip's points in the part's frame at the scan
     (R at home) gathered while the arc burns, drawn as chords of the scenario's bead style once they span a step

@@ -135,8 +135,9 @@ def weld_on_positioner(scenario: Scenario, job: WeldJob | None = None, *, progre
         from cell.pipeline.coordinated import weld_curves_coordinated  # curved seams: the part turns while welded
 
         done, why_c = weld_curves_coordinated(station, det, pos, q_now, execute=job.execute, progress=progress)
-        groups_c = [GroupRun(p, 0.0, None, None, ex, (w,), cw.plan_s) for p, w, cw, ex in done if cw is not None]
-        coordinated = tuple(cw for _, _, cw, _ in done if cw is not None)
+        groups_c = [GroupRun(p, 0.0, None, None, ex, (w,), sum(a.plan_s for a in cw.arcs)) for p, w, cw, ex in done
+                    if cw is not None]  # fmt: skip
+        coordinated = tuple(a for _, _, cw, _ in done if cw is not None for a in cw.arcs)  # each arc its program
         unheld |= why_c
         codes |= {w.id: w.code or WeldReason.NOT_PLANNED for _, w, cw, _ in done if cw is None}
         timings = {**det.timings, "choose_poses_s": choose_s, "choose_poses_cpu_s": choose_cpu_s}

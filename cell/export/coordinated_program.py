@@ -299,6 +299,11 @@ def coordinated_rapid(
     return "\n".join([*head, *decl, "", *body])
 
 
+def coordinated_names(stem: str, n: int) -> list[str]:
+    """The programs' names of ``n`` coordinated welds, in the order they are played: ``stem``_c1, ... (24 at most)."""
+    return [f"{stem}_c{k + 1}"[:24] for k in range(n)]
+
+
 def write_coordinated_programs(
     controller: str,
     cws: list[CoordinatedWeld],
@@ -307,10 +312,10 @@ def write_coordinated_programs(
     stem: str,
     out_dir: str | Path,
 ) -> list[Path]:
-    """One program per coordinated weld (``stem``_c1, ...) into ``out_dir``; their paths."""
+    """One program per coordinated weld (``stem``_c1, ...: :func:`coordinated_names`) into ``out_dir``; their
+    paths."""
     texts: dict[str, str] = {}
-    for k, cw in enumerate(cws):
-        name = f"{stem}_c{k + 1}"[:24]
+    for name, cw in zip(coordinated_names(stem, len(cws)), cws, strict=True):
         if controller == "rapid":
             texts[f"{name}.mod"] = coordinated_rapid(cw, robot, name)
         else:

@@ -130,3 +130,23 @@ def test_a_partial_positioner_job_names_each_unwelded_seams_reason() -> None:
     rep = {"seams": seams, "error": None, "totals": {"welded": 1, "seams": 4}}
     assert partial_line(rep) == "exit 3: 3 seams not welded (low_confidence: 1, not_planned: 2); 1/4 welded"
     assert partial_line({**rep, "seams": seams[:1], "totals": {"welded": 1, "seams": 1}}) is None
+
+
+def test_the_main_program_calls_the_coordinated_welds_after_the_poses_as_they_were_played(
+    jobs: list[ProgramJob],
+) -> None:
+    """The coordinated welds' programs are called by the main program after the poses' (the order the simulation
+    played them), each named with what it welds; with no pose's plan the main program still calls them, its home
+    the one given."""
+    after = [("pos_c1", "seam RUN>END_L:circle from 356 to 578 mm along it"), ("pos_c2", "seam BRANCH>RUN:saddle")]
+    src = positioner_texts("krl", jobs, "pos", after)["POS.src"]
+    calls = re.findall(r"^(\w+)\( \)$", src, flags=re.M)
+    assert calls == [*(j.name.upper() for j in jobs), "POS_C1", "POS_C2"]
+    assert ";- coordinated weld 2 of 2: POS_C2, seam BRANCH>RUN:saddle" in src
+    q_home = np.radians([-90.0, -100.0, 100.0, 0.0, 45.0, 0.0])
+    alone = positioner_texts("krl", [], "pos", after, q_home)
+    assert set(alone) == {"POS.src", "POS.dat"}  # the coordinated programs are written beside it by their own post
+    assert re.findall(r"^(\w+)\( \)$", alone["POS.src"], flags=re.M) == ["POS_C1", "POS_C2"]
+    assert "XHOME_PLAN={A1 -90.000, A2 -100.000, A3 100.000," in alone["POS.dat"]
+    with pytest.raises(ValueError, match="nothing to export"):
+        positioner_texts("krl", [], "pos")

@@ -135,14 +135,26 @@ def _programs(sc: Scenario, run: Any, out_dir: Path, controller: str) -> list[Pa
                                                        for w in g.seams if w.id == cw.seam_id)]  # fmt: skip
     if not jobs and not coordinated:
         return []
+    from cell.export.coordinated_program import coordinated_names, write_coordinated_programs
+
     make_folder(out_dir)
     stem = f"{sc.name.replace('-', '_')}"[:24]
-    written = write_positioner_programs(controller, jobs, stem, out_dir) if jobs else []
+    names = coordinated_names(stem[:20], len(coordinated))  # the main calls them after the poses, as they were played
+    after = [(n, _welds(cw)) for n, cw in zip(names, coordinated, strict=True)]
+    home = np.radians(np.asarray(sc.robot.home_deg, dtype=float))
+    written = write_positioner_programs(controller, jobs, stem, out_dir, after, home)
     if coordinated:  # curved seams welded with the part turning: a program each (docs/positioner.md)
-        from cell.export.coordinated_program import write_coordinated_programs
-
         written += write_coordinated_programs(controller, coordinated, robot, pos, stem[:20], out_dir)
     return written
+
+
+def _welds(cw: Any) -> str:
+    """What a coordinated weld's program welds, for the main program's comment: its seam, and the stretch of it
+    when it welds one (an arc of a loop welded in part)."""
+    if cw.span_m is None:
+        return f"seam {cw.seam_id}"
+    a, b = (v * 1000.0 for v in cw.span_m)
+    return f"seam {cw.seam_id} from {a:.0f} to {b:.0f} mm along it"
 
 
 def _robot(sc: Scenario) -> Kinematics:

@@ -111,12 +111,15 @@ class Remainder:
     """A stretch of a curved seam its planned arcs leave for a manual weld: from ``from_m`` to ``to_m`` [m] along the
     located curve (a closed curve's ``to_m`` may pass its length: round its start), ``code`` what stops the arm
     there and ``why`` in words (no torch setting holds it, a restart whose overlap is short of the WPS's, an arc
-    that failed its full solve)."""
+    that failed its full solve). ``end``, for an arc refused after the search (the safety gate, a transfer): the
+    end of the arc whose motions were at fault, ``start`` (the move into it, its approach) or ``end`` (its depart,
+    the move on), the arc then planned again trimmed there; "" for its weld, or no arc."""
 
     from_m: float
     to_m: float
     code: PlanReason
     why: str
+    end: str = ""
 
     @property
     def length_m(self) -> float:

@@ -53,7 +53,7 @@ def blamed_seams(
 
 
 def in_arcs(plan: WeldPlan) -> set[str]:
-    """The curved seams of ``plan`` welded in several arcs (:attr:`WeldPlan.arcs`)."""
+    """The curved seams of ``plan`` welded in several arcs or in part (:attr:`WeldPlan.arcs`)."""
     return {seam_of_arc(a.arc_id) for a in plan.arcs}
 
 

@@ -24,13 +24,7 @@ from cell.planning.access.screen import first_unjoined
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
 from cell.planning.curves import arc_spans, cover_curves, curve_pieces, in_part, weldable, whole_or_none, with_paths
-from cell.planning.curves.exits import (
-    EXIT_TRIES,
-    exit_at_fault,
-    exit_refusal,
-    replan_exit,
-    still_welds,
-)
+from cell.planning.curves.refused import exit_at_fault
 from cell.planning.curves.split import seam_of
 from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
@@ -140,60 +134,41 @@ def plan_welds(
     arcs, still, in_parts, spans = cover_curves(to_search, searches, q0, curve_procs, refused)  # one go, arcs, part
     for cid, res in still.items():
         outcomes[cid] = _failed(cid, res.code, res.where, res.p_R)
+    for aid, sols in arcs.items():  # each arc welded as an open curve of its own, the seam's search and procedure
+        solved[aid], searches[aid] = sols, searches[seam_of(aid)]
+        if seam_of(aid) in chosen:
+            chosen[aid] = chosen[seam_of(aid)]
+        curve_ids.add(aid)
+
     transfers = Transfers(robot, process, checker, opt, obstacles, q0, WAYS)
     seam_parts: dict[str, list[Piece]] = {}
-
-    def add(new: Mapping[str, tuple[SeamSolution, ...]]) -> None:  # planned seams (arcs) timed, or their failure
-        for aid, sols in new.items():  # each arc welded as an open curve of its own, the seam's search and procedure
-            if seam_of(aid) != aid:
-                solved[aid], searches[aid] = sols, searches[seam_of(aid)]
-                if seam_of(aid) in chosen:
-                    chosen[aid] = chosen[seam_of(aid)]
-                curve_ids.add(aid)
-        for sid in new:
-            sel = chosen.get(sid)
-            got = _timed(sid, robot, searches[sid].process, opt, transfers, solved[sid], sel, sid in curve_ids)
-            if isinstance(got, SeamOutcome):
-                solved.pop(sid)
-                outcomes[sid] = got
-            else:
-                seam_parts[sid] = got
-
-    add({**solved, **arcs})
+    for sid in list(solved):
+        sel = chosen.get(sid)
+        proc = sel.procedure if isinstance(sel, SeamProcedure) else None
+        try:
+            pr = searches[sid].process
+            timed = curve_lines if sid in curve_ids else seam_pieces
+            parts: list[Piece] | TransferFail = (
+                curve_pieces(robot, pr, opt, solved[sid][0], None)  # one pass, the controller's crater
+                if sid in curve_ids and proc is None
+                else pass_pieces(robot, pr, opt, transfers, solved[sid], proc, timed)
+            )
+        except TimingError as exc:
+            sols = solved.pop(sid)
+            outcomes[sid] = _failed(sid, PlanReason.TIMING, exc.message, sols[0].X_weld[0][:3, 3])
+            continue
+        if isinstance(parts, TransferFail):
+            solved.pop(sid)
+            detail = f"no free move between two passes: {parts.reason}"
+            outcomes[sid] = _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
+            continue
+        seam_parts[sid] = parts
     whole_or_none(solved, outcomes, seam_parts, parts=in_parts)
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
     lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
     forbidden = _expand(avoid, solved)
-    exits: dict[str, list[Remainder]] = {}  # curved seam -> its arcs whose way out failed, each trimmed there
     failed_out: set[tuple[str, str]] = set()  # the transfers (from, to) found with no free way so far
-    futile: dict[str, set[tuple[float, float]]] = {}  # ... whose trim left too little of it (not planned again)
-
-    def replanned(aid: str, fail: TransferFail, home: bool) -> bool:  # the curve covered again, aid's end trimmed
-        sid, r = seam_of(aid), exit_refusal(aid, spans[aid], fail, home)
-        if (r.from_m, r.to_m) in futile.get(sid, set()):
-            return False
-        est = next(e for e in to_search if e.id == sid)
-        got = replan_exit(est, searches, q0, curve_procs, [*(refused or {}).get(sid, ()), *exits.get(sid, ()), r])
-        if not still_welds(got, spans[aid], est):  # its stretch no longer welded: another arc to lose, not this
-            futile.setdefault(sid, set()).add((r.from_m, r.to_m))
-            return False
-        exits.setdefault(sid, []).append(r)
-        for k in [k for k in solved if seam_of(k) == sid]:
-            for d in (solved, seam_parts, ends, lines, spans):
-                d.pop(k, None)
-        for pairs in (forbidden, failed_out):  # the seam's arcs are new: what failed to or from the old ones, forgotten
-            pairs.difference_update({(x, y) for x, y in pairs if sid in (seam_of(x), seam_of(y))})
-        spans.update(got.spans)
-        in_parts[sid] = got.part  # type: ignore[assignment]  # still_welds: a part
-        add(got.arcs)
-        whole_or_none(solved, outcomes, seam_parts, parts=in_parts)
-        for k in [k for k in solved if seam_of(k) == sid]:
-            ends[k] = (solved[k][0].q_approach[0], solved[k][-1].q_depart[-1])
-            lines[k] = seam_lines(solved[k][0], solved[k][-1], process, opt.short_lines)
-        forbidden.update({(x, y) for x, y in _expand(avoid, solved) if sid in (seam_of(x), seam_of(y))})
-        return True
-
     while True:
         ids = list(solved)
         order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)
@@ -209,8 +184,6 @@ def plan_welds(
         fault = exit_at_fault(a, b, failed_out, in_parts)  # the move out of arc a failed towards two places
         if fault and transfers.retreat_from([e.q for e in lines[a].exits], RETREATS):  # other ways out of it
             forbidden -= {(x, y) for x, y in forbidden if x == a} - _expand(avoid, solved)
-            continue
-        if fault and len(exits.get(seam_of(a), ())) < EXIT_TRIES and replanned(a, why, not b):  # a trimmed there
             continue
         again = (a, b) not in forbidden and len(ids) > 1  # another order may do without this transfer
         cut = first_cut_off(transfers, lines, q0, (b, a)) if elsewhere and again else None
@@ -359,33 +332,6 @@ def _expand(avoid: Collection[tuple[str, str]], solved: Collection[str]) -> set[
     """The transfers (from, to; "" = home) ``avoid`` names, a curved seam's named as each of its arcs in ``solved``."""
     pieces = {sid: [k for k in solved if seam_of(k) == sid] or [sid] for pair in avoid for sid in pair if sid}
     return {(x, y) for a, b in avoid for x in pieces.get(a, [a]) for y in pieces.get(b, [b])}
-
-
-def _timed(
-    sid: str,
-    robot: RobotModel,
-    pr: WeldProcess,
-    opt: PlanOptions,
-    transfers: Transfers,
-    sols: tuple[SeamSolution, ...],
-    sel: SeamProcedure | NoProcedure | None,
-    curve: bool,
-) -> list[Piece] | SeamOutcome:
-    """A planned seam's ``sid`` (or arc's: ``curve``) approach, weld and depart of every pass, timed with ``pr``; or
-    why it cannot be (its timing, no free move between two passes)."""
-    proc = sel.procedure if isinstance(sel, SeamProcedure) else None
-    try:
-        parts = (
-            curve_pieces(robot, pr, opt, sols[0], None)  # one pass, the controller's crater
-            if curve and proc is None
-            else pass_pieces(robot, pr, opt, transfers, sols, proc, curve_lines if curve else seam_pieces)
-        )
-    except TimingError as exc:
-        return _failed(sid, PlanReason.TIMING, exc.message, sols[0].X_weld[0][:3, 3])
-    if isinstance(parts, TransferFail):
-        detail = f"no free move between two passes: {parts.reason}"
-        return _failed(sid, PlanReason.TRANSFER_COLLISION, detail, parts.p_R)
-    return parts
 
 
 def _failed(seam_id: str, code: PlanReason, detail: str, p_R: npt.ArrayLike) -> SeamOutcome:

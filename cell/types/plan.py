@@ -163,9 +163,9 @@ class SeamOutcome:
 
 @dataclass(frozen=True)
 class ArcSpan:
-    """One arc of a curved seam welded in several (id ``<seam>#arcK``): its stretch from ``from_m`` to ``to_m`` [m]
-    along the located curve (a closed curve's ``to_m`` may pass its length) and when it runs in the plan, from the
-    start of the move into it to the end of its depart, ``t0`` to ``t1`` [s]."""
+    """One arc of a curved seam welded in several or in part (id ``<seam>#arcK``): its stretch from ``from_m`` to
+    ``to_m`` [m] along the located curve (a closed curve's ``to_m`` may pass its length) and when it runs in the
+    plan, from the start of the move into it to the end of its depart, ``t0`` to ``t1`` [s]."""
 
     arc_id: str
     from_m: float
@@ -180,8 +180,8 @@ class WeldPlan:
     seams: one outcome per seam asked for, in input order; order: ids of the welded seams in welding order;
     planning_s: wall time spent planning [s]. track: the linear track the base rides on (None: a fixed base);
     then every segment's trajectory carries E1 (``Trajectory.e1``), and the poses (X_end) stay in R, the base at
-    E1 = 0. arcs: the arcs of the curved seams welded in several (their segments carry the seam's id), in time
-    order."""
+    E1 = 0. arcs: the arcs of the curved seams welded in several or in part (their segments carry the seam's id),
+    in time order."""
 
     joint_names: tuple[str, ...]
     q_home: FloatArray

@@ -212,3 +212,18 @@ def test_an_arc_refused_at_an_end_and_planned_again_trimmed_is_kept() -> None:
     assert sorted(arcs) == [A1, A2, A3] and not still
     arcs, still, _, _ = _covered(_split(SPANS, (GAP,)), [gate])  # the same arc again: left out, as before
     assert sorted(arcs) == [A2, A3]
+
+
+def test_an_exit_is_at_fault_when_the_move_out_of_an_arc_failed_towards_another_place_too() -> None:
+    """The order search tries the ways out of an arc's exits (retreats) only where a move out of it failed towards
+    two places or more (not where one move failed, nor out of a straight seam or a curve welded whole or refused)."""
+    from cell.planning.curves.refused import exit_at_fault
+    from cell.planning.curves.split import Partial
+
+    parts = {SEAM: Partial(1.0, True, 0.8, (GAP,), {a: (x, y) for a, x, y in SPANS}, 0.01)}
+    assert not exit_at_fault(A1, "TOP#arc1", {(A1, "TOP#arc1")}, parts)  # its first failure: another order first
+    assert exit_at_fault(A1, "TOP#arc1", {(A1, "B1"), (A1, "TOP#arc1")}, parts)  # towards B1 too
+    assert exit_at_fault(A1, "", {(A1, "B1"), (A1, "")}, parts)  # home too
+    assert not exit_at_fault(A1, "TOP#arc1", {("B1", "TOP#arc1"), (A1, "TOP#arc1")}, parts)  # into it: not its exit
+    assert not exit_at_fault("B1", "C1", {("B1", "X"), ("B1", "C1")}, parts)  # a straight seam: as before
+    assert not exit_at_fault(A1, "B1", {(A1, "X"), (A1, "B1")}, {})  # a curve not welded in part: as before

@@ -35,8 +35,9 @@ def gate_answer(
     """The answer to violations ``found`` in ``plan`` (None: none, or one that concerns the whole plan). A violation
     on the move into a seam (or its approach, the move blended into it) is first answered by another order without
     that transfer (``reorder``; not one in ``avoid``, tried already); a seam blamed on a move already avoided, or for
-    its own motions, is dropped, except that a curved seam welded in several arcs (``by_arc``: the process's
-    ``curve_remainder`` is ``manual``) loses only the arc each violation falls on."""
+    its own motions, is dropped, except that a curved seam welded in several arcs or in part (``by_arc``: the
+    process's ``curve_remainder`` is ``manual``) loses only the arc each violation falls on, the end of it named
+    (``Remainder.end``: the planner trims a partial cover's arc there and chooses again)."""
     split = in_arcs(plan) if by_arc else set()
     blamed = blamed_seams(plan, found, split)
     if blamed is None:

@@ -13,7 +13,7 @@ from cell.geometry import readonly
 from cell.planning.curves.split import ARC_MARK
 from cell.planning.curves.split import seam_of as seam_of_arc
 from cell.planning.failures import reason_text
-from cell.types.plan import PlanReason, Remainder, SeamOutcome, Segment, WeldPlan
+from cell.types.plan import ArcSpan, PlanReason, Remainder, SeamOutcome, Segment, WeldPlan
 
 _CODE = {
     ViolationKind.COLLISION: PlanReason.COLLISION,
@@ -53,7 +53,7 @@ def blamed_seams(
 
 
 def in_arcs(plan: WeldPlan) -> set[str]:
-    """The curved seams of ``plan`` welded in several arcs (:attr:`WeldPlan.arcs`)."""
+    """The curved seams of ``plan`` welded in several arcs or in part (:attr:`WeldPlan.arcs`)."""
     return {seam_of_arc(a.arc_id) for a in plan.arcs}
 
 
@@ -84,8 +84,18 @@ def blamed_arcs(plan: WeldPlan, violations: Sequence[Violation], seams: Collecti
             o = _outcome(plan, v, sid)
             assert o.code is not None
             why = f"arc {arc.arc_id.rsplit(ARC_MARK, 1)[1]}: the safety gate: {v}"
-            out[arc.arc_id] = Remainder(arc.from_m, arc.to_m, o.code, why)
+            out[arc.arc_id] = Remainder(arc.from_m, arc.to_m, o.code, why, _end_of(plan, arc, sid, t))
     return out
+
+
+def _end_of(plan: WeldPlan, arc: ArcSpan, sid: str, t: float) -> str:
+    """Which end of ``arc`` (of seam ``sid``) the segment starting at plan time t [s] lies at: "start" (the move into
+    it, its approach: before its first weld), "end" (its depart, the move home after it: after its last weld), ""
+    (its weld)."""
+    welds = [s for s in plan.segments if s.seam_id == sid and s.arc_on and arc.t0 - 1e-9 <= s.t0 < arc.t1]
+    if not welds or t < welds[0].t0 - 1e-9:
+        return "start"
+    return "end" if t >= welds[-1].t1 - 1e-9 else ""
 
 
 def _segment_at(plan: WeldPlan, t: float) -> Segment:

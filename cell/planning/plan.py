@@ -19,11 +19,12 @@ from cell.geometry import readonly
 from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.planning.access.home import first_cut_off
-from cell.planning.access.openings import WAYS
+from cell.planning.access.openings import RETREATS, WAYS
 from cell.planning.access.screen import first_unjoined
 from cell.planning.assembly import assemble, seam_pieces
 from cell.planning.blend import blend_plan
 from cell.planning.curves import arc_spans, cover_curves, curve_pieces, in_part, weldable, whole_or_none, with_paths
+from cell.planning.curves.refused import exit_at_fault
 from cell.planning.curves.split import seam_of
 from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
@@ -166,8 +167,8 @@ def plan_welds(
     ends = {sid: (sols[0].q_approach[0], sols[-1].q_depart[-1]) for sid, sols in solved.items()}
     lines = {sid: seam_lines(sols[0], sols[-1], process, opt.short_lines) for sid, sols in solved.items()}
     seam_procs = {sid: sel.procedure for sid, sel in chosen.items() if isinstance(sel, SeamProcedure)}
-    pieces = {sid: [k for k in solved if seam_of(k) == sid] or [sid] for pair in avoid for sid in pair if sid}
-    forbidden = {(x, y) for a, b in avoid for x in pieces.get(a, [a]) for y in pieces.get(b, [b])}  # arcs too
+    forbidden = _expand(avoid, solved)
+    failed_out: set[tuple[str, str]] = set()  # the transfers (from, to) found with no free way so far
     while True:
         ids = list(solved)
         order = seam_order(ids, [ends[i][0] for i in ids], [ends[i][1] for i in ids], q0, robot, forbidden, first)
@@ -179,6 +180,11 @@ def plan_welds(
             if failed is None:
                 break
         a, b, why = failed
+        failed_out.add((a, b))
+        fault = exit_at_fault(a, b, failed_out, in_parts)  # the move out of arc a failed towards two places
+        if fault and transfers.retreat_from([e.q for e in lines[a].exits], RETREATS):  # other ways out of it
+            forbidden -= {(x, y) for x, y in forbidden if x == a} - _expand(avoid, solved)
+            continue
         again = (a, b) not in forbidden and len(ids) > 1  # another order may do without this transfer
         cut = first_cut_off(transfers, lines, q0, (b, a)) if elsewhere and again else None
         if cut is None and again:
@@ -197,7 +203,8 @@ def plan_welds(
             segments, robot.limits, lambda q: robot.fk(q)[:3, 3], transfers.clear, fraction=opt.blend, dt=opt.dt
         )
     segments = with_paths(segments, {sid: [p.X_weld for p in solved[sid]] for sid in curve_ids if sid in solved})
-    timed_arcs = arc_spans(segments, {aid: s for aid, s in spans.items() if aid in solved})
+    welded_in_part = {sid for sid, part in in_parts.items() if part.remainder}
+    timed_arcs = arc_spans(segments, {aid: s for aid, s in spans.items() if aid in solved}, welded_in_part)
     segments = [replace(g, seam_id=seam_of(g.seam_id)) for g in segments]  # a split seam's arcs: its welds
     for sid, sols in solved.items():
         c, pr, sel = sols[0].cand, searches[sid].process, chosen.get(sid)
@@ -319,6 +326,12 @@ def _table_stand_off(
 
 def _as_is(task: SeamTask) -> SeamTask:
     return task
+
+
+def _expand(avoid: Collection[tuple[str, str]], solved: Collection[str]) -> set[tuple[str, str]]:
+    """The transfers (from, to; "" = home) ``avoid`` names, a curved seam's named as each of its arcs in ``solved``."""
+    pieces = {sid: [k for k in solved if seam_of(k) == sid] or [sid] for pair in avoid for sid in pair if sid}
+    return {(x, y) for a, b in avoid for x in pieces.get(a, [a]) for y in pieces.get(b, [b])}
 
 
 def _failed(seam_id: str, code: PlanReason, detail: str, p_R: npt.ArrayLike) -> SeamOutcome:

@@ -68,6 +68,21 @@ class Transfers:
         self._tried: dict[tuple[TransferStrategy, bytes, bytes], list[Piece] | None] = {}
         self._shallow: set[tuple[str, bytes, bytes, int]] = set()
         self._probing = False
+        self.retreats: tuple[TransferStrategy, ...] = ()
+        self._retreat: set[bytes] = set()
+
+    def retreat_from(self, qs: Sequence[FloatArray], ways: Sequence[TransferStrategy]) -> bool:
+        """Try ``ways`` too (after every strategy) for the transfers out of the configurations ``qs`` (dof,) [rad]
+        each: a seam's exits found at fault (every way out of them meets a part, whatever follows). False when
+        they are tried already; the transfers searched so far are searched again (each strategy's answer kept)."""
+        keys = {np.asarray(q, dtype=float).tobytes() for q in qs}
+        if keys <= self._retreat:
+            return False
+        self._retreat |= keys
+        self.retreats = tuple(dict.fromkeys((*self.retreats, *ways)))
+        self._memo.clear()
+        self._between.clear()
+        return True
 
     def move(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail:
         """:meth:`search`, remembered per (q_a, q_b)."""
@@ -96,8 +111,12 @@ class Transfers:
         if key in self._between:
             return self._between[key]
         found: tuple[int, int, list[Piece]] | TransferFail | None = None
-        for strategy in self.strategies:
+        out_of = [np.asarray(q, dtype=float).tobytes() in self._retreat for q in outs]
+        for strategy in (*self.strategies, *(self.retreats if any(out_of) else ())):
+            extra = strategy not in self.strategies
             for i, k in pairs:
+                if extra and not out_of[i]:
+                    continue
                 got = self._tries(strategy, outs[i], ins[k])
                 if got is not None:
                     found = (i, k, got)

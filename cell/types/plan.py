@@ -111,12 +111,15 @@ class Remainder:
     """A stretch of a curved seam its planned arcs leave for a manual weld: from ``from_m`` to ``to_m`` [m] along the
     located curve (a closed curve's ``to_m`` may pass its length: round its start), ``code`` what stops the arm
     there and ``why`` in words (no torch setting holds it, a restart whose overlap is short of the WPS's, an arc
-    that failed its full solve)."""
+    that failed its full solve). ``end``, for an arc refused after the search (the safety gate, a transfer): the
+    end of the arc whose motions were at fault, ``start`` (the move into it, its approach) or ``end`` (its depart,
+    the move on), the arc then planned again trimmed there; "" for its weld, or no arc."""
 
     from_m: float
     to_m: float
     code: PlanReason
     why: str
+    end: str = ""
 
     @property
     def length_m(self) -> float:
@@ -160,9 +163,9 @@ class SeamOutcome:
 
 @dataclass(frozen=True)
 class ArcSpan:
-    """One arc of a curved seam welded in several (id ``<seam>#arcK``): its stretch from ``from_m`` to ``to_m`` [m]
-    along the located curve (a closed curve's ``to_m`` may pass its length) and when it runs in the plan, from the
-    start of the move into it to the end of its depart, ``t0`` to ``t1`` [s]."""
+    """One arc of a curved seam welded in several or in part (id ``<seam>#arcK``): its stretch from ``from_m`` to
+    ``to_m`` [m] along the located curve (a closed curve's ``to_m`` may pass its length) and when it runs in the
+    plan, from the start of the move into it to the end of its depart, ``t0`` to ``t1`` [s]."""
 
     arc_id: str
     from_m: float
@@ -177,8 +180,8 @@ class WeldPlan:
     seams: one outcome per seam asked for, in input order; order: ids of the welded seams in welding order;
     planning_s: wall time spent planning [s]. track: the linear track the base rides on (None: a fixed base);
     then every segment's trajectory carries E1 (``Trajectory.e1``), and the poses (X_end) stay in R, the base at
-    E1 = 0. arcs: the arcs of the curved seams welded in several (their segments carry the seam's id), in time
-    order."""
+    E1 = 0. arcs: the arcs of the curved seams welded in several or in part (their segments carry the seam's id),
+    in time order."""
 
     joint_names: tuple[str, ...]
     q_home: FloatArray

@@ -239,3 +239,58 @@ def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(
     sheet = draw_sheet("tube-on-plate", rows_in, {est.id: (est, invert(X_RM))}, plate, tmp_path)
     assert sheet == tmp_path / SHEET and colour_fraction(sheet, MANUAL_COLOUR) > 1e-3
     assert write_welder_sheet([], rep, tmp_path / "none") == []  # no run drawn from: nothing written
+
+
+def test_an_arc_the_gate_refused_at_one_end_is_trimmed_there_and_chosen_again() -> None:
+    """partial_arcs fails an arc a refusal names (its stretch exactly, at its start or end) without solving it,
+    trims :data:`TRIM_M` off that end (in the weld's direction: a reversed arc's start is its far end), chooses
+    again (the arc then stops :data:`STOP_BACK_M` short of the stretch given up, as off any gap) and solves the
+    arc left; the stretch given up is left for a manual weld with the refusal's code and words."""
+    from dataclasses import dataclass
+    from types import SimpleNamespace
+
+    import cell.planning.curves.partial as partial_mod
+    from cell.planning.curves.arc_solve import TRIM_M
+    from cell.planning.curves.partial import STOP_BACK_M
+    from cell.planning.failures import SeamFailure
+    from cell.types import SeamStatus
+    from cell.types.curve_estimate import CurveEstimate
+
+    @dataclass(frozen=True)
+    class Task:
+        id: str
+
+    @dataclass(frozen=True)
+    class Sol:
+        task: Task
+
+    n = 201  # an open curve 200 mm long along x
+    p = np.column_stack([np.linspace(0.0, 0.2, n), np.zeros(n), np.zeros(n)])
+    est = CurveEstimate("POST>RAIL:circle", SeamStatus.FOUND, p_RS=p, n_abutting_R=np.tile([0, 1.0, 0], (n, 1)),
+                        n_receiving_R=np.tile([0, 0, 1.0], (n, 1)), sigma_m=np.full(n, 1e-4))  # fmt: skip
+    search = SimpleNamespace(process=SimpleNamespace(closed_overlap=OVERLAP_M))
+    solved: list[tuple[float, float]] = []
+
+    def solve(_s: object, arc: CurveEstimate, part: Run, *_a: object) -> tuple[Sol, ...]:
+        solved.append((round(part.a_m, 6), round(part.b_m, 6)))
+        return (Sol(Task(arc.id)),)
+
+    no_cover = SeamFailure(PlanReason.IK_FAILED, "no cover", np.zeros(3), 0.0)
+    mp = pytest.MonkeyPatch()
+    mp.setattr(partial_mod, "arc_solution", solve)
+    try:
+        cut = TRIM_M + STOP_BACK_M
+        cases = ((C0, "start", (cut, 0.2)), (C1, "start", (0.0, 0.2 - cut)), (C0, "end", (0.0, 0.2 - cut)))
+        for cand, end, kept in cases:
+            solved.clear()
+            gate = Remainder(0.0, 0.2, PlanReason.SINGULAR, "arc 1: the safety gate: singularity", end)
+            runs = [_run(0.0, 0.2, cand)]
+            got = partial_mod.partial_arcs(search, est, runs, [], None, 0.001, None, no_cover, [gate])  # type: ignore[arg-type]
+            assert solved == [pytest.approx(kept)]  # the refused arc is never solved again as it was
+            assert got.spans == ((f"{est.id}#arc1", pytest.approx(kept[0]), pytest.approx(kept[1])),)
+            (r,) = got.remainder
+            lost = (0.0, cut) if kept[0] > 0.0 else (0.2 - cut, 0.2)
+            assert (r.from_m, r.to_m) == pytest.approx(lost) and (r.code, r.why) == (gate.code, gate.why)
+            assert got.share == pytest.approx(1.0 - cut / 0.2, abs=0.006)
+    finally:
+        mp.undo()

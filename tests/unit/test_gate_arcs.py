@@ -5,6 +5,7 @@ still drops the seam whole, and a seam whose every arc is refused is refused wit
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any
 
@@ -172,3 +173,57 @@ def test_a_whole_covers_arc_no_transfer_reaches_leaves_the_seam_in_part_under_ma
             assert rest[0].why == f"arc 2: {why}" and parts[SEAM].share == pytest.approx(0.51, abs=0.002)
         else:
             assert solved == {"OTHER": 0} and not outcomes[SEAM].feasible
+
+
+def test_the_gate_says_which_end_of_the_arc_it_refuses() -> None:
+    """A refusal on an arc's move in or approach is at its start, on its depart or the move home after it at its
+    end, on its weld at neither (the partial cover trims the arc at that end, :func:`partial_arcs`)."""
+    plan = _plan()
+    again = gate_answer(plan, [_sing(4.5)], {("s", SEAM)}, by_arc=True)  # arc 1's move in, avoided already
+    assert again is not None and again.arcs[A1].end == "start"
+    ends = {t: gate_answer(plan, [_sing(t)], set(), by_arc=True) for t in (8.5, 9.5, 10.5, 15.5)}
+    got = {t: [(a, r.end) for a, r in g.arcs.items()] for t, g in ends.items() if g is not None}
+    assert got == {8.5: [(A2, "start")], 9.5: [(A2, "")], 10.5: [(A2, "end")], 15.5: [(A3, "end")]}
+
+
+def test_a_seam_welded_in_part_in_one_arc_is_recorded_so_the_gate_can_refuse_that_arc() -> None:
+    """arc_spans records the one arc of a seam welded in part (before: only seams of two arcs or more, so the gate
+    dropped such a seam whole); a seam welded whole in one go is not recorded."""
+    from cell.planning.curves import arc_spans
+
+    plan = _plan()
+    one = [replace(s, seam_id=A1 if s.seam_id == SEAM else s.seam_id) for s in plan.segments[:7]]
+    assert arc_spans(one, {A1: (0.1, 0.4)}) == ()
+    got = arc_spans(one, {A1: (0.1, 0.4)}, {SEAM})
+    assert got == (ArcSpan(A1, 0.1, 0.4, 3.0, 7.0),)
+    single = replace(plan, segments=tuple(replace(s, seam_id=SEAM if s.seam_id == A1 else s.seam_id) for s in one),
+                     arcs=got, order=("s", SEAM))  # fmt: skip
+    refused = gate_answer(single, [_sing(4.5)], {("s", SEAM)}, by_arc=True)
+    assert refused is not None and not refused.drop and list(refused.arcs) == [A1]
+    assert (refused.arcs[A1].from_m, refused.arcs[A1].to_m, refused.arcs[A1].end) == (0.1, 0.4, "start")
+
+
+def test_an_arc_refused_at_an_end_and_planned_again_trimmed_is_kept() -> None:
+    """cover_curves leaves out an arc a refusal names only when it is planned again on exactly the refused stretch
+    (its weld refused, or a whole cover's arc); the partial cover's arc trimmed at the refused end stays."""
+    gate = Remainder(0.10, 0.40, PlanReason.SINGULAR, "arc 1: the safety gate: singularity", "start")
+    trimmed = ((A1, 0.115, 0.40), (A2, 0.39, 0.70), (A3, 0.69, 0.90))
+    arcs, still, _, _ = _covered(_split(trimmed, (GAP,)), [gate])
+    assert sorted(arcs) == [A1, A2, A3] and not still
+    arcs, still, _, _ = _covered(_split(SPANS, (GAP,)), [gate])  # the same arc again: left out, as before
+    assert sorted(arcs) == [A2, A3]
+
+
+def test_an_exit_is_at_fault_when_the_move_out_of_an_arc_failed_towards_another_place_too() -> None:
+    """The order search tries the ways out of an arc's exits (retreats) only where a move out of it failed towards
+    two places or more (not where one move failed, nor out of a straight seam or a curve welded whole or refused)."""
+    from cell.planning.curves.refused import exit_at_fault
+    from cell.planning.curves.split import Partial
+
+    parts = {SEAM: Partial(1.0, True, 0.8, (GAP,), {a: (x, y) for a, x, y in SPANS}, 0.01)}
+    assert not exit_at_fault(A1, "TOP#arc1", {(A1, "TOP#arc1")}, parts)  # its first failure: another order first
+    assert exit_at_fault(A1, "TOP#arc1", {(A1, "B1"), (A1, "TOP#arc1")}, parts)  # towards B1 too
+    assert exit_at_fault(A1, "", {(A1, "B1"), (A1, "")}, parts)  # home too
+    assert not exit_at_fault(A1, "TOP#arc1", {("B1", "TOP#arc1"), (A1, "TOP#arc1")}, parts)  # into it: not its exit
+    assert not exit_at_fault("B1", "C1", {("B1", "X"), ("B1", "C1")}, parts)  # a straight seam: as before
+    assert not exit_at_fault(A1, "B1", {(A1, "X"), (A1, "B1")}, {})  # a curve not welded in part: as before

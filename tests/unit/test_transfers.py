@@ -176,3 +176,19 @@ def test_a_strategy_is_asked_once_between_the_same_ends(robot: RobotModel) -> No
     assert isinstance(first, TransferFail) and isinstance(again, TransferFail)
     assert len(asked) == len(set(asked)) == n_asked + 2  # the new pair with either strategy, the old one never
     assert n_probed == 3 and len(probed) == n_probed + 1  # the free motions out and back probed once
+
+
+def test_the_ways_out_of_an_exit_at_fault_are_tried_from_it_alone(robot: RobotModel) -> None:
+    """retreat_from adds ways (after every strategy) for the transfers out of the given configurations only, and
+    searches again what failed before; a second call for the same configurations adds nothing."""
+    from cell.planning.access.openings import RETREATS, Retreat
+
+    assert RETREATS[:3] == (Retreat("retreat_250", 0.25), Retreat("retreat_350", 0.35), Retreat("retreat_450", 0.45))
+    assert RETREATS[3:] == tuple(Retreat(f"retreat_{d}_home", d / 1000, True) for d in (250, 350, 450))
+    mover = _mover(robot, OBSTACLES, _Untimeable())
+    other = HOME + np.radians([0.0, 0.0, 0.0, 0.0, 0.0, 5.0])
+    assert isinstance(mover.move(HOME, Q_B), TransferFail)
+    assert mover.retreat_from([HOME], [Direct("way_out")]) and not mover.retreat_from([HOME], [Direct("way_out")])
+    moves = mover.move(HOME, Q_B)  # out of HOME: the way out is free
+    assert not isinstance(moves, TransferFail) and [p.kind for p in moves] == ["move"]
+    assert isinstance(mover.move(other, Q_B), TransferFail)  # out of another configuration: as before

@@ -47,13 +47,13 @@ _VIAS: weakref.WeakKeyDictionary[Mover, dict[tuple[bytes, float], list[FloatArra
 )
 
 
-def _vias_of(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
-    """:func:`_vias`, remembered per mover, configuration and distance (an IKError too)."""
+def _vias_of(mover: Mover, q: FloatArray, aside_m: float, rise: bool = True) -> list[FloatArray]:
+    """:func:`_vias`, remembered per mover, configuration, distance and ``rise`` (an IKError too)."""
     memo = _VIAS.setdefault(mover, {})
-    key = (np.asarray(q, dtype=float).tobytes(), aside_m)
+    key = (np.asarray(q, dtype=float).tobytes(), aside_m if rise else -aside_m)
     if key not in memo:
         try:
-            memo[key] = _vias(mover, q, aside_m)
+            memo[key] = _vias(mover, q, aside_m, rise)
         except IKError as exc:
             memo[key] = exc
     got = memo[key]
@@ -62,10 +62,10 @@ def _vias_of(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
     return got
 
 
-def _vias(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
-    """The via points (dof,) [rad] out of q: ``aside_m`` towards the shoulder square to the torch axis, then that
-    pose raised towards the lift height, as high as the arm reaches it (IK seeded at q and walked up); none when
-    ``aside_m`` is 0. Raises IKError when the first cannot be reached."""
+def _vias(mover: Mover, q: FloatArray, aside_m: float, rise: bool = True) -> list[FloatArray]:
+    """The via points (dof,) [rad] out of q: ``aside_m`` towards the shoulder square to the torch axis, then (with
+    ``rise``) that pose raised towards the lift height, as high as the arm reaches it (IK seeded at q and walked
+    up); none when ``aside_m`` is 0. Raises IKError when the first cannot be reached."""
     if aside_m <= 0.0:
         return []
     robot, ik = mover.robot, mover.opt.ik
@@ -77,7 +77,7 @@ def _vias(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
     X[:3, 3] += aside_m * v / max(float(np.linalg.norm(v)), 1e-9)
     out = [np.asarray(solve_ik(robot, X, q, options=ik))]
     z0 = float(X[2, 3])
-    if mover.lift_z - z0 < 1e-3:
+    if mover.lift_z - z0 < 1e-3 or not rise:
         return out
     q_up = out[0]
     for h in [*np.arange(z0 + RISE_STEP_M, mover.lift_z, RISE_STEP_M), mover.lift_z]:
@@ -87,6 +87,40 @@ def _vias(mover: Mover, q: FloatArray, aside_m: float) -> list[FloatArray]:
         except IKError:  # the arm reaches no higher with this orientation: the rise stops where it could
             break
     return out if q_up is out[0] else [*out, q_up]
+
+
+@dataclass(frozen=True)
+class Retreat:
+    """A way out of a seam whose every other way meets a part on the arm's first turn (an arm reaching under one
+    rail to the next: the forearm rises into the upper one): a PTP move to a via point ``out_m`` from q_a's TCP
+    towards the arm's shoulder, square to its torch axis and its orientation kept (the forearm drawn back from
+    under what is above it), then (``home``: a PTP move home first) on to q_b the first way the transfers find
+    from there (a PTP move where none does)."""
+
+    name: str = "retreat"
+    out_m: float = 0.35
+    home: bool = False
+
+    def pieces(self, mover: Mover, q_a: FloatArray, q_b: FloatArray) -> list[Piece]:
+        (via,) = _vias_of(mover, q_a, self.out_m, rise=False)
+        robot, lim, dt = mover.robot, mover.robot.limits, mover.opt.dt
+        stops = [q_a, via, *([mover.q_home] if self.home else [])]
+        out = [Piece("move", ptp(a, b, lim, dt=dt), 0.0, robot.fk(b)) for a, b in itertools.pairwise(stops)]
+        on = mover.search(stops[-1], q_b)
+        return [
+            *out,
+            *(on if isinstance(on, list) else [Piece("move", ptp(stops[-1], q_b, lim, dt=dt), 0.0, robot.fk(q_b))]),
+        ]
+
+
+# The ways out of an exit found at fault (:meth:`cell.planning.transfers.Transfers.retreat_from`), after WAYS: the
+# located railing's POST_L bottom fillet (reaching under the top rail) is left 350 mm back, not 250; from there, or
+# from home, on the transfers' own ways.
+RETREATS: tuple[TransferStrategy, ...] = tuple(
+    Retreat(f"retreat_{d * 1000:.0f}{'_home' if home else ''}", d, home)
+    for home in (False, True)
+    for d in (0.25, 0.35, 0.45)
+)
 
 
 def opening_ways() -> tuple[Aside, ...]:

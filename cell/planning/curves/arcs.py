@@ -6,6 +6,8 @@ Frames: everything in the robot base frame R [m]; joints [rad]."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from cell.geometry import FloatArray
@@ -26,7 +28,7 @@ from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.process.torch_orientations import Candidate
 from cell.process.weave import knot_spacing as weave_spacing
 from cell.types.curve_estimate import CurveEstimate
-from cell.types.plan import PlanReason
+from cell.types.plan import PlanReason, Remainder
 from cell.types.procedure import WeldProcedure
 
 SPARE_TRIES = 4  # covers tried more once the map's spare paths are added (each a full solve of its arcs)
@@ -39,6 +41,7 @@ def plan_arcs(
     q_seed: FloatArray,
     procedure: WeldProcedure | None = None,
     gap_walk: bool = False,
+    refused: Sequence[Remainder] = (),
 ) -> Split:
     """The arcs that weld ``est`` whole (a closed curve all round and over its overlap; an open one end to end),
     fewest first, at most :data:`MAX_ARCS`, each solved (a :class:`SeamSolution` per pass of ``procedure``, its
@@ -48,7 +51,8 @@ def plan_arcs(
     stations (:mod:`.gapwalk`, :mod:`.gapseed`: no round scenario's curve welded by it yet, 10-60 s more per curve
     with a gap, so not in ``cell weld``; docs/curves-welding.md section 10). With no whole cover and the process's
     ``curve_remainder`` ``manual``: the arcs that weld what the arm reaches and the remainder left for a manual weld
-    (:mod:`.partial`)."""
+    (:mod:`.partial`); ``refused``: arcs refused after the search at one end (the safety gate, a transfer), each
+    trimmed there and the partial cover chosen again (:func:`.partial.partial_arcs`)."""
     pr, opt = search.process, search.opt
     knot = knot_spacing(est, opt.spacing)
     if procedure is not None:
@@ -100,7 +104,7 @@ def plan_arcs(
     if failure is None:
         failure = _gap(runs, misses, est, overlap)
     if pr.curve_remainder == "manual" and runs:  # weld what the arm reaches, the rest left for a manual weld
-        got_part = partial_arcs(search, est, runs, misses, flange, knot, procedure, failure)
+        got_part = partial_arcs(search, est, runs, misses, flange, knot, procedure, failure, refused)
         if got_part.partial:
             return got_part
     return Split((), reached, failure)

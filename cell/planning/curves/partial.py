@@ -127,11 +127,13 @@ def remainder(
     closed: bool,
     overlap: float,
     failed: Sequence[tuple[float, float, SeamFailure]] = (),
+    refused: Sequence[Remainder] = (),
 ) -> list[Remainder]:
     """What arcs welding ``spans`` (from, to) [m] along a curve ``total`` long leave for a manual weld, in order:
     every stretch no arc welds (its code and words: an arc over it that failed its full solve, ``failed``; else
     what stops the torch settings there, from ``misses``; else that the arm holds it only in stretches too short
-    to weld or beyond the arcs' bound) and, where one arc restarts over the last by less than ``overlap`` [m], the
+    to weld or beyond the arcs' bound; an arc over it refused after the search, ``refused``: its code and words)
+    and, where one arc restarts over the last by less than ``overlap`` [m], the
     ``overlap`` about that restart (the arcs give out there: a pinch; the restart is a manual weld's, never the
     robot's with a shorter overlap)."""
     if not spans:
@@ -140,14 +142,14 @@ def remainder(
     arcs = sorted(((a % total, a % total + (b - a)) if closed else (a, b) for a, b in spans), key=lambda s: s[0])
     out: list[Remainder] = []
     if not closed and arcs[0][0] > EPS_M:
-        out.append(_unwelded(0.0, arcs[0][0], runs, misses, total, closed, failed))
+        out.append(_unwelded(0.0, arcs[0][0], runs, misses, total, closed, failed, refused))
     end = arcs[0][1]
     after = [*arcs[1:], (arcs[0][0] + total, arcs[0][1] + total)] if closed else arcs[1:]
     for a_next, b_next in after:
         if b_next <= end + EPS_M:  # wholly within the arcs before it
             continue
         if a_next > end + EPS_M:
-            out.append(_unwelded(end, a_next, runs, misses, total, closed, failed))
+            out.append(_unwelded(end, a_next, runs, misses, total, closed, failed, refused))
         elif end - a_next < overlap - EPS_M:
             mid = 0.5 * (end + a_next)
             code, why = why_stopped(list(misses), mid - overlap, mid + overlap, total, closed)
@@ -156,7 +158,7 @@ def remainder(
             out.append(Remainder(mid - 0.5 * overlap, mid + 0.5 * overlap, code, words))
         end = max(end, b_next)
     if not closed and end < total - EPS_M:
-        out.append(_unwelded(end, total, runs, misses, total, closed, failed))
+        out.append(_unwelded(end, total, runs, misses, total, closed, failed, refused))
     if closed:  # each from where it starts on the located curve's own lap
         out = sorted((replace(r, from_m=r.from_m % total, to_m=r.from_m % total + r.length_m) for r in out),
                      key=lambda r: r.from_m)  # fmt: skip
@@ -171,8 +173,10 @@ def _unwelded(
     total: float,
     closed: bool,
     failed: Sequence[tuple[float, float, SeamFailure]],
+    refused: Sequence[Remainder] = (),
 ) -> Remainder:
     """A stretch from lo to hi [m] no arc welds, with why (:func:`remainder`)."""
+    gated = next((r for r in refused if shared_m(r.from_m, r.to_m, lo, hi, total, closed) > EPS_M), None)
     f = next((f for a, b, f in failed if shared_m(a, b, lo, hi, total, closed) > EPS_M), None)
     unheld = sum(shared_m(a, b, lo, hi, total, closed) for a, b in gaps(runs, total, closed, 0.0))
     if unheld > EPS_M or not runs:
@@ -185,6 +189,8 @@ def _unwelded(
         elif hi - lo > unheld + 0.002:
             words += f"; the arcs stop {STOP_BACK_M * 1000:.0f} mm short of it (the arm at a limit where it gives out)"
         return Remainder(lo, hi, code, words)
+    if gated is not None:  # trimmed off an arc refused after the search: that refusal
+        return Remainder(lo, hi, gated.code, gated.why)
     if f is not None:
         return Remainder(lo, hi, f.code or PlanReason.IK_FAILED, f"an arc over it failed its full solve: {f.where}")
     code, _ = why_stopped(list(misses), lo - 0.01, hi + 0.01, total, closed)
@@ -216,16 +222,21 @@ def partial_arcs(
     knot: float,
     procedure: WeldProcedure | None,
     failure: SeamFailure,
+    refused: Sequence[Remainder] = (),
 ) -> Split:
     """``est`` welded in part (:func:`partial_cover`), each arc solved as a whole cover's
     (:func:`.arc_solve.arc_solution`); an arc that fails is trimmed or dropped (:func:`.arc_solve.trimmed`) and
     the arcs chosen again, up to :data:`.arc_solve.TRIES` times; then the solved arcs of the try that welds the
     most are kept and the failed ones' stretches left to the manual weld. ``failure``: why no cover welds it whole
-    (kept as the split's). No arc solved: that failure alone."""
+    (kept as the split's). No arc solved: that failure alone. ``refused``: arcs refused after the search at one
+    end (each its stretch, the refusal's code and words, ``end``): an arc chosen on exactly that stretch fails
+    so at once, without a solve (:func:`refusal`), and is trimmed at that end; the stretch given up is listed
+    with the refusal's code and words."""
     pr, total = search.process, est.length_m
     overlap = pr.closed_overlap if est.closed else 0.0
     memo: dict[tuple[float, float, Candidate], tuple[SeamSolution, ...] | SeamFailure] = {}
     failed: list[tuple[float, float, SeamFailure]] = []
+    named: set[tuple[float, float, Candidate]] = set()  # arcs a refusal names (failed so, not solved)
     kept: list[tuple[Run, tuple[SeamSolution, ...]]] = []
     best: list[tuple[Run, tuple[SeamSolution, ...]]] = []
     mapped = list(runs)  # what the map holds, before failed arcs are trimmed out of it
@@ -235,10 +246,12 @@ def partial_arcs(
         for k, (run, part) in enumerate(chosen, 1):
             key = (round(part.a_m % total if est.closed else part.a_m, 6), round(part.length, 6), part.cand)
             arc = sub_arc(est, part.a_m, part.b_m, k)
-            got = memo.get(key) or arc_solution(search, arc, part, flange, knot, procedure)
+            gated = refusal(refused, part, arc, total, est.closed)
+            named |= {key} if gated is not None else set()
+            got = gated or memo.get(key) or arc_solution(search, arc, part, flange, knot, procedure)
             memo[key] = got
             if isinstance(got, SeamFailure):
-                failed.append((part.a_m, part.b_m, got))
+                failed += [] if key in named else [(part.a_m, part.b_m, got)]
                 runs = [r for r in runs if not same_stretch(r, run, total)] + trimmed(part, got, arc)
                 again = True
             else:
@@ -250,10 +263,26 @@ def partial_arcs(
     kept = best  # the try whose solved arcs weld the most (a later try may lose what an earlier one solved)
     if not kept:
         return Split((), 0.0, failure)
-    rest = remainder([(p.a_m, p.b_m) for p, _ in kept], mapped, misses, total, est.closed, overlap, failed)
+    spans_m = [(p.a_m, p.b_m) for p, _ in kept]
+    rest = remainder(spans_m, mapped, misses, total, est.closed, overlap, failed, [r for r in refused if r.end])
     arcs = tuple((sub_arc(est, p.a_m, p.b_m, k), _named(s, arc_id(est.id, k))) for k, (p, s) in enumerate(kept, 1))
     spans = tuple((a.id, p.a_m, p.b_m) for (a, _), (p, _) in zip(arcs, kept, strict=True))
     return Split(arcs, welded_share(rest, total, est.closed), failure, tuple(rest), spans)
+
+
+def refusal(
+    refused: Sequence[Remainder], part: Run, arc: CurveEstimate, total: float, closed: bool
+) -> SeamFailure | None:
+    """The failure of an arc ``part`` (along a curve ``total`` [m] long) that a refusal in ``refused`` names at one
+    end (its stretch exactly the arc's, its ``end`` set): its code and words, before the weld's start (``start``)
+    or at the weld's end (``end``), so that :func:`.arc_solve.trimmed` cuts that end; None when none names it."""
+    for r in refused:
+        same = abs(math.remainder(r.from_m - part.a_m, total) if closed else r.from_m - part.a_m) < EPS_M
+        if r.end and same and abs(r.length_m - part.length) < EPS_M:
+            ends = np.asarray(arc.p_RS)[[-1, 0] if part.cand.reversed else [0, -1]]  # the weld's start and end
+            at_start = r.end == "start"
+            return SeamFailure(r.code, r.why, ends[0 if at_start else 1].copy(), -1.0 if at_start else arc.length_m)
+    return None
 
 
 def _named(sols: tuple[SeamSolution, ...], aid: str) -> tuple[SeamSolution, ...]:

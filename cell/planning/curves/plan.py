@@ -7,7 +7,7 @@ Frames: everything in the robot base frame R [m]; joints [rad]."""
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -75,14 +75,16 @@ def with_paths(segments: Sequence[Segment], paths: Mapping[str, Sequence[npt.Arr
     return out
 
 
-def arc_spans(segments: Sequence[Segment], spans: Mapping[str, tuple[float, float]]) -> tuple[ArcSpan, ...]:
-    """The arcs of the seams welded in several (``spans``: arc id -> (from, to) [m] along its curve), each with when
-    it runs among ``segments`` (their ids still the arcs'): from the start of the move into it to the end of its
-    depart, in time order."""
+def arc_spans(
+    segments: Sequence[Segment], spans: Mapping[str, tuple[float, float]], in_part: Collection[str] = ()
+) -> tuple[ArcSpan, ...]:
+    """The arcs of the seams welded in several or in part (``spans``: arc id -> (from, to) [m] along its curve;
+    ``in_part``: the seams welded in part, whose one arc is recorded too), each with when it runs among ``segments``
+    (their ids still the arcs'): from the start of the move into it to the end of its depart, in time order."""
     many = Counter(seam_of(a) for a in spans)
     runs: dict[str, tuple[float, float]] = {}
     for g in segments:
-        if g.seam_id in spans and many[seam_of(g.seam_id)] > 1:
+        if g.seam_id in spans and (many[seam_of(g.seam_id)] > 1 or seam_of(g.seam_id) in in_part):
             runs[g.seam_id] = (runs.get(g.seam_id, (g.t0, 0.0))[0], g.t1)
     return tuple(sorted((ArcSpan(a, *spans[a], t0, t1) for a, (t0, t1) in runs.items()), key=lambda x: x.t0))
 
@@ -122,9 +124,14 @@ def cover_curves(
             if isinstance(one, SeamSolution):
                 aid = arc_id(c.id, 1)
                 got = Split(((replace(c, id=aid), (one,)),), 1.0, None, spans=((aid, 0.0, c.length_m),))
-        got = got or plan_arcs(make_search[c.id], c, q0, proc)
-        if out.get(c.id) and got.arcs:
-            got = _without(got, c, out[c.id], make_search[c.id])
+        got = got or plan_arcs(make_search[c.id], c, q0, proc, refused=out.get(c.id, ()))
+        if not got.arcs and any(r.end for r in out.get(c.id, ())):  # every arc trimmed away: the first refusal
+            first = next(r for r in out[c.id] if r.end)
+            still[c.id] = SeamFailure(first.code, first.why, _at(c, first.from_m), 0.0)
+            continue
+        left = _still_named(got, out.get(c.id, ()))
+        if left and got.arcs:
+            got = _without(got, c, left, make_search[c.id])
             if not got.arcs:  # every arc refused: the refusal's reason
                 assert got.failure is not None
                 still[c.id] = got.failure
@@ -148,6 +155,14 @@ def cover_curves(
 Span = tuple[float, float]  # (from, to) [m] along a curve
 
 
+def _still_named(got: Split, refused: Sequence[Remainder]) -> list[Remainder]:
+    """The refusals of ``refused`` that still name an arc of ``got``: one of its weld (no ``end``), or one at an end
+    whose arc is planned again on exactly its stretch (the partial cover trims such an arc,
+    :func:`.partial.partial_arcs`; a whole cover's, or one it did not choose again, is left out so)."""
+    spans = [(a, b) for _, a, b in got.spans]
+    return [r for r in refused if not r.end or any(abs(a - r.from_m) + abs(b - r.to_m) < 1e-6 for a, b in spans)]
+
+
 def _without(got: Split, c: CurveEstimate, refused: Sequence[Remainder], search: SeamSearch) -> Split:
     """``got`` with its arcs that the ``refused`` stretches name left out (:func:`.refused.without_refused`); a
     seam covered whole that would be left in part without the process's ``curve_remainder: manual``, or with no
@@ -161,10 +176,15 @@ def _without(got: Split, c: CurveEstimate, refused: Sequence[Remainder], search:
     left = tuple((arc, sol) for arc, sol in got.arcs if arc.id not in gone)
     first = next(iter(gone.values()))
     if not left or (rest and not got.partial and pr.curve_remainder != "manual"):
-        k = int(np.argmin(np.abs(np.linspace(0.0, c.length_m, len(c.p_RS)) - first.from_m % c.length_m)))
-        return Split((), 0.0, SeamFailure(first.code, first.why, np.asarray(c.p_RS[k]), 0.0))
+        return Split((), 0.0, SeamFailure(first.code, first.why, _at(c, first.from_m), 0.0))
     kept_spans = tuple(s for s in got.spans if s[0] not in gone)
     return Split(left, share, got.failure, rest, kept_spans)
+
+
+def _at(c: CurveEstimate, s_m: float) -> npt.NDArray[np.float64]:
+    """The located curve's sample (3,) in R nearest ``s_m`` [m] along it."""
+    k = int(np.argmin(np.abs(np.linspace(0.0, c.length_m, len(c.p_RS)) - s_m % c.length_m)))
+    return np.asarray(c.p_RS[k])
 
 
 def whole_or_none(

@@ -1,14 +1,16 @@
 """Arcs of a curved seam refused after the search (the safety gate on an arc's own moves, a transfer no way makes,
 its timing): each left out alone, its stretch joined to the seam's remainder for a manual weld with the refusal as
-its reason, the seam's other arcs kept (docs/curves-welding.md section 9, "Welded in part").
+its reason, the seam's other arcs kept (docs/curves-welding.md section 9, "Welded in part"); and whether a
+failing transfer is the fault of the arc it comes out of (section 9, "A failing exit planned again").
 
 Frames: stretches in metres along the located curve (a closed curve's ``to`` may pass its length)."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 
 from cell.planning.curves.partial import EPS_M, shared_m, welded_share
+from cell.planning.curves.split import Partial, seam_of
 from cell.types.plan import Remainder
 
 
@@ -103,3 +105,10 @@ def without_refused(
     kept = [v for k, v in spans.items() if k not in out]
     rest = left_over(kept, list(out.values()), before, total, closed, overlap)
     return out, rest, welded_share(rest, total, closed)
+
+
+def exit_at_fault(a: str, b: str, failed: Collection[tuple[str, str]], parts: Mapping[str, Partial]) -> bool:
+    """Whether the failing transfer from ``a`` to ``b`` ("" = home) is ``a``'s exit's fault: ``a`` is an arc of a
+    curve that may be welded in part (in ``parts``) and a move out of it towards another place than ``b`` failed
+    too (in ``failed``, the transfers (from, to) the order search found no free way for)."""
+    return bool(a) and seam_of(a) != a and seam_of(a) in parts and any(x == a and y != b for x, y in failed)

@@ -12,12 +12,13 @@ from cell.config.motion import PlanOptions
 from cell.geometry import FloatArray
 from cell.motion.robot import RobotModel
 from cell.motion.timing import ptp
-from cell.planning.moves.pieces import Piece
+from cell.planning.moves.pieces import Piece, TransferFail
 
 
 class Mover(Protocol):
     """What a strategy asks of the transfers it serves (:class:`cell.planning.transfers.Transfers`): the arm, the
-    plan's options, the lift height [m] in R, home (dof,) [rad], a pose raised and a vertical line."""
+    plan's options, the lift height [m] in R, home (dof,) [rad], a pose raised, a vertical line and the first free
+    way between two configurations."""
 
     robot: RobotModel
     opt: PlanOptions
@@ -29,6 +30,8 @@ class Mover(Protocol):
     def vertical(self, q: FloatArray, height: float, up: bool) -> Piece | None: ...
 
     def midway(self, q_a: FloatArray, q_b: FloatArray, height: float) -> FloatArray: ...
+
+    def search(self, q_a: FloatArray, q_b: FloatArray) -> list[Piece] | TransferFail: ...
 
 
 class TransferStrategy(Protocol):

@@ -34,8 +34,9 @@ from cell.pipeline.weld import plan_for
 def bench(name: str) -> dict[str, Any]:
     """One row: the scenario's seams, what the planner made of them and what it cost."""
     from cell.pipeline.placeable import seam_procedures
-    from cell.planning.plan import reach_model, seam_process
+    from cell.planning.plan import reach_model
     from cell.planning.reach import seam_reach
+    from cell.planning.seam_search import seam_process
     from cell.planning.tasks import seam_tasks
     from cell.process.torch import WeldProcess
     from cell.types.plan import SeamProcedure

@@ -5,7 +5,6 @@ Frames: everything in the robot base frame R [m]; joints [rad]; time [s]."""
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import replace
@@ -31,9 +30,9 @@ from cell.planning.failures import SeamFailure, reason_text
 from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
 from cell.planning.reach import ReachModel
-from cell.planning.seam_search import SeamSearch, SeamSolution
+from cell.planning.seam_search import SeamSearch, SeamSolution, seam_process
 from cell.planning.short_lines import seam_lines
-from cell.planning.stand_off import blocked_by_table, stand_off, table_top
+from cell.planning.stand_off import as_is, blocked_by_table, shortened_plan, stand_off, table_top
 from cell.planning.transfers import Piece, TransferFail, Transfers
 from cell.process.torch import WeldProcess
 from cell.types import Part
@@ -111,7 +110,7 @@ def plan_welds(
         search = searches[task.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach)
         found = search.plan_seam(sel.oriented(task) if sel else task, q0)
         if isinstance(found, SeamFailure) and table_z is not None:
-            short = _table_stand_off(search, task, found, table_z, opt, sel, q0)
+            short = shortened_plan(search, task, found, table_z, opt, sel, q0)
             if short is not None:
                 found, trims[task.id] = short
         res = found if isinstance(found, SeamFailure) or sel is None else solve_passes(search, found, sel.procedure)
@@ -262,7 +261,7 @@ def unplaceable(
         search = SeamSearch(robot, seam_process(process, sel), checker, opt, np.random.default_rng(0), reach)
         fail = search.placeable(sel.oriented(task) if sel else task, q0)
         if fail is not None and table_z is not None and blocked_by_table(fail, opt.collision.table_name):
-            orient = sel.oriented if sel else _as_is
+            orient = sel.oriented if sel else as_is
             if stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0) is not None:
                 fail = None  # placed from the table stand-off, as plan_welds would
         if fail is not None:
@@ -279,55 +278,6 @@ def reach_model(robot: RobotModel) -> ReachModel | None:
         return None
 
 
-def seam_process(process: WeldProcess, sel: SeamProcedure | None) -> WeldProcess:
-    """The process a seam is searched and welded with: ``process`` with its procedure's travel speed and torch
-    angles, and one direction only where the procedure fixes it (a vertical seam).
-
-    A fixed direction takes away the other direction's torch tilts: the travel-angle tolerance then grows by twice
-    the nominal angle, so the search may drag as far as it could have pushed the other way (the same torch
-    orientations: a vertical-up weld that starts at the table holds the torch as a downhill one ended there,
-    20 deg down). Nominal angles are still tried first."""
-    if sel is None:
-        return process
-    p = sel.procedure
-    travel = math.radians(p.travel_angle_deg)
-    tol = process.travel_angle_tol + (2.0 * abs(travel) if sel.fixed_direction else 0.0)
-    return replace(
-        process,
-        travel_speed=p.travel_speed_mm_s / 1000.0,
-        work_angle=math.radians(p.work_angle_deg),
-        travel_angle=travel,
-        travel_angle_tol=tol,
-        reversible=not sel.fixed_direction,
-    )
-
-
-def _table_stand_off(
-    search: SeamSearch,
-    task: SeamTask,
-    fail: SeamFailure,
-    table_z: float,
-    opt: PlanOptions,
-    sel: SeamProcedure | None,
-    q0: npt.NDArray[np.float64],
-) -> tuple[SeamSolution, float] | None:
-    """The seam planned shortened at its table end (:mod:`cell.planning.stand_off`) and by how much [m], when its
-    failure is the torch against the table where it is placed; None otherwise or when the shortened seam does
-    not plan either (the seam keeps its failure)."""
-    if not blocked_by_table(fail, opt.collision.table_name):
-        return None
-    orient = sel.oriented if sel else _as_is
-    short = stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0)
-    if short is None:
-        return None
-    again = search.plan_seam(orient(short[0]), q0)
-    return None if isinstance(again, SeamFailure) else (again, short[1])
-
-
-def _as_is(task: SeamTask) -> SeamTask:
-    return task
-
-
 def _expand(avoid: Collection[tuple[str, str]], solved: Collection[str]) -> set[tuple[str, str]]:
     """The transfers (from, to; "" = home) ``avoid`` names, a curved seam's named as each of its arcs in ``solved``."""
     pieces = {sid: [k for k in solved if seam_of(k) == sid] or [sid] for pair in avoid for sid in pair if sid}
@@ -338,4 +288,4 @@ def _failed(seam_id: str, code: PlanReason, detail: str, p_R: npt.ArrayLike) -> 
     return SeamOutcome(seam_id, False, reason_text(code, detail), readonly(p_R), code=code)
 
 
-__all__ = ["plan_welds", "reach_model", "seam_process", "unplaceable"]
+__all__ = ["plan_welds", "reach_model", "unplaceable"]

@@ -6,7 +6,8 @@ Frames: everything in the robot base frame R [m]; joints [rad]."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from cell.planning.placement import Rotations, place, sweep, torch_tests, wordin
 from cell.planning.reach import ReachModel, seam_reach
 from cell.process.torch import WeldProcess, back_off, line_poses
 from cell.process.torch_orientations import Candidate, candidate_groups
-from cell.types.plan import PlanReason, SeamTask
+from cell.types.plan import PlanReason, SeamProcedure, SeamTask
 
 _GOOD = 0.6  # candidates within this share of the best start manipulability are ranked by their wrist
 AT_START = 1e-6  # a SeamFailure's progress [m] when the arm collides at the weld start (above IK failing there)
@@ -233,3 +234,26 @@ class SeamSearch:
                 float(s_path[k]),
             )
         return SeamSolution(task, cand, X, q_app, q_weld, q_dep, X_app, X_dep)
+
+
+def seam_process(process: WeldProcess, sel: SeamProcedure | None) -> WeldProcess:
+    """The process a seam is searched and welded with: ``process`` with its procedure's travel speed and torch
+    angles, and one direction only where the procedure fixes it (a vertical seam).
+
+    A fixed direction takes away the other direction's torch tilts: the travel-angle tolerance then grows by twice
+    the nominal angle, so the search may drag as far as it could have pushed the other way (the same torch
+    orientations: a vertical-up weld that starts at the table holds the torch as a downhill one ended there,
+    20 deg down). Nominal angles are still tried first."""
+    if sel is None:
+        return process
+    p = sel.procedure
+    travel = math.radians(p.travel_angle_deg)
+    tol = process.travel_angle_tol + (2.0 * abs(travel) if sel.fixed_direction else 0.0)
+    return replace(
+        process,
+        travel_speed=p.travel_speed_mm_s / 1000.0,
+        work_angle=math.radians(p.work_angle_deg),
+        travel_angle=travel,
+        travel_angle_tol=tol,
+        reversible=not sel.fixed_direction,
+    )

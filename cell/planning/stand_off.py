@@ -8,11 +8,13 @@ from collections.abc import Callable, Sequence
 from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 
+from cell.config.motion import PlanOptions
 from cell.planning.failures import SeamFailure
-from cell.planning.seam_search import SeamSearch
+from cell.planning.seam_search import SeamSearch, SeamSolution
 from cell.types import Part
-from cell.types.plan import PlanReason, SeamTask
+from cell.types.plan import PlanReason, SeamProcedure, SeamTask
 
 _STEP = 0.002  # [m] the stand-off grows in these steps
 _NEAR = 0.002  # [m] a seam end this near the table top (or below it) lies on the table
@@ -88,3 +90,30 @@ def stand_off(
         else:
             lo = mid + 1
     return shortened(task, end, trims[hi]), trims[hi]
+
+
+def shortened_plan(
+    search: SeamSearch,
+    task: SeamTask,
+    fail: SeamFailure,
+    table_z: float,
+    opt: PlanOptions,
+    sel: SeamProcedure | None,
+    q0: npt.NDArray[np.float64],
+) -> tuple[SeamSolution, float] | None:
+    """The seam planned shortened at its table end (:mod:`cell.planning.stand_off`) and by how much [m], when its
+    failure is the torch against the table where it is placed; None otherwise or when the shortened seam does
+    not plan either (the seam keeps its failure)."""
+    if not blocked_by_table(fail, opt.collision.table_name):
+        return None
+    orient = sel.oriented if sel else as_is
+    short = stand_off(search, task, table_z, opt.table_stand_off_max, orient, q0)
+    if short is None:
+        return None
+    again = search.plan_seam(orient(short[0]), q0)
+    return None if isinstance(again, SeamFailure) else (again, short[1])
+
+
+def as_is(task: SeamTask) -> SeamTask:
+    """The task unchanged (where a seam has no procedure to orient it)."""
+    return task

@@ -22,8 +22,9 @@ from cell.motion.timing import path_profile
 from cell.planning.blend import blend_plan, blend_track
 from cell.planning.curves import weldable
 from cell.planning.curves.track import curve_e1s, curve_probes, in_part_at, retried
-from cell.planning.plan import plan_welds, reach_model, seam_process
+from cell.planning.plan import plan_welds, reach_model
 from cell.planning.reach import ReachModel, cone_excess
+from cell.planning.seam_search import seam_process
 from cell.planning.track_moves import GroupLegs, TrackMoves, stitched
 from cell.planning.transfers import Transfers
 from cell.process.torch import WeldProcess, fillet_axes

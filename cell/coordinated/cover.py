@@ -7,9 +7,10 @@ Pure interval arithmetic along the located curve [m] (a closed one's positions t
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
-EPS_M = 1e-6  # [m] two ends this close are one place
+from cell.planning.curves.partial import EPS_M
+
 MAX_ARCS = 4  # a seam's coordinated arcs at most, the first one's included
 
 
@@ -68,18 +69,21 @@ def cover(
     overlap: float,
     min_arc: float,
     max_arcs: int = MAX_ARCS,
+    planned: Callable[[int, float, float], bool] = lambda i, lo, hi: True,
+    tries: int = 1,
 ) -> list[tuple[int, float, float]]:
     """The further arcs (the stretch's index, from, to [m]) a greedy cover of a loop ``total`` [m] long adds to the
-    first arc ``first`` (from, to): each time the one welding the most of what is left (:func:`next_arcs`), up to
-    ``max_arcs`` in all; every arc assumed planned (the measure of what the held stretches can cover: the planner
-    tries each in turn, :func:`cell.coordinated.partial.plan_in_part`)."""
+    first arc ``first`` (from, to): each time the one welding the most of what is left (:func:`next_arcs`) that
+    ``planned(index, from, to)`` plans, the next of the ``tries`` best where it does not, up to ``max_arcs`` in
+    all; it stops where none of them is planned. By default every arc is taken as planned (what the held stretches
+    can cover); the planner passes its own (:func:`cell.coordinated.partial.further_arcs`)."""
     spans = [first]
     out: list[tuple[int, float, float]] = []
     while len(spans) < max_arcs:
         opts = next_arcs(spans, held, total, overlap, min_arc)
-        if not opts:
+        got = next(((i, lo, hi) for _, i, lo, hi in opts[:tries] if planned(i, lo, hi)), None)
+        if got is None:
             break
-        _, i, lo, hi = opts[0]
-        spans.append((lo, hi))
-        out.append((i, lo, hi))
+        spans.append(got[1:])
+        out.append(got)
     return out

@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from cell.coordinated.cover import MAX_ARCS, loop_gaps, next_arcs
+from cell.coordinated.cover import cover, loop_gaps
 from cell.coordinated.plan import SPINS_DEG, Candidate, Setup, candidates, solve_candidate, torch_poses
 from cell.coordinated.record import CoordinatedWeld
 from cell.errors import MotionError, PlanError
@@ -238,22 +238,20 @@ def further_arcs(su: Setup, est: CurveEstimate, held: Sequence[Held], first: tup
                  rng: np.random.Generator) -> tuple[CoordinatedWeld, ...]:  # fmt: skip
     """The coordinated arcs after the ``first`` (from, to) [m] over what it leaves of a closed curve: each time the
     held stretch that welds the most of what is left, restarting the process's ``closed_overlap`` back over the
-    bead at each junction (:func:`cell.coordinated.cover.next_arcs`), the next where one is not timed or gated (up
-    to :data:`MAX_TRIES`), up to :data:`cell.coordinated.cover.MAX_ARCS` arcs in all."""
-    spans = [first]
+    bead at each junction, the next where one is not timed or gated (up to :data:`MAX_TRIES`), up to
+    :data:`cell.coordinated.cover.MAX_ARCS` arcs in all (:func:`cell.coordinated.cover.cover`)."""
     out: list[CoordinatedWeld] = []
-    while len(spans) < MAX_ARCS:
-        opts = next_arcs(spans, [(h.lo_m, h.hi_m) for h in held], est.length_m, su.process.closed_overlap,
-                         MIN_ARC_M)  # fmt: skip
-        t_wall = time.perf_counter()
-        for _, i, lo, hi in opts[:MAX_TRIES]:
-            try:
-                cw = _stretch_plan(su, est, held[i].cand, held[i].spin, lo, hi, rng, t_wall)
-            except MotionError:
-                continue
-            out.append(replace(cw, span_m=(lo, hi)))
-            spans.append((lo, hi))
-            break
-        else:
-            break
+    since = [time.perf_counter()]  # the wall clock from the last arc planned: each arc's planning time
+
+    def planned(i: int, lo: float, hi: float) -> bool:
+        try:
+            cw = _stretch_plan(su, est, held[i].cand, held[i].spin, lo, hi, rng, since[0])
+        except MotionError:
+            return False
+        out.append(replace(cw, span_m=(lo, hi)))
+        since[0] = time.perf_counter()
+        return True
+
+    stretches_m = [(h.lo_m, h.hi_m) for h in held]
+    cover(first, stretches_m, est.length_m, su.process.closed_overlap, MIN_ARC_M, planned=planned, tries=MAX_TRIES)
     return tuple(out)

@@ -110,6 +110,11 @@ def test_a_loop_is_covered_by_arcs_restarting_the_overlap_over_the_bead_or_left_
     assert sorted((round(a, 3), round(b, 3)) for _, a, b in arcs) == [(0.21, 0.25), (0.3, 0.37)]
     left = loop_gaps([(0.0, 0.22), *((a, b) for _, a, b in arcs)], total)
     assert [v for g in left for v in g] == pytest.approx([0.25, 0.30])
+    # The planner's own loop: an arc it cannot plan gives way to the next best within its tries, else ends the cover.
+    held = [(0.0, 0.22), (0.15, 0.25), (0.30, 0.40)]
+    assert cover((0.0, 0.22), held, total, ov, arc, planned=lambda i, lo, hi: i != 2) == []
+    got = cover((0.0, 0.22), held, total, ov, arc, planned=lambda i, lo, hi: i != 2, tries=3)
+    assert [(i, round(a, 3), round(b, 3)) for i, a, b in got] == [(1, 0.21, 0.25)]
     # What the arcs leave for a manual weld, with the first arc's words: that stretch alone.
     misses = [Miss(0.27, PlanReason.IK_FAILED, "IK: joint_a3 at its limit")]
     (rest,) = leftover([(0.0, 0.22), *((a, b) for _, a, b in arcs)], total, True, misses)

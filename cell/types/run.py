@@ -43,6 +43,16 @@ def partial_text(n: int, manual_mm: float | None) -> str:
     return f"{n} curved seam{'s' * (n != 1)} partly welded: {manual_mm or 0.0:.0f} mm left for a manual weld"
 
 
+def in_part_text(share: float, remainder: tuple[Remainder, ...], n_arcs: int, how: str = "") -> str:
+    """How one curved seam welded in part is said in its reason (the planner's, the positioner's): the ``share``
+    its ``n_arcs`` arcs weld (``how``: e.g. " with the part turning"), the length left and each stretch of its
+    ``remainder`` (:meth:`Remainder.describe`)."""
+    left = sum(r.length_m for r in remainder)
+    stretches = "; ".join(r.describe() for r in remainder)
+    return (f"welded in part: {share:.0%} in {n_arcs} arc{'s' * (n_arcs != 1)}{how}, {left * 1000:.0f} mm left for a "
+            f"manual weld: {stretches}")  # fmt: skip
+
+
 class LastCheck(enum.StrEnum):
     """Which test of the last check before the arc a located seam failed (:mod:`cell.seams.checks.last_check`)."""
 

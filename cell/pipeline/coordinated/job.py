@@ -22,7 +22,7 @@ from cell.types import Part, SeamStatus
 from cell.types.curve_estimate import CurveEstimate
 from cell.types.execution import Execution
 from cell.types.positioner import TiltRotatePositioner, WeldPosition
-from cell.types.run import SeamWeld, WeldReason
+from cell.types.run import SeamWeld, WeldReason, in_part_text
 
 if TYPE_CHECKING:
     from cell.config.motion import PlanOptions
@@ -174,13 +174,7 @@ def _planned(robot: RobotModel, pos: TiltRotatePositioner, c: CurveEstimate, pro
 def _in_part_text(cw: CoordinatedWeld) -> str:
     """A coordinated weld of part of its curve in words (as the fixed arm's): the share welded and each stretch
     left for a manual weld; "" for a weld of the whole curve."""
-    if not cw.remainder:
-        return ""
-    left = sum(r.length_m for r in cw.remainder)
-    stretches = "; ".join(r.describe() for r in cw.remainder)
-    n = len(cw.arcs)
-    return (f"welded in part: {cw.share:.0%} in {n} arc{'s' * (n > 1)} with the part turning, {left * 1000:.0f} mm "
-            f"left for a manual weld: {stretches}")  # fmt: skip
+    return in_part_text(cw.share, cw.remainder, len(cw.arcs), " with the part turning") if cw.remainder else ""
 
 
 def _arcs_text(cw: CoordinatedWeld) -> str:

@@ -35,6 +35,7 @@ from cell.types.plan import (
     Segment,
 )
 from cell.types.procedure import WeldProcedure
+from cell.types.run import in_part_text
 
 
 def weldable(curves: Sequence[CurveEstimate]) -> list[CurveEstimate]:
@@ -229,8 +230,5 @@ def whole_or_none(
 def in_part(outcome: SeamOutcome, part: Partial, n_arcs: int) -> SeamOutcome:
     """A seam's planned outcome (feasible, as its first arc) welded in part: its share, its remainder and, in words,
     how much of it the ``n_arcs`` arcs weld and each stretch they leave for a manual weld."""
-    left = sum(r.length_m for r in part.remainder)
-    stretches = "; ".join(r.describe() for r in part.remainder)
-    why = (f"welded in part: {part.share:.0%} in {n_arcs} arc{'s' * (n_arcs != 1)}, {left * 1000:.0f} mm left for a "
-           f"manual weld: {stretches}")  # fmt: skip
+    why = in_part_text(part.share, part.remainder, n_arcs)
     return replace(outcome, reason=why, remainder=part.remainder, share=part.share)

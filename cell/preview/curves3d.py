@@ -51,6 +51,13 @@ def _outcome(e: CurveEstimate, w: SeamWeld | None) -> tuple[str, str]:
     return "curves not welded", f"not welded: {w.reason}"
 
 
+def stretch_R(est: CurveEstimate, from_m: float, to_m: float) -> FloatArray:
+    """(k, 3) [m] in R: the located curve from ``from_m`` to ``to_m`` along it (round a closed curve's start), a
+    point every 2 mm or so (:meth:`CurveEstimate.points_at`: the report's lengths)."""
+    n = max(2, math.ceil(abs(to_m - from_m) / _STEP_M) + 1)
+    return est.points_at(np.linspace(from_m, to_m, n))
+
+
 def _polyline(xyz: list[list[float | None]], text: list[str | None], p_mm: FloatArray, tip: str) -> None:
     """Appends one polyline (k, 3) [mm] and its hover text to a trace's columns, a None break after it."""
     for i in range(3):
@@ -93,8 +100,7 @@ def curve_traces(
         xyz, text = groups.setdefault(group, ([[], [], []], []))
         _polyline(xyz, text, p, f"{e.id}<br>{html.escape(words)}")
         for r in w.remainder if w is not None and w.code in _LEFT else ():  # not when nothing ran
-            n = max(2, math.ceil(r.length_m / _STEP_M) + 1)
-            stretch = e.points_at(np.linspace(r.from_m, r.to_m, n)) * MM
+            stretch = stretch_R(e, r.from_m, r.to_m) * MM
             tip = f"{e.id}<br>manual weld {html.escape(remainder_words(remainder_entry(r, e, X_MR)))}"
             _polyline(*manual, stretch, tip)
     traces = [

@@ -18,7 +18,7 @@ import numpy as np
 
 from cell.export.curve_report import remainder_words
 from cell.geometry import FloatArray, invert, transform_points
-from cell.preview.curves3d import MANUAL_COLOUR
+from cell.preview.curves3d import MANUAL_COLOUR, stretch_R
 from cell.preview.figures import new_figure, save_figure
 from cell.preview.views import BOX_COLOUR, MM, STATUS_COLOURS
 from cell.types import SeamStatus
@@ -50,15 +50,10 @@ def _curves(dets: Sequence[Detection]) -> dict[str, tuple[CurveEstimate, FloatAr
     return out
 
 
-def _in_M(est: CurveEstimate, X_MR: FloatArray, s_mm: FloatArray | None = None) -> FloatArray:
-    """(k, 3) [mm] in M: the located curve's samples (a closed one's first repeated at its end), or its points
-    ``s_mm`` along it (the report's lengths: :meth:`CurveEstimate.points_at`)."""
-    if s_mm is None:
-        p = np.asarray(est.p_RS)
-        p = np.vstack([p, p[:1]]) if est.closed else p
-    else:
-        p = est.points_at(np.asarray(s_mm) / MM)
-    return transform_points(X_MR, p) * MM
+def _in_M(est: CurveEstimate, X_MR: FloatArray) -> FloatArray:
+    """(k, 3) [mm] in M: the located curve's samples (a closed one's first repeated at its end)."""
+    p = np.asarray(est.p_RS)
+    return transform_points(X_MR, np.vstack([p, p[:1]]) if est.closed else p) * MM
 
 
 def _draw(ax: Axes, ij: tuple[int, int], edges_mm: FloatArray, curves_mm: Sequence[FloatArray],
@@ -95,8 +90,8 @@ def stretches_M(
     out = []
     for n, (sid, r) in enumerate(rows, start=1):
         if sid in curves:
-            s_mm = np.linspace(r["from_mm"], r["to_mm"], max(2, int(r["length_mm"] / 2.0) + 1))
-            out.append((n, _in_M(*curves[sid], s_mm)))
+            est, X_MR = curves[sid]
+            out.append((n, transform_points(X_MR, stretch_R(est, r["from_mm"] / MM, r["to_mm"] / MM)) * MM))
     return out
 
 

@@ -151,6 +151,8 @@ class Polyhedron:
         # Only points within the body's bounds (grown by the margin) can be inside: most that a stage asks are not.
         grow = max(margin, 0.0)
         near = np.flatnonzero(np.all((p >= self._bounds[0] - grow) & (p <= self._bounds[1] + grow), axis=1))
+        if len(near) == 0:
+            return out[0] if single else out
         tri = self.vertices[self._tris]
         a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
         step = max(1, _CHUNK // max(1, len(tri)))

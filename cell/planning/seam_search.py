@@ -19,6 +19,7 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
 from cell.planning.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
+from cell.planning.ik_memo import IKMemo
 from cell.planning.lines import solve_line
 from cell.planning.placement import Rotations, place, sweep, torch_tests, wording
 from cell.planning.reach import ReachModel, seam_reach
@@ -57,10 +58,13 @@ class SeamSearch:
         options: PlanOptions,
         rng: np.random.Generator,
         reach: ReachModel | None = None,
+        memo: IKMemo | None = None,
     ) -> None:
         self.robot, self.process, self.checker, self.opt, self.rng = robot, process, checker, options, rng
         self.window = HoseWindow(options.a6_center, options.a6_window)
         self.reach = reach
+        # the reach map's IK answers, kept across the plans of one job (None: not kept); only for this arm and scene
+        self.memo = memo if memo is not None and memo.fits(robot, checker, options) else None
 
     def _reference(self, q_seed: FloatArray) -> FloatArray:
         """The wrist every seam is held near: q_seed (dof,) [rad] with A6 at the hose window's centre."""

@@ -12,13 +12,16 @@ import numpy as np
 import pytest
 from tiny_cell import HOME, TABLE, URDF
 
+import cell.planning.curves.reach as reach_module
 from cell import scenario as sc
 from cell.config.motion import PlanOptions
 from cell.geometry import make_pose
 from cell.motion.collision import CollisionChecker
+from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.planning.curves.arcs import _gap, _windows, plan_arcs
 from cell.planning.curves.reach import Miss, Run, cover, pinch, share
+from cell.planning.ik_memo import IKMemo
 from cell.planning.plan import reach_model
 from cell.planning.seam_search import SeamSearch
 from cell.process.curve_quality import pass_truth
@@ -146,11 +149,40 @@ def test_a_pass_is_measured_against_the_true_curve_moved_by_its_offset() -> None
 GUSSET = Part("GUSSET", Box(make_pose(p=CENTRE_R + np.array([0.0, 0.09, 0.05])), np.array([0.008, 0.1, 0.1])))
 
 
-def test_a_gusset_across_the_foot_is_refused_with_the_share_reached_when_the_process_refuses_a_remainder() -> None:
+def test_a_gusset_across_the_foot_is_refused_with_the_share_reached_when_the_process_refuses_a_remainder(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Refused with the share reached; planned again with the first plan's IK memo (the safety gate's next
+    round), the same answer without one IK of the reach map asked again, and none kept for the base moved."""
     stiff = sc.ProcessSpec(travel_angle_tol_deg=0.0, work_angle_tol_deg=0.0, curve_remainder="refuse")  # quicker
-    got = plan_arcs(_search(GUSSET, spec=stiff), _foot(), HOME)
+    search = _search(GUSSET, spec=stiff)
+    memo = IKMemo(search.robot, search.checker, search.opt)
+    search = SeamSearch(search.robot, search.process, search.checker, search.opt, search.rng, search.reach, memo)
+    got = plan_arcs(search, _foot(), HOME)
     assert not got.whole and not got.partial and got.failure is not None and got.arcs == ()
     assert 0.6 < got.share < 1.0
+    kept, asked = len(memo._kept), []
+    assert kept > 100 and memo.hits > 0  # the stages' walks ask some stations again within one plan too
+
+    def counted(*args: object, **kw: object) -> object:
+        asked.append(args)
+        return solve_ik(*args, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(reach_module, "solve_ik", counted)
+    again = plan_arcs(search, _foot(), HOME)
+    assert asked == [] and len(memo._kept) == kept
+    assert again.share == got.share and again.failure is not None and got.failure is not None
+    assert (again.failure.code, again.failure.where) == (got.failure.code, got.failure.where)
+    np.testing.assert_array_equal(again.failure.p_R, got.failure.p_R)
+    search.checker.set_base(np.array([0.0, 0.0, 0.001]))  # another place of the arm: nothing kept answers it
+    try:
+        plan_arcs(search, _foot(), HOME)
+    finally:
+        search.checker.set_base(np.zeros(3))
+    assert len(asked) > 100
+    other = CollisionChecker(search.robot, (TABLE,), search.opt.collision)
+    assert not memo.fits(search.robot, other, search.opt)
+    assert SeamSearch(search.robot, search.process, other, search.opt, search.rng, None, memo).memo is None
 
 
 def test_a_gusset_across_the_foot_is_welded_up_to_it_the_rest_left_for_a_manual_weld() -> None:

@@ -157,6 +157,11 @@ class CollisionChecker:
             obj.placement = step * obj.placement
         self._base_X = X.copy()
 
+    def base_key(self) -> bytes:
+        """Where the arm's base stands (:meth:`set_base`, :meth:`place_base`) as bytes: two equal keys, the same
+        answers to every query."""
+        return self._base_X.tobytes() + self._base_offset.tobytes()
+
     def step_bound(self, q: npt.ArrayLike) -> tuple[float, Contact | None]:
         """The motion [m] any arm point may make from q (dof,) before the next check, or the contact at q."""
         return self._step_bound(q)

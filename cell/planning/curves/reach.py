@@ -92,7 +92,14 @@ class Miss:
 
 def _fresh(search: SeamSearch, X: FloatArray, seeds: Sequence[FloatArray]) -> FloatArray | Miss:
     """IK at X (4, 4) from each seed in turn, the first clear of the parts and the arm itself and not singular;
-    else why not (the last seed's, a collision's or singularity's before an IK failure's; ``at_m`` unset)."""
+    else why not (the last seed's, a collision's or singularity's before an IK failure's; ``at_m`` unset); kept in
+    the search's memo when it has one."""
+    if search.memo is not None:
+        return search.memo.answer("fresh", (X, *seeds), 0.0, lambda: _fresh_solved(search, X, seeds))
+    return _fresh_solved(search, X, seeds)
+
+
+def _fresh_solved(search: SeamSearch, X: FloatArray, seeds: Sequence[FloatArray]) -> FloatArray | Miss:
     miss = Miss(0.0, PlanReason.IK_FAILED)
     for seed in seeds:
         try:
@@ -111,7 +118,13 @@ def _fresh(search: SeamSearch, X: FloatArray, seeds: Sequence[FloatArray]) -> Fl
 
 def _next(search: SeamSearch, X: FloatArray, q_prev: FloatArray, max_step: float) -> FloatArray | None:
     """IK at X (4, 4) warm-started from q_prev (dof,): None where it fails, a joint steps more than max_step [rad]
-    or the arm meets a part or itself or is singular."""
+    or the arm meets a part or itself or is singular; kept in the search's memo when it has one."""
+    if search.memo is not None:
+        return search.memo.answer("next", (X, q_prev), max_step, lambda: _next_solved(search, X, q_prev, max_step))
+    return _next_solved(search, X, q_prev, max_step)
+
+
+def _next_solved(search: SeamSearch, X: FloatArray, q_prev: FloatArray, max_step: float) -> FloatArray | None:
     try:
         q = np.asarray(solve_ik(search.robot, X, q_prev, options=search.opt.ik))
     except IKError:

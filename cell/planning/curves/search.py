@@ -129,7 +129,7 @@ def _solved(search: SeamSearch, f: _Preview) -> SeamSolution | SeamFailure:
         if not isinstance(res, SeamFailure) or 0.0 <= res.progress < f.task.length - 1e-9:
             break
         short = SeamSearch(search.robot, replace(pr, approach=min(pr.approach, d), depart=min(pr.depart, d)),
-                           search.checker, search.opt, search.rng, search.reach)  # fmt: skip
+                           search.checker, search.opt, search.rng, search.reach, search.memo)  # fmt: skip
         again = short.solve_candidate(f.task, f.cand, f.X, f.q0)
         if isinstance(again, SeamSolution):
             return again

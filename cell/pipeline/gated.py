@@ -57,7 +57,7 @@ def plan_for(
     from cell.motion.timing import ptp
     from cell.pipeline.tacks import tack_procedures
     from cell.planning.curves.split import seam_of
-    from cell.planning.ik_memo import IKMemo
+    from cell.planning.memo import PlanMemo
     from cell.planning.plan import plan_welds
     from cell.planning.tasks import seam_tasks
     from cell.planning.track import plan_on_track
@@ -95,7 +95,7 @@ def plan_for(
     dropped: dict[str, SeamOutcome] = {}
     avoid: set[tuple[str, str]] = set()  # transfers the gate found at fault: another order is tried first
     refused: dict[str, list[Remainder]] = {}  # curved seam -> its arcs' stretches the gate found at fault
-    memo = IKMemo(arm.model, checker, sc.motion.plan)  # each round's curves ask the reach map the same IK
+    memo = PlanMemo(arm.model, checker, sc.motion.plan)  # each round asks the reach map and transfers the same
     for _ in range(_GATE_ROUNDS):
         kept = [t for t in tasks if t.id not in dropped]
         kept_tacks = [t for t in tack_tasks if t.id not in dropped]

@@ -27,7 +27,7 @@ from cell.planning.curves.refused import exit_at_fault
 from cell.planning.curves.split import seam_of
 from cell.planning.curves.timing import curve_lines
 from cell.planning.failures import SeamFailure, reason_text
-from cell.planning.ik_memo import IKMemo
+from cell.planning.memo import PlanMemo
 from cell.planning.order import seam_order
 from cell.planning.passes import pass_pieces, solve_passes
 from cell.planning.reach import ReachModel
@@ -58,7 +58,7 @@ def plan_welds(
     elsewhere: bool = False,
     avoid: Collection[tuple[str, str]] = (),
     refused: Mapping[str, Sequence[Remainder]] | None = None,
-    memo: IKMemo | None = None,
+    memo: PlanMemo | None = None,
 ) -> WeldPlan:
     """Plan every seam that can be welded, skip and report the others (see the module docstring).
 
@@ -78,8 +78,8 @@ def plan_welds(
         procedure from ``procedures`` too; their outcomes follow the tasks'.
     refused : curved seam id -> stretches along it (from, to [m], code, why) whose arc the safety gate refused:
         that arc is left out alone, its stretch left for a manual weld (:func:`cell.planning.curves.cover_curves`).
-    memo : the curves' reach-map IK answers kept from an earlier plan of the same job (the safety gate's rounds:
-        :class:`~cell.planning.ik_memo.IKMemo`), and what this plan asks kept in it.
+    memo : the answers kept from an earlier plan of the same job (the safety gate's rounds): the curves' reach-map
+        IK and the transfers' searches (:class:`~cell.planning.memo.PlanMemo`); what this plan asks is kept in it.
     elsewhere : another place may hold a seam (a positioner's other poses): one whose transfer fails and that no
         transfer joins to home either way is refused at once (:mod:`cell.planning.access.home`), not tried from
         every other seam in turn; and the order search leaves out a transfer that no strategy makes between the
@@ -130,7 +130,9 @@ def plan_welds(
         if isinstance(sel, NoProcedure):
             outcomes[curve.id] = _failed(curve.id, PlanReason.NO_PROCEDURE, sel.reason, curve.p_RS[0])
             continue
-        searches[curve.id] = SeamSearch(robot, seam_process(process, sel), checker, opt, rng, reach, memo)
+        searches[curve.id] = SeamSearch(
+            robot, seam_process(process, sel), checker, opt, rng, reach, memo.ik if memo else None
+        )
     curve_ids = {e.id for e in found_curves if e.id not in outcomes}
     curve_procs = {i: p.procedure for i, p in chosen.items() if isinstance(p, SeamProcedure)}
     to_search = [e for e in found_curves if e.id in curve_ids]
@@ -143,7 +145,7 @@ def plan_welds(
             chosen[aid] = chosen[seam_of(aid)]
         curve_ids.add(aid)
 
-    transfers = Transfers(robot, process, checker, opt, obstacles, q0, WAYS)
+    transfers = Transfers(robot, process, checker, opt, obstacles, q0, WAYS, memo.transfers if memo else None)
     seam_parts: dict[str, list[Piece]] = {}
     for sid in list(solved):
         sel = chosen.get(sid)

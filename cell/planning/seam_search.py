@@ -19,8 +19,8 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.motion.wrist import HoseWindow, nearest_wrist, wrist_cost
 from cell.planning.failures import LineError, SeamFailure, better, mm, unreachable, where_on_path
-from cell.planning.ik_memo import IKMemo
 from cell.planning.lines import solve_line
+from cell.planning.memo import IKMemo
 from cell.planning.placement import Rotations, place, sweep, torch_tests, wording
 from cell.planning.reach import ReachModel, seam_reach
 from cell.process.torch import WeldProcess, back_off, line_poses

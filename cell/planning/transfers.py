@@ -18,6 +18,7 @@ from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
 from cell.motion.wrist import HoseWindow, nearest_wrist
 from cell.planning.failures import LineError
+from cell.planning.memo import TransferAnswers
 from cell.planning.moves.lifts import DeepKnotError, vertical_line
 from cell.planning.moves.pieces import Piece, TransferFail, joined
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
@@ -46,6 +47,7 @@ class Transfers:
         obstacles: Sequence[Part],
         q_home: FloatArray,
         strategies: Sequence[TransferStrategy] = DEFAULT_STRATEGIES,
+        answers: TransferAnswers | None = None,
     ) -> None:
         self.robot, self.process, self.checker, self.opt = robot, process, checker, options
         self.q_home = q_home
@@ -59,14 +61,16 @@ class Transfers:
         # for every transfer it kept (without this, n re-orderings cost n times the whole plan's transfers).
         self._memo: dict[tuple[bytes, bytes], list[Piece] | TransferFail] = {}
         self._between: dict[tuple[int, bytes], tuple[int, int, list[Piece]] | TransferFail] = {}
-        self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = {}
-        self._above: dict[tuple[bytes, float], FloatArray | IKError] = {}
-        self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = {}
         # A search's attempts, each answered once: the order search, its screen and the shorter lines ask the same
         # strategy between the same ends again (None: not free), and a motion found not to run deep is not probed
-        # again (the strategies share via points).
-        self._tried: dict[tuple[TransferStrategy, bytes, bytes], list[Piece] | None] = {}
-        self._shallow: set[tuple[str, bytes, bytes, int]] = set()
+        # again (the strategies share via points); ``answers``: kept from an earlier plan with this set-up.
+        fit = answers is not None and answers.fits(robot, process, checker, options, obstacles, q_home)
+        kept = answers if answers is not None and fit else TransferAnswers()
+        self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = kept.pieces
+        self._above: dict[tuple[bytes, float], FloatArray | IKError] = kept.above
+        self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = kept.vertical
+        self._tried: dict[tuple[TransferStrategy, bytes, bytes], list[Piece] | None] = kept.tried
+        self._shallow: set[tuple[str, bytes, bytes, int]] = kept.shallow
         self._probing = False
         self.retreats: tuple[TransferStrategy, ...] = ()
         self._retreat: set[bytes] = set()

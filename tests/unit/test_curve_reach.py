@@ -21,7 +21,7 @@ from cell.motion.ik import solve_ik
 from cell.motion.robot import RobotModel
 from cell.planning.curves.arcs import _gap, _windows, plan_arcs
 from cell.planning.curves.reach import Miss, Run, cover, pinch, share
-from cell.planning.ik_memo import IKMemo
+from cell.planning.memo import IKMemo
 from cell.planning.plan import reach_model
 from cell.planning.seam_search import SeamSearch
 from cell.process.curve_quality import pass_truth

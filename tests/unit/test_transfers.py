@@ -16,6 +16,7 @@ from cell.motion.collision import CollisionChecker
 from cell.motion.robot import RobotModel
 from cell.motion.timing import ptp
 from cell.planning.failures import SeamFailure, better, reason_text
+from cell.planning.memo import TransferAnswers
 from cell.planning.moves.strategies import Mover
 from cell.planning.transfers import DEFAULT_STRATEGIES, Direct, Lift, Piece, TransferFail, Transfers, TransferStrategy
 from cell.process.torch import WeldProcess
@@ -192,3 +193,36 @@ def test_the_ways_out_of_an_exit_at_fault_are_tried_from_it_alone(robot: RobotMo
     moves = mover.move(HOME, Q_B)  # out of HOME: the way out is free
     assert not isinstance(moves, TransferFail) and [p.kind for p in moves] == ["move"]
     assert isinstance(mover.move(other, Q_B), TransferFail)  # out of another configuration: as before
+
+
+def test_a_later_plan_with_the_same_set_up_answers_from_the_first_plans_searches(robot: RobotModel) -> None:
+    """The safety gate's next round (another Transfers, the same arm, process, checker, options, obstacles and
+    home, the first one's answers handed over): the same way over the wall, found without one motion checked
+    again; with another home (or the base moved), nothing is taken from them."""
+    mid = 0.5 * (robot.fk(HOME)[:3, 3] + robot.fk(Q_B)[:3, 3])
+    wall = Part("WALL", Box(make_pose(p=[mid[0], mid[1], 0.4]), np.array([0.02, 0.3, 0.8])))
+    obstacles, opt = (*OBSTACLES, wall), PlanOptions()
+    checker = CollisionChecker(robot, obstacles)
+    kept = TransferAnswers()
+    first = Transfers(robot, PROCESS, checker, opt, obstacles, HOME, answers=kept).move(HOME, Q_B)
+    assert not isinstance(first, TransferFail) and len(first) == 2 and kept.pieces and kept.tried
+    checked: list[int] = []
+    path = checker.check_path
+
+    def counted(q: FloatArray, *args: object, **kwargs: object) -> object:
+        checked.append(len(q))
+        return path(q, *args, **kwargs)  # type: ignore[arg-type]
+
+    checker.check_path = counted  # type: ignore[method-assign, assignment]
+    again = Transfers(robot, PROCESS, checker, opt, obstacles, HOME, answers=kept).move(HOME, Q_B)
+    assert not isinstance(again, TransferFail) and checked == []
+    for a, b in zip(first, again, strict=True):
+        np.testing.assert_array_equal(a.trajectory.q, b.trajectory.q)
+    Transfers(robot, PROCESS, checker, opt, obstacles, Q_B, answers=kept).move(HOME, Q_B)
+    assert checked  # another home: searched afresh
+    checker.set_base(np.array([0.0, 0.0, 0.001]))
+    try:
+        assert not kept.fits(robot, PROCESS, checker, opt, obstacles, HOME)
+    finally:
+        checker.set_base(np.zeros(3))
+    assert kept.fits(robot, PROCESS, checker, opt, obstacles, HOME)

@@ -7,9 +7,9 @@ Frames: targets X_RT in the robot base frame R [m]; joints [rad]."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import numpy as np
 
@@ -21,6 +21,18 @@ from cell.motion.robot import RobotModel
 if TYPE_CHECKING:
     from cell.process.torch import WeldProcess
     from cell.types import Part
+
+
+class SetUp(Protocol):
+    """What a transfers' search is for (:class:`~cell.planning.transfers.Transfers` has it)."""
+
+    robot: RobotModel
+    process: WeldProcess
+    checker: CollisionChecker
+    opt: PlanOptions
+    obstacles: tuple[Part, ...]
+    q_home: FloatArray
+
 
 T = TypeVar("T")
 
@@ -70,18 +82,11 @@ class TransferAnswers:
     tried: dict[Any, Any] = field(default_factory=dict)
     _owner: tuple[object, ...] | None = None
 
-    def fits(
-        self,
-        robot: RobotModel,
-        process: WeldProcess,
-        checker: CollisionChecker,
-        options: PlanOptions,
-        obstacles: Sequence[Part],
-        q_home: FloatArray,
-    ) -> bool:
-        """Whether these answers are a search's with this set-up (the same objects, the base where it stood, the
-        same home); the first set-up asked is the one they keep."""
-        owner = (robot, process, checker, checker.base_key(), options, *obstacles, np.asarray(q_home).tobytes())
+    def fits(self, mover: SetUp) -> bool:
+        """Whether these answers are a search's with ``mover``'s set-up (the same arm, process, checker with its base
+        where it stood, options, obstacles and home); the first set-up asked is the one they keep."""
+        owner = (mover.robot, mover.process, mover.checker, mover.checker.base_key(), mover.opt, *mover.obstacles)
+        owner += (np.asarray(mover.q_home).tobytes(),)
         if self._owner is None:
             self._owner = owner
         return len(owner) == len(self._owner) and all(

@@ -64,8 +64,7 @@ class Transfers:
         # A search's attempts, each answered once: the order search, its screen and the shorter lines ask the same
         # strategy between the same ends again (None: not free), and a motion found not to run deep is not probed
         # again (the strategies share via points); ``answers``: kept from an earlier plan with this set-up.
-        fit = answers is not None and answers.fits(robot, process, checker, options, obstacles, q_home)
-        kept = answers if answers is not None and fit else TransferAnswers()
+        kept = answers if answers is not None and answers.fits(self) else TransferAnswers()
         self._pieces: dict[tuple[str, bytes, bytes, int], tuple[bool, str, FloatArray] | None] = kept.pieces
         self._above: dict[tuple[bytes, float], FloatArray | IKError] = kept.above
         self._vertical: dict[tuple[bytes, float, bool], Piece | Exception | None] = kept.vertical

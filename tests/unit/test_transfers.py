@@ -220,9 +220,10 @@ def test_a_later_plan_with_the_same_set_up_answers_from_the_first_plans_searches
         np.testing.assert_array_equal(a.trajectory.q, b.trajectory.q)
     Transfers(robot, PROCESS, checker, opt, obstacles, Q_B, answers=kept).move(HOME, Q_B)
     assert checked  # another home: searched afresh
+    same = Transfers(robot, PROCESS, checker, opt, obstacles, HOME)
     checker.set_base(np.array([0.0, 0.0, 0.001]))
     try:
-        assert not kept.fits(robot, PROCESS, checker, opt, obstacles, HOME)
+        assert not kept.fits(same)
     finally:
         checker.set_base(np.zeros(3))
-    assert kept.fits(robot, PROCESS, checker, opt, obstacles, HOME)
+    assert kept.fits(same)

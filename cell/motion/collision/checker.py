@@ -7,7 +7,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-import coal
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
@@ -16,7 +15,16 @@ from cell.config.motion import CollisionOptions
 from cell.geometry import FloatArray, readonly
 from cell.motion.collision.contact import Contact, advance_along, advance_linear, deep_sample
 from cell.motion.collision.relative import RelativeBounds
-from cell.motion.collision.shapes import Boxes, ToolShapes, add_obstacles, signed, torch_contacts, trim_near_tcp
+from cell.motion.collision.shapes import (
+    Boxes,
+    ToolShapes,
+    add_obstacles,
+    joint_radii,
+    local_spheres,
+    signed,
+    torch_contacts,
+    trim_near_tcp,
+)
 from cell.motion.robot import RobotModel
 from cell.types import Part
 from cell.types.track import LinearTrack
@@ -70,7 +78,7 @@ class CollisionChecker:
         self._geom = geom
         self._gdata = pin.GeometryData(geom)
         self._data = self._model.createData()
-        self._radius, pairs = self._joint_radii(), geom.collisionPairs
+        self._radius, pairs = joint_radii(self._model, objs[: self._n_robot]), geom.collisionPairs
         ends = [(objs[pairs[k].first].parentJoint, objs[pairs[k].second].parentJoint) for k in self._pairs.self_]
         self._relative = RelativeBounds.build(list(parents), self._radius, ends)  # the path check's step bounds
         self._tool_shapes = [i for i in range(self._n_robot) if objs[i].parentJoint == self._model.njoints - 1]
@@ -80,14 +88,7 @@ class CollisionChecker:
         # The broad phase of a check: every robot shape's bounding sphere (centre in its own frame, radius), and
         # per pair its two shapes; a pair whose spheres (or sphere and box) are farther apart than what could
         # change the answer gets that lower bound instead of a distance query.
-        self._centre_G, self._radius_G = [], []
-        for obj in objs[: self._n_robot]:
-            obj.geometry.computeLocalAABB()
-            lo, hi = np.array(obj.geometry.aabb_local.min_), np.array(obj.geometry.aabb_local.max_)
-            self._centre_G.append((lo + hi) / 2.0)
-            self._radius_G.append(float(np.linalg.norm(hi - lo)) / 2.0)
-        self._radius_arr = np.array(self._radius_G)
-        self._centre_arr = np.array(self._centre_G).reshape(-1, 3)
+        self._centre_arr, self._radius_arr = local_spheres(objs[: self._n_robot])
         self._pair_first = np.array([p.first for p in pairs], dtype=int)
         self._pair_second = np.array([p.second for p in pairs], dtype=int)
         self._is_obstacle_pair = self._pair_second >= self._n_robot
@@ -95,30 +96,6 @@ class CollisionChecker:
         self._base_offset = np.zeros(3)
         self._base_X = np.eye(4)  # the base's rigid placement (place_base)
         self.set_base(robot.base_offset_R)
-
-    # -- set-up ------------------------------------------------------------------------------------------------
-
-    def _joint_radii(self) -> FloatArray:
-        """r_j (dof,): bound on the distance of any collision shape point from joint j's axis [m]."""
-        m = self._model
-        r = np.zeros(m.njoints - 1)
-        for obj in self._geom.geometryObjects[: self._n_robot]:
-            # radius of a ball around the shape's origin that holds the shape
-            g = obj.geometry
-            if isinstance(g, coal.Box):
-                rad = float(np.linalg.norm(g.halfSide))
-            elif isinstance(g, coal.Cylinder):
-                rad = float(np.hypot(g.radius, g.halfLength))
-            else:
-                g.computeLocalAABB()
-                rad = float(np.linalg.norm(g.aabb_local.max_ - g.aabb_local.min_) / 2.0)
-            j = obj.parentJoint
-            reach = float(np.linalg.norm(obj.placement.translation)) + rad
-            while j > 0:  # the shape's distance from each joint up the chain, by the triangle inequality
-                r[j - 1] = max(r[j - 1], reach)
-                reach += float(np.linalg.norm(m.jointPlacements[j].translation))
-                j = m.parents[j]
-        return readonly(r)
 
     # -- the base on a linear track (docs/track.md) -------------------------------------------------------------
 

@@ -1,6 +1,7 @@
-"""The torch test's geometry, part of the coal adapter: the torch's shapes cut back near the wire tip, the obstacles'
+"""The shapes' geometry, part of the coal adapter: the torch's shapes cut back near the wire tip, the obstacles'
 coal shapes (box, convex polyhedron or triangle mesh, each grown by its margin) and the contacts of many TCP poses
-in one broad-phase query, with a point-in-body test where a mesh reads clear (docs/bodies.md section 2)."""
+in one broad-phase query, with a point-in-body test where a mesh reads clear (docs/bodies.md section 2); the arm's
+shapes' bounds (each one's sphere, each joint's radius) for the checker's broad phase and path steps."""
 
 from __future__ import annotations
 
@@ -79,6 +80,40 @@ class ToolShapes:
             rad.append(float(np.linalg.norm(hi - lo)) / 2.0)
             shapes.append(g)
         return ToolShapes(np.array(X).reshape(-1, 4, 4), np.array(cen).reshape(-1, 3), np.array(rad), tuple(shapes))
+
+
+def joint_radii(model: pin.Model, robot_shapes: Sequence[pin.GeometryObject]) -> FloatArray:
+    """r_j (dof,): bound on the distance of any point of the arm's collision shapes from joint j's axis [m]."""
+    r = np.zeros(model.njoints - 1)
+    for obj in robot_shapes:
+        # radius of a ball around the shape's origin that holds the shape
+        g = obj.geometry
+        if isinstance(g, coal.Box):
+            rad = float(np.linalg.norm(g.halfSide))
+        elif isinstance(g, coal.Cylinder):
+            rad = float(np.hypot(g.radius, g.halfLength))
+        else:
+            g.computeLocalAABB()
+            rad = float(np.linalg.norm(g.aabb_local.max_ - g.aabb_local.min_) / 2.0)
+        j = obj.parentJoint
+        reach = float(np.linalg.norm(obj.placement.translation)) + rad
+        while j > 0:  # the shape's distance from each joint up the chain, by the triangle inequality
+            r[j - 1] = max(r[j - 1], reach)
+            reach += float(np.linalg.norm(model.jointPlacements[j].translation))
+            j = model.parents[j]
+    return readonly(r)
+
+
+def local_spheres(robot_shapes: Sequence[pin.GeometryObject]) -> tuple[FloatArray, FloatArray]:
+    """Each of the arm's shapes' bounding sphere in its own frame (the centre of its local box): centres (n, 3)
+    and radii (n,) [m], the broad phase of a check."""
+    centres, radii = [], []
+    for obj in robot_shapes:
+        obj.geometry.computeLocalAABB()
+        lo, hi = np.array(obj.geometry.aabb_local.min_), np.array(obj.geometry.aabb_local.max_)
+        centres.append((lo + hi) / 2.0)
+        radii.append(float(np.linalg.norm(hi - lo)) / 2.0)
+    return np.array(centres).reshape(-1, 3), np.array(radii)
 
 
 Solids = Mapping[int, Polyhedron]  # obstacle index -> a non-convex body whose coal shape is its surface only

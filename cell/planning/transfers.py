@@ -20,7 +20,7 @@ from cell.motion.wrist import HoseWindow, nearest_wrist
 from cell.planning.failures import LineError
 from cell.planning.memo import TransferAnswers
 from cell.planning.moves.lifts import DeepKnotError, vertical_line
-from cell.planning.moves.pieces import Piece, TransferFail, joined
+from cell.planning.moves.pieces import Piece, TransferFail, joined, out_of_window
 from cell.planning.moves.strategies import DEFAULT_STRATEGIES, Direct, Hop, Lift, TransferStrategy, ViaHome
 from cell.planning.reach import ReachModel
 from cell.process.torch import WeldProcess
@@ -169,7 +169,7 @@ class Transfers:
             return TransferFail(f"{strategy.name}: collides", _NO_PLACE)
         finally:
             self._probing = False
-        wound = self._wound(pieces, q_a, q_b)
+        wound = out_of_window(self.robot, self.window, pieces, q_a, q_b)
         if wound is not None:
             return TransferFail(f"{strategy.name}: {wound.reason}", wound.p_R)
         # Where only whether the way is free matters: a motion already known not to be free ends it before any
@@ -239,22 +239,6 @@ class Transfers:
             if hit is not None:
                 return hit
         return None
-
-    def _wound(self, pieces: list[Piece], q_a: FloatArray, q_b: FloatArray) -> TransferFail | None:
-        """Why the motions take A6 further out of the hose window than their ends q_a, q_b are (None: they do
-        not), with the TCP p_R (3,) [m] where it is furthest out."""
-        allowed = max(self.window.excess(q_a), self.window.excess(q_b)) + 1e-9
-        q = np.concatenate([pc.trajectory.q for pc in pieces])
-        over = np.abs(q[:, -1] - self.window.center) - self.window.half_width
-        k = int(np.argmax(over))
-        if over[k] <= allowed:
-            return None
-        w = self.window
-        why = (
-            f"A6 leaves the hose package window ({np.degrees(w.center):.0f} +- {np.degrees(w.half_width):.0f} deg)"
-            f" by {np.degrees(over[k]):.1f} deg"
-        )
-        return TransferFail(why, self.robot.fk(q[k])[:3, 3].copy())
 
     def above(self, q: FloatArray, height: float) -> FloatArray | None:
         """The configuration (dof,) [rad] with q's TCP pose raised to ``height`` [m] in R (IK seeded at q); None

@@ -9,7 +9,9 @@ from typing import NamedTuple
 import numpy as np
 
 from cell.geometry import FloatArray
+from cell.motion.robot import RobotModel
 from cell.motion.timing import Trajectory
+from cell.motion.wrist import HoseWindow
 from cell.types.plan import SegmentKind
 
 
@@ -71,3 +73,21 @@ def joined(pieces: Sequence[Piece]) -> Trajectory:
         qdd.append(tr.qdd[skip:])
         t0 += tr.duration
     return Trajectory(np.concatenate(times), np.concatenate(q), np.concatenate(qd), np.concatenate(qdd))
+
+
+def out_of_window(
+    robot: RobotModel, window: HoseWindow, pieces: Sequence[Piece], q_a: FloatArray, q_b: FloatArray
+) -> TransferFail | None:
+    """Why a transfer's motions take A6 further out of the hose ``window`` than their ends q_a, q_b (dof,) [rad] are
+    (None: they do not), with the TCP p_R (3,) [m] where it is furthest out."""
+    allowed = max(window.excess(q_a), window.excess(q_b)) + 1e-9
+    q = np.concatenate([pc.trajectory.q for pc in pieces])
+    over = np.abs(q[:, -1] - window.center) - window.half_width
+    k = int(np.argmax(over))
+    if over[k] <= allowed:
+        return None
+    why = (
+        f"A6 leaves the hose package window ({np.degrees(window.center):.0f} +- {np.degrees(window.half_width):.0f}"
+        f" deg) by {np.degrees(over[k]):.1f} deg"
+    )
+    return TransferFail(why, robot.fk(q[k])[:3, 3].copy())

@@ -84,6 +84,15 @@ def _voxel_keys(points: np.ndarray, voxel_m: float) -> np.ndarray:
     return np.asarray((ijk[:, 0] << 42) | (ijk[:, 1] << 21) | ijk[:, 2])
 
 
+def _among(keys: np.ndarray, sorted_unique: np.ndarray) -> npt.NDArray[np.bool_]:
+    """(n,) which of ``keys`` are in ``sorted_unique`` (sorted, no repeats): ``np.isin``'s answer, by binary search
+    in the one sorted array instead of sorting both for every pair."""
+    if not len(sorted_unique):
+        return np.zeros(len(keys), dtype=bool)
+    pos = np.minimum(np.searchsorted(sorted_unique, keys), len(sorted_unique) - 1)
+    return np.asarray(sorted_unique[pos] == keys)
+
+
 def seen_by(p_R: FloatArray, image: DepthImage, X_WR: FloatArray, tol_m: float) -> npt.NDArray[np.bool_]:
     """(n,) which points p_R (n, 3) [m, frame R] the camera of ``image`` could have seen: in front of it, inside its
     image, where it has a depth, and not behind the surface it saw there by more than ``tol_m`` (a point behind
@@ -136,13 +145,15 @@ def _shares(
     shortcut = o.agree_voxel_m * math.sqrt(3.0) * (1.0 + 1e-6) <= o.agree_tol_m
     keys = {n: _voxel_keys(p, o.agree_voxel_m) for n, p in grids.items()} if shortcut else {}
     coarse = {n: _voxel_keys(p, FOOTPRINT_TOLS * o.agree_tol_m) for n, p in grids.items()}
+    occupied = {n: np.unique(k) for n, k in keys.items()}  # each camera's voxels, sorted once for every pair
+    footprint = {n: np.unique(k) for n, k in coarse.items()}
     out: dict[tuple[str, str], float] = {}
     within: dict[tuple[str, str], float] = {}
     for a, pa in grids.items():
         for b, tree in trees.items():
             if a == b:
                 continue
-            near = np.isin(keys[a], keys[b]) if shortcut else np.zeros(len(pa), dtype=bool)
+            near = _among(keys[a], occupied[b]) if shortcut else np.zeros(len(pa), dtype=bool)
             agrees = near.copy()
             dist, _ = tree.query(pa[~near], distance_upper_bound=o.agree_tol_m, workers=-1)
             agrees[~near] = np.isfinite(dist)
@@ -152,7 +163,7 @@ def _shares(
             agrees &= judged
             n_judged = np.count_nonzero(judged)
             out[(a, b)] = float(np.count_nonzero(agrees) / n_judged) if n_judged else float("nan")
-            inside = np.isin(coarse[a], coarse[b]) & judged
+            inside = _among(coarse[a], footprint[b]) & judged
             n_in = np.count_nonzero(inside)
             within[(a, b)] = float(np.count_nonzero(agrees & inside) / n_in) if n_in else float("nan")
     return out, within

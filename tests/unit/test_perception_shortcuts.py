@@ -10,7 +10,7 @@ from scipy.spatial import cKDTree
 
 from cell.config.perception import HealthOptions
 from cell.perception import downsample
-from cell.perception.camera_health import agreement
+from cell.perception.camera_health import _among, agreement
 from cell.types import Cloud
 
 
@@ -50,3 +50,15 @@ def test_agreement_shortcut_gives_the_searched_shares() -> None:
         for key, share in brute.items():
             assert fast[key] == share
     assert 0.2 < agreement(clouds)[("b", "a")] < 0.95  # a real mix of agreeing and disagreeing points
+
+
+def test_voxel_membership_by_binary_search_is_isins_answer() -> None:
+    """The camera agreement's voxel membership (one sorted array searched per pair) answers as ``np.isin`` does,
+    shared voxels, repeats and an empty camera included."""
+    rng = np.random.default_rng(3)
+    a = rng.integers(0, 1 << 40, 5000)
+    b = np.concatenate([a[::3], rng.integers(0, 1 << 40, 4000), a[:10]])
+    for x, y in ((a, b), (b, a), (a, b[:0]), (a[:0], b), (np.repeat(a[:50], 3), a[25:75])):
+        got = _among(x, np.unique(y))
+        assert got.dtype == bool and np.array_equal(got, np.isin(x, y))
+    assert _among(a, np.unique(b)).sum() == np.isin(a, b).sum() > 1000

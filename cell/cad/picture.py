@@ -106,7 +106,7 @@ def draw_proposals(found: Proposals, path: str | Path) -> Path:
     fig.suptitle(f"{Path(found.model.source).name}: {n_prop} seams proposed, {n_rej} rejected", fontsize=10)
     handles = [
         Line2D([], [], color=PROPOSED_COLOUR, lw=2.2, label="proposed (WELD_SEAMS)"),
-        Line2D([], [], color=PROPOSED_COLOUR, lw=2.2, ls="--", label="proposed, curved (not welded yet)"),
+        Line2D([], [], color=PROPOSED_COLOUR, lw=2.2, ls="--", label="proposed, curved"),
         Line2D([], [], color=REJECTED_COLOUR, lw=1.2, ls=":", label="rejected (WELD_REJECTED)"),
         Line2D([], [], color=PART_COLOUR, lw=0.8, label="part"),
         Line2D([], [], color=FIXTURE_COLOUR, lw=0.8, label="fastener or fixture"),

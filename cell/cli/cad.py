@@ -66,7 +66,7 @@ def convert(
         )
     curved = sum(1 for s in found.proposed if s.curved)
     out.print(
-        f"{len(found.proposed)} seams proposed ({curved} curved: listed, not welded yet), "
+        f"{len(found.proposed)} seams proposed ({curved} curved), "
         f"{len(found.seams) - len(found.proposed)} rejected; bodies: {bodies}",
         soft_wrap=True,
         markup=False,

@@ -107,12 +107,12 @@ def _curve_rescans(rep: dict) -> None:
         _why_lines([(s["id"], r["reason"])])
 
 
-LOCATED_CURVE_CODE = Unsupported.CURVED_NO_TORCH_PATH.value  # a curved seam located, no torch path yet
+LOCATED_CURVE_CODE = Unsupported.CURVED_NO_TORCH_PATH.value  # a curved seam located by a run that plans no weld
 
 
 def not_supported_text(summary: Mapping[str, Any]) -> str:
     """``1 not supported: curved`` (the map's seams the cell cannot weld, by reason code), then ``2 curved located,
-    not welded (curved_no_torch_path)`` (curved seams located, with no torch path along a curve yet), or empty."""
+    not welded (curved_no_torch_path)`` (curved seams located by a run that plans no weld, a detection), or empty."""
     codes = dict(summary.get("not_supported") or {})
     located = codes.pop(LOCATED_CURVE_CODE, 0)
     n = sum(codes.values())

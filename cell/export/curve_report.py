@@ -169,7 +169,8 @@ def curve_summary(det: Detection) -> dict[str, Any]:
 
 
 def weld_reason_code(entry: dict[str, Any]) -> str:
-    """Why a seam the run does not weld was not welded, as a code: a located curve has no torch path yet."""
+    """Why a seam the run does not weld was not welded, as a code: a located curve that no torch path was planned
+    for (a run that plans no weld)."""
     code = (entry.get("not_welded") or {}).get("code")
     return (WeldReason.NO_TORCH_PATH if code == Unsupported.CURVED_NO_TORCH_PATH else WeldReason.NOT_SUPPORTED).value
 

@@ -111,7 +111,8 @@ class Detection:
                 code = w.plan_code or w.code or WeldReason.NOT_PLANNED
                 out.append(UnsupportedSeam(u.id, f"{drawn}: located; not welded: {w.reason}", code))
             elif e.status is SeamStatus.FOUND:
-                why = f"{drawn}: located (sigma up to {e.sigma_max_m * 1000:.2f} mm); no torch path along a curve yet"
+                sigma = f"sigma up to {e.sigma_max_m * 1000:.2f} mm"
+                why = f"{drawn}: located ({sigma}); no torch path planned (this run plans no weld)"
                 out.append(UnsupportedSeam(u.id, why, Unsupported.CURVED_NO_TORCH_PATH))
             else:
                 out.append(UnsupportedSeam(u.id, f"{drawn}; {e.reason}", Unsupported.CURVED_NOT_LOCATED))

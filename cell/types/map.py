@@ -235,7 +235,8 @@ class Unsupported(enum.StrEnum):
     # A curved seam (an arc, circle, ellipse, spline, helix or bulged polyline segment) not located: no two parts
     # hold it (no joint), the locator cannot take it, or the run never came to locate it.
     CURVED_NOT_LOCATED = "curved_not_located"
-    # A curved seam located (its CurveEstimate found), but no torch path along a curve exists yet: not welded.
+    # A curved seam located (its CurveEstimate found) by a run that plans no weld (a detection, a locate): no torch
+    # path was planned for it, so it is not welded by this run.
     CURVED_NO_TORCH_PATH = "curved_no_torch_path"
     ON_FIXTURE = "on_fixture"  # it lies on a fixture, not between two parts
 

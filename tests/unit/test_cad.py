@@ -170,7 +170,7 @@ def test_from_cad_writes_a_map_the_reader_welds(step_file: Path, tmp_path: Path)
     assert (tmp_path / "bench.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     weldmap = read_map(out)
     assert sorted(s.id for s in weldmap.seams) == ["WEB>PLATE:+x", "WEB>PLATE:-x"]  # red: welded
-    [circle] = weldmap.curved  # the curve: read as a curved seam, listed, not welded
+    [circle] = weldmap.curved  # the curve: read as a curved seam
     assert circle.id == "TUBE>PLATE:circle.1" and circle.kind == "circle" and not weldmap.unsupported
     tube = weldmap.part("TUBE").cylinder  # the STEP's tube, tessellated into the MESH: recognised as round again
     assert tube is not None and abs(tube.radius - 0.03) < 1e-4 and abs(tube.inner_radius - 0.025) < 1e-4

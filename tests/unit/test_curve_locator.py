@@ -189,7 +189,8 @@ def test_other_locators_say_not_supported_and_a_third_part_cuts_the_curve(tmp_pa
 def test_cell_locate_finds_the_circle_in_a_brought_lidar_cloud(tmp_path: Path) -> None:
     """A tube standing on a 400 x 240 plate off its middle, scanned (its round, the plate, the table) at a known
     pose with lidar-like noise (1.2 mm per axis) and written as a binary PLY: ``cell locate`` finds the fillet's
-    circle within 2 mm of the true one, reports it with its sigma, and the run stays partial (no torch path yet)."""
+    circle within 2 mm of the true one, reports it with its sigma, and the run stays partial (a locate plans no
+    weld)."""
     doc = ezdxf.new("R2018", units=4)
     msp = doc.modelspace()
     doc.layers.add("WELD_SEAMS", color=1)

@@ -142,7 +142,7 @@ def _passes(
             pieces = curve_lines(search.robot, replace(pr, travel_speed=speed), search.opt, got)
         except TimingError as exc:
             return _pass(SeamFailure(PlanReason.TIMING, exc.message, X[0][:3, 3].copy(), 0.0), k)
-        singular = _singular(search, pieces, task.length)
+        singular = _singular(search, pieces, task.length) or _outside_limits(search, pieces, task.length)
         if singular is not None:
             return _pass(singular, k)
         off = _off_path(search, pieces, X)
@@ -183,6 +183,26 @@ def _singular(search: SeamSearch, pieces: list[Piece], length: float) -> SeamFai
                 where = f"manipulability {m:.4f} below {search.opt.min_manipulability:g} on the {piece.kind}"
                 p_R = search.robot.fk(q)[:3, 3].copy()
                 return SeamFailure(PlanReason.SINGULAR, where, p_R, 0.0 if piece.kind == "weld" else length)
+    return None
+
+
+def _outside_limits(search: SeamSearch, pieces: list[Piece], length: float) -> SeamFailure | None:
+    """The first sample of the timed approach, weld or depart where a joint leaves its position limits (the safety
+    gate's test), or None; its progress as :func:`_singular`'s. Every IK knot lies within the limits, but the timed
+    spline between two knots of a joint held at its limit can swing past it (tube-tee's saddle from 0.65 m: A3
+    0.04 deg past 158 deg between knots)."""
+    lim = search.robot.limits
+    for piece in pieces:
+        q = piece.trajectory.q
+        out = np.maximum(lim.q_min - q, q - lim.q_max)
+        bad = np.flatnonzero(np.any(out > 1e-9, axis=1))
+        if len(bad):
+            i = int(bad[0])
+            j = int(np.argmax(out[i]))
+            past = math.degrees(float(out[i, j]))
+            where = f"{search.robot.joint_names[j]} {past:.3g} deg past its limit between the knots of the {piece.kind}"
+            p_R = search.robot.fk(q[i])[:3, 3].copy()
+            return SeamFailure(PlanReason.TIMING, where, p_R, 0.0 if piece.kind == "weld" else length)
     return None
 
 

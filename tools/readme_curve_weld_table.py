@@ -67,3 +67,32 @@ def located_table(data: Mapping[str, Any]) -> str:
                 f" | {r['arcs']} | {_tcp(r)} | {prog} | {row['total_s']:.0f} | {why} |"
             )
     return "\n".join(lines) + f"\n\n`{data['command']}` (commit {str(data.get('commit', ''))[:10]})\n"
+
+
+def layout_table(data: Mapping[str, Any]) -> str:
+    """Per round scenario and curved seam, the share the fixed arm welds with its base at each distance (the shipped
+    one marked), and what stops it on the rest (the remainder's codes, or the planner's code when nothing is welded)."""
+    rows = data["rows"]
+    dists = sorted({r["distance_m"] for r in rows}, reverse=True)
+    head = " | ".join(f"{d:.2f} m" + (" (shipped)" if d == data["shipped_m"] else "") for d in dists)
+    lines = [f"| scenario | curved seam | {head} |", "|---|---|" + "---|" * len(dists)]
+    by = {(r["scenario"], r["distance_m"]): r for r in rows}
+    for name in dict.fromkeys(r["scenario"] for r in rows):
+        seams = list(dict.fromkeys(c["seam"] for d in dists for c in by[name, d]["curves"] if (name, d) in by))
+        for sid in seams:
+            cells = []
+            for d in dists:
+                row = by.get((name, d))
+                c = next((c for c in row["curves"] if c["seam"] == sid), None) if row else None
+                if row is not None and row["error"]:
+                    cells.append(f"error: {row['error']}".replace("|", "/"))
+                elif c is None or c["located"] != "found":
+                    cells.append("not located" if c is not None else "-")
+                elif c["welded"]:
+                    cells.append("**100%**")
+                else:
+                    why = ", ".join(c["stops"]) if c["stops"] else (c["code"] or "")
+                    cells.append(f"{c['share']:.0%} ({why})")
+            lines.append(f"| {name} | `{sid}` | " + " | ".join(cells) + " |")
+    commit = str(data.get("commit", ""))[:10]
+    return "\n".join(lines) + f"\n\n`{data['command']}` (commit {commit}, {data['wall_min']} min)\n"

@@ -249,6 +249,7 @@ BLOCKS: Mapping[str, Callable[[Path], str]] = {
         _load_object(results, "curve_weld_located.json")
     ),
     "curve-track": lambda results: curve_weld_tables.located_table(_load_object(results, "curve_track.json")),
+    "layout": lambda results: curve_weld_tables.layout_table(_load_object(results, "layout.json")),
     "positioner": lambda results: positioner_tables.positioner_table(_load_object(results, "positioner.json")),
     "coordinated": lambda results: positioner_tables.coordinated_table(_load_object(results, "coordinated.json")),
 }

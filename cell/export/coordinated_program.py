@@ -31,6 +31,7 @@ from cell.types.robot import Kinematics
 CHORD_TOL_M = 0.0001  # [m] a chord stays this close to every knot it stands for (in the part's frame)
 MAX_TURN_DEG = 10.0  # and the rotate axis turns at most this much along it
 MAX_AXES_DEV_RAD = math.radians(0.5)  # the planned axes this close to the controller's interpolation along a move
+MIN_CIRC_SWEEP_RAD = math.radians(10.0)  # a circle is split into moves down to this angle before chords are taken
 
 
 @dataclass(frozen=True)
@@ -59,15 +60,16 @@ def _axes_dev(cw: CoordinatedWeld, a: int, b: int) -> float:
 
 def coordinated_moves(cw: CoordinatedWeld, woven: bool = True) -> list[CoordMove]:
     """The weld's moves: circular ones when its knots in the part's frame lie on a circle (within
-    :data:`CIRCLE_TOL_M`), each at most :data:`MAX_SWEEP_RAD` and split further until the planned axes stay within
-    :data:`MAX_AXES_DEV_RAD` of the controller's interpolation; else the chords of :func:`chord_knots`. ``woven``
-    False: along the pass's line (the weave left to the controller)."""
+    :data:`CIRCLE_TOL_M`), each at most :data:`MAX_SWEEP_RAD` and split further (into four times as many, or moves
+    of :data:`MIN_CIRC_SWEEP_RAD`, whichever are more) until the planned axes stay within :data:`MAX_AXES_DEV_RAD`
+    of the controller's interpolation; else the chords of :func:`chord_knots`. ``woven`` False: along the pass's
+    line (the weave left to the controller)."""
     p = _knots(cw, woven)
     centre, normal, r, err = fit_circle(p)
     if err <= CIRCLE_TOL_M and r > 0.0:
         ang = np.abs(swept(p, centre, normal))
         k0 = max(1, math.ceil(ang[-1] / MAX_SWEEP_RAD - 1e-9))
-        for k in range(k0, 4 * k0 + 1):
+        for k in range(k0, max(4 * k0, math.floor(ang[-1] / MIN_CIRC_SWEEP_RAD + 1e-9)) + 1):
             cuts = [int(np.argmin(np.abs(ang - ang[-1] * i / k))) for i in range(k + 1)]
             cuts[0], cuts[-1] = 0, len(p) - 1
             moves = []
@@ -75,7 +77,7 @@ def coordinated_moves(cw: CoordinatedWeld, woven: bool = True) -> list[CoordMove
                 m = int(np.argmin(np.abs(ang - 0.5 * (ang[a] + ang[b]))))
                 sweep = float(ang[b] - ang[a])
                 moves.append(CoordMove("CIRC", a, b, m, sweep, centre, r, axes_dev=_axes_dev(cw, a, b)))
-            if all(mv.axes_dev <= MAX_AXES_DEV_RAD and 0 < mv.aux < mv.end for mv in moves):
+            if all(mv.axes_dev <= MAX_AXES_DEV_RAD and mv.start < mv.aux < mv.end for mv in moves):
                 return moves
     knots = chord_knots(cw, woven=woven)
     return [CoordMove("LIN", a, b, chord=_chord(p, a, b), axes_dev=_axes_dev(cw, a, b))

@@ -3,6 +3,7 @@ the axes' motion timed together at the travel speed relative to the part, and th
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from pathlib import Path
@@ -263,6 +264,30 @@ def test_a_seam_that_is_no_circle_in_the_part_is_written_in_chords(planned: tupl
     assert {mv.kind for mv in moves} == {"LIN"} and program_path_off(replace(cw, X_FT=X), moves) <= CHORD_TOL_M
     assert moves[0].start == 0 and moves[-1].end == len(X) - 1
     assert max(mv.axes_dev for mv in moves) < math.radians(0.01)  # the axes turn in step with the chords
+
+
+def test_a_circle_whose_axes_swing_is_split_finer_into_circular_moves_not_chords(planned: tuple) -> None:
+    """tube-tee-positioner's end-plate arcs (210-222 deg, the tilt turning 70 deg): twelve moves, four per 90 deg,
+    left the planned E2/E3 0.63-0.75 deg off the controller's interpolation, so they were written in chords; split
+    into moves down to 10 deg they are circles, each within 0.5 deg. Here the loop's tilt swings 5 deg four times
+    round, which twenty moves cannot follow within 0.5 deg."""
+    from dataclasses import replace
+
+    from cell.export.coordinated_program import MAX_AXES_DEV_RAD, MIN_CIRC_SWEEP_RAD, coordinated_moves
+
+    cw = planned[4]
+    s = np.asarray(cw.s) / float(cw.s[-1])
+    axes = np.array(cw.knot_axes, dtype=float)
+    axes[:, 0] += math.radians(5.0) * np.sin(2.0 * math.pi * 4.0 * s)  # the tilt swinging 5 deg, four times
+    swung = replace(cw, knot_axes=axes)
+    moves = coordinated_moves(swung)
+    assert {mv.kind for mv in moves} == {"CIRC"}, [mv.kind for mv in moves]
+    assert len(moves) > 4 * math.ceil(sum(mv.angle for mv in moves) / math.radians(90.0))  # beyond the old bound
+    assert max(mv.axes_dev for mv in moves) <= MAX_AXES_DEV_RAD
+    assert min(mv.angle for mv in moves) >= 0.9 * MIN_CIRC_SWEEP_RAD
+    assert all(mv.start < mv.aux < mv.end for mv in moves)
+    assert moves[0].start == 0 and moves[-1].end == len(s) - 1
+    assert all(a.end == b.start for a, b in itertools.pairwise(moves))
 
 
 @pytest.fixture(scope="module")

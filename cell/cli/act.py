@@ -38,7 +38,7 @@ from cell.cli.outputs import (
     interrupted_report,
     on_interrupt,
 )
-from cell.cli.tables import print_rescan
+from cell.cli.rescan_table import print_rescan
 from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, UsageError
 
 if TYPE_CHECKING:

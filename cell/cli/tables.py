@@ -26,7 +26,7 @@ if TYPE_CHECKING:
 _LEFT = ("seam", "result", "why not")
 
 
-def _table(title: str, headers: Sequence[str]) -> Table:
+def compact_table(title: str, headers: Sequence[str]) -> Table:
     """A compact table: no vertical rules, the seam id never wrapped (nor cut), numbers to the right."""
     t = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
     for h in headers:
@@ -34,77 +34,11 @@ def _table(title: str, headers: Sequence[str]) -> Table:
     return t
 
 
-def _why_lines(whys: Sequence[tuple[str, str]]) -> None:
+def why_lines(whys: Sequence[tuple[str, str]]) -> None:
     """The reasons in words after the table, one line per seam (wrapped by the terminal, whole in a file)."""
     for sid, why in whys:
         if why:
             out.print(f"  {sid}: {why}", soft_wrap=True, markup=False, highlight=False)
-
-
-RESCAN_LEGEND = "lat, end: lateral and endpoint error [mm], before (0) and after the close-up"
-
-
-def print_rescan(rep: dict) -> None:
-    t = _table(
-        f"re-scan {rep['scenario']} · method {rep['method']} · frame R",
-        ("seam", "lat 0", "lat", "end 0", "end", "weight", "why not"),
-    )
-    whys = []
-    for s in (s for s in rep["seams"] if not s.get("curved")):
-        b, a = s.get("error_mm_before", {}), s.get("error_mm", {})
-        r = s["rescan"]
-        t.add_row(
-            s["id"],
-            _fmt(b.get("lateral")),
-            _fmt(a.get("lateral")),
-            _fmt(b.get("endpoint")),
-            _fmt(a.get("endpoint")),
-            _fmt(r["weight"]),
-            "" if r["used"] else "not used",
-        )
-        whys.append((s["id"], r["reason"]))
-    out.print(t)
-    out.print(RESCAN_LEGEND, soft_wrap=True, markup=False)
-    _why_lines(whys)
-    _curve_rescans(rep)
-    b, a, c = rep["summary_before_rescan"], rep["summary"], rep["rescan"].get("curves") or {}
-    out.print(
-        f"{rep['rescan']['seams']} seams re-scanned ({rep['rescan']['used']} used) · mean lateral"
-        f" {_fmt(b['lateral_mean_mm'], 3)} -> {_fmt(a['lateral_mean_mm'], 3)} mm · mean endpoint"
-        f" {_fmt(b['endpoint_mean_mm'], 3)} -> {_fmt(a['endpoint_mean_mm'], 3)} mm · robot time"
-        f" {_fmt(rep['rescan']['motion_s'], 1)} s"
-        + (f" · {c['seams']} curves re-scanned, {c['within_tolerance']} now within the tolerance" if c else ""),
-        soft_wrap=True,
-    )
-
-
-def _curve_rescans(rep: dict) -> None:
-    """One line per curved seam of a ``cell rescan`` report: its worst sigma and its ends' (or closed) before and
-    after, the close-ups taken and their robot time, its error before and after (simulation); then why it was not
-    re-scanned or is still over the tolerance."""
-    for s in (s for s in rep["seams"] if s.get("curved")):
-        r, c = s["rescan"], s.get("curve")
-        line = f"curve {s['id']}: "
-        if not r["chosen"]:
-            out.print(line + r["reason"], soft_wrap=True, markup=False, highlight=False)
-            continue
-        after = c["sigma_max_mm"] if c is not None else None
-        line += f"sigma max {_fmt(r['sigma_max_mm_before'], 3)} -> {_fmt(after, 3)} mm"
-        if c is not None and c["end_sigma_mm"] is not None:
-            ends = r["end_sigma_mm_before"] or [None, None]
-            line += ", ends +-" + "/".join(map(_fmt, ends)) + " -> " + "/".join(map(_fmt, c["end_sigma_mm"])) + " mm"
-        elif c is not None:
-            line += ", closed"
-        line += f" ({'within' if r['within_tolerance'] else 'over'} the tolerance); {r['views']} close-ups"
-        line += f", {_fmt(r['motion_s'], 1)} s, weight {_fmt(r['weight'])}"
-        if any(r.get("e1_mm") or ()):  # a linear track's carriage moved for them
-            line += ", from E1 = " + "/".join(_fmt(e, 0) for e in r["e1_mm"]) + " mm"
-        b, a = s.get("error_mm_before"), s.get("error_mm")
-        if b is not None or a is not None:
-            b, a = b or {}, a or {}
-            line += f"; error rms {_fmt(b.get('rms'))} -> {_fmt(a.get('rms'))} mm"
-        out.print(line, soft_wrap=True, markup=False, highlight=False)
-        _why_lines([(s["id"], r["reason"])])
 
 
 LOCATED_CURVE_CODE = Unsupported.CURVED_NO_TORCH_PATH.value  # a curved seam located by a run that plans no weld
@@ -141,16 +75,16 @@ def print_curves(rep: Mapping[str, Any]) -> None:
         c, e = s.get("curve"), s.get("error_mm")
         line = f"curved {s['id']}: {s['status']}"
         if c is not None:
-            ends = "closed" if c["closed"] else "ends +-" + "/".join(_fmt(v) for v in c["end_sigma_mm"]) + " mm"
-            line += f", {ends}, sigma max {_fmt(c['sigma_max_mm'])} mm"
+            ends = "closed" if c["closed"] else "ends +-" + "/".join(num(v) for v in c["end_sigma_mm"]) + " mm"
+            line += f", {ends}, sigma max {num(c['sigma_max_mm'])} mm"
         if e is not None:
-            line += f", error rms {_fmt(e['rms'])} / max {_fmt(e['max'])} mm"
+            line += f", error rms {num(e['rms'])} / max {num(e['max'])} mm"
         undone = s.get("not_welded")
         if s.get("remainder"):  # welded in part: its share, then each stretch left for a manual weld
             done = f"partly welded {s['share']:.0%}, {s['manual_mm']:.0f} mm left for a manual weld"
         else:
             done = f"not welded ({undone['code']})" if undone else "welded"
-        line += f", {_fmt(s['time_ms'], 1)} ms; {done}"
+        line += f", {num(s['time_ms'], 1)} ms; {done}"
         out.print(line, soft_wrap=True, markup=False)
         for r in s.get("remainder") or ():
             out.print(f"  manual weld: {remainder_words(r)}", soft_wrap=True, markup=False, highlight=False)
@@ -225,12 +159,12 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
                 "yes" if s["welded"] else "partial" if s.get("remainder") else "planned" if s.get("planned") else "no"
             )
             rows.append(
-                (s["id"], s["status"], _fmt(e.get("paper_me")), _fmt(e.get("lateral")), welded, _fmt(tcp.get("rms")),
-                 _fmt(tcp.get("max")), _fmt(s.get("weld_time_s"), 1), s.get("weld_reason", ""))
+                (s["id"], s["status"], num(e.get("paper_me")), num(e.get("lateral")), welded, num(tcp.get("rms")),
+                 num(tcp.get("max")), num(s.get("weld_time_s"), 1), s.get("weld_reason", ""))
             )  # fmt: skip
         _emit(WELD_COLUMNS, rows, fmt)
         return
-    t = _table(
+    t = compact_table(
         f"{title} {rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
         ("seam", "ME", "lat", "result", "rms", "max", "s"),
     )
@@ -239,18 +173,18 @@ def print_weld(rep: dict, title: str, fmt: TableFormat = "table") -> None:
         e, tcp = s.get("error_mm", {}), s.get("tcp_error_mm", {})
         t.add_row(
             s["id"],
-            _fmt(e.get("paper_me")),
-            _fmt(e.get("lateral")),
+            num(e.get("paper_me")),
+            num(e.get("lateral")),
             _result(s),
-            _fmt(tcp.get("rms")),
-            _fmt(tcp.get("max")),
-            _fmt(s.get("weld_time_s"), 1),
+            num(tcp.get("rms")),
+            num(tcp.get("max")),
+            num(s.get("weld_time_s"), 1),
         )
         if not s["welded"] and s.get("weld_reason_code") != "preview":
             whys.append((s["id"], s.get("weld_reason", "")))
     out.print(t)
     out.print(WELD_LEGEND, soft_wrap=True, markup=False)
-    _why_lines(whys)
+    why_lines(whys)
     print_curves(rep)
     out.print(weld_summary(rep), soft_wrap=True)
     print_timings(rep)
@@ -266,8 +200,8 @@ def weld_summary(rep: Mapping[str, Any]) -> str:
     done = f"planned {sum(bool(s.get('planned')) for s in rep['seams'])}" if preview else f"welded {rep['welded']}"
     return (
         f"{done} of {m['seams']} seams in the map" + (f"; {unsupported}" if unsupported else "")
-        + f" · visible {m['visible']} · located {m['found']} · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm"
-        + f" · cycle time {_fmt(cyc, 1)} s" + ("" if rep["cycle_time_s"] else " (planned)")
+        + f" · visible {m['visible']} · located {m['found']} · paper ME mean {num(m['paper_me_mean_mm'])} mm"
+        + f" · cycle time {num(cyc, 1)} s" + ("" if rep["cycle_time_s"] else " (planned)")
     )  # fmt: skip
 
 
@@ -280,7 +214,8 @@ def print_timings(rep: dict) -> None:
     )
 
 
-def _fmt(v: float | None, nd: int = 2) -> str:
+def num(v: float | None, nd: int = 2) -> str:
+    """``v`` with ``nd`` decimals, or ``-`` where there is none."""
     return "-" if v is None else f"{v:.{nd}f}"
 
 
@@ -301,13 +236,13 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
         e = s.get("error_mm", {})
         found = s["status"] == "found"
         rows.append(
-            (s["id"], s["status"], _fmt(e.get("paper_me")), _fmt(e.get("endpoint")), _fmt(e.get("lateral")),
-             _fmt(s.get("confidence")), _fmt(s["time_ms"], 1) if found else "-", s["reason"])
+            (s["id"], s["status"], num(e.get("paper_me")), num(e.get("endpoint")), num(e.get("lateral")),
+             num(s.get("confidence")), num(s["time_ms"], 1) if found else "-", s["reason"])
         )  # fmt: skip
     if fmt != "table":
         _emit(DETECT_COLUMNS, rows, fmt)
         return
-    t = _table(
+    t = compact_table(
         f"{rep['scenario']} · method {rep['method']} · {_data(rep)} · frame {_frame(rep)}",
         ("seam", "ME", "end", "lat", "conf", "ms", "result"),
     )
@@ -315,16 +250,16 @@ def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
         t.add_row(row[0], *row[2:7], "found" if s["status"] == "found" else str(s.get("reason_code") or s["status"]))
     out.print(t)
     out.print(DETECT_LEGEND, soft_wrap=True, markup=False)
-    _why_lines([(s["id"], s["reason"]) for s in rep["seams"] if s["status"] != "found"])
+    why_lines([(s["id"], s["reason"]) for s in rep["seams"] if s["status"] != "found"])
     print_curves(rep)
     m = rep["summary"]
     unsupported = not_supported_text(m)
     out.print(
         f"found {m['found']}/{m['visible']} visible ({m['seams']} seams in the map"
         + (f"; {unsupported}" if unsupported else "")
-        + f") · paper ME mean {_fmt(m['paper_me_mean_mm'])} mm (p95 {_fmt(m['paper_me_p95_mm'])}) · endpoint"
-        f" {_fmt(m['endpoint_mean_mm'])} mm · lateral"
-        f" {_fmt(m['lateral_mean_mm'])} mm · {_fmt(m['time_ms_per_seam_median'], 1)} ms/seam (median)",
+        + f") · paper ME mean {num(m['paper_me_mean_mm'])} mm (p95 {num(m['paper_me_p95_mm'])}) · endpoint"
+        f" {num(m['endpoint_mean_mm'])} mm · lateral"
+        f" {num(m['lateral_mean_mm'])} mm · {num(m['time_ms_per_seam_median'], 1)} ms/seam (median)",
         soft_wrap=True,
     )
     print_timings(rep)

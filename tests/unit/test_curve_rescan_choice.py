@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from cell.cli.tables import print_rescan
+from cell.cli.rescan_table import print_rescan
 from cell.export.curve_report import add_curve_rescan
 from cell.pipeline import Detection, evaluate
 from cell.pipeline.curved.rescan_all import chosen_curves

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import enum
 import json
 import math
 import sys
@@ -11,35 +10,16 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from cell.errors import CellError
 from cell.export.curve_report import add_curve_rescan, curve_summary, not_welded_entries, weld_reason_code
 from cell.export.procedure_report import procedure_entry, tcp_error_entry
+from cell.export.report_values import error_entry, metrics_entry, point, rounded
+from cell.export.rescan_figures import add_rescan
 from cell.outputs import write_atomic
 from cell.pipeline.records import Detection, WeldRun
-from cell.types import Rescan, SeamMetrics, SeamRecord, SeamStatus, UnsupportedSeam, Violation
+from cell.types import Rescan, SeamRecord, SeamStatus, UnsupportedSeam, Violation
 from cell.types.rescan import PlannedCloseup
 
 REPORT_VERSION = 1
-
-
-def _r(v: float, nd: int = 6) -> float | None:
-    """Round for the report; NaN/inf become null (JSON has no NaN)."""
-    return None if not math.isfinite(v) else round(float(v), nd)
-
-
-def _pt(p: np.ndarray) -> list[float | None]:
-    return [_r(float(x), 7) for x in p]
-
-
-def _errors(m: SeamMetrics) -> dict[str, Any]:
-    return {
-        "paper_me": _r(m.paper_me_mm, 4),
-        "endpoint": _r(m.endpoint_mm, 4),
-        "lateral": _r(m.lateral_mm, 4),
-        "end_along": [_r(v, 4) for v in m.end_along_mm],
-    }
 
 
 def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
@@ -52,16 +32,16 @@ def _seam_entry(rec: SeamRecord) -> dict[str, Any]:
         "reason_code": est.code.value if est.code is not None else None,
     }
     if est.status is SeamStatus.FOUND:
-        entry["detected"] = {"start": _pt(est.p_start), "end": _pt(est.p_end)}
-        entry["confidence"] = _r(est.confidence, 4)
-        entry["sigma_mm"] = _r(est.sigma_m * 1000.0, 4)
-        entry["end_sigma_mm"] = [_r(v * 1000.0, 4) for v in est.end_sigma_m]
+        entry["detected"] = {"start": point(est.p_start), "end": point(est.p_end)}
+        entry["confidence"] = rounded(est.confidence, 4)
+        entry["sigma_mm"] = rounded(est.sigma_m * 1000.0, 4)
+        entry["end_sigma_mm"] = [rounded(v * 1000.0, 4) for v in est.end_sigma_m]
         entry["end_source"] = [k.value for k in est.end_source]
     if rec.truth is not None:  # none when the station knows no truth (real data)
-        entry["truth"] = {"start": _pt(rec.truth[0]), "end": _pt(rec.truth[1])}
+        entry["truth"] = {"start": point(rec.truth[0]), "end": point(rec.truth[1])}
     if rec.metrics is not None:
-        entry["error_mm"] = _errors(rec.metrics)
-    entry["time_ms"] = _r(est.time_s * 1000.0, 3)
+        entry["error_mm"] = metrics_entry(rec.metrics)
+    entry["time_ms"] = rounded(est.time_s * 1000.0, 3)
     return entry
 
 
@@ -96,11 +76,11 @@ def detection_report(
         "curved": curve_summary(det),
         "visible": sum(e.status is not SeamStatus.NOT_VISIBLE for e in det.estimates),
         "found": s.found,
-        "paper_me_mean_mm": _r(s.paper_me_mean_mm, 4),
-        "paper_me_p95_mm": _r(s.paper_me_p95_mm, 4),
-        "endpoint_mean_mm": _r(s.endpoint_mean_mm, 4),
-        "lateral_mean_mm": _r(s.lateral_mean_mm, 4),
-        "time_ms_per_seam_median": _r(s.time_ms_per_seam_median, 3),
+        "paper_me_mean_mm": rounded(s.paper_me_mean_mm, 4),
+        "paper_me_p95_mm": rounded(s.paper_me_p95_mm, 4),
+        "endpoint_mean_mm": rounded(s.endpoint_mean_mm, 4),
+        "lateral_mean_mm": rounded(s.lateral_mean_mm, 4),
+        "time_ms_per_seam_median": rounded(s.time_ms_per_seam_median, 3),
     }
     return {
         "report_version": REPORT_VERSION,
@@ -112,7 +92,7 @@ def detection_report(
         "noise": det.scenario.noise if det.source == "simulation" else None,
         "frame": det.weldmap_R.frame,
         "units": "m",
-        "X_WR": [[_r(v, 9) for v in row] for row in det.scenario.X_WR],
+        "X_WR": [[rounded(v, 9) for v in row] for row in det.scenario.X_WR],
         "lost_cameras": list(det.lost_cameras),
         # Per registered camera: the splice's correction of its calibration, applied or refused and why.
         "splice": det.scene.perceived.splice_corrections() if det.scene is not None else None,
@@ -120,50 +100,11 @@ def detection_report(
         "camera_checks": _camera_checks(det),
         "seams": seams,
         "summary": summary,
-        "timings_s": {k: _r(v, 4) for k, v in det.timings.items()},
-        "error": _error(det.error),
+        "timings_s": {k: rounded(v, 4) for k, v in det.timings.items()},
+        "error": error_entry(det.error),
         # What ran: the whole scenario as resolved (every default filled in, the --method/--noise/--rescan
         # overrides applied), so a report says exactly which configuration produced it.
         "config": det.scenario.model_dump(mode="json"),
-    }
-
-
-def _add_rescan(rep: dict[str, Any], records: Sequence[SeamRecord], first: Detection | None, rs: Rescan | None) -> None:
-    """Before/after figures of the close-up re-scan: per seam ``rescan`` and ``error_mm_before``, and at the top
-    ``rescan`` (counts, robot time) and ``summary_before_rescan``."""
-    if rs is None or first is None:
-        rep["rescan"] = None
-        return
-    by_id = {rec.id: rec for rec in records}
-    for entry in rep["seams"]:
-        rec = by_id.get(entry["id"])  # none for a seam the cell cannot weld
-        r = rec.rescan if rec is not None else None
-        if rec is None or r is None:
-            continue
-        if rec.first_metrics is not None:
-            entry["error_mm_before"] = _errors(rec.first_metrics)
-        entry["rescan"] = {
-            "used": r.used,
-            "weight": _r(r.weight, 3),
-            "reason": r.reason,
-            "confidence_before": _r(r.before.confidence, 4),
-            "view_distance_m": _r(r.viewpoint.distance_m, 4) if r.viewpoint is not None else None,
-            "points": r.points,
-        }
-    s = first.summary
-    rep["summary_before_rescan"] = {
-        "found": s.found,
-        "paper_me_mean_mm": _r(s.paper_me_mean_mm, 4),
-        "endpoint_mean_mm": _r(s.endpoint_mean_mm, 4),
-        "lateral_mean_mm": _r(s.lateral_mean_mm, 4),
-    }
-    rep["rescan"] = {
-        "seams": len(rs.seams),
-        "used": sum(r.used for r in rs.seams),
-        "motion_s": _r(rs.motion_s, 3),
-        "returned_to_scan_pose": rs.returned,
-        "note": rs.note,
-        "escalated_mm": _r(rs.escalated_mm, 3),
     }
 
 
@@ -173,28 +114,12 @@ def _closeup_plan(c: PlannedCloseup) -> dict[str, Any]:
     vp = c.viewpoint
     return {
         "planned": c.planned,
-        "eye": _pt(vp.X_RC[:3, 3]) if vp is not None else None,
-        "distance_mm": _r(vp.distance_m * 1000.0, 1) if vp is not None else None,
-        "incidence_deg": [_r(a, 1) for a in vp.incidence_deg] if vp is not None else None,
+        "eye": point(vp.X_RC[:3, 3]) if vp is not None else None,
+        "distance_mm": rounded(vp.distance_m * 1000.0, 1) if vp is not None else None,
+        "incidence_deg": [rounded(a, 1) for a in vp.incidence_deg] if vp is not None else None,
         "served_by": c.served_by or None,
         "reason": c.reason,
     }
-
-
-def _error(e: CellError | None) -> dict[str, Any] | None:
-    """The failure that stopped a run early (the seams still say why each was not done), or None: its class,
-    message and exit code, and the fields it carries (a code, the figure that decided it, the lost cameras)."""
-    if e is None:
-        return None
-    out: dict[str, Any] = {"type": type(e).__name__, "message": e.message, "exit_code": e.exit_code}
-    for key, value in vars(e).items():
-        if isinstance(value, str | bool | int):  # enum codes are str
-            out[key] = str(value) if isinstance(value, enum.Enum) else value
-        elif isinstance(value, float):
-            out[key] = _r(value, 6)
-        elif isinstance(value, dict) and all(isinstance(v, str) for v in value.values()):
-            out[key] = {str(k): v for k, v in value.items()}
-    return out
 
 
 STDOUT = "-"  # the path that means standard output
@@ -217,11 +142,11 @@ def violation_entry(v: Violation) -> dict[str, Any]:
     return {
         "code": v.kind.value,
         "detail": str(v),
-        "t_s": _r(v.t, 4),
+        "t_s": rounded(v.t, 4),
         "joint": v.joint,
         "seam": v.seam_id,
         "body": v.body,
-        "excess": _r(v.excess, 6),
+        "excess": rounded(v.excess, 6),
     }
 
 
@@ -254,51 +179,51 @@ def weld_report(run: WeldRun, *, provenance: Mapping[str, Any] | None = None) ->
                     "code": c.code.value,
                     "end": c.end,
                     "part": c.part,
-                    "value_mm": _r(c.value_m * 1000.0, 3),
-                    "limit_mm": _r(c.limit_m * 1000.0, 3),
+                    "value_mm": rounded(c.value_m * 1000.0, 3),
+                    "limit_mm": rounded(c.limit_m * 1000.0, 3),
                 }
         o = rec.outcome
         if o is not None and o.feasible:
             entry["torch"] = {
-                "work_angle_deg": _r(math.degrees(o.work_angle), 2),
-                "travel_angle_deg": _r(math.degrees(o.travel_angle), 2),
-                "spin_deg": _r(math.degrees(o.spin), 2),
+                "work_angle_deg": rounded(math.degrees(o.work_angle), 2),
+                "travel_angle_deg": rounded(math.degrees(o.travel_angle), 2),
+                "spin_deg": rounded(math.degrees(o.spin), 2),
                 "reversed": o.reversed,
             }
-            entry["trimmed_mm"] = _r(o.trimmed * 1000.0, 2)  # not welded at the table end (the stand-off)
+            entry["trimmed_mm"] = rounded(o.trimmed * 1000.0, 2)  # not welded at the table end (the stand-off)
         elif o is not None:
             entry["plan_reason_code"] = o.code.value if o.code is not None else None
             if o.p_fail.size == 3:
-                entry["failing_point"] = _pt(o.p_fail)
+                entry["failing_point"] = point(o.p_fail)
         if w.quality is not None:
             q = w.quality
             entry["tcp_error_mm"] = tcp_error_entry(q)
-            entry["weld_time_s"] = _r(q.weld_time_s, 3)
-            entry["travel_speed_mm_s"] = _r(q.speed_mm_s, 4)
+            entry["weld_time_s"] = rounded(q.weld_time_s, 3)
+            entry["travel_speed_mm_s"] = rounded(q.speed_mm_s, 4)
         entry.update(procedure_entry(w))  # the weld procedure it got and the bead per pass
-    _add_rescan(rep, records, run.first_detection, run.rescan)
+    add_rescan(rep, records, run.first_detection, run.rescan)
     planned = {c.seam_id: c for c in run.closeups}
     for entry in rep["seams"]:
         if entry["id"] in planned:
             entry["closeup_plan"] = _closeup_plan(planned[entry["id"]])
     ex = run.execution
     rep["welded"] = sum(w.welded for w in run.seams) + rep["summary"]["curved"]["welded"]
-    rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
+    rep["cycle_time_s"] = rounded(run.cycle_time_s, 3)
     rep["planned_cycle_time_s"] = (
-        _r(plan.cycle_time + (run.pre_move.duration if run.pre_move is not None else 0.0), 3) if plan else None
+        rounded(plan.cycle_time + (run.pre_move.duration if run.pre_move is not None else 0.0), 3) if plan else None
     )
-    rep["arc_time_s"] = _r(ex.arc_time, 3) if ex is not None else None
+    rep["arc_time_s"] = rounded(ex.arc_time, 3) if ex is not None else None
     rep["weld_order"] = list(plan.order) if plan is not None else []
     # How far each axis travels over the plan (A6: the hose package's wind-up), [deg].
     rep["joint_range_deg"] = (
-        {n: [_r(math.degrees(lo), 2), _r(math.degrees(hi), 2)] for n, (lo, hi) in plan.joint_ranges().items()}
+        {n: [rounded(math.degrees(lo), 2), rounded(math.degrees(hi), 2)] for n, (lo, hi) in plan.joint_ranges().items()}
         if plan is not None
         else None
     )
-    rep["events"] = [{"t_s": _r(e.t, 4), "kind": e.kind, "detail": e.detail} for e in ex.events] if ex else []
+    rep["events"] = [{"t_s": rounded(e.t, 4), "kind": e.kind, "detail": e.detail} for e in ex.events] if ex else []
     rep["violations"] = [violation_entry(v) for v in run.violations]
-    rep["error"] = _error(run.error)
-    rep["timings_s"] = {k: _r(v, 4) for k, v in run.timings.items()}
+    rep["error"] = error_entry(run.error)
+    rep["timings_s"] = {k: rounded(v, 4) for k, v in run.timings.items()}
     return rep
 
 
@@ -313,7 +238,7 @@ def rescan_report(
         if rec.id in rescans
     ]
     rep = detection_report(after, records, provenance=provenance, unsupported=False)
-    _add_rescan(rep, records, before, rs)
+    add_rescan(rep, records, before, rs)
     add_curve_rescan(rep, before, after, rs)  # every curved seam: re-scanned, or why not
     return rep
 
@@ -324,10 +249,10 @@ def _camera_checks(det: Detection) -> dict[str, dict[str, Any]] | None:
     return {
         name: {
             "table_pixels": c.pixels,
-            "depth_scale": _r(c.depth_scale, 5),
-            "depth_scale_sigma": _r(c.depth_scale_sigma, 5),
-            "focal_scale": _r(c.focal_scale, 5),
-            "focal_scale_sigma": _r(c.focal_scale_sigma, 5),
+            "depth_scale": rounded(c.depth_scale, 5),
+            "depth_scale_sigma": rounded(c.depth_scale_sigma, 5),
+            "focal_scale": rounded(c.focal_scale, 5),
+            "focal_scale_sigma": rounded(c.focal_scale_sigma, 5),
             "flags": list(c.flags),
         }
         for name, c in det.scene.perceived.sensor_checks.items()

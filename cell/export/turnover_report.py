@@ -7,7 +7,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from cell.export.report import _error, _pt, _r, weld_report
+from cell.export.report import weld_report
+from cell.export.report_values import error_entry, point, rounded
 from cell.pipeline.turnover_run import TurnoverRun
 from cell.types import SeamStatus
 
@@ -42,14 +43,14 @@ def turnover_report(run: TurnoverRun, *, provenance: Mapping[str, Any] | None = 
         seams.append(e)
     rep["seams"] = seams
     rep["welded"] = run.welded
-    rep["cycle_time_s"] = _r(run.cycle_time_s, 3)
-    rep["job_time_s"] = _r(run.job_time_s, 3)
+    rep["cycle_time_s"] = rounded(run.cycle_time_s, 3)
+    rep["job_time_s"] = rounded(run.job_time_s, 3)
     rep["sides"] = sides
     rep["flip"] = _turnover_entry(run)
     if rep["error"] is None and run.side_b is not None and run.side_b.error is not None:
-        rep["error"] = _error(run.side_b.error)
+        rep["error"] = error_entry(run.side_b.error)
     if rep["error"] is None and run.error is not None:
-        rep["error"] = _error(run.error)
+        rep["error"] = error_entry(run.error)
     return rep
 
 
@@ -78,20 +79,20 @@ def _turnover_entry(run: TurnoverRun) -> dict[str, Any] | None:
         "stable": p.stable,
         "reason": p.reason,
         "axis": p.axis,
-        "axis_R": _pt(p.axis_R),
-        "rotation_deg": _r(math.degrees(p.angle_rad), 3),
-        "tilt_deg": _r(math.degrees(p.tilt_rad), 3),
-        "X_RM_after": [[_r(v) for v in row] for row in p.X_RM_after],
+        "axis_R": point(p.axis_R),
+        "rotation_deg": rounded(math.degrees(p.angle_rad), 3),
+        "tilt_deg": rounded(math.degrees(p.tilt_rad), 3),
+        "X_RM_after": [[rounded(v) for v in row] for row in p.X_RM_after],
         "exposed": list(p.exposed),
         "left": dict(p.left),
-        "placement_error_mm": _r(res.offset_m * 1000.0, 3) if res is not None else None,
-        "placement_rotation_deg": _r(math.degrees(res.rotation_rad), 3) if res is not None else None,
-        "fitness": _r(res.fitness, 4) if res is not None else None,
-        "operator_s": _r(run.operator_s, 3),
+        "placement_error_mm": rounded(res.offset_m * 1000.0, 3) if res is not None else None,
+        "placement_rotation_deg": rounded(math.degrees(res.rotation_rad), 3) if res is not None else None,
+        "fitness": rounded(res.fitness, 4) if res is not None else None,
+        "operator_s": rounded(run.operator_s, 3),
         # what a tilt-rotate positioner would take for the same turn, and what it would save of the job
-        "positioner_turn_s": _r(turn_s, 3),
-        "positioner_saves_s": _r(run.operator_s - turn_s, 3) if run.side_b is not None else None,
-        "tacks_s": _r(run.tacks_s, 3),
+        "positioner_turn_s": rounded(turn_s, 3),
+        "positioner_saves_s": rounded(run.operator_s - turn_s, 3) if run.side_b is not None else None,
+        "tacks_s": rounded(run.tacks_s, 3),
         "tacks": [
             {
                 "id": t.id,

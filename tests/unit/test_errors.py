@@ -12,13 +12,13 @@ import pytest
 from cell import errors
 from cell.cli.krl import EXIT_CHECK_FAILED
 from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
-from cell.export.report import _error
+from cell.export.report_values import error_entry
 
 
 def test_an_alignment_failure_carries_its_code_and_figures_into_the_report() -> None:
     e = AlignmentError("fitness 0.496 < 0.500", code=AlignmentFailure.LOW_FITNESS, value=0.4961, needed=0.5)
     assert isinstance(e, RuntimeError) and e.exit_code == 14
-    rep = _error(e)
+    rep = error_entry(e)
     assert rep == {
         "type": "AlignmentError",
         "message": "fitness 0.496 < 0.500",
@@ -31,8 +31,8 @@ def test_an_alignment_failure_carries_its_code_and_figures_into_the_report() -> 
 
 def test_a_sensor_failure_names_every_lost_camera() -> None:
     e = SensorError("no usable camera", lost={"cam_left": "0 valid pixels", "cam_right": "frozen"})
-    assert _error(e)["lost"] == {"cam_left": "0 valid pixels", "cam_right": "frozen"}  # type: ignore[index]
-    assert _error(SensorError("no images"))["lost"] == {}  # type: ignore[index]
+    assert error_entry(e)["lost"] == {"cam_left": "0 valid pixels", "cam_right": "frozen"}  # type: ignore[index]
+    assert error_entry(SensorError("no images"))["lost"] == {}  # type: ignore[index]
 
 
 def test_messages_are_one_line_and_fields_default_to_nan() -> None:
@@ -41,7 +41,7 @@ def test_messages_are_one_line_and_fields_default_to_nan() -> None:
     assert math.isnan(e.value) and math.isnan(e.needed)
     with pytest.raises(TypeError):
         AlignmentError("no code")  # type: ignore[call-arg]
-    assert _error(None) is None and _error(CellError("x"))["exit_code"] == 1  # type: ignore[index]
+    assert error_entry(None) is None and error_entry(CellError("x"))["exit_code"] == 1  # type: ignore[index]
 
 
 def _exit_code_table() -> list[tuple[list[str], int]]:

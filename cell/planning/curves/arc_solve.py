@@ -142,9 +142,9 @@ def _passes(
             pieces = curve_lines(search.robot, replace(pr, travel_speed=speed), search.opt, got)
         except TimingError as exc:
             return _pass(SeamFailure(PlanReason.TIMING, exc.message, X[0][:3, 3].copy(), 0.0), k)
-        singular = _singular(search, pieces, task.length) or _outside_limits(search, pieces, task.length)
-        if singular is not None:
-            return _pass(singular, k)
+        fault = _singular(search, pieces, task.length) or _outside_limits(search, pieces, task.length)
+        if fault is not None:
+            return _pass(fault, k)
         off = _off_path(search, pieces, X)
         if off is not None:
             return _pass(off, k)
@@ -189,8 +189,7 @@ def _singular(search: SeamSearch, pieces: list[Piece], length: float) -> SeamFai
 def _outside_limits(search: SeamSearch, pieces: list[Piece], length: float) -> SeamFailure | None:
     """The first sample of the timed approach, weld or depart where a joint leaves its position limits (the safety
     gate's test), or None; its progress as :func:`_singular`'s. Every IK knot lies within the limits, but the timed
-    spline between two knots of a joint held at its limit can swing past it (tube-tee's saddle from 0.65 m: A3
-    0.04 deg past 158 deg between knots)."""
+    spline between two knots of a joint held at its limit can swing past it (docs/curves-welding.md section 10)."""
     lim = search.robot.limits
     for piece in pieces:
         q = piece.trajectory.q

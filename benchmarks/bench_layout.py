@@ -52,6 +52,7 @@ def run_one(name: str, distance_m: float) -> dict[str, Any]:
     manual weld, each stretch's code) or not (the planner's code); the straight seams welded; the run's time."""
     from cell.pipeline.job import WeldJob
     from cell.pipeline.weld import weld
+    from cell.types import SeamStatus
 
     t0 = time.perf_counter()
     run = weld(moved(name, distance_m), WeldJob(sides="first"))
@@ -70,6 +71,7 @@ def run_one(name: str, distance_m: float) -> dict[str, Any]:
                 "manual_mm": round(w.manual_m * 1000.0, 1) if w is not None and w.partial else None,
                 "stops": sorted({r.code.value for r in w.remainder}) if w is not None and w.partial else [],
                 "code": None if w is None or w.welded else str(w.plan_code or w.code),
+                "reason": c.reason if c.status is not SeamStatus.FOUND else None,  # why not located
             }
         )
     return {

@@ -6,13 +6,13 @@
     .venv/bin/python benchmarks/bench_cell.py faults [--scenarios faults/NAME,...] [--json PATH]
 
 ``weld`` runs what ``cell weld SCENARIO`` runs, the whole part (:func:`cell.pipeline.turnover.weld_part`: side A, the
-turn, side B; its report :func:`cell.export.turnover_report.turnover_report`) and keeps per seam its side, the located
-error, welded or why not, the executed TCP against the true seam, the travel speed and the weld time; per run the
-cycle, arc and re-scan robot times, the job time, the turn and what side B's alignment measured, and the wall time
-of each stage (default ``benchmarks/results/weld.json``). ``faults`` welds side A only (``cell weld --sides first``):
-a fault's table is about what the fault does to the part as it lies. ``rescan`` runs what
+turn, side B; its report :func:`cell.export.reports.turnover_report.turnover_report`) and keeps per seam its side, the
+located error, welded or why not, the executed TCP against the true seam, the travel speed and the weld time; per run
+the cycle, arc and re-scan robot times, the job time, the turn and what side B's alignment measured, and the wall time
+of each stage (default ``benchmarks/results/weld.json``). ``faults`` welds side A only (``cell weld --sides first``): a
+fault's table is about what the fault does to the part as it lies. ``rescan`` runs what
 ``cell rescan SCENARIO --all`` runs (detect, :func:`cell.pipeline.rescan_detection` on every visible seam, its report
-:func:`cell.export.report.rescan_report`): the mean lateral and end point error before and after, the robot time
+:func:`cell.export.reports.report.rescan_report`): the mean lateral and end point error before and after, the robot time
 (``rescan.json``). ``faults`` runs ``cell weld`` on every scenario of ``scenarios/faults/`` and keeps what the
 fault table of docs/results.md quotes: welded count, the worst executed TCP error, the exit code the CLI gives, the lost
 cameras with their reason, the seams re-scanned (and whether a close-up escalated to every seam), the seams not
@@ -33,7 +33,7 @@ from typing import Any
 from cell import pipeline
 from cell import scenario as sc
 from cell.errors import EXIT_OK, EXIT_PARTIAL, CellError
-from cell.export.report import rescan_report, weld_report, write_json
+from cell.export.reports.report import rescan_report, weld_report, write_json
 from cell.pipeline.geometry import open_cell
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -93,7 +93,7 @@ def weld_row(name: str) -> Row:
 
 def part_row(name: str) -> Row:
     """``cell weld NAME`` (both sides): the whole part's figures from its report, with the turn's."""
-    from cell.export.turnover_report import turnover_report
+    from cell.export.reports.turnover_report import turnover_report
     from cell.pipeline.turnover import weld_part
 
     _say(f"cell weld {name}")

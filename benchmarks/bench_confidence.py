@@ -23,7 +23,7 @@ from scipy.stats import spearmanr
 from cell import pipeline
 from cell import scenario as sc
 from cell.config.rescan import CONFIDENCE_THRESHOLD
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 
 RESULTS = Path(__file__).resolve().parent / "results"
 THRESHOLDS = (0.45, 0.5, CONFIDENCE_THRESHOLD, 0.6, 0.65)

@@ -63,7 +63,7 @@ def _in_part(run: Any) -> list[dict[str, Any]]:
     the turning base, the knots' distance from them, E2/E3 against the controller's interpolation) and what is
     left for a manual weld (each stretch, its code and why)."""
     from cell.export.coordinated_program import coordinated_moves, program_path_off
-    from cell.export.positioner_report import coordinated_entry
+    from cell.export.reports.positioner_report import coordinated_entry
 
     welds, out = run.welds(), []
     for cw in run.coordinated:
@@ -94,7 +94,7 @@ def _arc_row(cw: Any, q: Any) -> dict[str, Any]:
     seam's over all its arcs): its stretch along the located curve [mm], its TCP against the true curve, its times
     and its program's moves."""
     from cell.export.coordinated_program import coordinated_moves, program_path_off
-    from cell.export.positioner_report import coordinated_entry
+    from cell.export.reports.positioner_report import coordinated_entry
 
     e, moves = coordinated_entry(cw), coordinated_moves(cw)
     return {"span_mm": e["span_mm"], "tcp_rms_mm": round(q.tcp_rms_mm, 3), "tcp_max_mm": round(q.tcp_max_mm, 3),
@@ -111,7 +111,7 @@ def coordinated_row(
     when the gate refuses); ``program``: a folder for its KRL program (``krl/``) and RAPID module (``rapid/``)."""
     from cell import scenario as sc
     from cell.export.coordinated_program import coordinated_moves, program_path_off
-    from cell.export.positioner_report import coordinated_entry
+    from cell.export.reports.positioner_report import coordinated_entry
     from cell.pipeline.coordinated import weld_curves_coordinated
     from cell.pipeline.curved.welds import curve_doubt
     from cell.pipeline.detect import detect, read_weldmap

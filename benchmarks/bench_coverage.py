@@ -28,7 +28,7 @@ from cell import pipeline
 from cell import scenario as sc
 from cell.config.seams import OursSettings
 from cell.errors import CellError
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.seams.registry import METHODS
 
 RESULTS = Path(__file__).resolve().parent / "results"

@@ -31,7 +31,7 @@ import trust_cells as tc  # noqa: E402
 
 from cell import scenario as sc  # noqa: E402
 from cell.errors import CellError  # noqa: E402
-from cell.export.report import write_json  # noqa: E402
+from cell.export.reports.report import write_json  # noqa: E402
 from cell.provenance import git_commit  # noqa: E402
 from cell.types import SeamStatus  # noqa: E402
 

@@ -35,7 +35,7 @@ import numpy as np
 from cell import pipeline
 from cell import scenario as sc
 from cell.errors import CellError
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.pipeline.evaluation import curve_truths
 from cell.provenance import git_commit
 from cell.seams.curved import locate_curves

@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle_bound import Breakdown, best_tour, breakdown, nodes, with_track
 
 from cell import scenario as sc
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 
 RESULTS = Path(__file__).resolve().parent / "results"
 SCENARIOS = ("fence1", "fence2", "ladder", "brace", "bracket", "fence1-wps")
@@ -103,7 +103,7 @@ _SUMMED = (
 
 def bench(name: str) -> Row:
     """One scenario's row: both sides summed, each side's own figures under ``sides``."""
-    from cell.export.turnover_report import turnover_report
+    from cell.export.reports.turnover_report import turnover_report
     from cell.pipeline.turnover import weld_part
 
     _say(f"cell weld {name}")

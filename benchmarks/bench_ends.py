@@ -28,7 +28,7 @@ from bench_coverage import FAULTS  # the same fault scenarios as the sigma acros
 from cell import pipeline
 from cell import scenario as sc
 from cell.errors import CellError
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.geometry import point_line_distance
 from cell.seams.metrics import end_errors_along
 

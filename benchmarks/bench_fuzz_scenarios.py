@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
 
 import scenario_fuzz as fuzz
 
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 
 RESULTS = Path(__file__).resolve().parent / "results"
 

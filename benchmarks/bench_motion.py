@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from cell.errors import IKError
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.geometry import FloatArray, make_pose, rot_y, rot_z
 from cell.motion.ik import solve_ik, solve_path
 from cell.motion.robot import RobotModel

@@ -25,7 +25,7 @@ from typing import Any
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.pipeline.detect import read_weldmap
 from cell.pipeline.geometry import motion_scene, open_cell
 from cell.pipeline.weld import plan_for

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from cell import scenario as sc
-from cell.export.positioner_report import positioner_report
+from cell.export.reports.positioner_report import positioner_report
 
 RESULTS = Path(__file__).resolve().parent / "results"
 

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.geometry import FloatArray, invert, make_pose, rpy_to_matrix, transform_points
 from cell.pipeline import locate_cloud
 from cell.types import Cloud, SeamStatus

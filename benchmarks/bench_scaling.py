@@ -44,7 +44,7 @@ from typing import Any
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.geometry import invert
 from cell.perception import align_map, check_alignment, check_alignment_unique, check_parts_seen, perceive
 from cell.perception.preprocess import downsample

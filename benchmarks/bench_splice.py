@@ -23,7 +23,7 @@ from typing import Any
 from cell import pipeline
 from cell import scenario as sc
 from cell.bench import Extrinsics, with_extrinsics
-from cell.export.report import write_json
+from cell.export.reports.report import write_json
 from cell.perception import perceive
 from cell.pipeline.detect import pose_uncertainties
 from cell.scenario import CalibrationSpec

@@ -43,7 +43,7 @@ import trust_cells as tc  # noqa: E402
 
 from cell import pipeline  # noqa: E402
 from cell import scenario as sc  # noqa: E402
-from cell.export.report import write_json  # noqa: E402
+from cell.export.reports.report import write_json  # noqa: E402
 from cell.geometry import FloatArray, invert, transform_points  # noqa: E402
 from cell.perception import perceive  # noqa: E402
 from cell.perception.deproject import clouds_in_robot_frame  # noqa: E402

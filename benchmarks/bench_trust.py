@@ -37,7 +37,7 @@ import trust_cells as tc  # noqa: E402  (after the path set-up above)
 import trust_metrics as tm  # noqa: E402
 
 from cell.errors import UsageError  # noqa: E402
-from cell.export.report import write_json  # noqa: E402
+from cell.export.reports.report import write_json  # noqa: E402
 from cell.provenance import git_commit  # noqa: E402
 from cell.sweep.store import RUNS, RunStore, dumps, open_store, params_key  # noqa: E402
 

@@ -1,11 +1,12 @@
 """One cell of the trust benchmark: made from its seed, run headless to its stage, reduced to its stored line.
 
 A cell is a random cell of ``tools/random_cells.py`` (``make_cell(seed, out_dir, kind)``: map, scenario and truth
-written to ``out_dir``), or, with ``scenarios``, a public scenario run with the cell's seed (new sensor noise and,
-where the scenario has them, new as-built deviations and calibration errors). ``detect`` runs what ``cell detect
---json`` runs (:func:`cell.pipeline.detect`, :func:`cell.export.report.detection_report`); ``weld`` what ``cell weld
---sides first --json`` runs (:func:`cell.pipeline.weld`, :func:`cell.export.report.weld_report`): the part as it
-lies. Every figure is read from that report (:mod:`trust_metrics`). A cell never raises: a failure is its line's
+written to ``out_dir``), or, with ``scenarios``, a public scenario run with the cell's seed (new sensor noise and, where
+the scenario has them, new as-built deviations and calibration errors). ``detect`` runs what ``cell detect --json`` runs
+(:func:`cell.pipeline.detect`, :func:`cell.export.reports.report.detection_report`); ``weld`` what
+``cell weld --sides first --json`` runs (:func:`cell.pipeline.weld`, :func:`cell.export.reports.report.weld_report`):
+the part as it lies.
+Every figure is read from that report (:mod:`trust_metrics`). A cell never raises: a failure is its line's
 ``error``.
 """
 
@@ -86,7 +87,7 @@ def report_of(job: CellJob, scenario: Any) -> dict[str, Any]:
     """Run ``scenario`` to ``job.stage`` and return the report the CLI's ``--json`` writes (a CellError that
     stops the run before any report propagates)."""
     from cell import pipeline
-    from cell.export.report import detection_report, weld_report
+    from cell.export.reports.report import detection_report, weld_report
 
     if job.stage == "detect":
         return detection_report(pipeline.detect(scenario, job.method))
@@ -98,7 +99,7 @@ def run_cell(job: CellJob) -> dict[str, Any]:
     The line: ``run`` (= ``cell``), the cell's seed and scenario, :func:`trust_metrics.cell_record` of its report,
     ``error`` (None, or the type, message and exit code of what stopped it before a report), ``make_s`` and
     ``wall_s``. The report itself is written to the cell's folder (``report-<stage>.json``)."""
-    from cell.export.report import write_json
+    from cell.export.reports.report import write_json
     from cell.provenance import git_commit
     from cell.sweep.task import error_json
 

@@ -1,5 +1,5 @@
 """The trust benchmark's figures for curved seams (a tube's fillet on a plate, a saddle), read from the report's
-curved entries (``"curved": true``, :mod:`cell.export.curve_report`) as a plain dict.
+curved entries (``"curved": true``, :mod:`cell.export.reports.curve_report`) as a plain dict.
 
 Per curved seam (:func:`curve_record`): what became of it; for a located one its error against the true curve over
 its length (RMS and max) and the share of its samples within two of their own sigmas, as the report states them;

@@ -1,5 +1,5 @@
 """The trust benchmark's figures, read from the pipeline's JSON report (``cell detect --json`` / ``cell weld --json``,
-:mod:`cell.export.report`) as a plain dict, so every key the report gains plugs in.
+:mod:`cell.export.reports.report`) as a plain dict, so every key the report gains plugs in.
 
 Per seam (:func:`seam_record`): what became of it, its lateral error and each end's error along the seam against
 the truth, each as a multiple of the sigma the report states for it. Per cell (:func:`cell_record`): the seams'

@@ -38,7 +38,7 @@ from cell.cli.outputs import (
     interrupted_report,
     on_interrupt,
 )
-from cell.cli.rescan_table import print_rescan
+from cell.cli.printout.rescan_table import print_rescan
 from cell.errors import EXIT_INTERRUPTED, EXIT_PARTIAL, EXIT_USAGE, UsageError
 
 if TYPE_CHECKING:
@@ -213,7 +213,7 @@ def rescan_cmd(
     The same re-scan as ``cell weld`` (its selection and its escalation when a close-up disagrees), curves too.
     """
     from cell import pipeline
-    from cell.export.report import detection_report, rescan_report
+    from cell.export.reports.report import detection_report, rescan_report
     from cell.pipeline.curved.rescan_all import rescan_all
     from cell.pipeline.geometry import open_cell
 

@@ -88,7 +88,7 @@ def joined(log: JobLog | None, on_b: bool) -> Callable[[dict[str, Any]], dict[st
         return None
 
     def amend(rep: dict[str, Any]) -> dict[str, Any]:
-        from cell.export.journal_report import joined_report
+        from cell.export.reports.journal_report import joined_report
 
         state = log.reread()
         return joined_report(rep, state, log.run, on_b=on_b) if state is not None else rep
@@ -156,7 +156,7 @@ def stopped(
 ) -> int:
     """A job stopped on the way (a signal, an exception): the journal's ``end``, the report built from it (every
     stage and weld it holds), the last line; returns the exit code (128 + the signal; 1 for an exception)."""
-    from cell.export.journal_report import stopped_job_report
+    from cell.export.reports.journal_report import stopped_job_report
 
     if isinstance(e, Interrupted):
         code, why = e.exit_code, f"interrupted ({e.name})"

@@ -28,9 +28,9 @@ from cell.cli.common import (
     say,
     was_interrupted,
 )
-from cell.cli.explain import detection_exit
 from cell.cli.outputs import Stage, Writer, check_file, finish, on_interrupt, stopped_report
 from cell.cli.placement import PlaceOpt, PlaceRpyOpt, placement
+from cell.cli.printout.explain import detection_exit
 from cell.errors import EXIT_INTERRUPTED, UsageError
 from cell.geometry import FloatArray
 
@@ -80,7 +80,7 @@ def locate(
     global registration. A cloud with no table in it (cropped above it, a part on a fixture) is recognised, or
     said so with --no-table or --table-z. Exit 3 when a seam that can be seen was not found (the report says why).
     """
-    from cell.export.report import detection_report
+    from cell.export.reports.report import detection_report
     from cell.perception.cloud_files import check_frame, check_units, read_cloud
     from cell.pipeline.cloud import locate_cloud
     from cell.provenance import provenance
@@ -226,7 +226,7 @@ def print_located(rep: dict[str, Any], fmt: str) -> None:
     report's frame [mm]."""
     from rich.table import Table
 
-    from cell.cli.tables import print_detection
+    from cell.cli.printout.tables import print_detection
 
     table_fmt = parse_format(fmt)
     print_detection(rep, table_fmt)

@@ -28,10 +28,10 @@ from cell.cli.common import (
     warn,
     was_interrupted,
 )
-from cell.cli.explain import detection_exit
 from cell.cli.outputs import Stage, Writer, check_file, check_folder, finish, interrupted_report, on_interrupt
 from cell.cli.placement import PlaceOpt, PlaceRpyOpt
-from cell.cli.tables import print_detection
+from cell.cli.printout.explain import detection_exit
+from cell.cli.printout.tables import print_detection
 from cell.errors import EXIT_INTERRUPTED, UsageError
 
 if TYPE_CHECKING:
@@ -110,7 +110,7 @@ def detect(
     """
     from cell import pipeline
     from cell import scenario as sc
-    from cell.export.report import detection_report
+    from cell.export.reports.report import detection_report
     from cell.provenance import provenance
 
     with cell_errors():

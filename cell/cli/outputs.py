@@ -143,7 +143,7 @@ class Writer:
         """Write the JSON report (stdout for ``-``), if one was asked for."""
         if path is None:
             return
-        from cell.export.report import write_json
+        from cell.export.reports.report import write_json
 
         if self.attempt(lambda: write_json(path, report)) is not None and str(path) != STDOUT:
             say(f"report written to {path}")
@@ -197,7 +197,7 @@ def stopped_report(
 ) -> dict[str, Any]:
     """The keys of every interrupted report (a scenario run's, or ``cell locate``'s without a scenario: no noise,
     no config, the cloud's frame)."""
-    from cell.export.report import REPORT_VERSION
+    from cell.export.reports.report import REPORT_VERSION
 
     return {
         "report_version": REPORT_VERSION,

@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from cell.cli.common import TableFormat, fail_line, say
-from cell.cli.explain import weld_exit
 from cell.cli.outputs import Stage, Writer, check_file, interrupted_report, on_interrupt
-from cell.cli.tables import print_weld
+from cell.cli.printout.explain import weld_exit
+from cell.cli.printout.tables import print_weld
 from cell.errors import EXIT_INTERRUPTED, UsageError
 from cell.pipeline.job import Sides
 
@@ -54,8 +54,8 @@ def finish_turnover(
     """Write the report first, then the programs; print the table and one line per side; the exit's explanation
     when the job is partial (None when complete). amend : the report joined with the job's journal (a resume:
     the seams earlier runs welded)."""
-    from cell.export.curve_report import write_manual_welds
-    from cell.export.turnover_report import turnover_report
+    from cell.export.reports.curve_report import write_manual_welds
+    from cell.export.reports.turnover_report import turnover_report
     from cell.preview.welder_sheet import write_welder_sheet
 
     rep = turnover_report(run, provenance=provenance)
@@ -207,7 +207,7 @@ def interrupted(
     json_path: Path | None,
 ) -> None:
     """Ctrl-C: the run's report if the pipeline returned, else what ran and where it stopped; exit 130."""
-    from cell.export.report import weld_report
+    from cell.export.reports.report import weld_report
 
     rep = weld_report(run, provenance=prov) if run is not None else interrupted_report(scn, method, stage.last, prov)
     on_interrupt(writer, json_path, rep, stage.last)

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from cell.export.curve_report import remainder_entry, remainder_words
+from cell.export.reports.curve_report import remainder_entry, remainder_words
 from cell.geometry import FloatArray
 from cell.preview.views import MM, STATUS_COLOURS
 from cell.types import SeamStatus

@@ -3,7 +3,7 @@ weld drawn along its located curve and numbered as the rows of the welder's list
 and an elevation, each row's words below them.
 
 matplotlib is imported inside the functions (through :mod:`cell.preview.figures`). Values only: the run records
-and the report's entries (:func:`cell.export.curve_report.remainder_entry`); drawn in millimetres in the aligned
+and the report's entries (:func:`cell.export.reports.curve_report.remainder_entry`); drawn in millimetres in the aligned
 map's frame M, as the welder reads the drawing.
 """
 
@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from cell.export.curve_report import remainder_words
+from cell.export.reports.curve_report import remainder_words
 from cell.geometry import FloatArray, invert, transform_points
 from cell.preview.curves3d import MANUAL_COLOUR, stretch_R
 from cell.preview.figures import new_figure, save_figure

@@ -15,7 +15,7 @@ import pytest
 from cell import pipeline
 from cell import scenario as sc
 from cell.cli.capture import write_simulated
-from cell.export.report import detection_report
+from cell.export.reports.report import detection_report
 from cell.recorded import read_capture
 from cell.recorded.cell_file import replay_scenario
 from cell.station.recorded import RecordedStation

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from round_post import SEAM, seen_scenario
 
-from cell.export.report import weld_report
+from cell.export.reports.report import weld_report
 from cell.pipeline.job import WeldJob
 from cell.pipeline.weld import weld
 

@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 from cell import pipeline
 from cell import scenario as sc
 from cell.cli import app
-from cell.export.report import weld_report
+from cell.export.reports.report import weld_report
 from cell.pipeline.job import WeldJob
 from cell.scenario.init import scenario_text
 

@@ -16,7 +16,7 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.export.report import weld_report
+from cell.export.reports.report import weld_report
 from cell.geometry import make_pose
 from cell.types import Box, Part, PlanReason, SeamStatus, WeldReason
 

@@ -27,7 +27,7 @@ def test_a_scenario_option_reaches_its_stage_and_the_report_records_it() -> None
     """Through pipeline.detect: the seam screen's threshold, built from its defaults before the scenario held it,
     turns every found seam into LOW_CONFIDENCE; the report's config is the scenario as resolved."""
     from cell import pipeline
-    from cell.export.report import detection_report
+    from cell.export.reports.report import detection_report
     from cell.types import Reason, SeamStatus
 
     s = load_text(with_keys("locator: {method: ours, options: {target_se_m: 0.0003}}"))
@@ -49,7 +49,7 @@ def test_a_gate_option_reaches_the_safety_gate(
     before the scenario held it, refuse the plan for singularities. The gate's option changes nothing before the
     plan: the session's detection of fence1 stands in for the weld's own (handed on with the scenario it was given)."""
     from cell.errors import PlanError
-    from cell.export.report import weld_report
+    from cell.export.reports.report import weld_report
     from cell.gate import GateRefusedError, ViolationKind
 
     scn = load_text(with_keys("motion: {gate: {min_manipulability: 1.0}}"))

@@ -20,7 +20,7 @@ import pytest
 from cell import pipeline
 from cell import scenario as sc
 from cell.export.krl import krl_program
-from cell.export.turnover_report import turnover_report
+from cell.export.reports.turnover_report import turnover_report
 from cell.pipeline.geometry import open_cell
 from cell.pipeline.tacks import Tack, is_tack
 from cell.pipeline.turnover import tack_rule, weld_part

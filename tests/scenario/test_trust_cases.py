@@ -29,7 +29,7 @@ from tools_loader import load_tool
 from cell import pipeline
 from cell import scenario as sc
 from cell.export import detection_report
-from cell.export.report import weld_report
+from cell.export.reports.report import weld_report
 from cell.rescan import seams_to_rescan
 from cell.scenario import Scenario
 from cell.types import EndSource, LastCheck, SeamEstimate, SeamStatus, WeldReason

@@ -19,7 +19,7 @@ import pytest
 from cell import scenario as sc
 from cell.cli.turnover import write_programs
 from cell.errors import AlignmentError, AlignmentFailure
-from cell.export.turnover_report import turnover_report
+from cell.export.reports.turnover_report import turnover_report
 from cell.geometry import invert
 from cell.perception.align.near_pose import near_seed
 from cell.pipeline import Detection

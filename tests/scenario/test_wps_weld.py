@@ -11,7 +11,7 @@ import pytest
 
 from cell import pipeline
 from cell import scenario as sc
-from cell.export.procedure_report import procedure_entry
+from cell.export.reports.procedure_report import procedure_entry
 from cell.geometry import invert, point_line_distance, transform_points
 from cell.pipeline.gated import plan_for
 from cell.pipeline.outcomes import seam_welds

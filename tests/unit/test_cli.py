@@ -238,7 +238,7 @@ def test_reports_are_written_whole_with_the_umask_permissions(
     import os
 
     from cell.errors import OutputError
-    from cell.export.report import write_json
+    from cell.export.reports.report import write_json
 
     with pytest.raises(OutputError) as e:
         write_json(tmp_path / "sub" / "r.json", {})  # a missing folder is not made
@@ -260,7 +260,7 @@ def test_reports_are_written_whole_with_the_umask_permissions(
 
 
 def test_the_exit_line_names_lost_cameras_and_undone_seams() -> None:
-    from cell.cli.explain import detection_exit, weld_exit
+    from cell.cli.printout.explain import detection_exit, weld_exit
 
     seams = [
         {"status": "found", "reason_code": None, "welded": True, "planned": True},
@@ -285,7 +285,7 @@ def test_the_exit_line_names_lost_cameras_and_undone_seams() -> None:
 
 
 def test_the_exit_line_of_a_run_that_welded_everything_or_only_planned() -> None:
-    from cell.cli.explain import weld_exit
+    from cell.cli.printout.explain import weld_exit
 
     welded = {"status": "found", "welded": True, "planned": True}
     rep = {"seams": [welded] * 2, "lost_cameras": ["cam_left: dead"], "error": None, "welded": 2}

@@ -111,8 +111,8 @@ def replace_id(o: SeamOutcome, sid: str) -> SeamOutcome:
 
 
 def test_a_partial_curve_is_said_apart_in_the_outcome_the_exit_line_and_the_tables() -> None:
-    from cell.cli.explain import weld_exit
-    from cell.cli.tables import not_supported_text
+    from cell.cli.printout.explain import weld_exit
+    from cell.cli.printout.tables import not_supported_text
     from cell.planning.curves import in_part
 
     rest = (
@@ -159,7 +159,7 @@ def test_on_a_track_a_curve_no_carriage_position_welds_whole_is_welded_in_part_f
 
 def test_a_partial_curve_in_the_report_and_the_programs_header() -> None:
     from cell.cli.turnover import not_welded
-    from cell.export.curve_report import weld_entry
+    from cell.export.reports.curve_report import weld_entry
     from cell.types.run import SeamWeld, WeldReason
 
     rest = (Remainder(0.161, 0.179, PlanReason.IK_FAILED, "no torch setting holds 7 mm of it"),)
@@ -185,8 +185,8 @@ def test_the_welders_list_gives_each_stretch_where_it_lies_on_the_drawing(
     pose undone); the list beside the programs has one row per stretch, none when no curve is welded in part."""
     import csv
 
-    from cell.cli.tables import print_curves
-    from cell.export.curve_report import MANUAL_WELDS, weld_entry, write_manual_welds
+    from cell.cli.printout.tables import print_curves
+    from cell.export.reports.curve_report import MANUAL_WELDS, weld_entry, write_manual_welds
     from cell.geometry import invert, make_pose
     from cell.types import SeamStatus
     from cell.types.curve_estimate import CurveEstimate

@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from cell.cli.rescan_table import print_rescan
-from cell.export.curve_report import add_curve_rescan
+from cell.cli.printout.rescan_table import print_rescan
+from cell.export.reports.curve_report import add_curve_rescan
 from cell.pipeline import Detection, evaluate
 from cell.pipeline.curved.rescan_all import chosen_curves
 from cell.types import Reason, SeamStatus, WeldMap

@@ -12,7 +12,7 @@ import pytest
 from cell import errors
 from cell.cli.krl import EXIT_CHECK_FAILED
 from cell.errors import AlignmentError, AlignmentFailure, CellError, SensorError
-from cell.export.report_values import error_entry
+from cell.export.reports.report_values import error_entry
 
 
 def test_an_alignment_failure_carries_its_code_and_figures_into_the_report() -> None:

@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from cell.errors import EXIT_HANGUP, EXIT_INTERRUPTED, EXIT_TERMINATED, JournalError, JournalFault
-from cell.export.journal_report import joined_report, stopped_job_report
+from cell.export.reports.journal_report import joined_report, stopped_job_report
 from cell.journal import Interrupted, JournalWriter, deferred, read_journal, stop_on_signals
 from cell.journal.writer import _parse_hook
 

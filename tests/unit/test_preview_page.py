@@ -243,7 +243,7 @@ def test_the_page_marks_the_stretches_left_for_a_manual_weld_on_their_located_cu
     """A curve welded in part is drawn with its remainder dashed over it, each stretch from its start to its end
     along the located curve (one passing the closed curve's start), hovering the console's words; a curve not
     welded goes in its own trace; with the map's pose, the stretch's ends on the drawing."""
-    from cell.export.curve_report import remainder_entry, remainder_words
+    from cell.export.reports.curve_report import remainder_entry, remainder_words
     from cell.geometry import invert
     from cell.preview.curves3d import curve_traces
     from cell.types.plan import PlanReason, Remainder

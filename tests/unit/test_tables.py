@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from cell.cli.tables import not_supported_text, weld_summary
+from cell.cli.printout.tables import not_supported_text, weld_summary
 
 
 def _report(codes: list[str | None], welded: list[bool], unsupported: dict[str, int]) -> dict[str, Any]:

@@ -47,7 +47,7 @@ def weld_positioned(
     counted). ``unused``: the options given that a positioner job has no use for (refused, with ``--sides
     first``). ``html``: the job's page (:meth:`PositionerRun.as_weld_run`: results, the cloud and the map at home,
     the curves and their stretches left for a manual weld; no robot or joint plots: the part moves between poses)."""
-    from cell.export.positioner_report import positioner_report
+    from cell.export.reports.positioner_report import positioner_report
     from cell.pipeline.positioned import weld_on_positioner
 
     refuse_options(sc.name, {**unused, "--sides first": job.sides == "first" or None})
@@ -57,7 +57,7 @@ def weld_positioned(
     rep = {**positioner_report(run), "provenance": dict(prov)}
     writer.report(json_path, rep)
     if program is not None and job.execute:
-        from cell.export.curve_report import write_manual_welds
+        from cell.export.reports.curve_report import write_manual_welds
         from cell.preview.welder_sheet import write_welder_sheet
 
         written = writer.attempt(lambda: [*_programs(sc, run, program, controller), *write_manual_welds(rep, program)])

@@ -1,6 +1,6 @@
 """The weld report's procedure part: per seam, the weld procedure it got and the bead each pass laid.
 
-Read by :func:`cell.export.report.weld_report` (values only: a :class:`~cell.types.run.SeamWeld`). Units as a
+Read by :func:`cell.export.reports.report.weld_report` (values only: a :class:`~cell.types.run.SeamWeld`). Units as a
 WPS states them: millimetres, seconds, amperes, volts, metres per minute.
 """
 

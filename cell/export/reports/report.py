@@ -10,10 +10,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from cell.export.curve_report import add_curve_rescan, curve_summary, not_welded_entries, weld_reason_code
-from cell.export.procedure_report import procedure_entry, tcp_error_entry
-from cell.export.report_values import error_entry, metrics_entry, point, rounded
-from cell.export.rescan_figures import add_rescan
+from cell.export.reports.curve_report import add_curve_rescan, curve_summary, not_welded_entries, weld_reason_code
+from cell.export.reports.procedure_report import procedure_entry, tcp_error_entry
+from cell.export.reports.report_values import error_entry, metrics_entry, point, rounded
+from cell.export.reports.rescan_figures import add_rescan
 from cell.outputs import write_atomic
 from cell.pipeline.records import Detection, WeldRun
 from cell.types import Rescan, SeamRecord, SeamStatus, UnsupportedSeam, Violation

@@ -1,5 +1,5 @@
 """The report's values (docs/report.md): numbers rounded with NaN as null, points, a seam's errors against its truth,
-and the failure that stopped a run, as every report writes them (:mod:`cell.export.report` and the others)."""
+and the failure that stopped a run, as every report writes them (:mod:`cell.export.reports.report` and the others)."""
 
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from cell.export.report_values import metrics_entry, rounded
+from cell.export.reports.report_values import metrics_entry, rounded
 from cell.pipeline.records import Detection
 from cell.types import Rescan, SeamRecord
 

@@ -67,7 +67,7 @@ def print_curves(rep: Mapping[str, Any]) -> None:
     """One line per curved seam of a report: found or why not, its sigmas, its error against the true curve (in
     simulation), its time, and why it is not welded; welded in part, a line per stretch left for a manual weld
     (along the curve, and its ends on the drawing where the report has them)."""
-    from cell.export.curve_report import remainder_words
+    from cell.export.reports.curve_report import remainder_words
 
     for s in rep["seams"]:
         if not s.get("curved"):
@@ -228,7 +228,7 @@ DETECT_LEGEND = (
 
 def print_detection(det: Detection | dict, fmt: TableFormat = "table") -> None:
     """The detection table of a Detection or of its report."""
-    from cell.export.report import detection_report
+    from cell.export.reports.report import detection_report
 
     rep = det if isinstance(det, dict) else detection_report(det)
     rows = []

@@ -8,7 +8,7 @@ import math
 from typing import Any
 
 from cell.coordinated.record import CoordinatedWeld
-from cell.export.curve_report import remainder_entry
+from cell.export.reports.curve_report import remainder_entry
 from cell.geometry import FloatArray, invert
 from cell.pipeline.positioned.run import PositionerRun
 from cell.types import SeamEstimate, WeldReason

@@ -4,7 +4,7 @@ curved seam (its sigmas, close-ups and errors before and after), and the summary
 from __future__ import annotations
 
 from cell.cli.common import out
-from cell.cli.tables import compact_table, num, why_lines
+from cell.cli.printout.tables import compact_table, num, why_lines
 
 RESCAN_LEGEND = "lat, end: lateral and endpoint error [mm], before (0) and after the close-up"
 

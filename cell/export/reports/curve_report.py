@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from cell.export.procedure_report import procedure_entry, tcp_error_entry
+from cell.export.reports.procedure_report import procedure_entry, tcp_error_entry
 from cell.geometry import FloatArray, invert, transform_points
 from cell.outputs import write_text
 from cell.pipeline.records import Detection

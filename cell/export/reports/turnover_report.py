@@ -7,8 +7,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from cell.export.report import weld_report
-from cell.export.report_values import error_entry, point, rounded
+from cell.export.reports.report import weld_report
+from cell.export.reports.report_values import error_entry, point, rounded
 from cell.pipeline.turnover_run import TurnoverRun
 from cell.types import SeamStatus
 
